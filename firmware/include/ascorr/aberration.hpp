@@ -1,0 +1,81 @@
+// ascorr/aberration.hpp: stellar aberration as an attitude rotation.
+//
+// Conventions:
+//  - beta_icrf = v_obs_icrf / c: observer velocity (Earth barycentric + spacecraft
+//    geocentric), ICRF axes, in units of the speed of light.
+//  - The formula is ERFA eraAb (relativistic, with the Sun's potential term):
+//      pdv = z·β,  bm1 = sqrt(1 − β²),  w1 = 1 + pdv/(1 + bm1),  w2 = SRS/s,
+//      p   = bm1·z + w1·β + w2·(β − pdv·z),   z_corr = p/|p|,
+//    where z is the natural (catalogue) direction and z_corr the proper one.
+//  - The result is q_ab, the minimal active rotation in ICRF with
+//    R(q_ab)·z = z_corr. The attitude correction is applied on the inertial
+//    side: R_corr = R_raw·R(q_ab)ᵀ, i.e. q_chu_icrf_corr = q_chu_icrf ⊗ q_ab*.
+//
+// Evaluation without sqrt or division:
+//  z × p = (w1 + w2)·(z × β) exactly, and |p| = 1 + pdv up to a relative
+//  2·w2·w1·(β² − pdv²) ≤ 5e-13 (the w1 part of the formula is exactly unit
+//  after division by 1 + pdv). Hence
+//      u = z × z_corr = sin θ·n = (w1 + w2)/(1 + pdv) · (z × β),
+//  and with x = |u|² = sin²θ the half-angle quaternion is
+//      q_ab = (cos θ/2, sin θ/2·n) = (1 − x/8, u/2·(1 + x/8)) + O(x²).
+//  Truncation errors for |β| ≤ kMaxBeta = 3.34e-3 (θ ≤ 3.34e-3 rad):
+//   - 1/(1 + bm1) = (1 + β²/4)/2 + O(β⁴/16): error in w1 ≤ pdv·β⁴/16 ≤ 2.6e-14;
+//   - 1/(1 + pdv) to pdv⁴: remainder ≤ |pdv|⁵/(1 − |pdv|) ≤ 4.3e-13 relative;
+//   - cos θ/2 = 1 − x/8 − 5x²/128 − …: dropped term ≤ 4.8e-12, a norm error
+//     the final renormalisation removes (its effect on the angle ≤ θ·4.8e-12);
+//   - 1/(2 cos θ/2) = (1 + x/8)/2 + O(3x²/128).
+//  In angle that is below 3e-9" at the domain limit and below 1e-12" for
+//  |v| ≤ 100 km/s. The solar term itself is ≤ 4e-7", which is why it stays.
+#pragma once
+
+#include "constants.hpp"
+#include "quaternion.hpp"
+#include "scalar_traits.hpp"
+#include "vector3.hpp"
+
+namespace ascorr {
+
+template <typename T>
+struct ObserverVelocity {
+    Vector3<T> beta_icrf;       // v_obs_icrf / c
+    T inv_sun_distance_au;      // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7")
+    bool valid;                 // false: not available or stale
+};
+
+// True when beta is finite and inside the domain of the series below
+// (|v| ≤ kMaxObserverSpeedKmS, which also excludes |v| ≥ c).
+template <typename T>
+constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
+    if (!(is_finite(beta.x) && is_finite(beta.y) && is_finite(beta.z))) {
+        return false;
+    }
+    // Per-component check first, so that squaring cannot overflow a
+    // fixed-point format or a float with huge inputs.
+    const T lim = k<T>(kMaxBeta);
+    const auto within = [&](const T& c) { return c <= lim && -lim <= c; };
+    if (!(within(beta.x) && within(beta.y) && within(beta.z))) {
+        return false;
+    }
+    return squared_norm(beta) <= k<T>(kMaxBeta * kMaxBeta);
+}
+
+// q_ab: the minimal rotation (ICRF, active) taking the natural direction
+// z_icrf (unit) to its aberrated, proper direction. Requires beta_in_domain().
+template <typename T>
+constexpr Quaternion<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
+                                            const T& inv_sun_distance_au) noexcept {
+    const T one = k<T>(1.0);
+    const T pdv = dot(z_icrf, beta_icrf);
+    const T b2 = squared_norm(beta_icrf);
+    const T w1 = one + k<T>(0.5) * pdv * (one + k<T>(0.25) * b2);
+    const T w2 = k<T>(kSunSchwarzschildRadiusAu) * inv_sun_distance_au;
+    // 1/(1 + pdv) by Horner: 1 − p(1 − p(1 − p(1 − p))).
+    const T inv_1_pdv = one - pdv * (one - pdv * (one - pdv * (one - pdv)));
+    const Vector3<T> u = ((w1 + w2) * inv_1_pdv) * cross(z_icrf, beta_icrf);
+    const T x = squared_norm(u);
+    const T eighth_x = k<T>(0.125) * x;
+    const T half_scale = k<T>(0.5) * (one + eighth_x);
+    return {one - eighth_x, half_scale * u.x, half_scale * u.y, half_scale * u.z};
+}
+
+}  // namespace ascorr

@@ -1,0 +1,150 @@
+// ascorr/correct.hpp: the per-solution entry point.
+//
+// correct_solution() takes one raw µASC attitude solution and returns the
+// corrected one with its status bits (status.hpp):
+//   1. validate: head in range, quaternion finite and unit within
+//      ScalarTraits<T>::unit_norm_tolerance; otherwise kRejected and the input
+//      quaternion is returned unchanged;
+//   2. aberration (if enabled): q ← q ⊗ q_ab*  (aberration.hpp);
+//   3. thermal (if a model is given): q ← q_th ⊗ q  (thermal.hpp);
+//   4. renormalise (one Newton step) and return with w ≥ 0.
+// A stage whose inputs are missing or outside the core's domain is skipped
+// and flagged, never evaluated. No allocation, no exceptions, no loops, no
+// I/O: the function is straight-line code with a bounded instruction count.
+#pragma once
+
+#include <cstdint>
+
+#include "aberration.hpp"
+#include "quaternion.hpp"
+#include "scalar_traits.hpp"
+#include "status.hpp"
+#include "thermal.hpp"
+
+namespace ascorr {
+
+template <typename T>
+struct SolutionInput {
+    Quaternion<T> q_chu_icrf;       // raw attitude, maps ICRF into CHU components
+    std::uint8_t head;              // 0 = A, 1 = B, 2 = C, 3 = D
+    HeadTemperatures<T> temperatures;
+    ObserverVelocity<T> velocity;
+};
+
+template <typename T>
+struct CorrectionConfig {
+    bool aberration;                // apply stellar aberration when a velocity is given
+    const ThermalModel<T>* thermal; // nullptr: no thermal stage
+};
+
+template <typename T>
+struct CorrectedSolution {
+    Quaternion<T> q_chu_icrf;
+    StatusBits status;
+};
+
+// Why an input is rejected; kRejected in the status, this for the message.
+enum class Rejection : std::uint8_t { kNone, kHeadOutOfRange, kQuaternionNotFinite, kQuaternionNotUnit };
+
+template <typename T>
+constexpr Rejection check_solution(const SolutionInput<T>& in) noexcept {
+    if (in.head >= kMaxHeads) {
+        return Rejection::kHeadOutOfRange;
+    }
+    if (!is_finite(in.q_chu_icrf)) {
+        return Rejection::kQuaternionNotFinite;
+    }
+    // Component bound first (|c| > 1 + tol already means ‖q‖² > 1 + 2·tol):
+    // keeps ‖q‖² inside a fixed-point format's range.
+    const T one = k<T>(1.0);
+    const T tol = ScalarTraits<T>::unit_norm_tolerance;
+    const T bound = one + tol;
+    const Quaternion<T>& q = in.q_chu_icrf;
+    const auto within = [&](const T& c) { return c <= bound && -bound <= c; };
+    if (!(within(q.w) && within(q.x) && within(q.y) && within(q.z))) {
+        return Rejection::kQuaternionNotUnit;
+    }
+    const T e = squared_norm(q) - one;
+    if (!(e <= tol && -tol <= e)) {
+        return Rejection::kQuaternionNotUnit;
+    }
+    return Rejection::kNone;
+}
+
+// The thermal stage's rotation for one solution, or the bits that say why it
+// is skipped. Split out so that the host can report the angles it applied.
+template <typename T>
+struct ThermalStage {
+    Quaternion<T> q_th;
+    StatusBits skip;  // 0: apply q_th
+};
+
+template <typename T>
+constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
+                                        const HeadTemperatures<T>& temps) noexcept {
+    ThermalStage<T> out{{k<T>(1.0), k<T>(0.0), k<T>(0.0), k<T>(0.0)}, 0U};
+    if (head >= kMaxHeads || !model.head[head].present) {
+        out.skip = status::kNoModelForHead;
+        return out;
+    }
+    if (!(temps.t_chu.valid && temps.t_029.valid && temps.t_032.valid)) {
+        out.skip = status::kNoTemperature;
+        return out;
+    }
+    if (!(temperature_in_domain<T>(temps.t_chu.value) && temperature_in_domain<T>(temps.t_029.value) &&
+          temperature_in_domain<T>(temps.t_032.value))) {
+        out.skip = status::kNoTemperature | status::kTemperatureInvalid;
+        return out;
+    }
+    const HeadThermalModel<T>& m = model.head[head];
+    const Celsius<T>& t1 = temps.t_chu.value;
+    const Celsius<T>& t2 = temps.t_029.value;
+    const Celsius<T>& t3 = temps.t_032.value;
+    const T alpha = thermal_angle<T>(m.alpha, t1, t2, t3);
+    const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
+    const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
+    const T lim = k<T>(kMaxThermalAngleRad);
+    const auto within = [&](const T& a) { return is_finite(a) && a <= lim && -lim <= a; };
+    if (!(within(alpha) && within(beta) && within(gamma))) {
+        out.skip = status::kThermalOutOfRange;
+        return out;
+    }
+    out.q_th = thermal_rotation(alpha, beta, gamma);
+    return out;
+}
+
+template <typename T>
+constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
+    if (check_solution(in) != Rejection::kNone) {
+        return {in.q_chu_icrf, status::kRejected};
+    }
+    StatusBits st = 0U;
+    Quaternion<T> q = renormalized(in.q_chu_icrf);
+
+    if (cfg.aberration) {
+        const ObserverVelocity<T>& v = in.velocity;
+        if (!v.valid) {
+            st |= status::kNoVelocity;
+        } else if (!beta_in_domain(v.beta_icrf) || !is_finite(v.inv_sun_distance_au)) {
+            st |= status::kNoVelocity | status::kVelocityInvalid;
+        } else {
+            const Quaternion<T> q_ab = aberration_rotation(boresight(q), v.beta_icrf, v.inv_sun_distance_au);
+            q = q * conjugate(q_ab);
+            st |= status::kAberrationApplied;
+        }
+    }
+
+    if (cfg.thermal != nullptr) {
+        const ThermalStage<T> th = thermal_stage(*cfg.thermal, in.head, in.temperatures);
+        if (th.skip != 0U) {
+            st |= th.skip;
+        } else {
+            q = th.q_th * q;
+            st |= status::kThermalApplied;
+        }
+    }
+
+    return {canonical(renormalized(q)), st};
+}
+
+}  // namespace ascorr

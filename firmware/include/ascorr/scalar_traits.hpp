@@ -1,0 +1,74 @@
+// ascorr/scalar_traits.hpp: per-scalar constants, tolerances and maths hooks.
+//
+// The core is written once, templated on a scalar type T, and instantiated for
+// double (ground), float (DPU with single-precision FPU) and a Q-format fixed
+// point type (DPU without FPU). Everything the core needs to know about T lives
+// here, so the algorithms never name FLT_EPSILON or call std:: maths directly:
+//
+//  - constants are made with ScalarTraits<T>::from_double(), evaluated at
+//    compile time for floating point;
+//  - is_finite() is found by argument-dependent lookup (a fixed-point type is
+//    always finite and supplies its own);
+//  - the tolerances that decide "bad input" are per type, because what counts
+//    as rounding noise depends on the representation.
+//
+// A new scalar type specialises ScalarTraits and provides is_finite() in its
+// own namespace. The core itself never calls sqrt, sin, cos or divides: every
+// nonlinear function is a truncated series whose error is bounded where it is
+// used, so that the same code is cheap on a Cortex-M without FPU.
+#pragma once
+
+#include <cmath>
+
+namespace ascorr {
+
+template <typename T>
+struct ScalarTraits;  // specialised per scalar type
+
+template <>
+struct ScalarTraits<double> {
+    using coefficient_type = double;   // thermal-model coefficients (rad, rad/°C, rad/°C²)
+    using temperature_type = double;   // °C
+    static constexpr double from_double(double x) noexcept { return x; }
+    static constexpr double to_double(double x) noexcept { return x; }
+    static constexpr double celsius(double x) noexcept { return x; }
+    static constexpr double coefficient(double x) noexcept { return x; }
+    // |‖q‖² − 1| above this rejects a quaternion. Recorded files carry 15
+    // decimals (‖q‖² − 1 ≈ 1e-15); 1e-6 leaves room for producers that
+    // normalise in float, and is far below any real attitude error
+    // (1e-6 in ‖q‖² is a pure scale, not a rotation).
+    static constexpr double unit_norm_tolerance = 1e-6;
+};
+
+template <>
+struct ScalarTraits<float> {
+    using coefficient_type = float;
+    using temperature_type = float;
+    static constexpr float from_double(double x) noexcept { return static_cast<float>(x); }
+    static constexpr double to_double(float x) noexcept { return static_cast<double>(x); }
+    static constexpr float celsius(double x) noexcept { return static_cast<float>(x); }
+    static constexpr float coefficient(double x) noexcept { return static_cast<float>(x); }
+    // Rounding four float components leaves ‖q‖² − 1 up to ~4.8e-7.
+    static constexpr float unit_norm_tolerance = 1e-5F;
+};
+
+// Finite-ness of floating-point scalars. Unqualified calls to is_finite(x) in
+// the core resolve here for float/double and to the fixed-point overload by ADL.
+inline bool is_finite(double x) noexcept { return std::isfinite(x); }
+inline bool is_finite(float x) noexcept { return std::isfinite(x); }
+
+// A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a
+// format with range ±2; coefficients and temperatures need other formats, so
+// the core names them through these aliases. For float and double all are T.
+template <typename T>
+using Coefficient = typename ScalarTraits<T>::coefficient_type;
+template <typename T>
+using Celsius = typename ScalarTraits<T>::temperature_type;
+
+// Shorthand used by the core: a compile-time constant of type T.
+template <typename T>
+constexpr T k(double x) noexcept {
+    return ScalarTraits<T>::from_double(x);
+}
+
+}  // namespace ascorr

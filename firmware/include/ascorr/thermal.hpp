@@ -1,0 +1,118 @@
+// ascorr/thermal.hpp: the thermal model of Herceg, Jørgensen & Jørgensen 2017.
+//
+// Conventions (formats.md, paper eqs. 4–10):
+//  - Per head and axis: angle = c0 + c1·T1 + c2·(T2 − T1) + c3·(T3 − T1)
+//      + c1_2·T1² + c2_2·(T2 − T1)² + c3_2·(T3 − T1)²,
+//    T1 = T_CHU, T2 = T_THT00029, T3 = T_THT00032 in °C. Here the coefficients
+//    are stored in radians (rad, rad/°C, rad/°C²); model files are in arcsec and
+//    are converted once when loaded.
+//  - R_corr = R3(γ)·R2(β)·R1(α)·R_raw with the paper's (passive) elementary
+//    matrices, R1(a) = [[1,0,0],[0,cos a,sin a],[0,−sin a,cos a]] etc. Each is
+//    the active rotation by −angle about its axis, so as quaternions
+//    q1 = (cos α/2, −sin α/2, 0, 0), q2 = (cos β/2, 0, −sin β/2, 0),
+//    q3 = (cos γ/2, 0, 0, −sin γ/2), and q_th = q3 ⊗ q2 ⊗ q1 is applied on the
+//    CHU side: q_chu_icrf_corr = q_th ⊗ q_chu_icrf.
+//
+// Small-angle series, |angle| ≤ kMaxThermalAngleRad (1°), so h = angle/2 ≤ 8.73e-3:
+//   cos h ≈ 1 − h²/2·(1 − h²/12),  truncation ≤ h⁶/720  = 6.1e-16;
+//   sin h ≈ h·(1 − h²/6·(1 − h²/20)), truncation ≤ h⁷/5040 = 7.6e-19.
+// Both are at or below double rounding; the cos error only scales the norm.
+#pragma once
+
+#include <cstdint>
+
+#include "constants.hpp"
+#include "quaternion.hpp"
+#include "scalar_traits.hpp"
+
+namespace ascorr {
+
+inline constexpr std::uint8_t kMaxHeads = 4;  // A, B, C, D
+
+// One axis of one head: radians and rad/°C, rad/°C².
+template <typename T>
+struct AxisPolynomial {
+    Coefficient<T> c0;
+    Coefficient<T> c1;
+    Coefficient<T> c2;
+    Coefficient<T> c3;
+    Coefficient<T> c1_2;
+    Coefficient<T> c2_2;
+    Coefficient<T> c3_2;
+};
+
+template <typename T>
+struct HeadThermalModel {
+    bool present;  // false: no coefficients for this head, thermal stage skipped
+    AxisPolynomial<T> alpha;
+    AxisPolynomial<T> beta;
+    AxisPolynomial<T> gamma;
+};
+
+template <typename T>
+struct ThermalModel {
+    HeadThermalModel<T> head[kMaxHeads];
+};
+
+template <typename T>
+struct TemperatureReading {
+    Celsius<T> value;
+    bool valid;  // false: missing, or withheld by the acquisition (fault, stale)
+};
+
+template <typename T>
+struct HeadTemperatures {
+    TemperatureReading<T> t_chu;  // T1, the head's own (CCD) temperature
+    TemperatureReading<T> t_029;  // T2, THT00029, optical bench / boom interface
+    TemperatureReading<T> t_032;  // T3, THT00032, optical bench next to the SiC cube
+};
+
+// A usable temperature: finite and inside ±kMaxAbsTemperatureC.
+template <typename T>
+constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
+    const Celsius<T> lim = ScalarTraits<T>::celsius(kMaxAbsTemperatureC);
+    return is_finite(t) && t <= lim && -lim <= t;
+}
+
+// The model angle of one axis, in radians. A fixed-point scalar overloads this
+// (the coefficient and temperature formats differ from T's).
+template <typename T>
+constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
+                          const Celsius<T>& t3) noexcept {
+    const Celsius<T> d2 = t2 - t1;
+    const Celsius<T> d3 = t3 - t1;
+    return p.c0 + t1 * (p.c1 + p.c1_2 * t1) + d2 * (p.c2 + p.c2_2 * d2) + d3 * (p.c3 + p.c3_2 * d3);
+}
+
+template <typename T>
+struct HalfAngle {
+    T c;  // cos(angle/2)
+    T s;  // sin(angle/2)
+};
+
+// cos and sin of half an angle, |angle| ≤ kMaxThermalAngleRad (series above).
+template <typename T>
+constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
+    const T one = k<T>(1.0);
+    const T h = k<T>(0.5) * angle;
+    const T h2 = h * h;
+    return {one - k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2),
+            h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
+}
+
+// q_th = q3(γ) ⊗ q2(β) ⊗ q1(α), expanded (16 products instead of 32):
+//   w =  c1c2c3 − s1s2s3      x = −s1c2c3 − c1s2s3
+//   y = −c1s2c3 + s1c2s3      z = −s1s2c3 − c1c2s3
+template <typename T>
+constexpr Quaternion<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
+    const HalfAngle<T> a = half_angle(alpha);
+    const HalfAngle<T> b = half_angle(beta);
+    const HalfAngle<T> g = half_angle(gamma);
+    const T cc = a.c * b.c;
+    const T sc = a.s * b.c;
+    const T cs = a.c * b.s;
+    const T ss = a.s * b.s;
+    return {cc * g.c - ss * g.s, -(sc * g.c + cs * g.s), sc * g.s - cs * g.c, -(ss * g.c + cc * g.s)};
+}
+
+}  // namespace ascorr

@@ -1,0 +1,30 @@
+#include <iostream>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "ascorr_host/correct_file.hpp"
+#include "commands.hpp"
+
+namespace ascorr::cli {
+
+void add_correct_command(CLI::App& app) {
+    auto opt = std::make_shared<host::CorrectOptions>();
+    CLI::App* cmd = app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
+    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
+    cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all")->required();
+    cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage");
+    cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
+    cmd->add_flag("!--no-thermal", opt->thermal, "skip the thermal stage");
+    const std::map<std::string, host::Scalar> scalars{
+        {"double", host::Scalar::kDouble}, {"float", host::Scalar::kFloat}, {"fixed", host::Scalar::kFixed}};
+    cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double, float or fixed")
+        ->transform(CLI::CheckedTransformer(scalars, CLI::ignore_case));
+    cmd->add_flag("--skip-bad", opt->skip_bad, "skip malformed rows (each is reported) instead of stopping");
+    cmd->callback([opt]() {
+        const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
+        std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';
+    });
+}
+
+}  // namespace ascorr::cli

@@ -1,0 +1,30 @@
+// ascorr: thermal and aberration correction of µASC attitude solutions.
+//
+// Exit status: 0 when every output is complete; 1 for bad input or an I/O
+// error (the message names file, line and column); 2 for a usage error.
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"ascorr: thermal and aberration correction of uASC star-tracker attitude solutions"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "ascorr 0.1.0");
+    ascorr::cli::add_correct_command(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "ascorr: " << e.what() << '\n';
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,41 @@
+// ascorr_host/correct_file.hpp: the `ascorr correct` job.
+//
+// Reads a solutions file, corrects every row with the core in the chosen
+// scalar type, and writes the corrected file (formats.md): every input row in
+// input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
+// Output is all or nothing (AtomicFile). A malformed row stops the run with
+// file:line:column, unless skip_bad, which reports and drops it.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <iosfwd>
+#include <string>
+
+namespace ascorr::host {
+
+enum class Scalar { kDouble, kFloat, kFixed };
+
+struct CorrectOptions {
+    std::string in;
+    std::string out;
+    std::string model;       // empty: no thermal stage
+    bool aberration = true;
+    bool thermal = true;
+    Scalar scalar = Scalar::kDouble;
+    bool skip_bad = false;
+};
+
+struct CorrectSummary {
+    std::size_t rows = 0;        // rows written
+    std::size_t malformed = 0;   // rows dropped (skip_bad only)
+    std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
+};
+
+// Throws InputError or std::runtime_error; writes nothing then.
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log);
+
+// A one-paragraph account of a summary, for the terminal.
+std::string describe(const CorrectSummary& s);
+
+}  // namespace ascorr::host

@@ -1,0 +1,58 @@
+// ascorr_host/csv.hpp: the plain CSV dialect of formats.md.
+//
+// Comma-separated, one header line, no quoting (no field of the formats needs
+// it; a quote character is a malformed field). LF or CRLF line ends. Fields are
+// string_views into a buffer that holds the whole file: no copies, no streams;
+// numbers are parsed with std::from_chars.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace ascorr::host {
+
+// The whole content of a file. Throws InputError (line 0) if it cannot be read.
+std::string read_text_file(const std::string& path);
+
+// Iterates the lines of a buffer, keeping 1-based line numbers.
+class LineReader {
+public:
+    explicit LineReader(std::string_view text) noexcept : text_(text) {}
+    // Next line without its line end; false at the end of the buffer.
+    bool next(std::string_view& line) noexcept;
+    std::size_t line_number() const noexcept { return line_; }
+
+private:
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t line_ = 0;
+};
+
+// Splits a line at commas into fields (reusing the vector's storage), and
+// records where each field starts (0-based character offset) for messages.
+void split_fields(std::string_view line, std::vector<std::string_view>& fields, std::vector<std::size_t>& starts);
+
+// A field as a double: a decimal or scientific number, "nan", "inf".
+// Leading/trailing spaces are not accepted (they are not in the format).
+std::optional<double> parse_double(std::string_view field) noexcept;
+std::optional<long long> parse_integer(std::string_view field) noexcept;
+
+// Formats x with `decimals` digits after the point into out, returns the end.
+char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
+
+// The header's columns by name; -1 where absent. Duplicate names are an error.
+class Header {
+public:
+    Header(std::string_view line, const std::string& file);
+    int index(std::string_view name) const noexcept;
+    std::size_t size() const noexcept { return names_.size(); }
+    const std::vector<std::string>& names() const noexcept { return names_; }
+
+private:
+    std::vector<std::string> names_;
+};
+
+}  // namespace ascorr::host

@@ -1,0 +1,52 @@
+// ascorr_host/model_csv.hpp: the thermal-model file (formats.md, "Model file").
+//
+// Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
+// One row per head and axis; a head that appears must have all three axes.
+// Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
+// the core's radians.
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "ascorr/constants.hpp"
+#include "ascorr/thermal.hpp"
+
+namespace ascorr::host {
+
+enum Axis : int { kAlpha = 0, kBeta = 1, kGamma = 2 };
+inline constexpr const char* kAxisNames[3] = {"alpha", "beta", "gamma"};
+inline constexpr const char* kCoefficientNames[7] = {"c0", "c1", "c2", "c3", "c1_2", "c2_2", "c3_2"};
+
+struct ModelFile {
+    std::array<bool, kMaxHeads> present{};
+    // coefficients[head][axis] = {c0, c1, c2, c3, c1_2, c2_2, c3_2} in arcsec.
+    std::array<std::array<std::array<double, 7>, 3>, kMaxHeads> coefficients{};
+    bool quadratic = false;  // write the quadratic columns
+};
+
+ModelFile read_model_file(const std::string& path);
+ModelFile parse_model(const std::string& file_name, std::string_view text);
+// Writes atomically (temporary file, then rename).
+void write_model_file(const std::string& path, const ModelFile& model);
+std::string format_model(const ModelFile& model);
+
+// The model in the core's units (radians), for scalar T.
+template <typename T>
+ThermalModel<T> to_core(const ModelFile& m) {
+    ThermalModel<T> out{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        out.head[h].present = m.present[h];
+        AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
+        for (std::size_t a = 0; a < 3; ++a) {
+            const auto& c = m.coefficients[h][a];
+            const auto r = [&](std::size_t i) {
+                return ScalarTraits<T>::coefficient(c[i] * kArcsecToRad);
+            };
+            *axes[a] = {r(0), r(1), r(2), r(3), r(4), r(5), r(6)};
+        }
+    }
+    return out;
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,82 @@
+// ascorr_host/solutions_csv.hpp: reader of the solutions file (formats.md).
+//
+// Columns are matched by name; unknown columns are ignored by the reader and
+// kept verbatim by writers. Required: t, chu, qw, qx, qy, qz. Optional:
+// t_chu, t_029, t_032, vx, vy, vz, flags, confidence (absent = not available).
+// A field that is present but not a number is malformed (InputError with
+// file:line:column); "nan" or an empty field means "not available" for
+// temperatures and velocities, and a NaN quaternion is passed on for the core
+// to reject.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ascorr/quaternion.hpp"
+#include "ascorr/vector3.hpp"
+#include "ascorr_host/csv.hpp"
+
+namespace ascorr::host {
+
+inline constexpr std::uint8_t kUnknownHead = 0xFF;
+
+// Head index 0–3 for 'A'–'D', kUnknownHead otherwise.
+std::uint8_t head_from_name(std::string_view chu) noexcept;
+char head_name(std::uint8_t head) noexcept;
+
+struct SolutionRecord {
+    std::size_t line = 0;          // 1-based line in the file
+    double t = 0.0;                // s since J2000.0, TT
+    std::string_view chu;          // as written
+    std::uint8_t head = kUnknownHead;
+    Quaternion<double> q_chu_icrf{};
+    std::array<double, 3> temperature{};       // t_chu, t_029, t_032 (°C)
+    std::array<bool, 3> temperature_present{};  // false: empty, nan or column absent
+    Vector3<double> v_sc_kms{};                 // vx, vy, vz
+    int velocity_components = 0;                // how many of vx, vy, vz are present
+    long long flags = 0;                        // 0 when absent
+    double confidence = 0.0;                    // arcsec; 0 when absent
+    bool confidence_present = false;
+};
+
+class SolutionsReader {
+public:
+    // Parses the header; throws InputError when a required column is missing.
+    SolutionsReader(std::string file_name, std::string_view text);
+
+    // Reads the next data row into rec (empty lines are skipped and counted).
+    // Returns false at the end. Throws InputError for a malformed row; the
+    // reader has then moved past it, so a caller may report it and go on.
+    bool next(SolutionRecord& rec);
+
+    const Header& header() const noexcept { return header_; }
+    const std::string& file_name() const noexcept { return file_; }
+    // The fields of the row last returned (or last rejected), in file order.
+    const std::vector<std::string_view>& fields() const noexcept { return fields_; }
+    std::size_t empty_lines() const noexcept { return empty_lines_; }
+
+    // Column indices (−1 where absent).
+    struct Columns {
+        int t, chu, qw, qx, qy, qz, t_chu, t_029, t_032, vx, vy, vz, flags, confidence;
+    };
+    const Columns& columns() const noexcept { return col_; }
+
+private:
+    [[noreturn]] void fail(std::size_t field, const std::string& what) const;
+    double number(int col, const char* name) const;
+    bool optional_number(int col, const char* name, double& out) const;
+
+    std::string file_;
+    LineReader lines_;
+    Header header_;
+    Columns col_{};
+    std::vector<std::string_view> fields_;
+    std::vector<std::size_t> starts_;
+    std::size_t empty_lines_ = 0;
+};
+
+}  // namespace ascorr::host

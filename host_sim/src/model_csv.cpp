@@ -1,0 +1,130 @@
+#include "ascorr_host/model_csv.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/csv.hpp"
+#include "ascorr_host/input_error.hpp"
+#include "ascorr_host/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+ModelFile parse_model(const std::string& file_name, std::string_view text) {
+    if (text.empty()) {
+        throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");
+    }
+    LineReader lines(text);
+    std::string_view line;
+    lines.next(line);
+    const Header header(line, file_name);
+    const int col_chu = header.index("chu");
+    const int col_axis = header.index("axis");
+    int col_c[7];
+    for (std::size_t i = 0; i < 7; ++i) {
+        col_c[i] = header.index(kCoefficientNames[i]);
+    }
+    if (col_chu < 0 || col_axis < 0 || col_c[0] < 0 || col_c[1] < 0 || col_c[2] < 0 || col_c[3] < 0) {
+        throw InputError(file_name, 1, 1, "the model header must have chu,axis,c0,c1,c2,c3");
+    }
+
+    ModelFile m;
+    m.quadratic = col_c[4] >= 0 || col_c[5] >= 0 || col_c[6] >= 0;
+    bool seen[kMaxHeads][3] = {};
+    std::vector<std::string_view> fields;
+    std::vector<std::size_t> starts;
+    std::size_t line_of_head[kMaxHeads] = {};
+    while (lines.next(line)) {
+        if (line.empty()) {
+            continue;
+        }
+        const std::size_t n = lines.line_number();
+        split_fields(line, fields, starts);
+        if (fields.size() != header.size()) {
+            throw InputError(file_name, n, starts.back() + 1,
+                             "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
+        }
+        const auto chu = fields[static_cast<std::size_t>(col_chu)];
+        const std::uint8_t head = head_from_name(chu);
+        if (head == kUnknownHead) {
+            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
+                             "chu must be A, B, C or D, got '" + std::string(chu) + "'");
+        }
+        const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+            if (axis_name == kAxisNames[a]) {
+                axis = a;
+            }
+        }
+        if (axis < 0) {
+            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
+                             "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
+        }
+        if (seen[head][axis]) {
+            throw InputError(file_name, n, 1,
+                             std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
+        }
+        seen[head][axis] = true;
+        line_of_head[head] = n;
+        for (std::size_t i = 0; i < 7; ++i) {
+            if (col_c[i] < 0) {
+                continue;
+            }
+            const auto f = fields[static_cast<std::size_t>(col_c[i])];
+            const auto x = parse_double(f);
+            if (!x || !std::isfinite(*x)) {
+                throw InputError(file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
+                                 std::string("column '") + kCoefficientNames[i] + "': expected a finite number, got '" +
+                                     std::string(f) + "'");
+            }
+            m.coefficients[head][static_cast<std::size_t>(axis)][i] = *x;
+        }
+    }
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        const int count = int(seen[h][0]) + int(seen[h][1]) + int(seen[h][2]);
+        if (count != 0 && count != 3) {
+            for (int a = 0; a < 3; ++a) {
+                if (!seen[h][a]) {
+                    throw InputError(file_name, line_of_head[h], 1,
+                                     std::string("head ") + head_name(static_cast<std::uint8_t>(h)) + " has no " +
+                                         kAxisNames[a] + " row");
+                }
+            }
+        }
+        m.present[h] = count == 3;
+    }
+    if (!(m.present[0] || m.present[1] || m.present[2] || m.present[3])) {
+        throw InputError(file_name, lines.line_number(), 1, "the model has no rows");
+    }
+    return m;
+}
+
+ModelFile read_model_file(const std::string& path) { return parse_model(path, read_text_file(path)); }
+
+std::string format_model(const ModelFile& m) {
+    std::string out = m.quadratic ? "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "chu,axis,c0,c1,c2,c3\n";
+    const std::size_t ncoef = m.quadratic ? 7 : 4;
+    char buf[64];
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        if (!m.present[h]) {
+            continue;
+        }
+        for (std::size_t a = 0; a < 3; ++a) {
+            out += head_name(static_cast<std::uint8_t>(h));
+            out += ',';
+            out += kAxisNames[a];
+            for (std::size_t i = 0; i < ncoef; ++i) {
+                // 17 significant digits: a model survives a write/read round trip exactly.
+                std::snprintf(buf, sizeof buf, ",%.16e", m.coefficients[h][a][i]);
+                out += buf;
+            }
+            out += '\n';
+        }
+    }
+    return out;
+}
+
+void write_model_file(const std::string& path, const ModelFile& model) { write_file_atomically(path, format_model(model)); }
+
+}  // namespace ascorr::host
