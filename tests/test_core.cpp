@@ -141,7 +141,7 @@ TEST(Thermal, MatchesMatrixReferenceOverDomain) {
 TEST(Thermal, HalfAngleSeriesWithinStatedBound) {
     for (double a = -kMaxThermalAngleRad; a <= kMaxThermalAngleRad; a += kMaxThermalAngleRad / 5000.0) {
         const HalfAngle<double> h = half_angle(a);
-        EXPECT_NEAR(h.c, std::cos(a / 2), 6.1e-16 + 2.3e-16) << a;
+        EXPECT_NEAR(1.0 + h.cm1, std::cos(a / 2), 6.1e-16 + 2.3e-16) << a;
         EXPECT_NEAR(h.s, std::sin(a / 2), 7.6e-19 + 2e-18) << a;
     }
 }
@@ -152,9 +152,9 @@ TEST(Thermal, ExpandedProductEqualsThreeQuaternionProduct) {
     for (int i = 0; i < 1000; ++i) {
         const double a = ang(rng), b = ang(rng), g = ang(rng);
         const HalfAngle<double> ha = half_angle(a), hb = half_angle(b), hg = half_angle(g);
-        const Quaternion<double> q1{ha.c, -ha.s, 0, 0}, q2{hb.c, 0, -hb.s, 0}, q3{hg.c, 0, 0, -hg.s};
+        const Quaternion<double> q1{1 + ha.cm1, -ha.s, 0, 0}, q2{1 + hb.cm1, 0, -hb.s, 0}, q3{1 + hg.cm1, 0, 0, -hg.s};
         const Quaternion<double> p = q3 * q2 * q1;
-        const Quaternion<double> e = thermal_rotation(a, b, g);
+        const Quaternion<double> e = to_quaternion(thermal_rotation(a, b, g));
         EXPECT_NEAR(p.w, e.w, 4e-16);
         EXPECT_NEAR(p.x, e.x, 4e-16);
         EXPECT_NEAR(p.y, e.y, 4e-16);

@@ -1,1 +1,211 @@
-int main(){}
+// Readers and writers of the formats: every malformed input is named by
+// file:line:column, nothing malformed passes as data.
+#include <gtest/gtest.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <fstream>
+#include <string>
+
+#include "ascorr_host/csv.hpp"
+#include "ascorr_host/input_error.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/solutions_csv.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::host {
+namespace {
+
+const char* kHeader = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+
+std::vector<SolutionRecord> parse_all(const std::string& text) {
+    SolutionsReader r("f.csv", text);
+    std::vector<SolutionRecord> out;
+    SolutionRecord rec;
+    while (r.next(rec)) {
+        out.push_back(rec);
+    }
+    return out;
+}
+
+// Returns "line:column: message" of the error, or "" if none.
+std::string error_of(const std::string& text) {
+    try {
+        parse_all(text);
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.file(), "f.csv");
+        return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.what();
+    }
+    return "";
+}
+
+TEST(SolutionsReader, ReadsExampleFile) {
+    std::string text;
+    const auto rows = test::read_records(test::data_path("solutions.csv"), text);
+    ASSERT_EQ(rows.size(), 12U);
+    EXPECT_EQ(rows[0].line, 2U);
+    EXPECT_DOUBLE_EQ(rows[0].t, 447534187.831);
+    EXPECT_EQ(rows[0].head, 0);
+    EXPECT_DOUBLE_EQ(rows[0].q_chu_icrf.x, -0.642227588171342);
+    EXPECT_DOUBLE_EQ(rows[0].temperature[2], -19.775);
+    EXPECT_EQ(rows[0].velocity_components, 3);
+    EXPECT_DOUBLE_EQ(rows[0].v_sc_kms.z, -1.785468);
+    EXPECT_EQ(rows[1].head, 1);
+    EXPECT_EQ(rows[2].head, 2);
+}
+
+TEST(SolutionsReader, MissingValuesAndUnknownColumns) {
+    const std::string text =
+        "extra,t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz\n"
+        "x,1.5,B,1,0,0,0,,nan,NaN,,,\r\n"
+        "y,2.5,D,1,0,0,0,1,2,3,1,,3\n";
+    const auto rows = parse_all(text);
+    ASSERT_EQ(rows.size(), 2U);
+    EXPECT_FALSE(rows[0].temperature_present[0]);
+    EXPECT_FALSE(rows[0].temperature_present[1]);
+    EXPECT_FALSE(rows[0].temperature_present[2]);
+    EXPECT_EQ(rows[0].velocity_components, 0);
+    EXPECT_EQ(rows[1].head, 3);
+    EXPECT_EQ(rows[1].velocity_components, 2);
+    EXPECT_EQ(rows[1].flags, 0);
+    EXPECT_FALSE(rows[1].confidence_present);
+}
+
+TEST(SolutionsReader, UnknownHeadIsDataNotSyntax) {
+    const auto rows = parse_all(std::string(kHeader) + "1,X,1,0,0,0,1,2,3,1,2,3,0,1\n");
+    ASSERT_EQ(rows.size(), 1U);
+    EXPECT_EQ(rows[0].head, kUnknownHead);  // the core rejects it; the row is kept
+}
+
+TEST(SolutionsReader, MalformedInputNamesLineAndColumn) {
+    const std::string h = kHeader;
+    EXPECT_EQ(error_of(""), "1:1: f.csv:1:1: empty file: expected a header line");
+    EXPECT_NE(error_of("t,chu,qw,qx,qy\n").find("required column 'qz' is missing"), std::string::npos);
+    EXPECT_NE(error_of("t,chu,qw,qw,qx,qy,qz\n").find("appears twice"), std::string::npos);
+    // A number that is not one: line 3, column of the qx field.
+    const std::string bad_qx = h + "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n" + "2,A,1,abc,0,0,1,2,3,1,2,3,0,1\n";
+    EXPECT_EQ(error_of(bad_qx).substr(0, 5), "3:7: ");
+    EXPECT_NE(error_of(bad_qx).find("column 'qx': expected a number, got 'abc'"), std::string::npos);
+    // Truncated row.
+    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2\n").find("truncated row"), std::string::npos);
+    // Too many fields.
+    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,0,1,9\n").find("found 15"), std::string::npos);
+    // Temperature garbage is an error, not "missing".
+    EXPECT_NE(error_of(h + "1,A,1,0,0,0,hot,2,3,1,2,3,0,1\n").find("column 't_chu'"), std::string::npos);
+    // Non-finite time.
+    EXPECT_NE(error_of(h + "inf,A,1,0,0,0,1,2,3,1,2,3,0,1\n").find("time must be finite"), std::string::npos);
+    // Flags must be a non-negative integer.
+    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,1.5,1\n").find("column 'flags'"), std::string::npos);
+    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,-1,1\n").find("column 'flags'"), std::string::npos);
+    // Spaces and quotes are not numbers in this format.
+    EXPECT_NE(error_of(h + "1,A, 1,0,0,0,1,2,3,1,2,3,0,1\n").find("column 'qw'"), std::string::npos);
+    EXPECT_NE(error_of(h + "1,A,\"1\",0,0,0,1,2,3,1,2,3,0,1\n").find("column 'qw'"), std::string::npos);
+}
+
+TEST(SolutionsReader, ReaderMovesPastABadRow) {
+    const std::string text = std::string(kHeader) + "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n2,A,x,0,0,0,1,2,3,1,2,3,0,1\n3,A,1,0,0,0,1,2,3,1,2,3,0,1\n";
+    SolutionsReader r("f.csv", text);
+    SolutionRecord rec;
+    ASSERT_TRUE(r.next(rec));
+    EXPECT_THROW(r.next(rec), InputError);
+    ASSERT_TRUE(r.next(rec));
+    EXPECT_EQ(rec.line, 4U);
+    EXPECT_FALSE(r.next(rec));
+}
+
+TEST(Csv, NumbersAndFormatting) {
+    EXPECT_EQ(*parse_double("1e-3"), 1e-3);
+    EXPECT_EQ(*parse_double("+2.5"), 2.5);
+    EXPECT_TRUE(std::isnan(*parse_double("nan")));
+    EXPECT_FALSE(parse_double("1.0x"));
+    EXPECT_FALSE(parse_double(""));
+    EXPECT_FALSE(parse_double("1e999"));
+    char buf[64];
+    EXPECT_EQ(std::string(buf, format_fixed(buf, buf + 64, -0.642227588171342, 15)), "-0.642227588171342");
+}
+
+// The fast decimal path must give the very bits std::from_chars gives.
+TEST(Csv, FastDecimalPathIsBitExact) {
+    std::mt19937_64 rng(3);
+    std::uniform_int_distribution<int> ndig(1, 17);
+    std::uniform_int_distribution<int> digit(0, 9);
+    for (int i = 0; i < 200000; ++i) {
+        std::string s = (i % 2 == 0) ? "-" : "";
+        const int int_digits = ndig(rng) % 6;
+        const int frac_digits = ndig(rng);
+        for (int k = 0; k < int_digits; ++k) s += static_cast<char>('0' + digit(rng));
+        if (int_digits == 0) s += '0';
+        s += '.';
+        for (int k = 0; k < frac_digits; ++k) s += static_cast<char>('0' + digit(rng));
+        double want = 0.0;
+        std::from_chars(s.data(), s.data() + s.size(), want);
+        const auto got = parse_double(s);
+        ASSERT_TRUE(got) << s;
+        ASSERT_EQ(std::memcmp(&*got, &want, sizeof want), 0) << s;
+    }
+    EXPECT_FALSE(parse_double("-"));
+    EXPECT_FALSE(parse_double("."));
+    EXPECT_FALSE(parse_double("1.2.3"));
+    EXPECT_FALSE(parse_double("--1"));
+}
+
+// The fast fixed formatting of unit quantities must equal printf's.
+TEST(Csv, FastFixedFormatEqualsPrintf) {
+    std::mt19937_64 rng(4);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    char a[64];
+    char b[64];
+    for (int i = 0; i < 300000; ++i) {
+        double x = u(rng);
+        if (i % 3 == 0) {  // decimal ties and near-ties: k / 2e15 and neighbours
+            x = std::nextafter(static_cast<double>(static_cast<long long>(x * 2e15)) / 2e15, i % 2 == 0 ? 2.0 : -2.0);
+        }
+        const std::string got(a, format_fixed(a, a + 64, x, 15));
+        std::snprintf(b, sizeof b, "%.15f", x);
+        ASSERT_EQ(got, std::string(b)) << x;
+    }
+    EXPECT_EQ(std::string(a, format_fixed(a, a + 64, -0.0, 15)), "-0.000000000000000");
+    EXPECT_EQ(std::string(a, format_fixed(a, a + 64, 0.9999999999999999, 15)), "1.000000000000000");
+}
+
+TEST(ModelFile, ReadsTable2AndRoundTrips) {
+    const ModelFile m = read_model_file(test::data_path("model_table2.csv"));
+    EXPECT_TRUE(m.present[0] && m.present[1] && m.present[2]);
+    EXPECT_FALSE(m.present[3]);
+    EXPECT_FALSE(m.quadratic);
+    EXPECT_DOUBLE_EQ(m.coefficients[2][kGamma][0], 11.7996);
+    EXPECT_DOUBLE_EQ(m.coefficients[1][kAlpha][3], 0.240148);
+    ModelFile q = m;
+    q.quadratic = true;
+    q.coefficients[0][kBeta][5] = -1.25e-3;
+    const ModelFile back = parse_model("mem", format_model(q));
+    EXPECT_EQ(back.coefficients, q.coefficients);  // bit-exact round trip
+    EXPECT_TRUE(back.quadratic);
+}
+
+TEST(ModelFile, MalformedModels) {
+    const auto err = [](const std::string& text) -> std::string {
+        try {
+            parse_model("m.csv", text);
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    const std::string h = "chu,axis,c0,c1,c2,c3\n";
+    EXPECT_NE(err("").find("empty model"), std::string::npos);
+    EXPECT_NE(err("chu,axis,c0,c1\n").find("must have chu,axis,c0,c1,c2,c3"), std::string::npos);
+    EXPECT_NE(err(h).find("no rows"), std::string::npos);
+    EXPECT_NE(err(h + "E,alpha,1,2,3,4\n").find("m.csv:2:1: chu must be"), std::string::npos);
+    EXPECT_NE(err(h + "A,delta,1,2,3,4\n").find("m.csv:2:3: axis must be"), std::string::npos);
+    EXPECT_NE(err(h + "A,alpha,1,2,x,4\n").find("m.csv:2:13: column 'c2'"), std::string::npos);
+    EXPECT_NE(err(h + "A,alpha,1,2,nan,4\n").find("finite"), std::string::npos);
+    EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,alpha,1,2,3,4\n").find("second row for A alpha"), std::string::npos);
+    EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,beta,1,2,3,4\n").find("head A has no gamma row"), std::string::npos);
+    EXPECT_NE(err(h + "A,alpha,1,2,3\n").find("expected 6 fields"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ascorr::host

@@ -1,5 +1,6 @@
 #include "ascorr_host/correct_file.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -135,8 +136,8 @@ public:
 private:
     void append_status(StatusBits st) {
         char num[8];
-        const int n = std::snprintf(num, sizeof num, "%u", static_cast<unsigned>(st));
-        buf_.append(num, static_cast<std::size_t>(n));
+        const auto r = std::to_chars(num, num + sizeof num, static_cast<unsigned>(st));
+        buf_.append(num, r.ptr);
     }
 
     const SolutionsReader& reader_;

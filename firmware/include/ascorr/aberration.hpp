@@ -7,7 +7,7 @@
 //      pdv = z·β,  bm1 = sqrt(1 − β²),  w1 = 1 + pdv/(1 + bm1),  w2 = SRS/s,
 //      p   = bm1·z + w1·β + w2·(β − pdv·z),   z_corr = p/|p|,
 //    where z is the natural (catalogue) direction and z_corr the proper one.
-//  - The result is q_ab, the minimal active rotation in ICRF with
+//  - The result is q_ab (as a SmallRotation), the minimal active rotation in ICRF with
 //    R(q_ab)·z = z_corr. The attitude correction is applied on the inertial
 //    side: R_corr = R_raw·R(q_ab)ᵀ, i.e. q_chu_icrf_corr = q_chu_icrf ⊗ q_ab*.
 //
@@ -62,7 +62,7 @@ constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
 // q_ab: the minimal rotation (ICRF, active) taking the natural direction
 // z_icrf (unit) to its aberrated, proper direction. Requires beta_in_domain().
 template <typename T>
-constexpr Quaternion<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
+constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
                                             const T& inv_sun_distance_au) noexcept {
     const T one = k<T>(1.0);
     const T pdv = dot(z_icrf, beta_icrf);
@@ -75,7 +75,7 @@ constexpr Quaternion<T> aberration_rotation(const Vector3<T>& z_icrf, const Vect
     const T x = squared_norm(u);
     const T eighth_x = k<T>(0.125) * x;
     const T half_scale = k<T>(0.5) * (one + eighth_x);
-    return {one - eighth_x, half_scale * u.x, half_scale * u.y, half_scale * u.z};
+    return {-eighth_x, {half_scale * u.x, half_scale * u.y, half_scale * u.z}};
 }
 
 }  // namespace ascorr

@@ -53,15 +53,64 @@ constexpr Quaternion<T> canonical(const Quaternion<T>& q) noexcept {
     return q.w < k<T>(0.0) ? Quaternion<T>{-q.w, -q.x, -q.y, -q.z} : q;
 }
 
-// One Newton step towards unit norm: q · (1 + (1 − ‖q‖²)/2).
-// For ‖q‖² = 1 + ε the result has ‖q‖² − 1 = O(ε²) (exactly −3ε²/4 − ε³/4),
-// so a quaternion within the input tolerance (ε ≤ 1e-5) comes out unit to
-// ~1e-10 after one step, and one that is unit to rounding stays so. No sqrt,
-// no division: the same code serves fixed point.
+template <typename T>
+constexpr Quaternion<T> operator+(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
+    return {a.w + b.w, a.x + b.x, a.y + b.y, a.z + b.z};
+}
+
+template <typename T>
+constexpr T dot(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
+    return a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// A rotation close to the identity, stored as its difference from it:
+// q = (1 + dw, v). Corrections are 1e-4 rad; kept this way they carry full
+// relative precision, and an attitude is rounded once, when the sum of all
+// small terms is added to it (see renormalized_sum). In float that halves the
+// error of applying two corrections to a stored quaternion.
+template <typename T>
+struct SmallRotation {
+    T dw;        // w − 1
+    Vector3<T> v;
+};
+
+template <typename T>
+constexpr SmallRotation<T> conjugate(const SmallRotation<T>& r) noexcept {
+    return {r.dw, {-r.v.x, -r.v.y, -r.v.z}};
+}
+
+// r − 1 as a quaternion: the increment that r ⊗ q or q ⊗ r adds to q.
+template <typename T>
+constexpr Quaternion<T> increment(const SmallRotation<T>& r) noexcept {
+    return {r.dw, r.v.x, r.v.y, r.v.z};
+}
+
+template <typename T>
+constexpr Quaternion<T> to_quaternion(const SmallRotation<T>& r) noexcept {
+    return {k<T>(1.0) + r.dw, r.v.x, r.v.y, r.v.z};
+}
+
+// (q + d) brought to unit norm by one Newton step, rounded once:
+//   q + [d + (q + d)·g],  g = (1 − ‖q + d‖²)/2,
+// with ‖q + d‖² − 1 = (‖q‖² − 1) + 2 q·d + ‖d‖² formed from small terms.
+// For ‖q + d‖² = 1 + ε the result has ‖·‖² − 1 = −3ε²/4 − ε³/4, so an input
+// within the tolerance (ε ≤ 1e-5) comes out unit to ~1e-10, and one unit to
+// rounding stays so. The step scales, it does not rotate: its own rounding
+// does not move the attitude. No sqrt, no division: the same code serves
+// fixed point.
+template <typename T>
+constexpr Quaternion<T> renormalized_sum(const Quaternion<T>& q, const Quaternion<T>& d) noexcept {
+    const T two_qd = dot(q, d) + dot(q, d);
+    const T eps = (squared_norm(q) - k<T>(1.0)) + two_qd + squared_norm(d);
+    const T g = -(k<T>(0.5) * eps);
+    const Quaternion<T> qd = q + d;
+    const Quaternion<T> e = d + Quaternion<T>{qd.w * g, qd.x * g, qd.y * g, qd.z * g};
+    return q + e;
+}
+
 template <typename T>
 constexpr Quaternion<T> renormalized(const Quaternion<T>& q) noexcept {
-    const T g = k<T>(0.5) * (k<T>(1.0) - squared_norm(q));
-    return {q.w + q.w * g, q.x + q.x * g, q.y + q.y * g, q.z + q.z * g};
+    return renormalized_sum(q, Quaternion<T>{k<T>(0.0), k<T>(0.0), k<T>(0.0), k<T>(0.0)});
 }
 
 // Third row of R(q): the CHU +Z axis (boresight) in the source frame, i.e.

@@ -86,8 +86,8 @@ constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, cons
 
 template <typename T>
 struct HalfAngle {
-    T c;  // cos(angle/2)
-    T s;  // sin(angle/2)
+    T cm1;  // cos(angle/2) − 1, kept small for precision
+    T s;    // sin(angle/2)
 };
 
 // cos and sin of half an angle, |angle| ≤ kMaxThermalAngleRad (series above).
@@ -96,23 +96,29 @@ constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
     const T one = k<T>(1.0);
     const T h = k<T>(0.5) * angle;
     const T h2 = h * h;
-    return {one - k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2),
-            h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
+    return {-(k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2)), h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
 }
 
-// q_th = q3(γ) ⊗ q2(β) ⊗ q1(α), expanded (16 products instead of 32):
+// q_th = q3(γ) ⊗ q2(β) ⊗ q1(α), expanded (16 products instead of 32), with
+// c_i = 1 + cm1_i and s_i the half-angle cosines and sines:
 //   w =  c1c2c3 − s1s2s3      x = −s1c2c3 − c1s2s3
 //   y = −c1s2c3 + s1c2s3      z = −s1s2c3 − c1c2s3
+// w − 1 is formed from the cm1 terms, never as a difference of near-ones.
 template <typename T>
-constexpr Quaternion<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
+constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
     const HalfAngle<T> a = half_angle(alpha);
     const HalfAngle<T> b = half_angle(beta);
     const HalfAngle<T> g = half_angle(gamma);
-    const T cc = a.c * b.c;
-    const T sc = a.s * b.c;
-    const T cs = a.c * b.s;
+    const T one = k<T>(1.0);
+    const T ac = one + a.cm1;
+    const T bc = one + b.cm1;
+    const T gc = one + g.cm1;
+    const T ccm1 = a.cm1 + b.cm1 + a.cm1 * b.cm1;  // c1c2 − 1
+    const T cc = one + ccm1;
+    const T sc = a.s * bc;
+    const T cs = ac * b.s;
     const T ss = a.s * b.s;
-    return {cc * g.c - ss * g.s, -(sc * g.c + cs * g.s), sc * g.s - cs * g.c, -(ss * g.c + cc * g.s)};
+    return {ccm1 + g.cm1 + ccm1 * g.cm1 - ss * g.s, {-(sc * gc + cs * g.s), sc * g.s - cs * gc, -(ss * gc + cc * g.s)}};
 }
 
 }  // namespace ascorr
