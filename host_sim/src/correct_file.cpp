@@ -1,5 +1,6 @@
 #include "ascorr_host/correct_file.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +8,9 @@
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "ascorr/correct.hpp"
 #include "ascorr_host/atomic_file.hpp"
@@ -21,16 +25,13 @@ namespace ascorr::host {
 
 namespace {
 
-constexpr std::size_t kFlushBytes = 1U << 20;
-
 std::string where(const std::string& file, const SolutionRecord& rec) {
     return file + ":" + std::to_string(rec.line) + ": ";
 }
 
 // Explains, once per affected row, the status bits that mean "bad input".
-template <typename T>
-void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file,
-             Diagnostics& diag) {
+template <typename T, typename Sink>
+void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file, Sink& diag) {
     if ((st & status::kRejected) != 0U) {
         std::string why;
         switch (check_solution(in)) {
@@ -84,86 +85,100 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
     }
 }
 
+// Formats corrected rows: all fields verbatim but the quaternion, plus status.
 class RowWriter {
 public:
-    RowWriter(const SolutionsReader& reader, AtomicFile& out) : reader_(reader), out_(out) {
+    explicit RowWriter(const SolutionsReader& reader) : reader_(reader) {
         const auto& c = reader.columns();
         q_cols_ = {c.qw, c.qx, c.qy, c.qz};
         status_col_ = reader.header().index("status");
-        const auto& names = reader.header().names();
-        for (std::size_t i = 0; i < names.size(); ++i) {
-            buf_ += (i == 0 ? "" : ",");
-            buf_ += names[i];
-        }
-        if (status_col_ < 0) {
-            buf_ += ",status";
-        }
-        buf_ += '\n';
     }
 
-    void row(const std::optional<Quaternion<double>>& q, StatusBits st) {
-        const auto& fields = reader_.fields();
+    std::string header_line() const {
+        std::string h;
+        const auto& names = reader_.header().names();
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            h += (i == 0 ? "" : ",");
+            h += names[i];
+        }
+        h += status_col_ < 0 ? ",status\n" : "\n";
+        return h;
+    }
+
+    // Appends the row last read by `reader` (which must share this header).
+    void row(const SolutionsReader& reader, const std::optional<Quaternion<double>>& q, StatusBits st, std::string& buf) const {
+        const auto& fields = reader.fields();
         char num[64];
         for (std::size_t i = 0; i < fields.size(); ++i) {
             if (i != 0) {
-                buf_ += ',';
+                buf += ',';
             }
             const int col = static_cast<int>(i);
             if (col == status_col_) {
-                append_status(st);
+                append_status(st, buf);
             } else if (q && (col == q_cols_[0] || col == q_cols_[1] || col == q_cols_[2] || col == q_cols_[3])) {
                 const double v = col == q_cols_[0] ? q->w : col == q_cols_[1] ? q->x : col == q_cols_[2] ? q->y : q->z;
-                buf_.append(num, format_fixed(num, num + sizeof num, v, 15));
+                buf.append(num, format_fixed(num, num + sizeof num, v, 15));
             } else {
-                buf_.append(fields[i]);
+                buf.append(fields[i]);
             }
         }
         if (status_col_ < 0) {
-            buf_ += ',';
-            append_status(st);
+            buf += ',';
+            append_status(st, buf);
         }
-        buf_ += '\n';
-        if (buf_.size() >= kFlushBytes) {
-            flush();
-        }
-    }
-
-    void flush() {
-        out_.write(buf_);
-        buf_.clear();
+        buf += '\n';
     }
 
 private:
-    void append_status(StatusBits st) {
+    static void append_status(StatusBits st, std::string& buf) {
         char num[8];
         const auto r = std::to_chars(num, num + sizeof num, static_cast<unsigned>(st));
-        buf_.append(num, r.ptr);
+        buf.append(num, r.ptr);
     }
 
     const SolutionsReader& reader_;
-    AtomicFile& out_;
     std::array<int, 4> q_cols_{};
     int status_col_ = -1;
-    std::string buf_;
+};
+
+// Diagnostics of one chunk, replayed in file order after the workers join.
+class DeferredDiagnostics {
+public:
+    void report(const std::string& kind, const std::string& message) { items_.emplace_back(kind, message); }
+    void replay(Diagnostics& d) const {
+        for (const auto& [kind, message] : items_) {
+            d.report(kind, message);
+        }
+    }
+
+private:
+    std::vector<std::pair<std::string, std::string>> items_;
+};
+
+struct ChunkResult {
+    std::string out;
+    CorrectSummary summary;
+    DeferredDiagnostics diag;
+    std::optional<InputError> error;  // the first malformed row, when not skipping
+    std::size_t empty_lines = 0;
 };
 
 template <typename T>
-CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
-    const std::string text = read_text_file(opt.in);
-    SolutionsReader reader(opt.in, text);
+struct Job {
+    const CorrectOptions& opt;
+    const CorrectionConfig<T>& cfg;
+    const SolutionsReader& header;
+    const RowWriter& writer;
+};
 
-    std::optional<ThermalModel<T>> model;
-    if (opt.thermal && !opt.model.empty()) {
-        model = to_core<T>(read_model_file(opt.model));
-    }
-    const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
-
-    Diagnostics diag(log);
+template <typename T>
+void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
+    const CorrectOptions& opt = job.opt;
+    SolutionsReader reader(job.header, body, lines_before);
     EarthVelocity earth;
-    AtomicFile out(opt.out);
-    RowWriter writer(reader, out);
-    CorrectSummary sum;
     SolutionRecord rec;
+    res.out.reserve(body.size() + body.size() / 8);
     for (;;) {
         try {
             if (!reader.next(rec)) {
@@ -171,35 +186,124 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             }
         } catch (const InputError& e) {
             if (!opt.skip_bad) {
-                throw;
+                res.error = e;
+                break;
             }
-            ++sum.malformed;
-            diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
+            ++res.summary.malformed;
+            res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
         const SolutionInput<T> in = to_core_input<T>(rec, opt.aberration ? &earth : nullptr);
-        const CorrectedSolution<T> c = correct_solution(in, cfg);
+        const CorrectedSolution<T> c = correct_solution(in, job.cfg);
         StatusBits st = c.status;
         if (opt.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
             st |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
         }
-        explain(rec, in, st, opt.in, diag);
+        explain(rec, in, st, opt.in, res.diag);
         if ((st & status::kRejected) != 0U) {
-            writer.row(std::nullopt, st);  // the input text, unchanged
+            job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
             const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-            writer.row(Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)}, st);
+            job.writer.row(reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
+                           st, res.out);
         }
-        ++sum.rows;
-        for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
-            sum.status_bit[b] += (st >> b) & 1U;
+        ++res.summary.rows;
+        for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
+            res.summary.status_bit[b] += (st >> b) & 1U;
         }
     }
-    if (reader.empty_lines() != 0) {
-        log << opt.in << ": " << reader.empty_lines() << " empty line(s) ignored\n";
+    res.empty_lines = reader.empty_lines();
+}
+
+// Splits a block of whole lines into n pieces of about equal size, at line ends.
+std::vector<std::string_view> split_at_lines(std::string_view block, std::size_t n) {
+    std::vector<std::string_view> parts;
+    std::size_t start = 0;
+    for (std::size_t i = 1; i <= n && start < block.size(); ++i) {
+        std::size_t end = i == n ? block.size() : std::max(start, block.size() * i / n);
+        if (end < block.size()) {
+            const std::size_t nl = block.find('\n', end);
+            end = nl == std::string_view::npos ? block.size() : nl + 1;
+        }
+        parts.push_back(block.substr(start, end - start));
+        start = end;
+    }
+    return parts;
+}
+
+std::size_t worker_count() {
+    const unsigned hw = std::thread::hardware_concurrency();
+    return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
+}
+
+template <typename T>
+CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+    std::optional<ThermalModel<T>> model;
+    if (opt.thermal && !opt.model.empty()) {
+        model = to_core<T>(read_model_file(opt.model));
+    }
+    const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
+
+    BlockReader blocks(opt.in);
+    std::string_view block;
+    if (!blocks.next(block)) {
+        throw InputError(opt.in, 1, 1, "empty file: expected a header line");
+    }
+    const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
+    const RowWriter writer(header);
+    const Job<T> job{opt, cfg, header, writer};
+
+    Diagnostics diag(log);
+    AtomicFile out(opt.out);
+    out.write(writer.header_line());
+    CorrectSummary sum;
+    std::size_t empty_lines = 0;
+    const std::size_t workers = worker_count();
+    bool first = true;
+    do {
+        std::size_t lines_before = blocks.lines_before();
+        if (first) {  // the header line is not data
+            const std::size_t nl = block.find('\n');
+            block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+            lines_before += 1;
+            first = false;
+        }
+        const std::vector<std::string_view> parts = split_at_lines(block, workers);
+        std::vector<std::size_t> first_line(parts.size(), lines_before);
+        for (std::size_t i = 1; i < parts.size(); ++i) {
+            first_line[i] = first_line[i - 1] + count_line_ends(parts[i - 1]);
+        }
+        std::vector<ChunkResult> results(parts.size());
+        {
+            std::vector<std::thread> threads;
+            for (std::size_t i = 1; i < parts.size(); ++i) {
+                threads.emplace_back([&, i] { correct_chunk(job, parts[i], first_line[i], results[i]); });
+            }
+            if (!parts.empty()) {
+                correct_chunk(job, parts[0], first_line[0], results[0]);
+            }
+            for (auto& t : threads) {
+                t.join();
+            }
+        }
+        for (const ChunkResult& r : results) {  // in file order
+            r.diag.replay(diag);
+            if (r.error) {
+                throw *r.error;
+            }
+            out.write(r.out);
+            sum.rows += r.summary.rows;
+            sum.malformed += r.summary.malformed;
+            for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
+                sum.status_bit[b] += r.summary.status_bit[b];
+            }
+            empty_lines += r.empty_lines;
+        }
+    } while (blocks.next(block));
+    if (empty_lines != 0) {
+        log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
     }
     diag.summarize();
-    writer.flush();
     out.commit();
     return sum;
 }

@@ -35,6 +35,76 @@ std::string read_text_file(const std::string& path) {
     return data;
 }
 
+BlockReader::BlockReader(std::string path, std::size_t block_bytes) : path_(std::move(path)), block_bytes_(block_bytes) {
+    f_ = std::fopen(path_.c_str(), "rb");
+    if (f_ == nullptr) {
+        throw InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+    }
+}
+
+BlockReader::~BlockReader() {
+    if (f_ != nullptr) {
+        std::fclose(f_);
+    }
+}
+
+std::size_t count_line_ends(std::string_view text) noexcept {
+    std::size_t n = 0;
+    const char* p = text.data();
+    const char* const end = p + text.size();
+    while (p != end) {
+        const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+        if (nl == nullptr) {
+            break;
+        }
+        ++n;
+        p = static_cast<const char*>(nl) + 1;
+    }
+    return n;
+}
+
+bool BlockReader::next(std::string_view& block) {
+    // Keep the partial last line of the previous block.
+    std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
+    size_ -= consumed_;
+    consumed_ = 0;
+    lines_before_ += lines_in_last_;
+    lines_in_last_ = 0;
+    const auto has_line_end = [&] { return std::memchr(buf_.get(), '\n', size_) != nullptr; };
+    // Read until the buffer holds a block's worth with a line end (or the file ends).
+    while (!eof_ && (size_ < block_bytes_ || !has_line_end())) {
+        if (capacity_ - size_ < block_bytes_) {  // grow: first call, or a line longer than a block
+            const std::size_t cap = std::max(2 * capacity_, size_ + block_bytes_);
+            std::unique_ptr<char[]> bigger(new char[cap]);
+            std::memcpy(bigger.get(), buf_.get(), size_);
+            buf_ = std::move(bigger);
+            capacity_ = cap;
+        }
+        const std::size_t n = std::fread(buf_.get() + size_, 1, block_bytes_, f_);
+        size_ += n;
+        if (n == 0) {
+            if (std::ferror(f_) != 0) {
+                throw InputError(path_, lines_before_ + 1, 0, "read error");
+            }
+            eof_ = true;
+        }
+    }
+    if (size_ == 0) {
+        return false;
+    }
+    const std::string_view all(buf_.get(), size_);
+    const std::size_t last_nl = all.rfind('\n');
+    consumed_ = eof_ || last_nl == std::string_view::npos ? size_ : last_nl + 1;
+    block = all.substr(0, consumed_);
+    if (const void* nul = std::memchr(block.data(), '\0', block.size()); nul != nullptr) {
+        const auto at = static_cast<std::size_t>(static_cast<const char*>(nul) - block.data());
+        throw InputError(path_, lines_before_ + 1 + count_line_ends(block.substr(0, at)), 0,
+                         "binary data (NUL byte) in a text file");
+    }
+    lines_in_last_ = count_line_ends(block) + (block.back() != '\n' ? 1 : 0);
+    return true;
+}
+
 bool LineReader::next(std::string_view& line) noexcept {
     if (pos_ >= text_.size()) {
         return false;
@@ -74,6 +144,22 @@ namespace {
 // IEEE division gives the correctly rounded value, the same bits as
 // from_chars. Anything else (exponents, long mantissas, nan) takes from_chars.
 // This halves the cost of reading a recorded file.
+// Eight ASCII digits at p, if they are all digits (little-endian SWAR, as in
+// fast_float): 8 digits in ~12 instructions instead of a loop of 8.
+bool eight_digits(const char* p, std::uint64_t& value) noexcept {
+    std::uint64_t v = 0;
+    std::memcpy(&v, p, 8);
+    if ((((v + 0x4646464646464646ULL) | (v - 0x3030303030303030ULL)) & 0x8080808080808080ULL) != 0) {
+        return false;
+    }
+    v -= 0x3030303030303030ULL;
+    v = (v * 10U) + (v >> 8);
+    v = (((v & 0x000000FF000000FFULL) * 0x000F424000000064ULL) +
+         (((v >> 16) & 0x000000FF000000FFULL) * 0x0000271000000001ULL)) >> 32;
+    value = v;
+    return true;
+}
+
 bool parse_plain_decimal(const char* first, const char* last, double& out) noexcept {
     static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                         1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
@@ -94,6 +180,11 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
     if (p != last && *p == '.') {
         ++p;
         const char* frac_begin = p;
+        std::uint64_t eight = 0;
+        while (last - p >= 8 && p - frac_begin < 16 && eight_digits(p, eight)) {
+            m = m * 100000000U + eight;
+            p += 8;
+        }
         while (p != last && static_cast<unsigned>(*p - '0') < 10U) {
             m = m * 10U + static_cast<unsigned>(*p - '0');
             ++p;
@@ -179,13 +270,25 @@ char* format_unit_15(char* out, double x) noexcept {
         *out++ = '-';
     }
     const std::uint64_t int_part = digits / 1000000000000000ULL;
-    std::uint64_t frac = digits % 1000000000000000ULL;
+    const std::uint64_t frac = digits % 1000000000000000ULL;
     *out++ = static_cast<char>('0' + int_part);
     *out++ = '.';
-    for (int i = 14; i >= 0; --i) {
-        out[i] = static_cast<char>('0' + frac % 10U);
-        frac /= 10U;
+    // 15 digits as 7 + 8, two at a time from a table, in 32-bit arithmetic.
+    static constexpr char kPairs[] =
+        "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+        "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+        "8081828384858687888990919293949596979899";
+    auto hi = static_cast<std::uint32_t>(frac / 100000000U);  // 7 digits
+    auto lo = static_cast<std::uint32_t>(frac % 100000000U);  // 8 digits
+    for (int i = 13; i >= 7; i -= 2) {
+        std::memcpy(out + i, kPairs + 2 * (lo % 100U), 2);
+        lo /= 100U;
     }
+    for (int i = 5; i >= 1; i -= 2) {
+        std::memcpy(out + i, kPairs + 2 * (hi % 100U), 2);
+        hi /= 100U;
+    }
+    out[0] = static_cast<char>('0' + hi);
     return out + 15;
 }
 }  // namespace

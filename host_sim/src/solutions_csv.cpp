@@ -56,6 +56,9 @@ SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
     col_.confidence = header_.index("confidence");
 }
 
+SolutionsReader::SolutionsReader(const SolutionsReader& header_from, std::string_view body, std::size_t lines_before)
+    : file_(header_from.file_), lines_(body, lines_before), header_(header_from.header_), col_(header_from.col_) {}
+
 void SolutionsReader::fail(std::size_t field, const std::string& what) const {
     const std::size_t column = field < starts_.size() ? starts_[field] + 1 : 1;
     throw InputError(file_, lines_.line_number(), column, what);

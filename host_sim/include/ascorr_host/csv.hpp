@@ -7,6 +7,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -17,10 +19,45 @@ namespace ascorr::host {
 // The whole content of a file. Throws InputError (line 0) if it cannot be read.
 std::string read_text_file(const std::string& path);
 
+// Reads a file in blocks of whole lines, so that a recorded mission of any
+// size is processed in bounded memory. Each block ends at a line end (the last
+// one may lack it) and is free of NUL bytes (InputError otherwise).
+class BlockReader {
+public:
+    static constexpr std::size_t kDefaultBlockBytes = 32U << 20;
+    explicit BlockReader(std::string path, std::size_t block_bytes = kDefaultBlockBytes);
+    ~BlockReader();
+    BlockReader(const BlockReader&) = delete;
+    BlockReader& operator=(const BlockReader&) = delete;
+
+    // The next block of whole lines; false at the end of the file.
+    bool next(std::string_view& block);
+    // Lines of the file before the block last returned.
+    std::size_t lines_before() const noexcept { return lines_before_; }
+    const std::string& path() const noexcept { return path_; }
+
+private:
+    std::string path_;
+    std::size_t block_bytes_;
+    std::FILE* f_ = nullptr;
+    std::unique_ptr<char[]> buf_;  // not std::string: no zero-fill of each block
+    std::size_t capacity_ = 0;
+    std::size_t size_ = 0;
+    std::size_t consumed_ = 0;  // bytes of buf_ handed out in the last block
+    std::size_t lines_before_ = 0;
+    std::size_t lines_in_last_ = 0;
+    bool eof_ = false;
+};
+
+// Number of line ends ('\n') in text; memchr-based, so it runs at memory speed.
+std::size_t count_line_ends(std::string_view text) noexcept;
+
 // Iterates the lines of a buffer, keeping 1-based line numbers.
 class LineReader {
 public:
-    explicit LineReader(std::string_view text) noexcept : text_(text) {}
+    // lines_before: how many lines of the file precede text (for numbering).
+    explicit LineReader(std::string_view text, std::size_t lines_before = 0) noexcept
+        : text_(text), line_(lines_before) {}
     // Next line without its line end; false at the end of the buffer.
     bool next(std::string_view& line) noexcept;
     std::size_t line_number() const noexcept { return line_; }

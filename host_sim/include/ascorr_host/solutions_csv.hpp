@@ -47,6 +47,9 @@ class SolutionsReader {
 public:
     // Parses the header; throws InputError when a required column is missing.
     SolutionsReader(std::string file_name, std::string_view text);
+    // Reads the data rows in body, a block of whole lines of the same file
+    // after the header (see BlockReader); lines_before numbers them.
+    SolutionsReader(const SolutionsReader& header_from, std::string_view body, std::size_t lines_before);
 
     // Reads the next data row into rec (empty lines are skipped and counted).
     // Returns false at the end. Throws InputError for a malformed row; the
