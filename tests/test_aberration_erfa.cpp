@@ -11,7 +11,9 @@
 namespace ascorr::test {
 namespace {
 
-Eigen::Vector3d rotate(const Quaternion<double>& q, const Eigen::Vector3d& v) { return to_eigen(q) * v; }
+Eigen::Vector3d rotate(const Quaternion<double>& q, const Eigen::Vector3d& v) {
+    return to_eigen(q) * v;
+}
 
 Eigen::Vector3d erfa_ab(const Eigen::Vector3d& pnat, const Eigen::Vector3d& beta, double s) {
     double p[3] = {pnat.x(), pnat.y(), pnat.z()};

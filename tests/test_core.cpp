@@ -56,7 +56,9 @@ SolutionInput<double> input(const Quaternion<double>& q, std::uint8_t head = 0) 
     return in;
 }
 
-host::ModelFile table2() { return host::read_model_file(data_path("model_table2.csv")); }
+host::ModelFile table2() {
+    return host::read_model_file(data_path("model_table2.csv"));
+}
 
 // ---- Worked examples (shared/spec/examples), all three stages.
 struct Stage {
@@ -81,7 +83,8 @@ TEST_P(WorkedExample, MatchesTo1e6Arcsec) {
     double worst = 0.0;
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const auto out = correct_solution(host::to_core_input<double>(rows[i], &earth), cfg);
-        const StatusBits want = (st.aberration ? status::kAberrationApplied : 0) | (st.thermal ? status::kThermalApplied : 0);
+        const StatusBits want =
+            (st.aberration ? status::kAberrationApplied : 0) | (st.thermal ? status::kThermalApplied : 0);
         EXPECT_EQ(out.status, want) << "row " << i;
         EXPECT_GE(out.q_chu_icrf.w, 0.0);
         worst = std::max(worst, angle_arcsec(out.q_chu_icrf, expected[i].q_chu_icrf));
@@ -124,7 +127,8 @@ TEST(Thermal, MatchesMatrixReferenceOverDomain) {
         const auto out = correct_solution(in, CorrectionConfig<double>{false, &model});
         bool in_domain = true;
         for (const auto& axis : m.coefficients[head]) {
-            in_domain = in_domain && std::abs(reference_angle_arcsec(axis, t1, t2, t3)) * kArcsecToRad <= kMaxThermalAngleRad;
+            in_domain =
+                in_domain && std::abs(reference_angle_arcsec(axis, t1, t2, t3)) * kArcsecToRad <= kMaxThermalAngleRad;
         }
         if (!in_domain) {
             EXPECT_EQ(out.status, status::kThermalOutOfRange);
@@ -315,11 +319,18 @@ TEST(BadInput, TemperatureCases) {
         {"t_chu missing", {{0, false}, {-5, true}, {-20, true}}, 0, status::kNoTemperature},
         {"t_029 missing", {{10, true}, {0, false}, {-20, true}}, 1, status::kNoTemperature},
         {"t_032 missing", {{10, true}, {-5, true}, {0, false}}, 2, status::kNoTemperature},
-        {"NaN marked valid", {{kNaN, true}, {-5, true}, {-20, true}}, 0, status::kNoTemperature | status::kTemperatureInvalid},
-        {"inf", {{10, true}, {inf, true}, {-20, true}}, 0, status::kNoTemperature | status::kTemperatureInvalid},
-        {"open circuit reading -273", {{10, true}, {-5, true}, {-273.15, true}}, 0,
+        {"NaN marked valid",
+         {{kNaN, true}, {-5, true}, {-20, true}},
+         0,
          status::kNoTemperature | status::kTemperatureInvalid},
-        {"short circuit reading 900", {{900, true}, {-5, true}, {-20, true}}, 0,
+        {"inf", {{10, true}, {inf, true}, {-20, true}}, 0, status::kNoTemperature | status::kTemperatureInvalid},
+        {"open circuit reading -273",
+         {{10, true}, {-5, true}, {-273.15, true}},
+         0,
+         status::kNoTemperature | status::kTemperatureInvalid},
+        {"short circuit reading 900",
+         {{900, true}, {-5, true}, {-20, true}},
+         0,
          status::kNoTemperature | status::kTemperatureInvalid},
         {"head D not in model", {{10, true}, {-5, true}, {-20, true}}, 3, status::kNoModelForHead},
         {"in domain", {{10, true}, {-5, true}, {-20, true}}, 2, status::kThermalApplied},

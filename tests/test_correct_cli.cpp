@@ -32,7 +32,9 @@ CliRun run(const std::string& args, const fs::path& dir) {
     return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
 }
 
-void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write(const fs::path& p, const std::string& text) {
+    std::ofstream(p) << text;
+}
 
 std::vector<std::string> lines_of(const fs::path& p) {
     std::ifstream f(p);
@@ -61,9 +63,15 @@ TEST(CorrectCli, WorkedExamplesAllStages) {
     const fs::path dir = scratch_dir("cli");
     const std::string in = data_path("solutions.csv");
     const std::string model = data_path("model_table2.csv");
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "ab.csv").string() + " --no-thermal --model " + model, dir).exit_code, 0);
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "th.csv").string() + " --no-aberration --model " + model, dir).exit_code, 0);
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "both.csv").string() + " --model " + model, dir).exit_code, 0);
+    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "ab.csv").string() + " --no-thermal --model " + model, dir)
+                  .exit_code,
+              0);
+    ASSERT_EQ(
+        run("correct --in " + in + " --out " + (dir / "th.csv").string() + " --no-aberration --model " + model, dir)
+            .exit_code,
+        0);
+    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "both.csv").string() + " --model " + model, dir).exit_code,
+              0);
     EXPECT_LE(max_error(dir / "ab.csv", "expected_aberration_only.csv"), 1e-6);
     EXPECT_LE(max_error(dir / "th.csv", "expected_thermal_only.csv"), 1e-6);
     EXPECT_LE(max_error(dir / "both.csv", "expected_both.csv"), 1e-6);
@@ -96,21 +104,20 @@ TEST(CorrectCli, FloatScalarWithinBound) {
 TEST(CorrectCli, EveryRowKeptWithItsStatus) {
     const fs::path dir = scratch_dir("cli");
     const std::string h = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,note\n";
-    write(dir / "in.csv", h +
-                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,ok\n"           // 3
-                              "447534187.831,B,0.5,0.5,0.5,0.5,,-9,-19,-7,0.7,-1.7,0,1,no_t\n"          // 1|8
-                              "447534187.831,C,0.5,0.5,0.5,0.5,3,-9,-19,,,,4,9,no_v\n"                 // 2|4
-                              "447534187.831,A,nan,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,nan_q\n"        // 16
-                              "447534187.831,A,0.6,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,not_unit\n"     // 16
-                              "447534187.831,E,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,bad_head\n"     // 16
-                              "447534187.831,D,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,no_model\n"     // 1|256
-                              "447534187.831,A,-0.5,-0.5,-0.5,-0.5,3,-9,-19,-7,0.7,-1.7,0,1,neg\n"      // 3
-                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,4e5,0,0,0,1,v_gt_c\n"           // 2|4|32
-                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,-7,,-1.7,0,1,v_partial\n"       // 2|4|32
-                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,999,-7,0.7,-1.7,0,1,t_short\n");    // 1|8|64
-    const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() + " --model " +
-                          data_path("model_table2.csv"),
-                      dir);
+    write(dir / "in.csv", h + "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,ok\n"         // 3
+                              "447534187.831,B,0.5,0.5,0.5,0.5,,-9,-19,-7,0.7,-1.7,0,1,no_t\n"        // 1|8
+                              "447534187.831,C,0.5,0.5,0.5,0.5,3,-9,-19,,,,4,9,no_v\n"                // 2|4
+                              "447534187.831,A,nan,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,nan_q\n"      // 16
+                              "447534187.831,A,0.6,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,not_unit\n"   // 16
+                              "447534187.831,E,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,bad_head\n"   // 16
+                              "447534187.831,D,0.5,0.5,0.5,0.5,3,-9,-19,-7,0.7,-1.7,0,1,no_model\n"   // 1|256
+                              "447534187.831,A,-0.5,-0.5,-0.5,-0.5,3,-9,-19,-7,0.7,-1.7,0,1,neg\n"    // 3
+                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,4e5,0,0,0,1,v_gt_c\n"         // 2|4|32
+                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,-7,,-1.7,0,1,v_partial\n"     // 2|4|32
+                              "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,999,-7,0.7,-1.7,0,1,t_short\n");  // 1|8|64
+    const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
+                             " --model " + data_path("model_table2.csv"),
+                         dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto l = lines_of(dir / "out.csv");
     ASSERT_EQ(l.size(), 12U);
@@ -153,7 +160,8 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
         EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << "temporary file left behind";
     }
     // --skip-bad: the bad row is reported and dropped, the rest written.
-    const CliRun s = run("correct --skip-bad --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
+    const CliRun s =
+        run("correct --skip-bad --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
     EXPECT_EQ(s.exit_code, 0) << s.err;
     EXPECT_EQ(lines_of(dir / "out.csv").size(), 12U);
     EXPECT_NE(s.err.find(":8:"), std::string::npos);
@@ -163,14 +171,18 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
 TEST(CorrectCli, BadInvocationsFailCleanly) {
     const fs::path dir = scratch_dir("cli");
     EXPECT_EQ(run("correct --in " + data_path("solutions.csv"), dir).exit_code, 2);  // --out missing
-    EXPECT_EQ(run("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() + " --scalar quad", dir).exit_code, 2);
-    const CliRun missing = run("correct --in " + (dir / "nope.csv").string() + " --out " + (dir / "o.csv").string(), dir);
+    EXPECT_EQ(
+        run("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() + " --scalar quad", dir)
+            .exit_code,
+        2);
+    const CliRun missing =
+        run("correct --in " + (dir / "nope.csv").string() + " --out " + (dir / "o.csv").string(), dir);
     EXPECT_EQ(missing.exit_code, 1);
     EXPECT_NE(missing.err.find("nope.csv"), std::string::npos);
     write(dir / "m.csv", "chu,axis,c0,c1,c2,c3\nA,alpha,1,2,3\n");
     const CliRun bad_model = run("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() +
-                                  " --model " + (dir / "m.csv").string(),
-                              dir);
+                                     " --model " + (dir / "m.csv").string(),
+                                 dir);
     EXPECT_EQ(bad_model.exit_code, 1);
     EXPECT_NE(bad_model.err.find("m.csv:2:"), std::string::npos) << bad_model.err;
     EXPECT_FALSE(fs::exists(dir / "o.csv"));

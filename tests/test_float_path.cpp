@@ -58,7 +58,8 @@ TEST(FloatPath, ErrorBudget) {
         const double t1 = temp(rng), t2 = temp(rng), t3 = temp(rng);
         const auto head = static_cast<std::uint8_t>(i % 3);
         // Double reference on the exact inputs.
-        const auto ref = correct_solution(make_input<double>(q, beta, t1, t2, t3, head), CorrectionConfig<double>{true, &model_d});
+        const auto ref =
+            correct_solution(make_input<double>(q, beta, t1, t2, t3, head), CorrectionConfig<double>{true, &model_d});
         // Float path.
         const SolutionInput<float> in_f = make_input<float>(q, beta, t1, t2, t3, head);
         const auto out_f = correct_solution(in_f, CorrectionConfig<float>{true, &model_f});
@@ -70,18 +71,22 @@ TEST(FloatPath, ErrorBudget) {
         in_rounded.temperatures = {{static_cast<double>(in_f.temperatures.t_chu.value), true},
                                    {static_cast<double>(in_f.temperatures.t_029.value), true},
                                    {static_cast<double>(in_f.temperatures.t_032.value), true}};
-        in_rounded.velocity = {{static_cast<double>(in_f.velocity.beta_icrf.x), static_cast<double>(in_f.velocity.beta_icrf.y),
-                                static_cast<double>(in_f.velocity.beta_icrf.z)},
-                               1.0, true};
+        in_rounded.velocity = {
+            {static_cast<double>(in_f.velocity.beta_icrf.x), static_cast<double>(in_f.velocity.beta_icrf.y),
+             static_cast<double>(in_f.velocity.beta_icrf.z)},
+            1.0,
+            true};
         const auto ref_rounded = correct_solution(in_rounded, CorrectionConfig<double>{true, &model_d});
         total = std::max(total, angle_arcsec(widen(out_f.q_chu_icrf), ref.q_chu_icrf));
         input_rounding = std::max(input_rounding, angle_arcsec(ref_rounded.q_chu_icrf, ref.q_chu_icrf));
-        output_rounding = std::max(output_rounding, angle_arcsec(narrow_wide(ref_rounded.q_chu_icrf), ref_rounded.q_chu_icrf));
+        output_rounding =
+            std::max(output_rounding, angle_arcsec(narrow_wide(ref_rounded.q_chu_icrf), ref_rounded.q_chu_icrf));
         arithmetic = std::max(arithmetic, angle_arcsec(widen(out_f.q_chu_icrf), ref_rounded.q_chu_icrf));
     }
-    std::printf("float path, max over 1e5 solutions: total %.4f\" = input rounding %.4f\" + arithmetic %.4f\""
-                " (output rounding alone %.4f\")\n",
-                total, input_rounding, arithmetic, output_rounding);
+    std::printf(
+        "float path, max over 1e5 solutions: total %.4f\" = input rounding %.4f\" + arithmetic %.4f\""
+        " (output rounding alone %.4f\")\n",
+        total, input_rounding, arithmetic, output_rounding);
     RecordProperty("max_error_arcsec", std::to_string(total));
     EXPECT_LE(total, 0.05);
     // Representation sets the floor: rounding a unit quaternion to float alone

@@ -5,8 +5,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <random>
 #include <fstream>
+#include <random>
 #include <string>
 
 #include "ascorr_host/csv.hpp"
@@ -105,7 +105,8 @@ TEST(SolutionsReader, MalformedInputNamesLineAndColumn) {
 }
 
 TEST(SolutionsReader, ReaderMovesPastABadRow) {
-    const std::string text = std::string(kHeader) + "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n2,A,x,0,0,0,1,2,3,1,2,3,0,1\n3,A,1,0,0,0,1,2,3,1,2,3,0,1\n";
+    const std::string text = std::string(kHeader) +
+                             "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n2,A,x,0,0,0,1,2,3,1,2,3,0,1\n3,A,1,0,0,0,1,2,3,1,2,3,0,1\n";
     SolutionsReader r("f.csv", text);
     SolutionRecord rec;
     ASSERT_TRUE(r.next(rec));
@@ -135,10 +136,13 @@ TEST(Csv, FastDecimalPathIsBitExact) {
         std::string s = (i % 2 == 0) ? "-" : "";
         const int int_digits = ndig(rng) % 6;
         const int frac_digits = ndig(rng);
-        for (int k = 0; k < int_digits; ++k) s += static_cast<char>('0' + digit(rng));
-        if (int_digits == 0) s += '0';
+        for (int k = 0; k < int_digits; ++k)
+            s += static_cast<char>('0' + digit(rng));
+        if (int_digits == 0)
+            s += '0';
         s += '.';
-        for (int k = 0; k < frac_digits; ++k) s += static_cast<char>('0' + digit(rng));
+        for (int k = 0; k < frac_digits; ++k)
+            s += static_cast<char>('0' + digit(rng));
         double want = 0.0;
         std::from_chars(s.data(), s.data() + s.size(), want);
         const auto got = parse_double(s);

@@ -31,11 +31,21 @@ void* operator new(std::size_t n) {
     }
     throw std::bad_alloc();
 }
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void* operator new[](std::size_t n) {
+    return operator new(n);
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
 
 namespace ascorr::test {
 namespace {
@@ -66,9 +76,12 @@ long allocations_while_correcting(int n) {
     for (int i = 0; i < n; ++i) {
         SolutionInput<T> in{};
         const T a = static_cast<T>(u(rng));
-        in.q_chu_icrf = {static_cast<T>(0.6), static_cast<T>(0.8) * a, static_cast<T>(0.8) * std::sqrt(T(1) - a * a), 0};
+        in.q_chu_icrf = {static_cast<T>(0.6), static_cast<T>(0.8) * a, static_cast<T>(0.8) * std::sqrt(T(1) - a * a),
+                         0};
         in.head = static_cast<std::uint8_t>(i % 6);  // includes out-of-range heads
-        in.temperatures = {{static_cast<T>(20), i % 5 != 0}, {i % 7 == 0 ? nan : static_cast<T>(-5), true}, {static_cast<T>(-20), true}};
+        in.temperatures = {{static_cast<T>(20), i % 5 != 0},
+                           {i % 7 == 0 ? nan : static_cast<T>(-5), true},
+                           {static_cast<T>(-20), true}};
         in.velocity = {{static_cast<T>(1e-4) * a, static_cast<T>(i % 11 == 0 ? 2.0 : 0.0), 0}, 1, i % 3 != 0};
         if (i % 13 == 0) {
             in.q_chu_icrf.w = nan;
@@ -90,8 +103,12 @@ TEST(NoAllocation, CounterSeesAllocations) {
     EXPECT_EQ(g_allocations.load(), 1);  // the hook works, so a zero below means something
 }
 
-TEST(NoAllocation, DoubleCore) { EXPECT_EQ(allocations_while_correcting<double>(100000), 0); }
-TEST(NoAllocation, FloatCore) { EXPECT_EQ(allocations_while_correcting<float>(100000), 0); }
+TEST(NoAllocation, DoubleCore) {
+    EXPECT_EQ(allocations_while_correcting<double>(100000), 0);
+}
+TEST(NoAllocation, FloatCore) {
+    EXPECT_EQ(allocations_while_correcting<float>(100000), 0);
+}
 
 }  // namespace
 }  // namespace ascorr::test

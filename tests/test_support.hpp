@@ -3,10 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
-#include <unistd.h>
 
 #include <filesystem>
 #include <random>
@@ -19,10 +19,16 @@
 
 namespace ascorr::test {
 
-inline std::string data_path(const std::string& name) { return std::string(ASCORR_TEST_DATA) + "/" + name; }
+inline std::string data_path(const std::string& name) {
+    return std::string(ASCORR_TEST_DATA) + "/" + name;
+}
 
-inline Eigen::Quaterniond to_eigen(const Quaternion<double>& q) { return {q.w, q.x, q.y, q.z}; }
-inline Quaternion<double> from_eigen(const Eigen::Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+inline Eigen::Quaterniond to_eigen(const Quaternion<double>& q) {
+    return {q.w, q.x, q.y, q.z};
+}
+inline Quaternion<double> from_eigen(const Eigen::Quaterniond& q) {
+    return {q.w(), q.x(), q.y(), q.z()};
+}
 
 // Rotation angle between two attitudes, arcsec (sign of q ignored). Uses the
 // vector part of a* ⊗ b, which keeps full precision for tiny angles.

@@ -10,7 +10,8 @@ namespace ascorr::cli {
 
 void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
-    CLI::App* cmd = app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
+    CLI::App* cmd =
+        app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
     cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage");

@@ -31,7 +31,8 @@ std::string where(const std::string& file, const SolutionRecord& rec) {
 
 // Explains, once per affected row, the status bits that mean "bad input".
 template <typename T, typename Sink>
-void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file, Sink& diag) {
+void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file,
+             Sink& diag) {
     if ((st & status::kRejected) != 0U) {
         std::string why;
         switch (check_solution(in)) {
@@ -80,8 +81,8 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
                     where(file, rec) + "model angle beyond 1 degree for these temperatures: thermal skipped");
     }
     if ((st & status::kNoModelForHead) != 0U) {
-        diag.report("no model for head",
-                    where(file, rec) + "the model has no coefficients for chu '" + std::string(rec.chu) + "': thermal skipped");
+        diag.report("no model for head", where(file, rec) + "the model has no coefficients for chu '" +
+                                             std::string(rec.chu) + "': thermal skipped");
     }
 }
 
@@ -106,7 +107,8 @@ public:
     }
 
     // Appends the row last read by `reader` (which must share this header).
-    void row(const SolutionsReader& reader, const std::optional<Quaternion<double>>& q, StatusBits st, std::string& buf) const {
+    void row(const SolutionsReader& reader, const std::optional<Quaternion<double>>& q, StatusBits st,
+             std::string& buf) const {
         const auto& fields = reader.fields();
         char num[64];
         for (std::size_t i = 0; i < fields.size(); ++i) {
@@ -204,8 +206,9 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
             const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-            job.writer.row(reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
-                           st, res.out);
+            job.writer.row(
+                reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
+                st, res.out);
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
@@ -325,7 +328,7 @@ CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
 std::string describe(const CorrectSummary& s) {
     std::ostringstream o;
     o << s.rows << " rows written";
-    const char* names[] = {"aberration applied", "thermal applied", "no velocity", "temperatures missing",
+    const char* names[] = {"aberration applied", "thermal applied",  "no velocity",         "temperatures missing",
                            "rejected",           "velocity invalid", "temperature invalid", "thermal out of range",
                            "no model for head"};
     for (std::size_t b = 0; b < 9; ++b) {

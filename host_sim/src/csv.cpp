@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <charconv>
-#include <cstdio>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 
@@ -29,13 +29,15 @@ std::string read_text_file(const std::string& path) {
     }
     if (data.find('\0') != std::string::npos) {
         const std::size_t at = data.find('\0');
-        const std::size_t line = 1 + static_cast<std::size_t>(std::count(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+        const std::size_t line = 1 + static_cast<std::size_t>(std::count(
+                                         data.begin(), data.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
         throw InputError(path, line, 0, "binary data (NUL byte) in a text file");
     }
     return data;
 }
 
-BlockReader::BlockReader(std::string path, std::size_t block_bytes) : path_(std::move(path)), block_bytes_(block_bytes) {
+BlockReader::BlockReader(std::string path, std::size_t block_bytes)
+    : path_(std::move(path)), block_bytes_(block_bytes) {
     f_ = std::fopen(path_.c_str(), "rb");
     if (f_ == nullptr) {
         throw InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
@@ -155,7 +157,8 @@ bool eight_digits(const char* p, std::uint64_t& value) noexcept {
     v -= 0x3030303030303030ULL;
     v = (v * 10U) + (v >> 8);
     v = (((v & 0x000000FF000000FFULL) * 0x000F424000000064ULL) +
-         (((v >> 16) & 0x000000FF000000FFULL) * 0x0000271000000001ULL)) >> 32;
+         (((v >> 16) & 0x000000FF000000FFULL) * 0x0000271000000001ULL)) >>
+        32;
     value = v;
     return true;
 }
@@ -266,7 +269,7 @@ char* format_unit_15(char* out, double x) noexcept {
         r -= 1.0;
     }
     const auto digits = static_cast<std::uint64_t>(r);  // ≤ 1e15
-    if (std::signbit(x)) {  // as printf: -0.000… for negative zero and tiny negatives
+    if (std::signbit(x)) {                              // as printf: -0.000… for negative zero and tiny negatives
         *out++ = '-';
     }
     const std::uint64_t int_part = digits / 1000000000000000ULL;

@@ -41,8 +41,9 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         const std::size_t n = lines.line_number();
         split_fields(line, fields, starts);
         if (fields.size() != header.size()) {
-            throw InputError(file_name, n, starts.back() + 1,
-                             "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
+            throw InputError(
+                file_name, n, starts.back() + 1,
+                "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
         }
         const auto chu = fields[static_cast<std::size_t>(col_chu)];
         const std::uint8_t head = head_from_name(chu);
@@ -100,7 +101,9 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
     return m;
 }
 
-ModelFile read_model_file(const std::string& path) { return parse_model(path, read_text_file(path)); }
+ModelFile read_model_file(const std::string& path) {
+    return parse_model(path, read_text_file(path));
+}
 
 std::string format_model(const ModelFile& m) {
     std::string out = m.quadratic ? "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "chu,axis,c0,c1,c2,c3\n";
@@ -125,6 +128,8 @@ std::string format_model(const ModelFile& m) {
     return out;
 }
 
-void write_model_file(const std::string& path, const ModelFile& model) { write_file_atomically(path, format_model(model)); }
+void write_model_file(const std::string& path, const ModelFile& model) {
+    write_file_atomically(path, format_model(model));
+}
 
 }  // namespace ascorr::host

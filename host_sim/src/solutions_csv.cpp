@@ -27,7 +27,9 @@ std::uint8_t head_from_name(std::string_view chu) noexcept {
     return kUnknownHead;
 }
 
-char head_name(std::uint8_t head) noexcept { return head < 4 ? static_cast<char>('A' + head) : '?'; }
+char head_name(std::uint8_t head) noexcept {
+    return head < 4 ? static_cast<char>('A' + head) : '?';
+}
 
 SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
     : file_(std::move(file_name)), lines_(text), header_(header_line_of(text, file_), file_) {
@@ -100,7 +102,8 @@ bool SolutionsReader::next(SolutionRecord& rec) {
     split_fields(line, fields_, starts_);
     if (fields_.size() != header_.size()) {
         fail(fields_.size() - 1, "expected " + std::to_string(header_.size()) + " fields as in the header, found " +
-                                     std::to_string(fields_.size()) + (fields_.size() < header_.size() ? " (truncated row?)" : ""));
+                                     std::to_string(fields_.size()) +
+                                     (fields_.size() < header_.size() ? " (truncated row?)" : ""));
     }
     rec.line = lines_.line_number();
     rec.t = number(col_.t, "t");

@@ -37,9 +37,9 @@ namespace ascorr {
 
 template <typename T>
 struct ObserverVelocity {
-    Vector3<T> beta_icrf;       // v_obs_icrf / c
-    T inv_sun_distance_au;      // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7")
-    bool valid;                 // false: not available or stale
+    Vector3<T> beta_icrf;   // v_obs_icrf / c
+    T inv_sun_distance_au;  // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7")
+    bool valid;             // false: not available or stale
 };
 
 // True when beta is finite and inside the domain of the series below
@@ -63,7 +63,7 @@ constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
 // z_icrf (unit) to its aberrated, proper direction. Requires beta_in_domain().
 template <typename T>
 constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
-                                            const T& inv_sun_distance_au) noexcept {
+                                               const T& inv_sun_distance_au) noexcept {
     const T one = k<T>(1.0);
     const T pdv = dot(z_icrf, beta_icrf);
     const T b2 = squared_norm(beta_icrf);

@@ -8,8 +8,8 @@
 
 namespace ascorr {
 
-inline constexpr double kSpeedOfLightKmS = 299792.458;         // km/s (exact)
-inline constexpr double kAstronomicalUnitKm = 149597870.7;      // km (IAU 2012, exact)
+inline constexpr double kSpeedOfLightKmS = 299792.458;      // km/s (exact)
+inline constexpr double kAstronomicalUnitKm = 149597870.7;  // km (IAU 2012, exact)
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kArcsecToRad = kPi / (180.0 * 3600.0);
 inline constexpr double kRadToArcsec = 1.0 / kArcsecToRad;

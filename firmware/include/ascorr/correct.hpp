@@ -25,16 +25,16 @@ namespace ascorr {
 
 template <typename T>
 struct SolutionInput {
-    Quaternion<T> q_chu_icrf;       // raw attitude, maps ICRF into CHU components
-    std::uint8_t head;              // 0 = A, 1 = B, 2 = C, 3 = D
+    Quaternion<T> q_chu_icrf;  // raw attitude, maps ICRF into CHU components
+    std::uint8_t head;         // 0 = A, 1 = B, 2 = C, 3 = D
     HeadTemperatures<T> temperatures;
     ObserverVelocity<T> velocity;
 };
 
 template <typename T>
 struct CorrectionConfig {
-    bool aberration;                // apply stellar aberration when a velocity is given
-    const ThermalModel<T>* thermal; // nullptr: no thermal stage
+    bool aberration;                 // apply stellar aberration when a velocity is given
+    const ThermalModel<T>* thermal;  // nullptr: no thermal stage
 };
 
 template <typename T>

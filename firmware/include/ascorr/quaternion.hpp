@@ -26,10 +26,8 @@ struct Quaternion {
 // Hamilton product a ⊗ b.
 template <typename T>
 constexpr Quaternion<T> operator*(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
-    return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
-            a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
-            a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
-            a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+    return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+            a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
 }
 
 template <typename T>
@@ -70,7 +68,7 @@ constexpr T dot(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
 // error of applying two corrections to a stored quaternion.
 template <typename T>
 struct SmallRotation {
-    T dw;        // w − 1
+    T dw;  // w − 1
     Vector3<T> v;
 };
 

@@ -27,8 +27,8 @@ struct ScalarTraits;  // specialised per scalar type
 
 template <>
 struct ScalarTraits<double> {
-    using coefficient_type = double;   // thermal-model coefficients (rad, rad/°C, rad/°C²)
-    using temperature_type = double;   // °C
+    using coefficient_type = double;  // thermal-model coefficients (rad, rad/°C, rad/°C²)
+    using temperature_type = double;  // °C
     static constexpr double from_double(double x) noexcept { return x; }
     static constexpr double to_double(double x) noexcept { return x; }
     static constexpr double celsius(double x) noexcept { return x; }
@@ -54,8 +54,12 @@ struct ScalarTraits<float> {
 
 // Finite-ness of floating-point scalars. Unqualified calls to is_finite(x) in
 // the core resolve here for float/double and to the fixed-point overload by ADL.
-inline bool is_finite(double x) noexcept { return std::isfinite(x); }
-inline bool is_finite(float x) noexcept { return std::isfinite(x); }
+inline bool is_finite(double x) noexcept {
+    return std::isfinite(x);
+}
+inline bool is_finite(float x) noexcept {
+    return std::isfinite(x);
+}
 
 // A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a
 // format with range ±2; coefficients and temperatures need other formats, so

@@ -96,7 +96,8 @@ constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
     const T one = k<T>(1.0);
     const T h = k<T>(0.5) * angle;
     const T h2 = h * h;
-    return {-(k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2)), h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
+    return {-(k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2)),
+            h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
 }
 
 // q_th = q3(γ) ⊗ q2(β) ⊗ q1(α), expanded (16 products instead of 32), with

@@ -19,7 +19,7 @@ enum class Scalar { kDouble, kFloat, kFixed };
 struct CorrectOptions {
     std::string in;
     std::string out;
-    std::string model;       // empty: no thermal stage
+    std::string model;  // empty: no thermal stage
     bool aberration = true;
     bool thermal = true;
     Scalar scalar = Scalar::kDouble;
@@ -27,8 +27,8 @@ struct CorrectOptions {
 };
 
 struct CorrectSummary {
-    std::size_t rows = 0;        // rows written
-    std::size_t malformed = 0;   // rows dropped (skip_bad only)
+    std::size_t rows = 0;                      // rows written
+    std::size_t malformed = 0;                 // rows dropped (skip_bad only)
     std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
 };
 

@@ -40,9 +40,7 @@ ThermalModel<T> to_core(const ModelFile& m) {
         AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
         for (std::size_t a = 0; a < 3; ++a) {
             const auto& c = m.coefficients[h][a];
-            const auto r = [&](std::size_t i) {
-                return ScalarTraits<T>::coefficient(c[i] * kArcsecToRad);
-            };
+            const auto r = [&](std::size_t i) { return ScalarTraits<T>::coefficient(c[i] * kArcsecToRad); };
             *axes[a] = {r(0), r(1), r(2), r(3), r(4), r(5), r(6)};
         }
     }

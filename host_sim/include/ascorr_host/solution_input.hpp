@@ -28,7 +28,8 @@ SolutionInput<T> to_core_input(const SolutionRecord& rec, EarthVelocity* earth) 
     if (in.velocity.valid) {
         const EarthState e = earth->at(rec.t);
         const double inv_c = 1.0 / kSpeedOfLightKmS;
-        in.velocity.beta_icrf = {s((e.v_bary_kms.x + rec.v_sc_kms.x) * inv_c), s((e.v_bary_kms.y + rec.v_sc_kms.y) * inv_c),
+        in.velocity.beta_icrf = {s((e.v_bary_kms.x + rec.v_sc_kms.x) * inv_c),
+                                 s((e.v_bary_kms.y + rec.v_sc_kms.y) * inv_c),
                                  s((e.v_bary_kms.z + rec.v_sc_kms.z) * inv_c)};
         in.velocity.inv_sun_distance_au = s(1.0 / e.sun_distance_au);
     }

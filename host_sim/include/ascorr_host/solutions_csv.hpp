@@ -29,12 +29,12 @@ std::uint8_t head_from_name(std::string_view chu) noexcept;
 char head_name(std::uint8_t head) noexcept;
 
 struct SolutionRecord {
-    std::size_t line = 0;          // 1-based line in the file
-    double t = 0.0;                // s since J2000.0, TT
-    std::string_view chu;          // as written
+    std::size_t line = 0;  // 1-based line in the file
+    double t = 0.0;        // s since J2000.0, TT
+    std::string_view chu;  // as written
     std::uint8_t head = kUnknownHead;
     Quaternion<double> q_chu_icrf{};
-    std::array<double, 3> temperature{};       // t_chu, t_029, t_032 (°C)
+    std::array<double, 3> temperature{};        // t_chu, t_029, t_032 (°C)
     std::array<bool, 3> temperature_present{};  // false: empty, nan or column absent
     Vector3<double> v_sc_kms{};                 // vx, vy, vz
     int velocity_components = 0;                // how many of vx, vy, vz are present
