@@ -212,7 +212,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
-            res.summary.status_bit[b] += (st >> b) & 1U;
+            res.summary.status_bit[b] += (static_cast<unsigned>(st) >> b) & 1U;
         }
     }
     res.empty_lines = reader.empty_lines();
