@@ -120,7 +120,8 @@ public:
                 append_status(st, buf);
             } else if (q && (col == q_cols_[0] || col == q_cols_[1] || col == q_cols_[2] || col == q_cols_[3])) {
                 const double v = col == q_cols_[0] ? q->w : col == q_cols_[1] ? q->x : col == q_cols_[2] ? q->y : q->z;
-                buf.append(num, format_fixed(num, num + sizeof num, v, 15));
+                const char* end = format_fixed(num, num + sizeof num, v, 15);
+                buf.append(num, static_cast<std::size_t>(end - num));
             } else {
                 buf.append(fields[i]);
             }
@@ -136,7 +137,7 @@ private:
     static void append_status(StatusBits st, std::string& buf) {
         char num[8];
         const auto r = std::to_chars(num, num + sizeof num, static_cast<unsigned>(st));
-        buf.append(num, r.ptr);
+        buf.append(num, static_cast<std::size_t>(r.ptr - num));
     }
 
     const SolutionsReader& reader_;

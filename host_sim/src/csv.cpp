@@ -222,6 +222,20 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
 }
 }  // namespace
 
+void split_fields(std::string_view line, std::vector<std::string_view>& fields) {
+    fields.clear();
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = line.find(',', start);
+        if (comma == std::string_view::npos) {
+            fields.push_back(line.substr(start));
+            return;
+        }
+        fields.push_back(line.substr(start, comma - start));
+        start = comma + 1;
+    }
+}
+
 std::optional<double> parse_double(std::string_view field) noexcept {
     if (field.empty()) {
         return std::nullopt;

@@ -62,7 +62,8 @@ SolutionsReader::SolutionsReader(const SolutionsReader& header_from, std::string
     : file_(header_from.file_), lines_(body, lines_before), header_(header_from.header_), col_(header_from.col_) {}
 
 void SolutionsReader::fail(std::size_t field, const std::string& what) const {
-    const std::size_t column = field < starts_.size() ? starts_[field] + 1 : 1;
+    const std::size_t column =
+        field < fields_.size() ? static_cast<std::size_t>(fields_[field].data() - line_.data()) + 1 : 1;
     throw InputError(file_, lines_.line_number(), column, what);
 }
 
@@ -99,7 +100,8 @@ bool SolutionsReader::next(SolutionRecord& rec) {
         }
         ++empty_lines_;
     }
-    split_fields(line, fields_, starts_);
+    line_ = line;
+    split_fields(line, fields_);
     if (fields_.size() != header_.size()) {
         fail(fields_.size() - 1, "expected " + std::to_string(header_.size()) + " fields as in the header, found " +
                                      std::to_string(fields_.size()) +

@@ -71,6 +71,8 @@ private:
 // Splits a line at commas into fields (reusing the vector's storage), and
 // records where each field starts (0-based character offset) for messages.
 void split_fields(std::string_view line, std::vector<std::string_view>& fields, std::vector<std::size_t>& starts);
+// The same without the offsets (a field's offset is field.data() − line.data()).
+void split_fields(std::string_view line, std::vector<std::string_view>& fields);
 
 // A field as a double: a decimal or scientific number, "nan", "inf".
 // Leading/trailing spaces are not accepted (they are not in the format).

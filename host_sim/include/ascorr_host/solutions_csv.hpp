@@ -78,7 +78,7 @@ private:
     Header header_;
     Columns col_{};
     std::vector<std::string_view> fields_;
-    std::vector<std::size_t> starts_;
+    std::string_view line_;  // the row last read, for column numbers in messages
     std::size_t empty_lines_ = 0;
 };
 
