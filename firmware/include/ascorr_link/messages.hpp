@@ -1,0 +1,312 @@
+// ascorr_link/messages.hpp: the messages of the host–DPU link.
+//
+// Payload layouts are little-endian; a "word" is one scalar of the target's
+// type in its 32-bit wire form (WireTraits below), so host and target exchange
+// exactly the values the core computes with: a float target gets IEEE binary32
+// bit patterns, a fixed-point target its raw Q integers. The host converts with
+// the same ScalarTraits as its own core in that type, which is why a replayed
+// solution can be compared bit for bit with the host core.
+// Every decode_* checks the exact payload length and every enumerated field,
+// and returns false rather than accept a frame it cannot fully account for.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+#include "ascorr/correct.hpp"
+#include "frame.hpp"
+
+namespace ascorr::link {
+
+// 32-bit wire form of a scalar type. kKind identifies the representation in
+// HELLO, so that a host never talks float to a fixed-point target.
+template <typename U>
+struct WireTraits;
+
+template <>
+struct WireTraits<float> {
+    static constexpr std::uint8_t kKind = 1;  // IEEE 754 binary32
+    static std::uint32_t encode(float x) noexcept {
+        std::uint32_t w = 0;
+        std::memcpy(&w, &x, sizeof w);
+        return w;
+    }
+    static float decode(std::uint32_t w) noexcept {
+        float x = 0.0F;
+        std::memcpy(&x, &w, sizeof x);
+        return x;
+    }
+};
+
+enum class MessageType : std::uint8_t {
+    kHello = 1,              // target → host: boot id, protocol, scalar kind
+    kModelUpload = 2,        // host → target: one head's thermal model
+    kVelocityUpdate = 3,     // host → target: observer velocity (v/c) and 1/s
+    kTemperatureUpdate = 4,  // host → target: one head's temperatures with validity
+    kSolutionIn = 5,         // host → target: a raw attitude solution
+    kSolutionOut = 6,        // target → host: the corrected solution, status, cost
+    kAck = 7,                // target → host: a request without data reply was applied (or why not)
+    kHelloRequest = 8,       // host → target: answer with kHello
+    kNak = 9,                // target → host: a frame arrived broken; resend
+};
+
+enum class AckResult : std::uint8_t {
+    kOk = 0,
+    kUnknownType = 1,  // a message type the target does not take
+    kBadPayload = 2,   // wrong length or an out-of-range field
+};
+
+inline constexpr std::size_t kCoefficientsPerHead = 21;  // alpha, beta, gamma × c0 c1 c2 c3 c1_2 c2_2 c3_2
+
+struct Hello {
+    std::uint32_t boot_id;  // changes at every target start: the host re-uploads state when it does
+    std::uint8_t protocol;
+    std::uint8_t scalar_kind;
+};
+
+template <typename T>
+struct ModelUpload {
+    std::uint8_t head;
+    HeadThermalModel<T> model;
+};
+
+template <typename T>
+struct SolutionIn {
+    std::uint32_t id;
+    std::uint8_t head;
+    Quaternion<T> q_chu_icrf;
+};
+
+template <typename T>
+struct SolutionOut {
+    std::uint32_t id;
+    std::uint8_t head;
+    StatusBits status;
+    Quaternion<T> q_chu_icrf;
+    std::uint32_t instructions;  // cost of correct_solution on the target
+};
+
+struct Ack {
+    std::uint16_t seq;  // the request's sequence number
+    AckResult result;
+};
+
+// ---- encoding helpers
+class Writer {
+public:
+    explicit Writer(std::uint8_t* p) noexcept : p_(p) {}
+    void u8(std::uint8_t v) noexcept { p_[n_++] = v; }
+    void u16(std::uint16_t v) noexcept {
+        put_u16(p_ + n_, v);
+        n_ += 2;
+    }
+    void u32(std::uint32_t v) noexcept {
+        put_u32(p_ + n_, v);
+        n_ += 4;
+    }
+    template <typename U>
+    void word(const U& v) noexcept {
+        u32(WireTraits<U>::encode(v));
+    }
+    std::size_t size() const noexcept { return n_; }
+
+private:
+    std::uint8_t* p_;
+    std::size_t n_ = 0;
+};
+
+class Reader {
+public:
+    Reader(const std::uint8_t* p, std::size_t n) noexcept : p_(p), n_(n) {}
+    bool u8(std::uint8_t& v) noexcept {
+        if (i_ + 1 > n_) {
+            return false;
+        }
+        v = p_[i_++];
+        return true;
+    }
+    bool u16(std::uint16_t& v) noexcept {
+        if (i_ + 2 > n_) {
+            return false;
+        }
+        v = get_u16(p_ + i_);
+        i_ += 2;
+        return true;
+    }
+    bool u32(std::uint32_t& v) noexcept {
+        if (i_ + 4 > n_) {
+            return false;
+        }
+        v = get_u32(p_ + i_);
+        i_ += 4;
+        return true;
+    }
+    template <typename U>
+    bool word(U& v) noexcept {
+        std::uint32_t w = 0;
+        if (!u32(w)) {
+            return false;
+        }
+        v = WireTraits<U>::decode(w);
+        return true;
+    }
+    bool done() const noexcept { return i_ == n_; }
+
+private:
+    const std::uint8_t* p_;
+    std::size_t n_;
+    std::size_t i_ = 0;
+};
+
+// ---- messages (encode returns the payload size; buffers of kMaxPayload suffice)
+inline std::size_t encode(const Hello& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.boot_id);
+    w.u8(m.protocol);
+    w.u8(m.scalar_kind);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, Hello& m) noexcept {
+    Reader r(p, n);
+    return r.u32(m.boot_id) && r.u8(m.protocol) && r.u8(m.scalar_kind) && r.done();
+}
+
+template <typename T>
+std::size_t encode(const ModelUpload<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u8(m.model.present ? 1U : 0U);
+    for (const AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
+        for (const Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3, &a->c1_2, &a->c2_2, &a->c3_2}) {
+            w.word(*c);
+        }
+    }
+    return w.size();
+}
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, ModelUpload<T>& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t present = 0;
+    if (!(r.u8(m.head) && r.u8(present)) || m.head >= kMaxHeads || present > 1U) {
+        return false;
+    }
+    m.model.present = present == 1U;
+    for (AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
+        for (Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3, &a->c1_2, &a->c2_2, &a->c3_2}) {
+            if (!r.word(*c)) {
+                return false;
+            }
+        }
+    }
+    return r.done();
+}
+
+template <typename T>
+std::size_t encode(const ObserverVelocity<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.valid ? 1U : 0U);
+    w.word(m.beta_icrf.x);
+    w.word(m.beta_icrf.y);
+    w.word(m.beta_icrf.z);
+    w.word(m.inv_sun_distance_au);
+    return w.size();
+}
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, ObserverVelocity<T>& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t valid = 0;
+    const bool ok = r.u8(valid) && r.word(m.beta_icrf.x) && r.word(m.beta_icrf.y) && r.word(m.beta_icrf.z) &&
+                    r.word(m.inv_sun_distance_au) && r.done() && valid <= 1U;
+    m.valid = valid == 1U;
+    return ok;
+}
+
+template <typename T>
+struct TemperatureUpdate {
+    std::uint8_t head;
+    HeadTemperatures<T> temperatures;
+};
+
+template <typename T>
+std::size_t encode(const TemperatureUpdate<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    const auto& t = m.temperatures;
+    w.u8(static_cast<std::uint8_t>((t.t_chu.valid ? 1U : 0U) | (t.t_029.valid ? 2U : 0U) | (t.t_032.valid ? 4U : 0U)));
+    w.word(t.t_chu.value);
+    w.word(t.t_029.value);
+    w.word(t.t_032.value);
+    return w.size();
+}
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, TemperatureUpdate<T>& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t mask = 0;
+    auto& t = m.temperatures;
+    if (!(r.u8(m.head) && r.u8(mask) && r.word(t.t_chu.value) && r.word(t.t_029.value) && r.word(t.t_032.value) &&
+          r.done()) ||
+        m.head >= kMaxHeads || mask > 7U) {
+        return false;
+    }
+    t.t_chu.valid = (mask & 1U) != 0U;
+    t.t_029.valid = (mask & 2U) != 0U;
+    t.t_032.valid = (mask & 4U) != 0U;
+    return true;
+}
+
+template <typename T>
+std::size_t encode(const SolutionIn<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.id);
+    w.u8(m.head);
+    w.word(m.q_chu_icrf.w);
+    w.word(m.q_chu_icrf.x);
+    w.word(m.q_chu_icrf.y);
+    w.word(m.q_chu_icrf.z);
+    return w.size();
+}
+// The head is not range-checked here: the core rejects a bad head with
+// status kRejected, which is the answer the host must see.
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
+    Reader r(p, n);
+    return r.u32(m.id) && r.u8(m.head) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) &&
+           r.word(m.q_chu_icrf.z) && r.done();
+}
+
+template <typename T>
+std::size_t encode(const SolutionOut<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.id);
+    w.u8(m.head);
+    w.u16(m.status);
+    w.word(m.q_chu_icrf.w);
+    w.word(m.q_chu_icrf.x);
+    w.word(m.q_chu_icrf.y);
+    w.word(m.q_chu_icrf.z);
+    w.u32(m.instructions);
+    return w.size();
+}
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, SolutionOut<T>& m) noexcept {
+    Reader r(p, n);
+    return r.u32(m.id) && r.u8(m.head) && r.u16(m.status) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) &&
+           r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.done();
+}
+
+inline std::size_t encode(const Ack& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u16(m.seq);
+    w.u8(static_cast<std::uint8_t>(m.result));
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, Ack& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t result = 0;
+    const bool ok = r.u16(m.seq) && r.u8(result) && r.done() && result <= 2U;
+    m.result = static_cast<AckResult>(result);
+    return ok;
+}
+
+}  // namespace ascorr::link

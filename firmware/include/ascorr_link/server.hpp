@@ -1,0 +1,182 @@
+// ascorr_link/server.hpp: the target's end of the link (DPU firmware).
+//
+// LinkServer<T> owns the correction state a DPU keeps between solutions: the
+// thermal model per head, the last observer velocity and each head's last
+// temperatures. It takes received bytes one at a time and hands each response
+// frame to a sink. Requests and answers:
+//   kHelloRequest      → kHello
+//   kModelUpload       → kAck (kBadPayload for a bad head or length)
+//   kVelocityUpdate    → kAck
+//   kTemperatureUpdate → kAck
+//   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>)
+//   broken frame       → kNak with the FrameError, so the host resends at once
+//   unknown type       → kAck kUnknownType
+// A request whose sequence number equals the last one served is a duplicate
+// (the host resent because a response was lost): the cached response is sent
+// again and nothing is applied twice. kHelloRequest starts a host session and
+// forgets the last sequence number. Every call is bounded; nothing allocates.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "ascorr/correct.hpp"
+#include "frame.hpp"
+#include "messages.hpp"
+
+namespace ascorr::link {
+
+// CycleCounter: a callable returning a free-running std::uint32_t counter
+// (SysTick or DWT on target), read around correct_solution().
+template <typename T, typename CycleCounter>
+class LinkServer {
+public:
+    LinkServer(std::uint32_t boot_id, CycleCounter counter) noexcept : boot_id_(boot_id), counter_(counter) {
+        for (auto& t : temperatures_) {
+            t = {};  // all readings invalid until the host sends them
+        }
+        velocity_.valid = false;
+    }
+
+    // Sends kHello unprompted (at boot), so the host learns of a restart.
+    template <typename Sink>
+    void announce(Sink&& sink) noexcept {
+        send_hello(0, sink);
+    }
+
+    template <typename Sink>
+    void on_byte(std::uint8_t b, Sink&& sink) noexcept {
+        switch (decoder_.push(b)) {
+            case FrameDecoder::Event::kNone:
+                return;
+            case FrameDecoder::Event::kError: {
+                ++frame_errors_;
+                std::uint8_t p[1] = {static_cast<std::uint8_t>(decoder_.error())};
+                emit(MessageType::kNak, 0, p, 1, sink, false);
+                return;
+            }
+            case FrameDecoder::Event::kFrame:
+                serve(decoder_.frame(), sink);
+                return;
+        }
+    }
+
+    std::uint32_t frame_errors() const noexcept { return frame_errors_; }
+    std::uint32_t duplicates() const noexcept { return duplicates_; }
+    std::uint32_t solutions() const noexcept { return solutions_; }
+
+private:
+    template <typename Sink>
+    void serve(const Frame& f, Sink& sink) noexcept {
+        if (have_last_ && f.seq == last_seq_ && f.type != static_cast<std::uint8_t>(MessageType::kHelloRequest)) {
+            ++duplicates_;
+            sink(last_response_, last_response_n_);
+            return;
+        }
+        switch (static_cast<MessageType>(f.type)) {
+            case MessageType::kHelloRequest:
+                have_last_ = false;  // a new host session: its sequence numbers start afresh
+                send_hello(f.seq, sink);
+                return;
+            case MessageType::kModelUpload: {
+                ModelUpload<T> m{};
+                const bool ok = decode(f.payload, f.length, m);
+                if (ok) {
+                    model_.head[m.head] = m.model;
+                }
+                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+                return;
+            }
+            case MessageType::kVelocityUpdate: {
+                ObserverVelocity<T> v{};
+                const bool ok = decode(f.payload, f.length, v);
+                if (ok) {
+                    velocity_ = v;
+                }
+                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+                return;
+            }
+            case MessageType::kTemperatureUpdate: {
+                TemperatureUpdate<T> t{};
+                const bool ok = decode(f.payload, f.length, t);
+                if (ok) {
+                    temperatures_[t.head] = t.temperatures;
+                }
+                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+                return;
+            }
+            case MessageType::kSolutionIn: {
+                SolutionIn<T> s{};
+                if (!decode(f.payload, f.length, s)) {
+                    ack(f.seq, AckResult::kBadPayload, sink);
+                    return;
+                }
+                SolutionInput<T> in{};
+                in.q_chu_icrf = s.q_chu_icrf;
+                in.head = s.head;
+                in.temperatures = temperatures_[s.head < kMaxHeads ? s.head : 0];
+                in.velocity = velocity_;
+                const std::uint32_t start = counter_();
+                const CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, &model_});
+                const std::uint32_t cost = counter_() - start;
+                ++solutions_;
+                const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost};
+                std::uint8_t p[kMaxPayload];
+                emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
+                return;
+            }
+            case MessageType::kHello:
+            case MessageType::kSolutionOut:
+            case MessageType::kAck:
+            case MessageType::kNak:
+                break;
+        }
+        ack(f.seq, AckResult::kUnknownType, sink);
+    }
+
+    template <typename Sink>
+    void send_hello(std::uint16_t seq, Sink& sink) noexcept {
+        std::uint8_t p[kMaxPayload];
+        const Hello h{boot_id_, kProtocolVersion, WireTraits<T>::kKind};
+        emit(MessageType::kHello, seq, p, encode(h, p), sink, false);
+    }
+
+    template <typename Sink>
+    void ack(std::uint16_t seq, AckResult r, Sink& sink) noexcept {
+        std::uint8_t p[kMaxPayload];
+        emit(MessageType::kAck, seq, p, encode(Ack{seq, r}, p), sink, true);
+    }
+
+    // Frames and sends a response; `cache` keeps it for a duplicate request.
+    template <typename Sink>
+    void emit(MessageType type, std::uint16_t seq, const std::uint8_t* p, std::size_t n, Sink& sink,
+              bool cache) noexcept {
+        std::uint8_t wire[kMaxWire];
+        const std::size_t w = encode_frame(static_cast<std::uint8_t>(type), seq, p, n, wire, sizeof wire);
+        if (cache) {
+            for (std::size_t i = 0; i < w; ++i) {
+                last_response_[i] = wire[i];
+            }
+            last_response_n_ = w;
+            last_seq_ = seq;
+            have_last_ = true;
+        }
+        sink(static_cast<const std::uint8_t*>(wire), w);
+    }
+
+    std::uint32_t boot_id_;
+    CycleCounter counter_;
+    FrameDecoder decoder_;
+    ThermalModel<T> model_{};
+    ObserverVelocity<T> velocity_{};
+    HeadTemperatures<T> temperatures_[kMaxHeads];
+    std::uint8_t last_response_[kMaxWire] = {};
+    std::size_t last_response_n_ = 0;
+    std::uint16_t last_seq_ = 0;
+    bool have_last_ = false;
+    std::uint32_t frame_errors_ = 0;
+    std::uint32_t duplicates_ = 0;
+    std::uint32_t solutions_ = 0;
+};
+
+}  // namespace ascorr::link

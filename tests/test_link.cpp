@@ -1,0 +1,279 @@
+// The host–DPU link: CRC, COBS, framing, messages and the target's server,
+// including every kind of corruption the replay must survive.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_link/server.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::link {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+Bytes wire_frame(MessageType type, std::uint16_t seq, const Bytes& payload) {
+    Bytes out(kMaxWire);
+    const std::size_t n =
+        encode_frame(static_cast<std::uint8_t>(type), seq, payload.data(), payload.size(), out.data(), out.size());
+    out.resize(n);
+    return out;
+}
+
+struct Decoded {
+    std::vector<Frame> frames;
+    std::vector<Bytes> payloads;
+    std::vector<FrameError> errors;
+};
+
+Decoded decode_all(const Bytes& wire) {
+    FrameDecoder d;
+    Decoded out;
+    for (std::uint8_t b : wire) {
+        switch (d.push(b)) {
+            case FrameDecoder::Event::kFrame:
+                out.frames.push_back(d.frame());
+                out.payloads.emplace_back(d.frame().payload, d.frame().payload + d.frame().length);
+                break;
+            case FrameDecoder::Event::kError:
+                out.errors.push_back(d.error());
+                break;
+            case FrameDecoder::Event::kNone:
+                break;
+        }
+    }
+    return out;
+}
+
+TEST(Crc32c, CheckValue) {
+    const char* s = "123456789";
+    EXPECT_EQ(crc32c(reinterpret_cast<const std::uint8_t*>(s), 9), 0xE3069283U);
+    EXPECT_EQ(crc32c(nullptr, 0), 0U);
+}
+
+TEST(Cobs, KnownVectorsAndRoundTrip) {
+    // Vectors from the COBS paper (Cheshire & Baker 1999) examples.
+    const Bytes in1 = {0x00};
+    const Bytes in2 = {0x11, 0x22, 0x00, 0x33};
+    std::uint8_t enc[300];
+    ASSERT_EQ(cobs_encode(in1.data(), in1.size(), enc, sizeof enc), 2U);
+    EXPECT_EQ(Bytes(enc, enc + 2), (Bytes{0x01, 0x01}));
+    ASSERT_EQ(cobs_encode(in2.data(), in2.size(), enc, sizeof enc), 5U);
+    EXPECT_EQ(Bytes(enc, enc + 5), (Bytes{0x03, 0x11, 0x22, 0x02, 0x33}));
+    std::mt19937 rng(1);
+    for (int trial = 0; trial < 2000; ++trial) {
+        Bytes raw(static_cast<std::size_t>(rng() % 600));
+        for (auto& b : raw) {
+            b = static_cast<std::uint8_t>(rng() % 4 == 0 ? 0 : rng());
+        }
+        Bytes e(cobs_max_encoded(raw.size()));
+        const std::size_t n = cobs_encode(raw.data(), raw.size(), e.data(), e.size());
+        ASSERT_GT(n, 0U);
+        for (std::size_t i = 0; i < n; ++i) {
+            ASSERT_NE(e[i], 0U);
+        }
+        Bytes back(raw.size() + 1);
+        const std::size_t m = cobs_decode(e.data(), n, back.data(), back.size());
+        if (raw.empty()) {
+            EXPECT_EQ(m, 0U);
+        } else {
+            ASSERT_EQ(m, raw.size());
+            back.resize(m);
+            EXPECT_EQ(back, raw);
+        }
+    }
+    // Capacity is never exceeded.
+    EXPECT_EQ(cobs_encode(in2.data(), in2.size(), enc, 4), 0U);
+    EXPECT_EQ(cobs_decode(enc, 5, enc + 100, 3), 0U);
+}
+
+TEST(Frame, RoundTripAndResync) {
+    Bytes stream = {0x00, 0x00};  // idle delimiters are ignored
+    for (std::uint16_t seq = 0; seq < 50; ++seq) {
+        Bytes p(seq % 30, static_cast<std::uint8_t>(seq));
+        const Bytes f = wire_frame(MessageType::kSolutionIn, seq, p);
+        stream.insert(stream.end(), f.begin(), f.end());
+        if (seq % 7 == 0) {  // line noise between frames
+            for (int g : {0x13, 0x37, 0x00}) {
+                stream.push_back(static_cast<std::uint8_t>(g));
+            }
+        }
+    }
+    const Decoded d = decode_all(stream);
+    ASSERT_EQ(d.frames.size(), 50U);
+    for (std::uint16_t seq = 0; seq < 50; ++seq) {
+        EXPECT_EQ(d.frames[seq].seq, seq);
+        EXPECT_EQ(d.payloads[seq], Bytes(seq % 30, static_cast<std::uint8_t>(seq)));
+    }
+    EXPECT_EQ(d.errors.size(), 8U);  // each burst of noise is one broken frame, then resync
+}
+
+// Every single-bit error and every truncation of a frame is detected; no
+// corrupted frame is ever accepted.
+TEST(Frame, EveryBitFlipAndTruncationIsDetected) {
+    Bytes payload(40);
+    for (std::size_t i = 0; i < payload.size(); ++i) {
+        payload[i] = static_cast<std::uint8_t>(i * 37 + 1);
+    }
+    const Bytes good = wire_frame(MessageType::kModelUpload, 0x1234, payload);
+    for (std::size_t byte = 0; byte + 1 < good.size(); ++byte) {
+        for (int bit = 0; bit < 8; ++bit) {
+            Bytes bad = good;
+            bad[byte] = static_cast<std::uint8_t>(bad[byte] ^ (1U << bit));
+            bad.push_back(0);  // the receiver resynchronises at a delimiter in any case
+            const Decoded d = decode_all(bad);
+            EXPECT_TRUE(d.frames.empty()) << "flip at " << byte << ":" << bit;
+        }
+    }
+    for (std::size_t cut = 1; cut + 1 < good.size(); ++cut) {
+        Bytes bad(good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut));
+        bad.push_back(0);
+        const Decoded d = decode_all(bad);
+        EXPECT_TRUE(d.frames.empty()) << "cut at " << cut;
+        EXPECT_EQ(d.errors.size(), 1U);
+    }
+    const Decoded ok = decode_all(good);
+    ASSERT_EQ(ok.frames.size(), 1U);
+    EXPECT_EQ(ok.frames[0].seq, 0x1234);
+}
+
+TEST(Frame, OverlongInputIsBoundedAndReported) {
+    Bytes noise(5 * kMaxEncoded, 0x55);
+    noise.push_back(0);
+    const Decoded d = decode_all(noise);
+    ASSERT_EQ(d.errors.size(), 1U);
+    EXPECT_EQ(d.errors[0], FrameError::kOverlong);
+    std::uint8_t out[kMaxWire];
+    std::uint8_t big[kMaxPayload + 1] = {};
+    EXPECT_EQ(encode_frame(1, 0, big, sizeof big, out, sizeof out), 0U);
+}
+
+TEST(Frame, RandomGarbageNeverCrashesNorPassesAsAFrame) {
+    std::mt19937 rng(9);
+    FrameDecoder d;
+    std::size_t frames = 0;
+    for (int i = 0; i < 2000000; ++i) {
+        const auto b = static_cast<std::uint8_t>(rng() % 16 == 0 ? 0 : rng());
+        frames += d.push(b) == FrameDecoder::Event::kFrame ? 1U : 0U;
+    }
+    EXPECT_EQ(frames, 0U);  // 2e6 random bytes, a CRC-32C match is a 1 in 4e9 event per candidate
+}
+
+// ---- the server, driven in memory as the host would drive the target.
+struct Loop {
+    std::uint32_t fake_cycles = 0;
+    struct Counter {
+        std::uint32_t* c;
+        std::uint32_t operator()() const { return *c += 100; }
+    };
+    LinkServer<float, Counter> server{0xC0FFEEU, Counter{&fake_cycles}};
+    Bytes received;
+
+    Decoded send(const Bytes& wire) {
+        received.clear();
+        auto sink = [this](const std::uint8_t* p, std::size_t n) { received.insert(received.end(), p, p + n); };
+        for (std::uint8_t b : wire) {
+            server.on_byte(b, sink);
+        }
+        return decode_all(received);
+    }
+    template <typename M>
+    Decoded request(MessageType type, std::uint16_t seq, const M& m) {
+        std::uint8_t p[kMaxPayload];
+        const std::size_t n = encode(m, p);
+        return send(wire_frame(type, seq, Bytes(p, p + n)));
+    }
+};
+
+TEST(LinkServer, CorrectsLikeTheHostCoreBitForBit) {
+    const host::ModelFile mf = host::read_model_file(test::data_path("model_table2.csv"));
+    const ThermalModel<float> model = host::to_core<float>(mf);
+    Loop loop;
+    const Decoded hello = loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
+    ASSERT_EQ(hello.frames.size(), 1U);
+    Hello h{};
+    ASSERT_TRUE(decode(hello.payloads[0].data(), hello.payloads[0].size(), h));
+    EXPECT_EQ(h.boot_id, 0xC0FFEEU);
+    EXPECT_EQ(h.scalar_kind, WireTraits<float>::kKind);
+    std::uint16_t seq = 2;
+    for (std::uint8_t head = 0; head < 3; ++head) {
+        const Decoded a = loop.request(MessageType::kModelUpload, seq++, ModelUpload<float>{head, model.head[head]});
+        ASSERT_EQ(a.frames.size(), 1U);
+        Ack ack{};
+        ASSERT_TRUE(decode(a.payloads[0].data(), a.payloads[0].size(), ack));
+        EXPECT_EQ(ack.result, AckResult::kOk);
+    }
+    std::mt19937_64 rng(5);
+    for (int i = 0; i < 500; ++i) {
+        SolutionInput<float> in{};
+        const Eigen::Quaterniond q = test::random_attitude(rng);
+        in.q_chu_icrf = {static_cast<float>(q.w()), static_cast<float>(q.x()), static_cast<float>(q.y()),
+                         static_cast<float>(q.z())};
+        in.head = static_cast<std::uint8_t>(i % 4);  // head D has no model: status 256
+        in.temperatures = {{static_cast<float>(i % 40) - 10.0F, i % 17 != 0}, {-5.0F, true}, {-20.0F, true}};
+        const Eigen::Vector3d v = test::random_unit_vector(rng) * 1e-4;
+        in.velocity = {
+            {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())}, 1.0F, i % 11 != 0};
+        loop.request(MessageType::kVelocityUpdate, seq++, in.velocity);
+        loop.request(MessageType::kTemperatureUpdate, seq++, TemperatureUpdate<float>{in.head, in.temperatures});
+        const Decoded r = loop.request(MessageType::kSolutionIn, seq++,
+                                       SolutionIn<float>{static_cast<std::uint32_t>(i), in.head, in.q_chu_icrf});
+        ASSERT_EQ(r.frames.size(), 1U);
+        ASSERT_EQ(r.frames[0].type, static_cast<std::uint8_t>(MessageType::kSolutionOut));
+        SolutionOut<float> out{};
+        ASSERT_TRUE(decode(r.payloads[0].data(), r.payloads[0].size(), out));
+        const CorrectedSolution<float> want = correct_solution(in, CorrectionConfig<float>{true, &model});
+        EXPECT_EQ(out.id, static_cast<std::uint32_t>(i));
+        EXPECT_EQ(out.status, want.status);
+        EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &want.q_chu_icrf, sizeof want.q_chu_icrf), 0) << i;
+        EXPECT_EQ(out.instructions, 100U);
+    }
+}
+
+TEST(LinkServer, DuplicatesAreAnsweredFromCacheAndNotReapplied) {
+    Loop loop;
+    loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
+    const SolutionIn<float> s{7, 0, {1.0F, 0.0F, 0.0F, 0.0F}};
+    const Decoded first = loop.request(MessageType::kSolutionIn, 2, s);
+    const Decoded again = loop.request(MessageType::kSolutionIn, 2, s);
+    ASSERT_EQ(first.frames.size(), 1U);
+    ASSERT_EQ(again.frames.size(), 1U);
+    EXPECT_EQ(first.payloads[0], again.payloads[0]);
+    EXPECT_EQ(loop.server.duplicates(), 1U);
+    EXPECT_EQ(loop.server.solutions(), 1U);
+}
+
+TEST(LinkServer, BrokenFramesGetANakAndBadPayloadsAreRefused) {
+    Loop loop;
+    Bytes f = wire_frame(MessageType::kSolutionIn, 3, Bytes(21, 1));
+    f[4] ^= 0x10;
+    const Decoded nak = loop.send(f);
+    ASSERT_EQ(nak.frames.size(), 1U);
+    EXPECT_EQ(nak.frames[0].type, static_cast<std::uint8_t>(MessageType::kNak));
+    EXPECT_EQ(loop.server.frame_errors(), 1U);
+    // A well-framed request with a wrong payload: refused, never applied.
+    const Decoded bad = loop.send(wire_frame(MessageType::kModelUpload, 4, Bytes(10, 0)));
+    Ack ack{};
+    ASSERT_TRUE(decode(bad.payloads.at(0).data(), bad.payloads.at(0).size(), ack));
+    EXPECT_EQ(ack.result, AckResult::kBadPayload);
+    ModelUpload<float> m{};
+    m.head = 9;  // no such head
+    const Decoded bad_head = loop.request(MessageType::kModelUpload, 5, m);
+    ASSERT_TRUE(decode(bad_head.payloads.at(0).data(), bad_head.payloads.at(0).size(), ack));
+    EXPECT_EQ(ack.result, AckResult::kBadPayload);
+    const Decoded unknown = loop.send(wire_frame(static_cast<MessageType>(77), 6, {}));
+    ASSERT_TRUE(decode(unknown.payloads.at(0).data(), unknown.payloads.at(0).size(), ack));
+    EXPECT_EQ(ack.result, AckResult::kUnknownType);
+    // Temperatures with an undefined validity bit are refused.
+    Bytes t(14, 0);
+    t[1] = 8;
+    const Decoded bad_t = loop.send(wire_frame(MessageType::kTemperatureUpdate, 7, t));
+    ASSERT_TRUE(decode(bad_t.payloads.at(0).data(), bad_t.payloads.at(0).size(), ack));
+    EXPECT_EQ(ack.result, AckResult::kBadPayload);
+}
+
+}  // namespace
+}  // namespace ascorr::link
