@@ -14,6 +14,7 @@
 
 #include "ascorr/correct.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/input_error.hpp"
@@ -85,65 +86,6 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
                                              std::string(rec.chu) + "': thermal skipped");
     }
 }
-
-// Formats corrected rows: all fields verbatim but the quaternion, plus status.
-class RowWriter {
-public:
-    explicit RowWriter(const SolutionsReader& reader) : reader_(reader) {
-        const auto& c = reader.columns();
-        q_cols_ = {c.qw, c.qx, c.qy, c.qz};
-        status_col_ = reader.header().index("status");
-    }
-
-    std::string header_line() const {
-        std::string h;
-        const auto& names = reader_.header().names();
-        for (std::size_t i = 0; i < names.size(); ++i) {
-            h += (i == 0 ? "" : ",");
-            h += names[i];
-        }
-        h += status_col_ < 0 ? ",status\n" : "\n";
-        return h;
-    }
-
-    // Appends the row last read by `reader` (which must share this header).
-    void row(const SolutionsReader& reader, const std::optional<Quaternion<double>>& q, StatusBits st,
-             std::string& buf) const {
-        const auto& fields = reader.fields();
-        char num[64];
-        for (std::size_t i = 0; i < fields.size(); ++i) {
-            if (i != 0) {
-                buf += ',';
-            }
-            const int col = static_cast<int>(i);
-            if (col == status_col_) {
-                append_status(st, buf);
-            } else if (q && (col == q_cols_[0] || col == q_cols_[1] || col == q_cols_[2] || col == q_cols_[3])) {
-                const double v = col == q_cols_[0] ? q->w : col == q_cols_[1] ? q->x : col == q_cols_[2] ? q->y : q->z;
-                const char* end = format_fixed(num, num + sizeof num, v, 15);
-                buf.append(num, static_cast<std::size_t>(end - num));
-            } else {
-                buf.append(fields[i]);
-            }
-        }
-        if (status_col_ < 0) {
-            buf += ',';
-            append_status(st, buf);
-        }
-        buf += '\n';
-    }
-
-private:
-    static void append_status(StatusBits st, std::string& buf) {
-        char num[8];
-        const auto r = std::to_chars(num, num + sizeof num, static_cast<unsigned>(st));
-        buf.append(num, static_cast<std::size_t>(r.ptr - num));
-    }
-
-    const SolutionsReader& reader_;
-    std::array<int, 4> q_cols_{};
-    int status_col_ = -1;
-};
 
 // Diagnostics of one chunk, replayed in file order after the workers join.
 class DeferredDiagnostics {

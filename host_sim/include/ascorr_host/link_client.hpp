@@ -1,0 +1,256 @@
+// ascorr_host/link_client.hpp: the host end of the link (protocol v1).
+//
+// One request in flight. Each request keeps its sequence number across
+// retries, so the target can recognise a resend and answer from its cache.
+// An answer is accepted only if it decodes exactly, has the request's type
+// and sequence number and (for solutions) the request's id and head: a wrong
+// solution is never accepted. A HELLO carrying a new boot id means the target
+// restarted: the client uploads the model, velocity and temperatures it last
+// sent, then resends the request in flight.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/link_transport.hpp"
+#include "ascorr_link/frame.hpp"
+#include "ascorr_link/messages.hpp"
+
+namespace ascorr::host {
+
+struct LinkStats {
+    std::size_t requests = 0;
+    std::size_t retries = 0;
+    std::size_t timeouts = 0;
+    std::size_t naks = 0;            // target saw a broken frame (host → target corruption)
+    std::size_t broken_answers = 0;  // host saw a broken frame (target → host corruption)
+    std::size_t stale_answers = 0;   // well-formed answers to an earlier request (duplicates, late)
+    std::size_t restarts = 0;        // target restarts detected
+};
+
+class LinkError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+template <typename T>
+class LinkClient {
+public:
+    LinkClient(Transport& t, int timeout_ms, int max_attempts)
+        : transport_(t), timeout_ms_(timeout_ms), max_attempts_(max_attempts) {}
+
+    // Opens a session: HELLO_REQUEST, checks the protocol and scalar kind.
+    link::Hello connect() {
+        const auto p = transact(link::MessageType::kHelloRequest, {}, link::MessageType::kHello);
+        link::Hello h{};
+        link::decode(p.data(), p.size(), h);
+        if (h.protocol != link::kProtocolVersion) {
+            throw LinkError("target speaks link protocol " + std::to_string(h.protocol) + ", this host " +
+                            std::to_string(link::kProtocolVersion));
+        }
+        if (h.scalar_kind != link::WireTraits<T>::kKind) {
+            throw LinkError("target computes in scalar kind " + std::to_string(h.scalar_kind) + ", the host expected " +
+                            std::to_string(link::WireTraits<T>::kKind));
+        }
+        boot_id_ = h.boot_id;
+        return h;
+    }
+
+    void upload_model(const ThermalModel<T>& model) {
+        model_ = model;
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            send_model(h);
+        }
+    }
+
+    void set_velocity(const ObserverVelocity<T>& v) {
+        if (velocity_ && same(*velocity_, v)) {
+            return;
+        }
+        velocity_ = v;
+        send_velocity();
+    }
+
+    void set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t) {
+        if (head >= kMaxHeads) {
+            return;  // the target would refuse it; the solution itself carries the bad head
+        }
+        if (temperatures_[head] && same(*temperatures_[head], t)) {
+            return;
+        }
+        temperatures_[head] = t;
+        send_temperatures(head);
+    }
+
+    link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q) {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(link::SolutionIn<T>{id, head, q}, p);
+        for (;;) {
+            const auto a = transact(link::MessageType::kSolutionIn, {p, p + n}, link::MessageType::kSolutionOut);
+            link::SolutionOut<T> out{};
+            if (link::decode(a.data(), a.size(), out) && out.id == id && out.head == head) {
+                return out;
+            }
+            ++stats_.stale_answers;  // well framed but not ours: ask again
+            ++stats_.retries;
+        }
+    }
+
+    const LinkStats& stats() const { return stats_; }
+
+private:
+    // Byte equality: at worst (padding that differs) an update is sent twice.
+    template <typename A>
+    static bool same(const A& a, const A& b) {
+        return std::memcmp(&a, &b, sizeof a) == 0;
+    }
+
+    void send_model(std::uint8_t head) {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(link::ModelUpload<T>{head, model_->head[head]}, p);
+        expect_ok(transact(link::MessageType::kModelUpload, {p, p + n}, link::MessageType::kAck), "model upload");
+    }
+    void send_velocity() {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(*velocity_, p);
+        expect_ok(transact(link::MessageType::kVelocityUpdate, {p, p + n}, link::MessageType::kAck), "velocity update");
+    }
+    void send_temperatures(std::uint8_t head) {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(link::TemperatureUpdate<T>{head, *temperatures_[head]}, p);
+        expect_ok(transact(link::MessageType::kTemperatureUpdate, {p, p + n}, link::MessageType::kAck),
+                  "temperature update");
+    }
+
+    static void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
+        link::Ack a{};
+        if (!link::decode(p.data(), p.size(), a) || a.result != link::AckResult::kOk) {
+            throw LinkError(std::string(what) + " refused by the target (result " +
+                            std::to_string(static_cast<int>(a.result)) + ")");
+        }
+    }
+
+    // The target restarted: give it back everything it had.
+    void restore() {
+        if (restoring_) {
+            return;  // a restart during restore: the outer restore starts over
+        }
+        restoring_ = true;
+        ++stats_.restarts;
+        if (model_) {
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                send_model(h);
+            }
+        }
+        if (velocity_) {
+            send_velocity();
+        }
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            if (temperatures_[h]) {
+                send_temperatures(h);
+            }
+        }
+        restoring_ = false;
+    }
+
+    std::vector<std::uint8_t> transact(link::MessageType type, const std::vector<std::uint8_t>& payload,
+                                       link::MessageType answer) {
+        const std::uint16_t seq = ++seq_;
+        ++stats_.requests;
+        std::uint8_t wire[link::kMaxWire];
+        const std::size_t w =
+            link::encode_frame(static_cast<std::uint8_t>(type), seq, payload.data(), payload.size(), wire, sizeof wire);
+        for (int attempt = 0; attempt < max_attempts_; ++attempt) {
+            if (attempt > 0) {
+                ++stats_.retries;
+            }
+            transport_.write(wire, w);
+            bool restarted = false;
+            if (auto got = await(seq, answer, restarted)) {
+                return *got;
+            }
+            if (restarted) {
+                restore();
+                --attempt;  // a restart is not the request's failure
+            }
+        }
+        throw LinkError("no answer from the target after " + std::to_string(max_attempts_) + " attempts");
+    }
+
+    // Waits for the answer to seq; empty when it is time to resend.
+    std::optional<std::vector<std::uint8_t>> await(std::uint16_t seq, link::MessageType answer, bool& restarted) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms_);
+        std::uint8_t buf[256];
+        for (;;) {
+            // Read what is there even when the time is up: an answer that has
+            // arrived is never thrown away for a resend.
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+            const std::size_t n =
+                transport_.read(buf, sizeof buf, static_cast<int>(std::max<long long>(0, left.count())));
+            if (n == 0) {
+                ++stats_.timeouts;
+                return std::nullopt;
+            }
+            for (std::size_t i = 0; i < n; ++i) {
+                switch (decoder_.push(buf[i])) {
+                    case link::FrameDecoder::Event::kNone:
+                        break;
+                    case link::FrameDecoder::Event::kError:
+                        ++stats_.broken_answers;
+                        break;  // its answer may still follow intact; otherwise the time-out resends
+                    case link::FrameDecoder::Event::kFrame: {
+                        const link::Frame& f = decoder_.frame();
+                        const auto t = static_cast<link::MessageType>(f.type);
+                        if (t == link::MessageType::kNak) {
+                            ++stats_.naks;
+                            return std::nullopt;  // resend at once
+                        }
+                        if (t == link::MessageType::kHello && answer != link::MessageType::kHello) {
+                            link::Hello h{};
+                            if (link::decode(f.payload, f.length, h) && h.boot_id != boot_id_) {
+                                boot_id_ = h.boot_id;
+                                restarted = true;
+                                return std::nullopt;
+                            }
+                            break;
+                        }
+                        if (f.seq == seq && t == answer) {
+                            return std::vector<std::uint8_t>(f.payload, f.payload + f.length);
+                        }
+                        if (f.seq == seq && t == link::MessageType::kAck) {
+                            link::Ack a{};
+                            if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
+                                throw LinkError("request type " + std::to_string(static_cast<int>(answer)) +
+                                                " refused by the target (result " +
+                                                std::to_string(static_cast<int>(a.result)) + ")");
+                            }
+                        }
+                        ++stats_.stale_answers;
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    Transport& transport_;
+    int timeout_ms_;
+    int max_attempts_;
+    link::FrameDecoder decoder_;
+    std::uint16_t seq_ = 0;
+    std::uint32_t boot_id_ = 0;
+    bool restoring_ = false;
+    std::optional<ThermalModel<T>> model_;
+    std::optional<ObserverVelocity<T>> velocity_;
+    std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
+    LinkStats stats_;
+};
+
+}  // namespace ascorr::host

@@ -1,0 +1,44 @@
+// ascorr_host/replay.hpp: the `ascorr replay` job (hardware in the loop).
+//
+// Streams a recorded solutions file to a target over the link: the model once,
+// then per row the velocity and the head's temperatures (when they change) and
+// the solution. Every returned solution is compared with the host core in the
+// same scalar type (bit for bit) and with the double reference (in arcsec),
+// and written in the corrected-file format.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace ascorr::host {
+
+struct ReplayOptions {
+    std::string target;  // qemu-m4f, qemu-m3, loopback-float, or a serial device path
+    std::string in;
+    std::string model;
+    std::string out;
+    double inject_errors = 0.0;  // fraction of frames faulted, each direction
+    bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
+    int timeout_ms = 500;
+    int max_attempts = 20;
+    std::uint64_t seed = 1;
+    unsigned baud = 115200;
+};
+
+struct ReplaySummary {
+    std::size_t frames = 0;         // solutions sent
+    std::size_t returned = 0;       // corrected solutions accepted
+    std::size_t mismatches = 0;     // differ from the host core in the same scalar type
+    double max_error_arcsec = 0.0;  // against the double reference, over rows both correct
+    std::size_t crc_errors = 0;     // corrupted frames detected, both directions
+    std::size_t retries = 0;
+    double instructions_per_solution = 0.0;  // mean over solutions with both stages applied
+    std::size_t restarts = 0;
+    std::size_t injected = 0;
+};
+
+ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
+std::string to_json(const ReplaySummary& s);
+
+}  // namespace ascorr::host

@@ -1,0 +1,171 @@
+#include "ascorr_host/replay.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+#include <thread>
+
+#include "ascorr/correct.hpp"
+#include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/corrected_csv.hpp"
+#include "ascorr_host/csv.hpp"
+#include "ascorr_host/link_client.hpp"
+#include "ascorr_host/link_transport.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/solution_input.hpp"
+#include "ascorr_link/server.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+// Rotation angle between two attitudes, arcsec, from the vector part of a*⊗b.
+double angle_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) {
+    const Quaternion<double> d = conjugate(a) * b;
+    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z) / std::sqrt(squared_norm(d));
+    return 2.0 * std::asin(std::min(1.0, s)) * kRadToArcsec;
+}
+
+template <typename T>
+Quaternion<double> widen(const Quaternion<T>& q) {
+    const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
+    return {d(q.w), d(q.x), d(q.y), d(q.z)};
+}
+
+// The in-process target: the firmware's LinkServer behind a loopback.
+template <typename T>
+class LoopbackTarget {
+public:
+    struct NoCounter {
+        std::uint32_t operator()() const { return 0; }  // no instruction counter in process
+    };
+    LoopbackTarget()
+        : server_(0x4C4F4F50U, NoCounter{}),
+          transport_([this](const std::uint8_t* p, std::size_t n, const LoopbackTransport::Reply& reply) {
+              for (std::size_t i = 0; i < n; ++i) {
+                  server_.on_byte(p[i], reply);
+              }
+          }) {}
+    Transport& transport() { return transport_; }
+
+private:
+    link::LinkServer<T, NoCounter> server_;
+    LoopbackTransport transport_;
+};
+
+template <typename T>
+ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
+    const std::string text = read_text_file(opt.in);
+    SolutionsReader reader(opt.in, text);
+    const ModelFile mf = read_model_file(opt.model);
+    const ThermalModel<T> model_t = to_core<T>(mf);
+    const ThermalModel<double> model_d = to_core<double>(mf);
+
+    std::unique_ptr<FaultInjector> injector;
+    Transport* transport = &raw;
+    if (opt.inject_errors > 0.0) {
+        injector = std::make_unique<FaultInjector>(raw, opt.inject_errors, opt.seed);
+        transport = injector.get();
+    }
+    LinkClient<T> client(*transport, opt.timeout_ms, opt.max_attempts);
+    const link::Hello hello = client.connect();
+    log << "ascorr replay: target " << opt.target << " (boot id " << hello.boot_id << ", scalar kind "
+        << static_cast<int>(hello.scalar_kind) << ")\n";
+    client.upload_model(model_t);
+
+    const RowWriter writer(reader);
+    AtomicFile out(opt.out);
+    out.write(writer.header_line());
+    std::string buf;
+    ReplaySummary sum;
+    EarthVelocity earth;
+    SolutionRecord rec;
+    double instructions = 0.0;
+    std::size_t costed = 0;
+    const auto start = std::chrono::steady_clock::now();
+    double t0 = 0.0;
+    std::uint32_t id = 0;
+    while (reader.next(rec)) {
+        if (opt.realtime) {
+            if (id == 0) {
+                t0 = rec.t;
+            }
+            std::this_thread::sleep_until(start + std::chrono::duration<double>(rec.t - t0));
+        }
+        const SolutionInput<T> in = to_core_input<T>(rec, &earth);
+        client.set_velocity(in.velocity);
+        client.set_temperatures(in.head, in.temperatures);
+        ++sum.frames;
+        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf);
+        ++sum.returned;
+        const CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &model_t});
+        const CorrectedSolution<double> ref =
+            correct_solution(to_core_input<double>(rec, &earth), CorrectionConfig<double>{true, &model_d});
+        const bool same =
+            got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
+        if (!same) {
+            ++sum.mismatches;
+            if (sum.mismatches <= 20) {
+                log << opt.in << ":" << rec.line << ": the target's answer differs from the host core (status "
+                    << got.status << " vs " << host.status << ")\n";
+            }
+        }
+        if ((got.status & status::kRejected) == 0U && (ref.status & status::kRejected) == 0U) {
+            sum.max_error_arcsec = std::max(sum.max_error_arcsec, angle_arcsec(widen(got.q_chu_icrf), ref.q_chu_icrf));
+        }
+        if ((got.status & (status::kAberrationApplied | status::kThermalApplied)) ==
+            (status::kAberrationApplied | status::kThermalApplied)) {
+            instructions += got.instructions;
+            ++costed;
+        }
+        if ((got.status & status::kRejected) != 0U) {
+            writer.row(reader, std::nullopt, got.status, buf);
+        } else {
+            writer.row(reader, widen(got.q_chu_icrf), got.status, buf);
+        }
+        ++id;
+    }
+    out.write(buf);
+    out.commit();
+    const LinkStats& st = client.stats();
+    sum.crc_errors = st.naks + st.broken_answers;
+    sum.retries = st.retries;
+    sum.restarts = st.restarts;
+    sum.instructions_per_solution = costed == 0 ? 0.0 : instructions / static_cast<double>(costed);
+    if (injector) {
+        sum.injected = injector->to_target().total() + injector->to_host().total();
+    }
+    return sum;
+}
+
+}  // namespace
+
+ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    if (opt.target == "loopback-float") {
+        LoopbackTarget<float> target;
+        return run<float>(opt, target.transport(), log);
+    }
+    if (opt.target.rfind("/dev/", 0) == 0) {
+        SerialTransport serial(opt.target, opt.baud);
+        return run<float>(opt, serial, log);
+    }
+    throw std::runtime_error("--target " + opt.target +
+                             ": unknown target (loopback-float or a serial device such as /dev/ttyUSB0)");
+}
+
+std::string to_json(const ReplaySummary& s) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
+                  "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
+                  "\"injected_faults\": %zu}",
+                  s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
+                  s.instructions_per_solution, s.restarts, s.injected);
+    return buf;
+}
+
+}  // namespace ascorr::host
