@@ -78,33 +78,16 @@ private:
                 have_last_ = false;  // a new host session: its sequence numbers start afresh
                 send_hello(f.seq, sink);
                 return;
-            case MessageType::kModelUpload: {
-                ModelUpload<T> m{};
-                const bool ok = decode(f.payload, f.length, m);
-                if (ok) {
-                    model_.head[m.head] = m.model;
-                }
-                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+            case MessageType::kModelUpload:
+                update<ModelUpload<T>>(f, sink, [this](const ModelUpload<T>& m) { model_.head[m.head] = m.model; });
                 return;
-            }
-            case MessageType::kVelocityUpdate: {
-                ObserverVelocity<T> v{};
-                const bool ok = decode(f.payload, f.length, v);
-                if (ok) {
-                    velocity_ = v;
-                }
-                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+            case MessageType::kVelocityUpdate:
+                update<ObserverVelocity<T>>(f, sink, [this](const ObserverVelocity<T>& v) { velocity_ = v; });
                 return;
-            }
-            case MessageType::kTemperatureUpdate: {
-                TemperatureUpdate<T> t{};
-                const bool ok = decode(f.payload, f.length, t);
-                if (ok) {
-                    temperatures_[t.head] = t.temperatures;
-                }
-                ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+            case MessageType::kTemperatureUpdate:
+                update<TemperatureUpdate<T>>(
+                    f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
                 return;
-            }
             case MessageType::kSolutionIn: {
                 SolutionIn<T> s{};
                 if (!decode(f.payload, f.length, s)) {
@@ -132,6 +115,17 @@ private:
                 break;
         }
         ack(f.seq, AckResult::kUnknownType, sink);
+    }
+
+    // Decodes a state update, applies it only if it decoded exactly, and acks.
+    template <typename M, typename Sink, typename Apply>
+    void update(const Frame& f, Sink& sink, Apply apply) noexcept {
+        M m{};
+        const bool ok = decode(f.payload, f.length, m);
+        if (ok) {
+            apply(m);
+        }
+        ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
     }
 
     template <typename Sink>
