@@ -7,8 +7,9 @@
 //    HeadTemperatures<T> with valid = false for every withheld value, plus
 //    the fault bits of T1, T2, T3.
 //  - status_bits() maps the faults to the core's status bits: a withheld
-//    value gives kNoTemperature, with kStale if any withheld value is stale
-//    and kTemperatureInvalid if any has another fault. merge_status() adds
+//    value gives kNoTemperature, with kStale if it (or the triplet members
+//    it lacks) is stale and kTemperatureInvalid for any other fault, or for
+//    valid members that disagree (kNoQuorum alone). merge_status() adds
 //    them to a CorrectedSolution only where the core itself skipped the
 //    thermal stage for missing temperatures, so the bits never claim a skip
 //    that did not happen.
@@ -43,17 +44,24 @@ struct HeadAcquisition {
     FaultBits faults_029;
     FaultBits faults_032;
 
+    // kStale when a value is withheld because it (or the members it was
+    // voted from) is stale; kTemperatureInvalid for any other reason,
+    // including a triplet whose valid members disagree (kNoQuorum alone).
     StatusBits status_bits() const noexcept {
-        const FaultBits all = static_cast<FaultBits>(faults_chu | faults_029 | faults_032);
-        if (all == 0U) {
-            return 0U;
-        }
-        StatusBits s = status::kNoTemperature;
-        if ((all & fault::kStale) != 0U) {
-            s |= status::kStale;
-        }
-        if ((all & static_cast<FaultBits>(~fault::kStale)) != 0U) {
-            s |= status::kTemperatureInvalid;
+        const FaultBits f[3] = {faults_chu, faults_029, faults_032};
+        StatusBits s = 0U;
+        for (const FaultBits x : f) {
+            if (x == 0U) {
+                continue;
+            }
+            s |= status::kNoTemperature;
+            const FaultBits reasons = static_cast<FaultBits>(x & static_cast<FaultBits>(~fault::kNoQuorum));
+            if ((reasons & fault::kStale) != 0U) {
+                s |= status::kStale;
+            }
+            if (reasons == 0U || (reasons & static_cast<FaultBits>(~fault::kStale)) != 0U) {
+                s |= status::kTemperatureInvalid;
+            }
         }
         return s;
     }

@@ -4,8 +4,10 @@
 //  - A reading is usable only when its FaultBits are 0; any bit set means the
 //    value is withheld (valid = false) and the core skips the thermal stage.
 //  - Bits are independent and can combine (e.g. kOpen with kStuck is reported
-//    as both). kStale is the only bit that maps to the core's status::kStale;
-//    every other bit maps to status::kTemperatureInvalid (see acquisition.hpp).
+//    as both). kStale maps to the core's status::kStale, every other bit to
+//    status::kTemperatureInvalid; kNoQuorum carries its members' bits and
+//    maps through them (alone, it means disagreement: kTemperatureInvalid).
+//    See HeadAcquisition::status_bits() in acquisition.hpp.
 //  - Freestanding: no heap, no exceptions, no I/O.
 #pragma once
 
