@@ -144,12 +144,12 @@ void run(const ThermistorOptions& opt) {
             const hal::ChannelReading<double>& r = readings[i];
             const hal::ChannelConfig<double>& c = acfg.channel[i];
             const bool has_counts = !std::isnan(r.ohm);
-            print_row(out, r.t_us, c.name, hal::kRoleNames[static_cast<int>(c.role)], has_counts ? r.counts : -1,
-                      r.ohm, r.celsius, r.faults);
+            print_row(out, r.t_us, c.name, hal::kRoleNames[static_cast<int>(c.role)], has_counts ? r.counts : -1, r.ohm,
+                      r.celsius, r.faults);
         }
         const hal::HeadAcquisition<double> h = acq.head(head, now);
-        const hal::VotedTemperature<double> v[3] = {acq.role(hal::chu_role(head), now),
-                                                    acq.role(hal::Role::kT029, now), acq.role(hal::Role::kT032, now)};
+        const hal::VotedTemperature<double> v[3] = {acq.role(hal::chu_role(head), now), acq.role(hal::Role::kT029, now),
+                                                    acq.role(hal::Role::kT032, now)};
         const hal::FaultBits f[3] = {h.faults_chu, h.faults_029, h.faults_032};
         const char* names[3] = {"t_chu", "t_029", "t_032"};
         for (int k = 0; k < 3; ++k) {

@@ -34,17 +34,17 @@ struct Script {
 struct Call {
     enum Kind { kOpen, kGetLine, kRequest, kSet, kGet, kRelease } kind;
     unsigned offset;
-    int value;              // kSet: level, kGet: level returned, kRequest: default value
-    int request_type;       // kRequest
-    std::string consumer;   // kRequest; kOpen: device name
+    int value;             // kSet: level, kGet: level returned, kRequest: default value
+    int request_type;      // kRequest
+    std::string consumer;  // kRequest; kOpen: device name
 };
 
 struct Conversion {
     bool start;
     bool single_ended;
     unsigned channel;
-    unsigned rising_clocks;  // while CS was low, counted from the start bit
-    std::uint16_t served;    // counts the device shifted out
+    unsigned rising_clocks;       // while CS was low, counted from the start bit
+    std::uint16_t served;         // counts the device shifted out
     unsigned miso_reads_clk_low;  // DOUT read while CLK was low (a protocol error)
 };
 

@@ -32,8 +32,7 @@ inline hal::ChannelConfig<double> channel(const char* name, hal::Role role, std:
 // The Swarm layout: THT00029/57/87 (T2), THT00032/60/90 (T3), CHU A and B.
 inline hal::AcquisitionConfig<double> swarm_config() {
     hal::AcquisitionConfig<double> a{};
-    const char* names[8] = {"THT00029", "THT00057", "THT00087", "THT00032",
-                            "THT00060", "THT00090", "CHU_A",    "CHU_B"};
+    const char* names[8] = {"THT00029", "THT00057", "THT00087", "THT00032", "THT00060", "THT00090", "CHU_A", "CHU_B"};
     const hal::Role roles[8] = {hal::Role::kT029, hal::Role::kT029, hal::Role::kT029, hal::Role::kT032,
                                 hal::Role::kT032, hal::Role::kT032, hal::Role::kChuA, hal::Role::kChuB};
     for (std::uint8_t i = 0; i < 8; ++i) {

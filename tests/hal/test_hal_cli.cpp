@@ -61,7 +61,8 @@ TEST(HalConfigFile, ErrorsNameLineAndColumn) {
     EXPECT_EQ(config_error("channel name=T1 adc=0 role=t033 a=1 b=2 c=3\n"),
               "board.cfg:1:28: unknown role 't033' (monitor, chu_a, chu_b, chu_c, chu_d, t029, t032)");
     EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=1 b=2\n"), "board.cfg:1:1: channel: missing 'c'");
-    EXPECT_EQ(config_error("  chanel name=T1\n"), "board.cfg:1:3: unknown directive 'chanel' (acquisition, gpio, channel)");
+    EXPECT_EQ(config_error("  chanel name=T1\n"),
+              "board.cfg:1:3: unknown directive 'chanel' (acquisition, gpio, channel)");
     EXPECT_EQ(config_error(std::string(kChannel) + "gpio cs=8 clk=8\n"), "board.cfg:2:1: gpio: two signals on line 8");
     EXPECT_EQ(config_error(std::string(kChannel) + "gpio cs 8\n"), "board.cfg:2:6: expected key=value, got 'cs'");
     EXPECT_EQ(config_error(std::string(kChannel) + "channel name=T2 adc=0 role=t029 a=1 b=2 c=3\n"),
@@ -124,13 +125,11 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
         int at;  // frame index to look at
         hal::FaultBits want;
     };
-    const Case cases[] = {{"THT00057:open:110:120", 1, 12, fault::kOpen},
-                          {"THT00057:short:110:120", 1, 12, fault::kShort},
-                          {"THT00057:bus:110:120", 1, 12, fault::kBus},
-                          {"THT00057:offset:110:111:8", 1, 10, fault::kRate},
-                          {"THT00057:noise:110:120:200", 1, 12, fault::kNoisy},
-                          {"CHU_A:stuck:110:300", 6, 110, fault::kStuck},
-                          {"CHU_A:drop:110:300", 6, 20, fault::kStale}};
+    const Case cases[] = {
+        {"THT00057:open:110:120", 1, 12, fault::kOpen},       {"THT00057:short:110:120", 1, 12, fault::kShort},
+        {"THT00057:bus:110:120", 1, 12, fault::kBus},         {"THT00057:offset:110:111:8", 1, 10, fault::kRate},
+        {"THT00057:noise:110:120:200", 1, 12, fault::kNoisy}, {"CHU_A:stuck:110:300", 6, 110, fault::kStuck},
+        {"CHU_A:drop:110:300", 6, 20, fault::kStale}};
     for (const Case& k : cases) {
         hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
         hal::TemperatureAcquisition<double> acq(c);
@@ -166,16 +165,15 @@ std::string slurp(const fs::path& p) {
 }
 
 CliRun run(const std::string& args, const fs::path& dir) {
-    const std::string cmd = std::string(ASCORR_EXE) + " thermistors " + args + " > " + (dir / "out").string() +
-                            " 2> " + (dir / "err").string();
+    const std::string cmd = std::string(ASCORR_EXE) + " thermistors " + args + " > " + (dir / "out").string() + " 2> " +
+                            (dir / "err").string();
     const int rc = std::system(cmd.c_str());
     return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(dir / "out"), slurp(dir / "err")};
 }
 
 TEST(HalCli, ThermistorsOnAReplayFile) {
     const fs::path dir = scratch_dir("hal-cli");
-    const CliRun r =
-        run("--config " + kExamples + "/board.cfg --replay " + kExamples + "/replay.csv", dir);
+    const CliRun r = run("--config " + kExamples + "/board.cfg --replay " + kExamples + "/replay.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     std::istringstream in(r.out);
     std::vector<std::string> lines;
@@ -204,8 +202,8 @@ TEST(HalCli, ThermistorsSimulatesASolutionsFileWithAFault) {
         std::ofstream f(dir / "solutions.csv");
         f << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
         for (int k = 0; k < 30; ++k) {
-            f << 447534187 + k << ",A,1,0,0,0," << 3.2 + 0.01 * k << "," << -9.5 + 0.01 * k << ","
-              << -19.8 + 0.01 * k << ",,,,0,1.00\n";
+            f << 447534187 + k << ",A,1,0,0,0," << 3.2 + 0.01 * k << "," << -9.5 + 0.01 * k << "," << -19.8 + 0.01 * k
+              << ",,,,0,1.00\n";
         }
     }
     const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "solutions.csv").string() +

@@ -33,12 +33,11 @@ struct TableRow {
     double celsius;
     double ratio;
 };
-constexpr TableRow kType1[] = {
-    {-40, 33.36},  {-35, 24.11},  {-30, 17.61},  {-25, 12.99},  {-20, 9.681},  {-15, 7.281},   {-10, 5.525},
-    {-5, 4.229},   {0, 3.264},    {5, 2.539},    {10, 1.990},   {15, 1.571},   {20, 1.249},    {25, 1.0000},
-    {30, 0.8056},  {35, 0.6530},  {40, 0.5325},  {45, 0.4367},  {50, 0.3601},  {55, 0.2985},   {60, 0.2487},
-    {65, 0.2082},  {70, 0.1751},  {75, 0.1480},  {80, 0.1256},  {85, 0.1070},  {90, 0.09155},  {95, 0.07864},
-    {100, 0.06781}};
+constexpr TableRow kType1[] = {{-40, 33.36}, {-35, 24.11}, {-30, 17.61},  {-25, 12.99},  {-20, 9.681},  {-15, 7.281},
+                               {-10, 5.525}, {-5, 4.229},  {0, 3.264},    {5, 2.539},    {10, 1.990},   {15, 1.571},
+                               {20, 1.249},  {25, 1.0000}, {30, 0.8056},  {35, 0.6530},  {40, 0.5325},  {45, 0.4367},
+                               {50, 0.3601}, {55, 0.2985}, {60, 0.2487},  {65, 0.2082},  {70, 0.1751},  {75, 0.1480},
+                               {80, 0.1256}, {85, 0.1070}, {90, 0.09155}, {95, 0.07864}, {100, 0.06781}};
 
 // Steinhart–Hart coefficients through three table points (Cramer's rule).
 hal::SteinhartHart<double> fit_three(const TableRow& p, const TableRow& q, const TableRow& r, double r25) {
@@ -141,8 +140,9 @@ TEST(HalConversion, QuantisationErrorAndItsEffectInArcsec) {
             worst_arcsec = std::max(worst_arcsec, s);
         }
     }
-    std::printf("[measured] 12-bit quantisation -30..60 degC: %.4f degC (float adds %.1e); Table-2 effect <= %.3f arcsec\n",
-                worst, worst_float, worst_arcsec);
+    std::printf(
+        "[measured] 12-bit quantisation -30..60 degC: %.4f degC (float adds %.1e); Table-2 effect <= %.3f arcsec\n",
+        worst, worst_float, worst_arcsec);
     EXPECT_LT(worst_arcsec, 0.25);
 }
 
@@ -190,8 +190,8 @@ TEST(HalSampler, SettlesDiscardsFirstAndTakesTheMedian) {
     EXPECT_EQ(adc.calls, 10);
     EXPECT_EQ(adc.last_channel, 5U);
     EXPECT_EQ(clock.now_us(), 2000U + 8U * 100U);  // settle once, 8 gaps
-    EXPECT_EQ(r.counts, 2000U);                   // one glitch (3900) does not move the median
-    EXPECT_LE(r.spread, 3U);                      // nor the inner-half spread
+    EXPECT_EQ(r.counts, 2000U);                    // one glitch (3900) does not move the median
+    EXPECT_LE(r.spread, 3U);                       // nor the inner-half spread
     EXPECT_EQ(r.faults, 0U);
 }
 
@@ -383,8 +383,8 @@ TEST(HalFaults, StaleWhenOldOrWhenTimeDoesNotAdvance) {
     r.frame(kNominal);
     r.commit();
     const std::uint64_t t0 = r.t;
-    EXPECT_EQ(r.acq.channel(6, t0 + 5000000U).faults, 0U);              // 5 s: still fresh
-    EXPECT_EQ(r.acq.channel(6, t0 + 5000001U).faults, fault::kStale);   // older than stale_s
+    EXPECT_EQ(r.acq.channel(6, t0 + 5000000U).faults, 0U);             // 5 s: still fresh
+    EXPECT_EQ(r.acq.channel(6, t0 + 5000001U).faults, fault::kStale);  // older than stale_s
     const hal::HeadAcquisition<double> h = r.acq.head(0, t0 + 6000000U);
     EXPECT_EQ(h.faults_chu, fault::kStale);
     EXPECT_EQ(h.status_bits(), status::kNoTemperature | status::kStale);

@@ -4,9 +4,9 @@
 // whole path from ADC counts to a corrected attitude.
 #include <gtest/gtest.h>
 
-#include <gpiod.hpp>
 #include <cmath>
 #include <cstdio>
+#include <gpiod.hpp>
 #include <string>
 #include <system_error>
 
@@ -43,10 +43,10 @@ TEST(HalGpiod, RequestsTheFourLinesAsTheWiringSaysAndReleasesThem) {
             int type;
             int initial;
         };
-        const Expect want[4] = {{8, gpiod::line_request::DIRECTION_OUTPUT, 1},  // CS idle high
-                                {11, gpiod::line_request::DIRECTION_OUTPUT, 0}, // CLK idle low
-                                {10, gpiod::line_request::DIRECTION_OUTPUT, 0}, // MOSI
-                                {9, gpiod::line_request::DIRECTION_INPUT, 0}};  // MISO
+        const Expect want[4] = {{8, gpiod::line_request::DIRECTION_OUTPUT, 1},   // CS idle high
+                                {11, gpiod::line_request::DIRECTION_OUTPUT, 0},  // CLK idle low
+                                {10, gpiod::line_request::DIRECTION_OUTPUT, 0},  // MOSI
+                                {9, gpiod::line_request::DIRECTION_INPUT, 0}};   // MISO
         int found = 0;
         for (const Call& c : calls) {
             if (c.kind != Call::kRequest) {

@@ -32,11 +32,11 @@ namespace ascorr::hal {
 
 template <typename T>
 struct ChannelReading {
-    T celsius;            // NaN when no temperature could be computed
-    T ohm;                // NaN for replayed temperatures, 0/inf at the rails
-    std::uint16_t counts; // raw median, 0 for replayed temperatures
-    FaultBits faults;     // 0: valid
-    std::uint64_t t_us;   // time of the sample
+    T celsius;             // NaN when no temperature could be computed
+    T ohm;                 // NaN for replayed temperatures, 0/inf at the rails
+    std::uint16_t counts;  // raw median, 0 for replayed temperatures
+    FaultBits faults;      // 0: valid
+    std::uint64_t t_us;    // time of the sample
     bool valid() const noexcept { return faults == 0U; }
 };
 
@@ -57,7 +57,8 @@ public:
 
     // Processes one sample. A kNone sample keeps the previous reading (it ages
     // and turns stale); every other sample replaces it.
-    const ChannelReading<T>& update(const ChannelConfig<T>& cfg, const ChannelSample<T>& s, std::uint64_t t_us) noexcept {
+    const ChannelReading<T>& update(const ChannelConfig<T>& cfg, const ChannelSample<T>& s,
+                                    std::uint64_t t_us) noexcept {
         if (s.kind == SampleKind::kNone) {
             if (!have_reading_) {
                 last_.faults = static_cast<FaultBits>(fault::kNoData | s.faults);

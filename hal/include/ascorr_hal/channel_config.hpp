@@ -25,8 +25,7 @@ inline constexpr std::uint8_t kNameLength = 16;  // including the terminating NU
 
 enum class Role : std::uint8_t { kMonitor = 0, kChuA, kChuB, kChuC, kChuD, kT029, kT032 };
 inline constexpr std::uint8_t kRoleCount = 7;
-inline constexpr const char* kRoleNames[kRoleCount] = {"monitor", "chu_a", "chu_b", "chu_c",
-                                                       "chu_d",   "t029",  "t032"};
+inline constexpr const char* kRoleNames[kRoleCount] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
 
 constexpr Role chu_role(std::uint8_t head) noexcept {
     return static_cast<Role>(static_cast<std::uint8_t>(Role::kChuA) + head);
@@ -34,28 +33,28 @@ constexpr Role chu_role(std::uint8_t head) noexcept {
 
 template <typename T>
 struct ChannelConfig {
-    char name[kNameLength];     // e.g. "THT00029"
+    char name[kNameLength];  // e.g. "THT00029"
     Role role;
-    std::uint8_t adc_channel;   // 0 … 7
+    std::uint8_t adc_channel;  // 0 … 7
     Divider<T> divider;
     SteinhartHart<T> sh;
-    T r_open;                   // ohm: at or above, kOpen
-    T r_short;                  // ohm: at or below, kShort
-    T t_min;                    // °C: outside [t_min, t_max], kOutOfRange
+    T r_open;   // ohm: at or above, kOpen
+    T r_short;  // ohm: at or below, kShort
+    T t_min;    // °C: outside [t_min, t_max], kOutOfRange
     T t_max;
-    T max_rate;                 // °C/s, 0: no rate check
-    std::uint16_t stuck_frames; // identical raw values in a row for kStuck, 0: no check
-    std::uint16_t max_spread;   // counts: inner-half spread above this, kNoisy
+    T max_rate;                  // °C/s, 0: no rate check
+    std::uint16_t stuck_frames;  // identical raw values in a row for kStuck, 0: no check
+    std::uint16_t max_spread;    // counts: inner-half spread above this, kNoisy
 };
 
 template <typename T>
 struct AcquisitionConfig {
     ChannelConfig<T> channel[kMaxChannels];
-    std::uint8_t channels;     // how many of channel[] are used
+    std::uint8_t channels;  // how many of channel[] are used
     SamplerSettings sampler;
-    std::uint64_t stale_us;    // a reading older than this is withheld (kStale)
-    T vote_tolerance;          // °C: a member farther than this from the median is outvoted
-    std::uint8_t quorum;       // agreeing valid members a voted value needs (1 … 3)
+    std::uint64_t stale_us;  // a reading older than this is withheld (kStale)
+    T vote_tolerance;        // °C: a member farther than this from the median is outvoted
+    std::uint8_t quorum;     // agreeing valid members a voted value needs (1 … 3)
 };
 
 }  // namespace ascorr::hal

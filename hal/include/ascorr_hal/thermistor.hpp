@@ -30,9 +30,9 @@ struct SteinhartHart {
 
 template <typename T>
 struct Divider {
-    bool thermistor_low;  // true: thermistor between the ADC input and ground
-    T r_fixed;            // ohm
-    std::uint16_t levels; // 4096 for a 12-bit ADC
+    bool thermistor_low;   // true: thermistor between the ADC input and ground
+    T r_fixed;             // ohm
+    std::uint16_t levels;  // 4096 for a 12-bit ADC
 };
 
 inline constexpr double kZeroCelsiusK = 273.15;

@@ -29,11 +29,11 @@ inline constexpr std::uint8_t kMaxVoters = 3;
 
 template <typename T>
 struct VotedTemperature {
-    T celsius;                // NaN when not valid
-    FaultBits faults;         // 0: valid
-    std::uint64_t t_us;       // oldest sample used
-    std::uint8_t members;     // configured members
-    std::uint8_t agreeing;    // valid members that agree with the value
+    T celsius;              // NaN when not valid
+    FaultBits faults;       // 0: valid
+    std::uint64_t t_us;     // oldest sample used
+    std::uint8_t members;   // configured members
+    std::uint8_t agreeing;  // valid members that agree with the value
     bool valid() const noexcept { return faults == 0U; }
 };
 
@@ -55,9 +55,21 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
     if (nv == 3U) {
         // Sort the three indices by value.
         std::uint8_t a = valid[0], b = valid[1], c = valid[2], t = 0;
-        if (m[b].celsius < m[a].celsius) { t = a; a = b; b = t; }
-        if (m[c].celsius < m[b].celsius) { t = b; b = c; c = t; }
-        if (m[b].celsius < m[a].celsius) { t = a; a = b; b = t; }
+        if (m[b].celsius < m[a].celsius) {
+            t = a;
+            a = b;
+            b = t;
+        }
+        if (m[c].celsius < m[b].celsius) {
+            t = b;
+            b = c;
+            c = t;
+        }
+        if (m[b].celsius < m[a].celsius) {
+            t = a;
+            a = b;
+            b = t;
+        }
         const T med = m[b].celsius;
         out.celsius = med;
         out.agreeing = 1U;

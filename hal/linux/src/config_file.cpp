@@ -24,7 +24,9 @@ class LineParser {
 public:
     LineParser(const std::string& file, std::size_t line) : file_(file), line_(line) {}
 
-    [[noreturn]] void fail(std::size_t col, const std::string& what) const { throw ConfigError(file_, line_, col, what); }
+    [[noreturn]] void fail(std::size_t col, const std::string& what) const {
+        throw ConfigError(file_, line_, col, what);
+    }
 
     double number(const Token& t) const {
         double v = 0.0;
@@ -295,7 +297,13 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
                     p.fail(t.key_col, "unknown channel key '" + std::string(t.key) + "'");
                 }
             }
-            const char* missing = !has_name ? "name" : !has_adc ? "adc" : !has_role ? "role" : !has_a ? "a" : !has_b ? "b" : !has_c ? "c" : nullptr;
+            const char* missing = !has_name   ? "name"
+                                  : !has_adc  ? "adc"
+                                  : !has_role ? "role"
+                                  : !has_a    ? "a"
+                                  : !has_b    ? "b"
+                                  : !has_c    ? "c"
+                                              : nullptr;
             if (missing != nullptr) {
                 p.fail(directive_col, std::string("channel: missing '") + missing + "'");
             }

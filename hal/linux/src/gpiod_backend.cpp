@@ -31,14 +31,14 @@ struct GpiodPins::Lines {
 
 namespace {
 
-gpiod::line request(const gpiod::chip& chip, const std::string& chip_name, unsigned offset, const char* what,
-                    int type, int initial) {
+gpiod::line request(const gpiod::chip& chip, const std::string& chip_name, unsigned offset, const char* what, int type,
+                    int initial) {
     gpiod::line l = chip.get_line(offset);
     try {
         l.request({"ascorr", type, 0}, initial);
     } catch (const std::system_error& e) {
-        throw std::system_error(e.code(), chip_name + ": cannot request line " + std::to_string(offset) + " (" + what +
-                                              ")");
+        throw std::system_error(e.code(),
+                                chip_name + ": cannot request line " + std::to_string(offset) + " (" + what + ")");
     }
     return l;
 }

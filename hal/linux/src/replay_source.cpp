@@ -84,9 +84,9 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             break;
         }
         if (fields.size() != columns.size()) {
-            throw ConfigError(file, line_no, line.size() + 1,
-                              "expected " + std::to_string(columns.size()) + " fields, found " +
-                                  std::to_string(fields.size()));
+            throw ConfigError(
+                file, line_no, line.size() + 1,
+                "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
         }
         Frame<double> f{};
         for (std::size_t i = 0; i < columns.size(); ++i) {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 namespace ascorr::hal {
@@ -95,9 +95,12 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
         if (line_no == 1) {
             for (std::size_t i = 0; i < f.size(); ++i) {
                 const std::string_view n = f[i].first;
-                int* slot = n == "t" ? &col_t : n == "chu" ? &col_chu : n == "t_chu" ? &col_t1 : n == "t_029" ? &col_t2
-                                                                     : n == "t_032"   ? &col_t3
-                                                                                      : nullptr;
+                int* slot = n == "t"       ? &col_t
+                            : n == "chu"   ? &col_chu
+                            : n == "t_chu" ? &col_t1
+                            : n == "t_029" ? &col_t2
+                            : n == "t_032" ? &col_t3
+                                           : nullptr;
                 if (slot != nullptr) {
                     *slot = static_cast<int>(i);
                 }
@@ -115,7 +118,8 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
             throw ConfigError(file, line_no, line.size() + 1,
                               "expected " + std::to_string(ncols) + " fields, found " + std::to_string(f.size()));
         }
-        HistoryRow r{0.0, -1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+        HistoryRow r{0.0, -1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::quiet_NaN()};
         if (!parse_number(f[static_cast<std::size_t>(col_t)].first, r.t) || !std::isfinite(r.t) || r.t < 0.0) {
             throw ConfigError(file, line_no, f[static_cast<std::size_t>(col_t)].second, "'t' must be seconds >= 0");
         }
