@@ -116,6 +116,42 @@ TEST(SolutionsReader, ReaderMovesPastABadRow) {
     EXPECT_FALSE(r.next(rec));
 }
 
+// Blocks are whole lines, in order, with correct line numbers, whatever the
+// block size: lines longer than a block, no final line end, CRLF.
+TEST(BlockReader, WholeLinesAtAnyBlockSize) {
+    const auto dir = test::scratch_dir("blocks");
+    std::string text;
+    for (int i = 1; i <= 200; ++i) {
+        text += "line" + std::to_string(i) + std::string(static_cast<std::size_t>(i % 37), 'x') +
+                (i % 3 == 0 ? "\r\n" : "\n");
+    }
+    text += "last-without-newline";
+    const auto path = (dir / "f.txt").string();
+    std::ofstream(path, std::ios::binary) << text;
+    for (std::size_t block_bytes : {1U, 7U, 64U, 1000U, 1U << 20}) {
+        BlockReader r(path, block_bytes);
+        std::string joined;
+        std::string_view block;
+        std::size_t expected_lines_before = 0;
+        while (r.next(block)) {
+            EXPECT_EQ(r.lines_before(), expected_lines_before) << block_bytes;
+            EXPECT_TRUE(block.back() == '\n' || joined.size() + block.size() == text.size()) << block_bytes;
+            expected_lines_before += count_line_ends(block);
+            joined += block;
+        }
+        EXPECT_EQ(joined, text) << block_bytes;
+    }
+    std::ofstream(path, std::ios::binary) << std::string("a\nb\0c\n", 6);
+    BlockReader r(path, 1U << 20);
+    std::string_view block;
+    try {
+        r.next(block);
+        ADD_FAILURE() << "NUL byte not detected";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 2U);
+    }
+}
+
 TEST(Csv, NumbersAndFormatting) {
     EXPECT_EQ(*parse_double("1e-3"), 1e-3);
     EXPECT_EQ(*parse_double("+2.5"), 2.5);
