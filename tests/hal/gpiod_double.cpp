@@ -3,6 +3,7 @@
 
 #include <gpiod.hpp>
 #include <map>
+#include <stdexcept>
 #include <system_error>
 
 struct gpiod_chip {
@@ -105,7 +106,7 @@ void on_edge(unsigned offset, int old_level, int new_level) {
         if (s.n == 6) {
             s.dout = 0;  // null bit
         } else if (s.n >= 7 && s.n <= 18) {
-            s.dout = (s.value >> (18U - s.n)) & 1U;
+            s.dout = (static_cast<unsigned>(s.value) >> (18U - s.n)) & 1U;
         } else if (s.n > 18) {
             s.dout = 0;
         }
@@ -163,7 +164,7 @@ void chip::open(const ::std::string& device, int) {
 line chip::get_line(unsigned int offset) const {
     st().calls.push_back({Call::kGetLine, offset, 0, 0, ""});
     if (!_m_chip || offset >= st().script.num_lines || offset >= st().lines.size()) {
-        gpiod_double::fail("line offset out of range: " + std::to_string(offset));
+        throw std::out_of_range("line offset greater than the number of lines");  // as libgpiod 1.6 does
     }
     st().lines[offset].offset = offset;
     return line(&st().lines[offset], *this);

@@ -83,7 +83,22 @@ TEST(HalGpiod, MissingChipOrLineIsAnErrorNamingIt) {
     gpiod_double::reset({});
     w = board().gpio;
     w.miso = 40;  // the scripted chip has 32 lines
-    EXPECT_THROW(hal::GpiodPins pins(w), std::system_error);
+    try {
+        hal::GpiodPins pins(w);
+        FAIL() << "no exception";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("gpiochip0: line 40 (MISO)"), std::string::npos) << e.what();
+    }
+    gpiod_double::reset({});
+    {
+        hal::GpiodPins first(board().gpio);  // a second user of the same lines
+        try {
+            hal::GpiodPins second(board().gpio);
+            FAIL() << "no exception";
+        } catch (const std::system_error& e) {
+            EXPECT_NE(std::string(e.what()).find("gpiochip0: line 8 (CS)"), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(HalGpiod, ConversionBitStreamAsTheChipSeesIt) {

@@ -59,14 +59,13 @@ public:
             return false;
         }
         bool ok = pins_.set_clk(false) && pins_.set_cs(false);
-        const std::uint8_t command =
-            static_cast<std::uint8_t>(0x18U | channel);  // 1 1 D2 D1 D0: start, single-ended, channel
-        std::uint16_t value = 0;
+        const unsigned command = 0x18U | channel;  // 1 1 D2 D1 D0: start, single-ended, channel
+        unsigned value = 0;
         bool null_bit = true;
         for (int clk = 1; ok && clk <= kClocksPerConversion; ++clk) {
             ok = pins_.set_clk(false);
             if (ok && clk <= 5) {
-                ok = pins_.set_mosi(((command >> (5 - clk)) & 1U) != 0U);
+                ok = pins_.set_mosi(((command >> static_cast<unsigned>(5 - clk)) & 1U) != 0U);
             }
             wait();
             ok = ok && pins_.set_clk(true);
@@ -77,7 +76,7 @@ public:
             if (clk == 7) {
                 null_bit = bit;
             } else if (clk >= 8) {
-                value = static_cast<std::uint16_t>((value << 1U) | (bit ? 1U : 0U));
+                value = (value << 1U) | (bit ? 1U : 0U);
             }
             wait();
         }
@@ -86,7 +85,7 @@ public:
         const bool mosi_low = pins_.set_mosi(false);
         const bool deselected = pins_.set_cs(true);
         const bool released = clk_low && mosi_low && deselected;
-        counts = value;
+        counts = static_cast<std::uint16_t>(value & 0x0FFFU);
         return ok && released && !null_bit;
     }
 

@@ -4,6 +4,7 @@
 #include <time.h>
 
 #include <gpiod.hpp>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 
@@ -33,14 +34,16 @@ namespace {
 
 gpiod::line request(const gpiod::chip& chip, const std::string& chip_name, unsigned offset, const char* what, int type,
                     int initial) {
-    gpiod::line l = chip.get_line(offset);
+    const std::string where = chip_name + ": line " + std::to_string(offset) + " (" + what + ")";
     try {
+        gpiod::line l = chip.get_line(offset);
         l.request({"ascorr", type, 0}, initial);
+        return l;
     } catch (const std::system_error& e) {
-        throw std::system_error(e.code(),
-                                chip_name + ": cannot request line " + std::to_string(offset) + " (" + what + ")");
+        throw std::system_error(e.code(), "cannot request " + where);
+    } catch (const std::exception& e) {  // std::out_of_range: no such offset on this chip
+        throw std::runtime_error("cannot request " + where + ": " + e.what());
     }
-    return l;
 }
 
 bool put(const gpiod::line& l, bool level) noexcept {
