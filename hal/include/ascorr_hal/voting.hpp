@@ -74,7 +74,8 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
         out.celsius = med;
         out.agreeing = 1U;
         out.t_us = m[b].t_us;
-        for (std::uint8_t k : {a, c}) {
+        const std::uint8_t outer[2] = {a, c};
+        for (const std::uint8_t k : outer) {
             if (std::fabs(m[k].celsius - med) <= tolerance) {
                 ++out.agreeing;
                 out.t_us = m[k].t_us < out.t_us ? m[k].t_us : out.t_us;

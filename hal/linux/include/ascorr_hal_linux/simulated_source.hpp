@@ -85,6 +85,8 @@ class SimulatedSource final : public FrameSource<double> {
 public:
     SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
                     std::vector<InjectedFault> faults);
+    SimulatedSource(const SimulatedSource&) = delete;  // members refer to each other
+    SimulatedSource& operator=(const SimulatedSource&) = delete;
     bool acquire(Frame<double>& frame) noexcept override;
 
 private:
