@@ -6,7 +6,11 @@
 //      thermistor low  (r_fixed to Vref, thermistor to GND): x = Rt/(Rf + Rt)
 //      thermistor high (thermistor to Vref, r_fixed to GND): x = Rf/(Rf + Rt)
 //    with x = counts / levels the ideal transfer of an N-bit ADC whose
-//    reference is the divider's supply (ratiometric: Vref cancels).
+//    reference is the divider's supply (ratiometric: Vref cancels), first
+//    code transition at ½ LSB, so code k is centred on k·LSB (the inverse,
+//    counts_from_resistance, rounds to nearest). ADC offset and gain errors
+//    and the thermistor's self-heating are not modelled; calibrate them into
+//    r_fixed and the Steinhart–Hart coefficients if they matter.
 //  - Steinhart–Hart: 1/T = A + B·ln R + C·(ln R)³, T in kelvin, R in ohm.
 //  - Open and short circuits are judged on the resistance (r_open, r_short),
 //    so the same limits hold for either divider orientation; counts at a rail
