@@ -3,6 +3,8 @@
 
 #include <time.h>
 
+#include <cerrno>
+
 #include <gpiod.hpp>
 #include <stdexcept>
 #include <string>
@@ -18,7 +20,8 @@ std::uint64_t SteadyClock::now_us() noexcept {
 
 void SteadyClock::wait_us(std::uint32_t us) noexcept {
     timespec ts{static_cast<time_t>(us / 1000000U), static_cast<long>(us % 1000000U) * 1000L};
-    while (::nanosleep(&ts, &ts) != 0) {
+    // Resume after signals (EINTR) only; any other error ends the wait.
+    while (::nanosleep(&ts, &ts) != 0 && errno == EINTR) {
     }
 }
 
