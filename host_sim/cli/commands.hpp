@@ -10,5 +10,6 @@ namespace ascorr::cli {
 
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
+void add_thermistors_command(CLI::App& app);
 
 }  // namespace ascorr::cli

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     app.set_version_flag("--version", "ascorr 0.1.0");
     ascorr::cli::add_correct_command(app);
     ascorr::cli::add_replay_command(app);
+    ascorr::cli::add_thermistors_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,101 @@
+// ascorr_hal_linux/simulated_source.hpp: frames from temperature histories,
+// through a simulated MCP3208, with injectable faults.
+//
+// History: CSV with columns t (s), t_chu, t_029, t_032 and optionally chu
+// (A–D); other columns are ignored, so a solutions file (formats.md) is a
+// history. A row with chu = X sets the truth of the chu_x channels; without a
+// chu column t_chu sets every chu channel. t_029 and t_032 set every member of
+// their triplet. Empty/nan keeps the previous truth; a channel without truth
+// yet is not sampled.
+// Each row becomes one frame at t: the truth goes through the inverse
+// Steinhart–Hart and the divider into counts (SimulatedAdc), and the frame is
+// acquired by the same AdcFrameSource as on hardware (settle, samples,
+// median) on a ManualClock, so the whole conversion path runs.
+// Faults (--inject NAME:KIND:FROM:TO[:VALUE], times in the history's seconds,
+// active for FROM ≤ t < TO):
+//   open, short   the thermistor at R = ∞ or 0
+//   bus           the ADC does not answer on that input (conversion fails)
+//   stuck         the counts frozen at their value when the fault began
+//   offset        VALUE °C added to the truth (a drifting or spiking member)
+//   noise         ±VALUE counts of pseudo-random noise on every conversion
+//   drop          no sample at all (the reading ages and turns stale)
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ascorr_hal/clock.hpp"
+#include "ascorr_hal/frame.hpp"
+#include "ascorr_hal/mcp3208.hpp"
+#include "config_file.hpp"
+
+namespace ascorr::hal {
+
+enum class FaultKind : std::uint8_t { kOpen, kShort, kBus, kStuck, kOffset, kNoise, kDrop };
+
+struct InjectedFault {
+    int channel;  // index in the configuration
+    FaultKind kind;
+    double from_s;
+    double to_s;
+    double value;
+};
+
+// "NAME:KIND:FROM:TO[:VALUE]"; throws std::invalid_argument naming the part.
+InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>& config);
+
+struct HistoryRow {
+    double t;
+    int head;  // -1: applies to every head
+    double t_chu;
+    double t_029;
+    double t_032;
+};
+std::vector<HistoryRow> parse_history(const std::string& file_name, std::string_view text);
+std::vector<HistoryRow> read_history(const std::string& path);
+
+// An MCP3208 whose inputs are set from temperatures.
+class SimulatedAdc final : public AdcPort {
+public:
+    SimulatedAdc(const AcquisitionConfig<double>& config, Clock& clock) : config_(config), clock_(clock) {}
+    void set_truth(int channel, double celsius) { truth_[channel] = celsius; }
+    bool has_truth(int channel) const { return truth_[channel] == truth_[channel]; }
+    void set_faults(std::vector<InjectedFault> faults) { faults_ = std::move(faults); }
+    bool dropped(int channel) const;
+    bool convert(std::uint8_t adc_channel, std::uint16_t& counts) noexcept override;
+
+private:
+    bool active(const InjectedFault& f) const noexcept;
+    const AcquisitionConfig<double>& config_;
+    Clock& clock_;
+    double truth_[kMaxChannels] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                   std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    std::vector<InjectedFault> faults_;
+    bool frozen_valid_[kMaxChannels] = {};
+    std::uint16_t frozen_[kMaxChannels] = {};
+    std::uint32_t lcg_ = 12345U;
+};
+
+class SimulatedSource final : public FrameSource<double> {
+public:
+    SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
+                    std::vector<InjectedFault> faults);
+    SimulatedSource(const SimulatedSource&) = delete;  // members refer to each other
+    SimulatedSource& operator=(const SimulatedSource&) = delete;
+    bool acquire(Frame<double>& frame) noexcept override;
+
+private:
+    AcquisitionConfig<double> config_;
+    std::vector<HistoryRow> history_;
+    std::size_t next_ = 0;
+    ManualClock clock_;
+    SimulatedAdc adc_;
+    AdcFrameSource<double> source_;
+};
+
+}  // namespace ascorr::hal

@@ -1,0 +1,153 @@
+// Replay of recorded temperatures or counts (replay_source.hpp).
+#include "ascorr_hal_linux/replay_source.hpp"
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace ascorr::hal {
+namespace {
+
+struct Column {
+    int channel;  // -1: the time column
+    bool counts;
+};
+
+std::vector<std::pair<std::string_view, std::size_t>> split(std::string_view line) {
+    std::vector<std::pair<std::string_view, std::size_t>> out;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t c = line.find(',', start);
+        if (c == std::string_view::npos) {
+            out.emplace_back(line.substr(start), start + 1);
+            return out;
+        }
+        out.emplace_back(line.substr(start, c - start), start + 1);
+        start = c + 1;
+    }
+}
+
+}  // namespace
+
+ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
+    std::vector<Column> columns;
+    std::size_t pos = 0;
+    std::size_t line_no = 0;
+    bool header = true;
+    while (pos < text.size()) {
+        std::size_t end = text.find('\n', pos);
+        if (end == std::string_view::npos) {
+            end = text.size();
+        }
+        std::string_view line = text.substr(pos, end - pos);
+        pos = end + 1;
+        ++line_no;
+        if (!line.empty() && line.back() == '\r') {
+            line.remove_suffix(1);
+        }
+        const auto fields = split(line);
+        if (header) {
+            header = false;
+            bool have_t = false;
+            bool used[kMaxChannels] = {};
+            for (const auto& [name, col] : fields) {
+                if (name == "t") {
+                    if (have_t) {
+                        throw ConfigError(file, line_no, col, "column 't' appears twice");
+                    }
+                    have_t = true;
+                    columns.push_back({-1, false});
+                    continue;
+                }
+                const bool counts = name.size() > 7 && name.substr(name.size() - 7) == ".counts";
+                const std::string_view ch = counts ? name.substr(0, name.size() - 7) : name;
+                const int idx = find_channel(config, ch);
+                if (idx < 0) {
+                    throw ConfigError(file, line_no, col,
+                                      "column '" + std::string(name) + "' names no configured channel");
+                }
+                if (used[idx]) {
+                    throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
+                }
+                used[idx] = true;
+                columns.push_back({idx, counts});
+            }
+            if (!have_t) {
+                throw ConfigError(file, line_no, 1, "no column 't'");
+            }
+            continue;
+        }
+        if (line.empty() && pos >= text.size()) {
+            break;
+        }
+        if (fields.size() != columns.size()) {
+            throw ConfigError(
+                file, line_no, line.size() + 1,
+                "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
+        }
+        Frame<double> f{};
+        for (std::size_t i = 0; i < columns.size(); ++i) {
+            const auto& [v, col] = fields[i];
+            const Column& c = columns[i];
+            const char* b = v.data();
+            const char* e = b + v.size();
+            if (c.channel < 0) {
+                double t = 0.0;
+                const auto r = std::from_chars(b, e, t);
+                if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
+                    throw ConfigError(file, line_no, col, "'t' must be a number of seconds in [0, 1e12]");
+                }
+                f.t_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
+                continue;
+            }
+            ChannelSample<double>& s = f.channel[c.channel];
+            if (v.empty() || v == "nan") {
+                continue;  // kNone
+            }
+            if (c.counts) {
+                unsigned long n = 0;
+                const auto r = std::from_chars(b, e, n);
+                const unsigned long top = config.channel[c.channel].divider.levels - 1UL;
+                if (r.ec != std::errc() || r.ptr != e || n > top) {
+                    throw ConfigError(file, line_no, col,
+                                      "counts must be an integer in [0, " + std::to_string(top) + "]");
+                }
+                s = {SampleKind::kCounts, static_cast<std::uint16_t>(n), 0U, 0.0, 0U};
+            } else {
+                double x = 0.0;
+                const auto r = std::from_chars(b, e, x);
+                if (r.ec != std::errc() || r.ptr != e) {
+                    throw ConfigError(file, line_no, col, "not a temperature: '" + std::string(v) + "'");
+                }
+                s = {SampleKind::kCelsius, 0U, 0U, x, 0U};
+            }
+        }
+        frames_.push_back(f);
+    }
+    if (header) {
+        throw ConfigError(file, 1, 1, "empty file (no header)");
+    }
+}
+
+ReplaySource ReplaySource::from_file(const std::string& path, const AcquisitionConfig<double>& config) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+    }
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return ReplaySource(path, ss.str(), config);
+}
+
+bool ReplaySource::acquire(Frame<double>& frame) noexcept {
+    if (next_ >= frames_.size()) {
+        return false;
+    }
+    frame = frames_[next_++];
+    return true;
+}
+
+}  // namespace ascorr::hal

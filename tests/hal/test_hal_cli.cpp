@@ -1,0 +1,229 @@
+// The host side of the HAL: configuration, replay and history files (every
+// error at file:line:column), simulated faults, and `ascorr thermistors`
+// end to end on a replay file and a simulation.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ascorr_hal/acquisition.hpp"
+#include "ascorr_hal_linux/config_file.hpp"
+#include "ascorr_hal_linux/replay_source.hpp"
+#include "ascorr_hal_linux/simulated_source.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+namespace fault = hal::fault;
+
+const std::string kExamples = ASCORR_HAL_EXAMPLES;
+
+std::string config_error(const std::string& text) {
+    try {
+        hal::parse_config("board.cfg", text);
+    } catch (const hal::ConfigError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+const char* kChannel = "channel name=T1 adc=0 role=t029 a=1.129241e-3 b=2.341077e-4 c=8.775468e-8\n";
+
+TEST(HalConfigFile, ExampleParses) {
+    const hal::HalConfig c = hal::read_config(kExamples + "/board.cfg");
+    EXPECT_EQ(c.acquisition.channels, 8U);
+    EXPECT_EQ(c.acquisition.sampler.samples, 9U);
+    EXPECT_EQ(c.acquisition.sampler.settle_us, 2000U);
+    EXPECT_EQ(c.acquisition.stale_us, 5000000U);
+    EXPECT_EQ(c.gpio.chip, "gpiochip0");
+    EXPECT_EQ(c.gpio.miso, 9U);
+    EXPECT_EQ(std::string(c.acquisition.channel[1].name), "THT00057");
+    EXPECT_EQ(c.acquisition.channel[1].role, hal::Role::kT029);
+    EXPECT_EQ(c.acquisition.channel[6].role, hal::Role::kChuA);
+    EXPECT_DOUBLE_EQ(c.acquisition.channel[0].sh.c, 8.775468e-8);
+    EXPECT_EQ(c.acquisition.channel[0].stuck_frames, 60U);
+}
+
+TEST(HalConfigFile, ErrorsNameLineAndColumn) {
+    EXPECT_EQ(config_error(std::string("# x\n") + kChannel + "channel name=T1 adc=1 role=t029 a=1 b=2 c=3\n"),
+              "board.cfg:3:14: channel 'T1' defined twice");
+    EXPECT_EQ(config_error(std::string(kChannel) + "acquisition samples=40\n"),
+              "board.cfg:2:21: 'samples': expected an integer in [1, 16], got '40'");
+    EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=x b=2 c=3\n"),
+              "board.cfg:1:35: 'a': not a finite number: 'x'");
+    EXPECT_EQ(config_error("channel name=T1 adc=0 role=t033 a=1 b=2 c=3\n"),
+              "board.cfg:1:28: unknown role 't033' (monitor, chu_a, chu_b, chu_c, chu_d, t029, t032)");
+    EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=1 b=2\n"), "board.cfg:1:1: channel: missing 'c'");
+    EXPECT_EQ(config_error("  chanel name=T1\n"),
+              "board.cfg:1:3: unknown directive 'chanel' (acquisition, gpio, channel)");
+    EXPECT_EQ(config_error(std::string(kChannel) + "gpio cs=8 clk=8\n"), "board.cfg:2:1: gpio: two signals on line 8");
+    EXPECT_EQ(config_error(std::string(kChannel) + "gpio cs 8\n"), "board.cfg:2:6: expected key=value, got 'cs'");
+    EXPECT_EQ(config_error(std::string(kChannel) + "channel name=T2 adc=0 role=t029 a=1 b=2 c=3\n"),
+              "board.cfg:2:21: ADC input 0 already used by 'T1'");
+    EXPECT_EQ(config_error("# nothing\n"), "board.cfg:2:1: no 'channel' line");
+    EXPECT_EQ(config_error(std::string(kChannel) + "channel name=T2 adc=1 role=t029 a=1 b=2 c=3 colour=red\n"),
+              "board.cfg:2:45: unknown channel key 'colour'");
+}
+
+TEST(HalReplay, ErrorsNameLineAndColumn) {
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    const auto err = [&](const std::string& text) {
+        try {
+            hal::ReplaySource("r.csv", text, c);
+        } catch (const hal::ConfigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(err("t,THT00029,NOPE\n"), "r.csv:1:12: column 'NOPE' names no configured channel");
+    EXPECT_EQ(err("t,THT00029,THT00029.counts\n"), "r.csv:1:12: channel 'THT00029' recorded twice");
+    EXPECT_EQ(err("THT00029\n1\n"), "r.csv:1:1: no column 't'");
+    EXPECT_EQ(err("t,THT00029.counts\n1,4096\n"), "r.csv:2:3: counts must be an integer in [0, 4095]");
+    EXPECT_EQ(err("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
+    EXPECT_EQ(err("t,THT00029\n-1,3\n"), "r.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
+    EXPECT_EQ(err("t,THT00029\n1,3,4\n"), "r.csv:2:6: expected 2 fields, found 3");
+    EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).frames(), 2U);
+}
+
+TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    const hal::InjectedFault f = hal::parse_fault("THT00057:offset:10:20:5.5", c);
+    EXPECT_EQ(f.channel, 1);
+    EXPECT_EQ(f.kind, hal::FaultKind::kOffset);
+    EXPECT_EQ(f.value, 5.5);
+    EXPECT_THROW(hal::parse_fault("THT00057:melt:10:20", c), std::invalid_argument);
+    EXPECT_THROW(hal::parse_fault("NOPE:open:10:20", c), std::invalid_argument);
+    EXPECT_THROW(hal::parse_fault("THT00057:open:20:10", c), std::invalid_argument);
+    EXPECT_THROW(hal::parse_fault("THT00057:offset:10:20", c), std::invalid_argument);
+    EXPECT_THROW(hal::parse_fault("THT00057:open:10:20:1", c), std::invalid_argument);
+    try {
+        hal::parse_history("h.csv", "t,t_chu,t_029,t_032,chu\n1,2,3,4,E\n");
+        FAIL();
+    } catch (const hal::ConfigError& e) {
+        EXPECT_STREQ(e.what(), "h.csv:2:9: 'chu' must be A, B, C or D");
+    }
+    EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
+}
+
+// Each injected fault class reaches the acquisition as its flag.
+TEST(HalSimulated, InjectedFaultsAreDetected) {
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    std::vector<hal::HistoryRow> h;
+    for (int k = 0; k < 120; ++k) {
+        h.push_back({100.0 + k, -1, 3.2 + 0.001 * k, -9.5, -19.8});
+    }
+    struct Case {
+        const char* spec;
+        int channel;
+        int at;  // frame index to look at
+        hal::FaultBits want;
+    };
+    const Case cases[] = {
+        {"THT00057:open:110:120", 1, 12, fault::kOpen},       {"THT00057:short:110:120", 1, 12, fault::kShort},
+        {"THT00057:bus:110:120", 1, 12, fault::kBus},         {"THT00057:offset:110:111:8", 1, 10, fault::kRate},
+        {"THT00057:noise:110:120:200", 1, 12, fault::kNoisy}, {"CHU_A:stuck:110:300", 6, 110, fault::kStuck},
+        {"CHU_A:drop:110:300", 6, 20, fault::kStale}};
+    for (const Case& k : cases) {
+        hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
+        hal::TemperatureAcquisition<double> acq(c);
+        hal::Frame<double> f{};
+        for (int i = 0; i <= k.at; ++i) {
+            ASSERT_TRUE(src.acquire(f));
+            acq.update(f);
+        }
+        const hal::ChannelReading<double> r = acq.channel(static_cast<std::uint8_t>(k.channel), f.t_us);
+        EXPECT_EQ(r.faults & k.want, k.want) << k.spec << " got " << r.faults;
+        // Before the fault window the same channel was fine.
+        hal::SimulatedSource clean(c, h, {});
+        hal::TemperatureAcquisition<double> acq2(c);
+        for (int i = 0; i <= k.at; ++i) {
+            ASSERT_TRUE(clean.acquire(f));
+            acq2.update(f);
+        }
+        EXPECT_EQ(acq2.channel(static_cast<std::uint8_t>(k.channel), f.t_us).faults, 0U) << k.spec;
+    }
+}
+
+struct CliRun {
+    int exit_code;
+    std::string out;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+CliRun run(const std::string& args, const fs::path& dir) {
+    const std::string cmd = std::string(ASCORR_EXE) + " thermistors " + args + " > " + (dir / "out").string() + " 2> " +
+                            (dir / "err").string();
+    const int rc = std::system(cmd.c_str());
+    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(dir / "out"), slurp(dir / "err")};
+}
+
+TEST(HalCli, ThermistorsOnAReplayFile) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const CliRun r = run("--config " + kExamples + "/board.cfg --replay " + kExamples + "/replay.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::istringstream in(r.out);
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) {
+        lines.push_back(l);
+    }
+    ASSERT_EQ(lines.size(), 1U + 4U * 11U);
+    EXPECT_EQ(lines[0], "t,name,role,counts,ohm,celsius,valid,faults");
+    EXPECT_EQ(lines[1], "100.000000,THT00029,t029,,,-9.500,1,");
+    EXPECT_EQ(lines[10], "100.000000,t_029,voted,,,-9.500,1,");
+    // Frame 3 (t = 102): THT00057 jumps 6.5 °C (rate, then outvoted), THT00060 open.
+    EXPECT_EQ(lines[24], "102.000000,THT00057,t029,,,-3.000,0,rate");
+    EXPECT_EQ(lines[27], "102.000000,THT00060,t032,4095,40950000.0,,0,open");
+    EXPECT_EQ(lines[32], "102.000000,t_029,voted,,,-9.490,1,");
+    // Frame 4: THT00090 shorted too: T3 withheld; CHU_A kept from t = 102.
+    EXPECT_EQ(lines[39], "103.000000,THT00090,t032,0,0.0,,0,short");
+    EXPECT_EQ(lines[40], "102.000000,CHU_A,chu_a,,,3.220,1,");
+    EXPECT_EQ(lines[44], "103.000000,t_032,voted,,,,0,open|short|no_quorum");
+    EXPECT_NE(r.err.find("4 frames, 1 voted values withheld"), std::string::npos) << r.err;
+}
+
+TEST(HalCli, ThermistorsSimulatesASolutionsFileWithAFault) {
+    const fs::path dir = scratch_dir("hal-cli");
+    // A solutions-format file, one solution of head A per second, slowly warming.
+    {
+        std::ofstream f(dir / "solutions.csv");
+        f << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+        for (int k = 0; k < 30; ++k) {
+            f << 447534187 + k << ",A,1,0,0,0," << 3.2 + 0.01 * k << "," << -9.5 + 0.01 * k << "," << -19.8 + 0.01 * k
+              << ",,,,0,1.00\n";
+        }
+    }
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "solutions.csv").string() +
+                             " --inject THT00029:open:0:1e12 --inject THT00060:bus:0:1e12",
+                         dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find(",THT00029,t029,4095,40950000.0,,0,open\n"), std::string::npos);
+    EXPECT_NE(r.out.find(",THT00060,t032,,,,0,bus\n"), std::string::npos);
+    EXPECT_EQ(r.out.find(",voted,,,,0,"), std::string::npos) << r.out;  // two of three still agree
+    EXPECT_NE(r.out.find("447534216.000000,t_029,voted,,,-9.2"), std::string::npos) << r.out;
+    EXPECT_NE(r.err.find("30 frames, 0 voted values withheld"), std::string::npos) << r.err;
+}
+
+TEST(HalCli, BadConfigExitsOneWithLocation) {
+    const fs::path dir = scratch_dir("hal-cli");
+    std::ofstream(dir / "bad.cfg") << "channel name=X adc=9 role=t029 a=1 b=2 c=3\n";
+    const CliRun r = run("--config " + (dir / "bad.cfg").string() + " --replay " + kExamples + "/replay.csv", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("bad.cfg:1:20: 'adc': expected an integer in [0, 7], got '9'"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace ascorr::test

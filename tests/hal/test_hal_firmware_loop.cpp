@@ -1,0 +1,164 @@
+// The firmware loop's use of the HAL, on the host: float scalar, an ADC
+// behind the AdcPort interface, acquisition at 1 Hz, a correction for every
+// solution at 22 Hz on a ManualClock, faults and a stalled acquisition in the
+// middle; with global operator new counted to prove the loop never allocates.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+
+#include "ascorr/ascorr.hpp"
+#include "ascorr_hal/acquisition.hpp"
+#include "hal_support.hpp"
+
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
+namespace {
+std::atomic<long> g_allocations{0};
+std::atomic<bool> g_armed{false};
+}  // namespace
+
+void* operator new(std::size_t n) {
+    if (g_armed.load()) {
+        ++g_allocations;
+    }
+    if (void* p = std::malloc(n == 0 ? 1 : n)) {
+        return p;
+    }
+    throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+    return operator new(n);
+}
+void operator delete(void* p) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p) noexcept {
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    std::free(p);
+}
+void operator delete[](void* p, std::size_t) noexcept {
+    std::free(p);
+}
+
+namespace ascorr::test {
+namespace {
+
+// An MCP3208 as the firmware sees it through AdcPort: counts from the
+// temperatures of the boom, with faults switched by the test.
+class BoomAdc final : public hal::AdcPort {
+public:
+    explicit BoomAdc(const hal::AcquisitionConfig<float>& c) : cfg_(c) {}
+    float celsius[8] = {-9.5F, -9.45F, -9.55F, -19.8F, -19.75F, -19.85F, 3.2F, 15.8F};
+    bool open[8] = {};
+    unsigned dither = 0;
+    bool convert(std::uint8_t ch, std::uint16_t& counts) noexcept override {
+        const hal::ChannelConfig<float>& c = cfg_.channel[ch];
+        if (open[ch]) {
+            counts = 4095U;
+            return true;
+        }
+        const std::uint16_t n = hal::counts_from_resistance(c.divider, hal::resistance_from_celsius(c.sh, celsius[ch]));
+        counts = static_cast<std::uint16_t>(n + (dither++ % 2U));  // one LSB of noise
+        return true;
+    }
+
+private:
+    const hal::AcquisitionConfig<float>& cfg_;
+};
+
+hal::AcquisitionConfig<float> float_config() {
+    const hal::AcquisitionConfig<double> d = swarm_config();
+    hal::AcquisitionConfig<float> f{};
+    for (std::uint8_t i = 0; i < d.channels; ++i) {
+        const hal::ChannelConfig<double>& a = d.channel[i];
+        hal::ChannelConfig<float>& b = f.channel[i];
+        std::copy(a.name, a.name + hal::kNameLength, b.name);
+        b.role = a.role;
+        b.adc_channel = a.adc_channel;
+        b.divider = {a.divider.thermistor_low, static_cast<float>(a.divider.r_fixed), a.divider.levels};
+        b.sh = {static_cast<float>(a.sh.a), static_cast<float>(a.sh.b), static_cast<float>(a.sh.c)};
+        b.r_open = static_cast<float>(a.r_open);
+        b.r_short = static_cast<float>(a.r_short);
+        b.t_min = static_cast<float>(a.t_min);
+        b.t_max = static_cast<float>(a.t_max);
+        b.max_rate = static_cast<float>(a.max_rate);
+        b.stuck_frames = 30U;
+        b.max_spread = a.max_spread;
+    }
+    f.channels = d.channels;
+    f.sampler = d.sampler;
+    f.stale_us = d.stale_us;
+    f.vote_tolerance = 1.0F;
+    f.quorum = 2U;
+    return f;
+}
+
+TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
+    const hal::AcquisitionConfig<float> cfg = float_config();
+    BoomAdc adc(cfg);
+    hal::ManualClock clock(0);
+    hal::AdcFrameSource<float> source(adc, clock, cfg);
+    hal::TemperatureAcquisition<float> acq(cfg);
+
+    ThermalModel<float> model{};
+    model.head[0].present = true;
+    model.head[0].gamma.c1 = 1e-5F;  // any model: the test is about validity
+    const CorrectionConfig<float> ccfg{false, &model};
+    SolutionInput<float> in{{1.0F, 0.0F, 0.0F, 0.0F}, 0U, {}, {{0.0F, 0.0F, 0.0F}, 1.0F, false}};
+
+    // Per second of the run: how many of its 22 solutions had the thermal
+    // correction applied, and the status of the last one.
+    constexpr int kSeconds = 60;
+    int applied[kSeconds] = {};
+    StatusBits last_status[kSeconds] = {};
+
+    g_allocations = 0;
+    g_armed = true;
+    for (int s = 0; s < kSeconds; ++s) {
+        // Scenario: THT00029 and THT00087 open from 20 s to 25 s (no quorum);
+        // the acquisition task stalls from 40 s to 50 s (stale after 5 s).
+        adc.open[0] = adc.open[2] = s >= 20 && s < 25;
+        const std::uint64_t second = static_cast<std::uint64_t>(s) * 1000000U;
+        if (clock.now_us() < second) {
+            clock.advance_us(second - clock.now_us());
+        }
+        if (s < 40 || s >= 50) {
+            acq.poll(source);  // the 1 Hz task
+        }
+        for (int k = 0; k < 22; ++k) {  // the solution task
+            const std::uint64_t t = second + 100000U + static_cast<std::uint64_t>(k) * 40000U;
+            if (clock.now_us() < t) {
+                clock.advance_us(t - clock.now_us());
+            }
+            const hal::HeadAcquisition<float> h = acq.head(0U, clock.now_us());
+            in.temperatures = h.temperatures;
+            CorrectedSolution<float> out = correct_solution(in, ccfg);
+            out.status = hal::merge_status(out.status, h);
+            applied[s] += (out.status & status::kThermalApplied) != 0U ? 1 : 0;
+            last_status[s] = out.status;
+        }
+    }
+    g_armed = false;
+    EXPECT_EQ(g_allocations.load(), 0);
+
+    for (int s = 0; s < kSeconds; ++s) {
+        if (s >= 20 && s < 25) {
+            EXPECT_EQ(applied[s], 0) << s;
+            EXPECT_EQ(last_status[s], status::kNoTemperature | status::kTemperatureInvalid) << s;
+        } else if (s >= 44 && s < 50) {  // last frame at 39.0 s: stale from 44.0 s on
+            EXPECT_EQ(applied[s], 0) << s;
+            EXPECT_EQ(last_status[s], status::kNoTemperature | status::kStale) << s;
+        } else {
+            EXPECT_EQ(applied[s], 22) << s;
+            EXPECT_EQ(last_status[s], status::kThermalApplied) << s;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace ascorr::test
