@@ -36,9 +36,9 @@ struct AxisPolynomial {
     Coefficient<T> c1;
     Coefficient<T> c2;
     Coefficient<T> c3;
-    Coefficient<T> c1_2;
-    Coefficient<T> c2_2;
-    Coefficient<T> c3_2;
+    QuadraticCoefficient<T> c1_2;
+    QuadraticCoefficient<T> c2_2;
+    QuadraticCoefficient<T> c3_2;
 };
 
 template <typename T>

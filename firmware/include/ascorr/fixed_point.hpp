@@ -1,0 +1,267 @@
+// ascorr/fixed_point.hpp: the fixed-point scalar of the core (DPU without FPU).
+//
+// Conventions (CMSIS style: every format states range, scaling, rounding and
+// saturation; 32-bit storage, 64-bit intermediates, no floating point at run
+// time; the double conversions are for constants folded at compile time and for
+// the host):
+//
+//  Q30 (the scalar T): signed Q1.30 ("Q2.30" in ARM's count), value = raw·2⁻³⁰,
+//    range [−2, 2 − 2⁻³⁰], resolution 9.3e-10 (1.9e-4" as an angle in rad).
+//    Holds unit quaternions and vectors, β = v/c, angles in radians, and the
+//    small terms the core forms from them. ±2 is the range a sum of unit terms
+//    needs (the core never doubles by multiplying with 2, see boresight()).
+//      a + b, a − b, −a : exact when the result is in range, else saturated to
+//                         the nearest end of the range (never wraps).
+//      a · b            : 64-bit product (exact, |a·b| ≤ 2⁶²), rounded to the
+//                         nearest Q30 (ties towards +∞: + 2²⁹, arithmetic shift
+//                         right by 30), saturated.  Error ≤ 2⁻³¹.
+//      comparisons      : exact.
+//  QCelsius (temperatures): signed Q11.20, value = raw·2⁻²⁰ °C, range ±2048 °C,
+//    resolution 9.5e-7 °C. The core accepts ±200 °C (temperature_in_domain), so
+//    a difference of two readings (≤ 400 °C) has |raw| < 2²⁹.
+//  QCoefficient (thermal-model coefficients, rad, rad/°C, rad/°C²): signed,
+//    value = raw·2⁻³⁶, range ±2⁻⁵ = ±0.03125 (±6445"), resolution 1.5e-11
+//    (3e-6"). Model coefficients are below 1e-3 rad (c0) and 1e-5 rad/°C (the
+//    paper's Table 2: 2e-3 to 5"/°C), so the format has 5 bits of headroom above
+//    c0 and resolves a linear coefficient to 1e-6 relative. Q1.30 would resolve
+//    1e-6 rad/°C to only 1e-3 relative, hence the extra fractional bits.
+//  QQuadraticCoefficient (rad/°C²): signed, value = raw·2⁻⁴⁸, range ±2⁻¹⁷
+//    = ±7.6e-6 rad/°C² (±1.57"/°C²), resolution 3.6e-15 rad/°C²: at the
+//    largest temperature difference (400 °C, T² = 1.6e5) one LSB is 1.2e-4".
+//    Quadratic coefficients are 1e3–1e4 times smaller than linear ones; in the
+//    linear format a 0.01"/°C² coefficient would carry a 0.03" error at 100 °C.
+//
+//  Conversions from double (ScalarTraits<Q30>::from_double, celsius,
+//  coefficient) round to nearest (ties away from zero) and saturate; NaN maps
+//  to the positive end of the range, so that a non-finite input lands outside
+//  every domain check of the core and is flagged exactly as it would be in
+//  floating point (is_finite() is always true for a fixed-point value).
+#pragma once
+
+#include <cstdint>
+
+#include "scalar_traits.hpp"
+#include "thermal.hpp"
+
+namespace ascorr {
+
+namespace fx {
+
+inline constexpr std::int32_t kRawMax = INT32_MAX;
+inline constexpr std::int32_t kRawMin = INT32_MIN;
+
+// A 64-bit intermediate brought back to 32-bit storage: clamped to the range.
+constexpr std::int32_t saturate(std::int64_t v) noexcept {
+    return v > kRawMax ? kRawMax : (v < kRawMin ? kRawMin : static_cast<std::int32_t>(v));
+}
+
+// v·2⁻ˢ rounded to nearest, ties towards +∞ (add half, arithmetic shift).
+// Precondition: v + 2^(s−1) does not overflow int64; s in [1, 62].
+constexpr std::int64_t round_shift(std::int64_t v, int s) noexcept {
+    return (v + (std::int64_t{1} << (s - 1))) >> s;
+}
+
+// x·2^frac as a raw value: round to nearest (ties away from zero), saturated;
+// NaN → kRawMax. Compile time for constants, host only otherwise.
+constexpr std::int32_t raw_from_double(double x, int frac) noexcept {
+    if (!(x == x)) {
+        return kRawMax;
+    }
+    double scale = 1.0;
+    for (int i = 0; i < frac; ++i) {  // exact powers of two; folded at compile time
+        scale *= 2.0;
+    }
+    const double s = x * scale;
+    if (s >= 2147483647.0) {
+        return kRawMax;
+    }
+    if (s <= -2147483648.0) {
+        return kRawMin;
+    }
+    return static_cast<std::int32_t>(s < 0.0 ? s - 0.5 : s + 0.5);
+}
+
+constexpr double raw_to_double(std::int32_t raw, int frac) noexcept {
+    double scale = 1.0;
+    for (int i = 0; i < frac; ++i) {
+        scale *= 0.5;
+    }
+    return static_cast<double>(raw) * scale;
+}
+
+constexpr std::int32_t add_sat(std::int32_t a, std::int32_t b) noexcept {
+    std::int32_t r = 0;
+    if (__builtin_add_overflow(a, b, &r)) {
+        return a < 0 ? kRawMin : kRawMax;  // both operands have a's sign
+    }
+    return r;
+}
+
+constexpr std::int32_t sub_sat(std::int32_t a, std::int32_t b) noexcept {
+    std::int32_t r = 0;
+    if (__builtin_sub_overflow(a, b, &r)) {
+        return a < 0 ? kRawMin : kRawMax;
+    }
+    return r;
+}
+
+constexpr std::int32_t neg_sat(std::int32_t a) noexcept {
+    return a == kRawMin ? kRawMax : -a;
+}
+
+}  // namespace fx
+
+// Q1.30 scalar, see the conventions above.
+struct Q30 {
+    static constexpr int kFracBits = 30;
+    std::int32_t raw;
+};
+
+constexpr Q30 operator+(Q30 a, Q30 b) noexcept {
+    return {fx::add_sat(a.raw, b.raw)};
+}
+constexpr Q30 operator-(Q30 a, Q30 b) noexcept {
+    return {fx::sub_sat(a.raw, b.raw)};
+}
+constexpr Q30 operator-(Q30 a) noexcept {
+    return {fx::neg_sat(a.raw)};
+}
+constexpr Q30 operator*(Q30 a, Q30 b) noexcept {
+    return {fx::saturate(fx::round_shift(std::int64_t{a.raw} * b.raw, Q30::kFracBits))};
+}
+constexpr bool operator<(Q30 a, Q30 b) noexcept {
+    return a.raw < b.raw;
+}
+constexpr bool operator<=(Q30 a, Q30 b) noexcept {
+    return a.raw <= b.raw;
+}
+constexpr bool operator>(Q30 a, Q30 b) noexcept {
+    return a.raw > b.raw;
+}
+constexpr bool operator>=(Q30 a, Q30 b) noexcept {
+    return a.raw >= b.raw;
+}
+constexpr bool operator==(Q30 a, Q30 b) noexcept {
+    return a.raw == b.raw;
+}
+constexpr bool operator!=(Q30 a, Q30 b) noexcept {
+    return a.raw != b.raw;
+}
+// A fixed-point value is always a number.
+constexpr bool is_finite(Q30 /*unused*/) noexcept {
+    return true;
+}
+
+// Q11.20 temperature in °C, see the conventions above.
+struct QCelsius {
+    static constexpr int kFracBits = 20;
+    std::int32_t raw;
+};
+
+constexpr QCelsius operator-(QCelsius a) noexcept {
+    return {fx::neg_sat(a.raw)};
+}
+constexpr bool operator<=(QCelsius a, QCelsius b) noexcept {
+    return a.raw <= b.raw;
+}
+constexpr bool is_finite(QCelsius /*unused*/) noexcept {
+    return true;
+}
+
+// Thermal-model coefficient, raw·2⁻³⁶ (rad, rad/°C), see above.
+struct QCoefficient {
+    static constexpr int kFracBits = 36;
+    std::int32_t raw;
+};
+
+// Quadratic thermal-model coefficient, raw·2⁻⁴⁸ (rad/°C²), see above.
+struct QQuadraticCoefficient {
+    static constexpr int kFracBits = 48;
+    std::int32_t raw;
+};
+
+template <>
+struct ScalarTraits<Q30> {
+    using coefficient_type = QCoefficient;
+    using quadratic_coefficient_type = QQuadraticCoefficient;
+    using temperature_type = QCelsius;
+    static constexpr Q30 from_double(double x) noexcept { return {fx::raw_from_double(x, Q30::kFracBits)}; }
+    static constexpr double to_double(Q30 x) noexcept { return fx::raw_to_double(x.raw, Q30::kFracBits); }
+    static constexpr QCelsius celsius(double x) noexcept { return {fx::raw_from_double(x, QCelsius::kFracBits)}; }
+    static constexpr double to_double(QCelsius x) noexcept { return fx::raw_to_double(x.raw, QCelsius::kFracBits); }
+    static constexpr QCoefficient coefficient(double x) noexcept {
+        return {fx::raw_from_double(x, QCoefficient::kFracBits)};
+    }
+    static constexpr double to_double(QCoefficient x) noexcept {
+        return fx::raw_to_double(x.raw, QCoefficient::kFracBits);
+    }
+    static constexpr QQuadraticCoefficient quadratic_coefficient(double x) noexcept {
+        return {fx::raw_from_double(x, QQuadraticCoefficient::kFracBits)};
+    }
+    static constexpr double to_double(QQuadraticCoefficient x) noexcept {
+        return fx::raw_to_double(x.raw, QQuadraticCoefficient::kFracBits);
+    }
+    // Largest coefficients the formats hold (rad, rad/°C; rad/°C²); a model
+    // beyond them cannot be represented and must be refused by the loader.
+    static constexpr double max_coefficient = 0x1p-5;
+    static constexpr double max_quadratic_coefficient = 0x1p-17;
+    // Rounding a unit quaternion's components to 2⁻³¹ leaves |‖q‖² − 1| ≤ 4e-9;
+    // the bound is the double path's, so both reject the same inputs.
+    static constexpr Q30 unit_norm_tolerance = {fx::raw_from_double(1e-6, Q30::kFracBits)};
+};
+
+namespace fx {
+
+// (t·2⁻²⁰)² in units of 2⁻¹² °C², rounded to nearest. |t| < 2²⁹ (≤ 512 °C):
+// t² < 2⁵⁸ fits int64 and the result < 2¹⁸·2¹² = 2³⁰ fits int32. Error ≤ 2⁻¹³ °C².
+constexpr std::int32_t square_celsius(std::int32_t t) noexcept {
+    return static_cast<std::int32_t>(round_shift(std::int64_t{t} * t, 2 * QCelsius::kFracBits - 12));
+}
+
+// Clamps a temperature or a difference of two to ±2²⁹ raw (±512 °C), the range
+// for which thermal_angle's 64-bit sums cannot overflow. Inputs inside the
+// core's domain (±200 °C, differences ≤ 400 °C) pass unchanged.
+constexpr std::int32_t clamp_celsius(std::int64_t t) noexcept {
+    constexpr std::int64_t lim = std::int64_t{1} << 29;
+    return static_cast<std::int32_t>(t > lim ? lim : (t < -lim ? -lim : t));
+}
+
+}  // namespace fx
+
+// The model angle in Q30 rad from QCoefficient / QQuadraticCoefficient
+// coefficients and QCelsius temperatures (thermal.hpp for the polynomial).
+// All products in int64:
+//   linear    c·T  : |c| < 2³¹, |T| ≤ 2²⁹ → < 2⁶⁰ each, units 2⁻⁵⁶ rad;
+//   quadratic c·T² : |c| < 2³¹, T² ≤ 2³⁰ (units 2⁻¹²) → < 2⁶¹ each, units 2⁻⁶⁰
+//                    rad, rounded to 2⁻⁵⁶ (→ < 2⁵⁷);
+//   the sum in units of 2⁻⁵⁶: c0·2²⁰ + Σlin + Σquad < 2⁵¹ + 3·2⁶⁰ + 3·2⁵⁷ < 2⁶²,
+//     no overflow for any input, because temperatures and their differences
+//     are clamped to ±512 °C first (the core calls this only for readings
+//     inside ±200 °C, where the clamp does nothing).
+// Result rounded once to Q30 (error ≤ 2⁻³¹ rad = 9.6e-5") and saturated (the
+// core then flags it beyond kMaxThermalAngleRad). Other rounding, in rad:
+// T² ≤ 2⁻¹³ °C²·|c_2| (≤ 1e-10 at the largest c_2) and 2⁻⁵⁷ per quadratic
+// term. Coefficient and temperature quantisation (the inputs) add ≤ 2⁻³⁷·|T|,
+// 2⁻⁴⁹·T² and 2⁻²¹·|c| per term.
+// The three quadratic products are skipped for an axis whose quadratic
+// coefficients are all zero (the usual linear model): same result, fewer
+// instructions. A branch, not a loop: the instruction count stays bounded.
+template <>
+constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t1, const QCelsius& t2,
+                                 const QCelsius& t3) noexcept {
+    constexpr int kSumFrac = QCoefficient::kFracBits + QCelsius::kFracBits;       // 56
+    constexpr int kQuadShift = QQuadraticCoefficient::kFracBits + 12 - kSumFrac;  // 4
+    const std::int32_t a = fx::clamp_celsius(t1.raw);
+    const std::int32_t d2 = fx::clamp_celsius(std::int64_t{t2.raw} - t1.raw);
+    const std::int32_t d3 = fx::clamp_celsius(std::int64_t{t3.raw} - t1.raw);
+    std::int64_t sum = std::int64_t{p.c0.raw} * (std::int64_t{1} << QCelsius::kFracBits) + std::int64_t{p.c1.raw} * a +
+                       std::int64_t{p.c2.raw} * d2 + std::int64_t{p.c3.raw} * d3;
+    if ((p.c1_2.raw | p.c2_2.raw | p.c3_2.raw) != 0) {
+        sum += fx::round_shift(std::int64_t{p.c1_2.raw} * fx::square_celsius(a), kQuadShift) +
+               fx::round_shift(std::int64_t{p.c2_2.raw} * fx::square_celsius(d2), kQuadShift) +
+               fx::round_shift(std::int64_t{p.c3_2.raw} * fx::square_celsius(d3), kQuadShift);
+    }
+    return {fx::saturate(fx::round_shift(sum, kSumFrac - Q30::kFracBits))};
+}
+
+}  // namespace ascorr
