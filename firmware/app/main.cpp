@@ -39,9 +39,9 @@ CorrectedSolution<Scalar> g_corrected[kMaxHeads];        // latest corrected sol
 struct Statistics {
     std::uint32_t cycles;
     std::uint32_t overruns;
-    std::uint32_t worst_busy;                    // SysTick counts
-    std::uint32_t applied[kMaxHeads];            // cycles with both corrections applied
-    StatusBits status_union[kMaxHeads];          // every status bit seen per head
+    std::uint32_t worst_busy;            // SysTick counts
+    std::uint32_t applied[kMaxHeads];    // cycles with both corrections applied
+    StatusBits status_union[kMaxHeads];  // every status bit seen per head
 };
 Statistics g_stats{};
 
