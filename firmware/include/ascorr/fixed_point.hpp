@@ -40,8 +40,10 @@
 
 #include <cstdint>
 
+#include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "thermal.hpp"
+#include "vector3.hpp"
 
 namespace ascorr {
 
@@ -109,6 +111,20 @@ constexpr std::int32_t neg_sat(std::int32_t a) noexcept {
     return a == kRawMin ? kRawMax : -a;
 }
 
+// A sum of Q30 products (units 2⁻⁶⁰) to Q30: + 2²⁹, arithmetic shift right by
+// 30 (round to nearest, ties towards +∞), saturated. Precondition
+// |acc| ≤ 2⁶³ − 2²⁹ (every caller's sums are, see mul2 and add64_sat). The
+// range test is on the high word only: the result fits iff acc + 2²⁹ lies in
+// [−2⁶¹, 2⁶¹), i.e. iff the high word lies in [−2²⁹, 2²⁹).
+constexpr std::int32_t narrow_raw(std::int64_t acc) noexcept {
+    const std::int64_t r = acc + (std::int64_t{1} << 29);
+    const auto hi = static_cast<std::uint32_t>(static_cast<std::uint64_t>(r) >> 32U);
+    if (hi + 0x20000000U >= 0x40000000U) {
+        return static_cast<std::int32_t>(hi) < 0 ? kRawMin : kRawMax;
+    }
+    return static_cast<std::int32_t>((static_cast<std::uint32_t>(static_cast<std::uint64_t>(r)) >> 30U) | (hi << 2U));
+}
+
 }  // namespace fx
 
 // Q1.30 scalar, see the conventions above.
@@ -127,7 +143,7 @@ constexpr Q30 operator-(Q30 a) noexcept {
     return {fx::neg_sat(a.raw)};
 }
 constexpr Q30 operator*(Q30 a, Q30 b) noexcept {
-    return {fx::saturate(fx::round_shift(std::int64_t{a.raw} * b.raw, Q30::kFracBits))};
+    return {fx::narrow_raw(std::int64_t{a.raw} * b.raw)};
 }
 constexpr bool operator<(Q30 a, Q30 b) noexcept {
     return a.raw < b.raw;
@@ -209,6 +225,90 @@ struct ScalarTraits<Q30> {
     // the bound is the double path's, so both reject the same inputs.
     static constexpr Q30 unit_norm_tolerance = {fx::raw_from_double(1e-6, Q30::kFracBits)};
 };
+
+// ---- Sums of products, rounded once. The core's vector and quaternion
+// operations on Q30 (found by argument-dependent lookup, preferred to the
+// generic templates) accumulate their exact products in int64 and round and
+// saturate once, as CMSIS's q31 dot products do: fewer roundings (error
+// ≤ 2⁻³¹ per result instead of per product) and fewer instructions. Range of
+// the accumulator: n products of |·| < 2⁶² each (n ≤ 4) → |Σ| < 2⁶⁴ would be
+// possible only for operands near ±2; the core's operands are unit quaternions
+// and vectors (|component| ≤ 1 + 1e-6) or small terms, so |Σ| ≤ 4·2⁶⁰·(1+ε)²
+// < 2⁶³; for any operands each sum of two products fits (< 2⁶³), and 4-term
+// sums are formed as two 2-term halves added in int64 with a saturating add.
+
+namespace fx {
+
+// Σ of two exact Q30 products (units 2⁻⁶⁰). Each product has |·| ≤ 2⁶², so
+// the sum has |·| < 2⁶³ except a·b = c·d = 2⁶² (all four −2): that one sum
+// wraps (unsigned addition, no undefined behaviour) to −2⁶³ and the result
+// saturates to −2 instead of +2. Neither conversions (from_double) nor the
+// core's data (validated unit quaternions and small terms) produce it.
+constexpr std::int64_t mul2(Q30 a, Q30 b, Q30 c, Q30 d) noexcept {
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(std::int64_t{a.raw} * b.raw) +
+                                     static_cast<std::uint64_t>(std::int64_t{c.raw} * d.raw));
+}
+
+// Sum of two mul2 results, saturated to ±2⁶² (beyond ±2⁶¹ the Q30 result
+// saturates anyway, and narrow_raw's precondition holds). Operands are below
+// 2⁶¹ in magnitude for the core's data; the test matters for inputs near ±2.
+constexpr std::int64_t add64_sat(std::int64_t a, std::int64_t b) noexcept {
+    constexpr std::int64_t kLim = std::int64_t{1} << 62;
+    std::int64_t r = 0;
+    if (__builtin_add_overflow(a, b, &r) || r > kLim || r < -kLim) {
+        return a < 0 ? -kLim : kLim;
+    }
+    return r;
+}
+
+constexpr Q30 narrow(std::int64_t acc) noexcept {
+    return {narrow_raw(acc)};
+}
+
+}  // namespace fx
+
+constexpr Q30 dot(const Vector3<Q30>& a, const Vector3<Q30>& b) noexcept {
+    return fx::narrow(fx::add64_sat(fx::mul2(a.x, b.x, a.y, b.y), std::int64_t{a.z.raw} * b.z.raw));
+}
+
+constexpr Q30 squared_norm(const Vector3<Q30>& a) noexcept {
+    return dot(a, a);
+}
+
+constexpr Vector3<Q30> cross(const Vector3<Q30>& a, const Vector3<Q30>& b) noexcept {
+    return {fx::narrow(fx::mul2(a.y, b.z, -a.z, b.y)), fx::narrow(fx::mul2(a.z, b.x, -a.x, b.z)),
+            fx::narrow(fx::mul2(a.x, b.y, -a.y, b.x))};
+}
+
+constexpr Q30 dot(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
+    return fx::narrow(fx::add64_sat(fx::mul2(a.w, b.w, a.x, b.x), fx::mul2(a.y, b.y, a.z, b.z)));
+}
+
+constexpr Q30 squared_norm(const Quaternion<Q30>& q) noexcept {
+    return dot(q, q);
+}
+
+// Hamilton product a ⊗ b (quaternion.hpp), each component rounded once.
+constexpr Quaternion<Q30> operator*(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
+    using fx::add64_sat;
+    using fx::mul2;
+    using fx::narrow;
+    return {narrow(add64_sat(mul2(a.w, b.w, -a.x, b.x), mul2(-a.y, b.y, -a.z, b.z))),
+            narrow(add64_sat(mul2(a.w, b.x, a.x, b.w), mul2(a.y, b.z, -a.z, b.y))),
+            narrow(add64_sat(mul2(a.w, b.y, -a.x, b.z), mul2(a.y, b.w, a.z, b.x))),
+            narrow(add64_sat(mul2(a.w, b.z, a.x, b.y), mul2(-a.y, b.x, a.z, b.w)))};
+}
+
+// Third row of R(q) (quaternion.hpp), each component rounded once; the
+// doubling is exact in the int64 sum.
+constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
+    const std::int64_t a = fx::mul2(q.x, q.z, -q.w, q.y);
+    const std::int64_t b = fx::mul2(q.y, q.z, q.w, q.x);
+    const std::int64_t c = fx::mul2(q.x, q.x, q.y, q.y);
+    constexpr std::int64_t kOne = std::int64_t{1} << 60;
+    return {fx::narrow(fx::add64_sat(a, a)), fx::narrow(fx::add64_sat(b, b)),
+            fx::narrow(fx::add64_sat(kOne, -fx::add64_sat(c, c)))};
+}
 
 namespace fx {
 
