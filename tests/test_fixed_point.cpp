@@ -114,7 +114,9 @@ TEST(FixedPoint, ThermalAngleMatchesDouble) {
                             QT::quadratic_coefficient(7e-6)};
     const QCelsius hot = QT::celsius(2000.0);
     const QCelsius cold = QT::celsius(-2000.0);
-    EXPECT_EQ(thermal_angle<Q30>(big, hot, cold, hot).raw, INT32_MAX);
+    EXPECT_EQ(thermal_angle<Q30>(big, hot, hot, hot).raw, INT32_MAX);
+    EXPECT_EQ(thermal_angle<Q30>(big, cold, hot, hot).raw, INT32_MAX);  // -7.7 + 2*15.4 + quadratic rad
+    EXPECT_EQ(thermal_angle<Q30>(big, hot, cold, cold).raw, INT32_MIN);  // 7.7 - 2*15.4 + quadratic rad
 }
 
 SolutionInput<Q30> to_fixed(const SolutionInput<double>& in) {

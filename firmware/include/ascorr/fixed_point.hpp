@@ -41,6 +41,7 @@
 #include <cstdint>
 
 #include "quaternion.hpp"
+#include "constants.hpp"
 #include "scalar_traits.hpp"
 #include "thermal.hpp"
 #include "vector3.hpp"
@@ -116,13 +117,24 @@ constexpr std::int32_t neg_sat(std::int32_t a) noexcept {
 // |acc| ≤ 2⁶³ − 2²⁹ (every caller's sums are, see mul2 and add64_sat). The
 // range test is on the high word only: the result fits iff acc + 2²⁹ lies in
 // [−2⁶¹, 2⁶¹), i.e. iff the high word lies in [−2²⁹, 2²⁹).
-constexpr std::int32_t narrow_raw(std::int64_t acc) noexcept {
-    const std::int64_t r = acc + (std::int64_t{1} << 29);
-    const auto hi = static_cast<std::uint32_t>(static_cast<std::uint64_t>(r) >> 32U);
-    if (hi + 0x20000000U >= 0x40000000U) {
+// The same for any shift S in [1, 31]: acc·2⁻ˢ rounded to nearest (ties
+// towards +∞) and saturated; precondition |acc| ≤ 2⁶³ − 2^(S−1).
+template <int S>
+constexpr std::int32_t narrow_shift(std::int64_t acc) noexcept {
+    static_assert(S >= 1 && S <= 31, "shift");
+    const std::int64_t r = acc + (std::int64_t{1} << (S - 1));
+    const auto u = static_cast<std::uint64_t>(r);
+    const auto hi = static_cast<std::uint32_t>(u >> 32U);
+    // Fits iff r ∈ [−2^(31+S), 2^(31+S)), i.e. iff the top 33 − S bits of the
+    // high word are all equal: hi + 2^(S−1) < 2^S as unsigned.
+    if (hi + (std::uint32_t{1} << (S - 1)) >= (std::uint32_t{1} << S)) {
         return static_cast<std::int32_t>(hi) < 0 ? kRawMin : kRawMax;
     }
-    return static_cast<std::int32_t>((static_cast<std::uint32_t>(static_cast<std::uint64_t>(r)) >> 30U) | (hi << 2U));
+    return static_cast<std::int32_t>((static_cast<std::uint32_t>(u) >> S) | (hi << (32 - S)));
+}
+
+constexpr std::int32_t narrow_raw(std::int64_t acc) noexcept {
+    return narrow_shift<30>(acc);
 }
 
 }  // namespace fx
@@ -310,6 +322,18 @@ constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
             fx::narrow(fx::add64_sat(kOne, -fx::add64_sat(c, c)))};
 }
 
+// q + d brought to unit norm by one Newton step (quaternion.hpp), in Q30.
+// In integers q + d is exact (saturating add: |·| ≤ 2), so ε = ‖q + d‖² − 1 is
+// formed exactly in int64 (units 2⁻⁶⁰; two mul2 halves, saturated to ±2⁶²),
+// g = −ε/2 is rounded once to Q30, and each component is
+// (q + d)ᵢ + round((q + d)ᵢ·g), saturated: one rounding per component.
+constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quaternion<Q30>& d) noexcept {
+    const Quaternion<Q30> s{q.w + d.w, q.x + d.x, q.y + d.y, q.z + d.z};
+    const std::int64_t n2 = fx::add64_sat(fx::mul2(s.w, s.w, s.x, s.x), fx::mul2(s.y, s.y, s.z, s.z));
+    const Q30 g{fx::narrow_shift<31>((std::int64_t{1} << 60) - n2)};
+    return {s.w + s.w * g, s.x + s.x * g, s.y + s.y * g, s.z + s.z * g};
+}
+
 namespace fx {
 
 // (t·2⁻²⁰)² in units of 2⁻¹² °C², rounded to nearest. |t| < 2²⁹ (≤ 512 °C):
@@ -318,12 +342,13 @@ constexpr std::int32_t square_celsius(std::int32_t t) noexcept {
     return static_cast<std::int32_t>(round_shift(std::int64_t{t} * t, 2 * QCelsius::kFracBits - 12));
 }
 
-// Clamps a temperature or a difference of two to ±2²⁹ raw (±512 °C), the range
-// for which thermal_angle's 64-bit sums cannot overflow. Inputs inside the
-// core's domain (±200 °C, differences ≤ 400 °C) pass unchanged.
-constexpr std::int32_t clamp_celsius(std::int64_t t) noexcept {
-    constexpr std::int64_t lim = std::int64_t{1} << 29;
-    return static_cast<std::int32_t>(t > lim ? lim : (t < -lim ? -lim : t));
+// Clamps a temperature to ±2²⁸ raw (±256 °C): then a difference of two is
+// within ±2²⁹ (±512 °C) in int32, the range for which thermal_angle's 64-bit
+// sums cannot overflow. Readings inside the core's domain (±200 °C) pass
+// unchanged.
+constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
+    constexpr std::int32_t lim = std::int32_t{1} << 28;
+    return t > lim ? lim : (t < -lim ? -lim : t);
 }
 
 }  // namespace fx
@@ -335,9 +360,9 @@ constexpr std::int32_t clamp_celsius(std::int64_t t) noexcept {
 //   quadratic c·T² : |c| < 2³¹, T² ≤ 2³⁰ (units 2⁻¹²) → < 2⁶¹ each, units 2⁻⁶⁰
 //                    rad, rounded to 2⁻⁵⁶ (→ < 2⁵⁷);
 //   the sum in units of 2⁻⁵⁶: c0·2²⁰ + Σlin + Σquad < 2⁵¹ + 3·2⁶⁰ + 3·2⁵⁷ < 2⁶²,
-//     no overflow for any input, because temperatures and their differences
-//     are clamped to ±512 °C first (the core calls this only for readings
-//     inside ±200 °C, where the clamp does nothing).
+//     no overflow for any input, because temperatures are clamped to ±256 °C
+//     first, so that they and their differences are within ±512 °C (the core
+//     calls this only for readings inside ±200 °C, where the clamp does nothing).
 // Result rounded once to Q30 (error ≤ 2⁻³¹ rad = 9.6e-5") and saturated (the
 // core then flags it beyond kMaxThermalAngleRad). Other rounding, in rad:
 // T² ≤ 2⁻¹³ °C²·|c_2| (≤ 1e-10 at the largest c_2) and 2⁻⁵⁷ per quadratic
@@ -352,8 +377,8 @@ constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t
     constexpr int kSumFrac = QCoefficient::kFracBits + QCelsius::kFracBits;       // 56
     constexpr int kQuadShift = QQuadraticCoefficient::kFracBits + 12 - kSumFrac;  // 4
     const std::int32_t a = fx::clamp_celsius(t1.raw);
-    const std::int32_t d2 = fx::clamp_celsius(std::int64_t{t2.raw} - t1.raw);
-    const std::int32_t d3 = fx::clamp_celsius(std::int64_t{t3.raw} - t1.raw);
+    const std::int32_t d2 = fx::clamp_celsius(t2.raw) - a;
+    const std::int32_t d3 = fx::clamp_celsius(t3.raw) - a;
     std::int64_t sum = std::int64_t{p.c0.raw} * (std::int64_t{1} << QCelsius::kFracBits) + std::int64_t{p.c1.raw} * a +
                        std::int64_t{p.c2.raw} * d2 + std::int64_t{p.c3.raw} * d3;
     if ((p.c1_2.raw | p.c2_2.raw | p.c3_2.raw) != 0) {
@@ -361,7 +386,72 @@ constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t
                fx::round_shift(std::int64_t{p.c2_2.raw} * fx::square_celsius(d2), kQuadShift) +
                fx::round_shift(std::int64_t{p.c3_2.raw} * fx::square_celsius(d3), kQuadShift);
     }
-    return {fx::saturate(fx::round_shift(sum, kSumFrac - Q30::kFracBits))};
+    return {fx::narrow_shift<kSumFrac - Q30::kFracBits>(sum)};
+}
+
+// ---- The thermal rotation in Q30 (thermal.hpp: q_th = q3(γ) ⊗ q2(β) ⊗ q1(α),
+// 16-product expansion), specialised for the format's resolution.
+//
+// Range: each angle is first clamped to ±kMaxThermalAngleRad (the core calls
+// this only after checking that bound, so the clamp never acts there). Then
+// |h| = |angle|/2 ≤ 8.73e-3, |s| ≤ |h|, |cos h − 1| ≤ 3.81e-5: every factor
+// is ≤ 1 in magnitude (raw ≤ 2³⁰), every product ≤ 2⁶⁰ and every sum of two
+// ≤ 2⁶¹ in int64, and every result ≤ 1 + 2e-4 in magnitude: no overflow and
+// no saturation needed, hence none is applied (plain int64 arithmetic).
+// Series at Q30 resolution (2⁻³⁰ = 9.3e-10):
+//   sin h = h − h³/6 + O(h⁵/120 ≤ 4.1e-13),
+//   cos h − 1 = −h²/2 + O(h⁴/24 ≤ 2.4e-10; this changes |q| only to first
+//     order, and the rotation angle by ≤ 2·s·2.4e-10 = 4e-12 rad).
+// h³/6 uses 1/12 as 174763·2⁻²¹ (relative error 1.9e-6 of a term ≤ 1.1e-7).
+// Rounding: to nearest at each product (≤ 2⁻³¹ each, about ten per
+// component): ≤ 5e-9 absolute, 1e-3" as a rotation.
+namespace fx {
+
+// (a·b) rounded to Q30, for operands with |a·b| ≤ 2⁶¹ (no saturation).
+constexpr std::int32_t mul_small(std::int32_t a, std::int32_t b) noexcept {
+    return static_cast<std::int32_t>((std::int64_t{a} * b + (std::int64_t{1} << 29)) >> 30);
+}
+
+// (a·b + c·d) rounded to Q30, for |a·b| + |c·d| ≤ 2⁶¹ (no saturation).
+constexpr std::int32_t mul2_small(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) noexcept {
+    return static_cast<std::int32_t>((std::int64_t{a} * b + std::int64_t{c} * d + (std::int64_t{1} << 29)) >> 30);
+}
+
+struct HalfAngleQ30 {
+    std::int32_t cm1;  // cos(angle/2) − 1, Q30
+    std::int32_t s;    // sin(angle/2), Q30
+};
+
+constexpr HalfAngleQ30 half_angle_q30(Q30 angle) noexcept {
+    constexpr std::int32_t lim = raw_from_double(kMaxThermalAngleRad, Q30::kFracBits);
+    const std::int32_t a = angle.raw > lim ? lim : (angle.raw < -lim ? -lim : angle.raw);  // |a| < 2²⁵
+    const std::int64_t a2 = std::int64_t{a} * a;                                            // (2h)², units 2⁻⁶⁰
+    const auto h2 = static_cast<std::int32_t>((a2 + (std::int64_t{1} << 31)) >> 32);       // h², Q30, < 2¹⁷
+    const std::int64_t t = std::int64_t{h2} * a;  // 2h³, units 2⁻⁶⁰, < 2⁴²
+    const auto h3_6 = static_cast<std::int32_t>((t * 174763 + (std::int64_t{1} << 50)) >> 51);  // h³/6, Q30
+    const std::int32_t h = (a + 1) >> 1;                                                        // Q30
+    return {-((h2 + 1) >> 1), h - h3_6};
+}
+
+}  // namespace fx
+
+constexpr SmallRotation<Q30> thermal_rotation(const Q30& alpha, const Q30& beta, const Q30& gamma) noexcept {
+    using fx::mul2_small;
+    using fx::mul_small;
+    const fx::HalfAngleQ30 a = fx::half_angle_q30(alpha);
+    const fx::HalfAngleQ30 b = fx::half_angle_q30(beta);
+    const fx::HalfAngleQ30 g = fx::half_angle_q30(gamma);
+    constexpr std::int32_t one = std::int32_t{1} << 30;
+    const std::int32_t ac = one + a.cm1;
+    const std::int32_t bc = one + b.cm1;
+    const std::int32_t gc = one + g.cm1;
+    const std::int32_t ccm1 = a.cm1 + b.cm1 + mul_small(a.cm1, b.cm1);  // c1c2 − 1
+    const std::int32_t cc = one + ccm1;
+    const std::int32_t sc = mul_small(a.s, bc);
+    const std::int32_t cs = mul_small(ac, b.s);
+    const std::int32_t ss = mul_small(a.s, b.s);
+    return {{ccm1 + g.cm1 + mul2_small(ccm1, g.cm1, -ss, g.s)},
+            {{-mul2_small(sc, gc, cs, g.s)}, {mul2_small(sc, g.s, -cs, gc)}, {-mul2_small(ss, gc, cc, g.s)}}};
 }
 
 }  // namespace ascorr
