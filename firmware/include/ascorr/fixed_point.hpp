@@ -114,7 +114,7 @@ constexpr std::int32_t neg_sat(std::int32_t a) noexcept {
 
 // A sum of Q30 products (units 2⁻⁶⁰) to Q30: + 2²⁹, arithmetic shift right by
 // 30 (round to nearest, ties towards +∞), saturated. Precondition
-// |acc| ≤ 2⁶³ − 2²⁹ (every caller's sums are, see mul2 and add64_sat). The
+// |acc| ≤ 2⁶³ − 2²⁹ (every caller's sums are, see mac2 and half_sum). The
 // range test is on the high word only: the result fits iff acc + 2²⁹ lies in
 // [−2⁶¹, 2⁶¹), i.e. iff the high word lies in [−2²⁹, 2²⁹).
 // The same for any shift S in [1, 31]: acc·2⁻ˢ rounded to nearest (ties
@@ -241,46 +241,45 @@ struct ScalarTraits<Q30> {
 // ---- Sums of products, rounded once. The core's vector and quaternion
 // operations on Q30 (found by argument-dependent lookup, preferred to the
 // generic templates) accumulate their exact products in int64 and round and
-// saturate once, as CMSIS's q31 dot products do: fewer roundings (error
-// ≤ 2⁻³¹ per result instead of per product) and fewer instructions. Range of
-// the accumulator: n products of |·| < 2⁶² each (n ≤ 4) → |Σ| < 2⁶⁴ would be
-// possible only for operands near ±2; the core's operands are unit quaternions
-// and vectors (|component| ≤ 1 + 1e-6) or small terms, so |Σ| ≤ 4·2⁶⁰·(1+ε)²
-// < 2⁶³; for any operands each sum of two products fits (< 2⁶³), and 4-term
-// sums are formed as two 2-term halves added in int64 with a saturating add.
+// saturate once, as CMSIS's q31 dot products do: fewer roundings (≤ 2⁻³¹ per
+// result instead of per product) and fewer instructions.
+// Range: a product of two Q30 raws has |·| ≤ 2⁶², a sum or difference of two
+// (mac2, msub2) |·| < 2⁶³, except a·b + c·d with all four −2 (raw INT32_MIN),
+// which wraps (unsigned arithmetic, no undefined behaviour) to −2⁶³; neither
+// conversions nor the core's data (validated unit quaternions, small terms)
+// produce that. Four-term sums add the halves of two such sums (half_sum: each
+// halved by an arithmetic shift, |·| < 2⁶², no overflow), losing at most
+// 2⁻⁶⁰, far below the final rounding (narrow_shift<29>: ≤ 2⁻³¹, saturated).
 
 namespace fx {
 
-// Σ of two exact Q30 products (units 2⁻⁶⁰). Each product has |·| ≤ 2⁶², so
-// the sum has |·| < 2⁶³ except a·b = c·d = 2⁶² (all four −2): that one sum
-// wraps (unsigned addition, no undefined behaviour) to −2⁶³ and the result
-// saturates to −2 instead of +2. Neither conversions (from_double) nor the
-// core's data (validated unit quaternions and small terms) produce it.
-constexpr std::int64_t mul2(Q30 a, Q30 b, Q30 c, Q30 d) noexcept {
+// a·b + c·d and a·b − c·d, units 2⁻⁶⁰ (see the range note above).
+constexpr std::int64_t mac2(Q30 a, Q30 b, Q30 c, Q30 d) noexcept {
     return static_cast<std::int64_t>(static_cast<std::uint64_t>(std::int64_t{a.raw} * b.raw) +
                                      static_cast<std::uint64_t>(std::int64_t{c.raw} * d.raw));
 }
-
-// Sum of two mul2 results, saturated to ±2⁶² (beyond ±2⁶¹ the Q30 result
-// saturates anyway, and narrow_raw's precondition holds). Operands are below
-// 2⁶¹ in magnitude for the core's data; the test matters for inputs near ±2.
-constexpr std::int64_t add64_sat(std::int64_t a, std::int64_t b) noexcept {
-    constexpr std::int64_t kLim = std::int64_t{1} << 62;
-    std::int64_t r = 0;
-    if (__builtin_add_overflow(a, b, &r) || r > kLim || r < -kLim) {
-        return a < 0 ? -kLim : kLim;
-    }
-    return r;
+constexpr std::int64_t msub2(Q30 a, Q30 b, Q30 c, Q30 d) noexcept {
+    return static_cast<std::int64_t>(static_cast<std::uint64_t>(std::int64_t{a.raw} * b.raw) -
+                                     static_cast<std::uint64_t>(std::int64_t{c.raw} * d.raw));
 }
 
-constexpr Q30 narrow(std::int64_t acc) noexcept {
-    return {narrow_raw(acc)};
+// (x + y)/2 for |x|, |y| < 2⁶³, without overflow; error ≤ 1 (units of x).
+// Of two sums in units 2⁻⁶⁰ it is their sum in units 2⁻⁵⁹.
+constexpr std::int64_t half_sum(std::int64_t x, std::int64_t y) noexcept {
+    return (x >> 1) + (y >> 1);
+}
+
+constexpr Q30 narrow(std::int64_t acc) noexcept {  // units 2⁻⁶⁰ → Q30
+    return {narrow_shift<30>(acc)};
+}
+constexpr Q30 narrow_half(std::int64_t half) noexcept {  // units 2⁻⁵⁹ → Q30
+    return {narrow_shift<29>(half)};
 }
 
 }  // namespace fx
 
 constexpr Q30 dot(const Vector3<Q30>& a, const Vector3<Q30>& b) noexcept {
-    return fx::narrow(fx::add64_sat(fx::mul2(a.x, b.x, a.y, b.y), std::int64_t{a.z.raw} * b.z.raw));
+    return fx::narrow_half(fx::half_sum(fx::mac2(a.x, b.x, a.y, b.y), std::int64_t{a.z.raw} * b.z.raw));
 }
 
 constexpr Q30 squared_norm(const Vector3<Q30>& a) noexcept {
@@ -288,12 +287,12 @@ constexpr Q30 squared_norm(const Vector3<Q30>& a) noexcept {
 }
 
 constexpr Vector3<Q30> cross(const Vector3<Q30>& a, const Vector3<Q30>& b) noexcept {
-    return {fx::narrow(fx::mul2(a.y, b.z, -a.z, b.y)), fx::narrow(fx::mul2(a.z, b.x, -a.x, b.z)),
-            fx::narrow(fx::mul2(a.x, b.y, -a.y, b.x))};
+    return {fx::narrow(fx::msub2(a.y, b.z, a.z, b.y)), fx::narrow(fx::msub2(a.z, b.x, a.x, b.z)),
+            fx::narrow(fx::msub2(a.x, b.y, a.y, b.x))};
 }
 
 constexpr Q30 dot(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
-    return fx::narrow(fx::add64_sat(fx::mul2(a.w, b.w, a.x, b.x), fx::mul2(a.y, b.y, a.z, b.z)));
+    return fx::narrow_half(fx::half_sum(fx::mac2(a.w, b.w, a.x, b.x), fx::mac2(a.y, b.y, a.z, b.z)));
 }
 
 constexpr Q30 squared_norm(const Quaternion<Q30>& q) noexcept {
@@ -302,35 +301,35 @@ constexpr Q30 squared_norm(const Quaternion<Q30>& q) noexcept {
 
 // Hamilton product a ⊗ b (quaternion.hpp), each component rounded once.
 constexpr Quaternion<Q30> operator*(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
-    using fx::add64_sat;
-    using fx::mul2;
-    using fx::narrow;
-    return {narrow(add64_sat(mul2(a.w, b.w, -a.x, b.x), mul2(-a.y, b.y, -a.z, b.z))),
-            narrow(add64_sat(mul2(a.w, b.x, a.x, b.w), mul2(a.y, b.z, -a.z, b.y))),
-            narrow(add64_sat(mul2(a.w, b.y, -a.x, b.z), mul2(a.y, b.w, a.z, b.x))),
-            narrow(add64_sat(mul2(a.w, b.z, a.x, b.y), mul2(-a.y, b.x, a.z, b.w)))};
+    using fx::half_sum;
+    using fx::mac2;
+    using fx::msub2;
+    using fx::narrow_half;
+    return {narrow_half(half_sum(msub2(a.w, b.w, a.x, b.x), -mac2(a.y, b.y, a.z, b.z))),
+            narrow_half(half_sum(mac2(a.w, b.x, a.x, b.w), msub2(a.y, b.z, a.z, b.y))),
+            narrow_half(half_sum(msub2(a.w, b.y, a.x, b.z), mac2(a.y, b.w, a.z, b.x))),
+            narrow_half(half_sum(mac2(a.w, b.z, a.x, b.y), msub2(a.z, b.w, a.y, b.x)))};
 }
 
 // Third row of R(q) (quaternion.hpp), each component rounded once; the
-// doubling is exact in the int64 sum.
+// doubling is exact: a sum in units 2⁻⁶⁰ read in units 2⁻⁵⁹.
 constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
-    const std::int64_t a = fx::mul2(q.x, q.z, -q.w, q.y);
-    const std::int64_t b = fx::mul2(q.y, q.z, q.w, q.x);
-    const std::int64_t c = fx::mul2(q.x, q.x, q.y, q.y);
-    constexpr std::int64_t kOne = std::int64_t{1} << 60;
-    return {fx::narrow(fx::add64_sat(a, a)), fx::narrow(fx::add64_sat(b, b)),
-            fx::narrow(fx::add64_sat(kOne, -fx::add64_sat(c, c)))};
+    const std::int64_t a = fx::msub2(q.x, q.z, q.w, q.y);
+    const std::int64_t b = fx::mac2(q.y, q.z, q.w, q.x);
+    const std::int64_t c = fx::mac2(q.x, q.x, q.y, q.y);  // ≥ 0 (wraps only at x = y = −2)
+    constexpr std::int64_t kOne = std::int64_t{1} << 59;  // 1 in units 2⁻⁵⁹
+    return {fx::narrow_half(a), fx::narrow_half(b), fx::narrow_half(kOne - c)};
 }
 
 // q + d brought to unit norm by one Newton step (quaternion.hpp), in Q30.
 // In integers q + d is exact (saturating add: |·| ≤ 2), so ε = ‖q + d‖² − 1 is
-// formed exactly in int64 (units 2⁻⁶⁰; two mul2 halves, saturated to ±2⁶²),
-// g = −ε/2 is rounded once to Q30, and each component is
-// (q + d)ᵢ + round((q + d)ᵢ·g), saturated: one rounding per component.
+// formed exactly in int64 (units 2⁻⁵⁹ after half_sum), g = −ε/2 is rounded
+// once to Q30 and saturated, and each component is (q + d)ᵢ + round((q + d)ᵢ·g),
+// saturated: one rounding per component.
 constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quaternion<Q30>& d) noexcept {
     const Quaternion<Q30> s{q.w + d.w, q.x + d.x, q.y + d.y, q.z + d.z};
-    const std::int64_t n2 = fx::add64_sat(fx::mul2(s.w, s.w, s.x, s.x), fx::mul2(s.y, s.y, s.z, s.z));
-    const Q30 g{fx::narrow_shift<31>((std::int64_t{1} << 60) - n2)};
+    const std::int64_t n2_half = fx::half_sum(fx::mac2(s.w, s.w, s.x, s.x), fx::mac2(s.y, s.y, s.z, s.z));
+    const Q30 g{fx::narrow_shift<30>((std::int64_t{1} << 59) - n2_half)};  // (1 − ‖s‖²)/2
     return {s.w + s.w * g, s.x + s.x * g, s.y + s.y * g, s.z + s.z * g};
 }
 
