@@ -107,11 +107,8 @@ Fixture<Q30> g_fixed;
 
 template <typename T>
 void run_stages(const Fixture<T>& fx, int stage) {
-    const CorrectionConfig<T> cfg[] = {{true, &fx.model[0]},
-                                       {true, nullptr},
-                                       {false, &fx.model[0]},
-                                       {true, &fx.model[1]},
-                                       {false, &fx.model[1]}};
+    const CorrectionConfig<T> cfg[] = {
+        {true, &fx.model[0]}, {true, nullptr}, {false, &fx.model[0]}, {true, &fx.model[1]}, {false, &fx.model[1]}};
     run_core(fx, cfg[stage]);
 }
 
@@ -125,21 +122,21 @@ void run_baseline_stage(int stage) {
 }  // namespace
 
 // One function per figure, for callgrind's inclusive counts.
-#define ASCORR_BENCH_STAGES(scalar, call)                               \
+#define ASCORR_BENCH_STAGES(scalar, call)                                                   \
     extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_both() {              \
-        call(0);                                                        \
-    }                                                                   \
+        call(0);                                                                            \
+    }                                                                                       \
     extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_aberration() {        \
-        call(1);                                                        \
-    }                                                                   \
+        call(1);                                                                            \
+    }                                                                                       \
     extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_thermal() {           \
-        call(2);                                                        \
-    }                                                                   \
+        call(2);                                                                            \
+    }                                                                                       \
     extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_both_quadratic() {    \
-        call(3);                                                        \
-    }                                                                   \
+        call(3);                                                                            \
+    }                                                                                       \
     extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_thermal_quadratic() { \
-        call(4);                                                        \
+        call(4);                                                                            \
     }
 
 #define ASCORR_CALL_DOUBLE(s) run_stages(g_double, s)
@@ -233,7 +230,8 @@ int main(int argc, char** argv) {
     for (const VectorRecord& r : all) {
         const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
         if (!(std::fabs(n2 - 1.0) < 1e-9) || r.head >= 3U || !(std::fabs(r.temperature[1]) < 200.0) ||
-            !(std::fabs(r.temperature[2]) < 200.0) || !(std::fabs(r.beta[0]) < 1e-3) || !(std::fabs(r.beta[1]) < 1e-3)) {
+            !(std::fabs(r.temperature[2]) < 200.0) || !(std::fabs(r.beta[0]) < 1e-3) ||
+            !(std::fabs(r.beta[1]) < 1e-3)) {
             continue;
         }
         SolutionInput<double> in{};

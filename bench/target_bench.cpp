@@ -98,15 +98,15 @@ void bench_scalar(const char* name, Fixture<T>& fx, std::uint32_t ipc) {
     for (std::uint32_t m = 0; m < kModels; ++m) {
         ThermalModel<T>& model = fx.model[m];
         for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
-        model.head[h].present = g_model_records[m].present[h] != 0U;
-        AxisPolynomial<T>* axes[3] = {&model.head[h].alpha, &model.head[h].beta, &model.head[h].gamma};
-        for (std::uint32_t a = 0; a < 3; ++a) {
-            const double* c = g_model_records[m].coefficient[h][a];
-            *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
-                        Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
-                        Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
-                        Tr::quadratic_coefficient(c[6])};
-        }
+            model.head[h].present = g_model_records[m].present[h] != 0U;
+            AxisPolynomial<T>* axes[3] = {&model.head[h].alpha, &model.head[h].beta, &model.head[h].gamma};
+            for (std::uint32_t a = 0; a < 3; ++a) {
+                const double* c = g_model_records[m].coefficient[h][a];
+                *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
+                            Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
+                            Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
+                            Tr::quadratic_coefficient(c[6])};
+            }
         }
     }
     for (std::uint32_t i = 0; i < kInputs; ++i) {
@@ -210,9 +210,8 @@ int main() {
         // inputs of the set take shorter paths and are left out).
         const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
         const bool good = r.model == 1U && r.temperature_valid == 7U && r.velocity_valid != 0U && r.head < 3U &&
-                          n2 < 1.0 + 1e-9 && n2 > 1.0 - 1e-9 && r.temperature[1] < 200.0 &&
-                          r.temperature[2] < 200.0 && r.beta[0] < 1e-3 && r.beta[1] < 1e-3 && r.beta[0] > -1e-3 &&
-                          r.beta[1] > -1e-3;
+                          n2 < 1.0 + 1e-9 && n2 > 1.0 - 1e-9 && r.temperature[1] < 200.0 && r.temperature[2] < 200.0 &&
+                          r.beta[0] < 1e-3 && r.beta[1] < 1e-3 && r.beta[0] > -1e-3 && r.beta[1] > -1e-3;
         if (good) {
             g_records[n++] = r;
         }

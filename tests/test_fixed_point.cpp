@@ -38,9 +38,9 @@ TEST(FixedPoint, ConversionRoundsAndSaturates) {
     EXPECT_EQ(q(0.6 * kLsb).raw, 1);
     EXPECT_EQ(q(-0.6 * kLsb).raw, -1);
     EXPECT_EQ(q(2.0).raw, INT32_MAX);
-    EXPECT_EQ(q(-2.0).raw, INT32_MIN);
+    EXPECT_EQ(q(-2.0).raw, -INT32_MAX);  // conversions saturate symmetrically
     EXPECT_EQ(q(1e300).raw, INT32_MAX);
-    EXPECT_EQ(q(-std::numeric_limits<double>::infinity()).raw, INT32_MIN);
+    EXPECT_EQ(q(-std::numeric_limits<double>::infinity()).raw, -INT32_MAX);
     EXPECT_EQ(q(std::nan("")).raw, INT32_MAX);
     EXPECT_EQ(QT::celsius(std::nan("")).raw, INT32_MAX);
     EXPECT_DOUBLE_EQ(QT::to_double(QT::celsius(-40.25)), -40.25);
@@ -49,7 +49,7 @@ TEST(FixedPoint, ConversionRoundsAndSaturates) {
 
 TEST(FixedPoint, AddSubNegSaturate) {
     EXPECT_EQ((q(1.5) + q(1.5)).raw, INT32_MAX);
-    EXPECT_EQ((q(-1.5) + q(-1.5)).raw, INT32_MIN);
+    EXPECT_EQ((q(-1.5) + q(-1.5)).raw, INT32_MIN);  // operations saturate to the format's ends
     EXPECT_EQ((q(-1.5) - q(1.5)).raw, INT32_MIN);
     EXPECT_EQ((q(1.5) - q(-1.5)).raw, INT32_MAX);
     EXPECT_EQ((-Q30{INT32_MIN}).raw, INT32_MAX);
@@ -68,6 +68,7 @@ TEST(FixedPoint, MultiplyRoundsToNearestAndSaturates) {
     }
     EXPECT_EQ((q(1.75) * q(1.75)).raw, INT32_MAX);
     EXPECT_EQ((q(-1.75) * q(1.75)).raw, INT32_MIN);
+    EXPECT_EQ((Q30{INT32_MIN} * Q30{INT32_MAX}).raw, INT32_MIN);
     EXPECT_EQ((Q30{INT32_MIN} * Q30{INT32_MIN}).raw, INT32_MAX);
     EXPECT_EQ((Q30{1} * Q30{1 << 29}).raw, 1);   // 0.5 LSB: tie rounds up
     EXPECT_EQ((Q30{-1} * Q30{1 << 29}).raw, 0);  // -0.5 LSB: tie rounds towards +inf
@@ -115,7 +116,7 @@ TEST(FixedPoint, ThermalAngleMatchesDouble) {
     const QCelsius hot = QT::celsius(2000.0);
     const QCelsius cold = QT::celsius(-2000.0);
     EXPECT_EQ(thermal_angle<Q30>(big, hot, hot, hot).raw, INT32_MAX);
-    EXPECT_EQ(thermal_angle<Q30>(big, cold, hot, hot).raw, INT32_MAX);  // -7.7 + 2*15.4 + quadratic rad
+    EXPECT_EQ(thermal_angle<Q30>(big, cold, hot, hot).raw, INT32_MAX);   // -7.7 + 2*15.4 + quadratic rad
     EXPECT_EQ(thermal_angle<Q30>(big, hot, cold, cold).raw, INT32_MIN);  // 7.7 - 2*15.4 + quadratic rad
 }
 
