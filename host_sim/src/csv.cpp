@@ -66,19 +66,24 @@ std::size_t count_line_ends(std::string_view text) noexcept {
 }
 
 bool BlockReader::next(std::string_view& block) {
-    // Keep the partial last line of the previous block.
-    std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
+    // Keep the partial last line of the previous block (none on the first call,
+    // when the buffer is not allocated yet: memmove must not see a null pointer).
+    if (size_ > consumed_) {
+        std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
+    }
     size_ -= consumed_;
     consumed_ = 0;
     lines_before_ += lines_in_last_;
     lines_in_last_ = 0;
-    const auto has_line_end = [&] { return std::memchr(buf_.get(), '\n', size_) != nullptr; };
+    const auto has_line_end = [&] { return size_ != 0 && std::memchr(buf_.get(), '\n', size_) != nullptr; };
     // Read until the buffer holds a block's worth with a line end (or the file ends).
     while (!eof_ && (size_ < block_bytes_ || !has_line_end())) {
         if (capacity_ - size_ < block_bytes_) {  // grow: first call, or a line longer than a block
             const std::size_t cap = std::max(2 * capacity_, size_ + block_bytes_);
             std::unique_ptr<char[]> bigger(new char[cap]);
-            std::memcpy(bigger.get(), buf_.get(), size_);
+            if (size_ != 0) {
+                std::memcpy(bigger.get(), buf_.get(), size_);
+            }
             buf_ = std::move(bigger);
             capacity_ = cap;
         }

@@ -16,10 +16,17 @@
 //                         nearest Q30 (ties towards +∞: + 2²⁹, arithmetic shift
 //                         right by 30), saturated.  Error ≤ 2⁻³¹.
 //      comparisons      : exact.
+//      dot, cross, squared_norm, quaternion product, boresight,
+//      renormalized_sum : overloads of the core's generic functions that sum
+//                         exact products in int64 and round and saturate once
+//                         per result (see "Sums of products" below).
+//      thermal_angle, thermal_rotation, beta_in_domain : Q30 versions of the
+//                         core's functions, each with its range argument.
+//    On a Cortex-M3 a product is one SMULL/SMLAL; no floating point is used.
 //  QCelsius (temperatures): signed Q11.20, value = raw·2⁻²⁰ °C, range ±2048 °C,
 //    resolution 9.5e-7 °C. The core accepts ±200 °C (temperature_in_domain), so
 //    a difference of two readings (≤ 400 °C) has |raw| < 2²⁹.
-//  QCoefficient (thermal-model coefficients, rad, rad/°C, rad/°C²): signed,
+//  QCoefficient (linear thermal-model coefficients, rad, rad/°C): signed,
 //    value = raw·2⁻³⁶, range ±2⁻⁵ = ±0.03125 (±6445"), resolution 1.5e-11
 //    (3e-6"). Model coefficients are below 1e-3 rad (c0) and 1e-5 rad/°C (the
 //    paper's Table 2: 2e-3 to 5"/°C), so the format has 5 bits of headroom above
@@ -373,8 +380,8 @@ constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
 // coefficients are all zero (the usual linear model): same result, fewer
 // instructions. A branch, not a loop: the instruction count stays bounded.
 template <>
-constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t1, const QCelsius& t2,
-                                 const QCelsius& t3) noexcept {
+[[gnu::always_inline]] constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t1,
+                                                        const QCelsius& t2, const QCelsius& t3) noexcept {
     constexpr int kSumFrac = QCoefficient::kFracBits + QCelsius::kFracBits;       // 56
     constexpr int kQuadShift = QQuadraticCoefficient::kFracBits + 12 - kSumFrac;  // 4
     const std::int32_t a = fx::clamp_celsius(t1.raw);
