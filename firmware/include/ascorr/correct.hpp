@@ -159,7 +159,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
         if (th.skip != 0U) {
             st |= th.skip;
         } else {
-            d = d + increment(th.q_th) * (q + d);
+            d = add_left_increment(d, th.q_th, q);
             st |= status::kThermalApplied;
         }
     }

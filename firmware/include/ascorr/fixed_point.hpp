@@ -474,4 +474,21 @@ constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
     return within(beta.x) && within(beta.y) && within(beta.z) && squared_norm(beta) <= lim2;
 }
 
+// add_left_increment (quaternion.hpp) in Q30: each component
+// dᵢ + Σ (r − 1)ⱼ·(q + d)ₖ summed exactly in int64 (dᵢ scaled to units 2⁻⁶⁰)
+// and rounded and saturated once. Range: q + d is a saturating sum (|·| ≤ 2);
+// for |r − 1| components ≤ 0.5 (a rotation's increment, here ≤ 3° of thermal
+// rotation: ≤ 0.03) each product is ≤ 2⁶⁰ and the sum ≤ 2⁶¹ + 4·2⁶⁰ < 2⁶³.
+constexpr Quaternion<Q30> add_left_increment(const Quaternion<Q30>& d, const SmallRotation<Q30>& r,
+                                             const Quaternion<Q30>& q) noexcept {
+    const Quaternion<Q30> s{q.w + d.w, q.x + d.x, q.y + d.y, q.z + d.z};
+    const Quaternion<Q30> a = increment(r);
+    const auto one = [](Q30 x) { return std::int64_t{x.raw} * (std::int64_t{1} << 30); };
+    const auto p = [](Q30 x, Q30 y) { return std::int64_t{x.raw} * y.raw; };
+    return {fx::narrow(one(d.w) + p(a.w, s.w) - p(a.x, s.x) - p(a.y, s.y) - p(a.z, s.z)),
+            fx::narrow(one(d.x) + p(a.w, s.x) + p(a.x, s.w) + p(a.y, s.z) - p(a.z, s.y)),
+            fx::narrow(one(d.y) + p(a.w, s.y) - p(a.x, s.z) + p(a.y, s.w) + p(a.z, s.x)),
+            fx::narrow(one(d.z) + p(a.w, s.z) + p(a.x, s.y) - p(a.y, s.x) + p(a.z, s.w))};
+}
+
 }  // namespace ascorr
