@@ -9,10 +9,12 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "ascorr/correct.hpp"
+#include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
@@ -48,7 +50,7 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
                 char buf[96];
                 std::snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
                               q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
-                              static_cast<double>(ScalarTraits<T>::unit_norm_tolerance));
+                              ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
                 why = buf;
                 break;
             }
@@ -182,11 +184,36 @@ std::size_t worker_count() {
     return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
 }
 
+// The fixed-point coefficient format holds ±ScalarTraits<Q30>::max_coefficient;
+// a model beyond it is refused rather than saturated.
+template <typename T>
+void check_model_range(const ModelFile& m, const std::string& path) {
+    if constexpr (std::is_same_v<T, Q30>) {
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t i = 0; i < 7; ++i) {
+                    const double c = m.coefficients[h][a][i];
+                    const double lim =
+                        i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
+                    if (!(std::abs(c * kArcsecToRad) < lim)) {
+                        throw std::runtime_error(path + ": " + "ABCD"[h] + " " + kAxisNames[a] + " " +
+                                                 kCoefficientNames[i] + " = " + std::to_string(c) +
+                                                 " is beyond the fixed-point coefficient range (+-" +
+                                                 std::to_string(lim * kRadToArcsec) + " arcsec)");
+                    }
+                }
+            }
+        }
+    }
+}
+
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     std::optional<ThermalModel<T>> model;
     if (opt.thermal && !opt.model.empty()) {
-        model = to_core<T>(read_model_file(opt.model));
+        const ModelFile m = read_model_file(opt.model);
+        check_model_range<T>(m, opt.model);
+        model = to_core<T>(m);
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
 
@@ -263,9 +290,9 @@ CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
         case Scalar::kFloat:
             return run<float>(opt, log);
         case Scalar::kFixed:
-            break;
+            return run<Q30>(opt, log);
     }
-    throw std::runtime_error("--scalar fixed: the fixed-point core is not part of this build yet");
+    throw std::logic_error("correct_file: unknown scalar type");
 }
 
 std::string describe(const CorrectSummary& s) {

@@ -66,8 +66,9 @@ std::size_t count_line_ends(std::string_view text) noexcept {
 }
 
 bool BlockReader::next(std::string_view& block) {
-    // Keep the partial last line of the previous block.
-    if (consumed_ != 0) {  // buf_ is null before the first read
+    // Keep the partial last line of the previous block (none on the first call,
+    // when the buffer is not allocated yet: memmove must not see a null pointer).
+    if (size_ > consumed_) {
         std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
     }
     size_ -= consumed_;

@@ -43,19 +43,12 @@ struct ObserverVelocity {
 };
 
 // True when beta is finite and inside the domain of the series below
-// (|v| ≤ kMaxObserverSpeedKmS, which also excludes |v| ≥ c).
+// (|v| ≤ kMaxObserverSpeedKmS, which also excludes |v| ≥ c). One comparison
+// decides: a NaN component makes |β|² NaN, which fails it; an infinite or
+// huge one makes |β|² infinite in floating point, or saturates it (≥ 2) in
+// fixed point, which fails it too.
 template <typename T>
 constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
-    if (!(is_finite(beta.x) && is_finite(beta.y) && is_finite(beta.z))) {
-        return false;
-    }
-    // Per-component check first, so that squaring cannot overflow a
-    // fixed-point format or a float with huge inputs.
-    const T lim = k<T>(kMaxBeta);
-    const auto within = [&](const T& c) { return c <= lim && -lim <= c; };
-    if (!(within(beta.x) && within(beta.y) && within(beta.z))) {
-        return false;
-    }
     return squared_norm(beta) <= k<T>(kMaxBeta * kMaxBeta);
 }
 

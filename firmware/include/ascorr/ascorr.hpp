@@ -10,11 +10,14 @@
 //   thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
 //   status.hpp         status bits of a corrected solution
 //   correct.hpp        correct_solution(): the per-solution entry point
+//   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
+//                      coefficient formats and thermal_angle)
 #pragma once
 
 #include "aberration.hpp"
 #include "constants.hpp"
 #include "correct.hpp"
+#include "fixed_point.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "status.hpp"

@@ -71,6 +71,18 @@ constexpr Rejection check_solution(const SolutionInput<T>& in) noexcept {
     return Rejection::kNone;
 }
 
+// The verdict of check_solution() == kNone with one comparison of the norm: a
+// component beyond 1 + tol makes ‖q‖² − 1 exceed tol; a NaN makes it NaN and
+// an infinite or huge one makes it infinite (floating point) or saturates it
+// (fixed point, ≥ 1), and either fails the test. Used on every solution;
+// check_solution() says why, for messages.
+template <typename T>
+constexpr bool solution_acceptable(const SolutionInput<T>& in) noexcept {
+    const T e = squared_norm(in.q_chu_icrf) - k<T>(1.0);
+    const T tol = ScalarTraits<T>::unit_norm_tolerance;
+    return in.head < kMaxHeads && e <= tol && -tol <= e;
+}
+
 // The thermal stage's rotation for one solution, or the bits that say why it
 // is skipped. Split out so that the host can report the angles it applied.
 template <typename T>
@@ -104,7 +116,7 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
     const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
     const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
     const T lim = k<T>(kMaxThermalAngleRad);
-    const auto within = [&](const T& a) { return is_finite(a) && a <= lim && -lim <= a; };
+    const auto within = [&](const T& a) { return a <= lim && -lim <= a; };  // false for NaN
     if (!(within(alpha) && within(beta) && within(gamma))) {
         out.skip = status::kThermalOutOfRange;
         return out;
@@ -119,7 +131,7 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
 // formed from small terms only, and q is rounded once, in renormalized_sum().
 template <typename T>
 constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
-    if (check_solution(in) != Rejection::kNone) {
+    if (!solution_acceptable(in)) {
         return {in.q_chu_icrf, status::kRejected};
     }
     StatusBits st = 0U;
@@ -147,7 +159,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
         if (th.skip != 0U) {
             st |= th.skip;
         } else {
-            d = d + increment(th.q_th) * (q + d);
+            d = add_left_increment(d, th.q_th, q);
             st |= status::kThermalApplied;
         }
     }

@@ -88,6 +88,14 @@ constexpr Quaternion<T> to_quaternion(const SmallRotation<T>& r) noexcept {
     return {k<T>(1.0) + r.dw, r.v.x, r.v.y, r.v.z};
 }
 
+// The increment after applying r on the left of the attitude q + d:
+// d + (r − 1) ⊗ (q + d), so that r ⊗ (q + d) = q + result.
+template <typename T>
+constexpr Quaternion<T> add_left_increment(const Quaternion<T>& d, const SmallRotation<T>& r,
+                                           const Quaternion<T>& q) noexcept {
+    return d + increment(r) * (q + d);
+}
+
 // (q + d) brought to unit norm by one Newton step, rounded once:
 //   q + [d + (q + d)·g],  g = (1 − ‖q + d‖²)/2,
 // with ‖q + d‖² − 1 = (‖q‖² − 1) + 2 q·d + ‖d‖² formed from small terms.

@@ -27,12 +27,14 @@ struct ScalarTraits;  // specialised per scalar type
 
 template <>
 struct ScalarTraits<double> {
-    using coefficient_type = double;  // thermal-model coefficients (rad, rad/°C, rad/°C²)
-    using temperature_type = double;  // °C
+    using coefficient_type = double;            // thermal-model coefficients (rad, rad/°C)
+    using quadratic_coefficient_type = double;  // quadratic thermal-model coefficients (rad/°C²)
+    using temperature_type = double;            // °C
     static constexpr double from_double(double x) noexcept { return x; }
     static constexpr double to_double(double x) noexcept { return x; }
     static constexpr double celsius(double x) noexcept { return x; }
     static constexpr double coefficient(double x) noexcept { return x; }
+    static constexpr double quadratic_coefficient(double x) noexcept { return x; }
     // |‖q‖² − 1| above this rejects a quaternion. Recorded files carry 15
     // decimals (‖q‖² − 1 ≈ 1e-15); 1e-6 leaves room for producers that
     // normalise in float, and is far below any real attitude error
@@ -43,11 +45,13 @@ struct ScalarTraits<double> {
 template <>
 struct ScalarTraits<float> {
     using coefficient_type = float;
+    using quadratic_coefficient_type = float;
     using temperature_type = float;
     static constexpr float from_double(double x) noexcept { return static_cast<float>(x); }
     static constexpr double to_double(float x) noexcept { return static_cast<double>(x); }
     static constexpr float celsius(double x) noexcept { return static_cast<float>(x); }
     static constexpr float coefficient(double x) noexcept { return static_cast<float>(x); }
+    static constexpr float quadratic_coefficient(double x) noexcept { return static_cast<float>(x); }
     // Rounding four float components leaves ‖q‖² − 1 up to ~4.8e-7.
     static constexpr float unit_norm_tolerance = 1e-5F;
 };
@@ -62,10 +66,13 @@ inline bool is_finite(float x) noexcept {
 }
 
 // A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a
-// format with range ±2; coefficients and temperatures need other formats, so
+// format with range ±2; coefficients (linear and quadratic, whose magnitudes
+// differ by 1e3–1e4) and temperatures need other formats, so
 // the core names them through these aliases. For float and double all are T.
 template <typename T>
 using Coefficient = typename ScalarTraits<T>::coefficient_type;
+template <typename T>
+using QuadraticCoefficient = typename ScalarTraits<T>::quadratic_coefficient_type;
 template <typename T>
 using Celsius = typename ScalarTraits<T>::temperature_type;
 

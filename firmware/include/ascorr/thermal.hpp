@@ -36,9 +36,9 @@ struct AxisPolynomial {
     Coefficient<T> c1;
     Coefficient<T> c2;
     Coefficient<T> c3;
-    Coefficient<T> c1_2;
-    Coefficient<T> c2_2;
-    Coefficient<T> c3_2;
+    QuadraticCoefficient<T> c1_2;
+    QuadraticCoefficient<T> c2_2;
+    QuadraticCoefficient<T> c3_2;
 };
 
 template <typename T>
@@ -67,11 +67,12 @@ struct HeadTemperatures {
     TemperatureReading<T> t_032;  // T3, THT00032, optical bench next to the SiC cube
 };
 
-// A usable temperature: finite and inside ±kMaxAbsTemperatureC.
+// A usable temperature: finite and inside ±kMaxAbsTemperatureC (a NaN fails
+// both comparisons, an infinity one of them).
 template <typename T>
 constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
     const Celsius<T> lim = ScalarTraits<T>::celsius(kMaxAbsTemperatureC);
-    return is_finite(t) && t <= lim && -lim <= t;
+    return t <= lim && -lim <= t;
 }
 
 // The model angle of one axis, in radians. A fixed-point scalar overloads this

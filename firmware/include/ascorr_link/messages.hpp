@@ -16,6 +16,7 @@
 #include <initializer_list>
 
 #include "ascorr/correct.hpp"
+#include "ascorr/fixed_point.hpp"
 #include "frame.hpp"
 
 namespace ascorr::link {
@@ -39,6 +40,32 @@ struct WireTraits<float> {
         return x;
     }
 };
+
+// Fixed-point types travel as their raw two's-complement integers, so the
+// target computes with exactly the values the host's fixed-point core uses.
+template <typename U>
+struct RawWire {
+    static std::uint32_t encode(U x) noexcept {
+        std::uint32_t w = 0;
+        std::memcpy(&w, &x.raw, sizeof w);
+        return w;
+    }
+    static U decode(std::uint32_t w) noexcept {
+        U x{};
+        std::memcpy(&x.raw, &w, sizeof w);
+        return x;
+    }
+};
+template <>
+struct WireTraits<Q30> : RawWire<Q30> {
+    static constexpr std::uint8_t kKind = 2;  // Q30 core (fixed_point.hpp)
+};
+template <>
+struct WireTraits<QCelsius> : RawWire<QCelsius> {};
+template <>
+struct WireTraits<QCoefficient> : RawWire<QCoefficient> {};
+template <>
+struct WireTraits<QQuadraticCoefficient> : RawWire<QQuadraticCoefficient> {};
 
 enum class MessageType : std::uint8_t {
     kHello = 1,              // target → host: boot id, protocol, scalar kind
@@ -179,7 +206,10 @@ std::size_t encode(const ModelUpload<T>& m, std::uint8_t* out) noexcept {
     w.u8(m.head);
     w.u8(m.model.present ? 1U : 0U);
     for (const AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
-        for (const Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3, &a->c1_2, &a->c2_2, &a->c3_2}) {
+        for (const Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3}) {
+            w.word(*c);
+        }
+        for (const QuadraticCoefficient<T>* c : {&a->c1_2, &a->c2_2, &a->c3_2}) {
             w.word(*c);
         }
     }
@@ -194,7 +224,12 @@ bool decode(const std::uint8_t* p, std::size_t n, ModelUpload<T>& m) noexcept {
     }
     m.model.present = present == 1U;
     for (AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
-        for (Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3, &a->c1_2, &a->c2_2, &a->c3_2}) {
+        for (Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3}) {
+            if (!r.word(*c)) {
+                return false;
+            }
+        }
+        for (QuadraticCoefficient<T>* c : {&a->c1_2, &a->c2_2, &a->c3_2}) {
             if (!r.word(*c)) {
                 return false;
             }

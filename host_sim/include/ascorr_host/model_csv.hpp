@@ -41,7 +41,8 @@ ThermalModel<T> to_core(const ModelFile& m) {
         for (std::size_t a = 0; a < 3; ++a) {
             const auto& c = m.coefficients[h][a];
             const auto r = [&](std::size_t i) { return ScalarTraits<T>::coefficient(c[i] * kArcsecToRad); };
-            *axes[a] = {r(0), r(1), r(2), r(3), r(4), r(5), r(6)};
+            const auto r2 = [&](std::size_t i) { return ScalarTraits<T>::quadratic_coefficient(c[i] * kArcsecToRad); };
+            *axes[a] = {r(0), r(1), r(2), r(3), r2(4), r2(5), r2(6)};
         }
     }
     return out;

@@ -1,0 +1,253 @@
+// bench/host_bench.cpp: the host figures of toolchain/run-target-bench.
+//
+//   ascorr_host_bench DIR RUNS
+// reads DIR/vectors.bin (tests/target_vectors.cpp), takes its first 32 fully
+// correctable random inputs (as bench/target_bench.cpp does) and corrects
+// RUNS solutions in each extern "C" function ascorr_bench_<scalar>_<stage>
+// (double, float, fixed core; the baseline of bench/baseline.hpp), and RUNS
+// copies in ascorr_bench_overhead. Run under valgrind --tool=callgrind, the
+// inclusive instruction count of each function minus the overhead's, over
+// RUNS, is the host's instructions per solution. It also prints the
+// baseline's largest difference from the double core over all 2000+ inputs:
+// "baseline_max_error_arcsec x".
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "ascorr/ascorr.hpp"
+#include "baseline.hpp"
+#include "target/vector_format.hpp"
+
+namespace {
+
+using namespace ascorr;
+using namespace ascorr::target;
+
+constexpr std::size_t kInputs = 32;
+std::uint32_t g_runs = 0;
+std::vector<VectorRecord> g_records;
+ModelRecord g_model_records[kModels];
+
+template <typename T>
+struct Fixture {
+    SolutionInput<T> in[kInputs];
+    ThermalModel<T> model[kModels];
+};
+
+template <typename T>
+Fixture<T> make_fixture() {
+    using Tr = ScalarTraits<T>;
+    Fixture<T> fx{};
+    for (std::size_t m = 0; m < kModels; ++m) {
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            fx.model[m].head[h].present = g_model_records[m].present[h] != 0U;
+            AxisPolynomial<T>* axes[3] = {&fx.model[m].head[h].alpha, &fx.model[m].head[h].beta,
+                                          &fx.model[m].head[h].gamma};
+            for (std::size_t a = 0; a < 3; ++a) {
+                const double* c = g_model_records[m].coefficient[h][a];
+                *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
+                            Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
+                            Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
+                            Tr::quadratic_coefficient(c[6])};
+            }
+        }
+    }
+    for (std::size_t i = 0; i < kInputs; ++i) {
+        const VectorRecord& r = g_records[i];
+        fx.in[i].q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
+                               Tr::from_double(r.q[3])};
+        fx.in[i].head = static_cast<std::uint8_t>(r.head);
+        fx.in[i].temperatures = {{Tr::celsius(r.temperature[0]), true},
+                                 {Tr::celsius(r.temperature[1]), true},
+                                 {Tr::celsius(r.temperature[2]), true}};
+        fx.in[i].velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
+                             Tr::from_double(r.inv_sun_distance_au),
+                             true};
+    }
+    return fx;
+}
+
+volatile std::uint32_t g_sink;
+
+template <typename T>
+__attribute__((noinline)) void run_core(const Fixture<T>& fx, const CorrectionConfig<T>& cfg) {
+    for (std::uint32_t i = 0; i < g_runs; ++i) {
+        g_sink = correct_solution(fx.in[i % kInputs], cfg).status;
+    }
+}
+
+bench::BaselineInput g_baseline_in[kInputs];
+bench::BaselineModel g_baseline_model[kModels];
+
+bench::BaselineInput baseline_input(const VectorRecord& r) {
+    return {{r.q[0], r.q[1], r.q[2], r.q[3]},
+            r.head,
+            {r.temperature[0], r.temperature[1], r.temperature[2]},
+            r.temperature_valid == 7U,
+            {r.beta[0], r.beta[1], r.beta[2]},
+            r.inv_sun_distance_au,
+            r.velocity_valid != 0U};
+}
+
+__attribute__((noinline)) void run_baseline(const bench::BaselineModel* model, bool ab) {
+    volatile double sink = 0.0;
+    for (std::uint32_t i = 0; i < g_runs; ++i) {
+        sink = bench::baseline_correct(g_baseline_in[i % kInputs], model, ab).q[0];
+    }
+    (void)sink;
+}
+
+Fixture<double> g_double;
+Fixture<float> g_float;
+Fixture<Q30> g_fixed;
+
+template <typename T>
+void run_stages(const Fixture<T>& fx, int stage) {
+    const CorrectionConfig<T> cfg[] = {
+        {true, &fx.model[0]}, {true, nullptr}, {false, &fx.model[0]}, {true, &fx.model[1]}, {false, &fx.model[1]}};
+    run_core(fx, cfg[stage]);
+}
+
+void run_baseline_stage(int stage) {
+    const bench::BaselineModel* m[] = {&g_baseline_model[0], nullptr, &g_baseline_model[0], &g_baseline_model[1],
+                                       &g_baseline_model[1]};
+    const bool ab[] = {true, true, false, true, false};
+    run_baseline(m[stage], ab[stage]);
+}
+
+}  // namespace
+
+// One function per figure, for callgrind's inclusive counts.
+#define ASCORR_BENCH_STAGES(scalar, call)                                                   \
+    extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_both() {              \
+        call(0);                                                                            \
+    }                                                                                       \
+    extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_aberration() {        \
+        call(1);                                                                            \
+    }                                                                                       \
+    extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_thermal() {           \
+        call(2);                                                                            \
+    }                                                                                       \
+    extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_both_quadratic() {    \
+        call(3);                                                                            \
+    }                                                                                       \
+    extern "C" __attribute__((noinline)) void ascorr_bench_##scalar##_thermal_quadratic() { \
+        call(4);                                                                            \
+    }
+
+#define ASCORR_CALL_DOUBLE(s) run_stages(g_double, s)
+#define ASCORR_CALL_FLOAT(s) run_stages(g_float, s)
+#define ASCORR_CALL_FIXED(s) run_stages(g_fixed, s)
+#define ASCORR_CALL_BASELINE(s) run_baseline_stage(s)
+ASCORR_BENCH_STAGES(double, ASCORR_CALL_DOUBLE)
+ASCORR_BENCH_STAGES(float, ASCORR_CALL_FLOAT)
+ASCORR_BENCH_STAGES(fixed, ASCORR_CALL_FIXED)
+ASCORR_BENCH_STAGES(baseline, ASCORR_CALL_BASELINE)
+
+extern "C" __attribute__((noinline)) void ascorr_bench_overhead() {
+    for (std::uint32_t i = 0; i < g_runs; ++i) {
+        g_sink = static_cast<std::uint32_t>(g_fixed.in[i % kInputs].q_chu_icrf.w.raw);
+    }
+}
+
+int main(int argc, char** argv) {
+    if (argc != 3) {
+        std::fputs("usage: ascorr_host_bench DIR RUNS\n", stderr);
+        return 2;
+    }
+    g_runs = static_cast<std::uint32_t>(std::stoul(argv[2]));
+    std::ifstream f(std::string(argv[1]) + "/vectors.bin", std::ios::binary);
+    VectorHeader header{};
+    f.read(reinterpret_cast<char*>(&header), sizeof header);
+    if (!f || header.magic != kVectorMagic) {
+        std::fputs("ascorr_host_bench: cannot read vectors.bin\n", stderr);
+        return 1;
+    }
+    std::vector<VectorRecord> all(header.count);
+    f.read(reinterpret_cast<char*>(all.data()), static_cast<std::streamsize>(all.size() * sizeof(VectorRecord)));
+    for (const VectorRecord& r : all) {
+        const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+        const bool good = r.model == 1U && r.temperature_valid == 7U && r.velocity_valid != 0U && r.head < 3U &&
+                          std::fabs(n2 - 1.0) < 1e-9 && std::fabs(r.temperature[1]) < 200.0 &&
+                          std::fabs(r.temperature[2]) < 200.0 && std::fabs(r.beta[0]) < 1e-3 &&
+                          std::fabs(r.beta[1]) < 1e-3;
+        if (good && g_records.size() < kInputs) {
+            g_records.push_back(r);
+        }
+    }
+    if (g_records.size() != kInputs) {
+        std::fputs("ascorr_host_bench: not enough inputs\n", stderr);
+        return 1;
+    }
+    for (std::size_t m = 0; m < kModels; ++m) {
+        g_model_records[m] = header.model[m];
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            g_baseline_model[m].present[h] = header.model[m].present[h] != 0U;
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t c = 0; c < 7; ++c) {
+                    g_baseline_model[m].coefficient[h][a][c] = header.model[m].coefficient[h][a][c];
+                }
+            }
+        }
+    }
+    for (std::size_t i = 0; i < kInputs; ++i) {
+        g_baseline_in[i] = baseline_input(g_records[i]);
+    }
+    g_double = make_fixture<double>();
+    g_float = make_fixture<float>();
+    g_fixed = make_fixture<Q30>();
+
+    ascorr_bench_overhead();
+    ascorr_bench_double_both();
+    ascorr_bench_double_aberration();
+    ascorr_bench_double_thermal();
+    ascorr_bench_double_both_quadratic();
+    ascorr_bench_double_thermal_quadratic();
+    ascorr_bench_float_both();
+    ascorr_bench_float_aberration();
+    ascorr_bench_float_thermal();
+    ascorr_bench_float_both_quadratic();
+    ascorr_bench_float_thermal_quadratic();
+    ascorr_bench_fixed_both();
+    ascorr_bench_fixed_aberration();
+    ascorr_bench_fixed_thermal();
+    ascorr_bench_fixed_both_quadratic();
+    ascorr_bench_fixed_thermal_quadratic();
+    ascorr_bench_baseline_both();
+    ascorr_bench_baseline_aberration();
+    ascorr_bench_baseline_thermal();
+    ascorr_bench_baseline_both_quadratic();
+    ascorr_bench_baseline_thermal_quadratic();
+
+    // The baseline against the double core, every input and configuration it
+    // corrects alike (same rules for missing inputs; no domain checks).
+    double worst = 0.0;
+    const ThermalModel<double>* models[kModels] = {&g_double.model[0], &g_double.model[1]};
+    for (const VectorRecord& r : all) {
+        const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+        if (!(std::fabs(n2 - 1.0) < 1e-9) || r.head >= 3U || !(std::fabs(r.temperature[1]) < 200.0) ||
+            !(std::fabs(r.temperature[2]) < 200.0) || !(std::fabs(r.beta[0]) < 1e-3) ||
+            !(std::fabs(r.beta[1]) < 1e-3)) {
+            continue;
+        }
+        SolutionInput<double> in{};
+        in.q_chu_icrf = {r.q[0], r.q[1], r.q[2], r.q[3]};
+        in.head = static_cast<std::uint8_t>(r.head);
+        const bool tv = r.temperature_valid == 7U;
+        in.temperatures = {{r.temperature[0], tv}, {r.temperature[1], tv}, {r.temperature[2], tv}};
+        in.velocity = {{r.beta[0], r.beta[1], r.beta[2]}, r.inv_sun_distance_au, r.velocity_valid != 0U};
+        const auto ref = correct_solution(in, CorrectionConfig<double>{true, models[r.model]});
+        const bench::BaselineModel* bm = &g_baseline_model[r.model];
+        const auto got = bench::baseline_correct(baseline_input(r), bm, true);
+        const Eigen::Quaterniond d =
+            Eigen::Quaterniond(ref.q_chu_icrf.w, ref.q_chu_icrf.x, ref.q_chu_icrf.y, ref.q_chu_icrf.z).conjugate() *
+            Eigen::Quaterniond(got.q[0], got.q[1], got.q[2], got.q[3]);
+        worst = std::max(worst, 2.0 * std::asin(std::min(1.0, d.vec().norm())) * kRadToArcsec);
+    }
+    std::printf("baseline_max_error_arcsec %.3g\n", worst);
+    return 0;
+}

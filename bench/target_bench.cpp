@@ -1,0 +1,235 @@
+// bench/target_bench.cpp: instructions per corrected solution on a target,
+// under QEMU with -icount shift=0 (toolchain/qemu-run).
+//
+// SysTick runs from the core clock (25 MHz) without interrupt; with icount
+// every instruction is 1 ns of virtual time, so a SysTick count is 40
+// instructions. The ratio is measured, not assumed: a loop of known length
+// (2 instructions per iteration) calibrates it. For each scalar and stage the
+// core (the out-of-line entry of firmware/app/core_entry_*.cpp, called through
+// a pointer) corrects kRuns solutions cycling over kInputs prepared inputs;
+// the same loop calling a function that only copies its input is subtracted,
+// so the figure is the call of the core and nothing else. Inputs are the first
+// kInputs random records of vectors.bin (tests/target_vectors.cpp) that the
+// core corrects fully (status 3), with the Table 2 model (linear, as flown) and
+// with the random model with quadratic terms (stages *_quadratic).
+// The baseline (bench/baseline.hpp, double, Eigen) is measured the same way.
+// Output: one line per figure, "bench <scalar> <stage> <instructions>".
+#include <cstdint>
+#include <cstdio>
+
+#include "ascorr/fixed_point.hpp"
+#include "baseline.hpp"
+#include "board.hpp"
+#include "core_entry.hpp"
+#include "vector_format.hpp"
+
+namespace {
+
+using namespace ascorr;
+using namespace ascorr::target;
+namespace board = ascorr::app::board;
+
+constexpr std::uint32_t kInputs = 32;
+constexpr std::uint32_t kRuns = 2048;  // per figure; the longest block (baseline) stays below 2^24 counts
+
+VectorRecord g_records[kInputs];
+volatile std::uint16_t g_sink_status;  // results are stored, so that calls cannot be dropped
+volatile double g_sink_q;
+ModelRecord g_model_records[kModels];
+
+// SysTick counts elapsed while `body` runs (< 2^24).
+template <typename F>
+std::uint32_t counts(F&& body) {
+    board::systick_start(board::kSysTickMax + 1U, false);
+    const std::uint32_t start = board::systick_value();
+    body();
+    const std::uint32_t end = board::systick_value();
+    return (start - end) & board::kSysTickMax;
+}
+
+// Instructions per SysTick count, from a loop of 2 instructions per iteration.
+std::uint32_t instructions_per_count() {
+    constexpr std::uint32_t kIterations = 1U << 20;
+    const std::uint32_t c = counts([] {
+        std::uint32_t n = kIterations;
+        __asm__ volatile("1: subs %0, %0, #1\n bne 1b" : "+r"(n) : : "cc");
+    });
+    return (2U * kIterations + c / 2U) / c;
+}
+
+template <typename T>
+struct Fixture {
+    SolutionInput<T> in[kInputs];
+    ThermalModel<T> model[kModels];  // 0: Table 2 (linear), 1: random with quadratic terms
+};
+
+template <typename T>
+using CoreFn = CorrectedSolution<T> (*)(const SolutionInput<T>&, const CorrectionConfig<T>&) noexcept;
+
+template <typename T>
+__attribute__((noinline)) CorrectedSolution<T> copy_only(const SolutionInput<T>& in,
+                                                         const CorrectionConfig<T>& /*cfg*/) noexcept {
+    return {in.q_chu_icrf, 0U};
+}
+
+template <typename T>
+__attribute__((noinline)) CorrectedSolution<T> core(const SolutionInput<T>& in,
+                                                    const CorrectionConfig<T>& cfg) noexcept {
+    return app::correct(in, cfg);
+}
+
+template <typename T>
+std::uint32_t run(volatile CoreFn<T> fn, const Fixture<T>& fx, const CorrectionConfig<T>& cfg) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kRuns; ++i) {
+            g_sink_status = fn(fx.in[i % kInputs], cfg).status;
+        }
+    });
+}
+
+void report(const char* scalar, const char* stage, std::uint32_t c, std::uint32_t c0, std::uint32_t ipc) {
+    const std::uint32_t per = ((c - c0) * ipc + kRuns / 2U) / kRuns;
+    std::printf("bench %s %s %u\n", scalar, stage, static_cast<unsigned>(per));
+}
+
+template <typename T>
+void bench_scalar(const char* name, Fixture<T>& fx, std::uint32_t ipc) {
+    using Tr = ScalarTraits<T>;
+    for (std::uint32_t m = 0; m < kModels; ++m) {
+        ThermalModel<T>& model = fx.model[m];
+        for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
+            model.head[h].present = g_model_records[m].present[h] != 0U;
+            AxisPolynomial<T>* axes[3] = {&model.head[h].alpha, &model.head[h].beta, &model.head[h].gamma};
+            for (std::uint32_t a = 0; a < 3; ++a) {
+                const double* c = g_model_records[m].coefficient[h][a];
+                *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
+                            Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
+                            Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
+                            Tr::quadratic_coefficient(c[6])};
+            }
+        }
+    }
+    for (std::uint32_t i = 0; i < kInputs; ++i) {
+        const VectorRecord& r = g_records[i];
+        fx.in[i].q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
+                               Tr::from_double(r.q[3])};
+        fx.in[i].head = static_cast<std::uint8_t>(r.head);
+        fx.in[i].temperatures = {{Tr::celsius(r.temperature[0]), true},
+                                 {Tr::celsius(r.temperature[1]), true},
+                                 {Tr::celsius(r.temperature[2]), true}};
+        fx.in[i].velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
+                             Tr::from_double(r.inv_sun_distance_au),
+                             true};
+    }
+    const CorrectionConfig<T> both{true, &fx.model[0]};
+    const CorrectionConfig<T> aberration{true, nullptr};
+    const CorrectionConfig<T> thermal{false, &fx.model[0]};
+    const CorrectionConfig<T> both_quadratic{true, &fx.model[1]};
+    const CorrectionConfig<T> thermal_quadratic{false, &fx.model[1]};
+    const std::uint32_t c0 = run<T>(&copy_only<T>, fx, both);
+    report(name, "both", run<T>(&core<T>, fx, both), c0, ipc);
+    report(name, "aberration", run<T>(&core<T>, fx, aberration), c0, ipc);
+    report(name, "thermal", run<T>(&core<T>, fx, thermal), c0, ipc);
+    report(name, "both_quadratic", run<T>(&core<T>, fx, both_quadratic), c0, ipc);
+    report(name, "thermal_quadratic", run<T>(&core<T>, fx, thermal_quadratic), c0, ipc);
+}
+
+using BaselineFn = bench::BaselineOutput (*)(const bench::BaselineInput&, const bench::BaselineModel*, bool);
+
+__attribute__((noinline)) bench::BaselineOutput baseline_copy(const bench::BaselineInput& in,
+                                                              const bench::BaselineModel* /*model*/, bool /*ab*/) {
+    return {{in.q[0], in.q[1], in.q[2], in.q[3]}};
+}
+
+__attribute__((noinline)) bench::BaselineOutput baseline(const bench::BaselineInput& in,
+                                                         const bench::BaselineModel* model, bool ab) {
+    return bench::baseline_correct(in, model, ab);
+}
+
+bench::BaselineInput g_baseline_in[kInputs];
+bench::BaselineModel g_baseline_model[kModels];
+
+std::uint32_t run_baseline(volatile BaselineFn fn, const bench::BaselineModel* model, bool ab) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kRuns; ++i) {
+            g_sink_q = fn(g_baseline_in[i % kInputs], model, ab).q[0];
+        }
+    });
+}
+
+void bench_baseline(std::uint32_t ipc) {
+    for (std::uint32_t m = 0; m < kModels; ++m) {
+        for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
+            g_baseline_model[m].present[h] = g_model_records[m].present[h] != 0U;
+            for (std::uint32_t a = 0; a < 3; ++a) {
+                for (std::uint32_t c = 0; c < 7; ++c) {
+                    g_baseline_model[m].coefficient[h][a][c] = g_model_records[m].coefficient[h][a][c];
+                }
+            }
+        }
+    }
+    for (std::uint32_t i = 0; i < kInputs; ++i) {
+        const VectorRecord& r = g_records[i];
+        g_baseline_in[i] = {{r.q[0], r.q[1], r.q[2], r.q[3]},
+                            r.head,
+                            {r.temperature[0], r.temperature[1], r.temperature[2]},
+                            true,
+                            {r.beta[0], r.beta[1], r.beta[2]},
+                            r.inv_sun_distance_au,
+                            true};
+    }
+    const std::uint32_t c0 = run_baseline(&baseline_copy, &g_baseline_model[0], true);
+    report("baseline", "both", run_baseline(&baseline, &g_baseline_model[0], true), c0, ipc);
+    report("baseline", "aberration", run_baseline(&baseline, nullptr, true), c0, ipc);
+    report("baseline", "thermal", run_baseline(&baseline, &g_baseline_model[0], false), c0, ipc);
+    report("baseline", "both_quadratic", run_baseline(&baseline, &g_baseline_model[1], true), c0, ipc);
+    report("baseline", "thermal_quadratic", run_baseline(&baseline, &g_baseline_model[1], false), c0, ipc);
+}
+
+Fixture<Q30> g_fixed;
+#if !defined(ASCORR_TARGET_FIXED)
+Fixture<float> g_float;
+#endif
+
+}  // namespace
+
+int main() {
+    std::FILE* f = std::fopen("vectors.bin", "rb");
+    static VectorHeader header;
+    if (f == nullptr || std::fread(&header, sizeof header, 1, f) != 1 || header.magic != kVectorMagic) {
+        std::fputs("bench: cannot read vectors.bin\n", stderr);
+        return 1;
+    }
+    std::uint32_t n = 0;
+    for (std::uint32_t i = 0; i < header.count && n < kInputs; ++i) {
+        VectorRecord r{};
+        if (std::fread(&r, sizeof r, 1, f) != 1) {
+            break;
+        }
+        // Random inputs that every configuration corrects fully (the bad
+        // inputs of the set take shorter paths and are left out).
+        const double n2 = r.q[0] * r.q[0] + r.q[1] * r.q[1] + r.q[2] * r.q[2] + r.q[3] * r.q[3];
+        const bool good = r.model == 1U && r.temperature_valid == 7U && r.velocity_valid != 0U && r.head < 3U &&
+                          n2 < 1.0 + 1e-9 && n2 > 1.0 - 1e-9 && r.temperature[1] < 200.0 && r.temperature[2] < 200.0 &&
+                          r.beta[0] < 1e-3 && r.beta[1] < 1e-3 && r.beta[0] > -1e-3 && r.beta[1] > -1e-3;
+        if (good) {
+            g_records[n++] = r;
+        }
+    }
+    std::fclose(f);
+    if (n != kInputs) {
+        std::fputs("bench: not enough inputs in vectors.bin\n", stderr);
+        return 1;
+    }
+    for (std::uint32_t m = 0; m < kModels; ++m) {
+        g_model_records[m] = header.model[m];
+    }
+    const std::uint32_t ipc = instructions_per_count();
+    std::printf("bench calibration %u instructions per SysTick count\n", static_cast<unsigned>(ipc));
+#if !defined(ASCORR_TARGET_FIXED)
+    bench_scalar<float>("float", g_float, ipc);
+#endif
+    bench_scalar<Q30>("fixed", g_fixed, ipc);
+    bench_baseline(ipc);
+    return 0;
+}

@@ -1,0 +1,28 @@
+// firmware/app/temperature_source.hpp: where the correction loop takes its
+// temperatures from.
+//
+// Conventions: one table in static storage, HeadTemperatures per head (T_CHU,
+// THT00029, THT00032 in the core's Celsius format, each with a valid flag).
+// The producer refreshes it once per 22 Hz cycle, before the heads are
+// corrected, in the same execution context as the loop (no locking). A reading
+// the producer could not make or withholds as stale has valid = false; the core
+// then skips the thermal stage and flags it (status 8). Today's producer is a
+// simulation (simulated_temperatures.cpp); the HAL (hal/, thermistor
+// acquisition) implements these two functions instead.
+#pragma once
+
+#include <cstdint>
+
+#include "app_scalar.hpp"
+#include "ascorr/thermal.hpp"
+
+namespace ascorr::app {
+
+// Refreshes the readings for cycle `cycle`. Bounded time, never blocks.
+void temperatures_update(std::uint32_t cycle) noexcept;
+
+// The readings of `head` for the current cycle; head ≥ kMaxHeads gets a
+// table entry whose readings are all invalid.
+const HeadTemperatures<Scalar>& temperatures_of(std::uint8_t head) noexcept;
+
+}  // namespace ascorr::app

@@ -1,0 +1,107 @@
+// tests/target/accuracy_main.cpp: runs the core on a target under QEMU over the
+// inputs in vectors.bin (written by the host, tests/target_vectors.cpp) and
+// writes results.bin for the host to compare with the double reference.
+//
+// One image per scalar (ASCORR_TARGET_FIXED: Q30, else float). The conversion
+// of inputs from double happens here, at run time, so this image (unlike the
+// flight application) links floating-point routines; the core itself is the
+// same object the application uses (firmware/app/core_entry_*.cpp).
+// Exit status: 0 after writing every result, 1 on an I/O or format error.
+#include <cstdint>
+#include <cstdio>
+
+#include "ascorr/fixed_point.hpp"
+#include "core_entry.hpp"
+#include "vector_format.hpp"
+
+namespace {
+
+using namespace ascorr;
+using namespace ascorr::target;
+
+#if defined(ASCORR_TARGET_FIXED)
+using T = Q30;
+#else
+using T = float;
+#endif
+using Tr = ScalarTraits<T>;
+
+ThermalModel<T> convert(const ModelRecord& m) {
+    ThermalModel<T> out{};
+    for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
+        out.head[h].present = m.present[h] != 0U;
+        AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
+        for (std::uint32_t a = 0; a < 3; ++a) {
+            const double* c = m.coefficient[h][a];
+            *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
+                        Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
+                        Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
+                        Tr::quadratic_coefficient(c[6])};
+        }
+    }
+    return out;
+}
+
+SolutionInput<T> convert(const VectorRecord& r) {
+    SolutionInput<T> in{};
+    in.q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
+                     Tr::from_double(r.q[3])};
+    in.head = static_cast<std::uint8_t>(r.head < 255U ? r.head : 255U);
+    in.temperatures.t_chu = {Tr::celsius(r.temperature[0]), (r.temperature_valid & 1U) != 0U};
+    in.temperatures.t_029 = {Tr::celsius(r.temperature[1]), (r.temperature_valid & 2U) != 0U};
+    in.temperatures.t_032 = {Tr::celsius(r.temperature[2]), (r.temperature_valid & 4U) != 0U};
+    in.velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
+                   Tr::from_double(r.inv_sun_distance_au),
+                   r.velocity_valid != 0U};
+    return in;
+}
+
+ThermalModel<T> g_models[kModels];
+
+}  // namespace
+
+int main() {
+    std::FILE* in = std::fopen("vectors.bin", "rb");
+    std::FILE* out = std::fopen("results.bin", "wb");
+    if (in == nullptr || out == nullptr) {
+        std::fputs("target: cannot open vectors.bin or results.bin\n", stderr);
+        return 1;
+    }
+    static VectorHeader header;
+    if (std::fread(&header, sizeof header, 1, in) != 1 || header.magic != kVectorMagic) {
+        std::fputs("target: bad vectors.bin header\n", stderr);
+        return 1;
+    }
+    for (std::uint32_t m = 0; m < kModels; ++m) {
+        g_models[m] = convert(header.model[m]);
+    }
+    for (std::uint32_t i = 0; i < header.count; ++i) {  // count is bounded by the file
+        VectorRecord r{};
+        if (std::fread(&r, sizeof r, 1, in) != 1 || r.model >= kModels) {
+            std::fputs("target: short or bad vectors.bin\n", stderr);
+            return 1;
+        }
+        const SolutionInput<T> s = convert(r);
+        const ThermalModel<T>* model = &g_models[r.model];
+        const CorrectionConfig<T> cfgs[kConfigs] = {{true, nullptr}, {false, model}, {true, model}};
+        ResultRecord res{};
+        for (int c = 0; c < kConfigs; ++c) {
+            const CorrectedSolution<T> o = app::correct(s, cfgs[c]);
+            res.q[c][0] = Tr::to_double(o.q_chu_icrf.w);
+            res.q[c][1] = Tr::to_double(o.q_chu_icrf.x);
+            res.q[c][2] = Tr::to_double(o.q_chu_icrf.y);
+            res.q[c][3] = Tr::to_double(o.q_chu_icrf.z);
+            res.status[c] = o.status;
+        }
+        if (std::fwrite(&res, sizeof res, 1, out) != 1) {
+            std::fputs("target: cannot write results.bin\n", stderr);
+            return 1;
+        }
+    }
+    std::fclose(in);
+    if (std::fclose(out) != 0) {
+        return 1;
+    }
+    std::printf("target: %u solutions corrected in 3 configurations\n", static_cast<unsigned>(header.count));
+    return 0;
+}

@@ -1,0 +1,66 @@
+# toolchain/targets.cmake: the Cortex-M builds and their tests, driven from the
+# host build (included by the top CMakeLists.txt when ASCORR_TARGETS is ON; the
+# `ci` preset sets it).
+#
+# Each target is a separate CMake build of this source tree with its toolchain
+# file (ExternalProject, binary dir <host build>/<target>), so that host and
+# cross flags never mix; it is rebuilt whenever the host build is (BUILD_ALWAYS,
+# a no-op when nothing changed). The images run under QEMU in CTest, label
+# `target`:
+#   target_<t>_accuracy_<scalar>   worked examples + random set vs the double core
+#   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun
+#   target_cortex-m3_no_soft_float the M3 application image has no soft-float
+#                                  routine (and its negative control: the M3
+#                                  accuracy image, which converts doubles, has)
+include(ExternalProject)
+find_program(ASCORR_ARM_GXX arm-none-eabi-g++ REQUIRED)
+find_program(ASCORR_ARM_NM arm-none-eabi-nm REQUIRED)
+find_program(ASCORR_QEMU qemu-system-arm REQUIRED)
+
+add_executable(ascorr_target_vectors ${PROJECT_SOURCE_DIR}/tests/target_vectors.cpp)
+target_include_directories(ascorr_target_vectors PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(ascorr_target_vectors PRIVATE ascorr_host ascorr_warnings)
+target_compile_definitions(ascorr_target_vectors PRIVATE ASCORR_TEST_DATA="${PROJECT_SOURCE_DIR}/tests/data")
+
+set(ASCORR_TARGET_LIST cortex-m3 cortex-m4f)
+set(machine_cortex-m3 mps2-an385)
+set(machine_cortex-m4f mps2-an386)
+set(scalars_cortex-m3 fixed)
+set(scalars_cortex-m4f float fixed)
+set(bound_fixed 0.01)
+set(bound_float 0.05)
+
+foreach(t ${ASCORR_TARGET_LIST})
+  set(bin ${CMAKE_BINARY_DIR}/${t})
+  ExternalProject_Add(ascorr_${t}
+    SOURCE_DIR ${PROJECT_SOURCE_DIR}
+    BINARY_DIR ${bin}
+    CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchain/${t}.cmake
+               -DASCORR_BUILD_HOST=OFF -DASCORR_WERROR=${ASCORR_WERROR}
+               -DCMAKE_BUILD_TYPE=Release
+    BUILD_ALWAYS ON
+    INSTALL_COMMAND ""
+    USES_TERMINAL_BUILD ON)
+  foreach(scalar ${scalars_${t}})
+    add_test(NAME target_${t}_accuracy_${scalar}
+             COMMAND ${PROJECT_SOURCE_DIR}/tests/target/run-accuracy $<TARGET_FILE:ascorr_target_vectors>
+                     ${machine_${t}} ${bin}/tests/target/ascorr_target_accuracy_${scalar}.elf ${bound_${scalar}}
+                     ${CMAKE_BINARY_DIR}/target-runs/${t}-${scalar})
+    set_tests_properties(target_${t}_accuracy_${scalar} PROPERTIES LABELS target TIMEOUT 120)
+  endforeach()
+  add_test(NAME target_${t}_firmware
+           COMMAND ${PROJECT_SOURCE_DIR}/toolchain/qemu-run ${machine_${t}} ${bin}/firmware/app/ascorr_firmware.elf)
+  # 352 cycles, no overrun; heads A and B corrected every cycle; head C loses
+  # T_029 for one simulated second in 16 (status 1|2|8 seen); head D has no model.
+  set_tests_properties(target_${t}_firmware PROPERTIES LABELS target TIMEOUT 60
+    PASS_REGULAR_EXPRESSION "352 cycles at 22 Hz, overruns 0.*head 0: applied 352 status seen 3 .*head 1: applied 352 status seen 3 .*head 2: applied 330 status seen 11 .*head 3: applied 0 status seen 257 ")
+endforeach()
+
+add_test(NAME target_cortex-m3_no_soft_float
+         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
+                 ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/ascorr_firmware.elf)
+add_test(NAME target_cortex-m3_no_soft_float_control
+         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
+                 ${CMAKE_BINARY_DIR}/cortex-m3/tests/target/ascorr_target_accuracy_fixed.elf)
+set_tests_properties(target_cortex-m3_no_soft_float PROPERTIES LABELS target)
+set_tests_properties(target_cortex-m3_no_soft_float_control PROPERTIES LABELS target WILL_FAIL ON)
