@@ -13,6 +13,10 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", "ascorr 0.1.0");
     ascorr::cli::add_correct_command(app);
+    ascorr::cli::add_simulate_command(app);
+    ascorr::cli::add_fit_command(app);
+    ascorr::cli::add_stats_command(app);
+    ascorr::cli::add_plot_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,304 @@
+#include "ascorr_host/fit.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "ascorr/correct.hpp"
+#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/epochs.hpp"
+#include "ascorr_host/solution_input.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+constexpr double kMuEarth = 398600.4418;  // km³/s²
+constexpr double kDay = 86400.0;
+
+struct Row {
+    Eigen::Quaterniond q;        // aberration-corrected, ICRF into head
+    std::array<double, 3> temp;  // T1, T2, T3
+};
+
+// Sums over one orbit of e_i and of the regressors, per head.
+struct OrbitSums {
+    std::size_t count = 0;
+    std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+};
+
+Eigen::Vector3d icrf_boresight(const Eigen::Quaterniond& q) {
+    return q.toRotationMatrix().row(2).transpose();
+}
+
+std::string time_text(double t) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", t);
+    return buf;
+}
+
+}  // namespace
+
+Drop fit_selection(const SolutionRecord& rec) noexcept {
+    if ((rec.flags & 1) != 0) {
+        return Drop::kHighRate;
+    }
+    if ((rec.flags & 2) != 0) {
+        return Drop::kBrightObject;
+    }
+    if ((rec.flags & 4) != 0) {
+        return Drop::kInvalid;
+    }
+    if (rec.confidence > 5.0) {
+        return Drop::kConfidence;
+    }
+    if (!(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2])) {
+        return Drop::kTemperature;
+    }
+    if (rec.velocity_components != 3) {
+        return Drop::kVelocity;
+    }
+    return Drop::kNone;
+}
+
+const char* drop_name(Drop d) noexcept {
+    switch (d) {
+        case Drop::kNone:
+            return "selected";
+        case Drop::kHighRate:
+            return "high-rate mode";
+        case Drop::kBrightObject:
+            return "bright object";
+        case Drop::kInvalid:
+            return "invalid";
+        case Drop::kConfidence:
+            return "confidence > 5";
+        case Drop::kTemperature:
+            return "temperature missing";
+        case Drop::kVelocity:
+            return "velocity missing";
+        case Drop::kRejected:
+            return "not correctable";
+    }
+    return "?";
+}
+
+FitReport fit_model(const FitOptions& opt) {
+    if (opt.from && opt.to && !(*opt.from < *opt.to)) {
+        throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
+                         time_text(*opt.to));
+    }
+    if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
+        throw FitRefused("--orbit-period must be in [600, 86400] s");
+    }
+    FitReport r;
+    EarthVelocity earth;
+    const CorrectionConfig<double> ab_only{true, nullptr};
+    std::optional<double> period = opt.orbit_period_s;
+    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // N_i
+    std::map<long long, OrbitSums> orbits;
+    bool any = false;
+
+    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
+        if (!(e.head[0] && e.head[1] && e.head[2])) {
+            return;  // F needs A and C; the same epochs serve all heads
+        }
+        // Frame F (eqs. 1–3), rows X_F, Y_F, Z_F in ICRF.
+        const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
+        const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
+        const Eigen::Vector3d z_f = za.cross(zc).normalized();
+        const Eigen::Vector3d x_f = (za + zc).normalized();
+        const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
+        Eigen::Matrix3d r_f_icrf;
+        r_f_icrf.row(0) = x_f.transpose();
+        r_f_icrf.row(1) = y_f.transpose();
+        r_f_icrf.row(2) = z_f.transpose();
+        const Eigen::Quaterniond q_f_icrf(r_f_icrf);
+        const auto bin = static_cast<long long>(std::floor(e.t / *period));
+        OrbitSums& o = orbits[bin];
+        ++o.count;
+        for (std::size_t h = 0; h < 3; ++h) {
+            const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
+            if (!reference[h]) {
+                reference[h] = q_head_f;
+            }
+            Eigen::Quaterniond d = q_head_f * reference[h]->conjugate();
+            if (d.w() < 0.0) {
+                d.coeffs() = -d.coeffs();
+            }
+            o.e[h] += 2.0 * d.vec() * kRadToArcsec;  // small angle: error ~ θ³/24
+            const auto& t = e.head[h]->temp;
+            o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
+        }
+        ++r.epochs;
+        if (!any || e.t < r.t_first) {
+            r.t_first = e.t;
+        }
+        if (!any || e.t > r.t_last) {
+            r.t_last = e.t;
+        }
+        any = true;
+    });
+    for_each_solution(
+        opt.in,
+        [&](const SolutionRecord& rec) {
+            if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2) {
+                return;
+            }
+            ++r.rows;
+            Drop d = fit_selection(rec);
+            CorrectedSolution<double> c{};
+            if (d == Drop::kNone) {
+                c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
+                if ((c.status & status::kAberrationApplied) == 0U) {
+                    d = Drop::kRejected;
+                }
+            }
+            ++r.dropped[static_cast<std::size_t>(d)];
+            if (d != Drop::kNone) {
+                return;
+            }
+            if (!period) {
+                const double v = std::sqrt(squared_norm(rec.v_sc_kms));
+                if (!(v > 1.0 && v < 12.0)) {
+                    throw InputError(opt.in, rec.line, 1,
+                                     "spacecraft speed " + std::to_string(v) +
+                                         " km/s is not that of an Earth orbit: give --orbit-period");
+                }
+                period = 2.0 * kPi * kMuEarth / (v * v * v);
+            }
+            Row row;
+            row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
+            row.temp = rec.temperature;
+            epochs.add(rec.t, rec.head, rec.line, row);
+        },
+        "fit");
+    epochs.finish();
+    r.orbit_period_s = period.value_or(0.0);
+
+    const std::string period_text = "t = " + time_text(r.t_first) + " .. " + time_text(r.t_last);
+    if (r.epochs == 0) {
+        throw FitRefused(opt.in +
+                         ": no epoch in the modelling period has solutions of A, B and C that pass the selection");
+    }
+    const double span_days = (r.t_last - r.t_first) / kDay;
+    if (span_days < opt.min_span_days) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
+                      "thermal period; --min-days) are needed",
+                      span_days, period_text.c_str(), opt.min_span_days);
+        throw FitRefused(opt.in + ": " + buf);
+    }
+
+    // Orbits with at least half the typical number of epochs: a short one
+    // (a gap, the ends of the period) is dominated by its part of the orbit.
+    std::vector<std::size_t> counts;
+    for (const auto& kv : orbits) {
+        counts.push_back(kv.second.count);
+    }
+    std::nth_element(counts.begin(), counts.begin() + static_cast<long>(counts.size() / 2), counts.end());
+    const std::size_t min_count = std::max<std::size_t>(2, counts[counts.size() / 2] / 2);
+    std::vector<const OrbitSums*> used;
+    for (const auto& kv : orbits) {
+        if (kv.second.count >= min_count) {
+            used.push_back(&kv.second);
+        }
+    }
+    r.orbits_used = used.size();
+    r.orbits_left_out = orbits.size() - used.size();
+    if (used.size() < opt.min_orbits) {
+        throw FitRefused(opt.in + ": too few orbits in the modelling period (" + period_text +
+                         "): " + std::to_string(used.size()) + " with enough data, at least " +
+                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
+    }
+
+    const auto n = static_cast<Eigen::Index>(used.size());
+    r.model.present = {true, true, true, false};
+    for (std::size_t h = 0; h < 3; ++h) {
+        Eigen::MatrixXd x(n, 4);
+        Eigen::MatrixXd y(n, 3);
+        for (Eigen::Index k = 0; k < n; ++k) {
+            const OrbitSums& o = *used[static_cast<std::size_t>(k)];
+            const double w = 1.0 / static_cast<double>(o.count);
+            x(k, 0) = 1.0;
+            x.block<1, 3>(k, 1) = (o.x[h] * w).transpose();
+            y.row(k) = (o.e[h] * w).transpose();
+        }
+        // Centre e on its mean, so that c0 refers to the mean orientation.
+        const Eigen::RowVector3d mean = y.colwise().mean();
+        y.rowwise() -= mean;
+        // Unit-norm columns: the singular values then measure how independent
+        // the regressors are, not their units.
+        const Eigen::Vector4d scale = x.colwise().norm().transpose();
+        const Eigen::MatrixXd xs = x * scale.cwiseInverse().asDiagonal();
+        Eigen::JacobiSVD<Eigen::MatrixXd> svd(xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
+        const Eigen::VectorXd sv = svd.singularValues();
+        HeadFit& hf = r.head[h];
+        for (int i = 0; i < 4; ++i) {
+            hf.singular_values[static_cast<std::size_t>(i)] = sv(i);
+        }
+        hf.condition = sv(3) > 0.0 ? sv(0) / sv(3) : std::numeric_limits<double>::infinity();
+        if (!(hf.condition <= opt.max_condition)) {
+            char buf[400];
+            std::snprintf(buf, sizeof buf,
+                          "rank-deficient design for CHU %c: condition number %.3g (scaled singular values %.3g %.3g "
+                          "%.3g %.3g) exceeds %.3g; T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently "
+                          "in the modelling period (%s)",
+                          head_name(static_cast<std::uint8_t>(h)), hf.condition, sv(0), sv(1), sv(2), sv(3),
+                          opt.max_condition, period_text.c_str());
+            throw FitRefused(opt.in + ": " + buf);
+        }
+        const Eigen::MatrixXd bs = svd.solve(y);
+        const Eigen::MatrixXd coef = scale.cwiseInverse().asDiagonal() * bs;  // 4 × 3
+        const Eigen::MatrixXd res = y - x * coef;
+        for (std::size_t a = 0; a < 3; ++a) {
+            const auto ai = static_cast<Eigen::Index>(a);
+            hf.residual_rms[a] = std::sqrt(res.col(ai).squaredNorm() / static_cast<double>(n));
+            hf.signal_rms[a] = std::sqrt(y.col(ai).squaredNorm() / static_cast<double>(n));
+            for (std::size_t c = 0; c < 4; ++c) {
+                r.model.coefficients[h][a][c] = coef(static_cast<Eigen::Index>(c), ai);
+            }
+        }
+    }
+    write_model_file(opt.out, r.model);
+    return r;
+}
+
+std::string describe(const FitReport& r) {
+    std::ostringstream o;
+    char buf[400];
+    std::snprintf(buf, sizeof buf, "modelling period t = %.3f .. %.3f (%.1f days), orbit period %.1f s\n", r.t_first,
+                  r.t_last, (r.t_last - r.t_first) / kDay, r.orbit_period_s);
+    o << buf;
+    o << "rows in the period " << r.rows << ", selected " << r.dropped[0] << "; dropped:";
+    for (std::size_t d = 1; d < kDropKinds; ++d) {
+        o << (d > 1 ? "," : "") << ' ' << drop_name(static_cast<Drop>(d)) << ' ' << r.dropped[d];
+    }
+    o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
+      << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
+    o << "fitted: each head's rotation relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged, against\n"
+         "[1, T_CHU, T029 - T_CHU, T032 - T_CHU]. Rotations common to all heads are not observable by the star\n"
+         "trackers and not in the model (they change no IBA); relative to F, A and C keep only their roll and half\n"
+         "the A-C opening each. c0 refers to the mean orientation over the period.\n";
+    o << "CHU  scaled singular values              condition   residual RMS a/b/g (\")   signal RMS a/b/g (\")\n";
+    for (std::size_t h = 0; h < 3; ++h) {
+        const HeadFit& f = r.head[h];
+        std::snprintf(buf, sizeof buf,
+                      "%c    %7.3f %7.3f %7.4f %7.4f   %9.1f   %5.3f %5.3f %5.3f        %6.3f %6.3f %6.3f\n",
+                      head_name(static_cast<std::uint8_t>(h)), f.singular_values[0], f.singular_values[1],
+                      f.singular_values[2], f.singular_values[3], f.condition, f.residual_rms[0], f.residual_rms[1],
+                      f.residual_rms[2], f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
+        o << buf;
+    }
+    return o.str();
+}
+
+}  // namespace ascorr::host
