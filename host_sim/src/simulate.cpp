@@ -144,7 +144,7 @@ char* put(char* p, char* end, double x, int decimals) {
 }  // namespace
 
 Eigen::Matrix3d head_mounting(int head) {
-    static constexpr double kAzimuthDeg[3] = {60.0, 180.0, 300.0};
+    static constexpr double kAzimuthDeg[3] = {90.0, 210.0, 330.0};
     const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
     const double az = kAzimuthDeg[head] * kDeg;
     const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir

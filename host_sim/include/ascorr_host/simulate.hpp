@@ -7,8 +7,8 @@
 //    turns against the Sun once per kPlaneSunPeriodDays (Swarm Alpha: 267 d).
 //  - Body frame (orbital frame, spacecraft fixed in it): x along the velocity,
 //    z to nadir, y = z × x. R_body_icrf has rows x, y, z in ICRF.
-//  - Heads: boresights 54.7° from the zenith at azimuths 60° (A), 180° (B),
-//    300° (C) from +x towards +y, hence mutually 90° apart. head_mounting(h)
+//  - Heads: boresights 54.7° from the zenith at azimuths 90° (A), 210° (B),
+//    330° (C) from +x towards +y, hence mutually 90° apart. head_mounting(h)
 //    maps body into head components, so q_chu_icrf = R_head_body·R_body_icrf.
 //  - Truth: the rigid attitude. The head really points along the deformed,
 //    noisy attitude q_meas = q_noise ⊗ q_th* ⊗ q_true, with q_th the thermal
