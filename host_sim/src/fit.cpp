@@ -220,51 +220,130 @@ FitReport fit_model(const FitOptions& opt) {
                          std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
     }
 
+    // Joint least squares over the orbits k. With y_k = (e_A, e_B, e_C) the
+    // orbit-averaged rotations relative to F (9 values) and c the 36
+    // coefficients (head, axis, term), the model is
+    //     y_k = A_k·c + G·g_k,   G = (N_A; N_B; N_C),
+    // g_k being F's own rotation in that orbit (eq. 1–3 make F move with the
+    // A and C boresights, i.e. with their temperatures): unknown, and common
+    // to all heads. It is removed by projecting each orbit's 9 equations on
+    // the complement of G's columns, P = I − G·Gᵀ/3 (GᵀG = 3·I). What remains
+    // determines c up to a common rotation linear in T029 and T032 (the only
+    // regressors all heads share): 9 directions the data cannot see.
     const auto n = static_cast<Eigen::Index>(used.size());
-    r.model.present = {true, true, true, false};
+    Eigen::Matrix<double, 9, 3> g;
     for (std::size_t h = 0; h < 3; ++h) {
-        Eigen::MatrixXd x(n, 4);
-        Eigen::MatrixXd y(n, 3);
+        g.block<3, 3>(static_cast<Eigen::Index>(3 * h), 0) = reference[h]->toRotationMatrix();
+    }
+    const Eigen::Matrix<double, 9, 9> proj = Eigen::Matrix<double, 9, 9>::Identity() - g * g.transpose() / 3.0;
+    Eigen::MatrixXd y(n, 9);
+    std::vector<std::array<Eigen::Vector4d, 3>> x(used.size());
+    for (Eigen::Index k = 0; k < n; ++k) {
+        const OrbitSums& o = *used[static_cast<std::size_t>(k)];
+        const double w = 1.0 / static_cast<double>(o.count);
+        for (std::size_t h = 0; h < 3; ++h) {
+            y.block<1, 3>(k, static_cast<Eigen::Index>(3 * h)) = (o.e[h] * w).transpose();
+            x[static_cast<std::size_t>(k)][h] << 1.0, o.x[h] * w;
+        }
+    }
+    // Centre e on its mean, so that c0 refers to the mean orientation.
+    const Eigen::RowVectorXd mean = y.colwise().mean();
+    y.rowwise() -= mean;
+    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(9 * n, kUnknowns);
+    Eigen::VectorXd target(9 * n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        Eigen::Matrix<double, 9, kUnknowns> a = Eigen::Matrix<double, 9, kUnknowns>::Zero();
+        for (Eigen::Index h = 0; h < 3; ++h) {
+            for (Eigen::Index ax = 0; ax < 3; ++ax) {
+                a.block<1, 4>(3 * h + ax, 12 * h + 4 * ax) =
+                    x[static_cast<std::size_t>(k)][static_cast<std::size_t>(h)];
+            }
+        }
+        design.block<9, kUnknowns>(9 * k, 0) = proj * a;
+        target.segment<9>(9 * k) = proj * y.row(k).transpose();
+    }
+    // Unit-norm columns: the singular values then measure how independent
+    // the regressors are, not their units.
+    const Eigen::VectorXd scale = design.colwise().norm().transpose();
+    design = design * scale.cwiseInverse().asDiagonal();
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    r.singular_values.assign(sv.data(), sv.data() + sv.size());
+    constexpr Eigen::Index kRank = kUnknowns - kGaugeDims;
+    r.condition = sv(kRank - 1) > 0.0 ? sv(0) / sv(kRank - 1) : std::numeric_limits<double>::infinity();
+    if (!(r.condition <= opt.max_condition)) {
+        // Name the head whose coefficients dominate the weakest direction.
+        const Eigen::VectorXd weakest = svd.matrixV().col(kRank - 1);
+        Eigen::Index head = 0;
+        Eigen::Vector3d share(weakest.segment<12>(0).squaredNorm(), weakest.segment<12>(12).squaredNorm(),
+                              weakest.segment<12>(24).squaredNorm());
+        share.maxCoeff(&head);
+        char buf[400];
+        std::snprintf(buf, sizeof buf,
+                      "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, "
+                      "the largest %.3g; the weakest direction is mostly CHU %c's coefficients): T_CHU, T029 - T_CHU "
+                      "and T032 - T_CHU do not vary independently in the modelling period (%s)",
+                      r.condition, opt.max_condition, static_cast<int>(kRank), static_cast<int>(kUnknowns),
+                      sv(kRank - 1), sv(0), head_name(static_cast<std::uint8_t>(head)), period_text.c_str());
+        throw FitRefused(opt.in + ": " + buf);
+    }
+    // Least squares on the observable directions only (truncated SVD).
+    const Eigen::MatrixXd u = svd.matrixU().leftCols(kRank);
+    const Eigen::MatrixXd v = svd.matrixV().leftCols(kRank);
+    const Eigen::VectorXd c_scaled = v * (u.transpose() * target).cwiseQuotient(sv.head(kRank));
+    Eigen::VectorXd c = scale.cwiseInverse().asDiagonal() * c_scaled;
+
+    // The gauge: of all models the star trackers cannot tell apart (c plus a
+    // common rotation w0 + w2·T029 + w3·T032), write the one whose corrections
+    // are smallest (RMS over the orbits of the period).
+    {
+        Eigen::MatrixXd gd(9 * n, 9);
+        Eigen::VectorXd gt(9 * n);
         for (Eigen::Index k = 0; k < n; ++k) {
-            const OrbitSums& o = *used[static_cast<std::size_t>(k)];
-            const double w = 1.0 / static_cast<double>(o.count);
-            x(k, 0) = 1.0;
-            x.block<1, 3>(k, 1) = (o.x[h] * w).transpose();
-            y.row(k) = (o.e[h] * w).transpose();
+            for (Eigen::Index h = 0; h < 3; ++h) {
+                const Eigen::Vector4d& xh = x[static_cast<std::size_t>(k)][static_cast<std::size_t>(h)];
+                const double t2 = xh(1) + xh(2);
+                const double t3 = xh(1) + xh(3);
+                const Eigen::Matrix3d nh = g.block<3, 3>(3 * h, 0);
+                gd.block<3, 3>(9 * k + 3 * h, 0) = nh;
+                gd.block<3, 3>(9 * k + 3 * h, 3) = nh * t2;
+                gd.block<3, 3>(9 * k + 3 * h, 6) = nh * t3;
+                for (Eigen::Index ax = 0; ax < 3; ++ax) {
+                    gt(9 * k + 3 * h + ax) = -xh.dot(c.segment<4>(12 * h + 4 * ax));
+                }
+            }
         }
-        // Centre e on its mean, so that c0 refers to the mean orientation.
-        const Eigen::RowVector3d mean = y.colwise().mean();
-        y.rowwise() -= mean;
-        // Unit-norm columns: the singular values then measure how independent
-        // the regressors are, not their units.
-        const Eigen::Vector4d scale = x.colwise().norm().transpose();
-        const Eigen::MatrixXd xs = x * scale.cwiseInverse().asDiagonal();
-        Eigen::JacobiSVD<Eigen::MatrixXd> svd(xs, Eigen::ComputeThinU | Eigen::ComputeThinV);
-        const Eigen::VectorXd sv = svd.singularValues();
-        HeadFit& hf = r.head[h];
-        for (int i = 0; i < 4; ++i) {
-            hf.singular_values[static_cast<std::size_t>(i)] = sv(i);
+        const Eigen::VectorXd wv = gd.bdcSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(gt);
+        for (Eigen::Index h = 0; h < 3; ++h) {
+            const Eigen::Matrix3d nh = g.block<3, 3>(3 * h, 0);
+            const Eigen::Vector3d w0 = nh * wv.segment<3>(0);
+            const Eigen::Vector3d w2 = nh * wv.segment<3>(3);
+            const Eigen::Vector3d w3 = nh * wv.segment<3>(6);
+            for (Eigen::Index ax = 0; ax < 3; ++ax) {
+                c(12 * h + 4 * ax + 0) += w0(ax);
+                c(12 * h + 4 * ax + 1) += w2(ax) + w3(ax);  // T2 = T1 + (T2 − T1), likewise T3
+                c(12 * h + 4 * ax + 2) += w2(ax);
+                c(12 * h + 4 * ax + 3) += w3(ax);
+            }
         }
-        hf.condition = sv(3) > 0.0 ? sv(0) / sv(3) : std::numeric_limits<double>::infinity();
-        if (!(hf.condition <= opt.max_condition)) {
-            char buf[400];
-            std::snprintf(buf, sizeof buf,
-                          "rank-deficient design for CHU %c: condition number %.3g (scaled singular values %.3g %.3g "
-                          "%.3g %.3g) exceeds %.3g; T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently "
-                          "in the modelling period (%s)",
-                          head_name(static_cast<std::uint8_t>(h)), hf.condition, sv(0), sv(1), sv(2), sv(3),
-                          opt.max_condition, period_text.c_str());
-            throw FitRefused(opt.in + ": " + buf);
-        }
-        const Eigen::MatrixXd bs = svd.solve(y);
-        const Eigen::MatrixXd coef = scale.cwiseInverse().asDiagonal() * bs;  // 4 × 3
-        const Eigen::MatrixXd res = y - x * coef;
-        for (std::size_t a = 0; a < 3; ++a) {
-            const auto ai = static_cast<Eigen::Index>(a);
-            hf.residual_rms[a] = std::sqrt(res.col(ai).squaredNorm() / static_cast<double>(n));
-            hf.signal_rms[a] = std::sqrt(y.col(ai).squaredNorm() / static_cast<double>(n));
-            for (std::size_t c = 0; c < 4; ++c) {
-                r.model.coefficients[h][a][c] = coef(static_cast<Eigen::Index>(c), ai);
+    }
+
+    // Residuals, with each orbit's common rotation removed (as in the fit).
+    r.model.present = {true, true, true, false};
+    Eigen::VectorXd res = target - design * c_scaled;
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            double ss = 0.0;
+            double sy = 0.0;
+            for (Eigen::Index k = 0; k < n; ++k) {
+                const Eigen::Index row = 9 * k + static_cast<Eigen::Index>(3 * h + ax);
+                ss += res(row) * res(row);
+                sy += target(row) * target(row);
+            }
+            r.head[h].residual_rms[ax] = std::sqrt(ss / static_cast<double>(n));
+            r.head[h].signal_rms[ax] = std::sqrt(sy / static_cast<double>(n));
+            for (std::size_t t = 0; t < 4; ++t) {
+                r.model.coefficients[h][ax][t] = c(static_cast<Eigen::Index>(12 * h + 4 * ax + t));
             }
         }
     }
@@ -284,18 +363,24 @@ std::string describe(const FitReport& r) {
     }
     o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
       << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
-    o << "fitted: each head's rotation relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged, against\n"
-         "[1, T_CHU, T029 - T_CHU, T032 - T_CHU]. Rotations common to all heads are not observable by the star\n"
-         "trackers and not in the model (they change no IBA); relative to F, A and C keep only their roll and half\n"
-         "the A-C opening each. c0 refers to the mean orientation over the period.\n";
-    o << "CHU  scaled singular values              condition   residual RMS a/b/g (\")   signal RMS a/b/g (\")\n";
+    o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
+         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head, with F's own rotation in each orbit\n"
+         "as a nuisance. Rotations common to all heads are not observable by the star trackers (they change no\n"
+         "IBA): of the models that differ by one linear in T029 and T032 (9 directions), the one with the smallest\n"
+         "corrections over the period is written. c0 refers to the mean orientations over the period.\n";
+    std::snprintf(buf, sizeof buf,
+                  "design %zu x %d (columns scaled to unit norm): singular values %.3g .. %.3g (%d observable), "
+                  "condition number %.1f; unobservable directions at %.1e\n",
+                  9 * r.orbits_used, static_cast<int>(kUnknowns), r.singular_values.front(),
+                  r.singular_values[kUnknowns - kGaugeDims - 1], static_cast<int>(kUnknowns - kGaugeDims), r.condition,
+                  r.singular_values[kUnknowns - kGaugeDims]);
+    o << buf;
+    o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";
     for (std::size_t h = 0; h < 3; ++h) {
         const HeadFit& f = r.head[h];
-        std::snprintf(buf, sizeof buf,
-                      "%c    %7.3f %7.3f %7.4f %7.4f   %9.1f   %5.3f %5.3f %5.3f        %6.3f %6.3f %6.3f\n",
-                      head_name(static_cast<std::uint8_t>(h)), f.singular_values[0], f.singular_values[1],
-                      f.singular_values[2], f.singular_values[3], f.condition, f.residual_rms[0], f.residual_rms[1],
-                      f.residual_rms[2], f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
+        std::snprintf(buf, sizeof buf, "%c    %6.3f %6.3f %6.3f                      %6.3f %6.3f %6.3f\n",
+                      head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1], f.residual_rms[2],
+                      f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
         o << buf;
     }
     return o.str();

@@ -29,6 +29,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
@@ -56,9 +57,10 @@ inline constexpr std::size_t kDropKinds = 8;
 Drop fit_selection(const SolutionRecord& rec) noexcept;
 const char* drop_name(Drop d) noexcept;
 
+inline constexpr int kUnknowns = 36;  // 3 heads × 3 axes × (c0, c1, c2, c3)
+inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032
+
 struct HeadFit {
-    std::array<double, 4> singular_values{};  // of the design with unit-norm columns
-    double condition = 0.0;
     std::array<double, 3> residual_rms{};  // orbit averages, arcsec, alpha/beta/gamma
     std::array<double, 3> signal_rms{};    // orbit-averaged angle about its mean
 };
@@ -72,6 +74,8 @@ struct FitReport {
     std::size_t epochs = 0;  // with A, B and C selected
     std::size_t orbits_used = 0;
     std::size_t orbits_left_out = 0;
+    std::vector<double> singular_values;  // of the joint design with unit-norm columns, descending
+    double condition = 0.0;               // largest / smallest observable singular value
     std::array<HeadFit, 3> head{};
     ModelFile model;
 };
