@@ -52,7 +52,7 @@ inline Eigen::Matrix3d model_rotation(const host::ModelFile& m, std::size_t h, c
 
 struct GeneratorOptions {
     double days = 330.0;
-    double step_s = 900.0;
+    double step_s = 1800.0;
     std::uint64_t seed = 7;
     bool collinear_temperatures = false;   // T029 − T_CHU and T032 − T_CHU constant: rank-deficient
     bool garbage_in_dropped_rows = false;  // rows the selection drops get random attitudes

@@ -51,6 +51,16 @@ const Shared& shared() {
     return s;
 }
 
+// Removes the shared data set when the test program ends.
+class RemoveShared : public ::testing::Environment {
+public:
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(fs::temp_directory_path() / ("ascorr-test-analysis-" + std::to_string(::getpid())), ec);
+    }
+};
+[[maybe_unused]] ::testing::Environment* const kRemoveShared = ::testing::AddGlobalTestEnvironment(new RemoveShared);
+
 host::FitReport fit_period(const fs::path& data, const fs::path& model, double from, double to) {
     host::FitOptions o;
     o.in = data.string();

@@ -335,7 +335,7 @@ SimulateSummary simulate(const SimulateOptions& opt) {
                                             std::string(1, head_name(static_cast<std::uint8_t>(h))) + ")");
             }
             const Quaternion<double> q_meas =
-                renormalized(from_eigen(q_noise) * conjugate(to_quaternion(th.q_th)) * from_eigen(q_true));
+                renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
             // Undo the aberration correction: q_raw = q_meas ⊗ q_ab(z_raw), by
             // fixed-point iteration (contraction ≈ |β| ≈ 1e-4 per step).
             SolutionRecord rec;

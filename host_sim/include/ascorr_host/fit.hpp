@@ -10,18 +10,23 @@
 //     N_i the head's orientation in F at the first such epoch;
 //  4. averages of e_i and of the temperatures over each orbit (the same
 //     epochs on both sides, so the linear model holds for the averages);
-//  5. per head, least squares by SVD of e_i against [1, T1, T2−T1, T3−T1]
-//     (T1 = the head's T_CHU, T2 = T029, T3 = T032).
+//  5. least squares by SVD (Eigen BDCSVD, columns scaled to unit norm) of
+//     the 9 orbit-averaged angles against each head's [1, T1, T2−T1, T3−T1]
+//     (T1 = the head's T_CHU, T2 = T029, T3 = T032), all heads jointly.
 // The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
 //
-// What is fitted, precisely: each head's rotation relative to F. A rotation
-// common to all heads (F's own thermal motion, and the bench's as a whole)
-// cannot be seen by star trackers and is not in the model; it does not change
-// any IBA. F is built from the A and C boresights, so relative to F head A
-// and head C keep only their roll about the boresight and half the A–C
-// opening each; head B keeps all three axes. c0 makes the corrected
-// orientation equal to the mean one over the modelling period: the absolute
-// mounting is not observable either.
+// What is fitted, precisely. F moves with the A and C boresights, hence with
+// their temperatures, and this motion shows in every head's e_i alike (as
+// N_i·g in head axes). A per-head fit would push A's and C's temperature
+// response into B's model, where it does not fit; so F's rotation g_k in each
+// orbit is a nuisance parameter, eliminated by projecting each orbit's 9
+// equations orthogonally to it. The data then fix the 36 coefficients up to a
+// rotation common to all heads that is linear in T029 and T032 (the only
+// regressors all heads share): 9 directions that star trackers cannot see and
+// that change no IBA. Of those equivalent models, the one whose corrections
+// are smallest (RMS over the orbits of the period) is written. c0 refers to
+// the mean orientations over the period: the absolute mounting is not
+// observable either.
 #pragma once
 
 #include <array>

@@ -11,7 +11,7 @@
 //    330° (C) from +x towards +y, hence mutually 90° apart. head_mounting(h)
 //    maps body into head components, so q_chu_icrf = R_head_body·R_body_icrf.
 //  - Truth: the rigid attitude. The head really points along the deformed,
-//    noisy attitude q_meas = q_noise ⊗ q_th* ⊗ q_true, with q_th the thermal
+//    noisy attitude q_meas = q_th* ⊗ q_noise ⊗ q_true, with q_th the thermal
 //    correction of the truth model for the recorded temperatures; the raw
 //    solution is q_meas with the aberration correction undone (fixed-point
 //    inversion of the core's own aberration rotation). So `ascorr correct`
