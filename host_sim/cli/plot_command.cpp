@@ -12,8 +12,11 @@ void add_plot_command(CLI::App& app) {
     cmd->add_option("--in", opt->in, "solutions file (CSV), raw")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required();
     cmd->add_option("--out", opt->out, "PNG file")->required();
-    cmd->add_option("--from", opt->period_from, "start of the modelling period to shade, s since J2000 TT");
-    cmd->add_option("--to", opt->period_to, "end of the modelling period to shade, s since J2000 TT");
+    CLI::Option* from =
+        cmd->add_option("--from", opt->period_from, "start of the modelling period to shade, s since J2000 TT");
+    CLI::Option* to = cmd->add_option("--to", opt->period_to, "end of the modelling period to shade, s since J2000 TT");
+    from->needs(to);
+    to->needs(from);
     cmd->callback([opt]() {
         host::plot_iba(*opt, std::cerr);
         std::cerr << "ascorr plot: " << opt->out << '\n';

@@ -66,8 +66,11 @@ std::size_t count_line_ends(std::string_view text) noexcept {
 }
 
 bool BlockReader::next(std::string_view& block) {
-    // Keep the partial last line of the previous block.
-    std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
+    // Keep the partial last line of the previous block (none before the
+    // first read, when buf_ is still null: memmove must not see it).
+    if (size_ > consumed_) {
+        std::memmove(buf_.get(), buf_.get() + consumed_, size_ - consumed_);
+    }
     size_ -= consumed_;
     consumed_ = 0;
     lines_before_ += lines_in_last_;
