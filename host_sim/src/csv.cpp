@@ -81,7 +81,9 @@ bool BlockReader::next(std::string_view& block) {
         if (capacity_ - size_ < block_bytes_) {  // grow: first call, or a line longer than a block
             const std::size_t cap = std::max(2 * capacity_, size_ + block_bytes_);
             std::unique_ptr<char[]> bigger(new char[cap]);
-            std::memcpy(bigger.get(), buf_.get(), size_);
+            if (size_ > 0) {  // buf_ is null before the first read
+                std::memcpy(bigger.get(), buf_.get(), size_);
+            }
             buf_ = std::move(bigger);
             capacity_ = cap;
         }
