@@ -11,5 +11,9 @@ namespace ascorr::cli {
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
 void add_thermistors_command(CLI::App& app);
+void add_simulate_command(CLI::App& app);
+void add_fit_command(CLI::App& app);
+void add_stats_command(CLI::App& app);
+void add_plot_command(CLI::App& app);
 
 }  // namespace ascorr::cli

@@ -15,6 +15,10 @@ int main(int argc, char** argv) {
     ascorr::cli::add_correct_command(app);
     ascorr::cli::add_replay_command(app);
     ascorr::cli::add_thermistors_command(app);
+    ascorr::cli::add_simulate_command(app);
+    ascorr::cli::add_fit_command(app);
+    ascorr::cli::add_stats_command(app);
+    ascorr::cli::add_plot_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

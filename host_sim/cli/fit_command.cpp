@@ -1,0 +1,27 @@
+#include <iostream>
+#include <memory>
+
+#include "ascorr_host/fit.hpp"
+#include "commands.hpp"
+
+namespace ascorr::cli {
+
+void add_fit_command(CLI::App& app) {
+    auto opt = std::make_shared<host::FitOptions>();
+    CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
+    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
+    cmd->add_option("--out", opt->out, "model file to write (CSV)")->required();
+    cmd->add_option("--from", opt->from, "start of the modelling period, s since J2000 TT");
+    cmd->add_option("--to", opt->to, "end of the modelling period, s since J2000 TT");
+    cmd->add_option("--min-days", opt->min_span_days, "shortest accepted period in days (default 267)");
+    cmd->add_option("--min-orbits", opt->min_orbits, "fewest accepted orbit averages (default 100)");
+    cmd->add_option("--max-condition", opt->max_condition, "largest accepted condition number (default 1e6)");
+    cmd->add_option("--orbit-period", opt->orbit_period_s, "orbit period in s (default: from the velocity)");
+    cmd->callback([opt]() {
+        const host::FitReport r = host::fit_model(*opt);
+        std::cout << host::describe(r);
+        std::cerr << "ascorr fit: model written to " << opt->out << '\n';
+    });
+}
+
+}  // namespace ascorr::cli

@@ -1,0 +1,26 @@
+#include <iostream>
+#include <memory>
+
+#include "ascorr_host/plot.hpp"
+#include "commands.hpp"
+
+namespace ascorr::cli {
+
+void add_plot_command(CLI::App& app) {
+    auto opt = std::make_shared<host::PlotOptions>();
+    CLI::App* cmd = app.add_subcommand("plot", "PNG of the IBA per pair for the three stages (gnuplot)");
+    cmd->add_option("--in", opt->in, "solutions file (CSV), raw")->required();
+    cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required();
+    cmd->add_option("--out", opt->out, "PNG file")->required();
+    CLI::Option* from =
+        cmd->add_option("--from", opt->period_from, "start of the modelling period to shade, s since J2000 TT");
+    CLI::Option* to = cmd->add_option("--to", opt->period_to, "end of the modelling period to shade, s since J2000 TT");
+    from->needs(to);
+    to->needs(from);
+    cmd->callback([opt]() {
+        host::plot_iba(*opt, std::cerr);
+        std::cerr << "ascorr plot: " << opt->out << '\n';
+    });
+}
+
+}  // namespace ascorr::cli

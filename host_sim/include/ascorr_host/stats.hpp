@@ -1,0 +1,56 @@
+// ascorr_host/stats.hpp: IBA statistics of a recorded file (`ascorr stats`).
+//
+// Per pair (A–B, A–C, B–C) and stage (original, aberration-corrected,
+// aberration- and thermal-corrected), the IBA RMS about the mean over the
+// clean epochs of formats.md: both rows with flags == 0, confidence <= 5,
+// all three temperatures and the velocity present (and accepted by the core),
+// rows matched by t to the millisecond. The same epochs serve every stage.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/iba.hpp"
+#include "ascorr_host/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+inline constexpr std::size_t kStages = 3;
+inline constexpr const char* kStageNames[kStages] = {"original", "aberration", "thermal"};
+
+struct StatsOptions {
+    std::string in;
+    std::string model;  // empty: no thermal stage
+    std::optional<double> from;
+    std::optional<double> to;
+    bool keep_series = false;  // keep the IBA time series (for plots)
+};
+
+struct PairSeries {
+    std::vector<double> t;
+    std::array<std::vector<double>, kStages> iba;  // arcsec, by stage
+};
+
+struct StatsResult {
+    bool thermal = false;
+    std::array<std::array<Rms, kStages>, kPairs> rms{};
+    std::array<std::size_t, kPairs> n{};
+    std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
+    std::size_t rows = 0;                   // rows in [from, to]
+    std::size_t clean_rows = 0;
+};
+
+// formats.md's clean solution (before the core has seen it).
+bool is_clean(const SolutionRecord& rec) noexcept;
+
+// Throws InputError for a malformed input; log gets one line per rejected row.
+StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
+
+std::string stats_table(const StatsResult& r);
+std::string stats_json(const StatsResult& r);
+
+}  // namespace ascorr::host

@@ -1,0 +1,183 @@
+#include "ascorr_host/plot.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "ascorr_host/stats.hpp"
+
+extern char** environ;
+
+namespace ascorr::host {
+
+namespace {
+
+// J2000.0 (TT) as Unix time: 2000-01-01T11:58:55.816 UTC. Plot labels only.
+constexpr double kJ2000Unix = 946727935.816;
+
+int run_gnuplot(const std::string& exe, const std::string& script, const std::string& log_path) {
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+    std::vector<char*> argv{const_cast<char*>(exe.c_str()), const_cast<char*>(script.c_str()), nullptr};
+    pid_t pid = 0;
+    const int rc = posix_spawnp(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) {
+        return -1;
+    }
+    int st = 0;
+    if (waitpid(pid, &st, 0) != pid) {
+        return -1;
+    }
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+class TempDir {
+public:
+    TempDir() {
+        std::string tmpl = (std::filesystem::temp_directory_path() / "ascorr-plot-XXXXXX").string();
+        if (::mkdtemp(tmpl.data()) == nullptr) {
+            throw std::runtime_error("cannot create a temporary directory for the plot");
+        }
+        path_ = tmpl;
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+std::string read_all(const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+}  // namespace
+
+void plot_iba(const PlotOptions& opt, std::ostream& log) {
+    StatsOptions so;
+    so.in = opt.in;
+    so.model = opt.model;
+    so.keep_series = true;
+    const StatsResult st = compute_stats(so, log);
+
+    TempDir dir;
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        const PairSeries& s = st.series[p];
+        if (s.t.empty()) {
+            throw std::runtime_error(opt.in + ": no clean epoch for pair " + kPairNames[p] + ": nothing to plot");
+        }
+        double mean[kStages] = {};
+        for (std::size_t k = 0; k < kStages; ++k) {
+            for (double v : s.iba[k]) {
+                mean[k] += v;
+            }
+            mean[k] /= static_cast<double>(s.t.size());
+        }
+        std::ofstream f(dir.path() / ("pair" + std::to_string(p) + ".dat"));
+        std::size_t i = 0;
+        while (i < s.t.size()) {
+            const double bin = std::floor(s.t[i] / kPlotBinS);
+            double sum_t = 0.0;
+            double sum[kStages] = {};
+            std::size_t n = 0;
+            for (; i < s.t.size() && std::floor(s.t[i] / kPlotBinS) == bin; ++i, ++n) {
+                sum_t += s.t[i] - s.t[0];
+                for (std::size_t k = 0; k < kStages; ++k) {
+                    sum[k] += s.iba[k][i] - mean[k];
+                }
+            }
+            const double dn = static_cast<double>(n);
+            f.precision(12);
+            f << s.t[0] + sum_t / dn + kJ2000Unix;
+            for (std::size_t k = 0; k < kStages; ++k) {
+                f << ' ' << sum[k] / dn;
+            }
+            f << '\n';
+        }
+        if (!f) {
+            throw std::runtime_error("cannot write plot data in " + dir.path().string());
+        }
+    }
+
+    const std::filesystem::path png = dir.path() / "plot.png";
+    const auto write_script = [&](const char* terminal) {
+        std::ofstream g(dir.path() / "plot.gp");
+        g << "set terminal " << terminal << " size 1400,1200\n";
+        g << "set output '" << png.string() << "'\n";
+        g << "set multiplot layout 3,1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
+          << "-minute means (RMS of the unbinned IBA in the legend)'\n";
+        g << "set xdata time\nset timefmt '%s'\nset format x '%Y-%m'\nset grid\nset key outside right top\n";
+        g << "set ylabel 'IBA - mean (arcsec)'\n";
+        if (opt.period_from && opt.period_to) {
+            g.precision(12);
+            g << "set object 1 rect from " << *opt.period_from + kJ2000Unix << ", graph 0 to "
+              << *opt.period_to + kJ2000Unix << ", graph 1 fc rgb '#e6e6e6' fs solid 1.0 noborder behind\n";
+            g << "set label 1 'modelling period' at " << *opt.period_from + kJ2000Unix
+              << ", graph 0.95 offset 1,0 front\n";
+        }
+        const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            g << "set title 'pair " << kPairNames[p] << " (" << st.n[p] << " clean epochs)'\n";
+            g << "plot ";
+            for (std::size_t k = 0; k < kStages; ++k) {
+                if (k == 2 && !st.thermal) {
+                    break;
+                }
+                char t[96];
+                std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                g << (k ? ", " : "") << "'" << (dir.path() / ("pair" + std::to_string(p) + ".dat")).string()
+                  << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
+            }
+            g << '\n';
+        }
+        g << "unset multiplot\n";
+    };
+    const std::string gp_log = (dir.path() / "gnuplot.log").string();
+    write_script("pngcairo");
+    int rc = run_gnuplot(opt.gnuplot, (dir.path() / "plot.gp").string(), gp_log);
+    if (rc == -1) {
+        throw std::runtime_error("cannot run '" + opt.gnuplot + "' (Debian package gnuplot-nox)");
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        write_script("png");  // a gnuplot built without cairo
+        rc = run_gnuplot(opt.gnuplot, (dir.path() / "plot.gp").string(), gp_log);
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
+    }
+    // Copy beside the target, then rename: whole or absent.
+    const std::filesystem::path target(opt.out);
+    const std::filesystem::path tmp = target.string() + ".tmp-" + std::to_string(::getpid());
+    std::error_code ec;
+    std::filesystem::copy_file(png, tmp, std::filesystem::copy_options::overwrite_existing, ec);
+    if (!ec) {
+        std::filesystem::rename(tmp, target, ec);
+    }
+    if (ec) {
+        std::filesystem::remove(tmp);
+        throw std::runtime_error("cannot write " + opt.out + ": " + ec.message());
+    }
+}
+
+}  // namespace ascorr::host
