@@ -59,6 +59,7 @@ void correct_all_heads() noexcept {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {  // fixed trip count
         const SolutionInput<Scalar> in{kRawAttitude[h], h, temperatures_of(h), g_velocity};
         g_corrected[h] = correct(in, cfg);
+        g_corrected[h].status = temperatures_merge_status(h, g_corrected[h].status);
         const StatusBits st = g_corrected[h].status;
         g_stats.status_union[h] = static_cast<StatusBits>(g_stats.status_union[h] | st);
         if (st == (status::kAberrationApplied | status::kThermalApplied)) {

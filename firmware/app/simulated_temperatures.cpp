@@ -1,5 +1,7 @@
 // firmware/app/simulated_temperatures.cpp: a simulated temperature producer
-// for temperature_source.hpp, until the HAL's thermistor acquisition replaces it.
+// for temperature_source.hpp, for the fixed-point build (Cortex-M3, no FPU),
+// where the HAL's floating-point conversion is not used (hal_temperatures.cpp
+// is the producer of the float build).
 //
 // Each head's three readings follow a stepped profile of 16 points (one point
 // per simulated second of 22 cycles), in °C around the worked examples'
@@ -60,6 +62,11 @@ void temperatures_update(std::uint32_t cycle) noexcept {
 
 const HeadTemperatures<Scalar>& temperatures_of(std::uint8_t head) noexcept {
     return g_table[head < kMaxHeads ? head : kMaxHeads];
+}
+
+// The simulation withholds readings without a reason: nothing to add.
+StatusBits temperatures_merge_status(std::uint8_t /*head*/, StatusBits core) noexcept {
+    return core;
 }
 
 }  // namespace ascorr::app

@@ -6,14 +6,15 @@
 // The producer refreshes it once per 22 Hz cycle, before the heads are
 // corrected, in the same execution context as the loop (no locking). A reading
 // the producer could not make or withholds as stale has valid = false; the core
-// then skips the thermal stage and flags it (status 8). Today's producer is a
-// simulation (simulated_temperatures.cpp); the HAL (hal/, thermistor
-// acquisition) implements these two functions instead.
+// then skips the thermal stage and flags it (status 8). Producers: the HAL's
+// thermistor acquisition (hal_temperatures.cpp, float builds) and a simulation
+// (simulated_temperatures.cpp, fixed-point builds without FPU).
 #pragma once
 
 #include <cstdint>
 
 #include "app_scalar.hpp"
+#include "ascorr/status.hpp"
 #include "ascorr/thermal.hpp"
 
 namespace ascorr::app {
@@ -24,5 +25,9 @@ void temperatures_update(std::uint32_t cycle) noexcept;
 // The readings of `head` for the current cycle; head ≥ kMaxHeads gets a
 // table entry whose readings are all invalid.
 const HeadTemperatures<Scalar>& temperatures_of(std::uint8_t head) noexcept;
+
+// The core's status with the producer's reasons added where the core skipped
+// the thermal stage for missing temperatures (64 for a fault, 512 for stale).
+StatusBits temperatures_merge_status(std::uint8_t head, StatusBits core) noexcept;
 
 }  // namespace ascorr::app
