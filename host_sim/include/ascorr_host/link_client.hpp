@@ -4,9 +4,11 @@
 // retries, so the target can recognise a resend and answer from its cache.
 // An answer is accepted only if it decodes exactly, has the request's type
 // and sequence number and (for solutions) the request's id and head: a wrong
-// solution is never accepted. A HELLO carrying a new boot id means the target
-// restarted: the client uploads the model, velocity and temperatures it last
-// sent, then resends the request in flight.
+// solution is never accepted. An unprompted HELLO (sequence number 0, which
+// the client never uses for a request) means the target restarted, whatever
+// its boot id (an emulator boots identically every time): the client uploads
+// the model, velocity and temperatures it last sent, then resends the request
+// in flight.
 #pragma once
 
 #include <algorithm>
@@ -139,21 +141,32 @@ private:
     // The target restarted: give it back everything it had.
     void restore() {
         if (restoring_) {
-            return;  // a restart during restore: the outer restore starts over
+            restart_again_ = true;  // a restart during restore: the outer restore starts over
+            return;
         }
         restoring_ = true;
-        ++stats_.restarts;
-        if (model_) {
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                send_model(h);
+        for (int round = 0;; ++round) {
+            if (round == max_attempts_) {
+                restoring_ = false;
+                throw LinkError("the target restarted " + std::to_string(round) + " times while being restored");
             }
-        }
-        if (velocity_) {
-            send_velocity();
-        }
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            if (temperatures_[h]) {
-                send_temperatures(h);
+            restart_again_ = false;
+            ++stats_.restarts;
+            if (model_) {
+                for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                    send_model(h);
+                }
+            }
+            if (velocity_) {
+                send_velocity();
+            }
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                if (temperatures_[h]) {
+                    send_temperatures(h);
+                }
+            }
+            if (!restart_again_) {
+                break;
             }
         }
         restoring_ = false;
@@ -161,7 +174,8 @@ private:
 
     std::vector<std::uint8_t> transact(link::MessageType type, const std::vector<std::uint8_t>& payload,
                                        link::MessageType answer) {
-        const std::uint16_t seq = ++seq_;
+        seq_ = static_cast<std::uint16_t>(seq_ == 0xFFFFU ? 1U : seq_ + 1U);  // 0 is the target's unprompted HELLO
+        const std::uint16_t seq = seq_;
         ++stats_.requests;
         std::uint8_t wire[link::kMaxWire];
         const std::size_t w =
@@ -212,13 +226,14 @@ private:
                             ++stats_.naks;
                             return std::nullopt;  // resend at once
                         }
-                        if (t == link::MessageType::kHello && answer != link::MessageType::kHello) {
+                        if (t == link::MessageType::kHello && f.seq == 0U && answer != link::MessageType::kHello) {
                             link::Hello h{};
-                            if (link::decode(f.payload, f.length, h) && h.boot_id != boot_id_) {
+                            if (link::decode(f.payload, f.length, h)) {
                                 boot_id_ = h.boot_id;
                                 restarted = true;
                                 return std::nullopt;
                             }
+                            ++stats_.stale_answers;
                             break;
                         }
                         if (f.seq == seq && t == answer) {
@@ -247,6 +262,7 @@ private:
     std::uint16_t seq_ = 0;
     std::uint32_t boot_id_ = 0;
     bool restoring_ = false;
+    bool restart_again_ = false;
     std::optional<ThermalModel<T>> model_;
     std::optional<ObserverVelocity<T>> velocity_;
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
