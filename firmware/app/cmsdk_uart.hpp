@@ -27,19 +27,24 @@ inline constexpr std::uint32_t kStateRxFull = 1U << 1;
 inline constexpr std::uint32_t kStateOverruns = (1U << 2) | (1U << 3);
 inline constexpr std::uint32_t kCtrlTxEnable = 1U << 0;
 inline constexpr std::uint32_t kCtrlRxEnable = 1U << 1;
+inline constexpr std::uint32_t kCtrlRxInterruptEnable = 1U << 3;
+inline constexpr std::uint32_t kIntRx = 1U << 1;
+inline constexpr std::uint32_t kUart0RxIrq = 0U;  // NVIC line of UART0 RX on AN385/AN386
 
 inline Registers& uart0() noexcept {
     return *reinterpret_cast<Registers*>(kUart0Base);  // NOLINT: memory-mapped register
 }
 
-// Enables transmit and receive at `baud` from a PCLK of `pclk_hz`, interrupts off.
+// Enables transmit and receive at `baud` from a PCLK of `pclk_hz`. The RX
+// interrupt is raised only to wake the core from WFI (wait_for_rx): the
+// caller keeps exceptions masked (PRIMASK), so no handler ever runs.
 inline void init(std::uint32_t pclk_hz, std::uint32_t baud) noexcept {
     Registers& u = uart0();
     u.ctrl = 0U;
     u.bauddiv = pclk_hz / baud;
     u.state = kStateOverruns;  // clear stale overrun flags
     u.intstatus = 0xFU;
-    u.ctrl = kCtrlTxEnable | kCtrlRxEnable;
+    u.ctrl = kCtrlTxEnable | kCtrlRxEnable | kCtrlRxInterruptEnable;
 }
 
 // One received byte, if any (never waits).
