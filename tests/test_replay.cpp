@@ -3,7 +3,6 @@
 // target restarts and wrong answers.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -12,34 +11,13 @@
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/replay.hpp"
 #include "ascorr_link/server.hpp"
+#include "replay_recording.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A recorded file of n rows cycling through the worked examples at 1 Hz.
-std::string make_recording(const fs::path& dir, int n) {
-    std::string text;
-    const auto lines = [] {
-        std::string storage = host::read_text_file(data_path("solutions.csv"));
-        std::vector<std::string> out;
-        std::istringstream ss(storage);
-        for (std::string l; std::getline(ss, l);) {
-            out.push_back(l);
-        }
-        return out;
-    }();
-    text = lines[0] + "\n";
-    for (int i = 0; i < n; ++i) {
-        const std::string& l = lines[1 + static_cast<std::size_t>(i % 12)];
-        text += std::to_string(450000000 + i / 3) + l.substr(l.find(',')) + "\n";
-    }
-    const auto path = (dir / "rec.csv").string();
-    std::ofstream(path) << text;
-    return path;
-}
 
 host::ReplaySummary run_replay(const fs::path& dir, int rows, double inject, std::uint64_t seed) {
     host::ReplayOptions o;

@@ -92,7 +92,12 @@ void wait_for_rx() noexcept {
     uart::uart0().intstatus = uart::kIntRx;
     nvic_icpr0() = 1U << uart::kUart0RxIrq;
     if ((uart::uart0().state & uart::kStateRxFull) == 0U) {
+        // SysTick holds its value while asleep: under QEMU's -icount
+        // sleep=off a running timer would make the emulator skip from one
+        // SysTick wrap to the next and spin the host's CPU while idle.
+        board::systick().ctrl = 0U;
         board::wait_for_interrupt();
+        board::systick().ctrl = 5U;  // enabled, core clock, no exception
     }
 }
 

@@ -175,8 +175,11 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
 std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image) {
     // UART0 on our stdin/stdout (no monitor, no mux, no signals from bytes
     // like 0x03); semihosting, unused by the link image, to a null device;
-    // -icount shift=0: one instruction per nanosecond, so that the image's
-    // SysTick counts instructions (40 per count, firmware/app/link_main.cpp).
+    // -icount shift=0: one instruction per nanosecond while the core runs, so
+    // that the image's SysTick counts instructions (40 per count,
+    // firmware/app/link_main.cpp); sleep=off keeps virtual time out of real
+    // time (the image stops SysTick while it waits, so QEMU idles, with a
+    // one-line warning that no timer is active).
     return {"qemu-system-arm",
             "-M",
             machine,
