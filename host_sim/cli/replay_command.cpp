@@ -21,7 +21,7 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
         ->check(CLI::Range(0.0, 0.5));
     cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));
-    cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 50 qemu, 500 serial)")
+    cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 20 qemu, 500 serial)")
         ->check(CLI::Range(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection");
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)");

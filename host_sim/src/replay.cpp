@@ -155,8 +155,9 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
     }
     if (opt.target == "qemu-m4f" || opt.target == "qemu-m3") {
         const bool m3 = opt.target == "qemu-m3";
-        // QEMU answers within a millisecond; a lost frame is resent soon after.
-        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 50;
+        // QEMU answers within a few milliseconds; a lost frame is resent soon after
+        // (a late answer only costs a resend, answered from the cache).
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 20;
         const std::string image =
             opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
         ProcessTransport qemu(qemu_link_command(m3 ? "mps2-an385" : "mps2-an386", image));

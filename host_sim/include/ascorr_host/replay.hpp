@@ -22,7 +22,7 @@ struct ReplayOptions {
     std::string out;
     double inject_errors = 0.0;  // fraction of frames faulted, each direction
     bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
-    int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 50, loopback 1)
+    int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
     int max_attempts = 20;
     std::uint64_t seed = 1;
     unsigned baud = 115200;
