@@ -2,13 +2,13 @@
 // replay, firmware/link-protocol.md) on the CMSDK UART0 of the MPS2 boards.
 //
 // Conventions: at boot the UART is enabled and, after one delimiter byte,
-// HELLO is announced (sequence 0), so that the host learns of every restart; then each received byte goes
-// to the LinkServer, which owns the model, velocity and temperatures in static
-// storage and answers through the UART; between bytes the core sleeps (WFI).
-// The core runs in the build's scalar
+// HELLO is announced (sequence 0), so that the host learns of every restart.
+// Then each received byte goes to the LinkServer, which owns the model,
+// velocity and temperatures in static storage and answers through the UART;
+// between bytes the core sleeps (WFI). The core runs in the build's scalar
 // (app_scalar.hpp). Each loop iteration is bounded; the image serves until
 // reset. The boot id is the same at every boot (no reset counter survives a
-// reset on these boards); the host therefore treats any unprompted HELLO as a
+// reset on these boards), so the host treats any unprompted HELLO as a
 // restart.
 //
 // The cost reported with each solution is the instructions of
