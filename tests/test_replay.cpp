@@ -70,15 +70,21 @@ public:
     };
     using Server = link::LinkServer<float, Counter>;
 
-    explicit MisbehavingTarget(int restart_after, int wrong_id_every)
-        : restart_after_(restart_after), wrong_id_every_(wrong_id_every), server_(new Server(1, Counter{})) {}
+    // announce = false: the HELLO after the restart is lost on the link.
+    explicit MisbehavingTarget(int restart_after, int wrong_id_every, bool announce = true)
+        : restart_after_(restart_after),
+          wrong_id_every_(wrong_id_every),
+          announce_(announce),
+          server_(new Server(1, Counter{})) {}
 
     void serve(const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
         for (std::size_t i = 0; i < n; ++i) {
             if (p[i] == 0U && ++frames_seen_ > 0 && solutions_ == restart_after_) {
                 ++solutions_;
                 server_ = std::make_unique<Server>(++boot_, Counter{});  // power cycle: state lost
-                server_->announce(reply);
+                if (announce_) {
+                    server_->announce(reply);
+                }
                 continue;  // the request in flight was lost with it
             }
             server_->on_byte(p[i], [&](const std::uint8_t* r, std::size_t m) {
@@ -110,6 +116,7 @@ public:
 private:
     int restart_after_;
     int wrong_id_every_;
+    bool announce_;
     int solutions_ = 0;
     std::size_t frames_seen_ = 0;
     bool lied_ = false;
@@ -146,6 +153,11 @@ void check_against_host_core(MisbehavingTarget& target, std::size_t expect_resta
 
 TEST(Replay, TargetRestartIsDetectedAndStateRestored) {
     MisbehavingTarget target(120, 0);
+    check_against_host_core(target, 1);
+}
+
+TEST(Replay, RestartWithItsHelloLostIsDetectedFromTheAnswer) {
+    MisbehavingTarget target(120, 0, false);
     check_against_host_core(target, 1);
 }
 

@@ -8,7 +8,8 @@
 // the client never uses for a request) means the target restarted, whatever
 // its boot id (an emulator boots identically every time): the client uploads
 // the model, velocity and temperatures it last sent, then resends the request
-// in flight.
+// in flight. So is a solution corrected without the model or velocity the
+// client gave the target (a restart whose HELLO was lost on the link).
 #pragma once
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/status.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_link/frame.hpp"
 #include "ascorr_link/messages.hpp"
@@ -93,15 +95,22 @@ public:
     link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q) {
         std::uint8_t p[link::kMaxPayload];
         const std::size_t n = link::encode(link::SolutionIn<T>{id, head, q}, p);
-        for (;;) {
+        for (int attempt = 0; attempt < max_attempts_; ++attempt) {
             const auto a = transact(link::MessageType::kSolutionIn, {p, p + n}, link::MessageType::kSolutionOut);
             link::SolutionOut<T> out{};
-            if (link::decode(a.data(), a.size(), out) && out.id == id && out.head == head) {
-                return out;
+            if (!link::decode(a.data(), a.size(), out) || out.id != id || out.head != head) {
+                ++stats_.stale_answers;  // well framed but not ours: ask again
+                ++stats_.retries;
+                continue;
             }
-            ++stats_.stale_answers;  // well framed but not ours: ask again
-            ++stats_.retries;
+            if (lost_state(out)) {
+                restore();  // a restart whose HELLO was lost on the link
+                continue;
+            }
+            return out;
         }
+        throw LinkError("no acceptable answer for solution " + std::to_string(id) + " after " +
+                        std::to_string(max_attempts_) + " attempts");
     }
 
     const LinkStats& stats() const { return stats_; }
@@ -111,6 +120,18 @@ private:
     template <typename A>
     static bool same(const A& a, const A& b) {
         return std::memcmp(&a, &b, sizeof a) == 0;
+    }
+
+    // The target corrected without the model or velocity this client gave
+    // it: it has restarted, and its HELLO did not arrive. Its answer is not
+    // accepted.
+    bool lost_state(const link::SolutionOut<T>& out) const {
+        const bool no_model = (out.status & status::kNoModelForHead) != 0U && model_ && out.head < kMaxHeads &&
+                              model_->head[out.head].present;
+        const bool no_velocity =
+            (out.status & (status::kNoVelocity | status::kVelocityInvalid)) == status::kNoVelocity && velocity_ &&
+            velocity_->valid;
+        return no_model || no_velocity;
     }
 
     void send_model(std::uint8_t head) {
