@@ -166,6 +166,14 @@ TEST(Replay, AnAnswerForAnotherSolutionIsNeverAccepted) {
     check_against_host_core(target, 0);
 }
 
+TEST(Replay, QemuTargetWithoutItsImageIsAnError) {
+    host::ReplayOptions o;
+    o.target = "qemu-m3";
+    o.firmware = (scratch_dir("replay") / "missing.elf").string();
+    std::ostringstream log;
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);
+}
+
 TEST(Replay, UnknownTargetIsAnError) {
     host::ReplayOptions o;
     o.target = "qemu-z80";

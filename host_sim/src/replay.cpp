@@ -160,6 +160,9 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 20;
         const std::string image =
             opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
+        if (!std::ifstream(image).good()) {
+            throw std::runtime_error(image + ": cannot read the link firmware image");
+        }
         ProcessTransport qemu(qemu_link_command(m3 ? "mps2-an385" : "mps2-an386", image));
         return m3 ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
     }
