@@ -3,7 +3,6 @@
 // target restarts and wrong answers.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -12,34 +11,13 @@
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/replay.hpp"
 #include "ascorr_link/server.hpp"
+#include "replay_recording.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A recorded file of n rows cycling through the worked examples at 1 Hz.
-std::string make_recording(const fs::path& dir, int n) {
-    std::string text;
-    const auto lines = [] {
-        std::string storage = host::read_text_file(data_path("solutions.csv"));
-        std::vector<std::string> out;
-        std::istringstream ss(storage);
-        for (std::string l; std::getline(ss, l);) {
-            out.push_back(l);
-        }
-        return out;
-    }();
-    text = lines[0] + "\n";
-    for (int i = 0; i < n; ++i) {
-        const std::string& l = lines[1 + static_cast<std::size_t>(i % 12)];
-        text += std::to_string(450000000 + i / 3) + l.substr(l.find(',')) + "\n";
-    }
-    const auto path = (dir / "rec.csv").string();
-    std::ofstream(path) << text;
-    return path;
-}
 
 host::ReplaySummary run_replay(const fs::path& dir, int rows, double inject, std::uint64_t seed) {
     host::ReplayOptions o;
@@ -92,15 +70,21 @@ public:
     };
     using Server = link::LinkServer<float, Counter>;
 
-    explicit MisbehavingTarget(int restart_after, int wrong_id_every)
-        : restart_after_(restart_after), wrong_id_every_(wrong_id_every), server_(new Server(1, Counter{})) {}
+    // announce = false: the HELLO after the restart is lost on the link.
+    explicit MisbehavingTarget(int restart_after, int wrong_id_every, bool announce = true)
+        : restart_after_(restart_after),
+          wrong_id_every_(wrong_id_every),
+          announce_(announce),
+          server_(new Server(1, Counter{})) {}
 
     void serve(const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
         for (std::size_t i = 0; i < n; ++i) {
             if (p[i] == 0U && ++frames_seen_ > 0 && solutions_ == restart_after_) {
                 ++solutions_;
                 server_ = std::make_unique<Server>(++boot_, Counter{});  // power cycle: state lost
-                server_->announce(reply);
+                if (announce_) {
+                    server_->announce(reply);
+                }
                 continue;  // the request in flight was lost with it
             }
             server_->on_byte(p[i], [&](const std::uint8_t* r, std::size_t m) {
@@ -132,6 +116,7 @@ public:
 private:
     int restart_after_;
     int wrong_id_every_;
+    bool announce_;
     int solutions_ = 0;
     std::size_t frames_seen_ = 0;
     bool lied_ = false;
@@ -171,9 +156,22 @@ TEST(Replay, TargetRestartIsDetectedAndStateRestored) {
     check_against_host_core(target, 1);
 }
 
+TEST(Replay, RestartWithItsHelloLostIsDetectedFromTheAnswer) {
+    MisbehavingTarget target(120, 0, false);
+    check_against_host_core(target, 1);
+}
+
 TEST(Replay, AnAnswerForAnotherSolutionIsNeverAccepted) {
     MisbehavingTarget target(-1, 10);
     check_against_host_core(target, 0);
+}
+
+TEST(Replay, QemuTargetWithoutItsImageIsAnError) {
+    host::ReplayOptions o;
+    o.target = "qemu-m3";
+    o.firmware = (scratch_dir("replay") / "missing.elf").string();
+    std::ostringstream log;
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);
 }
 
 TEST(Replay, UnknownTargetIsAnError) {

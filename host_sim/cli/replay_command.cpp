@@ -11,14 +11,18 @@ void add_replay_command(CLI::App& app) {
     auto opt = std::make_shared<host::ReplayOptions>();
     auto speed = std::make_shared<std::string>("max");
     CLI::App* cmd = app.add_subcommand("replay", "replay a recorded file through a target over the serial link");
-    cmd->add_option("--target", opt->target, "loopback-float, or a serial device such as /dev/ttyUSB0")->required();
+    cmd->add_option("--target", opt->target,
+                    "qemu-m4f (float), qemu-m3 (Q30), loopback-float, or a serial device such as /dev/ttyUSB0")
+        ->required();
+    cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required();
     cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")->required();
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
         ->check(CLI::Range(0.0, 0.5));
     cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));
-    cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend")->check(CLI::Range(1, 60000));
+    cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 20 qemu, 500 serial)")
+        ->check(CLI::Range(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection");
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)");
     cmd->callback([opt, speed]() {

@@ -7,7 +7,9 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 
@@ -247,9 +249,19 @@ void FaultInjector::write(const std::uint8_t* p, std::size_t n) {
 }
 
 std::size_t FaultInjector::read(std::uint8_t* p, std::size_t cap, int timeout_ms) {
-    if (ready_in_.empty()) {
+    // Frames are faulted whole, so bytes are held until their frame is
+    // complete; reading on until then (or the time-out) keeps a frame that
+    // arrives in pieces (a UART, QEMU: byte by byte) from looking like a
+    // time-out to the caller.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (ready_in_.empty()) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
         std::uint8_t buf[512];
-        const std::size_t n = inner_.read(buf, sizeof buf, timeout_ms);
+        const std::size_t n = inner_.read(buf, sizeof buf, static_cast<int>(std::max<long long>(0, left.count())));
+        if (n == 0) {
+            break;
+        }
         for (std::size_t i = 0; i < n; ++i) {
             partial_in_.push_back(buf[i]);
             if (buf[i] == 0U) {

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
 #include <thread>
 
 #include "ascorr/correct.hpp"
+#include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
@@ -145,16 +147,77 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
 }  // namespace
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never
         LoopbackTarget<float> target;
-        return run<float>(opt, target.transport(), log);
+        return run<float>(o, target.transport(), log);
+    }
+    if (opt.target == "qemu-m4f" || opt.target == "qemu-m3") {
+        const bool m3 = opt.target == "qemu-m3";
+        // QEMU answers within a few milliseconds; a lost frame is resent soon after
+        // (a late answer only costs a resend, answered from the cache).
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 20;
+        const std::string image =
+            opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
+        if (!std::ifstream(image).good()) {
+            throw std::runtime_error(image + ": cannot read the link firmware image");
+        }
+        ProcessTransport qemu(qemu_link_command(m3 ? "mps2-an385" : "mps2-an386", image));
+        return m3 ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
     }
     if (opt.target.rfind("/dev/", 0) == 0) {
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
         SerialTransport serial(opt.target, opt.baud);
-        return run<float>(opt, serial, log);
+        return run<float>(o, serial, log);
     }
     throw std::runtime_error("--target " + opt.target +
-                             ": unknown target (loopback-float or a serial device such as /dev/ttyUSB0)");
+                             ": unknown target (loopback-float, qemu-m4f, qemu-m3 or a serial device such as "
+                             "/dev/ttyUSB0)");
+}
+
+std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image) {
+    // UART0 on our stdin/stdout (no monitor, no mux, no signals from bytes
+    // like 0x03); semihosting, unused by the link image, to a null device;
+    // -icount shift=0: one instruction per nanosecond while the core runs, so
+    // that the image's SysTick counts instructions (40 per count,
+    // firmware/app/link_main.cpp); sleep=off keeps virtual time out of real
+    // time (the image stops SysTick while it waits, so QEMU idles, with a
+    // one-line warning that no timer is active).
+    return {"qemu-system-arm",
+            "-M",
+            machine,
+            "-display",
+            "none",
+            "-monitor",
+            "none",
+            "-chardev",
+            "stdio,id=link,signal=off",
+            "-serial",
+            "chardev:link",
+            "-chardev",
+            "null,id=semi",
+            "-semihosting-config",
+            "enable=on,target=native,chardev=semi",
+            "-icount",
+            "shift=0,sleep=off",
+            "-kernel",
+            image};
+}
+
+std::string default_link_firmware(const std::string& target) {
+#ifdef ASCORR_LINK_FIRMWARE_DIR
+    const std::string path =
+        std::string(ASCORR_LINK_FIRMWARE_DIR) + "/" + target + "/firmware/app/ascorr_link_firmware.elf";
+    if (std::ifstream(path).good()) {
+        return path;
+    }
+    throw std::runtime_error(path +
+                             ": no link firmware image; build with the ci preset (ASCORR_TARGETS) or pass --firmware");
+#else
+    throw std::runtime_error("no link firmware image for " + target +
+                             " in this build (configured without ASCORR_TARGETS): pass --firmware");
+#endif
 }
 
 std::string to_json(const ReplaySummary& s) {

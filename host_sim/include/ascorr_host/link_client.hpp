@@ -4,9 +4,12 @@
 // retries, so the target can recognise a resend and answer from its cache.
 // An answer is accepted only if it decodes exactly, has the request's type
 // and sequence number and (for solutions) the request's id and head: a wrong
-// solution is never accepted. A HELLO carrying a new boot id means the target
-// restarted: the client uploads the model, velocity and temperatures it last
-// sent, then resends the request in flight.
+// solution is never accepted. An unprompted HELLO (sequence number 0, which
+// the client never uses for a request) means the target restarted, whatever
+// its boot id (an emulator boots identically every time): the client uploads
+// the model, velocity and temperatures it last sent, then resends the request
+// in flight. So is a solution corrected without the model or velocity the
+// client gave the target (a restart whose HELLO was lost on the link).
 #pragma once
 
 #include <algorithm>
@@ -18,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/status.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_link/frame.hpp"
 #include "ascorr_link/messages.hpp"
@@ -91,15 +95,22 @@ public:
     link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q) {
         std::uint8_t p[link::kMaxPayload];
         const std::size_t n = link::encode(link::SolutionIn<T>{id, head, q}, p);
-        for (;;) {
+        for (int attempt = 0; attempt < max_attempts_; ++attempt) {
             const auto a = transact(link::MessageType::kSolutionIn, {p, p + n}, link::MessageType::kSolutionOut);
             link::SolutionOut<T> out{};
-            if (link::decode(a.data(), a.size(), out) && out.id == id && out.head == head) {
-                return out;
+            if (!link::decode(a.data(), a.size(), out) || out.id != id || out.head != head) {
+                ++stats_.stale_answers;  // well framed but not ours: ask again
+                ++stats_.retries;
+                continue;
             }
-            ++stats_.stale_answers;  // well framed but not ours: ask again
-            ++stats_.retries;
+            if (lost_state(out)) {
+                restore();  // a restart whose HELLO was lost on the link
+                continue;
+            }
+            return out;
         }
+        throw LinkError("no acceptable answer for solution " + std::to_string(id) + " after " +
+                        std::to_string(max_attempts_) + " attempts");
     }
 
     const LinkStats& stats() const { return stats_; }
@@ -109,6 +120,18 @@ private:
     template <typename A>
     static bool same(const A& a, const A& b) {
         return std::memcmp(&a, &b, sizeof a) == 0;
+    }
+
+    // The target corrected without the model or velocity this client gave
+    // it: it has restarted, and its HELLO did not arrive. Its answer is not
+    // accepted.
+    bool lost_state(const link::SolutionOut<T>& out) const {
+        const bool no_model = (out.status & status::kNoModelForHead) != 0U && model_ && out.head < kMaxHeads &&
+                              model_->head[out.head].present;
+        const bool no_velocity =
+            (out.status & (status::kNoVelocity | status::kVelocityInvalid)) == status::kNoVelocity && velocity_ &&
+            velocity_->valid;
+        return no_model || no_velocity;
     }
 
     void send_model(std::uint8_t head) {
@@ -139,21 +162,32 @@ private:
     // The target restarted: give it back everything it had.
     void restore() {
         if (restoring_) {
-            return;  // a restart during restore: the outer restore starts over
+            restart_again_ = true;  // a restart during restore: the outer restore starts over
+            return;
         }
         restoring_ = true;
-        ++stats_.restarts;
-        if (model_) {
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                send_model(h);
+        for (int round = 0;; ++round) {
+            if (round == max_attempts_) {
+                restoring_ = false;
+                throw LinkError("the target restarted " + std::to_string(round) + " times while being restored");
             }
-        }
-        if (velocity_) {
-            send_velocity();
-        }
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            if (temperatures_[h]) {
-                send_temperatures(h);
+            restart_again_ = false;
+            ++stats_.restarts;
+            if (model_) {
+                for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                    send_model(h);
+                }
+            }
+            if (velocity_) {
+                send_velocity();
+            }
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                if (temperatures_[h]) {
+                    send_temperatures(h);
+                }
+            }
+            if (!restart_again_) {
+                break;
             }
         }
         restoring_ = false;
@@ -161,7 +195,8 @@ private:
 
     std::vector<std::uint8_t> transact(link::MessageType type, const std::vector<std::uint8_t>& payload,
                                        link::MessageType answer) {
-        const std::uint16_t seq = ++seq_;
+        seq_ = static_cast<std::uint16_t>(seq_ == 0xFFFFU ? 1U : seq_ + 1U);  // 0 is the target's unprompted HELLO
+        const std::uint16_t seq = seq_;
         ++stats_.requests;
         std::uint8_t wire[link::kMaxWire];
         const std::size_t w =
@@ -212,13 +247,14 @@ private:
                             ++stats_.naks;
                             return std::nullopt;  // resend at once
                         }
-                        if (t == link::MessageType::kHello && answer != link::MessageType::kHello) {
+                        if (t == link::MessageType::kHello && f.seq == 0U && answer != link::MessageType::kHello) {
                             link::Hello h{};
-                            if (link::decode(f.payload, f.length, h) && h.boot_id != boot_id_) {
+                            if (link::decode(f.payload, f.length, h)) {
                                 boot_id_ = h.boot_id;
                                 restarted = true;
                                 return std::nullopt;
                             }
+                            ++stats_.stale_answers;
                             break;
                         }
                         if (f.seq == seq && t == answer) {
@@ -247,6 +283,7 @@ private:
     std::uint16_t seq_ = 0;
     std::uint32_t boot_id_ = 0;
     bool restoring_ = false;
+    bool restart_again_ = false;
     std::optional<ThermalModel<T>> model_;
     std::optional<ObserverVelocity<T>> velocity_;
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];

@@ -10,17 +10,19 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace ascorr::host {
 
 struct ReplayOptions {
-    std::string target;  // qemu-m4f, qemu-m3, loopback-float, or a serial device path
+    std::string target;    // qemu-m4f (float), qemu-m3 (Q30), loopback-float, or a serial device path
+    std::string firmware;  // qemu targets: the link image; empty: the one of this build tree
     std::string in;
     std::string model;
     std::string out;
     double inject_errors = 0.0;  // fraction of frames faulted, each direction
     bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
-    int timeout_ms = 500;
+    int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
     int max_attempts = 20;
     std::uint64_t seed = 1;
     unsigned baud = 115200;
@@ -39,6 +41,10 @@ struct ReplaySummary {
 };
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
+// The QEMU command line that runs a link image with UART0 on stdin/stdout.
+std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image);
+// The link image of this build tree for a target (cortex-m3, cortex-m4f).
+std::string default_link_firmware(const std::string& target);
 std::string to_json(const ReplaySummary& s);
 
 }  // namespace ascorr::host

@@ -1,0 +1,137 @@
+// Hardware-in-the-loop replay with QEMU standing in for the board: the link
+// images (firmware/app/link_main.cpp) on mps2-an386 (M4F, float) and
+// mps2-an385 (M3, Q30), driven over their UART by `ascorr replay`'s job and by
+// the LinkClient, with faults injected and the emulator killed mid-run.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <sstream>
+#include <string>
+
+#include "ascorr/fixed_point.hpp"
+#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/link_client.hpp"
+#include "ascorr_host/link_transport.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/replay.hpp"
+#include "ascorr_host/solution_input.hpp"
+#include "replay_recording.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+constexpr int kRows = 10000;
+
+struct Case {
+    const char* target;
+    double bound_arcsec;  // of the scalar type against the double reference
+};
+constexpr Case kM4f{"qemu-m4f", 0.05};
+constexpr Case kM3{"qemu-m3", 0.01};
+
+host::ReplaySummary replay_through(const Case& c, double inject, const std::string& name) {
+    const auto dir = scratch_dir(name);
+    host::ReplayOptions o;
+    o.target = c.target;
+    o.in = make_recording(dir, kRows);
+    o.model = data_path("model_table2.csv");
+    o.out = (dir / "out.csv").string();
+    o.inject_errors = inject;
+    o.seed = 11;
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    std::cout << c.target << " inject " << inject << ": " << host::to_json(s) << "\n";
+    return s;
+}
+
+// Every solution back, bit for bit the host core's in the target's scalar,
+// within the scalar's bound of the double reference, with its cost measured.
+void expect_complete(const Case& c, const host::ReplaySummary& s) {
+    EXPECT_EQ(s.frames, static_cast<std::size_t>(kRows));
+    EXPECT_EQ(s.returned, static_cast<std::size_t>(kRows));
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, c.bound_arcsec);
+    EXPECT_GT(s.instructions_per_solution, 0.0);
+    EXPECT_EQ(s.restarts, 0U);
+}
+
+TEST(ReplayQemu, M4fFloatCleanLink) {
+    const host::ReplaySummary s = replay_through(kM4f, 0.0, "qemu_m4f");
+    expect_complete(kM4f, s);
+    EXPECT_EQ(s.crc_errors, 0U);
+    EXPECT_EQ(s.injected, 0U);
+}
+
+TEST(ReplayQemu, M4fFloatOnePercentFaults) {
+    const host::ReplaySummary s = replay_through(kM4f, 0.01, "qemu_m4f_faults");
+    expect_complete(kM4f, s);
+    EXPECT_GT(s.injected, 0U);
+    EXPECT_GT(s.crc_errors, 0U);
+    EXPECT_GT(s.retries, 0U);
+}
+
+TEST(ReplayQemu, M3FixedCleanLink) {
+    const host::ReplaySummary s = replay_through(kM3, 0.0, "qemu_m3");
+    expect_complete(kM3, s);
+    EXPECT_EQ(s.crc_errors, 0U);
+    EXPECT_EQ(s.injected, 0U);
+}
+
+TEST(ReplayQemu, M3FixedOnePercentFaults) {
+    const host::ReplaySummary s = replay_through(kM3, 0.01, "qemu_m3_faults");
+    expect_complete(kM3, s);
+    EXPECT_GT(s.injected, 0U);
+    EXPECT_GT(s.crc_errors, 0U);
+    EXPECT_GT(s.retries, 0U);
+}
+
+// Kills the emulator halfway (ProcessTransport::restart: a fresh boot, state
+// lost, identical boot id); the client sees the unprompted HELLO, restores
+// the model, velocity and temperatures, and every answer stays exact.
+template <typename T>
+void survive_restart(const char* machine, const char* target, const std::string& name) {
+    constexpr int kRestartRows = 1200;
+    const auto dir = scratch_dir(name);
+    const std::string rec = make_recording(dir, kRestartRows);
+    const std::string text = host::read_text_file(rec);
+    host::SolutionsReader reader(rec, text);
+    const ThermalModel<T> model = host::to_core<T>(host::read_model_file(data_path("model_table2.csv")));
+    host::ProcessTransport qemu(host::qemu_link_command(machine, host::default_link_firmware(target)));
+    host::LinkClient<T> client(qemu, 50, 20);
+    client.connect();
+    client.upload_model(model);
+    host::EarthVelocity earth;
+    host::SolutionRecord r;
+    std::uint32_t id = 0;
+    std::size_t thermal_applied = 0;
+    while (reader.next(r)) {
+        if (id == kRestartRows / 2) {
+            qemu.restart();
+        }
+        const SolutionInput<T> in = host::to_core_input<T>(r, &earth);
+        client.set_velocity(in.velocity);
+        client.set_temperatures(in.head, in.temperatures);
+        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf);
+        const CorrectedSolution<T> want = correct_solution(in, CorrectionConfig<T>{true, &model});
+        ASSERT_EQ(got.id, id);
+        ASSERT_EQ(got.status, want.status) << "row " << id;
+        ASSERT_EQ(std::memcmp(&got.q_chu_icrf, &want.q_chu_icrf, sizeof want.q_chu_icrf), 0) << "row " << id;
+        thermal_applied += (got.status & status::kThermalApplied) != 0U ? 1U : 0U;
+        ++id;
+    }
+    EXPECT_EQ(id, static_cast<std::uint32_t>(kRestartRows));
+    EXPECT_EQ(client.stats().restarts, 1U);
+    EXPECT_GT(thermal_applied, static_cast<std::size_t>(kRestartRows / 2));  // the model was restored
+}
+
+TEST(ReplayQemu, M3RestartMidRunIsRecovered) {
+    survive_restart<Q30>("mps2-an385", "cortex-m3", "qemu_m3_restart");
+}
+
+TEST(ReplayQemu, M4fRestartMidRunIsRecovered) {
+    survive_restart<float>("mps2-an386", "cortex-m4f", "qemu_m4f_restart");
+}
+
+}  // namespace
+}  // namespace ascorr::test
