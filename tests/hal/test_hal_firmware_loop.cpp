@@ -4,46 +4,14 @@
 // middle; with global operator new counted to prove the loop never allocates.
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <new>
 
+#include "alloc_counter.hpp"
 #include "ascorr/ascorr.hpp"
 #include "ascorr_hal/acquisition.hpp"
 #include "hal_support.hpp"
-
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-
-namespace {
-std::atomic<long> g_allocations{0};
-std::atomic<bool> g_armed{false};
-}  // namespace
-
-void* operator new(std::size_t n) {
-    if (g_armed.load()) {
-        ++g_allocations;
-    }
-    if (void* p = std::malloc(n == 0 ? 1 : n)) {
-        return p;
-    }
-    throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) {
-    return operator new(n);
-}
-void operator delete(void* p) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p) noexcept {
-    std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
-void operator delete[](void* p, std::size_t) noexcept {
-    std::free(p);
-}
 
 namespace ascorr::test {
 namespace {
@@ -117,8 +85,7 @@ TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
     int applied[kSeconds] = {};
     StatusBits last_status[kSeconds] = {};
 
-    g_allocations = 0;
-    g_armed = true;
+    arm_allocation_counter();
     for (int s = 0; s < kSeconds; ++s) {
         // Scenario: THT00029 and THT00087 open from 20 s to 25 s (no quorum);
         // the acquisition task stalls from 40 s to 50 s (stale after 5 s).
@@ -143,8 +110,7 @@ TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
             last_status[s] = out.status;
         }
     }
-    g_armed = false;
-    EXPECT_EQ(g_allocations.load(), 0);
+    EXPECT_EQ(disarm_allocation_counter(), 0);
 
     for (int s = 0; s < kSeconds; ++s) {
         if (s >= 20 && s < 25) {
