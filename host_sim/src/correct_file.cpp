@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <future>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -232,6 +233,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     CorrectSummary sum;
     std::size_t empty_lines = 0;
     const std::size_t workers = worker_count();
+    std::future<void> writing;  // declared after `out`: destroyed (joined) before it
     bool first = true;
     do {
         std::size_t lines_before = blocks.lines_before();
@@ -264,7 +266,6 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             if (r.error) {
                 throw *r.error;
             }
-            out.write(r.out);
             sum.rows += r.summary.rows;
             sum.malformed += r.summary.malformed;
             for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
@@ -272,7 +273,20 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             }
             empty_lines += r.empty_lines;
         }
+        // Write this block while the workers correct the next one; one block
+        // in flight, its errors surface at the next block or at the end.
+        if (writing.valid()) {
+            writing.get();
+        }
+        writing = std::async(std::launch::async, [&out, done = std::move(results)] {
+            for (const ChunkResult& r : done) {
+                out.write(r.out);
+            }
+        });
     } while (blocks.next(block));
+    if (writing.valid()) {
+        writing.get();
+    }
     if (empty_lines != 0) {
         log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
     }
