@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <charconv>
-#include <future>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <optional>
 #include <ostream>
 #include <sstream>
