@@ -20,7 +20,7 @@
 
 #include "ascorr/ascorr.hpp"
 #include "baseline.hpp"
-#include "target/vector_format.hpp"
+#include "target/vector_convert.hpp"
 
 namespace {
 
@@ -40,33 +40,12 @@ struct Fixture {
 
 template <typename T>
 Fixture<T> make_fixture() {
-    using Tr = ScalarTraits<T>;
     Fixture<T> fx{};
     for (std::size_t m = 0; m < kModels; ++m) {
-        for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            fx.model[m].head[h].present = g_model_records[m].present[h] != 0U;
-            AxisPolynomial<T>* axes[3] = {&fx.model[m].head[h].alpha, &fx.model[m].head[h].beta,
-                                          &fx.model[m].head[h].gamma};
-            for (std::size_t a = 0; a < 3; ++a) {
-                const double* c = g_model_records[m].coefficient[h][a];
-                *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
-                            Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
-                            Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
-                            Tr::quadratic_coefficient(c[6])};
-            }
-        }
+        fx.model[m] = to_core_model<T>(g_model_records[m]);
     }
     for (std::size_t i = 0; i < kInputs; ++i) {
-        const VectorRecord& r = g_records[i];
-        fx.in[i].q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
-                               Tr::from_double(r.q[3])};
-        fx.in[i].head = static_cast<std::uint8_t>(r.head);
-        fx.in[i].temperatures = {{Tr::celsius(r.temperature[0]), true},
-                                 {Tr::celsius(r.temperature[1]), true},
-                                 {Tr::celsius(r.temperature[2]), true}};
-        fx.in[i].velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
-                             Tr::from_double(r.inv_sun_distance_au),
-                             true};
+        fx.in[i] = to_core_input<T>(g_records[i]);  // fully valid records (selected below)
     }
     return fx;
 }

@@ -21,7 +21,7 @@
 #include "baseline.hpp"
 #include "board.hpp"
 #include "core_entry.hpp"
-#include "vector_format.hpp"
+#include "vector_convert.hpp"
 
 namespace {
 
@@ -94,32 +94,12 @@ void report(const char* scalar, const char* stage, std::uint32_t c, std::uint32_
 
 template <typename T>
 void bench_scalar(const char* name, Fixture<T>& fx, std::uint32_t ipc) {
-    using Tr = ScalarTraits<T>;
+    // The selected records are fully valid (temperatures, velocity, head < 3).
     for (std::uint32_t m = 0; m < kModels; ++m) {
-        ThermalModel<T>& model = fx.model[m];
-        for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
-            model.head[h].present = g_model_records[m].present[h] != 0U;
-            AxisPolynomial<T>* axes[3] = {&model.head[h].alpha, &model.head[h].beta, &model.head[h].gamma};
-            for (std::uint32_t a = 0; a < 3; ++a) {
-                const double* c = g_model_records[m].coefficient[h][a];
-                *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
-                            Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
-                            Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
-                            Tr::quadratic_coefficient(c[6])};
-            }
-        }
+        fx.model[m] = to_core_model<T>(g_model_records[m]);
     }
     for (std::uint32_t i = 0; i < kInputs; ++i) {
-        const VectorRecord& r = g_records[i];
-        fx.in[i].q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
-                               Tr::from_double(r.q[3])};
-        fx.in[i].head = static_cast<std::uint8_t>(r.head);
-        fx.in[i].temperatures = {{Tr::celsius(r.temperature[0]), true},
-                                 {Tr::celsius(r.temperature[1]), true},
-                                 {Tr::celsius(r.temperature[2]), true}};
-        fx.in[i].velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
-                             Tr::from_double(r.inv_sun_distance_au),
-                             true};
+        fx.in[i] = to_core_input<T>(g_records[i]);
     }
     const CorrectionConfig<T> both{true, &fx.model[0]};
     const CorrectionConfig<T> aberration{true, nullptr};

@@ -12,7 +12,7 @@
 
 #include "ascorr/fixed_point.hpp"
 #include "core_entry.hpp"
-#include "vector_format.hpp"
+#include "vector_convert.hpp"
 
 namespace {
 
@@ -25,36 +25,6 @@ using T = Q30;
 using T = float;
 #endif
 using Tr = ScalarTraits<T>;
-
-ThermalModel<T> convert(const ModelRecord& m) {
-    ThermalModel<T> out{};
-    for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
-        out.head[h].present = m.present[h] != 0U;
-        AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
-        for (std::uint32_t a = 0; a < 3; ++a) {
-            const double* c = m.coefficient[h][a];
-            *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
-                        Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
-                        Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
-                        Tr::quadratic_coefficient(c[6])};
-        }
-    }
-    return out;
-}
-
-SolutionInput<T> convert(const VectorRecord& r) {
-    SolutionInput<T> in{};
-    in.q_chu_icrf = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
-                     Tr::from_double(r.q[3])};
-    in.head = static_cast<std::uint8_t>(r.head < 255U ? r.head : 255U);
-    in.temperatures.t_chu = {Tr::celsius(r.temperature[0]), (r.temperature_valid & 1U) != 0U};
-    in.temperatures.t_029 = {Tr::celsius(r.temperature[1]), (r.temperature_valid & 2U) != 0U};
-    in.temperatures.t_032 = {Tr::celsius(r.temperature[2]), (r.temperature_valid & 4U) != 0U};
-    in.velocity = {{Tr::from_double(r.beta[0]), Tr::from_double(r.beta[1]), Tr::from_double(r.beta[2])},
-                   Tr::from_double(r.inv_sun_distance_au),
-                   r.velocity_valid != 0U};
-    return in;
-}
 
 ThermalModel<T> g_models[kModels];
 
@@ -73,7 +43,7 @@ int main() {
         return 1;
     }
     for (std::uint32_t m = 0; m < kModels; ++m) {
-        g_models[m] = convert(header.model[m]);
+        g_models[m] = to_core_model<T>(header.model[m]);
     }
     for (std::uint32_t i = 0; i < header.count; ++i) {  // count is bounded by the file
         VectorRecord r{};
@@ -81,7 +51,7 @@ int main() {
             std::fputs("target: short or bad vectors.bin\n", stderr);
             return 1;
         }
-        const SolutionInput<T> s = convert(r);
+        const SolutionInput<T> s = to_core_input<T>(r);
         const ThermalModel<T>* model = &g_models[r.model];
         const CorrectionConfig<T> cfgs[kConfigs] = {{true, nullptr}, {false, model}, {true, model}};
         ResultRecord res{};
