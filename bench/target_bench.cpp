@@ -106,12 +106,14 @@ void bench_scalar(const char* name, Fixture<T>& fx, std::uint32_t ipc) {
     const CorrectionConfig<T> thermal{false, &fx.model[0]};
     const CorrectionConfig<T> both_quadratic{true, &fx.model[1]};
     const CorrectionConfig<T> thermal_quadratic{false, &fx.model[1]};
+    const CorrectionConfig<T> neither{false, nullptr};
     const std::uint32_t c0 = run<T>(&copy_only<T>, fx, both);
     report(name, "both", run<T>(&core<T>, fx, both), c0, ipc);
     report(name, "aberration", run<T>(&core<T>, fx, aberration), c0, ipc);
     report(name, "thermal", run<T>(&core<T>, fx, thermal), c0, ipc);
     report(name, "both_quadratic", run<T>(&core<T>, fx, both_quadratic), c0, ipc);
     report(name, "thermal_quadratic", run<T>(&core<T>, fx, thermal_quadratic), c0, ipc);
+    report(name, "neither", run<T>(&core<T>, fx, neither), c0, ipc);
 }
 
 using BaselineFn = bench::BaselineOutput (*)(const bench::BaselineInput&, const bench::BaselineModel*, bool);

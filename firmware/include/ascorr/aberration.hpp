@@ -14,11 +14,11 @@
 // Evaluation without sqrt or division:
 //  z × p = (w1 + w2)·(z × β) exactly, and |p| = 1 + pdv up to a relative
 //  2·w2·w1·(β² − pdv²) ≤ 5e-13 (the w1 part of the formula is exactly unit
-//  after division by 1 + pdv). Hence
-//      u = z × z_corr = sin θ·n = (w1 + w2)/(1 + pdv) · (z × β),
-//  and with x = |u|² = sin²θ the half-angle quaternion is
-//      q_ab = (cos θ/2, sin θ/2·n) = (1 − x/8, u/2·(1 + x/8)) + O(x²).
-//  Truncation errors for |β| ≤ kMaxBeta = 3.34e-3 (θ ≤ 3.34e-3 rad):
+//  after division by 1 + pdv). Hence, with c = z × β,
+//      u = z × z_corr = sin θ·n = f·c,   f = (w1 + w2)/(1 + pdv),
+//  and with x = |u|² = sin²θ = f²·|c|² the half-angle quaternion is
+//      q_ab = (cos θ/2, sin θ/2·n) = (1 − x/8, f/2·(1 + x/8)·c) + O(x²).
+//  Truncation errors for |β| ≤ kMaxBeta = 3.34e-3 (θ ≤ 3.34e-3 rad), double:
 //   - 1/(1 + bm1) = (1 + β²/4)/2 + O(β⁴/16): error in w1 ≤ pdv·β⁴/16 ≤ 2.6e-14;
 //   - 1/(1 + pdv) to pdv⁴: remainder ≤ |pdv|⁵/(1 − |pdv|) ≤ 4.3e-13 relative;
 //   - cos θ/2 = 1 − x/8 − 5x²/128 − …: dropped term ≤ 4.8e-12, a norm error
@@ -26,6 +26,14 @@
 //   - 1/(2 cos θ/2) = (1 + x/8)/2 + O(3x²/128).
 //  In angle that is below 3e-9" at the domain limit and below 1e-12" for
 //  |v| ≤ 100 km/s. The solar term itself is ≤ 4e-7", which is why it stays.
+//  Without double precision (float; Q30 has its own, fixed_point.hpp) the
+//  series stop where float's resolution (2⁻²⁴ = 6e-8 relative) does:
+//      f = 1 − pdv/2 + pdv²/2,   x = |c|²,
+//  dropping pdv³/2 ≤ 1.9e-8 and pdv·β²/8 ≤ 4.6e-9 (relative to f), the
+//  solar term w2 ≤ 2e-8/s (below half an ulp of f ≈ 1, so float would round it
+//  away), and in x the factor f² = 1 + O(2·pdv): x/8 is then off by ≤ 9e-9, a
+//  change of norm (≤ 1.6e-11 rad in direction), and the scale by ≤ 9e-9
+//  relative. Together ≤ 5e-9 of θ: 3.5e-6" at the domain limit.
 #pragma once
 
 #include "constants.hpp"
@@ -59,16 +67,23 @@ constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const V
                                                const T& inv_sun_distance_au) noexcept {
     const T one = k<T>(1.0);
     const T pdv = dot(z_icrf, beta_icrf);
-    const T b2 = squared_norm(beta_icrf);
-    const T w1 = one + k<T>(0.5) * pdv * (one + k<T>(0.25) * b2);
-    const T w2 = k<T>(kSunSchwarzschildRadiusAu) * inv_sun_distance_au;
-    // 1/(1 + pdv) by Horner: 1 − p(1 − p(1 − p(1 − p))).
-    const T inv_1_pdv = one - pdv * (one - pdv * (one - pdv * (one - pdv)));
-    const Vector3<T> u = ((w1 + w2) * inv_1_pdv) * cross(z_icrf, beta_icrf);
-    const T x = squared_norm(u);
+    const Vector3<T> c = cross(z_icrf, beta_icrf);
+    const T n = squared_norm(c);
+    T f = one + k<T>(0.5) * pdv * (pdv - one);
+    T x = n;
+    if constexpr (ScalarTraits<T>::double_precision) {
+        const T b2 = squared_norm(beta_icrf);
+        const T w1 = one + k<T>(0.5) * pdv * (one + k<T>(0.25) * b2);
+        const T w2 = k<T>(kSunSchwarzschildRadiusAu) * inv_sun_distance_au;
+        // 1/(1 + pdv) by Horner: 1 − p(1 − p(1 − p(1 − p))).
+        const T inv_1_pdv = one - pdv * (one - pdv * (one - pdv * (one - pdv)));
+        f = (w1 + w2) * inv_1_pdv;
+        x = f * f * n;
+    } else {
+        static_cast<void>(inv_sun_distance_au);
+    }
     const T eighth_x = k<T>(0.125) * x;
-    const T half_scale = k<T>(0.5) * (one + eighth_x);
-    return {-eighth_x, {half_scale * u.x, half_scale * u.y, half_scale * u.z}};
+    return {-eighth_x, (k<T>(0.5) * f * (one + eighth_x)) * c};
 }
 
 }  // namespace ascorr

@@ -54,33 +54,18 @@ constexpr Rejection check_solution(const SolutionInput<T>& in) noexcept {
     if (!is_finite(in.q_chu_icrf)) {
         return Rejection::kQuaternionNotFinite;
     }
-    // Component bound first (|c| > 1 + tol already means ‖q‖² > 1 + 2·tol):
-    // keeps ‖q‖² inside a fixed-point format's range.
-    const T one = k<T>(1.0);
-    const T tol = ScalarTraits<T>::unit_norm_tolerance;
-    const T bound = one + tol;
-    const Quaternion<T>& q = in.q_chu_icrf;
-    const auto within = [&](const T& c) { return c <= bound && -bound <= c; };
-    if (!(within(q.w) && within(q.x) && within(q.y) && within(q.z))) {
-        return Rejection::kQuaternionNotUnit;
-    }
-    const T e = squared_norm(q) - one;
-    if (!(e <= tol && -tol <= e)) {
+    if (!norm_within(in.q_chu_icrf, ScalarTraits<T>::unit_norm_tolerance)) {
         return Rejection::kQuaternionNotUnit;
     }
     return Rejection::kNone;
 }
 
-// The verdict of check_solution() == kNone with one comparison of the norm: a
-// component beyond 1 + tol makes ‖q‖² − 1 exceed tol; a NaN makes it NaN and
-// an infinite or huge one makes it infinite (floating point) or saturates it
-// (fixed point, ≥ 1), and either fails the test. Used on every solution;
-// check_solution() says why, for messages.
+// The verdict of check_solution() == kNone without telling the reasons apart:
+// norm_within() is false for a non-finite quaternion too. Used on every
+// solution; check_solution() says why, for messages.
 template <typename T>
 constexpr bool solution_acceptable(const SolutionInput<T>& in) noexcept {
-    const T e = squared_norm(in.q_chu_icrf) - k<T>(1.0);
-    const T tol = ScalarTraits<T>::unit_norm_tolerance;
-    return in.head < kMaxHeads && e <= tol && -tol <= e;
+    return in.head < kMaxHeads && norm_within(in.q_chu_icrf, ScalarTraits<T>::unit_norm_tolerance);
 }
 
 // The thermal stage's rotation for one solution, or the bits that say why it
@@ -116,8 +101,7 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
     const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
     const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
     const T lim = k<T>(kMaxThermalAngleRad);
-    const auto within = [&](const T& a) { return a <= lim && -lim <= a; };  // false for NaN
-    if (!(within(alpha) && within(beta) && within(gamma))) {
+    if (!(abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim))) {  // false for NaN
         out.skip = status::kThermalOutOfRange;
         return out;
     }
@@ -149,7 +133,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
             // off by ≤ |ε| rad in direction and length, which changes a 25"
             // correction by ≤ 25"·|ε| (2.5e-5" at the double tolerance).
             const SmallRotation<T> q_ab = aberration_rotation(boresight(q), v.beta_icrf, v.inv_sun_distance_au);
-            d = q * increment(conjugate(q_ab));
+            d = right_increment(q, conjugate(q_ab));
             st |= status::kAberrationApplied;
         }
     }

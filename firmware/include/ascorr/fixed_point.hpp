@@ -188,6 +188,10 @@ constexpr bool operator!=(Q30 a, Q30 b) noexcept {
 constexpr bool is_finite(Q30 /*unused*/) noexcept {
     return true;
 }
+// |x| ≤ lim for lim ≥ 0 (scalar_traits.hpp): two comparisons, exact.
+constexpr bool abs_within(Q30 x, Q30 lim) noexcept {
+    return x.raw <= lim.raw && -lim.raw <= x.raw;
+}
 
 // Q11.20 temperature in °C, see the conventions above.
 struct QCelsius {
@@ -203,6 +207,9 @@ constexpr bool operator<=(QCelsius a, QCelsius b) noexcept {
 }
 constexpr bool is_finite(QCelsius /*unused*/) noexcept {
     return true;
+}
+constexpr bool abs_within(QCelsius x, QCelsius lim) noexcept {
+    return x.raw <= lim.raw && -lim.raw <= x.raw;
 }
 
 // Thermal-model coefficient, raw·2⁻³⁶ (rad, rad/°C), see above.
@@ -245,6 +252,9 @@ struct ScalarTraits<Q30> {
     // Rounding a unit quaternion's components to 2⁻³¹ leaves |‖q‖² − 1| ≤ 4e-9;
     // the bound is the double path's, so both reject the same inputs.
     static constexpr Q30 unit_norm_tolerance = {fx::raw_from_double(1e-6, Q30::kFracBits)};
+    // The core's series are specialised for Q30 below (aberration_rotation,
+    // thermal_rotation), cut at the format's resolution.
+    static constexpr bool double_precision = false;
 };
 
 // ---- Sums of products, rounded once. The core's vector and quaternion
@@ -330,33 +340,221 @@ constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
     return {fx::narrow_half(a), fx::narrow_half(b), fx::narrow_half(kOne - c)};
 }
 
-// q + d brought to unit norm by one Newton step (quaternion.hpp), in Q30.
-// In integers q + d is exact (saturating add: |·| ≤ 2), so ε = ‖q + d‖² − 1 is
-// formed exactly in int64 (units 2⁻⁵⁹ after half_sum), g = −ε/2 is rounded
-// once to Q30 and saturated, and each component is (q + d)ᵢ + round((q + d)ᵢ·g),
-// saturated: one rounding per component.
+// ---- The correction's kernels in Q30: the functions correct_solution() calls
+// (found by argument-dependent lookup, preferred to the generic templates).
+// Their operands are bounded by the core's own checks, stated per function,
+// so that no sum can overflow and no result can leave the format: each sum of
+// products is formed exactly in int64 and rounded once to Q30 (to nearest,
+// ties towards +∞, error ≤ 2⁻³¹), without saturation. A subtracted product is
+// written as the product with the negated smaller operand (bounded far from
+// −2, so negation is exact): every sum is then a chain of multiply-accumulates,
+// one SMULL and then one SMLAL per product on a Cortex-M3. (Written as a
+// difference, or with saturating steps in between, GCC 12 builds some products
+// from MUL/MLA/UMULL instead, three to four times the instructions.)
+namespace fx {
+
+// x, as a value the compiler cannot identify with x. Each kernel below takes
+// its operands through this, so that their 64-bit sign extensions are not
+// shared with other kernels: when one value feeds products in several
+// kernels (inlined into one function), GCC 12 for Armv7-M extends it once and
+// then multiplies 64 × 64 bits with MUL, MLA and UMULL instead of one SMULL
+// or SMLAL, three to four times the instructions. Emits no instruction.
+#if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
+inline void arm_opaque(std::int32_t& x) noexcept {
+    __asm__("" : "+r"(x));
+}
+#endif
+
+constexpr std::int32_t unshared(std::int32_t x) noexcept {
+#if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
+    if (!__builtin_is_constant_evaluated()) {
+        arm_opaque(x);
+    }
+#endif
+    return x;
+}
+
+// a·b exactly, in 64 bits (one SMULL; SMLAL into a sum).
+constexpr std::int64_t mul(std::int32_t a, std::int32_t b) noexcept {
+    return std::int64_t{a} * b;
+}
+
+// acc + Σ aᵢ·bᵢ over the pairs (a₀, b₀, a₁, b₁, …), exact: a chain of SMLAL.
+constexpr std::int64_t accumulate_products(std::int64_t acc) noexcept {
+    return acc;
+}
+template <typename... Rest>
+constexpr std::int64_t accumulate_products(std::int64_t acc, std::int32_t a, std::int32_t b, Rest... rest) noexcept {
+    return accumulate_products(acc + mul(a, b), rest...);
+}
+// Σ aᵢ·bᵢ, exact: one SMULL, then SMLAL.
+template <typename... Rest>
+constexpr std::int64_t sum_products(std::int32_t a, std::int32_t b, Rest... rest) noexcept {
+    return accumulate_products(mul(a, b), rest...);
+}
+
+// (acc + Σ aᵢ·bᵢ)·2⁻³⁰ rounded to nearest (ties towards +∞), without
+// saturation: a sum of Q30 products (units 2⁻⁶⁰; acc in the same units)
+// rounded once to Q30. The rounding constant starts the accumulator, so the
+// rounding costs no instruction of its own. Precondition: the result fits.
+template <typename... Pairs>
+constexpr Q30 round30_sum(std::int64_t acc, Pairs... pairs) noexcept {
+    return {static_cast<std::int32_t>(accumulate_products(acc + (std::int64_t{1} << 29), pairs...) >> 30)};
+}
+
+// v·2⁻ˢ rounded to nearest (ties towards +∞). Precondition: the result fits
+// int32 and v + 2^(S−1) fits int64.
+template <int S>
+constexpr std::int32_t round_shift_to_int32(std::int64_t v) noexcept {
+    static_assert(S >= 1 && S <= 62, "shift");
+    return static_cast<std::int32_t>((v + (std::int64_t{1} << (S - 1))) >> S);
+}
+
+}  // namespace fx
+
+// norm_within (quaternion.hpp) in Q30, exact and for any input: ‖q‖² − 1 in
+// units 2⁻⁶⁰. The four squares (each ≤ 2⁶²) are summed modulo 2⁶⁴: exact
+// below 2⁶⁴; the only sum that wraps (all four components −2) reads 0, and
+// any true ‖q‖² − 1 ≥ 2⁶³ (units 2⁻⁶⁰; some |component| > 1.4) reads
+// ≤ −2⁶⁰ as a signed value: both are rejected, as they must be.
+constexpr bool norm_within(const Quaternion<Q30>& q, Q30 tol) noexcept {
+    const auto sq = [](Q30 c) { return static_cast<std::uint64_t>(fx::mul(c.raw, c.raw)); };
+    const auto e = static_cast<std::int64_t>(sq(q.w) + sq(q.x) + sq(q.y) + sq(q.z) - (std::uint64_t{1} << 60));
+    const std::int64_t t = fx::mul(tol.raw, std::int32_t{1} << 30);
+    return -t <= e && e <= t;
+}
+
+// right_increment (quaternion.hpp): q ⊗ (r − 1) in Q30, each component
+// rounded once. Range: q passed norm_within() (|qᵢ| ≤ 1 + 5e-7) and the
+// components of r − 1 are within ±2⁻⁴ (aberration: ≤ 1.7e-3); each
+// product ≤ 2⁵⁷, each result ≤ 2⁻² in magnitude.
+constexpr Quaternion<Q30> right_increment(const Quaternion<Q30>& q, const SmallRotation<Q30>& r) noexcept {
+    using fx::round30_sum;
+    using fx::unshared;
+    const std::int32_t qw = unshared(q.w.raw);
+    const std::int32_t qx = unshared(q.x.raw);
+    const std::int32_t qy = unshared(q.y.raw);
+    const std::int32_t qz = unshared(q.z.raw);
+    const std::int32_t aw = unshared(r.dw.raw);
+    const std::int32_t ax = unshared(r.v.x.raw);
+    const std::int32_t ay = unshared(r.v.y.raw);
+    const std::int32_t az = unshared(r.v.z.raw);
+    return {round30_sum(0, qw, aw, qx, -ax, qy, -ay, qz, -az), round30_sum(0, qw, ax, qx, aw, qy, az, qz, -ay),
+            round30_sum(0, qw, ay, qx, -az, qy, aw, qz, ax), round30_sum(0, qw, az, qx, ay, qy, -ax, qz, aw)};
+}
+
+// add_left_increment (quaternion.hpp): d + (r − 1) ⊗ (q + d) in Q30, each
+// component dᵢ·2³⁰ + Σ (r − 1)ⱼ·(q + d)ₖ exact in int64 and rounded once.
+// Range: q passed norm_within(), |dᵢ| ≤ 2⁻⁴ (the aberration increment,
+// ≤ 1.7e-3), the components of r − 1 within ±2⁻⁴ (thermal, angles ≤ 1°:
+// ≤ 0.016); then |q + d| < 1.07, each product < 2⁵⁷ and each result ≤ 2⁻³.
+constexpr Quaternion<Q30> add_left_increment(const Quaternion<Q30>& d, const SmallRotation<Q30>& r,
+                                             const Quaternion<Q30>& q) noexcept {
+    using fx::round30_sum;
+    using fx::unshared;
+    const std::int32_t sw = unshared(q.w.raw + d.w.raw);
+    const std::int32_t sx = unshared(q.x.raw + d.x.raw);
+    const std::int32_t sy = unshared(q.y.raw + d.y.raw);
+    const std::int32_t sz = unshared(q.z.raw + d.z.raw);
+    const std::int32_t aw = unshared(r.dw.raw);
+    const std::int32_t ax = unshared(r.v.x.raw);
+    const std::int32_t ay = unshared(r.v.y.raw);
+    const std::int32_t az = unshared(r.v.z.raw);
+    const auto units60 = [](Q30 x) { return std::int64_t{x.raw} * (std::int64_t{1} << 30); };
+    // (r − 1) ⊗ s: w = aw sw − ax sx − ay sy − az sz, x = aw sx + ax sw + ay sz − az sy,
+    //              y = aw sy − ax sz + ay sw + az sx,  z = aw sz + ax sy − ay sx + az sw.
+    return {round30_sum(units60(d.w), aw, sw, -ax, sx, -ay, sy, -az, sz),
+            round30_sum(units60(d.x), aw, sx, ax, sw, ay, sz, -az, sy),
+            round30_sum(units60(d.y), aw, sy, -ax, sz, ay, sw, az, sx),
+            round30_sum(units60(d.z), aw, sz, ax, sy, -ay, sx, az, sw)};
+}
+
+// renormalized_sum (quaternion.hpp) in Q30: s = q + d (exact), ε = ‖s‖² − 1
+// exact in int64, and each component sᵢ·(1 + g) with the Newton step taken to
+// second order, g = −ε/2 + 3ε²/8 (1/√(1 + ε) = 1 − ε/2 + 3ε²/8 − …): then
+// ‖result‖² − 1 = 5ε³/8 + O(ε⁴), which stays below 2⁻³⁰ for |ε| ≤ 1.1e-3,
+// four times what the thermal rotation's scale (≤ 2.3e-4) and the input's
+// tolerance (1e-6) add. g and each sᵢ·g are rounded once. Range: q passed
+// norm_within(), |dᵢ| ≤ 2⁻⁴ (the corrections' increments are ≤ 0.017,
+// correct.hpp); then |sᵢ| < 1.07, ‖s‖² < 4.6 (< 2⁶³ in units 2⁻⁶⁰), |ε| < 3.6,
+// and, for the |ε| ≤ 0.14 those increments allow, |g| < 0.08 and every
+// result < 1.2 in magnitude.
 constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quaternion<Q30>& d) noexcept {
-    const Quaternion<Q30> s{q.w + d.w, q.x + d.x, q.y + d.y, q.z + d.z};
-    const std::int64_t n2_half = fx::half_sum(fx::mac2(s.w, s.w, s.x, s.x), fx::mac2(s.y, s.y, s.z, s.z));
-    const Q30 g{fx::narrow_shift<30>((std::int64_t{1} << 59) - n2_half)};  // (1 − ‖s‖²)/2
-    return {s.w + s.w * g, s.x + s.x * g, s.y + s.y * g, s.z + s.z * g};
+    using fx::unshared;
+    const std::int32_t sw = unshared(q.w.raw + d.w.raw);
+    const std::int32_t sx = unshared(q.x.raw + d.x.raw);
+    const std::int32_t sy = unshared(q.y.raw + d.y.raw);
+    const std::int32_t sz = unshared(q.z.raw + d.z.raw);
+    const std::int64_t eps = fx::accumulate_products(-(std::int64_t{1} << 60), sw, sw, sx, sx, sy, sy, sz, sz);
+    const std::int32_t e = fx::round_shift_to_int32<30>(eps);  // ε, Q30
+    const std::int32_t g = fx::round_shift_to_int32<33>(3 * fx::mul(e, e)) - fx::round_shift_to_int32<31>(eps);
+    const auto step = [g](std::int32_t s) { return s + fx::round30_sum(0, s, g).raw; };
+    return {{step(sw)}, {step(sx)}, {step(sy)}, {step(sz)}};
+}
+
+// beta_in_domain (aberration.hpp) in Q30, for any input: each component
+// within ±kMaxBeta (then |βᵢ| < 2²², the squares are exact and small), then
+// |β|² against kMaxBeta² exactly, in units 2⁻⁶⁰.
+constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
+    constexpr std::int32_t lim = fx::raw_from_double(kMaxBeta, Q30::kFracBits);
+    constexpr auto lim2 = static_cast<std::int64_t>(kMaxBeta * kMaxBeta * 0x1p60);
+    const auto within = [](Q30 c) { return c.raw <= lim && -lim <= c.raw; };
+    return within(beta.x) && within(beta.y) && within(beta.z) &&
+           fx::mul(beta.x.raw, beta.x.raw) + fx::mul(beta.y.raw, beta.y.raw) + fx::mul(beta.z.raw, beta.z.raw) <= lim2;
+}
+
+// aberration_rotation (aberration.hpp) in Q30: the same q_ab, with the series
+// cut at the format's resolution (2⁻³⁰ = 9.3e-10). With c = z × β,
+// n = |c|² = sin²θ·(1 + p)²/(w1 + w2)² and p = z·β:
+//   f = (w1 + w2)/(1 + p) = 1 − p/2 + p²/2 + O(p³/2, p·β²/8, w2),
+//   q_ab = (−x/8, f/2·(1 + x/8)·c) with x = f²n = n·(1 + O(p)).
+// Dropped, relative to |c| ≤ kMaxBeta (3.34e-3), hence in absolute terms:
+// p³/2 ≤ 1.9e-8 → 6e-11; p·β²/8 ≤ 4.6e-9 → 1.5e-11; the solar term
+// w2 ≤ 2e-8/s → 7e-11 for s ≥ 1 au (the unused inv_sun_distance_au); in
+// x/8, the O(p) ≤ 4.6e-9 (a change of norm) and 7.7e-12 in v. All below
+// one LSB. Precondition: beta_in_domain(β) and |zᵢ| ≤ 1 + 2e-6 (the
+// boresight of a quaternion that passed norm_within()); then |p|, |cᵢ| ≤
+// 3.35e-3 and n ≤ 1.2e-5, so nothing overflows.
+// Rounding: c, p, f, the scale and v once each (≤ 2⁻³¹ each; v's error
+// ≤ 2.1·2⁻³¹ absolute), n exact (units 2⁻⁶⁰).
+constexpr SmallRotation<Q30> aberration_rotation(const Vector3<Q30>& z_icrf, const Vector3<Q30>& beta_icrf,
+                                                 const Q30& /*inv_sun_distance_au*/) noexcept {
+    using fx::unshared;
+    const std::int32_t zx = unshared(z_icrf.x.raw);
+    const std::int32_t zy = unshared(z_icrf.y.raw);
+    const std::int32_t zz = unshared(z_icrf.z.raw);
+    const std::int32_t bx = unshared(beta_icrf.x.raw);
+    const std::int32_t by = unshared(beta_icrf.y.raw);
+    const std::int32_t bz = unshared(beta_icrf.z.raw);
+    const std::int32_t p = fx::round30_sum(0, zx, bx, zy, by, zz, bz).raw;
+    const std::int32_t cx = fx::round30_sum(0, zy, bz, zz, -by).raw;
+    const std::int32_t cy = fx::round30_sum(0, zz, bx, zx, -bz).raw;
+    const std::int32_t cz = fx::round30_sum(0, zx, by, zy, -bx).raw;
+    const std::int64_t n = fx::sum_products(cx, cx, cy, cy, cz, cz);  // units 2⁻⁶⁰
+    constexpr std::int32_t kOne = std::int32_t{1} << 30;
+    const std::int32_t f = kOne - fx::round_shift_to_int32<1>(p) + fx::round_shift_to_int32<31>(fx::mul(p, p));
+    const std::int32_t half_1_x8 = (kOne >> 1) + fx::round_shift_to_int32<34>(n);  // (1 + n/8)/2
+    const std::int32_t scale = fx::round30_sum(0, f, half_1_x8).raw;
+    return {{-fx::round_shift_to_int32<33>(n)},
+            {fx::round30_sum(0, scale, cx), fx::round30_sum(0, scale, cy), fx::round30_sum(0, scale, cz)}};
 }
 
 namespace fx {
 
-// (t·2⁻²⁰)² in units of 2⁻¹² °C², rounded to nearest. |t| < 2²⁹ (≤ 512 °C):
-// t² < 2⁵⁸ fits int64 and the result < 2¹⁸·2¹² = 2³⁰ fits int32. Error ≤ 2⁻¹³ °C².
+// (t·2⁻²⁰)² in units of 2⁻¹² °C², rounded to nearest. |t| ≤ 2²⁹ (≤ 512 °C):
+// t² ≤ 2⁵⁸ fits int64 and the result ≤ 2¹⁸·2¹² = 2³⁰ fits int32. Error ≤ 2⁻¹³ °C².
 constexpr std::int32_t square_celsius(std::int32_t t) noexcept {
-    return static_cast<std::int32_t>(round_shift(std::int64_t{t} * t, 2 * QCelsius::kFracBits - 12));
+    return round_shift_to_int32<2 * QCelsius::kFracBits - 12>(mul(t, t));
 }
 
-// Clamps a temperature to ±2²⁸ raw (±256 °C): then a difference of two is
-// within ±2²⁹ (±512 °C) in int32, the range for which thermal_angle's 64-bit
-// sums cannot overflow. Readings inside the core's domain (±200 °C) pass
-// unchanged.
+// Clamps a temperature to [−2²⁸, 2²⁸ − 1] raw (±256 °C; one SSAT on Armv7-M):
+// then a difference of two is within ±2²⁹ (±512 °C) in int32, the range for
+// which thermal_angle's 64-bit sums cannot overflow. Readings inside the
+// core's domain (±200 °C) pass unchanged.
 constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
-    constexpr std::int32_t lim = std::int32_t{1} << 28;
-    return t > lim ? lim : (t < -lim ? -lim : t);
+    constexpr std::int32_t hi = (std::int32_t{1} << 28) - 1;
+    constexpr std::int32_t lo = -(std::int32_t{1} << 28);
+    return t > hi ? hi : (t < lo ? lo : t);
 }
 
 }  // namespace fx
@@ -382,113 +580,62 @@ constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
 template <>
 [[gnu::always_inline]] constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t1,
                                                         const QCelsius& t2, const QCelsius& t3) noexcept {
+    using fx::mul;
     constexpr int kSumFrac = QCoefficient::kFracBits + QCelsius::kFracBits;       // 56
     constexpr int kQuadShift = QQuadraticCoefficient::kFracBits + 12 - kSumFrac;  // 4
     const std::int32_t a = fx::clamp_celsius(t1.raw);
     const std::int32_t d2 = fx::clamp_celsius(t2.raw) - a;
     const std::int32_t d3 = fx::clamp_celsius(t3.raw) - a;
-    std::int64_t sum = std::int64_t{p.c0.raw} * (std::int64_t{1} << QCelsius::kFracBits) + std::int64_t{p.c1.raw} * a +
-                       std::int64_t{p.c2.raw} * d2 + std::int64_t{p.c3.raw} * d3;
+    std::int64_t sum =
+        fx::sum_products(p.c0.raw, std::int32_t{1} << QCelsius::kFracBits, p.c1.raw, a, p.c2.raw, d2, p.c3.raw, d3);
     if ((p.c1_2.raw | p.c2_2.raw | p.c3_2.raw) != 0) {
-        sum += fx::round_shift(std::int64_t{p.c1_2.raw} * fx::square_celsius(a), kQuadShift) +
-               fx::round_shift(std::int64_t{p.c2_2.raw} * fx::square_celsius(d2), kQuadShift) +
-               fx::round_shift(std::int64_t{p.c3_2.raw} * fx::square_celsius(d3), kQuadShift);
+        sum += fx::round_shift(mul(p.c1_2.raw, fx::square_celsius(a)), kQuadShift) +
+               fx::round_shift(mul(p.c2_2.raw, fx::square_celsius(d2)), kQuadShift) +
+               fx::round_shift(mul(p.c3_2.raw, fx::square_celsius(d3)), kQuadShift);
     }
     return {fx::narrow_shift<kSumFrac - Q30::kFracBits>(sum)};
 }
 
-// ---- The thermal rotation in Q30 (thermal.hpp: q_th = q3(γ) ⊗ q2(β) ⊗ q1(α),
-// 16-product expansion), specialised for the format's resolution.
+// ---- The thermal rotation in Q30 (thermal.hpp: q_th = q3(γ) ⊗ q2(β) ⊗ q1(α)),
+// in the format's own, cheaper form: q_th divided by c1c2c3 (cᵢ = cos hᵢ,
+// hᵢ = angleᵢ/2), a positive multiple of q_th and so the same rotation. With
+// tᵢ = tan hᵢ each factor is (1, −tᵢ·axisᵢ) and the product is exactly
+//   q_th/(c1c2c3) = (1 − t1t2t3, −t1 − t2t3, −t2 + t1t3, −t1t2 − t3):
+// four products instead of sixteen. Its norm² is Π(1 + tᵢ²) ≤ 1 + 2.3e-4
+// (angles ≤ 1°); renormalized_sum() removes that with its second-order step.
 //
 // Range: each angle is first clamped to ±kMaxThermalAngleRad (the core calls
-// this only after checking that bound, so the clamp never acts there). Then
-// |h| = |angle|/2 ≤ 8.73e-3, |s| ≤ |h|, |cos h − 1| ≤ 3.81e-5: every factor
-// is ≤ 1 in magnitude (raw ≤ 2³⁰), every product ≤ 2⁶⁰ and every sum of two
-// ≤ 2⁶¹ in int64, and every result ≤ 1 + 2e-4 in magnitude: no overflow and
-// no saturation needed, hence none is applied (plain int64 arithmetic).
-// Series at Q30 resolution (2⁻³⁰ = 9.3e-10):
-//   sin h = h − h³/6 + O(h⁵/120 ≤ 4.1e-13),
-//   cos h − 1 = −h²/2 + O(h⁴/24 ≤ 2.4e-10; this changes |q| only to first
-//     order, and the rotation angle by ≤ 2·s·2.4e-10 = 4e-12 rad).
-// h³/6 uses 1/12 as 174763·2⁻²¹ (relative error 1.9e-6 of a term ≤ 1.1e-7).
-// Rounding: to nearest at each product (≤ 2⁻³¹ each, about ten per
-// component): ≤ 5e-9 absolute, 1e-3" as a rotation.
+// this only after checking that bound, so the clamp never acts there): then
+// |a| < 2²⁵ raw, |h| ≤ 8.73e-3, |t| ≤ 8.74e-3 and every product is far inside
+// int64, every result inside ±2⁻⁶: no saturation is needed.
+// Series: tan h = h·(1 + h²/3) + O(2h⁵/15 ≤ 6.7e-12), with h²/6 taken as
+// h²·⌈2³²/6⌉·2⁻³² (relative error 5e-10 of a term ≤ 1.3e-5).
+// Rounding: h², h²/6, t, the products: ≤ 2⁻³¹ each, ≤ 2·2⁻³⁰ per component
+// (4e-4" as a rotation).
 namespace fx {
 
-// (a·b) rounded to Q30, for operands with |a·b| ≤ 2⁶¹ (no saturation).
-constexpr std::int32_t mul_small(std::int32_t a, std::int32_t b) noexcept {
-    return static_cast<std::int32_t>((std::int64_t{a} * b + (std::int64_t{1} << 29)) >> 30);
-}
-
-// (a·b + c·d) rounded to Q30, for |a·b| + |c·d| ≤ 2⁶¹ (no saturation).
-constexpr std::int32_t mul2_small(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) noexcept {
-    return static_cast<std::int32_t>((std::int64_t{a} * b + std::int64_t{c} * d + (std::int64_t{1} << 29)) >> 30);
-}
-
-struct HalfAngleQ30 {
-    std::int32_t cm1;  // cos(angle/2) − 1, Q30
-    std::int32_t s;    // sin(angle/2), Q30
-};
-
-constexpr HalfAngleQ30 half_angle_q30(Q30 angle) noexcept {
+// tan(angle/2) in Q30, |angle| clamped to ≤ kMaxThermalAngleRad.
+constexpr std::int32_t tan_half_angle(Q30 angle) noexcept {
     constexpr std::int32_t lim = raw_from_double(kMaxThermalAngleRad, Q30::kFracBits);
-    const std::int32_t a = angle.raw > lim ? lim : (angle.raw < -lim ? -lim : angle.raw);  // |a| < 2²⁵
-    const std::int64_t a2 = std::int64_t{a} * a;                                           // (2h)², units 2⁻⁶⁰
-    const auto h2 = static_cast<std::int32_t>((a2 + (std::int64_t{1} << 31)) >> 32);       // h², Q30, < 2¹⁷
-    const std::int64_t t = std::int64_t{h2} * a;  // 2h³, units 2⁻⁶⁰, < 2⁴²
-    const auto h3_6 = static_cast<std::int32_t>((t * 174763 + (std::int64_t{1} << 50)) >> 51);  // h³/6, Q30
-    const std::int32_t h = (a + 1) >> 1;                                                        // Q30
-    return {-((h2 + 1) >> 1), h - h3_6};
+    constexpr std::int32_t kSixth = 715827883;  // ⌈2³²/6⌉
+    const std::int32_t a = unshared(angle.raw > lim ? lim : (angle.raw < -lim ? -lim : angle.raw));
+    const std::int32_t h2 = round_shift_to_int32<32>(mul(a, a));  // (a/2)², Q30, < 2¹⁷
+    const std::int32_t half_1_h2_3 = (std::int32_t{1} << 29) + round_shift_to_int32<32>(mul(h2, kSixth));
+    return round30_sum(0, a, half_1_h2_3).raw;  // (a/2)·(1 + h²/3)
 }
 
 }  // namespace fx
 
 constexpr SmallRotation<Q30> thermal_rotation(const Q30& alpha, const Q30& beta, const Q30& gamma) noexcept {
-    using fx::mul2_small;
-    using fx::mul_small;
-    const fx::HalfAngleQ30 a = fx::half_angle_q30(alpha);
-    const fx::HalfAngleQ30 b = fx::half_angle_q30(beta);
-    const fx::HalfAngleQ30 g = fx::half_angle_q30(gamma);
-    constexpr std::int32_t one = std::int32_t{1} << 30;
-    const std::int32_t ac = one + a.cm1;
-    const std::int32_t bc = one + b.cm1;
-    const std::int32_t gc = one + g.cm1;
-    const std::int32_t ccm1 = a.cm1 + b.cm1 + mul_small(a.cm1, b.cm1);  // c1c2 − 1
-    const std::int32_t cc = one + ccm1;
-    const std::int32_t sc = mul_small(a.s, bc);
-    const std::int32_t cs = mul_small(ac, b.s);
-    const std::int32_t ss = mul_small(a.s, b.s);
-    return {{ccm1 + g.cm1 + mul2_small(ccm1, g.cm1, -ss, g.s)},
-            {{-mul2_small(sc, gc, cs, g.s)}, {mul2_small(sc, g.s, -cs, gc)}, {-mul2_small(ss, gc, cc, g.s)}}};
-}
-
-// beta_in_domain (aberration.hpp) for Q30: the components first (each within
-// ±kMaxBeta), then |β|². The same verdict as the generic test (which relies
-// on saturation for huge components); on the Cortex-M3 the cheaper code, as
-// measured (toolchain/run-target-bench): the early exits keep the aberration
-// stage's registers free.
-constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
-    constexpr Q30 lim{fx::raw_from_double(kMaxBeta, Q30::kFracBits)};
-    constexpr Q30 lim2{fx::raw_from_double(kMaxBeta * kMaxBeta, Q30::kFracBits)};
-    const auto within = [&](Q30 c) { return c <= lim && -lim <= c; };
-    return within(beta.x) && within(beta.y) && within(beta.z) && squared_norm(beta) <= lim2;
-}
-
-// add_left_increment (quaternion.hpp) in Q30: each component
-// dᵢ + Σ (r − 1)ⱼ·(q + d)ₖ summed exactly in int64 (dᵢ scaled to units 2⁻⁶⁰)
-// and rounded and saturated once. Range: q + d is a saturating sum (|·| ≤ 2);
-// for |r − 1| components ≤ 0.5 (a rotation's increment, here ≤ 3° of thermal
-// rotation: ≤ 0.03) each product is ≤ 2⁶⁰ and the sum ≤ 2⁶¹ + 4·2⁶⁰ < 2⁶³.
-constexpr Quaternion<Q30> add_left_increment(const Quaternion<Q30>& d, const SmallRotation<Q30>& r,
-                                             const Quaternion<Q30>& q) noexcept {
-    const Quaternion<Q30> s{q.w + d.w, q.x + d.x, q.y + d.y, q.z + d.z};
-    const Quaternion<Q30> a = increment(r);
-    const auto one = [](Q30 x) { return std::int64_t{x.raw} * (std::int64_t{1} << 30); };
-    const auto p = [](Q30 x, Q30 y) { return std::int64_t{x.raw} * y.raw; };
-    return {fx::narrow(one(d.w) + p(a.w, s.w) - p(a.x, s.x) - p(a.y, s.y) - p(a.z, s.z)),
-            fx::narrow(one(d.x) + p(a.w, s.x) + p(a.x, s.w) + p(a.y, s.z) - p(a.z, s.y)),
-            fx::narrow(one(d.y) + p(a.w, s.y) - p(a.x, s.z) + p(a.y, s.w) + p(a.z, s.x)),
-            fx::narrow(one(d.z) + p(a.w, s.z) + p(a.x, s.y) - p(a.y, s.x) + p(a.z, s.w))};
+    using fx::round30_sum;
+    const std::int32_t t1 = fx::tan_half_angle(alpha);
+    const std::int32_t t2 = fx::tan_half_angle(beta);
+    const std::int32_t t3 = fx::tan_half_angle(gamma);
+    const std::int32_t t12 = round30_sum(0, t1, t2).raw;
+    const std::int32_t t13 = round30_sum(0, t1, t3).raw;
+    const std::int32_t t23 = round30_sum(0, t2, t3).raw;
+    const std::int32_t t123 = round30_sum(0, t12, t3).raw;
+    return {{-t123}, {{-t1 - t23}, {t13 - t2}, {-t12 - t3}}};
 }
 
 }  // namespace ascorr

@@ -45,6 +45,14 @@ constexpr bool is_finite(const Quaternion<T>& q) noexcept {
     return is_finite(q.w) && is_finite(q.x) && is_finite(q.y) && is_finite(q.z);
 }
 
+// |‖q‖² − 1| ≤ tol: q is a unit quaternion to within tol. False for a
+// non-finite q (NaN fails the comparison, an infinity exceeds it). A
+// fixed-point scalar overloads this with an exact test.
+template <typename T>
+constexpr bool norm_within(const Quaternion<T>& q, const T& tol) noexcept {
+    return abs_within(squared_norm(q) - k<T>(1.0), tol);
+}
+
 // The same attitude with w ≥ 0.
 template <typename T>
 constexpr Quaternion<T> canonical(const Quaternion<T>& q) noexcept {
@@ -86,6 +94,13 @@ constexpr Quaternion<T> increment(const SmallRotation<T>& r) noexcept {
 template <typename T>
 constexpr Quaternion<T> to_quaternion(const SmallRotation<T>& r) noexcept {
     return {k<T>(1.0) + r.dw, r.v.x, r.v.y, r.v.z};
+}
+
+// The increment after applying r on the right of the attitude q:
+// q ⊗ (r − 1), so that q ⊗ r = q + result.
+template <typename T>
+constexpr Quaternion<T> right_increment(const Quaternion<T>& q, const SmallRotation<T>& r) noexcept {
+    return q * increment(r);
 }
 
 // The increment after applying r on the left of the attitude q + d:

@@ -10,7 +10,10 @@
 //  - is_finite() is found by argument-dependent lookup (a fixed-point type is
 //    always finite and supplies its own);
 //  - the tolerances that decide "bad input" are per type, because what counts
-//    as rounding noise depends on the representation.
+//    as rounding noise depends on the representation;
+//  - double_precision says whether the core's truncated series carry the
+//    terms that only a double resolves (each dropped term's bound is stated
+//    where the series is).
 //
 // A new scalar type specialises ScalarTraits and provides is_finite() in its
 // own namespace. The core itself never calls sqrt, sin, cos or divides: every
@@ -40,6 +43,8 @@ struct ScalarTraits<double> {
     // normalise in float, and is far below any real attitude error
     // (1e-6 in ‖q‖² is a pure scale, not a rotation).
     static constexpr double unit_norm_tolerance = 1e-6;
+    // The core's series keep the terms that only double resolves.
+    static constexpr bool double_precision = true;
 };
 
 template <>
@@ -54,6 +59,9 @@ struct ScalarTraits<float> {
     static constexpr float quadratic_coefficient(double x) noexcept { return static_cast<float>(x); }
     // Rounding four float components leaves ‖q‖² − 1 up to ~4.8e-7.
     static constexpr float unit_norm_tolerance = 1e-5F;
+    // Series terms below float's resolution (2⁻²⁴ relative) are dropped,
+    // each with its bound where the series is (aberration.hpp, thermal.hpp).
+    static constexpr bool double_precision = false;
 };
 
 // Finite-ness of floating-point scalars. Unqualified calls to is_finite(x) in
@@ -63,6 +71,15 @@ inline bool is_finite(double x) noexcept {
 }
 inline bool is_finite(float x) noexcept {
     return std::isfinite(x);
+}
+
+// |x| ≤ lim (lim ≥ 0), false for NaN: one comparison after clearing the sign.
+// A fixed-point scalar overloads this.
+inline bool abs_within(double x, double lim) noexcept {
+    return std::fabs(x) <= lim;
+}
+inline bool abs_within(float x, float lim) noexcept {
+    return std::fabs(x) <= lim;
 }
 
 // A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a

@@ -17,6 +17,15 @@
 //   cos h ≈ 1 − h²/2·(1 − h²/12),  truncation ≤ h⁶/720  = 6.1e-16;
 //   sin h ≈ h·(1 − h²/6·(1 − h²/20)), truncation ≤ h⁷/5040 = 7.6e-19.
 // Both are at or below double rounding; the cos error only scales the norm.
+//
+// Without double precision (float; Q30 has the same form in fixed_point.hpp)
+// the rotation is returned as q_th/(c1c2c3), cᵢ = cos hᵢ: a positive multiple
+// of q_th, hence the same rotation, and with tᵢ = tan hᵢ exactly
+//   (1 − t1t2t3, −t1 − t2t3, −t2 + t1t3, −t1t2 − t3),
+// four products instead of sixteen. tan h ≈ h·(1 + h²/3), truncation
+// ≤ 2h⁵/15 = 6.7e-12. Its norm² is Π(1 + tᵢ²) ≤ 1 + 2.3e-4; the final
+// renormalisation (one Newton step, quaternion.hpp) takes it out to
+// ‖q‖² − 1 ≥ −3ε²/4 ≥ −4e-8 at the domain's limit, below float's resolution.
 #pragma once
 
 #include <cstdint>
@@ -67,12 +76,11 @@ struct HeadTemperatures {
     TemperatureReading<T> t_032;  // T3, THT00032, optical bench next to the SiC cube
 };
 
-// A usable temperature: finite and inside ±kMaxAbsTemperatureC (a NaN fails
-// both comparisons, an infinity one of them).
+// A usable temperature: finite and inside ±kMaxAbsTemperatureC (false for a
+// NaN or an infinity).
 template <typename T>
 constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
-    const Celsius<T> lim = ScalarTraits<T>::celsius(kMaxAbsTemperatureC);
-    return t <= lim && -lim <= t;
+    return abs_within(t, ScalarTraits<T>::celsius(kMaxAbsTemperatureC));
 }
 
 // The model angle of one axis, in radians. A fixed-point scalar overloads this
@@ -101,13 +109,25 @@ constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
             h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
 }
 
-// q_th = q3(γ) ⊗ q2(β) ⊗ q1(α), expanded (16 products instead of 32), with
+// q_th = q3(γ) ⊗ q2(β) ⊗ q1(α) (double precision; without, the multiple of
+// it described at the top), expanded (16 products instead of 32), with
 // c_i = 1 + cm1_i and s_i the half-angle cosines and sines:
 //   w =  c1c2c3 − s1s2s3      x = −s1c2c3 − c1s2s3
 //   y = −c1s2c3 + s1c2s3      z = −s1s2c3 − c1c2s3
 // w − 1 is formed from the cm1 terms, never as a difference of near-ones.
 template <typename T>
 constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
+    if constexpr (!ScalarTraits<T>::double_precision) {
+        const auto tan_half = [](const T& angle) {
+            const T h = k<T>(0.5) * angle;
+            return h + k<T>(1.0 / 3.0) * (h * h) * h;
+        };
+        const T t1 = tan_half(alpha);
+        const T t2 = tan_half(beta);
+        const T t3 = tan_half(gamma);
+        const T t12 = t1 * t2;
+        return {-(t12 * t3), {-(t1 + t2 * t3), t1 * t3 - t2, -(t12 + t3)}};
+    }
     const HalfAngle<T> a = half_angle(alpha);
     const HalfAngle<T> b = half_angle(beta);
     const HalfAngle<T> g = half_angle(gamma);
