@@ -50,7 +50,6 @@ Fixture<T> make_fixture() {
     return fx;
 }
 
-
 // The whole result is kept (in memory, as the compiler must assume it is
 // read): with only the status kept, the compiler drops every computation the
 // status does not depend on, e.g. all of the aberration stage in Q30.

@@ -330,16 +330,6 @@ constexpr Quaternion<Q30> operator*(const Quaternion<Q30>& a, const Quaternion<Q
             narrow_half(half_sum(mac2(a.w, b.z, a.x, b.y), msub2(a.z, b.w, a.y, b.x)))};
 }
 
-// Third row of R(q) (quaternion.hpp), each component rounded once; the
-// doubling is exact: a sum in units 2⁻⁶⁰ read in units 2⁻⁵⁹.
-constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
-    const std::int64_t a = fx::msub2(q.x, q.z, q.w, q.y);
-    const std::int64_t b = fx::mac2(q.y, q.z, q.w, q.x);
-    const std::int64_t c = fx::mac2(q.x, q.x, q.y, q.y);  // ≥ 0 (wraps only at x = y = −2)
-    constexpr std::int64_t kOne = std::int64_t{1} << 59;  // 1 in units 2⁻⁵⁹
-    return {fx::narrow_half(a), fx::narrow_half(b), fx::narrow_half(kOne - c)};
-}
-
 // ---- The correction's kernels in Q30: the functions correct_solution() calls
 // (found by argument-dependent lookup, preferred to the generic templates).
 // Their operands are bounded by the core's own checks, stated per function,
@@ -411,6 +401,29 @@ constexpr std::int32_t round_shift_to_int32(std::int64_t v) noexcept {
 }
 
 }  // namespace fx
+
+// boresight (quaternion.hpp), the third row of R(q), in Q30: each component
+// a sum of two products, exact, doubled exactly (read in units 2⁻⁵⁹) and
+// rounded once. Range: q passed norm_within() (|qᵢ| ≤ 1 + 5e-7); then every
+// component is ≤ 1 + 1e-6 in magnitude.
+constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
+    using fx::unshared;
+    const std::int32_t qw = unshared(q.w.raw);
+    const std::int32_t qx = unshared(q.x.raw);
+    const std::int32_t qy = unshared(q.y.raw);
+    const std::int32_t qz = unshared(q.z.raw);
+    constexpr std::int64_t kHalfLsb = std::int64_t{1} << 28;  // units 2⁻⁵⁹
+    const auto round29 = [](std::int64_t v) { return Q30{static_cast<std::int32_t>(v >> 29)}; };
+    return {round29(fx::accumulate_products(kHalfLsb, qx, qz, -qw, qy)),
+            round29(fx::accumulate_products(kHalfLsb, qy, qz, qw, qx)),
+            round29(fx::accumulate_products((std::int64_t{1} << 59) + kHalfLsb, -qx, qx, -qy, qy))};
+}
+
+// conjugate (quaternion.hpp) of a SmallRotation in Q30: plain negation, exact,
+// since a rotation's vector part is within ±1 (never −2).
+constexpr SmallRotation<Q30> conjugate(const SmallRotation<Q30>& r) noexcept {
+    return {r.dw, {{-r.v.x.raw}, {-r.v.y.raw}, {-r.v.z.raw}}};
+}
 
 // norm_within (quaternion.hpp) in Q30, exact and for any input: ‖q‖² − 1 in
 // units 2⁻⁶⁰. The four squares (each ≤ 2⁶²) are summed modulo 2⁶⁴: exact
@@ -544,7 +557,8 @@ namespace fx {
 // (t·2⁻²⁰)² in units of 2⁻¹² °C², rounded to nearest. |t| ≤ 2²⁹ (≤ 512 °C):
 // t² ≤ 2⁵⁸ fits int64 and the result ≤ 2¹⁸·2¹² = 2³⁰ fits int32. Error ≤ 2⁻¹³ °C².
 constexpr std::int32_t square_celsius(std::int32_t t) noexcept {
-    return round_shift_to_int32<2 * QCelsius::kFracBits - 12>(mul(t, t));
+    const std::int32_t u = unshared(t);
+    return round_shift_to_int32<2 * QCelsius::kFracBits - 12>(mul(u, u));
 }
 
 // Clamps a temperature to [−2²⁸, 2²⁸ − 1] raw (±256 °C; one SSAT on Armv7-M):
@@ -564,15 +578,15 @@ constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
 // All products in int64:
 //   linear    c·T  : |c| < 2³¹, |T| ≤ 2²⁹ → < 2⁶⁰ each, units 2⁻⁵⁶ rad;
 //   quadratic c·T² : |c| < 2³¹, T² ≤ 2³⁰ (units 2⁻¹²) → < 2⁶¹ each, units 2⁻⁶⁰
-//                    rad, rounded to 2⁻⁵⁶ (→ < 2⁵⁷);
-//   the sum in units of 2⁻⁵⁶: c0·2²⁰ + Σlin + Σquad < 2⁵¹ + 3·2⁶⁰ + 3·2⁵⁷ < 2⁶²,
+//                    rad, their sum (< 1.5·2⁶²) rounded once to 2⁻⁵⁶ (→ < 1.5·2⁵⁸);
+//   the sum in units of 2⁻⁵⁶: c0·2²⁰ + Σlin + Σquad < 2⁵¹ + 3·2⁶⁰ + 1.5·2⁵⁸ < 2⁶²,
 //     no overflow for any input, because temperatures are clamped to ±256 °C
 //     first, so that they and their differences are within ±512 °C (the core
 //     calls this only for readings inside ±200 °C, where the clamp does nothing).
 // Result rounded once to Q30 (error ≤ 2⁻³¹ rad = 9.6e-5") and saturated (the
 // core then flags it beyond kMaxThermalAngleRad). Other rounding, in rad:
-// T² ≤ 2⁻¹³ °C²·|c_2| (≤ 1e-10 at the largest c_2) and 2⁻⁵⁷ per quadratic
-// term. Coefficient and temperature quantisation (the inputs) add ≤ 2⁻³⁷·|T|,
+// T² ≤ 2⁻¹³ °C²·|c_2| (≤ 1e-10 at the largest c_2) and 2⁻⁵⁷ for the
+// quadratic terms together. Coefficient and temperature quantisation (the inputs) add ≤ 2⁻³⁷·|T|,
 // 2⁻⁴⁹·T² and 2⁻²¹·|c| per term.
 // The three quadratic products are skipped for an axis whose quadratic
 // coefficients are all zero (the usual linear model): same result, fewer
@@ -589,9 +603,9 @@ template <>
     std::int64_t sum =
         fx::sum_products(p.c0.raw, std::int32_t{1} << QCelsius::kFracBits, p.c1.raw, a, p.c2.raw, d2, p.c3.raw, d3);
     if ((p.c1_2.raw | p.c2_2.raw | p.c3_2.raw) != 0) {
-        sum += fx::round_shift(mul(p.c1_2.raw, fx::square_celsius(a)), kQuadShift) +
-               fx::round_shift(mul(p.c2_2.raw, fx::square_celsius(d2)), kQuadShift) +
-               fx::round_shift(mul(p.c3_2.raw, fx::square_celsius(d3)), kQuadShift);
+        sum += fx::round_shift(fx::sum_products(p.c1_2.raw, fx::square_celsius(a), p.c2_2.raw, fx::square_celsius(d2),
+                                                p.c3_2.raw, fx::square_celsius(d3)),
+                               kQuadShift);
     }
     return {fx::narrow_shift<kSumFrac - Q30::kFracBits>(sum)};
 }
