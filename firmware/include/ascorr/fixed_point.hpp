@@ -16,12 +16,18 @@
 //                         nearest Q30 (ties towards +∞: + 2²⁹, arithmetic shift
 //                         right by 30), saturated.  Error ≤ 2⁻³¹.
 //      comparisons      : exact.
-//      dot, cross, squared_norm, quaternion product, boresight,
-//      renormalized_sum : overloads of the core's generic functions that sum
-//                         exact products in int64 and round and saturate once
-//                         per result (see "Sums of products" below).
-//      thermal_angle, thermal_rotation, beta_in_domain : Q30 versions of the
-//                         core's functions, each with its range argument.
+//      dot, cross, squared_norm, quaternion product : overloads of the
+//                         generic functions for any input: exact products
+//                         summed in int64, rounded and saturated once per
+//                         result (see "Sums of products" below).
+//      the correction's kernels (norm_within, boresight, right_increment,
+//      add_left_increment, renormalized_sum, beta_in_domain,
+//      aberration_rotation, thermal_angle, thermal_rotation) : Q30 versions
+//                         of the core's functions, each with its range
+//                         argument: the core's checks bound their operands, so
+//                         they round once per result and need no saturation
+//                         (thermal_angle, which takes any temperatures and
+//                         coefficients, saturates).
 //    On a Cortex-M3 a product is one SMULL/SMLAL; no floating point is used.
 //  QCelsius (temperatures): signed Q11.20, value = raw·2⁻²⁰ °C, range ±2048 °C,
 //    resolution 9.5e-7 °C. The core accepts ±200 °C (temperature_in_domain), so

@@ -74,6 +74,9 @@ constexpr T dot(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
 // relative precision, and an attitude is rounded once, when the sum of all
 // small terms is added to it (see renormalized_sum). In float that halves the
 // error of applying two corrections to a stored quaternion.
+// q may be a positive multiple 1 + O(θ²) of the unit quaternion (the thermal
+// rotation without double precision, thermal.hpp): the same rotation, whose
+// scale the final renormalisation takes out.
 template <typename T>
 struct SmallRotation {
     T dw;  // w − 1
