@@ -31,9 +31,9 @@
 //      f = 1 − pdv/2 + pdv²/2,   x = |c|²,
 //  dropping pdv³/2 ≤ 1.9e-8 and pdv·β²/8 ≤ 4.6e-9 (relative to f), the
 //  solar term w2 ≤ 2e-8/s (below half an ulp of f ≈ 1, so float would round it
-//  away), and in x the factor f² = 1 + O(2·pdv): x/8 is then off by ≤ 9e-9, a
-//  change of norm (≤ 1.6e-11 rad in direction), and the scale by ≤ 9e-9
-//  relative. Together ≤ 5e-9 of θ: 3.5e-6" at the domain limit.
+//  away), and in x the factor f² = 1 − pdv + …: x/8 is then off by ≤ 4.6e-9,
+//  a change of norm (≤ 1.6e-11 rad in direction), and the scale by ≤ 4.6e-9
+//  relative. Together ≤ 5e-8 of θ: 3.4e-5" at the domain limit.
 #pragma once
 
 #include "constants.hpp"

@@ -357,7 +357,7 @@ namespace fx {
 // or SMLAL, three to four times the instructions. Emits no instruction.
 #if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
 inline void arm_opaque(std::int32_t& x) noexcept {
-    __asm__("" : "+r"(x));
+    __asm__ volatile("" : "+r"(x));  // volatile: two with the same input are not merged
 }
 #endif
 
@@ -495,9 +495,9 @@ constexpr Quaternion<Q30> add_left_increment(const Quaternion<Q30>& d, const Sma
 // four times what the thermal rotation's scale (≤ 2.3e-4) and the input's
 // tolerance (1e-6) add. g and each sᵢ·g are rounded once. Range: q passed
 // norm_within(), |dᵢ| ≤ 2⁻⁴ (the corrections' increments are ≤ 0.017,
-// correct.hpp); then |sᵢ| < 1.07, ‖s‖² < 4.6 (< 2⁶³ in units 2⁻⁶⁰), |ε| < 3.6,
-// and, for the |ε| ≤ 0.14 those increments allow, |g| < 0.08 and every
-// result < 1.2 in magnitude.
+// correct.hpp); then |sᵢ| < 1.07, ‖s‖² < 4.6 (< 2⁶³ in units 2⁻⁶⁰); with
+// |dᵢ| ≤ 2⁻⁴, |ε| ≤ 0.27, |g| < 0.17 and every result < 1.3 in magnitude
+// (the actual increments give |ε| ≤ 0.07).
 constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quaternion<Q30>& d) noexcept {
     using fx::unshared;
     const std::int32_t sw = unshared(q.w.raw + d.w.raw);
@@ -529,9 +529,9 @@ constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
 //   q_ab = (−x/8, f/2·(1 + x/8)·c) with x = f²n = n·(1 + O(p)).
 // Dropped, relative to |c| ≤ kMaxBeta (3.34e-3), hence in absolute terms:
 // p³/2 ≤ 1.9e-8 → 6e-11; p·β²/8 ≤ 4.6e-9 → 1.5e-11; the solar term
-// w2 ≤ 2e-8/s → 7e-11 for s ≥ 1 au (the unused inv_sun_distance_au); in
-// x/8, the O(p) ≤ 4.6e-9 (a change of norm) and 7.7e-12 in v. All below
-// one LSB. Precondition: beta_in_domain(β) and |zᵢ| ≤ 1 + 2e-6 (the
+// w2 ≤ 2e-8/s → 7e-11 for s ≥ 1 au (the unused inv_sun_distance_au): each
+// below one LSB. In x/8 the O(p) is ≤ 4.6e-9 (5 LSB) in dw, a change of norm
+// only, which the renormalisation takes out, and 7.7e-12 in v. Precondition: beta_in_domain(β) and |zᵢ| ≤ 1 + 2e-6 (the
 // boresight of a quaternion that passed norm_within()); then |p|, |cᵢ| ≤
 // 3.35e-3 and n ≤ 1.2e-5, so nothing overflows.
 // Rounding: c, p, f, the scale and v once each (≤ 2⁻³¹ each; v's error
@@ -631,7 +631,7 @@ template <>
 // Series: tan h = h·(1 + h²/3) + O(2h⁵/15 ≤ 6.7e-12), with h²/6 taken as
 // h²·⌈2³²/6⌉·2⁻³² (relative error 5e-10 of a term ≤ 1.3e-5).
 // Rounding: h², h²/6, t, the products: ≤ 2⁻³¹ each, ≤ 2·2⁻³⁰ per component
-// (4e-4" as a rotation).
+// (7.7e-4" as a rotation: an error δ in the vector part turns by 2δ).
 namespace fx {
 
 // tan(angle/2) in Q30, |angle| clamped to ≤ kMaxThermalAngleRad.

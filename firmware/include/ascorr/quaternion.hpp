@@ -117,7 +117,7 @@ constexpr Quaternion<T> add_left_increment(const Quaternion<T>& d, const SmallRo
 // (q + d) brought to unit norm by one Newton step, rounded once:
 //   q + [d + (q + d)·g],  g = (1 − ‖q + d‖²)/2,
 // with ‖q + d‖² − 1 = (‖q‖² − 1) + 2 q·d + ‖d‖² formed from small terms.
-// For ‖q + d‖² = 1 + ε the result has ‖·‖² − 1 = −3ε²/4 − ε³/4, so an input
+// For ‖q + d‖² = 1 + ε the result has ‖·‖² − 1 = −3ε²/4 + ε³/4, so an input
 // within the tolerance (ε ≤ 1e-5) comes out unit to ~1e-10, and one unit to
 // rounding stays so. The step scales, it does not rotate: its own rounding
 // does not move the attitude. No sqrt, no division: the same code serves
