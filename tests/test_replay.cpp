@@ -3,10 +3,20 @@
 // target restarts and wrong answers.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <random>
 #include <sstream>
+#include <thread>
+#include <type_traits>
 
+#include "ascorr/fixed_point.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/replay.hpp"
@@ -164,6 +174,109 @@ TEST(Replay, RestartWithItsHelloLostIsDetectedFromTheAnswer) {
 TEST(Replay, AnAnswerForAnotherSolutionIsNeverAccepted) {
     MisbehavingTarget target(-1, 10);
     check_against_host_core(target, 0);
+}
+
+// A serial device without hardware: a pseudo-terminal whose master end is
+// served, in a thread, by the firmware's LinkServer<T>, as a DPU on a UART
+// would. The host opens the slave end (/dev/pts/N) as it would /dev/ttyUSB0.
+template <typename T>
+class PtyTarget {
+public:
+    struct Counter {
+        std::uint32_t operator()() const { return 0; }
+    };
+    PtyTarget() : server_(0x50545900U, Counter{}) {
+        master_ = ::posix_openpt(O_RDWR | O_NOCTTY);
+        if (master_ < 0 || ::grantpt(master_) != 0 || ::unlockpt(master_) != 0 || ::ptsname(master_) == nullptr) {
+            throw std::runtime_error("no pseudo-terminal");
+        }
+        device_ = ::ptsname(master_);
+        thread_ = std::thread([this] { serve(); });
+    }
+    ~PtyTarget() {
+        stop_ = true;
+        thread_.join();
+        ::close(master_);
+    }
+    const std::string& device() const { return device_; }
+    std::uint32_t solutions() const { return solutions_; }
+
+private:
+    void serve() {
+        std::uint8_t buf[512];
+        while (!stop_) {
+            pollfd p{master_, POLLIN, 0};
+            if (::poll(&p, 1, 20) <= 0 || (p.revents & POLLIN) == 0) {
+                continue;  // also POLLHUP while the host has the slave closed
+            }
+            const ssize_t n = ::read(master_, buf, sizeof buf);
+            for (ssize_t i = 0; i < n; ++i) {
+                server_.on_byte(buf[i], [this](const std::uint8_t* r, std::size_t m) {
+                    for (std::size_t k = 0; k < m;) {
+                        const ssize_t w = ::write(master_, r + k, m - k);
+                        k += w > 0 ? static_cast<std::size_t>(w) : 0U;
+                    }
+                });
+            }
+            solutions_ = server_.solutions();
+        }
+    }
+    link::LinkServer<T, Counter> server_;
+    int master_ = -1;
+    std::string device_;
+    std::atomic<bool> stop_{false};
+    std::atomic<std::uint32_t> solutions_{0};
+    std::thread thread_;
+};
+
+template <typename T>
+void replay_over_serial(const char* what) {
+    PtyTarget<T> target;
+    const auto dir = scratch_dir("replay-serial");
+    host::ReplayOptions o;
+    o.target = target.device();
+    o.in = make_recording(dir, 400);
+    o.model = data_path("model_table2.csv");
+    o.out = (dir / "out.csv").string();
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    EXPECT_EQ(s.returned, 400U) << what;
+    EXPECT_EQ(s.mismatches, 0U) << what;  // bit for bit with the host core in the target's scalar
+    const double bound = std::is_same_v<T, Q30> ? 0.01 : 0.05;
+    EXPECT_LE(s.max_error_arcsec, bound) << what;
+    EXPECT_NE(log.str().find("scalar kind " + std::to_string(link::WireTraits<T>::kKind)), std::string::npos)
+        << log.str();
+    EXPECT_GE(target.solutions(), 400U) << what;
+}
+
+// The session's scalar comes from the target's HELLO: a float DPU and a
+// fixed-point one on the same serial path.
+TEST(Replay, SerialDeviceSpeaksTheTargetsScalar) {
+    replay_over_serial<float>("float target");
+    replay_over_serial<Q30>("Q30 target");
+}
+
+// A model the Q30 formats cannot hold is refused before anything is sent, as
+// `ascorr correct --scalar fixed` refuses it, with the coefficient named.
+TEST(Replay, FixedPointTargetRefusesAModelBeyondItsFormats) {
+    PtyTarget<Q30> target;
+    const auto dir = scratch_dir("replay-serial");
+    const std::string model = (dir / "big.csv").string();
+    std::ofstream(model) << "chu,axis,c0,c1,c2,c3\nA,alpha,7000,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    host::ReplayOptions o;
+    o.target = target.device();
+    o.in = make_recording(dir, 10);
+    o.model = model;
+    o.out = (dir / "out.csv").string();
+    std::ostringstream log;
+    try {
+        host::replay(o, log);
+        ADD_FAILURE() << "accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("A alpha c0 = 7000"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(target.solutions(), 0U);
+    EXPECT_FALSE(std::ifstream(o.out).good());
 }
 
 TEST(Replay, QemuTargetWithoutItsImageIsAnError) {

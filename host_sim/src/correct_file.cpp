@@ -185,35 +185,14 @@ std::size_t worker_count() {
     return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
 }
 
-// The fixed-point coefficient format holds ±ScalarTraits<Q30>::max_coefficient;
-// a model beyond it is refused rather than saturated.
-template <typename T>
-void check_model_range(const ModelFile& m, const std::string& path) {
-    if constexpr (std::is_same_v<T, Q30>) {
-        for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            for (std::size_t a = 0; a < 3; ++a) {
-                for (std::size_t i = 0; i < 7; ++i) {
-                    const double c = m.coefficients[h][a][i];
-                    const double lim =
-                        i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
-                    if (!(std::abs(c * kArcsecToRad) < lim)) {
-                        throw std::runtime_error(path + ": " + "ABCD"[h] + " " + kAxisNames[a] + " " +
-                                                 kCoefficientNames[i] + " = " + std::to_string(c) +
-                                                 " is beyond the fixed-point coefficient range (+-" +
-                                                 std::to_string(lim * kRadToArcsec) + " arcsec)");
-                    }
-                }
-            }
-        }
-    }
-}
-
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     std::optional<ThermalModel<T>> model;
     if (opt.thermal && !opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
-        check_model_range<T>(m, opt.model);
+        if constexpr (std::is_same_v<T, Q30>) {
+            check_fixed_point_range(m, opt.model);
+        }
         model = to_core<T>(m);
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};

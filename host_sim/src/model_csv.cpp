@@ -2,13 +2,33 @@
 
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
+#include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
 namespace ascorr::host {
+
+void check_fixed_point_range(const ModelFile& m, const std::string& path) {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t i = 0; i < 7; ++i) {
+                const double c = m.coefficients[h][a][i];
+                const double lim =
+                    i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
+                if (!(std::abs(c * kArcsecToRad) < lim)) {
+                    throw std::runtime_error(path + ": " + "ABCD"[h] + " " + kAxisNames[a] + " " +
+                                             kCoefficientNames[i] + " = " + std::to_string(c) +
+                                             " is beyond the fixed-point coefficient range (+-" +
+                                             std::to_string(lim * kRadToArcsec) + " arcsec)");
+                }
+            }
+        }
+    }
+}
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
     if (text.empty()) {

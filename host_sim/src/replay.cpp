@@ -9,6 +9,7 @@
 #include <ostream>
 #include <stdexcept>
 #include <thread>
+#include <type_traits>
 
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
@@ -64,6 +65,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const std::string text = read_text_file(opt.in);
     SolutionsReader reader(opt.in, text);
     const ModelFile mf = read_model_file(opt.model);
+    if constexpr (std::is_same_v<T, Q30>) {
+        check_fixed_point_range(mf, opt.model);  // refused before the target sees it, as by `correct`
+    }
     const ThermalModel<T> model_t = to_core<T>(mf);
     const ThermalModel<double> model_d = to_core<double>(mf);
 
@@ -169,7 +173,17 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
     if (opt.target.rfind("/dev/", 0) == 0) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
         SerialTransport serial(opt.target, opt.baud);
-        return run<float>(o, serial, log);
+        // The target says in its HELLO which core it runs (float or Q30); the
+        // session then speaks that scalar.
+        const std::uint8_t kind = LinkClient<float>(serial, o.timeout_ms, o.max_attempts).request_hello().scalar_kind;
+        if (kind == link::WireTraits<Q30>::kKind) {
+            return run<Q30>(o, serial, log);
+        }
+        if (kind == link::WireTraits<float>::kKind) {
+            return run<float>(o, serial, log);
+        }
+        throw LinkError(opt.target + ": the target computes in scalar kind " + std::to_string(kind) +
+                        ", which this host does not speak (1 = float, 2 = Q30)");
     }
     throw std::runtime_error("--target " + opt.target +
                              ": unknown target (loopback-float, qemu-m4f, qemu-m3 or a serial device such as "

@@ -49,8 +49,9 @@ public:
     LinkClient(Transport& t, int timeout_ms, int max_attempts)
         : transport_(t), timeout_ms_(timeout_ms), max_attempts_(max_attempts) {}
 
-    // Opens a session: HELLO_REQUEST, checks the protocol and scalar kind.
-    link::Hello connect() {
+    // HELLO_REQUEST → HELLO, with the protocol checked: what the target is
+    // (its scalar kind says which client it needs; see replay()).
+    link::Hello request_hello() {
         const auto p = transact(link::MessageType::kHelloRequest, {}, link::MessageType::kHello);
         link::Hello h{};
         link::decode(p.data(), p.size(), h);
@@ -58,6 +59,12 @@ public:
             throw LinkError("target speaks link protocol " + std::to_string(h.protocol) + ", this host " +
                             std::to_string(link::kProtocolVersion));
         }
+        return h;
+    }
+
+    // Opens a session: request_hello(), and the scalar kind must be T's.
+    link::Hello connect() {
+        const link::Hello h = request_hello();
         if (h.scalar_kind != link::WireTraits<T>::kKind) {
             throw LinkError("target computes in scalar kind " + std::to_string(h.scalar_kind) + ", the host expected " +
                             std::to_string(link::WireTraits<T>::kKind));

@@ -31,6 +31,11 @@ ModelFile parse_model(const std::string& file_name, std::string_view text);
 void write_model_file(const std::string& path, const ModelFile& model);
 std::string format_model(const ModelFile& model);
 
+// Throws (naming the file, head, axis and coefficient) if a coefficient is
+// beyond what the fixed-point core's formats hold (fixed_point.hpp): such a
+// model is refused, never saturated.
+void check_fixed_point_range(const ModelFile& m, const std::string& path);
+
 // The model in the core's units (radians), for scalar T.
 template <typename T>
 ThermalModel<T> to_core(const ModelFile& m) {
