@@ -1,5 +1,6 @@
 // The thermistor configuration file (config_file.hpp).
 #include "ascorr_hal_linux/config_file.hpp"
+#include "text_lines.hpp"
 
 #include <cctype>
 #include <cerrno>
@@ -99,20 +100,11 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
     a.quorum = 2U;
     bool seen_acq = false;
     bool seen_gpio = false;
-    std::size_t line_no = 0;
-    std::size_t pos = 0;
+    linux_detail::TextLines lines(text);
+    std::string_view line;
     std::vector<Token> tokens;
-    while (pos <= text.size()) {
-        std::size_t end = text.find('\n', pos);
-        if (end == std::string_view::npos) {
-            end = text.size();
-        }
-        std::string_view line = text.substr(pos, end - pos);
-        pos = end + 1;
-        ++line_no;
-        if (!line.empty() && line.back() == '\r') {
-            line.remove_suffix(1);
-        }
+    while (lines.next(line)) {
+        const std::size_t line_no = lines.number();
         const std::size_t hash = line.find('#');
         if (hash != std::string_view::npos) {
             line = line.substr(0, hash);
@@ -322,7 +314,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
         }
     }
     if (a.channels == 0U) {
-        throw ConfigError(file_name, line_no, 1, "no 'channel' line");
+        throw ConfigError(file_name, lines.end_line(), 1, "no 'channel' line");
     }
     return cfg;
 }

@@ -1,5 +1,6 @@
 // Replay of recorded temperatures or counts (replay_source.hpp).
 #include "ascorr_hal_linux/replay_source.hpp"
+#include "text_lines.hpp"
 
 #include <cerrno>
 #include <charconv>
@@ -16,39 +17,17 @@ struct Column {
     bool counts;
 };
 
-std::vector<std::pair<std::string_view, std::size_t>> split(std::string_view line) {
-    std::vector<std::pair<std::string_view, std::size_t>> out;
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t c = line.find(',', start);
-        if (c == std::string_view::npos) {
-            out.emplace_back(line.substr(start), start + 1);
-            return out;
-        }
-        out.emplace_back(line.substr(start, c - start), start + 1);
-        start = c + 1;
-    }
-}
-
 }  // namespace
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
-    std::size_t pos = 0;
-    std::size_t line_no = 0;
+    linux_detail::TextLines lines(text);
+    std::string_view line;
+    std::vector<linux_detail::Field> fields;
     bool header = true;
-    while (pos < text.size()) {
-        std::size_t end = text.find('\n', pos);
-        if (end == std::string_view::npos) {
-            end = text.size();
-        }
-        std::string_view line = text.substr(pos, end - pos);
-        pos = end + 1;
-        ++line_no;
-        if (!line.empty() && line.back() == '\r') {
-            line.remove_suffix(1);
-        }
-        const auto fields = split(line);
+    while (lines.next(line)) {
+        const std::size_t line_no = lines.number();
+        linux_detail::split_fields(line, fields);
         if (header) {
             header = false;
             bool have_t = false;
@@ -80,7 +59,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             }
             continue;
         }
-        if (line.empty() && pos >= text.size()) {
+        if (line.empty() && lines.at_end()) {  // a blank last line
             break;
         }
         if (fields.size() != columns.size()) {

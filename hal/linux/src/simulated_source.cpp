@@ -1,5 +1,6 @@
 // Simulated acquisition from temperature histories (simulated_source.hpp).
 #include "ascorr_hal_linux/simulated_source.hpp"
+#include "text_lines.hpp"
 
 #include <cerrno>
 #include <charconv>
@@ -68,30 +69,12 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
     std::vector<HistoryRow> rows;
     int col_t = -1, col_chu = -1, col_t1 = -1, col_t2 = -1, col_t3 = -1;
     std::size_t ncols = 0;
-    std::size_t pos = 0;
-    std::size_t line_no = 0;
-    std::vector<std::pair<std::string_view, std::size_t>> f;
-    while (pos < text.size()) {
-        std::size_t end = text.find('\n', pos);
-        if (end == std::string_view::npos) {
-            end = text.size();
-        }
-        std::string_view line = text.substr(pos, end - pos);
-        pos = end + 1;
-        ++line_no;
-        if (!line.empty() && line.back() == '\r') {
-            line.remove_suffix(1);
-        }
-        f.clear();
-        std::size_t s = 0;
-        while (true) {
-            const std::size_t c = line.find(',', s);
-            f.emplace_back(line.substr(s, c == std::string_view::npos ? std::string_view::npos : c - s), s + 1);
-            if (c == std::string_view::npos) {
-                break;
-            }
-            s = c + 1;
-        }
+    linux_detail::TextLines lines(text);
+    std::string_view line;
+    std::vector<linux_detail::Field> f;
+    while (lines.next(line)) {
+        const std::size_t line_no = lines.number();
+        linux_detail::split_fields(line, f);
         if (line_no == 1) {
             for (std::size_t i = 0; i < f.size(); ++i) {
                 const std::string_view n = f[i].first;
@@ -111,7 +94,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
             ncols = f.size();
             continue;
         }
-        if (line.empty() && pos >= text.size()) {
+        if (line.empty() && lines.at_end()) {  // a blank last line
             break;
         }
         if (f.size() != ncols) {
@@ -143,7 +126,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
         }
         rows.push_back(r);
     }
-    if (line_no == 0) {
+    if (lines.number() == 0) {
         throw ConfigError(file, 1, 1, "empty file (no header)");
     }
     return rows;
