@@ -11,7 +11,8 @@
 // so the figure is the call of the core and nothing else. Inputs are the first
 // kInputs random records of vectors.bin (tests/target_vectors.cpp) that the
 // core corrects fully (status 3), with the Table 2 model (linear, as flown) and
-// with the random model with quadratic terms (stages *_quadratic).
+// with the random model with quadratic terms (stages *_quadratic), and with
+// both stages off ("neither": validation and renormalisation alone).
 // The baseline (bench/baseline.hpp, double, Eigen) is measured the same way.
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cstdint>
