@@ -194,6 +194,64 @@ TEST(FixedPoint, RandomizedAgainstDoubleWithin0p01Arcsec) {
     EXPECT_LE(worst, 0.01);
 }
 
+// At the edges of the core's domain, where the reduced series and the scaled
+// thermal rotation (q_th/(c1c2c3), norm² up to 1 + 2.3e-4) are at their
+// worst: thermal angles up to 0.999° on each axis and |v| up to 999 km/s.
+// Float and Q30 against the double core: the error bound and a unit result
+// (the renormalisation takes the thermal rotation's scale out).
+template <typename T>
+void check_domain_edge(double bound_arcsec, double norm_tolerance, const char* what) {
+    std::mt19937_64 rng(1999);
+    std::uniform_real_distribution<double> c0(-3596.0, 3596.0);  // arcsec; ±0.999°
+    std::uniform_real_distribution<double> speed(900.0, 999.0);
+    std::uniform_real_distribution<double> temp(-40.0, 60.0);
+    double worst = 0.0;
+    double worst_norm = 0.0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        host::ModelFile m{};
+        m.present = {true, true, true, true};
+        for (auto& head : m.coefficients) {
+            for (auto& axis : head) {
+                axis = {c0(rng), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // temperature-independent: the angle is c0
+            }
+        }
+        const ThermalModel<double> model_d = host::to_core<double>(m);
+        const ThermalModel<T> model_t = host::to_core<T>(m);
+        const Eigen::Vector3d beta = random_unit_vector(rng) * (speed(rng) / kSpeedOfLightKmS);
+        SolutionInput<double> in{};
+        in.q_chu_icrf = from_eigen(random_attitude(rng));
+        in.head = static_cast<std::uint8_t>(trial % 4);
+        in.temperatures = {{temp(rng), true}, {temp(rng), true}, {temp(rng), true}};
+        in.velocity = {{beta.x(), beta.y(), beta.z()}, 1.0, true};
+        const auto ref = correct_solution(in, CorrectionConfig<double>{true, &model_d});
+        SolutionInput<T> in_t{};
+        const auto s = [](double x) { return ScalarTraits<T>::from_double(x); };
+        const auto c = [](double x) { return ScalarTraits<T>::celsius(x); };
+        in_t.q_chu_icrf = {s(in.q_chu_icrf.w), s(in.q_chu_icrf.x), s(in.q_chu_icrf.y), s(in.q_chu_icrf.z)};
+        in_t.head = in.head;
+        in_t.temperatures = {{c(in.temperatures.t_chu.value), true},
+                             {c(in.temperatures.t_029.value), true},
+                             {c(in.temperatures.t_032.value), true}};
+        in_t.velocity = {{s(beta.x()), s(beta.y()), s(beta.z())}, s(1.0), true};
+        const auto got = correct_solution(in_t, CorrectionConfig<T>{true, &model_t});
+        ASSERT_EQ(got.status, ref.status) << what << " " << trial;
+        ASSERT_EQ(ref.status, status::kAberrationApplied | status::kThermalApplied) << what << " " << trial;
+        const auto w = [](const T& x) { return ScalarTraits<T>::to_double(x); };
+        const Quaternion<double> out{w(got.q_chu_icrf.w), w(got.q_chu_icrf.x), w(got.q_chu_icrf.y),
+                                     w(got.q_chu_icrf.z)};
+        worst = std::max(worst, angle_arcsec(out, ref.q_chu_icrf));
+        worst_norm = std::max(worst_norm, std::abs(squared_norm(out) - 1.0));
+    }
+    std::printf("%s at the domain edges: max %.5f\", |norm^2 - 1| max %.2e\n", what, worst, worst_norm);
+    EXPECT_LE(worst, bound_arcsec) << what;
+    EXPECT_LE(worst_norm, norm_tolerance) << what;
+}
+
+TEST(ReducedPrecision, DomainEdgesWithinBounds) {
+    check_domain_edge<Q30>(0.01, 2e-8, "Q30");
+    check_domain_edge<float>(0.05, 4e-7, "float");
+}
+
 class FixedWorkedExample : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(FixedWorkedExample, Within0p01Arcsec) {
