@@ -159,7 +159,7 @@ TEST(EarthSeries, MutationDroppingTheLunarOrJupiterTermBreaksTheBound) {
         int others = 0;
         int jup = 0;
         for (int j = 0; j < tb::kArguments; ++j) {
-            if (tb::kTerm[k].multiple[j] == 0) {
+            if (tb::kMultiple[k][j] == 0) {
                 continue;
             }
             if (tb::kRateRadS[j] > 2e-6) {
