@@ -12,11 +12,20 @@ that carries the most energy of the residual velocity (divided by a small
 penalty for higher-order combinations, so that the physical term wins over an
 alias of it) joins the basis, the whole basis is refitted, and the loop stops
 when the largest velocity error on the fitting grid is below --target m/s.
+The distance then gets the terms it needs beyond those (same choice on its
+residual, to --target-au); the velocity does not use them. Last, per output,
+the smallest coefficients are dropped while the sum of their largest
+contributions stays within --prune-kms (each velocity component) or
+--prune-au, and the others are refitted. The result is checked on a
+quarter-day grid over the span and written, formatted with the repository's
+.clang-format (clang-format).
 
-Run from the repository root (not by CI; the test against liberfa is):
+Run by hand (not by CI; tests/test_earth_series.cpp checks the committed table
+against liberfa), from anywhere:
     /usr/bin/python3 tools/earth_series/generate.py
-Needs python3-erfa and python3-numpy (toolchain/debian-packages.txt). Takes
-about a minute on the 2-core machine. Deterministic: same packages, same table.
+Needs python3-erfa and python3-numpy (toolchain/debian-packages.txt) and
+clang-format. About two minutes on the 2-core machine. Deterministic: same
+packages, same table.
 """
 import argparse
 import itertools
@@ -27,6 +36,7 @@ import sys
 import erfa
 import numpy as np
 
+REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 AU_KM = 149597870.7
 DAY = 86400.0
 JULIAN_CENTURY_S = 36525.0 * DAY
@@ -170,7 +180,7 @@ def main():
     ap.add_argument("--prune-kms", type=float, default=1e-3, help="budget of dropped coefficients per velocity axis, km/s")
     ap.add_argument("--prune-au", type=float, default=5e-6, help="budget of dropped distance coefficients, au")
     ap.add_argument("--penalty", type=float, default=0.25, help="score divisor per order above one")
-    ap.add_argument("--out", default="firmware/include/ascorr/earth_series_table.hpp")
+    ap.add_argument("--out", default=os.path.join(REPO, "firmware", "include", "ascorr", "earth_series_table.hpp"))
     args = ap.parse_args()
 
     phase, rate = linear_arguments()
@@ -299,9 +309,9 @@ def write_header(path, phase, rate, basis, terms, coef, dv_max, dr_max, args_pru
     mm = max(maxmul.values())
     w("inline constexpr int kMaxMultiple = %d;" % mm)
     w("inline constexpr int kPowers = %d;" % len(slots))
-    w("inline constexpr std::int8_t kPowerArgument[kPowers] = {%s};" % ", ".join(str(i) for i, _ in slots))
-    w("inline constexpr std::int8_t kPowerMultiple[kPowers] = {%s};" % ", ".join(str(m) for _, m in slots))
-    w("inline constexpr std::int8_t kPowerSlot[kArguments][kMaxMultiple] = {")
+    w("inline constexpr std::uint8_t kPowerArgument[kPowers] = {%s};" % ", ".join(str(i) for i, _ in slots))
+    w("inline constexpr std::uint8_t kPowerMultiple[kPowers] = {%s};" % ", ".join(str(m) for _, m in slots))
+    w("inline constexpr std::int16_t kPowerSlot[kArguments][kMaxMultiple] = {")
     for i, j in enumerate(used):
         row = [slots.index((i, m)) if (i, m) in slots else -1 for m in range(1, mm + 1)]
         w("    {%s},  // %s" % (", ".join(str(x) for x in row), SHORT[j]))
@@ -311,7 +321,7 @@ def write_header(path, phase, rate, basis, terms, coef, dv_max, dr_max, args_pru
     w("// coefficient, then the terms of the distance alone; in each comment the")
     w("// argument and that coefficient.")
     w("inline constexpr int kTerms = %d;" % len(terms))
-    w("inline constexpr std::int8_t kMultiple[kTerms][kArguments] = {")
+    w("inline constexpr std::int16_t kMultiple[kTerms][kArguments] = {")
     for k, vec in enumerate(terms):
         big = 1000.0 * np.abs(coef[k * BASES:(k + 1) * BASES, :3]).max()
         size = "%.3g m/s" % big if big > 0.0 else "distance only, %.2g au" % np.abs(coef[k * BASES:(k + 1) * BASES,
@@ -355,7 +365,7 @@ def write_header(path, phase, rate, basis, terms, coef, dv_max, dr_max, args_pru
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
     # The repository's style, wherever the output goes.
-    style = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", ".clang-format")
+    style = os.path.join(REPO, ".clang-format")
     subprocess.run(["clang-format", "-i", "--style=file:" + style, path], check=True)
     print("wrote %s: %d terms, %d arguments, %d powers" % (path, len(terms), len(used), len(slots)), file=sys.stderr)
 

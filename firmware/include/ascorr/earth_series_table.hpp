@@ -51,9 +51,9 @@ inline constexpr double kRateRadS[kArguments] = {
 // is the slot of argument j to the power m (-1: not used).
 inline constexpr int kMaxMultiple = 4;
 inline constexpr int kPowers = 15;
-inline constexpr std::int8_t kPowerArgument[kPowers] = {0, 0, 1, 1, 1, 1, 2, 2, 2, 3, 4, 4, 4, 5, 6};
-inline constexpr std::int8_t kPowerMultiple[kPowers] = {1, 2, 1, 2, 3, 4, 1, 2, 3, 1, 1, 2, 3, 1, 1};
-inline constexpr std::int8_t kPowerSlot[kArguments][kMaxMultiple] = {
+inline constexpr std::uint8_t kPowerArgument[kPowers] = {0, 0, 1, 1, 1, 1, 2, 2, 2, 3, 4, 4, 4, 5, 6};
+inline constexpr std::uint8_t kPowerMultiple[kPowers] = {1, 2, 1, 2, 3, 4, 1, 2, 3, 1, 1, 2, 3, 1, 1};
+inline constexpr std::int16_t kPowerSlot[kArguments][kMaxMultiple] = {
     {0, 1, -1, -1},    // Ve
     {2, 3, 4, 5},      // E
     {6, 7, 8, -1},     // J
@@ -67,7 +67,7 @@ inline constexpr std::int8_t kPowerSlot[kArguments][kMaxMultiple] = {
 // coefficient, then the terms of the distance alone; in each comment the
 // argument and that coefficient.
 inline constexpr int kTerms = 27;
-inline constexpr std::int8_t kMultiple[kTerms][kArguments] = {
+inline constexpr std::int16_t kMultiple[kTerms][kArguments] = {
     {0, 0, 0, 0, 0, 0, 0},   // 0: secular, 10.3 m/s
     {0, 1, 0, 0, 0, 0, 0},   // 1: +1E, 2.98e+04 m/s
     {0, 2, 0, 0, 0, 0, 0},   // 2: +2E, 484 m/s
