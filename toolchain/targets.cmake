@@ -11,7 +11,9 @@
 #   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun
 #   target_cortex-m3_no_soft_float the M3 application image has no soft-float
 #                                  routine (and its negative control: the M3
-#                                  accuracy image, which converts doubles, has)
+#                                  accuracy image, which converts doubles, has);
+#                                  the same on a Debug (-O0) M3 build
+#                                  (target_cortex-m3-debug_no_soft_float*)
 include(ExternalProject)
 find_program(ASCORR_ARM_GXX arm-none-eabi-g++ REQUIRED)
 find_program(ASCORR_ARM_NM arm-none-eabi-nm REQUIRED)
@@ -62,6 +64,29 @@ foreach(t ${ASCORR_TARGET_LIST})
   set_tests_properties(target_${t}_firmware PROPERTIES LABELS target TIMEOUT 60
     PASS_REGULAR_EXPRESSION "${firmware_expect_${t}}")
 endforeach()
+
+# The M3 image at -O0 (Debug): no constant of the core may be converted from
+# double at run time (scalar_traits.hpp, k<T>()). Only the two images the check
+# needs are built: the flight image and, as the negative control, the
+# accuracy image (which converts doubles).
+ExternalProject_Add(ascorr_cortex-m3-debug
+  SOURCE_DIR ${PROJECT_SOURCE_DIR}
+  BINARY_DIR ${CMAKE_BINARY_DIR}/cortex-m3-debug
+  CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchain/cortex-m3.cmake
+             -DASCORR_BUILD_HOST=OFF -DASCORR_WERROR=${ASCORR_WERROR}
+             -DCMAKE_BUILD_TYPE=Debug
+  BUILD_COMMAND ${CMAKE_COMMAND} --build <BINARY_DIR> --target ascorr_firmware ascorr_target_accuracy_fixed
+  BUILD_ALWAYS ON
+  INSTALL_COMMAND ""
+  USES_TERMINAL_BUILD ON)
+add_test(NAME target_cortex-m3-debug_no_soft_float
+         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
+                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf)
+add_test(NAME target_cortex-m3-debug_no_soft_float_control
+         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
+                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/tests/target/ascorr_target_accuracy_fixed.elf)
+set_tests_properties(target_cortex-m3-debug_no_soft_float PROPERTIES LABELS target)
+set_tests_properties(target_cortex-m3-debug_no_soft_float_control PROPERTIES LABELS target WILL_FAIL ON)
 
 add_test(NAME target_cortex-m3_no_soft_float
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
