@@ -60,7 +60,7 @@ public:
         frame.t_us = clock_.now_us();
         for (std::uint8_t i = 0; i < kMaxChannels; ++i) {
             ChannelSample<T>& s = frame.channel[i];
-            s = {SampleKind::kNone, 0U, 0U, T(0), 0U};
+            s = {SampleKind::kNone, 0U, 0U, T{}, 0U};
             if (i >= config_.channels) {
                 continue;
             }
