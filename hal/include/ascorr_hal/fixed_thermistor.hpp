@@ -126,15 +126,24 @@ namespace table_detail {
 inline constexpr double kLn2 = 0.69314718055994530942;
 
 // Natural logarithm for x > 0 finite, at compile time: x = m·2ᵉ with m in
-// [√½, √2), ln m = 2·atanh(z), z = (m − 1)/(m + 1), |z| ≤ 0.1716; 20 terms of
-// the series: truncation < 0.1716⁴¹/41 < 1e-32, below double's rounding.
+// [√½, √2) (exact scalings by 2¹⁶, then by 2), ln m = 2·atanh(z),
+// z = (m − 1)/(m + 1), |z| ≤ 0.1716; 12 terms of the series: truncation
+// < 0.1716²⁵/25/(1 − z²) < 1e-20, below double's rounding of ln m.
 constexpr double ln(double x) noexcept {
     int e = 0;
-    for (int i = 0; i < 2100 && x >= 1.4142135623730951; ++i) {
+    for (int i = 0; i < 70 && x >= 65536.0; ++i) {
+        x *= 1.0 / 65536.0;
+        e += 16;
+    }
+    for (int i = 0; i < 70 && x < 1.0 / 65536.0; ++i) {
+        x *= 65536.0;
+        e -= 16;
+    }
+    for (int i = 0; i < 17 && x >= 1.4142135623730951; ++i) {
         x *= 0.5;
         ++e;
     }
-    for (int i = 0; i < 2100 && x < 0.70710678118654752; ++i) {
+    for (int i = 0; i < 17 && x < 0.70710678118654752; ++i) {
         x *= 2.0;
         --e;
     }
@@ -142,7 +151,7 @@ constexpr double ln(double x) noexcept {
     const double z2 = z * z;
     double term = z;
     double sum = 0.0;
-    for (int k = 0; k < 20; ++k) {
+    for (int k = 0; k < 12; ++k) {
         sum += term / static_cast<double>(2 * k + 1);
         term *= z2;
     }
@@ -161,10 +170,6 @@ constexpr std::int32_t raw(double celsius) noexcept {
     return fx::raw_from_double(celsius, QCelsius::kFracBits);
 }
 
-constexpr std::int64_t abs64(std::int64_t v) noexcept {
-    return v < 0 ? -v : v;
-}
-
 // Slope of a segment, raw per code ·2⁸, rounded to nearest.
 constexpr std::int64_t slope_of(std::int32_t t0, std::int32_t t1, std::uint16_t c0, std::uint16_t c1) noexcept {
     const std::int64_t num = (static_cast<std::int64_t>(t1) - t0) * (std::int64_t{1} << kSlopeShift);
@@ -177,9 +182,11 @@ constexpr std::int32_t interpolate(std::int32_t t0, std::int32_t slope, std::uin
     return static_cast<std::int32_t>(t0 + fx::round_shift(d, kSlopeShift));
 }
 
-// Largest |interpolated − double| (raw) over the codes of segment [c0, c1];
-// temp[c]: the double temperature of code c.
-constexpr std::int64_t segment_error(const double* temp, std::uint16_t c0, std::uint16_t c1) noexcept {
+// Largest |interpolated − double| (raw) over the codes of segment [c0, c1]
+// (every code for stride 0; else at the seven eighths c0 + i·(c1 − c0)/8,
+// the estimate the breakpoint search uses, ahead of the verification of every
+// code); temp[c]: the double temperature of code c.
+constexpr std::int64_t segment_error(const double* temp, std::uint16_t c0, std::uint16_t c1, bool every_code) noexcept {
     const std::int32_t t0 = raw(temp[c0]);
     const std::int32_t t1 = raw(temp[c1]);
     const std::int64_t s = slope_of(t0, t1, c0, c1);
@@ -187,7 +194,10 @@ constexpr std::int64_t segment_error(const double* temp, std::uint16_t c0, std::
         return INT64_MAX;
     }
     std::int64_t worst = 0;
-    for (std::uint32_t c = c0; c <= c1; ++c) {
+    const std::uint32_t span = static_cast<std::uint32_t>(c1) - c0;
+    const std::uint32_t points = every_code ? span + 1U : 7U;
+    for (std::uint32_t i = 0; i < points; ++i) {
+        const std::uint32_t c = every_code ? c0 + i : c0 + (span * (i + 1U) + 4U) / 8U;
         const double exact = temp[c] * 1048576.0;
         const double e =
             static_cast<double>(interpolate(t0, static_cast<std::int32_t>(s), c0, static_cast<std::uint16_t>(c))) -
@@ -286,8 +296,10 @@ constexpr CountsTable make_counts_table(const ChannelConfig<F>& cfg) noexcept {
             return t;
         }
     }
-    // Breakpoints, greedily: the longest segment whose error is within budget.
+    // Breakpoints, greedily: the longest segment whose error is within budget
+    // (searched on the sampled estimate, then checked on every code).
     const auto budget = static_cast<std::int64_t>(kTableBudgetC * 1048576.0);
+    const std::int64_t search_budget = budget - budget / 16;  // room for the codes between the sampled ones
     std::uint32_t a = lo;
     std::uint16_t n = 0;
     t.code[n++] = static_cast<std::uint16_t>(a);
@@ -299,12 +311,20 @@ constexpr CountsTable make_counts_table(const ChannelConfig<F>& cfg) noexcept {
         std::uint32_t top = a + kMaxSegment < hi ? a + kMaxSegment : hi;
         while (good < top) {  // largest end whose segment passes (binary search, ≤ 10 steps)
             const std::uint32_t mid = (good + top + 1U) / 2U;
-            if (table_detail::segment_error(temp, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(mid)) <=
-                budget) {
+            if (table_detail::segment_error(temp, static_cast<std::uint16_t>(a), static_cast<std::uint16_t>(mid),
+                                            false) <= search_budget) {
                 good = mid;
             } else {
                 top = mid - 1U;
             }
+        }
+        // The estimate checked every code: shorten until every code passes
+        // (a two-code segment always does: no code between its ends).
+        for (int i = 0; i < 64 && good > a + 1U &&
+                        table_detail::segment_error(temp, static_cast<std::uint16_t>(a),
+                                                    static_cast<std::uint16_t>(good), true) > budget;
+             ++i) {
+            good = a + 1U + (good - a - 1U) * 7U / 8U;
         }
         a = good;
         t.code[n++] = static_cast<std::uint16_t>(a);
@@ -317,7 +337,7 @@ constexpr CountsTable make_counts_table(const ChannelConfig<F>& cfg) noexcept {
     for (std::uint16_t i = 0; i + 1U < n; ++i) {
         t.slope[i] =
             static_cast<std::int32_t>(table_detail::slope_of(t.celsius[i], t.celsius[i + 1], t.code[i], t.code[i + 1]));
-        const std::int64_t e = table_detail::segment_error(temp, t.code[i], t.code[i + 1]);
+        const std::int64_t e = table_detail::segment_error(temp, t.code[i], t.code[i + 1], true);
         worst = e > worst ? e : worst;
     }
     t.slope[n - 1] = 0;
