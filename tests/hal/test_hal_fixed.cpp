@@ -179,7 +179,8 @@ struct CodeSweep {
     int codes_in_range = 0;     // codes whose float temperature is within [t_min, t_max]
     double worst_vs_float = 0;  // °C
     double worst_vs_double = 0;
-    int fault_mismatches = 0;  // codes where open/short differ (every code 0 … 0xFFFF)
+    double worst_float_vs_double = 0;  // the float conversion's own error
+    int fault_mismatches = 0;          // codes where open/short differ (every code 0 … 0xFFFF)
 };
 
 // Every code through the float conversion and the table.
@@ -202,6 +203,8 @@ CodeSweep sweep(const hal::ChannelConfig<float>& fc, const hal::CountsTable& tab
         ++s.codes_in_range;
         s.worst_vs_float = std::max(s.worst_vs_float, std::fabs(to_c(b.celsius) - static_cast<double>(a.celsius)));
         s.worst_vs_double = std::max(s.worst_vs_double, std::fabs(to_c(b.celsius) - double_sh(fc, c16)));
+        s.worst_float_vs_double =
+            std::max(s.worst_float_vs_double, std::fabs(static_cast<double>(a.celsius) - double_sh(fc, c16)));
     }
     return s;
 }
@@ -216,9 +219,10 @@ TEST(HalFixed, TableOnEveryCodeWithinTheBoundOfTheFloatConversion) {
         const CodeSweep s = sweep(fc, table);
         std::printf(
             "divider %s: %u breakpoints, table error %.5f °C (built), codes in [t_min, t_max] %d, "
-            "|fixed - float| <= %.5f °C, |fixed - double| <= %.5f °C\n",
+            "|fixed - float| <= %.5f °C, |fixed - double| <= %.5f °C, |float - double| <= %.6f °C\n",
             fc.divider.thermistor_low ? "low" : "high", static_cast<unsigned>(table.n),
-            table.worst_error_raw / 1048576.0, s.codes_in_range, s.worst_vs_float, s.worst_vs_double);
+            table.worst_error_raw / 1048576.0, s.codes_in_range, s.worst_vs_float, s.worst_vs_double,
+            s.worst_float_vs_double);
         EXPECT_EQ(s.fault_mismatches, 0);   // open and short on the same codes, all 65536
         EXPECT_GT(s.codes_in_range, 3000);  // the whole valid range was swept
         EXPECT_LE(s.worst_vs_float, kConversionBoundC);
