@@ -275,6 +275,26 @@ TEST(HalFixed, BadCoefficientsAreConversionFaultsOnBothPaths) {
     EXPECT_EQ(rb.faults, fault::kConversion);
 }
 
+// A replayed temperature that is not a number: kConversion on both paths;
+// a finite one beyond the limits: kOutOfRange on both.
+TEST(HalFixed, ReplayedTemperaturesBeyondTheDomainOnBothPaths) {
+    const hal::ChannelConfig<float> fc = boom_channel();
+    const hal::CountsTable table = hal::make_counts_table(fc);
+    const hal::ChannelConfig<QCelsius> q = hal::fixed_channel(fc, &table);
+    const double values[] = {NAN, 500.0, -100.0, 12.5};
+    const hal::FaultBits want[] = {fault::kConversion, fault::kOutOfRange, fault::kOutOfRange, 0U};
+    for (std::size_t i = 0; i < 4; ++i) {
+        hal::ChannelCheck<float> a;
+        hal::ChannelCheck<QCelsius> b;
+        const hal::ChannelReading<float> ra =
+            a.update(fc, {hal::SampleKind::kCelsius, 0U, 0U, static_cast<float>(values[i]), 0U}, 1000U);
+        const hal::ChannelReading<QCelsius> rb =
+            b.update(q, {hal::SampleKind::kCelsius, 0U, 0U, hal::celsius_sample(values[i]), 0U}, 1000U);
+        EXPECT_EQ(ra.faults, want[i]) << values[i];
+        EXPECT_EQ(rb.faults, want[i]) << values[i];
+    }
+}
+
 // The recorded example (counts and converted temperatures, an open member, a
 // short and a gap) through both paths.
 TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
