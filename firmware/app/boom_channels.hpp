@@ -108,18 +108,23 @@ struct Config<QCelsius> {
     }
 };
 
+// The profiles' common shape: 0.75 °C per second up for 8 s, then down.
+constexpr double ramp(std::uint32_t s) {
+    return 0.75 * static_cast<double>(s < 8U ? s : kProfileSeconds - s);
+}
+
 // The boom's temperature at second s of the profile, per channel (°C):
 // triplet members read almost the same.
 constexpr double profile_celsius(std::uint8_t channel, std::uint32_t s) {
-    const double ramp = 0.75 * static_cast<double>(s < 8U ? s : 16U - s);
+    const double r = ramp(s);
     const double spread = 0.05 * static_cast<double>(channel % 3U);
     if (channel < 3U) {
-        return -6.5 + 0.5 * ramp + spread;
+        return -6.5 + 0.5 * r + spread;
     }
     if (channel < 6U) {
-        return -20.0 + 0.25 * ramp + spread;
+        return -20.0 + 0.25 * r + spread;
     }
-    return 10.0 + 2.5 * static_cast<double>(channel - 6U) + ramp;  // CHU_A, CHU_B (benchmark only)
+    return 10.0 + 2.5 * static_cast<double>(channel - 6U) + r;  // CHU_A, CHU_B (benchmark only)
 }
 
 struct CountsProfile {

@@ -71,8 +71,7 @@ constexpr ChuProfile make_chu_profile() {
     ChuProfile p{};
     for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
         for (std::uint32_t s = 0; s < boom::kProfileSeconds; ++s) {
-            const double ramp = 0.75 * static_cast<double>(s < 8U ? s : 16U - s);
-            p.t[h][s] = ScalarTraits<Scalar>::celsius(10.0 + 2.5 * static_cast<double>(h) + ramp);
+            p.t[h][s] = ScalarTraits<Scalar>::celsius(10.0 + 2.5 * static_cast<double>(h) + boom::ramp(s));
         }
     }
     return p;

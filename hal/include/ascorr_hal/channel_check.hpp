@@ -53,7 +53,8 @@ struct TemperatureMath {
     // |a − b| ≤ tol (false for NaN)
     static bool within(T a, T b, T tol) noexcept { return std::fabs(a - b) <= tol; }
     static T mean(T a, T b) noexcept { return T(0.5) * (a + b); }
-    static bool rate_enabled(T max_rate) noexcept { return max_rate > T(0); }
+    // false for max_rate ≤ 0; a NaN limit enables the check (and fails every step)
+    static bool rate_enabled(T max_rate) noexcept { return !(max_rate <= T(0)); }
     // |c − from_c| ≤ max_rate·(t_us − from_us)·10⁻⁶
     static bool within_rate(T max_rate, T from_c, std::uint64_t from_us, T c, std::uint64_t t_us) noexcept {
         const T dt = static_cast<T>(t_us - from_us) * T(1e-6);
