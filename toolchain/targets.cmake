@@ -13,7 +13,9 @@
 #                                  routine (and its negative control: the M3
 #                                  accuracy image, which converts doubles, has);
 #                                  the same on a Debug (-O0) M3 build
-#                                  (target_cortex-m3-debug_no_soft_float*)
+#                                  (target_cortex-m3-debug_no_soft_float*),
+#                                  whose loop also flies without overrun
+#                                  (target_cortex-m3-debug_firmware)
 include(ExternalProject)
 find_program(ASCORR_ARM_GXX arm-none-eabi-g++ REQUIRED)
 find_program(ASCORR_ARM_NM arm-none-eabi-nm REQUIRED)
