@@ -305,6 +305,41 @@ TEST(BadInput, VelocityCases) {
     }
 }
 
+// 1/s outside [1/40, 1/0.6] au⁻¹ makes the velocity unusable (4|32) in every
+// scalar, and leaves the attitude untouched; its edges and Swarm's range are
+// accepted. Without the check, 1/s = 1e9 turns the 4e-7" solar term into 425".
+template <typename T>
+void expect_sun_distance_domain() {
+    using Tr = ScalarTraits<T>;
+    const Quaternion<T> q{Tr::from_double(0.5), Tr::from_double(0.5), Tr::from_double(0.5), Tr::from_double(0.5)};
+    const Vector3<T> beta{Tr::from_double(1e-4), Tr::from_double(-2e-5), Tr::from_double(3e-5)};
+    struct Case {
+        double inv_s;
+        bool usable;
+    };
+    const Case cases[] = {
+        {1e9, false},   {-1.0, false},       {0.0, false},          {1.0 / 40.5, false},   {1.0 / 0.59, false},
+        {kNaN, false},  {1.0 / 40.0, true},  {1.0 / 0.6001, true},  {1.0 / 1.017, true},   {1.0 / 0.983, true},
+        {1.0, true},    {1.0 / 5.2, true},   {-kNaN, false},
+    };
+    for (const Case& c : cases) {
+        SolutionInput<T> in{q, 0, {}, {beta, Tr::from_double(c.inv_s), true}};
+        const auto out = correct_solution(in, CorrectionConfig<T>{true, nullptr});
+        if (c.usable) {
+            EXPECT_EQ(out.status, status::kAberrationApplied) << "1/s = " << c.inv_s;
+        } else {
+            EXPECT_EQ(out.status, status::kNoVelocity | status::kVelocityInvalid) << "1/s = " << c.inv_s;
+            EXPECT_EQ(Tr::to_double(out.q_chu_icrf.w), 0.5) << "1/s = " << c.inv_s << ": attitude must be untouched";
+        }
+    }
+}
+
+TEST(BadInput, SunDistanceOutsideItsDomainMakesTheVelocityUnusable) {
+    expect_sun_distance_domain<double>();
+    expect_sun_distance_domain<float>();
+    expect_sun_distance_domain<Q30>();
+}
+
 TEST(BadInput, TemperatureCases) {
     const ThermalModel<double> model = host::to_core<double>(table2());
     const Quaternion<double> q{0.5, 0.5, 0.5, 0.5};

@@ -65,12 +65,18 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
         if (rec.velocity_components != 3) {
             diag.report("velocity incomplete", where(file, rec) + "only " + std::to_string(rec.velocity_components) +
                                                    " of vx,vy,vz given: aberration skipped");
-        } else {
+        } else if (!beta_in_domain(in.velocity.beta_icrf)) {
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
             char buf[128];
             std::snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped", speed,
                           kMaxObserverSpeedKmS);
+            diag.report("velocity invalid", where(file, rec) + buf);
+        } else {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
+                          ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
+                          kMaxSunDistanceAu);
             diag.report("velocity invalid", where(file, rec) + buf);
         }
     }
