@@ -102,9 +102,10 @@ int read_model(const char* path, ModelRow* rows) {
             std::fclose(f);
             return -1;
         }
-        rows[n] = {line[0], std::strncmp(line + 2, "alpha", 5) == 0  ? 'a'
-                            : std::strncmp(line + 2, "beta", 4) == 0 ? 'b'
-                                                                      : 'g',
+        rows[n] = {line[0],
+                   std::strncmp(line + 2, "alpha", 5) == 0  ? 'a'
+                   : std::strncmp(line + 2, "beta", 4) == 0 ? 'b'
+                                                            : 'g',
                    {c[0], c[1], c[2], c[3]}};
         ++n;
     }
@@ -124,9 +125,12 @@ ascorr::ThermalModel<T> to_core(const ModelRow* rows, int n) {
         ascorr::HeadThermalModel<T>& head = m.head[h];
         head.present = true;
         ascorr::AxisPolynomial<T>& a = rows[i].axis == 'a' ? head.alpha : rows[i].axis == 'b' ? head.beta : head.gamma;
-        a = {Tr::coefficient(rows[i].c[0] * ascorr::kArcsecToRad), Tr::coefficient(rows[i].c[1] * ascorr::kArcsecToRad),
-             Tr::coefficient(rows[i].c[2] * ascorr::kArcsecToRad), Tr::coefficient(rows[i].c[3] * ascorr::kArcsecToRad),
-             Tr::quadratic_coefficient(0.0),        Tr::quadratic_coefficient(0.0),
+        a = {Tr::coefficient(rows[i].c[0] * ascorr::kArcsecToRad),
+             Tr::coefficient(rows[i].c[1] * ascorr::kArcsecToRad),
+             Tr::coefficient(rows[i].c[2] * ascorr::kArcsecToRad),
+             Tr::coefficient(rows[i].c[3] * ascorr::kArcsecToRad),
+             Tr::quadratic_coefficient(0.0),
+             Tr::quadratic_coefficient(0.0),
              Tr::quadratic_coefficient(0.0)};
     }
     return m;
@@ -144,9 +148,8 @@ double max_error_arcsec(const Row* in, const Row* want, int n, const ModelRow* m
         s.q_chu_icrf = {Tr::from_double(in[i].q[0]), Tr::from_double(in[i].q[1]), Tr::from_double(in[i].q[2]),
                         Tr::from_double(in[i].q[3])};
         s.head = static_cast<std::uint8_t>(in[i].chu - 'A');
-        s.temperatures = {{Tr::celsius(in[i].temp[0]), true},
-                          {Tr::celsius(in[i].temp[1]), true},
-                          {Tr::celsius(in[i].temp[2]), true}};
+        s.temperatures = {
+            {Tr::celsius(in[i].temp[0]), true}, {Tr::celsius(in[i].temp[1]), true}, {Tr::celsius(in[i].temp[2]), true}};
         s.velocity.valid = false;
         const ascorr::CorrectedSolution<T> out = ascorr::correct_solution(s, cfg);
         const double got[4] = {Tr::to_double(out.q_chu_icrf.w), Tr::to_double(out.q_chu_icrf.x),
@@ -194,8 +197,9 @@ int main(int argc, char** argv) {
     const double e_double = max_error_arcsec<double>(in, want, n, model, nm);
     const double e_float = max_error_arcsec<float>(in, want, n, model, nm);
     const double e_q30 = max_error_arcsec<ascorr::Q30>(in, want, n, model, nm);
-    std::printf("ascorr package (link protocol %u): %d worked-example rows, thermal stage, max error vs expected: "
-                "double %.3g\", float %.3g\", Q30 %.3g\"\n",
-                static_cast<unsigned>(ascorr::link::kProtocolVersion), n, e_double, e_float, e_q30);
+    std::printf(
+        "ascorr package (link protocol %u): %d worked-example rows, thermal stage, max error vs expected: "
+        "double %.3g\", float %.3g\", Q30 %.3g\"\n",
+        static_cast<unsigned>(ascorr::link::kProtocolVersion), n, e_double, e_float, e_q30);
     return e_double <= 1e-6 && e_float <= 0.05 && e_q30 <= 0.01 ? 0 : 1;
 }

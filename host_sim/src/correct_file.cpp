@@ -297,12 +297,9 @@ CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
 std::string describe(const CorrectSummary& s) {
     std::ostringstream o;
     o << s.rows << " rows written";
-    const char* names[] = {"aberration applied", "thermal applied",  "no velocity",         "temperatures missing",
-                           "rejected",           "velocity invalid", "temperature invalid", "thermal out of range",
-                           "no model for head"};
-    for (std::size_t b = 0; b < 9; ++b) {
+    for (std::size_t b = 0; b < static_cast<std::size_t>(status::kStatusBitCount); ++b) {
         if (s.status_bit[b] != 0) {
-            o << ", " << s.status_bit[b] << " " << names[b];
+            o << ", " << s.status_bit[b] << " " << status::kStatusBitNames[b];
         }
     }
     if (s.malformed != 0) {
