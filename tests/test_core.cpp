@@ -205,7 +205,7 @@ TEST(Properties, NegatedInputGivesSameAttitude) {
 }
 
 // Both stages = thermal applied to the aberration-corrected attitude, and the
-// stages do not commute (the order of formats.md matters).
+// stages do not commute (the order of docs/contract.md matters).
 TEST(Properties, StagesComposeAsSpecified) {
     std::mt19937_64 rng(4);
     const ThermalModel<double> model = host::to_core<double>(table2());
