@@ -15,3 +15,16 @@ template class ascorr::hal::ChannelCheck<float>;
 template class ascorr::hal::TemperatureAcquisition<ascorr::QCelsius>;
 template class ascorr::hal::AdcFrameSource<ascorr::QCelsius>;
 template class ascorr::hal::ChannelCheck<ascorr::QCelsius>;
+
+// The device interfaces (and so every implementation) are neither copyable nor
+// movable (ascorr_hal/interface.hpp).
+#include <type_traits>
+namespace hal_interface_check {
+using namespace ascorr::hal;
+template <typename I>
+constexpr bool resource_like = !std::is_copy_constructible_v<I> && !std::is_copy_assignable_v<I> &&
+                               !std::is_move_constructible_v<I> && !std::is_move_assignable_v<I>;
+static_assert(resource_like<Clock> && resource_like<ManualClock>);
+static_assert(resource_like<BitBangPins> && resource_like<AdcPort> && resource_like<Mcp3208>);
+static_assert(resource_like<FrameSource<float>> && resource_like<AdcFrameSource<float>>);
+}  // namespace hal_interface_check

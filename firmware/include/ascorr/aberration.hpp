@@ -46,7 +46,8 @@ namespace ascorr {
 template <typename T>
 struct ObserverVelocity {
     Vector3<T> beta_icrf;   // v_obs_icrf / c
-    T inv_sun_distance_au;  // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7")
+    T inv_sun_distance_au;  // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7");
+                            // domain [1/kMaxSunDistanceAu, 1/kMinSunDistanceAu]
     bool valid;             // false: not available or stale
 };
 
@@ -59,6 +60,22 @@ template <typename T>
 constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
     constexpr T lim = k<T>(kMaxBeta * kMaxBeta);
     return squared_norm(beta) <= lim;
+}
+
+// True when 1/s (1/au) is inside [1/kMaxSunDistanceAu, 1/kMinSunDistanceAu];
+// false for NaN (both comparisons fail). In fixed point a NaN or huge input
+// converts to the top of the range (≥ 1.99), which fails the upper bound.
+template <typename T>
+constexpr bool inv_sun_distance_in_domain(const T& inv_sun_distance_au) noexcept {
+    constexpr T lo = k<T>(1.0 / kMaxSunDistanceAu);
+    constexpr T hi = k<T>(1.0 / kMinSunDistanceAu);
+    return lo <= inv_sun_distance_au && inv_sun_distance_au <= hi;
+}
+
+// Both parts of an observer velocity inside the series' domain.
+template <typename T>
+constexpr bool velocity_in_domain(const ObserverVelocity<T>& v) noexcept {
+    return beta_in_domain(v.beta_icrf) && inv_sun_distance_in_domain(v.inv_sun_distance_au);
 }
 
 // q_ab: the minimal rotation (ICRF, active) taking the natural direction

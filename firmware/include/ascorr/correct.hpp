@@ -128,7 +128,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
         const ObserverVelocity<T>& v = in.velocity;
         if (!v.valid) {
             st |= status::kNoVelocity;
-        } else if (!beta_in_domain(v.beta_icrf) || !is_finite(v.inv_sun_distance_au)) {
+        } else if (!velocity_in_domain(v)) {
             st |= status::kNoVelocity | status::kVelocityInvalid;
         } else {
             // The boresight of q before renormalisation: for ‖q‖² = 1 + ε it is

@@ -1,6 +1,6 @@
 // ascorr/quaternion.hpp: attitude quaternions for the core.
 //
-// Conventions (the same as formats.md and Eigen::Quaternion):
+// Conventions (the same as docs/contract.md and Eigen::Quaternion):
 //  - Hamilton algebra (i² = j² = k² = ijk = −1), scalar first: q = (w, x, y, z).
 //  - rotation_matrix(q) is the usual active rotation matrix of q, equal to
 //    Eigen::Quaterniond(w, x, y, z).toRotationMatrix().

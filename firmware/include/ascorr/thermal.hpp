@@ -1,6 +1,6 @@
 // ascorr/thermal.hpp: the thermal model of Herceg, Jørgensen & Jørgensen 2017.
 //
-// Conventions (formats.md, paper eqs. 4–10):
+// Conventions (docs/contract.md, paper eqs. 4–10):
 //  - Per head and axis: angle = c0 + c1·T1 + c2·(T2 − T1) + c3·(T3 − T1)
 //      + c1_2·T1² + c2_2·(T2 − T1)² + c3_2·(T3 − T1)²,
 //    T1 = T_CHU, T2 = T_THT00029, T3 = T_THT00032 in °C. Here the coefficients

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include "interface.hpp"
 
 #include "channel_config.hpp"
 #include "clock.hpp"
@@ -42,7 +43,7 @@ struct Frame {
 };
 
 template <typename T>
-class FrameSource {
+class FrameSource : private Interface {
 public:
     virtual ~FrameSource() = default;
     virtual bool acquire(Frame<T>& frame) noexcept = 0;
