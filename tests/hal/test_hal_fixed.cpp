@@ -300,10 +300,10 @@ TEST(HalFixed, ReplayedTemperaturesBeyondTheDomainOnBothPaths) {
 TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
     const hal::AcquisitionConfig<double> cfg = hal::read_config(kExamples + "/board.cfg").acquisition;
     Paths p(cfg);
-    hal::ReplaySource src = hal::ReplaySource::from_file(kExamples + "/replay.csv", cfg);
+    const std::unique_ptr<hal::ReplaySource> src = hal::ReplaySource::from_file(kExamples + "/replay.csv", cfg);
     Comparison cmp;
     hal::Frame<double> f{};
-    while (src.acquire(f)) {
+    while (src->acquire(f)) {
         compare_frame(p, f, cmp, "replay.csv");
     }
     std::printf("replay.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C\n", cmp.frames,
