@@ -12,12 +12,14 @@
 //   correct.hpp        correct_solution(): the per-solution entry point
 //   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
 //                      coefficient formats and thermal_angle)
+//   compiler.hpp       what the fixed-point core asks of the compiler, checked
 //   earth_series.hpp   the Earth's barycentric velocity and Sun distance, a
 //                      series fitted to ERFA eraEpv00 (double; coefficients in
 //                      the generated earth_series_table.hpp)
 #pragma once
 
 #include "aberration.hpp"
+#include "compiler.hpp"
 #include "constants.hpp"
 #include "correct.hpp"
 #include "earth_series.hpp"

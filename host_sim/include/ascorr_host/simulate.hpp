@@ -17,7 +17,7 @@
 //    inversion of the core's own aberration rotation). So `ascorr correct`
 //    with the truth model returns q_noise ⊗ q_true, and its IBA is the floor.
 //  - The floor: the IBA RMS per pair of q_noise ⊗ q_true over the clean
-//    epochs (formats.md), written beside the data.
+//    epochs (docs/contract.md), written beside the data.
 #pragma once
 
 #include <Eigen/Core>
