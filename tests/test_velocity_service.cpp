@@ -4,7 +4,7 @@
 //    precession-nutation, ERA, polar motion, UT1 − UTC);
 //  - propagation against this file's own integration (RK4 at 1 s with J2, J3,
 //    J4 about ERFA's CIP and a small drag the service does not model);
-//  - the Earth's part against liberfa's eraEpv00;
+//  - the Earth's part (the on-board series) against liberfa's eraEpv00;
 //  - the corrected attitudes against the same solutions corrected with the
 //    true velocity (the reference orbit + eraEpv00), in arcsec.
 // The orbits are generated here: a near-polar LEO at 460 km, 24 h of 1 Hz
@@ -45,7 +45,7 @@ Eigen::Vector3d ev(const V3& v) {
 // ---- References ---------------------------------------------------------
 
 // The Earth's barycentric velocity (km/s, ICRF) and Sun distance (au), eraEpv00.
-bool erfa_earth(double t_tt_s, EarthState& out) {
+bool erfa_earth(double t_tt_s, EarthBarycentric& out) {
     double pvh[2][3];
     double pvb[2][3];
     eraEpv00(kDj00, t_tt_s / kDayS, pvh, pvb);
@@ -54,10 +54,9 @@ bool erfa_earth(double t_tt_s, EarthState& out) {
     return true;
 }
 
-// The service's Earth: until the on-board series is merged, eraEpv00 itself.
-struct ServiceEarth {
-    bool operator()(double t_tt_s, EarthState& out) const { return erfa_earth(t_tt_s, out); }
-};
+// The service's Earth is the on-board series (earth_series.hpp, ≤ 0.75 m/s
+// from eraEpv00); the true velocity below is eraEpv00's.
+using ServiceEarth = OnBoardEarth;
 
 // Earth orientation of the reference world: UT1 − UTC and polar motion that
 // the service does not know (it assumes TT − UT1 = 69.184 s, no polar motion).
@@ -215,7 +214,7 @@ struct TrueVelocity {
     Eigen::Vector3d v_kms;
     double inv_s;
 };
-TrueVelocity true_velocity(const ReferenceOrbit& orbit, double t_s, EarthState& e) {
+TrueVelocity true_velocity(const ReferenceOrbit& orbit, double t_s, EarthBarycentric& e) {
     erfa_earth(t_s, e);
     return {orbit.at(t_s).v + ev(e.v_earth_icrf_kms), 1.0 / e.sun_distance_au};
 }
@@ -426,7 +425,7 @@ Errors run_solutions(const ReferenceOrbit& orbit, const Feed& feed, StateFrame f
         EXPECT_EQ(vf.status, 0U);
         EXPECT_EQ(vq.status, 0U);
         const Eigen::Quaterniond q = random_attitude(rng);
-        EarthState es{};
+        EarthBarycentric es{};
         const TrueVelocity tv = true_velocity(orbit, ts, es);
         const auto ref = correct_with<double>(q, observer(tv));
         EXPECT_EQ(ref.status, status::kAberrationApplied);
@@ -570,7 +569,7 @@ TEST(VelocityService, UnformableVelocityIsInvalid) {
     VelocityService<double> svc(default_velocity_service_config());
     const Pv s = day_orbit().at(kT0);
     ASSERT_EQ(svc.push_state(tt(kT0), v3(s.r), v3(s.v), StateFrame::kGcrs), StateVerdict::kAccepted);
-    const auto no_earth = [](double, EarthState&) { return false; };
+    const auto no_earth = [](double, EarthBarycentric&) { return false; };
     EXPECT_TRUE(svc.advance(tt(kT0 + 5.0), no_earth));
     ServiceVelocity<double> v = svc.velocity_at(tt(kT0 + 5.0));
     EXPECT_FALSE(v.velocity.valid);

@@ -44,6 +44,7 @@
 #include "constants.hpp"
 #include "correct.hpp"
 #include "earth_frame.hpp"
+#include "earth_series.hpp"
 #include "fixed_point.hpp"
 #include "orbit_propagation.hpp"
 #include "status.hpp"
@@ -99,11 +100,12 @@ struct StateCounts {
     std::uint32_t duplicate_time;
 };
 
-// The Earth's barycentric velocity (ICRF, km/s) and the Sun's distance (au)
-// at a TT time; false outside the series' span or for a non-finite time.
-struct EarthState {
-    Vector3<double> v_earth_icrf_kms;
-    double sun_distance_au;
+// The Earth's part: earth_series.hpp on board and on the host; any callable
+// bool(double t_tt_j2000_s, EarthBarycentric&) in its place (tests).
+struct OnBoardEarth {
+    bool operator()(double t_tt_j2000_s, EarthBarycentric& out) const noexcept {
+        return earth_series(t_tt_j2000_s, out);
+    }
 };
 
 template <typename T>
@@ -191,7 +193,7 @@ public:
 
     // Propagates (double) until the velocity node holding t is ready, taking
     // at most cfg.max_steps_per_advance RK4 steps; true when it is. earth is
-    // called as earth(t_tt_j2000_s, EarthState&) → bool on a 60 s grid (once
+    // called as earth(t_tt_j2000_s, EarthBarycentric&) → bool (OnBoardEarth) on a 60 s grid (once
     // per minute of flight, see earth_at). A t before the current node
     // restarts from the state (same bits).
     template <typename EarthFn>
@@ -260,10 +262,10 @@ private:
 
     // The Earth at t, linear between evaluations of the series on a 60 s TT
     // grid anchored at J2000 (so again one function of t, whatever the path):
-    // the Earth's jerk is ≤ 1.2e-12 km/s³, so the error is ≤ 60²/8 · 1.2e-12 km/s
-    // = 5e-7 m/s; the series runs once per minute of flight, not per state.
+    // |v''| ≤ 1.4e-9 m/s³ (earth_series.hpp), so the error is ≤ 60²/8 · 1.4e-9
+    // = 6.3e-7 m/s; the series runs once per minute of flight, not per state.
     template <typename EarthFn>
-    bool earth_at(TtTime t, EarthFn& earth, EarthState& out) noexcept {
+    bool earth_at(TtTime t, EarthFn& earth, EarthBarycentric& out) noexcept {
         std::int64_t k = t.us / kEarthNodeUs;
         if (k * kEarthNodeUs > t.us) {
             --k;  // floor for negative times
@@ -287,7 +289,7 @@ private:
 
     template <typename EarthFn>
     void build_node(EarthFn& earth) noexcept {
-        EarthState e1{};
+        EarthBarycentric e1{};
         const bool e1_ok = earth_at(node_start(cursor_n_ + 1), earth, e1);
         node_t0_ = node_start(cursor_n_);
         node_n_ = cursor_n_;
@@ -323,13 +325,13 @@ private:
     std::int64_t cursor_n_ = -1;
     OrbitState y_n_{};
     OrbitState y_next_{};
-    EarthState earth_n_{};
+    EarthBarycentric earth_n_{};
     bool earth_n_ok_ = false;
     // The Earth on its 60 s grid: samples at k and k + 1.
     bool earth_grid_valid_ = false;
     std::int64_t earth_k_ = 0;
-    EarthState earth_a_{};
-    EarthState earth_b_{};
+    EarthBarycentric earth_a_{};
+    EarthBarycentric earth_b_{};
     bool earth_a_ok_ = false;
     bool earth_b_ok_ = false;
     // The node the per-solution query reads.
