@@ -80,7 +80,7 @@ std::vector<State> gcrs_states() {
     for (int k = 0; k < 120; ++k) {
         out.push_back({kT0 + k, s.r_km, s.v_kms});
         for (int i = 0; i < 10; ++i) {
-            s = rk4_step(s, {0, 0, 1}, 0.1);
+            s = rk4_step(s, gravity_j2(s.r_km, {0, 0, 1}), {0, 0, 1}, 0.1);
         }
     }
     return out;

@@ -340,7 +340,7 @@ TEST(Propagation, AgainstIntegrationWithJ3J4AndDrag) {
     double err6 = 0;
     double err12 = 0;
     for (int n = 1; n <= 4320; ++n) {
-        y = rk4_step(y, pole, kPropagationStepS);
+        y = rk4_step(y, gravity_j2(y.r_km, pole), pole, kPropagationStepS);
         const double e = (ev(y.v_kms) - orbit.at(kT0 + n * kPropagationStepS).v).norm() * 1e3;
         if (n <= 360) {
             err1 = std::max(err1, e);

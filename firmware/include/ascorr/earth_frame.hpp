@@ -21,7 +21,9 @@
 //  - the rate of precession-nutation in v (≤ 2e-3 m/s) and s (≤ 4e-3 m/s).
 // Everything here is double and runs once per accepted state (1 Hz at most),
 // outside the per-solution path. No library calls: sin/cos are the
-// polynomials below, so the host and both targets compute the same bits.
+// polynomials below (divisions by constants as products with their
+// reciprocals: soft-float division is slow on the M3), so the host and both
+// targets compute the same bits.
 #pragma once
 
 #include <cstdint>
@@ -60,23 +62,23 @@ constexpr SinCos sincos_turns(double f) noexcept {
     const double x2 = x * x;
     const double s =
         x *
-        (1.0 -
-         x2 / 6.0 *
-             (1.0 -
-              x2 / 20.0 *
-                  (1.0 -
-                   x2 / 42.0 *
-                       (1.0 - x2 / 72.0 *
-                                  (1.0 - x2 / 110.0 * (1.0 - x2 / 156.0 * (1.0 - x2 / 210.0 * (1.0 - x2 / 272.0))))))));
+        (1.0 - x2 * (1.0 / 6.0) *
+                   (1.0 - x2 * (1.0 / 20.0) *
+                              (1.0 - x2 * (1.0 / 42.0) *
+                                         (1.0 - x2 * (1.0 / 72.0) *
+                                                    (1.0 - x2 * (1.0 / 110.0) *
+                                                               (1.0 - x2 * (1.0 / 156.0) *
+                                                                          (1.0 - x2 * (1.0 / 210.0) *
+                                                                                     (1.0 - x2 * (1.0 / 272.0)))))))));
     const double c =
-        1.0 -
-        x2 / 2.0 *
-            (1.0 -
-             x2 / 12.0 *
-                 (1.0 -
-                  x2 / 30.0 *
-                      (1.0 -
-                       x2 / 56.0 * (1.0 - x2 / 90.0 * (1.0 - x2 / 132.0 * (1.0 - x2 / 182.0 * (1.0 - x2 / 240.0)))))));
+        1.0 - x2 * (1.0 / 2.0) *
+                  (1.0 - x2 * (1.0 / 12.0) *
+                             (1.0 - x2 * (1.0 / 30.0) *
+                                        (1.0 - x2 * (1.0 / 56.0) *
+                                                   (1.0 - x2 * (1.0 / 90.0) *
+                                                              (1.0 - x2 * (1.0 / 132.0) *
+                                                                         (1.0 - x2 * (1.0 / 182.0) *
+                                                                                    (1.0 - x2 * (1.0 / 240.0))))))));
     switch (static_cast<unsigned>(quadrant & 3)) {
         case 0U:
             return {s, c};
@@ -99,7 +101,7 @@ constexpr double earth_rotation_turns(std::int64_t ut1_us) noexcept {
         rem += kMicrosecondsPerDay;
         --day;
     }
-    const double frac_day = static_cast<double>(rem) / static_cast<double>(kMicrosecondsPerDay);
+    const double frac_day = static_cast<double>(rem) * (1.0 / static_cast<double>(kMicrosecondsPerDay));
     const double tu = static_cast<double>(day) + frac_day;
     double f = frac_day + 0.7790572732640 + 0.00273781191135448 * tu;
     f -= static_cast<double>(static_cast<std::int64_t>(f));  // truncation towards zero
@@ -117,7 +119,7 @@ struct CelestialFromTerrestrial {
 };
 
 constexpr CelestialFromTerrestrial celestial_from_terrestrial(TtTime t, std::int64_t tt_minus_ut1_us) noexcept {
-    const double tc = tt_seconds(t) / kSecondsPerJulianCentury;
+    const double tc = tt_seconds(t) * (1.0 / kSecondsPerJulianCentury);
     // IAU 2006 X, Y polynomials (arcsec), eraXy06's polynomial part.
     const double x_as =
         -0.016617 +

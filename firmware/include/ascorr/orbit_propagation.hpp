@@ -15,8 +15,9 @@
 // tests/test_velocity_service.cpp, and they set the default horizon
 // (velocity_service.hpp).
 // Double, software on the Cortex-M3: one step is 4 force evaluations (one
-// sqrt, two divisions each), run once per 10 s of flight, outside the
-// per-solution path. sqrt and division are IEEE correctly rounded on every
+// sqrt and one division each), run only when a solution's time passes 10 s
+// after the latest state (in GNSS gaps, or from an uplinked state), outside
+// the per-solution path. sqrt and division are IEEE correctly rounded on every
 // platform we build for, so the bits agree.
 #pragma once
 
@@ -38,8 +39,9 @@ struct OrbitState {
 
 inline Vector3<double> gravity_j2(const Vector3<double>& r, const Vector3<double>& pole) noexcept {
     const double rr = dot(r, r);
-    const double inv_r2 = 1.0 / rr;
-    const double inv_r3 = inv_r2 / std::sqrt(rr);
+    const double inv_r = 1.0 / std::sqrt(rr);
+    const double inv_r2 = inv_r * inv_r;
+    const double inv_r3 = inv_r2 * inv_r;
     const double z = dot(r, pole);
     const double u = z * z * inv_r2;
     const double k = 1.5 * kEarthJ2 * kEarthEquatorialRadiusKm * kEarthEquatorialRadiusKm * inv_r2;
@@ -47,10 +49,12 @@ inline Vector3<double> gravity_j2(const Vector3<double>& r, const Vector3<double
     return (m * (1.0 + k * (1.0 - 5.0 * u))) * r + (m * 2.0 * k * z) * pole;
 }
 
-// One RK4 step of h seconds.
-inline OrbitState rk4_step(const OrbitState& s, const Vector3<double>& pole, double h) noexcept {
+// One RK4 step of h seconds; a_s = gravity_j2(s.r_km, pole), which the
+// caller has (the velocity service keeps it for its Taylor nodes).
+inline OrbitState rk4_step(const OrbitState& s, const Vector3<double>& a_s, const Vector3<double>& pole,
+                           double h) noexcept {
     const double h2 = 0.5 * h;
-    const Vector3<double> k1v = gravity_j2(s.r_km, pole);
+    const Vector3<double>& k1v = a_s;
     const Vector3<double> k1r = s.v_kms;
     const Vector3<double> k2r = s.v_kms + h2 * k1v;
     const Vector3<double> k2v = gravity_j2(s.r_km + h2 * k1r, pole);
@@ -58,7 +62,7 @@ inline OrbitState rk4_step(const OrbitState& s, const Vector3<double>& pole, dou
     const Vector3<double> k3v = gravity_j2(s.r_km + h2 * k2r, pole);
     const Vector3<double> k4r = s.v_kms + h * k3v;
     const Vector3<double> k4v = gravity_j2(s.r_km + h * k3r, pole);
-    const double h6 = h / 6.0;
+    const double h6 = h * (1.0 / 6.0);
     return {s.r_km + h6 * (k1r + 2.0 * k2r + 2.0 * k3r + k4r), s.v_kms + h6 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)};
 }
 

@@ -15,20 +15,22 @@
 //            (kVelocityInvalid).
 // Causal, as on board: a solution's velocity comes from the latest accepted
 // state at or before its time, propagated (orbit_propagation.hpp, RK4 in
-// double, steps of 10 s anchored at the state) to the velocity node
-// [t_state + n·10 s, t_state + (n+1)·10 s] that holds the solution's time.
+// double, steps of 10 s anchored at the state) to the start of the velocity
+// node [t_state + n·10 s, t_state + (n+1)·10 s) that holds the solution's
+// time, and continued over the node by its first-order Taylor series.
 //
 // Two paths, for the FPU-less Cortex-M3:
 //  - push_state() and advance() are double (software on the M3): the frame
-//    conversion once per state, one RK4 step and one Earth evaluation per 10 s
-//    of flight and one Earth series per minute, bounded by
-//    max_steps_per_advance per call (no unbounded loop);
+//    conversion once per state, one force evaluation per state, one RK4 step
+//    per 10 s of flight beyond the latest state (gaps, uplinked states) and one
+//    Earth series per minute, bounded by max_steps_per_advance per call (no
+//    unbounded loop);
 //  - velocity_at() is the per-solution query, in the core's scalar T:
 //    β = β₀ + f·Δβ, f = (t − t₀)/10 s from integer microseconds. No double, no
 //    division: free of soft-float (tests/target/check-no-soft-float).
-// Linear interpolation over 10 s: |v''| ≤ n²·v = 9.7e-3 m/s³ in LEO, so the
-// error is ≤ (10 s)²/8 · 9.7e-3 = 0.12 m/s (8e-5″; the Earth's part 1e-9 m/s).
-// Q30 rounds β₀, Δβ and f·Δβ to 2⁻³¹: ≤ 3 · 4.7e-10 · c = 0.42 m/s (3e-4″).
+// Taylor over a node: ≤ ½·9.5e-3 m/s³·(10 s)² = 0.48 m/s (3e-4″) at its end,
+// ≤ 4.8e-3 m/s 1 s after a GNSS state (build_node). Q30 rounds β₀, Δβ and
+// f·Δβ to 2⁻³¹: ≤ 3 · 4.7e-10 · c = 0.42 m/s (3e-4″).
 //
 // Bad states are refused, counted (StateCounts) and reported by verdict; the
 // service keeps its latest accepted state, so nothing already known is lost:
@@ -129,6 +131,27 @@ constexpr Q30 node_fraction(std::int32_t dt_us, Q30 /*tag*/) noexcept {
     return {static_cast<std::int32_t>(fx::round_shift(std::int64_t{dt_us} * kMul, 31))};
 }
 
+// double → T at run time (node building, outside the per-solution path):
+// rounded to nearest. Q30: x·2³⁰ by one multiplication (fx::raw_from_double
+// builds 2³⁰ in a loop, fine for constants, 30 soft-float products on the M3),
+// saturated to ±(2 − 2⁻³⁰); the callers' values are ≤ 3.4e-3 (β) and ≤ 10 (1/s: ≤ 1.02).
+constexpr double scalar_from_double(double x, double /*tag*/) noexcept {
+    return x;
+}
+constexpr float scalar_from_double(double x, float /*tag*/) noexcept {
+    return static_cast<float>(x);
+}
+constexpr Q30 scalar_from_double(double x, Q30 /*tag*/) noexcept {
+    const double s = x * 1073741824.0;
+    if (!(s < 2147483647.0)) {
+        return {fx::kRawMax};  // also NaN
+    }
+    if (s <= -2147483647.0) {
+        return {-fx::kRawMax};
+    }
+    return {static_cast<std::int32_t>(s < 0.0 ? s - 0.5 : s + 0.5)};
+}
+
 template <typename T>
 class VelocityService {
 public:
@@ -201,24 +224,23 @@ public:
         if (!has_state_ || t < state_t_ || t.us - state_t_.us > cfg_.horizon_us) {
             return false;
         }
-        const std::int64_t n_target = (t.us - state_t_.us) / kVelocityNodeUs;
-        if (node_present_ && node_n_ == n_target) {
-            return true;
+        if (node_present_ && node_t0_ <= t && t.us - node_t0_.us < kVelocityNodeUs) {
+            return true;  // the per-solution common case: integer compares only
         }
+        const std::int64_t n_target = (t.us - state_t_.us) / kVelocityNodeUs;
         if (cursor_n_ < 0 || cursor_n_ > n_target) {
             cursor_n_ = 0;
             y_n_ = state_;
-            earth_n_ok_ = earth_at(state_t_, earth, earth_n_);
-            y_next_ = rk4_step(y_n_, pole_gcrs_, kPropagationStepS);
+            a_n_ = gravity_j2(y_n_.r_km, pole_gcrs_);
         }
         for (std::uint32_t steps = 0U; cursor_n_ < n_target; ++steps) {
             if (steps >= cfg_.max_steps_per_advance) {
                 return false;  // the next call continues from here
             }
-            y_n_ = y_next_;
+            y_n_ = rk4_step(y_n_, a_n_, pole_gcrs_, kPropagationStepS);
+            a_n_ = gravity_j2(y_n_.r_km, pole_gcrs_);
             ++cursor_n_;
-            earth_n_ok_ = earth_at(node_start(cursor_n_), earth, earth_n_);
-            y_next_ = rk4_step(y_n_, pole_gcrs_, kPropagationStepS);
+            ++steps_;
         }
         build_node(earth);
         return true;
@@ -226,7 +248,9 @@ public:
 
     // The per-solution query, in T (no double, no division). advance(t) first.
     constexpr ServiceVelocity<T> velocity_at(TtTime t) const noexcept {
-        ServiceVelocity<T> out{{{k<T>(0.0), k<T>(0.0), k<T>(0.0)}, k<T>(1.0), false}, status::kNoVelocity};
+        constexpr T zero = k<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
+        constexpr T one = k<T>(1.0);
+        ServiceVelocity<T> out{{{zero, zero, zero}, one, false}, status::kNoVelocity};
         if (!has_state_ || t < state_t_) {
             return out;
         }
@@ -247,6 +271,9 @@ public:
 
     constexpr const StateCounts& counts() const noexcept { return counts_; }
     constexpr bool has_state() const noexcept { return has_state_; }
+    // RK4 steps taken and velocity nodes built so far (for cost reports).
+    constexpr std::uint32_t steps_taken() const noexcept { return steps_; }
+    constexpr std::uint32_t nodes_built() const noexcept { return nodes_; }
     constexpr TtTime state_time() const noexcept { return state_t_; }
     // The accepted state in GCRS (for reports and tests).
     constexpr const OrbitState& state_gcrs() const noexcept { return state_; }
@@ -265,7 +292,7 @@ private:
     // |v''| ≤ 1.4e-9 m/s³ (earth_series.hpp), so the error is ≤ 60²/8 · 1.4e-9
     // = 6.3e-7 m/s; the series runs once per minute of flight, not per state.
     template <typename EarthFn>
-    bool earth_at(TtTime t, EarthFn& earth, EarthBarycentric& out) noexcept {
+    bool earth_at(TtTime t, EarthFn& earth, EarthBarycentric& out, Vector3<double>& rate_kms2) noexcept {
         std::int64_t k = t.us / kEarthNodeUs;
         if (k * kEarthNodeUs > t.us) {
             --k;  // floor for negative times
@@ -281,52 +308,59 @@ private:
             earth_k_ = k;
             earth_grid_valid_ = true;
         }
-        const double f = static_cast<double>(t.us - k * kEarthNodeUs) / static_cast<double>(kEarthNodeUs);
-        out.v_earth_icrf_kms = earth_a_.v_earth_icrf_kms + f * (earth_b_.v_earth_icrf_kms - earth_a_.v_earth_icrf_kms);
+        const double f = static_cast<double>(t.us - k * kEarthNodeUs) * (1.0 / static_cast<double>(kEarthNodeUs));
+        const Vector3<double> chord = earth_b_.v_earth_icrf_kms - earth_a_.v_earth_icrf_kms;
+        rate_kms2 = (static_cast<double>(kMicrosecondsPerSecond) / static_cast<double>(kEarthNodeUs)) * chord;
+        out.v_earth_icrf_kms = earth_a_.v_earth_icrf_kms + f * chord;
         out.sun_distance_au = earth_a_.sun_distance_au + f * (earth_b_.sun_distance_au - earth_a_.sun_distance_au);
         return earth_a_ok_ && earth_b_ok_;
     }
 
+    // The node at t_n = t_state + n·10 s: β(t) = β_n + (t − t_n)·β'_n, the
+    // first-order Taylor series of the propagated state (velocity y_n.v and
+    // acceleration a_n, the J2 force) plus the Earth's (its grid chord).
+    // Truncation: ½·|jerk|·dt² with |jerk| = n·|a| ≤ 1.13e-3 · 8.4 = 9.5e-3 m/s³
+    // in LEO: ≤ 4.8e-3 m/s 1 s after a state, ≤ 0.48 m/s (0.0003″) at the end
+    // of a node in a gap. A fresh state costs one force evaluation, not an RK4
+    // step: with 1 Hz GNSS states the service never steps.
     template <typename EarthFn>
     void build_node(EarthFn& earth) noexcept {
-        EarthBarycentric e1{};
-        const bool e1_ok = earth_at(node_start(cursor_n_ + 1), earth, e1);
+        EarthBarycentric e{};
+        Vector3<double> e_rate{};
+        const bool e_ok = earth_at(node_start(cursor_n_), earth, e, e_rate);
         node_t0_ = node_start(cursor_n_);
-        node_n_ = cursor_n_;
         node_present_ = true;
+        ++nodes_;
         node_status_ = 0U;
-        if (!(earth_n_ok_ && e1_ok && plausible(y_n_) && plausible(y_next_))) {
+        if (!(e_ok && plausible(y_n_))) {
             node_status_ = status::kNoVelocity | status::kVelocityInvalid;
             return;
         }
         constexpr double inv_c = 1.0 / kSpeedOfLightKmS;
-        const Vector3<double> b0 = inv_c * (earth_n_.v_earth_icrf_kms + y_n_.v_kms);
-        const Vector3<double> b1 = inv_c * (e1.v_earth_icrf_kms + y_next_.v_kms);
-        const Vector3<double> db = b1 - b0;
-        const double inv_s = 1.0 / earth_n_.sun_distance_au;
-        if (!(squared_norm(b1) <= kMaxBeta * kMaxBeta && squared_norm(b0) <= kMaxBeta * kMaxBeta && inv_s > 0.1 &&
-              inv_s < 10.0)) {
+        const Vector3<double> b0 = inv_c * (e.v_earth_icrf_kms + y_n_.v_kms);
+        const Vector3<double> db = (inv_c * kPropagationStepS) * (e_rate + a_n_);  // over one node
+        const double inv_s = 1.0 / e.sun_distance_au;
+        if (!(squared_norm(b0) <= kMaxBeta * kMaxBeta && squared_norm(db) <= 1e-12 && inv_s > 0.1 && inv_s < 10.0)) {
             node_status_ = status::kNoVelocity | status::kVelocityInvalid;
             return;
         }
-        using Tr = ScalarTraits<T>;
-        beta0_ = {Tr::from_double(b0.x), Tr::from_double(b0.y), Tr::from_double(b0.z)};
-        dbeta_ = {Tr::from_double(db.x), Tr::from_double(db.y), Tr::from_double(db.z)};
-        inv_sun_distance_ = Tr::from_double(inv_s);
+        beta0_ = {scalar_from_double(b0.x, T{}), scalar_from_double(b0.y, T{}), scalar_from_double(b0.z, T{})};
+        dbeta_ = {scalar_from_double(db.x, T{}), scalar_from_double(db.y, T{}), scalar_from_double(db.z, T{})};
+        inv_sun_distance_ = scalar_from_double(inv_s, T{});
     }
 
     VelocityServiceConfig cfg_;
     StateCounts counts_{};
+    std::uint32_t steps_ = 0U;
+    std::uint32_t nodes_ = 0U;
     bool has_state_ = false;
     TtTime state_t_{0};
     OrbitState state_{};
     Vector3<double> pole_gcrs_{0.0, 0.0, 1.0};
-    // Propagation cursor: the state at node n and n + 1, the Earth at node n.
+    // Propagation cursor: the state at node n and its acceleration.
     std::int64_t cursor_n_ = -1;
     OrbitState y_n_{};
-    OrbitState y_next_{};
-    EarthBarycentric earth_n_{};
-    bool earth_n_ok_ = false;
+    Vector3<double> a_n_{};
     // The Earth on its 60 s grid: samples at k and k + 1.
     bool earth_grid_valid_ = false;
     std::int64_t earth_k_ = 0;
@@ -336,7 +370,6 @@ private:
     bool earth_b_ok_ = false;
     // The node the per-solution query reads.
     bool node_present_ = false;
-    std::int64_t node_n_ = -1;
     TtTime node_t0_{0};
     Vector3<T> beta0_{};
     Vector3<T> dbeta_{};
