@@ -73,7 +73,7 @@ TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
 }
 
 #ifdef ASCORR_REPLAY_QEMU
-constexpr int kRows = 1500;
+constexpr int kRows = 1000;
 
 void expect_complete(const host::ReplaySummary& s, double bound) {
     EXPECT_EQ(s.frames, static_cast<std::size_t>(kRows));

@@ -199,7 +199,9 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         const bool m3 = opt.target == "qemu-m3";
         // QEMU answers within a few milliseconds; a lost frame is resent soon after
         // (a late answer only costs a resend, answered from the cache).
-        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 20;
+        // With states the target's double propagation and Earth series (software
+        // double on both boards) can delay an answer past 20 ms on a loaded machine.
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : (opt.states.empty() ? 20 : 100);
         const std::string image =
             opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
         if (!std::ifstream(image).good()) {
