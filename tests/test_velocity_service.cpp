@@ -276,13 +276,15 @@ TEST(TtTime, NodeFractionInEveryScalar) {
 // ---- Frame --------------------------------------------------------------
 
 TEST(EarthFrame, SinCosAndRotationAngleAgainstLibm) {
-    for (double f = -3.0; f <= 3.0; f += 0.001237) {
+    for (int i = 0; i <= 4850; ++i) {
+        const double f = -3.0 + 0.001237 * i;
         const SinCos sc = sincos_turns(f);
         const double x = 2 * kPi * (f - std::round(f));  // exact reduction, then ≤ 4.4e-16 rounding
         EXPECT_NEAR(sc.s, std::sin(x), 8e-16) << f;
         EXPECT_NEAR(sc.c, std::cos(x), 8e-16) << f;
     }
-    for (double t = -1e9; t <= 2e9; t += 3.3e7 + 0.123456) {
+    for (int i = 0; i <= 90; ++i) {
+        const double t = -1e9 + (3.3e7 + 0.123456) * i;
         TtTime ut1{};
         ASSERT_TRUE(tt_from_seconds(t, ut1));
         const double days = std::floor(t / kDayS);  // whole days in the first part: ERFA keeps precision
@@ -300,7 +302,8 @@ TEST(EarthFrame, ItrfToGcrsAgainstErfaC2t06a) {
     double worst_v = 0.0;
     double worst_r = 0.0;
     double worst_v_no_precession = 1e9;
-    for (double year = 2000.0; year <= 2050.0; year += 0.37) {
+    for (int i = 0; i <= 135; ++i) {
+        const double year = 2000.0 + 0.37 * i;
         const double t = (year - 2000.0) * 365.25 * kDayS + 0.184;
         const Pv itrf = gcrs_to_itrf(t, leo, true);
         const CelestialFromTerrestrial m = celestial_from_terrestrial(tt(t), kDefaultTtMinusUt1Us);
@@ -376,7 +379,8 @@ struct Feed {
 Feed gnss_feed(const ReferenceOrbit& orbit, double t0, double span,
                const std::vector<std::pair<double, double>>& gaps) {
     Feed f;
-    for (double t = t0; t <= t0 + span; t += 1.0) {
+    for (int k = 0; k <= static_cast<int>(span); ++k) {
+        const double t = t0 + k;
         bool in_gap = false;
         for (const auto& g : gaps) {
             in_gap = in_gap || (t >= t0 + g.first && t < t0 + g.first + g.second);
@@ -401,7 +405,9 @@ Errors run_solutions(const ReferenceOrbit& orbit, const Feed& feed, StateFrame f
     Errors e;
     std::size_t next_state = 0;
     Eigen::Vector3d held_v(0, 0, 0);
-    for (double base = from; base < to; base += spacing) {
+    const auto n = static_cast<int>(std::ceil((to - from) / spacing));
+    for (int i = 0; i < n; ++i) {
+        const double base = from + spacing * i;
         const TtTime t = tt(std::min(base + jitter(rng), to));
         while (next_state < feed.t.size() && tt(feed.t[next_state]) <= t) {
             const V3 r = v3(feed.itrf[next_state].r);

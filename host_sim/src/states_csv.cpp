@@ -61,7 +61,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
                                  std::to_string(fields.size()) +
                                  (fields.size() < header.size() ? " (truncated row?)" : ""));
         }
-        double x[7];
+        double x[7] = {};
         for (std::size_t i = 0; i < kNames.size(); ++i) {
             const auto v = parse_double(fields[col[i]]);
             if (!v) {

@@ -236,7 +236,11 @@ private:
         std::uint8_t wire[link::kMaxWire];
         const std::size_t w =
             link::encode_frame(static_cast<std::uint8_t>(type), seq, payload.data(), payload.size(), wire, sizeof wire);
-        for (int attempt = 0; attempt < max_attempts_; ++attempt) {
+        // Given up after max_attempts and at least kMinPatienceMs: a target
+        // that is booting (QEMU takes 0.3–1 s on a loaded machine, before its
+        // first byte) must not exhaust 20 short time-outs.
+        const auto give_up_after = std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs);
+        for (int attempt = 0; attempt < max_attempts_ || std::chrono::steady_clock::now() < give_up_after; ++attempt) {
             if (attempt > 0) {
                 ++stats_.retries;
             }
@@ -311,6 +315,7 @@ private:
         }
     }
 
+    static constexpr int kMinPatienceMs = 3000;
     Transport& transport_;
     int timeout_ms_;
     int max_attempts_;
