@@ -12,20 +12,31 @@ that carries the most energy of the residual velocity (divided by a small
 penalty for higher-order combinations, so that the physical term wins over an
 alias of it) joins the basis, the whole basis is refitted, and the loop stops
 when the largest velocity error on the fitting grid is below --target m/s.
+The distance then gets the terms it needs beyond those (same choice on its
+residual, to --target-au); the velocity does not use them. Last, per output,
+the smallest coefficients are dropped while the sum of their largest
+contributions stays within --prune-kms (each velocity component) or
+--prune-au, and the others are refitted. The result is checked on a
+quarter-day grid over the span and written, formatted with the repository's
+.clang-format (clang-format).
 
-Run from the repository root (not by CI; the test against liberfa is):
+Run by hand (not by CI; tests/test_earth_series.cpp checks the committed table
+against liberfa), from anywhere:
     /usr/bin/python3 tools/earth_series/generate.py
-Needs python3-erfa and python3-numpy (toolchain/debian-packages.txt). Takes
-about a minute on the 2-core machine. Deterministic: same packages, same table.
+Needs python3-erfa and python3-numpy (toolchain/debian-packages.txt) and
+clang-format. About two minutes on the 2-core machine. Deterministic: same
+packages, same table.
 """
 import argparse
 import itertools
+import os
 import subprocess
 import sys
 
 import erfa
 import numpy as np
 
+REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 AU_KM = 149597870.7
 DAY = 86400.0
 JULIAN_CENTURY_S = 36525.0 * DAY
@@ -123,31 +134,39 @@ class Basis:
         self.hs = 0.5 * (LAST_TT - FIRST_TT)
 
     def design(self, terms, t):
-        """Columns: per term, cos*tau^p, sin*tau^p (p = 0..DEGREE); the zero term has cos only."""
+        """Columns, BASES per term: tau^p cos(theta), tau^p sin(theta) for p = 0..DEGREE
+        (column term * BASES + 2p + (0 cos, 1 sin)); the secular term's sines are zero."""
         tau = (t - self.tc) / self.hs
         cols = []
         for vec in terms:
             a = np.dot(vec, self.phase) + np.dot(vec, self.rate) * t
-            c, s = np.cos(a), np.sin(a)
+            c, s = (np.cos(a), np.sin(a)) if any(vec) else (np.ones_like(t), np.zeros_like(t))
             for p in range(DEGREE + 1):
                 cols.append(c * tau**p)
-                if any(vec):
-                    cols.append(s * tau**p)
+                cols.append(s * tau**p)
         return np.array(cols).T
 
-    def unpack(self, terms, coef):
-        """Coefficients per term as [output][cos/sin][p]."""
-        out, j = [], 0
-        for vec in terms:
-            cs = np.zeros((coef.shape[1], 2, DEGREE + 1))
-            for p in range(DEGREE + 1):
-                cs[:, 0, p] = coef[j]
-                j += 1
-                if any(vec):
-                    cs[:, 1, p] = coef[j]
-                    j += 1
-            out.append(cs)
-        return out
+
+BASES = 2 * (DEGREE + 1)
+OUTPUTS = ["v_x", "v_y", "v_z", "s"]
+
+
+def prune(a, y, budget):
+    """Least squares of y on the columns of a, then the smallest coefficients
+    dropped while the sum of their largest contributions (|x_j| max|a_j|, a
+    bound of the change anywhere in the span) stays within budget, then the
+    kept ones refitted. Returns the coefficients (zero where dropped)."""
+    x, *_ = np.linalg.lstsq(a, y, rcond=None)
+    size = np.abs(x) * np.abs(a).max(0)
+    keep = np.ones(len(x), bool)
+    spent = 0.0
+    for j in np.argsort(size):
+        if size[j] == 0.0 or spent + size[j] <= budget:
+            spent += size[j]
+            keep[j] = False
+    out = np.zeros(len(x))
+    out[keep], *_ = np.linalg.lstsq(a[:, keep], y, rcond=None)
+    return out
 
 
 def fmt(x):
@@ -156,10 +175,12 @@ def fmt(x):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--target", type=float, default=1.0, help="largest velocity error on the fit grid, m/s")
+    ap.add_argument("--target", type=float, default=0.8, help="largest velocity error on the fit grid, m/s")
     ap.add_argument("--target-au", type=float, default=1e-5, help="largest Sun distance error on the fit grid, au")
+    ap.add_argument("--prune-kms", type=float, default=1e-3, help="budget of dropped coefficients per velocity axis, km/s")
+    ap.add_argument("--prune-au", type=float, default=5e-6, help="budget of dropped distance coefficients, au")
     ap.add_argument("--penalty", type=float, default=0.25, help="score divisor per order above one")
-    ap.add_argument("--out", default="firmware/include/ascorr/earth_series_table.hpp")
+    ap.add_argument("--out", default=os.path.join(REPO, "firmware", "include", "ascorr", "earth_series_table.hpp"))
     args = ap.parse_args()
 
     phase, rate = linear_arguments()
@@ -193,7 +214,9 @@ def main():
                 break
 
     # Sun distance on the same frequencies, plus those it needs beyond them
-    # (same greedy choice on the distance residual, to --target-au).
+    # (same greedy choice on the distance residual, to --target-au); the
+    # velocity keeps its own terms only.
+    velocity_columns = len(terms) * BASES
     while True:
         a = basis.design(terms, t)
         coef_r, *_ = np.linalg.lstsq(a, r, rcond=None)
@@ -210,33 +233,27 @@ def main():
             if cands[j] not in terms:
                 terms.append(cands[j])
                 break
-    coef_v, *_ = np.linalg.lstsq(a, v, rcond=None)
-    coef = np.column_stack([coef_v, coef_r])
-    # Order terms by their velocity amplitude (largest first; the zero term first).
-    unpacked = basis.unpack(terms, coef)
-    amp = [np.abs(c[:3]).max() for c in unpacked]
+    # Coefficients per output, the negligible ones dropped (budgets per output:
+    # --prune-kms for each velocity component, --prune-au for the distance).
+    av = a[:, :velocity_columns]
+    pad = np.zeros(a.shape[1] - velocity_columns)
+    coef = np.column_stack([np.concatenate([prune(av, v[:, i], args.prune_kms), pad]) for i in range(3)] +
+                           [prune(a, r, args.prune_au)])
+    # Order terms by their largest velocity coefficient (the secular term first).
+    amp = [np.abs(coef[k * BASES:(k + 1) * BASES, :3]).max() for k in range(len(terms))]
     order_idx = [0] + sorted(range(1, len(terms)), key=lambda i: -amp[i])
     terms = [terms[i] for i in order_idx]
-    unpacked = [unpacked[i] for i in order_idx]
+    coef = np.concatenate([coef[k * BASES:(k + 1) * BASES] for k in order_idx])
 
     # Check on a finer grid (quarter day, offset) over the span itself.
     tv = np.arange(FIRST_TT + 0.1 * DAY, LAST_TT, 0.25 * DAY)
     vv, rv = reference(tv)
-    pred = basis.design(terms, tv) @ np.concatenate([pack(c, vec) for c, vec in zip(unpacked, terms)])
+    pred = basis.design(terms, tv) @ coef
     dv = np.linalg.norm(pred[:, :3] - vv, axis=1) * 1000.0
     dr = np.abs(pred[:, 3] - rv)
-    print("check (quarter day, %d epochs): |dv| max %.3f m/s rms %.3f m/s; |dr| max %.3g au" %
-          (len(tv), dv.max(), np.sqrt((dv**2).mean()), dr.max()), file=sys.stderr)
-    write_header(args.out, phase, rate, basis, terms, unpacked, dv.max(), dr.max())
-
-
-def pack(cs, vec):
-    rows = []
-    for p in range(DEGREE + 1):
-        rows.append(cs[:, 0, p])
-        if any(vec):
-            rows.append(cs[:, 1, p])
-    return np.array(rows)
+    print("check (quarter day, %d epochs): |dv| max %.3f m/s rms %.3f m/s; |dr| max %.3g au; %d coefficients" %
+          (len(tv), dv.max(), np.sqrt((dv**2).mean()), dr.max(), np.count_nonzero(coef)), file=sys.stderr)
+    write_header(args.out, phase, rate, basis, terms, coef, dv.max(), dr.max(), (args.prune_kms, args.prune_au))
 
 
 def name(vec):
@@ -244,7 +261,7 @@ def name(vec):
     return s if s else "secular"
 
 
-def write_header(path, phase, rate, basis, terms, unpacked, dv_max, dr_max):
+def write_header(path, phase, rate, basis, terms, coef, dv_max, dr_max, args_prune):
     used = [j for j in range(K) if any(vec[j] for vec in terms)]
     maxmul = {j: max(abs(vec[j]) for vec in terms) for j in used}
     lines = []
@@ -292,45 +309,64 @@ def write_header(path, phase, rate, basis, terms, unpacked, dv_max, dr_max):
     mm = max(maxmul.values())
     w("inline constexpr int kMaxMultiple = %d;" % mm)
     w("inline constexpr int kPowers = %d;" % len(slots))
-    w("inline constexpr std::int8_t kPowerArgument[kPowers] = {%s};" % ", ".join(str(i) for i, _ in slots))
-    w("inline constexpr std::int8_t kPowerMultiple[kPowers] = {%s};" % ", ".join(str(m) for _, m in slots))
-    w("inline constexpr std::int8_t kPowerSlot[kArguments][kMaxMultiple] = {")
+    w("inline constexpr std::uint8_t kPowerArgument[kPowers] = {%s};" % ", ".join(str(i) for i, _ in slots))
+    w("inline constexpr std::uint8_t kPowerMultiple[kPowers] = {%s};" % ", ".join(str(m) for _, m in slots))
+    w("inline constexpr std::int16_t kPowerSlot[kArguments][kMaxMultiple] = {")
     for i, j in enumerate(used):
         row = [slots.index((i, m)) if (i, m) in slots else -1 for m in range(1, mm + 1)]
         w("    {%s},  // %s" % (", ".join(str(x) for x in row), SHORT[j]))
     w("};")
     w("")
-    w("// Outputs of a term: v_x, v_y, v_z (km/s, ICRF axes), Sun distance (au).")
+    w("// The secular term (theta = 0) first, then by decreasing largest velocity")
+    w("// coefficient, then the terms of the distance alone; in each comment the")
+    w("// argument and that coefficient.")
+    w("inline constexpr int kTerms = %d;" % len(terms))
+    w("inline constexpr std::int16_t kMultiple[kTerms][kArguments] = {")
+    for k, vec in enumerate(terms):
+        big = 1000.0 * np.abs(coef[k * BASES:(k + 1) * BASES, :3]).max()
+        size = "%.3g m/s" % big if big > 0.0 else "distance only, %.2g au" % np.abs(coef[k * BASES:(k + 1) * BASES,
+                                                                                          3]).max()
+        w("    {%s},  // %d: %s, %s" % (", ".join(str(vec[j]) for j in used), k, name(vec), size))
+    w("};")
+    w("")
+    w("// Outputs: 0..2 v_x, v_y, v_z (km/s, ICRF axes), 3 Sun distance (au).")
     w("inline constexpr int kOutputs = 4;")
     w("// Amplitude polynomial degree in tau.")
     w("inline constexpr int kDegree = %d;" % DEGREE)
+    w("// Bases of a term: b = 2p + f is tau^p cos(theta) (f = 0) or tau^p sin(theta) (f = 1).")
+    w("inline constexpr int kBases = 2 * (kDegree + 1);")
     w("")
-    w("// One term: argument theta = sum_j multiple[j] * argument_j, and for each")
-    w("// output o the contribution sum_p tau^p (c[o][p] cos theta + s[o][p] sin theta).")
-    w("struct Term {")
-    w("    std::int8_t multiple[kArguments];")
-    w("    double c[kOutputs][kDegree + 1];")
-    w("    double s[kOutputs][kDegree + 1];")
+    w("// The coefficients that are not negligible (the others were dropped with a")
+    w("// bound on the sum of their largest contributions: %.3g m/s per velocity" % (args_prune[0] * 1000.0))
+    w("// component, %.3g au in distance; the kept ones refitted), by term: those of" % args_prune[1])
+    w("// term k are kFirst[k] .. kFirst[k + 1] - 1. Coefficient n adds")
+    w("// kValue[n] * basis (kCode[n] % kBases) to output kCode[n] / kBases.")
+    nz = [(k, o, b, coef[k * BASES + b, o]) for k in range(len(terms)) for o in range(4) for b in range(BASES)
+          if coef[k * BASES + b, o] != 0.0]
+    first = [0]
+    for k in range(len(terms)):
+        first.append(first[-1] + sum(1 for e in nz if e[0] == k))
+    w("inline constexpr int kCoefficients = %d;" % len(nz))
+    w("inline constexpr std::int16_t kFirst[kTerms + 1] = {%s};" % ", ".join(str(x) for x in first))
+    w("inline constexpr std::uint8_t kCode[kCoefficients] = {")
+    for k in range(len(terms)):
+        codes = [str(o * BASES + b) for kk, o, b, _ in nz if kk == k]
+        w("    %s,  // term %d" % (", ".join(codes), k))
     w("};")
-    w("")
-    w("// Term 0 is the secular part (theta = 0); the others by decreasing largest")
-    w("// velocity coefficient. In each comment: the argument and that coefficient.")
-    w("inline constexpr int kTerms = %d;" % len(terms))
-    w("inline constexpr Term kTerm[kTerms] = {")
-    for vec, cs in zip(terms, unpacked):
-        w("    // %s: %.4g m/s" % (name(vec), 1000.0 * np.abs(cs[:3]).max()))
-        w("    {{%s}," % ", ".join(str(vec[j]) for j in used))
-        for part in (0, 1):
-            w("     {")
-            for o in range(4):
-                w("         {%s}," % ", ".join(fmt(x) for x in cs[o, part]))
-            w("     }%s" % ("," if part == 0 else "},"))
+    w("inline constexpr double kValue[kCoefficients] = {")
+    for k in range(len(terms)):
+        w("    // term %d: %s" % (k, name(terms[k])))
+        for kk, o, b, x in nz:
+            if kk == k:
+                w("    %s,  // %s tau^%d %s" % (fmt(x), OUTPUTS[o], b // 2, "sin" if b % 2 else "cos"))
     w("};")
     w("")
     w("}  // namespace ascorr::earth_series_table")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
-    subprocess.run(["clang-format", "-i", path], check=True)  # the repository's style (.clang-format)
+    # The repository's style, wherever the output goes.
+    style = os.path.join(REPO, ".clang-format")
+    subprocess.run(["clang-format", "-i", "--style=file:" + style, path], check=True)
     print("wrote %s: %d terms, %d arguments, %d powers" % (path, len(terms), len(used), len(slots)), file=sys.stderr)
 
 

@@ -6,7 +6,7 @@
 //    everywhere in ascorr. The series is a fit of eraEpv00, whose argument is
 //    TDB; the series takes TT for TDB. TDB − TT is periodic with amplitude
 //    ≤ 1.7 ms, so the time error moves the velocity by ≤ |a|·1.7 ms with
-//    |a| ≤ 6.0e-3 m/s² (the Sun's pull at 0.983 au plus the Moon's on the
+//    |a| ≤ 6.2e-3 m/s² (the Sun's pull at 0.983 au plus the Moon's on the
 //    Earth about the Earth–Moon barycentre): ≤ 1.1e-5 m/s; and the distance by
 //    ≤ 30.3 km/s · 1.7 ms = 52 m (3.5e-10 au). Both negligible.
 //  - Frame: v_earth_icrf_kms, the Earth's velocity relative to the solar-system
@@ -29,12 +29,15 @@
 // Jupiter and Saturn; the Moon's D, l, F; linear parts, the rest is absorbed by
 // the quadratic amplitudes): the Earth–Moon barycentre's orbit (λ_E to 4λ_E),
 // the Earth about the Earth–Moon barycentre (λ_E + D, the Moon's sidereal
-// motion, 12.4 m/s; F, its inclination; the lunar anomaly), the Sun about the
-// solar-system barycentre (Jupiter 12.1 m/s, Saturn; 2λ_J, 3λ_J), and the
-// leading Venus and Jupiter perturbations of the Earth's orbit. 25 periodic
-// terms and a secular one; the generator chose them greedily by their measured
-// contribution until the velocity error was below 1 m/s and the distance error
-// below 1e-5 au on a one-day grid.
+// motion, 12.4 m/s; F, its inclination; the lunar anomaly and evection), the Sun
+// about the solar-system barycentre (Jupiter 12.1 m/s, Saturn 2.8 m/s; 2λ_J,
+// 3λ_J), and the leading Venus and Jupiter perturbations of the Earth's orbit.
+// The generator chose the terms greedily by their measured contribution until
+// the velocity error was below 0.8 m/s and the distance error below 1e-5 au on
+// a one-day grid (23 periodic terms and the secular one for the velocity, 3
+// more for the distance), then dropped the coefficients whose contributions
+// sum to at most 1 m/s per velocity component and 5e-6 au in distance, and
+// refitted the others: 242 coefficients (table: 27 terms, 15 powers).
 // Each term's cos/sin comes from one sin and one cos per fundamental argument
 // (7 of each per evaluation) and complex products: powers exp(i·m·φ_j) by the
 // recurrence z^m = z^(m−1)·z, then one product per further argument of the term.
@@ -44,13 +47,15 @@
 // the double 2π (2.4e-16 below the true one): ≤ 1e-12 rad after reduction.
 //
 // Error bound against eraEpv00 over the whole span (tests/test_earth_series.cpp,
-// liberfa, every 0.5 day and 20,000 random epochs): |Δv| ≤ 0.75 m/s measured,
+// liberfa, every 0.5 day and 20,000 random epochs): |Δv| ≤ 0.84 m/s measured,
 // 3 m/s asserted (the requirement; 3 m/s is 0.002" of aberration); |Δs| ≤ 9.1e-6
 // au measured, 1e-5 au asserted (the core uses 1/s only in the solar-potential
 // term of aberration: 1e-5 au changes it by 4e-12"). eraEpv00 itself is within
-// a few mm/s and a few km of JPL DE405 (its documentation).
+// 4.9 mm/s (barycentric velocity) and 11.2 km (heliocentric position) of JPL
+// DE405 over 1900–2100 (its documentation).
 //
-// Cost (bench/target_bench.cpp, QEMU -icount): see README.md, "Earth series".
+// Cost (bench/target_bench.cpp, QEMU -icount): README.md, "On-board Earth
+// ephemeris": about 79,000 instructions per evaluation on the M4F and the M3.
 // On board the service evaluates it every N seconds and interpolates linearly;
 // the chord error is ≤ N²/8·max|y''|. |v''| ≤ 1.4e-9 m/s³: the Earth–Moon
 // barycentre's GM☉·v/r³ = 1.26e-9 at perihelion plus the Earth about the
@@ -61,8 +66,8 @@
 // (EarthSeries.LinearInterpolationBetweenEvaluationsIsNegligible).
 //
 // No allocation, no exceptions, no recursion; the loops have fixed trip counts
-// (7 arguments, 13 powers, 26 terms × 7 arguments); std::sin, std::cos,
-// std::remainder are called with finite arguments only.
+// (the table's powers; its terms, each with its arguments and its coefficients);
+// std::sin, std::cos, std::remainder are called with finite arguments only.
 #pragma once
 
 #include <cmath>
@@ -90,7 +95,7 @@ namespace detail {
 // mutation check. Same contract as earth_series().
 inline bool earth_series_omitting(double t_tt_j2000_s, EarthBarycentric& out, int omitted_term) noexcept {
     namespace tb = earth_series_table;
-    static_assert(tb::kDegree == 2, "the amplitudes below are evaluated as quadratics");
+    static_assert(tb::kBases == 6, "the bases below are those of quadratic amplitudes");
     // NaN fails both comparisons; ±inf fails one.
     if (!(t_tt_j2000_s >= kEarthSeriesFirstTt && t_tt_j2000_s <= kEarthSeriesLastTt)) {
         return false;
@@ -111,16 +116,16 @@ inline bool earth_series_omitting(double t_tt_j2000_s, EarthBarycentric& out, in
         }
     }
     const double tau = (t_tt_j2000_s - tb::kCentreTt) * tb::kInverseHalfSpanS;
+    const double tau2 = tau * tau;
     double acc[tb::kOutputs] = {};
     for (int k = 0; k < tb::kTerms; ++k) {
         if (k == omitted_term) {
             continue;
         }
-        const tb::Term& term = tb::kTerm[k];
         double c = 1.0;  // cos θ_k, sin θ_k
         double s = 0.0;
         for (int j = 0; j < tb::kArguments; ++j) {
-            const int m = term.multiple[j];
+            const int m = tb::kMultiple[k][j];
             if (m != 0) {
                 const int slot = tb::kPowerSlot[j][(m > 0 ? m : -m) - 1];
                 const double fc = pc[slot];
@@ -130,10 +135,10 @@ inline bool earth_series_omitting(double t_tt_j2000_s, EarthBarycentric& out, in
                 c = nc;
             }
         }
-        for (int o = 0; o < tb::kOutputs; ++o) {
-            const double a_cos = term.c[o][0] + tau * (term.c[o][1] + tau * term.c[o][2]);
-            const double a_sin = term.s[o][0] + tau * (term.s[o][1] + tau * term.s[o][2]);
-            acc[o] += a_cos * c + a_sin * s;
+        const double basis[tb::kBases] = {c, s, tau * c, tau * s, tau2 * c, tau2 * s};
+        for (int n = tb::kFirst[k]; n < tb::kFirst[k + 1]; ++n) {
+            const int code = tb::kCode[n];
+            acc[code / tb::kBases] += tb::kValue[n] * basis[code % tb::kBases];
         }
     }
     out.v_earth_icrf_kms = {acc[0], acc[1], acc[2]};
