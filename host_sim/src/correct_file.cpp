@@ -17,12 +17,12 @@
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
 namespace ascorr::host {
@@ -141,20 +141,13 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
-        const SolutionInput<T> in = to_core_input<T>(rec, opt.aberration ? &earth : nullptr);
-        const CorrectedSolution<T> c = correct_solution(in, job.cfg);
-        StatusBits st = c.status;
-        if (opt.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
-            st |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
-        }
-        explain(rec, in, st, opt.in, res.diag);
+        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg);
+        const StatusBits st = row.status;
+        explain(rec, row.in, st, opt.in, res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
-            const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-            job.writer.row(
-                reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
-                st, res.out);
+            job.writer.row(reader, row.q_chu_icrf, st, res.out);
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {

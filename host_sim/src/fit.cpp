@@ -91,6 +91,14 @@ const char* drop_name(Drop d) noexcept {
 }
 
 FitReport fit_model(const FitOptions& opt) {
+    FitReport r = fit_model(opt, [&](const std::function<void(const SolutionRecord&)>& fn) {
+        for_each_solution(opt.in, fn, "fit");
+    });
+    write_model_file(opt.out, r.model);
+    return r;
+}
+
+FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));
@@ -146,9 +154,7 @@ FitReport fit_model(const FitOptions& opt) {
         }
         any = true;
     });
-    for_each_solution(
-        opt.in,
-        [&](const SolutionRecord& rec) {
+    rows([&](const SolutionRecord& rec) {
             if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2) {
                 return;
             }
@@ -178,8 +184,7 @@ FitReport fit_model(const FitOptions& opt) {
             row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
             row.temp = rec.temperature;
             epochs.add(rec.t, rec.head, rec.line, row);
-        },
-        "fit");
+        });
     epochs.finish();
     r.orbit_period_s = period.value_or(0.0);
 
@@ -347,7 +352,6 @@ FitReport fit_model(const FitOptions& opt) {
             }
         }
     }
-    write_model_file(opt.out, r.model);
     return r;
 }
 

@@ -34,10 +34,17 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));
     }
+    return compute_stats(
+        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
+        model ? &*model : nullptr, log);
+}
+
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log) {
     const CorrectionConfig<double> ab_only{true, nullptr};
-    const CorrectionConfig<double> both{true, model ? &*model : nullptr};
+    const CorrectionConfig<double> both{true, model};
     StatsResult r;
-    r.thermal = model.has_value();
+    r.thermal = model != nullptr;
     EarthVelocity earth;
     Diagnostics diag(log);
 
@@ -53,9 +60,7 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
             }
         }
     });
-    for_each_solution(
-        opt.in,
-        [&](const SolutionRecord& rec) {
+    rows([&](const SolutionRecord& rec) {
             if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
                 return;
             }
@@ -80,8 +85,7 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
             row.z[1] = boresight(c1.q_chu_icrf);
             row.z[2] = boresight(c2.q_chu_icrf);
             epochs.add(rec.t, rec.head, rec.line, row);
-        },
-        "stats");
+        });
     epochs.finish();
     diag.summarize();
 

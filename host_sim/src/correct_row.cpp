@@ -1,0 +1,26 @@
+#include "ascorr_host/correct_row.hpp"
+
+#include "ascorr_host/solution_input.hpp"
+
+namespace ascorr::host {
+
+template <typename T>
+RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg) {
+    RowCorrection<T> r{to_core_input<T>(rec, cfg.aberration ? earth : nullptr), 0, rec.q_chu_icrf};
+    const CorrectedSolution<T> c = correct_solution(r.in, cfg);
+    r.status = c.status;
+    if (cfg.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
+        r.status |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
+    }
+    if ((r.status & status::kRejected) == 0U) {
+        const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
+        r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
+    }
+    return r;
+}
+
+template RowCorrection<double> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<double>&);
+template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<float>&);
+template RowCorrection<Q30> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<Q30>&);
+
+}  // namespace ascorr::host
