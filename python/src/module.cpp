@@ -724,8 +724,10 @@ PYBIND11_MODULE(_ascorr, mod) {
     // Malformed input and refused fits are ValueErrors; other failures of the
     // host library (a file that cannot be written, a model beyond the fixed-point
     // formats) are std::runtime_error, hence RuntimeError.
-    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError);
-    py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError);
+    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError)
+        .attr("__doc__") = "A malformed input file or rows (a ValueError); the message starts with file:line:column.";
+    py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") =
+        "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
 
     py::class_<host::ModelFile>(mod, "Model", R"doc(A thermal model: per head and axis, angles in arcsec linear (and
 optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (formats.md, "Model file").
