@@ -165,4 +165,4 @@ def test_write_solutions_round_trip_and_cli_agreement(exe, tmp_path):
     q, status = ascorr.correct(d["t"], d["chu"], d["q"], d["temps"], d["v"])
     assert np.array_equal(c["status"], status)
     ok = (status & 16) == 0
-    assert np.all(np.abs(c["q"][ok] - q[ok]) <= 5e-16)  # the file has 15 decimals
+    assert np.all(np.abs(c["q"][ok] - q[ok]) <= 6e-16)  # 15 decimals (5e-16) plus reading back (ulp/2)
