@@ -241,8 +241,8 @@ void record_of(const Rows& r, py::ssize_t i, SolutionRecord& rec) {
     }
     const double* v = r.v.data() + 3 * i;
     rec.v_sc_kms = {v[0], v[1], v[2]};
-    rec.velocity_components = static_cast<int>(!std::isnan(v[0])) + static_cast<int>(!std::isnan(v[1])) +
-                              static_cast<int>(!std::isnan(v[2]));
+    rec.velocity_components =
+        static_cast<int>(!std::isnan(v[0])) + static_cast<int>(!std::isnan(v[1])) + static_cast<int>(!std::isnan(v[2]));
     rec.flags = r.flags[k];
     const double c = r.confidence.data()[i];
     rec.confidence_present = !std::isnan(c);
@@ -543,8 +543,9 @@ py::dict read_solutions(const std::string& path) {
                     const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
                     const auto s = host::parse_integer(f);
                     if (!s || *s < 0 || *s > 0xFFFF) {
-                        throw host::InputError(path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
-                                               "column 'status': expected an integer 0..65535, got '" + std::string(f) + "'");
+                        throw host::InputError(
+                            path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
+                            "column 'status': expected an integer 0..65535, got '" + std::string(f) + "'");
                     }
                     st.push_back(*s);
                 }
@@ -573,7 +574,8 @@ py::dict read_solutions(const std::string& path) {
     d["confidence"] = arr(conf, n, 0);
     if (has_status) {
         py::array_t<std::uint16_t> sa(n);
-        std::transform(st.begin(), st.end(), sa.mutable_data(), [](long long x) { return static_cast<std::uint16_t>(x); });
+        std::transform(st.begin(), st.end(), sa.mutable_data(),
+                       [](long long x) { return static_cast<std::uint16_t>(x); });
         d["status"] = sa;
     }
     return d;
@@ -724,8 +726,8 @@ PYBIND11_MODULE(_ascorr, mod) {
     // Malformed input and refused fits are ValueErrors; other failures of the
     // host library (a file that cannot be written, a model beyond the fixed-point
     // formats) are std::runtime_error, hence RuntimeError.
-    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError)
-        .attr("__doc__") = "A malformed input file or rows (a ValueError); the message starts with file:line:column.";
+    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") =
+        "A malformed input file or rows (a ValueError); the message starts with file:line:column.";
     py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") =
         "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
 
@@ -756,8 +758,8 @@ coefficients (a head not listed gets status 256 in correct()).)doc")
             R"doc(Read a model file (formats.md, "Model file"). A malformed file raises ascorr.InputError
 (a ValueError) with file:line:column, as the command line reports it.)doc");
 
-    mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(),
-            "scalar"_a = "double", "aberration"_a = true,
+    mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
+            "aberration"_a = true,
             R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
 `ascorr correct` on the same rows, bit for bit, in every scalar.
 
@@ -798,10 +800,10 @@ Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed
 (arcsec or None), "n"}}, "rows", "clean_rows", "table" (the command's text),
 "messages" (rows left out, one line each)}.)doc");
 
-    mod.def("fit", &fit, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
-            "confidence"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
-            "min_days"_a = host::kDefaultMinSpanDays, "min_orbits"_a = host::kDefaultMinOrbits,
-            "max_condition"_a = host::kDefaultMaxCondition, "orbit_period"_a = py::none(),
+    mod.def("fit", &fit, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(), "confidence"_a = py::none(),
+            "t_from"_a = py::none(), "t_to"_a = py::none(), "min_days"_a = host::kDefaultMinSpanDays,
+            "min_orbits"_a = host::kDefaultMinOrbits, "max_condition"_a = host::kDefaultMaxCondition,
+            "orbit_period"_a = py::none(),
             R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see the README). Returns
 (model, report): model an ascorr.Model (model.write(path) writes the model file),
 report a dict (rows, dropped, epochs, orbits_used, condition, singular_values,

@@ -20,8 +20,8 @@ namespace ascorr::host {
 
 template <typename T>
 struct RowCorrection {
-    SolutionInput<T> in;         // what the core was given (for messages)
-    StatusBits status;           // the core's bits, plus 4 + 32 for a partial velocity
+    SolutionInput<T> in;            // what the core was given (for messages)
+    StatusBits status;              // the core's bits, plus 4 + 32 for a partial velocity
     Quaternion<double> q_chu_icrf;  // corrected; the input exactly when status has kRejected
 };
 
@@ -31,8 +31,7 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
 
 extern template RowCorrection<double> correct_row(const SolutionRecord&, EarthVelocity*,
                                                   const CorrectionConfig<double>&);
-extern template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*,
-                                                 const CorrectionConfig<float>&);
+extern template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<float>&);
 extern template RowCorrection<Q30> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<Q30>&);
 
 }  // namespace ascorr::host
