@@ -166,3 +166,28 @@ def test_write_solutions_round_trip_and_cli_agreement(exe, tmp_path):
     assert np.array_equal(c["status"], status)
     ok = (status & 16) == 0
     assert np.all(np.abs(c["q"][ok] - q[ok]) <= 6e-16)  # 15 decimals (5e-16) plus reading back (ulp/2)
+
+
+def test_contiguous_float64_inputs_are_not_copied():
+    """NumPy reports its buffers to tracemalloc: with float64 C-contiguous inputs
+    the call allocates its two outputs and no copy of q, temps or v; float32
+    inputs (the control) show their conversions."""
+    import tracemalloc
+
+    n = 100_000
+    d = random_solutions(n, seed=5)
+    outputs = n * 4 * 8 + n * 2
+    inputs = n * (4 + 3 + 3 + 1) * 8
+
+    def peak(args):
+        tracemalloc.start()
+        tracemalloc.reset_peak()
+        ascorr.correct(*args)
+        p = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return p
+
+    f64 = [d["t"], d["chu"], d["q"], d["temps"], d["v"]]
+    f32 = [x.astype(np.float32) if x.dtype.kind == "f" else x for x in f64]
+    assert peak(f64) < outputs + 0.1 * inputs
+    assert peak(f32) > outputs + 0.9 * inputs
