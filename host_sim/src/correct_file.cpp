@@ -24,6 +24,8 @@
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/states_csv.hpp"
+#include "ascorr_host/states_velocity.hpp"
 
 namespace ascorr::host {
 
@@ -118,13 +120,39 @@ struct Job {
     const CorrectionConfig<T>& cfg;
     const SolutionsReader& header;
     const RowWriter& writer;
+    const StatesFile* states;  // nullptr: no --states
+    VelocityServiceConfig service;
 };
+
+// With --states, a row without its own velocity gets the service's
+// (correct_row); the status bits the service adds (4, 4|512, 4|32) are
+// explained here.
+template <typename Sink>
+void explain_service(StatusBits service, const SolutionRecord& rec, const std::string& file, Sink& diag) {
+    if (service == status::kNoVelocity) {
+        diag.report("no state yet",
+                    where(file, rec) + "no accepted state at or before t: aberration skipped (status 4)");
+    } else if ((service & status::kStale) != 0U) {
+        diag.report("state too old", where(file, rec) +
+                                         "the latest state is older than --max-propagation: aberration skipped "
+                                         "(status 4+512)");
+    } else if ((service & status::kVelocityInvalid) != 0U) {
+        diag.report("velocity from states invalid",
+                    where(file, rec) +
+                        "the propagated state left a plausible orbit, or t is outside the Earth series' span "
+                        "(2000-2050): aberration skipped (status 4+32)");
+    }
+}
 
 template <typename T>
 void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
     const CorrectOptions& opt = job.opt;
     SolutionsReader reader(job.header, body, lines_before);
     EarthVelocity earth;
+    std::optional<StatesVelocity<T>> states;
+    if (job.states != nullptr) {
+        states.emplace(*job.states, job.service);
+    }
     SolutionRecord rec;
     res.out.reserve(body.size() + body.size() / 8);
     for (;;) {
@@ -141,9 +169,13 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
-        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg);
+        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg, states ? &*states : nullptr);
         const StatusBits st = row.status;
-        explain(rec, row.in, st, opt.in, res.diag);
+        if (row.from_states) {
+            explain_service(row.service, rec, opt.in, res.diag);
+        }
+        explain(rec, row.in, row.from_states ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+                res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
@@ -197,9 +229,16 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     }
     const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
     const RowWriter writer(header);
-    const Job<T> job{opt, cfg, header, writer};
-
     Diagnostics diag(log);
+    std::optional<StatesFile> states;
+    if (!opt.states.empty()) {
+        if (!(opt.max_propagation_s > 0.0 && opt.max_propagation_s <= 7.0 * 86400.0)) {
+            throw std::runtime_error("--max-propagation must be above 0 and at most 604800 s (7 days)");
+        }
+        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    }
+    const Job<T> job{opt, cfg, header, writer, states ? &*states : nullptr, service_config(opt.max_propagation_s)};
+
     AtomicFile out(opt.out);
     out.write(writer.header_line());
     CorrectSummary sum;
@@ -286,8 +325,8 @@ std::string describe(const CorrectSummary& s) {
     o << s.rows << " rows written";
     const char* names[] = {"aberration applied", "thermal applied",  "no velocity",         "temperatures missing",
                            "rejected",           "velocity invalid", "temperature invalid", "thermal out of range",
-                           "no model for head"};
-    for (std::size_t b = 0; b < 9; ++b) {
+                           "no model for head",  "velocity stale"};
+    for (std::size_t b = 0; b < 10; ++b) {
         if (s.status_bit[b] != 0) {
             o << ", " << s.status_bit[b] << " " << names[b];
         }
