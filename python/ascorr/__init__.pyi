@@ -33,6 +33,9 @@ def correct(
     model: Optional[Model] = ...,
     scalar: Literal["double", "float", "fixed"] = ...,
     aberration: bool = ...,
+    states: Optional[_Path] = ...,
+    states_frame: Literal["itrf", "gcrs"] = ...,
+    max_propagation: float = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16]]: ...
 def earth_velocity(t: _Real, exact: bool = ...) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def iba(

@@ -37,6 +37,7 @@
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/csv.hpp"
+#include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/epochs.hpp"
 #include "ascorr_host/fit.hpp"
@@ -44,6 +45,8 @@
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/states_csv.hpp"
+#include "ascorr_host/states_velocity.hpp"
 #include "ascorr_host/stats.hpp"
 
 namespace py = pybind11;
@@ -281,7 +284,8 @@ void parallel_rows(py::ssize_t n, const std::function<void(py::ssize_t, py::ssiz
 }
 
 template <typename T>
-void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, double* q_out, std::uint16_t* st_out) {
+void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, const host::StatesFile* states,
+                  double max_propagation_s, double* q_out, std::uint16_t* st_out) {
     std::optional<ThermalModel<T>> model;
     if (m != nullptr) {
         model = host::to_core<T>(*m);
@@ -290,10 +294,14 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, doub
     py::gil_scoped_release unlocked;
     parallel_rows(r.n, [&](py::ssize_t begin, py::ssize_t end) {
         host::EarthVelocity earth;
+        std::optional<host::StatesVelocity<T>> service;  // per thread, as per chunk in `ascorr correct`
+        if (states != nullptr) {
+            service.emplace(*states, host::service_config(max_propagation_s));
+        }
         SolutionRecord rec;
         for (py::ssize_t i = begin; i < end; ++i) {
             record_of(r, i, rec);
-            const host::RowCorrection<T> c = host::correct_row(rec, &earth, cfg);
+            const host::RowCorrection<T> c = host::correct_row(rec, &earth, cfg, service ? &*service : nullptr);
             double* q = q_out + 4 * i;
             q[0] = c.q_chu_icrf.w;
             q[1] = c.q_chu_icrf.x;
@@ -315,9 +323,43 @@ const host::ModelFile* model_arg(const py::object& model) {
     return &model.cast<const host::ModelFile&>();
 }
 
+// The states file of `ascorr correct --states`, read as it reads it; the
+// states the on-board service refuses are reported as a Python warning.
+std::optional<host::StatesFile> states_arg(const py::object& states, const std::string& frame,
+                                           double max_propagation_s) {
+    if (frame != "itrf" && frame != "gcrs") {
+        bad_argument("states_frame", "expected 'itrf' or 'gcrs', got '" + frame + "'");
+    }
+    if (!(max_propagation_s > 0.0 && max_propagation_s <= 7.0 * 86400.0)) {
+        bad_argument("max_propagation", "must be above 0 and at most 604800 s (7 days)");
+    }
+    if (states.is_none()) {
+        return std::nullopt;
+    }
+    if (!py::isinstance<py::str>(states) && !py::hasattr(states, "__fspath__")) {
+        bad_argument("states", "expected the path of a states file (t,x,y,z,vx,vy,vz) or None, got " +
+                                   std::string(py::str(states.get_type())));
+    }
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(states));
+    std::ostringstream log;
+    host::Diagnostics diag(log);
+    std::optional<host::StatesFile> f =
+        host::read_states_file(path, frame == "gcrs" ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    diag.summarize();
+    if (!log.str().empty()) {
+        if (PyErr_WarnEx(PyExc_UserWarning, log.str().c_str(), 1) != 0) {
+            throw py::error_already_set();
+        }
+    }
+    return f;
+}
+
 py::tuple correct(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
-                  const py::object& v, const py::object& model, const std::string& scalar, bool aberration) {
+                  const py::object& v, const py::object& model, const std::string& scalar, bool aberration,
+                  const py::object& states, const std::string& states_frame, double max_propagation) {
     const host::ModelFile* m = model_arg(model);
+    const std::optional<host::StatesFile> sf = states_arg(states, states_frame, max_propagation);
+    const host::StatesFile* s = sf ? &*sf : nullptr;
     if (scalar != "double" && scalar != "float" && scalar != "fixed") {
         bad_argument("scalar", "expected 'double', 'float' or 'fixed', got '" + scalar + "'");
     }
@@ -334,11 +376,11 @@ py::tuple correct(const py::object& t, const py::object& chu, const py::object& 
     double* qo = q_out.mutable_data();
     std::uint16_t* so = st_out.mutable_data();
     if (scalar == "double") {
-        correct_rows<double>(r, m, aberration, qo, so);
+        correct_rows<double>(r, m, aberration, s, max_propagation, qo, so);
     } else if (scalar == "float") {
-        correct_rows<float>(r, m, aberration, qo, so);
+        correct_rows<float>(r, m, aberration, s, max_propagation, qo, so);
     } else {
-        correct_rows<Q30>(r, m, aberration, qo, so);
+        correct_rows<Q30>(r, m, aberration, s, max_propagation, qo, so);
     }
     return py::make_tuple(q_out, st_out);
 }
@@ -759,7 +801,7 @@ coefficients (a head not listed gets status 256 in correct()).)doc")
 (a ValueError) with file:line:column, as the command line reports it.)doc");
 
     mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
-            "aberration"_a = true,
+            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf", "max_propagation"_a = 21600.0,
             R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
 `ascorr correct` on the same rows, bit for bit, in every scalar.
 
@@ -768,7 +810,12 @@ t: float64 (n,), s since J2000.0 TT. chu: (n,) strings 'A'..'D' or head indices
 degC, NaN where missing. v: (n, 3) spacecraft velocity, km/s GCRS, NaN where
 missing. temps and v may be None (all missing). model: an ascorr.Model, or None
 for no thermal stage. scalar: 'double', 'float' or 'fixed' (the core's Q30).
-aberration: False skips the aberration stage.
+aberration: False skips the aberration stage. states: the path of a states file
+(t,x,y,z,vx,vy,vz; `ascorr correct --states`): a row without its own velocity
+(all three NaN) gets the on-board velocity service's, propagated from the
+latest state at or before it (status 4 before the first state, 4+512 beyond
+max_propagation seconds, 4+32 off a plausible orbit); states_frame 'itrf' (GNSS)
+or 'gcrs' (uplinked). States the service refuses are reported as a warning.
 
 Returns (q_corrected float64 (n, 4), status uint16 (n,)). Every row comes back;
 a row that cannot be corrected keeps its quaternion exactly and says why in its
