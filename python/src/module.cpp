@@ -35,6 +35,7 @@
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/correct_file.hpp"
 #include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/diagnostics.hpp"
@@ -801,7 +802,8 @@ coefficients (a head not listed gets status 256 in correct()).)doc")
 (a ValueError) with file:line:column, as the command line reports it.)doc");
 
     mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
-            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf", "max_propagation"_a = 21600.0,
+            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf",
+            "max_propagation"_a = host::CorrectOptions{}.max_propagation_s,
             R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
 `ascorr correct` on the same rows, bit for bit, in every scalar.
 
