@@ -17,12 +17,12 @@
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 #include "ascorr_host/states_csv.hpp"
 #include "ascorr_host/states_velocity.hpp"
@@ -130,26 +130,24 @@ struct Job {
     VelocityServiceConfig service;
 };
 
-// With --states, a row without its own velocity gets the service's; the
-// status bits the service adds (4, 4|512, 4|32) are explained here.
-template <typename T, typename Sink>
-ServiceVelocity<T> velocity_from_states(StatesVelocity<T>& sv, const SolutionRecord& rec, const std::string& file,
-                                        Sink& diag) {
-    const ServiceVelocity<T> v = sv.at(rec.t);
-    if (v.status == status::kNoVelocity) {
+// With --states, a row without its own velocity gets the service's
+// (correct_row); the status bits the service adds (4, 4|512, 4|32) are
+// explained here.
+template <typename Sink>
+void explain_service(StatusBits service, const SolutionRecord& rec, const std::string& file, Sink& diag) {
+    if (service == status::kNoVelocity) {
         diag.report("no state yet",
                     where(file, rec) + "no accepted state at or before t: aberration skipped (status 4)");
-    } else if ((v.status & status::kStale) != 0U) {
+    } else if ((service & status::kStale) != 0U) {
         diag.report("state too old", where(file, rec) +
                                          "the latest state is older than --max-propagation: aberration skipped "
                                          "(status 4+512)");
-    } else if ((v.status & status::kVelocityInvalid) != 0U) {
+    } else if ((service & status::kVelocityInvalid) != 0U) {
         diag.report("velocity from states invalid",
                     where(file, rec) +
                         "the propagated state left a plausible orbit, or t is outside the Earth series' span "
                         "(2000-2050): aberration skipped (status 4+32)");
     }
-    return v;
 }
 
 template <typename T>
@@ -177,28 +175,17 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
-        SolutionInput<T> in = to_core_input<T>(rec, opt.aberration ? &earth : nullptr);
-        const bool use_states = states && opt.aberration && rec.velocity_components == 0;
-        StatusBits from_states = 0U;
-        if (use_states) {
-            const ServiceVelocity<T> v = velocity_from_states(*states, rec, opt.in, res.diag);
-            in.velocity = v.velocity;
-            from_states = v.status;
+        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg, states ? &*states : nullptr);
+        const StatusBits st = row.status;
+        if (row.from_states) {
+            explain_service(row.service, rec, opt.in, res.diag);
         }
-        const CorrectedSolution<T> c = correct_solution(in, job.cfg);
-        StatusBits st = c.status;
-        if (opt.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
-            st |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
-        }
-        st = with_service_status(st, from_states, use_states);
-        explain(rec, in, use_states ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in, res.diag);
+        explain(rec, row.in, row.from_states ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+                res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
-            const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-            job.writer.row(
-                reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
-                st, res.out);
+            job.writer.row(reader, row.q_chu_icrf, st, res.out);
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
