@@ -10,7 +10,7 @@
 // Arrays: float64 C-contiguous inputs are used in place; other real dtypes
 // (float32, integers) and non-contiguous arrays are converted once. A wrong
 // shape or dtype raises ValueError naming the argument. Per-row problems are
-// status bits (formats.md) and never an exception: every row comes back. The
+// status bits (docs/contract.md) and never an exception: every row comes back. The
 // GIL is released while rows are corrected, on up to 8 threads.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -676,7 +676,7 @@ void write_solutions(const std::string& path, const py::object& t, const py::obj
         for (int j = 0; j < 3; ++j) {
             out += ',';
             const double x = r.v.data()[3 * i + j];
-            if (!std::isnan(x)) {  // formats.md: empty when not available
+            if (!std::isnan(x)) {  // docs/contract.md: empty when not available
                 append_number(out, x);
             }
         }
@@ -775,7 +775,7 @@ PYBIND11_MODULE(_ascorr, mod) {
         "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
 
     py::class_<host::ModelFile>(mod, "Model", R"doc(A thermal model: per head and axis, angles in arcsec linear (and
-optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (formats.md, "Model file").
+optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
 
 Model(coefficients, heads="ABCD"): coefficients of shape (4, 3, 4) or (4, 3, 7),
 indexed [head A..D][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
@@ -791,14 +791,14 @@ coefficients (a head not listed gets status 256 in correct()).)doc")
             "True when the model has (and its file will carry) the quadratic columns.")
         .def(
             "write", [](const host::ModelFile& m, const std::string& path) { host::write_model_file(path, m); },
-            "path"_a, "Write the model file (formats.md), atomically: the whole file or nothing.")
+            "path"_a, "Write the model file (docs/contract.md), atomically: the whole file or nothing.")
         .def("to_csv", &host::format_model, "The model file's text.")
         .def("__repr__", [](const host::ModelFile& m) {
             return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") + ">";
         });
 
     mod.def("read_model", &host::read_model_file, "path"_a,
-            R"doc(Read a model file (formats.md, "Model file"). A malformed file raises ascorr.InputError
+            R"doc(Read a model file (docs/contract.md, "Model file"). A malformed file raises ascorr.InputError
 (a ValueError) with file:line:column, as the command line reports it.)doc");
 
     mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
