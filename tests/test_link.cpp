@@ -288,7 +288,8 @@ TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
         return ack.result;
     };
     const auto status_of = [&loop](std::uint16_t seq) {
-        const Decoded r = loop.request(MessageType::kSolutionIn, seq, SolutionIn<float>{seq, 0, {1.0F, 0, 0, 0}});
+        const Decoded r =
+            loop.request(MessageType::kSolutionIn, seq, SolutionIn<float>{seq, 0, {1.0F, 0, 0, 0}, {0}, 0});
         SolutionOut<float> out{};
         EXPECT_TRUE(decode(r.payloads.at(0).data(), r.payloads.at(0).size(), out));
         EXPECT_NE(out.status & status::kNoModelForHead, 0U);  // no model uploaded: thermal skipped
