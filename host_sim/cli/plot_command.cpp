@@ -22,6 +22,7 @@ void add_plot_command(CLI::App& app) {
     CLI::Option* wfrom = cmd->add_option("--window-from", opt->window_from,
                                          "draw only from this epoch (s since J2000 TT), IBA as 200 s running means");
     CLI::Option* wto = cmd->add_option("--window-to", opt->window_to, "draw only up to this epoch (s since J2000 TT)");
+    cmd->add_option("--width", opt->width, "figure width in pixels, 400..4000 (default 1400; panels 2/7 of it high)");
     wfrom->needs(wto);
     wto->needs(wfrom);
     cmd->callback([opt]() {

@@ -143,6 +143,9 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     so.in = opt.in;
     so.model = opt.model;
     so.keep_series = true;
+    if (!(opt.width >= 400 && opt.width <= 4000)) {
+        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
+    }
     const bool window = opt.window_from.has_value() || opt.window_to.has_value();
     if (window) {
         check_window(opt);
@@ -193,7 +196,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     const auto write_script = [&](const char* terminal) {
         std::ofstream g(dir.path() / "plot.gp");
         g.precision(12);
-        g << "set terminal " << terminal << " size 1400," << 400 * rows << "\n";
+        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(rows)
+          << (opt.width < 1000 ? " font ',8'" : "") << "\n";
         g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
         if (window) {
             g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kSmoothingWindowS
@@ -202,8 +206,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
             g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
               << "-minute means (RMS of the unbinned IBA in the legend)'\n";
         }
-        g << "set xdata time\nset timefmt '%s'\nset format x '" << (window ? "%m-%d %H:%M" : "%Y-%m")
-          << "'\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
+        g << "set xdata time\nset timefmt '%s'\nset format x \"" << (window ? "%m-%d\\n%H:%M" : "%Y-%m")
+          << "\"\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
         g << "set xrange ['" << t_lo + kJ2000Unix << "':'" << t_hi + kJ2000Unix << "']\n";
         g << "set lmargin 10\nset rmargin 42\n";  // the panels' time axes aligned
         g << "set ylabel 'IBA - mean (arcsec)'\n";

@@ -33,6 +33,7 @@ struct PlotOptions {
     bool temperatures = false;          // add the temperature panels
     std::optional<double> window_from;  // draw only [window_from, window_to]
     std::optional<double> window_to;
+    int width = 1400;  // pixels; each panel is 2/7 of it high
     std::string gnuplot = "gnuplot";
 };
 
