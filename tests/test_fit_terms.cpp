@@ -206,6 +206,13 @@ TEST(FitTerms, LinearTruth) {
         EXPECT_GT(rep.selection.models[1].out[p].rms,
                   (1.0 - host::kSelectionMargin) * rep.selection.models[0].out[p].rms);
     }
+    // Fitting noise costs little: the quadratic model of a linear truth is
+    // still at the floor.
+    const auto ex = excess_over_floor(d, model, "quadratic");
+    for (std::size_t p = 0; p < 3; ++p) {
+        EXPECT_LT(std::fabs(ex[0][p]), 0.03) << host::kPairNames[p] << " inside";
+        EXPECT_LT(std::fabs(ex[1][p]), 0.03) << host::kPairNames[p] << " outside";
+    }
     // The holdout changes the report, never the model written.
     host::FitOptions o;
     o.in = d.data.string();
