@@ -160,6 +160,12 @@ TEST(Plot, TemperaturePanelsAndAWindow) {
               1);
     EXPECT_NE(slurp(dir / "err.txt").find("no clean epoch for pair A-B in the window"), std::string::npos)
         << slurp(dir / "err.txt");
+    EXPECT_EQ(
+        run_cli("plot --width 10 --in " + data.string() + " --model " + model + " --out " + (dir / "x.png").string(),
+                dir),
+        1);
+    EXPECT_NE(slurp(dir / "err.txt").find("--width must be in [400, 4000] pixels"), std::string::npos)
+        << slurp(dir / "err.txt");
     EXPECT_EQ(run_cli("plot --window-from 456170000 --in " + data.string() + " --model " + model + " --out " +
                           (dir / "x.png").string(),
                       dir),
