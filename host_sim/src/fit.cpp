@@ -294,8 +294,8 @@ std::string describe(const FitReport& r) {
     o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
          "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their squares),\n"
          "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by the\n"
-         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032 (9 directions),\n"
-         "the one with the smallest corrections over the period is written.\n";
+         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
+         "(9 directions), the one with the smallest corrections over the period is written.\n";
     const auto rank = static_cast<std::size_t>(r.fit.rank);
     std::snprintf(buf, sizeof buf,
                   "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
