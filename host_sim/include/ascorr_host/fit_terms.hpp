@@ -1,7 +1,7 @@
 // ascorr_host/fit_terms.hpp: the least-squares step of `ascorr fit` for the
 // linear or the quadratic model, and the model-selection report.
 //
-// Regressors, per head h (formats.md): x1 = T1 = T_CHU of h, x2 = T2 − T1,
+// Regressors, per head h (the data contract, docs/contract.md): x1 = T1 = T_CHU of h, x2 = T2 − T1,
 // x3 = T3 − T1 (T2 = T029, T3 = T032), in °C. The linear model has the terms
 // [1, x1, x2, x3] per axis, the quadratic one also [x1², x2², x3²].
 //
