@@ -22,6 +22,7 @@
 #include "baseline.hpp"
 #include "board.hpp"
 #include "core_entry.hpp"
+#include "systick_counter.hpp"
 #include "vector_convert.hpp"
 
 namespace {
@@ -29,6 +30,8 @@ namespace {
 using namespace ascorr;
 using namespace ascorr::target;
 namespace board = ascorr::app::board;
+using ascorr::bench::counts;
+using ascorr::bench::instructions_per_count;
 
 constexpr std::uint32_t kInputs = 32;
 constexpr std::uint32_t kRuns = 2048;  // per figure; the longest block (baseline) stays below 2^24 counts
@@ -37,26 +40,6 @@ VectorRecord g_records[kInputs];
 volatile std::uint16_t g_sink_status;  // results are stored, so that calls cannot be dropped
 volatile double g_sink_q;
 ModelRecord g_model_records[kModels];
-
-// SysTick counts elapsed while `body` runs (< 2^24).
-template <typename F>
-std::uint32_t counts(F&& body) {
-    board::systick_start(board::kSysTickMax + 1U, false);
-    const std::uint32_t start = board::systick_value();
-    body();
-    const std::uint32_t end = board::systick_value();
-    return (start - end) & board::kSysTickMax;
-}
-
-// Instructions per SysTick count, from a loop of 2 instructions per iteration.
-std::uint32_t instructions_per_count() {
-    constexpr std::uint32_t kIterations = 1U << 20;
-    const std::uint32_t c = counts([] {
-        std::uint32_t n = kIterations;
-        __asm__ volatile("1: subs %0, %0, #1\n bne 1b" : "+r"(n) : : "cc");
-    });
-    return (2U * kIterations + c / 2U) / c;
-}
 
 template <typename T>
 struct Fixture {

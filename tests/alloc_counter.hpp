@@ -1,8 +1,9 @@
 // tests/alloc_counter.hpp: counts heap allocations while armed.
 //
 // alloc_counter.cpp replaces the global operator new/delete (a malloc/free
-// pair); a test program that links it can prove a piece of code never
-// allocates: arm, run, disarm, read the count.
+// pair) and wraps malloc, calloc and realloc at link time; a test program that
+// links it (tests/CMakeLists.txt: ascorr_count_allocations) can prove a piece
+// of code never allocates: arm, run, disarm, read the count.
 #pragma once
 
 namespace ascorr::test {

@@ -26,7 +26,7 @@
 
 namespace ascorr::test {
 
-// R3(γ)·R2(β)·R1(α), the paper's matrices (formats.md), angles in rad.
+// R3(γ)·R2(β)·R1(α), the paper's matrices (docs/contract.md), angles in rad.
 inline Eigen::Matrix3d paper_rotation(double a, double b, double g) {
     Eigen::Matrix3d r1;
     r1 << 1, 0, 0, 0, std::cos(a), std::sin(a), 0, -std::sin(a), std::cos(a);

@@ -76,7 +76,7 @@ TEST(Aberration, DomainEdge) {
 }
 
 // The attitude-level correction: the corrected boresight is eraAb of the raw
-// one, and R_corr = R_raw·Qᵀ with Q the minimal rotation (formats.md).
+// one, and R_corr = R_raw·Qᵀ with Q the minimal rotation (docs/contract.md).
 TEST(Aberration, AttitudeCorrectionAgainstLiberfa) {
     std::mt19937_64 rng(4242);
     std::uniform_real_distribution<double> speed(0.0, 100.0);

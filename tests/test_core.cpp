@@ -205,7 +205,7 @@ TEST(Properties, NegatedInputGivesSameAttitude) {
 }
 
 // Both stages = thermal applied to the aberration-corrected attitude, and the
-// stages do not commute (the order of formats.md matters).
+// stages do not commute (the order of docs/contract.md matters).
 TEST(Properties, StagesComposeAsSpecified) {
     std::mt19937_64 rng(4);
     const ThermalModel<double> model = host::to_core<double>(table2());
@@ -302,6 +302,107 @@ TEST(BadInput, VelocityCases) {
         if ((c.want & status::kAberrationApplied) == 0) {
             EXPECT_LE(angle_arcsec(out.q_chu_icrf, q), 1e-12) << c.what << ": attitude must be untouched";
         }
+    }
+}
+
+// 1/s outside [1/40, 1/0.6] au⁻¹ makes the velocity unusable (4|32) in every
+// scalar, and leaves the attitude untouched; its edges and Swarm's range are
+// accepted. Without the check, 1/s = 1e9 turns the 4e-7" solar term into 425".
+template <typename T>
+void expect_sun_distance_domain() {
+    using Tr = ScalarTraits<T>;
+    const Quaternion<T> q{Tr::from_double(0.5), Tr::from_double(0.5), Tr::from_double(0.5), Tr::from_double(0.5)};
+    const Vector3<T> beta{Tr::from_double(1e-4), Tr::from_double(-2e-5), Tr::from_double(3e-5)};
+    struct Case {
+        double inv_s;
+        bool usable;
+    };
+    const Case cases[] = {
+        {1e9, false},  {-1.0, false},      {0.0, false},         {1.0 / 40.5, false}, {1.0 / 0.59, false},
+        {kNaN, false}, {1.0 / 40.0, true}, {1.0 / 0.6001, true}, {1.0 / 1.017, true}, {1.0 / 0.983, true},
+        {1.0, true},   {1.0 / 5.2, true},  {-kNaN, false},
+    };
+    for (const Case& c : cases) {
+        SolutionInput<T> in{q, 0, {}, {beta, Tr::from_double(c.inv_s), true}};
+        const auto out = correct_solution(in, CorrectionConfig<T>{true, nullptr});
+        if (c.usable) {
+            EXPECT_EQ(out.status, status::kAberrationApplied) << "1/s = " << c.inv_s;
+        } else {
+            EXPECT_EQ(out.status, status::kNoVelocity | status::kVelocityInvalid) << "1/s = " << c.inv_s;
+            EXPECT_EQ(Tr::to_double(out.q_chu_icrf.w), 0.5) << "1/s = " << c.inv_s << ": attitude must be untouched";
+        }
+    }
+}
+
+TEST(BadInput, SunDistanceOutsideItsDomainMakesTheVelocityUnusable) {
+    expect_sun_distance_domain<double>();
+    expect_sun_distance_domain<float>();
+    expect_sun_distance_domain<Q30>();
+}
+
+// ---- Status bits: the rule of status.hpp, on everything the core emits.
+TEST(StatusBits, TheRuleRejectsEachKindOfViolation) {
+    using namespace status;
+    EXPECT_TRUE(status_consistent(kAberrationApplied | kThermalApplied));
+    EXPECT_TRUE(status_consistent(kNoVelocity | kVelocityInvalid | kNoTemperature | kTemperatureInvalid | kStale));
+    EXPECT_TRUE(status_consistent(kAberrationApplied | kThermalOutOfRange));
+    EXPECT_TRUE(status_consistent(kNoVelocity | kNoModelForHead));
+    EXPECT_TRUE(status_consistent(kRejected));
+    EXPECT_FALSE(status_consistent(kVelocityInvalid));                               // 32 without 4
+    EXPECT_FALSE(status_consistent(kAberrationApplied | kTemperatureInvalid));       // 64 without 8
+    EXPECT_FALSE(status_consistent(kAberrationApplied | kThermalApplied | kStale));  // 512 without 4 or 8
+    EXPECT_FALSE(status_consistent(kAberrationApplied | kNoVelocity));               // applied and skipped
+    EXPECT_FALSE(status_consistent(kThermalApplied | kThermalOutOfRange));           // applied and skipped
+    EXPECT_FALSE(status_consistent(kNoTemperature | kNoModelForHead));               // two reasons
+    EXPECT_FALSE(status_consistent(kRejected | kNoVelocity));
+    EXPECT_FALSE(status_consistent(1024U));
+    // One name per bit, the last one the highest bit defined.
+    static_assert(kStale == 1U << (kStatusBitCount - 1), "a name for every bit");
+    EXPECT_STREQ(kStatusBitNames[9], "stale");
+}
+
+template <typename T>
+void expect_core_statuses_follow_the_rule(std::uint32_t* seen) {
+    using Tr = ScalarTraits<T>;
+    ThermalModel<T> model = host::to_core<T>(table2());
+    model.head[2].gamma.c0 = Tr::coefficient(4000.0 * kArcsecToRad);  // head C beyond 1°: 128
+    model.head[3].present = false;                                    // head D: 256
+    std::mt19937_64 rng(7);
+    std::uniform_int_distribution<int> pick(0, 7);
+    for (int i = 0; i < 20000; ++i) {
+        const Eigen::Quaterniond qe = random_attitude(rng);
+        SolutionInput<T> in{};
+        in.q_chu_icrf = {Tr::from_double(qe.w()), Tr::from_double(qe.x()), Tr::from_double(qe.y()),
+                         Tr::from_double(qe.z())};
+        if (pick(rng) == 0) {
+            in.q_chu_icrf.w = Tr::from_double(2.0 * qe.w() + 0.1);  // not unit
+        }
+        in.head = static_cast<std::uint8_t>(pick(rng) % 5);  // 4: no such head
+        const double temps[] = {10.0, -5.0, -20.0, 500.0, kNaN, 150.0, -190.0, 30.0};
+        in.temperatures = {{Tr::celsius(temps[pick(rng)]), pick(rng) != 0},
+                           {Tr::celsius(temps[pick(rng)]), true},
+                           {Tr::celsius(temps[pick(rng)]), true}};
+        const double betas[] = {1e-4, -3e-4, 0.0, 1.0, kNaN, 2e-3, 5e-5, -1e-4};
+        in.velocity = {{Tr::from_double(betas[pick(rng)]), Tr::from_double(betas[pick(rng)]), Tr::from_double(1e-5)},
+                       Tr::from_double(pick(rng) == 0 ? 1e9 : 1.0),
+                       pick(rng) != 0};
+        const CorrectionConfig<T> cfg{pick(rng) != 0, pick(rng) != 0 ? &model : nullptr};
+        const StatusBits st = correct_solution(in, cfg).status;
+        ASSERT_TRUE(status::status_consistent(st)) << "status " << st;
+        for (int b = 0; b < status::kStatusBitCount; ++b) {
+            seen[b] += (st >> b) & 1U;
+        }
+    }
+}
+
+TEST(StatusBits, EveryStatusTheCoreEmitsFollowsTheRule) {
+    std::uint32_t seen[status::kStatusBitCount] = {};
+    expect_core_statuses_follow_the_rule<double>(seen);
+    expect_core_statuses_follow_the_rule<float>(seen);
+    expect_core_statuses_follow_the_rule<Q30>(seen);
+    // Every bit the core itself sets was exercised (512 is the callers').
+    for (int b = 0; b < status::kStatusBitCount - 1; ++b) {
+        EXPECT_GT(seen[b], 0U) << status::kStatusBitNames[b];
     }
 }
 

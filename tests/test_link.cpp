@@ -275,5 +275,41 @@ TEST(LinkServer, BrokenFramesGetANakAndBadPayloadsAreRefused) {
     EXPECT_EQ(ack.result, AckResult::kBadPayload);
 }
 
+// A velocity outside the core's domain is refused (kBadPayload), and the
+// velocity held before it is dropped, so the next solution is flagged 4, not
+// corrected with an older velocity.
+TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
+    Loop loop;
+    loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
+    const auto ack_of = [](const Decoded& d) {
+        Ack ack{};
+        EXPECT_TRUE(decode(d.payloads.at(0).data(), d.payloads.at(0).size(), ack));
+        return ack.result;
+    };
+    const auto status_of = [&loop](std::uint16_t seq) {
+        const Decoded r = loop.request(MessageType::kSolutionIn, seq, SolutionIn<float>{seq, 0, {1.0F, 0, 0, 0}});
+        SolutionOut<float> out{};
+        EXPECT_TRUE(decode(r.payloads.at(0).data(), r.payloads.at(0).size(), out));
+        EXPECT_NE(out.status & status::kNoModelForHead, 0U);  // no model uploaded: thermal skipped
+        return static_cast<StatusBits>(out.status & ~status::kNoModelForHead);
+    };
+    const ObserverVelocity<float> good{{1e-4F, 0.0F, 0.0F}, 1.0F, true};
+    EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 2, good)), AckResult::kOk);
+    EXPECT_EQ(status_of(3), status::kAberrationApplied);
+    ObserverVelocity<float> bad = good;
+    bad.inv_sun_distance_au = 1e9F;
+    EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 4, bad)), AckResult::kBadPayload);
+    EXPECT_EQ(status_of(5), status::kNoVelocity);
+    bad = good;
+    bad.beta_icrf.x = 1.0F;  // |v| = c
+    EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 6, good)), AckResult::kOk);
+    EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 7, bad)), AckResult::kBadPayload);
+    EXPECT_EQ(status_of(8), status::kNoVelocity);
+    // "Not available" is a valid update whatever its numbers.
+    ObserverVelocity<float> none = bad;
+    none.valid = false;
+    EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 9, none)), AckResult::kOk);
+}
+
 }  // namespace
 }  // namespace ascorr::link

@@ -6,9 +6,9 @@
 // The producer refreshes it once per 22 Hz cycle, before the heads are
 // corrected, in the same execution context as the loop (no locking). A reading
 // the producer could not make or withholds as stale has valid = false; the core
-// then skips the thermal stage and flags it (status 8). Producers: the HAL's
-// thermistor acquisition (hal_temperatures.cpp, float builds) and a simulation
-// (simulated_temperatures.cpp, fixed-point builds without FPU).
+// then skips the thermal stage and flags it (status 8). Producer: the HAL's
+// thermistor acquisition (hal_temperatures.cpp; float on the FPU target, fixed
+// point on the target without FPU).
 #pragma once
 
 #include <cstdint>

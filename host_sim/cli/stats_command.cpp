@@ -14,7 +14,7 @@ void add_stats_command(CLI::App& app) {
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it the thermal stage is null");
     cmd->add_option("--from", opt->from, "first epoch, s since J2000 TT");
     cmd->add_option("--to", opt->to, "last epoch, s since J2000 TT");
-    cmd->add_flag("--json", *json, "print JSON (formats.md) instead of the table");
+    cmd->add_flag("--json", *json, "print JSON (docs/contract.md) instead of the table");
     cmd->callback([opt, json]() {
         const host::StatsResult r = host::compute_stats(*opt, std::cerr);
         std::cout << (*json ? host::stats_json(r) : host::stats_table(r));

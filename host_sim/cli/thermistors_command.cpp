@@ -94,7 +94,7 @@ void run(const ThermistorOptions& opt) {
         throw std::runtime_error("--inject needs --simulate");
     }
     if (!opt.replay.empty()) {
-        source = std::make_unique<hal::ReplaySource>(hal::ReplaySource::from_file(opt.replay, acfg));
+        source = hal::ReplaySource::from_file(opt.replay, acfg);
     } else if (!opt.simulate.empty()) {
         std::vector<hal::InjectedFault> faults;
         for (const std::string& s : opt.inject) {

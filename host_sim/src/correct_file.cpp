@@ -65,12 +65,18 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
         if (rec.velocity_components != 3) {
             diag.report("velocity incomplete", where(file, rec) + "only " + std::to_string(rec.velocity_components) +
                                                    " of vx,vy,vz given: aberration skipped");
-        } else {
+        } else if (!beta_in_domain(in.velocity.beta_icrf)) {
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
             char buf[128];
             std::snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped", speed,
                           kMaxObserverSpeedKmS);
+            diag.report("velocity invalid", where(file, rec) + buf);
+        } else {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
+                          ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
+                          kMaxSunDistanceAu);
             diag.report("velocity invalid", where(file, rec) + buf);
         }
     }
@@ -291,12 +297,9 @@ CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
 std::string describe(const CorrectSummary& s) {
     std::ostringstream o;
     o << s.rows << " rows written";
-    const char* names[] = {"aberration applied", "thermal applied",  "no velocity",         "temperatures missing",
-                           "rejected",           "velocity invalid", "temperature invalid", "thermal out of range",
-                           "no model for head"};
-    for (std::size_t b = 0; b < 9; ++b) {
+    for (std::size_t b = 0; b < static_cast<std::size_t>(status::kStatusBitCount); ++b) {
         if (s.status_bit[b] != 0) {
-            o << ", " << s.status_bit[b] << " " << names[b];
+            o << ", " << s.status_bit[b] << " " << status::kStatusBitNames[b];
         }
     }
     if (s.malformed != 0) {

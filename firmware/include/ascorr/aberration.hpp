@@ -46,7 +46,8 @@ namespace ascorr {
 template <typename T>
 struct ObserverVelocity {
     Vector3<T> beta_icrf;   // v_obs_icrf / c
-    T inv_sun_distance_au;  // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7")
+    T inv_sun_distance_au;  // 1/s, s = Sun–observer distance in au (1 if unknown: the term is ≤ 4e-7");
+                            // domain [1/kMaxSunDistanceAu, 1/kMinSunDistanceAu]
     bool valid;             // false: not available or stale
 };
 
@@ -57,7 +58,24 @@ struct ObserverVelocity {
 // fixed point, which fails it too.
 template <typename T>
 constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
-    return squared_norm(beta) <= k<T>(kMaxBeta * kMaxBeta);
+    constexpr T lim = k<T>(kMaxBeta * kMaxBeta);
+    return squared_norm(beta) <= lim;
+}
+
+// True when 1/s (1/au) is inside [1/kMaxSunDistanceAu, 1/kMinSunDistanceAu];
+// false for NaN (both comparisons fail). In fixed point a NaN or huge input
+// converts to the top of the range (≥ 1.99), which fails the upper bound.
+template <typename T>
+constexpr bool inv_sun_distance_in_domain(const T& inv_sun_distance_au) noexcept {
+    constexpr T lo = k<T>(1.0 / kMaxSunDistanceAu);
+    constexpr T hi = k<T>(1.0 / kMinSunDistanceAu);
+    return lo <= inv_sun_distance_au && inv_sun_distance_au <= hi;
+}
+
+// Both parts of an observer velocity inside the series' domain.
+template <typename T>
+constexpr bool velocity_in_domain(const ObserverVelocity<T>& v) noexcept {
+    return beta_in_domain(v.beta_icrf) && inv_sun_distance_in_domain(v.inv_sun_distance_au);
 }
 
 // q_ab: the minimal rotation (ICRF, active) taking the natural direction
@@ -65,16 +83,20 @@ constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
 template <typename T>
 constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
                                                const T& inv_sun_distance_au) noexcept {
-    const T one = k<T>(1.0);
+    constexpr T one = k<T>(1.0);
+    constexpr T half = k<T>(0.5);
+    constexpr T eighth = k<T>(0.125);
     const T pdv = dot(z_icrf, beta_icrf);
     const Vector3<T> c = cross(z_icrf, beta_icrf);
     const T n = squared_norm(c);
-    T f = one + k<T>(0.5) * pdv * (pdv - one);
+    T f = one + half * pdv * (pdv - one);
     T x = n;
     if constexpr (ScalarTraits<T>::double_precision) {
         const T b2 = squared_norm(beta_icrf);
-        const T w1 = one + k<T>(0.5) * pdv * (one + k<T>(0.25) * b2);
-        const T w2 = k<T>(kSunSchwarzschildRadiusAu) * inv_sun_distance_au;
+        constexpr T quarter = k<T>(0.25);
+        constexpr T sun_radius = k<T>(kSunSchwarzschildRadiusAu);
+        const T w1 = one + half * pdv * (one + quarter * b2);
+        const T w2 = sun_radius * inv_sun_distance_au;
         // 1/(1 + pdv) by Horner: 1 − p(1 − p(1 − p(1 − p))).
         const T inv_1_pdv = one - pdv * (one - pdv * (one - pdv * (one - pdv)));
         f = (w1 + w2) * inv_1_pdv;
@@ -82,8 +104,8 @@ constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const V
     } else {
         static_cast<void>(inv_sun_distance_au);
     }
-    const T eighth_x = k<T>(0.125) * x;
-    return {-eighth_x, (k<T>(0.5) * f * (one + eighth_x)) * c};
+    const T eighth_x = eighth * x;
+    return {-eighth_x, (half * f * (one + eighth_x)) * c};
 }
 
 }  // namespace ascorr

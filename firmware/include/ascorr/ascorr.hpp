@@ -12,9 +12,11 @@
 //   correct.hpp        correct_solution(): the per-solution entry point
 //   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
 //                      coefficient formats and thermal_angle)
+//   compiler.hpp       what the fixed-point core asks of the compiler, checked
 #pragma once
 
 #include "aberration.hpp"
+#include "compiler.hpp"
 #include "constants.hpp"
 #include "correct.hpp"
 #include "fixed_point.hpp"

@@ -23,6 +23,15 @@ inline constexpr double kSunSchwarzschildRadiusAu = 1.97412574336e-8;
 inline constexpr double kMaxObserverSpeedKmS = 1000.0;
 inline constexpr double kMaxBeta = kMaxObserverSpeedKmS / kSpeedOfLightKmS;  // 3.34e-3
 
+// Heliocentric distance of the observer the aberration stage accepts, au: from
+// inside Venus's perihelion (0.72 au) to beyond Neptune (30 au). Swarm sees
+// 0.983–1.017 au. The distance enters only the solar-potential term (≤ 4e-7"
+// at 1 au, ∝ 1/s), but a corrupted 1/s (1e9) would turn that term into
+// hundreds of arcseconds; outside this range the velocity is unusable (4|32).
+// Q30 holds 1/s up to 2 − 2⁻³⁰, so the upper end of 1/s must stay below 2.
+inline constexpr double kMinSunDistanceAu = 0.6;
+inline constexpr double kMaxSunDistanceAu = 40.0;
+
 // Largest thermal rotation angle the small-angle series accepts: 1 degree.
 // The paper's angles are below 100"; a model that asks for more than 1° is
 // applied to temperatures it was not made for.

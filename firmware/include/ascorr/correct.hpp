@@ -79,7 +79,8 @@ struct ThermalStage {
 template <typename T>
 constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
                                         const HeadTemperatures<T>& temps) noexcept {
-    ThermalStage<T> out{{k<T>(0.0), {k<T>(0.0), k<T>(0.0), k<T>(0.0)}}, 0U};
+    constexpr T zero = k<T>(0.0);
+    ThermalStage<T> out{{zero, {zero, zero, zero}}, 0U};
     if (head >= kMaxHeads || !model.head[head].present) {
         out.skip = status::kNoModelForHead;
         return out;
@@ -100,7 +101,7 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
     const T alpha = thermal_angle<T>(m.alpha, t1, t2, t3);
     const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
     const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
-    const T lim = k<T>(kMaxThermalAngleRad);
+    constexpr T lim = k<T>(kMaxThermalAngleRad);
     if (!(abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim))) {  // false for NaN
         out.skip = status::kThermalOutOfRange;
         return out;
@@ -120,13 +121,14 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
     }
     StatusBits st = 0U;
     const Quaternion<T>& q = in.q_chu_icrf;
-    Quaternion<T> d{k<T>(0.0), k<T>(0.0), k<T>(0.0), k<T>(0.0)};
+    constexpr T zero = k<T>(0.0);
+    Quaternion<T> d{zero, zero, zero, zero};
 
     if (cfg.aberration) {
         const ObserverVelocity<T>& v = in.velocity;
         if (!v.valid) {
             st |= status::kNoVelocity;
-        } else if (!beta_in_domain(v.beta_icrf) || !is_finite(v.inv_sun_distance_au)) {
+        } else if (!velocity_in_domain(v)) {
             st |= status::kNoVelocity | status::kVelocityInvalid;
         } else {
             // The boresight of q before renormalisation: for ‖q‖² = 1 + ε it is

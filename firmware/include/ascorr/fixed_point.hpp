@@ -55,6 +55,7 @@
 #include <cstdint>
 
 #include "aberration.hpp"
+#include "compiler.hpp"
 #include "constants.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
@@ -657,5 +658,47 @@ constexpr SmallRotation<Q30> thermal_rotation(const Q30& alpha, const Q30& beta,
     const std::int32_t t123 = round30_sum(0, t12, t3).raw;
     return {{-t123}, {{-t1 - t23}, {t13 - t2}, {-t12 - t3}}};
 }
+
+// ---- Guards: a Q30 call never falls back to a generic template.
+// Each kernel above is an overload of a generic template of the core (which
+// rounds per product, saturates per operation and, for the series, is cut for
+// floating point). Overload resolution prefers these non-templates only while
+// their signatures match the call; one that drifts (a parameter's type or
+// reference changed) would silently lose to the template. The templates'
+// Q30 specialisations are therefore deleted: such a call does not compile.
+// The error analysis of each kernel stays with the kernel above.
+// tests/compile_fail/q30_guards.cpp checks every line (and, as its control,
+// that the same calls compile for float).
+template <>
+Q30 dot<Q30>(const Vector3<Q30>&, const Vector3<Q30>&) noexcept = delete;
+template <>
+Q30 squared_norm<Q30>(const Vector3<Q30>&) noexcept = delete;
+template <>
+Vector3<Q30> cross<Q30>(const Vector3<Q30>&, const Vector3<Q30>&) noexcept = delete;
+template <>
+Q30 dot<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&) noexcept = delete;
+template <>
+Q30 squared_norm<Q30>(const Quaternion<Q30>&) noexcept = delete;
+template <>
+Quaternion<Q30> operator*<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&) noexcept = delete;
+template <>
+Vector3<Q30> boresight<Q30>(const Quaternion<Q30>&) noexcept = delete;
+template <>
+SmallRotation<Q30> conjugate<Q30>(const SmallRotation<Q30>&) noexcept = delete;
+template <>
+bool norm_within<Q30>(const Quaternion<Q30>&, const Q30&) noexcept = delete;
+template <>
+Quaternion<Q30> right_increment<Q30>(const Quaternion<Q30>&, const SmallRotation<Q30>&) noexcept = delete;
+template <>
+Quaternion<Q30> add_left_increment<Q30>(const Quaternion<Q30>&, const SmallRotation<Q30>&,
+                                        const Quaternion<Q30>&) noexcept = delete;
+template <>
+Quaternion<Q30> renormalized_sum<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&) noexcept = delete;
+template <>
+bool beta_in_domain<Q30>(const Vector3<Q30>&) noexcept = delete;
+template <>
+SmallRotation<Q30> aberration_rotation<Q30>(const Vector3<Q30>&, const Vector3<Q30>&, const Q30&) noexcept = delete;
+template <>
+SmallRotation<Q30> thermal_rotation<Q30>(const Q30&, const Q30&, const Q30&) noexcept = delete;
 
 }  // namespace ascorr

@@ -1,6 +1,6 @@
 // ascorr/quaternion.hpp: attitude quaternions for the core.
 //
-// Conventions (the same as formats.md and Eigen::Quaternion):
+// Conventions (the same as docs/contract.md and Eigen::Quaternion):
 //  - Hamilton algebra (i² = j² = k² = ijk = −1), scalar first: q = (w, x, y, z).
 //  - rotation_matrix(q) is the usual active rotation matrix of q, equal to
 //    Eigen::Quaterniond(w, x, y, z).toRotationMatrix().
@@ -50,13 +50,15 @@ constexpr bool is_finite(const Quaternion<T>& q) noexcept {
 // fixed-point scalar overloads this with an exact test.
 template <typename T>
 constexpr bool norm_within(const Quaternion<T>& q, const T& tol) noexcept {
-    return abs_within(squared_norm(q) - k<T>(1.0), tol);
+    constexpr T one = k<T>(1.0);
+    return abs_within(squared_norm(q) - one, tol);
 }
 
 // The same attitude with w ≥ 0.
 template <typename T>
 constexpr Quaternion<T> canonical(const Quaternion<T>& q) noexcept {
-    return q.w < k<T>(0.0) ? Quaternion<T>{-q.w, -q.x, -q.y, -q.z} : q;
+    constexpr T zero = k<T>(0.0);
+    return q.w < zero ? Quaternion<T>{-q.w, -q.x, -q.y, -q.z} : q;
 }
 
 template <typename T>
@@ -96,7 +98,8 @@ constexpr Quaternion<T> increment(const SmallRotation<T>& r) noexcept {
 
 template <typename T>
 constexpr Quaternion<T> to_quaternion(const SmallRotation<T>& r) noexcept {
-    return {k<T>(1.0) + r.dw, r.v.x, r.v.y, r.v.z};
+    constexpr T one = k<T>(1.0);
+    return {one + r.dw, r.v.x, r.v.y, r.v.z};
 }
 
 // The increment after applying r on the right of the attitude q:
@@ -125,8 +128,10 @@ constexpr Quaternion<T> add_left_increment(const Quaternion<T>& d, const SmallRo
 template <typename T>
 constexpr Quaternion<T> renormalized_sum(const Quaternion<T>& q, const Quaternion<T>& d) noexcept {
     const T two_qd = dot(q, d) + dot(q, d);
-    const T eps = (squared_norm(q) - k<T>(1.0)) + two_qd + squared_norm(d);
-    const T g = -(k<T>(0.5) * eps);
+    constexpr T one = k<T>(1.0);
+    constexpr T half = k<T>(0.5);
+    const T eps = (squared_norm(q) - one) + two_qd + squared_norm(d);
+    const T g = -(half * eps);
     const Quaternion<T> qd = q + d;
     const Quaternion<T> e = d + Quaternion<T>{qd.w * g, qd.x * g, qd.y * g, qd.z * g};
     return q + e;
@@ -134,7 +139,8 @@ constexpr Quaternion<T> renormalized_sum(const Quaternion<T>& q, const Quaternio
 
 template <typename T>
 constexpr Quaternion<T> renormalized(const Quaternion<T>& q) noexcept {
-    return renormalized_sum(q, Quaternion<T>{k<T>(0.0), k<T>(0.0), k<T>(0.0), k<T>(0.0)});
+    constexpr T zero = k<T>(0.0);
+    return renormalized_sum(q, Quaternion<T>{zero, zero, zero, zero});
 }
 
 // Third row of R(q): the CHU +Z axis (boresight) in the source frame, i.e.
@@ -145,7 +151,8 @@ constexpr Vector3<T> boresight(const Quaternion<T>& q) noexcept {
     const T a = q.x * q.z - q.w * q.y;
     const T b = q.y * q.z + q.w * q.x;
     const T c = q.x * q.x + q.y * q.y;
-    return {a + a, b + b, k<T>(1.0) - (c + c)};
+    constexpr T one = k<T>(1.0);
+    return {a + a, b + b, one - (c + c)};
 }
 
 }  // namespace ascorr

@@ -1,6 +1,6 @@
 // ascorr/thermal.hpp: the thermal model of Herceg, Jørgensen & Jørgensen 2017.
 //
-// Conventions (formats.md, paper eqs. 4–10):
+// Conventions (docs/contract.md, paper eqs. 4–10):
 //  - Per head and axis: angle = c0 + c1·T1 + c2·(T2 − T1) + c3·(T3 − T1)
 //      + c1_2·T1² + c2_2·(T2 − T1)² + c3_2·(T3 − T1)²,
 //    T1 = T_CHU, T2 = T_THT00029, T3 = T_THT00032 in °C. Here the coefficients
@@ -80,7 +80,8 @@ struct HeadTemperatures {
 // NaN or an infinity).
 template <typename T>
 constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
-    return abs_within(t, ScalarTraits<T>::celsius(kMaxAbsTemperatureC));
+    constexpr Celsius<T> lim = ScalarTraits<T>::celsius(kMaxAbsTemperatureC);
+    return abs_within(t, lim);
 }
 
 // The model angle of one axis, in radians. A fixed-point scalar overloads this
@@ -102,11 +103,14 @@ struct HalfAngle {
 // cos and sin of half an angle, |angle| ≤ kMaxThermalAngleRad (series above).
 template <typename T>
 constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
-    const T one = k<T>(1.0);
-    const T h = k<T>(0.5) * angle;
+    constexpr T one = k<T>(1.0);
+    constexpr T half = k<T>(0.5);
+    constexpr T twelfth = k<T>(1.0 / 12.0);
+    constexpr T sixth = k<T>(1.0 / 6.0);
+    constexpr T twentieth = k<T>(0.05);
+    const T h = half * angle;
     const T h2 = h * h;
-    return {-(k<T>(0.5) * h2 * (one - k<T>(1.0 / 12.0) * h2)),
-            h * (one - k<T>(1.0 / 6.0) * h2 * (one - k<T>(0.05) * h2))};
+    return {-(half * h2 * (one - twelfth * h2)), h * (one - sixth * h2 * (one - twentieth * h2))};
 }
 
 // q_th = q3(γ) ⊗ q2(β) ⊗ q1(α) (double precision; without, the multiple of
@@ -119,8 +123,10 @@ template <typename T>
 constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
     if constexpr (!ScalarTraits<T>::double_precision) {
         const auto tan_half = [](const T& angle) {
-            const T h = k<T>(0.5) * angle;
-            return h + k<T>(1.0 / 3.0) * (h * h) * h;
+            constexpr T half = k<T>(0.5);
+            constexpr T third = k<T>(1.0 / 3.0);
+            const T h = half * angle;
+            return h + third * (h * h) * h;
         };
         const T t1 = tan_half(alpha);
         const T t2 = tan_half(beta);
@@ -131,7 +137,7 @@ constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const
     const HalfAngle<T> a = half_angle(alpha);
     const HalfAngle<T> b = half_angle(beta);
     const HalfAngle<T> g = half_angle(gamma);
-    const T one = k<T>(1.0);
+    constexpr T one = k<T>(1.0);
     const T ac = one + a.cm1;
     const T bc = one + b.cm1;
     const T gc = one + g.cm1;

@@ -82,7 +82,15 @@ private:
                 update<ModelUpload<T>>(f, sink, [this](const ModelUpload<T>& m) { model_.head[m.head] = m.model; });
                 return;
             case MessageType::kVelocityUpdate:
-                update<ObserverVelocity<T>>(f, sink, [this](const ObserverVelocity<T>& v) { velocity_ = v; });
+                // A velocity outside the core's domain (|v| > 1000 km/s, 1/s
+                // outside [1/40, 1/0.6] au⁻¹, non-finite) is refused with
+                // kBadPayload, and the velocity held so far is dropped: a
+                // refused update must not leave an older one in use.
+                if (!update<ObserverVelocity<T>>(
+                        f, sink, [this](const ObserverVelocity<T>& v) { velocity_ = v; },
+                        [](const ObserverVelocity<T>& v) { return !v.valid || velocity_in_domain(v); })) {
+                    velocity_.valid = false;
+                }
                 return;
             case MessageType::kTemperatureUpdate:
                 update<TemperatureUpdate<T>>(
@@ -117,15 +125,21 @@ private:
         ack(f.seq, AckResult::kUnknownType, sink);
     }
 
-    // Decodes a state update, applies it only if it decoded exactly, and acks.
-    template <typename M, typename Sink, typename Apply>
-    void update(const Frame& f, Sink& sink, Apply apply) noexcept {
+    // Decodes a state update, applies it only if it decoded exactly and
+    // `acceptable` holds, and acks; returns whether it was applied.
+    template <typename M, typename Sink, typename Apply, typename Acceptable>
+    bool update(const Frame& f, Sink& sink, Apply apply, Acceptable acceptable) noexcept {
         M m{};
-        const bool ok = decode(f.payload, f.length, m);
+        const bool ok = decode(f.payload, f.length, m) && acceptable(m);
         if (ok) {
             apply(m);
         }
         ack(f.seq, ok ? AckResult::kOk : AckResult::kBadPayload, sink);
+        return ok;
+    }
+    template <typename M, typename Sink, typename Apply>
+    bool update(const Frame& f, Sink& sink, Apply apply) noexcept {
+        return update<M>(f, sink, apply, [](const M&) { return true; });
     }
 
     template <typename Sink>

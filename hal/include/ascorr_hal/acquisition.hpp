@@ -39,7 +39,9 @@ namespace ascorr::hal {
 
 template <typename T>
 struct HeadAcquisition {
-    HeadTemperatures<T> temperatures;  // valid = false where withheld
+    // valid = false where withheld; in the core's scalar whose Celsius<> is T
+    // (float, double; Q30 for the fixed-point path's QCelsius)
+    HeadTemperatures<typename TemperatureMath<T>::CoreScalar> temperatures;
     FaultBits faults_chu;
     FaultBits faults_029;
     FaultBits faults_032;
@@ -136,9 +138,9 @@ public:
             f1 = fault::kNoData;
         }
         HeadAcquisition<T> out{};
-        out.temperatures.t_chu = {f1 == 0U ? t1.celsius : T(0), f1 == 0U};
-        out.temperatures.t_029 = {t2.valid() ? t2.celsius : T(0), t2.valid()};
-        out.temperatures.t_032 = {t3.valid() ? t3.celsius : T(0), t3.valid()};
+        out.temperatures.t_chu = {f1 == 0U ? t1.celsius : T{}, f1 == 0U};
+        out.temperatures.t_029 = {t2.valid() ? t2.celsius : T{}, t2.valid()};
+        out.temperatures.t_032 = {t3.valid() ? t3.celsius : T{}, t3.valid()};
         out.faults_chu = f1;
         out.faults_029 = t2.faults;
         out.faults_032 = t3.faults;

@@ -9,10 +9,11 @@
 #pragma once
 
 #include <cstdint>
+#include "interface.hpp"
 
 namespace ascorr::hal {
 
-class Clock {
+class Clock : private Interface {
 public:
     virtual ~Clock() = default;
     virtual std::uint64_t now_us() noexcept = 0;

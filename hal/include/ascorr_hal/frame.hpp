@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include "interface.hpp"
 
 #include "channel_config.hpp"
 #include "clock.hpp"
@@ -42,7 +43,7 @@ struct Frame {
 };
 
 template <typename T>
-class FrameSource {
+class FrameSource : private Interface {
 public:
     virtual ~FrameSource() = default;
     virtual bool acquire(Frame<T>& frame) noexcept = 0;
@@ -60,7 +61,7 @@ public:
         frame.t_us = clock_.now_us();
         for (std::uint8_t i = 0; i < kMaxChannels; ++i) {
             ChannelSample<T>& s = frame.channel[i];
-            s = {SampleKind::kNone, 0U, 0U, T(0), 0U};
+            s = {SampleKind::kNone, 0U, 0U, T{}, 0U};
             if (i >= config_.channels) {
                 continue;
             }

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <cstdint>
+#include "interface.hpp"
 
 #include "clock.hpp"
 
@@ -24,7 +25,7 @@ namespace ascorr::hal {
 
 // Four GPIO lines. Every call returns false when the line could not be driven
 // or read (the conversion then fails with a bus fault).
-class BitBangPins {
+class BitBangPins : private Interface {
 public:
     virtual ~BitBangPins() = default;
     virtual bool set_cs(bool level) noexcept = 0;
@@ -35,7 +36,7 @@ public:
 
 // One ADC that converts a channel into counts: the device interface the
 // sampler uses (a MCP3208, a replayed or simulated ADC).
-class AdcPort {
+class AdcPort : private Interface {
 public:
     virtual ~AdcPort() = default;
     // false: the conversion failed (bus fault); counts is then unspecified.

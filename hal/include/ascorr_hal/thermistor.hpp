@@ -43,7 +43,7 @@ inline constexpr double kZeroCelsiusK = 273.15;
 
 // Thermistor resistance from a count; 0 or +inf at the rails.
 template <typename T>
-T resistance_from_counts(const Divider<T>& d, std::uint16_t counts) noexcept {
+constexpr T resistance_from_counts(const Divider<T>& d, std::uint16_t counts) noexcept {
     const T inf = std::numeric_limits<T>::infinity();
     const T zero = T(0);
     if (counts == 0U) {

@@ -29,7 +29,7 @@ inline constexpr std::uint8_t kMaxVoters = 3;
 
 template <typename T>
 struct VotedTemperature {
-    T celsius;              // NaN when not valid
+    T celsius;              // NaN (TemperatureMath<T>::none()) when not valid
     FaultBits faults;       // 0: valid
     std::uint64_t t_us;     // oldest sample used
     std::uint8_t members;   // configured members
@@ -40,7 +40,8 @@ struct VotedTemperature {
 // Votes `n` (≤ kMaxVoters) readings; sets kOutvoted on disagreeing members.
 template <typename T>
 VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std::uint8_t quorum) noexcept {
-    const T nan = std::numeric_limits<T>::quiet_NaN();
+    using Math = TemperatureMath<T>;
+    const T nan = Math::none();
     VotedTemperature<T> out{nan, 0U, 0U, n, 0U};
     std::uint8_t valid[kMaxVoters] = {};
     std::uint8_t nv = 0;
@@ -55,17 +56,17 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
     if (nv == 3U) {
         // Sort the three indices by value.
         std::uint8_t a = valid[0], b = valid[1], c = valid[2], t = 0;
-        if (m[b].celsius < m[a].celsius) {
+        if (Math::less(m[b].celsius, m[a].celsius)) {
             t = a;
             a = b;
             b = t;
         }
-        if (m[c].celsius < m[b].celsius) {
+        if (Math::less(m[c].celsius, m[b].celsius)) {
             t = b;
             b = c;
             c = t;
         }
-        if (m[b].celsius < m[a].celsius) {
+        if (Math::less(m[b].celsius, m[a].celsius)) {
             t = a;
             a = b;
             b = t;
@@ -76,7 +77,7 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
         out.t_us = m[b].t_us;
         const std::uint8_t outer[2] = {a, c};
         for (const std::uint8_t k : outer) {
-            if (std::fabs(m[k].celsius - med) <= tolerance) {
+            if (Math::within(m[k].celsius, med, tolerance)) {
                 ++out.agreeing;
                 out.t_us = m[k].t_us < out.t_us ? m[k].t_us : out.t_us;
             } else {
@@ -86,8 +87,8 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
     } else if (nv == 2U) {
         const ChannelReading<T>& x = m[valid[0]];
         const ChannelReading<T>& y = m[valid[1]];
-        if (std::fabs(x.celsius - y.celsius) <= tolerance) {
-            out.celsius = T(0.5) * (x.celsius + y.celsius);
+        if (Math::within(x.celsius, y.celsius, tolerance)) {
+            out.celsius = Math::mean(x.celsius, y.celsius);
             out.agreeing = 2U;
             out.t_us = x.t_us < y.t_us ? x.t_us : y.t_us;
         }

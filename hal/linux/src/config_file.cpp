@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace ascorr::hal {
@@ -90,6 +91,249 @@ int find_channel(const AcquisitionConfig<double>& c, std::string_view name) noex
     return -1;
 }
 
+namespace {
+
+// One directive line split into its directive word and key=value tokens
+// (columns 1-based); a malformed or repeated key is an error at its column.
+struct DirectiveLine {
+    std::string_view directive;
+    std::size_t directive_col = 0;
+    std::vector<Token> tokens;
+};
+
+void split_line(std::string_view line, const LineParser& p, DirectiveLine& out) {
+    const std::size_t hash = line.find('#');
+    if (hash != std::string_view::npos) {
+        line = line.substr(0, hash);
+    }
+    out.directive = {};
+    out.directive_col = 0;
+    out.tokens.clear();
+    std::size_t i = 0;
+    while (i < line.size()) {
+        if (line[i] == ' ' || line[i] == '\t') {
+            ++i;
+            continue;
+        }
+        const std::size_t start = i;
+        while (i < line.size() && line[i] != ' ' && line[i] != '\t') {
+            ++i;
+        }
+        const std::string_view word = line.substr(start, i - start);
+        if (out.directive.empty()) {
+            out.directive = word;
+            out.directive_col = start + 1;
+            continue;
+        }
+        const std::size_t eq = word.find('=');
+        if (eq == std::string_view::npos || eq == 0) {
+            p.fail(start + 1, "expected key=value, got '" + std::string(word) + "'");
+        }
+        for (const Token& t : out.tokens) {
+            if (t.key == word.substr(0, eq)) {
+                p.fail(start + 1, "duplicate key '" + std::string(t.key) + "'");
+            }
+        }
+        out.tokens.push_back({word.substr(0, eq), word.substr(eq + 1), start + 1, start + eq + 2});
+    }
+}
+
+void parse_acquisition(const DirectiveLine& d, const LineParser& p, HalConfig& cfg) {
+    AcquisitionConfig<double>& a = cfg.acquisition;
+    for (const Token& t : d.tokens) {
+        if (t.key == "settle_us") {
+            a.sampler.settle_us = static_cast<std::uint32_t>(p.integer(t, 0, 10000000));
+        } else if (t.key == "samples") {
+            a.sampler.samples = static_cast<std::uint8_t>(p.integer(t, 1, kMaxSamples));
+        } else if (t.key == "gap_us") {
+            a.sampler.gap_us = static_cast<std::uint32_t>(p.integer(t, 0, 10000000));
+        } else if (t.key == "half_period_us") {
+            cfg.gpio.half_period_us = static_cast<std::uint32_t>(p.integer(t, 0, 50));
+        } else if (t.key == "stale_s") {
+            a.stale_us = static_cast<std::uint64_t>(std::llround(p.positive(t) * 1e6));
+        } else if (t.key == "vote_tolerance") {
+            a.vote_tolerance = p.positive(t);
+        } else if (t.key == "quorum") {
+            a.quorum = static_cast<std::uint8_t>(p.integer(t, 1, kMaxVoters));
+        } else {
+            p.fail(t.key_col, "unknown acquisition key '" + std::string(t.key) + "'");
+        }
+    }
+}
+
+void parse_gpio(const DirectiveLine& d, const LineParser& p, GpioWiring& gpio) {
+    for (const Token& t : d.tokens) {
+        if (t.key == "chip") {
+            if (t.value.empty()) {
+                p.fail(t.value_col, "'chip' is empty");
+            }
+            gpio.chip = std::string(t.value);
+        } else if (t.key == "cs") {
+            gpio.cs = static_cast<unsigned>(p.integer(t, 0, 1023));
+        } else if (t.key == "clk") {
+            gpio.clk = static_cast<unsigned>(p.integer(t, 0, 1023));
+        } else if (t.key == "mosi") {
+            gpio.mosi = static_cast<unsigned>(p.integer(t, 0, 1023));
+        } else if (t.key == "miso") {
+            gpio.miso = static_cast<unsigned>(p.integer(t, 0, 1023));
+        } else {
+            p.fail(t.key_col, "unknown gpio key '" + std::string(t.key) + "'");
+        }
+    }
+    const unsigned lines[4] = {gpio.cs, gpio.clk, gpio.mosi, gpio.miso};
+    for (int x = 0; x < 4; ++x) {
+        for (int y = x + 1; y < 4; ++y) {
+            if (lines[x] == lines[y]) {
+                p.fail(d.directive_col, "gpio: two signals on line " + std::to_string(lines[x]));
+            }
+        }
+    }
+}
+
+// The keys a channel line must have, as they are seen.
+struct RequiredChannelKeys {
+    bool name = false, adc = false, role = false, a = false, b = false, c = false;
+    const char* first_missing() const noexcept {
+        return !name ? "name" : !adc ? "adc" : !role ? "role" : !a ? "a" : !b ? "b" : !c ? "c" : nullptr;
+    }
+};
+
+void parse_channel_name(const Token& t, const LineParser& p, const AcquisitionConfig<double>& a,
+                        ChannelConfig<double>& c) {
+    if (t.value.empty() || t.value.size() >= kNameLength) {
+        p.fail(t.value_col, "'name' must have 1 to " + std::to_string(kNameLength - 1) + " characters");
+    }
+    for (char ch : t.value) {
+        if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) {
+            p.fail(t.value_col, "'name' may hold letters, digits and '_' only");
+        }
+    }
+    if (find_channel(a, t.value) >= 0) {
+        p.fail(t.value_col, "channel '" + std::string(t.value) + "' defined twice");
+    }
+    std::memcpy(c.name, t.value.data(), t.value.size());
+    c.name[t.value.size()] = '\0';
+}
+
+void parse_channel_adc(const Token& t, const LineParser& p, const AcquisitionConfig<double>& a,
+                       ChannelConfig<double>& c) {
+    c.adc_channel = static_cast<std::uint8_t>(p.integer(t, 0, 7));
+    for (std::uint8_t k = 0; k < a.channels; ++k) {
+        if (a.channel[k].adc_channel == c.adc_channel) {
+            p.fail(t.value_col,
+                   "ADC input " + std::to_string(c.adc_channel) + " already used by '" + a.channel[k].name + "'");
+        }
+    }
+}
+
+void parse_channel_role(const Token& t, const LineParser& p, const AcquisitionConfig<double>& a,
+                        ChannelConfig<double>& c) {
+    bool found = false;
+    for (std::uint8_t r = 0; r < kRoleCount; ++r) {
+        if (t.value == kRoleNames[r]) {
+            c.role = static_cast<Role>(r);
+            found = true;
+        }
+    }
+    if (!found) {
+        p.fail(t.value_col,
+               "unknown role '" + std::string(t.value) + "' (monitor, chu_a, chu_b, chu_c, chu_d, t029, t032)");
+    }
+    std::uint8_t same = 0;
+    for (std::uint8_t k = 0; k < a.channels; ++k) {
+        same = static_cast<std::uint8_t>(same + (a.channel[k].role == c.role ? 1 : 0));
+    }
+    if (c.role != Role::kMonitor && same >= kMaxVoters) {
+        p.fail(t.value_col, "more than 3 channels with role '" + std::string(t.value) + "'");
+    }
+}
+
+// The optional keys of a channel line: its divider, limits and checks.
+void parse_channel_option(const Token& t, const LineParser& p, ChannelConfig<double>& c) {
+    if (t.key == "divider") {
+        if (t.value != "low" && t.value != "high") {
+            p.fail(t.value_col, "'divider' is low or high");
+        }
+        c.divider.thermistor_low = t.value == "low";
+    } else if (t.key == "r_fixed") {
+        c.divider.r_fixed = p.positive(t);
+    } else if (t.key == "levels") {
+        c.divider.levels = static_cast<std::uint16_t>(p.integer(t, 2, 65535));
+    } else if (t.key == "r_open") {
+        c.r_open = p.positive(t);
+    } else if (t.key == "r_short") {
+        c.r_short = p.number(t);
+    } else if (t.key == "t_min") {
+        c.t_min = p.number(t);
+    } else if (t.key == "t_max") {
+        c.t_max = p.number(t);
+    } else if (t.key == "max_rate") {
+        c.max_rate = p.number(t);
+        if (c.max_rate < 0.0) {
+            p.fail(t.value_col, "'max_rate' must be >= 0");
+        }
+    } else if (t.key == "stuck_frames") {
+        c.stuck_frames = static_cast<std::uint16_t>(p.integer(t, 0, 65535));
+    } else if (t.key == "max_spread") {
+        c.max_spread = static_cast<std::uint16_t>(p.integer(t, 0, 65535));
+    } else {
+        p.fail(t.key_col, "unknown channel key '" + std::string(t.key) + "'");
+    }
+}
+
+// Checks that need the whole channel line: the required keys and the ranges.
+void check_channel(const DirectiveLine& d, const LineParser& p, const RequiredChannelKeys& seen,
+                   const ChannelConfig<double>& c) {
+    if (const char* missing = seen.first_missing()) {
+        p.fail(d.directive_col, std::string("channel: missing '") + missing + "'");
+    }
+    const std::string name(c.name);
+    if (!(c.t_min < c.t_max)) {
+        p.fail(d.directive_col, "channel '" + name + "': t_min must be below t_max");
+    }
+    if (!(c.r_short < c.r_open)) {
+        p.fail(d.directive_col, "channel '" + name + "': r_short must be below r_open");
+    }
+    if (!(std::fabs(c.t_min) <= 200.0 && std::fabs(c.t_max) <= 200.0)) {
+        p.fail(d.directive_col, "channel '" + name + "': t_min, t_max must be within ±200 °C");
+    }
+}
+
+void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfig<double>& a) {
+    if (a.channels >= kMaxChannels) {
+        p.fail(d.directive_col, "more than " + std::to_string(kMaxChannels) + " channels");
+    }
+    ChannelConfig<double> c = default_channel();
+    RequiredChannelKeys seen;
+    for (const Token& t : d.tokens) {
+        if (t.key == "name") {
+            parse_channel_name(t, p, a, c);
+            seen.name = true;
+        } else if (t.key == "adc") {
+            parse_channel_adc(t, p, a, c);
+            seen.adc = true;
+        } else if (t.key == "role") {
+            parse_channel_role(t, p, a, c);
+            seen.role = true;
+        } else if (t.key == "a") {
+            c.sh.a = p.number(t);
+            seen.a = true;
+        } else if (t.key == "b") {
+            c.sh.b = p.number(t);
+            seen.b = true;
+        } else if (t.key == "c") {
+            c.sh.c = p.number(t);
+            seen.c = true;
+        } else {
+            parse_channel_option(t, p, c);
+        }
+    }
+    check_channel(d, p, seen, c);
+    a.channel[a.channels++] = c;
+}
+
+}  // namespace
+
 HalConfig parse_config(const std::string& file_name, std::string_view text) {
     HalConfig cfg;
     AcquisitionConfig<double>& a = cfg.acquisition;
@@ -102,215 +346,28 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
     bool seen_gpio = false;
     linux_detail::TextLines lines(text);
     std::string_view line;
-    std::vector<Token> tokens;
+    DirectiveLine d;
     while (lines.next(line)) {
-        const std::size_t line_no = lines.number();
-        const std::size_t hash = line.find('#');
-        if (hash != std::string_view::npos) {
-            line = line.substr(0, hash);
-        }
-        LineParser p(file_name, line_no);
-        // Split into words with their columns (1-based).
-        std::string_view directive;
-        std::size_t directive_col = 0;
-        tokens.clear();
-        std::size_t i = 0;
-        while (i < line.size()) {
-            if (line[i] == ' ' || line[i] == '\t') {
-                ++i;
-                continue;
-            }
-            const std::size_t start = i;
-            while (i < line.size() && line[i] != ' ' && line[i] != '\t') {
-                ++i;
-            }
-            const std::string_view word = line.substr(start, i - start);
-            if (directive.empty()) {
-                directive = word;
-                directive_col = start + 1;
-                continue;
-            }
-            const std::size_t eq = word.find('=');
-            if (eq == std::string_view::npos || eq == 0) {
-                p.fail(start + 1, "expected key=value, got '" + std::string(word) + "'");
-            }
-            for (const Token& t : tokens) {
-                if (t.key == word.substr(0, eq)) {
-                    p.fail(start + 1, "duplicate key '" + std::string(t.key) + "'");
-                }
-            }
-            tokens.push_back({word.substr(0, eq), word.substr(eq + 1), start + 1, start + eq + 2});
-        }
-        if (directive.empty()) {
+        const LineParser p(file_name, lines.number());
+        split_line(line, p, d);
+        if (d.directive.empty()) {
             continue;
         }
-        if (directive == "acquisition") {
-            if (seen_acq) {
-                p.fail(directive_col, "a second 'acquisition' line");
+        if (d.directive == "acquisition") {
+            if (std::exchange(seen_acq, true)) {
+                p.fail(d.directive_col, "a second 'acquisition' line");
             }
-            seen_acq = true;
-            for (const Token& t : tokens) {
-                if (t.key == "settle_us") {
-                    a.sampler.settle_us = static_cast<std::uint32_t>(p.integer(t, 0, 10000000));
-                } else if (t.key == "samples") {
-                    a.sampler.samples = static_cast<std::uint8_t>(p.integer(t, 1, kMaxSamples));
-                } else if (t.key == "gap_us") {
-                    a.sampler.gap_us = static_cast<std::uint32_t>(p.integer(t, 0, 10000000));
-                } else if (t.key == "half_period_us") {
-                    cfg.gpio.half_period_us = static_cast<std::uint32_t>(p.integer(t, 0, 50));
-                } else if (t.key == "stale_s") {
-                    a.stale_us = static_cast<std::uint64_t>(std::llround(p.positive(t) * 1e6));
-                } else if (t.key == "vote_tolerance") {
-                    a.vote_tolerance = p.positive(t);
-                } else if (t.key == "quorum") {
-                    a.quorum = static_cast<std::uint8_t>(p.integer(t, 1, kMaxVoters));
-                } else {
-                    p.fail(t.key_col, "unknown acquisition key '" + std::string(t.key) + "'");
-                }
+            parse_acquisition(d, p, cfg);
+        } else if (d.directive == "gpio") {
+            if (std::exchange(seen_gpio, true)) {
+                p.fail(d.directive_col, "a second 'gpio' line");
             }
-        } else if (directive == "gpio") {
-            if (seen_gpio) {
-                p.fail(directive_col, "a second 'gpio' line");
-            }
-            seen_gpio = true;
-            for (const Token& t : tokens) {
-                if (t.key == "chip") {
-                    if (t.value.empty()) {
-                        p.fail(t.value_col, "'chip' is empty");
-                    }
-                    cfg.gpio.chip = std::string(t.value);
-                } else if (t.key == "cs") {
-                    cfg.gpio.cs = static_cast<unsigned>(p.integer(t, 0, 1023));
-                } else if (t.key == "clk") {
-                    cfg.gpio.clk = static_cast<unsigned>(p.integer(t, 0, 1023));
-                } else if (t.key == "mosi") {
-                    cfg.gpio.mosi = static_cast<unsigned>(p.integer(t, 0, 1023));
-                } else if (t.key == "miso") {
-                    cfg.gpio.miso = static_cast<unsigned>(p.integer(t, 0, 1023));
-                } else {
-                    p.fail(t.key_col, "unknown gpio key '" + std::string(t.key) + "'");
-                }
-            }
-            const unsigned o[4] = {cfg.gpio.cs, cfg.gpio.clk, cfg.gpio.mosi, cfg.gpio.miso};
-            for (int x = 0; x < 4; ++x) {
-                for (int y = x + 1; y < 4; ++y) {
-                    if (o[x] == o[y]) {
-                        p.fail(directive_col, "gpio: two signals on line " + std::to_string(o[x]));
-                    }
-                }
-            }
-        } else if (directive == "channel") {
-            if (a.channels >= kMaxChannels) {
-                p.fail(directive_col, "more than " + std::to_string(kMaxChannels) + " channels");
-            }
-            ChannelConfig<double> c = default_channel();
-            bool has_name = false, has_adc = false, has_role = false, has_a = false, has_b = false, has_c = false;
-            for (const Token& t : tokens) {
-                if (t.key == "name") {
-                    if (t.value.empty() || t.value.size() >= kNameLength) {
-                        p.fail(t.value_col, "'name' must have 1 to " + std::to_string(kNameLength - 1) + " characters");
-                    }
-                    for (char ch : t.value) {
-                        if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_')) {
-                            p.fail(t.value_col, "'name' may hold letters, digits and '_' only");
-                        }
-                    }
-                    if (find_channel(a, t.value) >= 0) {
-                        p.fail(t.value_col, "channel '" + std::string(t.value) + "' defined twice");
-                    }
-                    std::memcpy(c.name, t.value.data(), t.value.size());
-                    c.name[t.value.size()] = '\0';
-                    has_name = true;
-                } else if (t.key == "adc") {
-                    c.adc_channel = static_cast<std::uint8_t>(p.integer(t, 0, 7));
-                    for (std::uint8_t k = 0; k < a.channels; ++k) {
-                        if (a.channel[k].adc_channel == c.adc_channel) {
-                            p.fail(t.value_col, "ADC input " + std::to_string(c.adc_channel) + " already used by '" +
-                                                    a.channel[k].name + "'");
-                        }
-                    }
-                    has_adc = true;
-                } else if (t.key == "role") {
-                    bool found = false;
-                    for (std::uint8_t r = 0; r < kRoleCount; ++r) {
-                        if (t.value == kRoleNames[r]) {
-                            c.role = static_cast<Role>(r);
-                            found = true;
-                        }
-                    }
-                    if (!found) {
-                        p.fail(t.value_col, "unknown role '" + std::string(t.value) +
-                                                "' (monitor, chu_a, chu_b, chu_c, chu_d, t029, t032)");
-                    }
-                    std::uint8_t same = 0;
-                    for (std::uint8_t k = 0; k < a.channels; ++k) {
-                        same = static_cast<std::uint8_t>(same + (a.channel[k].role == c.role ? 1 : 0));
-                    }
-                    if (c.role != Role::kMonitor && same >= kMaxVoters) {
-                        p.fail(t.value_col, "more than 3 channels with role '" + std::string(t.value) + "'");
-                    }
-                    has_role = true;
-                } else if (t.key == "a") {
-                    c.sh.a = p.number(t);
-                    has_a = true;
-                } else if (t.key == "b") {
-                    c.sh.b = p.number(t);
-                    has_b = true;
-                } else if (t.key == "c") {
-                    c.sh.c = p.number(t);
-                    has_c = true;
-                } else if (t.key == "divider") {
-                    if (t.value != "low" && t.value != "high") {
-                        p.fail(t.value_col, "'divider' is low or high");
-                    }
-                    c.divider.thermistor_low = t.value == "low";
-                } else if (t.key == "r_fixed") {
-                    c.divider.r_fixed = p.positive(t);
-                } else if (t.key == "levels") {
-                    c.divider.levels = static_cast<std::uint16_t>(p.integer(t, 2, 65535));
-                } else if (t.key == "r_open") {
-                    c.r_open = p.positive(t);
-                } else if (t.key == "r_short") {
-                    c.r_short = p.number(t);
-                } else if (t.key == "t_min") {
-                    c.t_min = p.number(t);
-                } else if (t.key == "t_max") {
-                    c.t_max = p.number(t);
-                } else if (t.key == "max_rate") {
-                    c.max_rate = p.number(t);
-                    if (c.max_rate < 0.0) {
-                        p.fail(t.value_col, "'max_rate' must be >= 0");
-                    }
-                } else if (t.key == "stuck_frames") {
-                    c.stuck_frames = static_cast<std::uint16_t>(p.integer(t, 0, 65535));
-                } else if (t.key == "max_spread") {
-                    c.max_spread = static_cast<std::uint16_t>(p.integer(t, 0, 65535));
-                } else {
-                    p.fail(t.key_col, "unknown channel key '" + std::string(t.key) + "'");
-                }
-            }
-            const char* missing = !has_name   ? "name"
-                                  : !has_adc  ? "adc"
-                                  : !has_role ? "role"
-                                  : !has_a    ? "a"
-                                  : !has_b    ? "b"
-                                  : !has_c    ? "c"
-                                              : nullptr;
-            if (missing != nullptr) {
-                p.fail(directive_col, std::string("channel: missing '") + missing + "'");
-            }
-            if (!(c.t_min < c.t_max)) {
-                p.fail(directive_col, "channel '" + std::string(c.name) + "': t_min must be below t_max");
-            }
-            if (!(c.r_short < c.r_open)) {
-                p.fail(directive_col, "channel '" + std::string(c.name) + "': r_short must be below r_open");
-            }
-            if (!(std::fabs(c.t_min) <= 200.0 && std::fabs(c.t_max) <= 200.0)) {
-                p.fail(directive_col, "channel '" + std::string(c.name) + "': t_min, t_max must be within ±200 °C");
-            }
-            a.channel[a.channels++] = c;
+            parse_gpio(d, p, cfg.gpio);
+        } else if (d.directive == "channel") {
+            parse_channel(d, p, a);
         } else {
-            p.fail(directive_col, "unknown directive '" + std::string(directive) + "' (acquisition, gpio, channel)");
+            p.fail(d.directive_col,
+                   "unknown directive '" + std::string(d.directive) + "' (acquisition, gpio, channel)");
         }
     }
     if (a.channels == 0U) {

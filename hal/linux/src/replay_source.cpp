@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 namespace ascorr::hal {
@@ -111,14 +112,15 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
     }
 }
 
-ReplaySource ReplaySource::from_file(const std::string& path, const AcquisitionConfig<double>& config) {
+std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
+                                                      const AcquisitionConfig<double>& config) {
     std::ifstream f(path, std::ios::binary);
     if (!f) {
         throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
     }
     std::ostringstream ss;
     ss << f.rdbuf();
-    return ReplaySource(path, ss.str(), config);
+    return std::make_unique<ReplaySource>(path, ss.str(), config);
 }
 
 bool ReplaySource::acquire(Frame<double>& frame) noexcept {

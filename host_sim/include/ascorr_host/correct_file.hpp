@@ -1,7 +1,7 @@
 // ascorr_host/correct_file.hpp: the `ascorr correct` job.
 //
 // Reads a solutions file, corrects every row with the core in the chosen
-// scalar type, and writes the corrected file (formats.md): every input row in
+// scalar type, and writes the corrected file (docs/contract.md): every input row in
 // input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
 // Output is all or nothing (AtomicFile). A malformed row stops the run with
 // file:line:column, unless skip_bad, which reports and drops it.

@@ -1,4 +1,4 @@
-// ascorr_host/corrected_csv.hpp: writer of the corrected file (formats.md).
+// ascorr_host/corrected_csv.hpp: writer of the corrected file (docs/contract.md).
 //
 // Every field of the input row verbatim except qw,qx,qy,qz (15 decimals), plus
 // a `status` column (or the existing one, overwritten). A rejected row keeps

@@ -1,4 +1,4 @@
-// ascorr_host/csv.hpp: the plain CSV dialect of formats.md.
+// ascorr_host/csv.hpp: the plain CSV dialect of docs/contract.md.
 //
 // Comma-separated, one header line, no quoting (no field of the formats needs
 // it; a quote character is a malformed field). LF or CRLF line ends. Fields are

@@ -2,7 +2,7 @@
 //
 // for_each_solution() streams a file of any size in blocks of whole lines.
 // EpochAssembler groups the rows of heads A, B and C that share an epoch
-// (t to the millisecond, formats.md), in any row order: an epoch is handed on
+// (t to the millisecond, docs/contract.md), in any row order: an epoch is handed on
 // as soon as all three heads are in, the incomplete ones at the end. A second
 // row of the same head at the same epoch is an input error.
 #pragma once

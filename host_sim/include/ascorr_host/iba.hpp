@@ -1,6 +1,6 @@
 // ascorr_host/iba.hpp: inter-boresight angles and their statistics.
 //
-// Conventions (formats.md, "Statistics"):
+// Conventions (docs/contract.md, "Statistics"):
 //  - pairs in the paper's order: 0 = A–B, 1 = A–C, 2 = B–C;
 //  - the IBA of a pair is the angle between the two boresights (the third rows
 //    of R(q_chu_icrf)) at the same epoch, in arcsec;

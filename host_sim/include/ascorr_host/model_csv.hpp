@@ -1,4 +1,4 @@
-// ascorr_host/model_csv.hpp: the thermal-model file (formats.md, "Model file").
+// ascorr_host/model_csv.hpp: the thermal-model file (docs/contract.md, "Model file").
 //
 // Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
 // One row per head and axis; a head that appears must have all three axes.

@@ -23,7 +23,7 @@
 //    heater on; the temperatures relax for a few days after) are written
 //    beside the data.
 //  - The floor: the IBA RMS per pair of q_noise ⊗ q_true over the clean
-//    epochs (formats.md), written beside the data.
+//    epochs (docs/contract.md), written beside the data.
 #pragma once
 
 #include <Eigen/Core>

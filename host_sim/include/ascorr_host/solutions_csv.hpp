@@ -1,4 +1,4 @@
-// ascorr_host/solutions_csv.hpp: reader of the solutions file (formats.md).
+// ascorr_host/solutions_csv.hpp: reader of the solutions file (docs/contract.md).
 //
 // Columns are matched by name; unknown columns are ignored by the reader and
 // kept verbatim by writers. Required: t, chu, qw, qx, qy, qz. Optional:

@@ -2,7 +2,7 @@
 //
 // Per pair (A–B, A–C, B–C) and stage (original, aberration-corrected,
 // aberration- and thermal-corrected), the IBA RMS about the mean over the
-// clean epochs of formats.md: both rows with flags == 0, confidence <= 5,
+// clean epochs of docs/contract.md: both rows with flags == 0, confidence <= 5,
 // all three temperatures and the velocity present (and accepted by the core),
 // rows matched by t to the millisecond. The same epochs serve every stage.
 #pragma once
@@ -44,7 +44,7 @@ struct StatsResult {
     std::size_t clean_rows = 0;
 };
 
-// formats.md's clean solution (before the core has seen it).
+// docs/contract.md's clean solution (before the core has seen it).
 bool is_clean(const SolutionRecord& rec) noexcept;
 
 // Throws InputError for a malformed input; log gets one line per rejected row.

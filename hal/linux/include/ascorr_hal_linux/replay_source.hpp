@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,7 +26,9 @@ namespace ascorr::hal {
 class ReplaySource final : public FrameSource<double> {
 public:
     ReplaySource(const std::string& file_name, std::string_view text, const AcquisitionConfig<double>& config);
-    static ReplaySource from_file(const std::string& path, const AcquisitionConfig<double>& config);
+    // A source is a device (hal/interface.hpp): not copied nor moved, so it
+    // comes on the heap.
+    static std::unique_ptr<ReplaySource> from_file(const std::string& path, const AcquisitionConfig<double>& config);
 
     bool acquire(Frame<double>& frame) noexcept override;
     std::size_t frames() const noexcept { return frames_.size(); }

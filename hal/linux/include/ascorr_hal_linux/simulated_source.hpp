@@ -2,7 +2,7 @@
 // through a simulated MCP3208, with injectable faults.
 //
 // History: CSV with columns t (s), t_chu, t_029, t_032 and optionally chu
-// (A–D); other columns are ignored, so a solutions file (formats.md) is a
+// (A–D); other columns are ignored, so a solutions file (docs/contract.md) is a
 // history. A row with chu = X sets the truth of the chu_x channels; without a
 // chu column t_chu sets every chu channel. t_029 and t_032 set every member of
 // their triplet. Empty/nan keeps the previous truth; a channel without truth
