@@ -148,12 +148,14 @@ FitReport fit_model(const FitOptions& opt) {
             o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
             o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
         }
-        FitEpoch& fe = fit_epochs.emplace_back();
-        fe.t = e.t;
-        for (std::size_t h = 0; h < 3; ++h) {
-            const Eigen::Quaterniond& q = e.head[h]->q;
-            fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
-            fe.temp[h] = e.head[h]->temp;
+        if (opt.selection_report) {
+            FitEpoch& fe = fit_epochs.emplace_back();
+            fe.t = e.t;
+            for (std::size_t h = 0; h < 3; ++h) {
+                const Eigen::Quaterniond& q = e.head[h]->q;
+                fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
+                fe.temp[h] = e.head[h]->temp;
+            }
         }
         ++r.epochs;
         if (!any || e.t < r.t_first) {
@@ -269,8 +271,10 @@ FitReport fit_model(const FitOptions& opt) {
                          period_text + ")");
     }
     std::sort(fit_epochs.begin(), fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
-    r.selection = select_terms(averages, fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
-                               opt.min_temperature_range_c);
+    if (opt.selection_report) {
+        r.selection = select_terms(averages, fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
+                                   opt.min_temperature_range_c);
+    }
     r.singular_values = r.fit.singular_values;
     r.condition = r.fit.condition;
     r.head = r.fit.head;
@@ -312,7 +316,9 @@ std::string describe(const FitReport& r) {
                       f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
         o << buf;
     }
-    o << describe_selection(r.selection);
+    if (!r.selection.models.empty()) {
+        o << describe_selection(r.selection);
+    }
     if (r.selection.decided && r.selection.preferred != r.terms) {
         o << "note: the model written has " << terms_name(r.terms) << " terms; the data support "
           << terms_name(r.selection.preferred) << " terms\n";

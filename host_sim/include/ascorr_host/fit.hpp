@@ -64,6 +64,7 @@ struct FitOptions {
     Terms terms = Terms::kLinear;
     double holdout = kDefaultHoldout;  // fraction of the period (its end) held out for the selection report
     double min_temperature_range_c = kDefaultMinTemperatureRange;  // of each regressor, for quadratic terms
+    bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
 };
 
 // Why a row is left out of the fit (the first reason that applies).
