@@ -14,6 +14,11 @@
 // with the random model with quadratic terms (stages *_quadratic), and with
 // both stages off ("neither": validation and renormalisation alone).
 // The baseline (bench/baseline.hpp, double, Eigen) is measured the same way.
+// The Earth ephemeris series (ascorr/earth_series.hpp, double: software floating
+// point on both targets, the M4F's FPU being single precision) is measured per
+// evaluation at kSeriesRuns epochs spread over its span, against a function
+// that only writes its output; the series is the out-of-line entry of
+// firmware/app/earth_series_entry.cpp ("bench double earth_series <instructions>").
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cstdint>
 #include <cstdio>
@@ -22,6 +27,7 @@
 #include "baseline.hpp"
 #include "board.hpp"
 #include "core_entry.hpp"
+#include "earth_series_entry.hpp"
 #include "systick_counter.hpp"
 #include "vector_convert.hpp"
 
@@ -152,6 +158,39 @@ void bench_baseline(std::uint32_t ipc) {
     report("baseline", "thermal_quadratic", run_baseline(&baseline, &g_baseline_model[1], false), c0, ipc);
 }
 
+// Earth series: one evaluation per call, at epochs spread evenly over the span.
+constexpr std::uint32_t kSeriesRuns = 256;  // ~60k instructions each: the block stays below 2^24 counts
+double g_series_t[kSeriesRuns];
+volatile double g_sink_series;
+
+using SeriesFn = bool (*)(double, EarthBarycentric&) noexcept;
+
+__attribute__((noinline)) bool series_copy(double t, EarthBarycentric& out) noexcept {
+    out.v_earth_icrf_kms.x = t;
+    return true;
+}
+
+std::uint32_t run_series(volatile SeriesFn fn) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kSeriesRuns; ++i) {
+            EarthBarycentric out{};
+            g_sink_status = static_cast<std::uint16_t>(fn(g_series_t[i], out));
+            g_sink_series = out.v_earth_icrf_kms.x;
+        }
+    });
+}
+
+void bench_series(std::uint32_t ipc) {
+    const double step = (kEarthSeriesLastTt - kEarthSeriesFirstTt) / kSeriesRuns;
+    for (std::uint32_t i = 0; i < kSeriesRuns; ++i) {
+        g_series_t[i] = kEarthSeriesFirstTt + (static_cast<double>(i) + 0.5) * step;
+    }
+    const std::uint32_t c0 = run_series(&series_copy);
+    const std::uint32_t c = run_series(&app::earth_series_entry);
+    const std::uint32_t per = ((c - c0) * ipc + kSeriesRuns / 2U) / kSeriesRuns;
+    std::printf("bench double earth_series %u\n", static_cast<unsigned>(per));
+}
+
 Fixture<Q30> g_fixed;
 #if !defined(ASCORR_TARGET_FIXED)
 Fixture<float> g_float;
@@ -197,5 +236,6 @@ int main() {
 #endif
     bench_scalar<Q30>("fixed", g_fixed, ipc);
     bench_baseline(ipc);
+    bench_series(ipc);
     return 0;
 }

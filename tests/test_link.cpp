@@ -219,8 +219,9 @@ TEST(LinkServer, CorrectsLikeTheHostCoreBitForBit) {
             {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())}, 1.0F, i % 11 != 0};
         loop.request(MessageType::kVelocityUpdate, seq++, in.velocity);
         loop.request(MessageType::kTemperatureUpdate, seq++, TemperatureUpdate<float>{in.head, in.temperatures});
-        const Decoded r = loop.request(MessageType::kSolutionIn, seq++,
-                                       SolutionIn<float>{static_cast<std::uint32_t>(i), in.head, in.q_chu_icrf});
+        const Decoded r =
+            loop.request(MessageType::kSolutionIn, seq++,
+                         SolutionIn<float>{static_cast<std::uint32_t>(i), in.head, in.q_chu_icrf, {0}, 0});
         ASSERT_EQ(r.frames.size(), 1U);
         ASSERT_EQ(r.frames[0].type, static_cast<std::uint8_t>(MessageType::kSolutionOut));
         SolutionOut<float> out{};
@@ -236,7 +237,7 @@ TEST(LinkServer, CorrectsLikeTheHostCoreBitForBit) {
 TEST(LinkServer, DuplicatesAreAnsweredFromCacheAndNotReapplied) {
     Loop loop;
     loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
-    const SolutionIn<float> s{7, 0, {1.0F, 0.0F, 0.0F, 0.0F}};
+    const SolutionIn<float> s{7, 0, {1.0F, 0.0F, 0.0F, 0.0F}, {0}, 0};
     const Decoded first = loop.request(MessageType::kSolutionIn, 2, s);
     const Decoded again = loop.request(MessageType::kSolutionIn, 2, s);
     ASSERT_EQ(first.frames.size(), 1U);

@@ -4,8 +4,8 @@
 // Conventions: the thermal model is Table 2 of Herceg et al. 2017 (heads A–C,
 // linear; arcsec and arcsec/°C, as in tests/data/model_table2.csv), converted
 // to the core's formats in radians at compile time and kept in flash. The
-// observer velocity is RAM, refreshed by whoever owns the ephemeris (ground
-// upload or on-board propagation; here a fixed value), as β = v/c in ICRF.
+// observer velocity is not here: the velocity service (velocity_service.hpp,
+// fed by gnss_feed.hpp) computes it for each solution's time.
 // The raw attitudes stand in for the star tracker's solutions (simulated: the
 // worked examples' raw quaternions of heads A, B, C).
 #pragma once
@@ -50,10 +50,6 @@ constexpr ThermalModel<Scalar> kThermalModel{{
 constexpr Scalar s(double x) {
     return ScalarTraits<Scalar>::from_double(x);
 }
-
-// Earth's barycentric velocity plus a LEO spacecraft's, km/s → v/c.
-constexpr ObserverVelocity<Scalar> kInitialVelocity{
-    {s(-29.1 / kSpeedOfLightKmS), s(-5.4 / kSpeedOfLightKmS), s(-2.3 / kSpeedOfLightKmS)}, s(1.0 / 1.0167), true};
 
 // Simulated raw solutions, one per head (D has no model: thermal skipped, status 256).
 constexpr Quaternion<Scalar> kRawAttitude[kMaxHeads] = {

@@ -22,6 +22,14 @@ void add_correct_command(CLI::App& app) {
     cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double, float or fixed")
         ->transform(CLI::CheckedTransformer(scalars, CLI::ignore_case));
     cmd->add_flag("--skip-bad", opt->skip_bad, "skip malformed rows (each is reported) instead of stopping");
+    cmd->add_option("--states", opt->states,
+                    "spacecraft states (CSV t,x,y,z,vx,vy,vz): the velocity of rows without vx,vy,vz, computed by "
+                    "the on-board service in the --scalar chosen");
+    const std::map<std::string, bool> frames{{"itrf", false}, {"gcrs", true}};
+    cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs (uplinked)")
+        ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
+    cmd->add_option("--max-propagation", opt->max_propagation_s,
+                    "seconds a state may be propagated (default 21600); later rows get status 4+512");
     cmd->callback([opt]() {
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';

@@ -1,4 +1,5 @@
 #include <iostream>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -18,6 +19,12 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required();
     cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")->required();
+    cmd->add_option("--states", opt->states,
+                    "spacecraft states (CSV t,x,y,z,vx,vy,vz), sent to the target in time order with the solutions; "
+                    "the target computes the velocity of rows without vx,vy,vz");
+    const std::map<std::string, bool> frames{{"itrf", false}, {"gcrs", true}};
+    cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs")
+        ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
         ->check(CLI::Range(0.0, 0.5));
     cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));

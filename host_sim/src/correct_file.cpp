@@ -17,13 +17,15 @@
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/states_csv.hpp"
+#include "ascorr_host/states_velocity.hpp"
 
 namespace ascorr::host {
 
@@ -124,13 +126,39 @@ struct Job {
     const CorrectionConfig<T>& cfg;
     const SolutionsReader& header;
     const RowWriter& writer;
+    const StatesFile* states;  // nullptr: no --states
+    VelocityServiceConfig service;
 };
+
+// With --states, a row without its own velocity gets the service's
+// (correct_row); the status bits the service adds (4, 4|512, 4|32) are
+// explained here.
+template <typename Sink>
+void explain_service(StatusBits service, const SolutionRecord& rec, const std::string& file, Sink& diag) {
+    if (service == status::kNoVelocity) {
+        diag.report("no state yet",
+                    where(file, rec) + "no accepted state at or before t: aberration skipped (status 4)");
+    } else if ((service & status::kStale) != 0U) {
+        diag.report("state too old", where(file, rec) +
+                                         "the latest state is older than --max-propagation: aberration skipped "
+                                         "(status 4+512)");
+    } else if ((service & status::kVelocityInvalid) != 0U) {
+        diag.report("velocity from states invalid",
+                    where(file, rec) +
+                        "the propagated state left a plausible orbit, or t is outside the Earth series' span "
+                        "(2000-2050): aberration skipped (status 4+32)");
+    }
+}
 
 template <typename T>
 void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
     const CorrectOptions& opt = job.opt;
     SolutionsReader reader(job.header, body, lines_before);
     EarthVelocity earth;
+    std::optional<StatesVelocity<T>> states;
+    if (job.states != nullptr) {
+        states.emplace(*job.states, job.service);
+    }
     SolutionRecord rec;
     res.out.reserve(body.size() + body.size() / 8);
     for (;;) {
@@ -147,20 +175,17 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
-        const SolutionInput<T> in = to_core_input<T>(rec, opt.aberration ? &earth : nullptr);
-        const CorrectedSolution<T> c = correct_solution(in, job.cfg);
-        StatusBits st = c.status;
-        if (opt.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
-            st |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
+        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg, states ? &*states : nullptr);
+        const StatusBits st = row.status;
+        if (row.from_states) {
+            explain_service(row.service, rec, opt.in, res.diag);
         }
-        explain(rec, in, st, opt.in, res.diag);
+        explain(rec, row.in, row.from_states ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+                res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
-            const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-            job.writer.row(
-                reader, Quaternion<double>{d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)},
-                st, res.out);
+            job.writer.row(reader, row.q_chu_icrf, st, res.out);
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
@@ -210,9 +235,16 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     }
     const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
     const RowWriter writer(header);
-    const Job<T> job{opt, cfg, header, writer};
-
     Diagnostics diag(log);
+    std::optional<StatesFile> states;
+    if (!opt.states.empty()) {
+        if (!(opt.max_propagation_s > 0.0 && opt.max_propagation_s <= 7.0 * 86400.0)) {
+            throw std::runtime_error("--max-propagation must be above 0 and at most 604800 s (7 days)");
+        }
+        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    }
+    const Job<T> job{opt, cfg, header, writer, states ? &*states : nullptr, service_config(opt.max_propagation_s)};
+
     AtomicFile out(opt.out);
     out.write(writer.header_line());
     CorrectSummary sum;

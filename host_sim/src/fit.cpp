@@ -92,6 +92,13 @@ const char* drop_name(Drop d) noexcept {
 }
 
 FitReport fit_model(const FitOptions& opt) {
+    FitReport r = fit_model(
+        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "fit"); });
+    write_model_file(opt.out, r.model);
+    return r;
+}
+
+FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));
@@ -166,40 +173,37 @@ FitReport fit_model(const FitOptions& opt) {
         }
         any = true;
     });
-    for_each_solution(
-        opt.in,
-        [&](const SolutionRecord& rec) {
-            if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2) {
-                return;
+    rows([&](const SolutionRecord& rec) {
+        if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2) {
+            return;
+        }
+        ++r.rows;
+        Drop d = fit_selection(rec);
+        CorrectedSolution<double> c{};
+        if (d == Drop::kNone) {
+            c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
+            if ((c.status & status::kAberrationApplied) == 0U) {
+                d = Drop::kRejected;
             }
-            ++r.rows;
-            Drop d = fit_selection(rec);
-            CorrectedSolution<double> c{};
-            if (d == Drop::kNone) {
-                c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
-                if ((c.status & status::kAberrationApplied) == 0U) {
-                    d = Drop::kRejected;
-                }
+        }
+        ++r.dropped[static_cast<std::size_t>(d)];
+        if (d != Drop::kNone) {
+            return;
+        }
+        if (!period) {
+            const double v = std::sqrt(squared_norm(rec.v_sc_kms));
+            if (!(v > 1.0 && v < 12.0)) {
+                throw InputError(opt.in, rec.line, 1,
+                                 "spacecraft speed " + std::to_string(v) +
+                                     " km/s is not that of an Earth orbit: give --orbit-period");
             }
-            ++r.dropped[static_cast<std::size_t>(d)];
-            if (d != Drop::kNone) {
-                return;
-            }
-            if (!period) {
-                const double v = std::sqrt(squared_norm(rec.v_sc_kms));
-                if (!(v > 1.0 && v < 12.0)) {
-                    throw InputError(opt.in, rec.line, 1,
-                                     "spacecraft speed " + std::to_string(v) +
-                                         " km/s is not that of an Earth orbit: give --orbit-period");
-                }
-                period = 2.0 * kPi * kMuEarth / (v * v * v);
-            }
-            Row row;
-            row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
-            row.temp = rec.temperature;
-            epochs.add(rec.t, rec.head, rec.line, row);
-        },
-        "fit");
+            period = 2.0 * kPi * kMuEarth / (v * v * v);
+        }
+        Row row;
+        row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
+        row.temp = rec.temperature;
+        epochs.add(rec.t, rec.head, rec.line, row);
+    });
     epochs.finish();
     r.orbit_period_s = period.value_or(0.0);
 
@@ -279,7 +283,6 @@ FitReport fit_model(const FitOptions& opt) {
     r.condition = r.fit.condition;
     r.head = r.fit.head;
     r.model = r.fit.model;
-    write_model_file(opt.out, r.model);
     return r;
 }
 

@@ -20,6 +20,7 @@
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solution_input.hpp"
+#include "ascorr_host/states_csv.hpp"
 #include "ascorr_link/server.hpp"
 
 namespace ascorr::host {
@@ -82,6 +83,16 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     log << "ascorr replay: target " << opt.target << " (boot id " << hello.boot_id << ", scalar kind "
         << static_cast<int>(hello.scalar_kind) << ")\n";
     client.upload_model(model_t);
+    std::optional<StatesFile> states;
+    if (!opt.states.empty()) {
+        Diagnostics diag(log);
+        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+        diag.summarize();
+    }
+    // The target's velocity service, mirrored in its scalar and in double.
+    VelocityService<T> mirror(default_velocity_service_config());
+    VelocityService<double> mirror_d(default_velocity_service_config());
+    std::size_t next_state = 0;
 
     const RowWriter writer(reader);
     AtomicFile out(opt.out);
@@ -102,15 +113,42 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
             }
             std::this_thread::sleep_until(start + std::chrono::duration<double>(rec.t - t0));
         }
-        const SolutionInput<T> in = to_core_input<T>(rec, &earth);
-        client.set_velocity(in.velocity);
+        SolutionInput<T> in = to_core_input<T>(rec, &earth);
+        SolutionInput<double> in_d = to_core_input<double>(rec, &earth);
+        TtTime t{};
+        const bool from_states = states && rec.velocity_components == 0 && tt_from_seconds(rec.t, t);
+        StatusBits service_status = 0U;
+        StatusBits service_status_d = 0U;
+        if (from_states) {
+            const auto& a = states->accepted;
+            for (; next_state < a.size() && a[next_state].t <= t; ++next_state) {  // the bus's time order
+                const StateRecord& s = a[next_state];
+                const StateFrame frame = states->frame;
+                client.send_state(
+                    {s.t, static_cast<std::uint8_t>(frame == StateFrame::kGcrs ? 1U : 0U), s.r_km, s.v_kms}, true);
+                mirror.push_state(s.t, s.r_km, s.v_kms, frame);
+                mirror_d.push_state(s.t, s.r_km, s.v_kms, frame);
+            }
+            mirror.advance(t, OnBoardEarth{});
+            mirror_d.advance(t, OnBoardEarth{});
+            const ServiceVelocity<T> v = mirror.velocity_at(t);
+            const ServiceVelocity<double> vd = mirror_d.velocity_at(t);
+            in.velocity = v.velocity;
+            in_d.velocity = vd.velocity;
+            service_status = v.status;
+            service_status_d = vd.status;
+        } else {
+            client.set_velocity(in.velocity);
+        }
         client.set_temperatures(in.head, in.temperatures);
         ++sum.frames;
-        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf);
+        const link::SolutionOut<T> got =
+            client.correct(id, in.head, in.q_chu_icrf, t, from_states, from_states && in.velocity.valid);
         ++sum.returned;
-        const CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &model_t});
-        const CorrectedSolution<double> ref =
-            correct_solution(to_core_input<double>(rec, &earth), CorrectionConfig<double>{true, &model_d});
+        CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &model_t});
+        host.status = with_service_status(host.status, service_status, from_states);
+        CorrectedSolution<double> ref = correct_solution(in_d, CorrectionConfig<double>{true, &model_d});
+        ref.status = with_service_status(ref.status, service_status_d, from_states);
         const bool same =
             got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
         if (!same) {
@@ -161,7 +199,9 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         const bool m3 = opt.target == "qemu-m3";
         // QEMU answers within a few milliseconds; a lost frame is resent soon after
         // (a late answer only costs a resend, answered from the cache).
-        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 20;
+        // With states the target's double propagation and Earth series (software
+        // double on both boards) can delay an answer past 20 ms on a loaded machine.
+        o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : (opt.states.empty() ? 20 : 100);
         const std::string image =
             opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
         if (!std::ifstream(image).good()) {

@@ -34,10 +34,17 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));
     }
+    return compute_stats(
+        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
+        model ? &*model : nullptr, log);
+}
+
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log) {
     const CorrectionConfig<double> ab_only{true, nullptr};
-    const CorrectionConfig<double> both{true, model ? &*model : nullptr};
+    const CorrectionConfig<double> both{true, model};
     StatsResult r;
-    r.thermal = model.has_value();
+    r.thermal = model != nullptr;
     EarthVelocity earth;
     Diagnostics diag(log);
 
@@ -53,35 +60,32 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
             }
         }
     });
-    for_each_solution(
-        opt.in,
-        [&](const SolutionRecord& rec) {
-            if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
-                return;
-            }
-            ++r.rows;
-            if (rec.head > 2) {
-                return;  // not in any pair (head D, or unknown: left to `correct` to report)
-            }
-            Row row;
-            row.clean = is_clean(rec);
-            const SolutionInput<double> in = to_core_input<double>(rec, &earth);
-            const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
-            const CorrectedSolution<double> c2 = correct_solution(in, both);
-            const bool thermal_ok = !model || (c2.status & status::kThermalApplied) != 0U;
-            if (row.clean && ((c1.status & status::kAberrationApplied) == 0U || !thermal_ok)) {
-                diag.report("not corrected", opt.in + ":" + std::to_string(rec.line) +
-                                                 ": clean row the core did not correct (status " +
-                                                 std::to_string(c2.status) + "): left out of the statistics");
-                row.clean = false;
-            }
-            r.clean_rows += row.clean ? 1U : 0U;
-            row.z[0] = boresight(rec.q_chu_icrf);
-            row.z[1] = boresight(c1.q_chu_icrf);
-            row.z[2] = boresight(c2.q_chu_icrf);
-            epochs.add(rec.t, rec.head, rec.line, row);
-        },
-        "stats");
+    rows([&](const SolutionRecord& rec) {
+        if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
+            return;
+        }
+        ++r.rows;
+        if (rec.head > 2) {
+            return;  // not in any pair (head D, or unknown: left to `correct` to report)
+        }
+        Row row;
+        row.clean = is_clean(rec);
+        const SolutionInput<double> in = to_core_input<double>(rec, &earth);
+        const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
+        const CorrectedSolution<double> c2 = correct_solution(in, both);
+        const bool thermal_ok = !model || (c2.status & status::kThermalApplied) != 0U;
+        if (row.clean && ((c1.status & status::kAberrationApplied) == 0U || !thermal_ok)) {
+            diag.report("not corrected", opt.in + ":" + std::to_string(rec.line) +
+                                             ": clean row the core did not correct (status " +
+                                             std::to_string(c2.status) + "): left out of the statistics");
+            row.clean = false;
+        }
+        r.clean_rows += row.clean ? 1U : 0U;
+        row.z[0] = boresight(rec.q_chu_icrf);
+        row.z[1] = boresight(c1.q_chu_icrf);
+        row.z[2] = boresight(c2.q_chu_icrf);
+        epochs.add(rec.t, rec.head, rec.line, row);
+    });
     epochs.finish();
     diag.summarize();
 

@@ -13,12 +13,21 @@
 //   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
 //                      coefficient formats and thermal_angle)
 //   compiler.hpp       what the fixed-point core asks of the compiler, checked
+//   earth_series.hpp   the Earth's barycentric velocity and Sun distance, a
+//                      series fitted to ERFA eraEpv00 (double; coefficients in
+//                      the generated earth_series_table.hpp)
+// The on-board observer velocity (not included here; include velocity_service.hpp):
+//   tt_time.hpp        TT time tags in integer microseconds
+//   earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
+//   orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
+//   velocity_service.hpp   states in, ObserverVelocity<T> per solution out
 #pragma once
 
 #include "aberration.hpp"
 #include "compiler.hpp"
 #include "constants.hpp"
 #include "correct.hpp"
+#include "earth_series.hpp"
 #include "fixed_point.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"

@@ -17,6 +17,7 @@
 
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
+#include "ascorr/velocity_service.hpp"
 #include "frame.hpp"
 
 namespace ascorr::link {
@@ -77,6 +78,7 @@ enum class MessageType : std::uint8_t {
     kAck = 7,                // target → host: a request without data reply was applied (or why not)
     kHelloRequest = 8,       // host → target: answer with kHello
     kNak = 9,                // target → host: a frame arrived broken; resend
+    kStateUpdate = 10,       // host → target: a spacecraft state for the velocity service (v2)
 };
 
 enum class AckResult : std::uint8_t {
@@ -104,6 +106,18 @@ struct SolutionIn {
     std::uint32_t id;
     std::uint8_t head;
     Quaternion<T> q_chu_icrf;
+    TtTime t;                  // the solution's time tag (v2)
+    std::uint8_t from_states;  // 1: velocity from the target's service at t; 0: the last VELOCITY_UPDATE
+};
+
+// A spacecraft state (velocity_service.hpp): TT µs, ITRF (0) or GCRS (1),
+// position km, velocity km/s, as IEEE binary64 on the wire (the service's
+// double part computes with them; the answers stay bit-comparable).
+struct StateUpdate {
+    TtTime t;
+    std::uint8_t frame;  // 0 itrf, 1 gcrs
+    Vector3<double> r_km;
+    Vector3<double> v_kms;
 };
 
 template <typename T>
@@ -136,6 +150,15 @@ public:
     template <typename U>
     void word(const U& v) noexcept {
         u32(WireTraits<U>::encode(v));
+    }
+    void u64(std::uint64_t v) noexcept {
+        u32(static_cast<std::uint32_t>(v));
+        u32(static_cast<std::uint32_t>(v >> 32));
+    }
+    void f64(double x) noexcept {
+        std::uint64_t v = 0;
+        std::memcpy(&v, &x, sizeof v);
+        u64(v);
     }
     std::size_t size() const noexcept { return n_; }
 
@@ -177,6 +200,31 @@ public:
             return false;
         }
         v = WireTraits<U>::decode(w);
+        return true;
+    }
+    bool u64(std::uint64_t& v) noexcept {
+        std::uint32_t lo = 0;
+        std::uint32_t hi = 0;
+        if (!(u32(lo) && u32(hi))) {
+            return false;
+        }
+        v = (std::uint64_t{hi} << 32) | lo;
+        return true;
+    }
+    bool f64(double& x) noexcept {
+        std::uint64_t v = 0;
+        if (!u64(v)) {
+            return false;
+        }
+        std::memcpy(&x, &v, sizeof x);
+        return true;
+    }
+    bool i64(std::int64_t& x) noexcept {
+        std::uint64_t v = 0;
+        if (!u64(v)) {
+            return false;
+        }
+        std::memcpy(&x, &v, sizeof x);
         return true;
     }
     bool done() const noexcept { return i_ == n_; }
@@ -296,6 +344,8 @@ std::size_t encode(const SolutionIn<T>& m, std::uint8_t* out) noexcept {
     Writer w(out);
     w.u32(m.id);
     w.u8(m.head);
+    w.u64(static_cast<std::uint64_t>(m.t.us));
+    w.u8(m.from_states);
     w.word(m.q_chu_icrf.w);
     w.word(m.q_chu_icrf.x);
     w.word(m.q_chu_icrf.y);
@@ -307,8 +357,25 @@ std::size_t encode(const SolutionIn<T>& m, std::uint8_t* out) noexcept {
 template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
     Reader r(p, n);
-    return r.u32(m.id) && r.u8(m.head) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) &&
-           r.word(m.q_chu_icrf.z) && r.done();
+    return r.u32(m.id) && r.u8(m.head) && r.i64(m.t.us) && r.u8(m.from_states) && m.from_states <= 1U &&
+           r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) &&
+           r.done();
+}
+
+inline std::size_t encode(const StateUpdate& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u64(static_cast<std::uint64_t>(m.t.us));
+    w.u8(m.frame);
+    for (const double x : {m.r_km.x, m.r_km.y, m.r_km.z, m.v_kms.x, m.v_kms.y, m.v_kms.z}) {
+        w.f64(x);
+    }
+    return w.size();
+}
+// Non-finite or implausible values decode: the service refuses them (and counts).
+inline bool decode(const std::uint8_t* p, std::size_t n, StateUpdate& m) noexcept {
+    Reader r(p, n);
+    return r.i64(m.t.us) && r.u8(m.frame) && m.frame <= 1U && r.f64(m.r_km.x) && r.f64(m.r_km.y) && r.f64(m.r_km.z) &&
+           r.f64(m.v_kms.x) && r.f64(m.v_kms.y) && r.f64(m.v_kms.z) && r.done();
 }
 
 template <typename T>

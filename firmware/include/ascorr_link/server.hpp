@@ -8,7 +8,11 @@
 //   kModelUpload       → kAck (kBadPayload for a bad head or length)
 //   kVelocityUpdate    → kAck
 //   kTemperatureUpdate → kAck
-//   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>)
+//   kStateUpdate       → kAck (the state goes to the velocity service, which
+//                        may refuse it: velocity_service.hpp)
+//   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>, with
+//                        the last velocity update or, if from_states, the
+//                        service's velocity at the solution's time tag)
 //   broken frame       → kNak with the FrameError, so the host resends at once
 //   unknown type       → kAck kUnknownType
 // A request whose sequence number equals the last one served is a duplicate
@@ -21,6 +25,7 @@
 #include <cstdint>
 
 #include "ascorr/correct.hpp"
+#include "ascorr/velocity_service.hpp"
 #include "frame.hpp"
 #include "messages.hpp"
 
@@ -92,6 +97,11 @@ private:
                     velocity_.valid = false;
                 }
                 return;
+            case MessageType::kStateUpdate:
+                update<StateUpdate>(f, sink, [this](const StateUpdate& m) {
+                    service_.push_state(m.t, m.r_km, m.v_kms, m.frame == 1U ? StateFrame::kGcrs : StateFrame::kItrf);
+                });
+                return;
             case MessageType::kTemperatureUpdate:
                 update<TemperatureUpdate<T>>(
                     f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
@@ -107,9 +117,19 @@ private:
                 in.head = s.head;
                 in.temperatures = temperatures_[s.head < kMaxHeads ? s.head : 0];
                 in.velocity = velocity_;
+                StatusBits service_status = 0U;
+                if (s.from_states == 1U) {
+                    service_.advance(s.t, OnBoardEarth{});  // double, before the measured part
+                }
                 const std::uint32_t start = counter_();
-                const CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, &model_});
+                if (s.from_states == 1U) {
+                    const ServiceVelocity<T> v = service_.velocity_at(s.t);
+                    in.velocity = v.velocity;
+                    service_status = v.status;
+                }
+                CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, &model_});
                 const std::uint32_t cost = counter_() - start;
+                c.status = with_service_status(c.status, service_status, true);
                 ++solutions_;
                 const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost};
                 std::uint8_t p[kMaxPayload];
@@ -177,6 +197,8 @@ private:
     FrameDecoder decoder_;
     ThermalModel<T> model_{};
     ObserverVelocity<T> velocity_{};
+    // Catches up to any solution within the horizon in one call (≤ 2161 RK4 steps).
+    VelocityService<T> service_{default_velocity_service_config()};
     HeadTemperatures<T> temperatures_[kMaxHeads];
     std::uint8_t last_response_[kMaxWire] = {};
     std::size_t last_response_n_ = 0;

@@ -4,7 +4,8 @@
 // scalar type, and writes the corrected file (docs/contract.md): every input row in
 // input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
 // Output is all or nothing (AtomicFile). A malformed row stops the run with
-// file:line:column, unless skip_bad, which reports and drops it.
+// file:line:column, unless skip_bad, which reports and drops it. With
+// states, rows without their own velocity get the on-board service's.
 #pragma once
 
 #include <array>
@@ -24,6 +25,11 @@ struct CorrectOptions {
     bool thermal = true;
     Scalar scalar = Scalar::kDouble;
     bool skip_bad = false;
+    // --states: the velocity of rows without vx,vy,vz from spacecraft states,
+    // by the on-board service (states_velocity.hpp); empty: none.
+    std::string states;
+    bool states_gcrs = false;            // --states-frame gcrs (default itrf)
+    double max_propagation_s = 21600.0;  // --max-propagation (the service's default horizon)
 };
 
 struct CorrectSummary {

@@ -27,6 +27,11 @@ namespace ascorr::host {
 void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
                        const std::string& label);
 
+// Where rows come from: calls its argument for every row, in order. A file is
+// [&](auto& fn) { for_each_solution(path, fn, label); }; the Python module
+// passes arrays (python/src/module.cpp).
+using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
+
 template <typename Payload>
 struct Epoch {
     double t = 0.0;

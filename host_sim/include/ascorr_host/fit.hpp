@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/epochs.hpp"
 #include "ascorr_host/fit_terms.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
@@ -103,6 +104,8 @@ public:
 
 // Fits and writes opt.out (atomically). Throws FitRefused, InputError.
 FitReport fit_model(const FitOptions& opt);
+// The same on rows from elsewhere (opt.in names them in messages); writes nothing.
+FitReport fit_model(const FitOptions& opt, const RowSource& rows);
 
 std::string describe(const FitReport& r);
 

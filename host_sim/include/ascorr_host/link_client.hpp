@@ -1,4 +1,4 @@
-// ascorr_host/link_client.hpp: the host end of the link (protocol v1).
+// ascorr_host/link_client.hpp: the host end of the link (protocol v2).
 //
 // One request in flight. Each request keeps its sequence number across
 // retries, so the target can recognise a resend and answer from its cache.
@@ -7,8 +7,9 @@
 // solution is never accepted. An unprompted HELLO (sequence number 0, which
 // the client never uses for a request) means the target restarted, whatever
 // its boot id (an emulator boots identically every time): the client uploads
-// the model, velocity and temperatures it last sent, then resends the request
-// in flight. So is a solution corrected without the model or velocity the
+// the model, velocity, temperatures and the latest accepted spacecraft state
+// it last sent (the velocity service's answers depend on that state only),
+// then resends the request in flight. So is a solution corrected without the model or velocity the
 // client gave the target (a restart whose HELLO was lost on the link).
 #pragma once
 
@@ -99,9 +100,25 @@ public:
         send_temperatures(head);
     }
 
-    link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q) {
+    // A spacecraft state for the target's velocity service; `accepted`: the
+    // on-board checks (run by the caller) accept it, so a restore resends it.
+    void send_state(const link::StateUpdate& s, bool accepted) {
+        if (accepted) {
+            state_ = s;
+        }
+        send_state_frame(s);
+    }
+
+    // t and from_states: the solution's time tag and whether the target takes
+    // the velocity from its service (then velocity_expected: the caller's
+    // mirror of the service has one, so an answer without is a lost restart).
+    link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q, TtTime t = {0},
+                                 bool from_states = false, bool velocity_expected = false) {
         std::uint8_t p[link::kMaxPayload];
-        const std::size_t n = link::encode(link::SolutionIn<T>{id, head, q}, p);
+        const std::size_t n =
+            link::encode(link::SolutionIn<T>{id, head, q, t, static_cast<std::uint8_t>(from_states ? 1U : 0U)}, p);
+        from_states_ = from_states;
+        velocity_expected_ = velocity_expected;
         for (int attempt = 0; attempt < max_attempts_; ++attempt) {
             const auto a = transact(link::MessageType::kSolutionIn, {p, p + n}, link::MessageType::kSolutionOut);
             link::SolutionOut<T> out{};
@@ -137,8 +154,11 @@ private:
                               model_->head[out.head].present;
         const bool no_velocity =
             (out.status & (status::kNoVelocity | status::kVelocityInvalid)) == status::kNoVelocity && velocity_ &&
-            velocity_->valid;
-        return no_model || no_velocity;
+            velocity_->valid && !from_states_;
+        const bool no_state =
+            from_states_ && velocity_expected_ &&
+            (out.status & (status::kNoVelocity | status::kVelocityInvalid | status::kStale)) == status::kNoVelocity;
+        return no_model || no_velocity || no_state;
     }
 
     void send_model(std::uint8_t head) {
@@ -150,6 +170,11 @@ private:
         std::uint8_t p[link::kMaxPayload];
         const std::size_t n = link::encode(*velocity_, p);
         expect_ok(transact(link::MessageType::kVelocityUpdate, {p, p + n}, link::MessageType::kAck), "velocity update");
+    }
+    void send_state_frame(const link::StateUpdate& s) {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(s, p);
+        expect_ok(transact(link::MessageType::kStateUpdate, {p, p + n}, link::MessageType::kAck), "state update");
     }
     void send_temperatures(std::uint8_t head) {
         std::uint8_t p[link::kMaxPayload];
@@ -188,6 +213,9 @@ private:
             if (velocity_) {
                 send_velocity();
             }
+            if (state_) {
+                send_state_frame(*state_);
+            }
             for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
                 if (temperatures_[h]) {
                     send_temperatures(h);
@@ -208,7 +236,11 @@ private:
         std::uint8_t wire[link::kMaxWire];
         const std::size_t w =
             link::encode_frame(static_cast<std::uint8_t>(type), seq, payload.data(), payload.size(), wire, sizeof wire);
-        for (int attempt = 0; attempt < max_attempts_; ++attempt) {
+        // Given up after max_attempts and at least kMinPatienceMs: a target
+        // that is booting (QEMU takes 0.3–1 s on a loaded machine, before its
+        // first byte) must not exhaust 20 short time-outs.
+        const auto give_up_after = std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs);
+        for (int attempt = 0; attempt < max_attempts_ || std::chrono::steady_clock::now() < give_up_after; ++attempt) {
             if (attempt > 0) {
                 ++stats_.retries;
             }
@@ -283,6 +315,7 @@ private:
         }
     }
 
+    static constexpr int kMinPatienceMs = 3000;
     Transport& transport_;
     int timeout_ms_;
     int max_attempts_;
@@ -293,6 +326,9 @@ private:
     bool restart_again_ = false;
     std::optional<ThermalModel<T>> model_;
     std::optional<ObserverVelocity<T>> velocity_;
+    std::optional<link::StateUpdate> state_;  // the latest accepted spacecraft state
+    bool from_states_ = false;
+    bool velocity_expected_ = false;
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
     LinkStats stats_;
 };

@@ -4,7 +4,11 @@
 // then per row the velocity and the head's temperatures (when they change) and
 // the solution. Every returned solution is compared with the host core in the
 // same scalar type (bit for bit) and with the double reference (in arcsec),
-// and written in the corrected-file format.
+// and written in the corrected-file format. With states, the accepted states
+// (states_csv.hpp: the on-board checks) go to the target before the first
+// solution at or after their time, and rows without their own velocity ask the
+// target to compute it; the host mirrors the target's service in the same
+// scalar (and in double for the reference) with the same states in the same order.
 #pragma once
 
 #include <cstdint>
@@ -20,6 +24,8 @@ struct ReplayOptions {
     std::string in;
     std::string model;
     std::string out;
+    std::string states;          // --states: spacecraft states sent over the link in time order; empty: none
+    bool states_gcrs = false;    // --states-frame gcrs (default itrf)
     double inject_errors = 0.0;  // fraction of frames faulted, each direction
     bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
     int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/thermal.hpp"
+#include "ascorr_host/epochs.hpp"
 #include "ascorr_host/iba.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
@@ -49,6 +51,10 @@ bool is_clean(const SolutionRecord& rec) noexcept;
 
 // Throws InputError for a malformed input; log gets one line per rejected row.
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
+// The same on rows from elsewhere (opt.in names them in messages; opt.model is
+// not read: model, nullptr for no thermal stage).
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log);
 
 std::string stats_table(const StatsResult& r);
 std::string stats_json(const StatsResult& r);

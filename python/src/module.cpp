@@ -1,0 +1,876 @@
+// python/src/module.cpp: the compiled part of `import ascorr` (pybind11).
+//
+// Glue only: every number comes from the core headers (firmware/include/) and
+// the host library (host_sim/, ascorr_host), the same code as the command
+// line. correct() builds, per row, the SolutionRecord that the solutions
+// reader would have made of the same values and runs it through
+// host::correct_row(), the per-row path of `ascorr correct`, so both agree
+// bit for bit in every scalar.
+//
+// Arrays: float64 C-contiguous inputs are used in place; other real dtypes
+// (float32, integers) and non-contiguous arrays are converted once. A wrong
+// shape or dtype raises ValueError naming the argument. Per-row problems are
+// status bits (docs/contract.md) and never an exception: every row comes back. The
+// GIL is released while rows are corrected, on up to 8 threads.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ascorr/correct.hpp"
+#include "ascorr/fixed_point.hpp"
+#include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/correct_file.hpp"
+#include "ascorr_host/correct_row.hpp"
+#include "ascorr_host/csv.hpp"
+#include "ascorr_host/diagnostics.hpp"
+#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/epochs.hpp"
+#include "ascorr_host/fit.hpp"
+#include "ascorr_host/iba.hpp"
+#include "ascorr_host/input_error.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/states_csv.hpp"
+#include "ascorr_host/states_velocity.hpp"
+#include "ascorr_host/stats.hpp"
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+
+namespace ascorr::python {
+
+using host::SolutionRecord;
+
+namespace {
+
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Largest |t| accepted (s from J2000.0): the Earth-velocity grid indexes t/600 s
+// as a 64-bit integer; 1e15 s (3e7 years) is far inside that and far outside
+// any ephemeris.
+constexpr double kMaxAbsTime = 1e15;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The label of array rows in messages (InputError's "file:line:column").
+constexpr const char* kArrayRows = "<arrays, 1-based row>";
+
+[[noreturn]] void bad_argument(const std::string& name, const std::string& what) {
+    throw py::value_error("argument '" + name + "': " + what);
+}
+
+std::string shape_text(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+        s += (i ? ", " : "") + std::to_string(a.shape(i));
+    }
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+py::array as_numpy(const py::handle& obj) {
+    return py::module_::import("numpy").attr("asarray")(obj);
+}
+
+// A real-valued array of shape (n,) (cols == 0) or (n, cols) as float64,
+// C-contiguous: the same buffer when it already is, else one converted copy.
+// n < 0: any length (it is then taken from this argument).
+Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols) {
+    const py::array a = as_numpy(obj);
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+        bad_argument(name, "expected real numbers, got dtype " + std::string(py::str(a.dtype())));
+    }
+    const bool shape_ok = cols == 0 ? a.ndim() == 1 : a.ndim() == 2 && a.shape(1) == cols;
+    if (!shape_ok) {
+        bad_argument(name, "expected shape " + std::string(cols == 0 ? "(n,)" : "(n, " + std::to_string(cols) + ")") +
+                               ", got " + shape_text(a));
+    }
+    if (n >= 0 && a.shape(0) != n) {
+        bad_argument(name, "expected " + std::to_string(n) + " rows (as t), got " + std::to_string(a.shape(0)));
+    }
+    return Doubles::ensure(a);
+}
+
+// Optional (n, cols) argument: None means "all missing" (NaN).
+Doubles optional_real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols,
+                            double fill) {
+    if (obj.is_none()) {
+        Doubles a(cols == 0 ? std::vector<py::ssize_t>{n} : std::vector<py::ssize_t>{n, cols});
+        std::fill(a.mutable_data(), a.mutable_data() + a.size(), fill);
+        return a;
+    }
+    return real_array(obj, name, n, cols);
+}
+
+// chu: strings "A".."D" (anything else is an unknown head, status 16) or
+// integer head indices (0..3; anything else: status 16), as the reader maps them.
+std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
+    const py::array a = as_numpy(obj);
+    if (a.ndim() != 1) {
+        bad_argument("chu", "expected shape (n,), got " + shape_text(a));
+    }
+    if (a.shape(0) != n) {
+        bad_argument("chu", "expected " + std::to_string(n) + " rows (as t), got " + std::to_string(a.shape(0)));
+    }
+    std::vector<std::uint8_t> heads(static_cast<std::size_t>(n), host::kUnknownHead);
+    const char kind = a.dtype().kind();
+    if (kind == 'i' || kind == 'u') {
+        const auto idx = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        const std::int64_t* p = idx.data();
+        for (py::ssize_t i = 0; i < n; ++i) {
+            if (p[i] >= 0 && p[i] < static_cast<std::int64_t>(kMaxHeads)) {
+                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(p[i]);
+            }
+        }
+    } else if (kind == 'U' || kind == 'S') {
+        // Fixed-width strings, read in place: UCS-4 code points or bytes, NUL-padded.
+        const py::array c = py::array::ensure(a, py::array::c_style);
+        const auto width = static_cast<std::size_t>(c.itemsize());
+        const std::size_t unit = kind == 'U' ? 4 : 1;
+        const auto* base = static_cast<const unsigned char*>(c.data());
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const unsigned char* e = base + static_cast<std::size_t>(i) * width;
+            std::uint32_t first = 0;  // assembled byte by byte: the elements need not be aligned
+            std::uint32_t second = 0;
+            if (width >= unit) {
+                for (std::size_t b = 0; b < unit; ++b) {
+                    first |= static_cast<std::uint32_t>(e[b]) << (8 * (kind == 'U' ? b : 0));
+                }
+            }
+            if (width >= 2 * unit) {
+                for (std::size_t b = 0; b < unit; ++b) {
+                    second |= static_cast<std::uint32_t>(e[unit + b]) << (8 * (kind == 'U' ? b : 0));
+                }
+            }
+            if (second == 0 && first >= 'A' && first <= 'D') {
+                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(first - 'A');
+            }
+        }
+    } else if (kind == 'O') {
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const py::object x = a[py::int_(i)];
+            if (py::isinstance<py::str>(x)) {
+                heads[static_cast<std::size_t>(i)] = host::head_from_name(x.cast<std::string>());
+            } else if (py::isinstance<py::int_>(x)) {
+                const long long h = x.cast<long long>();
+                if (h >= 0 && h < static_cast<long long>(kMaxHeads)) {
+                    heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(h);
+                }
+            } else {
+                bad_argument("chu", "row " + std::to_string(i) + ": expected a string or an integer, got " +
+                                        std::string(py::str(x.get_type())));
+            }
+        }
+    } else {
+        bad_argument("chu", "expected strings 'A'..'D' or integers 0..3, got dtype " + std::string(py::str(a.dtype())));
+    }
+    return heads;
+}
+
+// The columns of a set of solutions, validated, as the core's caller needs them.
+struct Rows {
+    py::ssize_t n = 0;
+    Doubles t, q, temps, v, confidence;
+    std::vector<std::uint8_t> head;
+    std::vector<long long> flags;
+};
+
+Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, const py::handle& temps,
+             const py::handle& v, const py::handle& flags = py::none(), const py::handle& confidence = py::none()) {
+    Rows r;
+    r.t = real_array(t, "t", -1, 0);
+    r.n = r.t.shape(0);
+    const double* tp = r.t.data();
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        if (!(std::abs(tp[i]) <= kMaxAbsTime)) {
+            bad_argument("t", "row " + std::to_string(i) + ": time " + std::to_string(tp[i]) +
+                                  " is not finite or beyond 1e15 s from J2000.0 (the command line refuses such a "
+                                  "row as malformed)");
+        }
+    }
+    r.head = heads_of(chu, r.n);
+    r.q = real_array(q, "q", r.n, 4);
+    r.temps = optional_real_array(temps, "temps", r.n, 3, kNaN);
+    r.v = optional_real_array(v, "v", r.n, 3, kNaN);
+    r.confidence = optional_real_array(confidence, "confidence", r.n, 0, kNaN);
+    r.flags.assign(static_cast<std::size_t>(r.n), 0);
+    if (!flags.is_none()) {
+        const py::array a = as_numpy(flags);
+        const char kind = a.dtype().kind();
+        if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
+            bad_argument("flags", "expected " + std::to_string(r.n) + " non-negative integers, shape (n,), got dtype " +
+                                      std::string(py::str(a.dtype())) + " shape " + shape_text(a));
+        }
+        const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (py::ssize_t i = 0; i < r.n; ++i) {
+            if (f.data()[i] < 0) {
+                bad_argument("flags", "row " + std::to_string(i) + ": negative flags");
+            }
+            r.flags[static_cast<std::size_t>(i)] = f.data()[i];
+        }
+    }
+    return r;
+}
+
+// Row i as the solutions reader would have read it from a file holding the
+// same values: NaN is "not available", as `nan` in a file.
+void record_of(const Rows& r, py::ssize_t i, SolutionRecord& rec) {
+    static constexpr const char* kNames[5] = {"A", "B", "C", "D", "?"};
+    const auto k = static_cast<std::size_t>(i);
+    rec.line = k + 1;
+    rec.t = r.t.data()[i];
+    rec.head = r.head[k];
+    rec.chu = kNames[std::min<std::size_t>(rec.head, 4)];
+    const double* q = r.q.data() + 4 * i;
+    rec.q_chu_icrf = {q[0], q[1], q[2], q[3]};
+    const double* tc = r.temps.data() + 3 * i;
+    for (std::size_t j = 0; j < 3; ++j) {
+        rec.temperature[j] = tc[j];
+        rec.temperature_present[j] = !std::isnan(tc[j]);
+    }
+    const double* v = r.v.data() + 3 * i;
+    rec.v_sc_kms = {v[0], v[1], v[2]};
+    rec.velocity_components =
+        static_cast<int>(!std::isnan(v[0])) + static_cast<int>(!std::isnan(v[1])) + static_cast<int>(!std::isnan(v[2]));
+    rec.flags = r.flags[k];
+    const double c = r.confidence.data()[i];
+    rec.confidence_present = !std::isnan(c);
+    rec.confidence = rec.confidence_present ? c : 0.0;
+}
+
+host::RowSource source_of(const Rows& r) {
+    return [&r](const std::function<void(const SolutionRecord&)>& fn) {
+        SolutionRecord rec;
+        for (py::ssize_t i = 0; i < r.n; ++i) {
+            record_of(r, i, rec);
+            fn(rec);
+        }
+    };
+}
+
+std::size_t thread_count(py::ssize_t n) {
+    constexpr py::ssize_t kRowsPerThread = 16384;  // below this a thread costs more than it saves
+    const unsigned hw = std::thread::hardware_concurrency();
+    const auto by_size = static_cast<std::size_t>(std::max<py::ssize_t>(1, n / kRowsPerThread));
+    return std::clamp<std::size_t>(std::min<std::size_t>(hw == 0 ? 1 : hw, by_size), 1, 8);
+}
+
+// Runs body(begin, end) over [0, n) in contiguous pieces, one per thread.
+void parallel_rows(py::ssize_t n, const std::function<void(py::ssize_t, py::ssize_t)>& body) {
+    const std::size_t k = thread_count(n);
+    std::vector<std::thread> threads;
+    const auto piece = [&](std::size_t j) { return static_cast<py::ssize_t>(static_cast<std::size_t>(n) * j / k); };
+    for (std::size_t j = 1; j < k; ++j) {
+        threads.emplace_back([&, j] { body(piece(j), piece(j + 1)); });
+    }
+    body(0, piece(1));
+    for (auto& t : threads) {
+        t.join();
+    }
+}
+
+template <typename T>
+void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, const host::StatesFile* states,
+                  double max_propagation_s, double* q_out, std::uint16_t* st_out) {
+    std::optional<ThermalModel<T>> model;
+    if (m != nullptr) {
+        model = host::to_core<T>(*m);
+    }
+    const CorrectionConfig<T> cfg{aberration, model ? &*model : nullptr};
+    py::gil_scoped_release unlocked;
+    parallel_rows(r.n, [&](py::ssize_t begin, py::ssize_t end) {
+        host::EarthVelocity earth;
+        std::optional<host::StatesVelocity<T>> service;  // per thread, as per chunk in `ascorr correct`
+        if (states != nullptr) {
+            service.emplace(*states, host::service_config(max_propagation_s));
+        }
+        SolutionRecord rec;
+        for (py::ssize_t i = begin; i < end; ++i) {
+            record_of(r, i, rec);
+            const host::RowCorrection<T> c = host::correct_row(rec, &earth, cfg, service ? &*service : nullptr);
+            double* q = q_out + 4 * i;
+            q[0] = c.q_chu_icrf.w;
+            q[1] = c.q_chu_icrf.x;
+            q[2] = c.q_chu_icrf.y;
+            q[3] = c.q_chu_icrf.z;
+            st_out[i] = c.status;
+        }
+    });
+}
+
+const host::ModelFile* model_arg(const py::object& model) {
+    if (model.is_none()) {
+        return nullptr;
+    }
+    if (!py::isinstance<host::ModelFile>(model)) {
+        bad_argument("model", "expected an ascorr.Model (read_model() or fit()) or None, got " +
+                                  std::string(py::str(model.get_type())));
+    }
+    return &model.cast<const host::ModelFile&>();
+}
+
+// The states file of `ascorr correct --states`, read as it reads it; the
+// states the on-board service refuses are reported as a Python warning.
+std::optional<host::StatesFile> states_arg(const py::object& states, const std::string& frame,
+                                           double max_propagation_s) {
+    if (frame != "itrf" && frame != "gcrs") {
+        bad_argument("states_frame", "expected 'itrf' or 'gcrs', got '" + frame + "'");
+    }
+    if (!(max_propagation_s > 0.0 && max_propagation_s <= 7.0 * 86400.0)) {
+        bad_argument("max_propagation", "must be above 0 and at most 604800 s (7 days)");
+    }
+    if (states.is_none()) {
+        return std::nullopt;
+    }
+    if (!py::isinstance<py::str>(states) && !py::hasattr(states, "__fspath__")) {
+        bad_argument("states", "expected the path of a states file (t,x,y,z,vx,vy,vz) or None, got " +
+                                   std::string(py::str(states.get_type())));
+    }
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(states));
+    std::ostringstream log;
+    host::Diagnostics diag(log);
+    std::optional<host::StatesFile> f =
+        host::read_states_file(path, frame == "gcrs" ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    diag.summarize();
+    if (!log.str().empty()) {
+        if (PyErr_WarnEx(PyExc_UserWarning, log.str().c_str(), 1) != 0) {
+            throw py::error_already_set();
+        }
+    }
+    return f;
+}
+
+py::tuple correct(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+                  const py::object& v, const py::object& model, const std::string& scalar, bool aberration,
+                  const py::object& states, const std::string& states_frame, double max_propagation) {
+    const host::ModelFile* m = model_arg(model);
+    const std::optional<host::StatesFile> sf = states_arg(states, states_frame, max_propagation);
+    const host::StatesFile* s = sf ? &*sf : nullptr;
+    if (scalar != "double" && scalar != "float" && scalar != "fixed") {
+        bad_argument("scalar", "expected 'double', 'float' or 'fixed', got '" + scalar + "'");
+    }
+    if (scalar == "fixed" && m != nullptr) {
+        try {
+            host::check_fixed_point_range(*m, "model");  // refused, never saturated, as by the command line
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
+        }
+    }
+    const Rows r = rows_of(t, chu, q, temps, v);
+    py::array_t<double> q_out({r.n, py::ssize_t{4}});
+    py::array_t<std::uint16_t> st_out(r.n);
+    double* qo = q_out.mutable_data();
+    std::uint16_t* so = st_out.mutable_data();
+    if (scalar == "double") {
+        correct_rows<double>(r, m, aberration, s, max_propagation, qo, so);
+    } else if (scalar == "float") {
+        correct_rows<float>(r, m, aberration, s, max_propagation, qo, so);
+    } else {
+        correct_rows<Q30>(r, m, aberration, s, max_propagation, qo, so);
+    }
+    return py::make_tuple(q_out, st_out);
+}
+
+py::tuple earth_velocity(const py::object& t_obj, bool exact) {
+    const Doubles t = real_array(t_obj, "t", -1, 0);
+    const py::ssize_t n = t.shape(0);
+    for (py::ssize_t i = 0; i < n; ++i) {
+        if (!(std::abs(t.data()[i]) <= kMaxAbsTime)) {
+            bad_argument("t", "row " + std::to_string(i) + ": time is not finite or beyond 1e15 s from J2000.0");
+        }
+    }
+    py::array_t<double> v({n, py::ssize_t{3}});
+    py::array_t<double> d(n);
+    double* vp = v.mutable_data();
+    double* dp = d.mutable_data();
+    const double* tp = t.data();
+    {
+        py::gil_scoped_release unlocked;
+        parallel_rows(n, [&](py::ssize_t begin, py::ssize_t end) {
+            host::EarthVelocity grid;
+            for (py::ssize_t i = begin; i < end; ++i) {
+                const host::EarthState s = exact ? host::earth_state_exact(tp[i]) : grid.at(tp[i]);
+                vp[3 * i] = s.v_bary_kms.x;
+                vp[3 * i + 1] = s.v_bary_kms.y;
+                vp[3 * i + 2] = s.v_bary_kms.z;
+                dp[i] = s.sun_distance_au;
+            }
+        });
+    }
+    return py::make_tuple(v, d);
+}
+
+py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
+    const Rows r = rows_of(t, chu, q, py::none(), py::none());
+    std::array<std::vector<double>, host::kPairs> pt;
+    std::array<std::vector<double>, host::kPairs> pv;
+    host::EpochAssembler<Vector3<double>> epochs(kArrayRows, [&](const host::Epoch<Vector3<double>>& e) {
+        for (std::size_t p = 0; p < host::kPairs; ++p) {
+            const auto& a = e.head[host::kPairHeads[p][0]];
+            const auto& b = e.head[host::kPairHeads[p][1]];
+            if (a && b) {
+                pt[p].push_back(e.t);
+                pv[p].push_back(host::angle_arcsec(*a, *b));
+            }
+        }
+    });
+    SolutionRecord rec;
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        if (rec.head <= 2) {
+            epochs.add(rec.t, rec.head, rec.line, boresight(rec.q_chu_icrf));
+        }
+    }
+    epochs.finish();
+    py::dict out;
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        std::vector<std::size_t> idx(pt[p].size());
+        std::iota(idx.begin(), idx.end(), std::size_t{0});
+        std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return pt[p][i] < pt[p][j]; });
+        py::array_t<double> ta(static_cast<py::ssize_t>(idx.size()));
+        py::array_t<double> va(static_cast<py::ssize_t>(idx.size()));
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+            ta.mutable_data()[i] = pt[p][idx[i]];
+            va.mutable_data()[i] = pv[p][idx[i]];
+        }
+        out[host::kPairNames[p]] = py::make_tuple(ta, va);
+    }
+    return out;
+}
+
+std::optional<double> time_arg(const py::object& x, const char* name) {
+    if (x.is_none()) {
+        return std::nullopt;
+    }
+    const double d = x.cast<double>();
+    if (std::isnan(d)) {
+        bad_argument(name, "must not be NaN");
+    }
+    return d;
+}
+
+py::dict stats(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+               const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
+               const py::object& t_from, const py::object& t_to) {
+    const host::ModelFile* m = model_arg(model);
+    host::StatsOptions opt;
+    opt.in = kArrayRows;
+    opt.from = time_arg(t_from, "t_from");
+    opt.to = time_arg(t_to, "t_to");
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    std::optional<ThermalModel<double>> core_model;
+    if (m != nullptr) {
+        core_model = host::to_core<double>(*m);
+    }
+    std::ostringstream log;
+    const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log);
+    py::dict pairs;
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        py::dict d;
+        for (std::size_t st = 0; st < host::kStages; ++st) {
+            const bool have = s.n[p] > 0 && (st < 2 || s.thermal);
+            d[host::kStageNames[st]] = have ? py::object(py::float_(s.rms[p][st].rms)) : py::object(py::none());
+            d[(std::string(host::kStageNames[st]) + "_smoothed").c_str()] =
+                have ? py::object(py::float_(s.rms[p][st].rms_smoothed)) : py::object(py::none());
+        }
+        d["n"] = s.n[p];
+        pairs[host::kPairNames[p]] = d;
+    }
+    py::dict out;
+    out["pairs"] = pairs;
+    out["rows"] = s.rows;
+    out["clean_rows"] = s.clean_rows;
+    out["table"] = host::stats_table(s);
+    out["messages"] = log.str();
+    return out;
+}
+
+py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+              const py::object& v, const py::object& flags, const py::object& confidence, const py::object& t_from,
+              const py::object& t_to, double min_days, std::size_t min_orbits, double max_condition,
+              const py::object& orbit_period) {
+    host::FitOptions opt;
+    opt.in = kArrayRows;
+    opt.from = time_arg(t_from, "t_from");
+    opt.to = time_arg(t_to, "t_to");
+    opt.min_span_days = min_days;
+    opt.min_orbits = min_orbits;
+    opt.max_condition = max_condition;
+    opt.orbit_period_s = time_arg(orbit_period, "orbit_period");
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    const host::FitReport rep = host::fit_model(opt, source_of(r));
+    py::dict d;
+    d["t_first"] = rep.t_first;
+    d["t_last"] = rep.t_last;
+    d["orbit_period_s"] = rep.orbit_period_s;
+    d["rows"] = rep.rows;
+    py::dict dropped;
+    for (std::size_t k = 0; k < host::kDropKinds; ++k) {
+        dropped[host::drop_name(static_cast<host::Drop>(k))] = rep.dropped[k];
+    }
+    d["dropped"] = dropped;
+    d["epochs"] = rep.epochs;
+    d["orbits_used"] = rep.orbits_used;
+    d["orbits_left_out"] = rep.orbits_left_out;
+    d["singular_values"] = rep.singular_values;
+    d["condition"] = rep.condition;
+    py::array_t<double> res({py::ssize_t{3}, py::ssize_t{3}});
+    py::array_t<double> sig({py::ssize_t{3}, py::ssize_t{3}});
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t a = 0; a < 3; ++a) {
+            res.mutable_data()[3 * h + a] = rep.head[h].residual_rms[a];
+            sig.mutable_data()[3 * h + a] = rep.head[h].signal_rms[a];
+        }
+    }
+    d["residual_rms"] = res;
+    d["signal_rms"] = sig;
+    d["text"] = host::describe(rep);
+    return py::make_tuple(py::cast(rep.model), d);
+}
+
+// ---- files <-> arrays
+
+py::dict read_solutions(const std::string& path) {
+    std::vector<double> t, q, temps, v, conf;
+    std::vector<std::string> chu;
+    std::vector<long long> flags, st;
+    std::size_t chu_width = 1;
+    bool has_status = false;
+    {
+        host::BlockReader blocks(path);
+        std::string_view block;
+        if (!blocks.next(block)) {
+            throw host::InputError(path, 1, 1, "empty file: expected a header line");
+        }
+        const std::size_t nl = block.find('\n');
+        const host::SolutionsReader header(path, block.substr(0, nl));
+        const int status_col = header.header().index("status");
+        has_status = status_col >= 0;
+        block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+        std::size_t lines_before = 1;
+        SolutionRecord rec;
+        for (;;) {
+            host::SolutionsReader reader(header, block, lines_before);
+            while (reader.next(rec)) {
+                t.push_back(rec.t);
+                chu.emplace_back(rec.chu);
+                chu_width = std::max(chu_width, rec.chu.size());
+                q.insert(q.end(), {rec.q_chu_icrf.w, rec.q_chu_icrf.x, rec.q_chu_icrf.y, rec.q_chu_icrf.z});
+                for (std::size_t j = 0; j < 3; ++j) {
+                    temps.push_back(rec.temperature_present[j] ? rec.temperature[j] : kNaN);
+                }
+                const int cols[3] = {header.columns().vx, header.columns().vy, header.columns().vz};
+                const double vs[3] = {rec.v_sc_kms.x, rec.v_sc_kms.y, rec.v_sc_kms.z};
+                for (std::size_t j = 0; j < 3; ++j) {  // present: a field that is there and not empty or nan
+                    const bool there = cols[j] >= 0 && !reader.fields()[static_cast<std::size_t>(cols[j])].empty();
+                    v.push_back(there ? vs[j] : kNaN);
+                }
+                flags.push_back(rec.flags);
+                conf.push_back(rec.confidence_present ? rec.confidence : kNaN);
+                if (has_status) {
+                    const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
+                    const auto s = host::parse_integer(f);
+                    if (!s || *s < 0 || *s > 0xFFFF) {
+                        throw host::InputError(
+                            path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
+                            "column 'status': expected an integer 0..65535, got '" + std::string(f) + "'");
+                    }
+                    st.push_back(*s);
+                }
+            }
+            if (!blocks.next(block)) {
+                break;
+            }
+            lines_before = blocks.lines_before();
+        }
+    }
+    const auto n = static_cast<py::ssize_t>(t.size());
+    const auto arr = [](const std::vector<double>& x, py::ssize_t rows, py::ssize_t cols) {
+        py::array_t<double> a(cols == 0 ? std::vector<py::ssize_t>{rows} : std::vector<py::ssize_t>{rows, cols});
+        std::copy(x.begin(), x.end(), a.mutable_data());
+        return a;
+    };
+    py::dict d;
+    d["t"] = arr(t, n, 0);
+    d["chu"] = py::module_::import("numpy").attr("array")(py::cast(chu), "dtype"_a = "U" + std::to_string(chu_width));
+    d["q"] = arr(q, n, 4);
+    d["temps"] = arr(temps, n, 3);
+    d["v"] = arr(v, n, 3);
+    py::array_t<std::int64_t> fa(n);
+    std::copy(flags.begin(), flags.end(), fa.mutable_data());
+    d["flags"] = fa;
+    d["confidence"] = arr(conf, n, 0);
+    if (has_status) {
+        py::array_t<std::uint16_t> sa(n);
+        std::transform(st.begin(), st.end(), sa.mutable_data(),
+                       [](long long x) { return static_cast<std::uint16_t>(x); });
+        d["status"] = sa;
+    }
+    return d;
+}
+
+void append_number(std::string& out, double x) {
+    if (std::isnan(x)) {
+        out += "nan";
+        return;
+    }
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);  // shortest text that reads back exactly
+    out.append(buf, static_cast<std::size_t>(r.ptr - buf));
+}
+
+void write_solutions(const std::string& path, const py::object& t, const py::object& chu, const py::object& q,
+                     const py::object& temps, const py::object& v, const py::object& flags,
+                     const py::object& confidence, const py::object& status) {
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    std::optional<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>> st;
+    if (!status.is_none()) {
+        const py::array a = as_numpy(status);
+        const char kind = a.dtype().kind();
+        if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
+            bad_argument("status", "expected " + std::to_string(r.n) + " integers, shape (n,), got dtype " +
+                                       std::string(py::str(a.dtype())) + " shape " + shape_text(a));
+        }
+        st = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    }
+    // chu as written: the head letter, or the text given for an unknown head.
+    const py::array chu_a = as_numpy(chu);
+    std::string out = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence";
+    out += st ? ",status\n" : "\n";
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        const auto k = static_cast<std::size_t>(i);
+        append_number(out, r.t.data()[i]);
+        out += ',';
+        if (r.head[k] < kMaxHeads) {
+            out += host::head_name(r.head[k]);
+        } else {
+            std::string name = py::str(chu_a[py::int_(i)]);
+            if (name.find_first_of(",\n\r\"") != std::string::npos) {
+                bad_argument("chu", "row " + std::to_string(i) + ": '" + name + "' cannot be written to a CSV field");
+            }
+            out += name;
+        }
+        for (int j = 0; j < 4; ++j) {
+            out += ',';
+            append_number(out, r.q.data()[4 * i + j]);
+        }
+        for (int j = 0; j < 3; ++j) {
+            out += ',';
+            append_number(out, r.temps.data()[3 * i + j]);
+        }
+        for (int j = 0; j < 3; ++j) {
+            out += ',';
+            const double x = r.v.data()[3 * i + j];
+            if (!std::isnan(x)) {  // docs/contract.md: empty when not available
+                append_number(out, x);
+            }
+        }
+        out += ',' + std::to_string(r.flags[k]) + ',';
+        if (!std::isnan(r.confidence.data()[i])) {
+            append_number(out, r.confidence.data()[i]);
+        }
+        if (st) {
+            out += ',' + std::to_string(st->data()[i]);
+        }
+        out += '\n';
+    }
+    host::write_file_atomically(path, out);
+}
+
+// ---- Model
+
+py::array_t<double> model_coefficients(const host::ModelFile& m) {
+    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{3}, py::ssize_t{7}});
+    double* p = a.mutable_data();
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t c = 0; c < 7; ++c) {
+                *p++ = m.coefficients[h][ax][c];
+            }
+        }
+    }
+    return a;
+}
+
+host::ModelFile model_from(const py::object& coefficients, const py::object& heads) {
+    const py::array a = as_numpy(coefficients);
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+        bad_argument("coefficients", "expected real numbers, got dtype " + std::string(py::str(a.dtype())));
+    }
+    if (a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} || a.shape(1) != 3 ||
+        (a.shape(2) != 4 && a.shape(2) != 7)) {
+        bad_argument("coefficients",
+                     "expected shape (4, 3, 4) or (4, 3, 7) (head A..D, axis alpha/beta/gamma, c0 c1 c2 c3 "
+                     "[c1_2 c2_2 c3_2]), got " +
+                         shape_text(a));
+    }
+    const Doubles c = Doubles::ensure(a);
+    const auto k = static_cast<std::size_t>(a.shape(2));
+    host::ModelFile m;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t j = 0; j < k; ++j) {
+                const double x = c.data()[(h * 3 + ax) * k + j];
+                if (!std::isfinite(x)) {
+                    bad_argument("coefficients", std::string("head ") + "ABCD"[h] + " " + host::kAxisNames[ax] + " " +
+                                                     host::kCoefficientNames[j] + " is not finite");
+                }
+                m.coefficients[h][ax][j] = x;
+                m.quadratic = m.quadratic || (j >= 4 && x != 0.0);
+            }
+        }
+    }
+    const std::string names = heads.is_none() ? std::string("ABCD") : heads.cast<std::string>();
+    for (const char ch : names) {
+        const std::uint8_t h = host::head_from_name(std::string_view(&ch, 1));
+        if (h == host::kUnknownHead) {
+            bad_argument("heads", std::string("'") + ch + "' is not a camera head (A, B, C or D)");
+        }
+        m.present[h] = true;
+    }
+    return m;
+}
+
+std::string model_heads(const host::ModelFile& m) {
+    std::string s;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        if (m.present[h]) {
+            s += host::head_name(static_cast<std::uint8_t>(h));
+        }
+    }
+    return s;
+}
+
+}  // namespace
+
+}  // namespace ascorr::python
+
+PYBIND11_MODULE(_ascorr, mod) {
+    using namespace ascorr;
+    using namespace ascorr::python;
+    mod.doc() = "Compiled part of the ascorr package (see help(ascorr)).";
+
+    // Malformed input and refused fits are ValueErrors; other failures of the
+    // host library (a file that cannot be written, a model beyond the fixed-point
+    // formats) are std::runtime_error, hence RuntimeError.
+    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") =
+        "A malformed input file or rows (a ValueError); the message starts with file:line:column.";
+    py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") =
+        "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
+
+    py::class_<host::ModelFile>(mod, "Model", R"doc(A thermal model: per head and axis, angles in arcsec linear (and
+optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
+
+Model(coefficients, heads="ABCD"): coefficients of shape (4, 3, 4) or (4, 3, 7),
+indexed [head A..D][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
+in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
+coefficients (a head not listed gets status 256 in correct()).)doc")
+        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none())
+        .def_property_readonly("coefficients", &model_coefficients,
+                               "Coefficients, float64 (4, 3, 7): [head A..D][alpha, beta, gamma][c0, c1, c2, c3, "
+                               "c1_2, c2_2, c3_2], arcsec (a copy).")
+        .def_property_readonly("heads", &model_heads, "The heads with coefficients, e.g. 'ABC'.")
+        .def_property_readonly(
+            "quadratic", [](const host::ModelFile& m) { return m.quadratic; },
+            "True when the model has (and its file will carry) the quadratic columns.")
+        .def(
+            "write", [](const host::ModelFile& m, const std::string& path) { host::write_model_file(path, m); },
+            "path"_a, "Write the model file (docs/contract.md), atomically: the whole file or nothing.")
+        .def("to_csv", &host::format_model, "The model file's text.")
+        .def("__repr__", [](const host::ModelFile& m) {
+            return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") + ">";
+        });
+
+    mod.def("read_model", &host::read_model_file, "path"_a,
+            R"doc(Read a model file (docs/contract.md, "Model file"). A malformed file raises ascorr.InputError
+(a ValueError) with file:line:column, as the command line reports it.)doc");
+
+    mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
+            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf",
+            "max_propagation"_a = host::CorrectOptions{}.max_propagation_s,
+            R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
+`ascorr correct` on the same rows, bit for bit, in every scalar.
+
+t: float64 (n,), s since J2000.0 TT. chu: (n,) strings 'A'..'D' or head indices
+0..3. q: (n, 4) q_chu_icrf (w, x, y, z). temps: (n, 3) t_chu, t_029, t_032 in
+degC, NaN where missing. v: (n, 3) spacecraft velocity, km/s GCRS, NaN where
+missing. temps and v may be None (all missing). model: an ascorr.Model, or None
+for no thermal stage. scalar: 'double', 'float' or 'fixed' (the core's Q30).
+aberration: False skips the aberration stage. states: the path of a states file
+(t,x,y,z,vx,vy,vz; `ascorr correct --states`): a row without its own velocity
+(all three NaN) gets the on-board velocity service's, propagated from the
+latest state at or before it (status 4 before the first state, 4+512 beyond
+max_propagation seconds, 4+32 off a plausible orbit); states_frame 'itrf' (GNSS)
+or 'gcrs' (uplinked). States the service refuses are reported as a warning.
+
+Returns (q_corrected float64 (n, 4), status uint16 (n,)). Every row comes back;
+a row that cannot be corrected keeps its quaternion exactly and says why in its
+status bits (1 aberration, 2 thermal, 4 no velocity, 8 temperatures missing,
+16 rejected, 32 velocity unusable, 64 temperature unusable, 128 model angle
+beyond 1 deg, 256 no model for the head). Raises ValueError naming the
+argument for a wrong shape or dtype, or a time that is not finite.)doc");
+
+    mod.def("earth_velocity", &earth_velocity, "t"_a, "exact"_a = false,
+            R"doc(The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t
+(s since J2000.0 TT), from ERFA's eraEpv00: as the correction uses it (a 600 s grid,
+linearly interpolated, error below 1e-7 km/s), or with exact=True a direct call for
+each t. Returns (v float64 (n, 3), sun_distance_au float64 (n,)).)doc");
+
+    mod.def("iba", &iba, "t"_a, "chu"_a, "q"_a,
+            R"doc(Inter-boresight angles: for each pair 'A-B', 'A-C', 'B-C', the angle in arcsec between the
+two heads' boresights at every epoch (t to the millisecond) where both have a row.
+Returns {pair: (t float64 (m,), iba float64 (m,))}, sorted by t. A second row of
+one head at one epoch raises ascorr.InputError.)doc");
+
+    mod.def("stats", &stats, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
+            "confidence"_a = py::none(), "model"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
+            R"doc(IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
+IBA RMS about the mean over the clean epochs (flags 0, confidence <= 5 or missing,
+temperatures and velocity present and accepted), and after 200 s smoothing.
+flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN or None when
+missing; t_from, t_to: the period (inclusive).
+Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
+(arcsec or None), "n"}}, "rows", "clean_rows", "table" (the command's text),
+"messages" (rows left out, one line each)}.)doc");
+
+    mod.def("fit", &fit, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(), "confidence"_a = py::none(),
+            "t_from"_a = py::none(), "t_to"_a = py::none(), "min_days"_a = host::kDefaultMinSpanDays,
+            "min_orbits"_a = host::kDefaultMinOrbits, "max_condition"_a = host::kDefaultMaxCondition,
+            "orbit_period"_a = py::none(),
+            R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see the README). Returns
+(model, report): model an ascorr.Model (model.write(path) writes the model file),
+report a dict (rows, dropped, epochs, orbits_used, condition, singular_values,
+residual_rms and signal_rms (3, 3) arcsec [head A..C][alpha, beta, gamma], text).
+Raises ascorr.FitRefused (a ValueError) when the data cannot determine the model
+(period shorter than min_days, fewer than min_orbits orbits, condition number
+above max_condition).)doc");
+
+    mod.def("read_solutions", &read_solutions, "path"_a,
+            R"doc(Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),
+"q" (n, 4), "temps" (n, 3), "v" (n, 3) (NaN where not available), "flags" (0 when
+absent), "confidence" (NaN when absent)} plus "status" for a corrected file. The
+keys are correct()'s argument names. Malformed rows raise ascorr.InputError with
+file:line:column, as the command line.)doc");
+
+    mod.def("write_solutions", &write_solutions, "path"_a, "t"_a, "chu"_a, "q"_a, "temps"_a = py::none(),
+            "v"_a = py::none(), "flags"_a = py::none(), "confidence"_a = py::none(), "status"_a = py::none(),
+            R"doc(Write a solutions file (or, with status, a corrected file) from arrays, atomically.
+Numbers are written with the fewest digits that read back exactly; NaN
+temperatures as 'nan', NaN velocities and confidences as empty fields.)doc");
+}

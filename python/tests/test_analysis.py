@@ -1,0 +1,107 @@
+"""iba, stats, fit and earth_velocity on arrays: against the command line on the
+same file (stats, fit), a NumPy evaluation of the angles (iba) and pyerfa
+(earth_velocity)."""
+
+import json
+
+import numpy as np
+import pytest
+
+import ascorr
+from conftest import DATA, run_cli
+
+T0 = 456148800.0  # the simulation's first epoch
+
+
+@pytest.fixture(scope="module")
+def mission(exe, tmp_path_factory):
+    """40 simulated days, one solution per head every 120 s (a second or so)."""
+    d = tmp_path_factory.mktemp("mission")
+    path = d / "mission.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 40, "--step", 120)
+    return path
+
+
+def as_args(d):
+    return d["t"], d["chu"], d["q"], d["temps"], d["v"]
+
+
+def test_fit_on_arrays_is_ascorr_fit(exe, mission, tmp_path):
+    out = tmp_path / "model.csv"
+    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30)
+    d = ascorr.read_solutions(str(mission))
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    assert model.to_csv() == out.read_text()
+    assert report["orbits_used"] > 100 and report["condition"] > 1.0
+    assert report["residual_rms"].shape == (3, 3)
+    written = tmp_path / "written.csv"
+    model.write(str(written))
+    assert written.read_text() == out.read_text()
+    assert ascorr.read_model(str(written)).to_csv() == model.to_csv()
+
+
+def test_fit_refuses_too_short_a_period(mission):
+    d = ascorr.read_solutions(str(mission))
+    with pytest.raises(ascorr.FitRefused, match="modelling period too short"):
+        ascorr.fit(*as_args(d), d["flags"], d["confidence"])  # 40 days < 267
+    with pytest.raises(ascorr.FitRefused, match="empty"):
+        ascorr.fit(*as_args(d), t_from=T0 + 10, t_to=T0)
+
+
+@pytest.mark.parametrize("period", [(None, None), (T0 + 5 * 86400, T0 + 20 * 86400)])
+def test_stats_on_arrays_is_ascorr_stats(exe, mission, period):
+    model_path = DATA / "model_table2.csv"
+    options = ["--model", model_path, "--json"]
+    if period[0] is not None:
+        options += ["--from", repr(period[0]), "--to", repr(period[1])]
+    cli = json.loads(run_cli(exe, "stats", "--in", mission, *options).stdout)
+    d = ascorr.read_solutions(str(mission))
+    s = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=ascorr.read_model(str(model_path)),
+                     t_from=period[0], t_to=period[1])
+    for pair, want in cli["pairs"].items():
+        got = s["pairs"][pair]
+        assert got["n"] == want["n"] > 1000
+        for stage in ("original", "aberration", "thermal"):
+            assert f"{got[stage]:.6f}" == f"{want[stage]:.6f}", (pair, stage)
+    assert s["clean_rows"] > 0 and "A-B" in s["table"]
+
+
+def test_iba_against_numpy(mission):
+    d = ascorr.read_solutions(str(mission))
+    got = ascorr.iba(d["t"], d["chu"], d["q"])
+    w, x, y, z = d["q"].T
+    z_icrf = np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z], axis=1)
+    key = np.round(d["t"] * 1000).astype(np.int64)
+    for pair, (a, b) in {"A-B": ("A", "B"), "A-C": ("A", "C"), "B-C": ("B", "C")}.items():
+        ia = {k: i for i, k in enumerate(key) if d["chu"][i] == a}
+        ib = {k: i for i, k in enumerate(key) if d["chu"][i] == b}
+        common = sorted(set(ia) & set(ib))
+        za = z_icrf[[ia[k] for k in common]]
+        zb = z_icrf[[ib[k] for k in common]]
+        ref = np.degrees(np.arctan2(np.linalg.norm(np.cross(za, zb), axis=1), np.sum(za * zb, axis=1))) * 3600
+        t, angle = got[pair]
+        assert len(t) == len(common) > 1000
+        assert np.array_equal(t, d["t"][[ia[k] for k in common]])
+        assert np.max(np.abs(angle - ref)) < 1e-6  # arcsec
+
+
+def test_iba_duplicate_epoch_is_an_input_error(mission):
+    d = ascorr.read_solutions(str(mission))
+    chu = d["chu"].copy()
+    chu[1] = chu[0]  # two rows of one head at the first epoch
+    with pytest.raises(ascorr.InputError, match="second solution of CHU A"):
+        ascorr.iba(d["t"], chu, d["q"])
+
+
+def test_earth_velocity_against_pyerfa():
+    erfa = pytest.importorskip("erfa")  # python3-erfa (toolchain/debian-packages.txt)
+    t = np.linspace(0.0, 25 * 365.25 * 86400, 2001) + 123.456
+    au_per_day = 149597870.7 / 86400.0
+    pvh, pvb = erfa.epv00(2451545.0, t / 86400.0)
+    v_ref = pvb["v"] * au_per_day
+    d_ref = np.linalg.norm(pvh["p"], axis=1)
+    v, dist = ascorr.earth_velocity(t, exact=True)
+    assert np.max(np.abs(v - v_ref)) < 1e-9 and np.max(np.abs(dist - d_ref)) < 1e-12
+    v, dist = ascorr.earth_velocity(t)  # the 600 s grid the correction uses
+    assert np.max(np.abs(v - v_ref)) < 1e-7  # km/s: below 4e-8 arcsec of aberration
+    assert np.max(np.abs(dist - d_ref)) < 1e-9

@@ -1,0 +1,171 @@
+// `ascorr replay --states`: states and solutions go to the target in time
+// order, the target computes the velocity (link protocol v2), and every answer
+// is compared bit for bit with the host's mirror of the target's service in the
+// target's scalar. In process (loopback, float) the replayed file must equal
+// `ascorr correct --states --scalar float` byte for byte; under QEMU (label
+// target) both boards, clean and with 1 % faulted frames, and a restart.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "ascorr/fixed_point.hpp"
+#include "ascorr/velocity_service.hpp"
+#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/link_client.hpp"
+#include "ascorr_host/link_transport.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/replay.hpp"
+#include "ascorr_host/solution_input.hpp"
+#include "ascorr_host/states_csv.hpp"
+#include "states_recording.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+std::string slurp(const std::string& p) {
+    std::ifstream f(p);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+host::ReplaySummary replay_states(const std::string& target, double inject, int rows, const std::string& name,
+                                  StatesRecording* rec_out = nullptr) {
+    const auto dir = scratch_dir(name);
+    const StatesRecording rec = make_states_recording(dir, rows);
+    host::ReplayOptions o;
+    o.target = target;
+    o.in = rec.solutions;
+    o.states = rec.states;
+    o.model = data_path("model_table2.csv");
+    o.out = (dir / "out.csv").string();
+    o.inject_errors = inject;
+    o.seed = 3;
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    std::cout << target << " --states, inject " << inject << ": " << host::to_json(s) << "\n";
+    if (rec_out != nullptr) {
+        *rec_out = rec;
+    }
+    return s;
+}
+
+TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
+    StatesRecording rec;
+    const host::ReplaySummary s = replay_states("loopback-float", 0.0, 900, "replay_states_loop", &rec);
+    EXPECT_EQ(s.returned, 900U);
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, 0.05);
+    const std::filesystem::path dir = std::filesystem::path(rec.solutions).parent_path();
+    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + rec.solutions + " --out " +
+                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
+                            " --states " + rec.states + " 2>/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string replayed = slurp((dir / "out.csv").string());
+    EXPECT_EQ(replayed, slurp((dir / "correct.csv").string()));
+    // Before the first state: status 4 (+ thermal); in and after the 40 s gap: applied.
+    EXPECT_NE(replayed.find(",6\n"), std::string::npos);  // 4 | 2
+    EXPECT_NE(replayed.find(",3\n"), std::string::npos);  // 1 | 2
+}
+
+#ifdef ASCORR_REPLAY_QEMU
+constexpr int kRows = 1000;
+
+void expect_complete(const host::ReplaySummary& s, double bound) {
+    EXPECT_EQ(s.frames, static_cast<std::size_t>(kRows));
+    EXPECT_EQ(s.returned, static_cast<std::size_t>(kRows));
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, bound);
+    EXPECT_EQ(s.restarts, 0U);
+}
+
+TEST(ReplayStatesQemu, M4fClean) {
+    expect_complete(replay_states("qemu-m4f", 0.0, kRows, "rs_m4f"), 0.05);
+}
+TEST(ReplayStatesQemu, M4fOnePercentFaults) {
+    const host::ReplaySummary s = replay_states("qemu-m4f", 0.01, kRows, "rs_m4f_f");
+    expect_complete(s, 0.05);
+    EXPECT_GT(s.crc_errors, 0U);
+}
+TEST(ReplayStatesQemu, M3Clean) {
+    expect_complete(replay_states("qemu-m3", 0.0, kRows, "rs_m3"), 0.01);
+}
+TEST(ReplayStatesQemu, M3OnePercentFaults) {
+    const host::ReplaySummary s = replay_states("qemu-m3", 0.01, kRows, "rs_m3_f");
+    expect_complete(s, 0.01);
+    EXPECT_GT(s.crc_errors, 0U);
+}
+
+// The emulator killed halfway: the client restores the model, temperatures
+// and the latest accepted state, and every answer stays exact.
+template <typename T>
+void survive_restart(const char* machine, const char* target, const std::string& name) {
+    constexpr int kRestartRows = 600;
+    const auto dir = scratch_dir(name);
+    const StatesRecording rec = make_states_recording(dir, kRestartRows);
+    std::ostringstream log;
+    host::Diagnostics diag(log);
+    const host::StatesFile states = host::read_states_file(rec.states, StateFrame::kItrf, diag);
+    const std::string text = host::read_text_file(rec.solutions);
+    host::SolutionsReader reader(rec.solutions, text);
+    const ThermalModel<T> model = host::to_core<T>(host::read_model_file(data_path("model_table2.csv")));
+    host::ProcessTransport qemu(host::qemu_link_command(machine, host::default_link_firmware(target)));
+    host::LinkClient<T> client(qemu, 50, 20);
+    client.connect();
+    client.upload_model(model);
+    VelocityService<T> mirror(default_velocity_service_config());
+    host::EarthVelocity earth;
+    host::SolutionRecord r;
+    std::uint32_t id = 0;
+    std::size_t next = 0;
+    std::size_t from_states_applied = 0;
+    while (reader.next(r)) {
+        if (id == kRestartRows / 2) {
+            qemu.restart();
+        }
+        SolutionInput<T> in = host::to_core_input<T>(r, &earth);
+        TtTime t{};
+        ASSERT_TRUE(tt_from_seconds(r.t, t));
+        const bool from_states = r.velocity_components == 0;
+        StatusBits sv = 0U;
+        if (from_states) {
+            for (; next < states.accepted.size() && states.accepted[next].t <= t; ++next) {
+                const host::StateRecord& s = states.accepted[next];
+                client.send_state({s.t, 0U, s.r_km, s.v_kms}, true);
+                mirror.push_state(s.t, s.r_km, s.v_kms, StateFrame::kItrf);
+            }
+            mirror.advance(t, OnBoardEarth{});
+            const ServiceVelocity<T> v = mirror.velocity_at(t);
+            in.velocity = v.velocity;
+            sv = v.status;
+        } else {
+            client.set_velocity(in.velocity);
+        }
+        client.set_temperatures(in.head, in.temperatures);
+        const link::SolutionOut<T> got =
+            client.correct(id, in.head, in.q_chu_icrf, t, from_states, from_states && in.velocity.valid);
+        CorrectedSolution<T> want = correct_solution(in, CorrectionConfig<T>{true, &model});
+        want.status = with_service_status(want.status, sv, from_states);
+        ASSERT_EQ(got.status, want.status) << "row " << id;
+        ASSERT_EQ(std::memcmp(&got.q_chu_icrf, &want.q_chu_icrf, sizeof want.q_chu_icrf), 0) << "row " << id;
+        from_states_applied += from_states && id > kRestartRows / 2 && (got.status & 1U) != 0U ? 1U : 0U;
+        ++id;
+    }
+    EXPECT_EQ(client.stats().restarts, 1U);
+    EXPECT_GT(from_states_applied, static_cast<std::size_t>(kRestartRows / 3));  // the state was restored
+}
+
+TEST(ReplayStatesQemu, M3RestartRestoresTheState) {
+    survive_restart<Q30>("mps2-an385", "cortex-m3", "rs_m3_restart");
+}
+TEST(ReplayStatesQemu, M4fRestartRestoresTheState) {
+    survive_restart<float>("mps2-an386", "cortex-m4f", "rs_m4f_restart");
+}
+#endif
+
+}  // namespace
+}  // namespace ascorr::test
