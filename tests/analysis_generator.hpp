@@ -56,6 +56,12 @@ struct GeneratorOptions {
     std::uint64_t seed = 7;
     bool collinear_temperatures = false;   // T029 − T_CHU and T032 − T_CHU constant: rank-deficient
     bool garbage_in_dropped_rows = false;  // rows the selection drops get random attitudes
+    // Quadratic terms in the truth: c1_2, c2_2, c3_2 uniform in ±quadratic_truth
+    // arcsec/°C² (drawn apart, so that the rest of the data set stays the same).
+    double quadratic_truth = 0.0;
+    // Factor on every temperature variation (seasons, orbit, wander, heater);
+    // small values give a period whose temperatures hardly change.
+    double temperature_swing = 1.0;
 };
 
 struct Generated {
@@ -85,6 +91,17 @@ inline Generated generate(const std::string& path, const GeneratorOptions& o) {
             c[1] = uni(rng) - 0.5;
             c[2] = 2.0 * uni(rng) - 1.0;
             c[3] = 2.0 * uni(rng) - 1.0;
+        }
+    }
+    if (o.quadratic_truth != 0.0) {
+        std::mt19937_64 quad_rng(o.seed + 2);
+        g.truth.quadratic = true;
+        for (std::size_t h = 0; h < 3; ++h) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t j = 4; j < 7; ++j) {
+                    g.truth.coefficients[h][a][j] = o.quadratic_truth * (2.0 * uni(quad_rng) - 1.0);
+                }
+            }
         }
     }
     // Heads: (azimuth, elevation) in the body frame (x velocity, z nadir), degrees.
@@ -138,11 +155,12 @@ inline Generated generate(const std::string& path, const GeneratorOptions& o) {
         const double orb = std::cos(u);
         const bool heater = std::fmod(dt, 50.0 * 86400.0) < 3.0 * 86400.0;
         std::array<double, 3> tchu{};
-        double t029 = -10.0 + 5.0 * std::sin(2.0 * kPi * dt / season + 2.2) + walk[3];
-        double t032 = -15.0 + 3.0 * c + walk[4] + (heater ? 4.0 : 0.0);
+        const double sw = o.temperature_swing;
+        double t029 = -10.0 + sw * (5.0 * std::sin(2.0 * kPi * dt / season + 2.2) + walk[3]);
+        double t032 = -15.0 + sw * (3.0 * c + walk[4] + (heater ? 4.0 : 0.0));
         for (std::size_t h = 0; h < 3; ++h) {
-            tchu[h] = 5.0 * static_cast<double>(h) + 8.0 * std::sin(2.0 * kPi * dt / season + static_cast<double>(h)) +
-                      orb + walk[h];
+            tchu[h] = 5.0 * static_cast<double>(h) +
+                      sw * (8.0 * std::sin(2.0 * kPi * dt / season + static_cast<double>(h)) + orb + walk[h]);
         }
         if (o.collinear_temperatures) {
             tchu = {8.0 * s, 8.0 * s, 8.0 * s};

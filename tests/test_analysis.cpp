@@ -67,6 +67,7 @@ host::FitReport fit_period(const fs::path& data, const fs::path& model, double f
     o.out = model.string();
     o.from = from;
     o.to = to;
+    o.selection_report = false;  // the model alone (test_fit_terms covers the report)
     return host::fit_model(o);
 }
 
@@ -307,6 +308,7 @@ TEST(Selection, DroppedRowsDoNotReachTheFit) {
     generate((dir / "b.csv").string(), o);
     host::FitOptions f;
     f.min_orbits = 50;
+    f.selection_report = false;
     f.in = (dir / "a.csv").string();
     f.out = (dir / "a.model").string();
     const host::FitReport ra = host::fit_model(f);

@@ -1,4 +1,5 @@
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include "ascorr_host/fit.hpp"
@@ -17,6 +18,14 @@ void add_fit_command(CLI::App& app) {
     cmd->add_option("--min-orbits", opt->min_orbits, "fewest accepted orbit averages (default 100)");
     cmd->add_option("--max-condition", opt->max_condition, "largest accepted condition number (default 1e6)");
     cmd->add_option("--orbit-period", opt->orbit_period_s, "orbit period in s (default: from the velocity)");
+    const std::map<std::string, host::Terms> terms{{"linear", host::Terms::kLinear},
+                                                   {"quadratic", host::Terms::kQuadratic}};
+    cmd->add_option("--terms", opt->terms, "linear (default) or quadratic: also c1_2, c2_2, c3_2")
+        ->transform(CLI::CheckedTransformer(terms));
+    cmd->add_option("--holdout", opt->holdout,
+                    "fraction of the period (its end) held out for the model-selection report, 0..0.5 (default 0.25)");
+    cmd->add_option("--min-temperature-range", opt->min_temperature_range_c,
+                    "smallest range (degC) of each regressor for quadratic terms (default 2)");
     cmd->callback([opt]() {
         const host::FitReport r = host::fit_model(*opt);
         std::cout << host::describe(r);

@@ -17,6 +17,14 @@ void add_plot_command(CLI::App& app) {
     CLI::Option* to = cmd->add_option("--to", opt->period_to, "end of the modelling period to shade, s since J2000 TT");
     from->needs(to);
     to->needs(from);
+    cmd->add_flag("--temperatures", opt->temperatures,
+                  "add panels of T_CHU (A, B, C), T029 and T032 on the same time axis (the paper's Fig. 4)");
+    CLI::Option* wfrom = cmd->add_option("--window-from", opt->window_from,
+                                         "draw only from this epoch (s since J2000 TT), IBA as 200 s running means");
+    CLI::Option* wto = cmd->add_option("--window-to", opt->window_to, "draw only up to this epoch (s since J2000 TT)");
+    cmd->add_option("--width", opt->width, "figure width in pixels, 400..4000 (default 1400; panels 2/7 of it high)");
+    wfrom->needs(wto);
+    wto->needs(wfrom);
     cmd->callback([opt]() {
         host::plot_iba(*opt, std::cerr);
         std::cerr << "ascorr plot: " << opt->out << '\n';

@@ -32,6 +32,7 @@ struct OrbitSums {
     std::size_t count = 0;
     std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
 
 Eigen::Vector3d icrf_boresight(const Eigen::Quaterniond& q) {
@@ -105,12 +106,21 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
         throw FitRefused("--orbit-period must be in [600, 86400] s");
     }
+    if (!(opt.holdout >= 0.0 && opt.holdout <= 0.5)) {
+        throw FitRefused("--holdout must be in [0, 0.5] (a fraction of the modelling period), got " +
+                         std::to_string(opt.holdout));
+    }
+    if (!(opt.min_temperature_range_c >= 0.0 && std::isfinite(opt.min_temperature_range_c))) {
+        throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
+                         std::to_string(opt.min_temperature_range_c));
+    }
     FitReport r;
     EarthVelocity earth;
     const CorrectionConfig<double> ab_only{true, nullptr};
     std::optional<double> period = opt.orbit_period_s;
     std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // N_i
     std::map<long long, OrbitSums> orbits;
+    std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
     bool any = false;
 
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
@@ -143,6 +153,16 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
             o.e[h] += 2.0 * d.vec() * kRadToArcsec;  // small angle: error ~ θ³/24
             const auto& t = e.head[h]->temp;
             o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
+            o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
+        }
+        if (opt.selection_report) {
+            FitEpoch& fe = fit_epochs.emplace_back();
+            fe.t = e.t;
+            for (std::size_t h = 0; h < 3; ++h) {
+                const Eigen::Quaterniond& q = e.head[h]->q;
+                fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
+                fe.temp[h] = e.head[h]->temp;
+            }
         }
         ++r.epochs;
         if (!any || e.t < r.t_first) {
@@ -224,133 +244,45 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
                          std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
     }
 
-    // Joint least squares over the orbits k. With y_k = (e_A, e_B, e_C) the
-    // orbit-averaged rotations relative to F (9 values) and c the 36
-    // coefficients (head, axis, term), the model is
-    //     y_k = A_k·c + G·g_k,   G = (N_A; N_B; N_C),
-    // g_k being F's own rotation in that orbit (eq. 1–3 make F move with the
-    // A and C boresights, i.e. with their temperatures): unknown, and common
-    // to all heads. It is removed by projecting each orbit's 9 equations on
-    // the complement of G's columns, P = I − G·Gᵀ/3 (GᵀG = 3·I). What remains
-    // determines c up to a common rotation linear in T029 and T032 (the only
-    // regressors all heads share): 9 directions the data cannot see.
-    const auto n = static_cast<Eigen::Index>(used.size());
-    Eigen::Matrix<double, 9, 3> g;
-    for (std::size_t h = 0; h < 3; ++h) {
-        g.block<3, 3>(static_cast<Eigen::Index>(3 * h), 0) = reference[h]->toRotationMatrix();
-    }
-    const Eigen::Matrix<double, 9, 9> proj = Eigen::Matrix<double, 9, 9>::Identity() - g * g.transpose() / 3.0;
-    Eigen::MatrixXd y(n, 9);
-    std::vector<std::array<Eigen::Vector4d, 3>> x(used.size());
-    for (Eigen::Index k = 0; k < n; ++k) {
-        const OrbitSums& o = *used[static_cast<std::size_t>(k)];
-        const double w = 1.0 / static_cast<double>(o.count);
+    // The orbit averages, and the heads' orientations N_i in F.
+    std::vector<OrbitAverage> averages;
+    for (const auto& kv : orbits) {
+        if (kv.second.count < min_count) {
+            continue;
+        }
+        OrbitAverage& a = averages.emplace_back();
+        const double w = 1.0 / static_cast<double>(kv.second.count);
+        a.t_mid = (static_cast<double>(kv.first) + 0.5) * *period;
         for (std::size_t h = 0; h < 3; ++h) {
-            y.block<1, 3>(k, static_cast<Eigen::Index>(3 * h)) = (o.e[h] * w).transpose();
-            x[static_cast<std::size_t>(k)][h] << 1.0, o.x[h] * w;
+            a.e[h] = kv.second.e[h] * w;
+            a.x[h] = kv.second.x[h] * w;
+            a.x2[h] = kv.second.x2[h] * w;
         }
     }
-    // Centre e on its mean, so that c0 refers to the mean orientation.
-    const Eigen::RowVectorXd mean = y.colwise().mean();
-    y.rowwise() -= mean;
-    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(9 * n, kUnknowns);
-    Eigen::VectorXd target(9 * n);
-    for (Eigen::Index k = 0; k < n; ++k) {
-        Eigen::Matrix<double, 9, kUnknowns> a = Eigen::Matrix<double, 9, kUnknowns>::Zero();
-        for (Eigen::Index h = 0; h < 3; ++h) {
-            for (Eigen::Index ax = 0; ax < 3; ++ax) {
-                a.block<1, 4>(3 * h + ax, 12 * h + 4 * ax) =
-                    x[static_cast<std::size_t>(k)][static_cast<std::size_t>(h)];
-            }
-        }
-        design.block<9, kUnknowns>(9 * k, 0) = proj * a;
-        target.segment<9>(9 * k) = proj * y.row(k).transpose();
-    }
-    // Unit-norm columns: the singular values then measure how independent
-    // the regressors are, not their units.
-    const Eigen::VectorXd scale = design.colwise().norm().transpose();
-    design = design * scale.cwiseInverse().asDiagonal();
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const Eigen::VectorXd sv = svd.singularValues();
-    r.singular_values.assign(sv.data(), sv.data() + sv.size());
-    constexpr Eigen::Index kRank = kUnknowns - kGaugeDims;
-    r.condition = sv(kRank - 1) > 0.0 ? sv(0) / sv(kRank - 1) : std::numeric_limits<double>::infinity();
-    if (!(r.condition <= opt.max_condition)) {
-        // Name the head whose coefficients dominate the weakest direction.
-        const Eigen::VectorXd weakest = svd.matrixV().col(kRank - 1);
-        Eigen::Index head = 0;
-        Eigen::Vector3d share(weakest.segment<12>(0).squaredNorm(), weakest.segment<12>(12).squaredNorm(),
-                              weakest.segment<12>(24).squaredNorm());
-        share.maxCoeff(&head);
-        char buf[400];
-        std::snprintf(buf, sizeof buf,
-                      "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, "
-                      "the largest %.3g; the weakest direction is mostly CHU %c's coefficients): T_CHU, T029 - T_CHU "
-                      "and T032 - T_CHU do not vary independently in the modelling period (%s)",
-                      r.condition, opt.max_condition, static_cast<int>(kRank), static_cast<int>(kUnknowns),
-                      sv(kRank - 1), sv(0), head_name(static_cast<std::uint8_t>(head)), period_text.c_str());
-        throw FitRefused(opt.in + ": " + buf);
-    }
-    // Least squares on the observable directions only (truncated SVD).
-    const Eigen::MatrixXd u = svd.matrixU().leftCols(kRank);
-    const Eigen::MatrixXd v = svd.matrixV().leftCols(kRank);
-    const Eigen::VectorXd c_scaled = v * (u.transpose() * target).cwiseQuotient(sv.head(kRank));
-    Eigen::VectorXd c = scale.cwiseInverse().asDiagonal() * c_scaled;
-
-    // The gauge: of all models the star trackers cannot tell apart (c plus a
-    // common rotation w0 + w2·T029 + w3·T032), write the one whose corrections
-    // are smallest (RMS over the orbits of the period).
-    {
-        Eigen::MatrixXd gd(9 * n, 9);
-        Eigen::VectorXd gt(9 * n);
-        for (Eigen::Index k = 0; k < n; ++k) {
-            for (Eigen::Index h = 0; h < 3; ++h) {
-                const Eigen::Vector4d& xh = x[static_cast<std::size_t>(k)][static_cast<std::size_t>(h)];
-                const double t2 = xh(1) + xh(2);
-                const double t3 = xh(1) + xh(3);
-                const Eigen::Matrix3d nh = g.block<3, 3>(3 * h, 0);
-                gd.block<3, 3>(9 * k + 3 * h, 0) = nh;
-                gd.block<3, 3>(9 * k + 3 * h, 3) = nh * t2;
-                gd.block<3, 3>(9 * k + 3 * h, 6) = nh * t3;
-                for (Eigen::Index ax = 0; ax < 3; ++ax) {
-                    gt(9 * k + 3 * h + ax) = -xh.dot(c.segment<4>(12 * h + 4 * ax));
-                }
-            }
-        }
-        const Eigen::VectorXd wv = gd.bdcSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(gt);
-        for (Eigen::Index h = 0; h < 3; ++h) {
-            const Eigen::Matrix3d nh = g.block<3, 3>(3 * h, 0);
-            const Eigen::Vector3d w0 = nh * wv.segment<3>(0);
-            const Eigen::Vector3d w2 = nh * wv.segment<3>(3);
-            const Eigen::Vector3d w3 = nh * wv.segment<3>(6);
-            for (Eigen::Index ax = 0; ax < 3; ++ax) {
-                c(12 * h + 4 * ax + 0) += w0(ax);
-                c(12 * h + 4 * ax + 1) += w2(ax) + w3(ax);  // T2 = T1 + (T2 − T1), likewise T3
-                c(12 * h + 4 * ax + 2) += w2(ax);
-                c(12 * h + 4 * ax + 3) += w3(ax);
-            }
-        }
-    }
-
-    // Residuals, with each orbit's common rotation removed (as in the fit).
-    r.model.present = {true, true, true, false};
-    Eigen::VectorXd res = target - design * c_scaled;
+    std::array<Eigen::Matrix3d, 3> n_ref;
     for (std::size_t h = 0; h < 3; ++h) {
-        for (std::size_t ax = 0; ax < 3; ++ax) {
-            double ss = 0.0;
-            double sy = 0.0;
-            for (Eigen::Index k = 0; k < n; ++k) {
-                const Eigen::Index row = 9 * k + static_cast<Eigen::Index>(3 * h + ax);
-                ss += res(row) * res(row);
-                sy += target(row) * target(row);
-            }
-            r.head[h].residual_rms[ax] = std::sqrt(ss / static_cast<double>(n));
-            r.head[h].signal_rms[ax] = std::sqrt(sy / static_cast<double>(n));
-            for (std::size_t t = 0; t < 4; ++t) {
-                r.model.coefficients[h][ax][t] = c(static_cast<Eigen::Index>(12 * h + 4 * ax + t));
-            }
-        }
+        n_ref[h] = reference[h]->toRotationMatrix();
     }
+    r.terms = opt.terms;
+    r.fit = solve_terms(averages, n_ref, opt.terms, opt.max_condition, opt.min_temperature_range_c);
+    if (!r.fit.refused.empty()) {
+        if (opt.terms == Terms::kQuadratic) {
+            throw FitRefused(opt.in + ": quadratic terms not supported by the data in the modelling period (" +
+                             period_text + "): " + r.fit.refused + "; use --terms linear");
+        }
+        throw FitRefused(opt.in + ": " + r.fit.refused +
+                         ": T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently in the modelling period (" +
+                         period_text + ")");
+    }
+    std::sort(fit_epochs.begin(), fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
+    if (opt.selection_report) {
+        r.selection = select_terms(averages, fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
+                                   opt.min_temperature_range_c);
+    }
+    r.singular_values = r.fit.singular_values;
+    r.condition = r.fit.condition;
+    r.head = r.fit.head;
+    r.model = r.fit.model;
     return r;
 }
 
@@ -367,17 +299,18 @@ std::string describe(const FitReport& r) {
     o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
       << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
     o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
-         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head, with F's own rotation in each orbit\n"
-         "as a nuisance. Rotations common to all heads are not observable by the star trackers (they change no\n"
-         "IBA): of the models that differ by one linear in T029 and T032 (9 directions), the one with the smallest\n"
-         "corrections over the period is written. c0 refers to the mean orientations over the period.\n";
+         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their squares),\n"
+         "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by the\n"
+         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
+         "(9 directions), the one with the smallest corrections over the period is written.\n";
+    const auto rank = static_cast<std::size_t>(r.fit.rank);
     std::snprintf(buf, sizeof buf,
-                  "design %zu x %d (columns scaled to unit norm): singular values %.3g .. %.3g (%d observable), "
-                  "condition number %.1f; unobservable directions at %.1e\n",
-                  9 * r.orbits_used, static_cast<int>(kUnknowns), r.singular_values.front(),
-                  r.singular_values[kUnknowns - kGaugeDims - 1], static_cast<int>(kUnknowns - kGaugeDims), r.condition,
-                  r.singular_values[kUnknowns - kGaugeDims]);
+                  "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
+                  "observable), condition number %.1f; unobservable directions at %.1e\n",
+                  terms_name(r.terms), 9 * r.orbits_used, r.fit.unknowns, r.singular_values.front(),
+                  r.singular_values[rank - 1], r.fit.rank, r.condition, r.singular_values[rank]);
     o << buf;
+    o << describe_centring(r.fit);
     o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";
     for (std::size_t h = 0; h < 3; ++h) {
         const HeadFit& f = r.head[h];
@@ -385,6 +318,13 @@ std::string describe(const FitReport& r) {
                       head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1], f.residual_rms[2],
                       f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
         o << buf;
+    }
+    if (!r.selection.models.empty()) {
+        o << describe_selection(r.selection);
+    }
+    if (r.selection.decided && r.selection.preferred != r.terms) {
+        o << "note: the model written has " << terms_name(r.terms) << " terms; the data support "
+          << terms_name(r.selection.preferred) << " terms\n";
     }
     return o.str();
 }

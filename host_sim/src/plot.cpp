@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -72,6 +73,69 @@ std::string read_all(const std::filesystem::path& p) {
     return s.str();
 }
 
+// Means over kPlotBinS bins of each stage's IBA about its mean.
+void write_binned(std::ofstream& f, const PairSeries& s, const double (&mean)[kStages]) {
+    std::size_t i = 0;
+    while (i < s.t.size()) {
+        const double bin = std::floor(s.t[i] / kPlotBinS);
+        double sum_t = 0.0;
+        double sum[kStages] = {};
+        std::size_t n = 0;
+        for (; i < s.t.size() && std::floor(s.t[i] / kPlotBinS) == bin; ++i, ++n) {
+            sum_t += s.t[i] - s.t[0];
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] += s.iba[k][i] - mean[k];
+            }
+        }
+        const double dn = static_cast<double>(n);
+        f.precision(12);
+        f << s.t[0] + sum_t / dn + kJ2000Unix;
+        for (std::size_t k = 0; k < kStages; ++k) {
+            f << ' ' << sum[k] / dn;
+        }
+        f << '\n';
+    }
+}
+
+// Each epoch's running mean over kSmoothingWindowS (|t_j − t_i| ≤ half of it,
+// as rms_about_mean) of each stage's IBA about its mean.
+void write_smoothed(std::ofstream& f, const PairSeries& s, const double (&mean)[kStages]) {
+    f.precision(12);
+    std::size_t lo = 0;
+    std::size_t hi = 0;
+    double sum[kStages] = {};
+    const double half = 0.5 * kSmoothingWindowS;
+    for (std::size_t i = 0; i < s.t.size(); ++i) {
+        while (hi < s.t.size() && s.t[hi] <= s.t[i] + half) {
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] += s.iba[k][hi] - mean[k];
+            }
+            ++hi;
+        }
+        while (s.t[lo] < s.t[i] - half) {
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] -= s.iba[k][lo] - mean[k];
+            }
+            ++lo;
+        }
+        f << s.t[i] + kJ2000Unix;
+        for (std::size_t k = 0; k < kStages; ++k) {
+            f << ' ' << sum[k] / static_cast<double>(hi - lo);
+        }
+        f << '\n';
+    }
+}
+
+void check_window(const PlotOptions& opt) {
+    if (!(opt.window_from && opt.window_to)) {
+        throw std::runtime_error("a plot window needs both --window-from and --window-to");
+    }
+    if (!(std::isfinite(*opt.window_from) && std::isfinite(*opt.window_to) && *opt.window_from < *opt.window_to)) {
+        throw std::runtime_error("the plot window is empty: --window-from " + std::to_string(*opt.window_from) +
+                                 " is not before --window-to " + std::to_string(*opt.window_to));
+    }
+}
+
 }  // namespace
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
@@ -79,13 +143,23 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     so.in = opt.in;
     so.model = opt.model;
     so.keep_series = true;
+    if (!(opt.width >= 400 && opt.width <= 4000)) {
+        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
+    }
+    const bool window = opt.window_from.has_value() || opt.window_to.has_value();
+    if (window) {
+        check_window(opt);
+        so.from = opt.window_from;
+        so.to = opt.window_to;
+    }
     const StatsResult st = compute_stats(so, log);
 
     TempDir dir;
     for (std::size_t p = 0; p < kPairs; ++p) {
         const PairSeries& s = st.series[p];
         if (s.t.empty()) {
-            throw std::runtime_error(opt.in + ": no clean epoch for pair " + kPairNames[p] + ": nothing to plot");
+            throw std::runtime_error(opt.in + ": no clean epoch for pair " + kPairNames[p] +
+                                     (window ? " in the window" : "") + ": nothing to plot");
         }
         double mean[kStages] = {};
         for (std::size_t k = 0; k < kStages; ++k) {
@@ -95,39 +169,47 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
             mean[k] /= static_cast<double>(s.t.size());
         }
         std::ofstream f(dir.path() / ("pair" + std::to_string(p) + ".dat"));
-        std::size_t i = 0;
-        while (i < s.t.size()) {
-            const double bin = std::floor(s.t[i] / kPlotBinS);
-            double sum_t = 0.0;
-            double sum[kStages] = {};
-            std::size_t n = 0;
-            for (; i < s.t.size() && std::floor(s.t[i] / kPlotBinS) == bin; ++i, ++n) {
-                sum_t += s.t[i] - s.t[0];
-                for (std::size_t k = 0; k < kStages; ++k) {
-                    sum[k] += s.iba[k][i] - mean[k];
-                }
-            }
-            const double dn = static_cast<double>(n);
-            f.precision(12);
-            f << s.t[0] + sum_t / dn + kJ2000Unix;
-            for (std::size_t k = 0; k < kStages; ++k) {
-                f << ' ' << sum[k] / dn;
-            }
-            f << '\n';
+        if (window) {
+            write_smoothed(f, s, mean);
+        } else {
+            write_binned(f, s, mean);
         }
         if (!f) {
             throw std::runtime_error("cannot write plot data in " + dir.path().string());
         }
     }
 
+    double t_lo = st.series[0].t.front();
+    double t_hi = st.series[0].t.back();
+    for (const PairSeries& s : st.series) {
+        t_lo = std::min(t_lo, s.t.front());
+        t_hi = std::max(t_hi, s.t.back());
+    }
+    const std::filesystem::path temps = dir.path() / "temperatures.dat";
+    if (opt.temperatures) {
+        write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
+                                 kJ2000Unix);
+    }
+    const std::size_t rows = kPairs + (opt.temperatures ? 2 : 0);
+
     const std::filesystem::path png = dir.path() / "plot.png";
     const auto write_script = [&](const char* terminal) {
         std::ofstream g(dir.path() / "plot.gp");
-        g << "set terminal " << terminal << " size 1400,1200\n";
-        g << "set output '" << png.string() << "'\n";
-        g << "set multiplot layout 3,1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
-          << "-minute means (RMS of the unbinned IBA in the legend)'\n";
-        g << "set xdata time\nset timefmt '%s'\nset format x '%Y-%m'\nset grid\nset key outside right top\n";
+        g.precision(12);
+        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(rows)
+          << (opt.width < 1000 ? " font ',8'" : "") << "\n";
+        g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
+        if (window) {
+            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kSmoothingWindowS
+              << " s running means (RMS of the IBA and of its running mean in the legend)'\n";
+        } else {
+            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
+              << "-minute means (RMS of the unbinned IBA in the legend)'\n";
+        }
+        g << "set xdata time\nset timefmt '%s'\nset format x \"" << (window ? "%m-%d\\n%H:%M" : "%Y-%m")
+          << "\"\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
+        g << "set xrange ['" << t_lo + kJ2000Unix << "':'" << t_hi + kJ2000Unix << "']\n";
+        g << "set lmargin 10\nset rmargin 42\n";  // the panels' time axes aligned
         g << "set ylabel 'IBA - mean (arcsec)'\n";
         if (opt.period_from && opt.period_to) {
             g.precision(12);
@@ -145,11 +227,27 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                     break;
                 }
                 char t[96];
-                std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                if (window) {
+                    std::snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
+                                  st.rms[p][k].rms_smoothed);
+                } else {
+                    std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                }
                 g << (k ? ", " : "") << "'" << (dir.path() / ("pair" + std::to_string(p) + ".dat")).string()
                   << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
             }
             g << '\n';
+        }
+        if (opt.temperatures) {
+            const std::string f = "'" + temps.string() + "'";
+            g << "set ylabel 'temperature (degC)'\n";
+            g << "set title 'T_CHU (T1) of each head'\n";
+            g << "plot " << f << " using 1:2 with lines lw 1.5 title 'T_CHU A', " << f
+              << " using 1:3 with lines lw 1.5 title 'T_CHU B', " << f
+              << " using 1:4 with lines lw 1.5 title 'T_CHU C'\n";
+            g << "set title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
+            g << "plot " << f << " using 1:5 with lines lw 1.5 title 'T029', " << f
+              << " using 1:6 with lines lw 1.5 title 'T032'\n";
         }
         g << "unset multiplot\n";
     };

@@ -87,6 +87,8 @@ struct Wander {
 class Heaters {
 public:
     Heaters(double t0, std::mt19937_64& rng) : rng_(rng) { schedule(t0); }
+    // Every event scheduled so far, in time order (the last may lie beyond the data).
+    const std::vector<HeaterEvent>& events() const { return events_; }
     // Profile 0..1 of the operational and survival heater at t.
     void at(double t, double& op, double& surv) {
         while (t > end_ + 5.0 * kTau) {
@@ -112,11 +114,13 @@ private:
         start_ = after + gap(rng_);
         end_ = start_ + len(rng_);
         operational_ = !operational_;
+        events_.push_back({start_, end_, operational_});
     }
     std::mt19937_64& rng_;
     double start_ = 0.0;
     double end_ = 0.0;
     bool operational_ = false;
+    std::vector<HeaterEvent> events_;
 };
 
 // A run of consecutive epochs with something missing (telemetry or GPS gaps).
@@ -158,6 +162,16 @@ Eigen::Matrix3d head_mounting(int head) {
     return m;
 }
 
+std::string heaters_csv(const std::vector<HeaterEvent>& events) {
+    std::string s = "start,end,heater\n";
+    char line[96];
+    for (const HeaterEvent& e : events) {
+        std::snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end, e.operational ? "operational" : "survival");
+        s += line;
+    }
+    return s;
+}
+
 std::string floor_json(const std::array<Rms, kPairs>& floor) {
     std::ostringstream s;
     s.precision(6);
@@ -182,7 +196,8 @@ std::string describe(const SimulateSummary& s) {
                       s.floor[p].rms_smoothed);
         o << buf;
     }
-    o << "\ntruth model: " << s.truth_path << "\nfloor: " << s.floor_path;
+    o << "\ntruth model: " << s.truth_path << "\nfloor: " << s.floor_path << "\nheater events (" << s.heaters.size()
+      << "): " << s.heaters_path;
     return o.str();
 }
 
@@ -413,9 +428,17 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     }
     sum.truth_path = opt.out + ".truth.csv";
     sum.floor_path = opt.out + ".floor.json";
+    sum.heaters_path = opt.out + ".heaters.csv";
+    const double t_last = opt.start_t + static_cast<double>(epochs - 1) * opt.step_s;
+    for (const HeaterEvent& e : heaters.events()) {
+        if (e.start <= t_last) {
+            sum.heaters.push_back(e);
+        }
+    }
     out.commit();
     write_model_file(sum.truth_path, truth_file);
     write_file_atomically(sum.floor_path, floor_json(sum.floor));
+    write_file_atomically(sum.heaters_path, heaters_csv(sum.heaters));
     return sum;
 }
 

@@ -10,9 +10,15 @@
 //     N_i the head's orientation in F at the first such epoch;
 //  4. averages of e_i and of the temperatures over each orbit (the same
 //     epochs on both sides, so the linear model holds for the averages);
-//  5. least squares by SVD (Eigen BDCSVD, columns scaled to unit norm) of
-//     the 9 orbit-averaged angles against each head's [1, T1, T2−T1, T3−T1]
-//     (T1 = the head's T_CHU, T2 = T029, T3 = T032), all heads jointly.
+//  5. least squares by SVD (Eigen BDCSVD, columns centred, scaled, then
+//     normalised: fit_terms.hpp) of the 9 orbit-averaged angles against each
+//     head's [1, T1, T2−T1, T3−T1] (T1 = the head's T_CHU, T2 = T029,
+//     T3 = T032), with --terms quadratic also their squares, all heads jointly;
+//  6. the model-selection report (fit_terms.hpp): linear and quadratic models
+//     fitted on the period without its held-out end (--holdout), their
+//     residuals, condition numbers and IBA RMS in and after that part, and
+//     which model the data support. The model written is fitted on the whole
+//     period with the terms asked for.
 // The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
 //
 // What is fitted, precisely. F moves with the A and C boresights, hence with
@@ -37,6 +43,7 @@
 #include <vector>
 
 #include "ascorr_host/epochs.hpp"
+#include "ascorr_host/fit_terms.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
@@ -55,6 +62,10 @@ struct FitOptions {
     std::size_t min_orbits = kDefaultMinOrbits;
     double max_condition = kDefaultMaxCondition;
     std::optional<double> orbit_period_s;  // default: 2πμ/|v|³ of the first selected row (circular orbit)
+    Terms terms = Terms::kLinear;
+    double holdout = kDefaultHoldout;  // fraction of the period (its end) held out for the selection report
+    double min_temperature_range_c = kDefaultMinTemperatureRange;  // of each regressor, for quadratic terms
+    bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
 };
 
 // Why a row is left out of the fit (the first reason that applies).
@@ -63,13 +74,8 @@ inline constexpr std::size_t kDropKinds = 8;
 Drop fit_selection(const SolutionRecord& rec) noexcept;
 const char* drop_name(Drop d) noexcept;
 
-inline constexpr int kUnknowns = 36;  // 3 heads × 3 axes × (c0, c1, c2, c3)
+inline constexpr int kUnknowns = 36;  // linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
 inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032
-
-struct HeadFit {
-    std::array<double, 3> residual_rms{};  // orbit averages, arcsec, alpha/beta/gamma
-    std::array<double, 3> signal_rms{};    // orbit-averaged angle about its mean
-};
 
 struct FitReport {
     double t_first = 0.0;
@@ -80,13 +86,17 @@ struct FitReport {
     std::size_t epochs = 0;  // with A, B and C selected
     std::size_t orbits_used = 0;
     std::size_t orbits_left_out = 0;
+    Terms terms = Terms::kLinear;
     std::vector<double> singular_values;  // of the joint design with unit-norm columns, descending
     double condition = 0.0;               // largest / smallest observable singular value
     std::array<HeadFit, 3> head{};
     ModelFile model;
+    TermsFit fit;         // the written model's fit: centring, rank
+    Selection selection;  // the model-selection report
 };
 
-// Refusal of the data given (too short, too few orbits, rank-deficient).
+// Refusal of the data given (too short, too few orbits, rank-deficient, for
+// quadratic terms a temperature range too small).
 class FitRefused : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;

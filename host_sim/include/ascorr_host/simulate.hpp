@@ -16,6 +16,12 @@
 //    solution is q_meas with the aberration correction undone (fixed-point
 //    inversion of the core's own aberration rotation). So `ascorr correct`
 //    with the truth model returns q_noise ⊗ q_true, and its IBA is the floor.
+//  - Heater events (the paper's §3.2 heater test, repeated): every 40–80 days
+//    for 3–5 days, alternately the operational heater (the CHUs +2–3 °C and
+//    THT00032 +2 °C) and the survival heater (THT00029 +3 °C), each switched
+//    on and off with a half-day time constant. Their windows [start, end] (the
+//    heater on; the temperatures relax for a few days after) are written
+//    beside the data.
 //  - The floor: the IBA RMS per pair of q_noise ⊗ q_true over the clean
 //    epochs (docs/contract.md), written beside the data.
 #pragma once
@@ -26,6 +32,7 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "ascorr_host/iba.hpp"
 
@@ -45,6 +52,12 @@ struct SimulateOptions {
     double start_t = kDefaultSimStartT;
 };
 
+struct HeaterEvent {
+    double start = 0.0;        // heater on, s since J2000 TT
+    double end = 0.0;          // heater off
+    bool operational = false;  // false: the survival heater
+};
+
 struct SimulateSummary {
     std::size_t epochs = 0;
     std::size_t rows = 0;
@@ -55,9 +68,12 @@ struct SimulateSummary {
     std::array<Rms, kPairs> floor{};
     std::string truth_path;
     std::string floor_path;
+    std::vector<HeaterEvent> heaters;  // those starting before the last epoch
+    std::string heaters_path;
 };
 
-// Writes opt.out, opt.out + ".truth.csv" and opt.out + ".floor.json".
+// Writes opt.out, opt.out + ".truth.csv", opt.out + ".floor.json" and
+// opt.out + ".heaters.csv" (start,end,heater: operational or survival).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
 SimulateSummary simulate(const SimulateOptions& opt);
 
@@ -66,5 +82,6 @@ Eigen::Matrix3d head_mounting(int head);
 
 std::string describe(const SimulateSummary& s);
 std::string floor_json(const std::array<Rms, kPairs>& floor);
+std::string heaters_csv(const std::vector<HeaterEvent>& events);
 
 }  // namespace ascorr::host
