@@ -187,6 +187,7 @@ std::size_t worker_count() {
 
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
     std::optional<ThermalModel<T>> model;
     if (opt.thermal && !opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
@@ -203,6 +204,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         throw InputError(opt.in, 1, 1, "empty file: expected a header line");
     }
     const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
+    refuse_corrected_input(header);
     const RowWriter writer(header);
     const Job<T> job{opt, cfg, header, writer};
 

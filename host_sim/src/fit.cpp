@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+
+#include "ascorr_host/atomic_file.hpp"
 #include <map>
 #include <sstream>
 #include <vector>
@@ -91,6 +93,7 @@ const char* drop_name(Drop d) noexcept {
 }
 
 FitReport fit_model(const FitOptions& opt) {
+    refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));

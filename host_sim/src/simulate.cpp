@@ -187,6 +187,9 @@ std::string describe(const SimulateSummary& s) {
 }
 
 SimulateSummary simulate(const SimulateOptions& opt) {
+    refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
+                                                        {"--out (truth model)", opt.out + ".truth.csv"},
+                                                        {"--out (noise floor)", opt.out + ".floor.json"}});
     if (!(opt.days > 0.0 && opt.days <= 36600.0)) {
         throw std::invalid_argument("--days must be in (0, 36600], got " + std::to_string(opt.days));
     }

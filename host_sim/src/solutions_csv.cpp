@@ -136,4 +136,17 @@ bool SolutionsReader::next(SolutionRecord& rec) {
     return true;
 }
 
+void refuse_corrected_input(const SolutionsReader& header) {
+    const int col = header.header().index("status");
+    if (col >= 0) {
+        std::size_t column = 1;  // character column of the name in the header line
+        for (int i = 0; i < col; ++i) {
+            column += header.header().names()[static_cast<std::size_t>(i)].size() + 1;
+        }
+        throw InputError(header.file_name(), 1, column,
+                         "column 'status': this file is already corrected (it has the status column of a corrected "
+                         "file); give the raw solutions file, so that no correction is applied twice");
+    }
+}
+
 }  // namespace ascorr::host

@@ -82,4 +82,9 @@ private:
     std::size_t empty_lines_ = 0;
 };
 
+// Throws InputError when the header has a `status` column: the file is already
+// corrected (formats.md), and correcting or fitting it again would apply the
+// corrections twice.
+void refuse_corrected_input(const SolutionsReader& header);
+
 }  // namespace ascorr::host
