@@ -63,8 +63,9 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
     }
     if ((st & status::kVelocityInvalid) != 0U) {
         if (rec.velocity_components != 3) {
-            diag.report("velocity incomplete", where(file, rec) + "only " + std::to_string(rec.velocity_components) +
-                                                   " of vx,vy,vz given: aberration skipped");
+            diag.report("velocity incomplete", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
+        } else if (!in_ephemeris_span(rec.t)) {
+            diag.report("outside the ephemeris", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
         } else {
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
@@ -143,10 +144,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
         const SolutionInput<T> in = to_core_input<T>(rec, opt.aberration ? &earth : nullptr);
         const CorrectedSolution<T> c = correct_solution(in, job.cfg);
-        StatusBits st = c.status;
-        if (opt.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
-            st |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
-        }
+        const StatusBits st = host_status(rec, opt.aberration, c.status);
         explain(rec, in, st, opt.in, res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged

@@ -129,10 +129,16 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
             instructions += got.instructions;
             ++costed;
         }
+        // The bits the host adds (velocity given but unusable before the core
+        // sees it), as `ascorr correct` does.
+        const StatusBits written = host_status(rec, true, got.status);
+        if (written != got.status && sum.frames <= 20) {
+            log << opt.in << ":" << rec.line << ": " << velocity_problem(rec) << ": aberration skipped\n";
+        }
         if ((got.status & status::kRejected) != 0U) {
-            writer.row(reader, std::nullopt, got.status, buf);
+            writer.row(reader, std::nullopt, written, buf);
         } else {
-            writer.row(reader, widen(got.q_chu_icrf), got.status, buf);
+            writer.row(reader, widen(got.q_chu_icrf), written, buf);
         }
         ++id;
     }

@@ -1,8 +1,11 @@
 #include "ascorr_host/solutions_csv.hpp"
 
 #include <cmath>
+#include <cstdio>
 
+#include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/input_error.hpp"
+#include "ascorr_host/solution_input.hpp"
 
 namespace ascorr::host {
 
@@ -147,6 +150,21 @@ void refuse_corrected_input(const SolutionsReader& header) {
                          "column 'status': this file is already corrected (it has the status column of a corrected "
                          "file); give the raw solutions file, so that no correction is applied twice");
     }
+}
+
+std::string velocity_problem(const SolutionRecord& rec) {
+    if (rec.velocity_components != 0 && rec.velocity_components != 3) {
+        return "only " + std::to_string(rec.velocity_components) + " of vx,vy,vz given";
+    }
+    if (rec.velocity_components == 3 && !in_ephemeris_span(rec.t)) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "t = %.17g s is outside the span of the Earth ephemeris (1900-2100, %.4g .. %.4g s since "
+                      "J2000 TT; a time in ms?)",
+                      rec.t, kEphemerisFirstT, kEphemerisEndT);
+        return buf;
+    }
+    return {};
 }
 
 }  // namespace ascorr::host
