@@ -30,8 +30,13 @@ struct Row {
 };
 
 // Sums over one orbit of e_i and of the regressors, per head.
+// Sums over one orbit's epochs. q: the rotations a = q_head_f ⊗ r⁻¹ relative
+// to a provisional reference r (4-vectors, w ≥ 0); e: filled at the end, the
+// small angles relative to the final reference, derived exactly from q (see
+// fit_model), so that the result does not depend on which epoch came first.
 struct OrbitSums {
     std::size_t count = 0;
+    std::array<Eigen::Vector4d, 3> q{Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
@@ -101,13 +106,29 @@ FitReport fit_model(const FitOptions& opt) {
     if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
         throw FitRefused("--orbit-period must be in [600, 86400] s");
     }
-    FitReport r;
     EarthVelocity earth;
     const CorrectionConfig<double> ab_only{true, nullptr};
-    std::optional<double> period = opt.orbit_period_s;
-    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // N_i
+    // Row order must not matter (issue 11). The reference N_i is the earliest
+    // epoch's (re-based exactly at the end), and the orbit period, when not
+    // given, comes from the earliest selected row: if that is not the first
+    // one read, the file is read again with that period (unordered files only).
+    FitReport r;
+    std::optional<double> period;
+    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
+    std::array<Eigen::Quaterniond, 3> earliest_a;                // the earliest epoch's a
+    double earliest_epoch = 0.0;
+    double earliest_row = 0.0;
+    double earliest_row_period = 0.0;
     std::map<long long, OrbitSums> orbits;
     bool any = false;
+    for (int pass = 0; pass < 2; ++pass) {
+    r = FitReport{};
+    reference = {};
+    orbits.clear();
+    any = false;
+    const bool period_given = opt.orbit_period_s.has_value() || pass == 1;
+    period = pass == 1 ? std::optional<double>(earliest_row_period) : opt.orbit_period_s;
+    bool any_row = false;
 
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
         if (!(e.head[0] && e.head[1] && e.head[2])) {
@@ -136,11 +157,17 @@ FitReport fit_model(const FitOptions& opt) {
             if (d.w() < 0.0) {
                 d.coeffs() = -d.coeffs();
             }
-            o.e[h] += 2.0 * d.vec() * kRadToArcsec;  // small angle: error ~ θ³/24
+            o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+            if (!any || e.t < earliest_epoch) {
+                earliest_a[h] = d;
+            }
             const auto& t = e.head[h]->temp;
             o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
         }
         ++r.epochs;
+        if (!any || e.t < earliest_epoch) {
+            earliest_epoch = e.t;
+        }
         if (!any || e.t < r.t_first) {
             r.t_first = e.t;
         }
@@ -168,15 +195,20 @@ FitReport fit_model(const FitOptions& opt) {
             if (d != Drop::kNone) {
                 return;
             }
-            if (!period) {
+            if (!period_given && (!any_row || rec.t < earliest_row)) {
                 const double v = std::sqrt(squared_norm(rec.v_sc_kms));
                 if (!(v > 1.0 && v < 12.0)) {
                     throw InputError(opt.in, rec.line, 1,
                                      "spacecraft speed " + std::to_string(v) +
                                          " km/s is not that of an Earth orbit: give --orbit-period");
                 }
-                period = 2.0 * kPi * kMuEarth / (v * v * v);
+                earliest_row = rec.t;
+                earliest_row_period = 2.0 * kPi * kMuEarth / (v * v * v);
+                if (!period) {
+                    period = earliest_row_period;
+                }
             }
+            any_row = true;
             Row row;
             row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
             row.temp = rec.temperature;
@@ -184,7 +216,23 @@ FitReport fit_model(const FitOptions& opt) {
         },
         "fit");
     epochs.finish();
+    if (period_given || !period || *period == earliest_row_period) {
+        break;
+    }
+    }  // passes
     r.orbit_period_s = period.value_or(0.0);
+    // Re-base on the earliest epoch: with b = earliest a, each epoch's small
+    // angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
+    // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
+    for (std::size_t h = 0; h < 3 && r.epochs != 0; ++h) {
+        const Eigen::Quaterniond b_inv = earliest_a[h].conjugate();
+        for (auto& kv : orbits) {
+            const Eigen::Vector4d& s = kv.second.q[h];
+            const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
+            kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
+        }
+        reference[h] = (earliest_a[h] * *reference[h]).normalized();
+    }
 
     const std::string period_text = "t = " + time_text(r.t_first) + " .. " + time_text(r.t_last);
     if (r.epochs == 0) {
