@@ -16,7 +16,7 @@ void add_replay_command(CLI::App& app) {
         ->required();
     cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
-    cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required();
+    cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")->required();
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
         ->check(CLI::Range(0.0, 0.5));

@@ -270,6 +270,11 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
     }
     diag.summarize();
+    if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
+        throw InputError(opt.in, 1, 1,
+                         "every one of the " + std::to_string(sum.malformed) +
+                             " data rows is malformed (--skip-bad dropped them all): nothing written");
+    }
     out.commit();
     return sum;
 }

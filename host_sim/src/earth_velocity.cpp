@@ -35,8 +35,11 @@ bool in_ephemeris_span(double t) noexcept {
 namespace {
 
 constexpr int kCoefficients = EarthVelocity::kDegree + 1;
+// 73049 days: 4566 segments, the last one reaching past 2100 (evaluated
+// there by eraEpv00 all the same; at() refuses times beyond kEphemerisEndT).
 constexpr std::size_t kSegments =
-    static_cast<std::size_t>((kEphemerisEndT - kEphemerisFirstT) / EarthVelocity::kSegmentS);  // 73049 days
+    static_cast<std::size_t>((kEphemerisEndT - kEphemerisFirstT) / EarthVelocity::kSegmentS) + 1;
+constexpr std::size_t kFillLocks = 64;
 
 // Chebyshev coefficients of vx, vy, vz (km/s) and the Sun distance (au) over
 // one day, in x = 2(t − t_start)/L − 1 ∈ [−1, 1].
@@ -53,7 +56,7 @@ public:
     }
     const Segment& segment(std::size_t i) {
         if (!ready_[i].load(std::memory_order_acquire)) {
-            const std::lock_guard<std::mutex> lock(fill_);
+            const std::lock_guard<std::mutex> lock(fill_[i % kFillLocks]);
             if (!ready_[i].load(std::memory_order_relaxed)) {
                 fill(i, segments_[i]);
                 ready_[i].store(true, std::memory_order_release);
@@ -92,7 +95,7 @@ private:
 
     std::unique_ptr<Segment[]> segments_;  // not value-initialised: pages are touched only when used
     std::unique_ptr<std::atomic<bool>[]> ready_;
-    std::mutex fill_;
+    std::array<std::mutex, kFillLocks> fill_;  // threads fill different segments at once
 };
 
 Table& table() {

@@ -97,8 +97,25 @@ const char* drop_name(Drop d) noexcept {
     return "?";
 }
 
+// NaN, zero or negative thresholds would silently accept or refuse everything.
+void refuse_bad_fit_options(const FitOptions& opt) {
+    if (opt.from && !std::isfinite(*opt.from)) {
+        throw FitRefused("--from " + std::to_string(*opt.from) + ": not a finite time");
+    }
+    if (opt.to && !std::isfinite(*opt.to)) {
+        throw FitRefused("--to " + std::to_string(*opt.to) + ": not a finite time");
+    }
+    if (!(opt.min_span_days > 0.0 && std::isfinite(opt.min_span_days))) {
+        throw FitRefused("--min-days " + std::to_string(opt.min_span_days) + ": must be a positive number of days");
+    }
+    if (!(opt.max_condition > 0.0) || std::isnan(opt.max_condition)) {
+        throw FitRefused("--max-condition " + std::to_string(opt.max_condition) + ": must be positive");
+    }
+}
+
 FitReport fit_model(const FitOptions& opt) {
     refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
+    refuse_bad_fit_options(opt);
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/epochs.hpp"
 #include "ascorr_host/stats.hpp"
 
 extern char** environ;
@@ -105,6 +106,7 @@ std::string read_all(const std::filesystem::path& p) {
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
+    refuse_bad_time_range(opt.period_from, opt.period_to);
     StatsOptions so;
     so.in = opt.in;
     so.model = opt.model;

@@ -32,6 +32,7 @@ struct Row {
 
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
+    refuse_bad_time_range(opt.from, opt.to);
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));

@@ -8,21 +8,24 @@
 // (status 4 + 32): a time in milliseconds, say, is not silently corrected.
 //
 // eraEpv00 sums a few thousand terms (~7 µs here), too slow to call for each
-// of a million solutions. So the span is cut into days, and each day's
-// velocity and Sun distance are a Chebyshev series of degree kDegree fitted
-// at its kDegree + 1 Chebyshev nodes (interpolation at the nodes). The cost of
-// a row does not depend on row order or time span: the day's segment is found
-// by direct indexing into one table for the whole span, filled on first use
-// (kDegree + 1 eraEpv00 calls per day touched, once per process) and shared
-// by all threads (a segment is published with a release store after it is
-// filled under a mutex; readers check it with an acquire load).
+// of a million solutions. So the span is cut into segments of kSegmentS (16
+// days), and each segment's velocity and Sun distance are a Chebyshev series
+// of degree kDegree, interpolating eraEpv00 at its kDegree + 1 Chebyshev
+// nodes. The cost of a row does not depend on row order or time span: its
+// segment is found by direct indexing into one table for the whole span,
+// filled on first use (kDegree + 1 = 16 eraEpv00 calls per segment touched,
+// one per day, once per process) and shared by all threads (a segment is
+// filled under one of 64 striped mutexes and published with a release store;
+// readers check it with an acquire load).
 //
 // Truncation: the fastest terms of the Earth's barycentric velocity are the
-// lunar monthly wobble (0.0126 km/s, 27.3 d) and the yearly motion (30 km/s);
-// for a day, ωL/2 ≤ 0.115 and the degree-7 interpolation error is below
-// A·(ωL/2)^8/(2^7·8!) ≈ 7e-17 km/s for the Moon's term, so what remains is
-// rounding and the series' own short terms: measured ≤ 1.4e-11 km/s (1e-11") against direct calls,
-// tests/test_earth_velocity.cpp (bound 1e-10 km/s in the test).
+// lunar ones (monthly, 0.0126 km/s; half-monthly, ~1e-4 km/s); for
+// L = 16 days and the half-monthly term ωL/2 ≈ 3.7, the degree-15 error
+// bound A·(ωL/2)^16/(2^15·16!) is ~3e-9 km/s. Measured against direct calls:
+// ≤ 1.8e-9 km/s (1.2e-9" of aberration) and 7.5e-13 au; the test,
+// tests/test_earth_velocity.cpp, bounds them at 5e-9 km/s and 5e-12 au.
+// (Other choices measured: 1 day/degree 7, 7e-12 km/s at 8 calls a day;
+// 8 days/degree 11, 1.3e-10 km/s at 1.5; 32 days/degree 19, 4.6e-7 km/s.)
 #pragma once
 
 #include <cstdint>
@@ -49,8 +52,8 @@ bool in_ephemeris_span(double t) noexcept;
 
 class EarthVelocity {
 public:
-    static constexpr int kDegree = 7;
-    static constexpr double kSegmentS = 86400.0;
+    static constexpr int kDegree = 15;
+    static constexpr double kSegmentS = 16.0 * 86400.0;
     // Thread-safe; all instances share one table.
     EarthState at(double t) const;
 };
