@@ -32,7 +32,8 @@ std::string slurp(const fs::path& p) {
 
 CliRun run(const std::string& args, const fs::path& dir) {
     const fs::path err = dir / "stderr.txt";
-    const std::string cmd = "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
+    const std::string cmd =
+        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
     const int rc = std::system(cmd.c_str());
     return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
 }
@@ -60,8 +61,7 @@ TEST(Refusals, ATimeOutsideTheEphemerisIsFlaggedNotCorrected) {
     const CliRun r = run("correct --in in.csv --out out.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(statuses(dir / "out.csv"), (std::vector<int>{1, 4 | 32, 4 | 32}));
-    EXPECT_NE(r.err.find("in.csv:3: t = 750000000000 s is outside the span of the Earth ephemeris"),
-              std::string::npos)
+    EXPECT_NE(r.err.find("in.csv:3: t = 750000000000 s is outside the span of the Earth ephemeris"), std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find("in.csv:4: t = -3200000000 s is outside"), std::string::npos) << r.err;
 }
@@ -181,6 +181,55 @@ TEST(Refusals, TheFloorFileIsValidJsonWithNullForEmptyPairs) {
     EXPECT_NE(json.find("\"A-C\": {\"rms\": null, \"rms_200s\": null, \"n\": 0}"), std::string::npos) << json;
     EXPECT_NE(json.find("\"A-B\": {\"rms\": 1."), std::string::npos) << json;
     EXPECT_EQ(json.find("nan"), std::string::npos) << json;
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+TEST(Refusals, AUtf8ByteOrderMarkIsAcceptedByEveryReader) {
+    const fs::path dir = scratch_dir("bom");
+    const std::string bom = "\xEF\xBB\xBF";
+    std::ofstream(dir / "s.csv", std::ios::binary) << bom << slurp(data_path("solutions.csv"));
+    std::ofstream(dir / "m.csv", std::ios::binary) << bom << slurp(data_path("model_table2.csv"));
+    const std::string ex = ASCORR_HAL_EXAMPLES;
+    std::ofstream(dir / "board.cfg", std::ios::binary) << bom << slurp(ex + "/board.cfg");
+    std::ofstream(dir / "rec.csv", std::ios::binary) << bom << slurp(ex + "/replay.csv");
+    const std::string model = data_path("model_table2.csv");
+    ASSERT_EQ(run("correct --in " + data_path("solutions.csv") + " --model " + model + " --out ref.csv", dir).exit_code,
+              0);
+    const CliRun r = run("correct --in s.csv --model m.csv --out bom.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "bom.csv"), slurp(dir / "ref.csv"));  // the mark is not copied into the output
+    ASSERT_EQ(
+        run("thermistors --config " + ex + "/board.cfg --replay " + ex + "/replay.csv > t_ref.csv", dir).exit_code, 0);
+    const CliRun t = run("thermistors --config board.cfg --replay rec.csv > t_bom.csv", dir);
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    EXPECT_EQ(slurp(dir / "t_bom.csv"), slurp(dir / "t_ref.csv"));
+}
+
+TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
+    const fs::path dir = scratch_dir("messages");
+    fs::create_directories(dir / "d");
+    const CliRun r = run("correct --in d --out out.csv", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("d: is a directory, not a file"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
+    const CliRun m = run("correct --in missing.csv --out out.csv", dir);
+    EXPECT_EQ(m.exit_code, 1);
+    EXPECT_NE(m.err.find("missing.csv: cannot open"), std::string::npos) << m.err;
+    std::string text = slurp(data_path("solutions.csv"));
+    for (char& c : text) {
+        c = c == '\n' ? '\r' : c;
+    }
+    std::ofstream(dir / "mac.csv", std::ios::binary) << text;
+    const CliRun c = run("correct --in mac.csv --out out.csv", dir);
+    EXPECT_EQ(c.exit_code, 1);
+    EXPECT_NE(c.err.find("mac.csv:1:"), std::string::npos) << c.err;
+    EXPECT_NE(c.err.find("CR-only line ends"), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(dir / "out.csv"));
 }
 
 }  // namespace
