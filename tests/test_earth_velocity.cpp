@@ -53,8 +53,7 @@ TEST(EarthVelocity, TableMatchesDirectCallsOverTheWholeSpan) {
 TEST(EarthVelocity, ATimeOutsideTheEphemerisIsInvalid) {
     const EarthVelocity earth;
     const double ms = 7.5e8 * 1000.0;  // 2023 given in milliseconds
-    for (const double t : {ms, -ms, kEphemerisEndT, std::nextafter(kEphemerisFirstT, -1e300), std::nan(""),
-                           HUGE_VAL}) {
+    for (const double t : {ms, -ms, kEphemerisEndT, std::nextafter(kEphemerisFirstT, -1e300), std::nan(""), HUGE_VAL}) {
         EXPECT_FALSE(earth.at(t).valid) << t;
         EXPECT_FALSE(in_ephemeris_span(t)) << t;
     }

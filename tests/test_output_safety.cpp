@@ -49,7 +49,8 @@ void write(const fs::path& p, const std::string& text) {
 // Runs `ascorr ARGS` through sh (ARGS may carry redirections of stdout).
 CliRun run(const std::string& args, const fs::path& dir) {
     const fs::path err = dir / "stderr.txt";
-    const std::string cmd = "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
+    const std::string cmd =
+        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
     const int rc = std::system(cmd.c_str());
     return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
 }
@@ -253,9 +254,9 @@ TEST(OutputSafety, ADirectoryOutputIsRefusedNamingTheOutput) {
 TEST(OutputSafety, ACorrectedFileFedBackIsRefused) {
     const fs::path dir = scratch_dir("twice");
     ASSERT_EQ(run("correct --in " + kSolutions + " --model " + kModel + " --out once.csv", dir).exit_code, 0);
-    for (const std::string& c : std::vector<std::string>
-         {"correct --in once.csv --out twice.csv", "fit --in once.csv --out m.csv", "stats --in once.csv",
-          "replay --target loopback-float --in once.csv --model " + kModel + " --out twice.csv"}) {
+    for (const std::string& c : std::vector<std::string>{
+             "correct --in once.csv --out twice.csv", "fit --in once.csv --out m.csv", "stats --in once.csv",
+             "replay --target loopback-float --in once.csv --model " + kModel + " --out twice.csv"}) {
         SCOPED_TRACE(c);
         const CliRun r = run(c, dir);
         EXPECT_EQ(r.exit_code, 1);
@@ -293,8 +294,8 @@ TEST(OutputSafety, ASignalledCorrectRemovesItsTemporaryFileAndKeepsTheOldOutput)
         fs::create_directories(dir);
         write(dir / "out.csv", "the previous output\n");
         ASSERT_EQ(::mkfifo((dir / "in.csv").c_str(), 0644), 0);
-        const pid_t pid = spawn({"correct", "--in", (dir / "in.csv").string(), "--out", (dir / "out.csv").string()},
-                                base);
+        const pid_t pid =
+            spawn({"correct", "--in", (dir / "in.csv").string(), "--out", (dir / "out.csv").string()}, base);
         const int wr = ::open((dir / "in.csv").c_str(), O_WRONLY);
         ASSERT_GE(wr, 0);
         // One block and a bit; the writer stops at EPIPE once the reader is gone.
@@ -329,8 +330,8 @@ TEST(OutputSafety, ASignalledPlotRemovesItsTemporaryFolderAndGnuplot) {
     ASSERT_EQ(run("simulate --days 1 --out sim.csv", dir).exit_code, 0);
     fs::create_directories(dir / "tmp");
     stand_in(dir / "bin", "gnuplot", dir / "gnuplot.pid");
-    const pid_t pid = spawn({"plot", "--in", (dir / "sim.csv").string(), "--model", (dir / "sim.csv.truth.csv").string(),
-                             "--out", (dir / "iba.png").string()},
+    const pid_t pid = spawn({"plot", "--in", (dir / "sim.csv").string(), "--model",
+                             (dir / "sim.csv.truth.csv").string(), "--out", (dir / "iba.png").string()},
                             dir, (dir / "bin").string(), (dir / "tmp").string());
     ASSERT_TRUE(eventually([&] { return fs::exists(dir / "gnuplot.pid"); })) << slurp(dir / "stderr.txt");
     ASSERT_FALSE(fs::is_empty(dir / "tmp"));  // the plot's folder, with its data files
@@ -349,10 +350,10 @@ TEST(OutputSafety, ReplaysEmulatorDiesWithItsParentEvenOnSigkill) {
     const fs::path dir = scratch_dir("pdeath");
     stand_in(dir / "bin", "qemu-system-arm", dir / "qemu.pid");
     write(dir / "image.elf", "not an image: the stand-in never reads it\n");
-    const pid_t pid = spawn({"replay", "--target", "qemu-m4f", "--firmware", (dir / "image.elf").string(), "--in",
-                             kSolutions, "--model", kModel, "--out", (dir / "out.csv").string(), "--timeout-ms",
-                             "60000"},
-                            dir, (dir / "bin").string());
+    const pid_t pid =
+        spawn({"replay", "--target", "qemu-m4f", "--firmware", (dir / "image.elf").string(), "--in", kSolutions,
+               "--model", kModel, "--out", (dir / "out.csv").string(), "--timeout-ms", "60000"},
+              dir, (dir / "bin").string());
     ASSERT_TRUE(eventually([&] { return fs::exists(dir / "qemu.pid"); })) << slurp(dir / "stderr.txt");
     const pid_t emulator = pid_in(dir / "qemu.pid");
     ASSERT_FALSE(process_gone(emulator));

@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <limits>
 
-#include "ascorr_host/atomic_file.hpp"
 #include <map>
 #include <sstream>
 #include <vector>
+#include "ascorr_host/atomic_file.hpp"
 
 #include "ascorr/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
@@ -97,6 +97,9 @@ const char* drop_name(Drop d) noexcept {
     return "?";
 }
 
+namespace {
+FitReport fit_pass(const FitOptions& opt, std::optional<double> earliest_period);
+
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
     if (opt.from && !std::isfinite(*opt.from)) {
@@ -112,6 +115,7 @@ void refuse_bad_fit_options(const FitOptions& opt) {
         throw FitRefused("--max-condition " + std::to_string(opt.max_condition) + ": must be positive");
     }
 }
+}  // namespace
 
 FitReport fit_model(const FitOptions& opt) {
     refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
@@ -123,12 +127,18 @@ FitReport fit_model(const FitOptions& opt) {
     if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
         throw FitRefused("--orbit-period must be in [600, 86400] s");
     }
+    return fit_pass(opt, std::nullopt);
+}
+
+namespace {
+FitReport fit_pass(const FitOptions& opt, std::optional<double> earliest_period) {
     EarthVelocity earth;
     const CorrectionConfig<double> ab_only{true, nullptr};
     // Row order must not matter (issue 11). The reference N_i is the earliest
     // epoch's (re-based exactly at the end), and the orbit period, when not
     // given, comes from the earliest selected row: if that is not the first
     // one read, the file is read again with that period (unordered files only).
+    // (earliest_period: that second reading.)
     FitReport r;
     std::optional<double> period;
     std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
@@ -138,13 +148,8 @@ FitReport fit_model(const FitOptions& opt) {
     double earliest_row_period = 0.0;
     std::map<long long, OrbitSums> orbits;
     bool any = false;
-    for (int pass = 0; pass < 2; ++pass) {
-    r = FitReport{};
-    reference = {};
-    orbits.clear();
-    any = false;
-    const bool period_given = opt.orbit_period_s.has_value() || pass == 1;
-    period = pass == 1 ? std::optional<double>(earliest_row_period) : opt.orbit_period_s;
+    const bool period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
+    period = earliest_period ? earliest_period : opt.orbit_period_s;
     bool any_row = false;
 
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
@@ -233,10 +238,9 @@ FitReport fit_model(const FitOptions& opt) {
         },
         "fit");
     epochs.finish();
-    if (period_given || !period || *period == earliest_row_period) {
-        break;
+    if (!period_given && period && *period != earliest_row_period) {
+        return fit_pass(opt, earliest_row_period);  // rows out of time order: again, with the earliest row's period
     }
-    }  // passes
     r.orbit_period_s = period.value_or(0.0);
     // Re-base on the earliest epoch: with b = earliest a, each epoch's small
     // angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
@@ -418,6 +422,8 @@ FitReport fit_model(const FitOptions& opt) {
     write_model_file(opt.out, r.model);
     return r;
 }
+
+}  // namespace
 
 std::string describe(const FitReport& r) {
     std::ostringstream o;

@@ -55,9 +55,10 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             known = known || name == c;
         }
         if (!known) {
-            throw InputError(file_name, 1, column,
-                             "unknown column '" + name +
-                                 "' (a model has chu, axis, c0, c1, c2, c3 and, for a quadratic one, c1_2, c2_2, c3_2)");
+            throw InputError(
+                file_name, 1, column,
+                "unknown column '" + name +
+                    "' (a model has chu, axis, c0, c1, c2, c3 and, for a quadratic one, c1_2, c2_2, c3_2)");
         }
         column += name.size() + 1;
     }
