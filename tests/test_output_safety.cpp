@@ -255,7 +255,7 @@ TEST(OutputSafety, ACorrectedFileFedBackIsRefused) {
     const fs::path dir = scratch_dir("twice");
     ASSERT_EQ(run("correct --in " + kSolutions + " --model " + kModel + " --out once.csv", dir).exit_code, 0);
     for (const std::string& c : std::vector<std::string>{
-             "correct --in once.csv --out twice.csv", "fit --in once.csv --out m.csv", "stats --in once.csv",
+             "correct --in once.csv --out twice.csv", "fit --in once.csv --out m.csv",
              "replay --target loopback-float --in once.csv --model " + kModel + " --out twice.csv"}) {
         SCOPED_TRACE(c);
         const CliRun r = run(c, dir);

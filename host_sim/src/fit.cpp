@@ -127,6 +127,7 @@ FitReport fit_model(const FitOptions& opt) {
     if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
         throw FitRefused("--orbit-period must be in [600, 86400] s");
     }
+    refuse_corrected_file(opt.in);  // fit applies the aberration itself: never twice
     return fit_pass(opt, std::nullopt);
 }
 

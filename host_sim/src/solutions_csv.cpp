@@ -167,4 +167,12 @@ std::string velocity_problem(const SolutionRecord& rec) {
     return {};
 }
 
+void refuse_corrected_file(const std::string& path) {
+    BlockReader blocks(path, 4096);
+    std::string_view block;
+    if (blocks.next(block)) {
+        refuse_corrected_input(SolutionsReader(path, block.substr(0, block.find('\n'))));
+    }
+}
+
 }  // namespace ascorr::host
