@@ -8,6 +8,12 @@
 
 namespace ascorr::cli {
 
+// Refuses an empty path (--model ""), which would otherwise read as "no model".
+inline CLI::Validator non_empty_path() {
+    return CLI::Validator(
+        [](std::string& s) { return s.empty() ? std::string("an empty path names no file") : std::string(); }, "FILE");
+}
+
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);
 void add_thermistors_command(CLI::App& app);

@@ -14,7 +14,8 @@ void add_correct_command(CLI::App& app) {
         app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
     cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all")->required();
-    cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage");
+    cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage")
+        ->check(non_empty_path());
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
     cmd->add_flag("!--no-thermal", opt->thermal, "skip the thermal stage");
     const std::map<std::string, host::Scalar> scalars{

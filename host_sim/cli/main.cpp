@@ -1,14 +1,20 @@
 // ascorr: thermal and aberration correction of µASC attitude solutions.
 //
 // Exit status: 0 when every output is complete; 1 for bad input or an I/O
-// error (the message names file, line and column); 2 for a usage error.
+// error (the message names file, line and column); 2 for a usage error;
+// ended by SIGINT, SIGTERM, SIGHUP or SIGPIPE: that signal (128 + signal in a
+// shell), with no temporary output left behind.
 #include <cstdio>
 #include <exception>
 #include <iostream>
 
+#include "ascorr_host/atomic_file.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
+    // SIGINT, SIGTERM, SIGHUP, SIGPIPE: temporary outputs removed, children
+    // killed, then the process ends by the signal (atomic_file.hpp).
+    ascorr::host::install_signal_cleanup();
     CLI::App app{"ascorr: thermal and aberration correction of uASC star-tracker attitude solutions"};
     app.require_subcommand(1);
     app.set_version_flag("--version", "ascorr 0.1.0");

@@ -14,7 +14,8 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--days", opt->days, "length of the mission in days (default 920, 2.5 years)");
     cmd->add_option("--step", opt->step_s, "time between epochs in s (default 60)");
     cmd->add_option("--seed", opt->seed, "random seed (default 1); the same seed gives the same file");
-    cmd->add_option("--truth", opt->truth, "truth thermal model (CSV); default: the paper's Table 2, built in");
+    cmd->add_option("--truth", opt->truth, "truth thermal model (CSV); default: the paper's Table 2, built in")
+        ->check(non_empty_path());
     cmd->add_option("--start", opt->start_t, "first epoch, s since J2000 TT (default 2014-06-16)");
     cmd->callback([opt]() {
         const host::SimulateSummary s = host::simulate(*opt);

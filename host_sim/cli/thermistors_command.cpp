@@ -23,6 +23,7 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_hal_linux/replay_source.hpp"
 #include "ascorr_hal_linux/simulated_source.hpp"
+#include "ascorr_host/atomic_file.hpp"
 #include "commands.hpp"
 #ifdef ASCORR_HAVE_GPIOD
 #include "ascorr_hal_linux/gpiod_backend.hpp"
@@ -78,6 +79,8 @@ void print_row(std::FILE* out, std::uint64_t t_us, const char* name, const char*
 }
 
 void run(const ThermistorOptions& opt) {
+    host::refuse_output_over_input({{"--config", opt.config}, {"--replay", opt.replay}, {"--simulate", opt.simulate}},
+                                   {}, true);
     const hal::HalConfig cfg_file = hal::read_config(opt.config);
     hal::HalConfig cfg = cfg_file;
     if (!opt.chip.empty()) {

@@ -65,8 +65,9 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
     }
     if ((st & status::kVelocityInvalid) != 0U) {
         if (rec.velocity_components != 3) {
-            diag.report("velocity incomplete", where(file, rec) + "only " + std::to_string(rec.velocity_components) +
-                                                   " of vx,vy,vz given: aberration skipped");
+            diag.report("velocity incomplete", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
+        } else if (!in_ephemeris_span(rec.t)) {
+            diag.report("outside the ephemeris", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
         } else if (!beta_in_domain(in.velocity.beta_icrf)) {
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
@@ -218,6 +219,7 @@ std::size_t worker_count() {
 
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
     std::optional<ThermalModel<T>> model;
     if (opt.thermal && !opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
@@ -234,6 +236,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         throw InputError(opt.in, 1, 1, "empty file: expected a header line");
     }
     const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
+    refuse_corrected_input(header);
     const RowWriter writer(header);
     Diagnostics diag(log);
     std::optional<StatesFile> states;
@@ -308,6 +311,11 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
     }
     diag.summarize();
+    if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
+        throw InputError(opt.in, 1, 1,
+                         "every one of the " + std::to_string(sum.malformed) +
+                             " data rows is malformed (--skip-bad dropped them all): nothing written");
+    }
     out.commit();
     return sum;
 }

@@ -15,10 +15,9 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
         r.service = v.status;
     }
     const CorrectedSolution<T> c = correct_solution(r.in, cfg);
-    r.status = c.status;
-    if (cfg.aberration && rec.velocity_components != 0 && rec.velocity_components != 3) {
-        r.status |= status::kVelocityInvalid;  // partial velocity: the core saw "not available"
-    }
+    // A velocity given but unusable before the core (1 or 2 of vx,vy,vz, a time
+    // outside the ephemeris): the core saw "not available", the row gets 4|32.
+    r.status = host_status(rec, cfg.aberration, c.status);
     r.status = with_service_status(r.status, r.service, r.from_states);
     if ((r.status & status::kRejected) == 0U) {
         const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };

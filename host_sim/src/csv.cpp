@@ -7,13 +7,25 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
+#include <system_error>
 
 #include "ascorr_host/input_error.hpp"
 
 namespace ascorr::host {
 
+namespace {
+void refuse_directory(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw InputError(path, 0, 0, "is a directory, not a file");
+    }
+}
+}  // namespace
+
 std::string read_text_file(const std::string& path) {
+    refuse_directory(path);
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) {
         throw InputError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
@@ -38,6 +50,7 @@ std::string read_text_file(const std::string& path) {
 
 BlockReader::BlockReader(std::string path, std::size_t block_bytes)
     : path_(std::move(path)), block_bytes_(block_bytes) {
+    refuse_directory(path_);
     f_ = std::fopen(path_.c_str(), "rb");
     if (f_ == nullptr) {
         throw InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
@@ -324,6 +337,14 @@ char* format_fixed(char* out, char* end, double x, int decimals) noexcept {
 }
 
 Header::Header(std::string_view line, const std::string& file) {
+    if (line.substr(0, 3) == "\xEF\xBB\xBF") {  // a UTF-8 byte-order mark (spreadsheet exports)
+        line.remove_prefix(3);
+    }
+    if (line.find('\r') != std::string_view::npos) {
+        throw InputError(file, 1, line.find('\r') + 1,
+                         "carriage return inside the header: the file has CR-only line ends (classic Mac); convert "
+                         "them to LF or CRLF");
+    }
     std::vector<std::string_view> fields;
     std::vector<std::size_t> starts;
     split_fields(line, fields, starts);

@@ -6,9 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+
 #include <map>
 #include <sstream>
 #include <vector>
+#include "ascorr_host/atomic_file.hpp"
 
 #include "ascorr/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
@@ -28,8 +30,13 @@ struct Row {
 };
 
 // Sums over one orbit of e_i and of the regressors, per head.
+// Sums over one orbit's epochs. q: the rotations a = q_head_f ⊗ r⁻¹ relative
+// to a provisional reference r (4-vectors, w ≥ 0); e: filled at the end, the
+// small angles relative to the final reference, derived exactly from q (see
+// fit_model), so that the result does not depend on which epoch came first.
 struct OrbitSums {
     std::size_t count = 0;
+    std::array<Eigen::Vector4d, 3> q{Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
@@ -91,7 +98,29 @@ const char* drop_name(Drop d) noexcept {
     return "?";
 }
 
+namespace {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period);
+
+// NaN, zero or negative thresholds would silently accept or refuse everything.
+void refuse_bad_fit_options(const FitOptions& opt) {
+    if (opt.from && !std::isfinite(*opt.from)) {
+        throw FitRefused("--from " + std::to_string(*opt.from) + ": not a finite time");
+    }
+    if (opt.to && !std::isfinite(*opt.to)) {
+        throw FitRefused("--to " + std::to_string(*opt.to) + ": not a finite time");
+    }
+    if (!(opt.min_span_days > 0.0 && std::isfinite(opt.min_span_days))) {
+        throw FitRefused("--min-days " + std::to_string(opt.min_span_days) + ": must be a positive number of days");
+    }
+    if (!(opt.max_condition > 0.0) || std::isnan(opt.max_condition)) {
+        throw FitRefused("--max-condition " + std::to_string(opt.max_condition) + ": must be positive");
+    }
+}
+}  // namespace
+
 FitReport fit_model(const FitOptions& opt) {
+    refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
+    refuse_corrected_file(opt.in);  // fit applies the aberration itself: never twice
     FitReport r = fit_model(
         opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "fit"); });
     write_model_file(opt.out, r.model);
@@ -99,6 +128,7 @@ FitReport fit_model(const FitOptions& opt) {
 }
 
 FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
+    refuse_bad_fit_options(opt);
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));
@@ -114,14 +144,31 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          std::to_string(opt.min_temperature_range_c));
     }
-    FitReport r;
+    return fit_pass(opt, rows, std::nullopt);
+}
+
+namespace {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period) {
     EarthVelocity earth;
     const CorrectionConfig<double> ab_only{true, nullptr};
-    std::optional<double> period = opt.orbit_period_s;
-    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // N_i
+    // Row order must not matter (issue 11). The reference N_i is the earliest
+    // epoch's (re-based exactly at the end), and the orbit period, when not
+    // given, comes from the earliest selected row: if that is not the first
+    // one read, the file is read again with that period (unordered files only).
+    // (earliest_period: that second reading.)
+    FitReport r;
+    std::optional<double> period;
+    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
+    std::array<Eigen::Quaterniond, 3> earliest_a;                // the earliest epoch's a
+    double earliest_epoch = 0.0;
+    double earliest_row = 0.0;
+    double earliest_row_period = 0.0;
     std::map<long long, OrbitSums> orbits;
     std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
     bool any = false;
+    const bool period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
+    period = earliest_period ? earliest_period : opt.orbit_period_s;
+    bool any_row = false;
 
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
         if (!(e.head[0] && e.head[1] && e.head[2])) {
@@ -150,7 +197,10 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
             if (d.w() < 0.0) {
                 d.coeffs() = -d.coeffs();
             }
-            o.e[h] += 2.0 * d.vec() * kRadToArcsec;  // small angle: error ~ θ³/24
+            o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+            if (!any || e.t < earliest_epoch) {
+                earliest_a[h] = d;
+            }
             const auto& t = e.head[h]->temp;
             o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
             o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
@@ -165,6 +215,9 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
             }
         }
         ++r.epochs;
+        if (!any || e.t < earliest_epoch) {
+            earliest_epoch = e.t;
+        }
         if (!any || e.t < r.t_first) {
             r.t_first = e.t;
         }
@@ -190,22 +243,43 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         if (d != Drop::kNone) {
             return;
         }
-        if (!period) {
+        if (!period_given && (!any_row || rec.t < earliest_row)) {
             const double v = std::sqrt(squared_norm(rec.v_sc_kms));
             if (!(v > 1.0 && v < 12.0)) {
                 throw InputError(opt.in, rec.line, 1,
                                  "spacecraft speed " + std::to_string(v) +
                                      " km/s is not that of an Earth orbit: give --orbit-period");
             }
-            period = 2.0 * kPi * kMuEarth / (v * v * v);
+            earliest_row = rec.t;
+            earliest_row_period = 2.0 * kPi * kMuEarth / (v * v * v);
+            if (!period) {
+                period = earliest_row_period;
+            }
         }
+        any_row = true;
         Row row;
         row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
         row.temp = rec.temperature;
         epochs.add(rec.t, rec.head, rec.line, row);
     });
     epochs.finish();
+    if (!period_given && period && *period != earliest_row_period) {
+        // Rows out of time order: again, with the earliest row's period.
+        return fit_pass(opt, rows, earliest_row_period);
+    }
     r.orbit_period_s = period.value_or(0.0);
+    // Re-base on the earliest epoch: with b = earliest a, each epoch's small
+    // angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
+    // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
+    for (std::size_t h = 0; h < 3 && r.epochs != 0; ++h) {
+        const Eigen::Quaterniond b_inv = earliest_a[h].conjugate();
+        for (auto& kv : orbits) {
+            const Eigen::Vector4d& s = kv.second.q[h];
+            const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
+            kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
+        }
+        reference[h] = (earliest_a[h] * *reference[h]).normalized();
+    }
 
     const std::string period_text = "t = " + time_text(r.t_first) + " .. " + time_text(r.t_last);
     if (r.epochs == 0) {
@@ -286,6 +360,8 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     return r;
 }
 
+}  // namespace
+
 std::string describe(const FitReport& r) {
     std::ostringstream o;
     char buf[400];
@@ -299,8 +375,10 @@ std::string describe(const FitReport& r) {
     o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
       << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
     o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
-         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their squares),\n"
-         "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by the\n"
+         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their "
+         "squares),\n"
+         "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by "
+         "the\n"
          "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
          "(9 directions), the one with the smallest corrections over the period is written.\n";
     const auto rank = static_cast<std::size_t>(r.fit.rank);

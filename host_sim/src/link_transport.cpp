@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <termios.h>
 #include <unistd.h>
@@ -12,6 +13,8 @@
 #include <chrono>
 #include <cstring>
 #include <stdexcept>
+
+#include "ascorr_host/atomic_file.hpp"
 
 namespace ascorr::host {
 
@@ -142,17 +145,24 @@ void ProcessTransport::start() {
         args.push_back(a.data());
     }
     args.push_back(nullptr);
+    const pid_t parent = ::getpid();
     pid_ = ::fork();
     if (pid_ < 0) {
         sys_error("fork");
     }
     if (pid_ == 0) {
+        // Die with the parent, even when it is SIGKILLed; if it died before
+        // prctl took effect, we have been reparented already: leave now.
+        if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) {
+            ::_exit(127);
+        }
         ::dup2(in[0], STDIN_FILENO);
         ::dup2(out[1], STDOUT_FILENO);
         ::execvp(args[0], args.data());
         std::fprintf(stderr, "ascorr: cannot run %s: %s\n", args[0], std::strerror(errno));
         ::_exit(127);
     }
+    cleanup_slot_ = cleanup_register_child(pid_);
     ::close(in[0]);
     ::close(out[1]);
     to_child_ = in[1];
@@ -173,6 +183,8 @@ void ProcessTransport::stop() {
         ::kill(pid_, SIGTERM);
         int status = 0;
         ::waitpid(pid_, &status, 0);
+        cleanup_release(cleanup_slot_);
+        cleanup_slot_ = -1;
         pid_ = -1;
     }
 }

@@ -47,6 +47,21 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
     if (col_chu < 0 || col_axis < 0 || col_c[0] < 0 || col_c[1] < 0 || col_c[2] < 0 || col_c[3] < 0) {
         throw InputError(file_name, 1, 1, "the model header must have chu,axis,c0,c1,c2,c3");
     }
+    // An unknown column is a misspelt coefficient (e.g. c1_2x): never dropped silently.
+    std::size_t column = 1;
+    for (const std::string& name : header.names()) {
+        bool known = name == "chu" || name == "axis";
+        for (const char* c : kCoefficientNames) {
+            known = known || name == c;
+        }
+        if (!known) {
+            throw InputError(
+                file_name, 1, column,
+                "unknown column '" + name +
+                    "' (a model has chu, axis, c0, c1, c2, c3 and, for a quadratic one, c1_2, c2_2, c3_2)");
+        }
+        column += name.size() + 1;
+    }
 
     ModelFile m;
     m.quadratic = col_c[4] >= 0 || col_c[5] >= 0 || col_c[6] >= 0;

@@ -15,6 +15,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/epochs.hpp"
 #include "ascorr_host/stats.hpp"
 
 extern char** environ;
@@ -38,13 +40,19 @@ int run_gnuplot(const std::string& exe, const std::string& script, const std::st
     if (rc != 0) {
         return -1;
     }
+    const int slot = cleanup_register_child(pid);  // killed, should a signal end us
     int st = 0;
-    if (waitpid(pid, &st, 0) != pid) {
+    const pid_t waited = waitpid(pid, &st, 0);
+    cleanup_release(slot);
+    if (waited != pid) {
         return -1;
     }
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+// The plot's working folder. Removed with its files on return, on an
+// exception and on a signal: the folder and every file name used in it are in
+// the signal-cleanup table (atomic_file.hpp) while it exists.
 class TempDir {
 public:
     TempDir() {
@@ -53,21 +61,43 @@ public:
             throw std::runtime_error("cannot create a temporary directory for the plot");
         }
         path_ = tmpl;
+        slots_.push_back(cleanup_register_folder(tmpl));
     }
     ~TempDir() {
         std::error_code ec;
         std::filesystem::remove_all(path_, ec);
+        release();
     }
     TempDir(const TempDir&) = delete;
     TempDir& operator=(const TempDir&) = delete;
     const std::filesystem::path& path() const { return path_; }
+    // A file in the folder, registered for removal on a signal.
+    std::filesystem::path file(const std::string& name) {
+        const std::filesystem::path p = path_ / name;
+        for (const auto& known : files_) {
+            if (known == p) {
+                return p;
+            }
+        }
+        slots_.push_back(cleanup_register_file(p.string()));
+        files_.push_back(p);
+        return p;
+    }
 
 private:
+    void release() noexcept {
+        for (const int s : slots_) {
+            cleanup_release(s);
+        }
+        slots_.clear();
+    }
     std::filesystem::path path_;
+    std::vector<std::filesystem::path> files_;
+    std::vector<int> slots_;
 };
 
 std::string read_all(const std::filesystem::path& p) {
-    std::ifstream f(p);
+    std::ifstream f(p, std::ios::binary);
     std::stringstream s;
     s << f.rdbuf();
     return s.str();
@@ -139,6 +169,8 @@ void check_window(const PlotOptions& opt) {
 }  // namespace
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
+    refuse_bad_time_range(opt.period_from, opt.period_to);
     StatsOptions so;
     so.in = opt.in;
     so.model = opt.model;
@@ -168,7 +200,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
             }
             mean[k] /= static_cast<double>(s.t.size());
         }
-        std::ofstream f(dir.path() / ("pair" + std::to_string(p) + ".dat"));
+        std::ofstream f(dir.file(("pair" + std::to_string(p) + ".dat")));
         if (window) {
             write_smoothed(f, s, mean);
         } else {
@@ -185,16 +217,16 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         t_lo = std::min(t_lo, s.t.front());
         t_hi = std::max(t_hi, s.t.back());
     }
-    const std::filesystem::path temps = dir.path() / "temperatures.dat";
+    const std::filesystem::path temps = dir.file("temperatures.dat");
     if (opt.temperatures) {
         write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
                                  kJ2000Unix);
     }
     const std::size_t rows = kPairs + (opt.temperatures ? 2 : 0);
 
-    const std::filesystem::path png = dir.path() / "plot.png";
+    const std::filesystem::path png = dir.file("plot.png");
     const auto write_script = [&](const char* terminal) {
-        std::ofstream g(dir.path() / "plot.gp");
+        std::ofstream g(dir.file("plot.gp"));
         g.precision(12);
         g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(rows)
           << (opt.width < 1000 ? " font ',8'" : "") << "\n";
@@ -233,7 +265,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                 } else {
                     std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
-                g << (k ? ", " : "") << "'" << (dir.path() / ("pair" + std::to_string(p) + ".dat")).string()
+                g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
                   << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
             }
             g << '\n';
@@ -251,31 +283,21 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         }
         g << "unset multiplot\n";
     };
-    const std::string gp_log = (dir.path() / "gnuplot.log").string();
+    const std::string gp_log = (dir.file("gnuplot.log")).string();
     write_script("pngcairo");
-    int rc = run_gnuplot(opt.gnuplot, (dir.path() / "plot.gp").string(), gp_log);
+    int rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
     if (rc == -1) {
         throw std::runtime_error("cannot run '" + opt.gnuplot + "' (Debian package gnuplot-nox)");
     }
     if (rc != 0 || !std::filesystem::exists(png)) {
         write_script("png");  // a gnuplot built without cairo
-        rc = run_gnuplot(opt.gnuplot, (dir.path() / "plot.gp").string(), gp_log);
+        rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
     }
     if (rc != 0 || !std::filesystem::exists(png)) {
         throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
     }
-    // Copy beside the target, then rename: whole or absent.
-    const std::filesystem::path target(opt.out);
-    const std::filesystem::path tmp = target.string() + ".tmp-" + std::to_string(::getpid());
-    std::error_code ec;
-    std::filesystem::copy_file(png, tmp, std::filesystem::copy_options::overwrite_existing, ec);
-    if (!ec) {
-        std::filesystem::rename(tmp, target, ec);
-    }
-    if (ec) {
-        std::filesystem::remove(tmp);
-        throw std::runtime_error("cannot write " + opt.out + ": " + ec.message());
-    }
+    // Whole or absent, through links, into streams (AtomicFile).
+    write_file_atomically(opt.out, read_all(png));
 }
 
 }  // namespace ascorr::host

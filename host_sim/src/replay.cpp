@@ -65,6 +65,7 @@ template <typename T>
 ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const std::string text = read_text_file(opt.in);
     SolutionsReader reader(opt.in, text);
+    refuse_corrected_input(reader);
     const ModelFile mf = read_model_file(opt.model);
     if constexpr (std::is_same_v<T, Q30>) {
         check_fixed_point_range(mf, opt.model);  // refused before the target sees it, as by `correct`
@@ -166,10 +167,16 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
             instructions += got.instructions;
             ++costed;
         }
+        // The bits the host adds (velocity given but unusable before the core
+        // sees it), as `ascorr correct` does.
+        const StatusBits written = host_status(rec, true, got.status);
+        if (written != got.status && sum.frames <= 20) {
+            log << opt.in << ":" << rec.line << ": " << velocity_problem(rec) << ": aberration skipped\n";
+        }
         if ((got.status & status::kRejected) != 0U) {
-            writer.row(reader, std::nullopt, got.status, buf);
+            writer.row(reader, std::nullopt, written, buf);
         } else {
-            writer.row(reader, widen(got.q_chu_icrf), got.status, buf);
+            writer.row(reader, widen(got.q_chu_icrf), written, buf);
         }
         ++id;
     }
@@ -189,6 +196,8 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
 }  // namespace
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}},
+                             {{"--out", opt.out}}, true);
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never

@@ -177,8 +177,15 @@ std::string floor_json(const std::array<Rms, kPairs>& floor) {
     s.precision(6);
     s << std::fixed << "{\"floor\": {";
     for (std::size_t p = 0; p < kPairs; ++p) {
-        s << (p ? ", " : "") << '"' << kPairNames[p] << "\": {\"rms\": " << floor[p].rms
-          << ", \"rms_200s\": " << floor[p].rms_smoothed << ", \"n\": " << floor[p].n << '}';
+        // A pair without clean epochs has no RMS: null (JSON has no NaN either).
+        const auto value = [n = floor[p].n](double x) {
+            std::ostringstream v;
+            v.precision(6);
+            v << std::fixed << x;
+            return n != 0 && std::isfinite(x) ? v.str() : std::string("null");
+        };
+        s << (p ? ", " : "") << '"' << kPairNames[p] << "\": {\"rms\": " << value(floor[p].rms)
+          << ", \"rms_200s\": " << value(floor[p].rms_smoothed) << ", \"n\": " << floor[p].n << '}';
     }
     s << "}}\n";
     return s.str();
@@ -202,12 +209,19 @@ std::string describe(const SimulateSummary& s) {
 }
 
 SimulateSummary simulate(const SimulateOptions& opt) {
+    refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
+                                                        {"--out (truth model)", opt.out + ".truth.csv"},
+                                                        {"--out (noise floor)", opt.out + ".floor.json"}});
     if (!(opt.days > 0.0 && opt.days <= 36600.0)) {
         throw std::invalid_argument("--days must be in (0, 36600], got " + std::to_string(opt.days));
     }
     if (!(opt.step_s >= 1.0 && opt.step_s <= 600.0)) {
         throw std::invalid_argument("--step must be in [1, 600] s (the orbit must be resolved), got " +
                                     std::to_string(opt.step_s));
+    }
+    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kDay)) {
+        throw std::invalid_argument("--start " + std::to_string(opt.start_t) +
+                                    ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
     }
     const ModelFile truth_file = opt.truth.empty() ? table2_model() : read_model_file(opt.truth);
     for (std::size_t h = 0; h < 3; ++h) {

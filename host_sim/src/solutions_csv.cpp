@@ -1,8 +1,11 @@
 #include "ascorr_host/solutions_csv.hpp"
 
 #include <cmath>
+#include <cstdio>
 
+#include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/input_error.hpp"
+#include "ascorr_host/solution_input.hpp"
 
 namespace ascorr::host {
 
@@ -134,6 +137,42 @@ bool SolutionsReader::next(SolutionRecord& rec) {
     rec.confidence = 0.0;
     rec.confidence_present = optional_number(col_.confidence, "confidence", rec.confidence);
     return true;
+}
+
+void refuse_corrected_input(const SolutionsReader& header) {
+    const int col = header.header().index("status");
+    if (col >= 0) {
+        std::size_t column = 1;  // character column of the name in the header line
+        for (int i = 0; i < col; ++i) {
+            column += header.header().names()[static_cast<std::size_t>(i)].size() + 1;
+        }
+        throw InputError(header.file_name(), 1, column,
+                         "column 'status': this file is already corrected (it has the status column of a corrected "
+                         "file); give the raw solutions file, so that no correction is applied twice");
+    }
+}
+
+std::string velocity_problem(const SolutionRecord& rec) {
+    if (rec.velocity_components != 0 && rec.velocity_components != 3) {
+        return "only " + std::to_string(rec.velocity_components) + " of vx,vy,vz given";
+    }
+    if (rec.velocity_components == 3 && !in_ephemeris_span(rec.t)) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "t = %.17g s is outside the span of the Earth ephemeris (1900-2100, %.4g .. %.4g s since "
+                      "J2000 TT; a time in ms?)",
+                      rec.t, kEphemerisFirstT, kEphemerisEndT);
+        return buf;
+    }
+    return {};
+}
+
+void refuse_corrected_file(const std::string& path) {
+    BlockReader blocks(path, 4096);
+    std::string_view block;
+    if (blocks.next(block)) {
+        refuse_corrected_input(SolutionsReader(path, block.substr(0, block.find('\n'))));
+    }
 }
 
 }  // namespace ascorr::host

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "ascorr/correct.hpp"
+#include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/epochs.hpp"
@@ -30,6 +31,8 @@ struct Row {
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
+    refuse_bad_time_range(opt.from, opt.to);
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));

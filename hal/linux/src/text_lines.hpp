@@ -16,7 +16,12 @@ namespace ascorr::hal::linux_detail {
 
 class TextLines {
 public:
-    explicit TextLines(std::string_view text) : text_(text) {}
+    // A UTF-8 byte-order mark at the start is skipped (spreadsheet exports).
+    explicit TextLines(std::string_view text) : text_(text) {
+        if (text_.substr(0, 3) == "\xEF\xBB\xBF") {
+            text_.remove_prefix(3);
+        }
+    }
 
     // The next line, without its end; false at the end of the text.
     bool next(std::string_view& line) {

@@ -32,6 +32,11 @@ void for_each_solution(const std::string& path, const std::function<void(const S
 // passes arrays (python/src/module.cpp).
 using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
 
+// Refuses a NaN or infinite --from/--to and --from not before --to
+// (std::invalid_argument naming the options), as fit, stats and plot share.
+void refuse_bad_time_range(const std::optional<double>& from, const std::optional<double>& to,
+                           const char* from_name = "--from", const char* to_name = "--to");
+
 template <typename Payload>
 struct Epoch {
     double t = 0.0;

@@ -10,10 +10,13 @@
 
 namespace ascorr::host {
 
+// line or column 0 means "not about a line" (or column): it is left out of
+// the message, which then reads file: or file:line:, never file:0:0:.
 class InputError : public std::runtime_error {
 public:
     InputError(std::string file, std::size_t line, std::size_t column, const std::string& what)
-        : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what),
+        : std::runtime_error(file + (line == 0 ? std::string() : ":" + std::to_string(line)) +
+                             (line == 0 || column == 0 ? std::string() : ":" + std::to_string(column)) + ": " + what),
           file_(std::move(file)),
           line_(line),
           column_(column) {}

@@ -43,6 +43,9 @@ private:
 };
 
 // A child process whose stdin/stdout carry the link (stderr is left alone).
+// The child never outlives us: it is killed by the signal cleanup
+// (atomic_file.hpp) and, should we be SIGKILLed, by PR_SET_PDEATHSIG (which
+// fires when the thread that forked it ends: start it from the main thread).
 class ProcessTransport final : public Transport {
 public:
     explicit ProcessTransport(const std::vector<std::string>& argv);
@@ -57,6 +60,7 @@ private:
     void stop();
     std::vector<std::string> argv_;
     pid_t pid_ = -1;
+    int cleanup_slot_ = -1;
     int to_child_ = -1;
     int from_child_ = -1;
 };

@@ -6,6 +6,8 @@
 // so that the core sees exactly what a DPU would be given.
 #pragma once
 
+#include <string>
+
 #include "ascorr/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/solutions_csv.hpp"
@@ -25,8 +27,9 @@ SolutionInput<T> to_core_input(const SolutionRecord& rec, EarthVelocity* earth) 
     in.velocity.valid = rec.velocity_components == 3 && earth != nullptr;
     in.velocity.beta_icrf = {s(0.0), s(0.0), s(0.0)};
     in.velocity.inv_sun_distance_au = s(1.0);
+    const EarthState e = in.velocity.valid ? earth->at(rec.t) : EarthState{};
+    in.velocity.valid = in.velocity.valid && e.valid;  // outside the ephemeris: see velocity_problem()
     if (in.velocity.valid) {
-        const EarthState e = earth->at(rec.t);
         const double inv_c = 1.0 / kSpeedOfLightKmS;
         in.velocity.beta_icrf = {s((e.v_bary_kms.x + rec.v_sc_kms.x) * inv_c),
                                  s((e.v_bary_kms.y + rec.v_sc_kms.y) * inv_c),
@@ -34,6 +37,17 @@ SolutionInput<T> to_core_input(const SolutionRecord& rec, EarthVelocity* earth) 
         in.velocity.inv_sun_distance_au = s(1.0 / e.sun_distance_au);
     }
     return in;
+}
+
+// Why a row's velocity, although given, could not reach the core: 1 or 2 of
+// vx,vy,vz only, or a time outside the span of the Earth ephemeris (1900–2100,
+// e.g. a time in ms). Empty when it could. Such a row gets status 32 on top of
+// the core's 4 (velocity given but unusable), in `correct` and `replay` alike.
+std::string velocity_problem(const SolutionRecord& rec);
+inline StatusBits host_status(const SolutionRecord& rec, bool aberration, StatusBits core_status) {
+    return aberration && (core_status & status::kNoVelocity) != 0U && !velocity_problem(rec).empty()
+               ? static_cast<StatusBits>(core_status | status::kVelocityInvalid)
+               : core_status;
 }
 
 }  // namespace ascorr::host

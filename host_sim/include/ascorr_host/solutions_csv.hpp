@@ -82,4 +82,13 @@ private:
     std::size_t empty_lines_ = 0;
 };
 
+// Throws InputError when the header has a `status` column: the file is already
+// corrected (formats.md), and correcting or fitting it again would apply the
+// corrections twice.
+// (`stats` and `plot` accept a corrected file: its "original" stage is then
+// the file as corrected.)
+void refuse_corrected_input(const SolutionsReader& header);
+// The same check on a file's header line, read alone.
+void refuse_corrected_file(const std::string& path);
+
 }  // namespace ascorr::host

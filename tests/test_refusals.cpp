@@ -1,0 +1,236 @@
+// Silent wrong results become flagged, and bad options are refused (issue 11,
+// items 4 and 5), through the `ascorr` executable.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+    int exit_code;
+    std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+CliRun run(const std::string& args, const fs::path& dir) {
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd =
+        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
+    const int rc = std::system(cmd.c_str());
+    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
+}
+
+// The status column of each row of a corrected file.
+std::vector<int> statuses(const fs::path& p) {
+    std::ifstream f(p);
+    std::vector<int> s;
+    std::string line;
+    std::getline(f, line);
+    while (std::getline(f, line)) {
+        s.push_back(std::stoi(line.substr(line.rfind(',') + 1)));
+    }
+    return s;
+}
+
+const std::string kHeader = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+const std::string kRow = "0.5,0.5,0.5,0.5,10.0,-8.0,-19.0";  // after t,chu
+
+TEST(Refusals, ATimeOutsideTheEphemerisIsFlaggedNotCorrected) {
+    const fs::path dir = scratch_dir("ephemeris");
+    std::ofstream(dir / "in.csv") << kHeader << "750000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"
+                                  << "750000000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"  // ms, not s
+                                  << "-3200000000.000,B," << kRow << ",1.0,2.0,3.0,0,1.00\n";  // before 1900
+    const CliRun r = run("correct --in in.csv --out out.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(statuses(dir / "out.csv"), (std::vector<int>{1, 4 | 32, 4 | 32}));
+    EXPECT_NE(r.err.find("in.csv:3: t = 750000000000 s is outside the span of the Earth ephemeris"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("in.csv:4: t = -3200000000 s is outside"), std::string::npos) << r.err;
+}
+
+TEST(Refusals, ReplayAndCorrectGiveTheSameStatusBits) {
+    const fs::path dir = scratch_dir("same-status");
+    std::ofstream(dir / "in.csv") << kHeader << "750000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"
+                                  << "750000001.000,A," << kRow << ",1.0,,3.0,0,1.00\n"  // incomplete velocity
+                                  << "750000002.000,B," << kRow << ",,,,0,1.00\n"        // none
+                                  << "750000000000.000,C," << kRow << ",1.0,2.0,3.0,0,1.00\n";
+    const std::string model = data_path("model_table2.csv");
+    ASSERT_EQ(run("correct --in in.csv --model " + model + " --out c.csv", dir).exit_code, 0);
+    const CliRun r = run("replay --target loopback-float --in in.csv --model " + model + " --out r.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(statuses(dir / "c.csv"), (std::vector<int>{3, 4 | 32 | 2, 4 | 2, 4 | 32 | 2}));
+    EXPECT_EQ(statuses(dir / "r.csv"), statuses(dir / "c.csv"));
+    EXPECT_NE(r.err.find("in.csv:3: only 2 of vx,vy,vz given: aberration skipped"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("in.csv:5: t = 750000000000 s is outside"), std::string::npos) << r.err;
+}
+
+TEST(Refusals, AModelWithAnUnknownColumnIsRefused) {
+    const fs::path dir = scratch_dir("model-column");
+    std::string text = slurp(data_path("model_table2.csv"));
+    const std::size_t nl = text.find('\n');
+    std::string header = text.substr(0, nl);
+    if (!header.empty() && header.back() == '\r') {
+        header.pop_back();
+    }
+    std::string body;
+    std::istringstream rows(text.substr(nl + 1));
+    for (std::string l; std::getline(rows, l);) {
+        if (!l.empty()) {
+            body += l + ",0.001\n";
+        }
+    }
+    std::ofstream(dir / "m.csv") << header << ",c1_2x\n" << body;  // a misspelt quadratic column
+    const CliRun r = run("correct --in " + data_path("solutions.csv") + " --model m.csv --out out.csv", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("m.csv:1:" + std::to_string(header.size() + 2) + ": unknown column 'c1_2x'"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
+TEST(Refusals, AnEmptyModelPathIsRefused) {
+    const fs::path dir = scratch_dir("empty-model");
+    for (const std::string& c :
+         std::vector<std::string>{"correct --in " + data_path("solutions.csv") + " --out out.csv --model ''",
+                                  "stats --in " + data_path("solutions.csv") + " --model ''",
+                                  "simulate --days 1 --out out.csv --truth ''"}) {
+        SCOPED_TRACE(c);
+        const CliRun r = run(c, dir);
+        EXPECT_EQ(r.exit_code, 2);  // a usage error
+        EXPECT_NE(r.err.find("an empty path names no file"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    }
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+TEST(Refusals, BadTimeRangesAndThresholdsAreRefused) {
+    const fs::path dir = scratch_dir("options");
+    const std::string in = data_path("solutions.csv");
+    const std::string model = data_path("model_table2.csv");
+    struct Case {
+        std::string args;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"stats --in " + in + " --from 5e8 --to 4e8", "is not before --to"},
+        {"stats --in " + in + " --from nan", "--from nan: not a finite time"},
+        {"plot --in " + in + " --model " + model + " --out p.png --from 5e8 --to 4e8", "is not before --to"},
+        {"plot --in " + in + " --model " + model + " --out p.png --from nan --to 4e8", "not a finite time"},
+        {"fit --in " + in + " --out m.csv --min-days nan", "--min-days nan: must be a positive number of days"},
+        {"fit --in " + in + " --out m.csv --min-days 0", "--min-days 0.000000: must be a positive"},
+        {"fit --in " + in + " --out m.csv --min-days -3", "must be a positive number of days"},
+        {"fit --in " + in + " --out m.csv --max-condition nan", "--max-condition nan: must be positive"},
+        {"fit --in " + in + " --out m.csv --max-condition -1", "must be positive"},
+        {"fit --in " + in + " --out m.csv --to nan", "--to nan: not a finite time"},
+        {"simulate --days 1 --out s.csv --start nan", "--start nan: the mission must lie within the Earth ephemeris"},
+        {"simulate --days 1 --out s.csv --start 1e13", "the mission must lie within the Earth ephemeris"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run(c.args, dir);
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "m.csv"));
+    EXPECT_FALSE(fs::exists(dir / "p.png"));
+    EXPECT_FALSE(fs::exists(dir / "s.csv"));
+}
+
+TEST(Refusals, SkipBadThatDropsEveryRowFails) {
+    const fs::path dir = scratch_dir("skip-all");
+    std::ofstream(dir / "in.csv") << kHeader << "x,A," << kRow << ",1,2,3,0,1.00\n"
+                                  << "750000000.0,A,nope,0.5,0.5,0.5,1,2,3,1,2,3,0,1.00\n";
+    const CliRun r = run("correct --in in.csv --out out.csv --skip-bad", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("every one of the 2 data rows is malformed"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    // One good row left: a success, the bad one reported.
+    std::ofstream(dir / "in.csv", std::ios::app) << "750000000.0,A," << kRow << ",1,2,3,0,1.00\n";
+    EXPECT_EQ(run("correct --in in.csv --out out.csv --skip-bad", dir).exit_code, 0);
+}
+
+TEST(Refusals, TheFloorFileIsValidJsonWithNullForEmptyPairs) {
+    const fs::path dir = scratch_dir("floor");
+    // Three minutes of mission: pair A-B has epochs, A-C and B-C none (C is
+    // blinded then), so they have no RMS.
+    ASSERT_EQ(run("simulate --days 0.002 --step 60 --out s.csv", dir).exit_code, 0);
+    const std::string json = slurp(dir / "s.csv.floor.json");
+    EXPECT_NE(json.find("\"A-C\": {\"rms\": null, \"rms_200s\": null, \"n\": 0}"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"A-B\": {\"rms\": 1."), std::string::npos) << json;
+    EXPECT_EQ(json.find("nan"), std::string::npos) << json;
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+TEST(Refusals, AUtf8ByteOrderMarkIsAcceptedByEveryReader) {
+    const fs::path dir = scratch_dir("bom");
+    const std::string bom = "\xEF\xBB\xBF";
+    std::ofstream(dir / "s.csv", std::ios::binary) << bom << slurp(data_path("solutions.csv"));
+    std::ofstream(dir / "m.csv", std::ios::binary) << bom << slurp(data_path("model_table2.csv"));
+    const std::string ex = ASCORR_HAL_EXAMPLES;
+    std::ofstream(dir / "board.cfg", std::ios::binary) << bom << slurp(ex + "/board.cfg");
+    std::ofstream(dir / "rec.csv", std::ios::binary) << bom << slurp(ex + "/replay.csv");
+    const std::string model = data_path("model_table2.csv");
+    ASSERT_EQ(run("correct --in " + data_path("solutions.csv") + " --model " + model + " --out ref.csv", dir).exit_code,
+              0);
+    const CliRun r = run("correct --in s.csv --model m.csv --out bom.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "bom.csv"), slurp(dir / "ref.csv"));  // the mark is not copied into the output
+    ASSERT_EQ(
+        run("thermistors --config " + ex + "/board.cfg --replay " + ex + "/replay.csv > t_ref.csv", dir).exit_code, 0);
+    const CliRun t = run("thermistors --config board.cfg --replay rec.csv > t_bom.csv", dir);
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    EXPECT_EQ(slurp(dir / "t_bom.csv"), slurp(dir / "t_ref.csv"));
+}
+
+TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
+    const fs::path dir = scratch_dir("messages");
+    fs::create_directories(dir / "d");
+    const CliRun r = run("correct --in d --out out.csv", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("d: is a directory, not a file"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
+    const CliRun m = run("correct --in missing.csv --out out.csv", dir);
+    EXPECT_EQ(m.exit_code, 1);
+    EXPECT_NE(m.err.find("missing.csv: cannot open"), std::string::npos) << m.err;
+    std::string text = slurp(data_path("solutions.csv"));
+    for (char& c : text) {
+        c = c == '\n' ? '\r' : c;
+    }
+    std::ofstream(dir / "mac.csv", std::ios::binary) << text;
+    const CliRun c = run("correct --in mac.csv --out out.csv", dir);
+    EXPECT_EQ(c.exit_code, 1);
+    EXPECT_NE(c.err.find("mac.csv:1:"), std::string::npos) << c.err;
+    EXPECT_NE(c.err.find("CR-only line ends"), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test
