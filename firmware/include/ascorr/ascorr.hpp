@@ -19,6 +19,7 @@
 // The on-board observer velocity (not included here; include velocity_service.hpp):
 //   tt_time.hpp        TT time tags in integer microseconds
 //   earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
+//   sincos.hpp         sin/cos in double with the same bits on every platform
 //   orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
 //   velocity_service.hpp   states in, ObserverVelocity<T> per solution out
 #pragma once

@@ -29,6 +29,7 @@
 #include <cstdint>
 
 #include "constants.hpp"
+#include "sincos.hpp"
 #include "tt_time.hpp"
 #include "vector3.hpp"
 
@@ -45,50 +46,6 @@ struct Matrix3 {
 
 constexpr Vector3<double> mul(const Matrix3& m, const Vector3<double>& v) noexcept {
     return {dot(m.row[0], v), dot(m.row[1], v), dot(m.row[2], v)};
-}
-
-// sin and cos of 2π·f, f any turn count with |f| < 2³¹: reduced to an octant
-// around a multiple of a quarter turn, then Taylor to x¹⁵ / x¹⁶ on |x| ≤ π/4,
-// whose truncation is ≤ (π/4)¹⁷/17! = 6.7e-17 / (π/4)¹⁸/18! = 3e-18.
-// Error ≤ 2e-16 + the reduction's f·2⁻⁵³ (θ's own rounding).
-struct SinCos {
-    double s;
-    double c;
-};
-constexpr SinCos sincos_turns(double f) noexcept {
-    const double q4 = 4.0 * f;
-    const std::int64_t quadrant = static_cast<std::int64_t>(q4 < 0.0 ? q4 - 0.5 : q4 + 0.5);
-    const double x = (q4 - static_cast<double>(quadrant)) * (0.5 * kPi);  // |x| ≤ π/4
-    const double x2 = x * x;
-    const double s =
-        x *
-        (1.0 - x2 * (1.0 / 6.0) *
-                   (1.0 - x2 * (1.0 / 20.0) *
-                              (1.0 - x2 * (1.0 / 42.0) *
-                                         (1.0 - x2 * (1.0 / 72.0) *
-                                                    (1.0 - x2 * (1.0 / 110.0) *
-                                                               (1.0 - x2 * (1.0 / 156.0) *
-                                                                          (1.0 - x2 * (1.0 / 210.0) *
-                                                                                     (1.0 - x2 * (1.0 / 272.0)))))))));
-    const double c =
-        1.0 - x2 * (1.0 / 2.0) *
-                  (1.0 - x2 * (1.0 / 12.0) *
-                             (1.0 - x2 * (1.0 / 30.0) *
-                                        (1.0 - x2 * (1.0 / 56.0) *
-                                                   (1.0 - x2 * (1.0 / 90.0) *
-                                                              (1.0 - x2 * (1.0 / 132.0) *
-                                                                         (1.0 - x2 * (1.0 / 182.0) *
-                                                                                    (1.0 - x2 * (1.0 / 240.0))))))));
-    switch (static_cast<unsigned>(quadrant & 3)) {
-        case 0U:
-            return {s, c};
-        case 1U:
-            return {c, -s};
-        case 2U:
-            return {-s, -c};
-        default:
-            return {-c, s};
-    }
 }
 
 // The Earth rotation angle in turns, in [0, 1), for a UT1 time in µs since

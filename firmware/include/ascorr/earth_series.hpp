@@ -67,7 +67,9 @@
 //
 // No allocation, no exceptions, no recursion; the loops have fixed trip counts
 // (the table's powers; its terms, each with its arguments and its coefficients);
-// std::sin, std::cos, std::remainder are called with finite arguments only.
+// std::remainder is called with finite arguments only; sin and cos come from
+// sincos.hpp (the same bits on every platform, which the link replay's
+// bit-for-bit comparison of host and DPU relies on).
 #pragma once
 
 #include <cmath>
@@ -75,6 +77,7 @@
 
 #include "constants.hpp"
 #include "earth_series_table.hpp"
+#include "sincos.hpp"
 #include "vector3.hpp"
 
 namespace ascorr {
@@ -106,9 +109,12 @@ inline bool earth_series_omitting(double t_tt_j2000_s, EarthBarycentric& out, in
     for (int p = 0; p < tb::kPowers; ++p) {
         const int j = tb::kPowerArgument[p];
         if (tb::kPowerMultiple[p] == 1) {
+            // remainder() is exact (IEEE 754), so a is the same on every
+            // platform; sincos_turns (sincos.hpp) then is too, unlike libm's.
             const double a = std::remainder(tb::kPhaseRad[j] + tb::kRateRadS[j] * t_tt_j2000_s, kTwoPi);
-            pc[p] = std::cos(a);
-            ps[p] = std::sin(a);
+            const SinCos sc = sincos_turns(a * (1.0 / kTwoPi));
+            pc[p] = sc.c;
+            ps[p] = sc.s;
         } else {  // z^m = z^(m-1)·z: slot p - 1 holds m - 1, kPowerSlot[j][0] holds z
             const int one = tb::kPowerSlot[j][0];
             pc[p] = pc[p - 1] * pc[one] - ps[p - 1] * ps[one];
