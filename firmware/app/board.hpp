@@ -45,4 +45,29 @@ inline void wait_for_interrupt() noexcept {
     __asm__ volatile("wfi" ::: "memory");
 }
 
+// PRIMASK: with interrupts masked an interrupt still wakes WFI (it stays
+// pending) but its handler runs only after unmask_interrupts().
+inline void mask_interrupts() noexcept {
+    __asm__ volatile("cpsid i" ::: "memory");
+}
+inline void unmask_interrupts() noexcept {
+    __asm__ volatile("cpsie i" ::: "memory");
+}
+
+// Sleeps until `counter` (advanced by an interrupt handler) differs from
+// `seen`, without the lost-wake-up race of check-then-sleep: the check and the
+// WFI run with interrupts masked, so a tick between them is pending and wakes
+// the WFI at once; the handler then runs when interrupts are unmasked.
+inline void sleep_until_changed(const volatile std::uint32_t& counter, std::uint32_t seen) noexcept {
+    for (;;) {  // one pass per interrupt taken while waiting
+        mask_interrupts();
+        if (counter != seen) {
+            unmask_interrupts();
+            return;
+        }
+        wait_for_interrupt();
+        unmask_interrupts();
+    }
+}
+
 }  // namespace ascorr::app::board

@@ -10,8 +10,12 @@
 // (velocity_entry.hpp), and keeps the corrected solutions for telemetry. Every
 // loop has a fixed trip count; the only wait is for the next tick. The work
 // of a cycle is measured in SysTick counts (core clocks; under QEMU's -icount
-// shift=0, 40 instructions each) and an overrun (work longer than a period) is
-// counted. ASCORR_APP_CYCLES > 0 ends the run after that many cycles with a
+// shift=0, 40 instructions each). Overruns are counted honestly: a cycle whose
+// work outlasts its period is one, and every further tick that passes before
+// the next cycle starts is one more (a period without its cycle). The wait for
+// the tick masks interrupts between its check and WFI (board.hpp,
+// sleep_until_changed), so a tick can never slip in between and cost a whole
+// period unseen. ASCORR_APP_CYCLES > 0 ends the run after that many cycles with a
 // report and exit status 0 (no overrun) or 1; 0 runs forever (flight).
 #include <cstdint>
 #include <cstring>
@@ -291,10 +295,15 @@ int main() {
     calibrate();
     std::uint32_t seen = g_ticks;
     for (std::uint32_t cycle = 0U; kCycles == 0U || cycle < kCycles; ++cycle) {
-        while (g_ticks == seen) {  // until the next 22 Hz tick
-            board::wait_for_interrupt();
+        board::sleep_until_changed(g_ticks, seen);  // the next 22 Hz tick (race-free: board.hpp)
+        const std::uint32_t start = g_ticks;
+        // Ticks that passed while the previous cycle overran: each is a period
+        // without its cycle, counted as an overrun (below, the overrunning
+        // cycle itself is counted once).
+        if (start - seen > 1U) {
+            g_stats.overruns += start - seen - 1U;
         }
-        seen = g_ticks;
+        seen = start;
         temperatures_update(cycle);
         take_states(cycle);
         correct_all_heads(cycle);

@@ -5,9 +5,9 @@
 // runs on the host and on the DPU, and the link replay compares their answers
 // bit for bit. Library sin/cos differ between C libraries (glibc, picolibc) in
 // the last bit for some arguments; this one is a fixed sequence of IEEE
-// additions and multiplications (no fused multiply-add: the project compiles
-// with -std=c++17, i.e. -ffp-contract=off), so every platform gets the same
-// bits.
+// double additions and multiplications. Double has no fused multiply-add on
+// either side (software double on the Cortex-M DPUs, SSE2 on x86-64), so every
+// platform gets the same bits.
 #pragma once
 
 #include <cstdint>
