@@ -23,6 +23,7 @@
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 #include "ascorr_host/states_csv.hpp"
 #include "ascorr_host/states_velocity.hpp"
