@@ -187,6 +187,28 @@ TEST(OutputSafety, FitPlotSimulateReplayAndThermistorsRefuseToOverwriteAnInput) 
 
 // ---- item 1: outputs that are not regular files, links, permissions ---------
 
+// The states file is an input too (issue 12's --states): correct and replay
+// refuse to write over it.
+TEST(OutputSafety, TheStatesFileIsAnInputCorrectAndReplayDoNotOverwrite) {
+    const fs::path dir = scratch_dir("same-states");
+    fs::copy_file(kSolutions, dir / "s.csv");
+    fs::copy_file(kModel, dir / "m.csv");
+    {
+        std::ofstream st(dir / "st.csv");
+        st << "t,x,y,z,vx,vy,vz\n447534180.184,6838.0,0.0,0.0,0.0,1.0,7.5\n";
+    }
+    const std::string before = slurp(dir / "st.csv");
+    for (const std::string& c : {std::string("correct --in s.csv --states st.csv --out st.csv"),
+                                 std::string("replay --target loopback-float --in s.csv --model m.csv "
+                                             "--states st.csv --out st.csv")}) {
+        SCOPED_TRACE(c);
+        const CliRun r = run(c, dir);
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_NE(r.err.find("--states"), std::string::npos) << r.err;
+        EXPECT_EQ(slurp(dir / "st.csv"), before);
+    }
+}
+
 TEST(OutputSafety, DashAndDevStdoutAreStreamsNotFiles) {
     const fs::path dir = scratch_dir("dash");
     ASSERT_EQ(run("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);

@@ -9,9 +9,11 @@
 # `target`:
 #   target_<t>_accuracy_<scalar>   worked examples + random set vs the double core
 #   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun
-#   target_cortex-m3_no_soft_float the M3's per-solution code (the core's entry
-#                                  and the velocity query, firmware/app/*_entry_fixed.cpp)
-#                                  references no soft-float routine (negative
+#   target_cortex-m3_no_soft_float the M3's per-solution and per-cycle code (the
+#                                  core's entry, the velocity query,
+#                                  firmware/app/*_entry_fixed.cpp, and the
+#                                  fixed-point thermistor acquisition,
+#                                  hal_temperatures.cpp) references no soft-float routine (negative
 #                                  control: the M3 application image, whose
 #                                  velocity service propagates in double, has);
 #                                  the same on a Debug (-O0) M3 build
@@ -96,7 +98,8 @@ ExternalProject_Add(ascorr_cortex-m3-debug
 set(m3_debug_entry_objs ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/CMakeFiles/ascorr_core_entry_fixed.dir)
 add_test(NAME target_cortex-m3-debug_no_soft_float
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${m3_debug_entry_objs}/core_entry_fixed.cpp.obj ${m3_debug_entry_objs}/velocity_entry_fixed.cpp.obj)
+                 ${m3_debug_entry_objs}/core_entry_fixed.cpp.obj ${m3_debug_entry_objs}/velocity_entry_fixed.cpp.obj
+                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/CMakeFiles/ascorr_firmware.dir/hal_temperatures.cpp.obj)
 add_test(NAME target_cortex-m3-debug_no_soft_float_control
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
                  ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf)
@@ -112,7 +115,8 @@ set_tests_properties(target_cortex-m3-debug_no_soft_float_control PROPERTIES LAB
 
 add_test(NAME target_cortex-m3_no_soft_float
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${m3_entry_objs}/core_entry_fixed.cpp.obj ${m3_entry_objs}/velocity_entry_fixed.cpp.obj)
+                 ${m3_entry_objs}/core_entry_fixed.cpp.obj ${m3_entry_objs}/velocity_entry_fixed.cpp.obj
+                 ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/CMakeFiles/ascorr_firmware.dir/hal_temperatures.cpp.obj)
 add_test(NAME target_cortex-m3_no_soft_float_control
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
                  ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/ascorr_firmware.elf)

@@ -1,8 +1,8 @@
 // firmware/app/report.hpp: text output over semihosting without printf.
 //
 // Conventions: integers only (decimal and 8-digit hex), so that no
-// floating-point formatting code is linked into an image that must not
-// contain soft-float routines. Output goes to stdout (semihosting under QEMU);
+// floating-point formatting code is linked into the images (the M3's
+// per-cycle code must stay free of soft-float routines). Output goes to stdout (semihosting under QEMU);
 // in flight the same calls would go to the telemetry UART.
 #pragma once
 

@@ -65,9 +65,11 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
         return;
     }
     if ((st & status::kVelocityInvalid) != 0U) {
-        if (rec.velocity_components != 3) {
+        // (A row without vx,vy,vz reaches here only with a velocity from the
+        // states that the core found out of its domain.)
+        if (rec.velocity_components != 3 && rec.velocity_components != 0) {
             diag.report("velocity incomplete", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
-        } else if (!in_ephemeris_span(rec.t)) {
+        } else if (rec.velocity_components == 3 && !in_ephemeris_span(rec.t)) {
             diag.report("outside the ephemeris", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
         } else if (!beta_in_domain(in.velocity.beta_icrf)) {
             const auto b = in.velocity.beta_icrf;
@@ -182,7 +184,10 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);
         }
-        explain(rec, row.in, row.from_states ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+        // A states row whose 32 comes from the service is explained by
+        // explain_service(); a 32 from the core itself (speed, Sun distance) by explain().
+        const bool service_invalid = row.from_states && (row.service & status::kVelocityInvalid) != 0U;
+        explain(rec, row.in, service_invalid ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
                 res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
@@ -220,7 +225,8 @@ std::size_t worker_count() {
 
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
-    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
+                             {{"--out", opt.out}});
     std::optional<ThermalModel<T>> model;
     if (opt.thermal && !opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);

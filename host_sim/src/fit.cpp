@@ -163,6 +163,9 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     double earliest_epoch = 0.0;
     double earliest_row = 0.0;
     double earliest_row_period = 0.0;
+    double earliest_row_speed = 0.0;
+    std::size_t earliest_row_line = 0;
+    constexpr double kPlaceholderPeriodS = 5400.0;
     std::map<long long, OrbitSums> orbits;
     std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
     bool any = false;
@@ -244,16 +247,18 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
             return;
         }
         if (!period_given && (!any_row || rec.t < earliest_row)) {
+            // Only the earliest row's speed matters, so it is judged after all
+            // rows are read (a later row read first must not decide). Until
+            // then an implausible speed gets a placeholder period, so that no
+            // orbit index overflows.
             const double v = std::sqrt(squared_norm(rec.v_sc_kms));
-            if (!(v > 1.0 && v < 12.0)) {
-                throw InputError(opt.in, rec.line, 1,
-                                 "spacecraft speed " + std::to_string(v) +
-                                     " km/s is not that of an Earth orbit: give --orbit-period");
-            }
+            const bool plausible = v > 1.0 && v < 12.0;
             earliest_row = rec.t;
-            earliest_row_period = 2.0 * kPi * kMuEarth / (v * v * v);
+            earliest_row_speed = v;
+            earliest_row_line = rec.line;
+            earliest_row_period = plausible ? 2.0 * kPi * kMuEarth / (v * v * v) : 0.0;
             if (!period) {
-                period = earliest_row_period;
+                period = plausible ? earliest_row_period : kPlaceholderPeriodS;
             }
         }
         any_row = true;
@@ -263,6 +268,11 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
         epochs.add(rec.t, rec.head, rec.line, row);
     });
     epochs.finish();
+    if (!period_given && any_row && !(earliest_row_speed > 1.0 && earliest_row_speed < 12.0)) {
+        throw InputError(opt.in, earliest_row_line, 1,
+                         "spacecraft speed " + std::to_string(earliest_row_speed) +
+                             " km/s is not that of an Earth orbit: give --orbit-period");
+    }
     if (!period_given && period && *period != earliest_row_period) {
         // Rows out of time order: again, with the earliest row's period.
         return fit_pass(opt, rows, earliest_row_period);

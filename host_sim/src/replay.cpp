@@ -107,6 +107,8 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const auto start = std::chrono::steady_clock::now();
     double t0 = 0.0;
     std::uint32_t id = 0;
+    constexpr int kMaxVelocityMessages = 20;  // as the diagnostics of `ascorr correct`
+    int velocity_messages = 0;
     while (reader.next(rec)) {
         if (opt.realtime) {
             if (id == 0) {
@@ -117,7 +119,11 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         SolutionInput<T> in = to_core_input<T>(rec, &earth);
         SolutionInput<double> in_d = to_core_input<double>(rec, &earth);
         TtTime t{};
-        const bool from_states = states && rec.velocity_components == 0 && tt_from_seconds(rec.t, t);
+        const bool wants_states = states && rec.velocity_components == 0;
+        const bool from_states = wants_states && tt_from_seconds(rec.t, t);
+        // A time the on-board clock cannot hold (|t| > 1e11 s): the states
+        // cannot give a velocity, 4|32 as in `ascorr correct --states`.
+        const bool time_unusable = wants_states && !from_states;
         StatusBits service_status = 0U;
         StatusBits service_status_d = 0U;
         if (from_states) {
@@ -169,9 +175,16 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         }
         // The bits the host adds (velocity given but unusable before the core
         // sees it), as `ascorr correct` does.
-        const StatusBits written = host_status(rec, true, got.status);
-        if (written != got.status && sum.frames <= 20) {
-            log << opt.in << ":" << rec.line << ": " << velocity_problem(rec) << ": aberration skipped\n";
+        StatusBits written = host_status(rec, true, got.status);
+        if (time_unusable && (written & status::kNoVelocity) != 0U) {
+            written = static_cast<StatusBits>(written | status::kVelocityInvalid);
+        }
+        if (written != got.status && velocity_messages < kMaxVelocityMessages) {
+            ++velocity_messages;
+            log << opt.in << ":" << rec.line << ": "
+                << (time_unusable ? "t is outside the on-board clock's range: no velocity from the states"
+                                  : velocity_problem(rec))
+                << ": aberration skipped\n";
         }
         if ((got.status & status::kRejected) != 0U) {
             writer.row(reader, std::nullopt, written, buf);
@@ -196,8 +209,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
 }  // namespace
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
-    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}},
-                             {{"--out", opt.out}}, true);
+    refuse_output_over_input(
+        {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}},
+        {{"--out", opt.out}}, true);
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never

@@ -33,7 +33,8 @@ void for_each_solution(const std::string& path, const std::function<void(const S
 using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
 
 // Refuses a NaN or infinite --from/--to and --from not before --to
-// (std::invalid_argument naming the options), as fit, stats and plot share.
+// (std::invalid_argument naming the options), for stats and plot (fit has its
+// own refusals, FitRefused, in fit.cpp).
 void refuse_bad_time_range(const std::optional<double>& from, const std::optional<double>& to,
                            const char* from_name = "--from", const char* to_name = "--to");
 
