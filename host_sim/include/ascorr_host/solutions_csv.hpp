@@ -83,7 +83,7 @@ private:
 };
 
 // Throws InputError when the header has a `status` column: the file is already
-// corrected (formats.md), and correcting or fitting it again would apply the
+// corrected (docs/contract.md), and correcting or fitting it again would apply the
 // corrections twice.
 // (`stats` and `plot` accept a corrected file: its "original" stage is then
 // the file as corrected.)
