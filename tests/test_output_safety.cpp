@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -30,29 +31,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int exit_code;
-    std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
 void write(const fs::path& p, const std::string& text) {
     std::ofstream(p, std::ios::binary) << text;
-}
-
-// Runs `ascorr ARGS` through sh (ARGS may carry redirections of stdout).
-CliRun run(const std::string& args, const fs::path& dir) {
-    const fs::path err = dir / "stderr.txt";
-    const std::string cmd =
-        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
 }
 
 // Starts ascorr with argv, PATH prefixed by path_prefix (stand-in programs),
@@ -143,7 +123,7 @@ TEST(OutputSafety, CorrectRefusesAnOutputThatIsItsInputByAnyPath) {
     for (const std::string& out :
          std::vector<std::string>{"s.csv", "./s.csv", (dir / "s.csv").string(), "link.csv", "hard.csv", "m.csv"}) {
         SCOPED_TRACE(out);
-        const CliRun r = run("correct --in s.csv --model m.csv --out " + out, dir);
+        const CliRun r = run_in("correct --in s.csv --model m.csv --out " + out, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find("is the same file as the input"), std::string::npos) << r.err;
         EXPECT_EQ(slurp(dir / "s.csv"), before);
@@ -174,7 +154,7 @@ TEST(OutputSafety, FitPlotSimulateReplayAndThermistorsRefuseToOverwriteAnInput) 
     const std::string rec = slurp(dir / "rec.csv");
     for (const std::string& c : cmds) {
         SCOPED_TRACE(c);
-        const CliRun r = run(c, dir);
+        const CliRun r = run_in(c, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find("is the same file as the input"), std::string::npos) << r.err;
         EXPECT_EQ(slurp(dir / "s.csv"), s);
@@ -202,7 +182,7 @@ TEST(OutputSafety, TheStatesFileIsAnInputCorrectAndReplayDoNotOverwrite) {
                                  std::string("replay --target loopback-float --in s.csv --model m.csv "
                                              "--states st.csv --out st.csv")}) {
         SCOPED_TRACE(c);
-        const CliRun r = run(c, dir);
+        const CliRun r = run_in(c, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find("--states"), std::string::npos) << r.err;
         EXPECT_EQ(slurp(dir / "st.csv"), before);
@@ -211,13 +191,13 @@ TEST(OutputSafety, TheStatesFileIsAnInputCorrectAndReplayDoNotOverwrite) {
 
 TEST(OutputSafety, DashAndDevStdoutAreStreamsNotFiles) {
     const fs::path dir = scratch_dir("dash");
-    ASSERT_EQ(run("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
-    const CliRun r = run("correct --in " + kSolutions + " --out - > dash.csv", dir);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
+    const CliRun r = run_in("correct --in " + kSolutions + " --out - > dash.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "dash.csv"), slurp(dir / "ref.csv"));
     EXPECT_FALSE(fs::exists(dir / "-"));
     // /dev/stdout into a pipe (it cannot be renamed over).
-    const CliRun p = run("correct --in " + kSolutions + " --out /dev/stdout | cat > piped.csv", dir);
+    const CliRun p = run_in("correct --in " + kSolutions + " --out /dev/stdout | cat > piped.csv", dir);
     ASSERT_EQ(p.exit_code, 0) << p.err;
     EXPECT_EQ(slurp(dir / "piped.csv"), slurp(dir / "ref.csv"));
     EXPECT_TRUE(fs::is_character_file("/dev/null"));
@@ -225,12 +205,12 @@ TEST(OutputSafety, DashAndDevStdoutAreStreamsNotFiles) {
 
 TEST(OutputSafety, AFifoOutputIsWrittenIntoAndStaysAFifo) {
     const fs::path dir = scratch_dir("fifo");
-    ASSERT_EQ(run("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
     ASSERT_LT(fs::file_size(dir / "ref.csv"), 60000U);  // fits in the pipe's buffer: no reader thread needed
     ASSERT_EQ(::mkfifo((dir / "out.fifo").c_str(), 0644), 0);
     const int rd = ::open((dir / "out.fifo").c_str(), O_RDONLY | O_NONBLOCK);
     ASSERT_GE(rd, 0);
-    const CliRun r = run("correct --in " + kSolutions + " --out out.fifo", dir);
+    const CliRun r = run_in("correct --in " + kSolutions + " --out out.fifo", dir);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     std::string got;
     char buf[4096];
@@ -245,14 +225,14 @@ TEST(OutputSafety, AFifoOutputIsWrittenIntoAndStaysAFifo) {
 
 TEST(OutputSafety, ALinkedOutputReplacesTheTargetAndKeepsLinkAndPermissions) {
     const fs::path dir = scratch_dir("link");
-    ASSERT_EQ(run("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
     fs::create_directories(dir / "real");
     write(dir / "real" / "out.csv", "old\n");
     ::chmod((dir / "real" / "out.csv").c_str(), 0604);  // not what any umask gives a new file
     fs::create_symlink("real/out.csv", dir / "out.csv");
     fs::create_symlink("real/new.csv", dir / "dangling.csv");  // target does not exist yet
-    ASSERT_EQ(run("correct --in " + kSolutions + " --out out.csv", dir).exit_code, 0);
-    ASSERT_EQ(run("correct --in " + kSolutions + " --out dangling.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out out.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out dangling.csv", dir).exit_code, 0);
     EXPECT_TRUE(fs::is_symlink(dir / "out.csv"));
     EXPECT_TRUE(fs::is_symlink(dir / "dangling.csv"));
     EXPECT_EQ(slurp(dir / "real" / "out.csv"), slurp(dir / "ref.csv"));
@@ -266,7 +246,7 @@ TEST(OutputSafety, ALinkedOutputReplacesTheTargetAndKeepsLinkAndPermissions) {
 TEST(OutputSafety, ADirectoryOutputIsRefusedNamingTheOutput) {
     const fs::path dir = scratch_dir("dirout");
     fs::create_directories(dir / "d");
-    const CliRun r = run("correct --in " + kSolutions + " --out d", dir);
+    const CliRun r = run_in("correct --in " + kSolutions + " --out d", dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("d: is a directory"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find(".tmp-"), std::string::npos) << r.err;
@@ -275,12 +255,12 @@ TEST(OutputSafety, ADirectoryOutputIsRefusedNamingTheOutput) {
 
 TEST(OutputSafety, ACorrectedFileFedBackIsRefused) {
     const fs::path dir = scratch_dir("twice");
-    ASSERT_EQ(run("correct --in " + kSolutions + " --model " + kModel + " --out once.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --model " + kModel + " --out once.csv", dir).exit_code, 0);
     for (const std::string& c : std::vector<std::string>{
              "correct --in once.csv --out twice.csv", "fit --in once.csv --out m.csv",
              "replay --target loopback-float --in once.csv --model " + kModel + " --out twice.csv"}) {
         SCOPED_TRACE(c);
-        const CliRun r = run(c, dir);
+        const CliRun r = run_in(c, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find("once.csv:1:"), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("column 'status': this file is already corrected"), std::string::npos) << r.err;
@@ -349,7 +329,7 @@ TEST(OutputSafety, ASignalledCorrectRemovesItsTemporaryFileAndKeepsTheOldOutput)
 
 TEST(OutputSafety, ASignalledPlotRemovesItsTemporaryFolderAndGnuplot) {
     const fs::path dir = scratch_dir("plot");
-    ASSERT_EQ(run("simulate --days 1 --out sim.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 1 --out sim.csv", dir).exit_code, 0);
     fs::create_directories(dir / "tmp");
     stand_in(dir / "bin", "gnuplot", dir / "gnuplot.pid");
     const pid_t pid = spawn({"plot", "--in", (dir / "sim.csv").string(), "--model",

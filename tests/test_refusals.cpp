@@ -11,32 +11,13 @@
 #include <string>
 #include <vector>
 
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-    int exit_code;
-    std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
-
-CliRun run(const std::string& args, const fs::path& dir) {
-    const fs::path err = dir / "stderr.txt";
-    const std::string cmd =
-        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
-}
 
 // The status column of each row of a corrected file.
 std::vector<int> statuses(const fs::path& p) {
@@ -58,7 +39,7 @@ TEST(Refusals, ATimeOutsideTheEphemerisIsFlaggedNotCorrected) {
     std::ofstream(dir / "in.csv") << kHeader << "750000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"
                                   << "750000000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"  // ms, not s
                                   << "-3200000000.000,B," << kRow << ",1.0,2.0,3.0,0,1.00\n";  // before 1900
-    const CliRun r = run("correct --in in.csv --out out.csv", dir);
+    const CliRun r = run_in("correct --in in.csv --out out.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(statuses(dir / "out.csv"), (std::vector<int>{1, 4 | 32, 4 | 32}));
     EXPECT_NE(r.err.find("in.csv:3: t = 750000000000 s is outside the span of the Earth ephemeris"), std::string::npos)
@@ -73,8 +54,8 @@ TEST(Refusals, ReplayAndCorrectGiveTheSameStatusBits) {
                                   << "750000002.000,B," << kRow << ",,,,0,1.00\n"        // none
                                   << "750000000000.000,C," << kRow << ",1.0,2.0,3.0,0,1.00\n";
     const std::string model = data_path("model_table2.csv");
-    ASSERT_EQ(run("correct --in in.csv --model " + model + " --out c.csv", dir).exit_code, 0);
-    const CliRun r = run("replay --target loopback-float --in in.csv --model " + model + " --out r.csv", dir);
+    ASSERT_EQ(run_in("correct --in in.csv --model " + model + " --out c.csv", dir).exit_code, 0);
+    const CliRun r = run_in("replay --target loopback-float --in in.csv --model " + model + " --out r.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(statuses(dir / "c.csv"), (std::vector<int>{3, 4 | 32 | 2, 4 | 2, 4 | 32 | 2}));
     EXPECT_EQ(statuses(dir / "r.csv"), statuses(dir / "c.csv"));
@@ -98,7 +79,7 @@ TEST(Refusals, AModelWithAnUnknownColumnIsRefused) {
         }
     }
     std::ofstream(dir / "m.csv") << header << ",c1_2x\n" << body;  // a misspelt quadratic column
-    const CliRun r = run("correct --in " + data_path("solutions.csv") + " --model m.csv --out out.csv", dir);
+    const CliRun r = run_in("correct --in " + data_path("solutions.csv") + " --model m.csv --out out.csv", dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("m.csv:1:" + std::to_string(header.size() + 2) + ": unknown column 'c1_2x'"),
               std::string::npos)
@@ -113,7 +94,7 @@ TEST(Refusals, AnEmptyModelPathIsRefused) {
                                   "stats --in " + data_path("solutions.csv") + " --model ''",
                                   "simulate --days 1 --out out.csv --truth ''"}) {
         SCOPED_TRACE(c);
-        const CliRun r = run(c, dir);
+        const CliRun r = run_in(c, dir);
         EXPECT_EQ(r.exit_code, 2);  // a usage error
         EXPECT_NE(r.err.find("an empty path names no file"), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(dir / "out.csv"));
@@ -150,7 +131,7 @@ TEST(Refusals, BadTimeRangesAndThresholdsAreRefused) {
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.args);
-        const CliRun r = run(c.args, dir);
+        const CliRun r = run_in(c.args, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
     }
@@ -163,20 +144,20 @@ TEST(Refusals, SkipBadThatDropsEveryRowFails) {
     const fs::path dir = scratch_dir("skip-all");
     std::ofstream(dir / "in.csv") << kHeader << "x,A," << kRow << ",1,2,3,0,1.00\n"
                                   << "750000000.0,A,nope,0.5,0.5,0.5,1,2,3,1,2,3,0,1.00\n";
-    const CliRun r = run("correct --in in.csv --out out.csv --skip-bad", dir);
+    const CliRun r = run_in("correct --in in.csv --out out.csv --skip-bad", dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("every one of the 2 data rows is malformed"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
     // One good row left: a success, the bad one reported.
     std::ofstream(dir / "in.csv", std::ios::app) << "750000000.0,A," << kRow << ",1,2,3,0,1.00\n";
-    EXPECT_EQ(run("correct --in in.csv --out out.csv --skip-bad", dir).exit_code, 0);
+    EXPECT_EQ(run_in("correct --in in.csv --out out.csv --skip-bad", dir).exit_code, 0);
 }
 
 TEST(Refusals, TheFloorFileIsValidJsonWithNullForEmptyPairs) {
     const fs::path dir = scratch_dir("floor");
     // Three minutes of mission: pair A-B has epochs, A-C and B-C none (C is
     // blinded then), so they have no RMS.
-    ASSERT_EQ(run("simulate --days 0.002 --step 60 --out s.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.002 --step 60 --out s.csv", dir).exit_code, 0);
     const std::string json = slurp(dir / "s.csv.floor.json");
     EXPECT_NE(json.find("\"A-C\": {\"rms\": null, \"rms_200s\": null, \"n\": 0}"), std::string::npos) << json;
     EXPECT_NE(json.find("\"A-B\": {\"rms\": 1."), std::string::npos) << json;
@@ -198,14 +179,16 @@ TEST(Refusals, AUtf8ByteOrderMarkIsAcceptedByEveryReader) {
     std::ofstream(dir / "board.cfg", std::ios::binary) << bom << slurp(ex + "/board.cfg");
     std::ofstream(dir / "rec.csv", std::ios::binary) << bom << slurp(ex + "/replay.csv");
     const std::string model = data_path("model_table2.csv");
-    ASSERT_EQ(run("correct --in " + data_path("solutions.csv") + " --model " + model + " --out ref.csv", dir).exit_code,
-              0);
-    const CliRun r = run("correct --in s.csv --model m.csv --out bom.csv", dir);
+    ASSERT_EQ(
+        run_in("correct --in " + data_path("solutions.csv") + " --model " + model + " --out ref.csv", dir).exit_code,
+        0);
+    const CliRun r = run_in("correct --in s.csv --model m.csv --out bom.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "bom.csv"), slurp(dir / "ref.csv"));  // the mark is not copied into the output
     ASSERT_EQ(
-        run("thermistors --config " + ex + "/board.cfg --replay " + ex + "/replay.csv > t_ref.csv", dir).exit_code, 0);
-    const CliRun t = run("thermistors --config board.cfg --replay rec.csv > t_bom.csv", dir);
+        run_in("thermistors --config " + ex + "/board.cfg --replay " + ex + "/replay.csv > t_ref.csv", dir).exit_code,
+        0);
+    const CliRun t = run_in("thermistors --config board.cfg --replay rec.csv > t_bom.csv", dir);
     ASSERT_EQ(t.exit_code, 0) << t.err;
     EXPECT_EQ(slurp(dir / "t_bom.csv"), slurp(dir / "t_ref.csv"));
 }
@@ -213,11 +196,11 @@ TEST(Refusals, AUtf8ByteOrderMarkIsAcceptedByEveryReader) {
 TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
     const fs::path dir = scratch_dir("messages");
     fs::create_directories(dir / "d");
-    const CliRun r = run("correct --in d --out out.csv", dir);
+    const CliRun r = run_in("correct --in d --out out.csv", dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("d: is a directory, not a file"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
-    const CliRun m = run("correct --in missing.csv --out out.csv", dir);
+    const CliRun m = run_in("correct --in missing.csv --out out.csv", dir);
     EXPECT_EQ(m.exit_code, 1);
     EXPECT_NE(m.err.find("missing.csv: cannot open"), std::string::npos) << m.err;
     std::string text = slurp(data_path("solutions.csv"));
@@ -225,7 +208,7 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
         c = c == '\n' ? '\r' : c;
     }
     std::ofstream(dir / "mac.csv", std::ios::binary) << text;
-    const CliRun c = run("correct --in mac.csv --out out.csv", dir);
+    const CliRun c = run_in("correct --in mac.csv --out out.csv", dir);
     EXPECT_EQ(c.exit_code, 1);
     EXPECT_NE(c.err.find("mac.csv:1:"), std::string::npos) << c.err;
     EXPECT_NE(c.err.find("CR-only line ends"), std::string::npos) << c.err;

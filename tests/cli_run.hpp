@@ -1,0 +1,37 @@
+// tests/cli_run.hpp: runs the `ascorr` executable under test (ASCORR_EXE) in a
+// scratch folder, for the tests of its command-line behaviour.
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace ascorr::test {
+
+struct CliRun {
+    int exit_code;    // -1 when it did not exit normally
+    std::string err;  // its standard error
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+// Runs `ascorr ARGS` through sh in `dir` (ARGS may use paths relative to it and
+// redirect standard output); standard error goes to dir/stderr.txt.
+inline CliRun run_in(const std::string& args, const std::filesystem::path& dir) {
+    const std::filesystem::path err = dir / "stderr.txt";
+    const std::string cmd =
+        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
+    const int rc = std::system(cmd.c_str());
+    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
+}
+
+}  // namespace ascorr::test
