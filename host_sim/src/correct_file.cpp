@@ -9,6 +9,7 @@
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <type_traits>
 #include <utility>
@@ -248,8 +249,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     Diagnostics diag(log);
     std::optional<StatesFile> states;
     if (!opt.states.empty()) {
-        if (!(opt.max_propagation_s > 0.0 && opt.max_propagation_s <= 7.0 * 86400.0)) {
-            throw std::runtime_error("--max-propagation must be above 0 and at most 604800 s (7 days)");
+        if (!max_propagation_acceptable(opt.max_propagation_s)) {
+            throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
         }
         states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
     }

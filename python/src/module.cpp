@@ -331,8 +331,8 @@ std::optional<host::StatesFile> states_arg(const py::object& states, const std::
     if (frame != "itrf" && frame != "gcrs") {
         bad_argument("states_frame", "expected 'itrf' or 'gcrs', got '" + frame + "'");
     }
-    if (!(max_propagation_s > 0.0 && max_propagation_s <= 7.0 * 86400.0)) {
-        bad_argument("max_propagation", "must be above 0 and at most 604800 s (7 days)");
+    if (!host::max_propagation_acceptable(max_propagation_s)) {
+        bad_argument("max_propagation", host::kMaxPropagationRule);
     }
     if (states.is_none()) {
         return std::nullopt;

@@ -17,8 +17,23 @@
 
 namespace ascorr::host {
 
-// Service configuration for `--max-propagation SECONDS` (> 0, ≤ 7 days;
-// InputError-free: the command line checks it): advance() catches up in one call.
+// The longest `--max-propagation` the host accepts (7 days): beyond it the J2
+// propagation is far outside its accuracy (0.98 m/s after 6 h), and one
+// advance() of horizon/10 s RK4 steps stays bounded.
+inline constexpr double kMaxPropagationLimitS = 7.0 * 86400.0;
+
+// Whether `--max-propagation` (or the Python module's max_propagation) is
+// acceptable: above 0 and at most kMaxPropagationLimitS; NaN is not.
+inline bool max_propagation_acceptable(double max_propagation_s) {
+    return max_propagation_s > 0.0 && max_propagation_s <= kMaxPropagationLimitS;
+}
+
+// The refusal text for an unacceptable value, one wording for CLI and Python.
+inline constexpr const char* kMaxPropagationRule = "must be above 0 and at most 604800 s (7 days)";
+static_assert(kMaxPropagationLimitS == 604800.0, "kMaxPropagationRule states the limit in seconds");
+
+// Service configuration for `--max-propagation SECONDS` (max_propagation_acceptable;
+// InputError-free: the callers check it): advance() catches up in one call.
 inline VelocityServiceConfig service_config(double max_propagation_s) {
     VelocityServiceConfig c = default_velocity_service_config();
     c.horizon_us = static_cast<std::int64_t>(std::llround(max_propagation_s * 1e6));
