@@ -94,12 +94,12 @@ template <typename T>
 using Celsius = typename ScalarTraits<T>::temperature_type;
 
 // Shorthand used by the core: a compile-time constant of type T. The core binds
-// every use to a constexpr variable (constexpr T half = k<T>(0.5);), so that
+// every use to a constexpr variable (constexpr T half = constant<T>(0.5);), so that
 // the double → T conversion is folded at every optimisation level: an -O0
 // build of the fixed-point core references no soft-float routine (checked on
 // the Cortex-M3 Debug image, toolchain/targets.cmake).
 template <typename T>
-constexpr T k(double x) noexcept {
+constexpr T constant(double x) noexcept {
     return ScalarTraits<T>::from_double(x);
 }
 
