@@ -47,12 +47,12 @@ struct Bench {
     hal::AcquisitionConfig<T> config;
     BenchClock clock;
     boom::EmulatedBoomAdc adc;
-    hal::Frame<T> frames[kRuns];
+    hal::SampleSet<T> frames[kRuns];
 };
 
 template <typename T>
 void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
-    hal::AdcFrameSource<T> src(b.adc, b.clock, b.config);
+    hal::AdcSampleSetSource<T> src(b.adc, b.clock, b.config);
     hal::TemperatureAcquisition<T> acq(b.config);
     // Empty loop of the same shape: its cost is subtracted.
     const std::uint32_t c0 = bench::counts([&] {

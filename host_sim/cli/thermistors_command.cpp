@@ -87,7 +87,7 @@ void run(const ThermistorOptions& opt) {
         cfg.gpio.chip = opt.chip;
     }
     const hal::AcquisitionConfig<double>& acfg = cfg.acquisition;
-    std::unique_ptr<hal::FrameSource<double>> source;
+    std::unique_ptr<hal::SampleSetSource<double>> source;
     std::unique_ptr<hal::Clock> live_clock;
     const bool live = opt.replay.empty() && opt.simulate.empty();
     if (!opt.replay.empty() && !opt.simulate.empty()) {
@@ -107,7 +107,7 @@ void run(const ThermistorOptions& opt) {
     } else {
 #ifdef ASCORR_HAVE_GPIOD
         live_clock = std::make_unique<hal::SteadyClock>();
-        source = std::make_unique<hal::GpiodFrameSource>(cfg, *live_clock);
+        source = std::make_unique<hal::GpiodSampleSetSource>(cfg, *live_clock);
 #else
         throw std::runtime_error("this build has no libgpiod backend: use --replay or --simulate");
 #endif
@@ -119,7 +119,7 @@ void run(const ThermistorOptions& opt) {
     std::size_t frames = 0;
     std::size_t invalid = 0;
     std::size_t per_fault[hal::fault::kCount] = {};
-    hal::Frame<double> frame{};
+    hal::SampleSet<double> frame{};
     while (!live || frames < opt.frames) {
         if (live && frames > 0U) {
             live_clock->wait_us(static_cast<std::uint32_t>(std::llround(opt.interval * 1e6)));

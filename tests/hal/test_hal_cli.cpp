@@ -133,7 +133,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
     for (const Case& k : cases) {
         hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
         hal::TemperatureAcquisition<double> acq(c);
-        hal::Frame<double> f{};
+        hal::SampleSet<double> f{};
         for (int i = 0; i <= k.at; ++i) {
             ASSERT_TRUE(src.acquire(f));
             acq.update(f);

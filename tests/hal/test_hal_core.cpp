@@ -20,8 +20,8 @@ namespace {
 using hal::ChannelReading;
 using hal::ChannelSample;
 using hal::FaultBits;
-using hal::Frame;
 using hal::SampleKind;
+using hal::SampleSet;
 namespace fault = hal::fault;
 
 // ---- conversion accuracy ----------------------------------------------------
@@ -209,7 +209,7 @@ TEST(HalSampler, AFailedConversionIsABusFault) {
 struct Rig {
     hal::AcquisitionConfig<double> cfg = swarm_config();
     hal::TemperatureAcquisition<double> acq{cfg};
-    Frame<double> f{};
+    SampleSet<double> f{};
     std::uint64_t t = 1000000000U;
 
     // Every channel at its temperature as counts, then one frame at t.

@@ -70,7 +70,7 @@ TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
     const hal::AcquisitionConfig<float> cfg = float_config();
     BoomAdc adc(cfg);
     hal::ManualClock clock(0);
-    hal::AdcFrameSource<float> source(adc, clock, cfg);
+    hal::AdcSampleSetSource<float> source(adc, clock, cfg);
     hal::TemperatureAcquisition<float> acq(cfg);
 
     ThermalModel<float> model{};

@@ -82,8 +82,8 @@ struct Paths {
 };
 
 template <typename T>
-hal::Frame<T> convert_frame(const hal::Frame<double>& in) {
-    hal::Frame<T> out{};
+hal::SampleSet<T> convert_frame(const hal::SampleSet<double>& in) {
+    hal::SampleSet<T> out{};
     out.t_us = in.t_us;
     for (std::uint8_t i = 0; i < hal::kMaxChannels; ++i) {
         const hal::ChannelSample<double>& s = in.channel[i];
@@ -107,7 +107,7 @@ struct Comparison {
     int voted_compared = 0;
 };
 
-void compare_frame(Paths& p, const hal::Frame<double>& frame, Comparison& cmp, const std::string& what) {
+void compare_frame(Paths& p, const hal::SampleSet<double>& frame, Comparison& cmp, const std::string& what) {
     p.float_acq->update(convert_frame<float>(frame));
     p.fixed_acq->update(convert_frame<QCelsius>(frame));
     ++cmp.frames;
@@ -302,7 +302,7 @@ TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
     Paths p(cfg);
     const std::unique_ptr<hal::ReplaySource> src = hal::ReplaySource::from_file(kExamples + "/replay.csv", cfg);
     Comparison cmp;
-    hal::Frame<double> f{};
+    hal::SampleSet<double> f{};
     while (src->acquire(f)) {
         compare_frame(p, f, cmp, "replay.csv");
     }
@@ -345,7 +345,7 @@ TEST(HalFixed, SimulatedStreamsWithEveryFaultClassGiveTheSameFaultsAndVotes) {
     hal::SimulatedSource src(cfg, history, faults);
     Paths p(cfg);
     Comparison cmp;
-    hal::Frame<double> f{};
+    hal::SampleSet<double> f{};
     while (src.acquire(f)) {
         compare_frame(p, f, cmp, "simulated");
     }

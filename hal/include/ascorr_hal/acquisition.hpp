@@ -15,7 +15,7 @@
 //    that did not happen.
 //  - Freestanding: fixed-size state, bounded loops, no heap, no exceptions.
 //    Typical firmware loop (1 Hz acquisition, corrections at any rate):
-//        AdcFrameSource<float> src(mcp3208, clock, config);
+//        AdcSampleSetSource<float> src(mcp3208, clock, config);
 //        TemperatureAcquisition<float> acq(config);
 //        every second:     acq.poll(src);
 //        every solution:   HeadAcquisition<float> h = acq.head(head, clock.now_us());
@@ -32,7 +32,7 @@
 #include "channel_check.hpp"
 #include "channel_config.hpp"
 #include "faults.hpp"
-#include "frame.hpp"
+#include "sample_set.hpp"
 #include "voting.hpp"
 
 namespace ascorr::hal {
@@ -83,14 +83,14 @@ public:
 
     const AcquisitionConfig<T>& config() const noexcept { return config_; }
 
-    void update(const Frame<T>& frame) noexcept {
+    void update(const SampleSet<T>& frame) noexcept {
         for (std::uint8_t i = 0; i < config_.channels && i < kMaxChannels; ++i) {
             check_[i].update(config_.channel[i], frame.channel[i], frame.t_us);
         }
     }
 
     // Acquires one frame from src and processes it; false if src had none.
-    bool poll(FrameSource<T>& src) noexcept {
+    bool poll(SampleSetSource<T>& src) noexcept {
         if (!src.acquire(frame_)) {
             return false;
         }
@@ -150,7 +150,7 @@ public:
 private:
     AcquisitionConfig<T> config_;
     ChannelCheck<T> check_[kMaxChannels];
-    Frame<T> frame_{};
+    SampleSet<T> frame_{};
 };
 
 }  // namespace ascorr::hal

@@ -30,7 +30,7 @@
 
 #include "channel_config.hpp"
 #include "faults.hpp"
-#include "frame.hpp"
+#include "sample_set.hpp"
 #include "thermistor.hpp"
 
 namespace ascorr::hal {

@@ -68,7 +68,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
                 file, line_no, line.size() + 1,
                 "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
         }
-        Frame<double> f{};
+        SampleSet<double> f{};
         for (std::size_t i = 0; i < columns.size(); ++i) {
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
@@ -123,7 +123,7 @@ std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
     return std::make_unique<ReplaySource>(path, ss.str(), config);
 }
 
-bool ReplaySource::acquire(Frame<double>& frame) noexcept {
+bool ReplaySource::acquire(SampleSet<double>& frame) noexcept {
     if (next_ >= frames_.size()) {
         return false;
     }

@@ -221,7 +221,7 @@ SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::v
     adc_.set_faults(std::move(faults));
 }
 
-bool SimulatedSource::acquire(Frame<double>& frame) noexcept {
+bool SimulatedSource::acquire(SampleSet<double>& frame) noexcept {
     if (next_ >= history_.size()) {
         return false;
     }

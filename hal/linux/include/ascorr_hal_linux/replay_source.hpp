@@ -18,23 +18,23 @@
 #include <string_view>
 #include <vector>
 
-#include "ascorr_hal/frame.hpp"
+#include "ascorr_hal/sample_set.hpp"
 #include "config_file.hpp"
 
 namespace ascorr::hal {
 
-class ReplaySource final : public FrameSource<double> {
+class ReplaySource final : public SampleSetSource<double> {
 public:
     ReplaySource(const std::string& file_name, std::string_view text, const AcquisitionConfig<double>& config);
     // A source is a device (hal/interface.hpp): not copied nor moved, so it
     // comes on the heap.
     static std::unique_ptr<ReplaySource> from_file(const std::string& path, const AcquisitionConfig<double>& config);
 
-    bool acquire(Frame<double>& frame) noexcept override;
+    bool acquire(SampleSet<double>& frame) noexcept override;
     std::size_t frames() const noexcept { return frames_.size(); }
 
 private:
-    std::vector<Frame<double>> frames_;
+    std::vector<SampleSet<double>> frames_;
     std::size_t next_ = 0;
 };
 

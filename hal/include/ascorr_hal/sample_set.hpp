@@ -1,14 +1,14 @@
-// ascorr_hal/frame.hpp: one acquisition of every channel, and the interface
+// ascorr_hal/sample_set.hpp: one acquisition of every channel, and the interface
 // of the backends that produce it.
 //
 // Conventions:
-//  - A Frame holds, per configured channel (index as in AcquisitionConfig),
+//  - A SampleSet holds, per configured channel (index as in AcquisitionConfig),
 //    either raw counts (an ADC: the robust average and its spread) or a
 //    temperature (a replay of converted values), or nothing (kNone), plus the
 //    device-level faults (kBus). t_us is the frame's time on the HAL clock.
-//  - FrameSource is the one interface every backend implements (F Prime
+//  - SampleSetSource is the one interface every backend implements (F Prime
 //    style: real and test-double implementations chosen at build time):
-//      AdcFrameSource (here, freestanding: any AdcPort, e.g. Mcp3208 over the
+//      AdcSampleSetSource (here, freestanding: any AdcPort, e.g. Mcp3208 over the
 //      DPU's pins or over libgpiod), ReplaySource and SimulatedSource (host).
 //  - acquire() never throws and never allocates; false means no frame
 //    (the end of a replay).
@@ -37,27 +37,27 @@ struct ChannelSample {
 };
 
 template <typename T>
-struct Frame {
+struct SampleSet {
     std::uint64_t t_us;
     ChannelSample<T> channel[kMaxChannels];
 };
 
 template <typename T>
-class FrameSource : private Interface {
+class SampleSetSource : private Interface {
 public:
-    virtual ~FrameSource() = default;
-    virtual bool acquire(Frame<T>& frame) noexcept = 0;
+    virtual ~SampleSetSource() = default;
+    virtual bool acquire(SampleSet<T>& frame) noexcept = 0;
 };
 
 // Reads every configured channel through an ADC with the sampler's settle
 // time, sample count and robust average. Time of the frame: its start.
 template <typename T>
-class AdcFrameSource final : public FrameSource<T> {
+class AdcSampleSetSource final : public SampleSetSource<T> {
 public:
-    AdcFrameSource(AdcPort& adc, Clock& clock, const AcquisitionConfig<T>& config) noexcept
+    AdcSampleSetSource(AdcPort& adc, Clock& clock, const AcquisitionConfig<T>& config) noexcept
         : adc_(adc), clock_(clock), config_(config) {}
 
-    bool acquire(Frame<T>& frame) noexcept override {
+    bool acquire(SampleSet<T>& frame) noexcept override {
         frame.t_us = clock_.now_us();
         for (std::uint8_t i = 0; i < kMaxChannels; ++i) {
             ChannelSample<T>& s = frame.channel[i];
