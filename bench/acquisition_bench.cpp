@@ -47,7 +47,7 @@ struct Bench {
     hal::AcquisitionConfig<T> config;
     BenchClock clock;
     boom::EmulatedBoomAdc adc;
-    hal::SampleSet<T> frames[kRuns];
+    hal::SampleSet<T> sets[kRuns];
 };
 
 template <typename T>
@@ -66,8 +66,8 @@ void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
             b.clock.set(std::uint64_t{i} * 1000000U);
             b.adc.set_second(i);
-            g_sink = src.acquire(b.frames[i]) ? 1U : 0U;
-            acq.update(b.frames[i]);
+            g_sink = src.acquire(b.sets[i]) ? 1U : 0U;
+            acq.update(b.sets[i]);
         }
     });
     hal::TemperatureAcquisition<T> acq2(b.config);
@@ -75,7 +75,7 @@ void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
             b.clock.set(std::uint64_t{i} * 1000000U);
             b.adc.set_second(i);
-            acq2.update(b.frames[i]);
+            acq2.update(b.sets[i]);
             g_sink = i;
         }
     });

@@ -89,7 +89,7 @@ TEST(HalReplay, ErrorsNameLineAndColumn) {
     EXPECT_EQ(err("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
     EXPECT_EQ(err("t,THT00029\n-1,3\n"), "r.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
     EXPECT_EQ(err("t,THT00029\n1,3,4\n"), "r.csv:2:6: expected 2 fields, found 3");
-    EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).frames(), 2U);
+    EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).sample_sets(), 2U);
 }
 
 TEST(HalSimulated, FaultSpecsAndHistoryErrors) {

@@ -82,7 +82,7 @@ struct Paths {
 };
 
 template <typename T>
-hal::SampleSet<T> convert_frame(const hal::SampleSet<double>& in) {
+hal::SampleSet<T> convert_sample_set(const hal::SampleSet<double>& in) {
     hal::SampleSet<T> out{};
     out.t_us = in.t_us;
     for (std::uint8_t i = 0; i < hal::kMaxChannels; ++i) {
@@ -100,18 +100,18 @@ hal::SampleSet<T> convert_frame(const hal::SampleSet<double>& in) {
 
 // What a run of frames through both paths showed.
 struct Comparison {
-    int frames = 0;
+    int sample_sets = 0;
     int mismatches = 0;
     hal::FaultBits seen = 0;  // every fault bit of a channel or a voted value, on either path
     double worst_voted_c = 0.0;
     int voted_compared = 0;
 };
 
-void compare_frame(Paths& p, const hal::SampleSet<double>& frame, Comparison& cmp, const std::string& what) {
-    p.float_acq->update(convert_frame<float>(frame));
-    p.fixed_acq->update(convert_frame<QCelsius>(frame));
-    ++cmp.frames;
-    const std::uint64_t now = frame.t_us;
+void compare_sample_set(Paths& p, const hal::SampleSet<double>& samples, Comparison& cmp, const std::string& what) {
+    p.float_acq->update(convert_sample_set<float>(samples));
+    p.fixed_acq->update(convert_sample_set<QCelsius>(samples));
+    ++cmp.sample_sets;
+    const std::uint64_t now = samples.t_us;
     for (std::uint8_t i = 0; i < p.f.channels; ++i) {
         const hal::ChannelReading<float> a = p.float_acq->channel(i, now);
         const hal::ChannelReading<QCelsius> b = p.fixed_acq->channel(i, now);
@@ -304,9 +304,9 @@ TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
     Comparison cmp;
     hal::SampleSet<double> f{};
     while (src->acquire(f)) {
-        compare_frame(p, f, cmp, "replay.csv");
+        compare_sample_set(p, f, cmp, "replay.csv");
     }
-    std::printf("replay.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C\n", cmp.frames,
+    std::printf("replay.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C\n", cmp.sample_sets,
                 cmp.voted_compared, cmp.worst_voted_c);
     EXPECT_EQ(cmp.mismatches, 0);
     EXPECT_GT(cmp.voted_compared, 0);
@@ -347,18 +347,18 @@ TEST(HalFixed, SimulatedStreamsWithEveryFaultClassGiveTheSameFaultsAndVotes) {
     Comparison cmp;
     hal::SampleSet<double> f{};
     while (src.acquire(f)) {
-        compare_frame(p, f, cmp, "simulated");
+        compare_sample_set(p, f, cmp, "simulated");
     }
     // The worked examples' temperatures as a history, without faults.
     hal::SimulatedSource examples(cfg, hal::read_history(data_path("solutions.csv")), {});
     Paths p2(cfg);
     while (examples.acquire(f)) {
-        compare_frame(p2, f, cmp, "solutions.csv");
+        compare_sample_set(p2, f, cmp, "solutions.csv");
     }
     std::printf(
         "simulated + solutions.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C, "
         "fault bits seen %#x\n",
-        cmp.frames, cmp.voted_compared, cmp.worst_voted_c, static_cast<unsigned>(cmp.seen));
+        cmp.sample_sets, cmp.voted_compared, cmp.worst_voted_c, static_cast<unsigned>(cmp.seen));
     EXPECT_EQ(cmp.mismatches, 0);
     EXPECT_GT(cmp.voted_compared, 1000);
     // Every fault class occurred (kConversion: BadCoefficientsAreConversionFaultsOnBothPaths).

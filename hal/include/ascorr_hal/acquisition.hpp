@@ -2,7 +2,7 @@
 //
 // Conventions:
 //  - TemperatureAcquisition<T> owns one ChannelCheck per configured channel.
-//    update(frame) runs the checks (channel_check.hpp); head(h, now_us) votes
+//    update(samples) runs the checks (channel_check.hpp); head(h, now_us) votes
 //    each role (voting.hpp) as seen at now_us and returns the core's
 //    HeadTemperatures<T> with valid = false for every withheld value, plus
 //    the fault bits of T1, T2, T3.
@@ -83,18 +83,18 @@ public:
 
     const AcquisitionConfig<T>& config() const noexcept { return config_; }
 
-    void update(const SampleSet<T>& frame) noexcept {
+    void update(const SampleSet<T>& samples) noexcept {
         for (std::uint8_t i = 0; i < config_.channels && i < kMaxChannels; ++i) {
-            check_[i].update(config_.channel[i], frame.channel[i], frame.t_us);
+            check_[i].update(config_.channel[i], samples.channel[i], samples.t_us);
         }
     }
 
     // Acquires one frame from src and processes it; false if src had none.
     bool poll(SampleSetSource<T>& src) noexcept {
-        if (!src.acquire(frame_)) {
+        if (!src.acquire(samples_)) {
             return false;
         }
-        update(frame_);
+        update(samples_);
         return true;
     }
 
@@ -150,7 +150,7 @@ public:
 private:
     AcquisitionConfig<T> config_;
     ChannelCheck<T> check_[kMaxChannels];
-    SampleSet<T> frame_{};
+    SampleSet<T> samples_{};
 };
 
 }  // namespace ascorr::hal

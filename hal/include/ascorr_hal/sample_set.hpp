@@ -46,7 +46,7 @@ template <typename T>
 class SampleSetSource : private Interface {
 public:
     virtual ~SampleSetSource() = default;
-    virtual bool acquire(SampleSet<T>& frame) noexcept = 0;
+    virtual bool acquire(SampleSet<T>& samples) noexcept = 0;
 };
 
 // Reads every configured channel through an ADC with the sampler's settle
@@ -57,10 +57,10 @@ public:
     AdcSampleSetSource(AdcPort& adc, Clock& clock, const AcquisitionConfig<T>& config) noexcept
         : adc_(adc), clock_(clock), config_(config) {}
 
-    bool acquire(SampleSet<T>& frame) noexcept override {
-        frame.t_us = clock_.now_us();
+    bool acquire(SampleSet<T>& samples) noexcept override {
+        samples.t_us = clock_.now_us();
         for (std::uint8_t i = 0; i < kMaxChannels; ++i) {
-            ChannelSample<T>& s = frame.channel[i];
+            ChannelSample<T>& s = samples.channel[i];
             s = {SampleKind::kNone, 0U, 0U, T{}, 0U};
             if (i >= config_.channels) {
                 continue;

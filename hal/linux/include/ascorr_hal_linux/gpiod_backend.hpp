@@ -58,7 +58,7 @@ private:
 class GpiodSampleSetSource final : public SampleSetSource<double> {
 public:
     GpiodSampleSetSource(const HalConfig& config, Clock& clock);
-    bool acquire(SampleSet<double>& frame) noexcept override { return source_.acquire(frame); }
+    bool acquire(SampleSet<double>& samples) noexcept override { return source_.acquire(samples); }
 
 private:
     HalConfig config_;

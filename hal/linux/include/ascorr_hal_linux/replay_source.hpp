@@ -30,11 +30,11 @@ public:
     // comes on the heap.
     static std::unique_ptr<ReplaySource> from_file(const std::string& path, const AcquisitionConfig<double>& config);
 
-    bool acquire(SampleSet<double>& frame) noexcept override;
-    std::size_t frames() const noexcept { return frames_.size(); }
+    bool acquire(SampleSet<double>& samples) noexcept override;
+    std::size_t sample_sets() const noexcept { return sample_sets_.size(); }
 
 private:
-    std::vector<SampleSet<double>> frames_;
+    std::vector<SampleSet<double>> sample_sets_;
     std::size_t next_ = 0;
 };
 

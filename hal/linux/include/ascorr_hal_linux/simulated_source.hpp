@@ -87,7 +87,7 @@ public:
                     std::vector<InjectedFault> faults);
     SimulatedSource(const SimulatedSource&) = delete;  // members refer to each other
     SimulatedSource& operator=(const SimulatedSource&) = delete;
-    bool acquire(SampleSet<double>& frame) noexcept override;
+    bool acquire(SampleSet<double>& samples) noexcept override;
 
 private:
     AcquisitionConfig<double> config_;
