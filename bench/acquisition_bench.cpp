@@ -1,7 +1,7 @@
 // bench/acquisition_bench.cpp: instructions per thermistor acquisition on a
 // target, fixed point against float, under QEMU -icount (systick_counter.hpp).
 //
-// One acquisition is one 1 Hz frame of eight channels (the boom's six plus
+// One acquisition is one 1 Hz sample set of eight channels (the boom's six plus
 // CHU_A and CHU_B, firmware/app/boom_channels.hpp, make_config(8)): for each
 // channel a selecting conversion and nine samples from the emulated ADC, the
 // median, then counts → °C, the checks; then the vote of each head's three
@@ -10,7 +10,7 @@
 // kRuns acquisitions cycle over the 16-s profile, with its injected open
 // circuits. Figures per acquisition:
 //   acquire  poll(): sampling + conversion + checks of eight channels
-//   update   conversion + checks alone, on the frames poll() read
+//   update   conversion + checks alone, on the sample sets poll() read
 //   heads    four head() calls (three votes each)
 // for the fixed-point path and, as the baseline in the same run, the float
 // path (on the Cortex-M3, which has no FPU, the float path runs in libgcc's

@@ -122,7 +122,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
     struct Case {
         const char* spec;
         int channel;
-        int at;  // frame index to look at
+        int at;  // sample set (row) index to look at
         hal::FaultBits want;
     };
     const Case cases[] = {
@@ -184,11 +184,11 @@ TEST(HalCli, ThermistorsOnAReplayFile) {
     EXPECT_EQ(lines[0], "t,name,role,counts,ohm,celsius,valid,faults");
     EXPECT_EQ(lines[1], "100.000000,THT00029,t029,,,-9.500,1,");
     EXPECT_EQ(lines[10], "100.000000,t_029,voted,,,-9.500,1,");
-    // Frame 3 (t = 102): THT00057 jumps 6.5 °C (rate, then outvoted), THT00060 open.
+    // Sample set 3 (t = 102): THT00057 jumps 6.5 °C (rate, then outvoted), THT00060 open.
     EXPECT_EQ(lines[24], "102.000000,THT00057,t029,,,-3.000,0,rate");
     EXPECT_EQ(lines[27], "102.000000,THT00060,t032,4095,40950000.0,,0,open");
     EXPECT_EQ(lines[32], "102.000000,t_029,voted,,,-9.490,1,");
-    // Frame 4: THT00090 shorted too: T3 withheld; CHU_A kept from t = 102.
+    // Sample set 4: THT00090 shorted too: T3 withheld; CHU_A kept from t = 102.
     EXPECT_EQ(lines[39], "103.000000,THT00090,t032,0,0.0,,0,short");
     EXPECT_EQ(lines[40], "102.000000,CHU_A,chu_a,,,3.220,1,");
     EXPECT_EQ(lines[44], "103.000000,t_032,voted,,,,0,open|short|no_quorum");

@@ -212,7 +212,8 @@ struct Rig {
     SampleSet<double> f{};
     std::uint64_t t = 1000000000U;
 
-    // Every channel at its temperature as counts, then one frame at t.
+    // Every channel at its temperature as counts: one sample set at t
+    // (commit() hands it to the acquisition).
     void fill(const double (&temps)[8], std::uint64_t dt_us = 1000000U) {
         t += dt_us;
         f.t_us = t;
@@ -364,7 +365,7 @@ TEST(HalFaults, StuckAfterIdenticalFramesAndRecovers) {
     r.fill(kNominal);
     r.f.channel[6].spread = 0U;
     r.commit();
-    EXPECT_EQ(r.ch(6).faults, fault::kStuck);  // 5th identical, noise-free frame
+    EXPECT_EQ(r.ch(6).faults, fault::kStuck);  // 5th identical, noise-free sample set
     expect_thermal_withheld(r.acq.head(0, r.t), status::kTemperatureInvalid);
     r.fill(kNominal);
     r.f.channel[6].spread = 1U;  // the ADC shows noise again
@@ -397,7 +398,7 @@ TEST(HalFaults, StaleWhenOldOrWhenTimeDoesNotAdvance) {
     r.commit();
     EXPECT_EQ(r.ch(6).faults, 0U);
     EXPECT_EQ(r.ch(6).t_us, t0);
-    // A frame whose time does not advance (replayed twice, frozen clock).
+    // A sample set whose time does not advance (replayed twice, frozen clock).
     r.fill(kNominal, 0U);
     r.commit();
     r.fill(kNominal, 0U);
@@ -464,7 +465,7 @@ TEST(HalVoting, AcquisitionFlagsTheOutvotedMemberAndKeepsTheMedian) {
     Rig r;
     double t[8];
     std::copy(kNominal, kNominal + 8, t);
-    t[2] = -4.0;  // THT00087 reads 5.5 °C warm (first frame: no rate anchor yet)
+    t[2] = -4.0;  // THT00087 reads 5.5 °C warm (first sample set: no rate anchor yet)
     r.fill(t);
     r.commit();
     ChannelReading<double> members[3];

@@ -98,7 +98,7 @@ hal::SampleSet<T> convert_sample_set(const hal::SampleSet<double>& in) {
     return out;
 }
 
-// What a run of frames through both paths showed.
+// What a run of sample sets through both paths showed.
 struct Comparison {
     int sample_sets = 0;
     int mismatches = 0;
@@ -306,8 +306,8 @@ TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
     while (src->acquire(f)) {
         compare_sample_set(p, f, cmp, "replay.csv");
     }
-    std::printf("replay.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C\n", cmp.sample_sets,
-                cmp.voted_compared, cmp.worst_voted_c);
+    std::printf("replay.csv: %d sample sets, %d voted values compared, worst |fixed - float| %.5f °C\n",
+                cmp.sample_sets, cmp.voted_compared, cmp.worst_voted_c);
     EXPECT_EQ(cmp.mismatches, 0);
     EXPECT_GT(cmp.voted_compared, 0);
     EXPECT_NE(cmp.seen & fault::kOpen, 0U);
@@ -356,7 +356,7 @@ TEST(HalFixed, SimulatedStreamsWithEveryFaultClassGiveTheSameFaultsAndVotes) {
         compare_sample_set(p2, f, cmp, "solutions.csv");
     }
     std::printf(
-        "simulated + solutions.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C, "
+        "simulated + solutions.csv: %d sample sets, %d voted values compared, worst |fixed - float| %.5f °C, "
         "fault bits seen %#x\n",
         cmp.sample_sets, cmp.voted_compared, cmp.worst_voted_c, static_cast<unsigned>(cmp.seen));
     EXPECT_EQ(cmp.mismatches, 0);

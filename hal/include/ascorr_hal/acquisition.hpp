@@ -1,4 +1,4 @@
-// ascorr_hal/acquisition.hpp: frames in, HeadTemperatures with validity out.
+// ascorr_hal/acquisition.hpp: sample sets in, HeadTemperatures with validity out.
 //
 // Conventions:
 //  - TemperatureAcquisition<T> owns one ChannelCheck per configured channel.
@@ -89,7 +89,7 @@ public:
         }
     }
 
-    // Acquires one frame from src and processes it; false if src had none.
+    // Acquires one sample set from src and processes it; false if src had none.
     bool poll(SampleSetSource<T>& src) noexcept {
         if (!src.acquire(samples_)) {
             return false;

@@ -5,13 +5,19 @@
 //  - A SampleSet holds, per configured channel (index as in AcquisitionConfig),
 //    either raw counts (an ADC: the robust average and its spread) or a
 //    temperature (a replay of converted values), or nothing (kNone), plus the
-//    device-level faults (kBus). t_us is the frame's time on the HAL clock.
+//    device-level faults (kBus). t_us is its time on the HAL clock.
 //  - SampleSetSource is the one interface every backend implements (F Prime
 //    style: real and test-double implementations chosen at build time):
 //      AdcSampleSetSource (here, freestanding: any AdcPort, e.g. Mcp3208 over the
 //      DPU's pins or over libgpiod), ReplaySource and SimulatedSource (host).
-//  - acquire() never throws and never allocates; false means no frame
+//  - acquire() never throws and never allocates; false means no sample set
 //    (the end of a replay).
+//  - Names: a sample set is not a frame. In ascorr "frame" means a reference
+//    frame (q_chu_icrf, StateFrame) or, in ascorr_link/frame.hpp, a framed
+//    link-protocol message. Two older interfaces keep the word for a sample
+//    set, unchanged because they are the command line and the board
+//    configuration file: `ascorr thermistors --frames N` acquires N sample
+//    sets, and a channel's stuck_frames counts sample sets.
 #pragma once
 
 #include <cstdint>
@@ -50,7 +56,7 @@ public:
 };
 
 // Reads every configured channel through an ADC with the sampler's settle
-// time, sample count and robust average. Time of the frame: its start.
+// time, sample count and robust average. Time of the sample set: its start.
 template <typename T>
 class AdcSampleSetSource final : public SampleSetSource<T> {
 public:

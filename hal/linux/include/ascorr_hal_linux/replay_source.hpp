@@ -1,4 +1,4 @@
-// ascorr_hal_linux/replay_source.hpp: frames from a recorded file.
+// ascorr_hal_linux/replay_source.hpp: sample sets from a recorded file.
 //
 // Format: CSV, one header line, no quoting, LF or CRLF. Column `t` (seconds,
 // ≥ 0, any origin: the HAL clock of the replay is t·10⁶ µs) and, per

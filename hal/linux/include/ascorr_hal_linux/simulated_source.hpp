@@ -1,4 +1,4 @@
-// ascorr_hal_linux/simulated_source.hpp: frames from temperature histories,
+// ascorr_hal_linux/simulated_source.hpp: sample sets from temperature histories,
 // through a simulated MCP3208, with injectable faults.
 //
 // History: CSV with columns t (s), t_chu, t_029, t_032 and optionally chu
@@ -7,8 +7,8 @@
 // chu column t_chu sets every chu channel. t_029 and t_032 set every member of
 // their triplet. Empty/nan keeps the previous truth; a channel without truth
 // yet is not sampled.
-// Each row becomes one frame at t: the truth goes through the inverse
-// Steinhart–Hart and the divider into counts (SimulatedAdc), and the frame is
+// Each row becomes one sample set at t: the truth goes through the inverse
+// Steinhart–Hart and the divider into counts (SimulatedAdc), and the sample set is
 // acquired by the same AdcSampleSetSource as on hardware (settle, samples,
 // median) on a ManualClock, so the whole conversion path runs.
 // Faults (--inject NAME:KIND:FROM:TO[:VALUE], times in the history's seconds,
