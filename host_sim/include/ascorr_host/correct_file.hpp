@@ -15,7 +15,7 @@
 
 namespace ascorr::host {
 
-enum class Scalar { kDouble, kFloat, kFixed };
+enum class ScalarKind { kDouble, kFloat, kFixed };
 
 struct CorrectOptions {
     std::string in;
@@ -23,7 +23,7 @@ struct CorrectOptions {
     std::string model;  // empty: no thermal stage
     bool aberration = true;
     bool thermal = true;
-    Scalar scalar = Scalar::kDouble;
+    ScalarKind scalar = ScalarKind::kDouble;
     bool skip_bad = false;
     // --states: the velocity of rows without vx,vy,vz from spacecraft states,
     // by the on-board service (states_velocity.hpp); empty: none.
