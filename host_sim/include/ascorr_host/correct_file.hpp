@@ -15,6 +15,9 @@
 
 namespace ascorr::host {
 
+// Which scalar the core is instantiated with (--scalar). A kind, not the type:
+// the firmware's type is firmware/app/app_scalar.hpp's Scalar, and a target
+// reports its kind in the link's HELLO (scalar_kind).
 enum class ScalarKind { kDouble, kFloat, kFixed };
 
 struct CorrectOptions {
