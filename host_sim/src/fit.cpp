@@ -342,6 +342,7 @@ void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::s
 // (a gap, the ends of the period) is dominated by its part of the orbit.
 std::size_t min_epochs_per_orbit(const std::map<long long, OrbitSums>& orbits) {
     std::vector<std::size_t> counts;
+    counts.reserve(orbits.size());
     for (const auto& kv : orbits) {
         counts.push_back(kv.second.count);
     }
