@@ -1,7 +1,7 @@
 // bench/acquisition_bench.cpp: instructions per thermistor acquisition on a
 // target, fixed point against float, under QEMU -icount (systick_counter.hpp).
 //
-// One acquisition is one 1 Hz frame of eight channels (the boom's six plus
+// One acquisition is one 1 Hz sample set of eight channels (the boom's six plus
 // CHU_A and CHU_B, firmware/app/boom_channels.hpp, make_config(8)): for each
 // channel a selecting conversion and nine samples from the emulated ADC, the
 // median, then counts → °C, the checks; then the vote of each head's three
@@ -10,7 +10,7 @@
 // kRuns acquisitions cycle over the 16-s profile, with its injected open
 // circuits. Figures per acquisition:
 //   acquire  poll(): sampling + conversion + checks of eight channels
-//   update   conversion + checks alone, on the frames poll() read
+//   update   conversion + checks alone, on the sample sets poll() read
 //   heads    four head() calls (three votes each)
 // for the fixed-point path and, as the baseline in the same run, the float
 // path (on the Cortex-M3, which has no FPU, the float path runs in libgcc's
@@ -47,12 +47,12 @@ struct Bench {
     hal::AcquisitionConfig<T> config;
     BenchClock clock;
     boom::EmulatedBoomAdc adc;
-    hal::Frame<T> frames[kRuns];
+    hal::SampleSet<T> sets[kRuns];
 };
 
 template <typename T>
 void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
-    hal::AdcFrameSource<T> src(b.adc, b.clock, b.config);
+    hal::AdcSampleSetSource<T> src(b.adc, b.clock, b.config);
     hal::TemperatureAcquisition<T> acq(b.config);
     // Empty loop of the same shape: its cost is subtracted.
     const std::uint32_t c0 = bench::counts([&] {
@@ -66,8 +66,8 @@ void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
             b.clock.set(std::uint64_t{i} * 1000000U);
             b.adc.set_second(i);
-            g_sink = src.acquire(b.frames[i]) ? 1U : 0U;
-            acq.update(b.frames[i]);
+            g_sink = src.acquire(b.sets[i]) ? 1U : 0U;
+            acq.update(b.sets[i]);
         }
     });
     hal::TemperatureAcquisition<T> acq2(b.config);
@@ -75,7 +75,7 @@ void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
             b.clock.set(std::uint64_t{i} * 1000000U);
             b.adc.set_second(i);
-            acq2.update(b.frames[i]);
+            acq2.update(b.sets[i]);
             g_sink = i;
         }
     });

@@ -1,5 +1,6 @@
-// tests/cli_run.hpp: runs the `ascorr` executable under test (ASCORR_EXE) in a
-// scratch folder, for the tests of its command-line behaviour.
+// tests/cli_run.hpp: runs the `ascorr` executable under test (ASCORR_EXE), in
+// a scratch folder (run_in) or in the test's directory (run_here), for the
+// tests of its command-line behaviour.
 #pragma once
 
 #include <sys/wait.h>
@@ -24,14 +25,24 @@ inline std::string slurp(const std::filesystem::path& p) {
     return ss.str();
 }
 
+// Runs COMMAND through sh with its standard error in dir/stderr.txt.
+inline CliRun run_shell(const std::string& command, const std::filesystem::path& dir) {
+    const std::filesystem::path err = dir / "stderr.txt";
+    const std::string cmd = command + " 2> " + err.string();
+    const int rc = std::system(cmd.c_str());
+    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
+}
+
 // Runs `ascorr ARGS` through sh in `dir` (ARGS may use paths relative to it and
 // redirect standard output); standard error goes to dir/stderr.txt.
 inline CliRun run_in(const std::string& args, const std::filesystem::path& dir) {
-    const std::filesystem::path err = dir / "stderr.txt";
-    const std::string cmd =
-        "cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, slurp(err)};
+    return run_shell("cd " + dir.string() + " && " + std::string(ASCORR_EXE) + " " + args, dir);
+}
+
+// The same without changing directory: relative paths in ARGS are the test's
+// working directory's; dir only receives stderr.txt.
+inline CliRun run_here(const std::string& args, const std::filesystem::path& dir) {
+    return run_shell(std::string(ASCORR_EXE) + " " + args, dir);
 }
 
 }  // namespace ascorr::test

@@ -2,35 +2,18 @@
 // status bits, bad rows, all-or-nothing output.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-    int exit_code;
-    std::string err;
-};
-
-CliRun run(const std::string& args, const fs::path& dir) {
-    const fs::path err = dir / "stderr.txt";
-    const std::string cmd = std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    std::ifstream f(err);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
-}
 
 void write(const fs::path& p, const std::string& text) {
     std::ofstream(p) << text;
@@ -63,20 +46,23 @@ TEST(CorrectCli, WorkedExamplesAllStages) {
     const fs::path dir = scratch_dir("cli");
     const std::string in = data_path("solutions.csv");
     const std::string model = data_path("model_table2.csv");
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "ab.csv").string() + " --no-thermal --model " + model, dir)
-                  .exit_code,
-              0);
     ASSERT_EQ(
-        run("correct --in " + in + " --out " + (dir / "th.csv").string() + " --no-aberration --model " + model, dir)
+        run_here("correct --in " + in + " --out " + (dir / "ab.csv").string() + " --no-thermal --model " + model, dir)
             .exit_code,
         0);
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "both.csv").string() + " --model " + model, dir).exit_code,
-              0);
+    ASSERT_EQ(
+        run_here("correct --in " + in + " --out " + (dir / "th.csv").string() + " --no-aberration --model " + model,
+                 dir)
+            .exit_code,
+        0);
+    ASSERT_EQ(
+        run_here("correct --in " + in + " --out " + (dir / "both.csv").string() + " --model " + model, dir).exit_code,
+        0);
     EXPECT_LE(max_error(dir / "ab.csv", "expected_aberration_only.csv"), 1e-6);
     EXPECT_LE(max_error(dir / "th.csv", "expected_thermal_only.csv"), 1e-6);
     EXPECT_LE(max_error(dir / "both.csv", "expected_both.csv"), 1e-6);
     // Without --model: aberration only, status 1.
-    ASSERT_EQ(run("correct --in " + in + " --out " + (dir / "nomodel.csv").string(), dir).exit_code, 0);
+    ASSERT_EQ(run_here("correct --in " + in + " --out " + (dir / "nomodel.csv").string(), dir).exit_code, 0);
     EXPECT_LE(max_error(dir / "nomodel.csv", "expected_aberration_only.csv"), 1e-6);
     const auto l = lines_of(dir / "both.csv");
     ASSERT_EQ(l.size(), 13U);
@@ -93,9 +79,9 @@ TEST(CorrectCli, WorkedExamplesAllStages) {
 
 TEST(CorrectCli, FloatScalarWithinBound) {
     const fs::path dir = scratch_dir("cli");
-    ASSERT_EQ(run("correct --scalar float --in " + data_path("solutions.csv") + " --out " + (dir / "f.csv").string() +
-                      " --model " + data_path("model_table2.csv"),
-                  dir)
+    ASSERT_EQ(run_here("correct --scalar float --in " + data_path("solutions.csv") + " --out " +
+                           (dir / "f.csv").string() + " --model " + data_path("model_table2.csv"),
+                       dir)
                   .exit_code,
               0);
     EXPECT_LE(max_error(dir / "f.csv", "expected_both.csv"), 0.05);
@@ -115,9 +101,9 @@ TEST(CorrectCli, EveryRowKeptWithItsStatus) {
                               "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,4e5,0,0,0,1,v_gt_c\n"         // 2|4|32
                               "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,-19,-7,,-1.7,0,1,v_partial\n"     // 2|4|32
                               "447534187.831,A,0.5,0.5,0.5,0.5,3,-9,999,-7,0.7,-1.7,0,1,t_short\n");  // 1|8|64
-    const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
-                             " --model " + data_path("model_table2.csv"),
-                         dir);
+    const CliRun r = run_here("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
+                                  " --model " + data_path("model_table2.csv"),
+                              dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto l = lines_of(dir / "out.csv");
     ASSERT_EQ(l.size(), 12U);
@@ -152,7 +138,8 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
     }
     write(dir / "in.csv", text);
     write(dir / "out.csv", "previous content\n");
-    const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
+    const CliRun r =
+        run_here("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find((dir / "in.csv").string() + ":8:"), std::string::npos) << r.err;
     EXPECT_EQ(lines_of(dir / "out.csv"), std::vector<std::string>{"previous content"});  // untouched
@@ -161,7 +148,7 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
     }
     // --skip-bad: the bad row is reported and dropped, the rest written.
     const CliRun s =
-        run("correct --skip-bad --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
+        run_here("correct --skip-bad --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
     EXPECT_EQ(s.exit_code, 0) << s.err;
     EXPECT_EQ(lines_of(dir / "out.csv").size(), 12U);
     EXPECT_NE(s.err.find(":8:"), std::string::npos);
@@ -170,19 +157,20 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
 
 TEST(CorrectCli, BadInvocationsFailCleanly) {
     const fs::path dir = scratch_dir("cli");
-    EXPECT_EQ(run("correct --in " + data_path("solutions.csv"), dir).exit_code, 2);  // --out missing
+    EXPECT_EQ(run_here("correct --in " + data_path("solutions.csv"), dir).exit_code, 2);  // --out missing
     EXPECT_EQ(
-        run("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() + " --scalar quad", dir)
+        run_here("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() + " --scalar quad",
+                 dir)
             .exit_code,
         2);
     const CliRun missing =
-        run("correct --in " + (dir / "nope.csv").string() + " --out " + (dir / "o.csv").string(), dir);
+        run_here("correct --in " + (dir / "nope.csv").string() + " --out " + (dir / "o.csv").string(), dir);
     EXPECT_EQ(missing.exit_code, 1);
     EXPECT_NE(missing.err.find("nope.csv"), std::string::npos);
     write(dir / "m.csv", "chu,axis,c0,c1,c2,c3\nA,alpha,1,2,3\n");
-    const CliRun bad_model = run("correct --in " + data_path("solutions.csv") + " --out " + (dir / "o.csv").string() +
-                                     " --model " + (dir / "m.csv").string(),
-                                 dir);
+    const CliRun bad_model = run_here("correct --in " + data_path("solutions.csv") + " --out " +
+                                          (dir / "o.csv").string() + " --model " + (dir / "m.csv").string(),
+                                      dir);
     EXPECT_EQ(bad_model.exit_code, 1);
     EXPECT_NE(bad_model.err.find("m.csv:2:"), std::string::npos) << bad_model.err;
     EXPECT_FALSE(fs::exists(dir / "o.csv"));

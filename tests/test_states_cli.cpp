@@ -5,8 +5,6 @@
 // staleness, rows with their own velocity, and malformed states files.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +14,7 @@
 
 #include "ascorr/velocity_service.hpp"
 #include "ascorr_host/states_velocity.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -23,21 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using V3 = Vector3<double>;
-
-struct CliRun {
-    int exit_code;
-    std::string err;
-};
-
-CliRun run(const std::string& args, const fs::path& dir) {
-    const fs::path err = dir / "stderr.txt";
-    const std::string cmd = std::string(ASCORR_EXE) + " " + args + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    std::ifstream f(err);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
-}
 
 void write(const fs::path& p, const std::string& text) {
     std::ofstream(p) << text;
@@ -222,9 +206,9 @@ void check_against_sequential(const char* scalar, StateFrame frame) {
     write(dir / "in.csv", solutions_csv(rs));
     const std::string common = "correct --in " + (dir / "in.csv").string() + " --scalar " + scalar;
     const CliRun r =
-        run(common + " --out " + (dir / "out.csv").string() + " --states " + (dir / "states.csv").string() +
-                " --states-frame " + (frame == StateFrame::kGcrs ? "gcrs" : "itrf") + " --max-propagation 120",
-            dir);
+        run_here(common + " --out " + (dir / "out.csv").string() + " --states " + (dir / "states.csv").string() +
+                     " --states-frame " + (frame == StateFrame::kGcrs ? "gcrs" : "itrf") + " --max-propagation 120",
+                 dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     // Each refused state named with its line (header = line 1; the bad rows follow line 32).
     for (const char* what : {"states.csv:33: state refused: position or velocity not finite",
@@ -255,7 +239,7 @@ void check_against_sequential(const char* scalar, StateFrame frame) {
     EXPECT_EQ(n_ok, 89U);     // t0 + 0.4 … t0 + 239 s
     EXPECT_EQ(n_stale, 22U);  // beyond 120 s after the last state (t0 + 119)
     // The row with its own velocity keeps it: the same line as without --states.
-    const CliRun plain = run(common + " --out " + (dir / "plain.csv").string(), dir);
+    const CliRun plain = run_here(common + " --out " + (dir / "plain.csv").string(), dir);
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     const std::vector<OutRow> p = read_out(dir / "plain.csv");
     EXPECT_EQ(got.back().line, p.back().line);
@@ -295,9 +279,9 @@ TEST(StatesCli, MalformedStatesFileNamesLineAndColumnAndWritesNothing) {
     for (const Case& c : cases) {
         write(dir / "states.csv", c.text);
         fs::remove(dir / "out.csv");
-        const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
-                                 " --states " + (dir / "states.csv").string(),
-                             dir);
+        const CliRun r = run_here("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
+                                      " --states " + (dir / "states.csv").string(),
+                                  dir);
         EXPECT_EQ(r.exit_code, 1) << c.text;
         EXPECT_NE(r.err.find(c.message), std::string::npos) << c.message << "\n" << r.err;
         EXPECT_FALSE(fs::exists(dir / "out.csv")) << c.text;
@@ -306,9 +290,9 @@ TEST(StatesCli, MalformedStatesFileNamesLineAndColumnAndWritesNothing) {
     write(dir / "states.csv", head + good);
     for (const std::string opt :
          {"--max-propagation 0", "--max-propagation -5", "--max-propagation 1e9", "--states-frame teme"}) {
-        const CliRun r = run("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
-                                 " --states " + (dir / "states.csv").string() + " " + opt,
-                             dir);
+        const CliRun r = run_here("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string() +
+                                      " --states " + (dir / "states.csv").string() + " " + opt,
+                                  dir);
         EXPECT_NE(r.exit_code, 0) << opt;
         EXPECT_FALSE(fs::exists(dir / "out.csv")) << opt;
     }

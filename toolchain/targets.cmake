@@ -81,7 +81,7 @@ endforeach()
 set(m3_entry_objs ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/CMakeFiles/ascorr_core_entry_fixed.dir)
 
 # The M3 build at -O0 (Debug): no constant of the core may be converted from
-# double at run time (scalar_traits.hpp, k<T>()), so the per-solution objects
+# double at run time (scalar_traits.hpp, constant<T>()), so the per-solution objects
 # stay free of soft-float there too. Only the flight image (and with it those
 # objects) is built; the image itself, which propagates in double, is the
 # negative control.

@@ -11,7 +11,7 @@
 //  - Channels 0–5: THT00029/57/87 (T2) and THT00032/60/90 (T3), in a divider
 //    with 10 kΩ to the ADC reference (thermistor to ground), 12 bits.
 //    make_config(8) adds CHU_A and CHU_B (channels 6, 7) for the acquisition
-//    benchmark's eight-channel frame; the flight image reads six.
+//    benchmark's eight-channel sample set; the flight image reads six.
 //  - EmulatedBoomAdc: QEMU's MPS2 board has no ADC, so this AdcPort returns
 //    the codes an ideal ADC gives for a boom temperature profile (16 points,
 //    one per second, computed at compile time: no arithmetic at run time),

@@ -84,7 +84,7 @@ constexpr hal::AcquisitionConfig<HalScalar> kConfig = boom::Config<HalScalar>::o
 
 SysTickClock g_clock;
 boom::EmulatedBoomAdc g_adc;
-hal::AdcFrameSource<HalScalar> g_source(g_adc, g_clock, kConfig);
+hal::AdcSampleSetSource<HalScalar> g_source(g_adc, g_clock, kConfig);
 hal::TemperatureAcquisition<HalScalar> g_acquisition(kConfig);
 hal::HeadAcquisition<HalScalar> g_heads[kMaxHeads + 1];  // the last entry: all invalid
 

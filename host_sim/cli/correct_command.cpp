@@ -18,8 +18,9 @@ void add_correct_command(CLI::App& app) {
         ->check(non_empty_path());
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
     cmd->add_flag("!--no-thermal", opt->thermal, "skip the thermal stage");
-    const std::map<std::string, host::Scalar> scalars{
-        {"double", host::Scalar::kDouble}, {"float", host::Scalar::kFloat}, {"fixed", host::Scalar::kFixed}};
+    const std::map<std::string, host::ScalarKind> scalars{{"double", host::ScalarKind::kDouble},
+                                                          {"float", host::ScalarKind::kFloat},
+                                                          {"fixed", host::ScalarKind::kFixed}};
     cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double, float or fixed")
         ->transform(CLI::CheckedTransformer(scalars, CLI::ignore_case));
     cmd->add_flag("--skip-bad", opt->skip_bad, "skip malformed rows (each is reported) instead of stopping");

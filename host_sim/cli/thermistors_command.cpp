@@ -87,7 +87,7 @@ void run(const ThermistorOptions& opt) {
         cfg.gpio.chip = opt.chip;
     }
     const hal::AcquisitionConfig<double>& acfg = cfg.acquisition;
-    std::unique_ptr<hal::FrameSource<double>> source;
+    std::unique_ptr<hal::SampleSetSource<double>> source;
     std::unique_ptr<hal::Clock> live_clock;
     const bool live = opt.replay.empty() && opt.simulate.empty();
     if (!opt.replay.empty() && !opt.simulate.empty()) {
@@ -107,7 +107,7 @@ void run(const ThermistorOptions& opt) {
     } else {
 #ifdef ASCORR_HAVE_GPIOD
         live_clock = std::make_unique<hal::SteadyClock>();
-        source = std::make_unique<hal::GpiodFrameSource>(cfg, *live_clock);
+        source = std::make_unique<hal::GpiodSampleSetSource>(cfg, *live_clock);
 #else
         throw std::runtime_error("this build has no libgpiod backend: use --replay or --simulate");
 #endif
@@ -119,17 +119,17 @@ void run(const ThermistorOptions& opt) {
     std::size_t frames = 0;
     std::size_t invalid = 0;
     std::size_t per_fault[hal::fault::kCount] = {};
-    hal::Frame<double> frame{};
+    hal::SampleSet<double> samples{};
     while (!live || frames < opt.frames) {
         if (live && frames > 0U) {
             live_clock->wait_us(static_cast<std::uint32_t>(std::llround(opt.interval * 1e6)));
         }
-        if (!source->acquire(frame)) {
+        if (!source->acquire(samples)) {
             break;
         }
-        acq.update(frame);
+        acq.update(samples);
         ++frames;
-        const std::uint64_t now = frame.t_us;
+        const std::uint64_t now = samples.t_us;
         // Channel readings, with kOutvoted from the vote of their role.
         hal::ChannelReading<double> readings[hal::kMaxChannels];
         for (std::uint8_t i = 0; i < acfg.channels; ++i) {

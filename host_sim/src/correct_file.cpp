@@ -332,11 +332,11 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
 
 CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
     switch (opt.scalar) {
-        case Scalar::kDouble:
+        case ScalarKind::kDouble:
             return run<double>(opt, log);
-        case Scalar::kFloat:
+        case ScalarKind::kFloat:
             return run<float>(opt, log);
-        case Scalar::kFixed:
+        case ScalarKind::kFixed:
             return run<Q30>(opt, log);
     }
     throw std::logic_error("correct_file: unknown scalar type");

@@ -29,11 +29,11 @@ struct Row {
     std::array<double, 3> temp;  // T1, T2, T3
 };
 
-// Sums over one orbit of e_i and of the regressors, per head.
-// Sums over one orbit's epochs. q: the rotations a = q_head_f ⊗ r⁻¹ relative
-// to a provisional reference r (4-vectors, w ≥ 0); e: filled at the end, the
-// small angles relative to the final reference, derived exactly from q (see
-// fit_model), so that the result does not depend on which epoch came first.
+// Sums over one orbit's epochs, per head. q: the rotations a = q_head_f ⊗ r⁻¹
+// relative to a provisional reference r (4-vectors, w ≥ 0); e: filled at the
+// end, the small angles relative to the final reference, derived exactly from
+// q (rebase_on_earliest_epoch), so that the result does not depend on which
+// epoch came first; x, x2: the regressors and their squares.
 struct OrbitSums {
     std::size_t count = 0;
     std::array<Eigen::Vector4d, 3> q{Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
@@ -148,150 +148,181 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
 }
 
 namespace {
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period) {
-    EarthVelocity earth;
-    const CorrectionConfig<double> ab_only{true, nullptr};
-    // Row order must not matter (issue 11). The reference N_i is the earliest
-    // epoch's (re-based exactly at the end), and the orbit period, when not
-    // given, comes from the earliest selected row: if that is not the first
-    // one read, the file is read again with that period (unordered files only).
-    // (earliest_period: that second reading.)
+
+constexpr double kPlaceholderPeriodS = 5400.0;
+
+// What one reading of the rows gathers (fit_pass reads them once, or twice
+// when the rows are out of time order).
+struct Pass {
     FitReport r;
-    std::optional<double> period;
+    std::optional<double> period;                                // bins the epochs into orbits
+    bool period_given = false;                                   // --orbit-period, or the second reading
     std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
     std::array<Eigen::Quaterniond, 3> earliest_a;                // the earliest epoch's a
+    bool any_epoch = false;
     double earliest_epoch = 0.0;
+    // The earliest selected row: its speed gives the orbit period.
+    bool any_row = false;
     double earliest_row = 0.0;
     double earliest_row_period = 0.0;
     double earliest_row_speed = 0.0;
     std::size_t earliest_row_line = 0;
-    constexpr double kPlaceholderPeriodS = 5400.0;
     std::map<long long, OrbitSums> orbits;
     std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
-    bool any = false;
-    const bool period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
-    period = earliest_period ? earliest_period : opt.orbit_period_s;
-    bool any_row = false;
+};
 
-    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
-        if (!(e.head[0] && e.head[1] && e.head[2])) {
-            return;  // F needs A and C; the same epochs serve all heads
-        }
-        // Frame F (eqs. 1–3), rows X_F, Y_F, Z_F in ICRF.
-        const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
-        const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
-        const Eigen::Vector3d z_f = za.cross(zc).normalized();
-        const Eigen::Vector3d x_f = (za + zc).normalized();
-        const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
-        Eigen::Matrix3d r_f_icrf;
-        r_f_icrf.row(0) = x_f.transpose();
-        r_f_icrf.row(1) = y_f.transpose();
-        r_f_icrf.row(2) = z_f.transpose();
-        const Eigen::Quaterniond q_f_icrf(r_f_icrf);
-        const auto bin = static_cast<long long>(std::floor(e.t / *period));
-        OrbitSums& o = orbits[bin];
-        ++o.count;
-        for (std::size_t h = 0; h < 3; ++h) {
-            const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
-            if (!reference[h]) {
-                reference[h] = q_head_f;
-            }
-            Eigen::Quaterniond d = q_head_f * reference[h]->conjugate();
-            if (d.w() < 0.0) {
-                d.coeffs() = -d.coeffs();
-            }
-            o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
-            if (!any || e.t < earliest_epoch) {
-                earliest_a[h] = d;
-            }
-            const auto& t = e.head[h]->temp;
-            o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
-            o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
-        }
-        if (opt.selection_report) {
-            FitEpoch& fe = fit_epochs.emplace_back();
-            fe.t = e.t;
-            for (std::size_t h = 0; h < 3; ++h) {
-                const Eigen::Quaterniond& q = e.head[h]->q;
-                fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
-                fe.temp[h] = e.head[h]->temp;
-            }
-        }
-        ++r.epochs;
-        if (!any || e.t < earliest_epoch) {
-            earliest_epoch = e.t;
-        }
-        if (!any || e.t < r.t_first) {
-            r.t_first = e.t;
-        }
-        if (!any || e.t > r.t_last) {
-            r.t_last = e.t;
-        }
-        any = true;
-    });
-    rows([&](const SolutionRecord& rec) {
-        if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2) {
-            return;
-        }
-        ++r.rows;
-        Drop d = fit_selection(rec);
-        CorrectedSolution<double> c{};
-        if (d == Drop::kNone) {
-            c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
-            if ((c.status & status::kAberrationApplied) == 0U) {
-                d = Drop::kRejected;
-            }
-        }
-        ++r.dropped[static_cast<std::size_t>(d)];
-        if (d != Drop::kNone) {
-            return;
-        }
-        if (!period_given && (!any_row || rec.t < earliest_row)) {
-            // Only the earliest row's speed matters, so it is judged after all
-            // rows are read (a later row read first must not decide). Until
-            // then an implausible speed gets a placeholder period, so that no
-            // orbit index overflows.
-            const double v = std::sqrt(squared_norm(rec.v_sc_kms));
-            const bool plausible = v > 1.0 && v < 12.0;
-            earliest_row = rec.t;
-            earliest_row_speed = v;
-            earliest_row_line = rec.line;
-            earliest_row_period = plausible ? 2.0 * kPi * kMuEarth / (v * v * v) : 0.0;
-            if (!period) {
-                period = plausible ? earliest_row_period : kPlaceholderPeriodS;
-            }
-        }
-        any_row = true;
-        Row row;
-        row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
-        row.temp = rec.temperature;
-        epochs.add(rec.t, rec.head, rec.line, row);
-    });
-    epochs.finish();
-    if (!period_given && any_row && !(earliest_row_speed > 1.0 && earliest_row_speed < 12.0)) {
-        throw InputError(opt.in, earliest_row_line, 1,
-                         "spacecraft speed " + std::to_string(earliest_row_speed) +
-                             " km/s is not that of an Earth orbit: give --orbit-period");
+// Frame F (eqs. 1–3) of heads A and C at one epoch, rows X_F, Y_F, Z_F in ICRF.
+Eigen::Quaterniond q_f_icrf_at(const Epoch<Row>& e) {
+    const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
+    const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
+    const Eigen::Vector3d z_f = za.cross(zc).normalized();
+    const Eigen::Vector3d x_f = (za + zc).normalized();
+    const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
+    Eigen::Matrix3d r_f_icrf;
+    r_f_icrf.row(0) = x_f.transpose();
+    r_f_icrf.row(1) = y_f.transpose();
+    r_f_icrf.row(2) = z_f.transpose();
+    return Eigen::Quaterniond(r_f_icrf);
+}
+
+// Head h's rotation in F relative to its provisional reference (the first
+// one seen), and its regressors, into the orbit's sums.
+void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Eigen::Quaterniond& q_f_icrf, std::size_t h) {
+    const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
+    if (!p.reference[h]) {
+        p.reference[h] = q_head_f;
     }
-    if (!period_given && period && *period != earliest_row_period) {
-        // Rows out of time order: again, with the earliest row's period.
-        return fit_pass(opt, rows, earliest_row_period);
+    Eigen::Quaterniond d = q_head_f * p.reference[h]->conjugate();
+    if (d.w() < 0.0) {
+        d.coeffs() = -d.coeffs();
     }
-    r.orbit_period_s = period.value_or(0.0);
-    // Re-base on the earliest epoch: with b = earliest a, each epoch's small
-    // angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
-    // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
-    for (std::size_t h = 0; h < 3 && r.epochs != 0; ++h) {
-        const Eigen::Quaterniond b_inv = earliest_a[h].conjugate();
-        for (auto& kv : orbits) {
+    o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+    if (!p.any_epoch || e.t < p.earliest_epoch) {
+        p.earliest_a[h] = d;
+    }
+    const auto& t = e.head[h]->temp;
+    o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
+    o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
+}
+
+FitEpoch fit_epoch_of(const Epoch<Row>& e) {
+    FitEpoch fe{};
+    fe.t = e.t;
+    for (std::size_t h = 0; h < 3; ++h) {
+        const Eigen::Quaterniond& q = e.head[h]->q;
+        fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
+        fe.temp[h] = e.head[h]->temp;
+    }
+    return fe;
+}
+
+// The epoch count, the earliest epoch and the period's first and last epochs.
+void note_epoch_time(Pass& p, double t) {
+    ++p.r.epochs;
+    if (!p.any_epoch || t < p.earliest_epoch) {
+        p.earliest_epoch = t;
+    }
+    if (!p.any_epoch || t < p.r.t_first) {
+        p.r.t_first = t;
+    }
+    if (!p.any_epoch || t > p.r.t_last) {
+        p.r.t_last = t;
+    }
+    p.any_epoch = true;
+}
+
+// One epoch into its orbit's sums. F needs A and C; the same epochs serve all
+// heads, so an epoch without all three is left out.
+void add_epoch(Pass& p, const Epoch<Row>& e, bool selection_report) {
+    if (!(e.head[0] && e.head[1] && e.head[2])) {
+        return;
+    }
+    const Eigen::Quaterniond q_f_icrf = q_f_icrf_at(e);
+    const auto bin = static_cast<long long>(std::floor(e.t / *p.period));
+    OrbitSums& o = p.orbits[bin];
+    ++o.count;
+    for (std::size_t h = 0; h < 3; ++h) {
+        add_head(p, o, e, q_f_icrf, h);
+    }
+    if (selection_report) {
+        p.fit_epochs.push_back(fit_epoch_of(e));
+    }
+    note_epoch_time(p, e.t);
+}
+
+bool in_modelling_period(const FitOptions& opt, const SolutionRecord& rec) {
+    return !((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2);
+}
+
+// The selection (fit_selection), then the aberration correction into c;
+// kRejected where the core does not correct the row.
+Drop select_and_correct(const SolutionRecord& rec, EarthVelocity& earth, CorrectedSolution<double>& c) {
+    const CorrectionConfig<double> ab_only{true, nullptr};
+    Drop d = fit_selection(rec);
+    if (d == Drop::kNone) {
+        c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
+        if ((c.status & status::kAberrationApplied) == 0U) {
+            d = Drop::kRejected;
+        }
+    }
+    return d;
+}
+
+// Only the earliest selected row's speed gives the orbit period, so it is
+// judged after all rows are read (a later row read first must not decide).
+// Until then an implausible speed gets a placeholder period, so that no orbit
+// index overflows.
+void note_selected_row(Pass& p, const SolutionRecord& rec) {
+    if (!p.period_given && (!p.any_row || rec.t < p.earliest_row)) {
+        const double v = std::sqrt(squared_norm(rec.v_sc_kms));
+        const bool plausible = v > 1.0 && v < 12.0;
+        p.earliest_row = rec.t;
+        p.earliest_row_speed = v;
+        p.earliest_row_line = rec.line;
+        p.earliest_row_period = plausible ? 2.0 * kPi * kMuEarth / (v * v * v) : 0.0;
+        if (!p.period) {
+            p.period = plausible ? p.earliest_row_period : kPlaceholderPeriodS;
+        }
+    }
+    p.any_row = true;
+}
+
+// One row: counted, selected and corrected, then handed to the epochs.
+void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssembler<Row>& epochs,
+             const SolutionRecord& rec) {
+    if (!in_modelling_period(opt, rec)) {
+        return;
+    }
+    ++p.r.rows;
+    CorrectedSolution<double> c{};
+    const Drop d = select_and_correct(rec, earth, c);
+    ++p.r.dropped[static_cast<std::size_t>(d)];
+    if (d != Drop::kNone) {
+        return;
+    }
+    note_selected_row(p, rec);
+    Row row;
+    row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
+    row.temp = rec.temperature;
+    epochs.add(rec.t, rec.head, rec.line, row);
+}
+
+// Re-base on the earliest epoch: with b = earliest a, each epoch's small
+// angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
+// 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
+void rebase_on_earliest_epoch(Pass& p) {
+    for (std::size_t h = 0; h < 3 && p.r.epochs != 0; ++h) {
+        const Eigen::Quaterniond b_inv = p.earliest_a[h].conjugate();
+        for (auto& kv : p.orbits) {
             const Eigen::Vector4d& s = kv.second.q[h];
             const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
             kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
         }
-        reference[h] = (earliest_a[h] * *reference[h]).normalized();
+        p.reference[h] = (p.earliest_a[h] * *p.reference[h]).normalized();
     }
+}
 
-    const std::string period_text = "t = " + time_text(r.t_first) + " .. " + time_text(r.t_last);
+void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::string& period_text) {
     if (r.epochs == 0) {
         throw FitRefused(opt.in +
                          ": no epoch in the modelling period has solutions of A, B and C that pass the selection");
@@ -305,30 +336,23 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
                       span_days, period_text.c_str(), opt.min_span_days);
         throw FitRefused(opt.in + ": " + buf);
     }
+}
 
-    // Orbits with at least half the typical number of epochs: a short one
-    // (a gap, the ends of the period) is dominated by its part of the orbit.
+// Orbits with at least half the typical number of epochs: a short one
+// (a gap, the ends of the period) is dominated by its part of the orbit.
+std::size_t min_epochs_per_orbit(const std::map<long long, OrbitSums>& orbits) {
     std::vector<std::size_t> counts;
+    counts.reserve(orbits.size());
     for (const auto& kv : orbits) {
         counts.push_back(kv.second.count);
     }
     std::nth_element(counts.begin(), counts.begin() + static_cast<long>(counts.size() / 2), counts.end());
-    const std::size_t min_count = std::max<std::size_t>(2, counts[counts.size() / 2] / 2);
-    std::vector<const OrbitSums*> used;
-    for (const auto& kv : orbits) {
-        if (kv.second.count >= min_count) {
-            used.push_back(&kv.second);
-        }
-    }
-    r.orbits_used = used.size();
-    r.orbits_left_out = orbits.size() - used.size();
-    if (used.size() < opt.min_orbits) {
-        throw FitRefused(opt.in + ": too few orbits in the modelling period (" + period_text +
-                         "): " + std::to_string(used.size()) + " with enough data, at least " +
-                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
-    }
+    return std::max<std::size_t>(2, counts[counts.size() / 2] / 2);
+}
 
-    // The orbit averages, and the heads' orientations N_i in F.
+// The averages of the orbits with at least min_count epochs.
+std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& orbits, std::size_t min_count,
+                                         double period) {
     std::vector<OrbitAverage> averages;
     for (const auto& kv : orbits) {
         if (kv.second.count < min_count) {
@@ -336,16 +360,23 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
         }
         OrbitAverage& a = averages.emplace_back();
         const double w = 1.0 / static_cast<double>(kv.second.count);
-        a.t_mid = (static_cast<double>(kv.first) + 0.5) * *period;
+        a.t_mid = (static_cast<double>(kv.first) + 0.5) * period;
         for (std::size_t h = 0; h < 3; ++h) {
             a.e[h] = kv.second.e[h] * w;
             a.x[h] = kv.second.x[h] * w;
             a.x2[h] = kv.second.x2[h] * w;
         }
     }
+    return averages;
+}
+
+// The fit of the orbit averages against the heads' orientations N_i in F,
+// refused as solve_terms says; then the model-selection report.
+void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& averages, const std::string& period_text) {
+    FitReport& r = p.r;
     std::array<Eigen::Matrix3d, 3> n_ref;
     for (std::size_t h = 0; h < 3; ++h) {
-        n_ref[h] = reference[h]->toRotationMatrix();
+        n_ref[h] = p.reference[h]->toRotationMatrix();
     }
     r.terms = opt.terms;
     r.fit = solve_terms(averages, n_ref, opt.terms, opt.max_condition, opt.min_temperature_range_c);
@@ -358,16 +389,54 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
                          ": T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently in the modelling period (" +
                          period_text + ")");
     }
-    std::sort(fit_epochs.begin(), fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
+    std::sort(p.fit_epochs.begin(), p.fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
     if (opt.selection_report) {
-        r.selection = select_terms(averages, fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
+        r.selection = select_terms(averages, p.fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
                                    opt.min_temperature_range_c);
     }
     r.singular_values = r.fit.singular_values;
     r.condition = r.fit.condition;
     r.head = r.fit.head;
     r.model = r.fit.model;
-    return r;
+}
+
+// Row order must not matter (issue 11). The reference N_i is the earliest
+// epoch's (re-based exactly at the end), and the orbit period, when not
+// given, comes from the earliest selected row: if that is not the first one
+// read, the file is read again with that period (unordered files only).
+// (earliest_period: that second reading.)
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period) {
+    EarthVelocity earth;
+    Pass p;
+    p.period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
+    p.period = earliest_period ? earliest_period : opt.orbit_period_s;
+    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt.selection_report); });
+    rows([&](const SolutionRecord& rec) { add_row(p, opt, earth, epochs, rec); });
+    epochs.finish();
+    if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
+        throw InputError(opt.in, p.earliest_row_line, 1,
+                         "spacecraft speed " + std::to_string(p.earliest_row_speed) +
+                             " km/s is not that of an Earth orbit: give --orbit-period");
+    }
+    if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
+        // Rows out of time order: again, with the earliest row's period.
+        return fit_pass(opt, rows, p.earliest_row_period);
+    }
+    p.r.orbit_period_s = p.period.value_or(0.0);
+    rebase_on_earliest_epoch(p);
+
+    const std::string period_text = "t = " + time_text(p.r.t_first) + " .. " + time_text(p.r.t_last);
+    refuse_short_period(opt, p.r, period_text);
+    const std::vector<OrbitAverage> averages = orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period);
+    p.r.orbits_used = averages.size();
+    p.r.orbits_left_out = p.orbits.size() - averages.size();
+    if (averages.size() < opt.min_orbits) {
+        throw FitRefused(opt.in + ": too few orbits in the modelling period (" + period_text +
+                         "): " + std::to_string(averages.size()) + " with enough data, at least " +
+                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
+    }
+    solve(opt, p, averages, period_text);
+    return p.r;
 }
 
 }  // namespace

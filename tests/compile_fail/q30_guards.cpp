@@ -11,8 +11,8 @@ namespace ascorr {
 using S = ASCORR_SCALAR;
 
 void call_kernel() {
-    const S one = k<S>(1.0);
-    const S zero = k<S>(0.0);
+    const S one = constant<S>(1.0);
+    const S zero = constant<S>(0.0);
     const Vector3<S> v{zero, zero, one};
     const Quaternion<S> q{one, zero, zero, zero};
     const SmallRotation<S> r{zero, v};

@@ -4,16 +4,16 @@
 // here runs; the build failing is the test.
 #include "ascorr_hal/acquisition.hpp"
 #include "ascorr_hal/fixed_thermistor.hpp"
-#include "ascorr_hal/frame.hpp"
 #include "ascorr_hal/mcp3208.hpp"
+#include "ascorr_hal/sample_set.hpp"
 #include "ascorr_hal/sampler.hpp"
 
 template class ascorr::hal::TemperatureAcquisition<float>;
 template class ascorr::hal::TemperatureAcquisition<double>;
-template class ascorr::hal::AdcFrameSource<float>;
+template class ascorr::hal::AdcSampleSetSource<float>;
 template class ascorr::hal::ChannelCheck<float>;
 template class ascorr::hal::TemperatureAcquisition<ascorr::QCelsius>;
-template class ascorr::hal::AdcFrameSource<ascorr::QCelsius>;
+template class ascorr::hal::AdcSampleSetSource<ascorr::QCelsius>;
 template class ascorr::hal::ChannelCheck<ascorr::QCelsius>;
 
 // The device interfaces (and so every implementation) are neither copyable nor
@@ -26,5 +26,5 @@ constexpr bool resource_like = !std::is_copy_constructible_v<I> && !std::is_copy
                                !std::is_move_constructible_v<I> && !std::is_move_assignable_v<I>;
 static_assert(resource_like<Clock> && resource_like<ManualClock>);
 static_assert(resource_like<BitBangPins> && resource_like<AdcPort> && resource_like<Mcp3208>);
-static_assert(resource_like<FrameSource<float>> && resource_like<AdcFrameSource<float>>);
+static_assert(resource_like<SampleSetSource<float>> && resource_like<AdcSampleSetSource<float>>);
 }  // namespace hal_interface_check

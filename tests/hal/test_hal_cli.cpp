@@ -89,7 +89,7 @@ TEST(HalReplay, ErrorsNameLineAndColumn) {
     EXPECT_EQ(err("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
     EXPECT_EQ(err("t,THT00029\n-1,3\n"), "r.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
     EXPECT_EQ(err("t,THT00029\n1,3,4\n"), "r.csv:2:6: expected 2 fields, found 3");
-    EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).frames(), 2U);
+    EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).sample_sets(), 2U);
 }
 
 TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
@@ -122,7 +122,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
     struct Case {
         const char* spec;
         int channel;
-        int at;  // frame index to look at
+        int at;  // sample set (row) index to look at
         hal::FaultBits want;
     };
     const Case cases[] = {
@@ -133,7 +133,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
     for (const Case& k : cases) {
         hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
         hal::TemperatureAcquisition<double> acq(c);
-        hal::Frame<double> f{};
+        hal::SampleSet<double> f{};
         for (int i = 0; i <= k.at; ++i) {
             ASSERT_TRUE(src.acquire(f));
             acq.update(f);
@@ -184,11 +184,11 @@ TEST(HalCli, ThermistorsOnAReplayFile) {
     EXPECT_EQ(lines[0], "t,name,role,counts,ohm,celsius,valid,faults");
     EXPECT_EQ(lines[1], "100.000000,THT00029,t029,,,-9.500,1,");
     EXPECT_EQ(lines[10], "100.000000,t_029,voted,,,-9.500,1,");
-    // Frame 3 (t = 102): THT00057 jumps 6.5 °C (rate, then outvoted), THT00060 open.
+    // Sample set 3 (t = 102): THT00057 jumps 6.5 °C (rate, then outvoted), THT00060 open.
     EXPECT_EQ(lines[24], "102.000000,THT00057,t029,,,-3.000,0,rate");
     EXPECT_EQ(lines[27], "102.000000,THT00060,t032,4095,40950000.0,,0,open");
     EXPECT_EQ(lines[32], "102.000000,t_029,voted,,,-9.490,1,");
-    // Frame 4: THT00090 shorted too: T3 withheld; CHU_A kept from t = 102.
+    // Sample set 4: THT00090 shorted too: T3 withheld; CHU_A kept from t = 102.
     EXPECT_EQ(lines[39], "103.000000,THT00090,t032,0,0.0,,0,short");
     EXPECT_EQ(lines[40], "102.000000,CHU_A,chu_a,,,3.220,1,");
     EXPECT_EQ(lines[44], "103.000000,t_032,voted,,,,0,open|short|no_quorum");

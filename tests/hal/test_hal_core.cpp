@@ -20,8 +20,8 @@ namespace {
 using hal::ChannelReading;
 using hal::ChannelSample;
 using hal::FaultBits;
-using hal::Frame;
 using hal::SampleKind;
+using hal::SampleSet;
 namespace fault = hal::fault;
 
 // ---- conversion accuracy ----------------------------------------------------
@@ -209,11 +209,12 @@ TEST(HalSampler, AFailedConversionIsABusFault) {
 struct Rig {
     hal::AcquisitionConfig<double> cfg = swarm_config();
     hal::TemperatureAcquisition<double> acq{cfg};
-    Frame<double> f{};
+    SampleSet<double> f{};
     std::uint64_t t = 1000000000U;
 
-    // Every channel at its temperature as counts, then one frame at t.
-    void frame(const double (&temps)[8], std::uint64_t dt_us = 1000000U) {
+    // Every channel at its temperature as counts: one sample set at t
+    // (commit() hands it to the acquisition).
+    void fill(const double (&temps)[8], std::uint64_t dt_us = 1000000U) {
         t += dt_us;
         f.t_us = t;
         for (std::uint8_t i = 0; i < 8; ++i) {
@@ -245,7 +246,7 @@ void expect_thermal_withheld(const hal::HeadAcquisition<double>& h, StatusBits m
 
 TEST(HalFaults, NominalFramesAreValidAndTheCoreAppliesThem) {
     Rig r;
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.commit();
     for (std::uint8_t i = 0; i < 8; ++i) {
         EXPECT_EQ(r.ch(i).faults, 0U) << int(i);
@@ -260,7 +261,7 @@ TEST(HalFaults, NominalFramesAreValidAndTheCoreAppliesThem) {
 
 TEST(HalFaults, NoData) {
     Rig r;
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[6].kind = SampleKind::kNone;  // CHU_A never sampled
     r.commit();
     EXPECT_EQ(r.ch(6).faults, fault::kNoData);
@@ -272,7 +273,7 @@ TEST(HalFaults, NoData) {
 
 TEST(HalFaults, BusOpenShortNoisyEachFlagged) {
     Rig r;
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[0].faults = fault::kBus;
     r.f.channel[1].counts = 4095U;  // thermistor open (low side)
     r.f.channel[3].counts = 0U;     // shorted
@@ -296,11 +297,11 @@ TEST(HalFaults, OpenAndShortOnAHighSideDivider) {
     Rig r;
     r.cfg.channel[7].divider.thermistor_low = false;
     hal::TemperatureAcquisition<double> acq(r.cfg);
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[7].counts = 0U;
     acq.update(r.f);
     EXPECT_EQ(acq.channel(7, r.t).faults, fault::kOpen);
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[7].counts = 4095U;
     acq.update(r.f);
     EXPECT_EQ(acq.channel(7, r.t).faults, fault::kShort);
@@ -311,7 +312,7 @@ TEST(HalFaults, OutOfRange) {
     double t[8];
     std::copy(kNominal, kNominal + 8, t);
     t[6] = 95.0;  // above t_max = 80, still a plausible resistance
-    r.frame(t);
+    r.fill(t);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, fault::kOutOfRange);
     expect_thermal_withheld(r.acq.head(0, r.t), status::kTemperatureInvalid);
@@ -319,7 +320,7 @@ TEST(HalFaults, OutOfRange) {
 
 TEST(HalFaults, ConversionWithBadCoefficients) {
     Rig r;
-    r.frame(kNominal);
+    r.fill(kNominal);
     hal::AcquisitionConfig<double> bad = r.cfg;
     bad.channel[6].sh = {0.0, 0.0, 0.0};  // 1/T = 0
     hal::TemperatureAcquisition<double> acq(bad);
@@ -331,23 +332,23 @@ TEST(HalFaults, RateSpikeCostsOneReadingAndAStepIsAcceptedAfterOne) {
     Rig r;
     double t[8];
     std::copy(kNominal, kNominal + 8, t);
-    r.frame(t);
+    r.fill(t);
     r.commit();
     t[6] = 13.2;  // +10 °C in 1 s, max_rate 0.5 °C/s
-    r.frame(t);
+    r.fill(t);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, fault::kRate);
     expect_thermal_withheld(r.acq.head(0, r.t), status::kTemperatureInvalid);
     t[6] = 3.3;  // back: it was a spike
-    r.frame(t);
+    r.fill(t);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, 0U);
     t[6] = 8.3;  // a real step (e.g. after a heater switched) ...
-    r.frame(t);
+    r.fill(t);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, fault::kRate);
     t[6] = 8.4;  // ... confirmed by the next reading
-    r.frame(t);
+    r.fill(t);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, 0U);
     EXPECT_NEAR(r.ch(6).celsius, 8.4, 0.03);
@@ -356,23 +357,23 @@ TEST(HalFaults, RateSpikeCostsOneReadingAndAStepIsAcceptedAfterOne) {
 TEST(HalFaults, StuckAfterIdenticalFramesAndRecovers) {
     Rig r;
     for (int k = 0; k < 4; ++k) {
-        r.frame(kNominal);
+        r.fill(kNominal);
         r.f.channel[6].spread = 0U;
         r.commit();
         EXPECT_EQ(r.ch(6).faults, 0U) << k;
     }
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[6].spread = 0U;
     r.commit();
-    EXPECT_EQ(r.ch(6).faults, fault::kStuck);  // 5th identical, noise-free frame
+    EXPECT_EQ(r.ch(6).faults, fault::kStuck);  // 5th identical, noise-free sample set
     expect_thermal_withheld(r.acq.head(0, r.t), status::kTemperatureInvalid);
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.f.channel[6].spread = 1U;  // the ADC shows noise again
     r.commit();
     EXPECT_EQ(r.ch(6).faults, 0U);
     // A quiet but live channel (identical median, spread 1) is never stuck.
     for (int k = 0; k < 10; ++k) {
-        r.frame(kNominal);
+        r.fill(kNominal);
         r.commit();
     }
     EXPECT_EQ(r.ch(6).faults, 0U);
@@ -380,7 +381,7 @@ TEST(HalFaults, StuckAfterIdenticalFramesAndRecovers) {
 
 TEST(HalFaults, StaleWhenOldOrWhenTimeDoesNotAdvance) {
     Rig r;
-    r.frame(kNominal);
+    r.fill(kNominal);
     r.commit();
     const std::uint64_t t0 = r.t;
     EXPECT_EQ(r.acq.channel(6, t0 + 5000000U).faults, 0U);             // 5 s: still fresh
@@ -390,17 +391,17 @@ TEST(HalFaults, StaleWhenOldOrWhenTimeDoesNotAdvance) {
     EXPECT_EQ(h.status_bits(), status::kNoTemperature | status::kStale);
     expect_thermal_withheld(h, status::kStale);
     // Samples stop (kNone) but the last reading is kept until it is stale.
-    r.frame(kNominal);
+    r.fill(kNominal);
     for (auto& s : r.f.channel) {
         s.kind = SampleKind::kNone;
     }
     r.commit();
     EXPECT_EQ(r.ch(6).faults, 0U);
     EXPECT_EQ(r.ch(6).t_us, t0);
-    // A frame whose time does not advance (replayed twice, frozen clock).
-    r.frame(kNominal, 0U);
+    // A sample set whose time does not advance (replayed twice, frozen clock).
+    r.fill(kNominal, 0U);
     r.commit();
-    r.frame(kNominal, 0U);
+    r.fill(kNominal, 0U);
     r.commit();
     EXPECT_EQ(r.ch(6).faults, fault::kStale);
 }
@@ -464,8 +465,8 @@ TEST(HalVoting, AcquisitionFlagsTheOutvotedMemberAndKeepsTheMedian) {
     Rig r;
     double t[8];
     std::copy(kNominal, kNominal + 8, t);
-    t[2] = -4.0;  // THT00087 reads 5.5 °C warm (first frame: no rate anchor yet)
-    r.frame(t);
+    t[2] = -4.0;  // THT00087 reads 5.5 °C warm (first sample set: no rate anchor yet)
+    r.fill(t);
     r.commit();
     ChannelReading<double> members[3];
     std::uint8_t index[3];

@@ -70,7 +70,7 @@ TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
     const hal::AcquisitionConfig<float> cfg = float_config();
     BoomAdc adc(cfg);
     hal::ManualClock clock(0);
-    hal::AdcFrameSource<float> source(adc, clock, cfg);
+    hal::AdcSampleSetSource<float> source(adc, clock, cfg);
     hal::TemperatureAcquisition<float> acq(cfg);
 
     ThermalModel<float> model{};
@@ -116,7 +116,7 @@ TEST(HalFirmwareLoop, OneHertzAcquisitionFeedsEverySolutionWithoutAllocating) {
         if (s >= 20 && s < 25) {
             EXPECT_EQ(applied[s], 0) << s;
             EXPECT_EQ(last_status[s], status::kNoTemperature | status::kTemperatureInvalid) << s;
-        } else if (s >= 44 && s < 50) {  // last frame at 39.0 s: stale from 44.0 s on
+        } else if (s >= 44 && s < 50) {  // last sample set at 39.0 s: stale from 44.0 s on
             EXPECT_EQ(applied[s], 0) << s;
             EXPECT_EQ(last_status[s], status::kNoTemperature | status::kStale) << s;
         } else {

@@ -82,8 +82,8 @@ struct Paths {
 };
 
 template <typename T>
-hal::Frame<T> convert_frame(const hal::Frame<double>& in) {
-    hal::Frame<T> out{};
+hal::SampleSet<T> convert_sample_set(const hal::SampleSet<double>& in) {
+    hal::SampleSet<T> out{};
     out.t_us = in.t_us;
     for (std::uint8_t i = 0; i < hal::kMaxChannels; ++i) {
         const hal::ChannelSample<double>& s = in.channel[i];
@@ -98,20 +98,20 @@ hal::Frame<T> convert_frame(const hal::Frame<double>& in) {
     return out;
 }
 
-// What a run of frames through both paths showed.
+// What a run of sample sets through both paths showed.
 struct Comparison {
-    int frames = 0;
+    int sample_sets = 0;
     int mismatches = 0;
     hal::FaultBits seen = 0;  // every fault bit of a channel or a voted value, on either path
     double worst_voted_c = 0.0;
     int voted_compared = 0;
 };
 
-void compare_frame(Paths& p, const hal::Frame<double>& frame, Comparison& cmp, const std::string& what) {
-    p.float_acq->update(convert_frame<float>(frame));
-    p.fixed_acq->update(convert_frame<QCelsius>(frame));
-    ++cmp.frames;
-    const std::uint64_t now = frame.t_us;
+void compare_sample_set(Paths& p, const hal::SampleSet<double>& samples, Comparison& cmp, const std::string& what) {
+    p.float_acq->update(convert_sample_set<float>(samples));
+    p.fixed_acq->update(convert_sample_set<QCelsius>(samples));
+    ++cmp.sample_sets;
+    const std::uint64_t now = samples.t_us;
     for (std::uint8_t i = 0; i < p.f.channels; ++i) {
         const hal::ChannelReading<float> a = p.float_acq->channel(i, now);
         const hal::ChannelReading<QCelsius> b = p.fixed_acq->channel(i, now);
@@ -302,12 +302,12 @@ TEST(HalFixed, RecordedStreamsGiveTheSameFaultsAndVotes) {
     Paths p(cfg);
     const std::unique_ptr<hal::ReplaySource> src = hal::ReplaySource::from_file(kExamples + "/replay.csv", cfg);
     Comparison cmp;
-    hal::Frame<double> f{};
+    hal::SampleSet<double> f{};
     while (src->acquire(f)) {
-        compare_frame(p, f, cmp, "replay.csv");
+        compare_sample_set(p, f, cmp, "replay.csv");
     }
-    std::printf("replay.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C\n", cmp.frames,
-                cmp.voted_compared, cmp.worst_voted_c);
+    std::printf("replay.csv: %d sample sets, %d voted values compared, worst |fixed - float| %.5f °C\n",
+                cmp.sample_sets, cmp.voted_compared, cmp.worst_voted_c);
     EXPECT_EQ(cmp.mismatches, 0);
     EXPECT_GT(cmp.voted_compared, 0);
     EXPECT_NE(cmp.seen & fault::kOpen, 0U);
@@ -345,20 +345,20 @@ TEST(HalFixed, SimulatedStreamsWithEveryFaultClassGiveTheSameFaultsAndVotes) {
     hal::SimulatedSource src(cfg, history, faults);
     Paths p(cfg);
     Comparison cmp;
-    hal::Frame<double> f{};
+    hal::SampleSet<double> f{};
     while (src.acquire(f)) {
-        compare_frame(p, f, cmp, "simulated");
+        compare_sample_set(p, f, cmp, "simulated");
     }
     // The worked examples' temperatures as a history, without faults.
     hal::SimulatedSource examples(cfg, hal::read_history(data_path("solutions.csv")), {});
     Paths p2(cfg);
     while (examples.acquire(f)) {
-        compare_frame(p2, f, cmp, "solutions.csv");
+        compare_sample_set(p2, f, cmp, "solutions.csv");
     }
     std::printf(
-        "simulated + solutions.csv: %d frames, %d voted values compared, worst |fixed - float| %.5f °C, "
+        "simulated + solutions.csv: %d sample sets, %d voted values compared, worst |fixed - float| %.5f °C, "
         "fault bits seen %#x\n",
-        cmp.frames, cmp.voted_compared, cmp.worst_voted_c, static_cast<unsigned>(cmp.seen));
+        cmp.sample_sets, cmp.voted_compared, cmp.worst_voted_c, static_cast<unsigned>(cmp.seen));
     EXPECT_EQ(cmp.mismatches, 0);
     EXPECT_GT(cmp.voted_compared, 1000);
     // Every fault class occurred (kConversion: BadCoefficientsAreConversionFaultsOnBothPaths).

@@ -136,7 +136,7 @@ TEST(HalGpiod, ConversionBitStreamAsTheChipSeesIt) {
     EXPECT_EQ(reads, 8 * 13);
 }
 
-TEST(HalGpiod, FrameSourceSettlesAndTakesTheMedianPerChannel) {
+TEST(HalGpiod, SampleSetSourceSettlesAndTakesTheMedianPerChannel) {
     gpiod_double::Script s;
     // Conversion 0 on each channel is the discarded settling one (far off);
     // then 9 samples with one glitch.
@@ -152,8 +152,8 @@ TEST(HalGpiod, FrameSourceSettlesAndTakesTheMedianPerChannel) {
     gpiod_double::reset(s);
     const hal::HalConfig cfg = board();
     hal::ManualClock clock(1000000U);
-    hal::GpiodFrameSource src(cfg, clock);
-    hal::Frame<double> f{};
+    hal::GpiodSampleSetSource src(cfg, clock);
+    hal::SampleSet<double> f{};
     ASSERT_TRUE(src.acquire(f));
     EXPECT_EQ(f.t_us, 1000000U);
     for (unsigned ch = 0; ch < 8; ++ch) {
@@ -173,8 +173,8 @@ TEST(HalGpiod, AbsentAdcIsABusFaultNotZeroCounts) {
     s.device_present = false;  // DOUT pulled up: the null bit reads 1
     gpiod_double::reset(s);
     hal::ManualClock clock(0);
-    hal::GpiodFrameSource src(board(), clock);
-    hal::Frame<double> f{};
+    hal::GpiodSampleSetSource src(board(), clock);
+    hal::SampleSet<double> f{};
     ASSERT_TRUE(src.acquire(f));
     hal::TemperatureAcquisition<double> acq(board().acquisition);
     acq.update(f);
@@ -226,7 +226,7 @@ PathResult run_path(const host::SolutionRecord& rec, const ThermalModel<double>&
     };
     gpiod_double::reset(s);
     hal::ManualClock clock(10000000U);
-    hal::GpiodFrameSource src(cfg, clock);
+    hal::GpiodSampleSetSource src(cfg, clock);
     hal::TemperatureAcquisition<double> acq(cfg.acquisition);
     EXPECT_TRUE(acq.poll(src));
     const hal::HeadAcquisition<double> h = acq.head(rec.head, clock.now_us());

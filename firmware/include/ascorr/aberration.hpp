@@ -58,7 +58,7 @@ struct ObserverVelocity {
 // fixed point, which fails it too.
 template <typename T>
 constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
-    constexpr T lim = k<T>(kMaxBeta * kMaxBeta);
+    constexpr T lim = constant<T>(kMaxBeta * kMaxBeta);
     return squared_norm(beta) <= lim;
 }
 
@@ -67,8 +67,8 @@ constexpr bool beta_in_domain(const Vector3<T>& beta) noexcept {
 // converts to the top of the range (≥ 1.99), which fails the upper bound.
 template <typename T>
 constexpr bool inv_sun_distance_in_domain(const T& inv_sun_distance_au) noexcept {
-    constexpr T lo = k<T>(1.0 / kMaxSunDistanceAu);
-    constexpr T hi = k<T>(1.0 / kMinSunDistanceAu);
+    constexpr T lo = constant<T>(1.0 / kMaxSunDistanceAu);
+    constexpr T hi = constant<T>(1.0 / kMinSunDistanceAu);
     return lo <= inv_sun_distance_au && inv_sun_distance_au <= hi;
 }
 
@@ -83,9 +83,9 @@ constexpr bool velocity_in_domain(const ObserverVelocity<T>& v) noexcept {
 template <typename T>
 constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const Vector3<T>& beta_icrf,
                                                const T& inv_sun_distance_au) noexcept {
-    constexpr T one = k<T>(1.0);
-    constexpr T half = k<T>(0.5);
-    constexpr T eighth = k<T>(0.125);
+    constexpr T one = constant<T>(1.0);
+    constexpr T half = constant<T>(0.5);
+    constexpr T eighth = constant<T>(0.125);
     const T pdv = dot(z_icrf, beta_icrf);
     const Vector3<T> c = cross(z_icrf, beta_icrf);
     const T n = squared_norm(c);
@@ -93,8 +93,8 @@ constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const V
     T x = n;
     if constexpr (ScalarTraits<T>::double_precision) {
         const T b2 = squared_norm(beta_icrf);
-        constexpr T quarter = k<T>(0.25);
-        constexpr T sun_radius = k<T>(kSunSchwarzschildRadiusAu);
+        constexpr T quarter = constant<T>(0.25);
+        constexpr T sun_radius = constant<T>(kSunSchwarzschildRadiusAu);
         const T w1 = one + half * pdv * (one + quarter * b2);
         const T w2 = sun_radius * inv_sun_distance_au;
         // 1/(1 + pdv) by Horner: 1 − p(1 − p(1 − p(1 − p))).

@@ -1,6 +1,6 @@
 // ascorr/constants.hpp: physical constants and the validity domain of the core.
 //
-// Values are doubles; the core converts them to its scalar type with k<T>().
+// Values are doubles; the core converts them to its scalar type with constant<T>().
 // The domain limits are where the core's truncated series stop meeting their
 // error bounds (stated in aberration.hpp and thermal.hpp); inputs outside them
 // are flagged and the stage is skipped, never evaluated.

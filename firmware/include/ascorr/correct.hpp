@@ -79,7 +79,7 @@ struct ThermalStage {
 template <typename T>
 constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
                                         const HeadTemperatures<T>& temps) noexcept {
-    constexpr T zero = k<T>(0.0);
+    constexpr T zero = constant<T>(0.0);
     ThermalStage<T> out{{zero, {zero, zero, zero}}, 0U};
     if (head >= kMaxHeads || !model.head[head].present) {
         out.skip = status::kNoModelForHead;
@@ -101,7 +101,7 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
     const T alpha = thermal_angle<T>(m.alpha, t1, t2, t3);
     const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
     const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
-    constexpr T lim = k<T>(kMaxThermalAngleRad);
+    constexpr T lim = constant<T>(kMaxThermalAngleRad);
     if (!(abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim))) {  // false for NaN
         out.skip = status::kThermalOutOfRange;
         return out;
@@ -121,7 +121,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
     }
     StatusBits st = 0U;
     const Quaternion<T>& q = in.q_chu_icrf;
-    constexpr T zero = k<T>(0.0);
+    constexpr T zero = constant<T>(0.0);
     Quaternion<T> d{zero, zero, zero, zero};
 
     if (cfg.aberration) {

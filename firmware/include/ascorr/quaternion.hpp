@@ -50,14 +50,14 @@ constexpr bool is_finite(const Quaternion<T>& q) noexcept {
 // fixed-point scalar overloads this with an exact test.
 template <typename T>
 constexpr bool norm_within(const Quaternion<T>& q, const T& tol) noexcept {
-    constexpr T one = k<T>(1.0);
+    constexpr T one = constant<T>(1.0);
     return abs_within(squared_norm(q) - one, tol);
 }
 
 // The same attitude with w ≥ 0.
 template <typename T>
 constexpr Quaternion<T> canonical(const Quaternion<T>& q) noexcept {
-    constexpr T zero = k<T>(0.0);
+    constexpr T zero = constant<T>(0.0);
     return q.w < zero ? Quaternion<T>{-q.w, -q.x, -q.y, -q.z} : q;
 }
 
@@ -98,7 +98,7 @@ constexpr Quaternion<T> increment(const SmallRotation<T>& r) noexcept {
 
 template <typename T>
 constexpr Quaternion<T> to_quaternion(const SmallRotation<T>& r) noexcept {
-    constexpr T one = k<T>(1.0);
+    constexpr T one = constant<T>(1.0);
     return {one + r.dw, r.v.x, r.v.y, r.v.z};
 }
 
@@ -128,8 +128,8 @@ constexpr Quaternion<T> add_left_increment(const Quaternion<T>& d, const SmallRo
 template <typename T>
 constexpr Quaternion<T> renormalized_sum(const Quaternion<T>& q, const Quaternion<T>& d) noexcept {
     const T two_qd = dot(q, d) + dot(q, d);
-    constexpr T one = k<T>(1.0);
-    constexpr T half = k<T>(0.5);
+    constexpr T one = constant<T>(1.0);
+    constexpr T half = constant<T>(0.5);
     const T eps = (squared_norm(q) - one) + two_qd + squared_norm(d);
     const T g = -(half * eps);
     const Quaternion<T> qd = q + d;
@@ -139,7 +139,7 @@ constexpr Quaternion<T> renormalized_sum(const Quaternion<T>& q, const Quaternio
 
 template <typename T>
 constexpr Quaternion<T> renormalized(const Quaternion<T>& q) noexcept {
-    constexpr T zero = k<T>(0.0);
+    constexpr T zero = constant<T>(0.0);
     return renormalized_sum(q, Quaternion<T>{zero, zero, zero, zero});
 }
 
@@ -151,7 +151,7 @@ constexpr Vector3<T> boresight(const Quaternion<T>& q) noexcept {
     const T a = q.x * q.z - q.w * q.y;
     const T b = q.y * q.z + q.w * q.x;
     const T c = q.x * q.x + q.y * q.y;
-    constexpr T one = k<T>(1.0);
+    constexpr T one = constant<T>(1.0);
     return {a + a, b + b, one - (c + c)};
 }
 

@@ -103,11 +103,11 @@ struct HalfAngle {
 // cos and sin of half an angle, |angle| ≤ kMaxThermalAngleRad (series above).
 template <typename T>
 constexpr HalfAngle<T> half_angle(const T& angle) noexcept {
-    constexpr T one = k<T>(1.0);
-    constexpr T half = k<T>(0.5);
-    constexpr T twelfth = k<T>(1.0 / 12.0);
-    constexpr T sixth = k<T>(1.0 / 6.0);
-    constexpr T twentieth = k<T>(0.05);
+    constexpr T one = constant<T>(1.0);
+    constexpr T half = constant<T>(0.5);
+    constexpr T twelfth = constant<T>(1.0 / 12.0);
+    constexpr T sixth = constant<T>(1.0 / 6.0);
+    constexpr T twentieth = constant<T>(0.05);
     const T h = half * angle;
     const T h2 = h * h;
     return {-(half * h2 * (one - twelfth * h2)), h * (one - sixth * h2 * (one - twentieth * h2))};
@@ -123,8 +123,8 @@ template <typename T>
 constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const T& gamma) noexcept {
     if constexpr (!ScalarTraits<T>::double_precision) {
         const auto tan_half = [](const T& angle) {
-            constexpr T half = k<T>(0.5);
-            constexpr T third = k<T>(1.0 / 3.0);
+            constexpr T half = constant<T>(0.5);
+            constexpr T third = constant<T>(1.0 / 3.0);
             const T h = half * angle;
             return h + third * (h * h) * h;
         };
@@ -137,7 +137,7 @@ constexpr SmallRotation<T> thermal_rotation(const T& alpha, const T& beta, const
     const HalfAngle<T> a = half_angle(alpha);
     const HalfAngle<T> b = half_angle(beta);
     const HalfAngle<T> g = half_angle(gamma);
-    constexpr T one = k<T>(1.0);
+    constexpr T one = constant<T>(1.0);
     const T ac = one + a.cm1;
     const T bc = one + b.cm1;
     const T gc = one + g.cm1;

@@ -248,8 +248,8 @@ public:
 
     // The per-solution query, in T (no double, no division). advance(t) first.
     constexpr ServiceVelocity<T> velocity_at(TtTime t) const noexcept {
-        constexpr T zero = k<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
-        constexpr T one = k<T>(1.0);
+        constexpr T zero = constant<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
+        constexpr T one = constant<T>(1.0);
         ServiceVelocity<T> out{{{zero, zero, zero}, one, false}, status::kNoVelocity};
         if (!has_state_ || t < state_t_) {
             return out;

@@ -7,6 +7,11 @@
 // time, holds at most kMaxEncoded bytes, and classifies every frame it ends:
 // a good frame, or exactly one error (overlong, bad COBS, bad length, bad CRC,
 // bad version). Nothing allocates; every loop is bounded by kMaxEncoded.
+//
+// Names: link::Frame is a framed protocol message, the only meaning of
+// "frame" in ascorr_link/ (a state's ITRF/GCRS is its reference_frame,
+// messages.hpp). Elsewhere "frame" is a reference frame (q_chu_icrf,
+// StateFrame); the HAL's acquisition of every channel is a SampleSet.
 #pragma once
 
 #include <cstddef>

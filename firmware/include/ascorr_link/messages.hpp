@@ -115,7 +115,7 @@ struct SolutionIn {
 // double part computes with them; the answers stay bit-comparable).
 struct StateUpdate {
     TtTime t;
-    std::uint8_t frame;  // 0 itrf, 1 gcrs
+    std::uint8_t reference_frame;  // StateFrame: 0 itrf, 1 gcrs
     Vector3<double> r_km;
     Vector3<double> v_kms;
 };
@@ -365,7 +365,7 @@ bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
 inline std::size_t encode(const StateUpdate& m, std::uint8_t* out) noexcept {
     Writer w(out);
     w.u64(static_cast<std::uint64_t>(m.t.us));
-    w.u8(m.frame);
+    w.u8(m.reference_frame);
     for (const double x : {m.r_km.x, m.r_km.y, m.r_km.z, m.v_kms.x, m.v_kms.y, m.v_kms.z}) {
         w.f64(x);
     }
@@ -374,8 +374,8 @@ inline std::size_t encode(const StateUpdate& m, std::uint8_t* out) noexcept {
 // Non-finite or implausible values decode: the service refuses them (and counts).
 inline bool decode(const std::uint8_t* p, std::size_t n, StateUpdate& m) noexcept {
     Reader r(p, n);
-    return r.i64(m.t.us) && r.u8(m.frame) && m.frame <= 1U && r.f64(m.r_km.x) && r.f64(m.r_km.y) && r.f64(m.r_km.z) &&
-           r.f64(m.v_kms.x) && r.f64(m.v_kms.y) && r.f64(m.v_kms.z) && r.done();
+    return r.i64(m.t.us) && r.u8(m.reference_frame) && m.reference_frame <= 1U && r.f64(m.r_km.x) && r.f64(m.r_km.y) &&
+           r.f64(m.r_km.z) && r.f64(m.v_kms.x) && r.f64(m.v_kms.y) && r.f64(m.v_kms.z) && r.done();
 }
 
 template <typename T>

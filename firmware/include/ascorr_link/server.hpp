@@ -99,7 +99,8 @@ private:
                 return;
             case MessageType::kStateUpdate:
                 update<StateUpdate>(f, sink, [this](const StateUpdate& m) {
-                    service_.push_state(m.t, m.r_km, m.v_kms, m.frame == 1U ? StateFrame::kGcrs : StateFrame::kItrf);
+                    service_.push_state(m.t, m.r_km, m.v_kms,
+                                        m.reference_frame == 1U ? StateFrame::kGcrs : StateFrame::kItrf);
                 });
                 return;
             case MessageType::kTemperatureUpdate:

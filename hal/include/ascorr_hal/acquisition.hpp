@@ -1,8 +1,8 @@
-// ascorr_hal/acquisition.hpp: frames in, HeadTemperatures with validity out.
+// ascorr_hal/acquisition.hpp: sample sets in, HeadTemperatures with validity out.
 //
 // Conventions:
 //  - TemperatureAcquisition<T> owns one ChannelCheck per configured channel.
-//    update(frame) runs the checks (channel_check.hpp); head(h, now_us) votes
+//    update(samples) runs the checks (channel_check.hpp); head(h, now_us) votes
 //    each role (voting.hpp) as seen at now_us and returns the core's
 //    HeadTemperatures<T> with valid = false for every withheld value, plus
 //    the fault bits of T1, T2, T3.
@@ -15,7 +15,7 @@
 //    that did not happen.
 //  - Freestanding: fixed-size state, bounded loops, no heap, no exceptions.
 //    Typical firmware loop (1 Hz acquisition, corrections at any rate):
-//        AdcFrameSource<float> src(mcp3208, clock, config);
+//        AdcSampleSetSource<float> src(mcp3208, clock, config);
 //        TemperatureAcquisition<float> acq(config);
 //        every second:     acq.poll(src);
 //        every solution:   HeadAcquisition<float> h = acq.head(head, clock.now_us());
@@ -32,7 +32,7 @@
 #include "channel_check.hpp"
 #include "channel_config.hpp"
 #include "faults.hpp"
-#include "frame.hpp"
+#include "sample_set.hpp"
 #include "voting.hpp"
 
 namespace ascorr::hal {
@@ -83,18 +83,18 @@ public:
 
     const AcquisitionConfig<T>& config() const noexcept { return config_; }
 
-    void update(const Frame<T>& frame) noexcept {
+    void update(const SampleSet<T>& samples) noexcept {
         for (std::uint8_t i = 0; i < config_.channels && i < kMaxChannels; ++i) {
-            check_[i].update(config_.channel[i], frame.channel[i], frame.t_us);
+            check_[i].update(config_.channel[i], samples.channel[i], samples.t_us);
         }
     }
 
-    // Acquires one frame from src and processes it; false if src had none.
-    bool poll(FrameSource<T>& src) noexcept {
-        if (!src.acquire(frame_)) {
+    // Acquires one sample set from src and processes it; false if src had none.
+    bool poll(SampleSetSource<T>& src) noexcept {
+        if (!src.acquire(samples_)) {
             return false;
         }
-        update(frame_);
+        update(samples_);
         return true;
     }
 
@@ -150,7 +150,7 @@ public:
 private:
     AcquisitionConfig<T> config_;
     ChannelCheck<T> check_[kMaxChannels];
-    Frame<T> frame_{};
+    SampleSet<T> samples_{};
 };
 
 }  // namespace ascorr::hal

@@ -1,6 +1,6 @@
 // ascorr_hal/channel_check.hpp: one channel's sample → temperature + faults.
 //
-// Conventions, in the order the checks run on each frame:
+// Conventions, in the order the checks run on each sample set:
 //  1. kNoData (no sample) and device faults (kBus) are taken as they come.
 //  2. Time must advance: a sample not later than the channel's previous one
 //     is kStale (a repeated or reordered replay row, a frozen clock).
@@ -9,7 +9,7 @@
 //     samples' inner-half spread exceeds max_spread; kConversion if the
 //     result is not finite; kOutOfRange outside [t_min, t_max].
 //  4. kStuck: the raw value (counts with zero spread, or a replayed
-//     temperature) identical for stuck_frames frames in a row.
+//     temperature) identical for stuck_frames sample sets in a row.
 //  5. kRate, for an otherwise good reading: |T − T_anchor| > max_rate·Δt, with
 //     the anchor the last accepted reading. A rejected reading is kept as a
 //     candidate: if the next one agrees with the candidate (within max_rate
@@ -30,7 +30,7 @@
 
 #include "channel_config.hpp"
 #include "faults.hpp"
-#include "frame.hpp"
+#include "sample_set.hpp"
 #include "thermistor.hpp"
 
 namespace ascorr::hal {

@@ -18,13 +18,13 @@ namespace ascorr::hal {
 using FaultBits = std::uint16_t;
 
 namespace fault {
-inline constexpr FaultBits kNoData = 1U;         // no sample for this channel in this frame
+inline constexpr FaultBits kNoData = 1U;         // no sample for this channel in this sample set
 inline constexpr FaultBits kBus = 2U;            // the ADC did not answer (bad null bit, line I/O error)
 inline constexpr FaultBits kOpen = 4U;           // thermistor resistance above the open-circuit limit
 inline constexpr FaultBits kShort = 8U;          // thermistor resistance below the short-circuit limit
 inline constexpr FaultBits kOutOfRange = 16U;    // temperature outside the channel's [t_min, t_max]
 inline constexpr FaultBits kRate = 32U;          // |dT/dt| above the channel's max_rate
-inline constexpr FaultBits kStuck = 64U;         // identical raw value for stuck_frames frames in a row
+inline constexpr FaultBits kStuck = 64U;         // identical raw value for stuck_frames sample sets in a row
 inline constexpr FaultBits kStale = 128U;        // reading older than stale_us, or time did not advance
 inline constexpr FaultBits kNoisy = 256U;        // sample spread (inner half) above max_spread counts
 inline constexpr FaultBits kOutvoted = 512U;     // disagrees with the median of its triplet

@@ -71,7 +71,7 @@
 #include "channel_check.hpp"
 #include "channel_config.hpp"
 #include "faults.hpp"
-#include "frame.hpp"
+#include "sample_set.hpp"
 #include "thermistor.hpp"
 #include "voting.hpp"
 

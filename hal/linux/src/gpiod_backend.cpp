@@ -103,7 +103,7 @@ bool GpiodPins::get_miso(bool& level) noexcept {
     }
 }
 
-GpiodFrameSource::GpiodFrameSource(const HalConfig& config, Clock& clock)
+GpiodSampleSetSource::GpiodSampleSetSource(const HalConfig& config, Clock& clock)
     : config_(config),
       pins_(config_.gpio),
       adc_(pins_, clock, config_.gpio.half_period_us),

@@ -68,7 +68,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
                 file, line_no, line.size() + 1,
                 "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
         }
-        Frame<double> f{};
+        SampleSet<double> f{};
         for (std::size_t i = 0; i < columns.size(); ++i) {
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
@@ -105,7 +105,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
                 s = {SampleKind::kCelsius, 0U, 0U, x, 0U};
             }
         }
-        frames_.push_back(f);
+        sample_sets_.push_back(f);
     }
     if (header) {
         throw ConfigError(file, 1, 1, "empty file (no header)");
@@ -123,11 +123,11 @@ std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
     return std::make_unique<ReplaySource>(path, ss.str(), config);
 }
 
-bool ReplaySource::acquire(Frame<double>& frame) noexcept {
-    if (next_ >= frames_.size()) {
+bool ReplaySource::acquire(SampleSet<double>& samples) noexcept {
+    if (next_ >= sample_sets_.size()) {
         return false;
     }
-    frame = frames_[next_++];
+    samples = sample_sets_[next_++];
     return true;
 }
 

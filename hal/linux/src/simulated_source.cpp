@@ -221,7 +221,7 @@ SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::v
     adc_.set_faults(std::move(faults));
 }
 
-bool SimulatedSource::acquire(Frame<double>& frame) noexcept {
+bool SimulatedSource::acquire(SampleSet<double>& samples) noexcept {
     if (next_ >= history_.size()) {
         return false;
     }
@@ -244,10 +244,10 @@ bool SimulatedSource::acquire(Frame<double>& frame) noexcept {
             adc_.set_truth(i, v);
         }
     }
-    source_.acquire(frame);
+    source_.acquire(samples);
     for (std::uint8_t i = 0; i < config_.channels; ++i) {
         if (!adc_.has_truth(i) || adc_.dropped(i)) {
-            frame.channel[i] = {SampleKind::kNone, 0U, 0U, 0.0, 0U};
+            samples.channel[i] = {SampleKind::kNone, 0U, 0U, 0.0, 0U};
         }
     }
     return true;

@@ -15,7 +15,10 @@
 
 namespace ascorr::host {
 
-enum class Scalar { kDouble, kFloat, kFixed };
+// Which scalar the core is instantiated with (--scalar). A kind, not the type:
+// the firmware's type is firmware/app/app_scalar.hpp's Scalar, and a target
+// reports its kind in the link's HELLO (scalar_kind).
+enum class ScalarKind { kDouble, kFloat, kFixed };
 
 struct CorrectOptions {
     std::string in;
@@ -23,7 +26,7 @@ struct CorrectOptions {
     std::string model;  // empty: no thermal stage
     bool aberration = true;
     bool thermal = true;
-    Scalar scalar = Scalar::kDouble;
+    ScalarKind scalar = ScalarKind::kDouble;
     bool skip_bad = false;
     // --states: the velocity of rows without vx,vy,vz from spacecraft states,
     // by the on-board service (states_velocity.hpp); empty: none.

@@ -24,8 +24,8 @@
 #include <string>
 
 #include "ascorr_hal/clock.hpp"
-#include "ascorr_hal/frame.hpp"
 #include "ascorr_hal/mcp3208.hpp"
+#include "ascorr_hal/sample_set.hpp"
 #include "config_file.hpp"
 
 namespace ascorr::hal {
@@ -55,16 +55,16 @@ private:
 };
 
 // The whole Linux backend: pins, MCP3208, sampler, on the given clock.
-class GpiodFrameSource final : public FrameSource<double> {
+class GpiodSampleSetSource final : public SampleSetSource<double> {
 public:
-    GpiodFrameSource(const HalConfig& config, Clock& clock);
-    bool acquire(Frame<double>& frame) noexcept override { return source_.acquire(frame); }
+    GpiodSampleSetSource(const HalConfig& config, Clock& clock);
+    bool acquire(SampleSet<double>& samples) noexcept override { return source_.acquire(samples); }
 
 private:
     HalConfig config_;
     GpiodPins pins_;
     Mcp3208 adc_;
-    AdcFrameSource<double> source_;
+    AdcSampleSetSource<double> source_;
 };
 
 }  // namespace ascorr::hal

@@ -1,4 +1,4 @@
-// ascorr_hal_linux/replay_source.hpp: frames from a recorded file.
+// ascorr_hal_linux/replay_source.hpp: sample sets from a recorded file.
 //
 // Format: CSV, one header line, no quoting, LF or CRLF. Column `t` (seconds,
 // ≥ 0, any origin: the HAL clock of the replay is t·10⁶ µs) and, per
@@ -18,23 +18,23 @@
 #include <string_view>
 #include <vector>
 
-#include "ascorr_hal/frame.hpp"
+#include "ascorr_hal/sample_set.hpp"
 #include "config_file.hpp"
 
 namespace ascorr::hal {
 
-class ReplaySource final : public FrameSource<double> {
+class ReplaySource final : public SampleSetSource<double> {
 public:
     ReplaySource(const std::string& file_name, std::string_view text, const AcquisitionConfig<double>& config);
     // A source is a device (hal/interface.hpp): not copied nor moved, so it
     // comes on the heap.
     static std::unique_ptr<ReplaySource> from_file(const std::string& path, const AcquisitionConfig<double>& config);
 
-    bool acquire(Frame<double>& frame) noexcept override;
-    std::size_t frames() const noexcept { return frames_.size(); }
+    bool acquire(SampleSet<double>& samples) noexcept override;
+    std::size_t sample_sets() const noexcept { return sample_sets_.size(); }
 
 private:
-    std::vector<Frame<double>> frames_;
+    std::vector<SampleSet<double>> sample_sets_;
     std::size_t next_ = 0;
 };
 

@@ -1,4 +1,4 @@
-// ascorr_hal_linux/simulated_source.hpp: frames from temperature histories,
+// ascorr_hal_linux/simulated_source.hpp: sample sets from temperature histories,
 // through a simulated MCP3208, with injectable faults.
 //
 // History: CSV with columns t (s), t_chu, t_029, t_032 and optionally chu
@@ -7,9 +7,9 @@
 // chu column t_chu sets every chu channel. t_029 and t_032 set every member of
 // their triplet. Empty/nan keeps the previous truth; a channel without truth
 // yet is not sampled.
-// Each row becomes one frame at t: the truth goes through the inverse
-// Steinhart–Hart and the divider into counts (SimulatedAdc), and the frame is
-// acquired by the same AdcFrameSource as on hardware (settle, samples,
+// Each row becomes one sample set at t: the truth goes through the inverse
+// Steinhart–Hart and the divider into counts (SimulatedAdc), and the sample set is
+// acquired by the same AdcSampleSetSource as on hardware (settle, samples,
 // median) on a ManualClock, so the whole conversion path runs.
 // Faults (--inject NAME:KIND:FROM:TO[:VALUE], times in the history's seconds,
 // active for FROM ≤ t < TO):
@@ -28,8 +28,8 @@
 #include <vector>
 
 #include "ascorr_hal/clock.hpp"
-#include "ascorr_hal/frame.hpp"
 #include "ascorr_hal/mcp3208.hpp"
+#include "ascorr_hal/sample_set.hpp"
 #include "config_file.hpp"
 
 namespace ascorr::hal {
@@ -81,13 +81,13 @@ private:
     std::uint32_t lcg_ = 12345U;
 };
 
-class SimulatedSource final : public FrameSource<double> {
+class SimulatedSource final : public SampleSetSource<double> {
 public:
     SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
                     std::vector<InjectedFault> faults);
     SimulatedSource(const SimulatedSource&) = delete;  // members refer to each other
     SimulatedSource& operator=(const SimulatedSource&) = delete;
-    bool acquire(Frame<double>& frame) noexcept override;
+    bool acquire(SampleSet<double>& samples) noexcept override;
 
 private:
     AcquisitionConfig<double> config_;
@@ -95,7 +95,7 @@ private:
     std::size_t next_ = 0;
     ManualClock clock_;
     SimulatedAdc adc_;
-    AdcFrameSource<double> source_;
+    AdcSampleSetSource<double> source_;
 };
 
 }  // namespace ascorr::hal

@@ -1,17 +1,23 @@
-// ascorr_hal/frame.hpp: one acquisition of every channel, and the interface
+// ascorr_hal/sample_set.hpp: one acquisition of every channel, and the interface
 // of the backends that produce it.
 //
 // Conventions:
-//  - A Frame holds, per configured channel (index as in AcquisitionConfig),
+//  - A SampleSet holds, per configured channel (index as in AcquisitionConfig),
 //    either raw counts (an ADC: the robust average and its spread) or a
 //    temperature (a replay of converted values), or nothing (kNone), plus the
-//    device-level faults (kBus). t_us is the frame's time on the HAL clock.
-//  - FrameSource is the one interface every backend implements (F Prime
+//    device-level faults (kBus). t_us is its time on the HAL clock.
+//  - SampleSetSource is the one interface every backend implements (F Prime
 //    style: real and test-double implementations chosen at build time):
-//      AdcFrameSource (here, freestanding: any AdcPort, e.g. Mcp3208 over the
+//      AdcSampleSetSource (here, freestanding: any AdcPort, e.g. Mcp3208 over the
 //      DPU's pins or over libgpiod), ReplaySource and SimulatedSource (host).
-//  - acquire() never throws and never allocates; false means no frame
+//  - acquire() never throws and never allocates; false means no sample set
 //    (the end of a replay).
+//  - Names: a sample set is not a frame. In ascorr "frame" means a reference
+//    frame (q_chu_icrf, StateFrame) or, in ascorr_link/frame.hpp, a framed
+//    link-protocol message. Two older interfaces keep the word for a sample
+//    set, unchanged because they are the command line and the board
+//    configuration file: `ascorr thermistors --frames N` acquires N sample
+//    sets, and a channel's stuck_frames counts sample sets.
 #pragma once
 
 #include <cstdint>
@@ -37,30 +43,30 @@ struct ChannelSample {
 };
 
 template <typename T>
-struct Frame {
+struct SampleSet {
     std::uint64_t t_us;
     ChannelSample<T> channel[kMaxChannels];
 };
 
 template <typename T>
-class FrameSource : private Interface {
+class SampleSetSource : private Interface {
 public:
-    virtual ~FrameSource() = default;
-    virtual bool acquire(Frame<T>& frame) noexcept = 0;
+    virtual ~SampleSetSource() = default;
+    virtual bool acquire(SampleSet<T>& samples) noexcept = 0;
 };
 
 // Reads every configured channel through an ADC with the sampler's settle
-// time, sample count and robust average. Time of the frame: its start.
+// time, sample count and robust average. Time of the sample set: its start.
 template <typename T>
-class AdcFrameSource final : public FrameSource<T> {
+class AdcSampleSetSource final : public SampleSetSource<T> {
 public:
-    AdcFrameSource(AdcPort& adc, Clock& clock, const AcquisitionConfig<T>& config) noexcept
+    AdcSampleSetSource(AdcPort& adc, Clock& clock, const AcquisitionConfig<T>& config) noexcept
         : adc_(adc), clock_(clock), config_(config) {}
 
-    bool acquire(Frame<T>& frame) noexcept override {
-        frame.t_us = clock_.now_us();
+    bool acquire(SampleSet<T>& samples) noexcept override {
+        samples.t_us = clock_.now_us();
         for (std::uint8_t i = 0; i < kMaxChannels; ++i) {
-            ChannelSample<T>& s = frame.channel[i];
+            ChannelSample<T>& s = samples.channel[i];
             s = {SampleKind::kNone, 0U, 0U, T{}, 0U};
             if (i >= config_.channels) {
                 continue;
