@@ -131,7 +131,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
         {"THT00057:noise:110:120:200", 1, 12, fault::kNoisy}, {"CHU_A:stuck:110:300", 6, 110, fault::kStuck},
         {"CHU_A:drop:110:300", 6, 20, fault::kStale}};
     for (const Case& k : cases) {
-        hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
+        hal::SimulatedSource src(c, hal::history_epochs("history", h), {hal::parse_fault(k.spec, c)});
         hal::TemperatureAcquisition<double> acq(c);
         hal::Frame<double> f{};
         for (int i = 0; i <= k.at; ++i) {
@@ -141,7 +141,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
         const hal::ChannelReading<double> r = acq.channel(static_cast<std::uint8_t>(k.channel), f.t_us);
         EXPECT_EQ(r.faults & k.want, k.want) << k.spec << " got " << r.faults;
         // Before the fault window the same channel was fine.
-        hal::SimulatedSource clean(c, h, {});
+        hal::SimulatedSource clean(c, hal::history_epochs("history", h), {});
         hal::TemperatureAcquisition<double> acq2(c);
         for (int i = 0; i <= k.at; ++i) {
             ASSERT_TRUE(clean.acquire(f));
@@ -215,6 +215,83 @@ TEST(HalCli, ThermistorsSimulatesASolutionsFileWithAFault) {
     EXPECT_EQ(r.out.find(",voted,,,,0,"), std::string::npos) << r.out;  // two of three still agree
     EXPECT_NE(r.out.find("447534216.000000,t_029,voted,,,-9.2"), std::string::npos) << r.out;
     EXPECT_NE(r.err.find("30 frames, 0 voted values withheld"), std::string::npos) << r.err;
+}
+
+// A history of three heads at one epoch per second, rows interleaved by head,
+// every temperature warming at 0.5 °C/min (10 min, about 5 °C: some 200
+// counts), with `step_b` °C added to head B's T_CHU from epoch 300 on.
+void write_interleaved_history(const fs::path& path, double step_b) {
+    std::ofstream f(path);
+    f << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    const char heads[3] = {'A', 'B', 'C'};
+    const double base[3] = {10.0, 12.0, 8.0};
+    char buf[160];
+    for (int k = 0; k < 600; ++k) {
+        const double warm = 0.5 / 60.0 * k;
+        for (int h = 0; h < 3; ++h) {
+            const double chu = base[h] + warm + (h == 1 && k >= 300 ? step_b : 0.0);
+            std::snprintf(buf, sizeof buf, "%d,%c,1,0,0,0,%.4f,%.4f,%.4f,,,,0,1.00\n", 1000 + k, heads[h], chu,
+                          -9.0 + warm, -20.0 + warm);
+            f << buf;
+        }
+    }
+}
+
+std::vector<std::string> lines_with(const std::string& text, const std::string& needle) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+        if (l.find(needle) != std::string::npos) {
+            out.push_back(l);
+        }
+    }
+    return out;
+}
+
+// Issue 11: one frame per epoch with every head's truth, at the epoch's time.
+// Each row used to be a frame, 16 ms after the previous one, so a one-count
+// step of CHU_B between the rows of A and B read as ~1.5 °C/s: a rate fault
+// every two or three seconds on a history warming at 0.5 °C/min.
+TEST(HalCli, ASlowHistoryWithHeadsInterleavedRaisesNoRateFault) {
+    const fs::path dir = scratch_dir("hal-cli");
+    write_interleaved_history(dir / "slow.csv", 0.0);
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "slow.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(lines_with(r.out, "rate").size(), 0U) << lines_with(r.out, "rate").front();
+    EXPECT_NE(r.err.find("600 frames, 0 voted values withheld"), std::string::npos) << r.err;
+    // Frames carry the history's times, every channel at each.
+    const std::vector<std::string> b = lines_with(r.out, ",CHU_B,");
+    ASSERT_EQ(b.size(), 600U);
+    EXPECT_EQ(b[599].substr(0, 19), "1599.000000,CHU_B,c");
+    // Not vacuous: the counts did move (0.5 °C/min over 10 min).
+    const auto counts = [](const std::string& line) { return std::stoi(line.substr(line.find("chu_b,") + 6)); };
+    EXPECT_GT(counts(b[0]) - counts(b[599]), 150);
+
+    // Mutation: a real step of 3 °C on CHU_B in one second is still a rate fault.
+    write_interleaved_history(dir / "step.csv", 3.0);
+    const CliRun s = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "step.csv").string(), dir);
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    const std::vector<std::string> rate = lines_with(s.out, "rate");
+    ASSERT_EQ(rate.size(), 1U) << s.out.substr(0, 2000);
+    EXPECT_EQ(rate[0].substr(0, 24), "1300.000000,CHU_B,chu_b,") << rate[0];
+    EXPECT_NE(rate[0].find(",17.50"), std::string::npos) << rate[0];  // 12 + 300 · 0.5/60 + 3 °C
+}
+
+// Rows of one epoch (t to the millisecond) that disagree are refused: one
+// thermistor cannot have two temperatures at one time.
+TEST(HalCli, RowsOfOneEpochThatDisagreeAreRefused) {
+    const fs::path dir = scratch_dir("hal-cli");
+    std::ofstream(dir / "h.csv") << "t,chu,t_chu,t_029,t_032\n10,A,5,-9,-20\n10,B,6,-9,-20\n10.0004,C,7,-8.5,-20\n";
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "h.csv").string(), dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("h.csv:4:13: t_029 = -8.5 at t = 10.000 s disagrees with -9 on line 3 (the same epoch)"),
+              std::string::npos)
+        << r.err;
+    // Rows of other epochs, in any order, are fine.
+    std::ofstream(dir / "h2.csv") << "t,chu,t_chu,t_029,t_032\n11,A,5,-9,-20\n10,B,6,-9,-20\n10,A,5,-9,-20\n";
+    const CliRun ok = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "h2.csv").string(), dir);
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_NE(ok.err.find("2 frames"), std::string::npos) << ok.err;
 }
 
 TEST(HalCli, BadConfigExitsOneWithLocation) {

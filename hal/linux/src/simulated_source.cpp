@@ -2,9 +2,11 @@
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "text_lines.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -103,8 +105,10 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
         }
         HistoryRow r{0.0, -1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
                      std::numeric_limits<double>::quiet_NaN()};
-        if (!parse_number(f[static_cast<std::size_t>(col_t)].first, r.t) || !std::isfinite(r.t) || r.t < 0.0) {
-            throw ConfigError(file, line_no, f[static_cast<std::size_t>(col_t)].second, "'t' must be seconds >= 0");
+        r.line = line_no;
+        if (!parse_number(f[static_cast<std::size_t>(col_t)].first, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
+            throw ConfigError(file, line_no, f[static_cast<std::size_t>(col_t)].second,
+                              "'t' must be a number of seconds in [0, 1e12]");
         }
         if (col_chu >= 0) {
             const auto& [v, c] = f[static_cast<std::size_t>(col_chu)];
@@ -117,6 +121,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
         const int cols[3] = {col_t1, col_t2, col_t3};
         for (int k = 0; k < 3; ++k) {
             const auto& [v, c] = f[static_cast<std::size_t>(cols[k])];
+            r.column[k] = c;
             if (v.empty() || v == "nan") {
                 continue;
             }
@@ -132,14 +137,76 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
     return rows;
 }
 
-std::vector<HistoryRow> read_history(const std::string& path) {
+namespace {
+
+static_assert(static_cast<int>(Role::kChuD) - static_cast<int>(Role::kChuA) + 1 == kHistoryHeads,
+              "one history head per chu role");
+
+// The epoch key of a time: t to the millisecond (t is within [0, 1e12] s).
+std::int64_t epoch_key(double t) noexcept {
+    return std::llround(t * 1000.0);
+}
+
+// One truth of an epoch and the row that gave it.
+struct EpochValue {
+    double value = std::numeric_limits<double>::quiet_NaN();
+    std::size_t line = 0;
+};
+
+// Sets `slot` from a row's value, or refuses a second, different value.
+void merge_value(const std::string& file, const HistoryRow& row, int k, const char* name, double v, EpochValue& slot) {
+    if (std::isnan(v)) {
+        return;
+    }
+    if (std::isnan(slot.value) || slot.value == v) {
+        slot = {v, row.line};
+        return;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)", name,
+                  v, row.t, slot.value, slot.line);
+    throw ConfigError(file, row.line, row.column[k], buf);
+}
+
+}  // namespace
+
+std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows) {
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const HistoryRow& a, const HistoryRow& b) { return epoch_key(a.t) < epoch_key(b.t); });
+    std::vector<HistoryEpoch> epochs;
+    std::size_t i = 0;
+    while (i < rows.size()) {
+        const std::int64_t key = epoch_key(rows[i].t);
+        EpochValue chu[kHistoryHeads];
+        EpochValue t029;
+        EpochValue t032;
+        for (; i < rows.size() && epoch_key(rows[i].t) == key; ++i) {
+            const HistoryRow& r = rows[i];
+            for (int h = 0; h < kHistoryHeads; ++h) {
+                if (r.head < 0 || r.head == h) {
+                    merge_value(file_name, r, 0, "t_chu", r.t_chu, chu[h]);
+                }
+            }
+            merge_value(file_name, r, 1, "t_029", r.t_029, t029);
+            merge_value(file_name, r, 2, "t_032", r.t_032, t032);
+        }
+        HistoryEpoch e{static_cast<std::uint64_t>(key) * 1000U, {}, t029.value, t032.value};
+        for (int h = 0; h < kHistoryHeads; ++h) {
+            e.t_chu[h] = chu[h].value;
+        }
+        epochs.push_back(e);
+    }
+    return epochs;
+}
+
+std::vector<HistoryEpoch> read_history(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
     }
     std::ostringstream ss;
     ss << in.rdbuf();
-    return parse_history(path, ss.str());
+    return history_epochs(path, parse_history(path, ss.str()));
 }
 
 bool SimulatedAdc::active(const InjectedFault& f) const noexcept {
@@ -215,7 +282,7 @@ bool SimulatedAdc::convert(std::uint8_t adc_channel, std::uint16_t& counts) noex
     return true;
 }
 
-SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
+SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryEpoch> history,
                                  std::vector<InjectedFault> faults)
     : config_(config), history_(std::move(history)), adc_(config_, clock_), source_(adc_, clock_, config_) {
     adc_.set_faults(std::move(faults));
@@ -225,20 +292,19 @@ bool SimulatedSource::acquire(Frame<double>& frame) noexcept {
     if (next_ >= history_.size()) {
         return false;
     }
-    const HistoryRow& row = history_[next_++];
-    const std::uint64_t t_us = static_cast<std::uint64_t>(std::llround(row.t * 1e6));
-    if (t_us > clock_.now_us()) {
-        clock_.advance_us(t_us - clock_.now_us());
+    const HistoryEpoch& e = history_[next_++];
+    if (e.t_us > clock_.now_us()) {
+        clock_.advance_us(e.t_us - clock_.now_us());
     }
     for (std::uint8_t i = 0; i < config_.channels; ++i) {
         const Role role = config_.channel[i].role;
         double v = std::numeric_limits<double>::quiet_NaN();
         if (role == Role::kT029) {
-            v = row.t_029;
+            v = e.t_029;
         } else if (role == Role::kT032) {
-            v = row.t_032;
-        } else if (role != Role::kMonitor && (row.head < 0 || chu_role(static_cast<std::uint8_t>(row.head)) == role)) {
-            v = row.t_chu;
+            v = e.t_032;
+        } else if (role != Role::kMonitor) {
+            v = e.t_chu[static_cast<int>(role) - static_cast<int>(Role::kChuA)];
         }
         if (std::isfinite(v)) {
             adc_.set_truth(i, v);
