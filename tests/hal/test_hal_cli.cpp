@@ -294,6 +294,37 @@ TEST(HalCli, RowsOfOneEpochThatDisagreeAreRefused) {
     EXPECT_NE(ok.err.find("2 frames"), std::string::npos) << ok.err;
 }
 
+// Issue 11: a file that cannot be opened was "file:0:0: cannot open: ...".
+// No message cites line or column 0; each reader names its file.
+TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = kExamples + "/board.cfg";
+    const std::string missing = (dir / "missing.csv").string();
+    fs::create_directory(dir / "adir");
+    struct Case {
+        std::string args;
+        std::string want;
+    };
+    const Case cases[] = {
+        {"--config " + missing + " --replay " + kExamples + "/replay.csv",
+         "cannot open " + missing + ": No such file or directory"},
+        {"--config " + cfg + " --replay " + missing, "cannot open " + missing + ": No such file or directory"},
+        {"--config " + cfg + " --simulate " + missing, "cannot open " + missing + ": No such file or directory"},
+        {"--config " + (dir / "adir").string() + " --simulate " + missing,
+         "cannot open " + (dir / "adir").string() + ": is a directory, not a file"},
+    };
+    for (const Case& c : cases) {
+        const CliRun r = run(c.args, dir);
+        EXPECT_EQ(r.exit_code, 1) << c.args;
+        EXPECT_NE(r.err.find(c.want), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
+    }
+    // The error itself: no line or column when there is none.
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 0, 0, "x").what(), "f.cfg: x");
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 0, "x").what(), "f.cfg:3: x");
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
+}
+
 TEST(HalCli, BadConfigExitsOneWithLocation) {
     const fs::path dir = scratch_dir("hal-cli");
     std::ofstream(dir / "bad.cfg") << "channel name=X adc=9 role=t029 a=1 b=2 c=3\n";

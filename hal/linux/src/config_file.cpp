@@ -3,12 +3,9 @@
 #include "text_lines.hpp"
 
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -377,13 +374,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
 }
 
 HalConfig read_config(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
-    }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return parse_config(path, ss.str());
+    return parse_config(path, linux_detail::read_text_file(path));
 }
 
 }  // namespace ascorr::hal

@@ -3,14 +3,10 @@
 #include "text_lines.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 namespace ascorr::hal {
@@ -200,13 +196,7 @@ std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vect
 }
 
 std::vector<HistoryEpoch> read_history(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
-    }
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return history_epochs(path, parse_history(path, ss.str()));
+    return history_epochs(path, parse_history(path, linux_detail::read_text_file(path)));
 }
 
 bool SimulatedAdc::active(const InjectedFault& f) const noexcept {

@@ -7,10 +7,19 @@
 // use host_sim's reader: nothing in hal/ depends on host_sim/).
 #pragma once
 
+#include <cerrno>
 #include <cstddef>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
+
+#include "ascorr_hal_linux/config_file.hpp"
 
 namespace ascorr::hal::linux_detail {
 
@@ -62,6 +71,25 @@ private:
     std::size_t pos_ = 0;
     std::size_t number_ = 0;
 };
+
+// The whole text of a file. A file that cannot be opened or read, or a
+// directory: ConfigError "cannot open FILE: reason" (no line, no column).
+inline std::string read_text_file(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw ConfigError::whole_file("cannot open " + path + ": is a directory, not a file");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw ConfigError::whole_file("cannot open " + path + ": " + std::strerror(errno));
+    }
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) {
+        throw ConfigError::whole_file("cannot read " + path + ": " + std::strerror(errno));
+    }
+    return ss.str();
+}
 
 // A field of a comma-separated line and its column (1-based).
 using Field = std::pair<std::string_view, std::size_t>;
