@@ -325,6 +325,64 @@ TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
     EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
 }
 
+// Issue 11: binary data in a configuration, replay or history file is refused
+// at file:line:column, and its bytes never reach the terminal (an escaped
+// excerpt at most).
+TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = kExamples + "/board.cfg";
+    const std::string good_cfg = slurp(cfg);
+    const std::string history = "t,t_chu,t_029,t_032\n1,2,3,4\n";
+    const std::string replay = "t,THT00029\n100,-9.5\n";
+    struct Bad {
+        std::string bytes;  // inserted at the start of line 3
+        std::string what;   // the message after file:3:column:
+        std::string excerpt;
+    };
+    const Bad bad[] = {
+        {std::string("\0\x01", 2), "binary data (byte 0x00)", "\\x00\\x01"},
+        {"\xff\xfe", "binary data (byte 0xff)", "\\xff\\xfe"},
+        {"\x1b[2J", "binary data (byte 0x1b)", "\\x1b[2J"},
+        {"\xc0\xaf", "binary data (byte 0xc0)", "\\xc0\\xaf"},      // overlong '/'
+        {"\xed\xa0\x80", "binary data (byte 0xed)", "\\xed\\xa0"},  // a surrogate
+        {"x\ry", "a CR not followed by LF (CR-only line ends?)", "x\\x0dy"},
+    };
+    for (const Bad& b : bad) {
+        const auto third_line = [&](const std::string& text) {  // b.bytes at the start of line 3
+            const std::size_t at = text.find('\n', text.find('\n') + 1) + 1;
+            return text.substr(0, at) + b.bytes + text.substr(at);
+        };
+        std::ofstream(dir / "b.cfg", std::ios::binary) << third_line(good_cfg);
+        std::ofstream(dir / "h.csv", std::ios::binary) << third_line(history + "2,2,3,4\n");
+        std::ofstream(dir / "r.csv", std::ios::binary) << third_line(replay + "101,-9.5\n");
+        const std::string column = b.bytes[0] == 'x' ? "2" : "1";
+        const std::pair<std::string, std::string> runs[] = {
+            {"--config " + (dir / "b.cfg").string() + " --simulate " + (dir / "h.csv").string(), "b.cfg"},
+            {"--config " + cfg + " --simulate " + (dir / "h.csv").string(), "h.csv"},
+            {"--config " + cfg + " --replay " + (dir / "r.csv").string(), "r.csv"},
+        };
+        for (const auto& [args, file] : runs) {
+            const CliRun r = run(args, dir);
+            EXPECT_EQ(r.exit_code, 1) << args;
+            EXPECT_NE(r.err.find(file + ":3:" + column + ": " + b.what + ": not a text file, line starts \""),
+                      std::string::npos)
+                << r.err;
+            EXPECT_NE(r.err.find(b.excerpt), std::string::npos) << r.err;
+            EXPECT_EQ(r.err.find(b.bytes), std::string::npos) << "the bytes reached the terminal: " << r.err;
+            for (const char c : r.err) {
+                const auto u = static_cast<unsigned char>(c);
+                EXPECT_TRUE(u == '\n' || (u >= 0x20U && u < 0x7FU)) << "byte " << unsigned{u} << " in " << r.err;
+            }
+        }
+    }
+    // Valid UTF-8 (the example's comments have Ω and –) and a byte-order mark pass.
+    std::ofstream(dir / "u.csv", std::ios::binary)
+        << "\xEF\xBB\xBFt,t_chu,t_029,t_032,note\n1,2,3,4,\xE2\x80\x94 \xF0\x9F\x8C\xA1\n";
+    EXPECT_NE(good_cfg.find("\xCE\xA9"), std::string::npos);
+    const CliRun u = run("--config " + cfg + " --simulate " + (dir / "u.csv").string(), dir);
+    EXPECT_EQ(u.exit_code, 0) << u.err;
+}
+
 TEST(HalCli, BadConfigExitsOneWithLocation) {
     const fs::path dir = scratch_dir("hal-cli");
     std::ofstream(dir / "bad.cfg") << "channel name=X adc=9 role=t029 a=1 b=2 c=3\n";

@@ -341,7 +341,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
     a.quorum = 2U;
     bool seen_acq = false;
     bool seen_gpio = false;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file_name, text);
     std::string_view line;
     DirectiveLine d;
     while (lines.next(line)) {

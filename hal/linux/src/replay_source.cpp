@@ -18,7 +18,7 @@ struct Column {
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file, text);
     std::string_view line;
     std::vector<linux_detail::Field> fields;
     bool header = true;

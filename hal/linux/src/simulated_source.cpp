@@ -67,7 +67,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
     std::vector<HistoryRow> rows;
     int col_t = -1, col_chu = -1, col_t1 = -1, col_t2 = -1, col_t3 = -1;
     std::size_t ncols = 0;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file, text);
     std::string_view line;
     std::vector<linux_detail::Field> f;
     while (lines.next(line)) {
