@@ -72,6 +72,72 @@ TEST(HalConfigFile, ErrorsNameLineAndColumn) {
               "board.cfg:2:45: unknown channel key 'colour'");
 }
 
+// Issue 11: a curve that is not an NTC's (T must fall as R rises, 1/T > 0) on
+// the resistances the channel converts is refused, naming where it fails.
+TEST(HalConfigFile, NonMonotonicSteinhartHartIsRefusedWithItsRange) {
+    const std::string line = "channel name=T1 adc=0 role=t029 a=1.129241e-3 b=2.341077e-4 ";
+    // C < 0: B + 3C·ln²R ≤ 0 from ln R = √(B/(6e-6)) = 6.2465, R = 516.17 ohm, up to r_open.
+    const std::string e1 = config_error("# x\n" + line + "c=-2e-6\n");
+    EXPECT_NE(e1.find("board.cfg:2:1: channel 'T1': the Steinhart-Hart coefficients are not monotonic (T does not "
+                      "fall as R rises) for R in [516.169"),
+              std::string::npos)
+        << e1;
+    EXPECT_NE(e1.find(", 2e+06] ohm"), std::string::npos) << e1;
+    EXPECT_NE(e1.find("the channel converts 100 ... 2e+06 ohm"), std::string::npos) << e1;
+    // The same curve is fine where it is monotonic: r_open below 516 ohm.
+    EXPECT_EQ(config_error(line + "c=-2e-6 r_open=500 r_short=50\n"), "no error");
+    // B < 0, C = 0: nowhere monotonic; r_short/r_open and the divider bound the range.
+    const std::string e2 = config_error(line.substr(0, line.find("b=")) + "b=-1e-4 c=0 r_short=1000 r_open=1e5\n");
+    EXPECT_NE(e2.find("board.cfg:1:1: channel 'T1': the Steinhart-Hart coefficients are not monotonic (T does not fall "
+                      "as R rises) for R in [1000, 100000] ohm"),
+              std::string::npos)
+        << e2;
+    // Monotonic, but no temperature: 1/T ≤ 0 at the low end.
+    const std::string e3 = config_error("channel name=T1 adc=0 role=t029 a=-1 b=1e-4 c=1e-8\n");
+    EXPECT_NE(e3.find("board.cfg:1:1: channel 'T1': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at "
+                      "R = 100 ohm"),
+              std::string::npos)
+        << e3;
+    // The example's 10K3A1 channels pass (ExampleParses), and so does any
+    // ordinary curve: B > 0, C ≥ 0.
+    EXPECT_EQ(config_error(line + "c=0\n"), "no error");
+}
+
+// Issue 11: injected values that are not numbers, and noise that is not
+// positive, are refused naming the fault; so are non-finite history values.
+TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    const auto err = [&](const char* spec) {
+        try {
+            hal::parse_fault(spec, c);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(
+        err("THT00057:offset:10:20:nan"),
+        "fault 'THT00057:offset:10:20:nan': offset VALUE must be a finite number of degC within +-200, got 'nan'");
+    EXPECT_NE(err("THT00057:offset:10:20:inf").find("offset VALUE must be a finite number"), std::string::npos);
+    EXPECT_EQ(err("THT00057:noise:10:20:-5"),
+              "fault 'THT00057:noise:10:20:-5': noise VALUE must be a number of counts in (0, 65535], got '-5'");
+    EXPECT_NE(err("THT00057:noise:10:20:0").find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(err("THT00057:noise:10:20:nan").find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(err("THT00057:noise:10:20:1e300").find("noise VALUE must be"), std::string::npos);
+    EXPECT_EQ(err("THT00057:open:nan:20"),
+              "fault 'THT00057:open:nan:20': FROM and TO must be finite numbers with FROM < TO");
+    EXPECT_NE(err("THT00057:open:0:inf").find("FROM and TO must be finite"), std::string::npos);
+    EXPECT_EQ(err("THT00057:noise:10:20:4"), "no error");
+    EXPECT_EQ(err("THT00057:offset:10:20:-3.5"), "no error");
+    try {
+        hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,inf,3,4\n");
+        FAIL();
+    } catch (const hal::ConfigError& e) {
+        EXPECT_STREQ(e.what(), "h.csv:3:3: not a temperature: 'inf' (a finite number, or empty or nan for none)");
+    }
+    EXPECT_EQ(hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,nan,,4\n").size(), 2U);
+}
+
 TEST(HalReplay, ErrorsNameLineAndColumn) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
     const auto err = [&](const std::string& text) {

@@ -2,9 +2,11 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "text_lines.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <utility>
 #include <vector>
@@ -278,6 +280,39 @@ void parse_channel_option(const Token& t, const LineParser& p, ChannelConfig<dou
     }
 }
 
+// The Steinhart–Hart curve must be an NTC's (check_curve) on every
+// resistance the channel converts: between r_short and r_open, and within
+// what the divider's codes 1 … levels − 1 can give.
+void check_channel_curve(const DirectiveLine& d, const LineParser& p, const ChannelConfig<double>& c) {
+    const auto top = static_cast<std::uint16_t>(c.divider.levels - 1U);  // levels >= 2
+    const std::uint16_t one = 1U;
+    const double code_lo = resistance_from_counts(c.divider, c.divider.thermistor_low ? one : top);
+    const double code_hi = resistance_from_counts(c.divider, c.divider.thermistor_low ? top : one);
+    const double r_lo = std::max(c.r_short > 0.0 ? c.r_short : 0.0, code_lo);
+    const double r_hi = std::min(c.r_open, code_hi);
+    if (!(r_lo < r_hi)) {
+        return;  // no resistance is converted: every reading is open or short
+    }
+    const CurveCheck<double> k = check_curve(c.sh, r_lo, r_hi);
+    if (k.ok) {
+        return;
+    }
+    char buf[320];
+    if (k.no_temperature) {
+        std::snprintf(buf, sizeof buf,
+                      "channel '%s': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at R = %.6g ohm "
+                      "(the channel converts %.6g ... %.6g ohm)",
+                      c.name, k.r_from, r_lo, r_hi);
+    } else {
+        std::snprintf(buf, sizeof buf,
+                      "channel '%s': the Steinhart-Hart coefficients are not monotonic (T does not fall as R rises) "
+                      "for R in [%.6g, %.6g] ohm (T %.6g ... %.6g degC); the channel converts %.6g ... %.6g ohm",
+                      c.name, k.r_from, k.r_to, celsius_from_resistance(c.sh, k.r_from),
+                      celsius_from_resistance(c.sh, k.r_to), r_lo, r_hi);
+    }
+    p.fail(d.directive_col, buf);
+}
+
 // Checks that need the whole channel line: the required keys and the ranges.
 void check_channel(const DirectiveLine& d, const LineParser& p, const RequiredChannelKeys& seen,
                    const ChannelConfig<double>& c) {
@@ -294,6 +329,7 @@ void check_channel(const DirectiveLine& d, const LineParser& p, const RequiredCh
     if (!(std::fabs(c.t_min) <= 200.0 && std::fabs(c.t_max) <= 200.0)) {
         p.fail(d.directive_col, "channel '" + name + "': t_min, t_max must be within ±200 °C");
     }
+    check_channel_curve(d, p, c);
 }
 
 void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfig<double>& a) {

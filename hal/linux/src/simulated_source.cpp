@@ -53,12 +53,25 @@ InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>
         throw std::invalid_argument("fault '" + s + "': unknown kind '" + std::string(part[1]) +
                                     "' (open, short, bus, stuck, offset, noise, drop)");
     }
-    if (!parse_number(part[2], f.from_s) || !parse_number(part[3], f.to_s) || !(f.from_s < f.to_s)) {
-        throw std::invalid_argument("fault '" + s + "': FROM and TO must be numbers with FROM < TO");
+    if (!parse_number(part[2], f.from_s) || !parse_number(part[3], f.to_s) || !std::isfinite(f.from_s) ||
+        !std::isfinite(f.to_s) || !(f.from_s < f.to_s)) {
+        throw std::invalid_argument("fault '" + s + "': FROM and TO must be finite numbers with FROM < TO");
     }
     const bool needs_value = f.kind == FaultKind::kOffset || f.kind == FaultKind::kNoise;
     if (needs_value != (part.size() == 5) || (needs_value && !parse_number(part[4], f.value))) {
         throw std::invalid_argument("fault '" + s + "': " + (needs_value ? "needs" : "takes no") + " VALUE");
+    }
+    // offset: °C, finite and within the ±200 °C any temperature has; noise:
+    // counts, > 0 (0 or less would inject nothing) and at most 65535 (an ADC
+    // code's range), so the simulated code stays an int.
+    if (f.kind == FaultKind::kOffset && !(std::fabs(f.value) <= 200.0)) {
+        throw std::invalid_argument("fault '" + s +
+                                    "': offset VALUE must be a finite number of degC within +-200, got '" +
+                                    std::string(part[4]) + "'");
+    }
+    if (f.kind == FaultKind::kNoise && !(f.value > 0.0 && f.value <= 65535.0)) {
+        throw std::invalid_argument("fault '" + s + "': noise VALUE must be a number of counts in (0, 65535], got '" +
+                                    std::string(part[4]) + "'");
     }
     return f;
 }
@@ -121,8 +134,10 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
             if (v.empty() || v == "nan") {
                 continue;
             }
-            if (!parse_number(v, *dst[k])) {
-                throw ConfigError(file, line_no, c, "not a temperature: '" + std::string(v) + "'");
+            if (!parse_number(v, *dst[k]) || !std::isfinite(*dst[k])) {
+                throw ConfigError(
+                    file, line_no, c,
+                    "not a temperature: '" + std::string(v) + "' (a finite number, or empty or nan for none)");
             }
         }
         rows.push_back(r);
