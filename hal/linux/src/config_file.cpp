@@ -2,6 +2,8 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "text_lines.hpp"
 
+#include "ascorr_hal/channel_defaults.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -64,20 +66,6 @@ private:
     const std::string& file_;
     std::size_t line_;
 };
-
-ChannelConfig<double> default_channel() {
-    ChannelConfig<double> c{};
-    c.role = Role::kMonitor;
-    c.divider = {true, 10000.0, 4096U};
-    c.r_open = 2.0e6;
-    c.r_short = 100.0;
-    c.t_min = -60.0;
-    c.t_max = 80.0;
-    c.max_rate = 0.5;
-    c.stuck_frames = 0U;
-    c.max_spread = 8U;
-    return c;
-}
 
 }  // namespace
 
@@ -336,7 +324,7 @@ void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfi
     if (a.channels >= kMaxChannels) {
         p.fail(d.directive_col, "more than " + std::to_string(kMaxChannels) + " channels");
     }
-    ChannelConfig<double> c = default_channel();
+    ChannelConfig<double> c = default_channel<double>();  // channel_defaults.hpp
     RequiredChannelKeys seen;
     for (const Token& t : d.tokens) {
         if (t.key == "name") {
@@ -369,12 +357,8 @@ void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfi
 
 HalConfig parse_config(const std::string& file_name, std::string_view text) {
     HalConfig cfg;
+    cfg.acquisition = default_acquisition<double>();  // channel_defaults.hpp
     AcquisitionConfig<double>& a = cfg.acquisition;
-    a.channels = 0;
-    a.sampler = {2000U, 9U, 0U};
-    a.stale_us = 5000000U;
-    a.vote_tolerance = 1.0;
-    a.quorum = 2U;
     bool seen_acq = false;
     bool seen_gpio = false;
     linux_detail::TextLines lines(file_name, text);

@@ -14,7 +14,8 @@
 // °C/s, ohm, counts; a, b, c are the thermistor's Steinhart–Hart coefficients.
 // role is one of monitor, chu_a … chu_d, t029, t032; at most 8 channels, at
 // most 3 per role, names and ADC inputs unique. `gpio` and `acquisition` are
-// optional (defaults as shown) and may appear once each. Every error is
+// optional (defaults as shown; they come from ascorr_hal/channel_defaults.hpp)
+// and may appear once each. Every error is
 // reported as file:line:column with the offending key or value.
 #pragma once
 
