@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -176,6 +177,40 @@ TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
         EXPECT_STREQ(e.what(), "h.csv:2:9: 'chu' must be A, B, C or D");
     }
     EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
+}
+
+// Issue 14 item 8 split parse_history; what it reads is unchanged (this test
+// passes on the earlier, single-function reader too).
+TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {
+    const std::vector<hal::HistoryRow> a =
+        hal::parse_history("h.csv", "x,t_032,chu,t,t_029,t_chu\r\n7,-20,B,1.5,-9,3\r\n,nan,D,2,,\r\n\r\n");
+    ASSERT_EQ(a.size(), 2U);
+    EXPECT_EQ(a[0].t, 1.5);
+    EXPECT_EQ(a[0].head, 1);
+    EXPECT_EQ(a[0].t_chu, 3.0);
+    EXPECT_EQ(a[0].t_029, -9.0);
+    EXPECT_EQ(a[0].t_032, -20.0);
+    EXPECT_EQ(a[1].head, 3);
+    EXPECT_TRUE(std::isnan(a[1].t_chu) && std::isnan(a[1].t_029) && std::isnan(a[1].t_032));
+    const std::vector<hal::HistoryRow> b = hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n0,1,2,3");
+    ASSERT_EQ(b.size(), 1U);
+    EXPECT_EQ(b[0].head, -1);
+    const auto err = [](const std::string& text) {
+        try {
+            hal::parse_history("h.csv", text);
+        } catch (const hal::ConfigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(err(""), "h.csv:1:1: empty file (no header)");
+    EXPECT_EQ(err("t,t_chu,t_029\n"), "h.csv:1:1: a temperature history needs columns t, t_chu, t_029, t_032");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3\n"), "h.csv:2:6: expected 4 fields, found 3");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3,4\n\n2,2,3,4\n"), "h.csv:3:1: expected 4 fields, found 1");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,x,4\n"),
+              "h.csv:2:5: not a temperature: 'x' (a finite number, or empty or nan for none)");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\nsoon,2,3,4\n"), "h.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
+    EXPECT_EQ(err("t,chu,t_chu,t_029,t_032\n1,AB,2,3,4\n"), "h.csv:2:3: 'chu' must be A, B, C or D");
 }
 
 // Each injected fault class reaches the acquisition as its flag.

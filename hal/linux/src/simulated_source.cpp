@@ -76,74 +76,113 @@ InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>
     return f;
 }
 
+namespace {
+
+// The columns of a history: their indices in a row (-1: absent).
+struct HistoryColumns {
+    int t = -1;
+    int chu = -1;
+    int temperature[3] = {-1, -1, -1};  // t_chu, t_029, t_032
+    std::size_t count = 0;              // fields every row has
+};
+
+// The header line: which field is which; t, t_chu, t_029, t_032 required.
+HistoryColumns history_columns(const std::string& file, const std::vector<linux_detail::Field>& header) {
+    static constexpr const char* kTemperatureNames[3] = {"t_chu", "t_029", "t_032"};
+    HistoryColumns cols;
+    cols.count = header.size();
+    for (std::size_t i = 0; i < header.size(); ++i) {
+        const std::string_view name = header[i].first;
+        const int index = static_cast<int>(i);
+        if (name == "t") {
+            cols.t = index;
+        } else if (name == "chu") {
+            cols.chu = index;
+        }
+        for (int k = 0; k < 3; ++k) {
+            if (name == kTemperatureNames[k]) {
+                cols.temperature[k] = index;
+            }
+        }
+    }
+    if (cols.t < 0 || cols.temperature[0] < 0 || cols.temperature[1] < 0 || cols.temperature[2] < 0) {
+        throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
+    }
+    return cols;
+}
+
+const linux_detail::Field& field(const std::vector<linux_detail::Field>& f, int column) {
+    return f[static_cast<std::size_t>(column)];
+}
+
+// The head of a row: -1 without a chu column, else A–D as 0–3.
+int history_head(const std::string& file, std::size_t line_no, const std::vector<linux_detail::Field>& f,
+                 const HistoryColumns& cols) {
+    if (cols.chu < 0) {
+        return -1;
+    }
+    const auto& [v, c] = field(f, cols.chu);
+    if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
+        throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
+    }
+    return v[0] - 'A';
+}
+
+// A temperature field: NaN when empty or nan (none), else a finite number.
+double history_temperature(const std::string& file, std::size_t line_no, const linux_detail::Field& field) {
+    const auto& [v, c] = field;
+    double x = std::numeric_limits<double>::quiet_NaN();
+    if (v.empty() || v == "nan") {
+        return x;
+    }
+    if (!parse_number(v, x) || !std::isfinite(x)) {
+        throw ConfigError(file, line_no, c,
+                          "not a temperature: '" + std::string(v) + "' (a finite number, or empty or nan for none)");
+    }
+    return x;
+}
+
+// One data line of a history.
+HistoryRow history_row(const std::string& file, std::size_t line_no, std::string_view line,
+                       const std::vector<linux_detail::Field>& f, const HistoryColumns& cols) {
+    if (f.size() != cols.count) {
+        throw ConfigError(file, line_no, line.size() + 1,
+                          "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
+    }
+    HistoryRow r{0.0, -1, 0.0, 0.0, 0.0};
+    r.line = line_no;
+    const auto& [t_text, t_col] = field(f, cols.t);
+    if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
+        throw ConfigError(file, line_no, t_col, "'t' must be a number of seconds in [0, 1e12]");
+    }
+    r.head = history_head(file, line_no, f, cols);
+    double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
+    for (int k = 0; k < 3; ++k) {
+        const linux_detail::Field& tf = field(f, cols.temperature[k]);
+        r.column[k] = tf.second;
+        *dst[k] = history_temperature(file, line_no, tf);
+    }
+    return r;
+}
+
+}  // namespace
+
 std::vector<HistoryRow> parse_history(const std::string& file, std::string_view text) {
-    std::vector<HistoryRow> rows;
-    int col_t = -1, col_chu = -1, col_t1 = -1, col_t2 = -1, col_t3 = -1;
-    std::size_t ncols = 0;
     linux_detail::TextLines lines(file, text);
     std::string_view line;
     std::vector<linux_detail::Field> f;
+    if (!lines.next(line)) {
+        throw ConfigError(file, 1, 1, "empty file (no header)");
+    }
+    linux_detail::split_fields(line, f);
+    const HistoryColumns cols = history_columns(file, f);
+    std::vector<HistoryRow> rows;
     while (lines.next(line)) {
-        const std::size_t line_no = lines.number();
-        linux_detail::split_fields(line, f);
-        if (line_no == 1) {
-            for (std::size_t i = 0; i < f.size(); ++i) {
-                const std::string_view n = f[i].first;
-                int* slot = n == "t"       ? &col_t
-                            : n == "chu"   ? &col_chu
-                            : n == "t_chu" ? &col_t1
-                            : n == "t_029" ? &col_t2
-                            : n == "t_032" ? &col_t3
-                                           : nullptr;
-                if (slot != nullptr) {
-                    *slot = static_cast<int>(i);
-                }
-            }
-            if (col_t < 0 || col_t1 < 0 || col_t2 < 0 || col_t3 < 0) {
-                throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
-            }
-            ncols = f.size();
-            continue;
-        }
         if (line.empty() && lines.at_end()) {  // a blank last line
             break;
         }
-        if (f.size() != ncols) {
-            throw ConfigError(file, line_no, line.size() + 1,
-                              "expected " + std::to_string(ncols) + " fields, found " + std::to_string(f.size()));
-        }
-        HistoryRow r{0.0, -1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::quiet_NaN()};
-        r.line = line_no;
-        if (!parse_number(f[static_cast<std::size_t>(col_t)].first, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
-            throw ConfigError(file, line_no, f[static_cast<std::size_t>(col_t)].second,
-                              "'t' must be a number of seconds in [0, 1e12]");
-        }
-        if (col_chu >= 0) {
-            const auto& [v, c] = f[static_cast<std::size_t>(col_chu)];
-            if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
-                throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
-            }
-            r.head = v[0] - 'A';
-        }
-        double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
-        const int cols[3] = {col_t1, col_t2, col_t3};
-        for (int k = 0; k < 3; ++k) {
-            const auto& [v, c] = f[static_cast<std::size_t>(cols[k])];
-            r.column[k] = c;
-            if (v.empty() || v == "nan") {
-                continue;
-            }
-            if (!parse_number(v, *dst[k]) || !std::isfinite(*dst[k])) {
-                throw ConfigError(
-                    file, line_no, c,
-                    "not a temperature: '" + std::string(v) + "' (a finite number, or empty or nan for none)");
-            }
-        }
-        rows.push_back(r);
-    }
-    if (lines.number() == 0) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        linux_detail::split_fields(line, f);
+        rows.push_back(history_row(file, lines.number(), line, f, cols));
     }
     return rows;
 }
