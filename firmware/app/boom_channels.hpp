@@ -26,6 +26,7 @@
 
 #include "app_scalar.hpp"
 #include "ascorr_hal/acquisition.hpp"
+#include "ascorr_hal/channel_defaults.hpp"
 #include "ascorr_hal/fixed_thermistor.hpp"
 
 namespace ascorr::app::boom {
@@ -39,30 +40,24 @@ using HalScalar = float;
 inline constexpr std::uint8_t kBoomChannels = 6;
 inline constexpr std::uint32_t kProfileSeconds = 16;
 
-// 10K3A1 (Campbell Scientific 109SS manual, Appendix C), as hal/examples/board.cfg.
-inline constexpr hal::SteinhartHart<float> k10K3A1{1.129241e-3F, 2.341077e-4F, 8.775468e-8F};
-
+// A boom channel: the HAL's default channel (hal/include/ascorr_hal/
+// channel_defaults.hpp: the 10K3A1 curve, 10 kΩ to the ADC reference with the
+// thermistor to ground, 12 bits, limits; stuck check off, as the emulated ADC
+// has no noise and a steady reading would trip it) with its name, role, input.
 constexpr hal::ChannelConfig<float> channel(const char (&name)[9], hal::Role role, std::uint8_t adc) {
-    hal::ChannelConfig<float> c{};
+    hal::ChannelConfig<float> c = hal::default_channel<float>();
     for (std::uint8_t i = 0; i < 9; ++i) {
         c.name[i] = name[i];
     }
     c.role = role;
     c.adc_channel = adc;
-    c.divider = {true, 10000.0F, 4096U};  // thermistor to ground, 10 kΩ to the ADC reference
-    c.sh = k10K3A1;
-    c.r_open = 2.0e6F;
-    c.r_short = 100.0F;
-    c.t_min = -60.0F;
-    c.t_max = 80.0F;
-    c.max_rate = 0.5F;
-    c.stuck_frames = 0U;  // the emulated ADC has no noise: a stuck check would fire on a steady reading
-    c.max_spread = 8U;
     return c;
 }
 
+// The HAL's default acquisition (2 ms settle, median of 9, 1 °C vote
+// tolerance, quorum 2) with the boom channels and a 3 s staleness limit.
 constexpr hal::AcquisitionConfig<float> make_config(std::uint8_t channels) {
-    hal::AcquisitionConfig<float> a{};
+    hal::AcquisitionConfig<float> a = hal::default_acquisition<float>();
     a.channel[0] = channel("THT00029", hal::Role::kT029, 0);
     a.channel[1] = channel("THT00057", hal::Role::kT029, 1);
     a.channel[2] = channel("THT00087", hal::Role::kT029, 2);
@@ -72,10 +67,7 @@ constexpr hal::AcquisitionConfig<float> make_config(std::uint8_t channels) {
     a.channel[6] = channel("CHU_A\0\0\0", hal::Role::kChuA, 6);
     a.channel[7] = channel("CHU_B\0\0\0", hal::Role::kChuB, 7);
     a.channels = channels;
-    a.sampler = {2000U, 9U, 0U};  // 2 ms settle, median of 9
-    a.stale_us = 3000000U;        // a reading older than 3 s (three missed polls) is withheld
-    a.vote_tolerance = 1.0F;
-    a.quorum = 2U;
+    a.stale_us = 3000000U;  // a reading older than 3 s (three missed 1 Hz polls) is withheld
     return a;
 }
 

@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -72,6 +73,72 @@ TEST(HalConfigFile, ErrorsNameLineAndColumn) {
               "board.cfg:2:45: unknown channel key 'colour'");
 }
 
+// Issue 11: a curve that is not an NTC's (T must fall as R rises, 1/T > 0) on
+// the resistances the channel converts is refused, naming where it fails.
+TEST(HalConfigFile, NonMonotonicSteinhartHartIsRefusedWithItsRange) {
+    const std::string line = "channel name=T1 adc=0 role=t029 a=1.129241e-3 b=2.341077e-4 ";
+    // C < 0: B + 3C·ln²R ≤ 0 from ln R = √(B/(6e-6)) = 6.2465, R = 516.17 ohm, up to r_open.
+    const std::string e1 = config_error("# x\n" + line + "c=-2e-6\n");
+    EXPECT_NE(e1.find("board.cfg:2:1: channel 'T1': the Steinhart-Hart coefficients are not monotonic (T does not "
+                      "fall as R rises) for R in [516.169"),
+              std::string::npos)
+        << e1;
+    EXPECT_NE(e1.find(", 2e+06] ohm"), std::string::npos) << e1;
+    EXPECT_NE(e1.find("the channel converts 100 ... 2e+06 ohm"), std::string::npos) << e1;
+    // The same curve is fine where it is monotonic: r_open below 516 ohm.
+    EXPECT_EQ(config_error(line + "c=-2e-6 r_open=500 r_short=50\n"), "no error");
+    // B < 0, C = 0: nowhere monotonic; r_short/r_open and the divider bound the range.
+    const std::string e2 = config_error(line.substr(0, line.find("b=")) + "b=-1e-4 c=0 r_short=1000 r_open=1e5\n");
+    EXPECT_NE(e2.find("board.cfg:1:1: channel 'T1': the Steinhart-Hart coefficients are not monotonic (T does not fall "
+                      "as R rises) for R in [1000, 100000] ohm"),
+              std::string::npos)
+        << e2;
+    // Monotonic, but no temperature: 1/T ≤ 0 at the low end.
+    const std::string e3 = config_error("channel name=T1 adc=0 role=t029 a=-1 b=1e-4 c=1e-8\n");
+    EXPECT_NE(e3.find("board.cfg:1:1: channel 'T1': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at "
+                      "R = 100 ohm"),
+              std::string::npos)
+        << e3;
+    // The example's 10K3A1 channels pass (ExampleParses), and so does any
+    // ordinary curve: B > 0, C ≥ 0.
+    EXPECT_EQ(config_error(line + "c=0\n"), "no error");
+}
+
+// Issue 11: injected values that are not numbers, and noise that is not
+// positive, are refused naming the fault; so are non-finite history values.
+TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    const auto err = [&](const char* spec) {
+        try {
+            hal::parse_fault(spec, c);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(
+        err("THT00057:offset:10:20:nan"),
+        "fault 'THT00057:offset:10:20:nan': offset VALUE must be a finite number of degC within +-200, got 'nan'");
+    EXPECT_NE(err("THT00057:offset:10:20:inf").find("offset VALUE must be a finite number"), std::string::npos);
+    EXPECT_EQ(err("THT00057:noise:10:20:-5"),
+              "fault 'THT00057:noise:10:20:-5': noise VALUE must be a number of counts in (0, 65535], got '-5'");
+    EXPECT_NE(err("THT00057:noise:10:20:0").find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(err("THT00057:noise:10:20:nan").find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(err("THT00057:noise:10:20:1e300").find("noise VALUE must be"), std::string::npos);
+    EXPECT_EQ(err("THT00057:open:nan:20"),
+              "fault 'THT00057:open:nan:20': FROM and TO must be finite numbers with FROM < TO");
+    EXPECT_NE(err("THT00057:open:0:inf").find("FROM and TO must be finite"), std::string::npos);
+    EXPECT_EQ(err("THT00057:noise:10:20:4"), "no error");
+    EXPECT_EQ(err("THT00057:offset:10:20:-3.5"), "no error");
+    try {
+        hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,inf,3,4\n");
+        FAIL();
+    } catch (const hal::ConfigError& e) {
+        EXPECT_STREQ(e.what(), "h.csv:3:3: not a temperature: 'inf' (a finite number, or empty or nan for none)");
+    }
+    EXPECT_EQ(hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,nan,,4\n").size(), 2U);
+}
+
 TEST(HalReplay, ErrorsNameLineAndColumn) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
     const auto err = [&](const std::string& text) {
@@ -112,6 +179,40 @@ TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
     EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
 }
 
+// Issue 14 item 8 split parse_history; what it reads is unchanged (this test
+// passes on the earlier, single-function reader too).
+TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {
+    const std::vector<hal::HistoryRow> a =
+        hal::parse_history("h.csv", "x,t_032,chu,t,t_029,t_chu\r\n7,-20,B,1.5,-9,3\r\n,nan,D,2,,\r\n\r\n");
+    ASSERT_EQ(a.size(), 2U);
+    EXPECT_EQ(a[0].t, 1.5);
+    EXPECT_EQ(a[0].head, 1);
+    EXPECT_EQ(a[0].t_chu, 3.0);
+    EXPECT_EQ(a[0].t_029, -9.0);
+    EXPECT_EQ(a[0].t_032, -20.0);
+    EXPECT_EQ(a[1].head, 3);
+    EXPECT_TRUE(std::isnan(a[1].t_chu) && std::isnan(a[1].t_029) && std::isnan(a[1].t_032));
+    const std::vector<hal::HistoryRow> b = hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n0,1,2,3");
+    ASSERT_EQ(b.size(), 1U);
+    EXPECT_EQ(b[0].head, -1);
+    const auto err = [](const std::string& text) {
+        try {
+            hal::parse_history("h.csv", text);
+        } catch (const hal::ConfigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(err(""), "h.csv:1:1: empty file (no header)");
+    EXPECT_EQ(err("t,t_chu,t_029\n"), "h.csv:1:1: a temperature history needs columns t, t_chu, t_029, t_032");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3\n"), "h.csv:2:6: expected 4 fields, found 3");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3,4\n\n2,2,3,4\n"), "h.csv:3:1: expected 4 fields, found 1");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,x,4\n"),
+              "h.csv:2:5: not a temperature: 'x' (a finite number, or empty or nan for none)");
+    EXPECT_EQ(err("t,t_chu,t_029,t_032\nsoon,2,3,4\n"), "h.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
+    EXPECT_EQ(err("t,chu,t_chu,t_029,t_032\n1,AB,2,3,4\n"), "h.csv:2:3: 'chu' must be A, B, C or D");
+}
+
 // Each injected fault class reaches the acquisition as its flag.
 TEST(HalSimulated, InjectedFaultsAreDetected) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
@@ -131,7 +232,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
         {"THT00057:noise:110:120:200", 1, 12, fault::kNoisy}, {"CHU_A:stuck:110:300", 6, 110, fault::kStuck},
         {"CHU_A:drop:110:300", 6, 20, fault::kStale}};
     for (const Case& k : cases) {
-        hal::SimulatedSource src(c, h, {hal::parse_fault(k.spec, c)});
+        hal::SimulatedSource src(c, hal::history_epochs("history", h), {hal::parse_fault(k.spec, c)});
         hal::TemperatureAcquisition<double> acq(c);
         hal::SampleSet<double> f{};
         for (int i = 0; i <= k.at; ++i) {
@@ -141,7 +242,7 @@ TEST(HalSimulated, InjectedFaultsAreDetected) {
         const hal::ChannelReading<double> r = acq.channel(static_cast<std::uint8_t>(k.channel), f.t_us);
         EXPECT_EQ(r.faults & k.want, k.want) << k.spec << " got " << r.faults;
         // Before the fault window the same channel was fine.
-        hal::SimulatedSource clean(c, h, {});
+        hal::SimulatedSource clean(c, hal::history_epochs("history", h), {});
         hal::TemperatureAcquisition<double> acq2(c);
         for (int i = 0; i <= k.at; ++i) {
             ASSERT_TRUE(clean.acquire(f));
@@ -215,6 +316,172 @@ TEST(HalCli, ThermistorsSimulatesASolutionsFileWithAFault) {
     EXPECT_EQ(r.out.find(",voted,,,,0,"), std::string::npos) << r.out;  // two of three still agree
     EXPECT_NE(r.out.find("447534216.000000,t_029,voted,,,-9.2"), std::string::npos) << r.out;
     EXPECT_NE(r.err.find("30 frames, 0 voted values withheld"), std::string::npos) << r.err;
+}
+
+// A history of three heads at one epoch per second, rows interleaved by head,
+// every temperature warming at 0.5 °C/min (10 min, about 5 °C: some 200
+// counts), with `step_b` °C added to head B's T_CHU from epoch 300 on.
+void write_interleaved_history(const fs::path& path, double step_b) {
+    std::ofstream f(path);
+    f << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    const char heads[3] = {'A', 'B', 'C'};
+    const double base[3] = {10.0, 12.0, 8.0};
+    char buf[160];
+    for (int k = 0; k < 600; ++k) {
+        const double warm = 0.5 / 60.0 * k;
+        for (int h = 0; h < 3; ++h) {
+            const double chu = base[h] + warm + (h == 1 && k >= 300 ? step_b : 0.0);
+            std::snprintf(buf, sizeof buf, "%d,%c,1,0,0,0,%.4f,%.4f,%.4f,,,,0,1.00\n", 1000 + k, heads[h], chu,
+                          -9.0 + warm, -20.0 + warm);
+            f << buf;
+        }
+    }
+}
+
+std::vector<std::string> lines_with(const std::string& text, const std::string& needle) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+        if (l.find(needle) != std::string::npos) {
+            out.push_back(l);
+        }
+    }
+    return out;
+}
+
+// Issue 11: one frame per epoch with every head's truth, at the epoch's time.
+// Each row used to be a frame, 16 ms after the previous one, so a one-count
+// step of CHU_B between the rows of A and B read as ~1.5 °C/s: a rate fault
+// every two or three seconds on a history warming at 0.5 °C/min.
+TEST(HalCli, ASlowHistoryWithHeadsInterleavedRaisesNoRateFault) {
+    const fs::path dir = scratch_dir("hal-cli");
+    write_interleaved_history(dir / "slow.csv", 0.0);
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "slow.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(lines_with(r.out, "rate").size(), 0U) << lines_with(r.out, "rate").front();
+    EXPECT_NE(r.err.find("600 frames, 0 voted values withheld"), std::string::npos) << r.err;
+    // Frames carry the history's times, every channel at each.
+    const std::vector<std::string> b = lines_with(r.out, ",CHU_B,");
+    ASSERT_EQ(b.size(), 600U);
+    EXPECT_EQ(b[599].substr(0, 19), "1599.000000,CHU_B,c");
+    // Not vacuous: the counts did move (0.5 °C/min over 10 min).
+    const auto counts = [](const std::string& line) { return std::stoi(line.substr(line.find("chu_b,") + 6)); };
+    EXPECT_GT(counts(b[0]) - counts(b[599]), 150);
+
+    // Mutation: a real step of 3 °C on CHU_B in one second is still a rate fault.
+    write_interleaved_history(dir / "step.csv", 3.0);
+    const CliRun s = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "step.csv").string(), dir);
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    const std::vector<std::string> rate = lines_with(s.out, "rate");
+    ASSERT_EQ(rate.size(), 1U) << s.out.substr(0, 2000);
+    EXPECT_EQ(rate[0].substr(0, 24), "1300.000000,CHU_B,chu_b,") << rate[0];
+    EXPECT_NE(rate[0].find(",17.50"), std::string::npos) << rate[0];  // 12 + 300 · 0.5/60 + 3 °C
+}
+
+// Rows of one epoch (t to the millisecond) that disagree are refused: one
+// thermistor cannot have two temperatures at one time.
+TEST(HalCli, RowsOfOneEpochThatDisagreeAreRefused) {
+    const fs::path dir = scratch_dir("hal-cli");
+    std::ofstream(dir / "h.csv") << "t,chu,t_chu,t_029,t_032\n10,A,5,-9,-20\n10,B,6,-9,-20\n10.0004,C,7,-8.5,-20\n";
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "h.csv").string(), dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("h.csv:4:13: t_029 = -8.5 at t = 10.000 s disagrees with -9 on line 3 (the same epoch)"),
+              std::string::npos)
+        << r.err;
+    // Rows of other epochs, in any order, are fine.
+    std::ofstream(dir / "h2.csv") << "t,chu,t_chu,t_029,t_032\n11,A,5,-9,-20\n10,B,6,-9,-20\n10,A,5,-9,-20\n";
+    const CliRun ok = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "h2.csv").string(), dir);
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_NE(ok.err.find("2 frames"), std::string::npos) << ok.err;
+}
+
+// Issue 11: a file that cannot be opened was "file:0:0: cannot open: ...".
+// No message cites line or column 0; each reader names its file.
+TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = kExamples + "/board.cfg";
+    const std::string missing = (dir / "missing.csv").string();
+    fs::create_directory(dir / "adir");
+    struct Case {
+        std::string args;
+        std::string want;
+    };
+    const Case cases[] = {
+        {"--config " + missing + " --replay " + kExamples + "/replay.csv",
+         "cannot open " + missing + ": No such file or directory"},
+        {"--config " + cfg + " --replay " + missing, "cannot open " + missing + ": No such file or directory"},
+        {"--config " + cfg + " --simulate " + missing, "cannot open " + missing + ": No such file or directory"},
+        {"--config " + (dir / "adir").string() + " --simulate " + missing,
+         "cannot open " + (dir / "adir").string() + ": is a directory, not a file"},
+    };
+    for (const Case& c : cases) {
+        const CliRun r = run(c.args, dir);
+        EXPECT_EQ(r.exit_code, 1) << c.args;
+        EXPECT_NE(r.err.find(c.want), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
+    }
+    // The error itself: no line or column when there is none.
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 0, 0, "x").what(), "f.cfg: x");
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 0, "x").what(), "f.cfg:3: x");
+    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
+}
+
+// Issue 11: binary data in a configuration, replay or history file is refused
+// at file:line:column, and its bytes never reach the terminal (an escaped
+// excerpt at most).
+TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = kExamples + "/board.cfg";
+    const std::string good_cfg = slurp(cfg);
+    const std::string history = "t,t_chu,t_029,t_032\n1,2,3,4\n";
+    const std::string replay = "t,THT00029\n100,-9.5\n";
+    struct Bad {
+        std::string bytes;  // inserted at the start of line 3
+        std::string what;   // the message after file:3:column:
+        std::string excerpt;
+    };
+    const Bad bad[] = {
+        {std::string("\0\x01", 2), "binary data (byte 0x00)", "\\x00\\x01"},
+        {"\xff\xfe", "binary data (byte 0xff)", "\\xff\\xfe"},
+        {"\x1b[2J", "binary data (byte 0x1b)", "\\x1b[2J"},
+        {"\xc0\xaf", "binary data (byte 0xc0)", "\\xc0\\xaf"},      // overlong '/'
+        {"\xed\xa0\x80", "binary data (byte 0xed)", "\\xed\\xa0"},  // a surrogate
+        {"x\ry", "a CR not followed by LF (CR-only line ends?)", "x\\x0dy"},
+    };
+    for (const Bad& b : bad) {
+        const auto third_line = [&](const std::string& text) {  // b.bytes at the start of line 3
+            const std::size_t at = text.find('\n', text.find('\n') + 1) + 1;
+            return text.substr(0, at) + b.bytes + text.substr(at);
+        };
+        std::ofstream(dir / "b.cfg", std::ios::binary) << third_line(good_cfg);
+        std::ofstream(dir / "h.csv", std::ios::binary) << third_line(history + "2,2,3,4\n");
+        std::ofstream(dir / "r.csv", std::ios::binary) << third_line(replay + "101,-9.5\n");
+        const std::string column = b.bytes[0] == 'x' ? "2" : "1";
+        const std::pair<std::string, std::string> runs[] = {
+            {"--config " + (dir / "b.cfg").string() + " --simulate " + (dir / "h.csv").string(), "b.cfg"},
+            {"--config " + cfg + " --simulate " + (dir / "h.csv").string(), "h.csv"},
+            {"--config " + cfg + " --replay " + (dir / "r.csv").string(), "r.csv"},
+        };
+        for (const auto& [args, file] : runs) {
+            const CliRun r = run(args, dir);
+            EXPECT_EQ(r.exit_code, 1) << args;
+            EXPECT_NE(r.err.find(file + ":3:" + column + ": " + b.what + ": not a text file, line starts \""),
+                      std::string::npos)
+                << r.err;
+            EXPECT_NE(r.err.find(b.excerpt), std::string::npos) << r.err;
+            EXPECT_EQ(r.err.find(b.bytes), std::string::npos) << "the bytes reached the terminal: " << r.err;
+            for (const char c : r.err) {
+                const auto u = static_cast<unsigned char>(c);
+                EXPECT_TRUE(u == '\n' || (u >= 0x20U && u < 0x7FU)) << "byte " << unsigned{u} << " in " << r.err;
+            }
+        }
+    }
+    // Valid UTF-8 (the example's comments have Ω and –) and a byte-order mark pass.
+    std::ofstream(dir / "u.csv", std::ios::binary)
+        << "\xEF\xBB\xBFt,t_chu,t_029,t_032,note\n1,2,3,4,\xE2\x80\x94 \xF0\x9F\x8C\xA1\n";
+    EXPECT_NE(good_cfg.find("\xCE\xA9"), std::string::npos);
+    const CliRun u = run("--config " + cfg + " --simulate " + (dir / "u.csv").string(), dir);
+    EXPECT_EQ(u.exit_code, 0) << u.err;
 }
 
 TEST(HalCli, BadConfigExitsOneWithLocation) {

@@ -342,7 +342,7 @@ TEST(HalFixed, SimulatedStreamsWithEveryFaultClassGiveTheSameFaultsAndVotes) {
     for (const char* s : specs) {
         faults.push_back(hal::parse_fault(s, cfg));
     }
-    hal::SimulatedSource src(cfg, history, faults);
+    hal::SimulatedSource src(cfg, hal::history_epochs("history", history), faults);
     Paths p(cfg);
     Comparison cmp;
     hal::SampleSet<double> f{};

@@ -81,6 +81,55 @@ T celsius_from_resistance(const SteinhartHart<T>& sh, T r) noexcept {
     return T(1) / inv_k - static_cast<T>(kZeroCelsiusK);
 }
 
+// Where a Steinhart–Hart curve fails to be a thermistor curve on the
+// resistances [r_lo, r_hi] (ohm, 0 < r_lo < r_hi): 1/T must be positive and
+// rise strictly with ln R, i.e. T fall strictly with R (an NTC). With
+// L = ln R, d(1/T)/dL = B + 3·C·L², so the set where it is ≤ 0 is found in
+// closed form: all L (C = 0, B ≤ 0); |L| ≤ √(−B/(3C)) (C > 0, B ≤ 0);
+// |L| ≥ √(−B/(3C)) (C < 0, B > 0); all L (C < 0, B ≤ 0). Where it rises,
+// 1/T is smallest at r_lo. Returns ok, or the first failing resistance
+// range [r_from, r_to] within [r_lo, r_hi] (host and configuration checks).
+template <typename T>
+struct CurveCheck {
+    bool ok;
+    bool no_temperature;  // monotonic, but 1/T ≤ 0 (or not finite) at r_from
+    T r_from;
+    T r_to;
+};
+
+template <typename T>
+CurveCheck<T> check_curve(const SteinhartHart<T>& sh, T r_lo, T r_hi) noexcept {
+    const T l_lo = std::log(r_lo);
+    const T l_hi = std::log(r_hi);
+    const T inf = std::numeric_limits<T>::infinity();
+    // The set where B + 3·C·L² ≤ 0 as up to two intervals of L.
+    T from[2] = {inf, inf};
+    T to[2] = {-inf, -inf};
+    if (sh.b <= T(0) && sh.c >= T(0)) {
+        const T s = sh.c == T(0) ? inf : std::sqrt(-sh.b / (T(3) * sh.c));
+        from[0] = -s;
+        to[0] = s;
+    } else if (sh.c < T(0)) {
+        const T s = sh.b <= T(0) ? T(0) : std::sqrt(-sh.b / (T(3) * sh.c));
+        from[0] = -inf;
+        to[0] = -s;
+        from[1] = s;
+        to[1] = inf;
+    }
+    for (int k = 0; k < 2; ++k) {
+        const T a = from[k] > l_lo ? from[k] : l_lo;
+        const T b = to[k] < l_hi ? to[k] : l_hi;
+        if (a <= b) {
+            return {false, false, std::exp(a), std::exp(b)};
+        }
+    }
+    const T inv_k = sh.a + sh.b * l_lo + sh.c * l_lo * l_lo * l_lo;
+    if (!(inv_k > T(0)) || !std::isfinite(T(1) / inv_k)) {
+        return {false, true, r_lo, r_lo};
+    }
+    return {true, false, r_lo, r_hi};
+}
+
 // Ohm from °C, the closed-form inverse of Steinhart–Hart (simulation, tests):
 //   x = (A − 1/T)/C, y = sqrt((B/(3C))³ + x²/4), ln R = cbrt(y − x/2) − cbrt(y + x/2).
 template <typename T>

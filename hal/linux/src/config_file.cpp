@@ -2,13 +2,14 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "text_lines.hpp"
 
+#include "ascorr_hal/channel_defaults.hpp"
+
+#include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <utility>
 #include <vector>
 
@@ -65,20 +66,6 @@ private:
     const std::string& file_;
     std::size_t line_;
 };
-
-ChannelConfig<double> default_channel() {
-    ChannelConfig<double> c{};
-    c.role = Role::kMonitor;
-    c.divider = {true, 10000.0, 4096U};
-    c.r_open = 2.0e6;
-    c.r_short = 100.0;
-    c.t_min = -60.0;
-    c.t_max = 80.0;
-    c.max_rate = 0.5;
-    c.stuck_frames = 0U;
-    c.max_spread = 8U;
-    return c;
-}
 
 }  // namespace
 
@@ -281,6 +268,39 @@ void parse_channel_option(const Token& t, const LineParser& p, ChannelConfig<dou
     }
 }
 
+// The Steinhart–Hart curve must be an NTC's (check_curve) on every
+// resistance the channel converts: between r_short and r_open, and within
+// what the divider's codes 1 … levels − 1 can give.
+void check_channel_curve(const DirectiveLine& d, const LineParser& p, const ChannelConfig<double>& c) {
+    const auto top = static_cast<std::uint16_t>(c.divider.levels - 1U);  // levels >= 2
+    const std::uint16_t one = 1U;
+    const double code_lo = resistance_from_counts(c.divider, c.divider.thermistor_low ? one : top);
+    const double code_hi = resistance_from_counts(c.divider, c.divider.thermistor_low ? top : one);
+    const double r_lo = std::max(c.r_short > 0.0 ? c.r_short : 0.0, code_lo);
+    const double r_hi = std::min(c.r_open, code_hi);
+    if (!(r_lo < r_hi)) {
+        return;  // no resistance is converted: every reading is open or short
+    }
+    const CurveCheck<double> k = check_curve(c.sh, r_lo, r_hi);
+    if (k.ok) {
+        return;
+    }
+    char buf[320];
+    if (k.no_temperature) {
+        std::snprintf(buf, sizeof buf,
+                      "channel '%s': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at R = %.6g ohm "
+                      "(the channel converts %.6g ... %.6g ohm)",
+                      c.name, k.r_from, r_lo, r_hi);
+    } else {
+        std::snprintf(buf, sizeof buf,
+                      "channel '%s': the Steinhart-Hart coefficients are not monotonic (T does not fall as R rises) "
+                      "for R in [%.6g, %.6g] ohm (T %.6g ... %.6g degC); the channel converts %.6g ... %.6g ohm",
+                      c.name, k.r_from, k.r_to, celsius_from_resistance(c.sh, k.r_from),
+                      celsius_from_resistance(c.sh, k.r_to), r_lo, r_hi);
+    }
+    p.fail(d.directive_col, buf);
+}
+
 // Checks that need the whole channel line: the required keys and the ranges.
 void check_channel(const DirectiveLine& d, const LineParser& p, const RequiredChannelKeys& seen,
                    const ChannelConfig<double>& c) {
@@ -297,13 +317,14 @@ void check_channel(const DirectiveLine& d, const LineParser& p, const RequiredCh
     if (!(std::fabs(c.t_min) <= 200.0 && std::fabs(c.t_max) <= 200.0)) {
         p.fail(d.directive_col, "channel '" + name + "': t_min, t_max must be within ±200 °C");
     }
+    check_channel_curve(d, p, c);
 }
 
 void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfig<double>& a) {
     if (a.channels >= kMaxChannels) {
         p.fail(d.directive_col, "more than " + std::to_string(kMaxChannels) + " channels");
     }
-    ChannelConfig<double> c = default_channel();
+    ChannelConfig<double> c = default_channel<double>();  // channel_defaults.hpp
     RequiredChannelKeys seen;
     for (const Token& t : d.tokens) {
         if (t.key == "name") {
@@ -336,15 +357,11 @@ void parse_channel(const DirectiveLine& d, const LineParser& p, AcquisitionConfi
 
 HalConfig parse_config(const std::string& file_name, std::string_view text) {
     HalConfig cfg;
+    cfg.acquisition = default_acquisition<double>();  // channel_defaults.hpp
     AcquisitionConfig<double>& a = cfg.acquisition;
-    a.channels = 0;
-    a.sampler = {2000U, 9U, 0U};
-    a.stale_us = 5000000U;
-    a.vote_tolerance = 1.0;
-    a.quorum = 2U;
     bool seen_acq = false;
     bool seen_gpio = false;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file_name, text);
     std::string_view line;
     DirectiveLine d;
     while (lines.next(line)) {
@@ -377,13 +394,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
 }
 
 HalConfig read_config(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
-    }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return parse_config(path, ss.str());
+    return parse_config(path, linux_detail::read_text_file(path));
 }
 
 }  // namespace ascorr::hal

@@ -2,13 +2,9 @@
 #include "ascorr_hal_linux/replay_source.hpp"
 #include "text_lines.hpp"
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <memory>
-#include <sstream>
 
 namespace ascorr::hal {
 namespace {
@@ -22,7 +18,7 @@ struct Column {
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file, text);
     std::string_view line;
     std::vector<linux_detail::Field> fields;
     bool header = true;
@@ -114,13 +110,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
 
 std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
                                                       const AcquisitionConfig<double>& config) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) {
-        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
-    }
-    std::ostringstream ss;
-    ss << f.rdbuf();
-    return std::make_unique<ReplaySource>(path, ss.str(), config);
+    return std::make_unique<ReplaySource>(path, linux_detail::read_text_file(path), config);
 }
 
 bool ReplaySource::acquire(SampleSet<double>& samples) noexcept {

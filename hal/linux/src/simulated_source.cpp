@@ -2,13 +2,11 @@
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "text_lines.hpp"
 
-#include <cerrno>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstring>
-#include <fstream>
+#include <cstdio>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 
 namespace ascorr::hal {
@@ -55,91 +53,204 @@ InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>
         throw std::invalid_argument("fault '" + s + "': unknown kind '" + std::string(part[1]) +
                                     "' (open, short, bus, stuck, offset, noise, drop)");
     }
-    if (!parse_number(part[2], f.from_s) || !parse_number(part[3], f.to_s) || !(f.from_s < f.to_s)) {
-        throw std::invalid_argument("fault '" + s + "': FROM and TO must be numbers with FROM < TO");
+    if (!parse_number(part[2], f.from_s) || !parse_number(part[3], f.to_s) || !std::isfinite(f.from_s) ||
+        !std::isfinite(f.to_s) || !(f.from_s < f.to_s)) {
+        throw std::invalid_argument("fault '" + s + "': FROM and TO must be finite numbers with FROM < TO");
     }
     const bool needs_value = f.kind == FaultKind::kOffset || f.kind == FaultKind::kNoise;
     if (needs_value != (part.size() == 5) || (needs_value && !parse_number(part[4], f.value))) {
         throw std::invalid_argument("fault '" + s + "': " + (needs_value ? "needs" : "takes no") + " VALUE");
     }
+    // offset: °C, finite and within the ±200 °C any temperature has; noise:
+    // counts, > 0 (0 or less would inject nothing) and at most 65535 (an ADC
+    // code's range), so the simulated code stays an int.
+    if (f.kind == FaultKind::kOffset && !(std::fabs(f.value) <= 200.0)) {
+        throw std::invalid_argument("fault '" + s +
+                                    "': offset VALUE must be a finite number of degC within +-200, got '" +
+                                    std::string(part[4]) + "'");
+    }
+    if (f.kind == FaultKind::kNoise && !(f.value > 0.0 && f.value <= 65535.0)) {
+        throw std::invalid_argument("fault '" + s + "': noise VALUE must be a number of counts in (0, 65535], got '" +
+                                    std::string(part[4]) + "'");
+    }
     return f;
 }
 
+namespace {
+
+// The columns of a history: their indices in a row (-1: absent).
+struct HistoryColumns {
+    int t = -1;
+    int chu = -1;
+    int temperature[3] = {-1, -1, -1};  // t_chu, t_029, t_032
+    std::size_t count = 0;              // fields every row has
+};
+
+// The header line: which field is which; t, t_chu, t_029, t_032 required.
+HistoryColumns history_columns(const std::string& file, const std::vector<linux_detail::Field>& header) {
+    static constexpr const char* kTemperatureNames[3] = {"t_chu", "t_029", "t_032"};
+    HistoryColumns cols;
+    cols.count = header.size();
+    for (std::size_t i = 0; i < header.size(); ++i) {
+        const std::string_view name = header[i].first;
+        const int index = static_cast<int>(i);
+        if (name == "t") {
+            cols.t = index;
+        } else if (name == "chu") {
+            cols.chu = index;
+        }
+        for (int k = 0; k < 3; ++k) {
+            if (name == kTemperatureNames[k]) {
+                cols.temperature[k] = index;
+            }
+        }
+    }
+    if (cols.t < 0 || cols.temperature[0] < 0 || cols.temperature[1] < 0 || cols.temperature[2] < 0) {
+        throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
+    }
+    return cols;
+}
+
+const linux_detail::Field& field(const std::vector<linux_detail::Field>& f, int column) {
+    return f[static_cast<std::size_t>(column)];
+}
+
+// The head of a row: -1 without a chu column, else A–D as 0–3.
+int history_head(const std::string& file, std::size_t line_no, const std::vector<linux_detail::Field>& f,
+                 const HistoryColumns& cols) {
+    if (cols.chu < 0) {
+        return -1;
+    }
+    const auto& [v, c] = field(f, cols.chu);
+    if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
+        throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
+    }
+    return v[0] - 'A';
+}
+
+// A temperature field: NaN when empty or nan (none), else a finite number.
+double history_temperature(const std::string& file, std::size_t line_no, const linux_detail::Field& field) {
+    const auto& [v, c] = field;
+    double x = std::numeric_limits<double>::quiet_NaN();
+    if (v.empty() || v == "nan") {
+        return x;
+    }
+    if (!parse_number(v, x) || !std::isfinite(x)) {
+        throw ConfigError(file, line_no, c,
+                          "not a temperature: '" + std::string(v) + "' (a finite number, or empty or nan for none)");
+    }
+    return x;
+}
+
+// One data line of a history.
+HistoryRow history_row(const std::string& file, std::size_t line_no, std::string_view line,
+                       const std::vector<linux_detail::Field>& f, const HistoryColumns& cols) {
+    if (f.size() != cols.count) {
+        throw ConfigError(file, line_no, line.size() + 1,
+                          "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
+    }
+    HistoryRow r{0.0, -1, 0.0, 0.0, 0.0};
+    r.line = line_no;
+    const auto& [t_text, t_col] = field(f, cols.t);
+    if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
+        throw ConfigError(file, line_no, t_col, "'t' must be a number of seconds in [0, 1e12]");
+    }
+    r.head = history_head(file, line_no, f, cols);
+    double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
+    for (int k = 0; k < 3; ++k) {
+        const linux_detail::Field& tf = field(f, cols.temperature[k]);
+        r.column[k] = tf.second;
+        *dst[k] = history_temperature(file, line_no, tf);
+    }
+    return r;
+}
+
+}  // namespace
+
 std::vector<HistoryRow> parse_history(const std::string& file, std::string_view text) {
-    std::vector<HistoryRow> rows;
-    int col_t = -1, col_chu = -1, col_t1 = -1, col_t2 = -1, col_t3 = -1;
-    std::size_t ncols = 0;
-    linux_detail::TextLines lines(text);
+    linux_detail::TextLines lines(file, text);
     std::string_view line;
     std::vector<linux_detail::Field> f;
+    if (!lines.next(line)) {
+        throw ConfigError(file, 1, 1, "empty file (no header)");
+    }
+    linux_detail::split_fields(line, f);
+    const HistoryColumns cols = history_columns(file, f);
+    std::vector<HistoryRow> rows;
     while (lines.next(line)) {
-        const std::size_t line_no = lines.number();
-        linux_detail::split_fields(line, f);
-        if (line_no == 1) {
-            for (std::size_t i = 0; i < f.size(); ++i) {
-                const std::string_view n = f[i].first;
-                int* slot = n == "t"       ? &col_t
-                            : n == "chu"   ? &col_chu
-                            : n == "t_chu" ? &col_t1
-                            : n == "t_029" ? &col_t2
-                            : n == "t_032" ? &col_t3
-                                           : nullptr;
-                if (slot != nullptr) {
-                    *slot = static_cast<int>(i);
-                }
-            }
-            if (col_t < 0 || col_t1 < 0 || col_t2 < 0 || col_t3 < 0) {
-                throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
-            }
-            ncols = f.size();
-            continue;
-        }
         if (line.empty() && lines.at_end()) {  // a blank last line
             break;
         }
-        if (f.size() != ncols) {
-            throw ConfigError(file, line_no, line.size() + 1,
-                              "expected " + std::to_string(ncols) + " fields, found " + std::to_string(f.size()));
-        }
-        HistoryRow r{0.0, -1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::quiet_NaN()};
-        if (!parse_number(f[static_cast<std::size_t>(col_t)].first, r.t) || !std::isfinite(r.t) || r.t < 0.0) {
-            throw ConfigError(file, line_no, f[static_cast<std::size_t>(col_t)].second, "'t' must be seconds >= 0");
-        }
-        if (col_chu >= 0) {
-            const auto& [v, c] = f[static_cast<std::size_t>(col_chu)];
-            if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
-                throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
-            }
-            r.head = v[0] - 'A';
-        }
-        double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
-        const int cols[3] = {col_t1, col_t2, col_t3};
-        for (int k = 0; k < 3; ++k) {
-            const auto& [v, c] = f[static_cast<std::size_t>(cols[k])];
-            if (v.empty() || v == "nan") {
-                continue;
-            }
-            if (!parse_number(v, *dst[k])) {
-                throw ConfigError(file, line_no, c, "not a temperature: '" + std::string(v) + "'");
-            }
-        }
-        rows.push_back(r);
-    }
-    if (lines.number() == 0) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        linux_detail::split_fields(line, f);
+        rows.push_back(history_row(file, lines.number(), line, f, cols));
     }
     return rows;
 }
 
-std::vector<HistoryRow> read_history(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        throw ConfigError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+namespace {
+
+static_assert(static_cast<int>(Role::kChuD) - static_cast<int>(Role::kChuA) + 1 == kHistoryHeads,
+              "one history head per chu role");
+
+// The epoch key of a time: t to the millisecond (t is within [0, 1e12] s).
+std::int64_t epoch_key(double t) noexcept {
+    return std::llround(t * 1000.0);
+}
+
+// One truth of an epoch and the row that gave it.
+struct EpochValue {
+    double value = std::numeric_limits<double>::quiet_NaN();
+    std::size_t line = 0;
+};
+
+// Sets `slot` from a row's value, or refuses a second, different value.
+void merge_value(const std::string& file, const HistoryRow& row, int k, const char* name, double v, EpochValue& slot) {
+    if (std::isnan(v)) {
+        return;
     }
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return parse_history(path, ss.str());
+    if (std::isnan(slot.value) || slot.value == v) {
+        slot = {v, row.line};
+        return;
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)", name,
+                  v, row.t, slot.value, slot.line);
+    throw ConfigError(file, row.line, row.column[k], buf);
+}
+
+}  // namespace
+
+std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows) {
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const HistoryRow& a, const HistoryRow& b) { return epoch_key(a.t) < epoch_key(b.t); });
+    std::vector<HistoryEpoch> epochs;
+    std::size_t i = 0;
+    while (i < rows.size()) {
+        const std::int64_t key = epoch_key(rows[i].t);
+        EpochValue chu[kHistoryHeads];
+        EpochValue t029;
+        EpochValue t032;
+        for (; i < rows.size() && epoch_key(rows[i].t) == key; ++i) {
+            const HistoryRow& r = rows[i];
+            for (int h = 0; h < kHistoryHeads; ++h) {
+                if (r.head < 0 || r.head == h) {
+                    merge_value(file_name, r, 0, "t_chu", r.t_chu, chu[h]);
+                }
+            }
+            merge_value(file_name, r, 1, "t_029", r.t_029, t029);
+            merge_value(file_name, r, 2, "t_032", r.t_032, t032);
+        }
+        HistoryEpoch e{static_cast<std::uint64_t>(key) * 1000U, {}, t029.value, t032.value};
+        for (int h = 0; h < kHistoryHeads; ++h) {
+            e.t_chu[h] = chu[h].value;
+        }
+        epochs.push_back(e);
+    }
+    return epochs;
+}
+
+std::vector<HistoryEpoch> read_history(const std::string& path) {
+    return history_epochs(path, parse_history(path, linux_detail::read_text_file(path)));
 }
 
 bool SimulatedAdc::active(const InjectedFault& f) const noexcept {
@@ -215,7 +326,7 @@ bool SimulatedAdc::convert(std::uint8_t adc_channel, std::uint16_t& counts) noex
     return true;
 }
 
-SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
+SimulatedSource::SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryEpoch> history,
                                  std::vector<InjectedFault> faults)
     : config_(config), history_(std::move(history)), adc_(config_, clock_), source_(adc_, clock_, config_) {
     adc_.set_faults(std::move(faults));
@@ -225,20 +336,19 @@ bool SimulatedSource::acquire(SampleSet<double>& samples) noexcept {
     if (next_ >= history_.size()) {
         return false;
     }
-    const HistoryRow& row = history_[next_++];
-    const std::uint64_t t_us = static_cast<std::uint64_t>(std::llround(row.t * 1e6));
-    if (t_us > clock_.now_us()) {
-        clock_.advance_us(t_us - clock_.now_us());
+    const HistoryEpoch& e = history_[next_++];
+    if (e.t_us > clock_.now_us()) {
+        clock_.advance_us(e.t_us - clock_.now_us());
     }
     for (std::uint8_t i = 0; i < config_.channels; ++i) {
         const Role role = config_.channel[i].role;
         double v = std::numeric_limits<double>::quiet_NaN();
         if (role == Role::kT029) {
-            v = row.t_029;
+            v = e.t_029;
         } else if (role == Role::kT032) {
-            v = row.t_032;
-        } else if (role != Role::kMonitor && (row.head < 0 || chu_role(static_cast<std::uint8_t>(row.head)) == role)) {
-            v = row.t_chu;
+            v = e.t_032;
+        } else if (role != Role::kMonitor) {
+            v = e.t_chu[static_cast<int>(role) - static_cast<int>(Role::kChuA)];
         }
         if (std::isfinite(v)) {
             adc_.set_truth(i, v);

@@ -7,17 +7,110 @@
 // use host_sim's reader: nothing in hal/ depends on host_sim/).
 #pragma once
 
+#include <cerrno>
 #include <cstddef>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
+#include "ascorr_hal_linux/config_file.hpp"
+
 namespace ascorr::hal::linux_detail {
+
+// The length of the valid UTF-8 sequence at s[i] (1 … 4), or 0 when it is
+// not one (a stray continuation byte, a truncated or overlong sequence, a
+// surrogate, beyond U+10FFFF). RFC 3629, section 4.
+inline std::size_t utf8_length(std::string_view s, std::size_t i) noexcept {
+    const auto at = [&](std::size_t k) { return static_cast<unsigned char>(k < s.size() ? s[k] : '\0'); };
+    const unsigned c = at(i);
+    const auto tail = [&](std::size_t k) { return (at(k) & 0xC0U) == 0x80U; };
+    if (c < 0x80U) {
+        return 1;
+    }
+    if (c >= 0xC2U && c <= 0xDFU) {
+        return tail(i + 1) ? 2 : 0;
+    }
+    if (c >= 0xE0U && c <= 0xEFU) {
+        const unsigned c1 = at(i + 1);
+        const bool ok1 = c == 0xE0U   ? (c1 >= 0xA0U && c1 <= 0xBFU)
+                         : c == 0xEDU ? (c1 >= 0x80U && c1 <= 0x9FU)
+                                      : tail(i + 1);
+        return ok1 && tail(i + 2) ? 3 : 0;
+    }
+    if (c >= 0xF0U && c <= 0xF4U) {
+        const unsigned c1 = at(i + 1);
+        const bool ok1 = c == 0xF0U   ? (c1 >= 0x90U && c1 <= 0xBFU)
+                         : c == 0xF4U ? (c1 >= 0x80U && c1 <= 0x8FU)
+                                      : tail(i + 1);
+        return ok1 && tail(i + 2) && tail(i + 3) ? 4 : 0;
+    }
+    return 0;
+}
+
+// Up to 24 bytes of a line as printable ASCII: bytes outside 0x20–0x7E, '\\'
+// and '"' as \xHH, so that no byte of a binary file reaches the terminal.
+inline std::string escaped_excerpt(std::string_view line) {
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    const std::size_t n = line.size() < 24U ? line.size() : 24U;
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto c = static_cast<unsigned char>(line[i]);
+        if (c >= 0x20U && c < 0x7FU && c != '\\' && c != '"') {
+            out += static_cast<char>(c);
+        } else {
+            out += "\\x";
+            out += kHex[c >> 4U];
+            out += kHex[c & 15U];
+        }
+    }
+    return out + (line.size() > n ? "..." : "");
+}
+
+// Refuses a text that is not UTF-8 text: a NUL or another control character
+// (but tab, and CR before LF), DEL, or invalid UTF-8. ConfigError at the
+// first such byte: "file:line:column: binary data (byte 0xHH): not a text
+// file, line starts \"…\"" with an escaped excerpt, never the bytes.
+inline void refuse_binary(const std::string& file, std::string_view text) {
+    std::size_t line = 1;
+    std::size_t line_start = 0;
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c == '\n') {
+            ++line;
+            line_start = ++i;
+            continue;
+        }
+        const bool cr_before_lf = c == '\r' && i + 1 < text.size() && text[i + 1] == '\n';
+        const bool control = (c < 0x20U && c != '\t' && !cr_before_lf) || c == 0x7FU;
+        const std::size_t n = control ? 0 : utf8_length(text, i);
+        if (n == 0) {
+            const std::size_t end = text.find('\n', line_start);
+            const std::string_view whole =
+                text.substr(line_start, end == std::string_view::npos ? end : end - line_start);
+            char byte[8];
+            std::snprintf(byte, sizeof byte, "0x%02x", c);
+            const std::string what = c == '\r' ? std::string("a CR not followed by LF (CR-only line ends?)")
+                                               : std::string("binary data (byte ") + byte + ")";
+            throw ConfigError(file, line, i - line_start + 1,
+                              what + ": not a text file, line starts \"" + escaped_excerpt(whole) + "\"");
+        }
+        i += n;
+    }
+}
 
 class TextLines {
 public:
-    // A UTF-8 byte-order mark at the start is skipped (spreadsheet exports).
-    explicit TextLines(std::string_view text) : text_(text) {
+    // Refuses binary data (refuse_binary); a UTF-8 byte-order mark at the
+    // start is skipped (spreadsheet exports).
+    TextLines(const std::string& file, std::string_view text) : text_(text) {
+        refuse_binary(file, text_);
         if (text_.substr(0, 3) == "\xEF\xBB\xBF") {
             text_.remove_prefix(3);
         }
@@ -62,6 +155,25 @@ private:
     std::size_t pos_ = 0;
     std::size_t number_ = 0;
 };
+
+// The whole text of a file. A file that cannot be opened or read, or a
+// directory: ConfigError "cannot open FILE: reason" (no line, no column).
+inline std::string read_text_file(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        throw ConfigError::whole_file("cannot open " + path + ": is a directory, not a file");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        throw ConfigError::whole_file("cannot open " + path + ": " + std::strerror(errno));
+    }
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) {
+        throw ConfigError::whole_file("cannot read " + path + ": " + std::strerror(errno));
+    }
+    return ss.str();
+}
 
 // A field of a comma-separated line and its column (1-based).
 using Field = std::pair<std::string_view, std::size_t>;

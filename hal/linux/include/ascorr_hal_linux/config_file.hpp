@@ -14,7 +14,8 @@
 // °C/s, ohm, counts; a, b, c are the thermistor's Steinhart–Hart coefficients.
 // role is one of monitor, chu_a … chu_d, t029, t032; at most 8 channels, at
 // most 3 per role, names and ADC inputs unique. `gpio` and `acquisition` are
-// optional (defaults as shown) and may appear once each. Every error is
+// optional (defaults as shown; they come from ascorr_hal/channel_defaults.hpp)
+// and may appear once each. Every error is
 // reported as file:line:column with the offending key or value.
 #pragma once
 
@@ -28,16 +29,27 @@
 
 namespace ascorr::hal {
 
+// A refused input file: "file:line:column: what". Lines and columns count
+// from 1; 0 means none, and is never printed: "file:line: what" without a
+// column, "file: what" for the whole file (e.g. "cannot open FILE: reason",
+// whole_file()).
 class ConfigError : public std::runtime_error {
 public:
     ConfigError(const std::string& file, std::size_t line, std::size_t column, const std::string& what)
-        : std::runtime_error(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what),
-          line_(line),
-          column_(column) {}
+        : std::runtime_error(where(file, line, column) + what), line_(line), column_(column) {}
+    // An error about the whole file, whose message names it itself.
+    static ConfigError whole_file(const std::string& message) { return ConfigError(message); }
     std::size_t line() const noexcept { return line_; }
     std::size_t column() const noexcept { return column_; }
 
 private:
+    explicit ConfigError(const std::string& message) : std::runtime_error(message), line_(0), column_(0) {}
+    static std::string where(const std::string& file, std::size_t line, std::size_t column) {
+        if (line == 0U) {
+            return file + ": ";
+        }
+        return file + ":" + std::to_string(line) + (column == 0U ? "" : ":" + std::to_string(column)) + ": ";
+    }
     std::size_t line_;
     std::size_t column_;
 };

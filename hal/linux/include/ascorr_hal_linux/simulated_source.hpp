@@ -7,10 +7,20 @@
 // chu column t_chu sets every chu channel. t_029 and t_032 set every member of
 // their triplet. Empty/nan keeps the previous truth; a channel without truth
 // yet is not sampled.
-// Each row becomes one sample set at t: the truth goes through the inverse
-// Steinhart–Hart and the divider into counts (SimulatedAdc), and the sample set is
-// acquired by the same AdcSampleSetSource as on hardware (settle, samples,
-// median) on a ManualClock, so the whole conversion path runs.
+// Epochs: the rows whose t agree to the millisecond (as docs/contract.md §5
+// matches the rows of the heads) are one epoch, in any row order (the rows
+// are sorted by t, stably); rows of one epoch must not disagree (two values of
+// one head's t_chu, of t_029 or of t_032: ConfigError at the later row).
+// Each epoch becomes one sample set at its t (µs = the millisecond key · 1000),
+// with every head's truth of that epoch: the truth goes through the inverse
+// Steinhart–Hart and the divider into counts (SimulatedAdc), and the sample set
+// is acquired by the same AdcSampleSetSource as on hardware (settle, samples,
+// median) on a ManualClock, so the whole conversion path runs. Between epochs
+// the truth holds. A sample set takes channels · (settle + (samples − 1) · gap) µs
+// of that clock; an epoch closer than that to the previous one is acquired
+// when the previous sample set ends, as the hardware would.
+// (One sample set per row, as before, sampled the heads of one epoch a few ms
+// apart: a one-count step between them read as a rate of several °C/s.)
 // Faults (--inject NAME:KIND:FROM:TO[:VALUE], times in the history's seconds,
 // active for FROM ≤ t < TO):
 //   open, short   the thermistor at R = ∞ or 0
@@ -53,9 +63,26 @@ struct HistoryRow {
     double t_chu;
     double t_029;
     double t_032;
+    std::size_t line = 0;                  // in the file, for messages (0: not from a file)
+    std::size_t column[3] = {0U, 0U, 0U};  // of t_chu, t_029, t_032
 };
 std::vector<HistoryRow> parse_history(const std::string& file_name, std::string_view text);
-std::vector<HistoryRow> read_history(const std::string& path);
+
+inline constexpr int kHistoryHeads = 4;  // A–D: the chu roles (channel_config.hpp)
+
+// One epoch of a history: the truths its rows give (NaN: none, the previous
+// truth holds).
+struct HistoryEpoch {
+    std::uint64_t t_us;  // the millisecond key · 1000
+    double t_chu[kHistoryHeads];
+    double t_029;
+    double t_032;
+};
+// Rows → epochs in time order (see the top); ConfigError at the first row
+// that disagrees with an earlier row of its epoch.
+std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows);
+// parse_history + history_epochs of a file.
+std::vector<HistoryEpoch> read_history(const std::string& path);
 
 // An MCP3208 whose inputs are set from temperatures.
 class SimulatedAdc final : public AdcPort {
@@ -83,7 +110,7 @@ private:
 
 class SimulatedSource final : public SampleSetSource<double> {
 public:
-    SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryRow> history,
+    SimulatedSource(const AcquisitionConfig<double>& config, std::vector<HistoryEpoch> history,
                     std::vector<InjectedFault> faults);
     SimulatedSource(const SimulatedSource&) = delete;  // members refer to each other
     SimulatedSource& operator=(const SimulatedSource&) = delete;
@@ -91,7 +118,7 @@ public:
 
 private:
     AcquisitionConfig<double> config_;
-    std::vector<HistoryRow> history_;
+    std::vector<HistoryEpoch> history_;
     std::size_t next_ = 0;
     ManualClock clock_;
     SimulatedAdc adc_;
