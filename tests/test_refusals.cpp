@@ -217,3 +217,109 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
 
 }  // namespace
 }  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: a seed is an unsigned 64-bit integer, in decimal. On
+// ed4f56e `--seed -1` ran with seed 2^64 − 1, `--seed 99999999999999999999`
+// with 2^64 − 1 and `--seed 010` with 8 (CLI11 reads base 0), all silently.
+TEST(Refusals, OutOfRangeSeedsAreRefusedNamingTheOptionAndTheRange) {
+    const fs::path dir = scratch_dir("seeds");
+    const std::string range = "expected an integer in [0, 18446744073709551615]";
+    struct Case {
+        std::string seed;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"-1", "--seed: -1 is out of range: " + range},
+        {"18446744073709551616", "--seed: 18446744073709551616 is out of range: " + range},
+        {"99999999999999999999", "is out of range: " + range},
+        {"1e999", "--seed: 1e999 is out of range: " + range},
+        {"1.5", "--seed: 1.5 is not an integer (decimal digits only): " + range},
+        {"nan", "--seed: nan is not an integer: " + range},
+        {"0x10", "--seed: 0x10 is not a number: " + range},
+    };
+    const std::string in = data_path("solutions.csv");
+    const std::string model = data_path("model_table2.csv");
+    for (const Case& c : cases) {
+        for (const std::string& cmd :
+             {"simulate --days 0.01 --out s.csv --seed=" + c.seed,
+              "replay --target loopback-float --in " + in + " --model " + model + " --out r.csv --seed=" + c.seed}) {
+            SCOPED_TRACE(cmd);
+            const CliRun r = run_in(cmd, dir);
+            EXPECT_EQ(r.exit_code, 2);  // a usage error, before anything is read or written
+            EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir / "s.csv"));
+    EXPECT_FALSE(fs::exists(dir / "r.csv"));
+    // The largest seed is accepted, and a leading zero is decimal: 010 is 10, not 8.
+    ASSERT_EQ(run_in("simulate --days 0.01 --out max.csv --seed 18446744073709551615", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out ten.csv --seed 10", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out ten0.csv --seed 010", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out eight.csv --seed 8", dir).exit_code, 0);
+    EXPECT_EQ(slurp(dir / "ten0.csv"), slurp(dir / "ten.csv"));
+    EXPECT_NE(slurp(dir / "ten0.csv"), slurp(dir / "eight.csv"));  // mutation check: seeds do change the file
+}
+
+// Issue 11, item 5: a number that is a number but beyond its range says "out of
+// range" and gives the range, in options and in every CSV reader (on ed4f56e:
+// "expected a number", "Could not convert", or 1e999 taken as infinity).
+TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
+    const fs::path dir = scratch_dir("out-of-range");
+    const std::string in = data_path("solutions.csv");
+    const std::string model = data_path("model_table2.csv");
+    struct Case {
+        std::string args;
+        int exit_code;
+        std::string message;
+    };
+    // Files with one field beyond range.
+    std::ofstream(dir / "big_q.csv") << kHeader << "750000000.0,A,1e999,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "tiny_v.csv") << kHeader << "750000000.0,A," << kRow << ",1e-999,2,3,0,1.00\n";
+    std::ofstream(dir / "flags.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,-1,1.00\n";
+    std::ofstream(dir / "flags64.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,99999999999999999999,1.00\n";
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,1e400,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    std::ofstream(dir / "states.csv") << "t,x,y,z,vx,vy,vz\n750000000.0,7000,0,0,0,7.5,1e999\n";
+    const std::string flags_range = "expected an integer in [0, 9223372036854775807]";
+    const std::vector<Case> cases = {
+        {"correct --in big_q.csv --out o.csv", 1,
+         "big_q.csv:2:15: column 'qw': '1e999' is out of range: a number's magnitude is at most 1.797693e+308"},
+        {"correct --in tiny_v.csv --out o.csv", 1,
+         "column 'vx': '1e-999' is out of range: a nonzero number's magnitude is at least 4.940656e-324"},
+        {"correct --in flags.csv --out o.csv", 1, "column 'flags': '-1' is out of range: " + flags_range},
+        {"correct --in flags64.csv --out o.csv", 1,
+         "column 'flags': '99999999999999999999' is out of range: " + flags_range},
+        {"correct --in " + in + " --model m.csv --out o.csv", 1,
+         "m.csv:2:9: column 'c0': '1e400' is out of range: a number's magnitude is at most 1.797693e+308"},
+        {"correct --in " + in + " --states states.csv --out o.csv", 1,
+         "states.csv:2:28: column 'vz': '1e999' is out of range"},
+        {"simulate --out o.csv --days 1e999", 2, "--days: 1e999 is out of range: a number's magnitude is at most"},
+        {"stats --in " + in + " --from -1e999", 2, "--from: -1e999 is out of range"},
+        {"fit --in " + in + " --out o.csv --min-orbits 99999999999999999999", 2,
+         "--min-orbits: 99999999999999999999 is out of range: expected an integer in [0, 18446744073709551615]"},
+        {"fit --in " + in + " --out o.csv --holdout 1e-400", 2, "--holdout: 1e-400 is out of range"},
+        {"plot --in " + in + " --model " + model + " --out o.csv --width 3000000000", 2,
+         "--width: 3000000000 is out of range: expected an integer in [-2147483648, 2147483647]"},
+        {"replay --target loopback-float --in " + in + " --model " + model + " --out o.csv --timeout-ms 0", 2,
+         "--timeout-ms: 0 is out of range: expected an integer in [1, 60000]"},
+        {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --frames 0 --head B", 2,
+         "--frames: 0 is out of range: expected an integer in [1, 1000000]"},
+        {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --head 7", 2,
+         "--head: 7 is out of range: a head is A, B, C or D"},
+        // Text that is no number still says so.
+        {"simulate --out o.csv --days ten", 2, "--days: ten is not a number"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args, dir);
+        EXPECT_EQ(r.exit_code, c.exit_code);
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("expected a number"), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -283,6 +284,34 @@ std::optional<long long> parse_integer(std::string_view field) noexcept {
         return std::nullopt;
     }
     return x;
+}
+
+std::string why_not_a_number(std::string_view field) {
+    const std::string text(field);
+    const char* first = text.c_str();
+    if (*first == '+') {
+        ++first;
+    }
+    double x = 0.0;
+    const auto [ptr, ec] = std::from_chars(first, text.c_str() + text.size(), x);
+    if (!text.empty() && ec == std::errc::result_out_of_range && ptr == text.c_str() + text.size()) {
+        const double huge = std::strtod(text.c_str(), nullptr);  // from_chars leaves x unset
+        return "'" + text + "' is out of range: " +
+               (std::isinf(huge) ? std::string("a number's magnitude is at most 1.797693e+308")
+                                 : std::string("a nonzero number's magnitude is at least 4.940656e-324 (write 0)"));
+    }
+    return "expected a number, got '" + text + "'";
+}
+
+std::string why_not_an_integer(std::string_view field, long long lo, long long hi) {
+    const std::string range = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    const std::string text(field);
+    std::size_t i = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
+    const bool digits = i < text.size() && text.find_first_not_of("0123456789", i) == std::string::npos;
+    if (digits) {  // decimal digits the caller refused: beyond long long or beyond [lo, hi]
+        return "'" + text + "' is out of range: expected " + range;
+    }
+    return "expected " + range + ", got '" + text + "'";
 }
 
 namespace {

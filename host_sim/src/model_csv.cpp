@@ -110,9 +110,10 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             const auto f = fields[static_cast<std::size_t>(col_c[i])];
             const auto x = parse_double(f);
             if (!x || !std::isfinite(*x)) {
-                throw InputError(file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
-                                 std::string("column '") + kCoefficientNames[i] + "': expected a finite number, got '" +
-                                     std::string(f) + "'");
+                throw InputError(
+                    file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
+                    std::string("column '") + kCoefficientNames[i] +
+                        "': " + (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
             }
             m.coefficients[head][static_cast<std::size_t>(axis)][i] = *x;
         }

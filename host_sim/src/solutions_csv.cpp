@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/input_error.hpp"
@@ -74,8 +75,7 @@ double SolutionsReader::number(int col, const char* name) const {
     const auto f = fields_[static_cast<std::size_t>(col)];
     const auto x = parse_double(f);
     if (!x) {
-        fail(static_cast<std::size_t>(col),
-             std::string("column '") + name + "': expected a number, got '" + std::string(f) + "'");
+        fail(static_cast<std::size_t>(col), std::string("column '") + name + "': " + why_not_a_number(f));
     }
     return *x;
 }
@@ -130,7 +130,7 @@ bool SolutionsReader::next(SolutionRecord& rec) {
         const auto v = parse_integer(f);
         if (!v || *v < 0) {
             fail(static_cast<std::size_t>(col_.flags),
-                 "column 'flags': expected a non-negative integer, got '" + std::string(f) + "'");
+                 "column 'flags': " + why_not_an_integer(f, 0, std::numeric_limits<long long>::max()));
         }
         rec.flags = *v;
     }

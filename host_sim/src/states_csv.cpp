@@ -66,8 +66,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             const auto v = parse_double(fields[col[i]]);
             if (!v) {
                 throw InputError(path, n, starts[col[i]] + 1,
-                                 std::string("column '") + kNames[i] + "': expected a number, got '" +
-                                     std::string(fields[col[i]]) + "'");
+                                 std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
             }
             x[i] = *v;
         }

@@ -79,6 +79,15 @@ void split_fields(std::string_view line, std::vector<std::string_view>& fields);
 std::optional<double> parse_double(std::string_view field) noexcept;
 std::optional<long long> parse_integer(std::string_view field) noexcept;
 
+// Why parse_double refused a field, for the message: "out of range ..." (with
+// a double's range) for a number beyond it (1e999, 1e-999), otherwise
+// "expected a number, got 'FIELD'".
+std::string why_not_a_number(std::string_view field);
+// Why an integer field is refused: "out of range ..." (with [lo, hi]) for
+// decimal digits beyond it (-1 for flags, 99999999999999999999), otherwise
+// "expected an integer in [lo, hi], got 'FIELD'".
+std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
+
 // Formats x with `decimals` digits after the point into out, returns the end.
 char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
 
