@@ -323,3 +323,48 @@ TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
 
 }  // namespace
 }  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: a model beyond a range names file:line:column and its
+// numbers in %g (on ed4f56e: "m.csv: A beta c1 = 1000000000.000000 is beyond
+// the fixed-point coefficient range (+-...)" without a line, and a truth model
+// beyond 1 degree named neither file nor line).
+TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
+    const fs::path dir = scratch_dir("model-range");
+    const std::string in = data_path("solutions.csv");
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\n"
+                                 << "A,alpha,0,0,0,0\nA,beta,0,1e9,0,0\nA,gamma,0,0,0,0\n";
+    {
+        const CliRun r = run_in("correct --scalar fixed --in " + in + " --model m.csv --out o.csv", dir);
+        EXPECT_EQ(r.exit_code, 1);
+        // Line 3 (A beta), column 10 (c1); the value and the limit in %g.
+        EXPECT_NE(r.err.find("m.csv:3:10: A beta c1 = 1e+09 arcsec/degC is beyond the fixed-point coefficient range "
+                             "(|c1| < "),
+                  std::string::npos)
+            << r.err;
+        EXPECT_EQ(r.err.find("000000 "), std::string::npos) << r.err;  // no %f padding
+    }
+    std::ofstream(dir / "q.csv") << "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n"
+                                 << "B,alpha,0,0,0,0,0,0,0\nB,beta,0,0,0,0,0,0,0\nB,gamma,0,0,0,0,0,0,-2.5e11\n";
+    const CliRun q = run_in("correct --scalar fixed --in " + in + " --model q.csv --out o.csv", dir);
+    EXPECT_EQ(q.exit_code, 1);
+    EXPECT_NE(q.err.find("q.csv:4:21: B gamma c3_2 = -2.5e+11 arcsec/degC^2 is beyond"), std::string::npos) << q.err;
+    // A truth model whose angle exceeds the core's 1-degree domain: the file and
+    // the line of the head, with the epoch and the temperatures.
+    std::ofstream(dir / "t.csv") << "chu,axis,c0,c1,c2,c3\n"
+                                 << "A,alpha,0,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n"
+                                 << "B,alpha,0,0,0,0\nB,beta,0,0,0,0\nB,gamma,0,0,0,0\n"
+                                 << "C,alpha,3500,100,0,0\nC,beta,0,0,0,0\nC,gamma,0,0,0,0\n";
+    const CliRun t = run_in("simulate --days 0.01 --truth t.csv --out s.csv", dir);
+    EXPECT_EQ(t.exit_code, 1);
+    EXPECT_NE(t.err.find("t.csv:8: CHU C: the truth model gives an angle beyond 1 degree at t = "), std::string::npos)
+        << t.err;
+    EXPECT_NE(t.err.find("degC)"), std::string::npos) << t.err;
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir / "s.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test

@@ -18,6 +18,7 @@
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/embedded_model.hpp"
+#include "ascorr_host/input_error.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/progress.hpp"
 #include "ascorr_host/solution_input.hpp"
@@ -360,8 +361,13 @@ SimulateSummary simulate(const SimulateOptions& opt) {
             HeadTemperatures<double> ht{{temp[h], true}, {temp[3], true}, {temp[4], true}};
             const ThermalStage<double> th = thermal_stage(truth, static_cast<std::uint8_t>(h), ht);
             if (th.skip != 0U) {
-                throw std::invalid_argument("truth model gives an angle beyond 1 degree (CHU " +
-                                            std::string(1, head_name(static_cast<std::uint8_t>(h))) + ")");
+                char what[200];
+                std::snprintf(what, sizeof what,
+                              "CHU %c: the truth model gives an angle beyond 1 degree at t = %.17g s (T_CHU %g, "
+                              "T029 %g, T032 %g degC)",
+                              head_name(static_cast<std::uint8_t>(h)), t, temp[h], temp[3], temp[4]);
+                throw InputError(opt.truth.empty() ? std::string("truth model (Table 2)") : opt.truth,
+                                 truth_file.line[h][0], 0, what);
             }
             const Quaternion<double> q_meas =
                 renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
