@@ -368,3 +368,71 @@ TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
 
 }  // namespace
 }  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: RFC 4180 quoting in columns ascorr ignores is accepted
+// and copied verbatim (on ed4f56e a comma inside quotes split the field: "expected
+// 15 fields as in the header, found 16"); in a column it reads it is refused,
+// naming the column; a line break inside quotes is refused as unterminated.
+TEST(Refusals, QuotedFieldsInIgnoredColumnsAreAcceptedAndCopiedVerbatim) {
+    const fs::path dir = scratch_dir("quoted");
+    const std::string header = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,\"note, free text\"\n";
+    const std::string row1 = "750000000.0,A," + kRow + ",1,2,3,0,1.00,";
+    const std::string row2 = "750000001.0,B," + kRow + ",1,2,3,0,1.00,";
+    std::ofstream(dir / "in.csv") << header << row1 << "\"a, \"\"quoted\"\" note\"\n" << row2 << "\"\"\n";
+    std::ofstream(dir / "plain.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,0,1.00\n"
+                                     << "750000001.0,B," << kRow << ",1,2,3,0,1.00\n";
+    const std::string model = data_path("model_table2.csv");
+    const CliRun r = run_in("correct --in in.csv --model " + model + " --out out.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(run_in("correct --in plain.csv --model " + model + " --out plain_out.csv", dir).exit_code, 0);
+    // Every line of the output: the plain file's, plus the note column as written.
+    std::istringstream quoted(slurp(dir / "out.csv"));
+    std::istringstream plain(slurp(dir / "plain_out.csv"));
+    const std::vector<std::string> notes = {"\"note, free text\"", "\"a, \"\"quoted\"\" note\"", "\"\""};
+    std::string q;
+    std::string p;
+    for (const std::string& note : notes) {
+        ASSERT_TRUE(std::getline(quoted, q));
+        ASSERT_TRUE(std::getline(plain, p));
+        const std::size_t cut = p.rfind(',');  // before status
+        EXPECT_EQ(q, p.substr(0, cut) + "," + note + p.substr(cut));
+    }
+    // stats reads the same file.
+    EXPECT_EQ(run_in("stats --in in.csv > stats.txt", dir).exit_code, 0);
+
+    // Quoted fields in columns that are read: refused, naming the column.
+    struct Case {
+        std::string file;
+        std::string text;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"qw.csv", kHeader + "750000000.0,A,\"0.5\",0.5,0.5,0.5,10,-8,-19,1,2,3,0,1.00\n",
+         "qw.csv:2:15: column 'qw': \"0.5\" is a quoted field in a column ascorr reads"},
+        {"chu.csv", kHeader + "750000000.0,\"A\"," + kRow + ",1,2,3,0,1.00\n",
+         "chu.csv:2:13: column 'chu': \"A\" is a quoted field in a column ascorr reads"},
+        {"flags.csv", kHeader + "750000000.0,A," + kRow + ",1,2,3,\"0\",1.00\n",
+         "column 'flags': \"0\" is a quoted field in a column ascorr reads"},
+        {"open.csv", header + row1 + "\"a note that goes on\nto the next line\"\n",
+         "open.csv:2:60: quoted field without its closing quote (a line break inside quotes is not supported"},
+        {"after.csv", header + row1 + "\"a\"b\n", "after.csv:2:63: text after the closing quote"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        std::ofstream(dir / c.file) << c.text;
+        const CliRun e = run_in("correct --in " + c.file + " --out bad.csv", dir);
+        EXPECT_EQ(e.exit_code, 1);
+        EXPECT_NE(e.err.find(c.message), std::string::npos) << e.err;
+    }
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,\"1\",0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    const CliRun m = run_in("correct --in plain.csv --model m.csv --out bad.csv", dir);
+    EXPECT_EQ(m.exit_code, 1);
+    EXPECT_NE(m.err.find("m.csv:2:9: column 'c0': \"1\" is a quoted field"), std::string::npos) << m.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test

@@ -81,7 +81,9 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             continue;
         }
         const std::size_t n = lines.line_number();
-        split_fields(line, fields, starts);
+        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+            throw InputError(file_name, n, bad + 1, why_split_failed(line, bad));
+        }
         if (fields.size() != header.size()) {
             throw InputError(
                 file_name, n, starts.back() + 1,
