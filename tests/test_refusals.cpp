@@ -436,3 +436,87 @@ TEST(Refusals, QuotedFieldsInIgnoredColumnsAreAcceptedAndCopiedVerbatim) {
 
 }  // namespace
 }  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Rows of heads A, B and C at n epochs 10 s apart; C's rows get c_flags and
+// c_dt seconds added to their time.
+std::string three_heads(int n, int c_flags, double c_dt) {
+    std::ostringstream s;
+    s << kHeader;
+    for (int i = 0; i < n; ++i) {
+        const double t = 750000000.0 + 10.0 * i;
+        for (const char h : {'A', 'B', 'C'}) {
+            s.precision(15);
+            s << (h == 'C' ? t + c_dt : t) << ',' << h << ',' << kRow << ",1,2,3," << (h == 'C' ? c_flags : 0)
+              << ",1.00\n";
+        }
+    }
+    return s.str();
+}
+
+// Issue 11, item 5: `stats` and `plot` say why a pair has no epochs, and
+// `plot` draws the pairs it has (on ed4f56e: stats printed "0" and "-" without
+// a reason; plot failed with "no clean epoch for pair A-C: nothing to plot").
+TEST(Refusals, StatsAndPlotSayWhyAPairHasNoEpochsAndPlotDrawsTheOthers) {
+    const fs::path dir = scratch_dir("no-epochs");
+    std::ofstream(dir / "flagged.csv") << three_heads(6, 2, 0.0);
+    std::ofstream(dir / "shifted.csv") << three_heads(6, 0, 0.5);
+    std::string no_c = three_heads(6, 0, 0.0);
+    std::string kept;
+    std::istringstream lines(no_c);
+    for (std::string l; std::getline(lines, l);) {
+        if (l.find(",C,") == std::string::npos) {
+            kept += l + "\n";
+        }
+    }
+    std::ofstream(dir / "no_c.csv") << kept;
+    struct Case {
+        std::string args;
+        std::vector<std::string> messages;
+    };
+    const std::vector<Case> cases = {
+        {"stats --in flagged.csv",
+         {"flagged.csv: pair A-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)",
+          "flagged.csv: pair B-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)"}},
+        {"stats --in shifted.csv",
+         {"pair A-C: no clean epochs: CHU A and CHU C never have a row at the same epoch (t to the millisecond)",
+          "pair B-C: no clean epochs: CHU B and CHU C never have a row at the same epoch"}},
+        {"stats --in no_c.csv", {"pair A-C: no clean epochs: CHU C has no rows", "pair B-C: no clean epochs: CHU C"}},
+        {"stats --in flagged.csv --from 1e9 --to 2e9",
+         {"pair A-B: no clean epochs: no rows in [1000000000, 2000000000] s (--from/--to) (the file has 18)"}},
+        {"stats --in no_c.csv --to 750000020",
+         {"pair A-C: no clean epochs: CHU C has no rows in [-inf, 750000020] s (--from/--to)"}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args + " > table.txt", dir);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        for (const std::string& m : c.messages) {
+            EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+        }
+    }
+    // Pair A-B has epochs: no reason is given for it.
+    EXPECT_EQ(run_in("stats --in flagged.csv > table.txt", dir).err.find("pair A-B"), std::string::npos);
+
+    // plot draws A-B and says why A-C and B-C are empty.
+    const std::string model = data_path("model_table2.csv");
+    const CliRun p = run_in("plot --in flagged.csv --model " + model + " --out p.png", dir);
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    EXPECT_NE(p.err.find("pair A-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)"), std::string::npos)
+        << p.err;
+    EXPECT_EQ(slurp(dir / "p.png").substr(1, 3), "PNG");
+    // With no pair at all there is nothing to plot: the reasons, exit 1, no figure.
+    const CliRun w =
+        run_in("plot --in flagged.csv --model " + model + " --out q.png --window-from 1e9 --window-to 2e9", dir);
+    EXPECT_EQ(w.exit_code, 1);
+    EXPECT_NE(w.err.find("nothing to plot"), std::string::npos) << w.err;
+    EXPECT_NE(w.err.find("no clean epoch for pair B-C in the window: no rows in [1000000000, 2000000000] s "
+                         "(--window-from/--window-to)"),
+              std::string::npos)
+        << w.err;
+}
+
+}  // namespace
+}  // namespace ascorr::test
