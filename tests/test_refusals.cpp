@@ -217,3 +217,306 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
 
 }  // namespace
 }  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: a seed is an unsigned 64-bit integer, in decimal. On
+// ed4f56e `--seed -1` ran with seed 2^64 − 1, `--seed 99999999999999999999`
+// with 2^64 − 1 and `--seed 010` with 8 (CLI11 reads base 0), all silently.
+TEST(Refusals, OutOfRangeSeedsAreRefusedNamingTheOptionAndTheRange) {
+    const fs::path dir = scratch_dir("seeds");
+    const std::string range = "expected an integer in [0, 18446744073709551615]";
+    struct Case {
+        std::string seed;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"-1", "--seed: -1 is out of range: " + range},
+        {"18446744073709551616", "--seed: 18446744073709551616 is out of range: " + range},
+        {"99999999999999999999", "is out of range: " + range},
+        {"1e999", "--seed: 1e999 is out of range: " + range},
+        {"1.5", "--seed: 1.5 is not an integer (decimal digits only): " + range},
+        {"nan", "--seed: nan is not an integer: " + range},
+        {"0x10", "--seed: 0x10 is not a number: " + range},
+    };
+    const std::string in = data_path("solutions.csv");
+    const std::string model = data_path("model_table2.csv");
+    for (const Case& c : cases) {
+        for (const std::string& cmd :
+             {"simulate --days 0.01 --out s.csv --seed=" + c.seed,
+              "replay --target loopback-float --in " + in + " --model " + model + " --out r.csv --seed=" + c.seed}) {
+            SCOPED_TRACE(cmd);
+            const CliRun r = run_in(cmd, dir);
+            EXPECT_EQ(r.exit_code, 2);  // a usage error, before anything is read or written
+            EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir / "s.csv"));
+    EXPECT_FALSE(fs::exists(dir / "r.csv"));
+    // The largest seed is accepted, and a leading zero is decimal: 010 is 10, not 8.
+    ASSERT_EQ(run_in("simulate --days 0.01 --out max.csv --seed 18446744073709551615", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out ten.csv --seed 10", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out ten0.csv --seed 010", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 0.01 --out eight.csv --seed 8", dir).exit_code, 0);
+    EXPECT_EQ(slurp(dir / "ten0.csv"), slurp(dir / "ten.csv"));
+    EXPECT_NE(slurp(dir / "ten0.csv"), slurp(dir / "eight.csv"));  // mutation check: seeds do change the file
+}
+
+// Issue 11, item 5: a number that is a number but beyond its range says "out of
+// range" and gives the range, in options and in every CSV reader (on ed4f56e:
+// "expected a number", "Could not convert", or 1e999 taken as infinity).
+TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
+    const fs::path dir = scratch_dir("out-of-range");
+    const std::string in = data_path("solutions.csv");
+    const std::string model = data_path("model_table2.csv");
+    struct Case {
+        std::string args;
+        int exit_code;
+        std::string message;
+    };
+    // Files with one field beyond range.
+    std::ofstream(dir / "big_q.csv") << kHeader << "750000000.0,A,1e999,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "tiny_v.csv") << kHeader << "750000000.0,A," << kRow << ",1e-999,2,3,0,1.00\n";
+    std::ofstream(dir / "flags.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,-1,1.00\n";
+    std::ofstream(dir / "flags64.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,99999999999999999999,1.00\n";
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,1e400,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    std::ofstream(dir / "states.csv") << "t,x,y,z,vx,vy,vz\n750000000.0,7000,0,0,0,7.5,1e999\n";
+    const std::string flags_range = "expected an integer in [0, 9223372036854775807]";
+    const std::vector<Case> cases = {
+        {"correct --in big_q.csv --out o.csv", 1,
+         "big_q.csv:2:15: column 'qw': '1e999' is out of range: a number's magnitude is at most 1.797693e+308"},
+        {"correct --in tiny_v.csv --out o.csv", 1,
+         "column 'vx': '1e-999' is out of range: a nonzero number's magnitude is at least 4.940656e-324"},
+        {"correct --in flags.csv --out o.csv", 1, "column 'flags': '-1' is out of range: " + flags_range},
+        {"correct --in flags64.csv --out o.csv", 1,
+         "column 'flags': '99999999999999999999' is out of range: " + flags_range},
+        {"correct --in " + in + " --model m.csv --out o.csv", 1,
+         "m.csv:2:9: column 'c0': '1e400' is out of range: a number's magnitude is at most 1.797693e+308"},
+        {"correct --in " + in + " --states states.csv --out o.csv", 1,
+         "states.csv:2:28: column 'vz': '1e999' is out of range"},
+        {"simulate --out o.csv --days 1e999", 2, "--days: 1e999 is out of range: a number's magnitude is at most"},
+        {"stats --in " + in + " --from -1e999", 2, "--from: -1e999 is out of range"},
+        {"fit --in " + in + " --out o.csv --min-orbits 99999999999999999999", 2,
+         "--min-orbits: 99999999999999999999 is out of range: expected an integer in [0, 18446744073709551615]"},
+        {"fit --in " + in + " --out o.csv --holdout 1e-400", 2, "--holdout: 1e-400 is out of range"},
+        {"plot --in " + in + " --model " + model + " --out o.csv --width 3000000000", 2,
+         "--width: 3000000000 is out of range: expected an integer in [-2147483648, 2147483647]"},
+        {"replay --target loopback-float --in " + in + " --model " + model + " --out o.csv --timeout-ms 0", 2,
+         "--timeout-ms: 0 is out of range: expected an integer in [1, 60000]"},
+        {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --frames 0 --head B", 2,
+         "--frames: 0 is out of range: expected an integer in [1, 1000000]"},
+        {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --head 7", 2,
+         "--head: 7 is out of range: a head is A, B, C or D"},
+        // Text that is no number still says so.
+        {"simulate --out o.csv --days ten", 2, "--days: ten is not a number"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args, dir);
+        EXPECT_EQ(r.exit_code, c.exit_code);
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("expected a number"), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: a model beyond a range names file:line:column and its
+// numbers in %g (on ed4f56e: "m.csv: A beta c1 = 1000000000.000000 is beyond
+// the fixed-point coefficient range (+-...)" without a line, and a truth model
+// beyond 1 degree named neither file nor line).
+TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
+    const fs::path dir = scratch_dir("model-range");
+    const std::string in = data_path("solutions.csv");
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\n"
+                                 << "A,alpha,0,0,0,0\nA,beta,0,1e9,0,0\nA,gamma,0,0,0,0\n";
+    {
+        const CliRun r = run_in("correct --scalar fixed --in " + in + " --model m.csv --out o.csv", dir);
+        EXPECT_EQ(r.exit_code, 1);
+        // Line 3 (A beta), column 10 (c1); the value and the limit in %g.
+        EXPECT_NE(r.err.find("m.csv:3:10: A beta c1 = 1e+09 arcsec/degC is beyond the fixed-point coefficient range "
+                             "(|c1| < "),
+                  std::string::npos)
+            << r.err;
+        EXPECT_EQ(r.err.find("000000 "), std::string::npos) << r.err;  // no %f padding
+    }
+    std::ofstream(dir / "q.csv") << "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n"
+                                 << "B,alpha,0,0,0,0,0,0,0\nB,beta,0,0,0,0,0,0,0\nB,gamma,0,0,0,0,0,0,-2.5e11\n";
+    const CliRun q = run_in("correct --scalar fixed --in " + in + " --model q.csv --out o.csv", dir);
+    EXPECT_EQ(q.exit_code, 1);
+    EXPECT_NE(q.err.find("q.csv:4:21: B gamma c3_2 = -2.5e+11 arcsec/degC^2 is beyond"), std::string::npos) << q.err;
+    // A truth model whose angle exceeds the core's 1-degree domain: the file and
+    // the line of the head, with the epoch and the temperatures.
+    std::ofstream(dir / "t.csv") << "chu,axis,c0,c1,c2,c3\n"
+                                 << "A,alpha,0,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n"
+                                 << "B,alpha,0,0,0,0\nB,beta,0,0,0,0\nB,gamma,0,0,0,0\n"
+                                 << "C,alpha,3500,100,0,0\nC,beta,0,0,0,0\nC,gamma,0,0,0,0\n";
+    const CliRun t = run_in("simulate --days 0.01 --truth t.csv --out s.csv", dir);
+    EXPECT_EQ(t.exit_code, 1);
+    EXPECT_NE(t.err.find("t.csv:8: CHU C: the truth model gives an angle beyond 1 degree at t = "), std::string::npos)
+        << t.err;
+    EXPECT_NE(t.err.find("degC)"), std::string::npos) << t.err;
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    EXPECT_FALSE(fs::exists(dir / "s.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Issue 11, item 5: RFC 4180 quoting in columns ascorr ignores is accepted
+// and copied verbatim (on ed4f56e a comma inside quotes split the field: "expected
+// 15 fields as in the header, found 16"); in a column it reads it is refused,
+// naming the column; a line break inside quotes is refused as unterminated.
+TEST(Refusals, QuotedFieldsInIgnoredColumnsAreAcceptedAndCopiedVerbatim) {
+    const fs::path dir = scratch_dir("quoted");
+    const std::string header = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,\"note, free text\"\n";
+    const std::string row1 = "750000000.0,A," + kRow + ",1,2,3,0,1.00,";
+    const std::string row2 = "750000001.0,B," + kRow + ",1,2,3,0,1.00,";
+    std::ofstream(dir / "in.csv") << header << row1 << "\"a, \"\"quoted\"\" note\"\n" << row2 << "\"\"\n";
+    std::ofstream(dir / "plain.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,0,1.00\n"
+                                     << "750000001.0,B," << kRow << ",1,2,3,0,1.00\n";
+    const std::string model = data_path("model_table2.csv");
+    const CliRun r = run_in("correct --in in.csv --model " + model + " --out out.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(run_in("correct --in plain.csv --model " + model + " --out plain_out.csv", dir).exit_code, 0);
+    // Every line of the output: the plain file's, plus the note column as written.
+    std::istringstream quoted(slurp(dir / "out.csv"));
+    std::istringstream plain(slurp(dir / "plain_out.csv"));
+    const std::vector<std::string> notes = {"\"note, free text\"", "\"a, \"\"quoted\"\" note\"", "\"\""};
+    std::string q;
+    std::string p;
+    for (const std::string& note : notes) {
+        ASSERT_TRUE(std::getline(quoted, q));
+        ASSERT_TRUE(std::getline(plain, p));
+        const std::size_t cut = p.rfind(',');  // before status
+        EXPECT_EQ(q, p.substr(0, cut) + "," + note + p.substr(cut));
+    }
+    // stats reads the same file.
+    EXPECT_EQ(run_in("stats --in in.csv > stats.txt", dir).exit_code, 0);
+
+    // Quoted fields in columns that are read: refused, naming the column.
+    struct Case {
+        std::string file;
+        std::string text;
+        std::string message;
+    };
+    const std::vector<Case> cases = {
+        {"qw.csv", kHeader + "750000000.0,A,\"0.5\",0.5,0.5,0.5,10,-8,-19,1,2,3,0,1.00\n",
+         "qw.csv:2:15: column 'qw': \"0.5\" is a quoted field in a column ascorr reads"},
+        {"chu.csv", kHeader + "750000000.0,\"A\"," + kRow + ",1,2,3,0,1.00\n",
+         "chu.csv:2:13: column 'chu': \"A\" is a quoted field in a column ascorr reads"},
+        {"flags.csv", kHeader + "750000000.0,A," + kRow + ",1,2,3,\"0\",1.00\n",
+         "column 'flags': \"0\" is a quoted field in a column ascorr reads"},
+        {"open.csv", header + row1 + "\"a note that goes on\nto the next line\"\n",
+         "open.csv:2:60: quoted field without its closing quote (a line break inside quotes is not supported"},
+        {"after.csv", header + row1 + "\"a\"b\n", "after.csv:2:63: text after the closing quote"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        std::ofstream(dir / c.file) << c.text;
+        const CliRun e = run_in("correct --in " + c.file + " --out bad.csv", dir);
+        EXPECT_EQ(e.exit_code, 1);
+        EXPECT_NE(e.err.find(c.message), std::string::npos) << e.err;
+    }
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,\"1\",0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    const CliRun m = run_in("correct --in plain.csv --model m.csv --out bad.csv", dir);
+    EXPECT_EQ(m.exit_code, 1);
+    EXPECT_NE(m.err.find("m.csv:2:9: column 'c0': \"1\" is a quoted field"), std::string::npos) << m.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test
+
+namespace ascorr::test {
+namespace {
+
+// Rows of heads A, B and C at n epochs 10 s apart; C's rows get c_flags and
+// c_dt seconds added to their time.
+std::string three_heads(int n, int c_flags, double c_dt) {
+    std::ostringstream s;
+    s << kHeader;
+    for (int i = 0; i < n; ++i) {
+        const double t = 750000000.0 + 10.0 * i;
+        for (const char h : {'A', 'B', 'C'}) {
+            s.precision(15);
+            s << (h == 'C' ? t + c_dt : t) << ',' << h << ',' << kRow << ",1,2,3," << (h == 'C' ? c_flags : 0)
+              << ",1.00\n";
+        }
+    }
+    return s.str();
+}
+
+// Issue 11, item 5: `stats` and `plot` say why a pair has no epochs, and
+// `plot` draws the pairs it has (on ed4f56e: stats printed "0" and "-" without
+// a reason; plot failed with "no clean epoch for pair A-C: nothing to plot").
+TEST(Refusals, StatsAndPlotSayWhyAPairHasNoEpochsAndPlotDrawsTheOthers) {
+    const fs::path dir = scratch_dir("no-epochs");
+    std::ofstream(dir / "flagged.csv") << three_heads(6, 2, 0.0);
+    std::ofstream(dir / "shifted.csv") << three_heads(6, 0, 0.5);
+    std::string no_c = three_heads(6, 0, 0.0);
+    std::string kept;
+    std::istringstream lines(no_c);
+    for (std::string l; std::getline(lines, l);) {
+        if (l.find(",C,") == std::string::npos) {
+            kept += l + "\n";
+        }
+    }
+    std::ofstream(dir / "no_c.csv") << kept;
+    struct Case {
+        std::string args;
+        std::vector<std::string> messages;
+    };
+    const std::vector<Case> cases = {
+        {"stats --in flagged.csv",
+         {"flagged.csv: pair A-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)",
+          "flagged.csv: pair B-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)"}},
+        {"stats --in shifted.csv",
+         {"pair A-C: no clean epochs: CHU A and CHU C never have a row at the same epoch (t to the millisecond)",
+          "pair B-C: no clean epochs: CHU B and CHU C never have a row at the same epoch"}},
+        {"stats --in no_c.csv", {"pair A-C: no clean epochs: CHU C has no rows", "pair B-C: no clean epochs: CHU C"}},
+        {"stats --in flagged.csv --from 1e9 --to 2e9",
+         {"pair A-B: no clean epochs: no rows in [1000000000, 2000000000] s (--from/--to) (the file has 18)"}},
+        {"stats --in no_c.csv --to 750000020",
+         {"pair A-C: no clean epochs: CHU C has no rows in [-inf, 750000020] s (--from/--to)"}},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args + " > table.txt", dir);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        for (const std::string& m : c.messages) {
+            EXPECT_NE(r.err.find(m), std::string::npos) << r.err;
+        }
+    }
+    // Pair A-B has epochs: no reason is given for it.
+    EXPECT_EQ(run_in("stats --in flagged.csv > table.txt", dir).err.find("pair A-B"), std::string::npos);
+
+    // plot draws A-B and says why A-C and B-C are empty.
+    const std::string model = data_path("model_table2.csv");
+    const CliRun p = run_in("plot --in flagged.csv --model " + model + " --out p.png", dir);
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    EXPECT_NE(p.err.find("pair A-C: no clean epochs: none of CHU C's 6 rows is clean (6 flags set)"), std::string::npos)
+        << p.err;
+    EXPECT_EQ(slurp(dir / "p.png").substr(1, 3), "PNG");
+    // With no pair at all there is nothing to plot: the reasons, exit 1, no figure.
+    const CliRun w =
+        run_in("plot --in flagged.csv --model " + model + " --out q.png --window-from 1e9 --window-to 2e9", dir);
+    EXPECT_EQ(w.exit_code, 1);
+    EXPECT_NE(w.err.find("nothing to plot"), std::string::npos) << w.err;
+    EXPECT_NE(w.err.find("no clean epoch for pair B-C in the window: no rows in [1000000000, 2000000000] s "
+                         "(--window-from/--window-to)"),
+              std::string::npos)
+        << w.err;
+}
+
+}  // namespace
+}  // namespace ascorr::test

@@ -5,6 +5,7 @@
 
 #include "ascorr_host/correct_file.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 
 namespace ascorr::cli {
 
@@ -31,7 +32,8 @@ void add_correct_command(CLI::App& app) {
     cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs (uplinked)")
         ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
     cmd->add_option("--max-propagation", opt->max_propagation_s,
-                    "seconds a state may be propagated (default 21600); later rows get status 4+512");
+                    "seconds a state may be propagated (default 21600); later rows get status 4+512")
+        ->check(real_number());
     cmd->callback([opt]() {
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';

@@ -5,6 +5,7 @@
 
 #include "ascorr_host/replay.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 
 namespace ascorr::cli {
 
@@ -26,12 +27,14 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs")
         ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
+
+        ->check(real_number())
         ->check(CLI::Range(0.0, 0.5));
     cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));
     cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 20 qemu, 500 serial)")
-        ->check(CLI::Range(1, 60000));
-    cmd->add_option("--seed", opt->seed, "seed of the fault injection");
-    cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)");
+        ->transform(integer_in<int>(1, 60000));
+    cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
+    cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
     cmd->callback([opt, speed]() {
         opt->realtime = *speed == "realtime";
         const host::ReplaySummary s = host::replay(*opt, std::cerr);

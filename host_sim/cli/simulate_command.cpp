@@ -3,6 +3,7 @@
 
 #include "ascorr_host/simulate.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 
 namespace ascorr::cli {
 
@@ -11,12 +12,15 @@ void add_simulate_command(CLI::App& app) {
     CLI::App* cmd =
         app.add_subcommand("simulate", "write a Swarm-like recorded data set, its truth model and noise floor");
     cmd->add_option("--out", opt->out, "solutions file (CSV); beside it OUT.truth.csv and OUT.floor.json")->required();
-    cmd->add_option("--days", opt->days, "length of the mission in days (default 920, 2.5 years)");
-    cmd->add_option("--step", opt->step_s, "time between epochs in s (default 60)");
-    cmd->add_option("--seed", opt->seed, "random seed (default 1); the same seed gives the same file");
+    cmd->add_option("--days", opt->days, "length of the mission in days (default 920, 2.5 years)")
+        ->check(real_number());
+    cmd->add_option("--step", opt->step_s, "time between epochs in s (default 60)")->check(real_number());
+    cmd->add_option("--seed", opt->seed, "random seed (default 1); the same seed gives the same file")
+        ->transform(integer_in<std::uint64_t>());
     cmd->add_option("--truth", opt->truth, "truth thermal model (CSV); default: the paper's Table 2, built in")
         ->check(non_empty_path());
-    cmd->add_option("--start", opt->start_t, "first epoch, s since J2000 TT (default 2014-06-16)");
+    cmd->add_option("--start", opt->start_t, "first epoch, s since J2000 TT (default 2014-06-16)")
+        ->check(real_number());
     cmd->callback([opt]() {
         const host::SimulateSummary s = host::simulate(*opt);
         std::cerr << "ascorr simulate: " << opt->out << ": " << host::describe(s) << '\n';

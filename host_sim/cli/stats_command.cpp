@@ -3,6 +3,7 @@
 
 #include "ascorr_host/stats.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 
 namespace ascorr::cli {
 
@@ -13,8 +14,8 @@ void add_stats_command(CLI::App& app) {
     cmd->add_option("--in", opt->in, "solutions file (CSV), raw")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it the thermal stage is null")
         ->check(non_empty_path());
-    cmd->add_option("--from", opt->from, "first epoch, s since J2000 TT");
-    cmd->add_option("--to", opt->to, "last epoch, s since J2000 TT");
+    cmd->add_option("--from", opt->from, "first epoch, s since J2000 TT")->check(real_number());
+    cmd->add_option("--to", opt->to, "last epoch, s since J2000 TT")->check(real_number());
     cmd->add_flag("--json", *json, "print JSON (docs/contract.md) instead of the table");
     cmd->callback([opt, json]() {
         const host::StatsResult r = host::compute_stats(*opt, std::cerr);

@@ -25,6 +25,7 @@
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 #ifdef ASCORR_HAVE_GPIOD
 #include "ascorr_hal_linux/gpiod_backend.hpp"
 #endif
@@ -186,10 +187,17 @@ void add_thermistors_command(CLI::App& app) {
     cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns");
     cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate");
     cmd->add_option("--inject", opt->inject, "simulated fault NAME:KIND:FROM:TO[:VALUE] (repeatable)");
-    cmd->add_option("--frames", opt->frames, "live: frames to acquire")->check(CLI::Range(1U, 1000000U));
-    cmd->add_option("--interval", opt->interval, "live: seconds between frames")->check(CLI::Range(0.0, 3600.0));
+    cmd->add_option("--frames", opt->frames, "live: frames to acquire")->transform(integer_in<unsigned>(1U, 1000000U));
+    cmd->add_option("--interval", opt->interval, "live: seconds between frames")
+        ->check(real_number())
+        ->check(CLI::Range(0.0, 3600.0));
     cmd->add_option("--head", opt->head, "head whose T_CHU is voted and printed (A-D)")
-        ->check(CLI::IsMember({'A', 'B', 'C', 'D'}));
+        ->check(CLI::Validator(
+            [](std::string& s) {
+                return s.size() == 1 && s[0] >= 'A' && s[0] <= 'D' ? std::string()
+                                                                   : s + " is out of range: a head is A, B, C or D";
+            },
+            "A-D"));
     cmd->callback([opt]() { run(*opt); });
 }
 

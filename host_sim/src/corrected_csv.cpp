@@ -22,7 +22,7 @@ RowWriter::RowWriter(const SolutionsReader& header) : header_(header) {
 
 std::string RowWriter::header_line() const {
     std::string h;
-    const auto& names = header_.header().names();
+    const auto& names = header_.header().raw_names();
     for (std::size_t i = 0; i < names.size(); ++i) {
         h += (i == 0 ? "" : ",");
         h += names[i];

@@ -13,6 +13,8 @@
 namespace ascorr::host {
 
 void check_fixed_point_range(const ModelFile& m, const std::string& path) {
+    static constexpr const char* kUnits[7] = {"arcsec",        "arcsec/degC",   "arcsec/degC",  "arcsec/degC",
+                                              "arcsec/degC^2", "arcsec/degC^2", "arcsec/degC^2"};
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         for (std::size_t a = 0; a < 3; ++a) {
             for (std::size_t i = 0; i < 7; ++i) {
@@ -20,10 +22,15 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                 const double lim =
                     i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
                 if (!(std::abs(c * kArcsecToRad) < lim)) {
-                    throw std::runtime_error(path + ": " + "ABCD"[h] + " " + kAxisNames[a] + " " +
-                                             kCoefficientNames[i] + " = " + std::to_string(c) +
-                                             " is beyond the fixed-point coefficient range (+-" +
-                                             std::to_string(lim * kRadToArcsec) + " arcsec)");
+                    char what[200];
+                    std::snprintf(what, sizeof what,
+                                  "%c %s %s = %g %s is beyond the fixed-point coefficient range (|%s| < %g %s)",
+                                  "ABCD"[h], kAxisNames[a], kCoefficientNames[i], c, kUnits[i], kCoefficientNames[i],
+                                  lim * kRadToArcsec, kUnits[i]);
+                    if (m.line[h][a] != 0) {
+                        throw InputError(path, m.line[h][a], m.column[h][a][i], what);
+                    }
+                    throw std::runtime_error(path + ": " + what);
                 }
             }
         }
@@ -74,7 +81,9 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             continue;
         }
         const std::size_t n = lines.line_number();
-        split_fields(line, fields, starts);
+        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+            throw InputError(file_name, n, bad + 1, why_split_failed(line, bad));
+        }
         if (fields.size() != header.size()) {
             throw InputError(
                 file_name, n, starts.back() + 1,
@@ -103,6 +112,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         }
         seen[head][axis] = true;
         line_of_head[head] = n;
+        m.line[head][static_cast<std::size_t>(axis)] = n;
         for (std::size_t i = 0; i < 7; ++i) {
             if (col_c[i] < 0) {
                 continue;
@@ -110,11 +120,13 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             const auto f = fields[static_cast<std::size_t>(col_c[i])];
             const auto x = parse_double(f);
             if (!x || !std::isfinite(*x)) {
-                throw InputError(file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
-                                 std::string("column '") + kCoefficientNames[i] + "': expected a finite number, got '" +
-                                     std::string(f) + "'");
+                throw InputError(
+                    file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
+                    std::string("column '") + kCoefficientNames[i] +
+                        "': " + (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
             }
             m.coefficients[head][static_cast<std::size_t>(axis)][i] = *x;
+            m.column[head][static_cast<std::size_t>(axis)][i] = starts[static_cast<std::size_t>(col_c[i])] + 1;
         }
     }
     for (std::size_t h = 0; h < kMaxHeads; ++h) {

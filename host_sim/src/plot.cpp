@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -156,6 +157,18 @@ void write_smoothed(std::ofstream& f, const PairSeries& s, const double (&mean)[
     }
 }
 
+// Text for a single-quoted gnuplot string ('' is one quote).
+std::string gnuplot_quoted(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        out += c;
+        if (c == '\'') {
+            out += '\'';
+        }
+    }
+    return out;
+}
+
 void check_window(const PlotOptions& opt) {
     if (!(opt.window_from && opt.window_to)) {
         throw std::runtime_error("a plot window needs both --window-from and --window-to");
@@ -183,16 +196,31 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         check_window(opt);
         so.from = opt.window_from;
         so.to = opt.window_to;
+        so.period_options = "--window-from/--window-to";
     }
     const StatsResult st = compute_stats(so, log);
 
+    // A pair without clean epochs gets an empty panel that says why
+    // (compute_stats has logged it); with none at all there is nothing to plot.
+    std::string why_nothing;
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + kPairNames[p] +
+                       (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
+    }
+    if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
+        throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+    }
+
     TempDir dir;
+    double t_lo = std::numeric_limits<double>::infinity();
+    double t_hi = -std::numeric_limits<double>::infinity();
     for (std::size_t p = 0; p < kPairs; ++p) {
         const PairSeries& s = st.series[p];
         if (s.t.empty()) {
-            throw std::runtime_error(opt.in + ": no clean epoch for pair " + kPairNames[p] +
-                                     (window ? " in the window" : "") + ": nothing to plot");
+            continue;
         }
+        t_lo = std::min(t_lo, s.t.front());
+        t_hi = std::max(t_hi, s.t.back());
         double mean[kStages] = {};
         for (std::size_t k = 0; k < kStages; ++k) {
             for (double v : s.iba[k]) {
@@ -211,12 +239,6 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         }
     }
 
-    double t_lo = st.series[0].t.front();
-    double t_hi = st.series[0].t.back();
-    for (const PairSeries& s : st.series) {
-        t_lo = std::min(t_lo, s.t.front());
-        t_hi = std::max(t_hi, s.t.back());
-    }
     const std::filesystem::path temps = dir.file("temperatures.dat");
     if (opt.temperatures) {
         write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
@@ -252,6 +274,13 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         }
         const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
         for (std::size_t p = 0; p < kPairs; ++p) {
+            if (st.n[p] == 0) {  // an empty panel with the reason in it
+                g << "set title 'pair " << kPairNames[p] << ": no clean epochs'\n";
+                g << "set label 99 '" << gnuplot_quoted(st.no_epochs_reason[p])
+                  << "' at graph 0.5, graph 0.5 center\nset yrange [-1:1]\nplot 2 notitle\n";
+                g << "unset label 99\nset autoscale y\n";
+                continue;
+            }
             g << "set title 'pair " << kPairNames[p] << " (" << st.n[p] << " clean epochs)'\n";
             g << "plot ";
             for (std::size_t k = 0; k < kStages; ++k) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/input_error.hpp"
@@ -74,8 +75,7 @@ double SolutionsReader::number(int col, const char* name) const {
     const auto f = fields_[static_cast<std::size_t>(col)];
     const auto x = parse_double(f);
     if (!x) {
-        fail(static_cast<std::size_t>(col),
-             std::string("column '") + name + "': expected a number, got '" + std::string(f) + "'");
+        fail(static_cast<std::size_t>(col), std::string("column '") + name + "': " + why_not_a_number(f));
     }
     return *x;
 }
@@ -104,7 +104,9 @@ bool SolutionsReader::next(SolutionRecord& rec) {
         ++empty_lines_;
     }
     line_ = line;
-    split_fields(line, fields_);
+    if (const std::size_t bad = split_fields(line, fields_); bad != kSplitOk) {
+        throw InputError(file_, lines_.line_number(), bad + 1, why_split_failed(line, bad));
+    }
     if (fields_.size() != header_.size()) {
         fail(fields_.size() - 1, "expected " + std::to_string(header_.size()) + " fields as in the header, found " +
                                      std::to_string(fields_.size()) +
@@ -116,6 +118,11 @@ bool SolutionsReader::next(SolutionRecord& rec) {
         fail(static_cast<std::size_t>(col_.t), "column 't': time must be finite");
     }
     rec.chu = fields_[static_cast<std::size_t>(col_.chu)];
+    if (!rec.chu.empty() && rec.chu[0] == '"') {
+        fail(static_cast<std::size_t>(col_.chu), "column 'chu': " + std::string(rec.chu) +
+                                                     " is a quoted field in a column ascorr reads: write A, B, C or "
+                                                     "D without quotes (docs/contract.md, section 3)");
+    }
     rec.head = head_from_name(rec.chu);
     rec.q_chu_icrf = {number(col_.qw, "qw"), number(col_.qx, "qx"), number(col_.qy, "qy"), number(col_.qz, "qz")};
     rec.temperature_present[0] = optional_number(col_.t_chu, "t_chu", rec.temperature[0]);
@@ -130,7 +137,7 @@ bool SolutionsReader::next(SolutionRecord& rec) {
         const auto v = parse_integer(f);
         if (!v || *v < 0) {
             fail(static_cast<std::size_t>(col_.flags),
-                 "column 'flags': expected a non-negative integer, got '" + std::string(f) + "'");
+                 "column 'flags': " + why_not_an_integer(f, 0, std::numeric_limits<long long>::max()));
         }
         rec.flags = *v;
     }

@@ -54,7 +54,9 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             continue;
         }
         const std::size_t n = lines.line_number();
-        split_fields(line, fields, starts);
+        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+            throw InputError(path, n, bad + 1, why_split_failed(line, bad));
+        }
         if (fields.size() != header.size()) {
             throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
                              "expected " + std::to_string(header.size()) + " fields as in the header, found " +
@@ -66,8 +68,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             const auto v = parse_double(fields[col[i]]);
             if (!v) {
                 throw InputError(path, n, starts[col[i]] + 1,
-                                 std::string("column '") + kNames[i] + "': expected a number, got '" +
-                                     std::string(fields[col[i]]) + "'");
+                                 std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
             }
             x[i] = *v;
         }

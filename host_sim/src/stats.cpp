@@ -5,6 +5,8 @@
 #include <numeric>
 #include <ostream>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "ascorr/correct.hpp"
 #include "ascorr_host/atomic_file.hpp"
@@ -27,6 +29,72 @@ struct Row {
     bool clean = false;
     std::array<Vector3<double>, kStages> z{};  // boresight per stage
 };
+
+// What kept each head's rows out of the clean epochs, for the reasons.
+struct HeadTally {
+    std::size_t rows = 0;  // in [from, to]
+    std::size_t clean = 0;
+    std::size_t flagged = 0;
+    std::size_t low_confidence = 0;  // confidence > 5 or NaN
+    std::size_t no_temperatures = 0;
+    std::size_t no_velocity = 0;
+    std::size_t not_corrected = 0;
+};
+
+std::string head_without_clean_rows(char name, const HeadTally& h) {
+    std::string s = std::string("none of CHU ") + name + "'s " + std::to_string(h.rows) + " rows is clean (";
+    const std::pair<std::size_t, const char*> parts[] = {{h.flagged, "flags set"},
+                                                         {h.low_confidence, "confidence above 5 or nan"},
+                                                         {h.no_temperatures, "temperatures missing"},
+                                                         {h.no_velocity, "velocity missing"},
+                                                         {h.not_corrected, "not corrected by the core"}};
+    const char* sep = "";
+    for (const auto& [n, what] : parts) {
+        if (n != 0) {
+            s += sep + std::to_string(n) + " " + what;
+            sep = ", ";
+        }
+    }
+    return s + ")";
+}
+
+// Why pair p has no clean epoch; the tests are in the order a reader would check.
+std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t rows_seen, std::size_t rows_in_period,
+                          const std::array<HeadTally, 3>& heads, std::size_t both_present) {
+    const bool period = opt.from.has_value() || opt.to.has_value();
+    const auto t = [](double x) {
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.17g", x);
+        return std::string(buf);
+    };
+    const std::string in_period = period ? " in [" + (opt.from ? t(*opt.from) : std::string("-inf")) + ", " +
+                                               (opt.to ? t(*opt.to) : std::string("inf")) + "] s (" +
+                                               opt.period_options + ")"
+                                         : std::string();
+    if (rows_seen == 0) {
+        return "the file has no data rows";
+    }
+    if (rows_in_period == 0) {
+        return "no rows" + in_period + " (the file has " + std::to_string(rows_seen) + ")";
+    }
+    for (const std::uint8_t h : kPairHeads[p]) {
+        if (heads[h].rows == 0) {
+            return std::string("CHU ") + head_name(h) + " has no rows" + in_period;
+        }
+    }
+    for (const std::uint8_t h : kPairHeads[p]) {
+        if (heads[h].clean == 0) {
+            return head_without_clean_rows(head_name(h), heads[h]);
+        }
+    }
+    const char a = head_name(kPairHeads[p][0]);
+    const char b = head_name(kPairHeads[p][1]);
+    if (both_present == 0) {
+        return std::string("CHU ") + a + " and CHU " + b + " never have a row at the same epoch (t to the millisecond)";
+    }
+    return "at the " + std::to_string(both_present) + " epochs with rows of both CHU " + a + " and CHU " + b +
+           ", one of the two is never clean";
+}
 
 }  // namespace
 
@@ -51,10 +119,14 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     EarthVelocity earth;
     Diagnostics diag(log);
 
+    std::size_t rows_seen = 0;
+    std::array<HeadTally, 3> heads{};
+    std::array<std::size_t, kPairs> both_present{};
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
         for (std::size_t p = 0; p < kPairs; ++p) {
             const auto& a = e.head[kPairHeads[p][0]];
             const auto& b = e.head[kPairHeads[p][1]];
+            both_present[p] += a && b ? 1U : 0U;
             if (a && b && a->clean && b->clean) {
                 r.series[p].t.push_back(e.t);
                 for (std::size_t s = 0; s < kStages; ++s) {
@@ -64,6 +136,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         }
     });
     rows([&](const SolutionRecord& rec) {
+        ++rows_seen;
         if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
             return;
         }
@@ -71,6 +144,13 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         if (rec.head > 2) {
             return;  // not in any pair (head D, or unknown: left to `correct` to report)
         }
+        HeadTally& tally = heads[rec.head];
+        ++tally.rows;
+        tally.flagged += rec.flags != 0 ? 1U : 0U;
+        tally.low_confidence += !(rec.confidence <= 5.0) ? 1U : 0U;  // as is_clean
+        tally.no_temperatures +=
+            !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
+        tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
         Row row;
         row.clean = is_clean(rec);
         const SolutionInput<double> in = to_core_input<double>(rec, &earth);
@@ -82,8 +162,10 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
                                              ": clean row the core did not correct (status " +
                                              std::to_string(c2.status) + "): left out of the statistics");
             row.clean = false;
+            ++tally.not_corrected;
         }
         r.clean_rows += row.clean ? 1U : 0U;
+        tally.clean += row.clean ? 1U : 0U;
         row.z[0] = boresight(rec.q_chu_icrf);
         row.z[1] = boresight(c1.q_chu_icrf);
         row.z[2] = boresight(c2.q_chu_icrf);
@@ -110,6 +192,10 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
             permute(v);
         }
         r.n[p] = s.t.size();
+        if (r.n[p] == 0) {
+            r.no_epochs_reason[p] = why_no_epochs(p, opt, rows_seen, r.rows, heads, both_present[p]);
+            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+        }
         for (std::size_t st = 0; st < kStages; ++st) {
             r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
         }

@@ -586,9 +586,9 @@ py::dict read_solutions(const std::string& path) {
                     const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
                     const auto s = host::parse_integer(f);
                     if (!s || *s < 0 || *s > 0xFFFF) {
-                        throw host::InputError(
-                            path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
-                            "column 'status': expected an integer 0..65535, got '" + std::string(f) + "'");
+                        throw host::InputError(path, rec.line,
+                                               static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
+                                               "column 'status': " + host::why_not_an_integer(f, 0, 0xFFFF));
                     }
                     st.push_back(*s);
                 }

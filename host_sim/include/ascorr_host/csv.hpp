@@ -1,7 +1,10 @@
 // ascorr_host/csv.hpp: the plain CSV dialect of docs/contract.md.
 //
-// Comma-separated, one header line, no quoting (no field of the formats needs
-// it; a quote character is a malformed field). LF or CRLF line ends. Fields are
+// Comma-separated, one header line, LF or CRLF line ends. RFC 4180 quoting
+// ("a, ""b""") is accepted in the header and in columns ascorr does not read
+// (they are copied verbatim); in a column it reads, a quoted field is refused
+// (numbers are written without quotes), and a line break inside quotes is not
+// supported (docs/contract.md, section 3). Fields are
 // string_views into a buffer that holds the whole file: no copies, no streams;
 // numbers are parsed with std::from_chars.
 #pragma once
@@ -70,14 +73,32 @@ private:
 
 // Splits a line at commas into fields (reusing the vector's storage), and
 // records where each field starts (0-based character offset) for messages.
-void split_fields(std::string_view line, std::vector<std::string_view>& fields, std::vector<std::size_t>& starts);
+// A quoted field (RFC 4180) is one field, handed on as written, quotes
+// included. Returns kSplitOk, or the 0-based offset where the quoting is
+// malformed (an unterminated quote, text after a closing quote; the fields
+// before it are split): why_split_failed() says which.
+inline constexpr std::size_t kSplitOk = static_cast<std::size_t>(-1);
+std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields,
+                         std::vector<std::size_t>& starts);
 // The same without the offsets (a field's offset is field.data() − line.data()).
-void split_fields(std::string_view line, std::vector<std::string_view>& fields);
+std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields);
+std::string why_split_failed(std::string_view line, std::size_t at);
+// A field's text without its RFC 4180 quotes ("a ""b""" is a "b"); other fields as they are.
+std::string unquoted(std::string_view field);
 
 // A field as a double: a decimal or scientific number, "nan", "inf".
 // Leading/trailing spaces are not accepted (they are not in the format).
 std::optional<double> parse_double(std::string_view field) noexcept;
 std::optional<long long> parse_integer(std::string_view field) noexcept;
+
+// Why parse_double refused a field, for the message: "out of range ..." (with
+// a double's range) for a number beyond it (1e999, 1e-999), otherwise
+// "expected a number, got 'FIELD'".
+std::string why_not_a_number(std::string_view field);
+// Why an integer field is refused: "out of range ..." (with [lo, hi]) for
+// decimal digits beyond it (-1 for flags, 99999999999999999999), otherwise
+// "expected an integer in [lo, hi], got 'FIELD'".
+std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
 
 // Formats x with `decimals` digits after the point into out, returns the end.
 char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
@@ -89,9 +110,12 @@ public:
     int index(std::string_view name) const noexcept;
     std::size_t size() const noexcept { return names_.size(); }
     const std::vector<std::string>& names() const noexcept { return names_; }
+    // The names as written (quotes kept), for a header copied into an output.
+    const std::vector<std::string>& raw_names() const noexcept { return raw_names_; }
 
 private:
     std::vector<std::string> names_;
+    std::vector<std::string> raw_names_;
 };
 
 }  // namespace ascorr::host

@@ -23,6 +23,10 @@ struct ModelFile {
     // coefficients[head][axis] = {c0, c1, c2, c3, c1_2, c2_2, c3_2} in arcsec.
     std::array<std::array<std::array<double, 7>, 3>, kMaxHeads> coefficients{};
     bool quadratic = false;  // write the quadratic columns
+    // Where each head and axis was read (1-based line) and each coefficient
+    // (1-based character column); 0 for a model not read from a file.
+    std::array<std::array<std::size_t, 3>, kMaxHeads> line{};
+    std::array<std::array<std::array<std::size_t, 7>, 3>, kMaxHeads> column{};
 };
 
 ModelFile read_model_file(const std::string& path);
@@ -31,7 +35,8 @@ ModelFile parse_model(const std::string& file_name, std::string_view text);
 void write_model_file(const std::string& path, const ModelFile& model);
 std::string format_model(const ModelFile& model);
 
-// Throws (naming the file, head, axis and coefficient) if a coefficient is
+// Throws (InputError at file:line:column for a model read from a file, naming
+// head, axis, coefficient, its value and the limit in %g) if a coefficient is
 // beyond what the fixed-point core's formats hold (fixed_point.hpp): such a
 // model is refused, never saturated.
 void check_fixed_point_range(const ModelFile& m, const std::string& path);

@@ -29,7 +29,8 @@ struct StatsOptions {
     std::string model;  // empty: no thermal stage
     std::optional<double> from;
     std::optional<double> to;
-    bool keep_series = false;  // keep the IBA time series (for plots)
+    bool keep_series = false;                    // keep the IBA time series (for plots)
+    std::string period_options = "--from/--to";  // the options that set from and to, for messages
 };
 
 struct PairSeries {
@@ -44,12 +45,17 @@ struct StatsResult {
     std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
     std::size_t rows = 0;                   // rows in [from, to]
     std::size_t clean_rows = 0;
+    // For a pair without clean epochs (n == 0), why, in words: no rows in the
+    // file or in [from, to], a head without rows or without clean rows (and
+    // what kept them out), or the two heads' clean rows never at one epoch.
+    std::array<std::string, kPairs> no_epochs_reason;
 };
 
 // docs/contract.md's clean solution (before the core has seen it).
 bool is_clean(const SolutionRecord& rec) noexcept;
 
-// Throws InputError for a malformed input; log gets one line per rejected row.
+// Throws InputError for a malformed input; log gets one line per rejected row
+// and one per pair without clean epochs ("FILE: pair A-C: no clean epochs: REASON").
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 // The same on rows from elsewhere (opt.in names them in messages; opt.model is
 // not read: model, nullptr for no thermal stage).
