@@ -45,13 +45,15 @@ foreach(scalar fixed float)
   endif()
 endforeach()
 
-set(ASCORR_TARGET_LIST cortex-m3 cortex-m4f)
-set(app_scalar_cortex-m3 fixed)
-set(app_scalar_cortex-m4f float)
-set(machine_cortex-m3 mps2-an385)
-set(machine_cortex-m4f mps2-an386)
-set(scalars_cortex-m3 fixed)
-set(scalars_cortex-m4f float fixed)
+# Each target's QEMU board and scalars: toolchain/targets.txt.
+include(${PROJECT_SOURCE_DIR}/toolchain/target-table.cmake)
+ascorr_read_targets()
+set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ASCORR_TARGET_TABLE})
+foreach(t ${ASCORR_TARGET_LIST})
+  set(machine_${t} ${ASCORR_TARGET_${t}_MACHINE})
+  set(app_scalar_${t} ${ASCORR_TARGET_${t}_SCALAR})
+  set(scalars_${t} ${ASCORR_TARGET_${t}_SCALARS})
+endforeach()
 set(bound_fixed 0.01)
 # The 22 Hz loop's report after 352 cycles (16 s), no overrun in either. Both
 # images take the boom temperatures through the HAL (firmware/app/
@@ -140,7 +142,7 @@ add_test(NAME target_cortex-m3-debug_no_soft_float_control
 # cost comparison is an optimised-build figure and is not asked of it).
 add_test(NAME target_cortex-m3-debug_firmware
          COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-flight-solutions $<TARGET_FILE:ascorr_flight_expectation_fixed>
-                 mps2-an385 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf ${flight_bound_fixed}
+                 ${machine_cortex-m3} ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf ${flight_bound_fixed}
                  ${CMAKE_BINARY_DIR}/target-runs/cortex-m3-debug-firmware)
 set_tests_properties(target_cortex-m3-debug_firmware PROPERTIES LABELS target TIMEOUT 60
   PASS_REGULAR_EXPRESSION "fixed-point core, ${firmware_expect}.*${flight_match_fixed}")
