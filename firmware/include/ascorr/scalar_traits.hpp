@@ -97,7 +97,7 @@ using Celsius = typename ScalarTraits<T>::temperature_type;
 // every use to a constexpr variable (constexpr T half = k<T>(0.5);), so that
 // the double → T conversion is folded at every optimisation level: an -O0
 // build of the fixed-point core references no soft-float routine (checked on
-// the Cortex-M3 Debug image, toolchain/targets.cmake).
+// the Cortex-M3 Debug image, tests/target/target-tests.cmake).
 template <typename T>
 constexpr T k(double x) noexcept {
     return ScalarTraits<T>::from_double(x);
