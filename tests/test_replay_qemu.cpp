@@ -1,18 +1,21 @@
 // Hardware-in-the-loop replay with QEMU standing in for the board: the link
-// images (firmware/app/link_main.cpp) on mps2-an386 (M4F, float) and
-// mps2-an385 (M3, Q30), driven over their UART by `ascorr replay`'s job and by
+// images (firmware/app/link_main.cpp) on the M4F (float) and M3 (Q30) boards
+// of toolchain/targets.txt, driven over their UART by `ascorr replay`'s job and by
 // the LinkClient, with faults injected and the emulator killed mid-run.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <type_traits>
 
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/qemu_targets.hpp"
 #include "ascorr_host/replay.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "replay_recording.hpp"
@@ -90,14 +93,18 @@ TEST(ReplayQemu, M3FixedOnePercentFaults) {
 // lost, identical boot id); the client sees the unprompted HELLO, restores
 // the model, velocity and temperatures, and every answer stays exact.
 template <typename T>
-void survive_restart(const char* machine, const char* target, const std::string& name) {
+void survive_restart(std::string_view replay_target, const std::string& name) {
+    const host::QemuTarget* board = host::find_qemu_target(replay_target);  // toolchain/targets.txt
+    ASSERT_NE(board, nullptr) << replay_target;
+    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
     constexpr int kRestartRows = 1200;
     const auto dir = scratch_dir(name);
     const std::string rec = make_recording(dir, kRestartRows);
     const std::string text = host::read_text_file(rec);
     host::SolutionsReader reader(rec, text);
     const ThermalModel<T> model = host::to_core<T>(host::read_model_file(data_path("model_table2.csv")));
-    host::ProcessTransport qemu(host::qemu_link_command(machine, host::default_link_firmware(target)));
+    host::ProcessTransport qemu(
+        host::qemu_link_command(std::string(board->machine), host::default_link_firmware(std::string(board->cpu))));
     host::LinkClient<T> client(qemu, 50, 20);
     client.connect();
     client.upload_model(model);
@@ -126,11 +133,11 @@ void survive_restart(const char* machine, const char* target, const std::string&
 }
 
 TEST(ReplayQemu, M3RestartMidRunIsRecovered) {
-    survive_restart<Q30>("mps2-an385", "cortex-m3", "qemu_m3_restart");
+    survive_restart<Q30>("qemu-m3", "qemu_m3_restart");
 }
 
 TEST(ReplayQemu, M4fRestartMidRunIsRecovered) {
-    survive_restart<float>("mps2-an386", "cortex-m4f", "qemu_m4f_restart");
+    survive_restart<float>("qemu-m4f", "qemu_m4f_restart");
 }
 
 }  // namespace

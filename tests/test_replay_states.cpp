@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <type_traits>
 
 #include "ascorr/fixed_point.hpp"
 #include "ascorr/velocity_service.hpp"
@@ -17,6 +19,7 @@
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/qemu_targets.hpp"
 #include "ascorr_host/replay.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/states_csv.hpp"
@@ -103,7 +106,10 @@ TEST(ReplayStatesQemu, M3OnePercentFaults) {
 // The emulator killed halfway: the client restores the model, temperatures
 // and the latest accepted state, and every answer stays exact.
 template <typename T>
-void survive_restart(const char* machine, const char* target, const std::string& name) {
+void survive_restart(std::string_view replay_target, const std::string& name) {
+    const host::QemuTarget* board = host::find_qemu_target(replay_target);  // toolchain/targets.txt
+    ASSERT_NE(board, nullptr) << replay_target;
+    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
     constexpr int kRestartRows = 600;
     const auto dir = scratch_dir(name);
     const StatesRecording rec = make_states_recording(dir, kRestartRows);
@@ -113,7 +119,8 @@ void survive_restart(const char* machine, const char* target, const std::string&
     const std::string text = host::read_text_file(rec.solutions);
     host::SolutionsReader reader(rec.solutions, text);
     const ThermalModel<T> model = host::to_core<T>(host::read_model_file(data_path("model_table2.csv")));
-    host::ProcessTransport qemu(host::qemu_link_command(machine, host::default_link_firmware(target)));
+    host::ProcessTransport qemu(
+        host::qemu_link_command(std::string(board->machine), host::default_link_firmware(std::string(board->cpu))));
     host::LinkClient<T> client(qemu, 50, 20);
     client.connect();
     client.upload_model(model);
@@ -160,10 +167,10 @@ void survive_restart(const char* machine, const char* target, const std::string&
 }
 
 TEST(ReplayStatesQemu, M3RestartRestoresTheState) {
-    survive_restart<Q30>("mps2-an385", "cortex-m3", "rs_m3_restart");
+    survive_restart<Q30>("qemu-m3", "rs_m3_restart");
 }
 TEST(ReplayStatesQemu, M4fRestartRestoresTheState) {
-    survive_restart<float>("mps2-an386", "cortex-m4f", "rs_m4f_restart");
+    survive_restart<float>("qemu-m4f", "rs_m4f_restart");
 }
 #endif
 

@@ -6,8 +6,19 @@
 # function so that --gc-sections keeps only what is used. Images run on QEMU's
 # MPS2 boards (toolchain/qemu-run) with semihosting for stdio and exit status;
 # the board's memory map is passed to picolibc's linker script here.
-# The including file sets ASCORR_CPU_FLAGS, ASCORR_TARGET_NAME, ASCORR_QEMU_MACHINE
-# and ASCORR_APP_SCALAR (fixed or float: the scalar the firmware runs).
+# The including file sets ASCORR_TARGET_NAME (a cpu of toolchain/targets.txt);
+# its line there gives ASCORR_CPU_FLAGS, ASCORR_QEMU_MACHINE, ASCORR_APP_SCALAR
+# (fixed or float: the scalar the firmware runs) and ASCORR_TARGET_SCALARS
+# (the accuracy images').
+include(${CMAKE_CURRENT_LIST_DIR}/target-table.cmake)
+ascorr_read_targets()
+if(NOT ASCORR_TARGET_NAME IN_LIST ASCORR_TARGET_LIST)
+  message(FATAL_ERROR "ASCORR_TARGET_NAME '${ASCORR_TARGET_NAME}' is not a cpu of ${ASCORR_TARGET_TABLE}")
+endif()
+set(ASCORR_CPU_FLAGS "${ASCORR_TARGET_${ASCORR_TARGET_NAME}_FLAGS}")
+set(ASCORR_QEMU_MACHINE ${ASCORR_TARGET_${ASCORR_TARGET_NAME}_MACHINE})
+set(ASCORR_APP_SCALAR ${ASCORR_TARGET_${ASCORR_TARGET_NAME}_SCALAR})
+set(ASCORR_TARGET_SCALARS ${ASCORR_TARGET_${ASCORR_TARGET_NAME}_SCALARS})
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
 set(CMAKE_C_COMPILER arm-none-eabi-gcc)

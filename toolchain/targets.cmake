@@ -1,93 +1,47 @@
-# toolchain/targets.cmake: the Cortex-M builds and their tests, driven from the
+# toolchain/targets.cmake: how the Cortex-M images are built, driven from the
 # host build (included by the top CMakeLists.txt when ASCORR_TARGETS is ON; the
-# `ci` preset sets it).
+# `ci` preset sets it). What they are expected to do is tests/target/
+# target-tests.cmake, included at the end.
 #
-# Each target is a separate CMake build of this source tree with its toolchain
-# file (ExternalProject, binary dir <host build>/<target>), so that host and
-# cross flags never mix; it is rebuilt whenever the host build is (BUILD_ALWAYS,
-# a no-op when nothing changed). The images run under QEMU in CTest, label
-# `target`:
-#   target_<t>_accuracy_<scalar>   worked examples + random set vs the double core
-#   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun
-#   target_cortex-m3_no_soft_float the M3's per-solution and per-cycle code (the
-#                                  core's entry, the velocity query,
-#                                  firmware/app/*_entry_fixed.cpp, and the
-#                                  fixed-point thermistor acquisition,
-#                                  hal_temperatures.cpp) references no soft-float routine (negative
-#                                  control: the M3 application image, whose
-#                                  velocity service propagates in double, has);
-#                                  the same on a Debug (-O0) M3 build
-#                                  (target_cortex-m3-debug_no_soft_float*),
-#                                  whose loop also flies without overrun
-#                                  (target_cortex-m3-debug_firmware)
+# Each target of toolchain/targets.txt is a separate CMake build of this
+# source tree with its toolchain file (ExternalProject ascorr_<cpu>, binary dir
+# ASCORR_TARGET_<cpu>_BINARY_DIR = <host build>/<cpu>), so that host and cross
+# flags never mix; it is rebuilt whenever the host build is (BUILD_ALWAYS, a
+# no-op when nothing changed). Besides, a Debug (-O0) build of the M3's flight
+# image (ascorr_cortex-m3-debug, <host build>/cortex-m3-debug), for the
+# no-soft-float check at -O0. The images run under QEMU through
+# toolchain/qemu-run on each target's board.
 include(ExternalProject)
 find_program(ASCORR_ARM_GXX arm-none-eabi-g++ REQUIRED)
 find_program(ASCORR_ARM_NM arm-none-eabi-nm REQUIRED)
 find_program(ASCORR_QEMU qemu-system-arm REQUIRED)
 
-add_executable(ascorr_target_vectors ${PROJECT_SOURCE_DIR}/tests/target_vectors.cpp)
-target_include_directories(ascorr_target_vectors PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-target_link_libraries(ascorr_target_vectors PRIVATE ascorr_host ascorr_warnings)
-target_compile_definitions(ascorr_target_vectors PRIVATE ASCORR_TEST_DATA="${PROJECT_SOURCE_DIR}/tests/data")
-
-set(ASCORR_TARGET_LIST cortex-m3 cortex-m4f)
-set(machine_cortex-m3 mps2-an385)
-set(machine_cortex-m4f mps2-an386)
-set(scalars_cortex-m3 fixed)
-set(scalars_cortex-m4f float fixed)
-set(bound_fixed 0.01)
-# The 22 Hz loop's report after 352 cycles (16 s), no overrun in either. Both
-# images take the boom temperatures through the HAL (firmware/app/
-# hal_temperatures.cpp; float on the M4F, fixed point on the M3) with the same
-# emulated ADC and faults (boom_channels.hpp): THT00057 open in seconds 4–6 is
-# outvoted (no effect); THT00032 and THT00060 open in seconds 9–10 leave T_032
-# without quorum, so heads A–C skip the thermal stage for those 44 cycles with
-# status 1|8|64 (status seen 75, applied 308). Head D has no model. The
-# velocity comes from the on-board service fed by the recorded GNSS orbit
-# (firmware/app/gnss_feed.hpp; one state refused as out of order), and in
-# steady state it costs no more than the correction of three heads.
-set(firmware_expect "352 cycles at 22 Hz, overruns 0.*head 0: applied 308 status seen 75 .*head 1: applied 308 status seen 75 .*head 2: applied 308 status seen 75 .*head 3: applied 0 status seen 257 .*states accepted 2 refused 1")
-set(firmware_expect_cortex-m3 "fixed-point core, ${firmware_expect}.*service within the correction's cost")
-set(firmware_expect_cortex-m4f "float core, ${firmware_expect}.*service within the correction's cost")
-set(bound_float 0.05)
+# Each target's QEMU board and scalars: toolchain/targets.txt.
+include(${PROJECT_SOURCE_DIR}/toolchain/target-table.cmake)
+ascorr_read_targets()
+set_property(DIRECTORY ${PROJECT_SOURCE_DIR} APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${ASCORR_TARGET_TABLE})
 
 foreach(t ${ASCORR_TARGET_LIST})
-  set(bin ${CMAKE_BINARY_DIR}/${t})
+  set(ASCORR_TARGET_${t}_BINARY_DIR ${CMAKE_BINARY_DIR}/${t})
   ExternalProject_Add(ascorr_${t}
     SOURCE_DIR ${PROJECT_SOURCE_DIR}
-    BINARY_DIR ${bin}
+    BINARY_DIR ${ASCORR_TARGET_${t}_BINARY_DIR}
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchain/${t}.cmake
                -DASCORR_BUILD_HOST=OFF -DASCORR_WERROR=${ASCORR_WERROR}
                -DCMAKE_BUILD_TYPE=Release
     BUILD_ALWAYS ON
     INSTALL_COMMAND ""
     USES_TERMINAL_BUILD ON)
-  foreach(scalar ${scalars_${t}})
-    add_test(NAME target_${t}_accuracy_${scalar}
-             COMMAND ${PROJECT_SOURCE_DIR}/tests/target/run-accuracy $<TARGET_FILE:ascorr_target_vectors>
-                     ${machine_${t}} ${bin}/tests/target/ascorr_target_accuracy_${scalar}.elf ${bound_${scalar}}
-                     ${CMAKE_BINARY_DIR}/target-runs/${t}-${scalar})
-    set_tests_properties(target_${t}_accuracy_${scalar} PROPERTIES LABELS target TIMEOUT 120)
-  endforeach()
-  add_test(NAME target_${t}_firmware
-           COMMAND ${PROJECT_SOURCE_DIR}/toolchain/qemu-run ${machine_${t}} ${bin}/firmware/app/ascorr_firmware.elf)
-  set_tests_properties(target_${t}_firmware PROPERTIES LABELS target TIMEOUT 60
-    PASS_REGULAR_EXPRESSION "${firmware_expect_${t}}")
 endforeach()
-
-# Scope: the per-solution path. Since issue 12 the application image holds the
-# velocity service's software-double part (frame conversion, propagation, Earth
-# series, once per state / node / minute, outside the per-solution path).
-set(m3_entry_objs ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/CMakeFiles/ascorr_core_entry_fixed.dir)
 
 # The M3 build at -O0 (Debug): no constant of the core may be converted from
 # double at run time (scalar_traits.hpp, constant<T>()), so the per-solution objects
 # stay free of soft-float there too. Only the flight image (and with it those
-# objects) is built; the image itself, which propagates in double, is the
-# negative control.
+# objects) is built.
+set(ASCORR_TARGET_cortex-m3-debug_BINARY_DIR ${CMAKE_BINARY_DIR}/cortex-m3-debug)
 ExternalProject_Add(ascorr_cortex-m3-debug
   SOURCE_DIR ${PROJECT_SOURCE_DIR}
-  BINARY_DIR ${CMAKE_BINARY_DIR}/cortex-m3-debug
+  BINARY_DIR ${ASCORR_TARGET_cortex-m3-debug_BINARY_DIR}
   CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/toolchain/cortex-m3.cmake
              -DASCORR_BUILD_HOST=OFF -DASCORR_WERROR=${ASCORR_WERROR}
              -DCMAKE_BUILD_TYPE=Debug
@@ -95,30 +49,5 @@ ExternalProject_Add(ascorr_cortex-m3-debug
   BUILD_ALWAYS ON
   INSTALL_COMMAND ""
   USES_TERMINAL_BUILD ON)
-set(m3_debug_entry_objs ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/CMakeFiles/ascorr_core_entry_fixed.dir)
-add_test(NAME target_cortex-m3-debug_no_soft_float
-         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${m3_debug_entry_objs}/core_entry_fixed.cpp.obj ${m3_debug_entry_objs}/velocity_entry_fixed.cpp.obj
-                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/CMakeFiles/ascorr_firmware.dir/hal_temperatures.cpp.obj)
-add_test(NAME target_cortex-m3-debug_no_soft_float_control
-         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf)
-# The -O0 image flies the same loop without overrun (the velocity service's
-# cost comparison is an optimised-build figure and is not asked of it).
-add_test(NAME target_cortex-m3-debug_firmware
-         COMMAND ${PROJECT_SOURCE_DIR}/toolchain/qemu-run mps2-an385
-                 ${CMAKE_BINARY_DIR}/cortex-m3-debug/firmware/app/ascorr_firmware.elf)
-set_tests_properties(target_cortex-m3-debug_firmware PROPERTIES LABELS target TIMEOUT 60
-  PASS_REGULAR_EXPRESSION "fixed-point core, ${firmware_expect}")
-set_tests_properties(target_cortex-m3-debug_no_soft_float PROPERTIES LABELS target)
-set_tests_properties(target_cortex-m3-debug_no_soft_float_control PROPERTIES LABELS target WILL_FAIL ON)
 
-add_test(NAME target_cortex-m3_no_soft_float
-         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${m3_entry_objs}/core_entry_fixed.cpp.obj ${m3_entry_objs}/velocity_entry_fixed.cpp.obj
-                 ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/CMakeFiles/ascorr_firmware.dir/hal_temperatures.cpp.obj)
-add_test(NAME target_cortex-m3_no_soft_float_control
-         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
-                 ${CMAKE_BINARY_DIR}/cortex-m3/firmware/app/ascorr_firmware.elf)
-set_tests_properties(target_cortex-m3_no_soft_float PROPERTIES LABELS target)
-set_tests_properties(target_cortex-m3_no_soft_float_control PROPERTIES LABELS target WILL_FAIL ON)
+include(${PROJECT_SOURCE_DIR}/tests/target/target-tests.cmake)

@@ -7,7 +7,9 @@
 // per cycle), then corrects one raw solution per camera head with the core in
 // the build's scalar (app_scalar.hpp), the model in flash (flight_data.hpp)
 // and the observer velocity the service gives for that solution's own time
-// (velocity_entry.hpp), and keeps the corrected solutions for telemetry. Every
+// (velocity_entry.hpp), and keeps the corrected solutions for telemetry (the
+// cycle's computation: flight_cycle.hpp, shared with the host's prediction of
+// this loop's output, tests/target/flight_expectation.cpp). Every
 // loop has a fixed trip count; the only wait is for the next tick. The work
 // of a cycle is measured in SysTick counts (core clocks; under QEMU's -icount
 // shift=0, 40 instructions each). Overruns are counted honestly: a cycle whose
@@ -16,18 +18,14 @@
 // the tick masks interrupts between its check and WFI (board.hpp,
 // sleep_until_changed), so a tick can never slip in between and cost a whole
 // period unseen. ASCORR_APP_CYCLES > 0 ends the run after that many cycles with a
-// report and exit status 0 (no overrun) or 1; 0 runs forever (flight).
+// report (with the solutions' record: samples and CRC-32C per head,
+// flight_cycle.hpp) and exit status 0 (no overrun) or 1; 0 runs forever (flight).
 #include <cstdint>
-#include <cstring>
 
 #include "app_scalar.hpp"
 #include "board.hpp"
-#include "core_entry.hpp"
-#include "flight_data.hpp"
-#include "gnss_feed.hpp"
+#include "flight_cycle.hpp"
 #include "report.hpp"
-#include "temperature_source.hpp"
-#include "velocity_entry.hpp"
 
 #ifndef ASCORR_APP_CYCLES
 #define ASCORR_APP_CYCLES 0
@@ -36,26 +34,12 @@
 namespace ascorr::app {
 namespace {
 
-constexpr std::uint32_t kRateHz = 22U;
 constexpr std::uint32_t kPeriod = board::kCoreClockHz / kRateHz;  // 1136363 < 2^24
 constexpr std::uint32_t kCycles = ASCORR_APP_CYCLES;
 
 volatile std::uint32_t g_ticks = 0U;
 
-// The velocity service: at most 4 RK4 steps per call of advance() (one per
-// 10 s of flight is the steady state), the default 6 h horizon.
-constexpr VelocityServiceConfig kServiceConfig{kDefaultHorizonUs, kDefaultTtMinusUt1Us, 4U};
-VelocityService<Scalar> g_service{kServiceConfig};
-GnssFeed g_gnss;
-CorrectedSolution<Scalar> g_corrected[kMaxHeads];  // latest corrected solution per head
-
-// A head's solution time in cycle `cycle`: the tick's time minus a per-head
-// exposure offset (heads 5 ms apart), TT µs. Integer: no time in the scalar.
-constexpr std::int64_t kHeadOffsetUs = 5000;
-TtTime solution_time(std::uint32_t cycle, std::uint8_t head) noexcept {
-    const std::int64_t tick = kLoopStartTtUs + static_cast<std::int64_t>(cycle) * 1000000LL / kRateHz;
-    return {tick - static_cast<std::int64_t>(kMaxHeads - head) * kHeadOffsetUs};
-}
+FlightCycle g_flight;  // the service, the GNSS feed, the solutions and their record (flight_cycle.hpp)
 
 // SysTick counts spent in each part (40 instructions each under QEMU).
 struct Cost {
@@ -73,9 +57,38 @@ struct VelocityCosts {
     Cost advance;  // advance() calls that built a node (force, RK4 steps, Earth series; double)
     Cost query;    // velocity_at(): the per-solution query (scalar)
     Cost correct;  // the core, for comparison
-    std::uint32_t refused;
 };
 VelocityCosts g_costs{};
+
+std::uint32_t now_counts() noexcept {
+    return board::systick_value();
+}
+std::uint32_t since(std::uint32_t start) noexcept {  // SysTick counts down; no wrap within a cycle
+    return start - board::systick_value();
+}
+
+// flight_cycle.hpp's Meter: SysTick counts per part.
+struct SysTickMeter {
+    std::uint32_t now() noexcept { return now_counts(); }
+    void add(Part part, std::uint32_t start) noexcept {
+        const std::uint32_t c = since(start);
+        switch (part) {
+            case Part::kState:
+                g_costs.states.add(c);
+                break;
+            case Part::kNode:
+                g_costs.advance.add(c);
+                break;
+            case Part::kQuery:
+                g_costs.query.add(c);
+                break;
+            case Part::kCorrect:
+                g_costs.correct.add(c);
+                break;
+        }
+    }
+};
+SysTickMeter g_meter;
 
 // Each part of the service measured once before the loop (SysTick counts),
 // for the steady-state figure: the 16 s run is dominated by its start.
@@ -87,55 +100,12 @@ struct Calibration {
 Calibration g_cal{};
 volatile double g_sink;
 
-std::uint32_t now_counts() noexcept {
-    return board::systick_value();
-}
-std::uint32_t since(std::uint32_t start) noexcept {  // SysTick counts down; no wrap within a cycle
-    return start - board::systick_value();
-}
-
 struct Statistics {
     std::uint32_t cycles;
     std::uint32_t overruns;
-    std::uint32_t worst_busy;            // SysTick counts
-    std::uint32_t applied[kMaxHeads];    // cycles with both corrections applied
-    StatusBits status_union[kMaxHeads];  // every status bit seen per head
+    std::uint32_t worst_busy;  // SysTick counts
 };
 Statistics g_stats{};
-
-[[maybe_unused]] std::uint32_t bits_of(Q30 x) {
-    return static_cast<std::uint32_t>(x.raw);
-}
-[[maybe_unused]] std::uint32_t bits_of(float x) {
-    std::uint32_t u = 0U;
-    std::memcpy(&u, &x, sizeof u);
-    return u;
-}
-
-// The GNSS states due by the cycle's first solution: at most two per cycle
-// (the receiver's rate is 1 Hz; a late one is taken next cycle).
-// One GNSS state per kStateIntervalUs is enough: 10 s of propagation adds
-// ≤ 0.5 m/s (velocity_service.hpp), and each state costs a frame conversion
-// and a node in software double. The others are skipped and counted (a state
-// going back in time still reaches the service, which refuses and counts it).
-constexpr std::int64_t kStateIntervalUs = 10 * kMicrosecondsPerSecond;
-std::uint32_t g_states_skipped = 0U;
-
-void take_states(std::uint32_t cycle) noexcept {
-    GnssState s{};
-    for (int i = 0; i < 2 && g_gnss.poll(solution_time(cycle, 0U), s); ++i) {
-        if (g_service.has_state() && g_service.state_time() < s.t &&
-            s.t.us - g_service.state_time().us < kStateIntervalUs) {
-            ++g_states_skipped;
-            continue;
-        }
-        const std::uint32_t start = now_counts();
-        if (g_service.push_state(s.t, s.r_itrf_km, s.v_itrf_kms, StateFrame::kItrf) != StateVerdict::kAccepted) {
-            ++g_costs.refused;
-        }
-        g_costs.states.add(since(start));
-    }
-}
 
 void calibrate() noexcept {
     const RecordedState& r0 = kRecordedOrbit[0];
@@ -164,33 +134,6 @@ void calibrate() noexcept {
     g_sink = static_cast<double>(svc.nodes_built());
 }
 
-void correct_all_heads(std::uint32_t cycle) noexcept {
-    const CorrectionConfig<Scalar> cfg{true, &kThermalModel};
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {  // fixed trip count
-        const TtTime t = solution_time(cycle, h);
-        std::uint32_t start = now_counts();
-        const std::uint32_t nodes_before = g_service.nodes_built();
-        g_service.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
-        if (g_service.nodes_built() != nodes_before) {
-            g_costs.advance.add(since(start));
-        }
-        start = now_counts();
-        const ServiceVelocity<Scalar> v = velocity_query(g_service, t);
-        g_costs.query.add(since(start));
-        const SolutionInput<Scalar> in{kRawAttitude[h], h, temperatures_of(h), v.velocity};
-        start = now_counts();
-        g_corrected[h] = correct(in, cfg);
-        g_costs.correct.add(since(start));
-        g_corrected[h].status = with_service_status(g_corrected[h].status, v.status, cfg.aberration);
-        g_corrected[h].status = temperatures_merge_status(h, g_corrected[h].status);
-        const StatusBits st = g_corrected[h].status;
-        g_stats.status_union[h] = static_cast<StatusBits>(g_stats.status_union[h] | st);
-        if (st == (status::kAberrationApplied | status::kThermalApplied)) {
-            ++g_stats.applied[h];
-        }
-    }
-}
-
 void cost(const char* name, const Cost& c) noexcept {
     using namespace report;
     text(name);
@@ -216,32 +159,15 @@ void print_report() noexcept {
     text(" SysTick counts of ");
     u32(kPeriod);
     text("\n");
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        const Quaternion<Scalar>& q = g_corrected[h].q_chu_icrf;
-        text("head ");
-        u32(h);
-        text(": applied ");
-        u32(g_stats.applied[h]);
-        text(" status seen ");
-        u32(g_stats.status_union[h]);
-        text(" last q ");
-        hex32(bits_of(q.w));
-        text(" ");
-        hex32(bits_of(q.x));
-        text(" ");
-        hex32(bits_of(q.y));
-        text(" ");
-        hex32(bits_of(q.z));
-        text("\n");
-    }
+    g_flight.record().print_heads();
     text("velocity service: states accepted ");
-    u32(g_service.counts().accepted);
+    u32(g_flight.service().counts().accepted);
     text(" refused ");
-    u32(g_costs.refused);
+    u32(g_flight.states_refused());
     text(", velocity nodes ");
-    u32(g_service.nodes_built());
+    u32(g_flight.service().nodes_built());
     text(", RK4 steps ");
-    u32(g_service.steps_taken());
+    u32(g_flight.service().steps_taken());
     text(" (SysTick counts x 40 = instructions under QEMU -icount)\n");
     cost("  state update", g_costs.states);
     cost("  propagation (node)", g_costs.advance);
@@ -253,7 +179,7 @@ void print_report() noexcept {
     text(" instructions, correction of the heads ");
     u32(g_stats.cycles == 0U ? 0U : g_costs.correct.total * 40U / g_stats.cycles);
     text(" (states skipped ");
-    u32(g_states_skipped);
+    u32(g_flight.states_skipped());
     text(")\n");
     text("parts: Earth series ");
     u32(g_cal.earth_series * 40U);
@@ -304,9 +230,7 @@ int main() {
             g_stats.overruns += start - seen - 1U;
         }
         seen = start;
-        temperatures_update(cycle);
-        take_states(cycle);
-        correct_all_heads(cycle);
+        g_flight.run(cycle, g_meter);  // temperatures, states, heads, record
         const std::uint32_t busy = kPeriod - 1U - board::systick_value();
         if (g_ticks != seen) {
             ++g_stats.overruns;
@@ -316,5 +240,6 @@ int main() {
         ++g_stats.cycles;
     }
     print_report();
+    g_flight.record().print_solutions();
     return g_stats.overruns == 0U ? 0 : 1;
 }

@@ -19,6 +19,7 @@
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/qemu_targets.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/states_csv.hpp"
 #include "ascorr_link/server.hpp"
@@ -218,20 +219,19 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         LoopbackTarget<float> target;
         return run<float>(o, target.transport(), log);
     }
-    if (opt.target == "qemu-m4f" || opt.target == "qemu-m3") {
-        const bool m3 = opt.target == "qemu-m3";
+    if (const QemuTarget* board = find_qemu_target(opt.target)) {  // toolchain/targets.txt
+        const bool fixed = board->scalar == TargetScalar::kFixed;
         // QEMU answers within a few milliseconds; a lost frame is resent soon after
         // (a late answer only costs a resend, answered from the cache).
         // With states the target's double propagation and Earth series (software
         // double on both boards) can delay an answer past 20 ms on a loaded machine.
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : (opt.states.empty() ? 20 : 100);
-        const std::string image =
-            opt.firmware.empty() ? default_link_firmware(m3 ? "cortex-m3" : "cortex-m4f") : opt.firmware;
+        const std::string image = opt.firmware.empty() ? default_link_firmware(std::string(board->cpu)) : opt.firmware;
         if (!std::ifstream(image).good()) {
             throw std::runtime_error(image + ": cannot read the link firmware image");
         }
-        ProcessTransport qemu(qemu_link_command(m3 ? "mps2-an385" : "mps2-an386", image));
-        return m3 ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
+        ProcessTransport qemu(qemu_link_command(std::string(board->machine), image));
+        return fixed ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
     }
     if (opt.target.rfind("/dev/", 0) == 0) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
@@ -248,9 +248,8 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         throw LinkError(opt.target + ": the target computes in scalar kind " + std::to_string(kind) +
                         ", which this host does not speak (1 = float, 2 = Q30)");
     }
-    throw std::runtime_error("--target " + opt.target +
-                             ": unknown target (loopback-float, qemu-m4f, qemu-m3 or a serial device such as "
-                             "/dev/ttyUSB0)");
+    throw std::runtime_error("--target " + opt.target + ": unknown target (loopback-float, " + qemu_target_names() +
+                             " or a serial device such as /dev/ttyUSB0)");
 }
 
 std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image) {

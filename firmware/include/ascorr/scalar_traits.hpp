@@ -100,7 +100,7 @@ using Celsius = typename ScalarTraits<T>::temperature_type;
 // (constexpr T half = constant<T>(0.5);), so the double → T conversion is
 // folded at every optimisation level and a -O0 build of the fixed-point core
 // references no soft-float routine (checked on the Cortex-M3 Debug image,
-// toolchain/targets.cmake). Run-time conversions use other functions
+// tests/target/target-tests.cmake). Run-time conversions use other functions
 // (velocity_service.hpp: scalar_from_double).
 //
 //   T       range                 rounding                     saturation

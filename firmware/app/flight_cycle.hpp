@@ -1,0 +1,268 @@
+// firmware/app/flight_cycle.hpp: what one cycle of the flight loop computes,
+// and what the loop reports of its solutions; one definition for the DPU
+// (main.cpp) and for the host's prediction of its output
+// (tests/target/flight_expectation.cpp).
+//
+// Conventions: the loop runs at kRateHz. Each cycle takes the GNSS states that
+// arrived (gnss_feed.hpp) into the velocity service (velocity_service.hpp:
+// frame conversion and propagation in double, bounded per cycle), then
+// corrects one raw solution per camera head (flight_data.hpp) with the core in
+// the build's scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
+// temperature_source.hpp and the velocity the service gives for that
+// solution's own time (velocity_entry.hpp). Times are TT µs (integers: no time
+// in the scalar). Every loop has a fixed trip count.
+//
+// The cost of each part is measured by the caller's Meter (main.cpp: SysTick
+// counts; the host: NoMeter), which sees the work but never changes it:
+//   std::uint32_t now() noexcept;                    a time stamp
+//   void add(Part part, std::uint32_t start) noexcept;  the part just done since `start`
+//
+// SolutionRecord: per head, the cycles with both corrections applied, every
+// status bit seen, the last corrected solution, and a CRC-32C (crc32c.hpp)
+// over every cycle's corrected solution (the four components' bit patterns,
+// then the status; little-endian); and every head's solution at each
+// kSampleEvery-th cycle (the first kMaxSamples of them). Printed with
+// report.hpp (integers and hex only), the same text on the DPU and the host.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "app_scalar.hpp"
+#include "ascorr/correct.hpp"
+#include "ascorr/status.hpp"
+#include "ascorr/velocity_service.hpp"
+#include "ascorr_link/crc32c.hpp"
+#include "core_entry.hpp"
+#include "flight_data.hpp"
+#include "gnss_feed.hpp"
+#include "recorded_orbit.hpp"
+#include "report.hpp"
+#include "temperature_source.hpp"
+#include "velocity_entry.hpp"
+
+namespace ascorr::app {
+
+inline constexpr std::uint32_t kRateHz = 22U;
+
+// A head's solution time in cycle `cycle`: the tick's time minus a per-head
+// exposure offset (heads 5 ms apart), TT µs.
+inline constexpr std::int64_t kHeadOffsetUs = 5000;
+constexpr TtTime solution_time(std::uint32_t cycle, std::uint8_t head) noexcept {
+    const std::int64_t tick = kLoopStartTtUs + static_cast<std::int64_t>(cycle) * 1000000LL / kRateHz;
+    return {tick - static_cast<std::int64_t>(kMaxHeads - head) * kHeadOffsetUs};
+}
+
+// The velocity service: at most 4 RK4 steps per call of advance() (one per
+// 10 s of flight is the steady state), the default 6 h horizon.
+inline constexpr VelocityServiceConfig kServiceConfig{kDefaultHorizonUs, kDefaultTtMinusUt1Us, 4U};
+
+// One GNSS state per kStateIntervalUs is enough: 10 s of propagation adds
+// ≤ 0.5 m/s (velocity_service.hpp), and each state costs a frame conversion
+// and a node in software double. The others are skipped and counted (a state
+// going back in time still reaches the service, which refuses and counts it).
+inline constexpr std::int64_t kStateIntervalUs = 10 * kMicrosecondsPerSecond;
+
+enum class Part : std::uint8_t {
+    kState,    // push_state: checks + ITRF → GCRS (double)
+    kNode,     // an advance() call that built a node (force, RK4 steps, Earth series; double)
+    kQuery,    // velocity_at(): the per-solution query (scalar)
+    kCorrect,  // the core
+};
+
+struct NoMeter {
+    std::uint32_t now() noexcept { return 0U; }
+    void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
+};
+
+inline std::uint32_t bits_of(Q30 x) noexcept {
+    return static_cast<std::uint32_t>(x.raw);
+}
+inline std::uint32_t bits_of(float x) noexcept {
+    std::uint32_t u = 0U;
+    std::memcpy(&u, &x, sizeof u);
+    return u;
+}
+
+class SolutionRecord {
+public:
+    static constexpr std::uint32_t kSampleEvery = 16U;
+    static constexpr std::uint32_t kMaxSamples = 32U;
+
+    // Head `head`'s corrected solution of cycle `cycle` (cycles in order from 0).
+    void add(std::uint32_t cycle, std::uint8_t head, const CorrectedSolution<Scalar>& c) noexcept {
+        if (head >= kMaxHeads) {
+            return;
+        }
+        Head& r = heads_[head];
+        const std::uint32_t words[5] = {bits_of(c.q_chu_icrf.w), bits_of(c.q_chu_icrf.x), bits_of(c.q_chu_icrf.y),
+                                        bits_of(c.q_chu_icrf.z), c.status};
+        std::uint8_t bytes[sizeof words];
+        for (std::uint32_t i = 0; i < 20U; ++i) {  // little-endian, whatever the machine
+            bytes[i] = static_cast<std::uint8_t>(words[i / 4U] >> (8U * (i % 4U)));
+        }
+        r.crc = link::crc32c(bytes, 18U, r.crc);  // the status: its 16 bits
+        r.solutions = cycle + 1U;
+        r.last = c;
+        r.status_union = static_cast<StatusBits>(r.status_union | c.status);
+        if (c.status == (status::kAberrationApplied | status::kThermalApplied)) {
+            ++r.applied;
+        }
+        if (cycle % kSampleEvery == 0U && cycle / kSampleEvery < kMaxSamples) {
+            samples_[cycle / kSampleEvery][head] = c;
+            samples_taken_ = cycle / kSampleEvery + 1U;
+        }
+    }
+
+    struct Head {
+        std::uint32_t applied;    // cycles with both corrections applied
+        StatusBits status_union;  // every status bit seen
+        std::uint32_t solutions;  // cycles recorded
+        std::uint32_t crc;        // CRC-32C over every cycle's solution and status
+        CorrectedSolution<Scalar> last;
+    };
+    const Head& head(std::uint8_t h) const noexcept { return heads_[h < kMaxHeads ? h : 0U]; }
+    std::uint32_t samples_taken() const noexcept { return samples_taken_; }
+    // Head h's solution of cycle i·kSampleEvery, i < samples_taken().
+    const CorrectedSolution<Scalar>& sample(std::uint32_t i, std::uint8_t h) const noexcept {
+        return samples_[i < kMaxSamples ? i : 0U][h < kMaxHeads ? h : 0U];
+    }
+
+    // Per head: "head H: applied N status seen S last q W X Y Z".
+    void print_heads() const noexcept {
+        using namespace report;
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            const Head& r = heads_[h];
+            text("head ");
+            u32(h);
+            text(": applied ");
+            u32(r.applied);
+            text(" status seen ");
+            u32(r.status_union);
+            text(" last q ");
+            quaternion(r.last.q_chu_icrf);
+            text("\n");
+        }
+    }
+
+    // "sample cycle C head H status S q W X Y Z" per sample and head, then
+    // "solutions head H cycles N crc32c X" per head.
+    void print_solutions() const noexcept {
+        using namespace report;
+        for (std::uint32_t i = 0; i < samples_taken_; ++i) {
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                text("sample cycle ");
+                u32(i * kSampleEvery);
+                text(" head ");
+                u32(h);
+                text(" status ");
+                u32(samples_[i][h].status);
+                text(" q ");
+                quaternion(samples_[i][h].q_chu_icrf);
+                text("\n");
+            }
+        }
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            text("solutions head ");
+            u32(h);
+            text(" cycles ");
+            u32(heads_[h].solutions);
+            text(" crc32c ");
+            hex32(heads_[h].crc);
+            text("\n");
+        }
+    }
+
+private:
+    static void quaternion(const Quaternion<Scalar>& q) noexcept {
+        report::hex32(bits_of(q.w));
+        report::text(" ");
+        report::hex32(bits_of(q.x));
+        report::text(" ");
+        report::hex32(bits_of(q.y));
+        report::text(" ");
+        report::hex32(bits_of(q.z));
+    }
+    Head heads_[kMaxHeads]{};
+    CorrectedSolution<Scalar> samples_[kMaxSamples][kMaxHeads]{};
+    std::uint32_t samples_taken_ = 0U;
+};
+
+class FlightCycle {
+public:
+    // One cycle: the temperatures (temperature_source.hpp), the states, the
+    // heads, and their solutions into the record.
+    template <typename Meter>
+    void run(std::uint32_t cycle, Meter& meter) noexcept;
+
+    // The GNSS states due by the cycle's first solution: at most two per cycle
+    // (the receiver's rate is 1 Hz; a late one is taken next cycle).
+    template <typename Meter>
+    void take_states(std::uint32_t cycle, Meter& meter) noexcept {
+        GnssState s{};
+        for (int i = 0; i < 2 && gnss_.poll(solution_time(cycle, 0U), s); ++i) {
+            if (service_.has_state() && service_.state_time() < s.t &&
+                s.t.us - service_.state_time().us < kStateIntervalUs) {
+                ++states_skipped_;
+                continue;
+            }
+            const std::uint32_t start = meter.now();
+            if (service_.push_state(s.t, s.r_itrf_km, s.v_itrf_kms, StateFrame::kItrf) != StateVerdict::kAccepted) {
+                ++states_refused_;
+            }
+            meter.add(Part::kState, start);
+        }
+    }
+
+    // One corrected solution per head, in head order (fixed trip count).
+    template <typename Meter>
+    void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
+        const CorrectionConfig<Scalar> cfg{true, &kThermalModel};
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            const TtTime t = solution_time(cycle, h);
+            std::uint32_t start = meter.now();
+            const std::uint32_t nodes_before = service_.nodes_built();
+            service_.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
+            if (service_.nodes_built() != nodes_before) {
+                meter.add(Part::kNode, start);
+            }
+            start = meter.now();
+            const ServiceVelocity<Scalar> v = velocity_query(service_, t);
+            meter.add(Part::kQuery, start);
+            const SolutionInput<Scalar> in{kRawAttitude[h], h, temperatures_of(h), v.velocity};
+            start = meter.now();
+            corrected_[h] = correct(in, cfg);
+            meter.add(Part::kCorrect, start);
+            corrected_[h].status = with_service_status(corrected_[h].status, v.status, cfg.aberration);
+            corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
+        }
+    }
+
+    const CorrectedSolution<Scalar>& corrected(std::uint8_t head) const noexcept {
+        return corrected_[head < kMaxHeads ? head : 0U];
+    }
+    const VelocityService<Scalar>& service() const noexcept { return service_; }
+    std::uint32_t states_skipped() const noexcept { return states_skipped_; }
+    std::uint32_t states_refused() const noexcept { return states_refused_; }
+    const SolutionRecord& record() const noexcept { return record_; }
+
+private:
+    VelocityService<Scalar> service_{kServiceConfig};
+    GnssFeed gnss_;
+    CorrectedSolution<Scalar> corrected_[kMaxHeads]{};  // latest corrected solution per head
+    std::uint32_t states_skipped_ = 0U;
+    std::uint32_t states_refused_ = 0U;
+    SolutionRecord record_;
+};
+
+template <typename Meter>
+void FlightCycle::run(std::uint32_t cycle, Meter& meter) noexcept {
+    temperatures_update(cycle);
+    take_states(cycle, meter);
+    correct_heads(cycle, meter);
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {  // fixed trip count
+        record_.add(cycle, h, corrected_[h]);
+    }
+}
+
+}  // namespace ascorr::app

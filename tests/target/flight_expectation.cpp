@@ -1,0 +1,408 @@
+// tests/target/flight_expectation.cpp: the flight loop's solutions (firmware/
+// app/main.cpp under QEMU) against the host core.
+//
+// Usage: ascorr_flight_expectation_<scalar> check REPORT BOUND_ARCSEC
+//        ascorr_flight_expectation_<scalar> print CYCLES
+// The host runs the very cycle the DPU runs (FlightCycle, flight_cycle.hpp:
+// the recorded GNSS orbit into the velocity service, the raw solutions and
+// model of flight_data.hpp, the core in the image's scalar, built with
+// ASCORR_APP_FIXED for the Q30 image) for as many cycles as the image's report
+// says, with the temperatures of the same HAL acquisition on the same emulated
+// boom ADC (boom_temperatures.hpp), timed by a test-double clock instead of
+// SysTick: each cycle starts at its nominal time and only the acquisition's
+// own waits advance it (on the DPU the instructions executed add
+// microseconds, far within the acquisition's margins: boom_temperatures.hpp).
+//
+// check: compares the image's report (REPORT: its standard output) with the
+// host's record (SolutionRecord): per head the cycles with both corrections
+// applied, every status bit seen, the last solution, every sample (every
+// 16th cycle) and, for BOUND_ARCSEC = 0, the CRC-32C over every cycle's
+// solution and status. BOUND_ARCSEC = 0: bit for bit. Otherwise statuses and
+// counts exactly, each quaternion within BOUND_ARCSEC of the host's (the
+// rotation angle between them). Then the mutation check: the same comparison
+// against the host's record with its first sample perturbed (its lowest bit
+// of w flipped; with a bound, rotated by twice the bound) must fail, so that
+// the check cannot pass vacuously. Exit 0 when both hold, 1 otherwise, every
+// difference named (line, head, cycle, value).
+// print: the lines the image prints of its solutions after CYCLES cycles.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "ascorr_hal/clock.hpp"
+#include "boom_temperatures.hpp"
+#include "flight_cycle.hpp"
+#include "temperature_source.hpp"
+
+namespace ascorr::app {
+namespace {
+
+// SysTickClock's behaviour (hal_temperatures.cpp) without the instructions'
+// own time: the cycle's nominal start plus the waits done in it, never decreasing.
+class CycleClock final : public hal::Clock {
+public:
+    void start_cycle(std::uint32_t cycle) noexcept {
+        base_us_ = static_cast<std::uint64_t>(cycle) * 1000000U / kRateHz;
+        waited_us_ = 0U;
+    }
+    std::uint64_t now_us() noexcept override {
+        const std::uint64_t t = base_us_ + waited_us_;
+        last_us_ = t > last_us_ ? t : last_us_;
+        return last_us_;
+    }
+    void wait_us(std::uint32_t us) noexcept override { waited_us_ += us; }
+
+private:
+    std::uint64_t base_us_ = 0U;
+    std::uint64_t waited_us_ = 0U;
+    std::uint64_t last_us_ = 0U;
+};
+
+CycleClock g_clock;
+BoomTemperatures g_temperatures{g_clock};
+
+}  // namespace
+
+// temperature_source.hpp on the host.
+void temperatures_update(std::uint32_t cycle) noexcept {
+    g_clock.start_cycle(cycle);
+    g_temperatures.update(cycle, kRateHz);
+}
+const HeadTemperatures<Scalar>& temperatures_of(std::uint8_t head) noexcept {
+    return g_temperatures.of(head);
+}
+StatusBits temperatures_merge_status(std::uint8_t head, StatusBits core) noexcept {
+    return g_temperatures.merge_status(head, core);
+}
+
+}  // namespace ascorr::app
+
+namespace {
+
+using ascorr::kMaxHeads;
+using ascorr::app::Scalar;
+using ascorr::app::SolutionRecord;
+
+constexpr double kRadToArcsec = 180.0 / 3.14159265358979323846 * 3600.0;
+
+// One corrected solution as printed: status and the components' bit patterns.
+struct Printed {
+    unsigned status = 0U;
+    std::uint32_t bits[4] = {};
+};
+
+// What a report says of the solutions.
+struct Report {
+    std::uint32_t cycles = 0U;
+    bool head_seen[kMaxHeads] = {};
+    unsigned applied[kMaxHeads] = {};
+    unsigned status_seen[kMaxHeads] = {};
+    Printed last[kMaxHeads];
+    struct Sample {
+        unsigned cycle;
+        unsigned head;
+        Printed s;
+    };
+    std::vector<Sample> samples;
+    bool crc_seen[kMaxHeads] = {};
+    unsigned crc_cycles[kMaxHeads] = {};
+    std::uint32_t crc[kMaxHeads] = {};
+};
+
+Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
+    using ascorr::app::bits_of;
+    return {c.status,
+            {bits_of(c.q_chu_icrf.w), bits_of(c.q_chu_icrf.x), bits_of(c.q_chu_icrf.y), bits_of(c.q_chu_icrf.z)}};
+}
+
+Report from_record(const SolutionRecord& r, std::uint32_t cycles) {
+    Report out;
+    out.cycles = cycles;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const SolutionRecord::Head& hd = r.head(h);
+        out.head_seen[h] = true;
+        out.applied[h] = hd.applied;
+        out.status_seen[h] = hd.status_union;
+        out.last[h] = printed(hd.last);
+        out.crc_seen[h] = true;
+        out.crc_cycles[h] = hd.solutions;
+        out.crc[h] = hd.crc;
+    }
+    for (std::uint32_t i = 0; i < r.samples_taken(); ++i) {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            out.samples.push_back({i * SolutionRecord::kSampleEvery, h, printed(r.sample(i, h))});
+        }
+    }
+    return out;
+}
+
+bool parse_report(const std::string& path, Report& out) {
+    std::ifstream in(path);
+    if (!in) {
+        std::cerr << path << ": cannot open\n";
+        return false;
+    }
+    std::string line;
+    for (int n = 1; std::getline(in, line); ++n) {
+        unsigned h = 0U;
+        unsigned a = 0U;
+        unsigned st = 0U;
+        unsigned c = 0U;
+        unsigned cycles = 0U;
+        Printed p;
+        char rest = 0;
+        if (std::sscanf(line.c_str(), "%*[^,], %u cycles at", &cycles) == 1 &&
+            line.find(" core, ") != std::string::npos) {
+            out.cycles = cycles;
+        } else if (std::sscanf(line.c_str(), "head %u: applied %u status seen %u last q %8x %8x %8x %8x%c", &h, &a, &st,
+                               &p.bits[0], &p.bits[1], &p.bits[2], &p.bits[3], &rest) == 7 &&
+                   h < kMaxHeads) {
+            out.head_seen[h] = true;
+            out.applied[h] = a;
+            out.status_seen[h] = st;
+            p.status = st;
+            out.last[h] = p;
+        } else if (std::sscanf(line.c_str(), "sample cycle %u head %u status %u q %8x %8x %8x %8x%c", &c, &h, &p.status,
+                               &p.bits[0], &p.bits[1], &p.bits[2], &p.bits[3], &rest) == 7 &&
+                   h < kMaxHeads) {
+            out.samples.push_back({c, h, p});
+        } else if (std::sscanf(line.c_str(), "solutions head %u cycles %u crc32c %8x%c", &h, &c, &p.bits[0], &rest) ==
+                       3 &&
+                   h < kMaxHeads) {
+            out.crc_seen[h] = true;
+            out.crc_cycles[h] = c;
+            out.crc[h] = p.bits[0];
+        } else if (line.rfind("head ", 0) == 0 || line.rfind("sample ", 0) == 0 || line.rfind("solutions ", 0) == 0) {
+            std::cerr << path << ":" << n << ": malformed line: " << line << "\n";
+            return false;
+        }
+    }
+    if (out.cycles == 0U) {
+        std::cerr << path << ": no \"core, N cycles at\" line: not a flight loop report\n";
+        return false;
+    }
+    return true;
+}
+
+double value(std::uint32_t bits) {
+    if constexpr (std::is_same_v<Scalar, float>) {
+        float f = 0.0F;
+        std::memcpy(&f, &bits, sizeof f);
+        return static_cast<double>(f);
+    } else {
+        return static_cast<double>(static_cast<std::int32_t>(bits)) / 1073741824.0;  // Q30: raw·2⁻³⁰
+    }
+}
+
+// The rotation angle between two printed quaternions, arcsec (sign-blind: q and −q are one rotation).
+double angle_arcsec(const Printed& a, const Printed& b) {
+    double qa[4];
+    double qb[4];
+    for (int i = 0; i < 4; ++i) {
+        qa[i] = value(a.bits[i]);
+        qb[i] = value(b.bits[i]);
+    }
+    // conj(a) ⊗ b: scalar part and vector part.
+    const double w = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+    const double x = qa[0] * qb[1] - qa[1] * qb[0] - qa[2] * qb[3] + qa[3] * qb[2];
+    const double y = qa[0] * qb[2] + qa[1] * qb[3] - qa[2] * qb[0] - qa[3] * qb[1];
+    const double z = qa[0] * qb[3] - qa[1] * qb[2] + qa[2] * qb[1] - qa[3] * qb[0];
+    return 2.0 * std::atan2(std::sqrt(x * x + y * y + z * z), std::fabs(w)) * kRadToArcsec;
+}
+
+std::string hex(std::uint32_t v) {
+    char b[9];
+    std::snprintf(b, sizeof b, "%08x", v);
+    return b;
+}
+
+struct Outcome {
+    int differences = 0;
+    int identical = 0;  // quaternions bit for bit
+    int compared = 0;   // quaternions
+    double worst = 0.0;
+};
+
+// One quaternion and its status: `what` names it in a message (printed when `loud`).
+void compare_one(const std::string& what, const Printed& host, const Printed& image, bool check_status, double bound,
+                 bool loud, Outcome& o) {
+    ++o.compared;
+    const bool same = std::memcmp(host.bits, image.bits, sizeof host.bits) == 0;
+    o.identical += same ? 1 : 0;
+    const double a = same ? 0.0 : angle_arcsec(host, image);
+    o.worst = a > o.worst ? a : o.worst;
+    std::string why;
+    if (check_status && host.status != image.status) {
+        why = "status " + std::to_string(image.status) + ", host " + std::to_string(host.status);
+    } else if (bound == 0.0 && !same) {
+        why = "q " + hex(image.bits[0]) + " " + hex(image.bits[1]) + " " + hex(image.bits[2]) + " " +
+              hex(image.bits[3]) + ", host " + hex(host.bits[0]) + " " + hex(host.bits[1]) + " " + hex(host.bits[2]) +
+              " " + hex(host.bits[3]) + " (bit for bit expected)";
+    } else if (bound > 0.0 && !(a <= bound)) {
+        why = "q " + std::to_string(a) + " arcsec from the host's (bound " + std::to_string(bound) + ")";
+    }
+    if (!why.empty()) {
+        ++o.differences;
+        if (loud) {
+            std::cout << "  " << what << ": " << why << "\n";
+        }
+    }
+}
+
+Outcome compare(const Report& host, const Report& image, double bound, bool loud) {
+    Outcome o;
+    auto differ = [&](const std::string& msg) {
+        ++o.differences;
+        if (loud) {
+            std::cout << "  " << msg << "\n";
+        }
+    };
+    for (unsigned h = 0; h < kMaxHeads; ++h) {
+        const std::string head = "head " + std::to_string(h);
+        if (!image.head_seen[h]) {
+            differ(head + ": no \"head\" line in the image's report");
+            continue;
+        }
+        if (image.applied[h] != host.applied[h] || image.status_seen[h] != host.status_seen[h]) {
+            differ(head + ": applied " + std::to_string(image.applied[h]) + " status seen " +
+                   std::to_string(image.status_seen[h]) + ", host " + std::to_string(host.applied[h]) + " / " +
+                   std::to_string(host.status_seen[h]));
+        }
+        compare_one(head + ", last solution (cycle " + std::to_string(host.cycles - 1U) + ")", host.last[h],
+                    image.last[h], false, bound, loud, o);
+        if (!image.crc_seen[h]) {
+            differ(head + ": no \"solutions\" line in the image's report");
+        } else if (image.crc_cycles[h] != host.crc_cycles[h] || (bound == 0.0 && image.crc[h] != host.crc[h])) {
+            differ(head + ": CRC-32C of " + std::to_string(image.crc_cycles[h]) + " cycles " + hex(image.crc[h]) +
+                   ", host " + std::to_string(host.crc_cycles[h]) + " cycles " + hex(host.crc[h]));
+        }
+    }
+    if (image.samples.size() != host.samples.size()) {
+        differ(std::to_string(image.samples.size()) + " samples, host " + std::to_string(host.samples.size()));
+    }
+    for (std::size_t i = 0; i < host.samples.size() && i < image.samples.size(); ++i) {
+        const Report::Sample& e = host.samples[i];
+        const Report::Sample& g = image.samples[i];
+        const std::string what = "sample cycle " + std::to_string(e.cycle) + " head " + std::to_string(e.head);
+        if (g.cycle != e.cycle || g.head != e.head) {
+            differ(what + ": the image's line " + std::to_string(i + 1U) + " is cycle " + std::to_string(g.cycle) +
+                   " head " + std::to_string(g.head));
+            continue;
+        }
+        compare_one(what, e.s, g.s, true, bound, loud, o);
+    }
+    return o;
+}
+
+// The smallest change the comparison must see: the first sample's w off by
+// one bit (bit for bit), or the first sample rotated by twice the bound about
+// its x axis (q ⊗ (cos θ/2, sin θ/2, 0, 0), θ = 2·bound).
+Report mutated(Report r, double bound) {
+    if (r.samples.empty()) {
+        return r;
+    }
+    Printed& p = r.samples.front().s;
+    if (bound == 0.0) {
+        p.bits[0] ^= 1U;
+        return r;
+    }
+    const double half = bound / kRadToArcsec;  // θ/2
+    const double c = std::cos(half);
+    const double sn = std::sin(half);
+    double q[4];
+    for (int i = 0; i < 4; ++i) {
+        q[i] = value(p.bits[i]);
+    }
+    const double m[4] = {q[0] * c - q[1] * sn, q[1] * c + q[0] * sn, q[2] * c + q[3] * sn, q[3] * c - q[2] * sn};
+    for (int i = 0; i < 4; ++i) {
+        if constexpr (std::is_same_v<Scalar, float>) {
+            p.bits[i] = ascorr::app::bits_of(static_cast<float>(m[i]));
+        } else {
+            p.bits[i] = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(m[i] * 1073741824.0)));
+        }
+    }
+    return r;
+}
+
+ascorr::app::FlightCycle& run(std::uint32_t cycles) {
+    static ascorr::app::FlightCycle flight;  // static, as on the DPU
+    ascorr::app::NoMeter meter;
+    for (std::uint32_t cycle = 0U; cycle < cycles; ++cycle) {
+        flight.run(cycle, meter);
+    }
+    return flight;
+}
+
+bool parse_count(const char* s, unsigned long max, unsigned long& out) {
+    char* end = nullptr;
+    out = std::strtoul(s, &end, 10);
+    return end != s && *end == '\0' && out >= 1UL && out <= max;
+}
+
+int usage(const char* argv0) {
+    std::cerr << "usage: " << argv0 << " check REPORT BOUND_ARCSEC   (0: bit for bit)\n"
+              << "       " << argv0 << " print CYCLES               (1 to 100000)\n";
+    return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc == 3 && std::strcmp(argv[1], "print") == 0) {
+        unsigned long cycles = 0UL;
+        if (!parse_count(argv[2], 100000UL, cycles)) {
+            return usage(argv[0]);
+        }
+        const ascorr::app::FlightCycle& flight = run(static_cast<std::uint32_t>(cycles));
+        flight.record().print_heads();
+        flight.record().print_solutions();
+        return 0;
+    }
+    if (argc != 4 || std::strcmp(argv[1], "check") != 0) {
+        return usage(argv[0]);
+    }
+    char* end = nullptr;
+    const double bound = std::strtod(argv[3], &end);
+    if (end == argv[3] || *end != '\0' || !(bound >= 0.0 && bound < 3600.0)) {
+        std::cerr << argv[0] << ": BOUND_ARCSEC '" << argv[3] << "' is not in [0, 3600)\n";
+        return 2;
+    }
+    Report image;
+    if (!parse_report(argv[2], image)) {
+        return 1;
+    }
+    if (image.cycles > 100000U) {
+        std::cerr << argv[2] << ": " << image.cycles << " cycles: more than this check runs (100000)\n";
+        return 1;
+    }
+    const Report host = from_record(run(image.cycles).record(), image.cycles);
+    std::cout << "flight loop vs the host core (" << (bound == 0.0 ? "bit for bit" : "within the bound") << "), "
+              << image.cycles << " cycles:\n";
+    const Outcome o = compare(host, image, bound, true);
+    std::cout << "  " << o.compared << " quaternions compared (" << host.samples.size()
+              << " samples and each head's last), " << o.identical << " bit for bit, worst " << o.worst << " arcsec";
+    if (bound > 0.0) {
+        std::cout << " (bound " << bound << ")";
+    }
+    std::cout << "; CRC-32C over every cycle " << (bound == 0.0 ? "compared" : "not compared (not bit for bit)")
+              << "\n";
+    if (o.differences != 0 || host.samples.empty()) {
+        std::cout << "  " << o.differences << " differences: the image's solutions are not the host core's\n";
+        return 1;
+    }
+    std::cout << "solutions match the host core's" << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
+    const Outcome m = compare(mutated(host, bound), image, bound, false);
+    if (m.differences == 0) {
+        std::cout << "  a mutated expectation (first sample perturbed) still matches: the comparison is vacuous\n";
+        return 1;
+    }
+    std::cout << "mutated expectation refused\n";
+    return 0;
+}
