@@ -118,7 +118,7 @@ ascorr::ThermalModel<T> to_core(const ModelRow* rows, int n) {
     using Tr = ascorr::ScalarTraits<T>;
     ascorr::ThermalModel<T> m{};
     for (int i = 0; i < n; ++i) {
-        const auto h = static_cast<unsigned>(rows[i].chu - 'A');
+        const std::uint8_t h = ascorr::head_index(rows[i].chu);
         if (h >= ascorr::kMaxHeads) {
             continue;
         }
@@ -147,7 +147,7 @@ double max_error_arcsec(const Row* in, const Row* want, int n, const ModelRow* m
         ascorr::SolutionInput<T> s{};
         s.q_chu_icrf = {Tr::from_double(in[i].q[0]), Tr::from_double(in[i].q[1]), Tr::from_double(in[i].q[2]),
                         Tr::from_double(in[i].q[3])};
-        s.head = static_cast<std::uint8_t>(in[i].chu - 'A');
+        s.head = ascorr::head_index(in[i].chu);
         s.temperatures = {
             {Tr::celsius(in[i].temp[0]), true}, {Tr::celsius(in[i].temp[1]), true}, {Tr::celsius(in[i].temp[2]), true}};
         s.velocity.valid = false;

@@ -20,8 +20,8 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                 const double lim =
                     i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
                 if (!(std::abs(c * kArcsecToRad) < lim)) {
-                    throw std::runtime_error(path + ": " + "ABCD"[h] + " " + kAxisNames[a] + " " +
-                                             kCoefficientNames[i] + " = " + std::to_string(c) +
+                    throw std::runtime_error(path + ": " + head_name(static_cast<std::uint8_t>(h)) + " " +
+                                             kAxisNames[a] + " " + kCoefficientNames[i] + " = " + std::to_string(c) +
                                              " is beyond the fixed-point coefficient range (+-" +
                                              std::to_string(lim * kRadToArcsec) + " arcsec)");
                 }
@@ -84,7 +84,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         const std::uint8_t head = head_from_name(chu);
         if (head == kUnknownHead) {
             throw InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
-                             "chu must be A, B, C or D, got '" + std::string(chu) + "'");
+                             "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
         }
         const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
         int axis = -1;

@@ -7,6 +7,7 @@
 //   vector3.hpp        3-vectors
 //   quaternion.hpp     Hamilton, scalar-first attitude quaternions
 //   aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
+//   heads.hpp          the camera heads: how many, their letters
 //   thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
 //   status.hpp         status bits of a corrected solution
 //   correct.hpp        correct_solution(): the per-solution entry point
@@ -30,6 +31,7 @@
 #include "correct.hpp"
 #include "earth_series.hpp"
 #include "fixed_point.hpp"
+#include "heads.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "status.hpp"

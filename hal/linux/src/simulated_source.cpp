@@ -108,10 +108,10 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
         }
         if (col_chu >= 0) {
             const auto& [v, c] = f[static_cast<std::size_t>(col_chu)];
-            if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
-                throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
+            if (v.size() != 1 || head_index(v[0]) == kUnknownHead) {
+                throw ConfigError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
             }
-            r.head = v[0] - 'A';
+            r.head = head_index(v[0]);
         }
         double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
         const int cols[3] = {col_t1, col_t2, col_t3};
