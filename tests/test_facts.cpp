@@ -5,16 +5,22 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
+#include <cmath>
 #include <fstream>
+#include <random>
 #include <regex>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "ascorr/fixed_point.hpp"
 #include "ascorr/heads.hpp"
+#include "ascorr/model_coefficients.hpp"
 #include "ascorr_hal/channel_config.hpp"
+#include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "target/vector_convert.hpp"
 
 namespace ascorr {
 namespace {
@@ -155,6 +161,92 @@ TEST(Heads, NoLetterRangeInTheDocumentationEndsElsewhere) {
     int m = 0;
     EXPECT_EQ(stray_ranges(fill("heads {first}–{next}, `\"{first}\"`…`\"{last}\"`"), m).size(), 1U);
     EXPECT_EQ(m, 2);
+}
+
+// ---- The model → core conversion (ascorr/model_coefficients.hpp)
+
+// The 3 × 7 coefficients of one head, back in double.
+template <typename T>
+std::vector<double> values(const HeadThermalModel<T>& h) {
+    using Tr = ScalarTraits<T>;
+    std::vector<double> v;
+    for (const AxisPolynomial<T>* a : {&h.alpha, &h.beta, &h.gamma}) {
+        for (const auto& c : {a->c0, a->c1, a->c2, a->c3}) {
+            v.push_back(Tr::to_double(c));
+        }
+        for (const auto& c : {a->c1_2, a->c2_2, a->c3_2}) {
+            v.push_back(Tr::to_double(c));
+        }
+    }
+    return v;
+}
+
+host::ModelFile random_model(std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> c0(-200.0, 200.0);
+    std::uniform_real_distribution<double> c1(-5.0, 5.0);
+    std::uniform_real_distribution<double> c2(-0.02, 0.02);
+    host::ModelFile m;
+    m.quadratic = true;
+    for (std::size_t h = 0; h + 1 < kMaxHeads; ++h) {  // the last head absent
+        m.present[h] = true;
+        for (auto& axis : m.coefficients[h]) {
+            axis = {c0(rng), c1(rng), c1(rng), c1(rng), c2(rng), c2(rng), c2(rng)};
+        }
+    }
+    return m;
+}
+
+target::ModelRecord record_of(const host::ModelFile& m) {  // radians, as target_vectors writes them
+    target::ModelRecord r{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        r.present[h] = m.present[h] ? 1U : 0U;
+        for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t i = 0; i < 7; ++i) {
+                r.coefficient[h][a][i] = m.coefficients[h][a][i] * kArcsecToRad;
+            }
+        }
+    }
+    return r;
+}
+
+// Every path into the core's model (the host's model files and Python's
+// Model: host::to_core; the target vectors: target::to_core_model) gives the
+// same bits, and those are the file's arcsec in radians rounded once to the
+// scalar's format: checked against π/648000 in long double, to half a unit of
+// the format (double and float: of the last place; Q30: 2⁻³⁷ linear, 2⁻⁴⁹
+// quadratic, fixed_point.hpp).
+template <typename T>
+void check_conversion(const host::ModelFile& m, double linear_bound, double quadratic_bound, bool relative) {
+    const ThermalModel<T> host_model = host::to_core<T>(m);
+    const ThermalModel<T> target_model = target::to_core_model<T>(record_of(m));
+    const long double arcsec = std::acos(-1.0L) / 648000.0L;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        EXPECT_EQ(host_model.head[h].present, m.present[h]);
+        EXPECT_EQ(target_model.head[h].present, m.present[h]);
+        const std::vector<double> got = values(host_model.head[h]);
+        EXPECT_EQ(got, values(target_model.head[h])) << head_letter(h);
+        for (std::size_t k = 0; k < got.size(); ++k) {
+            const long double want = static_cast<long double>(m.coefficients[h][k / 7][k % 7]) * arcsec;
+            const double bound =
+                (k % 7 < 4 ? linear_bound : quadratic_bound) * (relative ? static_cast<double>(std::fabs(want)) : 1.0);
+            EXPECT_LE(static_cast<double>(std::fabs(static_cast<long double>(got[k]) - want)), bound)
+                << head_letter(h) << " axis " << k / 7 << " term " << k % 7;
+        }
+    }
+}
+
+TEST(ModelConversion, EveryPathGivesTheCoresBitsWithinHalfAUnitOfTheFormat) {
+    std::mt19937_64 rng(14);
+    for (int i = 0; i < 20; ++i) {
+        const host::ModelFile m = random_model(rng);
+        check_conversion<double>(m, 0x1p-52, 0x1p-52, true);  // the product's rounding, then none
+        check_conversion<float>(m, 0x1p-24 + 0x1p-52, 0x1p-24 + 0x1p-52, true);
+        check_conversion<Q30>(m, 0x1p-37 + 1e-18, 0x1p-49 + 1e-20, false);
+    }
+    // Mutation: the same numbers taken as radians (no arcsec conversion) are caught.
+    const host::ModelFile m = random_model(rng);
+    const ThermalModel<double> wrong = thermal_model<double>(host::coefficients_of(m), 1.0);
+    EXPECT_NE(values(wrong.head[0]), values(host::to_core<double>(m).head[0]));
 }
 
 }  // namespace

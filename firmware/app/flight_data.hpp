@@ -13,39 +13,30 @@
 #include "app_scalar.hpp"
 #include "ascorr/aberration.hpp"
 #include "ascorr/constants.hpp"
+#include "ascorr/model_coefficients.hpp"
 #include "ascorr/quaternion.hpp"
 #include "ascorr/thermal.hpp"
 
 namespace ascorr::app {
 
-struct ArcsecAxis {
-    double c0;
-    double c1;
-    double c2;
-    double c3;
+// Herceg, Jørgensen & Jørgensen 2017, Table 2 (alpha, beta, gamma per head;
+// c0, c1, c2, c3 in arcsec and arcsec/°C).
+constexpr ModelCoefficients kTable2Arcsec = {
+    {true, true, true},
+    {
+        {{-4.67067e-01, 3.58190e-03, -9.04363e-03, -1.04154e-01},
+         {4.59718e-01, -3.52161e-03, 8.89788e-03, 1.02497e-01},
+         {2.36543e-01, -7.31744e-01, 4.50041e-01, -1.12265e+00}},
+        {{-1.19000e+00, 3.27044e-01, -2.10603e-01, 2.40148e-01},
+         {2.03750e+00, -4.03134e-01, 4.04762e-02, 6.57657e-02},
+         {5.51564e+00, -3.12725e-02, -7.31304e-01, 2.07894e+00}},
+        {{4.08584e-02, 1.36145e-02, 1.57687e-02, 8.06663e-03},
+         {2.99157e-02, 9.95873e-03, 1.15304e-02, 5.89875e-03},
+         {1.17996e+01, -2.01007e-01, 4.97267e-01, 2.25162e+00}},
+    },
 };
 
-constexpr AxisPolynomial<Scalar> axis_rad(const ArcsecAxis& a) {
-    using Tr = ScalarTraits<Scalar>;
-    return {Tr::coefficient(a.c0 * kArcsecToRad), Tr::coefficient(a.c1 * kArcsecToRad),
-            Tr::coefficient(a.c2 * kArcsecToRad), Tr::coefficient(a.c3 * kArcsecToRad),
-            Tr::quadratic_coefficient(0.0),       Tr::quadratic_coefficient(0.0),
-            Tr::quadratic_coefficient(0.0)};
-}
-
-// Herceg, Jørgensen & Jørgensen 2017, Table 2 (alpha, beta, gamma per head).
-constexpr ThermalModel<Scalar> kThermalModel{{
-    {true, axis_rad({-4.67067e-01, 3.58190e-03, -9.04363e-03, -1.04154e-01}),
-     axis_rad({4.59718e-01, -3.52161e-03, 8.89788e-03, 1.02497e-01}),
-     axis_rad({2.36543e-01, -7.31744e-01, 4.50041e-01, -1.12265e+00})},
-    {true, axis_rad({-1.19000e+00, 3.27044e-01, -2.10603e-01, 2.40148e-01}),
-     axis_rad({2.03750e+00, -4.03134e-01, 4.04762e-02, 6.57657e-02}),
-     axis_rad({5.51564e+00, -3.12725e-02, -7.31304e-01, 2.07894e+00})},
-    {true, axis_rad({4.08584e-02, 1.36145e-02, 1.57687e-02, 8.06663e-03}),
-     axis_rad({2.99157e-02, 9.95873e-03, 1.15304e-02, 5.89875e-03}),
-     axis_rad({1.17996e+01, -2.01007e-01, 4.97267e-01, 2.25162e+00})},
-    {false, {}, {}, {}},
-}};
+constexpr ThermalModel<Scalar> kThermalModel = thermal_model<Scalar>(kTable2Arcsec, kArcsecToRad);
 
 constexpr Scalar s(double x) {
     return ScalarTraits<Scalar>::from_double(x);

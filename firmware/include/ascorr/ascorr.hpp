@@ -9,6 +9,7 @@
 //   aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
 //   heads.hpp          the camera heads: how many, their letters
 //   thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
+//   model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
 //   status.hpp         status bits of a corrected solution
 //   correct.hpp        correct_solution(): the per-solution entry point
 //   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
@@ -32,6 +33,7 @@
 #include "earth_series.hpp"
 #include "fixed_point.hpp"
 #include "heads.hpp"
+#include "model_coefficients.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "status.hpp"
