@@ -12,14 +12,18 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "ascorr/fixed_point.hpp"
 #include "ascorr/heads.hpp"
 #include "ascorr/model_coefficients.hpp"
+#include "ascorr/table2.hpp"
 #include "ascorr_hal/channel_config.hpp"
+#include "ascorr_host/embedded_model.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "flight_data.hpp"  // firmware/app: the flight model, in float (app_scalar.hpp) on the host
 #include "target/vector_convert.hpp"
 
 namespace ascorr {
@@ -163,8 +167,6 @@ TEST(Heads, NoLetterRangeInTheDocumentationEndsElsewhere) {
     EXPECT_EQ(m, 2);
 }
 
-// ---- The model → core conversion (ascorr/model_coefficients.hpp)
-
 // The 3 × 7 coefficients of one head, back in double.
 template <typename T>
 std::vector<double> values(const HeadThermalModel<T>& h) {
@@ -180,6 +182,68 @@ std::vector<double> values(const HeadThermalModel<T>& h) {
     }
     return v;
 }
+
+// ---- Table 2 (ascorr/table2.hpp)
+
+std::string contract_table2_path() {
+    return std::string(ASCORR_TEST_DATA) + "/model_table2.csv";
+}
+
+// Coefficients (and presence) of `file` that differ from the core's kTable2.
+int differences_from_table2(const host::ModelFile& file) {
+    int n = 0;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        n += file.present[h] != kTable2.present[h] ? 1 : 0;
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                // Bit for bit: the file's decimal and the header's literal round to the same double.
+                n += file.coefficients[h][a][i] != kTable2.coefficient[h][a][i] ? 1 : 0;
+            }
+        }
+    }
+    return n;
+}
+
+// The core's table is the data contract's Table 2 (tests/data/model_table2.csv,
+// itself the specification's file by tests/data/SHA256SUMS), bit for bit.
+TEST(Table2, TheCoresTableIsTheContractsFileBitForBit) {
+    const host::ModelFile file = host::read_model_file(contract_table2_path());
+    EXPECT_FALSE(file.quadratic);
+    EXPECT_EQ(differences_from_table2(file), 0);
+    // Mutation: one coefficient off in its last printed digit is caught.
+    std::string text = source_file("tests/data/model_table2.csv");
+    const std::string digit = "1.17996e+01";
+    ASSERT_NE(text.find(digit), std::string::npos);
+    text.replace(text.find(digit), digit.size(), "1.17997e+01");
+    EXPECT_EQ(differences_from_table2(host::parse_model("mutated", text)), 1);
+}
+
+// The files that carry Table 2 besides the contract's: the README's example
+// model and the fuzzer's seed, byte for byte the contract's.
+TEST(Table2, EveryFileCopyIsTheContractsFile) {
+    const std::string contract = source_file("tests/data/model_table2.csv");
+    EXPECT_EQ(source_file("host_sim/data/model_table2.csv"), contract);
+    EXPECT_EQ(source_file("tests/fuzz/corpus/model_csv/table2.csv"), contract);
+}
+
+// What is built from it: `simulate`'s default truth, and the flight
+// application's model (firmware/app/flight_data.hpp, compiled here in the
+// flight scalar float; the Q30 image converts the same kTable2 through the
+// same thermal_model()) equals the contract's file converted by the host.
+TEST(Table2, TheFlightModelAndTheSimulatorsTruthAreTheContractsFile) {
+    const host::ModelFile file = host::read_model_file(contract_table2_path());
+    EXPECT_EQ(differences_from_table2(host::table2_model()), 0);
+    EXPECT_EQ(host::table2_model().coefficients, file.coefficients);
+    static_assert(std::is_same_v<app::Scalar, float>, "the host sees the float flight build");
+    const ThermalModel<float> want = host::to_core<float>(file);
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        EXPECT_EQ(app::kThermalModel.head[h].present, file.present[h]) << head_letter(h);
+        EXPECT_EQ(values(app::kThermalModel.head[h]), values(want.head[h])) << head_letter(h);
+    }
+    EXPECT_NE(values(app::kThermalModel.head[2]), values(ThermalModel<float>{}.head[2]));  // not vacuous
+}
+
+// ---- The model → core conversion (ascorr/model_coefficients.hpp)
 
 host::ModelFile random_model(std::mt19937_64& rng) {
     std::uniform_real_distribution<double> c0(-200.0, 200.0);

@@ -18,6 +18,7 @@
 //   earth_series.hpp   the Earth's barycentric velocity and Sun distance, a
 //                      series fitted to ERFA eraEpv00 (double; coefficients in
 //                      the generated earth_series_table.hpp)
+// Data (not included here): table2.hpp, the paper's Table 2 as ModelCoefficients.
 // The on-board observer velocity (not included here; include velocity_service.hpp):
 //   tt_time.hpp        TT time tags in integer microseconds
 //   earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
