@@ -84,7 +84,7 @@ void run(const char* name, Bench<T>& b, std::uint32_t ipc) {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
             b.clock.set(std::uint64_t{i} * 1000000U);
             b.adc.set_second(i);
-            for (std::uint8_t h = 0; h < 4U; ++h) {
+            for (std::uint8_t h = 0; h < ascorr::kMaxHeads; ++h) {
                 valid += acq.head(h, std::uint64_t{kRuns - 1U} * 1000000U).temperatures.t_032.valid ? 1U : 0U;
             }
             g_sink = valid;

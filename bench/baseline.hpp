@@ -18,11 +18,13 @@
 #include <cmath>
 #include <cstdint>
 
+#include "ascorr/heads.hpp"
+
 namespace ascorr::bench {
 
 struct BaselineModel {
-    bool present[4];
-    double coefficient[4][3][7];  // rad, rad/°C, rad/°C²
+    bool present[kMaxHeads];
+    double coefficient[kMaxHeads][3][7];  // rad, rad/°C, rad/°C²
 };
 
 struct BaselineInput {
@@ -64,7 +66,7 @@ inline BaselineOutput baseline_correct(const BaselineInput& in, const BaselineMo
         const Eigen::Quaterniond q_ab(Eigen::AngleAxisd(angle, axis.normalized()));
         q = q * q_ab.conjugate();
     }
-    if (model != nullptr && in.head < 4 && model->present[in.head] && in.temperatures_valid) {
+    if (model != nullptr && in.head < kMaxHeads && model->present[in.head] && in.temperatures_valid) {
         const double a = baseline_angle(model->coefficient[in.head][0], in.temperature);
         const double b = baseline_angle(model->coefficient[in.head][1], in.temperature);
         const double g = baseline_angle(model->coefficient[in.head][2], in.temperature);

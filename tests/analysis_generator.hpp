@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "ascorr/constants.hpp"
+#include "ascorr/heads.hpp"
 #include "ascorr_host/model_csv.hpp"
 
 namespace ascorr::test {
@@ -240,8 +241,8 @@ inline Generated generate(const std::string& path, const GeneratorOptions& o) {
                 std::snprintf(vel, sizeof vel, "%.6f,%.6f,%.6f", v_sc.x(), v_sc.y(), v_sc.z());
             }
             std::snprintf(line, sizeof line, "%.3f,%c,%.15f,%.15f,%.15f,%.15f,%s,%.3f,%.3f,%s,%d,%.2f\n", t,
-                          static_cast<char>('A' + hi), q_raw.w(), q_raw.x(), q_raw.y(), q_raw.z(), tc.c_str(), t029,
-                          t032, vel, flags, conf);
+                          ascorr::head_letter(static_cast<std::uint8_t>(hi)), q_raw.w(), q_raw.x(), q_raw.y(),
+                          q_raw.z(), tc.c_str(), t029, t032, vel, flags, conf);
             f << line;
             written[h] = true;
             clean[h] = !dropped;

@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 
+#include "ascorr/heads.hpp"
 #include "ascorr/velocity_service.hpp"
 #include "test_support.hpp"
 
@@ -60,9 +61,9 @@ inline StatesRecording make_states_recording(const std::filesystem::path& dir, i
         const Eigen::Quaterniond q = random_attitude(rng);
         const double t = kT0 - 2.0 + 0.3 * (i / 3);
         std::snprintf(buf, sizeof buf, "%.6f,%c,%.15f,%.15f,%.15f,%.15f,%.2f,%.2f,%.2f,%s,0,1\n", t,
-                      static_cast<char>('A' + i % 3), q.w() < 0 ? -q.w() : q.w(), q.w() < 0 ? -q.x() : q.x(),
-                      q.w() < 0 ? -q.y() : q.y(), q.w() < 0 ? -q.z() : q.z(), 20.0 + 0.001 * i, 21.5, 19.25,
-                      i % 37 == 5 ? "1.25,-6.5,3.75" : ",,");
+                      ascorr::head_letter(static_cast<std::uint8_t>(i % 3)), q.w() < 0 ? -q.w() : q.w(),
+                      q.w() < 0 ? -q.x() : q.x(), q.w() < 0 ? -q.y() : q.y(), q.w() < 0 ? -q.z() : q.z(),
+                      20.0 + 0.001 * i, 21.5, 19.25, i % 37 == 5 ? "1.25,-6.5,3.75" : ",,");
         sol += buf;
     }
     StatesRecording out{(dir / "rec.csv").string(), (dir / "states.csv").string()};

@@ -29,6 +29,7 @@
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "target/vector_convert.hpp"
 #include "target/vector_format.hpp"
 
 namespace {
@@ -62,19 +63,6 @@ ModelRecord to_record(const host::ModelFile& m) {
         }
     }
     return r;
-}
-
-ThermalModel<double> to_model(const ModelRecord& r) {
-    ThermalModel<double> m{};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        m.head[h].present = r.present[h] != 0U;
-        AxisPolynomial<double>* axes[3] = {&m.head[h].alpha, &m.head[h].beta, &m.head[h].gamma};
-        for (std::size_t a = 0; a < 3; ++a) {
-            const double* c = r.coefficient[h][a];
-            *axes[a] = {c[0], c[1], c[2], c[3], c[4], c[5], c[6]};
-        }
-    }
-    return m;
 }
 
 SolutionInput<double> to_input(const VectorRecord& r) {
@@ -214,7 +202,8 @@ int check(const std::string& dir, double bound) {
         std::cerr << dir << "/vectors.bin: unreadable\n";
         return 1;
     }
-    const ThermalModel<double> models[kModels] = {to_model(header.model[0]), to_model(header.model[1])};
+    const ThermalModel<double> models[kModels] = {to_core_model<double>(header.model[0]),
+                                                  to_core_model<double>(header.model[1])};
     const char* expected_files[kConfigs] = {"expected_aberration_only.csv", "expected_thermal_only.csv",
                                             "expected_both.csv"};
     std::string storage[kConfigs];

@@ -16,6 +16,7 @@
 #include <cstring>
 
 #include "ascorr/ascorr.hpp"
+#include "ascorr/model_coefficients.hpp"
 #include "ascorr_hal/thermistor.hpp"  // installed with the package (unused beyond this check)
 #include "ascorr_link/frame.hpp"
 
@@ -113,25 +114,20 @@ int read_model(const char* path, ModelRow* rows) {
     return n;
 }
 
-template <typename T>
-ascorr::ThermalModel<T> to_core(const ModelRow* rows, int n) {
-    using Tr = ascorr::ScalarTraits<T>;
-    ascorr::ThermalModel<T> m{};
+// The rows in the core's layout (arcsec); the installed core converts them
+// (ascorr/model_coefficients.hpp).
+ascorr::ModelCoefficients coefficients_of(const ModelRow* rows, int n) {
+    ascorr::ModelCoefficients m{};
     for (int i = 0; i < n; ++i) {
-        const auto h = static_cast<unsigned>(rows[i].chu - 'A');
+        const std::uint8_t h = ascorr::head_index(rows[i].chu);
         if (h >= ascorr::kMaxHeads) {
             continue;
         }
-        ascorr::HeadThermalModel<T>& head = m.head[h];
-        head.present = true;
-        ascorr::AxisPolynomial<T>& a = rows[i].axis == 'a' ? head.alpha : rows[i].axis == 'b' ? head.beta : head.gamma;
-        a = {Tr::coefficient(rows[i].c[0] * ascorr::kArcsecToRad),
-             Tr::coefficient(rows[i].c[1] * ascorr::kArcsecToRad),
-             Tr::coefficient(rows[i].c[2] * ascorr::kArcsecToRad),
-             Tr::coefficient(rows[i].c[3] * ascorr::kArcsecToRad),
-             Tr::quadratic_coefficient(0.0),
-             Tr::quadratic_coefficient(0.0),
-             Tr::quadratic_coefficient(0.0)};
+        m.present[h] = true;
+        const int axis = rows[i].axis == 'a' ? 0 : rows[i].axis == 'b' ? 1 : 2;
+        for (int c = 0; c < 4; ++c) {
+            m.coefficient[h][axis][c] = rows[i].c[c];
+        }
     }
     return m;
 }
@@ -140,14 +136,14 @@ ascorr::ThermalModel<T> to_core(const ModelRow* rows, int n) {
 template <typename T>
 double max_error_arcsec(const Row* in, const Row* want, int n, const ModelRow* model, int nm) {
     using Tr = ascorr::ScalarTraits<T>;
-    const ascorr::ThermalModel<T> m = to_core<T>(model, nm);
+    const ascorr::ThermalModel<T> m = ascorr::thermal_model<T>(coefficients_of(model, nm), ascorr::kArcsecToRad);
     const ascorr::CorrectionConfig<T> cfg{false, &m};
     double worst = 0.0;
     for (int i = 0; i < n; ++i) {
         ascorr::SolutionInput<T> s{};
         s.q_chu_icrf = {Tr::from_double(in[i].q[0]), Tr::from_double(in[i].q[1]), Tr::from_double(in[i].q[2]),
                         Tr::from_double(in[i].q[3])};
-        s.head = static_cast<std::uint8_t>(in[i].chu - 'A');
+        s.head = ascorr::head_index(in[i].chu);
         s.temperatures = {
             {Tr::celsius(in[i].temp[0]), true}, {Tr::celsius(in[i].temp[1]), true}, {Tr::celsius(in[i].temp[2]), true}};
         s.velocity.valid = false;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -24,6 +25,7 @@
 #include "ascorr_hal_linux/replay_source.hpp"
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/solutions_csv.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 #ifdef ASCORR_HAVE_GPIOD
@@ -43,7 +45,7 @@ struct ThermistorOptions {
     std::vector<std::string> inject;
     unsigned frames = 1;
     double interval = 1.0;
-    char head = 'A';
+    char head = kHeadLetters[0];
 };
 
 std::string fault_list(hal::FaultBits f) {
@@ -113,7 +115,7 @@ void run(const ThermistorOptions& opt) {
         throw std::runtime_error("this build has no libgpiod backend: use --replay or --simulate");
 #endif
     }
-    const std::uint8_t head = static_cast<std::uint8_t>(opt.head - 'A');
+    const std::uint8_t head = head_index(opt.head);
     hal::TemperatureAcquisition<double> acq(acfg);
     std::FILE* out = stdout;
     std::fprintf(out, "t,name,role,counts,ohm,celsius,valid,faults\n");
@@ -191,13 +193,15 @@ void add_thermistors_command(CLI::App& app) {
     cmd->add_option("--interval", opt->interval, "live: seconds between frames")
         ->check(real_number())
         ->check(CLI::Range(0.0, 3600.0));
-    cmd->add_option("--head", opt->head, "head whose T_CHU is voted and printed (A-D)")
+    cmd->add_option("--head", opt->head,
+                    "head whose T_CHU is voted and printed (" + std::string(kHeadChoices.text) + ")")
         ->check(CLI::Validator(
             [](std::string& s) {
-                return s.size() == 1 && s[0] >= 'A' && s[0] <= 'D' ? std::string()
-                                                                   : s + " is out of range: a head is A, B, C or D";
+                return s.size() == 1 && head_index(s[0]) != kUnknownHead
+                           ? std::string()
+                           : s + " is out of range: a head is " + std::string(kHeadChoices.text);
             },
-            "A-D"));
+            kHeadChoices.text));
     cmd->callback([opt]() { run(*opt); });
 }
 

@@ -45,7 +45,8 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
         std::string why;
         switch (check_solution(in)) {
             case Rejection::kHeadOutOfRange:
-                why = "chu '" + std::string(rec.chu) + "' is not a camera head (A, B, C or D)";
+                why =
+                    "chu '" + std::string(rec.chu) + "' is not a camera head (" + std::string(kHeadChoices.text) + ")";
                 break;
             case Rejection::kQuaternionNotFinite:
                 why = "quaternion is not finite";

@@ -25,7 +25,7 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                     char what[200];
                     std::snprintf(what, sizeof what,
                                   "%c %s %s = %g %s is beyond the fixed-point coefficient range (|%s| < %g %s)",
-                                  "ABCD"[h], kAxisNames[a], kCoefficientNames[i], c, kUnits[i], kCoefficientNames[i],
+                                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[a], kCoefficientNames[i], c, kUnits[i], kCoefficientNames[i],
                                   lim * kRadToArcsec, kUnits[i]);
                     if (m.line[h][a] != 0) {
                         throw InputError(path, m.line[h][a], m.column[h][a][i], what);
@@ -93,7 +93,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         const std::uint8_t head = head_from_name(chu);
         if (head == kUnknownHead) {
             throw InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
-                             "chu must be A, B, C or D, got '" + std::string(chu) + "'");
+                             "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
         }
         const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
         int axis = -1;

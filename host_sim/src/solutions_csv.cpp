@@ -25,14 +25,11 @@ std::string_view header_line_of(std::string_view text, const std::string& file) 
 }  // namespace
 
 std::uint8_t head_from_name(std::string_view chu) noexcept {
-    if (chu.size() == 1 && chu[0] >= 'A' && chu[0] <= 'D') {
-        return static_cast<std::uint8_t>(chu[0] - 'A');
-    }
-    return kUnknownHead;
+    return chu.size() == 1 ? head_index(chu[0]) : kUnknownHead;
 }
 
 char head_name(std::uint8_t head) noexcept {
-    return head < 4 ? static_cast<char>('A' + head) : '?';
+    return head_letter(head);
 }
 
 SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)

@@ -7,10 +7,12 @@ components into CHU components; velocities km/s; angles arcsec.
 
 Functions: read_model, correct, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame. Classes: Model. Exceptions:
-InputError and FitRefused (both ValueError).
+InputError and FitRefused (both ValueError). HEADS: the head letters in
+index order (from the core's ascorr/heads.hpp).
 """
 
 from ._ascorr import (  # noqa: F401
+    HEADS,
     FitRefused,
     InputError,
     Model,

@@ -9,13 +9,15 @@ import numpy.typing as npt
 _Real = npt.ArrayLike  # any real dtype; float64 C-contiguous is used in place
 _Path = Union[str, PathLike[str]]
 
+HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
+
 class InputError(ValueError): ...
 class FitRefused(ValueError): ...
 
 class Model:
     def __init__(self, coefficients: npt.ArrayLike, heads: Optional[str] = ...) -> None: ...
     @property
-    def coefficients(self) -> npt.NDArray[np.float64]: ...  # (4, 3, 7) arcsec
+    def coefficients(self) -> npt.NDArray[np.float64]: ...  # (len(HEADS), 3, 7) arcsec
     @property
     def heads(self) -> str: ...
     @property

@@ -117,8 +117,18 @@ Doubles optional_real_array(const py::handle& obj, const std::string& name, py::
     return real_array(obj, name, n, cols);
 }
 
-// chu: strings "A".."D" (anything else is an unknown head, status 16) or
-// integer head indices (0..3; anything else: status 16), as the reader maps them.
+// The heads for messages and docstrings, from ascorr/heads.hpp: "'A'..'D'" and "0..3".
+std::string head_letter_range() {
+    return std::string("'") + kHeadLetters[0] + "'..'" + kHeadLetters[kMaxHeads - 1] + "'";
+}
+
+std::string head_index_range() {
+    return "0.." + std::to_string(kMaxHeads - 1);
+}
+
+// chu: head letters (kHeadLetters; anything else is an unknown head, status 16)
+// or integer head indices (below kMaxHeads; anything else: status 16), as the
+// reader maps them.
 std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
     const py::array a = as_numpy(obj);
     if (a.ndim() != 1) {
@@ -157,8 +167,8 @@ std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
                     second |= static_cast<std::uint32_t>(e[unit + b]) << (8 * (kind == 'U' ? b : 0));
                 }
             }
-            if (second == 0 && first >= 'A' && first <= 'D') {
-                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(first - 'A');
+            if (second == 0 && first < 0x80U) {
+                heads[static_cast<std::size_t>(i)] = head_index(static_cast<char>(first));
             }
         }
     } else if (kind == 'O') {
@@ -177,7 +187,8 @@ std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
             }
         }
     } else {
-        bad_argument("chu", "expected strings 'A'..'D' or integers 0..3, got dtype " + std::string(py::str(a.dtype())));
+        bad_argument("chu", "expected strings " + head_letter_range() + " or integers " + head_index_range() +
+                                ", got dtype " + std::string(py::str(a.dtype())));
     }
     return heads;
 }
@@ -230,12 +241,11 @@ Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, co
 // Row i as the solutions reader would have read it from a file holding the
 // same values: NaN is "not available", as `nan` in a file.
 void record_of(const Rows& r, py::ssize_t i, SolutionRecord& rec) {
-    static constexpr const char* kNames[5] = {"A", "B", "C", "D", "?"};
     const auto k = static_cast<std::size_t>(i);
     rec.line = k + 1;
     rec.t = r.t.data()[i];
     rec.head = r.head[k];
-    rec.chu = kNames[std::min<std::size_t>(rec.head, 4)];
+    rec.chu = rec.head < kMaxHeads ? std::string_view(&kHeadLetters[rec.head], 1) : std::string_view("?");
     const double* q = r.q.data() + 4 * i;
     rec.q_chu_icrf = {q[0], q[1], q[2], q[3]};
     const double* tc = r.temps.data() + 3 * i;
@@ -715,10 +725,10 @@ host::ModelFile model_from(const py::object& coefficients, const py::object& hea
     }
     if (a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} || a.shape(1) != 3 ||
         (a.shape(2) != 4 && a.shape(2) != 7)) {
-        bad_argument("coefficients",
-                     "expected shape (4, 3, 4) or (4, 3, 7) (head A..D, axis alpha/beta/gamma, c0 c1 c2 c3 "
-                     "[c1_2 c2_2 c3_2]), got " +
-                         shape_text(a));
+        bad_argument("coefficients", "expected shape (" + std::to_string(kMaxHeads) + ", 3, 4) or (" +
+                                         std::to_string(kMaxHeads) + ", 3, 7) (head " + head_letter_range() +
+                                         ", axis alpha/beta/gamma, c0 c1 c2 c3 [c1_2 c2_2 c3_2]), got " +
+                                         shape_text(a));
     }
     const Doubles c = Doubles::ensure(a);
     const auto k = static_cast<std::size_t>(a.shape(2));
@@ -728,19 +738,20 @@ host::ModelFile model_from(const py::object& coefficients, const py::object& hea
             for (std::size_t j = 0; j < k; ++j) {
                 const double x = c.data()[(h * 3 + ax) * k + j];
                 if (!std::isfinite(x)) {
-                    bad_argument("coefficients", std::string("head ") + "ABCD"[h] + " " + host::kAxisNames[ax] + " " +
-                                                     host::kCoefficientNames[j] + " is not finite");
+                    bad_argument("coefficients", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) +
+                                                     " " + host::kAxisNames[ax] + " " + host::kCoefficientNames[j] +
+                                                     " is not finite");
                 }
                 m.coefficients[h][ax][j] = x;
                 m.quadratic = m.quadratic || (j >= 4 && x != 0.0);
             }
         }
     }
-    const std::string names = heads.is_none() ? std::string("ABCD") : heads.cast<std::string>();
+    const std::string names = heads.is_none() ? std::string(kHeadLetters) : heads.cast<std::string>();
     for (const char ch : names) {
         const std::uint8_t h = host::head_from_name(std::string_view(&ch, 1));
         if (h == host::kUnknownHead) {
-            bad_argument("heads", std::string("'") + ch + "' is not a camera head (A, B, C or D)");
+            bad_argument("heads", std::string("'") + ch + "' is not a camera head (" + kHeadChoices.text + ")");
         }
         m.present[h] = true;
     }
@@ -774,17 +785,26 @@ PYBIND11_MODULE(_ascorr, mod) {
     py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") =
         "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
 
-    py::class_<host::ModelFile>(mod, "Model", R"doc(A thermal model: per head and axis, angles in arcsec linear (and
+    // The heads (ascorr/heads.hpp), for Python and for the docstrings below.
+    mod.attr("HEADS") = py::str(kHeadLetters);
+    const std::string n_heads = std::to_string(kMaxHeads);
+    static const std::string model_doc =
+        R"doc(A thermal model: per head and axis, angles in arcsec linear (and
 optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
 
-Model(coefficients, heads="ABCD"): coefficients of shape (4, 3, 4) or (4, 3, 7),
-indexed [head A..D][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
+Model(coefficients, heads=")doc" +
+        std::string(kHeadLetters) + "\"): coefficients of shape (" + n_heads + ", 3, 4) or (" + n_heads +
+        ", 3, 7),\nindexed [head " + head_letter_range() +
+        R"doc(][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
 in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
-coefficients (a head not listed gets status 256 in correct()).)doc")
+coefficients (a head not listed gets status 256 in correct()).)doc";
+    static const std::string coefficients_doc = "Coefficients, float64 (" + n_heads + ", 3, 7): [head " +
+                                                head_letter_range() +
+                                                "][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], arcsec "
+                                                "(a copy).";
+    py::class_<host::ModelFile>(mod, "Model", model_doc.c_str())
         .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none())
-        .def_property_readonly("coefficients", &model_coefficients,
-                               "Coefficients, float64 (4, 3, 7): [head A..D][alpha, beta, gamma][c0, c1, c2, c3, "
-                               "c1_2, c2_2, c3_2], arcsec (a copy).")
+        .def_property_readonly("coefficients", &model_coefficients, coefficients_doc.c_str())
         .def_property_readonly("heads", &model_heads, "The heads with coefficients, e.g. 'ABC'.")
         .def_property_readonly(
             "quadratic", [](const host::ModelFile& m) { return m.quadratic; },
@@ -801,14 +821,13 @@ coefficients (a head not listed gets status 256 in correct()).)doc")
             R"doc(Read a model file (docs/contract.md, "Model file"). A malformed file raises ascorr.InputError
 (a ValueError) with file:line:column, as the command line reports it.)doc");
 
-    mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
-            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf",
-            "max_propagation"_a = host::CorrectOptions{}.max_propagation_s,
-            R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
+    static const std::string correct_doc =
+        R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
 `ascorr correct` on the same rows, bit for bit, in every scalar.
 
-t: float64 (n,), s since J2000.0 TT. chu: (n,) strings 'A'..'D' or head indices
-0..3. q: (n, 4) q_chu_icrf (w, x, y, z). temps: (n, 3) t_chu, t_029, t_032 in
+t: float64 (n,), s since J2000.0 TT. chu: (n,) strings )doc" +
+        head_letter_range() + " or head indices\n" + head_index_range() +
+        R"doc(. q: (n, 4) q_chu_icrf (w, x, y, z). temps: (n, 3) t_chu, t_029, t_032 in
 degC, NaN where missing. v: (n, 3) spacecraft velocity, km/s GCRS, NaN where
 missing. temps and v may be None (all missing). model: an ascorr.Model, or None
 for no thermal stage. scalar: 'double', 'float' or 'fixed' (the core's Q30).
@@ -824,7 +843,10 @@ a row that cannot be corrected keeps its quaternion exactly and says why in its
 status bits (1 aberration, 2 thermal, 4 no velocity, 8 temperatures missing,
 16 rejected, 32 velocity unusable, 64 temperature unusable, 128 model angle
 beyond 1 deg, 256 no model for the head). Raises ValueError naming the
-argument for a wrong shape or dtype, or a time that is not finite.)doc");
+argument for a wrong shape or dtype, or a time that is not finite.)doc";
+    mod.def("correct", &correct, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "model"_a = py::none(), "scalar"_a = "double",
+            "aberration"_a = true, "states"_a = py::none(), "states_frame"_a = "itrf",
+            "max_propagation"_a = host::CorrectOptions{}.max_propagation_s, correct_doc.c_str());
 
     mod.def("earth_velocity", &earth_velocity, "t"_a, "exact"_a = false,
             R"doc(The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t

@@ -62,7 +62,7 @@ def random_solutions(n, seed):
     """n random rows in the formats' ranges, with every per-row problem mixed in."""
     rng = np.random.default_rng(seed)
     t = rng.uniform(4.0e8, 7.5e8, n)  # 2012..2023
-    chu = rng.choice(np.array(["A", "B", "C", "D"]), n)
+    chu = rng.choice(np.array(list(ascorr.HEADS)), n)
     q = rng.normal(size=(n, 4))
     q /= np.linalg.norm(q, axis=1)[:, None]
     temps = rng.uniform(-30.0, 40.0, (n, 3))
@@ -128,7 +128,7 @@ def test_chu_as_indices_float32_and_non_contiguous_inputs_give_the_same_bits():
     d = random_solutions(2000, seed=7)
     model = ascorr.read_model(str(DATA / "model_table2.csv"))
     ref_q, ref_st = ascorr.correct(d["t"], d["chu"], d["q"], d["temps"], d["v"], model=model)
-    heads = np.array([{"A": 0, "B": 1, "C": 2, "D": 3}.get(c, 9) for c in d["chu"]], dtype=np.int32)
+    heads = np.array([ascorr.HEADS.index(c) if c in ascorr.HEADS else 9 for c in d["chu"]], dtype=np.int32)
     q2, st2 = ascorr.correct(d["t"], heads, d["q"], d["temps"], d["v"], model=model)
     assert np.array_equal(st2, ref_st) and q2.tobytes() == ref_q.tobytes()
     objects = np.array(list(d["chu"]), dtype=object)

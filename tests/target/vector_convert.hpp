@@ -1,32 +1,31 @@
 // tests/target/vector_convert.hpp: records of vector_format.hpp → the core's
 // types in scalar T, rounded the way a DPU would be given them
-// (ScalarTraits<T>::from_double, celsius, coefficient, quadratic_coefficient).
+// (ScalarTraits<T>::from_double, celsius; the model through the core's
+// thermal_model(), ascorr/model_coefficients.hpp).
 // Shared by the target accuracy image and the benchmarks.
 #pragma once
 
 #include <cstdint>
 
 #include "ascorr/correct.hpp"
+#include "ascorr/model_coefficients.hpp"
 #include "vector_format.hpp"
 
 namespace ascorr::target {
 
+// Radians already: the core's conversion with unit 1 (exact).
 template <typename T>
 ThermalModel<T> to_core_model(const ModelRecord& m) {
-    using Tr = ScalarTraits<T>;
-    ThermalModel<T> out{};
+    ModelCoefficients c{};
     for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
-        out.head[h].present = m.present[h] != 0U;
-        AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
-        for (std::uint32_t a = 0; a < 3; ++a) {
-            const double* c = m.coefficient[h][a];
-            *axes[a] = {Tr::coefficient(c[0]),           Tr::coefficient(c[1]),
-                        Tr::coefficient(c[2]),           Tr::coefficient(c[3]),
-                        Tr::quadratic_coefficient(c[4]), Tr::quadratic_coefficient(c[5]),
-                        Tr::quadratic_coefficient(c[6])};
+        c.present[h] = m.present[h] != 0U;
+        for (std::uint32_t a = 0; a < kModelAxes; ++a) {
+            for (std::uint32_t i = 0; i < kModelTerms; ++i) {
+                c.coefficient[h][a][i] = m.coefficient[h][a][i];
+            }
         }
     }
-    return out;
+    return thermal_model<T>(c, 1.0);
 }
 
 template <typename T>

@@ -14,14 +14,16 @@
 
 #include <cstdint>
 
+#include "ascorr/heads.hpp"
+
 namespace ascorr::target {
 
 inline constexpr std::uint32_t kVectorMagic = 0x41534331U;  // "ASC1"
 inline constexpr std::uint32_t kModels = 2;                 // 0: Table 2, 1: random with quadratic terms
 
 struct ModelRecord {
-    std::uint32_t present[4];
-    double coefficient[4][3][7];  // [head][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], rad
+    std::uint32_t present[kMaxHeads];
+    double coefficient[kMaxHeads][3][7];  // [head][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], rad
 };
 
 struct VectorHeader {
@@ -49,7 +51,7 @@ struct ResultRecord {
     std::uint32_t pad;
 };
 
-static_assert(sizeof(ModelRecord) == 16 + 4 * 3 * 7 * 8, "layout");
+static_assert(sizeof(ModelRecord) == kMaxHeads * (4 + 3 * 7 * 8) + (kMaxHeads % 2) * 4, "layout");
 static_assert(sizeof(VectorRecord) == 11 * 8 + 16, "layout");
 static_assert(sizeof(ResultRecord) == 12 * 8 + 16, "layout");
 

@@ -7,7 +7,9 @@
 //   vector3.hpp        3-vectors
 //   quaternion.hpp     Hamilton, scalar-first attitude quaternions
 //   aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
+//   heads.hpp          the camera heads: how many, their letters
 //   thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
+//   model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
 //   status.hpp         status bits of a corrected solution
 //   correct.hpp        correct_solution(): the per-solution entry point
 //   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
@@ -16,6 +18,7 @@
 //   earth_series.hpp   the Earth's barycentric velocity and Sun distance, a
 //                      series fitted to ERFA eraEpv00 (double; coefficients in
 //                      the generated earth_series_table.hpp)
+// Data (not included here): table2.hpp, the paper's Table 2 as ModelCoefficients.
 // The on-board observer velocity (not included here; include velocity_service.hpp):
 //   tt_time.hpp        TT time tags in integer microseconds
 //   earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
@@ -30,6 +33,8 @@
 #include "correct.hpp"
 #include "earth_series.hpp"
 #include "fixed_point.hpp"
+#include "heads.hpp"
+#include "model_coefficients.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "status.hpp"

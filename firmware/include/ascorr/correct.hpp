@@ -26,7 +26,7 @@ namespace ascorr {
 template <typename T>
 struct SolutionInput {
     Quaternion<T> q_chu_icrf;  // raw attitude, maps ICRF into CHU components
-    std::uint8_t head;         // 0 = A, 1 = B, 2 = C, 3 = D
+    std::uint8_t head;         // head index (heads.hpp): 0 = A, 1 = B, …
     HeadTemperatures<T> temperatures;
     ObserverVelocity<T> velocity;
 };

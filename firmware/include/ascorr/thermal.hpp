@@ -31,12 +31,11 @@
 #include <cstdint>
 
 #include "constants.hpp"
+#include "heads.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 
 namespace ascorr {
-
-inline constexpr std::uint8_t kMaxHeads = 4;  // A, B, C, D
 
 // One axis of one head: radians and rad/°C, rad/°C².
 template <typename T>
@@ -60,7 +59,7 @@ struct HeadThermalModel {
 
 template <typename T>
 struct ThermalModel {
-    HeadThermalModel<T> head[kMaxHeads];
+    HeadThermalModel<T> head[kMaxHeads];  // by head index (heads.hpp)
 };
 
 template <typename T>

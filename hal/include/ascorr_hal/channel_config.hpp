@@ -15,6 +15,7 @@
 
 #include <cstdint>
 
+#include "ascorr/heads.hpp"
 #include "sampler.hpp"
 #include "thermistor.hpp"
 
@@ -26,6 +27,10 @@ inline constexpr std::uint8_t kNameLength = 16;  // including the terminating NU
 enum class Role : std::uint8_t { kMonitor = 0, kChuA, kChuB, kChuC, kChuD, kT029, kT032 };
 inline constexpr std::uint8_t kRoleCount = 7;
 inline constexpr const char* kRoleNames[kRoleCount] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
+// One CHU role per head of ascorr/heads.hpp, in head order, named chu_<letter>
+// (tests/test_heads.cpp checks the names): a head added there needs its role here.
+static_assert(static_cast<std::uint8_t>(Role::kT029) == static_cast<std::uint8_t>(Role::kChuA) + ascorr::kMaxHeads,
+              "one Role::kChu<letter> per head of ascorr/heads.hpp");
 
 constexpr Role chu_role(std::uint8_t head) noexcept {
     return static_cast<Role>(static_cast<std::uint8_t>(Role::kChuA) + head);

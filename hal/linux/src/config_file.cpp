@@ -213,6 +213,15 @@ void parse_channel_adc(const Token& t, const LineParser& p, const AcquisitionCon
     }
 }
 
+// "monitor, chu_a, …, t032", from kRoleNames.
+std::string role_list() {
+    std::string s;
+    for (std::uint8_t r = 0; r < kRoleCount; ++r) {
+        s += (r == 0 ? "" : ", ") + std::string(kRoleNames[r]);
+    }
+    return s;
+}
+
 void parse_channel_role(const Token& t, const LineParser& p, const AcquisitionConfig<double>& a,
                         ChannelConfig<double>& c) {
     bool found = false;
@@ -223,8 +232,7 @@ void parse_channel_role(const Token& t, const LineParser& p, const AcquisitionCo
         }
     }
     if (!found) {
-        p.fail(t.value_col,
-               "unknown role '" + std::string(t.value) + "' (monitor, chu_a, chu_b, chu_c, chu_d, t029, t032)");
+        p.fail(t.value_col, "unknown role '" + std::string(t.value) + "' (" + role_list() + ")");
     }
     std::uint8_t same = 0;
     for (std::uint8_t k = 0; k < a.channels; ++k) {

@@ -115,17 +115,17 @@ const linux_detail::Field& field(const std::vector<linux_detail::Field>& f, int 
     return f[static_cast<std::size_t>(column)];
 }
 
-// The head of a row: -1 without a chu column, else A–D as 0–3.
+// The head of a row: -1 without a chu column, else its index (heads.hpp).
 int history_head(const std::string& file, std::size_t line_no, const std::vector<linux_detail::Field>& f,
                  const HistoryColumns& cols) {
     if (cols.chu < 0) {
         return -1;
     }
     const auto& [v, c] = field(f, cols.chu);
-    if (v.size() != 1 || v[0] < 'A' || v[0] > 'D') {
-        throw ConfigError(file, line_no, c, "'chu' must be A, B, C or D");
+    if (v.size() != 1 || head_index(v[0]) == kUnknownHead) {
+        throw ConfigError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
     }
-    return v[0] - 'A';
+    return head_index(v[0]);
 }
 
 // A temperature field: NaN when empty or nan (none), else a finite number.

@@ -3,25 +3,26 @@
 // Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
 // One row per head and axis; a head that appears must have all three axes.
 // Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
-// the core's radians.
+// the core's radians (ascorr/model_coefficients.hpp).
 #pragma once
 
 #include <array>
 #include <string>
 
 #include "ascorr/constants.hpp"
+#include "ascorr/model_coefficients.hpp"
 #include "ascorr/thermal.hpp"
 
 namespace ascorr::host {
 
 enum Axis : int { kAlpha = 0, kBeta = 1, kGamma = 2 };
-inline constexpr const char* kAxisNames[3] = {"alpha", "beta", "gamma"};
-inline constexpr const char* kCoefficientNames[7] = {"c0", "c1", "c2", "c3", "c1_2", "c2_2", "c3_2"};
+inline constexpr const char* kAxisNames[kModelAxes] = {"alpha", "beta", "gamma"};
+inline constexpr const char* kCoefficientNames[kModelTerms] = {"c0", "c1", "c2", "c3", "c1_2", "c2_2", "c3_2"};
 
 struct ModelFile {
     std::array<bool, kMaxHeads> present{};
     // coefficients[head][axis] = {c0, c1, c2, c3, c1_2, c2_2, c3_2} in arcsec.
-    std::array<std::array<std::array<double, 7>, 3>, kMaxHeads> coefficients{};
+    std::array<std::array<std::array<double, kModelTerms>, kModelAxes>, kMaxHeads> coefficients{};
     bool quadratic = false;  // write the quadratic columns
     // Where each head and axis was read (1-based line) and each coefficient
     // (1-based character column); 0 for a model not read from a file.
@@ -41,21 +42,25 @@ std::string format_model(const ModelFile& model);
 // model is refused, never saturated.
 void check_fixed_point_range(const ModelFile& m, const std::string& path);
 
-// The model in the core's units (radians), for scalar T.
-template <typename T>
-ThermalModel<T> to_core(const ModelFile& m) {
-    ThermalModel<T> out{};
+// The model's numbers in the core's layout (arcsec, as in the file).
+inline ModelCoefficients coefficients_of(const ModelFile& m) {
+    ModelCoefficients c{};
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        out.head[h].present = m.present[h];
-        AxisPolynomial<T>* axes[3] = {&out.head[h].alpha, &out.head[h].beta, &out.head[h].gamma};
-        for (std::size_t a = 0; a < 3; ++a) {
-            const auto& c = m.coefficients[h][a];
-            const auto r = [&](std::size_t i) { return ScalarTraits<T>::coefficient(c[i] * kArcsecToRad); };
-            const auto r2 = [&](std::size_t i) { return ScalarTraits<T>::quadratic_coefficient(c[i] * kArcsecToRad); };
-            *axes[a] = {r(0), r(1), r(2), r(3), r2(4), r2(5), r2(6)};
+        c.present[h] = m.present[h];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                c.coefficient[h][a][i] = m.coefficients[h][a][i];
+            }
         }
     }
-    return out;
+    return c;
+}
+
+// The model in the core's units (radians), for scalar T: the core's one
+// conversion (ascorr/model_coefficients.hpp).
+template <typename T>
+ThermalModel<T> to_core(const ModelFile& m) {
+    return thermal_model<T>(coefficients_of(m), kArcsecToRad);
 }
 
 }  // namespace ascorr::host

@@ -16,17 +16,19 @@
 #include <string_view>
 #include <vector>
 
+#include "ascorr/heads.hpp"
 #include "ascorr/quaternion.hpp"
 #include "ascorr/vector3.hpp"
 #include "ascorr_host/csv.hpp"
 
 namespace ascorr::host {
 
-inline constexpr std::uint8_t kUnknownHead = 0xFF;
+using ascorr::kUnknownHead;  // heads.hpp
 
-// Head index 0–3 for 'A'–'D', kUnknownHead otherwise.
+// The head index of a `chu` field (one letter of kHeadLetters, ascorr/heads.hpp),
+// kUnknownHead otherwise.
 std::uint8_t head_from_name(std::string_view chu) noexcept;
-char head_name(std::uint8_t head) noexcept;
+char head_name(std::uint8_t head) noexcept;  // its letter, '?' for an unknown head
 
 struct SolutionRecord {
     std::size_t line = 0;  // 1-based line in the file

@@ -68,7 +68,7 @@ struct HistoryRow {
 };
 std::vector<HistoryRow> parse_history(const std::string& file_name, std::string_view text);
 
-inline constexpr int kHistoryHeads = 4;  // A–D: the chu roles (channel_config.hpp)
+inline constexpr int kHistoryHeads = kMaxHeads;  // the chu roles (channel_config.hpp, heads.hpp)
 
 // One epoch of a history: the truths its rows give (NaN: none, the previous
 // truth holds).
