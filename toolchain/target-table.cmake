@@ -9,7 +9,9 @@
 #   ASCORR_TARGET_<cpu>_REPLAY         `ascorr replay --target` name
 #   ASCORR_TARGET_<cpu>_FLAGS          compiler CPU flags
 # A malformed line stops the configuration, naming the file and line.
-set(ASCORR_TARGET_TABLE ${CMAKE_CURRENT_LIST_DIR}/targets.txt)
+if(NOT ASCORR_TARGET_TABLE)  # another table only in tests/target/read-target-table.cmake's tests
+  set(ASCORR_TARGET_TABLE ${CMAKE_CURRENT_LIST_DIR}/targets.txt)
+endif()
 
 function(ascorr_read_targets)
   file(READ ${ASCORR_TARGET_TABLE} text)
