@@ -9,10 +9,14 @@
 #   ASCORR_TARGET_<cpu>_REPLAY         `ascorr replay --target` name
 #   ASCORR_TARGET_<cpu>_FLAGS          compiler CPU flags
 # A malformed line stops the configuration, naming the file and line.
-set(ASCORR_TARGET_TABLE ${CMAKE_CURRENT_LIST_DIR}/targets.txt)
+if(NOT ASCORR_TARGET_TABLE)  # another table only in tests/target/read-target-table.cmake's tests
+  set(ASCORR_TARGET_TABLE ${CMAKE_CURRENT_LIST_DIR}/targets.txt)
+endif()
 
 function(ascorr_read_targets)
-  file(STRINGS ${ASCORR_TARGET_TABLE} lines)
+  file(READ ${ASCORR_TARGET_TABLE} text)
+  string(REPLACE ";" "," text "${text}")  # no list separator inside a line (none is valid in a row)
+  string(REPLACE "\n" ";" lines "${text}")  # one element per line, empty lines kept (line numbers)
   set(list "")
   set(n 0)
   foreach(line IN LISTS lines)
@@ -21,8 +25,8 @@ function(ascorr_read_targets)
       continue()
     endif()
     if(NOT line MATCHES "^([a-z0-9-]+) +([a-z0-9-]+) +(fixed|float) +([a-z,]+) +([a-z0-9-]+) +(-.*)$")
-      message(FATAL_ERROR "${ASCORR_TARGET_TABLE}: a line is not 'cpu machine flight_scalar accuracy_scalars "
-                          "replay_target flags': ${line}")
+      message(FATAL_ERROR "${ASCORR_TARGET_TABLE}:${n}: not 'cpu machine flight_scalar(fixed|float) "
+                          "accuracy_scalars replay_target flags': ${line}")
     endif()
     set(cpu ${CMAKE_MATCH_1})
     string(REPLACE "," ";" scalars "${CMAKE_MATCH_4}")
