@@ -25,8 +25,8 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                     char what[200];
                     std::snprintf(what, sizeof what,
                                   "%c %s %s = %g %s is beyond the fixed-point coefficient range (|%s| < %g %s)",
-                                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[a], kCoefficientNames[i], c, kUnits[i], kCoefficientNames[i],
-                                  lim * kRadToArcsec, kUnits[i]);
+                                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[a], kCoefficientNames[i], c,
+                                  kUnits[i], kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
                     if (m.line[h][a] != 0) {
                         throw InputError(path, m.line[h][a], m.column[h][a][i], what);
                     }
