@@ -179,6 +179,52 @@ TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
     EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
 }
 
+// Issue 11: a well-formed number beyond double's range says "out of range"
+// (as the host's readers do) in every HAL file and in --inject; malformed
+// text keeps its own message (the control: 'warm', 'x').
+TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
+    const std::string huge = "'1e999' is out of range: a number's magnitude is at most 1.797693e+308";
+    const std::string tiny =
+        "'1e-999' is out of range: a nonzero number's magnitude is at least 4.940656e-324 (write 0)";
+    EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=1e999 b=2 c=3\n"), "board.cfg:1:35: 'a': " + huge);
+    EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=x b=2 c=3\n"),
+              "board.cfg:1:35: 'a': not a finite number: 'x'");
+    const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
+    const auto replay_error = [&](const std::string& text) {
+        try {
+            hal::ReplaySource("r.csv", text, c);
+        } catch (const hal::ConfigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(replay_error("t,THT00029\n1,1e999\n"), "r.csv:2:3: " + huge);
+    EXPECT_EQ(replay_error("t,THT00029\n1e999,3\n"), "r.csv:2:1: 't': " + huge);
+    EXPECT_EQ(replay_error("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
+    const auto history_error = [](const std::string& text) {
+        try {
+            hal::parse_history("h.csv", text);
+        } catch (const hal::ConfigError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1,1e-999,3,4\n"), "h.csv:2:3: " + tiny);
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1e999,2,3,4\n"), "h.csv:2:1: 't': " + huge);
+    const auto fault_error = [&](const std::string& spec) {
+        try {
+            hal::parse_fault(spec, c);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(fault_error("THT00057:offset:10:20:1e999"), "fault 'THT00057:offset:10:20:1e999': " + huge);
+    EXPECT_EQ(fault_error("THT00057:open:1e999:20"), "fault 'THT00057:open:1e999:20': " + huge);
+    EXPECT_EQ(fault_error("THT00057:open:x:20"),
+              "fault 'THT00057:open:x:20': FROM and TO must be finite numbers with FROM < TO");
+}
+
 // Issue 14 item 8 split parse_history; what it reads is unchanged (this test
 // passes on the earlier, single-function reader too).
 TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {

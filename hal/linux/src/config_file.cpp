@@ -37,7 +37,9 @@ public:
         const char* e = b + t.value.size();
         const auto r = std::from_chars(b, e, v);
         if (t.value.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(v)) {
-            fail(t.value_col, "'" + std::string(t.key) + "': not a finite number: '" + std::string(t.value) + "'");
+            fail(t.value_col,
+                 "'" + std::string(t.key) + "': " +
+                     linux_detail::number_refusal(t.value, "not a finite number: '" + std::string(t.value) + "'"));
         }
         return v;
     }

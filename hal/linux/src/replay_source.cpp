@@ -74,7 +74,9 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
                 double t = 0.0;
                 const auto r = std::from_chars(b, e, t);
                 if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
-                    throw ConfigError(file, line_no, col, "'t' must be a number of seconds in [0, 1e12]");
+                    throw ConfigError(
+                        file, line_no, col,
+                        linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
                 }
                 f.t_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
                 continue;
@@ -96,7 +98,8 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
                 double x = 0.0;
                 const auto r = std::from_chars(b, e, x);
                 if (r.ec != std::errc() || r.ptr != e) {
-                    throw ConfigError(file, line_no, col, "not a temperature: '" + std::string(v) + "'");
+                    throw ConfigError(file, line_no, col,
+                                      linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
                 }
                 s = {SampleKind::kCelsius, 0U, 0U, x, 0U};
             }

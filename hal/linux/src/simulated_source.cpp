@@ -19,17 +19,78 @@ bool parse_number(std::string_view v, double& x) {
 
 }  // namespace
 
-InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>& config) {
+namespace {
+
+// NAME:KIND:FROM:TO[:VALUE] split at ':'.
+std::vector<std::string_view> fault_parts(std::string_view spec) {
     std::vector<std::string_view> part;
     std::size_t start = 0;
     while (true) {
         const std::size_t c = spec.find(':', start);
         part.push_back(spec.substr(start, c == std::string_view::npos ? std::string_view::npos : c - start));
         if (c == std::string_view::npos) {
-            break;
+            return part;
         }
         start = c + 1;
     }
+}
+
+// The fault kind named by text; throws naming the spec s.
+FaultKind fault_kind(const std::string& s, std::string_view text) {
+    static constexpr std::pair<const char*, FaultKind> kinds[] = {
+        {"open", FaultKind::kOpen},   {"short", FaultKind::kShort},   {"bus", FaultKind::kBus},
+        {"stuck", FaultKind::kStuck}, {"offset", FaultKind::kOffset}, {"noise", FaultKind::kNoise},
+        {"drop", FaultKind::kDrop}};
+    for (const auto& [name, kind] : kinds) {
+        if (text == name) {
+            return kind;
+        }
+    }
+    throw std::invalid_argument("fault '" + s + "': unknown kind '" + std::string(text) +
+                                "' (open, short, bus, stuck, offset, noise, drop)");
+}
+
+// FROM and TO: finite seconds, FROM < TO.
+void fault_times(const std::string& s, std::string_view from, std::string_view to, InjectedFault& f) {
+    if (!parse_number(from, f.from_s) || !parse_number(to, f.to_s) || !std::isfinite(f.from_s) ||
+        !std::isfinite(f.to_s) || !(f.from_s < f.to_s)) {
+        const std::string why = linux_detail::out_of_range_reason(from) + linux_detail::out_of_range_reason(to);
+        throw std::invalid_argument("fault '" + s +
+                                    "': " + (why.empty() ? "FROM and TO must be finite numbers with FROM < TO" : why));
+    }
+}
+
+// VALUE of an offset (°C, finite and within the ±200 °C any temperature has)
+// or of noise (counts, > 0: 0 or less would inject nothing, and at most 65535,
+// an ADC code's range, so the simulated code stays an int); the other kinds
+// take none.
+void fault_value(const std::string& s, const std::vector<std::string_view>& part, InjectedFault& f) {
+    const bool needs_value = f.kind == FaultKind::kOffset || f.kind == FaultKind::kNoise;
+    if (needs_value != (part.size() == 5)) {
+        throw std::invalid_argument("fault '" + s + "': " + (needs_value ? "needs" : "takes no") + " VALUE");
+    }
+    if (!needs_value) {
+        return;
+    }
+    const std::string text(part[4]);
+    if (!parse_number(part[4], f.value)) {
+        const std::string why = linux_detail::out_of_range_reason(part[4]);
+        throw std::invalid_argument("fault '" + s + "': " + (why.empty() ? "needs VALUE" : why));
+    }
+    if (f.kind == FaultKind::kOffset && !(std::fabs(f.value) <= 200.0)) {
+        throw std::invalid_argument("fault '" + s +
+                                    "': offset VALUE must be a finite number of degC within +-200, got '" + text + "'");
+    }
+    if (f.kind == FaultKind::kNoise && !(f.value > 0.0 && f.value <= 65535.0)) {
+        throw std::invalid_argument("fault '" + s + "': noise VALUE must be a number of counts in (0, 65535], got '" +
+                                    text + "'");
+    }
+}
+
+}  // namespace
+
+InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>& config) {
+    const std::vector<std::string_view> part = fault_parts(spec);
     const std::string s(spec);
     if (part.size() < 4 || part.size() > 5) {
         throw std::invalid_argument("fault '" + s + "': expected NAME:KIND:FROM:TO[:VALUE]");
@@ -38,41 +99,9 @@ InjectedFault parse_fault(std::string_view spec, const AcquisitionConfig<double>
     if (f.channel < 0) {
         throw std::invalid_argument("fault '" + s + "': no channel '" + std::string(part[0]) + "'");
     }
-    static constexpr std::pair<const char*, FaultKind> kinds[] = {
-        {"open", FaultKind::kOpen},   {"short", FaultKind::kShort},   {"bus", FaultKind::kBus},
-        {"stuck", FaultKind::kStuck}, {"offset", FaultKind::kOffset}, {"noise", FaultKind::kNoise},
-        {"drop", FaultKind::kDrop}};
-    bool found = false;
-    for (const auto& [name, kind] : kinds) {
-        if (part[1] == name) {
-            f.kind = kind;
-            found = true;
-        }
-    }
-    if (!found) {
-        throw std::invalid_argument("fault '" + s + "': unknown kind '" + std::string(part[1]) +
-                                    "' (open, short, bus, stuck, offset, noise, drop)");
-    }
-    if (!parse_number(part[2], f.from_s) || !parse_number(part[3], f.to_s) || !std::isfinite(f.from_s) ||
-        !std::isfinite(f.to_s) || !(f.from_s < f.to_s)) {
-        throw std::invalid_argument("fault '" + s + "': FROM and TO must be finite numbers with FROM < TO");
-    }
-    const bool needs_value = f.kind == FaultKind::kOffset || f.kind == FaultKind::kNoise;
-    if (needs_value != (part.size() == 5) || (needs_value && !parse_number(part[4], f.value))) {
-        throw std::invalid_argument("fault '" + s + "': " + (needs_value ? "needs" : "takes no") + " VALUE");
-    }
-    // offset: °C, finite and within the ±200 °C any temperature has; noise:
-    // counts, > 0 (0 or less would inject nothing) and at most 65535 (an ADC
-    // code's range), so the simulated code stays an int.
-    if (f.kind == FaultKind::kOffset && !(std::fabs(f.value) <= 200.0)) {
-        throw std::invalid_argument("fault '" + s +
-                                    "': offset VALUE must be a finite number of degC within +-200, got '" +
-                                    std::string(part[4]) + "'");
-    }
-    if (f.kind == FaultKind::kNoise && !(f.value > 0.0 && f.value <= 65535.0)) {
-        throw std::invalid_argument("fault '" + s + "': noise VALUE must be a number of counts in (0, 65535], got '" +
-                                    std::string(part[4]) + "'");
-    }
+    f.kind = fault_kind(s, part[1]);
+    fault_times(s, part[2], part[3], f);
+    fault_value(s, part, f);
     return f;
 }
 
@@ -137,7 +166,8 @@ double history_temperature(const std::string& file, std::size_t line_no, const l
     }
     if (!parse_number(v, x) || !std::isfinite(x)) {
         throw ConfigError(file, line_no, c,
-                          "not a temperature: '" + std::string(v) + "' (a finite number, or empty or nan for none)");
+                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) +
+                                                              "' (a finite number, or empty or nan for none)"));
     }
     return x;
 }
@@ -153,7 +183,9 @@ HistoryRow history_row(const std::string& file, std::size_t line_no, std::string
     r.line = line_no;
     const auto& [t_text, t_col] = field(f, cols.t);
     if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
-        throw ConfigError(file, line_no, t_col, "'t' must be a number of seconds in [0, 1e12]");
+        throw ConfigError(
+            file, line_no, t_col,
+            linux_detail::number_refusal(t_text, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
     r.head = history_head(file, line_no, f, cols);
     double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};

@@ -8,8 +8,11 @@
 #pragma once
 
 #include <cerrno>
+#include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +26,31 @@
 #include "ascorr_hal_linux/config_file.hpp"
 
 namespace ascorr::hal::linux_detail {
+
+// Why a field is not a usable number when it is a well-formed decimal beyond
+// double's range ("1e999", "1e-999"): "'1e999' is out of range: ..." in the
+// host readers' words (host_sim/src/csv.cpp, why_not_a_number). Empty for any
+// other field, so the caller keeps its own message for malformed text.
+inline std::string out_of_range_reason(std::string_view v) {
+    double x = 0.0;
+    const char* end = v.data() + v.size();
+    const auto r = std::from_chars(v.data(), end, x);
+    if (v.empty() || r.ec != std::errc::result_out_of_range || r.ptr != end) {
+        return {};
+    }
+    const std::string text(v);
+    const bool huge = std::isinf(std::strtod(text.c_str(), nullptr));  // from_chars leaves x unset
+    return "'" + text + "' is out of range: " +
+           (huge ? std::string("a number's magnitude is at most 1.797693e+308")
+                 : std::string("a nonzero number's magnitude is at least 4.940656e-324 (write 0)"));
+}
+
+// `what` unless v is a number beyond double's range: then `prefix` and
+// out_of_range_reason(v).
+inline std::string number_refusal(std::string_view v, const std::string& what, const std::string& prefix = "") {
+    const std::string why = out_of_range_reason(v);
+    return why.empty() ? what : prefix + why;
+}
 
 // The length of the valid UTF-8 sequence at s[i] (1 … 4), or 0 when it is
 // not one (a stray continuation byte, a truncated or overlong sequence, a
