@@ -29,6 +29,7 @@
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"
+#include "target/model_record.hpp"
 #include "target/vector_convert.hpp"
 #include "target/vector_format.hpp"
 
@@ -50,19 +51,6 @@ std::vector<host::SolutionRecord> records(const std::string& path, std::string& 
         out.push_back(rec);
     }
     return out;
-}
-
-ModelRecord to_record(const host::ModelFile& m) {
-    ModelRecord r{};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        r.present[h] = m.present[h] ? 1U : 0U;
-        for (std::size_t a = 0; a < 3; ++a) {
-            for (std::size_t i = 0; i < 7; ++i) {
-                r.coefficient[h][a][i] = m.coefficients[h][a][i] * kArcsecToRad;
-            }
-        }
-    }
-    return r;
 }
 
 SolutionInput<double> to_input(const VectorRecord& r) {
@@ -91,7 +79,7 @@ int write(const std::string& dir, std::uint32_t n, std::uint64_t seed) {
     VectorHeader header{};
     header.magic = kVectorMagic;
     header.count = static_cast<std::uint32_t>(rows.size()) + n;
-    header.model[0] = to_record(host::read_model_file(data("model_table2.csv")));
+    header.model[0] = model_record(host::read_model_file(data("model_table2.csv")));
     {
         std::uniform_real_distribution<double> c0(-100.0, 100.0);
         std::uniform_real_distribution<double> c1(-5.0, 5.0);
@@ -103,7 +91,7 @@ int write(const std::string& dir, std::uint32_t n, std::uint64_t seed) {
                 axis = {c0(rng), c1(rng), c1(rng), c1(rng), c2(rng), c2(rng), c2(rng)};
             }
         }
-        header.model[1] = to_record(m);
+        header.model[1] = model_record(m);
     }
     std::vector<VectorRecord> out;
     for (const auto& rec : rows) {

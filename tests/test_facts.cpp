@@ -24,6 +24,7 @@
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 #include "flight_data.hpp"  // firmware/app: the flight model, in float (app_scalar.hpp) on the host
+#include "target/model_record.hpp"
 #include "target/vector_convert.hpp"
 
 namespace ascorr {
@@ -260,19 +261,6 @@ host::ModelFile random_model(std::mt19937_64& rng) {
     return m;
 }
 
-target::ModelRecord record_of(const host::ModelFile& m) {  // radians, as target_vectors writes them
-    target::ModelRecord r{};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        r.present[h] = m.present[h] ? 1U : 0U;
-        for (std::size_t a = 0; a < 3; ++a) {
-            for (std::size_t i = 0; i < 7; ++i) {
-                r.coefficient[h][a][i] = m.coefficients[h][a][i] * kArcsecToRad;
-            }
-        }
-    }
-    return r;
-}
-
 // Every path into the core's model (the host's model files and Python's
 // Model: host::to_core; the target vectors: target::to_core_model) gives the
 // same bits, and those are the file's arcsec in radians rounded once to the
@@ -282,7 +270,7 @@ target::ModelRecord record_of(const host::ModelFile& m) {  // radians, as target
 template <typename T>
 void check_conversion(const host::ModelFile& m, double linear_bound, double quadratic_bound, bool relative) {
     const ThermalModel<T> host_model = host::to_core<T>(m);
-    const ThermalModel<T> target_model = target::to_core_model<T>(record_of(m));
+    const ThermalModel<T> target_model = target::to_core_model<T>(target::model_record(m));
     const long double arcsec = std::acos(-1.0L) / 648000.0L;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         EXPECT_EQ(host_model.head[h].present, m.present[h]);
