@@ -19,8 +19,10 @@
 #include "ascorr/fixed_point.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/qemu_targets.hpp"
 #include "ascorr_host/replay.hpp"
 #include "ascorr_link/server.hpp"
+#include "cli_run.hpp"
 #include "replay_recording.hpp"
 #include "test_support.hpp"
 
@@ -281,7 +283,7 @@ TEST(Replay, FixedPointTargetRefusesAModelBeyondItsFormats) {
 
 TEST(Replay, QemuTargetWithoutItsImageIsAnError) {
     host::ReplayOptions o;
-    o.target = "qemu-m3";
+    o.target = std::string(host::kQemuTargets[0].replay);
     o.firmware = (scratch_dir("replay") / "missing.elf").string();
     std::ostringstream log;
     EXPECT_THROW(host::replay(o, log), std::runtime_error);
@@ -292,6 +294,32 @@ TEST(Replay, UnknownTargetIsAnError) {
     o.target = "qemu-z80";
     std::ostringstream log;
     EXPECT_THROW(host::replay(o, log), std::runtime_error);
+}
+
+// `ascorr replay --help` offers every board of toolchain/targets.txt with its
+// image's scalar, and no other (the text is built from the generated table).
+TEST(Replay, HelpOffersEveryQemuTargetOfTheTableWithItsScalar) {
+    const fs::path dir = scratch_dir("replay_help");
+    const CliRun r = run_here("replay --help > " + (dir / "help.txt").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::string help = slurp(dir / "help.txt");
+    for (char& c : help) {  // CLI11 wraps long descriptions
+        if (c == '\n') {
+            c = ' ';
+        }
+    }
+    std::string squeezed;
+    for (const char c : help) {
+        if (c != ' ' || squeezed.empty() || squeezed.back() != ' ') {
+            squeezed += c;
+        }
+    }
+    for (const host::QemuTarget& t : host::kQemuTargets) {
+        const std::string choice =
+            std::string(t.replay) + (t.scalar == host::TargetScalar::kFixed ? " (Q30)" : " (float)");
+        EXPECT_NE(squeezed.find(choice), std::string::npos) << choice << " not in:\n" << help;
+    }
+    EXPECT_NE(squeezed.find(host::qemu_target_choices() + ", loopback-float"), std::string::npos) << help;
 }
 
 }  // namespace

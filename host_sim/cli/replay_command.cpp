@@ -3,6 +3,7 @@
 #include <memory>
 #include <string>
 
+#include "ascorr_host/qemu_targets.hpp"
 #include "ascorr_host/replay.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
@@ -13,8 +14,9 @@ void add_replay_command(CLI::App& app) {
     auto opt = std::make_shared<host::ReplayOptions>();
     auto speed = std::make_shared<std::string>("max");
     CLI::App* cmd = app.add_subcommand("replay", "replay a recorded file through a target over the serial link");
+    // The QEMU boards come from toolchain/targets.txt (the generated ascorr_host/qemu_targets.hpp).
     cmd->add_option("--target", opt->target,
-                    "qemu-m4f (float), qemu-m3 (Q30), loopback-float, or a serial device such as /dev/ttyUSB0")
+                    host::qemu_target_choices() + ", loopback-float, or a serial device such as /dev/ttyUSB0")
         ->required();
     cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();

@@ -19,7 +19,7 @@
 namespace ascorr::host {
 
 struct ReplayOptions {
-    std::string target;    // qemu-m4f (float), qemu-m3 (Q30), loopback-float, or a serial device path
+    std::string target;    // a replay name of ascorr_host/qemu_targets.hpp, loopback-float, or a serial device
     std::string firmware;  // qemu targets: the link image; empty: the one of this build tree
     std::string in;
     std::string model;
@@ -49,7 +49,7 @@ struct ReplaySummary {
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
 // The QEMU command line that runs a link image with UART0 on stdin/stdout.
 std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image);
-// The link image of this build tree for a target (cortex-m3, cortex-m4f).
+// The link image of this build tree for a target (a cpu of toolchain/targets.txt).
 std::string default_link_firmware(const std::string& target);
 std::string to_json(const ReplaySummary& s);
 
