@@ -41,9 +41,13 @@ foreach(scalar fixed float)
   endif()
 endforeach()
 
-# Accuracy against the double core, arcsec.
-set(bound_fixed 0.01)
-set(bound_float 0.05)
+# Accuracy against the double core, arcsec: tests/target/accuracy-bounds.txt
+# (also read by toolchain/target-info bound, and by tests/CMakeLists.txt for
+# the replay tests).
+include(${CMAKE_CURRENT_LIST_DIR}/accuracy-bounds.cmake)
+ascorr_read_accuracy_bounds()
+set(bound_fixed ${ASCORR_BOUND_fixed})
+set(bound_float ${ASCORR_BOUND_float})
 # The 22 Hz loop's report after 352 cycles (16 s), no overrun in either. Both
 # images take the boom temperatures through the HAL (firmware/app/
 # boom_temperatures.hpp; float on the M4F, fixed point on the M3) with the same
