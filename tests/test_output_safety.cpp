@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "ascorr_host/qemu_targets.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -352,10 +353,10 @@ TEST(OutputSafety, ReplaysEmulatorDiesWithItsParentEvenOnSigkill) {
     const fs::path dir = scratch_dir("pdeath");
     stand_in(dir / "bin", "qemu-system-arm", dir / "qemu.pid");
     write(dir / "image.elf", "not an image: the stand-in never reads it\n");
-    const pid_t pid =
-        spawn({"replay", "--target", "qemu-m4f", "--firmware", (dir / "image.elf").string(), "--in", kSolutions,
-               "--model", kModel, "--out", (dir / "out.csv").string(), "--timeout-ms", "60000"},
-              dir, (dir / "bin").string());
+    const pid_t pid = spawn(
+        {"replay", "--target", std::string(host::kQemuTargets[0].replay), "--firmware", (dir / "image.elf").string(),
+         "--in", kSolutions, "--model", kModel, "--out", (dir / "out.csv").string(), "--timeout-ms", "60000"},
+        dir, (dir / "bin").string());
     ASSERT_TRUE(eventually([&] { return fs::exists(dir / "qemu.pid"); })) << slurp(dir / "stderr.txt");
     const pid_t emulator = pid_in(dir / "qemu.pid");
     ASSERT_FALSE(process_gone(emulator));

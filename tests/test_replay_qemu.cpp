@@ -1,10 +1,11 @@
 // Hardware-in-the-loop replay with QEMU standing in for the board: the link
-// images (firmware/app/link_main.cpp) on the M4F (float) and M3 (Q30) boards
-// of toolchain/targets.txt, driven over their UART by `ascorr replay`'s job and by
+// images (firmware/app/link_main.cpp) on every board of toolchain/targets.txt
+// (the generated kQemuTargets; each test runs once per board), driven over their UART by `ascorr replay`'s job and by
 // the LinkClient, with faults injected and the emulator killed mid-run.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -21,22 +22,36 @@
 #include "replay_recording.hpp"
 #include "test_support.hpp"
 
+namespace ascorr::host {
+// GoogleTest shows a board by its replay name (not its bytes) in test names.
+inline void PrintTo(const QemuTarget& board, std::ostream* os) {
+    *os << board.replay;
+}
+}  // namespace ascorr::host
+
 namespace ascorr::test {
 namespace {
 
 constexpr int kRows = 10000;
 
-struct Case {
-    const char* target;
-    double bound_arcsec;  // of the scalar type against the double reference
-};
-constexpr Case kM4f{"qemu-m4f", 0.05};
-constexpr Case kM3{"qemu-m3", 0.01};
+// The bound of the board's scalar against the double reference, arcsec
+// (tests/target/accuracy-bounds.txt, compile definitions of tests/CMakeLists.txt).
+double bound_arcsec(const host::QemuTarget& board) {
+    return board.scalar == host::TargetScalar::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
+}
 
-host::ReplaySummary replay_through(const Case& c, double inject, const std::string& name) {
+std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
+    std::string s(board.replay);
+    for (char& c : s) {
+        c = c == '-' ? '_' : c;
+    }
+    return s + what;
+}
+
+host::ReplaySummary replay_through(const host::QemuTarget& board, double inject, const std::string& name) {
     const auto dir = scratch_dir(name);
     host::ReplayOptions o;
-    o.target = c.target;
+    o.target = std::string(board.replay);
     o.in = make_recording(dir, kRows);
     o.model = data_path("model_table2.csv");
     o.out = (dir / "out.csv").string();
@@ -44,46 +59,33 @@ host::ReplaySummary replay_through(const Case& c, double inject, const std::stri
     o.seed = 11;
     std::ostringstream log;
     const host::ReplaySummary s = host::replay(o, log);
-    std::cout << c.target << " inject " << inject << ": " << host::to_json(s) << "\n";
+    std::cout << board.replay << " inject " << inject << ": " << host::to_json(s) << "\n";
     return s;
 }
 
 // Every solution back, bit for bit the host core's in the target's scalar,
 // within the scalar's bound of the double reference, with its cost measured.
-void expect_complete(const Case& c, const host::ReplaySummary& s) {
+void expect_complete(const host::QemuTarget& board, const host::ReplaySummary& s) {
     EXPECT_EQ(s.frames, static_cast<std::size_t>(kRows));
     EXPECT_EQ(s.returned, static_cast<std::size_t>(kRows));
     EXPECT_EQ(s.mismatches, 0U);
-    EXPECT_LE(s.max_error_arcsec, c.bound_arcsec);
+    EXPECT_LE(s.max_error_arcsec, bound_arcsec(board));
     EXPECT_GT(s.instructions_per_solution, 0.0);
     EXPECT_EQ(s.restarts, 0U);
 }
 
-TEST(ReplayQemu, M4fFloatCleanLink) {
-    const host::ReplaySummary s = replay_through(kM4f, 0.0, "qemu_m4f");
-    expect_complete(kM4f, s);
+class ReplayQemu : public ::testing::TestWithParam<host::QemuTarget> {};
+
+TEST_P(ReplayQemu, CleanLink) {
+    const host::ReplaySummary s = replay_through(GetParam(), 0.0, scratch_name(GetParam(), ""));
+    expect_complete(GetParam(), s);
     EXPECT_EQ(s.crc_errors, 0U);
     EXPECT_EQ(s.injected, 0U);
 }
 
-TEST(ReplayQemu, M4fFloatOnePercentFaults) {
-    const host::ReplaySummary s = replay_through(kM4f, 0.01, "qemu_m4f_faults");
-    expect_complete(kM4f, s);
-    EXPECT_GT(s.injected, 0U);
-    EXPECT_GT(s.crc_errors, 0U);
-    EXPECT_GT(s.retries, 0U);
-}
-
-TEST(ReplayQemu, M3FixedCleanLink) {
-    const host::ReplaySummary s = replay_through(kM3, 0.0, "qemu_m3");
-    expect_complete(kM3, s);
-    EXPECT_EQ(s.crc_errors, 0U);
-    EXPECT_EQ(s.injected, 0U);
-}
-
-TEST(ReplayQemu, M3FixedOnePercentFaults) {
-    const host::ReplaySummary s = replay_through(kM3, 0.01, "qemu_m3_faults");
-    expect_complete(kM3, s);
+TEST_P(ReplayQemu, OnePercentFaults) {
+    const host::ReplaySummary s = replay_through(GetParam(), 0.01, scratch_name(GetParam(), "_faults"));
+    expect_complete(GetParam(), s);
     EXPECT_GT(s.injected, 0U);
     EXPECT_GT(s.crc_errors, 0U);
     EXPECT_GT(s.retries, 0U);
@@ -93,9 +95,7 @@ TEST(ReplayQemu, M3FixedOnePercentFaults) {
 // lost, identical boot id); the client sees the unprompted HELLO, restores
 // the model, velocity and temperatures, and every answer stays exact.
 template <typename T>
-void survive_restart(std::string_view replay_target, const std::string& name) {
-    const host::QemuTarget* board = host::find_qemu_target(replay_target);  // toolchain/targets.txt
-    ASSERT_NE(board, nullptr) << replay_target;
+void survive_restart(const host::QemuTarget* board, const std::string& name) {
     ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
     constexpr int kRestartRows = 1200;
     const auto dir = scratch_dir(name);
@@ -132,13 +132,17 @@ void survive_restart(std::string_view replay_target, const std::string& name) {
     EXPECT_GT(thermal_applied, static_cast<std::size_t>(kRestartRows / 2));  // the model was restored
 }
 
-TEST(ReplayQemu, M3RestartMidRunIsRecovered) {
-    survive_restart<Q30>("qemu-m3", "qemu_m3_restart");
+TEST_P(ReplayQemu, RestartMidRunIsRecovered) {
+    if (GetParam().scalar == host::TargetScalar::kFixed) {
+        survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    } else {
+        survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    }
 }
 
-TEST(ReplayQemu, M4fRestartMidRunIsRecovered) {
-    survive_restart<float>("qemu-m4f", "qemu_m4f_restart");
-}
+// Each test once per board: Boards/ReplayQemu.CleanLink/qemu_m3, ...
+INSTANTIATE_TEST_SUITE_P(Boards, ReplayQemu, ::testing::ValuesIn(host::kQemuTargets),
+                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) { return scratch_name(i.param, ""); });
 
 }  // namespace
 }  // namespace ascorr::test

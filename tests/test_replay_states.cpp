@@ -8,6 +8,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -25,6 +26,13 @@
 #include "ascorr_host/states_csv.hpp"
 #include "states_recording.hpp"
 #include "test_support.hpp"
+
+namespace ascorr::host {
+// GoogleTest shows a board by its replay name (not its bytes) in test names.
+inline void PrintTo(const QemuTarget& board, std::ostream* os) {
+    *os << board.replay;
+}
+}  // namespace ascorr::host
 
 namespace ascorr::test {
 namespace {
@@ -86,29 +94,38 @@ void expect_complete(const host::ReplaySummary& s, double bound) {
     EXPECT_EQ(s.restarts, 0U);
 }
 
-TEST(ReplayStatesQemu, M4fClean) {
-    expect_complete(replay_states("qemu-m4f", 0.0, kRows, "rs_m4f"), 0.05);
+// Every board of toolchain/targets.txt (the generated kQemuTargets), each at
+// the bound of its scalar (tests/target/accuracy-bounds.txt, compile
+// definitions of tests/CMakeLists.txt).
+double bound_arcsec(const host::QemuTarget& board) {
+    return board.scalar == host::TargetScalar::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
 }
-TEST(ReplayStatesQemu, M4fOnePercentFaults) {
-    const host::ReplaySummary s = replay_states("qemu-m4f", 0.01, kRows, "rs_m4f_f");
-    expect_complete(s, 0.05);
-    EXPECT_GT(s.crc_errors, 0U);
+
+std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
+    std::string s(board.replay);
+    for (char& c : s) {
+        c = c == '-' ? '_' : c;
+    }
+    return "rs_" + s + what;
 }
-TEST(ReplayStatesQemu, M3Clean) {
-    expect_complete(replay_states("qemu-m3", 0.0, kRows, "rs_m3"), 0.01);
+
+class ReplayStatesQemu : public ::testing::TestWithParam<host::QemuTarget> {};
+
+TEST_P(ReplayStatesQemu, Clean) {
+    expect_complete(replay_states(std::string(GetParam().replay), 0.0, kRows, scratch_name(GetParam(), "")),
+                    bound_arcsec(GetParam()));
 }
-TEST(ReplayStatesQemu, M3OnePercentFaults) {
-    const host::ReplaySummary s = replay_states("qemu-m3", 0.01, kRows, "rs_m3_f");
-    expect_complete(s, 0.01);
+TEST_P(ReplayStatesQemu, OnePercentFaults) {
+    const host::ReplaySummary s =
+        replay_states(std::string(GetParam().replay), 0.01, kRows, scratch_name(GetParam(), "_f"));
+    expect_complete(s, bound_arcsec(GetParam()));
     EXPECT_GT(s.crc_errors, 0U);
 }
 
 // The emulator killed halfway: the client restores the model, temperatures
 // and the latest accepted state, and every answer stays exact.
 template <typename T>
-void survive_restart(std::string_view replay_target, const std::string& name) {
-    const host::QemuTarget* board = host::find_qemu_target(replay_target);  // toolchain/targets.txt
-    ASSERT_NE(board, nullptr) << replay_target;
+void survive_restart(const host::QemuTarget* board, const std::string& name) {
     ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
     constexpr int kRestartRows = 600;
     const auto dir = scratch_dir(name);
@@ -166,12 +183,23 @@ void survive_restart(std::string_view replay_target, const std::string& name) {
     EXPECT_GT(from_states_applied, static_cast<std::size_t>(kRestartRows / 3));  // the state was restored
 }
 
-TEST(ReplayStatesQemu, M3RestartRestoresTheState) {
-    survive_restart<Q30>("qemu-m3", "rs_m3_restart");
+TEST_P(ReplayStatesQemu, RestartRestoresTheState) {
+    if (GetParam().scalar == host::TargetScalar::kFixed) {
+        survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    } else {
+        survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    }
 }
-TEST(ReplayStatesQemu, M4fRestartRestoresTheState) {
-    survive_restart<float>("qemu-m4f", "rs_m4f_restart");
-}
+
+// Each test once per board: Boards/ReplayStatesQemu.Clean/qemu_m3, ...
+INSTANTIATE_TEST_SUITE_P(Boards, ReplayStatesQemu, ::testing::ValuesIn(host::kQemuTargets),
+                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) {
+                             std::string s(i.param.replay);
+                             for (char& c : s) {
+                                 c = c == '-' ? '_' : c;
+                             }
+                             return s;
+                         });
 #endif
 
 }  // namespace

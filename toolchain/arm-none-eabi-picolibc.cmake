@@ -1,5 +1,6 @@
 # toolchain/arm-none-eabi-picolibc.cmake: the part of the Cortex-M toolchain
-# files common to every core (included by cortex-m3.cmake, cortex-m4f.cmake).
+# files common to every core (included by each toolchain/<cpu>.cmake of
+# toolchain/targets.txt).
 #
 # Debian 12's gcc-arm-none-eabi with picolibc-arm-none-eabi (picolibcpp.specs):
 # bare metal, no exceptions, no RTTI, no thread-safe statics, sections per

@@ -6,19 +6,20 @@
 #   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun, its
 #                                  report as below and its solutions those of
 #                                  the host core (check-flight-solutions)
-#   target_cortex-m3_no_soft_float the M3's per-solution and per-cycle code (the
+#   target_<t>_no_soft_float       on a fixed-point target (no FPU), the
+#                                  per-solution and per-cycle code (the
 #                                  core's entry, the velocity query,
 #                                  firmware/app/*_entry_fixed.cpp, and the
 #                                  fixed-point thermistor acquisition,
 #                                  hal_temperatures.cpp) references no
-#                                  soft-float routine (negative control: the M3
+#                                  soft-float routine (negative control: its
 #                                  application image, whose velocity service
-#                                  propagates in double, has); the same on the
-#                                  Debug (-O0) M3 build
-#                                  (target_cortex-m3-debug_no_soft_float*),
+#                                  propagates in double, has); the same on its
+#                                  Debug (-O0) build
+#                                  (target_<t>-debug_no_soft_float*),
 #                                  whose loop also flies without overrun and
 #                                  with the same solutions
-#                                  (target_cortex-m3-debug_firmware)
+#                                  (target_<t>-debug_firmware)
 
 # The host's side of the accuracy tests: inputs and the double core's check.
 add_executable(ascorr_target_vectors ${PROJECT_SOURCE_DIR}/tests/target_vectors.cpp)
@@ -107,7 +108,7 @@ foreach(t ${ASCORR_TARGET_LIST})
     list(APPEND no_fpu_builds ${t})
   endif()
 endforeach()
-foreach(build ${no_fpu_builds} cortex-m3-debug)
+foreach(build ${no_fpu_builds} ${ASCORR_TARGET_DEBUG_BUILDS})
   set(app ${ASCORR_TARGET_${build}_BINARY_DIR}/firmware/app)
   set(entry_objs ${app}/CMakeFiles/ascorr_core_entry_fixed.dir)
   add_test(NAME target_${build}_no_soft_float
@@ -123,9 +124,12 @@ endforeach()
 # The -O0 image flies the same loop without overrun and with the same
 # solutions (the velocity service's cost comparison is an optimised-build
 # figure and is not asked of it).
-add_test(NAME target_cortex-m3-debug_firmware
-         COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-flight-solutions $<TARGET_FILE:ascorr_flight_expectation_fixed>
-                 ${ASCORR_TARGET_cortex-m3_MACHINE} ${ASCORR_TARGET_cortex-m3-debug_BINARY_DIR}/firmware/app/ascorr_firmware.elf
-                 ${flight_bound_fixed} ${CMAKE_BINARY_DIR}/target-runs/cortex-m3-debug-firmware)
-set_tests_properties(target_cortex-m3-debug_firmware PROPERTIES LABELS target TIMEOUT 60
-  PASS_REGULAR_EXPRESSION "${scalar_name_fixed} core, ${firmware_expect}.*${flight_match_fixed}")
+foreach(build ${ASCORR_TARGET_DEBUG_BUILDS})
+  set(cpu ${ASCORR_TARGET_${build}_CPU})
+  add_test(NAME target_${build}_firmware
+           COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-flight-solutions $<TARGET_FILE:ascorr_flight_expectation_fixed>
+                   ${ASCORR_TARGET_${cpu}_MACHINE} ${ASCORR_TARGET_${build}_BINARY_DIR}/firmware/app/ascorr_firmware.elf
+                   ${flight_bound_fixed} ${CMAKE_BINARY_DIR}/target-runs/${build}-firmware)
+  set_tests_properties(target_${build}_firmware PROPERTIES LABELS target TIMEOUT 60
+    PASS_REGULAR_EXPRESSION "${scalar_name_fixed} core, ${firmware_expect}.*${flight_match_fixed}")
+endforeach()
