@@ -530,6 +530,78 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
     EXPECT_EQ(u.exit_code, 0) << u.err;
 }
 
+// docs/contract.md, section 3: RFC 4180 quoting in the header and in columns
+// the reader ignores is accepted, as the host readers accept it (ascorr
+// correct); in a column it reads a quoted field is refused, naming the column.
+// The thermistor readers used to split at every comma ("expected 15 fields,
+// found 16") and did not know a quoted header name.
+TEST(HalCli, ThermistorReadersAcceptQuotingWhereTheyDoNotReadAndRefuseItWhereTheyDo) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = "--config " + kExamples + "/board.cfg ";
+    // A solutions file with a quoted header name and a quoted note column
+    // holding commas and doubled quotes; the same without: the same output.
+    std::ofstream(dir / "q.csv") << "\"t\",chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,\"note, free\"\n"
+                                 << "100,A,1,0,0,0,3.2,-9.5,-19.8,,,,0,1.00,\"a, \"\"b\"\"\"\n"
+                                 << "101,A,1,0,0,0,3.3,-9.4,-19.7,,,,0,1.00,\"\"\n"
+                                 << "102,A,1,0,0,0,3.4,-9.3,-19.6,,,,0,1.00,plain\n";
+    std::ofstream(dir / "p.csv") << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,note\n"
+                                 << "100,A,1,0,0,0,3.2,-9.5,-19.8,,,,0,1.00,x\n"
+                                 << "101,A,1,0,0,0,3.3,-9.4,-19.7,,,,0,1.00,x\n"
+                                 << "102,A,1,0,0,0,3.4,-9.3,-19.6,,,,0,1.00,x\n";
+    const CliRun q = run(cfg + "--simulate " + (dir / "q.csv").string(), dir);
+    const CliRun p = run(cfg + "--simulate " + (dir / "p.csv").string(), dir);
+    ASSERT_EQ(q.exit_code, 0) << q.err;
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    EXPECT_EQ(q.out, p.out);
+    EXPECT_NE(q.err.find("3 frames, 0 voted values withheld"), std::string::npos) << q.err;
+    EXPECT_NE(q.out.find("102.000000,t_029,voted,,,-9.290,1,"), std::string::npos) << q.out;  // not vacuous
+    // The host reader takes the same file (the contract is one).
+    EXPECT_EQ(std::system((std::string(ASCORR_EXE) + " stats --in " + (dir / "q.csv").string() + " > " +
+                           (dir / "stats.txt").string() + " 2>&1")
+                              .c_str()),
+              0)
+        << slurp(dir / "stats.txt");
+
+    // A replay file reads every column: a quoted header is accepted.
+    std::ofstream(dir / "r.csv") << "\"t\",\"THT00029\"\n100,-9.5\n101,-9.4\n";
+    std::ofstream(dir / "rp.csv") << "t,THT00029\n100,-9.5\n101,-9.4\n";
+    const CliRun r = run(cfg + "--replay " + (dir / "r.csv").string(), dir);
+    const CliRun rp = run(cfg + "--replay " + (dir / "rp.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, rp.out);
+    EXPECT_NE(r.out.find("101.000000,THT00029,t029,,,-9.400,1,"), std::string::npos) << r.out;
+
+    // Quoted fields where the readers read, and malformed quoting: refused at
+    // file:line:column, naming the column.
+    const std::string quoted = " is a quoted field in a column ascorr reads: write numbers without quotes";
+    const std::string history = "t,chu,t_chu,t_029,t_032,note\n";
+    struct Case {
+        std::string file;
+        std::string text;
+        std::string option;
+        std::string message;
+    };
+    const Case cases[] = {
+        {"t.csv", history + "10,A,\"5\",-9,-20,x\n", "--simulate", "t.csv:2:6: column 't_chu': \"5\"" + quoted},
+        {"t2.csv", history + "10,A,5,-9,\"-20\",x\n", "--simulate", "t2.csv:2:11: column 't_032': \"-20\"" + quoted},
+        {"time.csv", history + "\"10\",A,5,-9,-20,x\n", "--simulate", "time.csv:2:1: column 't': \"10\"" + quoted},
+        {"chu.csv", history + "10,\"A\",5,-9,-20,x\n", "--simulate", "chu.csv:2:4: column 'chu': \"A\"" + quoted},
+        {"rq.csv", "t,THT00029\n100,-9.5\n101,\"-9.4\"\n", "--replay",
+         "rq.csv:3:5: column 'THT00029': \"-9.4\"" + quoted},
+        {"open.csv", history + "10,A,5,-9,-20,\"a note that goes on\nto the next line\"\n", "--simulate",
+         "open.csv:2:15: quoted field without its closing quote (a line break inside quotes is not supported"},
+        {"after.csv", history + "10,A,5,-9,-20,\"a\"b\n", "--simulate",
+         "after.csv:2:18: text after the closing quote of a quoted field"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        std::ofstream(dir / c.file) << c.text;
+        const CliRun e = run(cfg + c.option + " " + (dir / c.file).string(), dir);
+        EXPECT_EQ(e.exit_code, 1);
+        EXPECT_NE(e.err.find(c.message), std::string::npos) << e.err;
+    }
+}
+
 TEST(HalCli, BadConfigExitsOneWithLocation) {
     const fs::path dir = scratch_dir("hal-cli");
     std::ofstream(dir / "bad.cfg") << "channel name=X adc=9 role=t029 a=1 b=2 c=3\n";

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ascorr_hal_linux/config_file.hpp"
+#include "ascorr_hal_linux/csv_fields.hpp"
 
 namespace ascorr::hal::linux_detail {
 
@@ -203,21 +204,41 @@ inline std::string read_text_file(const std::string& path) {
     return ss.str();
 }
 
-// A field of a comma-separated line and its column (1-based).
+// A field of a comma-separated line, as written (quotes included), and its
+// column (1-based).
 using Field = std::pair<std::string_view, std::size_t>;
 
-// The comma-separated fields of a line into `out` (cleared first).
-inline void split_fields(std::string_view line, std::vector<Field>& out) {
-    out.clear();
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t c = line.find(',', start);
-        if (c == std::string_view::npos) {
-            out.emplace_back(line.substr(start), start + 1);
-            return;
+// The fields of the lines of a file, split by the dialect's one splitter
+// (ascorr_hal_linux/csv_fields.hpp: RFC 4180 quoting as docs/contract.md,
+// section 3 says). Reuses its storage from line to line.
+class FieldSplitter {
+public:
+    // The fields of line `line_no` of `file`. Malformed quoting (an
+    // unterminated quoted field, text after a closing quote): ConfigError at
+    // file:line:column, in the host readers' words.
+    const std::vector<Field>& split(const std::string& file, std::size_t line_no, std::string_view line) {
+        const std::size_t bad = csv::split_fields(line, text_);
+        if (bad != csv::kSplitOk) {
+            throw ConfigError(file, line_no, bad + 1, csv::why_split_failed(line, bad));
         }
-        out.emplace_back(line.substr(start, c - start), start + 1);
-        start = c + 1;
+        fields_.clear();
+        for (const std::string_view f : text_) {
+            fields_.emplace_back(f, static_cast<std::size_t>(f.data() - line.data()) + 1U);
+        }
+        return fields_;
+    }
+
+private:
+    std::vector<std::string_view> text_;
+    std::vector<Field> fields_;
+};
+
+// A field of a column the reader reads: refused when quoted, naming the
+// column ("column 't_chu': \"5\" is a quoted field in a column ascorr reads").
+inline void refuse_quoted(const std::string& file, std::size_t line_no, const Field& field, std::string_view column) {
+    if (csv::is_quoted(field.first)) {
+        throw ConfigError(file, line_no, field.second,
+                          "column '" + std::string(column) + "': " + csv::quoted_field_refusal(field.first));
     }
 }
 
