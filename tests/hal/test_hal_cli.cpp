@@ -482,17 +482,26 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
     const std::string history = "t,t_chu,t_029,t_032\n1,2,3,4\n";
     const std::string replay = "t,THT00029\n100,-9.5\n";
     struct Bad {
-        std::string bytes;  // inserted at the start of line 3
-        std::string what;   // the message after file:3:column:
+        std::string bytes;   // inserted at the start of line 3
+        std::string column;  // of the first bad byte
+        std::string what;    // the message after file:3:column:
         std::string excerpt;
     };
+    const std::string binary = ": not a text file, line starts \"";
+    const std::string latin1 = "; the file may be Latin-1: convert it with iconv -f latin1 -t utf-8), line starts \"";
     const Bad bad[] = {
-        {std::string("\0\x01", 2), "binary data (byte 0x00)", "\\x00\\x01"},
-        {"\xff\xfe", "binary data (byte 0xff)", "\\xff\\xfe"},
-        {"\x1b[2J", "binary data (byte 0x1b)", "\\x1b[2J"},
-        {"\xc0\xaf", "binary data (byte 0xc0)", "\\xc0\\xaf"},      // overlong '/'
-        {"\xed\xa0\x80", "binary data (byte 0xed)", "\\xed\\xa0"},  // a surrogate
-        {"x\ry", "a CR not followed by LF (CR-only line ends?)", "x\\x0dy"},
+        {std::string("\0\x01", 2), "1", "binary data (byte 0x00)" + binary, "\\x00\\x01"},
+        {"\x1b[2J", "1", "binary data (byte 0x1b)" + binary, "\\x1b[2J"},
+        {"x\ry", "2", "a CR not followed by LF (CR-only line ends?)" + binary, "x\\x0dy"},
+        // Invalid UTF-8 in a line with a control byte is binary data too.
+        {"\xff\xfe\x01", "1", "binary data (byte 0xff)" + binary, "\\xff\\xfe\\x01"},
+        // Invalid UTF-8 in an otherwise printable line: not UTF-8 (Latin-1?).
+        {"\xff\xfe", "1", "not UTF-8 text (byte 0xff" + latin1, "\\xff\\xfe"},
+        {"\xc0\xaf", "1", "not UTF-8 text (byte 0xc0" + latin1, "\\xc0\\xaf"},      // overlong '/'
+        {"\xed\xa0\x80", "1", "not UTF-8 text (byte 0xed" + latin1, "\\xed\\xa0"},  // a surrogate
+        {"# 25 \xb0"
+         "C\n",
+         "6", "not UTF-8 text (byte 0xb0" + latin1, "# 25 \\xb0C"},  // Latin-1 '°', a comment
     };
     for (const Bad& b : bad) {
         const auto third_line = [&](const std::string& text) {  // b.bytes at the start of line 3
@@ -502,7 +511,6 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
         std::ofstream(dir / "b.cfg", std::ios::binary) << third_line(good_cfg);
         std::ofstream(dir / "h.csv", std::ios::binary) << third_line(history + "2,2,3,4\n");
         std::ofstream(dir / "r.csv", std::ios::binary) << third_line(replay + "101,-9.5\n");
-        const std::string column = b.bytes[0] == 'x' ? "2" : "1";
         const std::pair<std::string, std::string> runs[] = {
             {"--config " + (dir / "b.cfg").string() + " --simulate " + (dir / "h.csv").string(), "b.cfg"},
             {"--config " + cfg + " --simulate " + (dir / "h.csv").string(), "h.csv"},
@@ -511,9 +519,7 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
         for (const auto& [args, file] : runs) {
             const CliRun r = run(args, dir);
             EXPECT_EQ(r.exit_code, 1) << args;
-            EXPECT_NE(r.err.find(file + ":3:" + column + ": " + b.what + ": not a text file, line starts \""),
-                      std::string::npos)
-                << r.err;
+            EXPECT_NE(r.err.find(file + ":3:" + b.column + ": " + b.what), std::string::npos) << r.err;
             EXPECT_NE(r.err.find(b.excerpt), std::string::npos) << r.err;
             EXPECT_EQ(r.err.find(b.bytes), std::string::npos) << "the bytes reached the terminal: " << r.err;
             for (const char c : r.err) {
