@@ -221,110 +221,6 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
 }
 }  // namespace
 
-namespace {
-// RFC 4180 quoting, taken only when the line has a quote: a field that begins
-// with '"' runs to the quote that closes it ("" inside stands for one quote,
-// commas inside are text) and must end there. The field is handed on as
-// written, quotes included, so that a writer copies it verbatim.
-std::size_t split_quoted(std::string_view line, std::vector<std::string_view>& fields,
-                         std::vector<std::size_t>* starts) {
-    std::size_t start = 0;
-    for (;;) {
-        if (starts != nullptr) {
-            starts->push_back(start);
-        }
-        std::size_t end = start;
-        if (start < line.size() && line[start] == '"') {
-            std::size_t i = start + 1;
-            for (;;) {
-                const std::size_t q = line.find('"', i);
-                if (q == std::string_view::npos) {
-                    return start;  // unterminated (a line break inside quotes is not supported)
-                }
-                if (q + 1 < line.size() && line[q + 1] == '"') {
-                    i = q + 2;  // a doubled quote
-                    continue;
-                }
-                end = q + 1;
-                break;
-            }
-            if (end < line.size() && line[end] != ',') {
-                return end;  // text after the closing quote
-            }
-        } else {
-            end = line.find(',', start);
-            if (end == std::string_view::npos) {
-                end = line.size();
-            }
-        }
-        fields.push_back(line.substr(start, end - start));
-        if (end >= line.size()) {
-            return kSplitOk;
-        }
-        start = end + 1;
-    }
-}
-}  // namespace
-
-std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields,
-                         std::vector<std::size_t>& starts) {
-    fields.clear();
-    starts.clear();
-    if (line.find('"') != std::string_view::npos) {
-        return split_quoted(line, fields, &starts);
-    }
-    std::size_t start = 0;
-    for (;;) {
-        const std::size_t comma = line.find(',', start);
-        starts.push_back(start);
-        if (comma == std::string_view::npos) {
-            fields.push_back(line.substr(start));
-            return kSplitOk;
-        }
-        fields.push_back(line.substr(start, comma - start));
-        start = comma + 1;
-    }
-}
-
-std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields) {
-    fields.clear();
-    if (std::memchr(line.data(), '"', line.size()) != nullptr) {
-        return split_quoted(line, fields, nullptr);
-    }
-    std::size_t start = 0;
-    for (;;) {
-        const std::size_t comma = line.find(',', start);
-        if (comma == std::string_view::npos) {
-            fields.push_back(line.substr(start));
-            return kSplitOk;
-        }
-        fields.push_back(line.substr(start, comma - start));
-        start = comma + 1;
-    }
-}
-
-std::string why_split_failed(std::string_view line, std::size_t at) {
-    if (at < line.size() && line[at] == '"') {
-        return "quoted field without its closing quote (a line break inside quotes is not supported: "
-               "docs/contract.md, section 3)";
-    }
-    return "text after the closing quote of a quoted field";
-}
-
-std::string unquoted(std::string_view field) {
-    if (field.size() < 2 || field.front() != '"') {
-        return std::string(field);
-    }
-    std::string out;
-    for (std::size_t i = 1; i + 1 < field.size(); ++i) {
-        out += field[i];
-        if (field[i] == '"') {
-            ++i;  // "" is one quote
-        }
-    }
-    return out;
-}
-
 std::optional<double> parse_double(std::string_view field) noexcept {
     if (field.empty()) {
         return std::nullopt;
@@ -360,15 +256,10 @@ std::optional<long long> parse_integer(std::string_view field) noexcept {
     return x;
 }
 
-namespace {
-const char* const kQuotedNumber =
-    " is a quoted field in a column ascorr reads: write numbers without quotes (docs/contract.md, section 3)";
-}  // namespace
-
 std::string why_not_a_number(std::string_view field) {
     const std::string text(field);
     if (!text.empty() && text[0] == '"') {
-        return text + kQuotedNumber;
+        return hal::csv::quoted_field_refusal(text);
     }
     const char* first = text.c_str();
     if (*first == '+') {
@@ -389,7 +280,7 @@ std::string why_not_an_integer(std::string_view field, long long lo, long long h
     const std::string range = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
     const std::string text(field);
     if (!text.empty() && text[0] == '"') {
-        return text + kQuotedNumber;
+        return hal::csv::quoted_field_refusal(text);
     }
     std::size_t i = !text.empty() && (text[0] == '-' || text[0] == '+') ? 1 : 0;
     const bool digits = i < text.size() && text.find_first_not_of("0123456789", i) == std::string::npos;

@@ -482,17 +482,26 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
     const std::string history = "t,t_chu,t_029,t_032\n1,2,3,4\n";
     const std::string replay = "t,THT00029\n100,-9.5\n";
     struct Bad {
-        std::string bytes;  // inserted at the start of line 3
-        std::string what;   // the message after file:3:column:
+        std::string bytes;   // inserted at the start of line 3
+        std::string column;  // of the first bad byte
+        std::string what;    // the message after file:3:column:
         std::string excerpt;
     };
+    const std::string binary = ": not a text file, line starts \"";
+    const std::string latin1 = "; the file may be Latin-1: convert it with iconv -f latin1 -t utf-8), line starts \"";
     const Bad bad[] = {
-        {std::string("\0\x01", 2), "binary data (byte 0x00)", "\\x00\\x01"},
-        {"\xff\xfe", "binary data (byte 0xff)", "\\xff\\xfe"},
-        {"\x1b[2J", "binary data (byte 0x1b)", "\\x1b[2J"},
-        {"\xc0\xaf", "binary data (byte 0xc0)", "\\xc0\\xaf"},      // overlong '/'
-        {"\xed\xa0\x80", "binary data (byte 0xed)", "\\xed\\xa0"},  // a surrogate
-        {"x\ry", "a CR not followed by LF (CR-only line ends?)", "x\\x0dy"},
+        {std::string("\0\x01", 2), "1", "binary data (byte 0x00)" + binary, "\\x00\\x01"},
+        {"\x1b[2J", "1", "binary data (byte 0x1b)" + binary, "\\x1b[2J"},
+        {"x\ry", "2", "a CR not followed by LF (CR-only line ends?)" + binary, "x\\x0dy"},
+        // Invalid UTF-8 in a line with a control byte is binary data too.
+        {"\xff\xfe\x01", "1", "binary data (byte 0xff)" + binary, "\\xff\\xfe\\x01"},
+        // Invalid UTF-8 in an otherwise printable line: not UTF-8 (Latin-1?).
+        {"\xff\xfe", "1", "not UTF-8 text (byte 0xff" + latin1, "\\xff\\xfe"},
+        {"\xc0\xaf", "1", "not UTF-8 text (byte 0xc0" + latin1, "\\xc0\\xaf"},      // overlong '/'
+        {"\xed\xa0\x80", "1", "not UTF-8 text (byte 0xed" + latin1, "\\xed\\xa0"},  // a surrogate
+        {"# 25 \xb0"
+         "C\n",
+         "6", "not UTF-8 text (byte 0xb0" + latin1, "# 25 \\xb0C"},  // Latin-1 '°', a comment
     };
     for (const Bad& b : bad) {
         const auto third_line = [&](const std::string& text) {  // b.bytes at the start of line 3
@@ -502,7 +511,6 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
         std::ofstream(dir / "b.cfg", std::ios::binary) << third_line(good_cfg);
         std::ofstream(dir / "h.csv", std::ios::binary) << third_line(history + "2,2,3,4\n");
         std::ofstream(dir / "r.csv", std::ios::binary) << third_line(replay + "101,-9.5\n");
-        const std::string column = b.bytes[0] == 'x' ? "2" : "1";
         const std::pair<std::string, std::string> runs[] = {
             {"--config " + (dir / "b.cfg").string() + " --simulate " + (dir / "h.csv").string(), "b.cfg"},
             {"--config " + cfg + " --simulate " + (dir / "h.csv").string(), "h.csv"},
@@ -511,9 +519,7 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
         for (const auto& [args, file] : runs) {
             const CliRun r = run(args, dir);
             EXPECT_EQ(r.exit_code, 1) << args;
-            EXPECT_NE(r.err.find(file + ":3:" + column + ": " + b.what + ": not a text file, line starts \""),
-                      std::string::npos)
-                << r.err;
+            EXPECT_NE(r.err.find(file + ":3:" + b.column + ": " + b.what), std::string::npos) << r.err;
             EXPECT_NE(r.err.find(b.excerpt), std::string::npos) << r.err;
             EXPECT_EQ(r.err.find(b.bytes), std::string::npos) << "the bytes reached the terminal: " << r.err;
             for (const char c : r.err) {
@@ -528,6 +534,78 @@ TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {
     EXPECT_NE(good_cfg.find("\xCE\xA9"), std::string::npos);
     const CliRun u = run("--config " + cfg + " --simulate " + (dir / "u.csv").string(), dir);
     EXPECT_EQ(u.exit_code, 0) << u.err;
+}
+
+// docs/contract.md, section 3: RFC 4180 quoting in the header and in columns
+// the reader ignores is accepted, as the host readers accept it (ascorr
+// correct); in a column it reads a quoted field is refused, naming the column.
+// The thermistor readers used to split at every comma ("expected 15 fields,
+// found 16") and did not know a quoted header name.
+TEST(HalCli, ThermistorReadersAcceptQuotingWhereTheyDoNotReadAndRefuseItWhereTheyDo) {
+    const fs::path dir = scratch_dir("hal-cli");
+    const std::string cfg = "--config " + kExamples + "/board.cfg ";
+    // A solutions file with a quoted header name and a quoted note column
+    // holding commas and doubled quotes; the same without: the same output.
+    std::ofstream(dir / "q.csv") << "\"t\",chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,\"note, free\"\n"
+                                 << "100,A,1,0,0,0,3.2,-9.5,-19.8,,,,0,1.00,\"a, \"\"b\"\"\"\n"
+                                 << "101,A,1,0,0,0,3.3,-9.4,-19.7,,,,0,1.00,\"\"\n"
+                                 << "102,A,1,0,0,0,3.4,-9.3,-19.6,,,,0,1.00,plain\n";
+    std::ofstream(dir / "p.csv") << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,note\n"
+                                 << "100,A,1,0,0,0,3.2,-9.5,-19.8,,,,0,1.00,x\n"
+                                 << "101,A,1,0,0,0,3.3,-9.4,-19.7,,,,0,1.00,x\n"
+                                 << "102,A,1,0,0,0,3.4,-9.3,-19.6,,,,0,1.00,x\n";
+    const CliRun q = run(cfg + "--simulate " + (dir / "q.csv").string(), dir);
+    const CliRun p = run(cfg + "--simulate " + (dir / "p.csv").string(), dir);
+    ASSERT_EQ(q.exit_code, 0) << q.err;
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    EXPECT_EQ(q.out, p.out);
+    EXPECT_NE(q.err.find("3 frames, 0 voted values withheld"), std::string::npos) << q.err;
+    EXPECT_NE(q.out.find("102.000000,t_029,voted,,,-9.290,1,"), std::string::npos) << q.out;  // not vacuous
+    // The host reader takes the same file (the contract is one).
+    EXPECT_EQ(std::system((std::string(ASCORR_EXE) + " stats --in " + (dir / "q.csv").string() + " > " +
+                           (dir / "stats.txt").string() + " 2>&1")
+                              .c_str()),
+              0)
+        << slurp(dir / "stats.txt");
+
+    // A replay file reads every column: a quoted header is accepted.
+    std::ofstream(dir / "r.csv") << "\"t\",\"THT00029\"\n100,-9.5\n101,-9.4\n";
+    std::ofstream(dir / "rp.csv") << "t,THT00029\n100,-9.5\n101,-9.4\n";
+    const CliRun r = run(cfg + "--replay " + (dir / "r.csv").string(), dir);
+    const CliRun rp = run(cfg + "--replay " + (dir / "rp.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, rp.out);
+    EXPECT_NE(r.out.find("101.000000,THT00029,t029,,,-9.400,1,"), std::string::npos) << r.out;
+
+    // Quoted fields where the readers read, and malformed quoting: refused at
+    // file:line:column, naming the column.
+    const std::string quoted = " is a quoted field in a column ascorr reads: write numbers without quotes";
+    const std::string history = "t,chu,t_chu,t_029,t_032,note\n";
+    struct Case {
+        std::string file;
+        std::string text;
+        std::string option;
+        std::string message;
+    };
+    const Case cases[] = {
+        {"t.csv", history + "10,A,\"5\",-9,-20,x\n", "--simulate", "t.csv:2:6: column 't_chu': \"5\"" + quoted},
+        {"t2.csv", history + "10,A,5,-9,\"-20\",x\n", "--simulate", "t2.csv:2:11: column 't_032': \"-20\"" + quoted},
+        {"time.csv", history + "\"10\",A,5,-9,-20,x\n", "--simulate", "time.csv:2:1: column 't': \"10\"" + quoted},
+        {"chu.csv", history + "10,\"A\",5,-9,-20,x\n", "--simulate", "chu.csv:2:4: column 'chu': \"A\"" + quoted},
+        {"rq.csv", "t,THT00029\n100,-9.5\n101,\"-9.4\"\n", "--replay",
+         "rq.csv:3:5: column 'THT00029': \"-9.4\"" + quoted},
+        {"open.csv", history + "10,A,5,-9,-20,\"a note that goes on\nto the next line\"\n", "--simulate",
+         "open.csv:2:15: quoted field without its closing quote (a line break inside quotes is not supported"},
+        {"after.csv", history + "10,A,5,-9,-20,\"a\"b\n", "--simulate",
+         "after.csv:2:18: text after the closing quote of a quoted field"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        std::ofstream(dir / c.file) << c.text;
+        const CliRun e = run(cfg + c.option + " " + (dir / c.file).string(), dir);
+        EXPECT_EQ(e.exit_code, 1);
+        EXPECT_NE(e.err.find(c.message), std::string::npos) << e.err;
+    }
 }
 
 TEST(HalCli, BadConfigExitsOneWithLocation) {

@@ -12,6 +12,7 @@ namespace {
 struct Column {
     int channel;  // -1: the time column
     bool counts;
+    std::string name;  // as the header names it, unquoted
 };
 
 }  // namespace
@@ -20,36 +21,36 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
     std::vector<Column> columns;
     linux_detail::TextLines lines(file, text);
     std::string_view line;
-    std::vector<linux_detail::Field> fields;
+    linux_detail::FieldSplitter splitter;
     bool header = true;
     while (lines.next(line)) {
         const std::size_t line_no = lines.number();
-        linux_detail::split_fields(line, fields);
+        const std::vector<linux_detail::Field>& fields = splitter.split(file, line_no, line);
         if (header) {
             header = false;
             bool have_t = false;
             bool used[kMaxChannels] = {};
-            for (const auto& [name, col] : fields) {
+            for (const auto& [raw, col] : fields) {
+                const std::string name = hal::csv::unquoted(raw);  // "t" names the column t
                 if (name == "t") {
                     if (have_t) {
                         throw ConfigError(file, line_no, col, "column 't' appears twice");
                     }
                     have_t = true;
-                    columns.push_back({-1, false});
+                    columns.push_back({-1, false, name});
                     continue;
                 }
                 const bool counts = name.size() > 7 && name.substr(name.size() - 7) == ".counts";
-                const std::string_view ch = counts ? name.substr(0, name.size() - 7) : name;
+                const std::string_view ch = std::string_view(name).substr(0, counts ? name.size() - 7 : name.size());
                 const int idx = find_channel(config, ch);
                 if (idx < 0) {
-                    throw ConfigError(file, line_no, col,
-                                      "column '" + std::string(name) + "' names no configured channel");
+                    throw ConfigError(file, line_no, col, "column '" + name + "' names no configured channel");
                 }
                 if (used[idx]) {
                     throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
                 }
                 used[idx] = true;
-                columns.push_back({idx, counts});
+                columns.push_back({idx, counts, name});
             }
             if (!have_t) {
                 throw ConfigError(file, line_no, 1, "no column 't'");
@@ -68,6 +69,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         for (std::size_t i = 0; i < columns.size(); ++i) {
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
+            linux_detail::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
             const char* b = v.data();
             const char* e = b + v.size();
             if (c.channel < 0) {

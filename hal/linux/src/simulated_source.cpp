@@ -115,13 +115,15 @@ struct HistoryColumns {
     std::size_t count = 0;              // fields every row has
 };
 
+// The temperature columns of a history, in HistoryColumns::temperature's order.
+constexpr const char* kHistoryTemperatureNames[3] = {"t_chu", "t_029", "t_032"};
+
 // The header line: which field is which; t, t_chu, t_029, t_032 required.
 HistoryColumns history_columns(const std::string& file, const std::vector<linux_detail::Field>& header) {
-    static constexpr const char* kTemperatureNames[3] = {"t_chu", "t_029", "t_032"};
     HistoryColumns cols;
     cols.count = header.size();
     for (std::size_t i = 0; i < header.size(); ++i) {
-        const std::string_view name = header[i].first;
+        const std::string name = csv::unquoted(header[i].first);  // "t" names the column t
         const int index = static_cast<int>(i);
         if (name == "t") {
             cols.t = index;
@@ -129,7 +131,7 @@ HistoryColumns history_columns(const std::string& file, const std::vector<linux_
             cols.chu = index;
         }
         for (int k = 0; k < 3; ++k) {
-            if (name == kTemperatureNames[k]) {
+            if (name == kHistoryTemperatureNames[k]) {
                 cols.temperature[k] = index;
             }
         }
@@ -150,6 +152,7 @@ int history_head(const std::string& file, std::size_t line_no, const std::vector
     if (cols.chu < 0) {
         return -1;
     }
+    linux_detail::refuse_quoted(file, line_no, field(f, cols.chu), "chu");
     const auto& [v, c] = field(f, cols.chu);
     if (v.size() != 1 || head_index(v[0]) == kUnknownHead) {
         throw ConfigError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
@@ -181,6 +184,7 @@ HistoryRow history_row(const std::string& file, std::size_t line_no, std::string
     }
     HistoryRow r{0.0, -1, 0.0, 0.0, 0.0};
     r.line = line_no;
+    linux_detail::refuse_quoted(file, line_no, field(f, cols.t), "t");
     const auto& [t_text, t_col] = field(f, cols.t);
     if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
         throw ConfigError(
@@ -191,6 +195,7 @@ HistoryRow history_row(const std::string& file, std::size_t line_no, std::string
     double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
     for (int k = 0; k < 3; ++k) {
         const linux_detail::Field& tf = field(f, cols.temperature[k]);
+        linux_detail::refuse_quoted(file, line_no, tf, kHistoryTemperatureNames[k]);
         r.column[k] = tf.second;
         *dst[k] = history_temperature(file, line_no, tf);
     }
@@ -202,19 +207,17 @@ HistoryRow history_row(const std::string& file, std::size_t line_no, std::string
 std::vector<HistoryRow> parse_history(const std::string& file, std::string_view text) {
     linux_detail::TextLines lines(file, text);
     std::string_view line;
-    std::vector<linux_detail::Field> f;
+    linux_detail::FieldSplitter splitter;
     if (!lines.next(line)) {
         throw ConfigError(file, 1, 1, "empty file (no header)");
     }
-    linux_detail::split_fields(line, f);
-    const HistoryColumns cols = history_columns(file, f);
+    const HistoryColumns cols = history_columns(file, splitter.split(file, lines.number(), line));
     std::vector<HistoryRow> rows;
     while (lines.next(line)) {
         if (line.empty() && lines.at_end()) {  // a blank last line
             break;
         }
-        linux_detail::split_fields(line, f);
-        rows.push_back(history_row(file, lines.number(), line, f, cols));
+        rows.push_back(history_row(file, lines.number(), line, splitter.split(file, lines.number(), line), cols));
     }
     return rows;
 }

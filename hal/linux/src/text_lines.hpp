@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ascorr_hal_linux/config_file.hpp"
+#include "ascorr_hal_linux/csv_fields.hpp"
 
 namespace ascorr::hal::linux_detail {
 
@@ -101,10 +102,32 @@ inline std::string escaped_excerpt(std::string_view line) {
     return out + (line.size() > n ? "..." : "");
 }
 
+// True when a byte is a control character a text line may not hold: below
+// 0x20 but tab (CR before LF is the caller's exception), or DEL.
+inline bool is_control(unsigned char c) noexcept {
+    return (c < 0x20U && c != '\t') || c == 0x7FU;
+}
+
+// True when no byte of the line is a control character (a final CR of a CRLF
+// line end excepted): the line is text, whatever its encoding.
+inline bool printable_line(std::string_view line) noexcept {
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const auto c = static_cast<unsigned char>(line[i]);
+        if (is_control(c) && !(c == '\r' && i + 1 == line.size())) {
+            return false;
+        }
+    }
+    return true;
+}
+
 // Refuses a text that is not UTF-8 text: a NUL or another control character
 // (but tab, and CR before LF), DEL, or invalid UTF-8. ConfigError at the
-// first such byte: "file:line:column: binary data (byte 0xHH): not a text
-// file, line starts \"…\"" with an escaped excerpt, never the bytes.
+// first such byte, with an escaped excerpt of its line, never the bytes:
+// invalid UTF-8 in an otherwise printable line (a Latin-1 '°', 0xb0) is
+// "file:line:column: not UTF-8 text (byte 0xb0; the file may be Latin-1:
+// convert it with iconv -f latin1 -t utf-8), line starts \"…\""; anything
+// else "file:line:column: binary data (byte 0xHH): not a text file, line
+// starts \"…\"" (or a CR not followed by LF).
 inline void refuse_binary(const std::string& file, std::string_view text) {
     std::size_t line = 1;
     std::size_t line_start = 0;
@@ -116,7 +139,7 @@ inline void refuse_binary(const std::string& file, std::string_view text) {
             continue;
         }
         const bool cr_before_lf = c == '\r' && i + 1 < text.size() && text[i + 1] == '\n';
-        const bool control = (c < 0x20U && c != '\t' && !cr_before_lf) || c == 0x7FU;
+        const bool control = is_control(c) && !cr_before_lf;
         const std::size_t n = control ? 0 : utf8_length(text, i);
         if (n == 0) {
             const std::size_t end = text.find('\n', line_start);
@@ -124,10 +147,17 @@ inline void refuse_binary(const std::string& file, std::string_view text) {
                 text.substr(line_start, end == std::string_view::npos ? end : end - line_start);
             char byte[8];
             std::snprintf(byte, sizeof byte, "0x%02x", c);
-            const std::string what = c == '\r' ? std::string("a CR not followed by LF (CR-only line ends?)")
-                                               : std::string("binary data (byte ") + byte + ")";
-            throw ConfigError(file, line, i - line_start + 1,
-                              what + ": not a text file, line starts \"" + escaped_excerpt(whole) + "\"");
+            const std::string starts = "line starts \"" + escaped_excerpt(whole) + "\"";
+            std::string what;
+            if (c >= 0x80U && printable_line(whole)) {
+                what = std::string("not UTF-8 text (byte ") + byte +
+                       "; the file may be Latin-1: convert it with iconv -f latin1 -t utf-8), " + starts;
+            } else if (c == '\r') {
+                what = "a CR not followed by LF (CR-only line ends?): not a text file, " + starts;
+            } else {
+                what = std::string("binary data (byte ") + byte + "): not a text file, " + starts;
+            }
+            throw ConfigError(file, line, i - line_start + 1, what);
         }
         i += n;
     }
@@ -203,21 +233,41 @@ inline std::string read_text_file(const std::string& path) {
     return ss.str();
 }
 
-// A field of a comma-separated line and its column (1-based).
+// A field of a comma-separated line, as written (quotes included), and its
+// column (1-based).
 using Field = std::pair<std::string_view, std::size_t>;
 
-// The comma-separated fields of a line into `out` (cleared first).
-inline void split_fields(std::string_view line, std::vector<Field>& out) {
-    out.clear();
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t c = line.find(',', start);
-        if (c == std::string_view::npos) {
-            out.emplace_back(line.substr(start), start + 1);
-            return;
+// The fields of the lines of a file, split by the dialect's one splitter
+// (ascorr_hal_linux/csv_fields.hpp: RFC 4180 quoting as docs/contract.md,
+// section 3 says). Reuses its storage from line to line.
+class FieldSplitter {
+public:
+    // The fields of line `line_no` of `file`. Malformed quoting (an
+    // unterminated quoted field, text after a closing quote): ConfigError at
+    // file:line:column, in the host readers' words.
+    const std::vector<Field>& split(const std::string& file, std::size_t line_no, std::string_view line) {
+        const std::size_t bad = csv::split_fields(line, text_);
+        if (bad != csv::kSplitOk) {
+            throw ConfigError(file, line_no, bad + 1, csv::why_split_failed(line, bad));
         }
-        out.emplace_back(line.substr(start, c - start), start + 1);
-        start = c + 1;
+        fields_.clear();
+        for (const std::string_view f : text_) {
+            fields_.emplace_back(f, static_cast<std::size_t>(f.data() - line.data()) + 1U);
+        }
+        return fields_;
+    }
+
+private:
+    std::vector<std::string_view> text_;
+    std::vector<Field> fields_;
+};
+
+// A field of a column the reader reads: refused when quoted, naming the
+// column ("column 't_chu': \"5\" is a quoted field in a column ascorr reads").
+inline void refuse_quoted(const std::string& file, std::size_t line_no, const Field& field, std::string_view column) {
+    if (csv::is_quoted(field.first)) {
+        throw ConfigError(file, line_no, field.second,
+                          "column '" + std::string(column) + "': " + csv::quoted_field_refusal(field.first));
     }
 }
 

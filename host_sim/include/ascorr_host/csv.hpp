@@ -17,6 +17,8 @@
 #include <string_view>
 #include <vector>
 
+#include "ascorr_hal_linux/csv_fields.hpp"
+
 namespace ascorr::host {
 
 // The whole content of a file. Throws InputError (line 0) if it cannot be read.
@@ -71,20 +73,15 @@ private:
     std::size_t line_ = 0;
 };
 
-// Splits a line at commas into fields (reusing the vector's storage), and
-// records where each field starts (0-based character offset) for messages.
-// A quoted field (RFC 4180) is one field, handed on as written, quotes
-// included. Returns kSplitOk, or the 0-based offset where the quoting is
-// malformed (an unterminated quote, text after a closing quote; the fields
-// before it are split): why_split_failed() says which.
-inline constexpr std::size_t kSplitOk = static_cast<std::size_t>(-1);
-std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields,
-                         std::vector<std::size_t>& starts);
-// The same without the offsets (a field's offset is field.data() − line.data()).
-std::size_t split_fields(std::string_view line, std::vector<std::string_view>& fields);
-std::string why_split_failed(std::string_view line, std::size_t at);
-// A field's text without its RFC 4180 quotes ("a ""b""" is a "b"); other fields as they are.
-std::string unquoted(std::string_view field);
+// The field splitter and unquoting of the dialect: one copy, in the HAL
+// (ascorr_hal_linux/csv_fields.hpp), which the HAL's readers use too. A quoted
+// field (RFC 4180) is one field, handed on as written, quotes included;
+// split_fields returns kSplitOk or the 0-based offset where the quoting is
+// malformed, why_split_failed() says which; unquoted() gives a field's text.
+using hal::csv::kSplitOk;
+using hal::csv::split_fields;
+using hal::csv::unquoted;
+using hal::csv::why_split_failed;
 
 // A field as a double: a decimal or scientific number, "nan", "inf".
 // Leading/trailing spaces are not accepted (they are not in the format).
