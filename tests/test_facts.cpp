@@ -242,6 +242,16 @@ TEST(Table2, TheFlightModelAndTheSimulatorsTruthAreTheContractsFile) {
         EXPECT_EQ(values(app::kThermalModel.head[h]), values(want.head[h])) << head_letter(h);
     }
     EXPECT_NE(values(app::kThermalModel.head[2]), values(ThermalModel<float>{}.head[2]));  // not vacuous
+    // The Cortex-M3 image flies the same expression in Q30 (flight_data.hpp,
+    // Scalar = Q30): it equals the contract's file converted by the host, bit
+    // for bit.
+    constexpr ThermalModel<Q30> q30_flight = thermal_model<Q30>(kTable2, kArcsecToRad);
+    const ThermalModel<Q30> q30_want = host::to_core<Q30>(file);
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        EXPECT_EQ(q30_flight.head[h].present, file.present[h]) << head_letter(h);
+        EXPECT_EQ(values(q30_flight.head[h]), values(q30_want.head[h])) << head_letter(h);
+    }
+    EXPECT_NE(values(q30_flight.head[2]), values(ThermalModel<Q30>{}.head[2]));  // not vacuous
 }
 
 // ---- The model → core conversion (ascorr/model_coefficients.hpp)

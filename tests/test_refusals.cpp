@@ -308,6 +308,13 @@ TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
          "--frames: 0 is out of range: expected an integer in [1, 1000000]"},
         {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --head 7", 2,
          "--head: 7 is out of range: a head is A, B, C or D"},
+        // NaN is out of every range (CLI::Range let it through: --inject-errors nan injected nothing).
+        {"replay --target loopback-float --in " + in + " --model " + model + " --out o.csv --inject-errors nan", 2,
+         "--inject-errors: nan is out of range: the range is [0, 0.5]"},
+        {"replay --target loopback-float --in " + in + " --model " + model + " --out o.csv --inject-errors 0.6", 2,
+         "--inject-errors: 0.6 is out of range: the range is [0, 0.5]"},
+        {"thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --interval nan", 2,
+         "--interval: nan is out of range: the range is [0, 3600]"},
         // Text that is no number still says so.
         {"simulate --out o.csv --days ten", 2, "--days: ten is not a number"},
     };
@@ -319,6 +326,17 @@ TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
         EXPECT_EQ(r.err.find("expected a number"), std::string::npos) << r.err;
     }
     EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    // A '+' before flags is a sign, as before a real field (it said "'+0' is
+    // out of range" before); "+-1" and "+" stay malformed.
+    std::ofstream(dir / "plus.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3,+0,1.00\n";
+    const CliRun plus = run_in("correct --in plus.csv --out o.csv", dir);
+    EXPECT_EQ(plus.exit_code, 0) << plus.err;
+    for (const char* bad : {"+-1", "+"}) {
+        std::ofstream(dir / "plus_bad.csv") << kHeader << "750000000.0,A," << kRow << ",1,2,3," << bad << ",1.00\n";
+        const CliRun r = run_in("correct --in plus_bad.csv --out o2.csv", dir);
+        EXPECT_EQ(r.exit_code, 1) << bad;
+        EXPECT_EQ(r.err.find("out of range"), std::string::npos) << r.err;
+    }
 }
 
 }  // namespace
@@ -352,15 +370,16 @@ TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
     EXPECT_EQ(q.exit_code, 1);
     EXPECT_NE(q.err.find("q.csv:4:21: B gamma c3_2 = -2.5e+11 arcsec/degC^2 is beyond"), std::string::npos) << q.err;
     // A truth model whose angle exceeds the core's 1-degree domain: the file and
-    // the line of the head, with the epoch and the temperatures.
+    // the line of the axis beyond it, with the angle, the epoch and the
+    // temperatures.
     std::ofstream(dir / "t.csv") << "chu,axis,c0,c1,c2,c3\n"
                                  << "A,alpha,0,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n"
                                  << "B,alpha,0,0,0,0\nB,beta,0,0,0,0\nB,gamma,0,0,0,0\n"
-                                 << "C,alpha,3500,100,0,0\nC,beta,0,0,0,0\nC,gamma,0,0,0,0\n";
+                                 << "C,alpha,0,0,0,0\nC,beta,3500,100,0,0\nC,gamma,0,0,0,0\n";
     const CliRun t = run_in("simulate --days 0.01 --truth t.csv --out s.csv", dir);
     EXPECT_EQ(t.exit_code, 1);
-    EXPECT_NE(t.err.find("t.csv:8: CHU C: the truth model gives an angle beyond 1 degree at t = "), std::string::npos)
-        << t.err;
+    EXPECT_NE(t.err.find("t.csv:9: CHU C beta: the truth model gives "), std::string::npos) << t.err;
+    EXPECT_NE(t.err.find(" degrees, beyond 1 degree, at t = "), std::string::npos) << t.err;
     EXPECT_NE(t.err.find("degC)"), std::string::npos) << t.err;
     EXPECT_FALSE(fs::exists(dir / "o.csv"));
     EXPECT_FALSE(fs::exists(dir / "s.csv"));

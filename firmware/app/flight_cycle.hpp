@@ -36,14 +36,13 @@
 #include "core_entry.hpp"
 #include "flight_data.hpp"
 #include "gnss_feed.hpp"
+#include "loop_rate.hpp"
 #include "recorded_orbit.hpp"
 #include "report.hpp"
 #include "temperature_source.hpp"
 #include "velocity_entry.hpp"
 
 namespace ascorr::app {
-
-inline constexpr std::uint32_t kRateHz = 22U;
 
 // A head's solution time in cycle `cycle`: the tick's time minus a per-head
 // exposure offset (heads 5 ms apart), TT µs.
@@ -191,9 +190,11 @@ private:
 class FlightCycle {
 public:
     // One cycle: the temperatures (temperature_source.hpp), the states, the
-    // heads, and their solutions into the record.
+    // heads, and (record: a bounded test run, whose report prints it) their
+    // solutions into the record; a flight run (record false) does no
+    // test-only work.
     template <typename Meter>
-    void run(std::uint32_t cycle, Meter& meter) noexcept;
+    void run(std::uint32_t cycle, Meter& meter, bool record) noexcept;
 
     // The GNSS states due by the cycle's first solution: at most two per cycle
     // (the receiver's rate is 1 Hz; a late one is taken next cycle).
@@ -256,11 +257,11 @@ private:
 };
 
 template <typename Meter>
-void FlightCycle::run(std::uint32_t cycle, Meter& meter) noexcept {
+void FlightCycle::run(std::uint32_t cycle, Meter& meter, bool record) noexcept {
     temperatures_update(cycle);
     take_states(cycle, meter);
     correct_heads(cycle, meter);
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {  // fixed trip count
+    for (std::uint8_t h = 0; record && h < kMaxHeads; ++h) {  // fixed trip count
         record_.add(cycle, h, corrected_[h]);
     }
 }

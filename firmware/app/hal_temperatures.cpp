@@ -7,13 +7,13 @@
 
 #include "board.hpp"
 #include "boom_temperatures.hpp"
+#include "loop_rate.hpp"
 #include "temperature_source.hpp"
 
 namespace ascorr::app {
 namespace {
 
-constexpr std::uint32_t kCyclesPerSecond = 22U;
-constexpr std::uint32_t kPeriod = board::kCoreClockHz / kCyclesPerSecond;  // SysTick reload + 1, as main.cpp
+constexpr std::uint32_t kPeriod = board::kCoreClockHz / kRateHz;  // SysTick reload + 1, as main.cpp
 constexpr std::uint32_t kCountsPerUs = board::kCoreClockHz / 1000000U;
 
 // Microseconds on SysTick. now_us: the cycle's start plus the time elapsed in
@@ -24,7 +24,7 @@ constexpr std::uint32_t kCountsPerUs = board::kCoreClockHz / 1000000U;
 class SysTickClock final : public hal::Clock {
 public:
     void start_cycle(std::uint32_t cycle) noexcept {
-        base_us_ = static_cast<std::uint64_t>(cycle) * 1000000U / kCyclesPerSecond;
+        base_us_ = static_cast<std::uint64_t>(cycle) * 1000000U / kRateHz;
     }
     std::uint64_t now_us() noexcept override {
         const std::uint32_t elapsed = (kPeriod - 1U - board::systick_value()) / kCountsPerUs;
@@ -55,7 +55,7 @@ BoomTemperatures g_temperatures{g_clock};
 
 void temperatures_update(std::uint32_t cycle) noexcept {
     g_clock.start_cycle(cycle);
-    g_temperatures.update(cycle, kCyclesPerSecond);
+    g_temperatures.update(cycle, kRateHz);
 }
 
 const HeadTemperatures<Scalar>& temperatures_of(std::uint8_t head) noexcept {

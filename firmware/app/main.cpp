@@ -230,7 +230,7 @@ int main() {
             g_stats.overruns += start - seen - 1U;
         }
         seen = start;
-        g_flight.run(cycle, g_meter);  // temperatures, states, heads, record
+        g_flight.run(cycle, g_meter, kCycles != 0U);  // temperatures, states, heads (, record: a test run)
         const std::uint32_t busy = kPeriod - 1U - board::systick_value();
         if (g_ticks != seen) {
             ++g_stats.overruns;

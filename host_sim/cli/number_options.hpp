@@ -21,6 +21,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string>
@@ -166,6 +167,28 @@ inline CLI::Validator real_number() {
                     break;
             }
             return s + " is not a number";
+        },
+        "NUMBER");
+}
+
+// A real option in [lo, hi]: real_number()'s checks, and then NaN, the
+// infinities and finite values outside [lo, hi] are "out of range" with the
+// range (CLI::Range lets NaN through: every comparison with it is false).
+inline CLI::Validator real_in(double lo, double hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& s) {
+            std::string why = real_number()(s);
+            if (!why.empty()) {
+                return why;
+            }
+            double x = 0.0;
+            detail::classify_real(s, x);
+            if (x >= lo && x <= hi) {
+                return std::string();
+            }
+            char range[64];
+            std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+            return s + " is out of range: the range is " + range;
         },
         "NUMBER");
 }

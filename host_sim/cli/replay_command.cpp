@@ -30,8 +30,7 @@ void add_replay_command(CLI::App& app) {
         ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
-        ->check(real_number())
-        ->check(CLI::Range(0.0, 0.5));
+        ->check(real_in(0.0, 0.5));
     cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));
     cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 20 qemu, 500 serial)")
         ->transform(integer_in<int>(1, 60000));

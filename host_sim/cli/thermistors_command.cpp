@@ -190,9 +190,7 @@ void add_thermistors_command(CLI::App& app) {
     cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate");
     cmd->add_option("--inject", opt->inject, "simulated fault NAME:KIND:FROM:TO[:VALUE] (repeatable)");
     cmd->add_option("--frames", opt->frames, "live: frames to acquire")->transform(integer_in<unsigned>(1U, 1000000U));
-    cmd->add_option("--interval", opt->interval, "live: seconds between frames")
-        ->check(real_number())
-        ->check(CLI::Range(0.0, 3600.0));
+    cmd->add_option("--interval", opt->interval, "live: seconds between frames")->check(real_in(0.0, 3600.0));
     cmd->add_option("--head", opt->head,
                     "head whose T_CHU is voted and printed (" + std::string(kHeadChoices.text) + ")")
         ->check(CLI::Validator(

@@ -245,6 +245,12 @@ std::optional<double> parse_double(std::string_view field) noexcept {
 }
 
 std::optional<long long> parse_integer(std::string_view field) noexcept {
+    if (!field.empty() && field[0] == '+') {  // as parse_double: CSV writers emit it
+        field.remove_prefix(1);
+        if (!field.empty() && (field[0] == '+' || field[0] == '-')) {
+            return std::nullopt;
+        }
+    }
     if (field.empty()) {
         return std::nullopt;
     }

@@ -408,12 +408,25 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     HeadTemperatures<double> ht{{e.temp[h], true}, {e.temp[3], true}, {e.temp[4], true}};
     const ThermalStage<double> th = thermal_stage(truth, static_cast<std::uint8_t>(h), ht);
     if (th.skip != 0U) {
-        char what[200];
+        // The first axis beyond 1 degree names the model row (line) to look at.
+        const HeadThermalModel<double>& m = truth.head[h];
+        const AxisPolynomial<double>* axes[3] = {&m.alpha, &m.beta, &m.gamma};
+        std::size_t axis = 0;
+        double angle = 0.0;
+        for (std::size_t a = 0; a < 3; ++a) {
+            angle = thermal_angle(*axes[a], ht.t_chu.value, ht.t_029.value, ht.t_032.value);
+            axis = a;
+            if (!(std::fabs(angle) <= kMaxThermalAngleRad)) {
+                break;
+            }
+        }
+        char what[240];
         std::snprintf(what, sizeof what,
-                      "CHU %c: the truth model gives an angle beyond 1 degree at t = %.17g s (T_CHU %g, "
+                      "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
                       "T029 %g, T032 %g degC)",
-                      head_name(static_cast<std::uint8_t>(h)), e.t, e.temp[h], e.temp[3], e.temp[4]);
-        throw InputError(truth_file, truth_rows.line[h][0], 0, what);
+                      head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, e.temp[h],
+                      e.temp[3], e.temp[4]);
+        throw InputError(truth_file, truth_rows.line[h][axis], 0, what);
     }
     const Quaternion<double> q_meas = renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
     out.q_raw = raw_attitude(q_meas, e.t, h, e.orbit.v_sc, earth);

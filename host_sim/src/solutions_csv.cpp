@@ -116,9 +116,9 @@ bool SolutionsReader::next(SolutionRecord& rec) {
     }
     rec.chu = fields_[static_cast<std::size_t>(col_.chu)];
     if (!rec.chu.empty() && rec.chu[0] == '"') {
-        fail(static_cast<std::size_t>(col_.chu), "column 'chu': " + std::string(rec.chu) +
-                                                     " is a quoted field in a column ascorr reads: write A, B, C or "
-                                                     "D without quotes (docs/contract.md, section 3)");
+        fail(static_cast<std::size_t>(col_.chu),
+             "column 'chu': " + std::string(rec.chu) + " is a quoted field in a column ascorr reads: write " +
+                 kHeadChoices.text + " without quotes (docs/contract.md, section 3)");
     }
     rec.head = head_from_name(rec.chu);
     rec.q_chu_icrf = {number(col_.qw, "qw"), number(col_.qx, "qx"), number(col_.qy, "qy"), number(col_.qz, "qz")};

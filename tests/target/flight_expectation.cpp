@@ -335,7 +335,7 @@ ascorr::app::FlightCycle& run(std::uint32_t cycles) {
     static ascorr::app::FlightCycle flight;  // static, as on the DPU
     ascorr::app::NoMeter meter;
     for (std::uint32_t cycle = 0U; cycle < cycles; ++cycle) {
-        flight.run(cycle, meter);
+        flight.run(cycle, meter, true);
     }
     return flight;
 }

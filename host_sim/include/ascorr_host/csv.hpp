@@ -86,6 +86,8 @@ using hal::csv::why_split_failed;
 // A field as a double: a decimal or scientific number, "nan", "inf".
 // Leading/trailing spaces are not accepted (they are not in the format).
 std::optional<double> parse_double(std::string_view field) noexcept;
+// A field as a decimal integer with an optional sign ('+' as in parse_double);
+// nullopt for other text and beyond long long (why_not_an_integer says which).
 std::optional<long long> parse_integer(std::string_view field) noexcept;
 
 // Why parse_double refused a field, for the message: "out of range ..." (with
