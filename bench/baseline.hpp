@@ -18,7 +18,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "ascorr/heads.hpp"
+#include "ascorr/core/heads.hpp"
 
 namespace ascorr::bench {
 

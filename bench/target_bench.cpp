@@ -23,7 +23,7 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "baseline.hpp"
 #include "board.hpp"
 #include "core_entry.hpp"

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/constants.hpp"
-#include "ascorr/heads.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/heads.hpp"
 #include "ascorr_host/model_csv.hpp"
 
 namespace ascorr::test {

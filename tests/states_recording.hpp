@@ -11,8 +11,8 @@
 #include <random>
 #include <string>
 
-#include "ascorr/heads.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/core/heads.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

@@ -15,7 +15,7 @@
 #include <random>
 #include <vector>
 
-#include "ascorr/earth_series.hpp"
+#include "ascorr/nav/earth_series.hpp"
 
 namespace ascorr {
 namespace {

@@ -8,7 +8,7 @@
 #include <thread>
 #include <vector>
 
-#include "ascorr/constants.hpp"
+#include "ascorr/core/constants.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 
 namespace ascorr::host {

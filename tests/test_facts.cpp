@@ -15,10 +15,10 @@
 #include <type_traits>
 #include <vector>
 
-#include "ascorr/fixed_point.hpp"
-#include "ascorr/heads.hpp"
-#include "ascorr/model_coefficients.hpp"
-#include "ascorr/table2.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/heads.hpp"
+#include "ascorr/core/model_coefficients.hpp"
+#include "ascorr/core/table2.hpp"
 #include "ascorr_hal/channel_config.hpp"
 #include "ascorr_host/embedded_model.hpp"
 #include "ascorr_host/model_csv.hpp"

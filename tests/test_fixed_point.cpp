@@ -13,7 +13,7 @@
 #include <random>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "test_support.hpp"

@@ -16,7 +16,7 @@
 #include <thread>
 #include <type_traits>
 
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "ascorr_host/qemu_targets.hpp"

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <type_traits>
 
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/link_transport.hpp"

@@ -14,8 +14,8 @@
 #include <string_view>
 #include <type_traits>
 
-#include "ascorr/fixed_point.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/link_client.hpp"
 #include "ascorr_host/link_transport.hpp"

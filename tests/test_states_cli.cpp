@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_host/states_velocity.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"

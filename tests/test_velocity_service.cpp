@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

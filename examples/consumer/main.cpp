@@ -16,7 +16,7 @@
 #include <cstring>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr/model_coefficients.hpp"
+#include "ascorr/core/model_coefficients.hpp"
 #include "ascorr_hal/thermistor.hpp"  // installed with the package (unused beyond this check)
 #include "ascorr_link/frame.hpp"
 

@@ -7,8 +7,8 @@
 // is in this scalar's formats, converted at compile time.
 #pragma once
 
-#include "ascorr/fixed_point.hpp"
-#include "ascorr/scalar_traits.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/scalar_traits.hpp"
 
 namespace ascorr::app {
 

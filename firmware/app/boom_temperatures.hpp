@@ -27,8 +27,8 @@
 #include <cstdint>
 
 #include "app_scalar.hpp"
-#include "ascorr/status.hpp"
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/status.hpp"
+#include "ascorr/core/thermal.hpp"
 #include "ascorr_hal/acquisition.hpp"
 #include "ascorr_hal/clock.hpp"
 #include "boom_channels.hpp"

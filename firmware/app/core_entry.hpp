@@ -8,8 +8,8 @@
 // measured alone. The core has no static data: its RAM is the caller's.
 #pragma once
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
 
 namespace ascorr::app {
 

@@ -7,7 +7,7 @@
 // (-fstack-usage) are measured alone; it calls libm's sin, cos and remainder.
 #pragma once
 
-#include "ascorr/earth_series.hpp"
+#include "ascorr/nav/earth_series.hpp"
 
 namespace ascorr::app {
 

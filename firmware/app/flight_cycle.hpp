@@ -29,9 +29,9 @@
 #include <cstring>
 
 #include "app_scalar.hpp"
-#include "ascorr/correct.hpp"
-#include "ascorr/status.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/status.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_link/crc32c.hpp"
 #include "core_entry.hpp"
 #include "flight_data.hpp"

@@ -13,12 +13,12 @@
 #pragma once
 
 #include "app_scalar.hpp"
-#include "ascorr/aberration.hpp"
-#include "ascorr/constants.hpp"
-#include "ascorr/model_coefficients.hpp"
-#include "ascorr/quaternion.hpp"
-#include "ascorr/table2.hpp"
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/aberration.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/model_coefficients.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/table2.hpp"
+#include "ascorr/core/thermal.hpp"
 
 namespace ascorr::app {
 

@@ -12,8 +12,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "ascorr/tt_time.hpp"
-#include "ascorr/vector3.hpp"
+#include "ascorr/core/vector3.hpp"
+#include "ascorr/nav/tt_time.hpp"
 #include "recorded_orbit.hpp"
 
 namespace ascorr::app {

@@ -14,8 +14,8 @@
 #include <cstdint>
 
 #include "app_scalar.hpp"
-#include "ascorr/status.hpp"
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/status.hpp"
+#include "ascorr/core/thermal.hpp"
 
 namespace ascorr::app {
 

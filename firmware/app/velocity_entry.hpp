@@ -9,7 +9,7 @@
 // (push_state, advance) lives in the application, outside them.
 #pragma once
 
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 
 namespace ascorr::app {
 

@@ -15,8 +15,8 @@
 #include <utility>
 #include <vector>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/correct_row.hpp"
 #include "ascorr_host/corrected_csv.hpp"

@@ -9,7 +9,7 @@
 #include <memory>
 #include <mutex>
 
-#include "ascorr/constants.hpp"
+#include "ascorr/core/constants.hpp"
 
 namespace ascorr::host {
 

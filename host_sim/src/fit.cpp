@@ -12,7 +12,7 @@
 #include <vector>
 #include "ascorr_host/atomic_file.hpp"
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/epochs.hpp"
 #include "ascorr_host/solution_input.hpp"

@@ -8,7 +8,7 @@
 #include <limits>
 #include <sstream>
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
 namespace ascorr::host {

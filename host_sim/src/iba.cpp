@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ascorr/constants.hpp"
+#include "ascorr/core/constants.hpp"
 
 namespace ascorr::host {
 

@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/input_error.hpp"

@@ -11,8 +11,8 @@
 #include <thread>
 #include <type_traits>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/corrected_csv.hpp"
 #include "ascorr_host/csv.hpp"

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/csv.hpp"
 #include "ascorr_host/earth_velocity.hpp"

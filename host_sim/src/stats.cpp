@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/diagnostics.hpp"
 #include "ascorr_host/earth_velocity.hpp"

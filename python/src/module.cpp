@@ -32,8 +32,8 @@
 #include <thread>
 #include <vector>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/atomic_file.hpp"
 #include "ascorr_host/correct_file.hpp"
 #include "ascorr_host/correct_row.hpp"

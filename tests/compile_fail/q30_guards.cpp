@@ -4,7 +4,7 @@
 // once per kernel (ASCORR_KERNEL = 0 … 14) with ASCORR_SCALAR=Q30 and expects
 // "deleted function"; the control compiles every call with ASCORR_SCALAR=float,
 // so a failure can only come from the guard, not from the file.
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 
 namespace ascorr {
 

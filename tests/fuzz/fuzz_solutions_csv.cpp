@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/input_error.hpp"
 #include "ascorr_host/solution_input.hpp"
 #include "ascorr_host/solutions_csv.hpp"

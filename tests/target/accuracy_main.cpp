@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "core_entry.hpp"
 #include "vector_convert.hpp"
 

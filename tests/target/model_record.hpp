@@ -8,8 +8,8 @@
 
 #include <cstddef>
 
-#include "ascorr/constants.hpp"
-#include "ascorr/heads.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/heads.hpp"
 #include "ascorr_host/model_csv.hpp"
 #include "target/vector_format.hpp"
 

@@ -7,8 +7,8 @@
 
 #include <cstdint>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/model_coefficients.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/model_coefficients.hpp"
 #include "vector_format.hpp"
 
 namespace ascorr::target {

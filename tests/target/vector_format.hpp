@@ -14,7 +14,7 @@
 
 #include <cstdint>
 
-#include "ascorr/heads.hpp"
+#include "ascorr/core/heads.hpp"
 
 namespace ascorr::target {
 

@@ -1,42 +1,53 @@
 // ascorr/ascorr.hpp: umbrella header of the ascorr correction core.
 //
-// Header-only, allocation-free, templated on the scalar type. One header per
-// concept; each states its conventions at the top:
-//   scalar_traits.hpp  per-scalar constants, tolerances, maths hooks
-//   constants.hpp      physical constants and the core's validity domain
-//   vector3.hpp        3-vectors
-//   quaternion.hpp     Hamilton, scalar-first attitude quaternions
-//   aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
-//   heads.hpp          the camera heads: how many, their letters
-//   thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
-//   model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
-//   status.hpp         status bits of a corrected solution
-//   correct.hpp        correct_solution(): the per-solution entry point
-//   fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
-//                      coefficient formats and thermal_angle)
-//   compiler.hpp       what the fixed-point core asks of the compiler, checked
-//   earth_series.hpp   the Earth's barycentric velocity and Sun distance, a
-//                      series fitted to ERFA eraEpv00 (double; coefficients in
-//                      the generated earth_series_table.hpp)
-// Data (not included here): table2.hpp, the paper's Table 2 as ModelCoefficients.
-// The on-board observer velocity (not included here; include velocity_service.hpp):
-//   tt_time.hpp        TT time tags in integer microseconds
-//   earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
-//   sincos.hpp         sin/cos in double with the same bits on every platform
-//   orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
-//   velocity_service.hpp   states in, ObserverVelocity<T> per solution out
+// The firmware side is in parts, each in its own folder with its own rules
+// (stated in the folder's README.md):
+//   core/   the per-solution correction: header-only, allocation-free,
+//           templated on the scalar (double, float, Q30); no loops (but over
+//           the kMaxHeads heads), no division, no sqrt, no exceptions, no I/O.
+//   nav/    the navigation behind the on-board observer velocity: double,
+//           loops of bounded trip count, sqrt allowed; only its per-solution
+//           query runs in the core's scalar.
+//   calib/  the thermal model's calibration, shared by the ground fit and the
+//           on-board estimator.
+// One header per concept; each states its conventions at the top:
+//   core/scalar_traits.hpp  per-scalar constants, tolerances, maths hooks
+//   core/constants.hpp      physical constants and the core's validity domain
+//   core/vector3.hpp        3-vectors
+//   core/quaternion.hpp     Hamilton, scalar-first attitude quaternions
+//   core/aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
+//   core/heads.hpp          the camera heads: how many, their letters
+//   core/thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
+//   core/model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
+//   core/status.hpp         status bits of a corrected solution
+//   core/correct.hpp        correct_solution(): the per-solution entry point
+//   core/fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
+//                           coefficient formats and thermal_angle)
+//   core/compiler.hpp       what the fixed-point core asks of the compiler, checked
+//   nav/earth_series.hpp    the Earth's barycentric velocity and Sun distance, a
+//                           series fitted to ERFA eraEpv00 (double; coefficients in
+//                           the generated earth_series_table.hpp)
+// Data (not included here): core/table2.hpp, the paper's Table 2 as ModelCoefficients.
+// The on-board observer velocity (not included here; include nav/velocity_service.hpp):
+//   nav/tt_time.hpp        TT time tags in integer microseconds
+//   nav/earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
+//   nav/sincos.hpp         sin/cos in double with the same bits on every platform
+//   nav/orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
+//   nav/velocity_service.hpp   states in, ObserverVelocity<T> per solution out
+// The headers at this folder's top level but this one forward to their part's
+// header, so that includes written before the parts existed keep working.
 #pragma once
 
-#include "aberration.hpp"
-#include "compiler.hpp"
-#include "constants.hpp"
-#include "correct.hpp"
-#include "earth_series.hpp"
-#include "fixed_point.hpp"
-#include "heads.hpp"
-#include "model_coefficients.hpp"
-#include "quaternion.hpp"
-#include "scalar_traits.hpp"
-#include "status.hpp"
-#include "thermal.hpp"
-#include "vector3.hpp"
+#include "core/aberration.hpp"
+#include "core/compiler.hpp"
+#include "core/constants.hpp"
+#include "core/correct.hpp"
+#include "core/fixed_point.hpp"
+#include "core/heads.hpp"
+#include "core/model_coefficients.hpp"
+#include "core/quaternion.hpp"
+#include "core/scalar_traits.hpp"
+#include "core/status.hpp"
+#include "core/thermal.hpp"
+#include "core/vector3.hpp"
+#include "nav/earth_series.hpp"

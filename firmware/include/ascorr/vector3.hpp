@@ -1,48 +1,5 @@
-// ascorr/vector3.hpp: a fixed-size 3-vector for the core.
-//
-// Conventions: plain Cartesian components, no implied frame. The frame is
-// named in the variable (z_chu_icrf: the CHU boresight, ICRF components).
-// A trivially copyable aggregate of three scalars: no alignment requirement,
-// no heap, usable in static storage on the DPU.
+// ascorr/vector3.hpp: forwarding header, kept so that existing includes keep
+// working; the header is ascorr/core/vector3.hpp.
 #pragma once
 
-namespace ascorr {
-
-template <typename T>
-struct Vector3 {
-    T x;
-    T y;
-    T z;
-};
-
-template <typename T>
-constexpr Vector3<T> operator+(const Vector3<T>& a, const Vector3<T>& b) noexcept {
-    return {a.x + b.x, a.y + b.y, a.z + b.z};
-}
-
-template <typename T>
-constexpr Vector3<T> operator-(const Vector3<T>& a, const Vector3<T>& b) noexcept {
-    return {a.x - b.x, a.y - b.y, a.z - b.z};
-}
-
-template <typename T>
-constexpr Vector3<T> operator*(const T& s, const Vector3<T>& a) noexcept {
-    return {s * a.x, s * a.y, s * a.z};
-}
-
-template <typename T>
-constexpr T dot(const Vector3<T>& a, const Vector3<T>& b) noexcept {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-template <typename T>
-constexpr Vector3<T> cross(const Vector3<T>& a, const Vector3<T>& b) noexcept {
-    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-template <typename T>
-constexpr T squared_norm(const Vector3<T>& a) noexcept {
-    return dot(a, a);
-}
-
-}  // namespace ascorr
+#include "core/vector3.hpp"

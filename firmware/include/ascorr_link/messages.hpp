@@ -15,9 +15,9 @@
 #include <cstring>
 #include <initializer_list>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "frame.hpp"
 
 namespace ascorr::link {

@@ -24,8 +24,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "frame.hpp"
 #include "messages.hpp"
 

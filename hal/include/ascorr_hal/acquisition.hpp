@@ -26,9 +26,9 @@
 
 #include <cstdint>
 
-#include "ascorr/correct.hpp"
-#include "ascorr/status.hpp"
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/status.hpp"
+#include "ascorr/core/thermal.hpp"
 #include "channel_check.hpp"
 #include "channel_config.hpp"
 #include "faults.hpp"

@@ -15,7 +15,7 @@
 
 #include <cstdint>
 
-#include "ascorr/heads.hpp"
+#include "ascorr/core/heads.hpp"
 #include "sampler.hpp"
 #include "thermistor.hpp"
 

@@ -67,7 +67,7 @@
 #include <cstdint>
 
 #include "acquisition.hpp"
-#include "ascorr/fixed_point.hpp"
+#include "ascorr/core/fixed_point.hpp"
 #include "channel_check.hpp"
 #include "channel_config.hpp"
 #include "faults.hpp"

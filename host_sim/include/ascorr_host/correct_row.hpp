@@ -12,9 +12,9 @@
 // bit.
 #pragma once
 
-#include "ascorr/correct.hpp"
-#include "ascorr/fixed_point.hpp"
-#include "ascorr/quaternion.hpp"
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/quaternion.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 #include "ascorr_host/states_velocity.hpp"

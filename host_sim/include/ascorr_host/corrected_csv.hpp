@@ -9,8 +9,8 @@
 #include <optional>
 #include <string>
 
-#include "ascorr/quaternion.hpp"
-#include "ascorr/status.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/status.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 
 namespace ascorr::host {

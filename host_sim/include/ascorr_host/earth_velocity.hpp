@@ -30,7 +30,7 @@
 
 #include <cstdint>
 
-#include "ascorr/vector3.hpp"
+#include "ascorr/core/vector3.hpp"
 
 namespace ascorr::host {
 

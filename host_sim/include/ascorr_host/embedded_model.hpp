@@ -6,7 +6,7 @@
 // tests/data/model_table2.csv and host_sim/data/model_table2.csv.
 #pragma once
 
-#include "ascorr/table2.hpp"
+#include "ascorr/core/table2.hpp"
 #include "ascorr_host/model_csv.hpp"
 
 namespace ascorr::host {

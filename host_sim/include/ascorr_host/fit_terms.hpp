@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/quaternion.hpp"
+#include "ascorr/core/quaternion.hpp"
 #include "ascorr_host/iba.hpp"
 #include "ascorr_host/model_csv.hpp"
 

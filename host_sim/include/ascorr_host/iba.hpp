@@ -14,8 +14,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "ascorr/quaternion.hpp"
-#include "ascorr/vector3.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/vector3.hpp"
 
 namespace ascorr::host {
 

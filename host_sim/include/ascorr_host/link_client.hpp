@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/status.hpp"
+#include "ascorr/core/status.hpp"
 #include "ascorr_host/link_transport.hpp"
 #include "ascorr_link/frame.hpp"
 #include "ascorr_link/messages.hpp"

@@ -9,9 +9,9 @@
 #include <array>
 #include <string>
 
-#include "ascorr/constants.hpp"
-#include "ascorr/model_coefficients.hpp"
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/model_coefficients.hpp"
+#include "ascorr/core/thermal.hpp"
 
 namespace ascorr::host {
 

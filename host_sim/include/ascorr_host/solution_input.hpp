@@ -8,7 +8,7 @@
 
 #include <string>
 
-#include "ascorr/correct.hpp"
+#include "ascorr/core/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/solutions_csv.hpp"
 

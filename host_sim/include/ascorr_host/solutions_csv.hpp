@@ -16,9 +16,9 @@
 #include <string_view>
 #include <vector>
 
-#include "ascorr/heads.hpp"
-#include "ascorr/quaternion.hpp"
-#include "ascorr/vector3.hpp"
+#include "ascorr/core/heads.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/vector3.hpp"
 #include "ascorr_host/csv.hpp"
 
 namespace ascorr::host {

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_host/diagnostics.hpp"
 
 namespace ascorr::host {

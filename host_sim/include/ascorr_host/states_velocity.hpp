@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "ascorr/velocity_service.hpp"
+#include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_host/states_csv.hpp"
 
 namespace ascorr::host {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "ascorr/thermal.hpp"
+#include "ascorr/core/thermal.hpp"
 #include "ascorr_host/epochs.hpp"
 #include "ascorr_host/iba.hpp"
 #include "ascorr_host/solutions_csv.hpp"

@@ -1,0 +1,61 @@
+// ascorr/core/heads.hpp: the camera heads (CHUs) one DPU serves, and their letters.
+//
+// Conventions: a head is an index 0 … kMaxHeads − 1 and a letter, index i ↔
+// kHeadLetters[i] (0 = A, 1 = B, 2 = C, 3 = D). This header is the one place
+// that says how many heads there are and what they are called: the core's
+// tables (thermal.hpp), the link protocol, the HAL's roles (static_asserted),
+// the host's file formats and messages, the Python module (ascorr.HEADS) and
+// the tests take them from here; the documentation's statements of them are
+// checked by the test Heads.* (tests/test_heads.cpp). Adding a head: append its
+// letter to kHeadLetters (DEVELOPERS.md, "Adding a head").
+#pragma once
+
+#include <cstdint>
+
+namespace ascorr {
+
+inline constexpr char kHeadLetters[] = "ABCD";  // index → letter; NUL-terminated
+inline constexpr std::uint8_t kMaxHeads = sizeof(kHeadLetters) - 1;
+
+// Not a head: what head_index() returns for anything else, and what a reader
+// stores for a head it does not know (the core rejects it, status 16).
+inline constexpr std::uint8_t kUnknownHead = 0xFF;
+static_assert(kMaxHeads > 0 && kMaxHeads < kUnknownHead, "head indices fit in a byte, below kUnknownHead");
+
+// The letter of head `head`, '?' for an index ≥ kMaxHeads.
+constexpr char head_letter(std::uint8_t head) noexcept {
+    return head < kMaxHeads ? kHeadLetters[head] : '?';
+}
+
+// The index of the head lettered `letter` (upper case only), kUnknownHead for
+// any other character. At most kMaxHeads comparisons.
+constexpr std::uint8_t head_index(char letter) noexcept {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (kHeadLetters[h] == letter) {
+            return h;
+        }
+    }
+    return kUnknownHead;
+}
+
+// The heads for a message, "A, B, C or D", built from kHeadLetters.
+struct HeadChoices {
+    char text[4 * kMaxHeads + 1];  // n letters, n − 2 ", ", one " or ", NUL
+};
+
+constexpr HeadChoices head_choices() noexcept {
+    HeadChoices c{};
+    std::uint8_t n = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const char* sep = h == 0 ? "" : h + 1 == kMaxHeads ? " or " : ", ";
+        for (; *sep != '\0'; ++sep) {
+            c.text[n++] = *sep;
+        }
+        c.text[n++] = kHeadLetters[h];
+    }
+    return c;
+}
+
+inline constexpr HeadChoices kHeadChoices = head_choices();
+
+}  // namespace ascorr

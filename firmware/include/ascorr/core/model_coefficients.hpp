@@ -1,0 +1,60 @@
+// ascorr/core/model_coefficients.hpp: a thermal model as plain numbers, and the one
+// conversion of such numbers into the core's ThermalModel<T>.
+//
+// Conventions: coefficient[head][axis][term], head by index (heads.hpp), axis
+// alpha, beta, gamma (kAlphaAxis …), term c0, c1, c2, c3, c1_2, c2_2, c3_2 (the
+// model file's columns, docs/contract.md "Model file"), in one unit given with
+// the numbers: `unit_to_rad` = kArcsecToRad for a model file's arcsec (arcsec/°C,
+// arcsec/°C²), 1 for radians. Each coefficient is multiplied by unit_to_rad in
+// double (× 1 is exact) and then rounded once into T's formats by
+// ScalarTraits<T>::coefficient (c0 … c3) or quadratic_coefficient (c1_2 …):
+// round to nearest; the fixed-point formats saturate, so a loader must refuse
+// a model beyond ScalarTraits<Q30>::max_coefficient / max_quadratic_coefficient
+// first (the host's check_fixed_point_range). Every producer of a core model
+// (the host's model files and Python's ascorr.Model, the flight application's
+// built-in Table 2, the example consumer, the target test vectors) converts
+// through thermal_model() below; constexpr, so the flight model is converted
+// at compile time. No allocation, fixed trip counts (kMaxHeads × 3).
+#pragma once
+
+#include <cstdint>
+
+#include "heads.hpp"
+#include "scalar_traits.hpp"
+#include "thermal.hpp"
+
+namespace ascorr {
+
+inline constexpr std::uint8_t kModelAxes = 3;         // alpha, beta, gamma
+inline constexpr std::uint8_t kModelTerms = 7;        // c0, c1, c2, c3, c1_2, c2_2, c3_2
+inline constexpr std::uint8_t kLinearModelTerms = 4;  // c0 … c3; the rest are quadratic
+
+struct ModelCoefficients {
+    bool present[kMaxHeads];  // false: no coefficients for this head (status 256)
+    double coefficient[kMaxHeads][kModelAxes][kModelTerms];
+};
+
+// One axis: seven numbers in the unit of unit_to_rad → the core's formats.
+template <typename T>
+constexpr AxisPolynomial<T> axis_polynomial(const double (&c)[kModelTerms], double unit_to_rad) noexcept {
+    using Tr = ScalarTraits<T>;
+    return {Tr::coefficient(c[0] * unit_to_rad),           Tr::coefficient(c[1] * unit_to_rad),
+            Tr::coefficient(c[2] * unit_to_rad),           Tr::coefficient(c[3] * unit_to_rad),
+            Tr::quadratic_coefficient(c[4] * unit_to_rad), Tr::quadratic_coefficient(c[5] * unit_to_rad),
+            Tr::quadratic_coefficient(c[6] * unit_to_rad)};
+}
+
+// The whole model; a head not present keeps zero coefficients.
+template <typename T>
+constexpr ThermalModel<T> thermal_model(const ModelCoefficients& m, double unit_to_rad) noexcept {
+    ThermalModel<T> out{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        out.head[h].present = m.present[h];
+        out.head[h].alpha = axis_polynomial<T>(m.coefficient[h][0], unit_to_rad);
+        out.head[h].beta = axis_polynomial<T>(m.coefficient[h][1], unit_to_rad);
+        out.head[h].gamma = axis_polynomial<T>(m.coefficient[h][2], unit_to_rad);
+    }
+    return out;
+}
+
+}  // namespace ascorr

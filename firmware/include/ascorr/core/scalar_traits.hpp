@@ -1,0 +1,122 @@
+// ascorr/core/scalar_traits.hpp: per-scalar constants, tolerances and maths hooks.
+//
+// The core is written once, templated on a scalar type T, and instantiated for
+// double (ground), float (DPU with single-precision FPU) and a Q-format fixed
+// point type (DPU without FPU). Everything the core needs to know about T lives
+// here, so the algorithms never name FLT_EPSILON or call std:: maths directly:
+//
+//  - constants are made with constant<T>() (ScalarTraits<T>::from_double(),
+//    see below), folded at compile time for every T;
+//  - is_finite() is found by argument-dependent lookup (a fixed-point type is
+//    always finite and supplies its own);
+//  - the tolerances that decide "bad input" are per type, because what counts
+//    as rounding noise depends on the representation;
+//  - double_precision says whether the core's truncated series carry the
+//    terms that only a double resolves (each dropped term's bound is stated
+//    where the series is).
+//
+// A new scalar type specialises ScalarTraits and provides is_finite() in its
+// own namespace. The core itself never calls sqrt, sin, cos or divides: every
+// nonlinear function is a truncated series whose error is bounded where it is
+// used, so that the same code is cheap on a Cortex-M without FPU.
+#pragma once
+
+#include <cmath>
+
+namespace ascorr {
+
+template <typename T>
+struct ScalarTraits;  // specialised per scalar type
+
+template <>
+struct ScalarTraits<double> {
+    using coefficient_type = double;            // thermal-model coefficients (rad, rad/°C)
+    using quadratic_coefficient_type = double;  // quadratic thermal-model coefficients (rad/°C²)
+    using temperature_type = double;            // °C
+    static constexpr double from_double(double x) noexcept { return x; }
+    static constexpr double to_double(double x) noexcept { return x; }
+    static constexpr double celsius(double x) noexcept { return x; }
+    static constexpr double coefficient(double x) noexcept { return x; }
+    static constexpr double quadratic_coefficient(double x) noexcept { return x; }
+    // |‖q‖² − 1| above this rejects a quaternion. Recorded files carry 15
+    // decimals (‖q‖² − 1 ≈ 1e-15); 1e-6 leaves room for producers that
+    // normalise in float, and is far below any real attitude error
+    // (1e-6 in ‖q‖² is a pure scale, not a rotation).
+    static constexpr double unit_norm_tolerance = 1e-6;
+    // The core's series keep the terms that only double resolves.
+    static constexpr bool double_precision = true;
+};
+
+template <>
+struct ScalarTraits<float> {
+    using coefficient_type = float;
+    using quadratic_coefficient_type = float;
+    using temperature_type = float;
+    static constexpr float from_double(double x) noexcept { return static_cast<float>(x); }
+    static constexpr double to_double(float x) noexcept { return static_cast<double>(x); }
+    static constexpr float celsius(double x) noexcept { return static_cast<float>(x); }
+    static constexpr float coefficient(double x) noexcept { return static_cast<float>(x); }
+    static constexpr float quadratic_coefficient(double x) noexcept { return static_cast<float>(x); }
+    // Rounding four float components leaves ‖q‖² − 1 up to ~4.8e-7.
+    static constexpr float unit_norm_tolerance = 1e-5F;
+    // Series terms below float's resolution (2⁻²⁴ relative) are dropped,
+    // each with its bound where the series is (aberration.hpp, thermal.hpp).
+    static constexpr bool double_precision = false;
+};
+
+// Finite-ness of floating-point scalars. Unqualified calls to is_finite(x) in
+// the core resolve here for float/double and to the fixed-point overload by ADL.
+inline bool is_finite(double x) noexcept {
+    return std::isfinite(x);
+}
+inline bool is_finite(float x) noexcept {
+    return std::isfinite(x);
+}
+
+// |x| ≤ lim (lim ≥ 0), false for NaN: one comparison after clearing the sign.
+// A fixed-point scalar overloads this.
+inline bool abs_within(double x, double lim) noexcept {
+    return std::fabs(x) <= lim;
+}
+inline bool abs_within(float x, float lim) noexcept {
+    return std::fabs(x) <= lim;
+}
+
+// A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a
+// format with range ±2; coefficients (linear and quadratic, whose magnitudes
+// differ by 1e3–1e4) and temperatures need other formats, so
+// the core names them through these aliases. For float and double all are T.
+template <typename T>
+using Coefficient = typename ScalarTraits<T>::coefficient_type;
+template <typename T>
+using QuadraticCoefficient = typename ScalarTraits<T>::quadratic_coefficient_type;
+template <typename T>
+using Celsius = typename ScalarTraits<T>::temperature_type;
+
+// constant<T>(x): the double x as a constant of the core's scalar T, for the
+// literals of the algorithms (½, 1, series coefficients, domain limits). The
+// conversion is ScalarTraits<T>::from_double (one definition per type); this
+// name marks the use: every call is bound to a constexpr variable
+// (constexpr T half = constant<T>(0.5);), so the double → T conversion is
+// folded at every optimisation level and a -O0 build of the fixed-point core
+// references no soft-float routine (checked on the Cortex-M3 Debug image,
+// tests/target/target-tests.cmake). Run-time conversions use other functions
+// (velocity_service.hpp: scalar_from_double).
+//
+//   T       range                 rounding                     saturation
+//   double  any                   exact                        none
+//   float   |x| ≤ 3.4e38          to nearest, ties to even     none: beyond
+//           (FLT_MAX)             (relative error ≤ 2⁻²⁴)      FLT_MAX ±inf
+//                                                              (IEEE), NaN stays
+//   Q30     [−2, 2 − 2⁻³⁰]        to nearest 2⁻³⁰, ties away   to ±(2 − 2⁻³⁰)
+//           (raw ±(2³¹ − 1))      from zero (error ≤ 2⁻³¹)     (raw ±(2³¹ − 1));
+//                                                              NaN → 2 − 2⁻³⁰
+//   (fixed_point.hpp: ScalarTraits<Q30>::from_double, fx::raw_from_double.)
+// Every constant of the core lies within ±1.7 (the largest: 1/0.6 au, the
+// Sun-distance domain), so none is rounded by more than 2⁻³¹ or saturated.
+template <typename T>
+constexpr T constant(double x) noexcept {
+    return ScalarTraits<T>::from_double(x);
+}
+
+}  // namespace ascorr
