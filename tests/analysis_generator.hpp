@@ -23,7 +23,7 @@
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 
 namespace ascorr::test {
 

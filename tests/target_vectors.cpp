@@ -25,10 +25,10 @@
 #include <vector>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr_host/csv.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "target/model_record.hpp"
 #include "target/vector_convert.hpp"
 #include "target/vector_format.hpp"

@@ -8,9 +8,9 @@
 #include <random>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr_host/earth_velocity.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

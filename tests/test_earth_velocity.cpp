@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "ascorr/core/constants.hpp"
-#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
 
 namespace ascorr::host {
 namespace {

@@ -20,9 +20,9 @@
 #include "ascorr/core/model_coefficients.hpp"
 #include "ascorr/core/table2.hpp"
 #include "ascorr_hal/channel_config.hpp"
-#include "ascorr_host/embedded_model.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/formats/embedded_model.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "flight_data.hpp"  // firmware/app: the flight model, in float (app_scalar.hpp) on the host
 #include "target/model_record.hpp"
 #include "target/vector_convert.hpp"

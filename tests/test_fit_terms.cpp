@@ -14,8 +14,8 @@
 #include <sstream>
 
 #include "analysis_generator.hpp"
-#include "ascorr_host/fit.hpp"
-#include "ascorr_host/stats.hpp"
+#include "ascorr_host/analysis/fit.hpp"
+#include "ascorr_host/analysis/stats.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

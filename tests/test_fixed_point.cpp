@@ -14,8 +14,8 @@
 
 #include "ascorr/ascorr.hpp"
 #include "ascorr/core/fixed_point.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solution_input.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

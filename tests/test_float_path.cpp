@@ -14,7 +14,7 @@
 #include <random>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

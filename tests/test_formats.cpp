@@ -9,10 +9,10 @@
 #include <random>
 #include <string>
 
-#include "ascorr_host/csv.hpp"
-#include "ascorr_host/input_error.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::host {

@@ -6,7 +6,7 @@
 #include <random>
 #include <vector>
 
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_link/server.hpp"
 #include "test_support.hpp"
 

@@ -23,7 +23,7 @@
 #include <thread>
 #include <vector>
 
-#include "ascorr_host/qemu_targets.hpp"
+#include "ascorr_host/link/qemu_targets.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 

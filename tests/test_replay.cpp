@@ -17,10 +17,10 @@
 #include <type_traits>
 
 #include "ascorr/core/fixed_point.hpp"
-#include "ascorr_host/link_client.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/qemu_targets.hpp"
-#include "ascorr_host/replay.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/link/link_client.hpp"
+#include "ascorr_host/link/qemu_targets.hpp"
+#include "ascorr_host/link/replay.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
 #include "replay_recording.hpp"

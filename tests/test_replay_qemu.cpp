@@ -12,13 +12,13 @@
 #include <type_traits>
 
 #include "ascorr/core/fixed_point.hpp"
-#include "ascorr_host/earth_velocity.hpp"
-#include "ascorr_host/link_client.hpp"
-#include "ascorr_host/link_transport.hpp"
-#include "ascorr_host/model_csv.hpp"
-#include "ascorr_host/qemu_targets.hpp"
-#include "ascorr_host/replay.hpp"
-#include "ascorr_host/solution_input.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/link/link_client.hpp"
+#include "ascorr_host/link/link_transport.hpp"
+#include "ascorr_host/link/qemu_targets.hpp"
+#include "ascorr_host/link/replay.hpp"
 #include "replay_recording.hpp"
 #include "test_support.hpp"
 

@@ -14,9 +14,9 @@
 #include <regex>
 #include <sstream>
 
-#include "ascorr_host/embedded_model.hpp"
-#include "ascorr_host/plot.hpp"
-#include "ascorr_host/stats.hpp"
+#include "ascorr_host/analysis/plot.hpp"
+#include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/formats/embedded_model.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "ascorr/nav/velocity_service.hpp"
-#include "ascorr_host/states_velocity.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "ascorr/ascorr.hpp"
-#include "ascorr_host/csv.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::test {
 

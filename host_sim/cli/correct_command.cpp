@@ -3,7 +3,7 @@
 #include <memory>
 #include <string>
 
-#include "ascorr_host/correct_file.hpp"
+#include "ascorr_host/correct/correct_file.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

@@ -2,7 +2,7 @@
 #include <map>
 #include <memory>
 
-#include "ascorr_host/fit.hpp"
+#include "ascorr_host/analysis/fit.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

@@ -8,7 +8,7 @@
 #include <exception>
 #include <iostream>
 
-#include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {

@@ -1,7 +1,7 @@
 #include <iostream>
 #include <memory>
 
-#include "ascorr_host/plot.hpp"
+#include "ascorr_host/analysis/plot.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

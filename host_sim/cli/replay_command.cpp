@@ -3,8 +3,8 @@
 #include <memory>
 #include <string>
 
-#include "ascorr_host/qemu_targets.hpp"
-#include "ascorr_host/replay.hpp"
+#include "ascorr_host/link/qemu_targets.hpp"
+#include "ascorr_host/link/replay.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

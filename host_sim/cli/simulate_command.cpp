@@ -1,7 +1,7 @@
 #include <iostream>
 #include <memory>
 
-#include "ascorr_host/simulate.hpp"
+#include "ascorr_host/analysis/simulate.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

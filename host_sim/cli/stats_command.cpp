@@ -1,7 +1,7 @@
 #include <iostream>
 #include <memory>
 
-#include "ascorr_host/stats.hpp"
+#include "ascorr_host/analysis/stats.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 

@@ -24,8 +24,8 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_hal_linux/replay_source.hpp"
 #include "ascorr_hal_linux/simulated_source.hpp"
-#include "ascorr_host/atomic_file.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 #ifdef ASCORR_HAVE_GPIOD

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "ascorr_host/input_error.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -6,9 +6,9 @@
 #include <string_view>
 
 #include "ascorr/core/correct.hpp"
-#include "ascorr_host/input_error.hpp"
-#include "ascorr_host/solution_input.hpp"
-#include "ascorr_host/solutions_csv.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "ascorr_host/embedded_model.hpp"
-#include "ascorr_host/link_client.hpp"
-#include "ascorr_host/link_transport.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/embedded_model.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/link/link_client.hpp"
+#include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_link/server.hpp"
 
 namespace {

@@ -11,7 +11,7 @@
 #include "ascorr/ascorr.hpp"
 #include "ascorr_hal/acquisition.hpp"
 #include "ascorr_hal/sampler.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "hal_support.hpp"
 
 namespace ascorr::test {

@@ -12,7 +12,7 @@
 
 #include "ascorr_hal/acquisition.hpp"
 #include "ascorr_hal_linux/gpiod_backend.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "gpiod_double.hpp"
 #include "hal_support.hpp"
 #include "test_support.hpp"

@@ -10,7 +10,7 @@
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
-#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "target/vector_format.hpp"
 
 namespace ascorr::target {

@@ -31,7 +31,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             bool have_t = false;
             bool used[kMaxChannels] = {};
             for (const auto& [raw, col] : fields) {
-                const std::string name = hal::csv::unquoted(raw);  // "t" names the column t
+                const std::string name = text::csv::unquoted(raw);  // "t" names the column t
                 if (name == "t") {
                     if (have_t) {
                         throw ConfigError(file, line_no, col, "column 't' appears twice");

@@ -123,7 +123,7 @@ HistoryColumns history_columns(const std::string& file, const std::vector<linux_
     HistoryColumns cols;
     cols.count = header.size();
     for (std::size_t i = 0; i < header.size(); ++i) {
-        const std::string name = csv::unquoted(header[i].first);  // "t" names the column t
+        const std::string name = text::csv::unquoted(header[i].first);  // "t" names the column t
         const int index = static_cast<int>(i);
         if (name == "t") {
             cols.t = index;

@@ -24,13 +24,13 @@
 #include <vector>
 
 #include "ascorr_hal_linux/config_file.hpp"
-#include "ascorr_hal_linux/csv_fields.hpp"
+#include "ascorr_text/csv_fields.hpp"
 
 namespace ascorr::hal::linux_detail {
 
 // Why a field is not a usable number when it is a well-formed decimal beyond
 // double's range ("1e999", "1e-999"): "'1e999' is out of range: ..." in the
-// host readers' words (host_sim/src/csv.cpp, why_not_a_number). Empty for any
+// host readers' words (host_sim/src/formats/csv.cpp, why_not_a_number). Empty for any
 // other field, so the caller keeps its own message for malformed text.
 inline std::string out_of_range_reason(std::string_view v) {
     double x = 0.0;
@@ -238,7 +238,7 @@ inline std::string read_text_file(const std::string& path) {
 using Field = std::pair<std::string_view, std::size_t>;
 
 // The fields of the lines of a file, split by the dialect's one splitter
-// (ascorr_hal_linux/csv_fields.hpp: RFC 4180 quoting as docs/contract.md,
+// (ascorr_text/csv_fields.hpp: RFC 4180 quoting as docs/contract.md,
 // section 3 says). Reuses its storage from line to line.
 class FieldSplitter {
 public:
@@ -246,9 +246,9 @@ public:
     // unterminated quoted field, text after a closing quote): ConfigError at
     // file:line:column, in the host readers' words.
     const std::vector<Field>& split(const std::string& file, std::size_t line_no, std::string_view line) {
-        const std::size_t bad = csv::split_fields(line, text_);
-        if (bad != csv::kSplitOk) {
-            throw ConfigError(file, line_no, bad + 1, csv::why_split_failed(line, bad));
+        const std::size_t bad = text::csv::split_fields(line, text_);
+        if (bad != text::csv::kSplitOk) {
+            throw ConfigError(file, line_no, bad + 1, text::csv::why_split_failed(line, bad));
         }
         fields_.clear();
         for (const std::string_view f : text_) {
@@ -265,9 +265,9 @@ private:
 // A field of a column the reader reads: refused when quoted, naming the
 // column ("column 't_chu': \"5\" is a quoted field in a column ascorr reads").
 inline void refuse_quoted(const std::string& file, std::size_t line_no, const Field& field, std::string_view column) {
-    if (csv::is_quoted(field.first)) {
+    if (text::csv::is_quoted(field.first)) {
         throw ConfigError(file, line_no, field.second,
-                          "column '" + std::string(column) + "': " + csv::quoted_field_refusal(field.first));
+                          "column '" + std::string(column) + "': " + text::csv::quoted_field_refusal(field.first));
     }
 }
 

@@ -1,0 +1,112 @@
+// ascorr_host/analysis/fit.hpp: calibration of the thermal model (`ascorr fit`).
+//
+// The paper's procedure (Herceg et al. 2017, section 4), in order:
+//  1. selection: rows with flags high-rate (1), bright object (2), invalid (4),
+//     confidence > 5, a temperature or the velocity missing are dropped;
+//  2. aberration correction by the core;
+//  3. at each epoch with A, B and C selected, the frame F of heads A and C
+//     (eqs. 1–3) and each head's rotation relative to it, as the small
+//     rotation vector e_i (head axes, arcsec) with R_i·R_Fᵀ = exp([e_i×])·N_i,
+//     N_i the head's orientation in F at the first such epoch;
+//  4. averages of e_i and of the temperatures over each orbit (the same
+//     epochs on both sides, so the linear model holds for the averages);
+//  5. least squares by SVD (Eigen BDCSVD, columns centred, scaled, then
+//     normalised: fit_terms.hpp) of the 9 orbit-averaged angles against each
+//     head's [1, T1, T2−T1, T3−T1] (T1 = the head's T_CHU, T2 = T029,
+//     T3 = T032), with --terms quadratic also their squares, all heads jointly;
+//  6. the model-selection report (fit_terms.hpp): linear and quadratic models
+//     fitted on the period without its held-out end (--holdout), their
+//     residuals, condition numbers and IBA RMS in and after that part, and
+//     which model the data support. The model written is fitted on the whole
+//     period with the terms asked for.
+// The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
+//
+// What is fitted, precisely. F moves with the A and C boresights, hence with
+// their temperatures, and this motion shows in every head's e_i alike (as
+// N_i·g in head axes). A per-head fit would push A's and C's temperature
+// response into B's model, where it does not fit; so F's rotation g_k in each
+// orbit is a nuisance parameter, eliminated by projecting each orbit's 9
+// equations orthogonally to it. The data then fix the 36 coefficients up to a
+// rotation common to all heads that is linear in T029 and T032 (the only
+// regressors all heads share): 9 directions that star trackers cannot see and
+// that change no IBA. Of those equivalent models, the one whose corrections
+// are smallest (RMS over the orbits of the period) is written. c0 refers to
+// the mean orientations over the period: the absolute mounting is not
+// observable either.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/fit_terms.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+inline constexpr double kDefaultMinSpanDays = 267.0;  // one thermal period of Swarm Alpha
+inline constexpr std::size_t kDefaultMinOrbits = 100;
+inline constexpr double kDefaultMaxCondition = 1e6;  // of the column-scaled design
+
+struct FitOptions {
+    std::string in;
+    std::string out;
+    std::optional<double> from;
+    std::optional<double> to;
+    double min_span_days = kDefaultMinSpanDays;
+    std::size_t min_orbits = kDefaultMinOrbits;
+    double max_condition = kDefaultMaxCondition;
+    std::optional<double> orbit_period_s;  // default: 2πμ/|v|³ of the first selected row (circular orbit)
+    Terms terms = Terms::kLinear;
+    double holdout = kDefaultHoldout;  // fraction of the period (its end) held out for the selection report
+    double min_temperature_range_c = kDefaultMinTemperatureRange;  // of each regressor, for quadratic terms
+    bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
+};
+
+// Why a row is left out of the fit (the first reason that applies).
+enum class Drop { kNone, kHighRate, kBrightObject, kInvalid, kConfidence, kTemperature, kVelocity, kRejected };
+inline constexpr std::size_t kDropKinds = 8;
+Drop fit_selection(const SolutionRecord& rec) noexcept;
+const char* drop_name(Drop d) noexcept;
+
+inline constexpr int kUnknowns = 36;  // linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
+inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032
+
+struct FitReport {
+    double t_first = 0.0;
+    double t_last = 0.0;
+    double orbit_period_s = 0.0;
+    std::size_t rows = 0;  // in [from, to]
+    std::array<std::size_t, kDropKinds> dropped{};
+    std::size_t epochs = 0;  // with A, B and C selected
+    std::size_t orbits_used = 0;
+    std::size_t orbits_left_out = 0;
+    Terms terms = Terms::kLinear;
+    std::vector<double> singular_values;  // of the joint design with unit-norm columns, descending
+    double condition = 0.0;               // largest / smallest observable singular value
+    std::array<HeadFit, 3> head{};
+    ModelFile model;
+    TermsFit fit;         // the written model's fit: centring, rank
+    Selection selection;  // the model-selection report
+};
+
+// Refusal of the data given (too short, too few orbits, rank-deficient, for
+// quadratic terms a temperature range too small).
+class FitRefused : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Fits and writes opt.out (atomically). Throws FitRefused, InputError.
+FitReport fit_model(const FitOptions& opt);
+// The same on rows from elsewhere (opt.in names them in messages); writes nothing.
+FitReport fit_model(const FitOptions& opt, const RowSource& rows);
+
+std::string describe(const FitReport& r);
+
+}  // namespace ascorr::host

@@ -1,0 +1,131 @@
+// ascorr_host/analysis/fit_terms.hpp: the least-squares step of `ascorr fit` for the
+// linear or the quadratic model, and the model-selection report.
+//
+// Regressors, per head h (the data contract, docs/contract.md): x1 = T1 = T_CHU of h, x2 = T2 − T1,
+// x3 = T3 − T1 (T2 = T029, T3 = T032), in °C. The linear model has the terms
+// [1, x1, x2, x3] per axis, the quadratic one also [x1², x2², x3²].
+//
+// Centring and scaling. The design is built from u_j = (x_j − m_j)/s_j, m_j and
+// s_j the mean and standard deviation of x_j over the orbit averages the fit
+// uses (per head), and u_j² (the orbit average of it, from the orbit averages
+// of x_j and x_j²). Raw x and x² are nearly collinear (x = 10 ± 3 °C gives
+// corr(x, x²) ≈ 0.99); u and u² are not. The columns are then scaled to unit
+// norm, so the condition number measures how independent the regressors are,
+// not their units. The solution is expanded back into the contract's form
+// before it is written:
+//     a + b·u + q·u²  =  (a − b·m/s + q·m²/s²) + (b/s − 2·q·m/s²)·x + (q/s²)·x²,
+// so the model file's coefficients refer to temperatures in °C (not centred),
+// and c0 to 0 °C and the mean orientation over the modelling period.
+//
+// Orbit averages of a quadratic model: the average of c·x² over an orbit is
+// c·avg(x²), not c·avg(x)², so the orbit sums carry x² too; the averaged
+// model is then exact (up to the small-angle error of e, ~θ³/24).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+
+namespace ascorr::host {
+
+enum class Terms { kLinear, kQuadratic };
+const char* terms_name(Terms t) noexcept;
+inline constexpr int terms_per_axis(Terms t) noexcept {
+    return t == Terms::kLinear ? 4 : 7;
+}
+
+inline constexpr double kDefaultHoldout = 0.25;             // last quarter of the period held out
+inline constexpr double kDefaultMinTemperatureRange = 2.0;  // °C, of each regressor, for quadratic terms
+// The quadratic model is preferred when its held-out IBA RMS (mean over the
+// pairs) is lower than the linear model's by more than this fraction; below
+// it, the quadratic terms fit noise.
+inline constexpr double kSelectionMargin = 0.01;
+
+inline constexpr const char* kRegressorNames[3] = {"T_CHU", "T029 - T_CHU", "T032 - T_CHU"};
+
+struct HeadFit {
+    std::array<double, 3> residual_rms{};  // orbit averages, arcsec, alpha/beta/gamma
+    std::array<double, 3> signal_rms{};    // orbit-averaged angle about its mean
+};
+
+// One orbit's averages, per head (A, B, C).
+struct OrbitAverage {
+    double t_mid = 0.0;                   // s since J2000 TT
+    std::array<Eigen::Vector3d, 3> e{};   // rotation relative to F, head axes, arcsec
+    std::array<Eigen::Vector3d, 3> x{};   // (x1, x2, x3), °C
+    std::array<Eigen::Vector3d, 3> x2{};  // (x1², x2², x3²), °C²
+};
+
+struct Centring {
+    std::array<std::array<double, 3>, 3> mean{};   // [head][regressor], °C
+    std::array<std::array<double, 3>, 3> scale{};  // standard deviation, °C
+    std::array<std::array<double, 3>, 3> range{};  // max − min over the orbit averages, °C
+};
+
+struct TermsFit {
+    Terms terms = Terms::kLinear;
+    std::string refused;  // non-empty: the data do not support this model (why); no model
+    int unknowns = 0;
+    int rank = 0;                         // observable directions: unknowns − 9
+    std::vector<double> singular_values;  // of the centred, unit-norm-column design, descending
+    double condition = 0.0;               // largest / smallest observable singular value
+    Centring centring;
+    std::array<HeadFit, 3> head{};
+    ModelFile model;
+};
+
+// Joint least squares over the orbits (fit.hpp explains the model and the
+// gauge). n_ref: the heads' orientations N_i in F. Refuses (TermsFit::refused)
+// a quadratic model when a regressor of a head spans less than min_range_c
+// over the orbit averages, and any model whose condition number exceeds
+// max_condition, naming the head and term of the weakest direction.
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<Eigen::Matrix3d, 3>& n_ref, Terms terms,
+                     double max_condition, double min_range_c);
+
+// One epoch with A, B and C selected: the aberration-corrected attitudes and
+// each head's (T1, T2, T3).
+struct FitEpoch {
+    double t = 0.0;
+    std::array<Quaternion<double>, 3> q_chu_icrf{};
+    std::array<std::array<double, 3>, 3> temp{};
+};
+
+// IBA RMS per pair of the epochs with t in [from, to), thermally corrected by
+// m (the core, double). Epochs the core does not correct are left out.
+// epochs must be sorted by t.
+std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, double from, double to,
+                                          const ModelFile& m);
+
+struct ModelScore {
+    TermsFit fit;                   // fitted on the part of the period before t_split
+    std::array<Rms, kPairs> in{};   // IBA RMS, t < t_split
+    std::array<Rms, kPairs> out{};  // IBA RMS, t ≥ t_split (held out)
+};
+
+struct Selection {
+    double holdout = 0.0;  // fraction of the period held out (its end)
+    double t_split = 0.0;
+    std::size_t orbits_fitted = 0;
+    std::vector<ModelScore> models;  // linear first, then quadratic
+    bool decided = false;            // false without a held-out part
+    Terms preferred = Terms::kLinear;
+    std::string verdict;  // one sentence: which model the data support, and why
+};
+
+// Fits both models on the orbits before t_split and scores them on the
+// epochs before and after it. holdout 0: fits and scores on the whole period,
+// no verdict.
+Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
+                       const std::array<Eigen::Matrix3d, 3>& n_ref, double t_first, double t_last, double holdout,
+                       double max_condition, double min_range_c);
+
+std::string describe_centring(const TermsFit& f);
+std::string describe_selection(const Selection& s);
+
+}  // namespace ascorr::host

@@ -1,0 +1,68 @@
+// ascorr_host/analysis/stats.hpp: IBA statistics of a recorded file (`ascorr stats`).
+//
+// Per pair (A–B, A–C, B–C) and stage (original, aberration-corrected,
+// aberration- and thermal-corrected), the IBA RMS about the mean over the
+// clean epochs of docs/contract.md: both rows with flags == 0, confidence <= 5,
+// all three temperatures and the velocity present (and accepted by the core),
+// rows matched by t to the millisecond. The same epochs serve every stage.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ascorr/core/thermal.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+inline constexpr std::size_t kStages = 3;
+inline constexpr const char* kStageNames[kStages] = {"original", "aberration", "thermal"};
+
+struct StatsOptions {
+    std::string in;
+    std::string model;  // empty: no thermal stage
+    std::optional<double> from;
+    std::optional<double> to;
+    bool keep_series = false;                    // keep the IBA time series (for plots)
+    std::string period_options = "--from/--to";  // the options that set from and to, for messages
+};
+
+struct PairSeries {
+    std::vector<double> t;
+    std::array<std::vector<double>, kStages> iba;  // arcsec, by stage
+};
+
+struct StatsResult {
+    bool thermal = false;
+    std::array<std::array<Rms, kStages>, kPairs> rms{};
+    std::array<std::size_t, kPairs> n{};
+    std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
+    std::size_t rows = 0;                   // rows in [from, to]
+    std::size_t clean_rows = 0;
+    // For a pair without clean epochs (n == 0), why, in words: no rows in the
+    // file or in [from, to], a head without rows or without clean rows (and
+    // what kept them out), or the two heads' clean rows never at one epoch.
+    std::array<std::string, kPairs> no_epochs_reason;
+};
+
+// docs/contract.md's clean solution (before the core has seen it).
+bool is_clean(const SolutionRecord& rec) noexcept;
+
+// Throws InputError for a malformed input; log gets one line per rejected row
+// and one per pair without clean epochs ("FILE: pair A-C: no clean epochs: REASON").
+StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
+// The same on rows from elsewhere (opt.in names them in messages; opt.model is
+// not read: model, nullptr for no thermal stage).
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log);
+
+std::string stats_table(const StatsResult& r);
+std::string stats_json(const StatsResult& r);
+
+}  // namespace ascorr::host

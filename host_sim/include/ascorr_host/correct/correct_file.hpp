@@ -1,0 +1,50 @@
+// ascorr_host/correct/correct_file.hpp: the `ascorr correct` job.
+//
+// Reads a solutions file, corrects every row with the core in the chosen
+// scalar type, and writes the corrected file (docs/contract.md): every input row in
+// input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
+// Output is all or nothing (AtomicFile). A malformed row stops the run with
+// file:line:column, unless skip_bad, which reports and drops it. With
+// states, rows without their own velocity get the on-board service's.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <iosfwd>
+#include <string>
+
+namespace ascorr::host {
+
+// Which scalar the core is instantiated with (--scalar). A kind, not the type:
+// the firmware's type is firmware/app/app_scalar.hpp's Scalar, and a target
+// reports its kind in the link's HELLO (scalar_kind).
+enum class ScalarKind { kDouble, kFloat, kFixed };
+
+struct CorrectOptions {
+    std::string in;
+    std::string out;
+    std::string model;  // empty: no thermal stage
+    bool aberration = true;
+    bool thermal = true;
+    ScalarKind scalar = ScalarKind::kDouble;
+    bool skip_bad = false;
+    // --states: the velocity of rows without vx,vy,vz from spacecraft states,
+    // by the on-board service (states_velocity.hpp); empty: none.
+    std::string states;
+    bool states_gcrs = false;            // --states-frame gcrs (default itrf)
+    double max_propagation_s = 21600.0;  // --max-propagation (the service's default horizon)
+};
+
+struct CorrectSummary {
+    std::size_t rows = 0;                      // rows written
+    std::size_t malformed = 0;                 // rows dropped (skip_bad only)
+    std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
+};
+
+// Throws InputError or std::runtime_error; writes nothing then.
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log);
+
+// A one-paragraph account of a summary, for the terminal.
+std::string describe(const CorrectSummary& s);
+
+}  // namespace ascorr::host

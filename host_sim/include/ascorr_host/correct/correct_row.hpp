@@ -1,0 +1,47 @@
+// ascorr_host/correct/correct_row.hpp: one recorded row through the core, as
+// `ascorr correct` does it.
+//
+// The per-row code path shared by `ascorr correct` (correct_file.cpp) and the
+// Python module (python/src/module.cpp): the row's inputs converted once to
+// the scalar T (solution_input.hpp), with --states the on-board velocity
+// service's velocity for a row without its own (states_velocity.hpp), the
+// core, and the status bits the core cannot know (a velocity with 1 or 2 of
+// its 3 components: the core saw "not available", the row gets 4 + 32; the
+// service's 4, 4|512, 4|32). Compiled once, in ascorr_host, for double,
+// float and Q30, so both callers run the same object code and agree bit for
+// bit.
+#pragma once
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+template <typename T>
+struct RowCorrection {
+    SolutionInput<T> in;            // what the core was given (for messages)
+    StatusBits status;              // the core's bits, plus 4 + 32 for a partial velocity
+    Quaternion<double> q_chu_icrf;  // corrected; the input exactly when status has kRejected
+    bool from_states;               // the velocity came from the states (the row had none)
+    StatusBits service;             // then the service's bits (0: a usable velocity)
+};
+
+// earth: used when the aberration stage is on (cfg.aberration) and the row
+// has its velocity; states: nullptr without --states (one per thread: it
+// keeps the service's state between rows).
+template <typename T>
+RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
+                             StatesVelocity<T>* states);
+
+extern template RowCorrection<double> correct_row(const SolutionRecord&, EarthVelocity*,
+                                                  const CorrectionConfig<double>&, StatesVelocity<double>*);
+extern template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<float>&,
+                                                 StatesVelocity<float>*);
+extern template RowCorrection<Q30> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<Q30>&,
+                                               StatesVelocity<Q30>*);
+
+}  // namespace ascorr::host

@@ -1,0 +1,120 @@
+// ascorr_host/formats/csv.hpp: the plain CSV dialect of docs/contract.md.
+//
+// Comma-separated, one header line, LF or CRLF line ends. RFC 4180 quoting
+// ("a, ""b""") is accepted in the header and in columns ascorr does not read
+// (they are copied verbatim); in a column it reads, a quoted field is refused
+// (numbers are written without quotes), and a line break inside quotes is not
+// supported (docs/contract.md, section 3). Fields are
+// string_views into a buffer that holds the whole file: no copies, no streams;
+// numbers are parsed with std::from_chars.
+#pragma once
+
+#include <cstddef>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ascorr_text/csv_fields.hpp"
+
+namespace ascorr::host {
+
+// The whole content of a file. Throws InputError (line 0) if it cannot be read.
+std::string read_text_file(const std::string& path);
+
+// Reads a file in blocks of whole lines, so that a recorded mission of any
+// size is processed in bounded memory. Each block ends at a line end (the last
+// one may lack it) and is free of NUL bytes (InputError otherwise).
+class BlockReader {
+public:
+    static constexpr std::size_t kDefaultBlockBytes = 32U << 20;
+    explicit BlockReader(std::string path, std::size_t block_bytes = kDefaultBlockBytes);
+    ~BlockReader();
+    BlockReader(const BlockReader&) = delete;
+    BlockReader& operator=(const BlockReader&) = delete;
+
+    // The next block of whole lines; false at the end of the file.
+    bool next(std::string_view& block);
+    // Lines of the file before the block last returned.
+    std::size_t lines_before() const noexcept { return lines_before_; }
+    const std::string& path() const noexcept { return path_; }
+
+private:
+    std::string path_;
+    std::size_t block_bytes_;
+    std::FILE* f_ = nullptr;
+    std::unique_ptr<char[]> buf_;  // not std::string: no zero-fill of each block
+    std::size_t capacity_ = 0;
+    std::size_t size_ = 0;
+    std::size_t consumed_ = 0;  // bytes of buf_ handed out in the last block
+    std::size_t lines_before_ = 0;
+    std::size_t lines_in_last_ = 0;
+    bool eof_ = false;
+};
+
+// Number of line ends ('\n') in text; memchr-based, so it runs at memory speed.
+std::size_t count_line_ends(std::string_view text) noexcept;
+
+// Iterates the lines of a buffer, keeping 1-based line numbers.
+class LineReader {
+public:
+    // lines_before: how many lines of the file precede text (for numbering).
+    explicit LineReader(std::string_view text, std::size_t lines_before = 0) noexcept
+        : text_(text), line_(lines_before) {}
+    // Next line without its line end; false at the end of the buffer.
+    bool next(std::string_view& line) noexcept;
+    std::size_t line_number() const noexcept { return line_; }
+
+private:
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t line_ = 0;
+};
+
+// The field splitter and unquoting of the dialect: one copy, in the HAL
+// (ascorr_text/csv_fields.hpp), which the HAL's readers use too. A quoted
+// field (RFC 4180) is one field, handed on as written, quotes included;
+// split_fields returns kSplitOk or the 0-based offset where the quoting is
+// malformed, why_split_failed() says which; unquoted() gives a field's text.
+using text::csv::kSplitOk;
+using text::csv::split_fields;
+using text::csv::unquoted;
+using text::csv::why_split_failed;
+
+// A field as a double: a decimal or scientific number, "nan", "inf".
+// Leading/trailing spaces are not accepted (they are not in the format).
+std::optional<double> parse_double(std::string_view field) noexcept;
+// A field as a decimal integer with an optional sign ('+' as in parse_double);
+// nullopt for other text and beyond long long (why_not_an_integer says which).
+std::optional<long long> parse_integer(std::string_view field) noexcept;
+
+// Why parse_double refused a field, for the message: "out of range ..." (with
+// a double's range) for a number beyond it (1e999, 1e-999), otherwise
+// "expected a number, got 'FIELD'".
+std::string why_not_a_number(std::string_view field);
+// Why an integer field is refused: "out of range ..." (with [lo, hi]) for
+// decimal digits beyond it (-1 for flags, 99999999999999999999), otherwise
+// "expected an integer in [lo, hi], got 'FIELD'".
+std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
+
+// Formats x with `decimals` digits after the point into out, returns the end.
+char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
+
+// The header's columns by name; -1 where absent. Duplicate names are an error.
+class Header {
+public:
+    Header(std::string_view line, const std::string& file);
+    int index(std::string_view name) const noexcept;
+    std::size_t size() const noexcept { return names_.size(); }
+    const std::vector<std::string>& names() const noexcept { return names_; }
+    // The names as written (quotes kept), for a header copied into an output.
+    const std::vector<std::string>& raw_names() const noexcept { return raw_names_; }
+
+private:
+    std::vector<std::string> names_;
+    std::vector<std::string> raw_names_;
+};
+
+}  // namespace ascorr::host

@@ -1,0 +1,66 @@
+// ascorr_host/formats/model_csv.hpp: the thermal-model file (docs/contract.md, "Model file").
+//
+// Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
+// One row per head and axis; a head that appears must have all three axes.
+// Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
+// the core's radians (ascorr/model_coefficients.hpp).
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/model_coefficients.hpp"
+#include "ascorr/core/thermal.hpp"
+
+namespace ascorr::host {
+
+enum Axis : int { kAlpha = 0, kBeta = 1, kGamma = 2 };
+inline constexpr const char* kAxisNames[kModelAxes] = {"alpha", "beta", "gamma"};
+inline constexpr const char* kCoefficientNames[kModelTerms] = {"c0", "c1", "c2", "c3", "c1_2", "c2_2", "c3_2"};
+
+struct ModelFile {
+    std::array<bool, kMaxHeads> present{};
+    // coefficients[head][axis] = {c0, c1, c2, c3, c1_2, c2_2, c3_2} in arcsec.
+    std::array<std::array<std::array<double, kModelTerms>, kModelAxes>, kMaxHeads> coefficients{};
+    bool quadratic = false;  // write the quadratic columns
+    // Where each head and axis was read (1-based line) and each coefficient
+    // (1-based character column); 0 for a model not read from a file.
+    std::array<std::array<std::size_t, 3>, kMaxHeads> line{};
+    std::array<std::array<std::array<std::size_t, 7>, 3>, kMaxHeads> column{};
+};
+
+ModelFile read_model_file(const std::string& path);
+ModelFile parse_model(const std::string& file_name, std::string_view text);
+// Writes atomically (temporary file, then rename).
+void write_model_file(const std::string& path, const ModelFile& model);
+std::string format_model(const ModelFile& model);
+
+// Throws (InputError at file:line:column for a model read from a file, naming
+// head, axis, coefficient, its value and the limit in %g) if a coefficient is
+// beyond what the fixed-point core's formats hold (fixed_point.hpp): such a
+// model is refused, never saturated.
+void check_fixed_point_range(const ModelFile& m, const std::string& path);
+
+// The model's numbers in the core's layout (arcsec, as in the file).
+inline ModelCoefficients coefficients_of(const ModelFile& m) {
+    ModelCoefficients c{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        c.present[h] = m.present[h];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                c.coefficient[h][a][i] = m.coefficients[h][a][i];
+            }
+        }
+    }
+    return c;
+}
+
+// The model in the core's units (radians), for scalar T: the core's one
+// conversion (ascorr/model_coefficients.hpp).
+template <typename T>
+ThermalModel<T> to_core(const ModelFile& m) {
+    return thermal_model<T>(coefficients_of(m), kArcsecToRad);
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,96 @@
+// ascorr_host/formats/solutions_csv.hpp: reader of the solutions file (docs/contract.md).
+//
+// Columns are matched by name; unknown columns are ignored by the reader and
+// kept verbatim by writers. Required: t, chu, qw, qx, qy, qz. Optional:
+// t_chu, t_029, t_032, vx, vy, vz, flags, confidence (absent = not available).
+// A field that is present but not a number is malformed (InputError with
+// file:line:column); "nan" or an empty field means "not available" for
+// temperatures and velocities, and a NaN quaternion is passed on for the core
+// to reject.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ascorr/core/heads.hpp"
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/vector3.hpp"
+#include "ascorr_host/formats/csv.hpp"
+
+namespace ascorr::host {
+
+using ascorr::kUnknownHead;  // heads.hpp
+
+// The head index of a `chu` field (one letter of kHeadLetters, ascorr/heads.hpp),
+// kUnknownHead otherwise.
+std::uint8_t head_from_name(std::string_view chu) noexcept;
+char head_name(std::uint8_t head) noexcept;  // its letter, '?' for an unknown head
+
+struct SolutionRecord {
+    std::size_t line = 0;  // 1-based line in the file
+    double t = 0.0;        // s since J2000.0, TT
+    std::string_view chu;  // as written
+    std::uint8_t head = kUnknownHead;
+    Quaternion<double> q_chu_icrf{};
+    std::array<double, 3> temperature{};        // t_chu, t_029, t_032 (°C)
+    std::array<bool, 3> temperature_present{};  // false: empty, nan or column absent
+    Vector3<double> v_sc_kms{};                 // vx, vy, vz
+    int velocity_components = 0;                // how many of vx, vy, vz are present
+    long long flags = 0;                        // 0 when absent
+    double confidence = 0.0;                    // arcsec; 0 when absent
+    bool confidence_present = false;
+};
+
+class SolutionsReader {
+public:
+    // Parses the header; throws InputError when a required column is missing.
+    SolutionsReader(std::string file_name, std::string_view text);
+    // Reads the data rows in body, a block of whole lines of the same file
+    // after the header (see BlockReader); lines_before numbers them.
+    SolutionsReader(const SolutionsReader& header_from, std::string_view body, std::size_t lines_before);
+
+    // Reads the next data row into rec (empty lines are skipped and counted).
+    // Returns false at the end. Throws InputError for a malformed row; the
+    // reader has then moved past it, so a caller may report it and go on.
+    bool next(SolutionRecord& rec);
+
+    const Header& header() const noexcept { return header_; }
+    const std::string& file_name() const noexcept { return file_; }
+    // The fields of the row last returned (or last rejected), in file order.
+    const std::vector<std::string_view>& fields() const noexcept { return fields_; }
+    std::size_t empty_lines() const noexcept { return empty_lines_; }
+
+    // Column indices (−1 where absent).
+    struct Columns {
+        int t, chu, qw, qx, qy, qz, t_chu, t_029, t_032, vx, vy, vz, flags, confidence;
+    };
+    const Columns& columns() const noexcept { return col_; }
+
+private:
+    [[noreturn]] void fail(std::size_t field, const std::string& what) const;
+    double number(int col, const char* name) const;
+    bool optional_number(int col, const char* name, double& out) const;
+
+    std::string file_;
+    LineReader lines_;
+    Header header_;
+    Columns col_{};
+    std::vector<std::string_view> fields_;
+    std::string_view line_;  // the row last read, for column numbers in messages
+    std::size_t empty_lines_ = 0;
+};
+
+// Throws InputError when the header has a `status` column: the file is already
+// corrected (docs/contract.md), and correcting or fitting it again would apply the
+// corrections twice.
+// (`stats` and `plot` accept a corrected file: its "original" stage is then
+// the file as corrected.)
+void refuse_corrected_input(const SolutionsReader& header);
+// The same check on a file's header line, read alone.
+void refuse_corrected_file(const std::string& path);
+
+}  // namespace ascorr::host

@@ -1,0 +1,489 @@
+#include "ascorr_host/analysis/fit.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <map>
+#include <sstream>
+#include <vector>
+#include "ascorr_host/formats/atomic_file.hpp"
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+constexpr double kMuEarth = 398600.4418;  // km³/s²
+constexpr double kDay = 86400.0;
+
+struct Row {
+    Eigen::Quaterniond q;        // aberration-corrected, ICRF into head
+    std::array<double, 3> temp;  // T1, T2, T3
+};
+
+// Sums over one orbit's epochs, per head. q: the rotations a = q_head_f ⊗ r⁻¹
+// relative to a provisional reference r (4-vectors, w ≥ 0); e: filled at the
+// end, the small angles relative to the final reference, derived exactly from
+// q (rebase_on_earliest_epoch), so that the result does not depend on which
+// epoch came first; x, x2: the regressors and their squares.
+struct OrbitSums {
+    std::size_t count = 0;
+    std::array<Eigen::Vector4d, 3> q{Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
+    std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+};
+
+Eigen::Vector3d icrf_boresight(const Eigen::Quaterniond& q) {
+    return q.toRotationMatrix().row(2).transpose();
+}
+
+std::string time_text(double t) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3f", t);
+    return buf;
+}
+
+}  // namespace
+
+Drop fit_selection(const SolutionRecord& rec) noexcept {
+    if ((rec.flags & 1) != 0) {
+        return Drop::kHighRate;
+    }
+    if ((rec.flags & 2) != 0) {
+        return Drop::kBrightObject;
+    }
+    if ((rec.flags & 4) != 0) {
+        return Drop::kInvalid;
+    }
+    if (rec.confidence > 5.0) {
+        return Drop::kConfidence;
+    }
+    if (!(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2])) {
+        return Drop::kTemperature;
+    }
+    if (rec.velocity_components != 3) {
+        return Drop::kVelocity;
+    }
+    return Drop::kNone;
+}
+
+const char* drop_name(Drop d) noexcept {
+    switch (d) {
+        case Drop::kNone:
+            return "selected";
+        case Drop::kHighRate:
+            return "high-rate mode";
+        case Drop::kBrightObject:
+            return "bright object";
+        case Drop::kInvalid:
+            return "invalid";
+        case Drop::kConfidence:
+            return "confidence > 5";
+        case Drop::kTemperature:
+            return "temperature missing";
+        case Drop::kVelocity:
+            return "velocity missing";
+        case Drop::kRejected:
+            return "not correctable";
+    }
+    return "?";
+}
+
+namespace {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period);
+
+// NaN, zero or negative thresholds would silently accept or refuse everything.
+void refuse_bad_fit_options(const FitOptions& opt) {
+    if (opt.from && !std::isfinite(*opt.from)) {
+        throw FitRefused("--from " + std::to_string(*opt.from) + ": not a finite time");
+    }
+    if (opt.to && !std::isfinite(*opt.to)) {
+        throw FitRefused("--to " + std::to_string(*opt.to) + ": not a finite time");
+    }
+    if (!(opt.min_span_days > 0.0 && std::isfinite(opt.min_span_days))) {
+        throw FitRefused("--min-days " + std::to_string(opt.min_span_days) + ": must be a positive number of days");
+    }
+    if (!(opt.max_condition > 0.0) || std::isnan(opt.max_condition)) {
+        throw FitRefused("--max-condition " + std::to_string(opt.max_condition) + ": must be positive");
+    }
+}
+}  // namespace
+
+FitReport fit_model(const FitOptions& opt) {
+    refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
+    refuse_corrected_file(opt.in);  // fit applies the aberration itself: never twice
+    FitReport r = fit_model(
+        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "fit"); });
+    write_model_file(opt.out, r.model);
+    return r;
+}
+
+FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
+    refuse_bad_fit_options(opt);
+    if (opt.from && opt.to && !(*opt.from < *opt.to)) {
+        throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
+                         time_text(*opt.to));
+    }
+    if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
+        throw FitRefused("--orbit-period must be in [600, 86400] s");
+    }
+    if (!(opt.holdout >= 0.0 && opt.holdout <= 0.5)) {
+        throw FitRefused("--holdout must be in [0, 0.5] (a fraction of the modelling period), got " +
+                         std::to_string(opt.holdout));
+    }
+    if (!(opt.min_temperature_range_c >= 0.0 && std::isfinite(opt.min_temperature_range_c))) {
+        throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
+                         std::to_string(opt.min_temperature_range_c));
+    }
+    return fit_pass(opt, rows, std::nullopt);
+}
+
+namespace {
+
+constexpr double kPlaceholderPeriodS = 5400.0;
+
+// What one reading of the rows gathers (fit_pass reads them once, or twice
+// when the rows are out of time order).
+struct Pass {
+    FitReport r;
+    std::optional<double> period;                                // bins the epochs into orbits
+    bool period_given = false;                                   // --orbit-period, or the second reading
+    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
+    std::array<Eigen::Quaterniond, 3> earliest_a;                // the earliest epoch's a
+    bool any_epoch = false;
+    double earliest_epoch = 0.0;
+    // The earliest selected row: its speed gives the orbit period.
+    bool any_row = false;
+    double earliest_row = 0.0;
+    double earliest_row_period = 0.0;
+    double earliest_row_speed = 0.0;
+    std::size_t earliest_row_line = 0;
+    std::map<long long, OrbitSums> orbits;
+    std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
+};
+
+// Frame F (eqs. 1–3) of heads A and C at one epoch, rows X_F, Y_F, Z_F in ICRF.
+Eigen::Quaterniond q_f_icrf_at(const Epoch<Row>& e) {
+    const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
+    const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
+    const Eigen::Vector3d z_f = za.cross(zc).normalized();
+    const Eigen::Vector3d x_f = (za + zc).normalized();
+    const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
+    Eigen::Matrix3d r_f_icrf;
+    r_f_icrf.row(0) = x_f.transpose();
+    r_f_icrf.row(1) = y_f.transpose();
+    r_f_icrf.row(2) = z_f.transpose();
+    return Eigen::Quaterniond(r_f_icrf);
+}
+
+// Head h's rotation in F relative to its provisional reference (the first
+// one seen), and its regressors, into the orbit's sums.
+void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Eigen::Quaterniond& q_f_icrf, std::size_t h) {
+    const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
+    if (!p.reference[h]) {
+        p.reference[h] = q_head_f;
+    }
+    Eigen::Quaterniond d = q_head_f * p.reference[h]->conjugate();
+    if (d.w() < 0.0) {
+        d.coeffs() = -d.coeffs();
+    }
+    o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+    if (!p.any_epoch || e.t < p.earliest_epoch) {
+        p.earliest_a[h] = d;
+    }
+    const auto& t = e.head[h]->temp;
+    o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
+    o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
+}
+
+FitEpoch fit_epoch_of(const Epoch<Row>& e) {
+    FitEpoch fe{};
+    fe.t = e.t;
+    for (std::size_t h = 0; h < 3; ++h) {
+        const Eigen::Quaterniond& q = e.head[h]->q;
+        fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
+        fe.temp[h] = e.head[h]->temp;
+    }
+    return fe;
+}
+
+// The epoch count, the earliest epoch and the period's first and last epochs.
+void note_epoch_time(Pass& p, double t) {
+    ++p.r.epochs;
+    if (!p.any_epoch || t < p.earliest_epoch) {
+        p.earliest_epoch = t;
+    }
+    if (!p.any_epoch || t < p.r.t_first) {
+        p.r.t_first = t;
+    }
+    if (!p.any_epoch || t > p.r.t_last) {
+        p.r.t_last = t;
+    }
+    p.any_epoch = true;
+}
+
+// One epoch into its orbit's sums. F needs A and C; the same epochs serve all
+// heads, so an epoch without all three is left out.
+void add_epoch(Pass& p, const Epoch<Row>& e, bool selection_report) {
+    if (!(e.head[0] && e.head[1] && e.head[2])) {
+        return;
+    }
+    const Eigen::Quaterniond q_f_icrf = q_f_icrf_at(e);
+    const auto bin = static_cast<long long>(std::floor(e.t / *p.period));
+    OrbitSums& o = p.orbits[bin];
+    ++o.count;
+    for (std::size_t h = 0; h < 3; ++h) {
+        add_head(p, o, e, q_f_icrf, h);
+    }
+    if (selection_report) {
+        p.fit_epochs.push_back(fit_epoch_of(e));
+    }
+    note_epoch_time(p, e.t);
+}
+
+bool in_modelling_period(const FitOptions& opt, const SolutionRecord& rec) {
+    return !((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2);
+}
+
+// The selection (fit_selection), then the aberration correction into c;
+// kRejected where the core does not correct the row.
+Drop select_and_correct(const SolutionRecord& rec, EarthVelocity& earth, CorrectedSolution<double>& c) {
+    const CorrectionConfig<double> ab_only{true, nullptr};
+    Drop d = fit_selection(rec);
+    if (d == Drop::kNone) {
+        c = correct_solution(to_core_input<double>(rec, &earth), ab_only);
+        if ((c.status & status::kAberrationApplied) == 0U) {
+            d = Drop::kRejected;
+        }
+    }
+    return d;
+}
+
+// Only the earliest selected row's speed gives the orbit period, so it is
+// judged after all rows are read (a later row read first must not decide).
+// Until then an implausible speed gets a placeholder period, so that no orbit
+// index overflows.
+void note_selected_row(Pass& p, const SolutionRecord& rec) {
+    if (!p.period_given && (!p.any_row || rec.t < p.earliest_row)) {
+        const double v = std::sqrt(squared_norm(rec.v_sc_kms));
+        const bool plausible = v > 1.0 && v < 12.0;
+        p.earliest_row = rec.t;
+        p.earliest_row_speed = v;
+        p.earliest_row_line = rec.line;
+        p.earliest_row_period = plausible ? 2.0 * kPi * kMuEarth / (v * v * v) : 0.0;
+        if (!p.period) {
+            p.period = plausible ? p.earliest_row_period : kPlaceholderPeriodS;
+        }
+    }
+    p.any_row = true;
+}
+
+// One row: counted, selected and corrected, then handed to the epochs.
+void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssembler<Row>& epochs,
+             const SolutionRecord& rec) {
+    if (!in_modelling_period(opt, rec)) {
+        return;
+    }
+    ++p.r.rows;
+    CorrectedSolution<double> c{};
+    const Drop d = select_and_correct(rec, earth, c);
+    ++p.r.dropped[static_cast<std::size_t>(d)];
+    if (d != Drop::kNone) {
+        return;
+    }
+    note_selected_row(p, rec);
+    Row row;
+    row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
+    row.temp = rec.temperature;
+    epochs.add(rec.t, rec.head, rec.line, row);
+}
+
+// Re-base on the earliest epoch: with b = earliest a, each epoch's small
+// angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
+// 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
+void rebase_on_earliest_epoch(Pass& p) {
+    for (std::size_t h = 0; h < 3 && p.r.epochs != 0; ++h) {
+        const Eigen::Quaterniond b_inv = p.earliest_a[h].conjugate();
+        for (auto& kv : p.orbits) {
+            const Eigen::Vector4d& s = kv.second.q[h];
+            const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
+            kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
+        }
+        p.reference[h] = (p.earliest_a[h] * *p.reference[h]).normalized();
+    }
+}
+
+void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::string& period_text) {
+    if (r.epochs == 0) {
+        throw FitRefused(opt.in +
+                         ": no epoch in the modelling period has solutions of A, B and C that pass the selection");
+    }
+    const double span_days = (r.t_last - r.t_first) / kDay;
+    if (span_days < opt.min_span_days) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
+                      "thermal period; --min-days) are needed",
+                      span_days, period_text.c_str(), opt.min_span_days);
+        throw FitRefused(opt.in + ": " + buf);
+    }
+}
+
+// Orbits with at least half the typical number of epochs: a short one
+// (a gap, the ends of the period) is dominated by its part of the orbit.
+std::size_t min_epochs_per_orbit(const std::map<long long, OrbitSums>& orbits) {
+    std::vector<std::size_t> counts;
+    counts.reserve(orbits.size());
+    for (const auto& kv : orbits) {
+        counts.push_back(kv.second.count);
+    }
+    std::nth_element(counts.begin(), counts.begin() + static_cast<long>(counts.size() / 2), counts.end());
+    return std::max<std::size_t>(2, counts[counts.size() / 2] / 2);
+}
+
+// The averages of the orbits with at least min_count epochs.
+std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& orbits, std::size_t min_count,
+                                         double period) {
+    std::vector<OrbitAverage> averages;
+    for (const auto& kv : orbits) {
+        if (kv.second.count < min_count) {
+            continue;
+        }
+        OrbitAverage& a = averages.emplace_back();
+        const double w = 1.0 / static_cast<double>(kv.second.count);
+        a.t_mid = (static_cast<double>(kv.first) + 0.5) * period;
+        for (std::size_t h = 0; h < 3; ++h) {
+            a.e[h] = kv.second.e[h] * w;
+            a.x[h] = kv.second.x[h] * w;
+            a.x2[h] = kv.second.x2[h] * w;
+        }
+    }
+    return averages;
+}
+
+// The fit of the orbit averages against the heads' orientations N_i in F,
+// refused as solve_terms says; then the model-selection report.
+void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& averages, const std::string& period_text) {
+    FitReport& r = p.r;
+    std::array<Eigen::Matrix3d, 3> n_ref;
+    for (std::size_t h = 0; h < 3; ++h) {
+        n_ref[h] = p.reference[h]->toRotationMatrix();
+    }
+    r.terms = opt.terms;
+    r.fit = solve_terms(averages, n_ref, opt.terms, opt.max_condition, opt.min_temperature_range_c);
+    if (!r.fit.refused.empty()) {
+        if (opt.terms == Terms::kQuadratic) {
+            throw FitRefused(opt.in + ": quadratic terms not supported by the data in the modelling period (" +
+                             period_text + "): " + r.fit.refused + "; use --terms linear");
+        }
+        throw FitRefused(opt.in + ": " + r.fit.refused +
+                         ": T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently in the modelling period (" +
+                         period_text + ")");
+    }
+    std::sort(p.fit_epochs.begin(), p.fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
+    if (opt.selection_report) {
+        r.selection = select_terms(averages, p.fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
+                                   opt.min_temperature_range_c);
+    }
+    r.singular_values = r.fit.singular_values;
+    r.condition = r.fit.condition;
+    r.head = r.fit.head;
+    r.model = r.fit.model;
+}
+
+// Row order must not matter (issue 11). The reference N_i is the earliest
+// epoch's (re-based exactly at the end), and the orbit period, when not
+// given, comes from the earliest selected row: if that is not the first one
+// read, the file is read again with that period (unordered files only).
+// (earliest_period: that second reading.)
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period) {
+    EarthVelocity earth;
+    Pass p;
+    p.period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
+    p.period = earliest_period ? earliest_period : opt.orbit_period_s;
+    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt.selection_report); });
+    rows([&](const SolutionRecord& rec) { add_row(p, opt, earth, epochs, rec); });
+    epochs.finish();
+    if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
+        throw InputError(opt.in, p.earliest_row_line, 1,
+                         "spacecraft speed " + std::to_string(p.earliest_row_speed) +
+                             " km/s is not that of an Earth orbit: give --orbit-period");
+    }
+    if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
+        // Rows out of time order: again, with the earliest row's period.
+        return fit_pass(opt, rows, p.earliest_row_period);
+    }
+    p.r.orbit_period_s = p.period.value_or(0.0);
+    rebase_on_earliest_epoch(p);
+
+    const std::string period_text = "t = " + time_text(p.r.t_first) + " .. " + time_text(p.r.t_last);
+    refuse_short_period(opt, p.r, period_text);
+    const std::vector<OrbitAverage> averages = orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period);
+    p.r.orbits_used = averages.size();
+    p.r.orbits_left_out = p.orbits.size() - averages.size();
+    if (averages.size() < opt.min_orbits) {
+        throw FitRefused(opt.in + ": too few orbits in the modelling period (" + period_text +
+                         "): " + std::to_string(averages.size()) + " with enough data, at least " +
+                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
+    }
+    solve(opt, p, averages, period_text);
+    return p.r;
+}
+
+}  // namespace
+
+std::string describe(const FitReport& r) {
+    std::ostringstream o;
+    char buf[400];
+    std::snprintf(buf, sizeof buf, "modelling period t = %.3f .. %.3f (%.1f days), orbit period %.1f s\n", r.t_first,
+                  r.t_last, (r.t_last - r.t_first) / kDay, r.orbit_period_s);
+    o << buf;
+    o << "rows in the period " << r.rows << ", selected " << r.dropped[0] << "; dropped:";
+    for (std::size_t d = 1; d < kDropKinds; ++d) {
+        o << (d > 1 ? "," : "") << ' ' << drop_name(static_cast<Drop>(d)) << ' ' << r.dropped[d];
+    }
+    o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
+      << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
+    o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
+         "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their "
+         "squares),\n"
+         "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by "
+         "the\n"
+         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
+         "(9 directions), the one with the smallest corrections over the period is written.\n";
+    const auto rank = static_cast<std::size_t>(r.fit.rank);
+    std::snprintf(buf, sizeof buf,
+                  "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
+                  "observable), condition number %.1f; unobservable directions at %.1e\n",
+                  terms_name(r.terms), 9 * r.orbits_used, r.fit.unknowns, r.singular_values.front(),
+                  r.singular_values[rank - 1], r.fit.rank, r.condition, r.singular_values[rank]);
+    o << buf;
+    o << describe_centring(r.fit);
+    o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";
+    for (std::size_t h = 0; h < 3; ++h) {
+        const HeadFit& f = r.head[h];
+        std::snprintf(buf, sizeof buf, "%c    %6.3f %6.3f %6.3f                      %6.3f %6.3f %6.3f\n",
+                      head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1], f.residual_rms[2],
+                      f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
+        o << buf;
+    }
+    if (!r.selection.models.empty()) {
+        o << describe_selection(r.selection);
+    }
+    if (r.selection.decided && r.selection.preferred != r.terms) {
+        o << "note: the model written has " << terms_name(r.terms) << " terms; the data support "
+          << terms_name(r.selection.preferred) << " terms\n";
+    }
+    return o.str();
+}
+
+}  // namespace ascorr::host

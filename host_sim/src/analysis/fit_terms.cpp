@@ -1,0 +1,420 @@
+#include "ascorr_host/analysis/fit_terms.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+constexpr int kGauge = 9;  // a rotation common to all heads, linear in T029 and T032 (fit.hpp)
+
+__attribute__((format(printf, 1, 2))) std::string format(const char* fmt, ...) {
+    char buf[600];
+    va_list ap;
+    va_start(ap, fmt);
+    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    return buf;
+}
+
+// The orbit's design row of head h: [1, u1, u2, u3 (, avg u1², avg u2², avg u3²)].
+Eigen::VectorXd regressors(const OrbitAverage& o, std::size_t h, const Centring& c, int per_axis) {
+    Eigen::VectorXd r(per_axis);
+    r(0) = 1.0;
+    for (std::size_t j = 0; j < 3; ++j) {
+        const double m = c.mean[h][j];
+        const double s = c.scale[h][j];
+        const auto ji = static_cast<Eigen::Index>(j);
+        r(1 + ji) = (o.x[h](ji) - m) / s;
+        if (per_axis == 7) {
+            r(4 + ji) = (o.x2[h](ji) - 2.0 * m * o.x[h](ji) + m * m) / (s * s);
+        }
+    }
+    return r;
+}
+
+// The model's angle (arcsec) for an orbit's averages, contract form.
+double predicted(const std::array<double, 7>& c, const OrbitAverage& o, std::size_t h) {
+    return c[0] + c[1] * o.x[h](0) + c[2] * o.x[h](1) + c[3] * o.x[h](2) + c[4] * o.x2[h](0) + c[5] * o.x2[h](1) +
+           c[6] * o.x2[h](2);
+}
+
+}  // namespace
+
+const char* terms_name(Terms t) noexcept {
+    return t == Terms::kLinear ? "linear" : "quadratic";
+}
+
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<Eigen::Matrix3d, 3>& n_ref, Terms terms,
+                     double max_condition, double min_range_c) {
+    TermsFit f;
+    f.terms = terms;
+    const int per_axis = terms_per_axis(terms);
+    const int unknowns = 9 * per_axis;
+    f.unknowns = unknowns;
+    f.rank = unknowns - kGauge;
+    const auto n = static_cast<Eigen::Index>(orbits.size());
+    if (n == 0) {
+        f.refused = "no orbit to fit";
+        return f;
+    }
+
+    // Centring and scaling of each head's regressors over the orbit averages.
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t j = 0; j < 3; ++j) {
+            const auto ji = static_cast<Eigen::Index>(j);
+            double sum = 0.0;
+            double lo = std::numeric_limits<double>::infinity();
+            double hi = -lo;
+            for (const OrbitAverage& o : orbits) {
+                sum += o.x[h](ji);
+                lo = std::min(lo, o.x[h](ji));
+                hi = std::max(hi, o.x[h](ji));
+            }
+            const double mean = sum / static_cast<double>(n);
+            double ss = 0.0;
+            for (const OrbitAverage& o : orbits) {
+                ss += (o.x[h](ji) - mean) * (o.x[h](ji) - mean);
+            }
+            const double sd = std::sqrt(ss / static_cast<double>(n));
+            f.centring.mean[h][j] = mean;
+            f.centring.scale[h][j] = sd > 0.0 ? sd : 1.0;  // a constant regressor: a zero column, refused below
+            f.centring.range[h][j] = hi - lo;
+        }
+    }
+    if (terms == Terms::kQuadratic) {
+        for (std::size_t h = 0; h < 3; ++h) {
+            for (std::size_t j = 0; j < 3; ++j) {
+                if (!(f.centring.range[h][j] >= min_range_c)) {
+                    f.refused = format(
+                        "temperature range too small for quadratic terms: CHU %c's %s spans %.3f degC over the orbit "
+                        "averages of the period; at least %.3f degC are needed to fit its square "
+                        "(--min-temperature-range)",
+                        head_name(static_cast<std::uint8_t>(h)), kRegressorNames[j], f.centring.range[h][j],
+                        min_range_c);
+                    return f;
+                }
+            }
+        }
+    }
+
+    // The joint design (fit.hpp): each orbit's 9 equations projected
+    // orthogonally to F's own rotation, P = I − G·Gᵀ/3.
+    Eigen::Matrix<double, 9, 3> g;
+    for (std::size_t h = 0; h < 3; ++h) {
+        g.block<3, 3>(static_cast<Eigen::Index>(3 * h), 0) = n_ref[h];
+    }
+    const Eigen::Matrix<double, 9, 9> proj = Eigen::Matrix<double, 9, 9>::Identity() - g * g.transpose() / 3.0;
+    Eigen::MatrixXd y(n, 9);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        for (std::size_t h = 0; h < 3; ++h) {
+            y.block<1, 3>(k, static_cast<Eigen::Index>(3 * h)) = orbits[static_cast<std::size_t>(k)].e[h].transpose();
+        }
+    }
+    // Centre e on its mean, so that c0 refers to the mean orientation.
+    const Eigen::RowVectorXd mean = y.colwise().mean();
+    y.rowwise() -= mean;
+    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(9 * n, unknowns);
+    Eigen::VectorXd target(9 * n);
+    Eigen::MatrixXd a(9, unknowns);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        a.setZero();
+        for (std::size_t h = 0; h < 3; ++h) {
+            const Eigen::VectorXd r = regressors(orbits[static_cast<std::size_t>(k)], h, f.centring, per_axis);
+            for (Eigen::Index ax = 0; ax < 3; ++ax) {
+                const Eigen::Index row = 3 * static_cast<Eigen::Index>(h) + ax;
+                a.block(row, row * per_axis, 1, per_axis) = r.transpose();
+            }
+        }
+        design.block(9 * k, 0, 9, unknowns) = proj * a;
+        target.segment<9>(9 * k) = proj * y.row(k).transpose();
+    }
+    Eigen::VectorXd scale = design.colwise().norm().transpose();
+    for (Eigen::Index i = 0; i < scale.size(); ++i) {
+        scale(i) = scale(i) > 0.0 ? scale(i) : 1.0;  // a zero column stays zero: its singular value is 0
+    }
+    design = design * scale.cwiseInverse().asDiagonal();
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    f.singular_values.assign(sv.data(), sv.data() + sv.size());
+    const Eigen::Index rank = f.rank;
+    f.condition = sv(rank - 1) > 0.0 ? sv(0) / sv(rank - 1) : std::numeric_limits<double>::infinity();
+    if (!(f.condition <= max_condition)) {
+        // Name the head, and the term, whose coefficients dominate the weakest direction.
+        const Eigen::VectorXd weakest = svd.matrixV().col(rank - 1);
+        std::array<double, 3> head_share{};
+        std::array<std::array<double, 7>, 3> term_share{};
+        for (Eigen::Index i = 0; i < unknowns; ++i) {
+            const auto h = static_cast<std::size_t>(i / (3 * per_axis));
+            const auto t = static_cast<std::size_t>(i % per_axis);
+            head_share[h] += weakest(i) * weakest(i);
+            term_share[h][t] += weakest(i) * weakest(i);
+        }
+        const auto head =
+            static_cast<std::size_t>(std::max_element(head_share.begin(), head_share.end()) - head_share.begin());
+        const auto term = static_cast<std::size_t>(
+            std::max_element(term_share[head].begin(), term_share[head].begin() + per_axis) - term_share[head].begin());
+        f.refused = format(
+            "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, the largest "
+            "%.3g; the weakest direction is mostly CHU %c's coefficients, most of all %s)",
+            f.condition, max_condition, static_cast<int>(rank), unknowns, sv(rank - 1), sv(0),
+            head_name(static_cast<std::uint8_t>(head)), kCoefficientNames[term]);
+        return f;
+    }
+    // Least squares on the observable directions only (truncated SVD).
+    const Eigen::VectorXd c_scaled =
+        svd.matrixV().leftCols(rank) * (svd.matrixU().leftCols(rank).transpose() * target).cwiseQuotient(sv.head(rank));
+    const Eigen::VectorXd b = scale.cwiseInverse().asDiagonal() * c_scaled;  // centred coefficients
+
+    // Residuals, with each orbit's common rotation removed (as in the fit).
+    const Eigen::VectorXd res = target - design * c_scaled;
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            double ss = 0.0;
+            double sy = 0.0;
+            for (Eigen::Index k = 0; k < n; ++k) {
+                const Eigen::Index row = 9 * k + static_cast<Eigen::Index>(3 * h + ax);
+                ss += res(row) * res(row);
+                sy += target(row) * target(row);
+            }
+            f.head[h].residual_rms[ax] = std::sqrt(ss / static_cast<double>(n));
+            f.head[h].signal_rms[ax] = std::sqrt(sy / static_cast<double>(n));
+        }
+    }
+
+    // Back into the contract's form (see the header).
+    ModelFile& m = f.model;
+    m.present = {true, true, true, false};
+    m.quadratic = terms == Terms::kQuadratic;
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            const Eigen::Index base = static_cast<Eigen::Index>(3 * h + ax) * per_axis;
+            auto& c = m.coefficients[h][ax];
+            c = {};
+            c[0] = b(base);
+            for (std::size_t j = 0; j < 3; ++j) {
+                const double mj = f.centring.mean[h][j];
+                const double sj = f.centring.scale[h][j];
+                const auto ji = static_cast<Eigen::Index>(j);
+                const double lin = b(base + 1 + ji);
+                const double quad = per_axis == 7 ? b(base + 4 + ji) : 0.0;
+                c[0] += -lin * mj / sj + quad * mj * mj / (sj * sj);
+                c[1 + j] = lin / sj - 2.0 * quad * mj / (sj * sj);
+                c[4 + j] = quad / (sj * sj);
+            }
+        }
+    }
+
+    // The gauge: of all models the star trackers cannot tell apart (c plus a
+    // common rotation w0 + w2·T029 + w3·T032), write the one whose corrections
+    // are smallest (RMS over the orbits of the period).
+    Eigen::MatrixXd gd(9 * n, 9);
+    Eigen::VectorXd gt(9 * n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        const OrbitAverage& o = orbits[static_cast<std::size_t>(k)];
+        for (Eigen::Index h = 0; h < 3; ++h) {
+            const auto hs = static_cast<std::size_t>(h);
+            const double t2 = o.x[hs](0) + o.x[hs](1);
+            const double t3 = o.x[hs](0) + o.x[hs](2);
+            const Eigen::Matrix3d nh = n_ref[hs];
+            gd.block<3, 3>(9 * k + 3 * h, 0) = nh;
+            gd.block<3, 3>(9 * k + 3 * h, 3) = nh * t2;
+            gd.block<3, 3>(9 * k + 3 * h, 6) = nh * t3;
+            for (std::size_t ax = 0; ax < 3; ++ax) {
+                gt(9 * k + 3 * h + static_cast<Eigen::Index>(ax)) = -predicted(m.coefficients[hs][ax], o, hs);
+            }
+        }
+    }
+    const Eigen::VectorXd wv = gd.bdcSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(gt);
+    for (std::size_t h = 0; h < 3; ++h) {
+        const Eigen::Vector3d w0 = n_ref[h] * wv.segment<3>(0);
+        const Eigen::Vector3d w2 = n_ref[h] * wv.segment<3>(3);
+        const Eigen::Vector3d w3 = n_ref[h] * wv.segment<3>(6);
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            const auto ai = static_cast<Eigen::Index>(ax);
+            auto& c = m.coefficients[h][ax];
+            c[0] += w0(ai);
+            c[1] += w2(ai) + w3(ai);  // T2 = T1 + (T2 − T1), likewise T3
+            c[2] += w2(ai);
+            c[3] += w3(ai);
+        }
+    }
+    return f;
+}
+
+std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, double from, double to,
+                                          const ModelFile& m) {
+    const ThermalModel<double> core = to_core<double>(m);
+    const CorrectionConfig<double> thermal_only{false, &core};
+    std::array<std::vector<double>, kPairs> t;
+    std::array<std::vector<double>, kPairs> v;
+    for (const FitEpoch& e : epochs) {
+        if (!(e.t >= from && e.t < to)) {
+            continue;
+        }
+        std::array<Vector3<double>, 3> z{};
+        std::array<bool, 3> ok{};
+        for (std::size_t h = 0; h < 3; ++h) {
+            SolutionInput<double> in{};
+            in.q_chu_icrf = e.q_chu_icrf[h];
+            in.head = static_cast<std::uint8_t>(h);
+            in.temperatures.t_chu = {ScalarTraits<double>::celsius(e.temp[h][0]), true};
+            in.temperatures.t_029 = {ScalarTraits<double>::celsius(e.temp[h][1]), true};
+            in.temperatures.t_032 = {ScalarTraits<double>::celsius(e.temp[h][2]), true};
+            in.velocity.valid = false;
+            const CorrectedSolution<double> c = correct_solution(in, thermal_only);
+            ok[h] = (c.status & status::kThermalApplied) != 0U;
+            z[h] = boresight(c.q_chu_icrf);
+        }
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            const auto i = kPairHeads[p][0];
+            const auto j = kPairHeads[p][1];
+            if (ok[i] && ok[j]) {
+                t[p].push_back(e.t);
+                v[p].push_back(angle_arcsec(z[i], z[j]));
+            }
+        }
+    }
+    std::array<Rms, kPairs> out{};
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        if (!t[p].empty()) {
+            out[p] = rms_about_mean(t[p], v[p]);
+        }
+    }
+    return out;
+}
+
+Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
+                       const std::array<Eigen::Matrix3d, 3>& n_ref, double t_first, double t_last, double holdout,
+                       double max_condition, double min_range_c) {
+    Selection s;
+    s.holdout = holdout;
+    const double inf = std::numeric_limits<double>::infinity();
+    s.t_split = holdout > 0.0 ? t_first + (1.0 - holdout) * (t_last - t_first) : inf;
+    std::vector<OrbitAverage> fitted;
+    for (const OrbitAverage& o : orbits) {
+        if (o.t_mid < s.t_split) {
+            fitted.push_back(o);
+        }
+    }
+    s.orbits_fitted = fitted.size();
+    for (Terms terms : {Terms::kLinear, Terms::kQuadratic}) {
+        ModelScore ms;
+        ms.fit = solve_terms(fitted, n_ref, terms, max_condition, min_range_c);
+        if (ms.fit.refused.empty()) {
+            ms.in = corrected_iba_rms(epochs, -inf, s.t_split, ms.fit.model);
+            if (holdout > 0.0) {
+                ms.out = corrected_iba_rms(epochs, s.t_split, inf, ms.fit.model);
+            }
+        }
+        s.models.push_back(ms);
+    }
+    const ModelScore& lin = s.models[0];
+    const ModelScore& quad = s.models[1];
+    const auto mean_out = [](const ModelScore& m) {
+        double sum = 0.0;
+        for (const Rms& r : m.out) {
+            if (r.n == 0) {
+                return std::numeric_limits<double>::quiet_NaN();
+            }
+            sum += r.rms;
+        }
+        return sum / static_cast<double>(kPairs);
+    };
+    if (!lin.fit.refused.empty()) {
+        s.verdict = "no selection: the linear model is not supported either (" + lin.fit.refused + ")";
+    } else if (holdout <= 0.0) {
+        s.verdict = "no selection: nothing held out (--holdout 0)";
+    } else if (!quad.fit.refused.empty()) {
+        s.decided = true;
+        s.preferred = Terms::kLinear;
+        s.verdict = "linear: the data do not support quadratic terms (" + quad.fit.refused + ")";
+    } else {
+        const double l = mean_out(lin);
+        const double q = mean_out(quad);
+        if (!(l > 0.0 && q > 0.0)) {
+            s.verdict = "no selection: a pair has no held-out epoch";
+        } else {
+            const double gain = 1.0 - q / l;
+            s.decided = true;
+            s.preferred = gain > kSelectionMargin ? Terms::kQuadratic : Terms::kLinear;
+            s.verdict = s.preferred == Terms::kQuadratic
+                            ? format(
+                                  "quadratic: its held-out IBA RMS (mean over the pairs) is %.2f %% lower than the "
+                                  "linear model's, more than the %.0f %% margin",
+                                  100.0 * gain, 100.0 * kSelectionMargin)
+                            : format(
+                                  "linear: the quadratic terms lower the held-out IBA RMS (mean over the pairs) by "
+                                  "%.2f %%, not more than the %.0f %% margin: they fit noise",
+                                  100.0 * gain, 100.0 * kSelectionMargin);
+        }
+    }
+    return s;
+}
+
+std::string describe_centring(const TermsFit& f) {
+    std::ostringstream o;
+    o << "regressors centred and scaled per head (mean +- standard deviation over the orbit averages, degC):\n";
+    for (std::size_t h = 0; h < 3; ++h) {
+        o << "  CHU " << head_name(static_cast<std::uint8_t>(h)) << ':';
+        for (std::size_t j = 0; j < 3; ++j) {
+            o << format("  %s %.2f +- %.2f (range %.2f)", kRegressorNames[j], f.centring.mean[h][j],
+                        f.centring.scale[h][j], f.centring.range[h][j]);
+        }
+        o << '\n';
+    }
+    o << "the model file is in the contract's form: coefficients of T_CHU, T029 - T_CHU, T032 - T_CHU"
+      << (f.terms == Terms::kQuadratic ? " and their squares" : "")
+      << " in degC (not centred); c0 is the angle at 0 degC relative to the mean orientation over the period\n";
+    return o.str();
+}
+
+std::string describe_selection(const Selection& s) {
+    std::ostringstream o;
+    if (s.holdout > 0.0) {
+        o << format(
+            "model selection: both models fitted on the first %.0f %% of the period (t < %.3f, %zu orbits), "
+            "IBA RMS (arcsec, thermal-corrected) on it and on the last %.0f %%, held out:\n",
+            100.0 * (1.0 - s.holdout), s.t_split, s.orbits_fitted, 100.0 * s.holdout);
+    } else {
+        o << format("model selection: both models fitted on the whole period (%zu orbits), nothing held out:\n",
+                    s.orbits_fitted);
+    }
+    for (const ModelScore& m : s.models) {
+        o << format("  %-9s ", terms_name(m.fit.terms));
+        if (!m.fit.refused.empty()) {
+            o << "not supported: " << m.fit.refused << '\n';
+            continue;
+        }
+        o << format("condition number %.1f; residual RMS alpha/beta/gamma (orbit averages, arcsec):", m.fit.condition);
+        for (std::size_t h = 0; h < 3; ++h) {
+            const HeadFit& hf = m.fit.head[h];
+            o << format(" %c %.3f/%.3f/%.3f", head_name(static_cast<std::uint8_t>(h)), hf.residual_rms[0],
+                        hf.residual_rms[1], hf.residual_rms[2]);
+        }
+        o << "\n            IBA RMS in the period";
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            o << format(" %s %.3f", kPairNames[p], m.in[p].rms);
+        }
+        if (s.holdout > 0.0) {
+            o << "; held out";
+            for (std::size_t p = 0; p < kPairs; ++p) {
+                o << format(" %s %.3f", kPairNames[p], m.out[p].rms);
+            }
+        }
+        o << '\n';
+    }
+    o << "supported by the data: " << s.verdict << '\n';
+    return o.str();
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,332 @@
+#include "ascorr_host/analysis/plot.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+
+extern char** environ;
+
+namespace ascorr::host {
+
+namespace {
+
+// J2000.0 (TT) as Unix time: 2000-01-01T11:58:55.816 UTC. Plot labels only.
+constexpr double kJ2000Unix = 946727935.816;
+
+int run_gnuplot(const std::string& exe, const std::string& script, const std::string& log_path) {
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+    std::vector<char*> argv{const_cast<char*>(exe.c_str()), const_cast<char*>(script.c_str()), nullptr};
+    pid_t pid = 0;
+    const int rc = posix_spawnp(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    if (rc != 0) {
+        return -1;
+    }
+    const int slot = cleanup_register_child(pid);  // killed, should a signal end us
+    int st = 0;
+    const pid_t waited = waitpid(pid, &st, 0);
+    cleanup_release(slot);
+    if (waited != pid) {
+        return -1;
+    }
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+// The plot's working folder. Removed with its files on return, on an
+// exception and on a signal: the folder and every file name used in it are in
+// the signal-cleanup table (atomic_file.hpp) while it exists.
+class TempDir {
+public:
+    TempDir() {
+        std::string tmpl = (std::filesystem::temp_directory_path() / "ascorr-plot-XXXXXX").string();
+        if (::mkdtemp(tmpl.data()) == nullptr) {
+            throw std::runtime_error("cannot create a temporary directory for the plot");
+        }
+        path_ = tmpl;
+        slots_.push_back(cleanup_register_folder(tmpl));
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+        release();
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+    // A file in the folder, registered for removal on a signal.
+    std::filesystem::path file(const std::string& name) {
+        const std::filesystem::path p = path_ / name;
+        for (const auto& known : files_) {
+            if (known == p) {
+                return p;
+            }
+        }
+        slots_.push_back(cleanup_register_file(p.string()));
+        files_.push_back(p);
+        return p;
+    }
+
+private:
+    void release() noexcept {
+        for (const int s : slots_) {
+            cleanup_release(s);
+        }
+        slots_.clear();
+    }
+    std::filesystem::path path_;
+    std::vector<std::filesystem::path> files_;
+    std::vector<int> slots_;
+};
+
+std::string read_all(const std::filesystem::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+// Means over kPlotBinS bins of each stage's IBA about its mean.
+void write_binned(std::ofstream& f, const PairSeries& s, const double (&mean)[kStages]) {
+    std::size_t i = 0;
+    while (i < s.t.size()) {
+        const double bin = std::floor(s.t[i] / kPlotBinS);
+        double sum_t = 0.0;
+        double sum[kStages] = {};
+        std::size_t n = 0;
+        for (; i < s.t.size() && std::floor(s.t[i] / kPlotBinS) == bin; ++i, ++n) {
+            sum_t += s.t[i] - s.t[0];
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] += s.iba[k][i] - mean[k];
+            }
+        }
+        const double dn = static_cast<double>(n);
+        f.precision(12);
+        f << s.t[0] + sum_t / dn + kJ2000Unix;
+        for (std::size_t k = 0; k < kStages; ++k) {
+            f << ' ' << sum[k] / dn;
+        }
+        f << '\n';
+    }
+}
+
+// Each epoch's running mean over kSmoothingWindowS (|t_j − t_i| ≤ half of it,
+// as rms_about_mean) of each stage's IBA about its mean.
+void write_smoothed(std::ofstream& f, const PairSeries& s, const double (&mean)[kStages]) {
+    f.precision(12);
+    std::size_t lo = 0;
+    std::size_t hi = 0;
+    double sum[kStages] = {};
+    const double half = 0.5 * kSmoothingWindowS;
+    for (std::size_t i = 0; i < s.t.size(); ++i) {
+        while (hi < s.t.size() && s.t[hi] <= s.t[i] + half) {
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] += s.iba[k][hi] - mean[k];
+            }
+            ++hi;
+        }
+        while (s.t[lo] < s.t[i] - half) {
+            for (std::size_t k = 0; k < kStages; ++k) {
+                sum[k] -= s.iba[k][lo] - mean[k];
+            }
+            ++lo;
+        }
+        f << s.t[i] + kJ2000Unix;
+        for (std::size_t k = 0; k < kStages; ++k) {
+            f << ' ' << sum[k] / static_cast<double>(hi - lo);
+        }
+        f << '\n';
+    }
+}
+
+// Text for a single-quoted gnuplot string ('' is one quote).
+std::string gnuplot_quoted(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        out += c;
+        if (c == '\'') {
+            out += '\'';
+        }
+    }
+    return out;
+}
+
+void check_window(const PlotOptions& opt) {
+    if (!(opt.window_from && opt.window_to)) {
+        throw std::runtime_error("a plot window needs both --window-from and --window-to");
+    }
+    if (!(std::isfinite(*opt.window_from) && std::isfinite(*opt.window_to) && *opt.window_from < *opt.window_to)) {
+        throw std::runtime_error("the plot window is empty: --window-from " + std::to_string(*opt.window_from) +
+                                 " is not before --window-to " + std::to_string(*opt.window_to));
+    }
+}
+
+}  // namespace
+
+void plot_iba(const PlotOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
+    refuse_bad_time_range(opt.period_from, opt.period_to);
+    StatsOptions so;
+    so.in = opt.in;
+    so.model = opt.model;
+    so.keep_series = true;
+    if (!(opt.width >= 400 && opt.width <= 4000)) {
+        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
+    }
+    const bool window = opt.window_from.has_value() || opt.window_to.has_value();
+    if (window) {
+        check_window(opt);
+        so.from = opt.window_from;
+        so.to = opt.window_to;
+        so.period_options = "--window-from/--window-to";
+    }
+    const StatsResult st = compute_stats(so, log);
+
+    // A pair without clean epochs gets an empty panel that says why
+    // (compute_stats has logged it); with none at all there is nothing to plot.
+    std::string why_nothing;
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + kPairNames[p] +
+                       (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
+    }
+    if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
+        throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+    }
+
+    TempDir dir;
+    double t_lo = std::numeric_limits<double>::infinity();
+    double t_hi = -std::numeric_limits<double>::infinity();
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        const PairSeries& s = st.series[p];
+        if (s.t.empty()) {
+            continue;
+        }
+        t_lo = std::min(t_lo, s.t.front());
+        t_hi = std::max(t_hi, s.t.back());
+        double mean[kStages] = {};
+        for (std::size_t k = 0; k < kStages; ++k) {
+            for (double v : s.iba[k]) {
+                mean[k] += v;
+            }
+            mean[k] /= static_cast<double>(s.t.size());
+        }
+        std::ofstream f(dir.file(("pair" + std::to_string(p) + ".dat")));
+        if (window) {
+            write_smoothed(f, s, mean);
+        } else {
+            write_binned(f, s, mean);
+        }
+        if (!f) {
+            throw std::runtime_error("cannot write plot data in " + dir.path().string());
+        }
+    }
+
+    const std::filesystem::path temps = dir.file("temperatures.dat");
+    if (opt.temperatures) {
+        write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
+                                 kJ2000Unix);
+    }
+    const std::size_t rows = kPairs + (opt.temperatures ? 2 : 0);
+
+    const std::filesystem::path png = dir.file("plot.png");
+    const auto write_script = [&](const char* terminal) {
+        std::ofstream g(dir.file("plot.gp"));
+        g.precision(12);
+        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(rows)
+          << (opt.width < 1000 ? " font ',8'" : "") << "\n";
+        g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
+        if (window) {
+            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kSmoothingWindowS
+              << " s running means (RMS of the IBA and of its running mean in the legend)'\n";
+        } else {
+            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
+              << "-minute means (RMS of the unbinned IBA in the legend)'\n";
+        }
+        g << "set xdata time\nset timefmt '%s'\nset format x \"" << (window ? "%m-%d\\n%H:%M" : "%Y-%m")
+          << "\"\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
+        g << "set xrange ['" << t_lo + kJ2000Unix << "':'" << t_hi + kJ2000Unix << "']\n";
+        g << "set lmargin 10\nset rmargin 42\n";  // the panels' time axes aligned
+        g << "set ylabel 'IBA - mean (arcsec)'\n";
+        if (opt.period_from && opt.period_to) {
+            g.precision(12);
+            g << "set object 1 rect from " << *opt.period_from + kJ2000Unix << ", graph 0 to "
+              << *opt.period_to + kJ2000Unix << ", graph 1 fc rgb '#e6e6e6' fs solid 1.0 noborder behind\n";
+            g << "set label 1 'modelling period' at " << *opt.period_from + kJ2000Unix
+              << ", graph 0.95 offset 1,0 front\n";
+        }
+        const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            if (st.n[p] == 0) {  // an empty panel with the reason in it
+                g << "set title 'pair " << kPairNames[p] << ": no clean epochs'\n";
+                g << "set label 99 '" << gnuplot_quoted(st.no_epochs_reason[p])
+                  << "' at graph 0.5, graph 0.5 center\nset yrange [-1:1]\nplot 2 notitle\n";
+                g << "unset label 99\nset autoscale y\n";
+                continue;
+            }
+            g << "set title 'pair " << kPairNames[p] << " (" << st.n[p] << " clean epochs)'\n";
+            g << "plot ";
+            for (std::size_t k = 0; k < kStages; ++k) {
+                if (k == 2 && !st.thermal) {
+                    break;
+                }
+                char t[96];
+                if (window) {
+                    std::snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
+                                  st.rms[p][k].rms_smoothed);
+                } else {
+                    std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                }
+                g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
+                  << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
+            }
+            g << '\n';
+        }
+        if (opt.temperatures) {
+            const std::string f = "'" + temps.string() + "'";
+            g << "set ylabel 'temperature (degC)'\n";
+            g << "set title 'T_CHU (T1) of each head'\n";
+            g << "plot " << f << " using 1:2 with lines lw 1.5 title 'T_CHU A', " << f
+              << " using 1:3 with lines lw 1.5 title 'T_CHU B', " << f
+              << " using 1:4 with lines lw 1.5 title 'T_CHU C'\n";
+            g << "set title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
+            g << "plot " << f << " using 1:5 with lines lw 1.5 title 'T029', " << f
+              << " using 1:6 with lines lw 1.5 title 'T032'\n";
+        }
+        g << "unset multiplot\n";
+    };
+    const std::string gp_log = (dir.file("gnuplot.log")).string();
+    write_script("pngcairo");
+    int rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
+    if (rc == -1) {
+        throw std::runtime_error("cannot run '" + opt.gnuplot + "' (Debian package gnuplot-nox)");
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        write_script("png");  // a gnuplot built without cairo
+        rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
+    }
+    // Whole or absent, through links, into streams (AtomicFile).
+    write_file_atomically(opt.out, read_all(png));
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,605 @@
+#include "ascorr_host/analysis/simulate.hpp"
+
+#include <erfa.h>
+#include <erfam.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/embedded_model.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/progress.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+constexpr double kMuEarth = 398600.4418;  // km³/s²
+constexpr double kEarthRadiusKm = 6378.137;
+constexpr double kDay = 86400.0;
+constexpr double kDeg = kPi / 180.0;
+
+// Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
+constexpr double kNoiseCrossArcsec = 1.5;
+constexpr double kNoiseAboutArcsec = 10.0;
+constexpr double kFlaggedNoiseArcsec = 40.0;  // flagged solutions are bad in every axis
+// Exclusion angles from the boresight (head blinded: no solution).
+constexpr double kSunExclusionDeg = 40.0;
+constexpr double kMoonExclusionDeg = 20.0;
+constexpr double kMoonBrightDeg = 30.0;  // Moon near the field: "big bright object" flag
+
+Quaternion<double> from_eigen(const Eigen::Quaterniond& q) {
+    return {q.w(), q.x(), q.y(), q.z()};
+}
+
+// Sun and Moon directions (GCRS), cached per hour: they move < 0.6° in that time,
+// far less than the exclusion angles.
+class SunMoon {
+public:
+    void at(double t, Eigen::Vector3d& sun, Eigen::Vector3d& moon) {
+        const auto hour = static_cast<long long>(std::floor(t / 3600.0));
+        if (hour != hour_) {
+            hour_ = hour;
+            const double tc = static_cast<double>(hour) * 3600.0 + 1800.0;
+            double pvh[2][3];
+            double pvb[2][3];
+            eraEpv00(ERFA_DJ00, tc / kDay, pvh, pvb);
+            sun_ = -Eigen::Vector3d(pvh[0][0], pvh[0][1], pvh[0][2]).normalized();
+            double pv[2][3];
+            eraMoon98(ERFA_DJ00, tc / kDay, pv);
+            moon_ = Eigen::Vector3d(pv[0][0], pv[0][1], pv[0][2]).normalized();
+        }
+        sun = sun_;
+        moon = moon_;
+    }
+
+private:
+    long long hour_ = LLONG_MIN;
+    Eigen::Vector3d sun_;
+    Eigen::Vector3d moon_;
+};
+
+// A slowly varying independent temperature part: Ornstein–Uhlenbeck process.
+struct Wander {
+    double x = 0.0;
+    void step(double dt, double tau, double sigma, std::mt19937_64& rng) {
+        std::normal_distribution<double> n(0.0, 1.0);
+        const double a = std::exp(-dt / tau);
+        x = a * x + sigma * std::sqrt(1.0 - a * a) * n(rng);
+    }
+};
+
+// Heater events: an operational heater (CHUs and THT00032 warm) and a survival
+// heater (THT00029 only), alternating, every 40–80 days for 3–5 days, with a
+// half-day thermal time constant.
+class Heaters {
+public:
+    Heaters(double t0, std::mt19937_64& rng) : rng_(rng) { schedule(t0); }
+    // Every event scheduled so far, in time order (the last may lie beyond the data).
+    const std::vector<HeaterEvent>& events() const { return events_; }
+    // Profile 0..1 of the operational and survival heater at t.
+    void at(double t, double& op, double& surv) {
+        while (t > end_ + 5.0 * kTau) {
+            schedule(end_);
+        }
+        double p = 0.0;
+        if (t >= start_) {
+            const double on = std::min(t, end_) - start_;
+            p = 1.0 - std::exp(-on / kTau);
+            if (t > end_) {
+                p *= std::exp(-(t - end_) / kTau);
+            }
+        }
+        op = operational_ ? p : 0.0;
+        surv = operational_ ? 0.0 : p;
+    }
+
+private:
+    static constexpr double kTau = 0.5 * kDay;
+    void schedule(double after) {
+        std::uniform_real_distribution<double> gap(40.0 * kDay, 80.0 * kDay);
+        std::uniform_real_distribution<double> len(3.0 * kDay, 5.0 * kDay);
+        start_ = after + gap(rng_);
+        end_ = start_ + len(rng_);
+        operational_ = !operational_;
+        events_.push_back({start_, end_, operational_});
+    }
+    std::mt19937_64& rng_;
+    double start_ = 0.0;
+    double end_ = 0.0;
+    bool operational_ = false;
+    std::vector<HeaterEvent> events_;
+};
+
+// A run of consecutive epochs with something missing (telemetry or GPS gaps).
+struct Gap {
+    std::size_t left = 0;
+    bool step(double p_start, std::size_t min_len, std::size_t max_len, std::mt19937_64& rng) {
+        if (left > 0) {
+            --left;
+            return true;
+        }
+        std::uniform_real_distribution<double> u(0.0, 1.0);
+        if (u(rng) < p_start) {
+            std::uniform_int_distribution<std::size_t> len(min_len, max_len);
+            left = len(rng) - 1;
+            return true;
+        }
+        return false;
+    }
+};
+
+char* put(char* p, char* end, double x, int decimals) {
+    return format_fixed(p, end, x, decimals);
+}
+
+}  // namespace
+
+Eigen::Matrix3d head_mounting(int head) {
+    static constexpr double kAzimuthDeg[3] = {90.0, 210.0, 330.0};
+    const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
+    const double az = kAzimuthDeg[head] * kDeg;
+    const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir
+    const Eigen::Vector3d z = std::sin(zeta) * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0) + std::cos(zeta) * up;
+    const Eigen::Vector3d x = up.cross(z).normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    Eigen::Matrix3d m;
+    m.row(0) = x.transpose();
+    m.row(1) = y.transpose();
+    m.row(2) = z.transpose();
+    return m;
+}
+
+std::string heaters_csv(const std::vector<HeaterEvent>& events) {
+    std::string s = "start,end,heater\n";
+    char line[96];
+    for (const HeaterEvent& e : events) {
+        std::snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end, e.operational ? "operational" : "survival");
+        s += line;
+    }
+    return s;
+}
+
+std::string floor_json(const std::array<Rms, kPairs>& floor) {
+    std::ostringstream s;
+    s.precision(6);
+    s << std::fixed << "{\"floor\": {";
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        // A pair without clean epochs has no RMS: null (JSON has no NaN either).
+        const auto value = [n = floor[p].n](double x) {
+            std::ostringstream v;
+            v.precision(6);
+            v << std::fixed << x;
+            return n != 0 && std::isfinite(x) ? v.str() : std::string("null");
+        };
+        s << (p ? ", " : "") << '"' << kPairNames[p] << "\": {\"rms\": " << value(floor[p].rms)
+          << ", \"rms_200s\": " << value(floor[p].rms_smoothed) << ", \"n\": " << floor[p].n << '}';
+    }
+    s << "}}\n";
+    return s.str();
+}
+
+std::string describe(const SimulateSummary& s) {
+    std::ostringstream o;
+    o << s.epochs << " epochs, " << s.rows << " rows; blinded (Sun/Moon) rows A/B/C: " << s.outage_rows[0] << '/'
+      << s.outage_rows[1] << '/' << s.outage_rows[2] << "; flagged " << s.flagged_rows << ", without temperatures "
+      << s.rows_without_temperature << ", without velocity " << s.rows_without_velocity
+      << "\nnoise floor (IBA RMS, arcsec):";
+    char buf[96];
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        std::snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", kPairNames[p], s.floor[p].rms,
+                      s.floor[p].rms_smoothed);
+        o << buf;
+    }
+    o << "\ntruth model: " << s.truth_path << "\nfloor: " << s.floor_path << "\nheater events (" << s.heaters.size()
+      << "): " << s.heaters_path;
+    return o.str();
+}
+
+namespace {
+
+// The random streams, shared in one fixed order of draws: the same seed gives
+// the same file. `normal` keeps state between calls (it draws in pairs), so
+// there is one, used by every draw below, never a copy.
+struct Random {
+    explicit Random(std::uint64_t seed) : engine(seed) {}
+    std::mt19937_64 engine;
+    std::normal_distribution<double> normal{0.0, 1.0};
+    std::uniform_real_distribution<double> uniform{0.0, 1.0};
+    double gauss() { return normal(engine); }
+    double unit() { return uniform(engine); }
+};
+
+void refuse_bad_options(const SimulateOptions& opt) {
+    if (!(opt.days > 0.0 && opt.days <= 36600.0)) {
+        throw std::invalid_argument("--days must be in (0, 36600], got " + std::to_string(opt.days));
+    }
+    if (!(opt.step_s >= 1.0 && opt.step_s <= 600.0)) {
+        throw std::invalid_argument("--step must be in [1, 600] s (the orbit must be resolved), got " +
+                                    std::to_string(opt.step_s));
+    }
+    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kDay)) {
+        throw std::invalid_argument("--start " + std::to_string(opt.start_t) +
+                                    ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
+    }
+}
+
+std::string truth_name(const SimulateOptions& opt) {
+    return opt.truth.empty() ? std::string("truth model (Table 2)") : opt.truth;
+}
+
+// --truth, or Table 2; heads A, B and C must all have coefficients.
+ModelFile truth_model(const SimulateOptions& opt) {
+    ModelFile truth_file = opt.truth.empty() ? table2_model() : read_model_file(opt.truth);
+    for (std::size_t h = 0; h < 3; ++h) {
+        if (!truth_file.present[h]) {
+            throw std::invalid_argument((opt.truth.empty() ? std::string("truth model") : opt.truth) +
+                                        ": no coefficients for CHU " + head_name(static_cast<std::uint8_t>(h)));
+        }
+    }
+    return truth_file;
+}
+
+// The circular orbit (header: Sun-synchronous-like node drift) and the
+// spacecraft's attitude at dt seconds after the start.
+struct OrbitState {
+    Eigen::Vector3d P;      // node direction (ICRF)
+    Eigen::Vector3d Q;      // 90° ahead in the orbital plane
+    Eigen::Vector3d r_hat;  // position direction
+    Eigen::Vector3d v_sc;   // velocity, km/s, rounded as written
+    Eigen::Matrix3d body_icrf;
+};
+
+class Orbit {
+public:
+    Orbit(double start_t, SunMoon& sky) {
+        Eigen::Vector3d sun0;
+        Eigen::Vector3d moon0;
+        sky.at(start_t, sun0, moon0);
+        node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDeg;
+    }
+    OrbitState at(double dt) const {
+        OrbitState o;
+        const double u = n_ * dt;
+        const double node = node0_ + node_rate_ * dt;
+        o.P = Eigen::Vector3d(std::cos(node), std::sin(node), 0.0);
+        o.Q = Eigen::Vector3d(-std::cos(inc_) * std::sin(node), std::cos(inc_) * std::cos(node), std::sin(inc_));
+        o.r_hat = std::cos(u) * o.P + std::sin(u) * o.Q;
+        const Eigen::Vector3d v_dir = -std::sin(u) * o.P + std::cos(u) * o.Q;
+        o.v_sc = a_ * n_ * v_dir;
+        for (int i = 0; i < 3; ++i) {
+            o.v_sc[i] = std::round(o.v_sc[i] * 1e6) / 1e6;  // as written
+        }
+        o.body_icrf.row(0) = v_dir.transpose();
+        o.body_icrf.row(2) = -o.r_hat.transpose();
+        o.body_icrf.row(1) = (-o.r_hat).cross(v_dir).transpose();
+        return o;
+    }
+
+private:
+    double a_ = kEarthRadiusKm + kSimAltitudeKm;
+    double n_ = std::sqrt(kMuEarth / (a_ * a_ * a_));
+    double inc_ = kSimInclinationDeg * kDeg;
+    double node_rate_ = 2.0 * kPi / (365.2422 * kDay) - 2.0 * kPi / (kPlaneSunPeriodDays * kDay);
+    double node0_ = 0.0;
+};
+
+// T_CHU A, B, C, T029, T032 (°C, rounded as written): seasonal (sine of the
+// Sun's angle to the orbital plane), orbital (sunlit side), independent
+// wander, heater events, read noise.
+std::array<double, 5> temperatures(const OrbitState& o, const Eigen::Vector3d& sun, double op, double surv,
+                                   std::array<Wander, 5>& wander, double step_s, Random& rnd) {
+    const double sinb = sun.dot(o.P.cross(o.Q));
+    const double orb = o.r_hat.dot(sun);
+    for (auto& w : wander) {
+        w.step(step_s, 3.0 * kDay, 0.6, rnd.engine);
+    }
+    const double s2 = sinb * sinb;
+    std::array<double, 5> temp = {
+        10.0 + 5.0 * sinb + 2.0 * s2 + 0.8 * orb + wander[0].x + 2.5 * op,
+        14.0 - 7.0 * sinb + 1.0 * s2 + 1.2 * orb + wander[1].x + 3.0 * op,
+        8.0 - 4.0 * sinb + 3.0 * s2 + 0.6 * orb + wander[2].x + 2.0 * op,
+        -9.0 + 3.0 * sinb - 2.0 * s2 + 0.3 * orb + wander[3].x + 3.0 * surv,
+        -20.0 + 2.0 * sinb + 4.0 * s2 + 0.2 * orb + wander[4].x + 2.0 * op,
+    };
+    for (double& x : temp) {
+        x = std::round((x + 0.02 * rnd.gauss()) * 1000.0) / 1000.0;  // as written
+    }
+    return temp;
+}
+
+// Flags, confidence and a missing T_CHU of one head's solution.
+struct Quality {
+    long long flags = 0;
+    double confidence = 0.0;
+    bool bad = false;  // flagged or confidence > 5
+    bool chu_temperature_missing = false;
+};
+
+Quality draw_quality(double moon_deg, Random& rnd) {
+    Quality q;
+    if (rnd.unit() < 0.002) {
+        q.flags |= 1;
+    }
+    if (moon_deg < kMoonBrightDeg || rnd.unit() < 0.001) {  // no draw with the Moon near the field
+        q.flags |= 2;
+    }
+    if (rnd.unit() < 0.0005) {
+        q.flags |= 4;
+    }
+    q.confidence = std::min(4.9, 1.0 + 0.5 * std::fabs(rnd.gauss()));
+    if (rnd.unit() < 0.003) {
+        q.confidence = 5.5 + 10.0 * rnd.unit();
+    }
+    q.bad = q.flags != 0 || q.confidence > 5.0;
+    q.chu_temperature_missing = rnd.unit() < 0.001;
+    return q;
+}
+
+// Undoes the aberration correction: q_raw = q_meas ⊗ q_ab(z_raw), by
+// fixed-point iteration (contraction ≈ |β| ≈ 1e-4 per step).
+Quaternion<double> raw_attitude(const Quaternion<double>& q_meas, double t, std::size_t h, const Eigen::Vector3d& v_sc,
+                                EarthVelocity& earth) {
+    SolutionRecord rec;
+    rec.t = t;
+    rec.head = static_cast<std::uint8_t>(h);
+    rec.q_chu_icrf = q_meas;
+    rec.velocity_components = 3;
+    rec.v_sc_kms = {v_sc.x(), v_sc.y(), v_sc.z()};
+    const SolutionInput<double> in = to_core_input<double>(rec, &earth);
+    Quaternion<double> q_raw = q_meas;
+    for (int it = 0; it < 4; ++it) {
+        const SmallRotation<double> q_ab =
+            aberration_rotation(boresight(q_raw), in.velocity.beta_icrf, in.velocity.inv_sun_distance_au);
+        q_raw = renormalized(q_meas * to_quaternion(q_ab));
+    }
+    return canonical(q_raw);
+}
+
+// Everything one epoch shares between its heads.
+struct EpochState {
+    double t = 0.0;
+    OrbitState orbit;
+    Eigen::Vector3d sun;
+    Eigen::Vector3d moon;
+    std::array<double, 5> temp{};
+    bool no_temperature = false;  // telemetry gap
+    bool no_velocity = false;     // GPS gap
+};
+
+// One head's solution at an epoch (when the head is not blinded).
+struct HeadSolution {
+    Quality quality;
+    Quaternion<double> q_raw{};
+    Vector3<double> z_floor{};  // boresight with noise only: for the noise floor
+};
+
+// Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), then the
+// raw attitude before the aberration correction.
+HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moon_deg, const EpochState& e,
+                        const ThermalModel<double>& truth, const std::string& truth_file, const ModelFile& truth_rows,
+                        EarthVelocity& earth, Random& rnd) {
+    HeadSolution out;
+    out.quality = draw_quality(moon_deg, rnd);
+    const bool bad = out.quality.bad;
+    const double sx = bad ? kFlaggedNoiseArcsec : kNoiseCrossArcsec;
+    const double sz = bad ? kFlaggedNoiseArcsec : kNoiseAboutArcsec;
+    std::normal_distribution<double>& normal = rnd.normal;
+    std::mt19937_64& rng = rnd.engine;
+    const Eigen::Vector3d noise(sx * normal(rng), sx * normal(rng), sz * normal(rng));
+    const Eigen::Vector3d noise_rad = noise * kArcsecToRad;
+    const Eigen::Quaterniond q_noise(Eigen::AngleAxisd(noise_rad.norm(), noise_rad.normalized()));
+    const Eigen::Quaterniond q_true(r_true);
+    const Eigen::Quaterniond q_noisy_true = (q_noise * q_true).normalized();
+
+    HeadTemperatures<double> ht{{e.temp[h], true}, {e.temp[3], true}, {e.temp[4], true}};
+    const ThermalStage<double> th = thermal_stage(truth, static_cast<std::uint8_t>(h), ht);
+    if (th.skip != 0U) {
+        // The first axis beyond 1 degree names the model row (line) to look at.
+        const HeadThermalModel<double>& m = truth.head[h];
+        const AxisPolynomial<double>* axes[3] = {&m.alpha, &m.beta, &m.gamma};
+        std::size_t axis = 0;
+        double angle = 0.0;
+        for (std::size_t a = 0; a < 3; ++a) {
+            angle = thermal_angle(*axes[a], ht.t_chu.value, ht.t_029.value, ht.t_032.value);
+            axis = a;
+            if (!(std::fabs(angle) <= kMaxThermalAngleRad)) {
+                break;
+            }
+        }
+        char what[240];
+        std::snprintf(what, sizeof what,
+                      "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
+                      "T029 %g, T032 %g degC)",
+                      head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, e.temp[h],
+                      e.temp[3], e.temp[4]);
+        throw InputError(truth_file, truth_rows.line[h][axis], 0, what);
+    }
+    const Quaternion<double> q_meas = renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
+    out.q_raw = raw_attitude(q_meas, e.t, h, e.orbit.v_sc, earth);
+    const Eigen::Vector3d zf = q_noisy_true.toRotationMatrix().row(2).transpose();
+    out.z_floor = {zf.x(), zf.y(), zf.z()};
+    return out;
+}
+
+// The row of docs/contract.md's solutions file.
+void append_row(std::string& buf, const EpochState& e, std::size_t h, const HeadSolution& s) {
+    char line[256];
+    char* p = line;
+    char* const end = line + sizeof line;
+    p = put(p, end, e.t, 3);
+    *p++ = ',';
+    *p++ = head_name(static_cast<std::uint8_t>(h));
+    for (double c : {s.q_raw.w, s.q_raw.x, s.q_raw.y, s.q_raw.z}) {
+        *p++ = ',';
+        p = put(p, end, c, 15);
+    }
+    for (std::size_t i = 0; i < 3; ++i) {
+        *p++ = ',';
+        const double value = i == 0 ? e.temp[h] : e.temp[i + 2];
+        if (!(e.no_temperature || (i == 0 && s.quality.chu_temperature_missing))) {
+            p = put(p, end, value, 3);
+        }
+    }
+    for (int i = 0; i < 3; ++i) {
+        *p++ = ',';
+        if (!e.no_velocity) {
+            p = put(p, end, e.orbit.v_sc[i], 6);
+        }
+    }
+    p += std::snprintf(p, static_cast<std::size_t>(end - p), ",%lld,", s.quality.flags);
+    p = put(p, end, s.quality.confidence, 2);
+    *p++ = '\n';
+    buf.append(line, static_cast<std::size_t>(p - line));
+}
+
+// The mission, epoch by epoch: everything simulate() writes and counts.
+class Mission {
+public:
+    Mission(const SimulateOptions& opt, const ModelFile& truth_file)
+        : opt_(opt),
+          truth_file_(truth_file),
+          truth_(to_core<double>(truth_file)),
+          truth_name_(truth_name(opt)),
+          rnd_(opt.seed),
+          orbit_(opt.start_t, sky_),
+          heaters_(opt.start_t, rnd_.engine) {
+        for (int h = 0; h < 3; ++h) {
+            mount_[static_cast<std::size_t>(h)] = head_mounting(h);
+        }
+    }
+
+    // Appends epoch k's rows to buf.
+    void epoch(std::size_t k, std::string& buf) {
+        EpochState e;
+        const double dt = static_cast<double>(k) * opt_.step_s;
+        e.t = std::round((opt_.start_t + dt) * 1000.0) / 1000.0;  // as written
+        e.orbit = orbit_.at(dt);
+        sky_.at(e.t, e.sun, e.moon);
+        double op = 0.0;
+        double surv = 0.0;
+        heaters_.at(e.t, op, surv);
+        e.temp = temperatures(e.orbit, e.sun, op, surv, wander_, opt_.step_s, rnd_);
+        e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
+        e.no_velocity = gps_gap_.step(1e-4, 5, 60, rnd_.engine);
+
+        std::array<bool, 3> clean{};  // written and clean
+        std::array<Vector3<double>, 3> z_floor{};
+        for (std::size_t h = 0; h < 3; ++h) {
+            const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
+            const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
+            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDeg;
+            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDeg;
+            if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
+                ++sum_.outage_rows[h];  // blinded: no solution
+                continue;
+            }
+            const HeadSolution s = solve_head(h, r_true, moon_deg, e, truth_, truth_name_, truth_file_, earth_, rnd_);
+            append_row(buf, e, h, s);
+            count(e, s);
+            clean[h] = !s.quality.bad && !(e.no_temperature || s.quality.chu_temperature_missing) && !e.no_velocity;
+            z_floor[h] = s.z_floor;
+        }
+        for (std::size_t pr = 0; pr < kPairs; ++pr) {
+            const auto i = kPairHeads[pr][0];
+            const auto j = kPairHeads[pr][1];
+            if (clean[i] && clean[j]) {
+                floor_t_[pr].push_back(e.t);
+                floor_v_[pr].push_back(angle_arcsec(z_floor[i], z_floor[j]));
+            }
+        }
+        ++sum_.epochs;
+    }
+
+    // The summary, once every epoch is in (t_last: the last epoch's time).
+    SimulateSummary finish(double t_last) {
+        for (std::size_t pr = 0; pr < kPairs; ++pr) {
+            sum_.floor[pr] = rms_about_mean(floor_t_[pr], floor_v_[pr]);
+        }
+        sum_.truth_path = opt_.out + ".truth.csv";
+        sum_.floor_path = opt_.out + ".floor.json";
+        sum_.heaters_path = opt_.out + ".heaters.csv";
+        for (const HeaterEvent& ev : heaters_.events()) {
+            if (ev.start <= t_last) {
+                sum_.heaters.push_back(ev);
+            }
+        }
+        return sum_;
+    }
+
+private:
+    void count(const EpochState& e, const HeadSolution& s) {
+        ++sum_.rows;
+        sum_.flagged_rows += s.quality.bad ? 1U : 0U;
+        sum_.rows_without_temperature += e.no_temperature || s.quality.chu_temperature_missing ? 1U : 0U;
+        sum_.rows_without_velocity += e.no_velocity ? 1U : 0U;
+    }
+
+    const SimulateOptions& opt_;
+    const ModelFile& truth_file_;
+    ThermalModel<double> truth_;
+    std::string truth_name_;
+    Random rnd_;
+    SunMoon sky_;
+    Orbit orbit_;
+    std::array<Eigen::Matrix3d, 3> mount_;
+    EarthVelocity earth_;
+    Heaters heaters_;
+    std::array<Wander, 5> wander_;  // T_CHU A, B, C, T029, T032
+    Gap telemetry_gap_;
+    Gap gps_gap_;
+    SimulateSummary sum_;
+    std::array<std::vector<double>, kPairs> floor_t_;
+    std::array<std::vector<double>, kPairs> floor_v_;
+};
+
+}  // namespace
+
+SimulateSummary simulate(const SimulateOptions& opt) {
+    refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
+                                                        {"--out (truth model)", opt.out + ".truth.csv"},
+                                                        {"--out (noise floor)", opt.out + ".floor.json"}});
+    refuse_bad_options(opt);
+    const ModelFile truth_file = truth_model(opt);
+    Mission mission(opt, truth_file);
+
+    AtomicFile out(opt.out);
+    std::string buf;
+    buf.reserve(2U << 20);
+    buf += "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kDay / opt.step_s)) + 1;
+    Progress progress("simulate");
+    for (std::size_t k = 0; k < epochs; ++k) {
+        if ((k & 4095U) == 0) {
+            progress.update(static_cast<double>(k) / static_cast<double>(epochs));
+        }
+        mission.epoch(k, buf);
+        if (buf.size() > (1U << 20)) {
+            out.write(buf);
+            buf.clear();
+        }
+    }
+    out.write(buf);
+    progress.done();
+    const SimulateSummary sum = mission.finish(opt.start_t + static_cast<double>(epochs - 1) * opt.step_s);
+    out.commit();
+    write_model_file(sum.truth_path, truth_file);
+    write_file_atomically(sum.floor_path, floor_json(sum.floor));
+    write_file_atomically(sum.heaters_path, heaters_csv(sum.heaters));
+    return sum;
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,254 @@
+#include "ascorr_host/analysis/stats.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <numeric>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/diagnostics.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+
+namespace ascorr::host {
+
+bool is_clean(const SolutionRecord& rec) noexcept {
+    return rec.flags == 0 && rec.confidence <= 5.0 && rec.temperature_present[0] && rec.temperature_present[1] &&
+           rec.temperature_present[2] && rec.velocity_components == 3;
+}
+
+namespace {
+
+struct Row {
+    bool clean = false;
+    std::array<Vector3<double>, kStages> z{};  // boresight per stage
+};
+
+// What kept each head's rows out of the clean epochs, for the reasons.
+struct HeadTally {
+    std::size_t rows = 0;  // in [from, to]
+    std::size_t clean = 0;
+    std::size_t flagged = 0;
+    std::size_t low_confidence = 0;  // confidence > 5 or NaN
+    std::size_t no_temperatures = 0;
+    std::size_t no_velocity = 0;
+    std::size_t not_corrected = 0;
+};
+
+std::string head_without_clean_rows(char name, const HeadTally& h) {
+    std::string s = std::string("none of CHU ") + name + "'s " + std::to_string(h.rows) + " rows is clean (";
+    const std::pair<std::size_t, const char*> parts[] = {{h.flagged, "flags set"},
+                                                         {h.low_confidence, "confidence above 5 or nan"},
+                                                         {h.no_temperatures, "temperatures missing"},
+                                                         {h.no_velocity, "velocity missing"},
+                                                         {h.not_corrected, "not corrected by the core"}};
+    const char* sep = "";
+    for (const auto& [n, what] : parts) {
+        if (n != 0) {
+            s += sep + std::to_string(n) + " " + what;
+            sep = ", ";
+        }
+    }
+    return s + ")";
+}
+
+// Why pair p has no clean epoch; the tests are in the order a reader would check.
+std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t rows_seen, std::size_t rows_in_period,
+                          const std::array<HeadTally, 3>& heads, std::size_t both_present) {
+    const bool period = opt.from.has_value() || opt.to.has_value();
+    const auto t = [](double x) {
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.17g", x);
+        return std::string(buf);
+    };
+    const std::string in_period = period ? " in [" + (opt.from ? t(*opt.from) : std::string("-inf")) + ", " +
+                                               (opt.to ? t(*opt.to) : std::string("inf")) + "] s (" +
+                                               opt.period_options + ")"
+                                         : std::string();
+    if (rows_seen == 0) {
+        return "the file has no data rows";
+    }
+    if (rows_in_period == 0) {
+        return "no rows" + in_period + " (the file has " + std::to_string(rows_seen) + ")";
+    }
+    for (const std::uint8_t h : kPairHeads[p]) {
+        if (heads[h].rows == 0) {
+            return std::string("CHU ") + head_name(h) + " has no rows" + in_period;
+        }
+    }
+    for (const std::uint8_t h : kPairHeads[p]) {
+        if (heads[h].clean == 0) {
+            return head_without_clean_rows(head_name(h), heads[h]);
+        }
+    }
+    const char a = head_name(kPairHeads[p][0]);
+    const char b = head_name(kPairHeads[p][1]);
+    if (both_present == 0) {
+        return std::string("CHU ") + a + " and CHU " + b + " never have a row at the same epoch (t to the millisecond)";
+    }
+    return "at the " + std::to_string(both_present) + " epochs with rows of both CHU " + a + " and CHU " + b +
+           ", one of the two is never clean";
+}
+
+}  // namespace
+
+StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
+    refuse_bad_time_range(opt.from, opt.to);
+    std::optional<ThermalModel<double>> model;
+    if (!opt.model.empty()) {
+        model = to_core<double>(read_model_file(opt.model));
+    }
+    return compute_stats(
+        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
+        model ? &*model : nullptr, log);
+}
+
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log) {
+    const CorrectionConfig<double> ab_only{true, nullptr};
+    const CorrectionConfig<double> both{true, model};
+    StatsResult r;
+    r.thermal = model != nullptr;
+    EarthVelocity earth;
+    Diagnostics diag(log);
+
+    std::size_t rows_seen = 0;
+    std::array<HeadTally, 3> heads{};
+    std::array<std::size_t, kPairs> both_present{};
+    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            const auto& a = e.head[kPairHeads[p][0]];
+            const auto& b = e.head[kPairHeads[p][1]];
+            both_present[p] += a && b ? 1U : 0U;
+            if (a && b && a->clean && b->clean) {
+                r.series[p].t.push_back(e.t);
+                for (std::size_t s = 0; s < kStages; ++s) {
+                    r.series[p].iba[s].push_back(angle_arcsec(a->z[s], b->z[s]));
+                }
+            }
+        }
+    });
+    rows([&](const SolutionRecord& rec) {
+        ++rows_seen;
+        if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
+            return;
+        }
+        ++r.rows;
+        if (rec.head > 2) {
+            return;  // not in any pair (head D, or unknown: left to `correct` to report)
+        }
+        HeadTally& tally = heads[rec.head];
+        ++tally.rows;
+        tally.flagged += rec.flags != 0 ? 1U : 0U;
+        tally.low_confidence += !(rec.confidence <= 5.0) ? 1U : 0U;  // as is_clean
+        tally.no_temperatures +=
+            !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
+        tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
+        Row row;
+        row.clean = is_clean(rec);
+        const SolutionInput<double> in = to_core_input<double>(rec, &earth);
+        const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
+        const CorrectedSolution<double> c2 = correct_solution(in, both);
+        const bool thermal_ok = !model || (c2.status & status::kThermalApplied) != 0U;
+        if (row.clean && ((c1.status & status::kAberrationApplied) == 0U || !thermal_ok)) {
+            diag.report("not corrected", opt.in + ":" + std::to_string(rec.line) +
+                                             ": clean row the core did not correct (status " +
+                                             std::to_string(c2.status) + "): left out of the statistics");
+            row.clean = false;
+            ++tally.not_corrected;
+        }
+        r.clean_rows += row.clean ? 1U : 0U;
+        tally.clean += row.clean ? 1U : 0U;
+        row.z[0] = boresight(rec.q_chu_icrf);
+        row.z[1] = boresight(c1.q_chu_icrf);
+        row.z[2] = boresight(c2.q_chu_icrf);
+        epochs.add(rec.t, rec.head, rec.line, row);
+    });
+    epochs.finish();
+    diag.summarize();
+
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        PairSeries& s = r.series[p];
+        // Incomplete epochs arrive last and unordered: sort by time for smoothing.
+        std::vector<std::size_t> idx(s.t.size());
+        std::iota(idx.begin(), idx.end(), std::size_t{0});
+        std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return s.t[i] < s.t[j]; });
+        const auto permute = [&](std::vector<double>& v) {
+            std::vector<double> o(v.size());
+            for (std::size_t i = 0; i < idx.size(); ++i) {
+                o[i] = v[idx[i]];
+            }
+            v.swap(o);
+        };
+        permute(s.t);
+        for (auto& v : s.iba) {
+            permute(v);
+        }
+        r.n[p] = s.t.size();
+        if (r.n[p] == 0) {
+            r.no_epochs_reason[p] = why_no_epochs(p, opt, rows_seen, r.rows, heads, both_present[p]);
+            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+        }
+        for (std::size_t st = 0; st < kStages; ++st) {
+            r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
+        }
+        if (!opt.keep_series) {
+            s = PairSeries{};
+        }
+    }
+    return r;
+}
+
+std::string stats_table(const StatsResult& r) {
+    std::ostringstream o;
+    o << "IBA RMS about the mean, arcsec, over clean epochs (after 200 s smoothing in brackets)\n";
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
+                  "thermal");
+    o << buf;
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        std::string cells[kStages];
+        for (std::size_t s = 0; s < kStages; ++s) {
+            if (r.n[p] == 0 || (s == 2 && !r.thermal)) {
+                cells[s] = "-";
+            } else {
+                char c[64];
+                std::snprintf(c, sizeof c, "%6.2f (%5.2f)", r.rms[p][s].rms, r.rms[p][s].rms_smoothed);
+                cells[s] = c;
+            }
+        }
+        std::snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", kPairNames[p], r.n[p], cells[0].c_str(),
+                      cells[1].c_str(), cells[2].c_str());
+        o << buf;
+    }
+    return o.str();
+}
+
+std::string stats_json(const StatsResult& r) {
+    std::ostringstream o;
+    const auto num = [](double x) {
+        char c[32];
+        std::snprintf(c, sizeof c, "%.6f", x);
+        return std::string(c);
+    };
+    o << "{\"pairs\": {";
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        const bool any = r.n[p] > 0;
+        o << (p ? ", " : "") << '"' << kPairNames[p] << "\": {";
+        o << "\"original\": " << (any ? num(r.rms[p][0].rms) : "null");
+        o << ", \"aberration\": " << (any ? num(r.rms[p][1].rms) : "null");
+        o << ", \"thermal\": " << (any && r.thermal ? num(r.rms[p][2].rms) : "null");
+        o << ", \"n\": " << r.n[p] << '}';
+    }
+    o << "}}\n";
+    return o.str();
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,360 @@
+#include "ascorr_host/correct/correct_file.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <future>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr_host/correct/correct_row.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/corrected_csv.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/diagnostics.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_host/formats/states_csv.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+std::string where(const std::string& file, const SolutionRecord& rec) {
+    return file + ":" + std::to_string(rec.line) + ": ";
+}
+
+// Explains, once per affected row, the status bits that mean "bad input".
+template <typename T, typename Sink>
+void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file,
+             Sink& diag) {
+    if ((st & status::kRejected) != 0U) {
+        std::string why;
+        switch (check_solution(in)) {
+            case Rejection::kHeadOutOfRange:
+                why =
+                    "chu '" + std::string(rec.chu) + "' is not a camera head (" + std::string(kHeadChoices.text) + ")";
+                break;
+            case Rejection::kQuaternionNotFinite:
+                why = "quaternion is not finite";
+                break;
+            case Rejection::kQuaternionNotUnit: {
+                const auto& q = rec.q_chu_icrf;
+                char buf[96];
+                std::snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
+                              q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
+                              ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
+                why = buf;
+                break;
+            }
+            case Rejection::kNone:
+                break;
+        }
+        diag.report("rejected", where(file, rec) + why + ": row kept, quaternion unchanged (status 16)");
+        return;
+    }
+    if ((st & status::kVelocityInvalid) != 0U) {
+        // (A row without vx,vy,vz reaches here only with a velocity from the
+        // states that the core found out of its domain.)
+        if (rec.velocity_components != 3 && rec.velocity_components != 0) {
+            diag.report("velocity incomplete", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
+        } else if (rec.velocity_components == 3 && !in_ephemeris_span(rec.t)) {
+            diag.report("outside the ephemeris", where(file, rec) + velocity_problem(rec) + ": aberration skipped");
+        } else if (!beta_in_domain(in.velocity.beta_icrf)) {
+            const auto b = in.velocity.beta_icrf;
+            const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
+            char buf[128];
+            std::snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped", speed,
+                          kMaxObserverSpeedKmS);
+            diag.report("velocity invalid", where(file, rec) + buf);
+        } else {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
+                          ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
+                          kMaxSunDistanceAu);
+            diag.report("velocity invalid", where(file, rec) + buf);
+        }
+    }
+    if ((st & status::kTemperatureInvalid) != 0U) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "temperature outside +-%.0f C (t_chu=%g, t_029=%g, t_032=%g): thermal skipped",
+                      kMaxAbsTemperatureC, rec.temperature[0], rec.temperature[1], rec.temperature[2]);
+        diag.report("temperature invalid", where(file, rec) + buf);
+    }
+    if ((st & status::kThermalOutOfRange) != 0U) {
+        diag.report("thermal out of range",
+                    where(file, rec) + "model angle beyond 1 degree for these temperatures: thermal skipped");
+    }
+    if ((st & status::kNoModelForHead) != 0U) {
+        diag.report("no model for head", where(file, rec) + "the model has no coefficients for chu '" +
+                                             std::string(rec.chu) + "': thermal skipped");
+    }
+}
+
+// Diagnostics of one chunk, replayed in file order after the workers join.
+class DeferredDiagnostics {
+public:
+    void report(const std::string& kind, const std::string& message) { items_.emplace_back(kind, message); }
+    void replay(Diagnostics& d) const {
+        for (const auto& [kind, message] : items_) {
+            d.report(kind, message);
+        }
+    }
+
+private:
+    std::vector<std::pair<std::string, std::string>> items_;
+};
+
+struct ChunkResult {
+    std::string out;
+    CorrectSummary summary;
+    DeferredDiagnostics diag;
+    std::optional<InputError> error;  // the first malformed row, when not skipping
+    std::size_t empty_lines = 0;
+};
+
+template <typename T>
+struct Job {
+    const CorrectOptions& opt;
+    const CorrectionConfig<T>& cfg;
+    const SolutionsReader& header;
+    const RowWriter& writer;
+    const StatesFile* states;  // nullptr: no --states
+    VelocityServiceConfig service;
+};
+
+// With --states, a row without its own velocity gets the service's
+// (correct_row); the status bits the service adds (4, 4|512, 4|32) are
+// explained here.
+template <typename Sink>
+void explain_service(StatusBits service, const SolutionRecord& rec, const std::string& file, Sink& diag) {
+    if (service == status::kNoVelocity) {
+        diag.report("no state yet",
+                    where(file, rec) + "no accepted state at or before t: aberration skipped (status 4)");
+    } else if ((service & status::kStale) != 0U) {
+        diag.report("state too old", where(file, rec) +
+                                         "the latest state is older than --max-propagation: aberration skipped "
+                                         "(status 4+512)");
+    } else if ((service & status::kVelocityInvalid) != 0U) {
+        diag.report("velocity from states invalid",
+                    where(file, rec) +
+                        "the propagated state left a plausible orbit, or t is outside the Earth series' span "
+                        "(2000-2050): aberration skipped (status 4+32)");
+    }
+}
+
+template <typename T>
+void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
+    const CorrectOptions& opt = job.opt;
+    SolutionsReader reader(job.header, body, lines_before);
+    EarthVelocity earth;
+    std::optional<StatesVelocity<T>> states;
+    if (job.states != nullptr) {
+        states.emplace(*job.states, job.service);
+    }
+    SolutionRecord rec;
+    res.out.reserve(body.size() + body.size() / 8);
+    for (;;) {
+        try {
+            if (!reader.next(rec)) {
+                break;
+            }
+        } catch (const InputError& e) {
+            if (!opt.skip_bad) {
+                res.error = e;
+                break;
+            }
+            ++res.summary.malformed;
+            res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
+            continue;
+        }
+        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg, states ? &*states : nullptr);
+        const StatusBits st = row.status;
+        if (row.from_states) {
+            explain_service(row.service, rec, opt.in, res.diag);
+        }
+        // A states row whose 32 comes from the service is explained by
+        // explain_service(); a 32 from the core itself (speed, Sun distance) by explain().
+        const bool service_invalid = row.from_states && (row.service & status::kVelocityInvalid) != 0U;
+        explain(rec, row.in, service_invalid ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+                res.diag);
+        if ((st & status::kRejected) != 0U) {
+            job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
+        } else {
+            job.writer.row(reader, row.q_chu_icrf, st, res.out);
+        }
+        ++res.summary.rows;
+        for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
+            res.summary.status_bit[b] += (static_cast<unsigned>(st) >> b) & 1U;
+        }
+    }
+    res.empty_lines = reader.empty_lines();
+}
+
+// Splits a block of whole lines into n pieces of about equal size, at line ends.
+std::vector<std::string_view> split_at_lines(std::string_view block, std::size_t n) {
+    std::vector<std::string_view> parts;
+    std::size_t start = 0;
+    for (std::size_t i = 1; i <= n && start < block.size(); ++i) {
+        std::size_t end = i == n ? block.size() : std::max(start, block.size() * i / n);
+        if (end < block.size()) {
+            const std::size_t nl = block.find('\n', end);
+            end = nl == std::string_view::npos ? block.size() : nl + 1;
+        }
+        parts.push_back(block.substr(start, end - start));
+        start = end;
+    }
+    return parts;
+}
+
+std::size_t worker_count() {
+    const unsigned hw = std::thread::hardware_concurrency();
+    return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
+}
+
+template <typename T>
+CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
+                             {{"--out", opt.out}});
+    std::optional<ThermalModel<T>> model;
+    if (opt.thermal && !opt.model.empty()) {
+        const ModelFile m = read_model_file(opt.model);
+        if constexpr (std::is_same_v<T, Q30>) {
+            check_fixed_point_range(m, opt.model);
+        }
+        model = to_core<T>(m);
+    }
+    const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
+
+    BlockReader blocks(opt.in);
+    std::string_view block;
+    if (!blocks.next(block)) {
+        throw InputError(opt.in, 1, 1, "empty file: expected a header line");
+    }
+    const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
+    refuse_corrected_input(header);
+    const RowWriter writer(header);
+    Diagnostics diag(log);
+    std::optional<StatesFile> states;
+    if (!opt.states.empty()) {
+        if (!max_propagation_acceptable(opt.max_propagation_s)) {
+            throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
+        }
+        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    }
+    const Job<T> job{opt, cfg, header, writer, states ? &*states : nullptr, service_config(opt.max_propagation_s)};
+
+    AtomicFile out(opt.out);
+    out.write(writer.header_line());
+    CorrectSummary sum;
+    std::size_t empty_lines = 0;
+    const std::size_t workers = worker_count();
+    std::future<void> writing;  // declared after `out`: destroyed (joined) before it
+    bool first = true;
+    do {
+        std::size_t lines_before = blocks.lines_before();
+        if (first) {  // the header line is not data
+            const std::size_t nl = block.find('\n');
+            block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+            lines_before += 1;
+            first = false;
+        }
+        const std::vector<std::string_view> parts = split_at_lines(block, workers);
+        std::vector<std::size_t> first_line(parts.size(), lines_before);
+        for (std::size_t i = 1; i < parts.size(); ++i) {
+            first_line[i] = first_line[i - 1] + count_line_ends(parts[i - 1]);
+        }
+        std::vector<ChunkResult> results(parts.size());
+        {
+            std::vector<std::thread> threads;
+            for (std::size_t i = 1; i < parts.size(); ++i) {
+                threads.emplace_back([&, i] { correct_chunk(job, parts[i], first_line[i], results[i]); });
+            }
+            if (!parts.empty()) {
+                correct_chunk(job, parts[0], first_line[0], results[0]);
+            }
+            for (auto& t : threads) {
+                t.join();
+            }
+        }
+        for (const ChunkResult& r : results) {  // in file order
+            r.diag.replay(diag);
+            if (r.error) {
+                throw *r.error;
+            }
+            sum.rows += r.summary.rows;
+            sum.malformed += r.summary.malformed;
+            for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
+                sum.status_bit[b] += r.summary.status_bit[b];
+            }
+            empty_lines += r.empty_lines;
+        }
+        // Write this block while the workers correct the next one; one block
+        // in flight, its errors surface at the next block or at the end.
+        if (writing.valid()) {
+            writing.get();
+        }
+        writing = std::async(std::launch::async, [&out, done = std::move(results)] {
+            for (const ChunkResult& r : done) {
+                out.write(r.out);
+            }
+        });
+    } while (blocks.next(block));
+    if (writing.valid()) {
+        writing.get();
+    }
+    if (empty_lines != 0) {
+        log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
+    }
+    diag.summarize();
+    if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
+        throw InputError(opt.in, 1, 1,
+                         "every one of the " + std::to_string(sum.malformed) +
+                             " data rows is malformed (--skip-bad dropped them all): nothing written");
+    }
+    out.commit();
+    return sum;
+}
+
+}  // namespace
+
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
+    switch (opt.scalar) {
+        case ScalarKind::kDouble:
+            return run<double>(opt, log);
+        case ScalarKind::kFloat:
+            return run<float>(opt, log);
+        case ScalarKind::kFixed:
+            return run<Q30>(opt, log);
+    }
+    throw std::logic_error("correct_file: unknown scalar type");
+}
+
+std::string describe(const CorrectSummary& s) {
+    std::ostringstream o;
+    o << s.rows << " rows written";
+    for (std::size_t b = 0; b < static_cast<std::size_t>(status::kStatusBitCount); ++b) {
+        if (s.status_bit[b] != 0) {
+            o << ", " << s.status_bit[b] << " " << status::kStatusBitNames[b];
+        }
+    }
+    if (s.malformed != 0) {
+        o << ", " << s.malformed << " malformed rows skipped";
+    }
+    return o.str();
+}
+
+}  // namespace ascorr::host

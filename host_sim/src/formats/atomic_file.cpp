@@ -1,0 +1,305 @@
+#include "ascorr_host/formats/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <limits.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+namespace ascorr::host {
+
+namespace {
+
+// ---- the signal-cleanup table -------------------------------------------
+// Fixed storage, no allocation: the handler reads it while the program may be
+// anywhere. A slot is claimed (kClaimed) by one thread, filled, then published
+// with its kind (release); the handler acts on published slots only.
+enum SlotState : int { kFree = 0, kClaimed, kFile, kFolder, kChild };
+struct Slot {
+    std::atomic<int> state{kFree};
+    pid_t pid = 0;
+    char path[PATH_MAX] = {};
+};
+constexpr std::size_t kSlots = 32;  // plot, the busiest command, needs 9
+std::array<Slot, kSlots> g_slots;
+constexpr std::array<int, 4> kCleanupSignals = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+
+int claim(SlotState kind, const std::string& path, pid_t pid) {
+    if (path.size() >= PATH_MAX) {
+        throw std::runtime_error(path + ": path longer than PATH_MAX");
+    }
+    for (std::size_t i = 0; i < kSlots; ++i) {
+        int expected = kFree;
+        if (g_slots[i].state.compare_exchange_strong(expected, kClaimed, std::memory_order_acq_rel)) {
+            std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
+            g_slots[i].pid = pid;
+            g_slots[i].state.store(kind, std::memory_order_release);
+            return static_cast<int>(i);
+        }
+    }
+    throw std::runtime_error("too many temporary files or child processes at once (" + std::to_string(kSlots) + ")");
+}
+
+void run_cleanup() noexcept {
+    for (Slot& s : g_slots) {  // children first: they may still be writing
+        if (s.state.load(std::memory_order_acquire) == kChild) {
+            ::kill(s.pid, SIGKILL);
+            ::waitpid(s.pid, nullptr, 0);
+        }
+    }
+    for (Slot& s : g_slots) {
+        if (s.state.load(std::memory_order_acquire) == kFile) {
+            ::unlink(s.path);
+        }
+    }
+    for (std::size_t i = kSlots; i-- > 0;) {  // folders after their files
+        if (g_slots[i].state.load(std::memory_order_acquire) == kFolder) {
+            ::rmdir(g_slots[i].path);
+        }
+    }
+}
+
+extern "C" void on_cleanup_signal(int sig) {
+    run_cleanup();
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    ::sigemptyset(&dfl.sa_mask);
+    ::sigaction(sig, &dfl, nullptr);
+    sigset_t set;
+    ::sigemptyset(&set);
+    ::sigaddset(&set, sig);
+    ::pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+    ::raise(sig);  // default action: the process ends by this signal
+}
+
+// ---- paths ---------------------------------------------------------------
+
+bool special_path(const std::string& p) {
+    return p.rfind("/dev/", 0) == 0 || p.rfind("/proc/", 0) == 0;
+}
+
+// Follows a chain of symbolic links to its end (which need not exist).
+// special: set when the chain passes through /dev/ or /proc/.
+std::string final_target(const std::string& path, bool& special) {
+    std::string p = path;
+    special = special_path(p);
+    if (special) {
+        return path;
+    }
+    for (int hop = 0; hop < 40; ++hop) {
+        struct stat ls {};
+        if (::lstat(p.c_str(), &ls) != 0 || !S_ISLNK(ls.st_mode)) {
+            return p;
+        }
+        std::array<char, PATH_MAX> buf{};
+        const ssize_t n = ::readlink(p.c_str(), buf.data(), buf.size() - 1);
+        if (n < 0) {
+            return p;
+        }
+        const std::string link(buf.data(), static_cast<std::size_t>(n));
+        if (link.empty() || link[0] == '/') {
+            p = link;
+        } else {
+            const std::size_t slash = p.rfind('/');
+            p = slash == std::string::npos ? link : p.substr(0, slash + 1) + link;
+        }
+        special = special || special_path(p);
+        if (special) {  // /proc's links name pipes and sockets as "pipe:[n]": let open() follow them
+            return path;
+        }
+    }
+    errno = ELOOP;
+    throw std::runtime_error(path + ": cannot write the output: " + std::strerror(errno));
+}
+
+}  // namespace
+
+// ---- AtomicFile ------------------------------------------------------------
+
+void AtomicFile::fail(const std::string& what) const {
+    throw std::runtime_error(target_ + ": " + what + ": " + std::strerror(errno));
+}
+
+AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
+    if (target_ == "-") {
+        f_ = stdout;
+        return;
+    }
+    bool special = false;
+    real_ = final_target(target_, special);
+    struct stat st {};
+    const bool exists = ::stat(real_.c_str(), &st) == 0;
+    if (exists && S_ISDIR(st.st_mode)) {
+        throw std::runtime_error(target_ + ": is a directory: the output must be a file");
+    }
+    if (special || (exists && !S_ISREG(st.st_mode))) {  // a stream: written in place
+        f_ = std::fopen(real_.c_str(), "wb");
+        if (f_ == nullptr) {
+            fail("cannot open the output");
+        }
+        return;
+    }
+    temp_ = real_ + ".tmp-" + std::to_string(::getpid());
+    cleanup_slot_ = cleanup_register_file(temp_);  // before it exists: no window for a signal
+    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd < 0) {
+        fail("cannot create a temporary file beside the output");
+    }
+    if (exists) {  // keep the output's permissions (and owner, when we may)
+        (void)::fchmod(fd, st.st_mode & 07777);
+        if (::geteuid() == 0) {
+            (void)::fchown(fd, st.st_uid, st.st_gid);
+        }
+    }
+    f_ = ::fdopen(fd, "wb");
+    if (f_ == nullptr) {
+        ::close(fd);
+        fail("cannot write the output");
+    }
+}
+
+AtomicFile::~AtomicFile() {
+    if (f_ != nullptr && f_ != stdout) {
+        std::fclose(f_);
+    }
+    if (!committed_ && !temp_.empty()) {
+        ::unlink(temp_.c_str());
+    }
+    if (cleanup_slot_ >= 0) {
+        cleanup_release(cleanup_slot_);
+    }
+}
+
+void AtomicFile::write(std::string_view data) {
+    if (std::fwrite(data.data(), 1, data.size(), f_) != data.size()) {
+        fail("write failed");
+    }
+}
+
+void AtomicFile::commit() {
+    if (std::fflush(f_) != 0) {
+        fail("write failed");
+    }
+    if (temp_.empty()) {  // a stream: nothing to rename
+        if (f_ != stdout) {
+            const int rc = std::fclose(f_);
+            f_ = nullptr;
+            if (rc != 0) {
+                fail("close failed");
+            }
+        }
+        committed_ = true;
+        return;
+    }
+    if (::fsync(::fileno(f_)) != 0) {
+        fail("write failed");
+    }
+    const int rc = std::fclose(f_);
+    f_ = nullptr;
+    if (rc != 0) {
+        fail("close failed");
+    }
+    if (std::rename(temp_.c_str(), real_.c_str()) != 0) {
+        fail("cannot rename the temporary file into place");
+    }
+    committed_ = true;
+}
+
+void write_file_atomically(const std::string& path, std::string_view data) {
+    AtomicFile f(path);
+    f.write(data);
+    f.commit();
+}
+
+// ---- same-file checks -----------------------------------------------------
+
+void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs,
+                              bool check_stdout) {
+    struct Id {
+        const NamedPath* named;
+        dev_t dev;
+        ino_t ino;
+    };
+    std::vector<Id> in_ids;
+    for (const NamedPath& p : inputs) {
+        struct stat st {};
+        if (!p.path.empty() && ::stat(p.path.c_str(), &st) == 0) {
+            in_ids.push_back({&p, st.st_dev, st.st_ino});
+        }
+    }
+    std::vector<Id> out_ids;
+    const NamedPath stdout_name{"standard output", "-"};
+    const auto check = [&](const NamedPath& out, const struct stat& st) {
+        for (const Id& in : in_ids) {
+            if (in.dev == st.st_dev && in.ino == st.st_ino) {
+                throw std::runtime_error(
+                    (out.path == "-" ? std::string("standard output") : out.option + " " + out.path) +
+                    " is the same file as the input " + in.named->option + " " + in.named->path +
+                    ": refusing to overwrite an input (nothing was read or written)");
+            }
+        }
+        for (const Id& o : out_ids) {
+            if (o.dev == st.st_dev && o.ino == st.st_ino) {
+                throw std::runtime_error(out.option + " " + out.path + " is the same file as the output " +
+                                         o.named->option + " " + o.named->path);
+            }
+        }
+    };
+    for (const NamedPath& p : outputs) {
+        struct stat st {};
+        const bool is_stdout = p.path == "-";
+        if (is_stdout ? ::fstat(STDOUT_FILENO, &st) != 0 : ::stat(p.path.c_str(), &st) != 0) {
+            continue;  // does not exist yet: cannot be an input
+        }
+        check(p, st);
+        if (S_ISREG(st.st_mode)) {
+            out_ids.push_back({&p, st.st_dev, st.st_ino});
+        }
+    }
+    struct stat st {};
+    if (check_stdout && ::fstat(STDOUT_FILENO, &st) == 0 && S_ISREG(st.st_mode)) {
+        check(stdout_name, st);
+    }
+}
+
+// ---- signals -----------------------------------------------------------------
+
+void install_signal_cleanup() {
+    for (const int sig : kCleanupSignals) {
+        struct sigaction old {};
+        if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) {
+            continue;  // ignored by whoever started us (nohup): keep it so
+        }
+        struct sigaction sa {};
+        sa.sa_handler = on_cleanup_signal;
+        ::sigemptyset(&sa.sa_mask);
+        for (const int other : kCleanupSignals) {  // one cleanup at a time
+            ::sigaddset(&sa.sa_mask, other);
+        }
+        ::sigaction(sig, &sa, nullptr);
+    }
+}
+
+int cleanup_register_file(const std::string& path) {
+    return claim(kFile, path, 0);
+}
+int cleanup_register_folder(const std::string& path) {
+    return claim(kFolder, path, 0);
+}
+int cleanup_register_child(pid_t pid) {
+    return claim(kChild, std::string(), pid);
+}
+void cleanup_release(int slot) noexcept {
+    if (slot >= 0 && static_cast<std::size_t>(slot) < kSlots) {
+        g_slots[static_cast<std::size_t>(slot)].state.store(kFree, std::memory_order_release);
+    }
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,182 @@
+#include "ascorr_host/formats/model_csv.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+void check_fixed_point_range(const ModelFile& m, const std::string& path) {
+    static constexpr const char* kUnits[7] = {"arcsec",        "arcsec/degC",   "arcsec/degC",  "arcsec/degC",
+                                              "arcsec/degC^2", "arcsec/degC^2", "arcsec/degC^2"};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t i = 0; i < 7; ++i) {
+                const double c = m.coefficients[h][a][i];
+                const double lim =
+                    i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
+                if (!(std::abs(c * kArcsecToRad) < lim)) {
+                    char what[200];
+                    std::snprintf(what, sizeof what,
+                                  "%c %s %s = %g %s is beyond the fixed-point coefficient range (|%s| < %g %s)",
+                                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[a], kCoefficientNames[i], c,
+                                  kUnits[i], kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
+                    if (m.line[h][a] != 0) {
+                        throw InputError(path, m.line[h][a], m.column[h][a][i], what);
+                    }
+                    throw std::runtime_error(path + ": " + what);
+                }
+            }
+        }
+    }
+}
+
+ModelFile parse_model(const std::string& file_name, std::string_view text) {
+    if (text.empty()) {
+        throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");
+    }
+    LineReader lines(text);
+    std::string_view line;
+    lines.next(line);
+    const Header header(line, file_name);
+    const int col_chu = header.index("chu");
+    const int col_axis = header.index("axis");
+    int col_c[7];
+    for (std::size_t i = 0; i < 7; ++i) {
+        col_c[i] = header.index(kCoefficientNames[i]);
+    }
+    if (col_chu < 0 || col_axis < 0 || col_c[0] < 0 || col_c[1] < 0 || col_c[2] < 0 || col_c[3] < 0) {
+        throw InputError(file_name, 1, 1, "the model header must have chu,axis,c0,c1,c2,c3");
+    }
+    // An unknown column is a misspelt coefficient (e.g. c1_2x): never dropped silently.
+    std::size_t column = 1;
+    for (const std::string& name : header.names()) {
+        bool known = name == "chu" || name == "axis";
+        for (const char* c : kCoefficientNames) {
+            known = known || name == c;
+        }
+        if (!known) {
+            throw InputError(
+                file_name, 1, column,
+                "unknown column '" + name +
+                    "' (a model has chu, axis, c0, c1, c2, c3 and, for a quadratic one, c1_2, c2_2, c3_2)");
+        }
+        column += name.size() + 1;
+    }
+
+    ModelFile m;
+    m.quadratic = col_c[4] >= 0 || col_c[5] >= 0 || col_c[6] >= 0;
+    bool seen[kMaxHeads][3] = {};
+    std::vector<std::string_view> fields;
+    std::vector<std::size_t> starts;
+    std::size_t line_of_head[kMaxHeads] = {};
+    while (lines.next(line)) {
+        if (line.empty()) {
+            continue;
+        }
+        const std::size_t n = lines.line_number();
+        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+            throw InputError(file_name, n, bad + 1, why_split_failed(line, bad));
+        }
+        if (fields.size() != header.size()) {
+            throw InputError(
+                file_name, n, starts.back() + 1,
+                "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
+        }
+        const auto chu = fields[static_cast<std::size_t>(col_chu)];
+        const std::uint8_t head = head_from_name(chu);
+        if (head == kUnknownHead) {
+            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
+                             "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
+        }
+        const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
+        int axis = -1;
+        for (int a = 0; a < 3; ++a) {
+            if (axis_name == kAxisNames[a]) {
+                axis = a;
+            }
+        }
+        if (axis < 0) {
+            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
+                             "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
+        }
+        if (seen[head][axis]) {
+            throw InputError(file_name, n, 1,
+                             std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
+        }
+        seen[head][axis] = true;
+        line_of_head[head] = n;
+        m.line[head][static_cast<std::size_t>(axis)] = n;
+        for (std::size_t i = 0; i < 7; ++i) {
+            if (col_c[i] < 0) {
+                continue;
+            }
+            const auto f = fields[static_cast<std::size_t>(col_c[i])];
+            const auto x = parse_double(f);
+            if (!x || !std::isfinite(*x)) {
+                throw InputError(
+                    file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
+                    std::string("column '") + kCoefficientNames[i] +
+                        "': " + (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
+            }
+            m.coefficients[head][static_cast<std::size_t>(axis)][i] = *x;
+            m.column[head][static_cast<std::size_t>(axis)][i] = starts[static_cast<std::size_t>(col_c[i])] + 1;
+        }
+    }
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        const int count = int(seen[h][0]) + int(seen[h][1]) + int(seen[h][2]);
+        if (count != 0 && count != 3) {
+            for (int a = 0; a < 3; ++a) {
+                if (!seen[h][a]) {
+                    throw InputError(file_name, line_of_head[h], 1,
+                                     std::string("head ") + head_name(static_cast<std::uint8_t>(h)) + " has no " +
+                                         kAxisNames[a] + " row");
+                }
+            }
+        }
+        m.present[h] = count == 3;
+    }
+    if (!(m.present[0] || m.present[1] || m.present[2] || m.present[3])) {
+        throw InputError(file_name, lines.line_number(), 1, "the model has no rows");
+    }
+    return m;
+}
+
+ModelFile read_model_file(const std::string& path) {
+    return parse_model(path, read_text_file(path));
+}
+
+std::string format_model(const ModelFile& m) {
+    std::string out = m.quadratic ? "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "chu,axis,c0,c1,c2,c3\n";
+    const std::size_t ncoef = m.quadratic ? 7 : 4;
+    char buf[64];
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        if (!m.present[h]) {
+            continue;
+        }
+        for (std::size_t a = 0; a < 3; ++a) {
+            out += head_name(static_cast<std::uint8_t>(h));
+            out += ',';
+            out += kAxisNames[a];
+            for (std::size_t i = 0; i < ncoef; ++i) {
+                // 17 significant digits: a model survives a write/read round trip exactly.
+                std::snprintf(buf, sizeof buf, ",%.16e", m.coefficients[h][a][i]);
+                out += buf;
+            }
+            out += '\n';
+        }
+    }
+    return out;
+}
+
+void write_model_file(const std::string& path, const ModelFile& model) {
+    write_file_atomically(path, format_model(model));
+}
+
+}  // namespace ascorr::host

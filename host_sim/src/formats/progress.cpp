@@ -1,0 +1,36 @@
+#include "ascorr_host/formats/progress.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <utility>
+
+namespace ascorr::host {
+
+Progress::Progress(std::string label) : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) == 1) {}
+
+Progress::~Progress() {
+    done();
+}
+
+void Progress::update(double fraction) {
+    if (!enabled_) {
+        return;
+    }
+    const int pct = fraction <= 0.0 ? 0 : fraction >= 1.0 ? 100 : static_cast<int>(fraction * 100.0);
+    if (pct != shown_) {
+        shown_ = pct;
+        std::fprintf(stderr, "\r%s: %3d%%", label_.c_str(), pct);
+        std::fflush(stderr);
+    }
+}
+
+void Progress::done() {
+    if (enabled_ && shown_ >= 0) {
+        std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
+        std::fflush(stderr);
+        shown_ = -1;
+    }
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,165 @@
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "ascorr_host/formats/input_error.hpp"
+
+namespace ascorr::host {
+
+namespace {
+std::string_view header_line_of(std::string_view text, const std::string& file) {
+    if (text.empty()) {
+        throw InputError(file, 1, 1, "empty file: expected a header line");
+    }
+    const std::size_t end = text.find('\n');
+    std::string_view line = text.substr(0, end);
+    if (!line.empty() && line.back() == '\r') {
+        line.remove_suffix(1);
+    }
+    return line;
+}
+}  // namespace
+
+std::uint8_t head_from_name(std::string_view chu) noexcept {
+    return chu.size() == 1 ? head_index(chu[0]) : kUnknownHead;
+}
+
+char head_name(std::uint8_t head) noexcept {
+    return head_letter(head);
+}
+
+SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
+    : file_(std::move(file_name)), lines_(text), header_(header_line_of(text, file_), file_) {
+    std::string_view header_line;
+    lines_.next(header_line);
+    const auto need = [&](const char* name) {
+        const int i = header_.index(name);
+        if (i < 0) {
+            throw InputError(file_, 1, 1, std::string("required column '") + name + "' is missing from the header");
+        }
+        return i;
+    };
+    col_.t = need("t");
+    col_.chu = need("chu");
+    col_.qw = need("qw");
+    col_.qx = need("qx");
+    col_.qy = need("qy");
+    col_.qz = need("qz");
+    col_.t_chu = header_.index("t_chu");
+    col_.t_029 = header_.index("t_029");
+    col_.t_032 = header_.index("t_032");
+    col_.vx = header_.index("vx");
+    col_.vy = header_.index("vy");
+    col_.vz = header_.index("vz");
+    col_.flags = header_.index("flags");
+    col_.confidence = header_.index("confidence");
+}
+
+SolutionsReader::SolutionsReader(const SolutionsReader& header_from, std::string_view body, std::size_t lines_before)
+    : file_(header_from.file_), lines_(body, lines_before), header_(header_from.header_), col_(header_from.col_) {}
+
+void SolutionsReader::fail(std::size_t field, const std::string& what) const {
+    const std::size_t column =
+        field < fields_.size() ? static_cast<std::size_t>(fields_[field].data() - line_.data()) + 1 : 1;
+    throw InputError(file_, lines_.line_number(), column, what);
+}
+
+double SolutionsReader::number(int col, const char* name) const {
+    const auto f = fields_[static_cast<std::size_t>(col)];
+    const auto x = parse_double(f);
+    if (!x) {
+        fail(static_cast<std::size_t>(col), std::string("column '") + name + "': " + why_not_a_number(f));
+    }
+    return *x;
+}
+
+bool SolutionsReader::optional_number(int col, const char* name, double& out) const {
+    if (col < 0) {
+        return false;
+    }
+    const auto f = fields_[static_cast<std::size_t>(col)];
+    if (f.empty()) {
+        return false;
+    }
+    out = number(col, name);
+    return !std::isnan(out);
+}
+
+bool SolutionsReader::next(SolutionRecord& rec) {
+    std::string_view line;
+    for (;;) {
+        if (!lines_.next(line)) {
+            return false;
+        }
+        if (!line.empty()) {
+            break;
+        }
+        ++empty_lines_;
+    }
+    line_ = line;
+    if (const std::size_t bad = split_fields(line, fields_); bad != kSplitOk) {
+        throw InputError(file_, lines_.line_number(), bad + 1, why_split_failed(line, bad));
+    }
+    if (fields_.size() != header_.size()) {
+        fail(fields_.size() - 1, "expected " + std::to_string(header_.size()) + " fields as in the header, found " +
+                                     std::to_string(fields_.size()) +
+                                     (fields_.size() < header_.size() ? " (truncated row?)" : ""));
+    }
+    rec.line = lines_.line_number();
+    rec.t = number(col_.t, "t");
+    if (!std::isfinite(rec.t)) {
+        fail(static_cast<std::size_t>(col_.t), "column 't': time must be finite");
+    }
+    rec.chu = fields_[static_cast<std::size_t>(col_.chu)];
+    if (!rec.chu.empty() && rec.chu[0] == '"') {
+        fail(static_cast<std::size_t>(col_.chu),
+             "column 'chu': " + std::string(rec.chu) + " is a quoted field in a column ascorr reads: write " +
+                 kHeadChoices.text + " without quotes (docs/contract.md, section 3)");
+    }
+    rec.head = head_from_name(rec.chu);
+    rec.q_chu_icrf = {number(col_.qw, "qw"), number(col_.qx, "qx"), number(col_.qy, "qy"), number(col_.qz, "qz")};
+    rec.temperature_present[0] = optional_number(col_.t_chu, "t_chu", rec.temperature[0]);
+    rec.temperature_present[1] = optional_number(col_.t_029, "t_029", rec.temperature[1]);
+    rec.temperature_present[2] = optional_number(col_.t_032, "t_032", rec.temperature[2]);
+    rec.velocity_components = static_cast<int>(optional_number(col_.vx, "vx", rec.v_sc_kms.x)) +
+                              static_cast<int>(optional_number(col_.vy, "vy", rec.v_sc_kms.y)) +
+                              static_cast<int>(optional_number(col_.vz, "vz", rec.v_sc_kms.z));
+    rec.flags = 0;
+    if (col_.flags >= 0 && !fields_[static_cast<std::size_t>(col_.flags)].empty()) {
+        const auto f = fields_[static_cast<std::size_t>(col_.flags)];
+        const auto v = parse_integer(f);
+        if (!v || *v < 0) {
+            fail(static_cast<std::size_t>(col_.flags),
+                 "column 'flags': " + why_not_an_integer(f, 0, std::numeric_limits<long long>::max()));
+        }
+        rec.flags = *v;
+    }
+    rec.confidence = 0.0;
+    rec.confidence_present = optional_number(col_.confidence, "confidence", rec.confidence);
+    return true;
+}
+
+void refuse_corrected_input(const SolutionsReader& header) {
+    const int col = header.header().index("status");
+    if (col >= 0) {
+        std::size_t column = 1;  // character column of the name in the header line
+        for (int i = 0; i < col; ++i) {
+            column += header.header().names()[static_cast<std::size_t>(i)].size() + 1;
+        }
+        throw InputError(header.file_name(), 1, column,
+                         "column 'status': this file is already corrected (it has the status column of a corrected "
+                         "file); give the raw solutions file, so that no correction is applied twice");
+    }
+}
+
+void refuse_corrected_file(const std::string& path) {
+    BlockReader blocks(path, 4096);
+    std::string_view block;
+    if (blocks.next(block)) {
+        refuse_corrected_input(SolutionsReader(path, block.substr(0, block.find('\n'))));
+    }
+}
+
+}  // namespace ascorr::host
