@@ -637,6 +637,29 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     return out;
 }
 
+// The value after "--terms " or "--holdout " at text[i], as a keyword's:
+// "='linear'", "=0"; empty (and i unchanged) when none follows.
+std::string keyword_value(const std::string& name, const std::string& text, std::size_t& i) {
+    if ((name != "terms" && name != "holdout") || i >= text.size() || text[i] != ' ') {
+        return {};
+    }
+    std::size_t v = i + 1;
+    while (v < text.size() &&
+           ((text[v] >= 'a' && text[v] <= 'z') || (text[v] >= '0' && text[v] <= '9') || text[v] == '.')) {
+        ++v;
+    }
+    const std::string value = text.substr(i + 1, v - i - 1);
+    if (name == "terms" && (value == "linear" || value == "quadratic")) {
+        i = v;
+        return "='" + value + "'";
+    }
+    if (name == "holdout" && !value.empty() && value[0] >= '0' && value[0] <= '9') {
+        i = v;
+        return "=" + value;
+    }
+    return {};
+}
+
 // The host's fit names its settings as the command line's options; from
 // Python they are fit()'s keywords: "--min-temperature-range" is
 // "min_temperature_range", "--from" "t_from", "--terms linear" "terms='linear'".
@@ -657,22 +680,7 @@ std::string as_keywords(const std::string& text) {
             name = "t_" + name;
         }
         std::replace(name.begin(), name.end(), '-', '_');
-        out += name;
-        if ((name == "terms" || name == "holdout") && i < text.size() && text[i] == ' ') {
-            std::size_t v = i + 1;  // "--terms linear" -> "terms='linear'", "--holdout 0" -> "holdout=0"
-            while (v < text.size() &&
-                   ((text[v] >= 'a' && text[v] <= 'z') || (text[v] >= '0' && text[v] <= '9') || text[v] == '.')) {
-                ++v;
-            }
-            const std::string value = text.substr(i + 1, v - i - 1);
-            if (name == "terms" && (value == "linear" || value == "quadratic")) {
-                out += "='" + value + "'";
-                i = v;
-            } else if (name == "holdout" && !value.empty() && value[0] >= '0' && value[0] <= '9') {
-                out += "=" + value;
-                i = v;
-            }
-        }
+        out += name + keyword_value(name, text, i);
     }
     return out;
 }
@@ -920,50 +928,73 @@ void check_reads_back(const std::string& text) {
     }
 }
 
+// write_solutions()'s status: integers in [0, 65535] that follow the rules of
+// docs/contract.md, section 4, and 16 for a row whose chu is no camera head
+// (what correct() gives it).
+using Statuses = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>;
+Statuses status_arg(const py::object& status, const Rows& r) {
+    const py::array a = as_numpy(status);
+    const char kind = a.dtype().kind();
+    if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
+        bad_argument("status", "expected " + std::to_string(r.n) + " integers, shape (n,), got dtype " +
+                                   std::string(py::str(a.dtype())) + " shape " + shape_text(a));
+    }
+    // uint64 beyond int64 would wrap in the conversion: refused as out of range first.
+    if (kind == 'u' && a.size() > 0 && py::int_(a.attr("max")()) > py::int_(0xFFFF)) {
+        const auto i =
+            py::module_::import("numpy").attr("flatnonzero")(a.attr("__gt__")(0xFFFF))[py::int_(0)].cast<py::ssize_t>();
+        bad_argument("status", "row " + std::to_string(i) + ": " + std::string(py::str(a[py::int_(i)])) +
+                                   " is out of range: a status is an integer in [0, 65535] (docs/contract.md, "
+                                   "section 4)");
+    }
+    Statuses st = Statuses::ensure(a);
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        const std::int64_t x = st.data()[i];
+        if (x < 0 || x > 0xFFFF) {
+            bad_argument("status", "row " + std::to_string(i) + ": " + std::to_string(x) +
+                                       " is out of range: a status is an integer in [0, 65535] (docs/contract.md, "
+                                       "section 4)");
+        }
+        if (!status::status_consistent(static_cast<StatusBits>(x))) {
+            bad_argument("status", "row " + std::to_string(i) + ": " + std::to_string(x) +
+                                       " is not a status correct() gives: bits that never come together "
+                                       "(docs/contract.md, section 4)");
+        }
+        if (r.head[static_cast<std::size_t>(i)] >= kMaxHeads && x != status::kRejected) {
+            bad_argument("chu", "row " + std::to_string(i) + ": not a camera head (" + std::string(kHeadChoices.text) +
+                                    ") with status " + std::to_string(x) +
+                                    ": correct() gives such a row status 16 (rejected)");
+        }
+    }
+    return st;
+}
+
+// Row i's chu as written: the head letter, or the text given for an unknown
+// head (bytes as Latin-1), which must be one unquoted CSV field.
+std::string chu_field(const Rows& r, const py::array& chu, py::ssize_t i) {
+    const std::uint8_t head = r.head[static_cast<std::size_t>(i)];
+    if (head < kMaxHeads) {
+        return std::string(1, host::head_name(head));
+    }
+    const py::object x = chu[py::int_(i)];
+    std::string name = chu.dtype().kind() == 'S' ? py::str(x.attr("decode")("latin-1")) : py::str(x);
+    if (name.find_first_of(std::string(",\n\r\"\0", 5)) != std::string::npos) {
+        bad_argument("chu", "row " + std::to_string(i) + ": '" + name + "' cannot be written to a CSV field");
+    }
+    return name;
+}
+
 void write_solutions(const py::object& path_obj, const py::object& t, const py::object& chu, const py::object& q,
                      const py::object& temps, const py::object& v, const py::object& flags,
                      const py::object& confidence, const py::object& status, const py::object& extra) {
     const std::string path = path_arg(path_obj, "path");
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
-    std::optional<py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>> st;
+    std::optional<Statuses> st;
     if (!status.is_none()) {
-        const py::array a = as_numpy(status);
-        const char kind = a.dtype().kind();
-        if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
-            bad_argument("status", "expected " + std::to_string(r.n) + " integers, shape (n,), got dtype " +
-                                       std::string(py::str(a.dtype())) + " shape " + shape_text(a));
-        }
-        // uint64 beyond int64 would wrap in the conversion: refused as out of range first.
-        if (kind == 'u' && a.size() > 0 && py::int_(a.attr("max")()) > py::int_(0xFFFF)) {
-            const py::ssize_t i = a.attr("argmax")().cast<py::ssize_t>();
-            bad_argument("status", "row " + std::to_string(i) + ": " + std::string(py::str(a[py::int_(i)])) +
-                                       " is out of range: a status is an integer in [0, 65535] (docs/contract.md, "
-                                       "section 4)");
-        }
-        st = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
-        for (py::ssize_t i = 0; i < r.n; ++i) {
-            const std::int64_t x = st->data()[i];
-            if (x < 0 || x > 0xFFFF) {
-                bad_argument("status", "row " + std::to_string(i) + ": " + std::to_string(x) +
-                                           " is out of range: a status is an integer in [0, 65535] (docs/contract.md, "
-                                           "section 4)");
-            }
-            if (!status::status_consistent(static_cast<StatusBits>(x))) {
-                bad_argument("status", "row " + std::to_string(i) + ": " + std::to_string(x) +
-                                           " is not a status correct() gives: bits that never come together "
-                                           "(docs/contract.md, section 4)");
-            }
-            if (r.head[static_cast<std::size_t>(i)] >= kMaxHeads && x != status::kRejected) {
-                bad_argument("chu", "row " + std::to_string(i) + ": not a camera head (" +
-                                        std::string(kHeadChoices.text) + ") with status " + std::to_string(x) +
-                                        ": correct() gives such a row status 16 (rejected)");
-            }
-        }
+        st = status_arg(status, r);
     }
     const auto extras = extra_columns(extra, r.n);
-    // chu as written: the head letter, or the text given for an unknown head.
     const py::array chu_a = as_numpy(chu);
-    const bool chu_bytes = chu_a.dtype().kind() == 'S';
     std::string out = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence";
     for (const auto& [name, values] : extras) {
         out += ',' + name;
@@ -973,16 +1004,7 @@ void write_solutions(const py::object& path_obj, const py::object& t, const py::
         const auto k = static_cast<std::size_t>(i);
         append_number(out, r.t.data()[i]);
         out += ',';
-        if (r.head[k] < kMaxHeads) {
-            out += host::head_name(r.head[k]);
-        } else {
-            const py::object x = chu_a[py::int_(i)];
-            std::string name = chu_bytes ? py::str(x.attr("decode")("latin-1")) : py::str(x);
-            if (name.find_first_of(std::string(",\n\r\"\0", 5)) != std::string::npos) {
-                bad_argument("chu", "row " + std::to_string(i) + ": '" + name + "' cannot be written to a CSV field");
-            }
-            out += name;
-        }
+        out += chu_field(r, chu_a, i);
         for (int j = 0; j < 4; ++j) {
             out += ',';
             append_number(out, r.q.data()[4 * i + j]);
