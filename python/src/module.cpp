@@ -609,6 +609,8 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     opt.in = kArrayRows;
     opt.from = time_arg(t_from, "t_from");
     opt.to = time_arg(t_to, "t_to");
+    opt.period_options = "t_from/t_to";
+    host::refuse_bad_time_range(opt.from, opt.to, "t_from", "t_to");  // as `ascorr stats`: an empty period is refused
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     std::optional<ThermalModel<double>> core_model;
     if (m != nullptr) {

@@ -294,6 +294,13 @@ def test_argument_errors_name_the_argument_and_what_it_accepts(ex, tmp_path, mon
         assert what in str(e.value) and "incompatible" not in str(e.value), str(e.value)
 
 
+def test_stats_names_its_period_by_the_keywords(ex):
+    with pytest.raises(ValueError, match=r"^the period is empty: t_from 10 is not before t_to 5$"):
+        ascorr.stats(**args(ex), t_from=10.0, t_to=5.0)  # refused, as by `ascorr stats --from 10 --to 5`
+    s = ascorr.stats(**args(ex), t_from=1.0, t_to=5.0)
+    assert "no rows in [1, 5] s (t_from/t_to)" in s["messages"] and "--" not in s["messages"]
+
+
 def test_pathlib_paths_are_accepted_wherever_a_path_is(ex, tmp_path):
     model = ascorr.read_model(MODEL)
     assert model == ascorr.read_model(str(MODEL))
