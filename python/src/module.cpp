@@ -8,10 +8,15 @@
 // bit for bit in every scalar.
 //
 // Arrays: float64 C-contiguous inputs are used in place; other real dtypes
-// (float32, integers) and non-contiguous arrays are converted once. A wrong
-// shape or dtype raises ValueError naming the argument. Per-row problems are
-// status bits (docs/contract.md) and never an exception: every row comes back. The
-// GIL is released while rows are corrected, on up to 8 threads.
+// (float32, integers) and non-contiguous arrays are converted once; times
+// must be float64 or integers. Every argument is a py::object checked here, so
+// that a wrong one raises ValueError "argument 'NAME': expected WHAT, got
+// REPR (TYPE)", never pybind11's cast error (python/ascorr/__init__.py turns a
+// missing or unknown argument into Python's own TypeError). Enumerations are
+// the command line's names in any case; paths are str or os.PathLike.
+// Per-row problems are status bits (docs/contract.md) and never an exception:
+// every row comes back. The GIL is released while rows are corrected, on up to
+// 8 threads.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
