@@ -177,6 +177,9 @@ py::array as_numpy(const py::handle& obj) {
 // C-contiguous: the same buffer when it already is, else one converted copy.
 // n < 0: any length (it is then taken from this argument).
 Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols) {
+    if (obj.is_none()) {
+        bad_argument(name, "expected an array of real numbers, got None");
+    }
     const py::array a = as_numpy(obj);
     const char kind = a.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u') {
@@ -197,6 +200,9 @@ Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n
 // refused: 24 bits of mantissa hold a time of 2020 to ~32 s, so the rows
 // would be matched and corrected at the wrong time.
 Doubles time_array(const py::handle& obj, const std::string& name) {
+    if (obj.is_none()) {
+        bad_argument(name, "expected an array of float64 (or integer) times, got None");
+    }
     const py::array a = as_numpy(obj);
     if (a.dtype().kind() == 'f' && a.itemsize() < 8) {
         bad_argument(name, "expected float64 (or integer) times, got dtype " + std::string(py::str(a.dtype())) +
@@ -231,6 +237,10 @@ std::string head_index_range() {
 // or integer head indices (below kMaxHeads; anything else: status 16), as the
 // reader maps them.
 std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
+    if (obj.is_none()) {
+        bad_argument("chu", "expected (n,) strings " + head_letter_range() + " or integers " + head_index_range() +
+                                ", got None");
+    }
     const py::array a = as_numpy(obj);
     if (a.ndim() != 1) {
         bad_argument("chu", "expected shape (n,), got " + shape_text(a));

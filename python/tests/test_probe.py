@@ -269,6 +269,9 @@ def bad_calls(ex):
         ("holdout", lambda: ascorr.fit(**a, holdout="0.25")),
         ("min_temperature_range", lambda: ascorr.fit(**a, min_temperature_range=True)),
         ("extra", lambda: ascorr.write_solutions("never.csv", **dict(ex, extra=[1, 2]))),
+        ("t", lambda: ascorr.correct(**dict(a, t=None))),
+        ("chu", lambda: ascorr.correct(**dict(a, chu=None))),
+        ("q", lambda: ascorr.iba(ex["t"], ex["chu"], None)),
     ]
 
 
