@@ -1,13 +1,13 @@
 # Type stub of the ascorr package (the compiled module ascorr._ascorr and
 # ascorr.to_frame). Docstrings: help(ascorr.correct) etc.
 from os import PathLike
-from typing import Any, Literal, Optional, TypedDict, Union
+from typing import Any, Optional, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
 
 _Real = npt.ArrayLike  # any real dtype; float64 C-contiguous is used in place
-_Path = Union[str, PathLike[str]]
+_Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pathlib.Path)
 
 HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
 
@@ -22,10 +22,14 @@ class Model:
     def heads(self) -> str: ...
     @property
     def quadratic(self) -> bool: ...
-    def write(self, path: str) -> None: ...
+    def write(self, path: _Path) -> None: ...
     def to_csv(self) -> str: ...
+    def __eq__(self, other: object) -> bool: ...  # the same model file; Model pickles
+    def __getstate__(self) -> tuple[npt.NDArray[np.float64], str, bool]: ...
+    def __setstate__(self, state: tuple[npt.NDArray[np.float64], str, bool]) -> None: ...
 
-def read_model(path: str) -> Model: ...
+# Enumerations are names in any case ("GCRS" is "gcrs"), as on the command line.
+def read_model(path: _Path) -> Model: ...
 def correct(
     t: _Real,
     chu: npt.ArrayLike,
@@ -33,10 +37,10 @@ def correct(
     temps: Optional[_Real],
     v: Optional[_Real],
     model: Optional[Model] = ...,
-    scalar: Literal["double", "float", "fixed"] = ...,
+    scalar: str = ...,  # "double", "float" or "fixed", any case
     aberration: bool = ...,
     states: Optional[_Path] = ...,
-    states_frame: Literal["itrf", "gcrs"] = ...,
+    states_frame: str = ...,  # "itrf" or "gcrs", any case
     max_propagation: float = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16]]: ...
 def earth_velocity(t: _Real, exact: bool = ...) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
@@ -86,10 +90,13 @@ def fit(
     min_orbits: int = ...,
     max_condition: float = ...,
     orbit_period: Optional[float] = ...,
+    terms: str = ...,  # "linear" or "quadratic", any case
+    holdout: float = ...,
+    min_temperature_range: float = ...,
 ) -> tuple[Model, dict[str, Any]]: ...
-def read_solutions(path: str) -> dict[str, npt.NDArray[Any]]: ...
+def read_solutions(path: _Path) -> dict[str, Any]: ...  # arrays, and "extra": dict[str, NDArray[str_]]
 def write_solutions(
-    path: str,
+    path: _Path,
     t: _Real,
     chu: npt.ArrayLike,
     q: _Real,
@@ -98,5 +105,6 @@ def write_solutions(
     flags: Optional[npt.ArrayLike] = ...,
     confidence: Optional[_Real] = ...,
     status: Optional[npt.ArrayLike] = ...,
+    extra: Optional[dict[str, npt.ArrayLike]] = ...,
 ) -> None: ...
 def to_frame(solutions: dict[str, npt.NDArray[Any]]) -> Any: ...  # pandas.DataFrame

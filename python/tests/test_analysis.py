@@ -102,6 +102,6 @@ def test_earth_velocity_against_pyerfa():
     d_ref = np.linalg.norm(pvh["p"], axis=1)
     v, dist = ascorr.earth_velocity(t, exact=True)
     assert np.max(np.abs(v - v_ref)) < 1e-9 and np.max(np.abs(dist - d_ref)) < 1e-12
-    v, dist = ascorr.earth_velocity(t)  # the 600 s grid the correction uses
+    v, dist = ascorr.earth_velocity(t)  # the series the correction uses
     assert np.max(np.abs(v - v_ref)) < 1e-7  # km/s: below 4e-8 arcsec of aberration
     assert np.max(np.abs(dist - d_ref)) < 1e-9

@@ -49,14 +49,6 @@ def test_wrong_shape_or_dtype_names_the_argument(ex, name, value):
         ascorr.correct(**args(ex, **{name: value(ex)}))
 
 
-@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf, 1e300])
-def test_time_not_finite_or_absurd_is_refused_as_by_the_command_line(ex, bad):
-    t = ex["t"].copy()
-    t[5] = bad
-    with pytest.raises(ValueError, match=r"argument 't': row 5"):
-        ascorr.correct(**args(ex, t=t))
-
-
 def test_bad_keyword_values(ex, model, tmp_path):
     with pytest.raises(ValueError, match="argument 'scalar'"):
         ascorr.correct(**args(ex), scalar="half")

@@ -206,6 +206,10 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     return r;
 }
 
+bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept {
+    return r.n[p] >= kMinEpochsForRms && (st != 2 || r.thermal);
+}
+
 std::string stats_table(const StatsResult& r) {
     std::ostringstream o;
     o << "IBA RMS about the mean, arcsec, over clean epochs (after 200 s smoothing in brackets)\n";
@@ -216,7 +220,7 @@ std::string stats_table(const StatsResult& r) {
     for (std::size_t p = 0; p < kPairs; ++p) {
         std::string cells[kStages];
         for (std::size_t s = 0; s < kStages; ++s) {
-            if (r.n[p] == 0 || (s == 2 && !r.thermal)) {
+            if (!rms_defined(r, p, s)) {
                 cells[s] = "-";
             } else {
                 char c[64];
@@ -240,11 +244,11 @@ std::string stats_json(const StatsResult& r) {
     };
     o << "{\"pairs\": {";
     for (std::size_t p = 0; p < kPairs; ++p) {
-        const bool any = r.n[p] > 0;
+        const auto cell = [&](std::size_t st) { return rms_defined(r, p, st) ? num(r.rms[p][st].rms) : "null"; };
         o << (p ? ", " : "") << '"' << kPairNames[p] << "\": {";
-        o << "\"original\": " << (any ? num(r.rms[p][0].rms) : "null");
-        o << ", \"aberration\": " << (any ? num(r.rms[p][1].rms) : "null");
-        o << ", \"thermal\": " << (any && r.thermal ? num(r.rms[p][2].rms) : "null");
+        o << "\"original\": " << cell(0);
+        o << ", \"aberration\": " << cell(1);
+        o << ", \"thermal\": " << cell(2);
         o << ", \"n\": " << r.n[p] << '}';
     }
     o << "}}\n";

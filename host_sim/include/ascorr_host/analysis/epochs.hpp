@@ -8,8 +8,10 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <optional>
 #include <string>
@@ -53,11 +55,16 @@ public:
 
     // head 0..2; other heads are not part of any pair and are left out by the caller.
     void add(double t, std::uint8_t head, std::size_t line, Payload p) {
+        if (!(std::abs(t) < kMaxEpochTimeS)) {
+            return;  // no millisecond key: in no epoch (iba.hpp)
+        }
         const std::int64_t key = epoch_key(t);
         Epoch<Payload>& e = pending_[key];
         if (e.head[head]) {
+            char when[32];
+            std::snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
             throw InputError(file_, line, 1,
-                             std::string("second solution of CHU ") + head_name(head) + " at t = " + std::to_string(t) +
+                             std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
                                  " (the first is on line " + std::to_string(e.line[head]) + ")");
         }
         if (!e.head[0] && !e.head[1] && !e.head[2]) {

@@ -27,7 +27,10 @@ inline constexpr double kSmoothingWindowS = 200.0;
 // Angle between two unit vectors in arcsec, precise for any angle.
 double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept;
 
-// Epoch key: t rounded to the millisecond, as rows are matched.
+// Epoch key: t rounded to the millisecond, as rows are matched. Only for
+// |t| < kMaxEpochTimeS (the key is a 64-bit count of milliseconds); a row
+// beyond it (1e300 s: far outside any ephemeris) belongs to no epoch.
+inline constexpr double kMaxEpochTimeS = 9.0e15;
 std::int64_t epoch_key(double t) noexcept;
 
 struct Rms {

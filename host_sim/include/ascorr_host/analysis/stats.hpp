@@ -62,6 +62,12 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
                           std::ostream& log);
 
+// Whether pair p has an RMS at stage st: two clean epochs at least (the RMS
+// of one epoch about itself is 0, not a measurement) and, for the thermal
+// stage, a model. Otherwise the table says "-", the JSON null, Python None.
+inline constexpr std::size_t kMinEpochsForRms = 2;
+bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept;
+
 std::string stats_table(const StatsResult& r);
 std::string stats_json(const StatsResult& r);
 
