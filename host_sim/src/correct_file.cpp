@@ -202,6 +202,9 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
     }
     res.empty_lines = reader.empty_lines();
+    if (states) {
+        res.summary.service_cost = states->cost();
+    }
 }
 
 // Splits a block of whole lines into n pieces of about equal size, at line ends.
@@ -297,6 +300,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             }
             sum.rows += r.summary.rows;
             sum.malformed += r.summary.malformed;
+            sum.service_cost += r.summary.service_cost;
             for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
                 sum.status_bit[b] += r.summary.status_bit[b];
             }

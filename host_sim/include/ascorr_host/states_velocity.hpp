@@ -41,6 +41,21 @@ inline VelocityServiceConfig service_config(double max_propagation_s) {
     return c;
 }
 
+// The velocity service's work for a set of rows: states pushed, RK4 steps,
+// velocity nodes built (VelocityService::steps_taken, nodes_built).
+struct ServiceCost {
+    std::uint64_t states_pushed = 0;
+    std::uint64_t rk4_steps = 0;
+    std::uint64_t nodes_built = 0;
+
+    ServiceCost& operator+=(const ServiceCost& o) noexcept {
+        states_pushed += o.states_pushed;
+        rk4_steps += o.rk4_steps;
+        nodes_built += o.nodes_built;
+        return *this;
+    }
+};
+
 template <typename T>
 class StatesVelocity {
 public:
@@ -62,6 +77,9 @@ public:
         }
         const auto idx = static_cast<std::size_t>(it - a.begin()) - 1;
         if (idx != current_) {
+            cost_.rk4_steps += svc_.steps_taken();
+            cost_.nodes_built += svc_.nodes_built();
+            ++cost_.states_pushed;
             svc_ = VelocityService<T>(cfg_);
             svc_.push_state(a[idx].t, a[idx].r_km, a[idx].v_kms, states_.frame);
             current_ = idx;
@@ -70,11 +88,17 @@ public:
         return svc_.velocity_at(t);
     }
 
+    // The work done so far: a deterministic measure of cost (row order must not change it much).
+    ServiceCost cost() const noexcept {
+        return {cost_.states_pushed, cost_.rk4_steps + svc_.steps_taken(), cost_.nodes_built + svc_.nodes_built()};
+    }
+
 private:
     const StatesFile& states_;
     VelocityServiceConfig cfg_;
     VelocityService<T> svc_;
     std::size_t current_ = static_cast<std::size_t>(-1);
+    ServiceCost cost_{};  // of the services replaced so far
 };
 
 }  // namespace ascorr::host
