@@ -193,8 +193,8 @@ TEST(StatesRowOrder, UplinkedWeekSameRowsAndWorkInEveryOrder) {
     check_orders(feed, host::ScalarKind::kFloat, "float");
     check_orders(feed, host::ScalarKind::kFixed, "fixed");
     EXPECT_EQ(c.states_pushed, 1U);
-    // The last fresh row is in node 60479 (one week / 10 s, minus one):
-    // one RK4 step per node, each node once.
+    // The last fresh row is at the horizon, in node 60480 (one week / 10 s):
+    // one RK4 step per node, each once.
     EXPECT_LE(c.rk4_steps, static_cast<std::uint64_t>(kWeekS / 10.0));
     EXPECT_LE(c.nodes_built, feed.rows.size());
 }

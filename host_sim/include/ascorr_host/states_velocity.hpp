@@ -7,10 +7,20 @@
 // service from it when it changed, and advances. A DPU fed the same states in
 // time order gives the same bits (tests/test_states_cli.cpp checks the jumps
 // against a sequential service).
+//
+// Jumping is cheap only forwards: a row earlier than the one before restarts
+// the propagation from its state (up to horizon/10 s RK4 steps), and each
+// change of state costs a frame conversion and the Earth series. So a file's
+// rows are not asked in file order: StatesVelocityTable asks the service for
+// every distinct row time once, in time order (the work of a DPU fed the rows
+// in time order, whatever their order in the file), and StatesVelocity then
+// reads the answer by binary search (tests/test_states_row_order.cpp).
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "ascorr/velocity_service.hpp"
 #include "ascorr_host/states_csv.hpp"
@@ -57,10 +67,16 @@ struct ServiceCost {
 };
 
 template <typename T>
+class StatesVelocityTable;
+
+// The velocity at a row's time: from `table` when it holds that time, else
+// by the jumps above (cheap for rows in time order).
+template <typename T>
 class StatesVelocity {
 public:
-    StatesVelocity(const StatesFile& states, const VelocityServiceConfig& cfg)
-        : states_(states), cfg_(cfg), svc_(cfg) {}
+    StatesVelocity(const StatesFile& states, const VelocityServiceConfig& cfg,
+                   const StatesVelocityTable<T>* table = nullptr)
+        : states_(states), cfg_(cfg), svc_(cfg), table_(table) {}
 
     ServiceVelocity<T> at(double t_s) {
         TtTime t{};
@@ -69,6 +85,15 @@ public:
             out.status = status::kNoVelocity | status::kVelocityInvalid;
             return out;
         }
+        if (table_ != nullptr) {
+            if (const ServiceVelocity<T>* v = table_->find(t)) {
+                return *v;
+            }
+        }
+        return at(t);
+    }
+
+    ServiceVelocity<T> at(TtTime t) {
         const auto& a = states_.accepted;
         const auto it =
             std::upper_bound(a.begin(), a.end(), t, [](const TtTime& x, const StateRecord& s) { return x < s.t; });
@@ -99,6 +124,42 @@ private:
     VelocityService<T> svc_;
     std::size_t current_ = static_cast<std::size_t>(-1);
     ServiceCost cost_{};  // of the services replaced so far
+    const StatesVelocityTable<T>* table_;
 };
+
+// The service's answers at a set of times, computed once in time order, then
+// read-only (any number of threads). Memory: 8 bytes per distinct time plus
+// sizeof(ServiceVelocity<T>) (48 bytes for double, 24 for float and Q30).
+template <typename T>
+class StatesVelocityTable {
+public:
+    // times_us: TtTime microseconds, in any order, repeats allowed. The sorted
+    // times are cut into up to `workers` runs at changes of state (no state is
+    // propagated twice), each run asked in time order by its own thread.
+    StatesVelocityTable(const StatesFile& states, const VelocityServiceConfig& cfg, std::vector<std::int64_t> times_us,
+                        std::size_t workers);
+
+    // The answer at t, or nullptr when t is not one of the table's times.
+    const ServiceVelocity<T>* find(TtTime t) const noexcept {
+        const auto it = std::lower_bound(t_us_.begin(), t_us_.end(), t.us);
+        if (it == t_us_.end() || *it != t.us) {
+            return nullptr;
+        }
+        return &v_[static_cast<std::size_t>(it - t_us_.begin())];
+    }
+
+    std::size_t size() const noexcept { return t_us_.size(); }
+    // The service's work to fill the table.
+    const ServiceCost& cost() const noexcept { return cost_; }
+
+private:
+    std::vector<std::int64_t> t_us_;  // increasing
+    std::vector<ServiceVelocity<T>> v_;
+    ServiceCost cost_{};
+};
+
+extern template class StatesVelocityTable<double>;
+extern template class StatesVelocityTable<float>;
+extern template class StatesVelocityTable<Q30>;
 
 }  // namespace ascorr::host
