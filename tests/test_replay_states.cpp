@@ -6,6 +6,7 @@
 // target) both boards, clean and with 1 % faulted frames, and a restart.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <ostream>
@@ -13,6 +14,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <vector>
 
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/velocity_service.hpp"
@@ -81,6 +83,50 @@ TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
     // Before the first state: status 4 (+ thermal); in and after the 40 s gap: applied.
     EXPECT_NE(replayed.find(",6\n"), std::string::npos);  // 4 | 2
     EXPECT_NE(replayed.find(",3\n"), std::string::npos);  // 1 | 2
+}
+
+// Rows out of time order: replay sends them to the target in time order (the
+// service is causal) and writes them in file order, so the replayed file still
+// equals `ascorr correct --states` of the same rows (before, a row earlier than
+// a state already sent got no velocity: status 4).
+TEST(ReplayStates, LoopbackReversedRowsEqualCorrectWithStates) {
+    const auto dir = scratch_dir("replay_states_reversed");
+    const StatesRecording rec = make_states_recording(dir, 600);
+    std::ifstream f(rec.solutions);
+    std::string header;
+    std::getline(f, header);
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(f, l);) {
+        lines.push_back(l);
+    }
+    const std::string reversed = (dir / "reversed.csv").string();
+    {
+        std::ofstream o(reversed);
+        o << header << '\n';
+        for (auto it = lines.rbegin(); it != lines.rend(); ++it) {
+            o << *it << '\n';
+        }
+    }
+    host::ReplayOptions o;
+    o.target = "loopback-float";
+    o.in = reversed;
+    o.states = rec.states;
+    o.model = data_path("model_table2.csv");
+    o.out = (dir / "out.csv").string();
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    EXPECT_EQ(s.returned, 600U);
+    EXPECT_EQ(s.mismatches, 0U) << log.str();
+    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + reversed + " --out " +
+                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
+                            " --states " + rec.states + " 2>/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string replayed = slurp((dir / "out.csv").string());
+    const std::string corrected = slurp((dir / "correct.csv").string());
+    const auto diff = std::mismatch(replayed.begin(), replayed.end(), corrected.begin(), corrected.end());
+    EXPECT_TRUE(replayed == corrected) << "first difference at byte " << (diff.first - replayed.begin()) << ": "
+                                       << replayed.substr(static_cast<std::size_t>(diff.first - replayed.begin()), 80);
+    EXPECT_NE(replayed.find(",3\n"), std::string::npos);  // velocities from the states applied
 }
 
 #ifdef ASCORR_REPLAY_QEMU

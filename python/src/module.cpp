@@ -416,11 +416,25 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
     }
     const CorrectionConfig<T> cfg{aberration, model ? &*model : nullptr};
     py::gil_scoped_release unlocked;
+    // The rows' velocities from the states asked in time order, as by `ascorr correct`.
+    std::optional<host::StatesVelocityTable<T>> table;
+    if (states != nullptr && aberration) {
+        std::vector<std::int64_t> times;
+        SolutionRecord rec;
+        TtTime t{};
+        for (py::ssize_t i = 0; i < r.n; ++i) {
+            record_of(r, i, rec);
+            if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
+                times.push_back(t.us);
+            }
+        }
+        table.emplace(*states, host::service_config(max_propagation_s), std::move(times), thread_count(r.n));
+    }
     parallel_rows(r.n, [&](py::ssize_t begin, py::ssize_t end) {
         host::EarthVelocity earth;
         std::optional<host::StatesVelocity<T>> service;  // per thread, as per chunk in `ascorr correct`
         if (states != nullptr) {
-            service.emplace(*states, host::service_config(max_propagation_s));
+            service.emplace(*states, host::service_config(max_propagation_s), table ? &*table : nullptr);
         }
         SolutionRecord rec;
         for (py::ssize_t i = begin; i < end; ++i) {

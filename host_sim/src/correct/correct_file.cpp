@@ -134,6 +134,7 @@ struct Job {
     const RowWriter& writer;
     const StatesFile* states;  // nullptr: no --states
     VelocityServiceConfig service;
+    const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
 };
 
 // With --states, a row without its own velocity gets the service's
@@ -163,7 +164,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
     EarthVelocity earth;
     std::optional<StatesVelocity<T>> states;
     if (job.states != nullptr) {
-        states.emplace(*job.states, job.service);
+        states.emplace(*job.states, job.service, job.table);
     }
     SolutionRecord rec;
     res.out.reserve(body.size() + body.size() / 8);
@@ -202,6 +203,9 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
     }
     res.empty_lines = reader.empty_lines();
+    if (states) {
+        res.summary.service_cost = states->cost();
+    }
 }
 
 // Splits a block of whole lines into n pieces of about equal size, at line ends.
@@ -223,6 +227,57 @@ std::vector<std::string_view> split_at_lines(std::string_view block, std::size_t
 std::size_t worker_count() {
     const unsigned hw = std::thread::hardware_concurrency();
     return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
+}
+
+// The TtTime (µs) of every row that will ask the states for its velocity (no
+// vx,vy,vz; a usable t), read ahead of the correction so that the service
+// answers in time order (StatesVelocityTable), whatever the rows' order.
+// Rows that do not parse are left to the correction, which reports them.
+std::vector<std::int64_t> service_times(const std::string& path, const SolutionsReader& header, std::size_t workers) {
+    BlockReader blocks(path);
+    std::string_view block;
+    std::vector<std::int64_t> out;
+    for (bool first = true; blocks.next(block); first = false) {
+        if (first) {  // the header line is not data
+            const std::size_t nl = block.find('\n');
+            block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+        }
+        const std::vector<std::string_view> parts = split_at_lines(block, workers);
+        std::vector<std::vector<std::int64_t>> times(parts.size());
+        const auto scan = [&](std::size_t i) {
+            SolutionsReader reader(header, parts[i], 0);
+            SolutionRecord rec;
+            for (;;) {
+                try {
+                    if (!reader.next(rec)) {
+                        break;
+                    }
+                } catch (const InputError&) {
+                    continue;
+                }
+                TtTime t{};
+                if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
+                    times[i].push_back(t.us);
+                }
+            }
+            std::sort(times[i].begin(), times[i].end());  // the heads of an epoch: one time
+            times[i].erase(std::unique(times[i].begin(), times[i].end()), times[i].end());
+        };
+        std::vector<std::thread> threads;
+        for (std::size_t i = 1; i < parts.size(); ++i) {
+            threads.emplace_back(scan, i);
+        }
+        if (!parts.empty()) {
+            scan(0);
+        }
+        for (auto& t : threads) {
+            t.join();
+        }
+        for (const auto& ts : times) {
+            out.insert(out.end(), ts.begin(), ts.end());
+        }
+    }
+    return out;
 }
 
 template <typename T>
@@ -255,13 +310,26 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         }
         states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
     }
-    const Job<T> job{opt, cfg, header, writer, states ? &*states : nullptr, service_config(opt.max_propagation_s)};
+    const std::size_t workers = worker_count();
+    std::optional<StatesVelocityTable<T>> table;
+    if (states && opt.aberration) {
+        table.emplace(*states, service_config(opt.max_propagation_s), service_times(opt.in, header, workers), workers);
+    }
+    const Job<T> job{opt,
+                     cfg,
+                     header,
+                     writer,
+                     states ? &*states : nullptr,
+                     service_config(opt.max_propagation_s),
+                     table ? &*table : nullptr};
 
     AtomicFile out(opt.out);
     out.write(writer.header_line());
     CorrectSummary sum;
+    if (table) {
+        sum.service_cost = table->cost();
+    }
     std::size_t empty_lines = 0;
-    const std::size_t workers = worker_count();
     std::future<void> writing;  // declared after `out`: destroyed (joined) before it
     bool first = true;
     do {
@@ -297,6 +365,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             }
             sum.rows += r.summary.rows;
             sum.malformed += r.summary.malformed;
+            sum.service_cost += r.summary.service_cost;
             for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
                 sum.status_bit[b] += r.summary.status_bit[b];
             }

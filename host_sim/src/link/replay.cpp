@@ -6,10 +6,13 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <numeric>
+#include <optional>
 #include <ostream>
 #include <stdexcept>
 #include <thread>
 #include <type_traits>
+#include <vector>
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
@@ -102,7 +105,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     std::string buf;
     ReplaySummary sum;
     EarthVelocity earth;
-    SolutionRecord rec;
+    SolutionRecord record;
     double instructions = 0.0;
     std::size_t costed = 0;
     const auto start = std::chrono::steady_clock::now();
@@ -110,7 +113,25 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     std::uint32_t id = 0;
     constexpr int kMaxVelocityMessages = 20;  // as the diagnostics of `ascorr correct`
     int velocity_messages = 0;
-    while (reader.next(rec)) {
+    // The rows go to the target in time order, as a DPU takes them (its
+    // velocity service is causal: a row earlier than a state it already has
+    // would get none), so that any row order gives `ascorr correct`'s answers;
+    // they are written in file order.
+    std::vector<SolutionRecord> rows;
+    while (reader.next(record)) {
+        rows.push_back(record);
+    }
+    const auto key = [&](std::size_t i) { return std::isnan(rows[i].t) ? HUGE_VAL : rows[i].t; };
+    std::vector<std::size_t> order(rows.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+    struct Written {
+        std::optional<Quaternion<double>> q;  // none: rejected, the input text unchanged
+        StatusBits status;
+    };
+    std::vector<Written> written_rows(rows.size());
+    for (const std::size_t k : order) {
+        const SolutionRecord& rec = rows[k];
         if (opt.realtime) {
             if (id == 0) {
                 t0 = rec.t;
@@ -187,12 +208,13 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
                                   : velocity_problem(rec))
                 << ": aberration skipped\n";
         }
-        if ((got.status & status::kRejected) != 0U) {
-            writer.row(reader, std::nullopt, written, buf);
-        } else {
-            writer.row(reader, widen(got.q_chu_icrf), written, buf);
-        }
+        written_rows[k] = {(got.status & status::kRejected) != 0U ? std::nullopt : std::optional(widen(got.q_chu_icrf)),
+                           written};
         ++id;
+    }
+    SolutionsReader again(opt.in, text);
+    for (std::size_t k = 0; again.next(record); ++k) {
+        writer.row(again, written_rows[k].q, written_rows[k].status, buf);
     }
     out.write(buf);
     out.commit();

@@ -13,6 +13,8 @@
 #include <iosfwd>
 #include <string>
 
+#include "ascorr_host/states_velocity.hpp"
+
 namespace ascorr::host {
 
 // Which scalar the core is instantiated with (--scalar). A kind, not the type:
@@ -39,6 +41,7 @@ struct CorrectSummary {
     std::size_t rows = 0;                      // rows written
     std::size_t malformed = 0;                 // rows dropped (skip_bad only)
     std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
+    ServiceCost service_cost;                  // the velocity service's work (--states)
 };
 
 // Throws InputError or std::runtime_error; writes nothing then.
