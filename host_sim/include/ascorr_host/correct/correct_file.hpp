@@ -13,7 +13,7 @@
 #include <iosfwd>
 #include <string>
 
-#include "ascorr_host/states_velocity.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
 
 namespace ascorr::host {
 
