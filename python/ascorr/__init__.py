@@ -65,9 +65,9 @@ def to_frame(solutions):
     return pandas.DataFrame(columns)
 
 
-# Columns of a solutions file that from_frame() may find absent, and the value
-# read_solutions() gives a file without them.
-_ABSENT = {"temps": float("nan"), "v": float("nan"), "flags": 0, "confidence": float("nan")}
+# Column groups that from_frame() may find absent: NaN, as read_solutions()
+# gives for a file without them.
+_OPTIONAL_GROUPS = ("temps", "v")
 
 
 def _column(frame, name, dtype):
@@ -97,7 +97,7 @@ def from_frame(frame):
     NaN, except in chu, flags and status, where they are refused. chu holds
     head letters (strings) or head indices (integers); "status" is kept when
     present (a corrected file). Rows are taken in the frame's order; its index
-    is not used."""
+    only names rows in messages."""
     import numpy as np
     import pandas
 
@@ -118,14 +118,13 @@ def from_frame(frame):
         present = [c in columns for c in names]
         if all(present):
             out[key] = np.column_stack([_column(frame, c, np.float64) for c in names])
-        elif not any(present) and key in _ABSENT:
-            out[key] = np.full((n, len(names)), _ABSENT[key])
+        elif not any(present) and key in _OPTIONAL_GROUPS:
+            out[key] = np.full((n, len(names)), np.nan)
         else:
-            absent = [c for c, p in zip(names, present) if not p]
-            raise ValueError(f"from_frame: no column {', '.join(map(repr, absent))} beside {[c for c in names if c in columns]}")
+            absent = ", ".join(repr(c) for c, p in zip(names, present) if not p)
+            raise ValueError(f"from_frame: no column {absent} beside {[c for c in names if c in columns]}")
     out["flags"] = _column(frame, "flags", np.int64) if "flags" in columns else np.zeros(n, np.int64)
-    out["confidence"] = (_column(frame, "confidence", np.float64) if "confidence" in columns
-                         else np.full(n, _ABSENT["confidence"]))
+    out["confidence"] = _column(frame, "confidence", np.float64) if "confidence" in columns else np.full(n, np.nan)
     if "status" in columns:
         status = _column(frame, "status", np.int64)
         bad = (status < 0) | (status > np.iinfo(np.uint16).max)

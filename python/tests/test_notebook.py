@@ -53,7 +53,8 @@ def test_notebook_prints_table_3_with_the_thermal_stage_at_the_noise_floor(execu
     (cell,) = [c for c in executed["cells"] if "table3.to_string" in "".join(c["source"])]
     lines = text_of(cell).splitlines()
     assert "whole mission" in lines[0] and "modelling period" in lines[0] and "prediction" in lines[0]
-    rows = {line.split()[0]: [float(x) for x in line.split()[1:]] for line in lines if line[:3] in ("A-B", "A-C", "B-C")}
+    rows = {line.split()[0]: [float(x) for x in line.split()[1:]]
+            for line in lines if line[:3] in ("A-B", "A-C", "B-C")}
     assert rows.keys() == {"A-B", "A-C", "B-C"}
     for pair, v in rows.items():
         assert len(v) == 10, (pair, v)  # 3 periods x 3 stages, and the floor

@@ -83,7 +83,8 @@ def main():
     shutil.rmtree(WORK / "wheels", ignore_errors=True)
     WORK.mkdir(parents=True, exist_ok=True)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-    env.update(ASCORR_BUILD_DIR=str(WORK / "build"), CMAKE_BUILD_PARALLEL_LEVEL=env.get("CMAKE_BUILD_PARALLEL_LEVEL", "2"),
+    env.update(ASCORR_BUILD_DIR=str(WORK / "build"),
+               CMAKE_BUILD_PARALLEL_LEVEL=env.get("CMAKE_BUILD_PARALLEL_LEVEL", "2"),
                PIP_DISABLE_PIP_VERSION_CHECK="1", PIP_NO_CACHE_DIR="1")
     run(sys.executable, "-m", "venv", "--system-site-packages", VENV, env=env)
     python = VENV / "bin" / "python"
