@@ -35,11 +35,13 @@ def run(*args, **kw):
 
 
 def source_listing():
-    """Every path in the source tree, except the contents of build/ (where CMake
-    presets put their build directories) and .git, whose top-level names count."""
+    """Every path in the source tree, except .git, the contents of build/ (where
+    CMake presets put their build directories), whose top-level names count,
+    and __pycache__ (the pytest suite, maybe running meanwhile, writes there)."""
     paths = set()
     for dirpath, dirnames, filenames in os.walk(SRC):
         rel = pathlib.Path(dirpath).relative_to(SRC)
+        dirnames[:] = [d for d in dirnames if d != "__pycache__"]
         if rel == pathlib.Path("."):
             dirnames[:] = [d for d in dirnames if d != ".git"]
             if "build" in dirnames:
