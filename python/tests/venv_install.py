@@ -35,9 +35,11 @@ def run(*args, **kw):
 
 
 def source_listing():
-    """Every path in the source tree, except .git, the contents of build/ (where
-    CMake presets put their build directories), whose top-level names count,
-    and __pycache__ (the pytest suite, maybe running meanwhile, writes there)."""
+    """Every path in the source tree, except .git, __pycache__ (the pytest
+    suite, maybe running meanwhile, writes there) and the contents of build/,
+    where only the names count that are not CMake build directories (the
+    presets', maybe configured meanwhile; setuptools' build/lib.*, bdist.*
+    would count)."""
     paths = set()
     for dirpath, dirnames, filenames in os.walk(SRC):
         rel = pathlib.Path(dirpath).relative_to(SRC)
@@ -46,7 +48,8 @@ def source_listing():
             dirnames[:] = [d for d in dirnames if d != ".git"]
             if "build" in dirnames:
                 dirnames.remove("build")
-                paths.update(f"build/{n}" for n in os.listdir(SRC / "build"))
+                paths.update(f"build/{n}" for n in os.listdir(SRC / "build")
+                             if not (SRC / "build" / n / "CMakeCache.txt").exists())
         paths.update(str(rel / n) for n in dirnames + filenames)
     return paths
 
