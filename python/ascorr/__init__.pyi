@@ -1,5 +1,5 @@
 # Type stub of the ascorr package (the compiled module ascorr._ascorr and
-# ascorr.to_frame). Docstrings: help(ascorr.correct) etc.
+# ascorr.to_frame, ascorr.from_frame). Docstrings: help(ascorr.correct) etc.
 from os import PathLike
 from typing import Any, Optional, TypedDict, Union
 
@@ -108,3 +108,4 @@ def write_solutions(
     extra: Optional[dict[str, npt.ArrayLike]] = ...,
 ) -> None: ...
 def to_frame(solutions: dict[str, npt.NDArray[Any]]) -> Any: ...  # pandas.DataFrame
+def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]: ...  # frame: pandas.DataFrame
