@@ -149,8 +149,9 @@ def from_frame(frame):
     flags 0, as in a file without them; missing values (NaN, None, pd.NA) are
     NaN, except in chu, flags and status, where they are refused. chu holds
     head letters (strings) or head indices (integers); "status" is kept when
-    present (a corrected file). Rows are taken in the frame's order; its index
-    only names rows in messages."""
+    present (a corrected file); every other column goes under "extra" as text,
+    as read_solutions() keeps the columns it does not know. Rows are taken in
+    the frame's order; its index only names rows in messages."""
     import numpy as np
     import pandas
 
@@ -185,4 +186,6 @@ def from_frame(frame):
             raise ValueError(f"from_frame: column 'status': row {frame.index[bad.argmax()]!r} is not a status "
                              f"(0 to 65535): {status[bad.argmax()]}")
         out["status"] = status.astype(np.uint16)
+    known = {"t", "chu", "flags", "confidence", "status", *(c for names in _COLUMNS.values() for c in names)}
+    out["extra"] = {str(c): frame[c].to_numpy(dtype=str) for c in frame.columns if c not in known}
     return out

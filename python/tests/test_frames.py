@@ -22,7 +22,10 @@ def files(exe, tmp_path_factory):
 
 def assert_same_arrays(a, b):
     assert a.keys() == b.keys()
-    for k in a:
+    assert a["extra"].keys() == b["extra"].keys()
+    for k in a["extra"]:
+        assert np.array_equal(a["extra"][k], b["extra"][k]), k
+    for k in a.keys() - {"extra"}:
         assert a[k].dtype == b[k].dtype and a[k].shape == b[k].shape, (k, a[k].dtype, b[k].dtype)
         if a[k].dtype.kind == "f":
             assert a[k].tobytes() == b[k].tobytes(), k  # bit for bit, NaN where NaN
