@@ -10,7 +10,8 @@ namespace ascorr::cli {
 void add_plot_command(CLI::App& app) {
     auto opt = std::make_shared<host::PlotOptions>();
     CLI::App* cmd = app.add_subcommand("plot", "PNG of the IBA per pair for the three stages (gnuplot)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV), raw")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused: plot applies the stages)")
+        ->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "PNG file")->required();
     CLI::Option* from =
@@ -28,7 +29,7 @@ void add_plot_command(CLI::App& app) {
     CLI::Option* wto = cmd->add_option("--window-to", opt->window_to, "draw only up to this epoch (s since J2000 TT)")
                            ->check(real_number());
     cmd->add_option("--width", opt->width, "figure width in pixels, 400..4000 (default 1400; panels 2/7 of it high)")
-        ->transform(integer_in<int>());
+        ->transform(integer_in<int>(400, 4000));
     wfrom->needs(wto);
     wto->needs(wfrom);
     cmd->callback([opt]() {

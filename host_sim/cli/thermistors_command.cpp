@@ -184,10 +184,13 @@ void add_thermistors_command(CLI::App& app) {
     auto opt = std::make_shared<ThermistorOptions>();
     CLI::App* cmd = app.add_subcommand(
         "thermistors", "acquire the thermistors (libgpiod board, replay or simulation); print values and validity");
-    cmd->add_option("--config", opt->config, "thermistor configuration file")->required();
-    cmd->add_option("--chip", opt->chip, "GPIO chip of the MCP3208 lines (overrides the configuration's)");
-    cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns");
-    cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate");
+    cmd->add_option("--config", opt->config, "thermistor configuration file")->required()->check(non_empty_path());
+    cmd->add_option("--chip", opt->chip, "GPIO chip of the MCP3208 lines (overrides the configuration's)")
+        ->check(non_empty_path());
+    cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns")
+        ->check(non_empty_path());
+    cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate")
+        ->check(non_empty_path());
     cmd->add_option("--inject", opt->inject, "simulated fault NAME:KIND:FROM:TO[:VALUE] (repeatable)");
     cmd->add_option("--frames", opt->frames, "live: frames to acquire")->transform(integer_in<unsigned>(1U, 1000000U));
     cmd->add_option("--interval", opt->interval, "live: seconds between frames")->check(real_in(0.0, 3600.0));

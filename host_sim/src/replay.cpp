@@ -213,6 +213,13 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
     refuse_output_over_input(
         {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}},
         {{"--out", opt.out}}, true);
+    if (std::llround(opt.max_propagation_s * 1e6) != default_velocity_service_config().horizon_us) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "--max-propagation %.17g: a target propagates a state for %.17g s, the "
+                      "horizon built into its firmware; replay cannot change it (correct can)",
+                      opt.max_propagation_s, static_cast<double>(default_velocity_service_config().horizon_us) * 1e-6);
+        throw std::runtime_error(buf);
+    }
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never

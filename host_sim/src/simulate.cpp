@@ -571,7 +571,8 @@ private:
 SimulateSummary simulate(const SimulateOptions& opt) {
     refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
                                                         {"--out (truth model)", opt.out + ".truth.csv"},
-                                                        {"--out (noise floor)", opt.out + ".floor.json"}});
+                                                        {"--out (noise floor)", opt.out + ".floor.json"},
+                                                        {"--out (heater events)", opt.out + ".heaters.csv"}});
     refuse_bad_options(opt);
     const ModelFile truth_file = truth_model(opt);
     Mission mission(opt, truth_file);

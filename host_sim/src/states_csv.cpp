@@ -20,12 +20,12 @@ const char* describe(StateVerdict v) noexcept {
         case StateVerdict::kTimeBackwards:
             return "time earlier than the previous accepted state's";
         case StateVerdict::kDuplicateTime:
-            return "same time as the previous accepted state (the first is kept)";
+            return "same time as the previous accepted state";
     }
     return "?";
 }
 
-StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag) {
+StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag, bool skip_bad) {
     const std::string text = read_text_file(path);
     LineReader lines(text);
     std::string_view line;
@@ -54,6 +54,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             continue;
         }
         const std::size_t n = lines.line_number();
+        try {
         if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
             throw InputError(path, n, bad + 1, why_split_failed(line, bad));
         }
@@ -86,11 +87,26 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
                                              " (kept the previous one)");
         }
+        } catch (const InputError& e) {
+            if (!skip_bad) {
+                throw;
+            }
+            diag.report("malformed states row", std::string(e.what()) + " (--skip-bad: row skipped)");
+            ++out.malformed;
+        }
     }
     out.counts = board.counts();
     const StateCounts& c = out.counts;
-    if (c.accepted + c.not_finite + c.implausible + c.time_backwards + c.duplicate_time == 0U) {
+    if (c.accepted + out.refused() + out.malformed == 0U) {
         throw InputError(path, lines.line_number() + 1, 1, "the states file has no rows");
+    }
+    if (c.accepted == 0U) {
+        throw InputError(path, 0, 0,
+                         "no state of the file is usable: " + std::to_string(out.refused()) +
+                             " refused by the velocity service" +
+                             (out.malformed != 0 ? ", " + std::to_string(out.malformed) + " malformed (--skip-bad)"
+                                                 : std::string()) +
+                             "; no row would get a velocity from it (km and km/s in increasing time?)");
     }
     return out;
 }

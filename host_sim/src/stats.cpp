@@ -101,12 +101,21 @@ std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t ro
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
     refuse_bad_time_range(opt.from, opt.to);
+    StatsOptions o = opt;
+    o.corrected_input = is_corrected_file(opt.in);
+    if (o.corrected_input) {
+        if (!opt.model.empty()) {
+            refuse_corrected_file(opt.in);  // the thermal stage would be applied a second time
+        }
+        log << opt.in << ": a corrected file (status column): shown as it is, under \"original\"; no stage is "
+                         "applied again\n";
+    }
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));
     }
     return compute_stats(
-        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
+        o, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
         model ? &*model : nullptr, log);
 }
 
@@ -115,7 +124,8 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     const CorrectionConfig<double> ab_only{true, nullptr};
     const CorrectionConfig<double> both{true, model};
     StatsResult r;
-    r.thermal = model != nullptr;
+    r.thermal = model != nullptr && !opt.corrected_input;
+    r.corrected_input = opt.corrected_input;
     EarthVelocity earth;
     Diagnostics diag(log);
 
@@ -167,8 +177,8 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         r.clean_rows += row.clean ? 1U : 0U;
         tally.clean += row.clean ? 1U : 0U;
         row.z[0] = boresight(rec.q_chu_icrf);
-        row.z[1] = boresight(c1.q_chu_icrf);
-        row.z[2] = boresight(c2.q_chu_icrf);
+        row.z[1] = opt.corrected_input ? row.z[0] : boresight(c1.q_chu_icrf);
+        row.z[2] = opt.corrected_input ? row.z[0] : boresight(c2.q_chu_icrf);
         epochs.add(rec.t, rec.head, rec.line, row);
     });
     epochs.finish();
@@ -216,7 +226,7 @@ std::string stats_table(const StatsResult& r) {
     for (std::size_t p = 0; p < kPairs; ++p) {
         std::string cells[kStages];
         for (std::size_t s = 0; s < kStages; ++s) {
-            if (r.n[p] == 0 || (s == 2 && !r.thermal)) {
+            if (r.n[p] == 0 || (s == 2 && !r.thermal) || (s != 0 && r.corrected_input)) {
                 cells[s] = "-";
             } else {
                 char c[64];
@@ -243,7 +253,7 @@ std::string stats_json(const StatsResult& r) {
         const bool any = r.n[p] > 0;
         o << (p ? ", " : "") << '"' << kPairNames[p] << "\": {";
         o << "\"original\": " << (any ? num(r.rms[p][0].rms) : "null");
-        o << ", \"aberration\": " << (any ? num(r.rms[p][1].rms) : "null");
+        o << ", \"aberration\": " << (any && !r.corrected_input ? num(r.rms[p][1].rms) : "null");
         o << ", \"thermal\": " << (any && r.thermal ? num(r.rms[p][2].rms) : "null");
         o << ", \"n\": " << r.n[p] << '}';
     }

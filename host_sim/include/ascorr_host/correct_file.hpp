@@ -39,6 +39,10 @@ struct CorrectSummary {
     std::size_t rows = 0;                      // rows written
     std::size_t malformed = 0;                 // rows dropped (skip_bad only)
     std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
+    bool states_given = false;                 // --states: the three counts below
+    std::size_t states_accepted = 0;
+    std::size_t states_refused = 0;    // by the velocity service's checks
+    std::size_t states_malformed = 0;  // skipped (skip_bad only)
 };
 
 // Throws InputError or std::runtime_error; writes nothing then.

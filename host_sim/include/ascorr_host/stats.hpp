@@ -31,6 +31,9 @@ struct StatsOptions {
     std::optional<double> to;
     bool keep_series = false;                    // keep the IBA time series (for plots)
     std::string period_options = "--from/--to";  // the options that set from and to, for messages
+    // The rows are already corrected (a corrected file): no stage is applied;
+    // the "original" stage is the rows as they are, the others are null.
+    bool corrected_input = false;
 };
 
 struct PairSeries {
@@ -40,6 +43,7 @@ struct PairSeries {
 
 struct StatsResult {
     bool thermal = false;
+    bool corrected_input = false;  // StatsOptions::corrected_input: only the "original" stage
     std::array<std::array<Rms, kStages>, kPairs> rms{};
     std::array<std::size_t, kPairs> n{};
     std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
@@ -56,6 +60,8 @@ bool is_clean(const SolutionRecord& rec) noexcept;
 
 // Throws InputError for a malformed input; log gets one line per rejected row
 // and one per pair without clean epochs ("FILE: pair A-C: no clean epochs: REASON").
+// A corrected file (a `status` column) is never corrected again: with a model it
+// is refused; without one it is shown as it is (corrected_input).
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 // The same on rows from elsewhere (opt.in names them in messages; opt.model is
 // not read: model, nullptr for no thermal stage).

@@ -1,0 +1,228 @@
+// The command line against a second hostile probe: every output checked
+// against every input, never a second correction, empty paths refused, a
+// states file with no usable row fails the run, a one-epoch plot window, bounded
+// lines in every reader, usage errors before any input is read, one spelling of
+// the enumerations, '-' on both sides, and a firmware image checked before the
+// emulator starts. Each case is a row of DEVELOPERS.md's bad-input table.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSolutions = data_path("solutions.csv");
+const std::string kModel = data_path("model_table2.csv");
+
+bool has(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+// ---- every output against every input ---------------------------------------
+
+// A model kept beside simulate's outputs under the name of one of them is an
+// input: simulate refuses before reading it, and the file stays as it was.
+TEST(CliProbe, SimulateRefusesATruthModelThatIsOneOfItsOwnOutputs) {
+    const fs::path dir = scratch_dir("probe-sim-truth");
+    for (const std::string suffix : {".heaters.csv", ".truth.csv", ".floor.json", ""}) {
+        SCOPED_TRACE(suffix);
+        const fs::path truth = dir / ("F" + suffix);
+        fs::remove(truth);
+        fs::copy_file(kModel, truth);
+        const CliRun r = run_in("simulate --days 0.05 --out F --truth F" + suffix, dir);
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_TRUE(has(r.err, "is the same file as the input --truth F" + suffix)) << r.err;
+        EXPECT_EQ(slurp(truth), slurp(kModel));
+        fs::remove(truth);
+        for (const std::string other : {".heaters.csv", ".truth.csv", ".floor.json", ""}) {
+            EXPECT_FALSE(fs::exists(dir / ("F" + other))) << other;
+        }
+    }
+}
+
+// ---- never a second correction ----------------------------------------------
+
+// stats and plot apply the stages themselves: with a model, a corrected file
+// is refused (the thermal stage would be applied twice); stats without a model
+// shows it as it is, its one stage under "original", the others null.
+TEST(CliProbe, StatsAndPlotNeverCorrectACorrectedFileAgain) {
+    const fs::path dir = scratch_dir("probe-twice");
+    ASSERT_EQ(run_in("simulate --days 0.2 --out s.csv", dir).exit_code, 0);
+    ASSERT_EQ(run_in("correct --in s.csv --model " + kModel + " --out c.csv", dir).exit_code, 0);
+    for (const std::string& c : {"stats --in c.csv --model " + kModel, "plot --in c.csv --model " + kModel + " --out p.png"}) {
+        SCOPED_TRACE(c);
+        const CliRun r = run_in(c + " > out.txt", dir);
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_TRUE(has(r.err, "c.csv:1:")) << r.err;
+        EXPECT_TRUE(has(r.err, "this file is already corrected")) << r.err;
+        EXPECT_EQ(slurp(dir / "out.txt"), "");
+        EXPECT_FALSE(fs::exists(dir / "p.png"));
+    }
+    // Without a model: the corrected file's IBA, as stats --model gives it on the raw file.
+    ASSERT_EQ(run_in("stats --json --in s.csv --model " + kModel + " > raw.json", dir).exit_code, 0);
+    const CliRun r = run_in("stats --json --in c.csv > c.json", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "c.csv: a corrected file (status column): shown as it is")) << r.err;
+    const std::string raw = slurp(dir / "raw.json");
+    const std::string cor = slurp(dir / "c.json");
+    EXPECT_TRUE(has(cor, "\"aberration\": null, \"thermal\": null")) << cor;
+    // The first pair's thermal RMS of the raw file is the corrected file's original.
+    const auto value = [](const std::string& j, const std::string& key) {
+        const std::size_t at = j.find("\"" + key + "\": ");
+        return at == std::string::npos ? std::string("absent") : j.substr(at + key.size() + 4, 8);
+    };
+    EXPECT_EQ(value(cor, "original"), value(raw, "thermal")) << raw << cor;
+    EXPECT_NE(value(raw, "original"), value(raw, "thermal"));  // the comparison can fail
+    EXPECT_NE(value(cor, "original"), "null, \"a");
+}
+
+// ---- empty paths ------------------------------------------------------------
+
+TEST(CliProbe, AnEmptyPathIsAUsageErrorNotNone) {
+    const fs::path dir = scratch_dir("probe-empty-path");
+    const std::string cmds[] = {
+        "correct --in " + kSolutions + " --out o.csv --states ''",
+        "correct --in '' --out o.csv",
+        "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --states ''",
+        "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --firmware ''",
+        "thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --simulate '' > o.csv",
+        "thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --replay '' > o.csv",
+    };
+    for (const std::string& c : cmds) {
+        SCOPED_TRACE(c);
+        fs::remove(dir / "o.csv");
+        const CliRun r = run_in(c, dir);
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_TRUE(has(r.err, "an empty path names no file")) << r.err;
+        EXPECT_TRUE(has(r.err, "Run with --help")) << r.err;
+        EXPECT_TRUE(!fs::exists(dir / "o.csv") || fs::file_size(dir / "o.csv") == 0);
+    }
+}
+
+// ---- a states file with no usable state -------------------------------------
+
+TEST(CliProbe, AStatesFileWithNoAcceptedStateFailsTheRun) {
+    const fs::path dir = scratch_dir("probe-states-none");
+    const std::string head = "t,x,y,z,vx,vy,vz\n";
+    const std::string metres = head + "447534180.184,6838000,0,0,0,300,7600\n447534190.184,6838000,0,0,0,300,7600\n";
+    const std::string backwards = head + "447534190.184,6838,0,0,0,0.3,7.6\n447534180.184,6838,0,0,0,0.3,7.6\n";
+    std::ofstream(dir / "metres.csv") << metres;
+    std::ofstream(dir / "bad.csv") << head << "447534180.184,6838,abc,0,0,0.3,7.6\n";
+    for (const std::string& c :
+         {std::string("correct --in ") + kSolutions + " --out o.csv --states metres.csv",
+          std::string("correct --in ") + kSolutions + " --out o.csv --states metres.csv --skip-bad",
+          std::string("correct --in ") + kSolutions + " --out o.csv --states bad.csv --skip-bad",
+          "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --states metres.csv"}) {
+        SCOPED_TRACE(c);
+        const CliRun r = run_in(c, dir);
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_TRUE(has(r.err, "no state of the file is usable")) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    }
+    // One good state: the run succeeds; the summary counts the refused and skipped states;
+    // the duplicate's message says once that the first state is kept.
+    std::ofstream(dir / "mixed.csv") << head << "447534180.184,6838,0,0,0,0.3,7.6\n"
+                                     << "447534180.184,6838,0,0,0,0.3,7.6\n"
+                                     << "447534181.184,6838,abc,0,0,0.3,7.6\n"
+                                     << "447534170.184,6838,0,0,0,0.3,7.6\n";
+    const CliRun ok = run_in("correct --in " + kSolutions + " --out o.csv --states mixed.csv --skip-bad", dir);
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_TRUE(has(ok.err, "states: 1 accepted, 2 refused, 1 malformed skipped")) << ok.err;
+    EXPECT_TRUE(has(ok.err, "mixed.csv:4:20: column 'y'")) << ok.err;
+    EXPECT_TRUE(has(ok.err, "same time as the previous accepted state (kept the previous one)")) << ok.err;
+    EXPECT_FALSE(has(ok.err, "(the first is kept) (kept")) << ok.err;
+    // Without --skip-bad, the malformed states row stops the run.
+    fs::remove(dir / "o.csv");
+    EXPECT_EQ(run_in("correct --in " + kSolutions + " --out o.csv --states mixed.csv", dir).exit_code, 1);
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    std::ofstream(dir / "backwards.csv") << backwards;
+    EXPECT_EQ(run_in("correct --in " + kSolutions + " --out o.csv --states backwards.csv", dir).exit_code, 0);
+}
+
+// ---- usage errors: exit 2, before any input is read, the value as given -------
+
+TEST(CliProbe, RangeErrorsAreUsageErrorsWithTheValueAsGiven) {
+    const fs::path dir = scratch_dir("probe-ranges");
+    struct Case {
+        std::string args;
+        std::string message;
+    };
+    // The inputs do not exist: a usage error must be found before any is read.
+    const std::vector<Case> cases{
+        {"fit --in none.csv --out m.csv --holdout 0.50000001", "--holdout: 0.50000001 is out of range: the range is [0, 0.5]"},
+        {"fit --in none.csv --out m.csv --holdout -0", ""},
+        {"fit --in none.csv --out m.csv --min-days 0", "--min-days: 0 is out of range"},
+        {"fit --in none.csv --out m.csv --min-days 1e-400", "--min-days: 1e-400 is out of range"},
+        {"plot --in none.csv --model none.csv --out p.png --width 399", "--width: 399 is out of range"},
+        {"simulate --out s.csv --days 36600.000001", "--days: 36600.000001 is out of range: the range is (0, 36600]"},
+        {"simulate --out s.csv --days 0", "--days: 0 is out of range"},
+        {"correct --in none.csv --out o.csv --max-propagation 604800.5", "--max-propagation: 604800.5 is out of range"},
+        {"correct --in none.csv --out o.csv --max-propagation 0", "--max-propagation: 0 is out of range"},
+        {"replay --target loopback-float --in none.csv --model none.csv --out o.csv --max-propagation -1",
+         "--max-propagation: -1 is out of range"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args, dir);
+        if (c.message.empty()) {  // accepted: the missing input is what stops it
+            EXPECT_EQ(r.exit_code, 1) << r.err;
+            EXPECT_TRUE(has(r.err, "none.csv")) << r.err;
+            continue;
+        }
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_TRUE(has(r.err, c.message)) << r.err;
+        EXPECT_TRUE(has(r.err, "Run with --help")) << r.err;
+        EXPECT_FALSE(has(r.err, "none.csv")) << r.err;
+    }
+    EXPECT_TRUE(fs::is_empty(dir / "") || !fs::exists(dir / "s.csv"));
+}
+
+// ---- one spelling of the enumerations ----------------------------------------
+
+TEST(CliProbe, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
+    const fs::path dir = scratch_dir("probe-choices");
+    std::ofstream(dir / "st.csv") << "t,x,y,z,vx,vy,vz\n447534180.184,6838,0,0,0,0.3,7.6\n";
+    for (const std::string bad : {"--states-frame 1", "--states-frame 0", "--scalar 2", "--scalar 0", "--scalar dbl"}) {
+        SCOPED_TRACE(bad);
+        const CliRun r = run_in("correct --in " + kSolutions + " --states st.csv --out o.csv " + bad, dir);
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_TRUE(has(r.err, "is not one of {")) << r.err;
+        EXPECT_TRUE(has(r.err, "numbers are not names")) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    }
+    for (const std::string bad : {"--terms 1", "--terms 0", "--terms cubic"}) {
+        SCOPED_TRACE(bad);
+        const CliRun r = run_in("fit --in " + kSolutions + " --out m.csv " + bad, dir);
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_TRUE(has(r.err, "is not one of {linear,quadratic}")) << r.err;
+    }
+    const CliRun speed = run_in("replay --target loopback-float --in " + kSolutions + " --model " + kModel +
+                                    " --out o.csv --speed 1",
+                                dir);
+    EXPECT_EQ(speed.exit_code, 2) << speed.err;
+    // Names in any case, the same result as in lower case.
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --states st.csv --out a.csv --states-frame gcrs --scalar float", dir)
+                  .exit_code,
+              0);
+    const CliRun upper =
+        run_in("correct --in " + kSolutions + " --states st.csv --out b.csv --states-frame GCRS --scalar Float", dir);
+    ASSERT_EQ(upper.exit_code, 0) << upper.err;
+    EXPECT_EQ(slurp(dir / "a.csv"), slurp(dir / "b.csv"));
+    // The help names the choices, not CLI11's mapping.
+    ASSERT_EQ(run_in("correct --help > help.txt", dir).exit_code, 0);
+    const std::string h = slurp(dir / "help.txt");
+    EXPECT_TRUE(has(h, "--states-frame NAME:{itrf,gcrs}")) << h;
+    EXPECT_TRUE(has(h, "--scalar NAME:{double,float,fixed}")) << h;
+    EXPECT_FALSE(has(h, "->")) << h;
+}
+
+}  // namespace
+}  // namespace ascorr::test
