@@ -224,5 +224,56 @@ TEST(CliProbe, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
     EXPECT_FALSE(has(h, "->")) << h;
 }
 
+// ---- bounded lines in every reader ---------------------------------------------
+
+// A line beyond 1 MiB is refused with file:line as soon as it is read, in every
+// reader; /dev/zero is refused at once (before this, --states /dev/zero read
+// until memory ran out). The line just within the limit is read as usual.
+TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
+    const fs::path dir = scratch_dir("probe-long-lines");
+    const std::size_t limit = std::size_t{1} << 20;
+    const std::string cfg = std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg";
+    const std::string header = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    std::ofstream(dir / "states.csv") << "t,x,y,z,vx,vy,vz\n" << std::string(limit + 1, ',') << "\n";
+    std::ofstream(dir / "solutions.csv") << header << std::string(3 * limit, '9') << "\n";
+    std::ofstream(dir / "model.csv") << "chu,axis,c0,c1,c2,c3\n" << std::string(limit + 1, 'x') << "\n";
+    std::ofstream(dir / "board.cfg") << slurp(cfg) << "#" << std::string(limit + 1, ' ') << "\n";
+    std::ofstream(dir / "history.csv") << "t,t_chu,t_029,t_032\n0,1,2,3\n" << std::string(limit + 1, '1') << "\n";
+    std::ofstream(dir / "replay.csv") << "t,x\n" << std::string(limit + 1, '1');  // no line end at all
+    struct Case {
+        std::string args;
+        std::string where;
+    };
+    const std::vector<Case> cases{
+        {"correct --in " + kSolutions + " --out o.csv --states states.csv", "states.csv:2: line longer than 1048576"},
+        {"correct --in " + kSolutions + " --out o.csv --states /dev/zero", "/dev/zero:1:"},
+        {"correct --in solutions.csv --out o.csv", "solutions.csv:2: line longer than 1048576"},
+        {"stats --in solutions.csv", "solutions.csv:2: line longer than 1048576"},
+        {"replay --target loopback-float --in solutions.csv --model " + kModel + " --out o.csv",
+         "solutions.csv:2: line longer than 1048576"},
+        {"correct --in " + kSolutions + " --model model.csv --out o.csv", "model.csv:2: line longer than 1048576"},
+        {"thermistors --config board.cfg --replay " + std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv",
+         "board.cfg:"},
+        {"thermistors --config /dev/zero", "/dev/zero:1: line longer than 1048576"},
+        {"thermistors --config " + cfg + " --simulate history.csv", "history.csv:3: line longer than 1048576"},
+        {"thermistors --config " + cfg + " --replay replay.csv", "replay.csv:2: line longer than 1048576"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args + " > stdout.txt", dir);
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_TRUE(has(r.err, c.where)) << r.err;
+        EXPECT_FALSE(has(r.err, "bad_alloc")) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    }
+    // Just within the limit: read as usual (an unknown column of 1 MiB - 100 bytes, copied).
+    std::ofstream(dir / "wide.csv") << "note," << header << std::string(limit - 200, 'n') << ","
+                                    << slurp(kSolutions).substr(header.size(), 200).substr(
+                                           0, slurp(kSolutions).substr(header.size()).find('\n'))
+                                    << "\n";
+    const CliRun wide = run_in("correct --in wide.csv --out o.csv", dir);
+    EXPECT_EQ(wide.exit_code, 0) << wide.err;
+}
+
 }  // namespace
 }  // namespace ascorr::test

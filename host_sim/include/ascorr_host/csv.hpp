@@ -18,15 +18,19 @@
 #include <vector>
 
 #include "ascorr_hal_linux/csv_fields.hpp"
+#include "ascorr_hal_linux/line_limit.hpp"
 
 namespace ascorr::host {
 
-// The whole content of a file. Throws InputError (line 0) if it cannot be read.
+// The whole content of a file. Throws InputError (line 0) if it cannot be read,
+// and at file:line for a line beyond hal::text::kMaxLineBytes or a NUL byte,
+// as soon as it is read.
 std::string read_text_file(const std::string& path);
 
 // Reads a file in blocks of whole lines, so that a recorded mission of any
 // size is processed in bounded memory. Each block ends at a line end (the last
-// one may lack it) and is free of NUL bytes (InputError otherwise).
+// one may lack it), is free of NUL bytes and has no line beyond
+// hal::text::kMaxLineBytes (InputError at file:line otherwise).
 class BlockReader {
 public:
     static constexpr std::size_t kDefaultBlockBytes = 32U << 20;
@@ -52,6 +56,7 @@ private:
     std::size_t lines_before_ = 0;
     std::size_t lines_in_last_ = 0;
     bool eof_ = false;
+    hal::text::LineLengthScan scan_;
 };
 
 // Number of line ends ('\n') in text; memchr-based, so it runs at memory speed.
