@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/fit_terms.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -273,6 +274,57 @@ TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
                                     << "\n";
     const CliRun wide = run_in("correct --in wide.csv --out o.csv", dir);
     EXPECT_EQ(wide.exit_code, 0) << wide.err;
+}
+
+// ---- plot: one epoch; reasons said once -------------------------------------------
+
+TEST(CliProbe, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
+    const fs::path dir = scratch_dir("probe-plot-one");
+    ASSERT_EQ(run_in("simulate --days 0.05 --out s.csv", dir).exit_code, 0);
+    // The second epoch of the file (A and B at 60 s), alone in its window: one clean A-B epoch.
+    std::ifstream f(dir / "s.csv");
+    std::string line;
+    std::getline(f, line);
+    std::getline(f, line);
+    const double t0 = std::stod(line.substr(0, line.find(',')));
+    const std::string window = " --window-from " + std::to_string(t0 + 59.0) + " --window-to " + std::to_string(t0 + 61.0);
+    const CliRun r = run_in("plot --in s.csv --model " + kModel + " --out p.png" + window, dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_FALSE(has(r.err, "gnuplot")) << r.err;
+    EXPECT_EQ(slurp(dir / "p.png").substr(1, 3), "PNG");
+    // Each pair's reason once, on standard error.
+    const std::string reason = "s.csv: pair A-C: no clean epochs:";
+    ASSERT_TRUE(has(r.err, reason)) << r.err;
+    EXPECT_EQ(r.err.find(reason), r.err.rfind(reason)) << r.err;
+    // Nothing to plot at all: each reason once, in the error.
+    const CliRun none = run_in("plot --in s.csv --model " + kModel + " --out q.png --window-from 1e9 --window-to 2e9", dir);
+    EXPECT_EQ(none.exit_code, 1);
+    const std::string b_c = "pair B-C";
+    ASSERT_TRUE(has(none.err, b_c)) << none.err;
+    EXPECT_EQ(none.err.find(b_c), none.err.rfind(b_c)) << none.err;
+    EXPECT_FALSE(fs::exists(dir / "q.png"));
+}
+
+// ---- the fit report: no number where there is none --------------------------------
+
+TEST(CliProbe, TheFitReportSaysNaForAPairWithoutEpochsAndNeverLowerByANegativePercentage) {
+    host::Selection s;
+    s.holdout = 0.25;
+    host::ModelScore m;
+    m.in[0] = {1.5, 1.0, 100};
+    m.in[1] = {1.25, 1.0, 80};
+    m.out[0] = {1.75, 1.0, 30};  // pairs 1 and 2 held out, and pair 2 in the period: no epoch
+    s.models.push_back(m);
+    s.verdict = "no selection: a pair has no held-out epoch";
+    const std::string report = host::describe_selection(s);
+    EXPECT_TRUE(has(report, "IBA RMS in the period A-B 1.500 A-C 1.250 B-C n/a; held out A-B 1.750 A-C n/a B-C n/a"))
+        << report;
+    // A quadratic model worse than the linear one raises the RMS; it does not lower it by -176.91 %.
+    const std::string worse = host::selection_verdict(1.0, 2.7691);
+    EXPECT_EQ(worse, "linear: the quadratic terms raise the held-out IBA RMS (mean over the pairs) by 176.91 %: they "
+                     "fit noise");
+    EXPECT_TRUE(has(host::selection_verdict(1.0, 0.999), "lower the held-out IBA RMS (mean over the pairs) by 0.10 %"));
+    EXPECT_TRUE(has(host::selection_verdict(1.0, 0.5), "quadratic: its held-out IBA RMS (mean over the pairs) is 50.00 %"));
 }
 
 }  // namespace

@@ -188,6 +188,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     so.in = opt.in;
     so.model = opt.model;
     so.keep_series = true;
+    so.log_empty_pairs = false;  // said once, below
     if (!(opt.width >= 400 && opt.width <= 4000)) {
         throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
     }
@@ -209,6 +210,11 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     }
     if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
         throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+    }
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        if (st.n[p] == 0) {
+            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+        }
     }
 
     TempDir dir;
@@ -237,6 +243,14 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         if (!f) {
             throw std::runtime_error("cannot write plot data in " + dir.path().string());
         }
+    }
+
+    // A single epoch (or several at one time) is drawn as a point on a time
+    // axis one smoothing window wide: gnuplot cannot scale an empty x range.
+    const bool one_time = !(t_hi > t_lo);
+    if (one_time) {
+        t_lo -= kSmoothingWindowS / 2.0;
+        t_hi += kSmoothingWindowS / 2.0;
     }
 
     const std::filesystem::path temps = dir.file("temperatures.dat");
@@ -295,7 +309,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                     std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
                 g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
-                  << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
+                  << "' using 1:" << k + 2 << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
+                  << " lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
             }
             g << '\n';
         }

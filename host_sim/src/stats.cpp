@@ -204,7 +204,9 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         r.n[p] = s.t.size();
         if (r.n[p] == 0) {
             r.no_epochs_reason[p] = why_no_epochs(p, opt, rows_seen, r.rows, heads, both_present[p]);
-            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+            if (opt.log_empty_pairs) {
+                log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+            }
         }
         for (std::size_t st = 0; st < kStages; ++st) {
             r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);

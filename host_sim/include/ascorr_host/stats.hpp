@@ -34,6 +34,8 @@ struct StatsOptions {
     // The rows are already corrected (a corrected file): no stage is applied;
     // the "original" stage is the rows as they are, the others are null.
     bool corrected_input = false;
+    // Log a line per pair without clean epochs (plot says it once, itself).
+    bool log_empty_pairs = true;
 };
 
 struct PairSeries {
