@@ -6,6 +6,7 @@
 // emulator starts. Each case is a row of DEVELOPERS.md's bad-input table.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -325,6 +326,84 @@ TEST(CliProbe, TheFitReportSaysNaForAPairWithoutEpochsAndNeverLowerByANegativePe
                      "fit noise");
     EXPECT_TRUE(has(host::selection_verdict(1.0, 0.999), "lower the held-out IBA RMS (mean over the pairs) by 0.10 %"));
     EXPECT_TRUE(has(host::selection_verdict(1.0, 0.5), "quadratic: its held-out IBA RMS (mean over the pairs) is 50.00 %"));
+}
+
+// ---- replay --firmware: the image is checked before the emulator starts -----------
+
+// The 52-byte header of a 32-bit little-endian ELF (the rest of an image does
+// not matter to the check).
+std::string elf_header(std::uint8_t elf_class, std::uint16_t type, std::uint16_t machine, std::uint32_t entry,
+                       std::uint32_t flags) {
+    std::string h(52, '\0');
+    h[0] = '\x7f';
+    h[1] = 'E';
+    h[2] = 'L';
+    h[3] = 'F';
+    h[4] = static_cast<char>(elf_class);
+    h[5] = 1;  // little-endian
+    h[6] = 1;
+    const auto put = [&](std::size_t at, std::uint32_t v, int bytes) {
+        for (int i = 0; i < bytes; ++i) {
+            h[at + static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xFFU);
+        }
+    };
+    put(16, type, 2);
+    put(18, machine, 2);
+    put(20, 1, 4);
+    put(24, entry, 4);
+    put(36, flags, 4);
+    return h;
+}
+
+TEST(CliProbe, ReplayChecksTheFirmwareImageBeforeStartingTheEmulator) {
+    const fs::path dir = scratch_dir("probe-firmware");
+    const std::uint32_t soft = 0x5000200U;
+    const std::uint32_t hard = 0x5000400U;
+    std::ofstream(dir / "text.elf") << "not an image\n";
+    std::ofstream(dir / "x86.elf", std::ios::binary) << elf_header(1, 2, 3, 0x41, 0);
+    std::ofstream(dir / "elf64.elf", std::ios::binary) << elf_header(2, 2, 40, 0x41, soft);
+    std::ofstream(dir / "object.elf", std::ios::binary) << elf_header(1, 1, 40, 0x41, soft);
+    std::ofstream(dir / "hard.elf", std::ios::binary) << elf_header(1, 2, 40, 0x41, hard);
+    std::ofstream(dir / "far.elf", std::ios::binary) << elf_header(1, 2, 40, 0x10000041U, soft);
+    struct Case {
+        std::string target;
+        std::string image;
+        std::string why;
+    };
+    const std::vector<Case> cases{
+        {"qemu-m3", "text.elf", "not an ELF file"},
+        {"qemu-m3", "x86.elf", "ELF machine 3, not ARM (40)"},
+        {"qemu-m3", "elf64.elf", "not a 32-bit little-endian ELF"},
+        {"qemu-m3", "object.elf", "ELF type 1, not an executable (2)"},
+        {"qemu-m3", "hard.elf", "a hard-float image, and the board's cpu (cortex-m3) has no FPU"},
+        {"qemu-m4f", "far.elf", "entry point 0x10000041 is outside the board's code memory [0, 0x400000)"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.image);
+        const CliRun r = run_in("replay --target " + c.target + " --firmware " + c.image + " --in " + kSolutions +
+                                    " --model " + kModel + " --out o.csv",
+                                dir);
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_TRUE(has(r.err, "--firmware " + c.image + ": not a link image for --target " + c.target)) << r.err;
+        EXPECT_TRUE(has(r.err, c.why)) << r.err;
+        EXPECT_FALSE(has(r.err, "closed the link")) << r.err;
+        EXPECT_FALSE(has(r.err, "R00=")) << r.err;  // no register dump of QEMU's
+        EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    }
+}
+
+// replay's --max-propagation: the target's horizon is its firmware's; another
+// value is refused, not silently ignored.
+TEST(CliProbe, ReplayMaxPropagationIsTheFirmwaresHorizon) {
+    const fs::path dir = scratch_dir("probe-replay-horizon");
+    const std::string run = "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv";
+    const CliRun other = run_in(run + " --max-propagation 120", dir);
+    EXPECT_EQ(other.exit_code, 1) << other.err;
+    EXPECT_TRUE(has(other.err, "--max-propagation 120: a target propagates a state for 21600 s")) << other.err;
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    const CliRun same = run_in(run + " --max-propagation 21600 > summary.json", dir);
+    EXPECT_EQ(same.exit_code, 0) << same.err;
+    EXPECT_TRUE(fs::exists(dir / "o.csv"));
 }
 
 }  // namespace
