@@ -406,5 +406,39 @@ TEST(CliProbe, ReplayMaxPropagationIsTheFirmwaresHorizon) {
     EXPECT_TRUE(fs::exists(dir / "o.csv"));
 }
 
+// ---- '-' is a stream on both sides ------------------------------------------------
+
+TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt) {
+    const fs::path dir = scratch_dir("probe-dash");
+    // simulate writes four files: '-' is refused naming why, and nothing is created.
+    const CliRun sim = run_in("simulate --days 0.01 --out -", dir);
+    EXPECT_EQ(sim.exit_code, 2) << sim.err;
+    EXPECT_TRUE(has(sim.err, "simulate writes four files")) << sim.err;
+    EXPECT_TRUE(fs::is_empty(dir) || !fs::exists(dir / "-.truth.csv"));
+    EXPECT_FALSE(fs::exists(dir / "-"));
+    EXPECT_FALSE(fs::exists(dir / "-.heaters.csv"));
+    // Standard output carries fit's report and replay's summary.
+    EXPECT_EQ(run_in("fit --in " + kSolutions + " --out -", dir).exit_code, 2);
+    EXPECT_EQ(run_in("replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out -", dir).exit_code,
+              2);
+    // --in - is standard input, in every command that reads it (stats reads the header twice).
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --model " + kModel + " --out ref.csv", dir).exit_code, 0);
+    const CliRun c = run_in("correct --in - --model " + kModel + " --out - < " + kSolutions + " > dash.csv", dir);
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    EXPECT_EQ(slurp(dir / "dash.csv"), slurp(dir / "ref.csv"));
+    ASSERT_EQ(run_in("stats --json --in " + kSolutions + " --model " + kModel + " > s1.json", dir).exit_code, 0);
+    const CliRun st =
+        run_shell("cat " + kSolutions + " | " + std::string(ASCORR_EXE) + " stats --json --in - --model " + kModel +
+                      " > " + (dir / "s2.json").string(),
+                  dir);
+    ASSERT_EQ(st.exit_code, 0) << st.err;
+    EXPECT_EQ(slurp(dir / "s2.json"), slurp(dir / "s1.json"));
+    EXPECT_FALSE(fs::exists(dir / "-"));
+    // One standard input, one input.
+    const CliRun two = run_in("correct --in - --model - --out o.csv < " + kSolutions, dir);
+    EXPECT_EQ(two.exit_code, 2) << two.err;
+    EXPECT_TRUE(has(two.err, "--model -: standard input is already --in")) << two.err;
+}
+
 }  // namespace
 }  // namespace ascorr::test

@@ -21,6 +21,14 @@ inline CLI::Validator non_empty_path() {
         [](std::string& s) { return s.empty() ? std::string("an empty path names no file") : std::string(); }, "FILE");
 }
 
+// An output that cannot be standard output ("-"), and why: the command writes
+// more than one file, or standard output carries its report.
+inline CLI::Validator not_standard_output(const std::string& why) {
+    return CLI::Validator(
+        [why](std::string& s) { return s == "-" ? "'-' (standard output) cannot be this output: " + why : std::string(); },
+        "FILE");
+}
+
 // The one spelling rule of every choice option (--scalar, --states-frame,
 // --terms, --speed): one of its names, in any case ("GCRS" is gcrs); a number is
 // not a name ("--states-frame 1" is refused, whatever the option's type). The
@@ -53,6 +61,12 @@ CLI::Validator one_of(std::vector<std::pair<std::string, T>> names) {
         },
         "{" + list + "}");
 }
+
+// "-" is a stream on both sides: as an output, standard output (atomic_file.hpp);
+// as an input, standard input, read whole into a temporary file first (inputs
+// may be read twice). Replaces the path of the one input given as "-" (option,
+// path pairs); two inputs "-" are a usage error.
+void read_dash_from_standard_input(const std::vector<std::pair<const char*, std::string*>>& inputs);
 
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);

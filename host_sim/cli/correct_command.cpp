@@ -13,10 +13,11 @@ void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
     CLI::App* cmd =
         app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused)")
+    cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused); '-': standard input")
         ->required()
         ->check(non_empty_path());
-    cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all")->required();
+    cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all; '-': standard output")
+        ->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage")
         ->check(non_empty_path());
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
@@ -40,6 +41,7 @@ void add_correct_command(CLI::App& app) {
                     "seconds a state may be propagated, (0, 604800] (default 21600); later rows get status 4+512")
         ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';
     });

@@ -12,7 +12,9 @@ void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
     CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
-    cmd->add_option("--out", opt->out, "model file to write (CSV)")->required();
+    cmd->add_option("--out", opt->out, "model file to write (CSV)")
+        ->required()
+        ->check(not_standard_output("standard output carries fit's report; give a path"));
     cmd->add_option("--from", opt->from, "start of the modelling period, s since J2000 TT")->check(real_number());
     cmd->add_option("--to", opt->to, "end of the modelling period, s since J2000 TT")->check(real_number());
     cmd->add_option("--min-days", opt->min_span_days, "shortest accepted period in days, above 0 (default 267)")
@@ -34,6 +36,7 @@ void add_fit_command(CLI::App& app) {
                     "smallest range (degC) of each regressor for quadratic terms, 0 or more (default 2)")
         ->check(real_in(0.0, HUGE_VAL, End::kClosed, End::kOpen));
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}});
         const host::FitReport r = host::fit_model(*opt);
         std::cout << host::describe(r);
         std::cerr << "ascorr fit: model written to " << opt->out << '\n';

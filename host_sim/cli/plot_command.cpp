@@ -33,6 +33,7 @@ void add_plot_command(CLI::App& app) {
     wfrom->needs(wto);
     wto->needs(wfrom);
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
         host::plot_iba(*opt, std::cerr);
         std::cerr << "ascorr plot: " << opt->out << '\n';
     });

@@ -22,7 +22,9 @@ void add_replay_command(CLI::App& app) {
         ->check(non_empty_path());
     cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
-    cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")->required();
+    cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")
+        ->required()
+        ->check(not_standard_output("standard output carries replay's summary (JSON); give a path"));
     cmd->add_option("--states", opt->states,
                     "spacecraft states (CSV t,x,y,z,vx,vy,vz), sent to the target in time order with the solutions; "
                     "the target computes the velocity of rows without vx,vy,vz; a file of which no state is accepted "
@@ -47,6 +49,10 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
     cmd->callback([opt, speed]() {
         opt->realtime = *speed == "realtime";
+        read_dash_from_standard_input({{"--in", &opt->in},
+                                       {"--model", &opt->model},
+                                       {"--states", &opt->states},
+                                       {"--firmware", &opt->firmware}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
     });

@@ -203,7 +203,11 @@ void add_thermistors_command(CLI::App& app) {
                            : s + " is out of range: a head is " + std::string(kHeadChoices.text);
             },
             kHeadChoices.text));
-    cmd->callback([opt]() { run(*opt); });
+    cmd->callback([opt]() {
+        read_dash_from_standard_input(
+            {{"--config", &opt->config}, {"--replay", &opt->replay}, {"--simulate", &opt->simulate}});
+        run(*opt);
+    });
 }
 
 }  // namespace ascorr::cli
