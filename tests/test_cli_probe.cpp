@@ -440,5 +440,31 @@ TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt
     EXPECT_TRUE(has(two.err, "--model -: standard input is already --in")) << two.err;
 }
 
+// ---- thermistors: live options, fault windows -------------------------------------
+
+TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheHistory) {
+    const fs::path dir = scratch_dir("probe-thermistors");
+    const std::string cfg = std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg";
+    std::ofstream(dir / "history.csv") << "t,t_chu,t_029,t_032\n100,3.2,-9.5,-19.8\n101,3.2,-9.5,-19.8\n";
+    for (const std::string& opt : {std::string("--frames 5"), std::string("--interval 2")}) {
+        for (const std::string& file :
+             {std::string("--simulate history.csv"), "--replay " + std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv"}) {
+            SCOPED_TRACE(opt + " " + file);
+            const CliRun r = run_in("thermistors --config " + cfg + " " + file + " " + opt + " > out.csv", dir);
+            EXPECT_EQ(r.exit_code, 2) << r.err;
+            EXPECT_TRUE(has(r.err, "excludes")) << r.err;
+        }
+    }
+    const CliRun in = run_in("thermistors --config " + cfg + " --simulate history.csv --inject THT00029:open:100:100.5 > o.csv", dir);
+    ASSERT_EQ(in.exit_code, 0) << in.err;
+    EXPECT_FALSE(has(in.err, "warning")) << in.err;
+    const CliRun out =
+        run_in("thermistors --config " + cfg + " --simulate history.csv --inject THT00029:open:5000:6000 > o.csv", dir);
+    ASSERT_EQ(out.exit_code, 0) << out.err;
+    EXPECT_TRUE(has(out.err, "warning: --inject THT00029:open:5000:6000: its window is outside the history "
+                             "history.csv [100, 101] s: it faults nothing"))
+        << out.err;
+}
+
 }  // namespace
 }  // namespace ascorr::test
