@@ -59,7 +59,8 @@ TEST(CliProbe, StatsAndPlotNeverCorrectACorrectedFileAgain) {
     const fs::path dir = scratch_dir("probe-twice");
     ASSERT_EQ(run_in("simulate --days 0.2 --out s.csv", dir).exit_code, 0);
     ASSERT_EQ(run_in("correct --in s.csv --model " + kModel + " --out c.csv", dir).exit_code, 0);
-    for (const std::string& c : {"stats --in c.csv --model " + kModel, "plot --in c.csv --model " + kModel + " --out p.png"}) {
+    for (const std::string& c :
+         {"stats --in c.csv --model " + kModel, "plot --in c.csv --model " + kModel + " --out p.png"}) {
         SCOPED_TRACE(c);
         const CliRun r = run_in(c + " > out.txt", dir);
         EXPECT_EQ(r.exit_code, 1) << r.err;
@@ -122,7 +123,8 @@ TEST(CliProbe, AStatesFileWithNoAcceptedStateFailsTheRun) {
          {std::string("correct --in ") + kSolutions + " --out o.csv --states metres.csv",
           std::string("correct --in ") + kSolutions + " --out o.csv --states metres.csv --skip-bad",
           std::string("correct --in ") + kSolutions + " --out o.csv --states bad.csv --skip-bad",
-          "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --states metres.csv"}) {
+          "replay --target loopback-float --in " + kSolutions + " --model " + kModel +
+              " --out o.csv --states metres.csv"}) {
         SCOPED_TRACE(c);
         const CliRun r = run_in(c, dir);
         EXPECT_EQ(r.exit_code, 1) << r.err;
@@ -159,7 +161,8 @@ TEST(CliProbe, RangeErrorsAreUsageErrorsWithTheValueAsGiven) {
     };
     // The inputs do not exist: a usage error must be found before any is read.
     const std::vector<Case> cases{
-        {"fit --in none.csv --out m.csv --holdout 0.50000001", "--holdout: 0.50000001 is out of range: the range is [0, 0.5]"},
+        {"fit --in none.csv --out m.csv --holdout 0.50000001",
+         "--holdout: 0.50000001 is out of range: the range is [0, 0.5]"},
         {"fit --in none.csv --out m.csv --holdout -0", ""},
         {"fit --in none.csv --out m.csv --min-days 0", "--min-days: 0 is out of range"},
         {"fit --in none.csv --out m.csv --min-days 1e-400", "--min-days: 1e-400 is out of range"},
@@ -206,14 +209,14 @@ TEST(CliProbe, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
         EXPECT_EQ(r.exit_code, 2) << r.err;
         EXPECT_TRUE(has(r.err, "is not one of {linear,quadratic}")) << r.err;
     }
-    const CliRun speed = run_in("replay --target loopback-float --in " + kSolutions + " --model " + kModel +
-                                    " --out o.csv --speed 1",
-                                dir);
+    const CliRun speed = run_in(
+        "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --speed 1", dir);
     EXPECT_EQ(speed.exit_code, 2) << speed.err;
     // Names in any case, the same result as in lower case.
-    ASSERT_EQ(run_in("correct --in " + kSolutions + " --states st.csv --out a.csv --states-frame gcrs --scalar float", dir)
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        run_in("correct --in " + kSolutions + " --states st.csv --out a.csv --states-frame gcrs --scalar float", dir)
+            .exit_code,
+        0);
     const CliRun upper =
         run_in("correct --in " + kSolutions + " --states st.csv --out b.csv --states-frame GCRS --scalar Float", dir);
     ASSERT_EQ(upper.exit_code, 0) << upper.err;
@@ -254,8 +257,7 @@ TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
         {"replay --target loopback-float --in solutions.csv --model " + kModel + " --out o.csv",
          "solutions.csv:2: line longer than 1048576"},
         {"correct --in " + kSolutions + " --model model.csv --out o.csv", "model.csv:2: line longer than 1048576"},
-        {"thermistors --config board.cfg --replay " + std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv",
-         "board.cfg:"},
+        {"thermistors --config board.cfg --replay " + std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv", "board.cfg:"},
         {"thermistors --config /dev/zero", "/dev/zero:1: line longer than 1048576"},
         {"thermistors --config " + cfg + " --simulate history.csv", "history.csv:3: line longer than 1048576"},
         {"thermistors --config " + cfg + " --replay replay.csv", "replay.csv:2: line longer than 1048576"},
@@ -269,10 +271,10 @@ TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
         EXPECT_FALSE(fs::exists(dir / "o.csv"));
     }
     // Just within the limit: read as usual (an unknown column of 1 MiB - 100 bytes, copied).
-    std::ofstream(dir / "wide.csv") << "note," << header << std::string(limit - 200, 'n') << ","
-                                    << slurp(kSolutions).substr(header.size(), 200).substr(
-                                           0, slurp(kSolutions).substr(header.size()).find('\n'))
-                                    << "\n";
+    std::ofstream(dir / "wide.csv")
+        << "note," << header << std::string(limit - 200, 'n') << ","
+        << slurp(kSolutions).substr(header.size(), 200).substr(0, slurp(kSolutions).substr(header.size()).find('\n'))
+        << "\n";
     const CliRun wide = run_in("correct --in wide.csv --out o.csv", dir);
     EXPECT_EQ(wide.exit_code, 0) << wide.err;
 }
@@ -288,7 +290,8 @@ TEST(CliProbe, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
     std::getline(f, line);
     std::getline(f, line);
     const double t0 = std::stod(line.substr(0, line.find(',')));
-    const std::string window = " --window-from " + std::to_string(t0 + 59.0) + " --window-to " + std::to_string(t0 + 61.0);
+    const std::string window =
+        " --window-from " + std::to_string(t0 + 59.0) + " --window-to " + std::to_string(t0 + 61.0);
     const CliRun r = run_in("plot --in s.csv --model " + kModel + " --out p.png" + window, dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_FALSE(has(r.err, "gnuplot")) << r.err;
@@ -298,7 +301,8 @@ TEST(CliProbe, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
     ASSERT_TRUE(has(r.err, reason)) << r.err;
     EXPECT_EQ(r.err.find(reason), r.err.rfind(reason)) << r.err;
     // Nothing to plot at all: each reason once, in the error.
-    const CliRun none = run_in("plot --in s.csv --model " + kModel + " --out q.png --window-from 1e9 --window-to 2e9", dir);
+    const CliRun none =
+        run_in("plot --in s.csv --model " + kModel + " --out q.png --window-from 1e9 --window-to 2e9", dir);
     EXPECT_EQ(none.exit_code, 1);
     const std::string b_c = "pair B-C";
     ASSERT_TRUE(has(none.err, b_c)) << none.err;
@@ -322,10 +326,12 @@ TEST(CliProbe, TheFitReportSaysNaForAPairWithoutEpochsAndNeverLowerByANegativePe
         << report;
     // A quadratic model worse than the linear one raises the RMS; it does not lower it by -176.91 %.
     const std::string worse = host::selection_verdict(1.0, 2.7691);
-    EXPECT_EQ(worse, "linear: the quadratic terms raise the held-out IBA RMS (mean over the pairs) by 176.91 %: they "
-                     "fit noise");
+    EXPECT_EQ(worse,
+              "linear: the quadratic terms raise the held-out IBA RMS (mean over the pairs) by 176.91 %: they "
+              "fit noise");
     EXPECT_TRUE(has(host::selection_verdict(1.0, 0.999), "lower the held-out IBA RMS (mean over the pairs) by 0.10 %"));
-    EXPECT_TRUE(has(host::selection_verdict(1.0, 0.5), "quadratic: its held-out IBA RMS (mean over the pairs) is 50.00 %"));
+    EXPECT_TRUE(
+        has(host::selection_verdict(1.0, 0.5), "quadratic: its held-out IBA RMS (mean over the pairs) is 50.00 %"));
 }
 
 // ---- replay --firmware: the image is checked before the emulator starts -----------
@@ -419,18 +425,18 @@ TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt
     EXPECT_FALSE(fs::exists(dir / "-.heaters.csv"));
     // Standard output carries fit's report and replay's summary.
     EXPECT_EQ(run_in("fit --in " + kSolutions + " --out -", dir).exit_code, 2);
-    EXPECT_EQ(run_in("replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out -", dir).exit_code,
-              2);
+    EXPECT_EQ(
+        run_in("replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out -", dir).exit_code,
+        2);
     // --in - is standard input, in every command that reads it (stats reads the header twice).
     ASSERT_EQ(run_in("correct --in " + kSolutions + " --model " + kModel + " --out ref.csv", dir).exit_code, 0);
     const CliRun c = run_in("correct --in - --model " + kModel + " --out - < " + kSolutions + " > dash.csv", dir);
     ASSERT_EQ(c.exit_code, 0) << c.err;
     EXPECT_EQ(slurp(dir / "dash.csv"), slurp(dir / "ref.csv"));
     ASSERT_EQ(run_in("stats --json --in " + kSolutions + " --model " + kModel + " > s1.json", dir).exit_code, 0);
-    const CliRun st =
-        run_shell("cat " + kSolutions + " | " + std::string(ASCORR_EXE) + " stats --json --in - --model " + kModel +
-                      " > " + (dir / "s2.json").string(),
-                  dir);
+    const CliRun st = run_shell("cat " + kSolutions + " | " + std::string(ASCORR_EXE) +
+                                    " stats --json --in - --model " + kModel + " > " + (dir / "s2.json").string(),
+                                dir);
     ASSERT_EQ(st.exit_code, 0) << st.err;
     EXPECT_EQ(slurp(dir / "s2.json"), slurp(dir / "s1.json"));
     EXPECT_FALSE(fs::exists(dir / "-"));
@@ -455,14 +461,16 @@ TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheH
             EXPECT_TRUE(has(r.err, "excludes")) << r.err;
         }
     }
-    const CliRun in = run_in("thermistors --config " + cfg + " --simulate history.csv --inject THT00029:open:100:100.5 > o.csv", dir);
+    const CliRun in =
+        run_in("thermistors --config " + cfg + " --simulate history.csv --inject THT00029:open:100:100.5 > o.csv", dir);
     ASSERT_EQ(in.exit_code, 0) << in.err;
     EXPECT_FALSE(has(in.err, "warning")) << in.err;
     const CliRun out =
         run_in("thermistors --config " + cfg + " --simulate history.csv --inject THT00029:open:5000:6000 > o.csv", dir);
     ASSERT_EQ(out.exit_code, 0) << out.err;
-    EXPECT_TRUE(has(out.err, "warning: --inject THT00029:open:5000:6000: its window is outside the history "
-                             "history.csv [100, 101] s: it faults nothing"))
+    EXPECT_TRUE(has(out.err,
+                    "warning: --inject THT00029:open:5000:6000: its window is outside the history "
+                    "history.csv [100, 101] s: it faults nothing"))
         << out.err;
 }
 

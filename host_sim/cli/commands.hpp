@@ -25,7 +25,9 @@ inline CLI::Validator non_empty_path() {
 // more than one file, or standard output carries its report.
 inline CLI::Validator not_standard_output(const std::string& why) {
     return CLI::Validator(
-        [why](std::string& s) { return s == "-" ? "'-' (standard output) cannot be this output: " + why : std::string(); },
+        [why](std::string& s) {
+            return s == "-" ? "'-' (standard output) cannot be this output: " + why : std::string();
+        },
         "FILE");
 }
 

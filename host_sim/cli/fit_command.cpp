@@ -1,5 +1,5 @@
-#include <iostream>
 #include <cmath>
+#include <iostream>
 #include <memory>
 
 #include "ascorr_host/fit.hpp"
@@ -23,8 +23,7 @@ void add_fit_command(CLI::App& app) {
         ->transform(integer_in<std::size_t>());
     cmd->add_option("--max-condition", opt->max_condition, "largest accepted condition number, above 0 (default 1e6)")
         ->check(real_in(0.0, HUGE_VAL, End::kOpen));
-    cmd->add_option("--orbit-period", opt->orbit_period_s,
-                    "orbit period in s, 600..86400 (default: from the velocity)")
+    cmd->add_option("--orbit-period", opt->orbit_period_s, "orbit period in s, 600..86400 (default: from the velocity)")
         ->check(real_in(600.0, 86400.0));
     cmd->add_option("--terms", opt->terms, "linear (default) or quadratic: also c1_2, c2_2, c3_2 (any case)")
         ->transform(one_of<host::Terms>({{"linear", host::Terms::kLinear}, {"quadratic", host::Terms::kQuadratic}}))

@@ -49,10 +49,8 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
     cmd->callback([opt, speed]() {
         opt->realtime = *speed == "realtime";
-        read_dash_from_standard_input({{"--in", &opt->in},
-                                       {"--model", &opt->model},
-                                       {"--states", &opt->states},
-                                       {"--firmware", &opt->firmware}});
+        read_dash_from_standard_input(
+            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
     });

@@ -213,10 +213,12 @@ void add_thermistors_command(CLI::App& app) {
     cmd->add_option("--config", opt->config, "thermistor configuration file")->required()->check(non_empty_path());
     cmd->add_option("--chip", opt->chip, "GPIO chip of the MCP3208 lines (overrides the configuration's)")
         ->check(non_empty_path());
-    CLI::Option* replay = cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns")
-        ->check(non_empty_path());
-    CLI::Option* simulate = cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate")
-        ->check(non_empty_path());
+    CLI::Option* replay =
+        cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns")
+            ->check(non_empty_path());
+    CLI::Option* simulate =
+        cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate")
+            ->check(non_empty_path());
     cmd->add_option("--inject", opt->inject, "simulated fault NAME:KIND:FROM:TO[:VALUE] (repeatable)");
     // Live options: --replay and --simulate run their whole file, so they exclude them.
     cmd->add_option("--frames", opt->frames, "live: frames to acquire (not with --replay or --simulate)")

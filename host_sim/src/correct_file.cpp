@@ -253,8 +253,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         if (!max_propagation_acceptable(opt.max_propagation_s)) {
             throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
         }
-        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag,
-                                  opt.skip_bad);
+        states =
+            read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag, opt.skip_bad);
     }
     const Job<T> job{opt, cfg, header, writer, states ? &*states : nullptr, service_config(opt.max_propagation_s)};
 

@@ -309,7 +309,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                     std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
                 g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
-                  << "' using 1:" << k + 2 << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
+                  << "' using 1:" << k + 2
+                  << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
                   << " lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
             }
             g << '\n';

@@ -237,8 +237,8 @@ void check_link_image(const std::string& path, const QemuTarget& board) {
         throw std::runtime_error(where + "not an ELF file");
     }
     if (h[4] != 1 || h[5] != 1) {
-        throw std::runtime_error(where + "not a 32-bit little-endian ELF (class " + std::to_string(h[4]) +
-                                 ", data " + std::to_string(h[5]) + ")");
+        throw std::runtime_error(where + "not a 32-bit little-endian ELF (class " + std::to_string(h[4]) + ", data " +
+                                 std::to_string(h[5]) + ")");
     }
     if (u16(18) != kElfMachineArm) {
         throw std::runtime_error(where + "ELF machine " + std::to_string(u16(18)) + ", not ARM (40)");
@@ -269,7 +269,8 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         {{"--out", opt.out}}, true);
     if (std::llround(opt.max_propagation_s * 1e6) != default_velocity_service_config().horizon_us) {
         char buf[160];
-        std::snprintf(buf, sizeof buf, "--max-propagation %.17g: a target propagates a state for %.17g s, the "
+        std::snprintf(buf, sizeof buf,
+                      "--max-propagation %.17g: a target propagates a state for %.17g s, the "
                       "horizon built into its firmware; replay cannot change it (correct can)",
                       opt.max_propagation_s, static_cast<double>(default_velocity_service_config().horizon_us) * 1e-6);
         throw std::runtime_error(buf);

@@ -55,38 +55,38 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
         }
         const std::size_t n = lines.line_number();
         try {
-        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw InputError(path, n, bad + 1, why_split_failed(line, bad));
-        }
-        if (fields.size() != header.size()) {
-            throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
-                             "expected " + std::to_string(header.size()) + " fields as in the header, found " +
-                                 std::to_string(fields.size()) +
-                                 (fields.size() < header.size() ? " (truncated row?)" : ""));
-        }
-        double x[7] = {};
-        for (std::size_t i = 0; i < kNames.size(); ++i) {
-            const auto v = parse_double(fields[col[i]]);
-            if (!v) {
-                throw InputError(path, n, starts[col[i]] + 1,
-                                 std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
+            if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+                throw InputError(path, n, bad + 1, why_split_failed(line, bad));
             }
-            x[i] = *v;
-        }
-        TtTime t{};
-        if (!tt_from_seconds(x[0], t)) {
-            throw InputError(path, n, starts[col[0]] + 1,
-                             "column 't': time must be finite and within 1e11 s of J2000, got '" +
-                                 std::string(fields[col[0]]) + "'");
-        }
-        const StateRecord rec{n, t, {x[1], x[2], x[3]}, {x[4], x[5], x[6]}};
-        const StateVerdict v = board.push_state(rec.t, rec.r_km, rec.v_kms, frame);
-        if (v == StateVerdict::kAccepted) {
-            out.accepted.push_back(rec);
-        } else {
-            diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
-                                             " (kept the previous one)");
-        }
+            if (fields.size() != header.size()) {
+                throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
+                                 "expected " + std::to_string(header.size()) + " fields as in the header, found " +
+                                     std::to_string(fields.size()) +
+                                     (fields.size() < header.size() ? " (truncated row?)" : ""));
+            }
+            double x[7] = {};
+            for (std::size_t i = 0; i < kNames.size(); ++i) {
+                const auto v = parse_double(fields[col[i]]);
+                if (!v) {
+                    throw InputError(path, n, starts[col[i]] + 1,
+                                     std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
+                }
+                x[i] = *v;
+            }
+            TtTime t{};
+            if (!tt_from_seconds(x[0], t)) {
+                throw InputError(path, n, starts[col[0]] + 1,
+                                 "column 't': time must be finite and within 1e11 s of J2000, got '" +
+                                     std::string(fields[col[0]]) + "'");
+            }
+            const StateRecord rec{n, t, {x[1], x[2], x[3]}, {x[4], x[5], x[6]}};
+            const StateVerdict v = board.push_state(rec.t, rec.r_km, rec.v_kms, frame);
+            if (v == StateVerdict::kAccepted) {
+                out.accepted.push_back(rec);
+            } else {
+                diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
+                                                 " (kept the previous one)");
+            }
         } catch (const InputError& e) {
             if (!skip_bad) {
                 throw;

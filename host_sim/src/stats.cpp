@@ -107,8 +107,9 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
         if (!opt.model.empty()) {
             refuse_corrected_file(opt.in);  // the thermal stage would be applied a second time
         }
-        log << opt.in << ": a corrected file (status column): shown as it is, under \"original\"; no stage is "
-                         "applied again\n";
+        log << opt.in
+            << ": a corrected file (status column): shown as it is, under \"original\"; no stage is "
+               "applied again\n";
     }
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {

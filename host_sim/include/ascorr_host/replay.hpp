@@ -24,8 +24,8 @@ struct ReplayOptions {
     std::string in;
     std::string model;
     std::string out;
-    std::string states;          // --states: spacecraft states sent over the link in time order; empty: none
-    bool states_gcrs = false;    // --states-frame gcrs (default itrf)
+    std::string states;        // --states: spacecraft states sent over the link in time order; empty: none
+    bool states_gcrs = false;  // --states-frame gcrs (default itrf)
     // --max-propagation: the target's horizon is its firmware's (the velocity
     // service's default); another value is refused, not silently ignored.
     double max_propagation_s = 21600.0;
