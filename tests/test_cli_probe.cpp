@@ -9,10 +9,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
 #include "ascorr_host/fit_terms.hpp"
+#include "ascorr_host/qemu_targets.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -376,14 +378,21 @@ TEST(CliProbe, ReplayChecksTheFirmwareImageBeforeStartingTheEmulator) {
         std::string image;
         std::string why;
     };
-    const std::vector<Case> cases{
-        {"qemu-m3", "text.elf", "not an ELF file"},
-        {"qemu-m3", "x86.elf", "ELF machine 3, not ARM (40)"},
-        {"qemu-m3", "elf64.elf", "not a 32-bit little-endian ELF"},
-        {"qemu-m3", "object.elf", "ELF type 1, not an executable (2)"},
-        {"qemu-m3", "hard.elf", "a hard-float image, and the board's cpu (cortex-m3) has no FPU"},
-        {"qemu-m4f", "far.elf", "entry point 0x10000041 is outside the board's code memory [0, 0x400000)"},
-    };
+    // The boards of toolchain/targets.txt; a hard-float image is refused on one without an FPU.
+    std::vector<Case> cases;
+    for (const host::QemuTarget& t : host::kQemuTargets) {
+        const std::string name(t.replay);
+        cases.push_back({name, "text.elf", "not an ELF file"});
+        cases.push_back({name, "x86.elf", "ELF machine 3, not ARM (40)"});
+        cases.push_back({name, "elf64.elf", "not a 32-bit little-endian ELF"});
+        cases.push_back({name, "object.elf", "ELF type 1, not an executable (2)"});
+        cases.push_back({name, "far.elf", "entry point 0x10000041 is outside the board's code memory [0, 0x400000)"});
+        if (t.cpu.back() != 'f') {
+            cases.push_back(
+                {name, "hard.elf", "a hard-float image, and the board's cpu (" + std::string(t.cpu) + ") has no FPU"});
+        }
+    }
+    ASSERT_GT(cases.size(), 5U * std::size(host::kQemuTargets));  // a board without an FPU is tested
     for (const Case& c : cases) {
         SCOPED_TRACE(c.image);
         const CliRun r = run_in("replay --target " + c.target + " --firmware " + c.image + " --in " + kSolutions +
