@@ -96,6 +96,13 @@ TEST(CliProbe, AnEmptyPathIsAUsageErrorNotNone) {
     const std::string cmds[] = {
         "correct --in " + kSolutions + " --out o.csv --states ''",
         "correct --in '' --out o.csv",
+        "correct --in " + kSolutions + " --out ''",
+        "stats --in ''",
+        "fit --in '' --out m.csv",
+        "fit --in " + kSolutions + " --out ''",
+        "plot --in '' --model " + kModel + " --out o.csv",
+        "simulate --days 0.01 --out ''",
+        "replay --target loopback-float --in '' --model " + kModel + " --out o.csv",
         "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --states ''",
         "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv --firmware ''",
         "thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --simulate '' > o.csv",

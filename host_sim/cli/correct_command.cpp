@@ -17,7 +17,8 @@ void add_correct_command(CLI::App& app) {
         ->required()
         ->check(non_empty_path());
     cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all; '-': standard output")
-        ->required();
+        ->required()
+        ->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage")
         ->check(non_empty_path());
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");

@@ -11,9 +11,10 @@ namespace ascorr::cli {
 void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
     CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "model file to write (CSV)")
         ->required()
+        ->check(non_empty_path())
         ->check(not_standard_output("standard output carries fit's report; give a path"));
     cmd->add_option("--from", opt->from, "start of the modelling period, s since J2000 TT")->check(real_number());
     cmd->add_option("--to", opt->to, "end of the modelling period, s since J2000 TT")->check(real_number());

@@ -11,9 +11,10 @@ void add_plot_command(CLI::App& app) {
     auto opt = std::make_shared<host::PlotOptions>();
     CLI::App* cmd = app.add_subcommand("plot", "PNG of the IBA per pair for the three stages (gnuplot)");
     cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused: plot applies the stages)")
-        ->required();
+        ->required()
+        ->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
-    cmd->add_option("--out", opt->out, "PNG file")->required();
+    cmd->add_option("--out", opt->out, "PNG file; '-': standard output")->required()->check(non_empty_path());
     CLI::Option* from =
         cmd->add_option("--from", opt->period_from, "start of the modelling period to shade, s since J2000 TT")
             ->check(real_number());

@@ -20,10 +20,11 @@ void add_replay_command(CLI::App& app) {
         ->required();
     cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)")
         ->check(non_empty_path());
-    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")
         ->required()
+        ->check(non_empty_path())
         ->check(not_standard_output("standard output carries replay's summary (JSON); give a path"));
     cmd->add_option("--states", opt->states,
                     "spacecraft states (CSV t,x,y,z,vx,vy,vz), sent to the target in time order with the solutions; "

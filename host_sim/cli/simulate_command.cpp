@@ -14,6 +14,7 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--out", opt->out,
                     "solutions file (CSV); beside it OUT.truth.csv, OUT.floor.json and OUT.heaters.csv (not '-')")
         ->required()
+        ->check(non_empty_path())
         ->check(not_standard_output("simulate writes four files (OUT, OUT.truth.csv, OUT.floor.json, "
                                     "OUT.heaters.csv); give a path"));
     cmd->add_option("--days", opt->days, "length of the mission in days, (0, 36600] (default 920, 2.5 years)")

@@ -14,7 +14,8 @@ void add_stats_command(CLI::App& app) {
     cmd->add_option("--in", opt->in,
                     "solutions file (CSV), raw; a corrected file is shown as it is, under \"original\", and refused "
                     "with --model (never corrected twice)")
-        ->required();
+        ->required()
+        ->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it the thermal stage is null")
         ->check(non_empty_path());
     cmd->add_option("--from", opt->from, "first epoch, s since J2000 TT")->check(real_number());
