@@ -9,10 +9,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 #include <vector>
 
+#include "ascorr_host/fit.hpp"
 #include "ascorr_host/fit_terms.hpp"
 #include "ascorr_host/qemu_targets.hpp"
 #include "cli_run.hpp"
@@ -488,6 +490,29 @@ TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheH
                     "warning: --inject THT00029:open:5000:6000: its window is outside the history "
                     "history.csv [100, 101] s: it faults nothing"))
         << out.err;
+}
+
+// The library's own refusals (the Python module reaches them) repeat the value
+// unrounded too.
+TEST(CliProbe, LibraryRefusalsRepeatTheValueUnrounded) {
+    host::FitOptions o;
+    o.holdout = 0.50000001;
+    const host::RowSource none = [](const std::function<void(const host::SolutionRecord&)>&) {};
+    try {
+        host::fit_model(o, none);
+        ADD_FAILURE() << "--holdout 0.50000001 accepted";
+    } catch (const std::exception& e) {
+        EXPECT_TRUE(has(e.what(), "got 0.50000001")) << e.what();
+        EXPECT_FALSE(has(e.what(), "0.500000,")) << e.what();
+    }
+    o.holdout = 0.25;
+    o.min_span_days = -1e-7;
+    try {
+        host::fit_model(o, none);
+        ADD_FAILURE() << "--min-days -1e-7 accepted";
+    } catch (const std::exception& e) {
+        EXPECT_TRUE(has(e.what(), "--min-days -1e-07")) << e.what();
+    }
 }
 
 }  // namespace

@@ -137,6 +137,12 @@ bool BlockReader::next(std::string_view& block) {
     return true;
 }
 
+std::string number_text(double x) {
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
+}
+
 bool LineReader::next(std::string_view& line) noexcept {
     if (pos_ >= text_.size()) {
         return false;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ascorr_host/atomic_file.hpp"
+#include "ascorr_host/csv.hpp"
 #include "ascorr_host/epochs.hpp"
 #include "ascorr_host/stats.hpp"
 
@@ -174,8 +175,8 @@ void check_window(const PlotOptions& opt) {
         throw std::runtime_error("a plot window needs both --window-from and --window-to");
     }
     if (!(std::isfinite(*opt.window_from) && std::isfinite(*opt.window_to) && *opt.window_from < *opt.window_to)) {
-        throw std::runtime_error("the plot window is empty: --window-from " + std::to_string(*opt.window_from) +
-                                 " is not before --window-to " + std::to_string(*opt.window_to));
+        throw std::runtime_error("the plot window is empty: --window-from " + number_text(*opt.window_from) +
+                                 " is not before --window-to " + number_text(*opt.window_to));
     }
 }
 

@@ -104,6 +104,10 @@ std::string why_not_a_number(std::string_view field);
 // "expected an integer in [lo, hi], got 'FIELD'".
 std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
 
+// The shortest decimal text that reads back as x ("0.50000001", "1e-05",
+// "nan", "inf"), for messages that repeat a refused value: never rounded.
+std::string number_text(double x);
+
 // Formats x with `decimals` digits after the point into out, returns the end.
 char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
 
