@@ -267,14 +267,18 @@ TEST(FitTerms, BadOptionsAreRefusedAndWriteNothing) {
     for (const char* h : {"-0.1", "0.6"}) {
         EXPECT_EQ(run_cli("fit --in " + data.string() + " --out " + model.string() + " --holdout " + h, dir / "out",
                           dir / "err"),
-                  1)
+                  2)  // a usage error, found before the input is read
             << h;
-        EXPECT_NE(slurp(dir / "err").find("--holdout must be in [0, 0.5]"), std::string::npos) << slurp(dir / "err");
+        EXPECT_NE(slurp(dir / "err").find("--holdout: " + std::string(h) + " is out of range: the range is [0, 0.5]"),
+                  std::string::npos)
+            << slurp(dir / "err");
     }
     EXPECT_EQ(run_cli("fit --in " + data.string() + " --out " + model.string() + " --min-temperature-range -1",
                       dir / "out", dir / "err"),
-              1);
-    EXPECT_NE(slurp(dir / "err").find("--min-temperature-range must be"), std::string::npos) << slurp(dir / "err");
+              2);
+    EXPECT_NE(slurp(dir / "err").find("--min-temperature-range: -1 is out of range: the range is [0, inf)"),
+              std::string::npos)
+        << slurp(dir / "err");
     host::FitOptions o;
     o.in = data.string();
     o.out = model.string();

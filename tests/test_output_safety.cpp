@@ -14,10 +14,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -352,7 +354,16 @@ TEST(OutputSafety, ASignalledPlotRemovesItsTemporaryFolderAndGnuplot) {
 TEST(OutputSafety, ReplaysEmulatorDiesWithItsParentEvenOnSigkill) {
     const fs::path dir = scratch_dir("pdeath");
     stand_in(dir / "bin", "qemu-system-arm", dir / "qemu.pid");
-    write(dir / "image.elf", "not an image: the stand-in never reads it\n");
+    // The header of a soft-float ARM executable, which replay checks before it
+    // starts the emulator; the stand-in never reads the rest.
+    std::string header(52, '\0');
+    const unsigned char elf[] = {0x7f, 'E', 'L', 'F', 1, 1, 1};
+    std::copy(std::begin(elf), std::end(elf), header.begin());
+    header[16] = 2;     // executable
+    header[18] = 40;    // ARM
+    header[20] = 1;     // version
+    header[24] = 0x41;  // entry point, in the board's code memory
+    write(dir / "image.elf", header);
     const pid_t pid = spawn(
         {"replay", "--target", std::string(host::kQemuTargets[0].replay), "--firmware", (dir / "image.elf").string(),
          "--in", kSolutions, "--model", kModel, "--out", (dir / "out.csv").string(), "--timeout-ms", "60000"},

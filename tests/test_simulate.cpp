@@ -84,9 +84,10 @@ TEST(Simulate, CorrectWithTheTruthGivesTheNoiseFloor) {
 TEST(Simulate, BadOptionsAndTruthWriteNothing) {
     const fs::path dir = scratch_dir("bad");
     const fs::path data = dir / "m.csv";
-    EXPECT_EQ(run_cli("simulate --step 0 --out " + data.string(), dir), 1);
-    EXPECT_NE(slurp(dir / "err.txt").find("--step must be in [1, 600] s"), std::string::npos) << slurp(dir / "err.txt");
-    EXPECT_EQ(run_cli("simulate --days -3 --out " + data.string(), dir), 1);
+    EXPECT_EQ(run_cli("simulate --step 0 --out " + data.string(), dir), 2);  // usage errors
+    EXPECT_NE(slurp(dir / "err.txt").find("--step: 0 is out of range: the range is [1, 600]"), std::string::npos)
+        << slurp(dir / "err.txt");
+    EXPECT_EQ(run_cli("simulate --days -3 --out " + data.string(), dir), 2);
     std::ofstream(dir / "truth.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,1,2,x,4\n";
     EXPECT_EQ(run_cli("simulate --days 1 --truth " + (dir / "truth.csv").string() + " --out " + data.string(), dir), 1);
     EXPECT_NE(slurp(dir / "err.txt").find("truth.csv:2:"), std::string::npos) << slurp(dir / "err.txt");
@@ -163,8 +164,9 @@ TEST(Plot, TemperaturePanelsAndAWindow) {
     EXPECT_EQ(
         run_cli("plot --width 10 --in " + data.string() + " --model " + model + " --out " + (dir / "x.png").string(),
                 dir),
-        1);
-    EXPECT_NE(slurp(dir / "err.txt").find("--width must be in [400, 4000] pixels"), std::string::npos)
+        2);  // a usage error
+    EXPECT_NE(slurp(dir / "err.txt").find("--width: 10 is out of range: expected an integer in [400, 4000]"),
+              std::string::npos)
         << slurp(dir / "err.txt");
     EXPECT_EQ(run_cli("plot --window-from 456170000 --in " + data.string() + " --model " + model + " --out " +
                           (dir / "x.png").string(),

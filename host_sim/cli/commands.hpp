@@ -6,13 +6,69 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cctype>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
 namespace ascorr::cli {
 
-// Refuses an empty path (--model ""), which would otherwise read as "no model".
+// Refuses an empty path (--model "", --states ""), which would otherwise read
+// as "no model", "no states".
 inline CLI::Validator non_empty_path() {
     return CLI::Validator(
         [](std::string& s) { return s.empty() ? std::string("an empty path names no file") : std::string(); }, "FILE");
 }
+
+// An output that cannot be standard output ("-"), and why: the command writes
+// more than one file, or standard output carries its report.
+inline CLI::Validator not_standard_output(const std::string& why) {
+    return CLI::Validator(
+        [why](std::string& s) {
+            return s == "-" ? "'-' (standard output) cannot be this output: " + why : std::string();
+        },
+        "FILE");
+}
+
+// The one spelling rule of every choice option (--scalar, --states-frame,
+// --terms, --speed): one of its names, in any case ("GCRS" is gcrs); a number is
+// not a name ("--states-frame 1" is refused, whatever the option's type). The
+// option's variable receives the name's value. Help: NAME:{a,b,c}.
+template <typename T>
+CLI::Validator one_of(std::vector<std::pair<std::string, T>> names) {
+    std::string list;
+    for (const auto& n : names) {
+        list += (list.empty() ? "" : ",") + n.first;
+    }
+    return CLI::Validator(
+        [names, list](std::string& s) {
+            std::string lower = s;
+            for (char& c : lower) {
+                c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+            }
+            for (const auto& [name, value] : names) {
+                if (lower == name) {
+                    if constexpr (std::is_enum_v<T>) {
+                        s = std::to_string(static_cast<std::underlying_type_t<T>>(value));
+                    } else if constexpr (std::is_same_v<T, bool>) {
+                        s = value ? "1" : "0";
+                    } else {
+                        s = value;
+                    }
+                    return std::string();
+                }
+            }
+            return "'" + s + "' is not one of {" + list + "} (names, any case; numbers are not names)";
+        },
+        "{" + list + "}");
+}
+
+// "-" is a stream on both sides: as an output, standard output (atomic_file.hpp);
+// as an input, standard input, read whole into a temporary file first (inputs
+// may be read twice). Replaces the path of the one input given as "-" (option,
+// path pairs); two inputs "-" are a usage error.
+void read_dash_from_standard_input(const std::vector<std::pair<const char*, std::string*>>& inputs);
 
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);

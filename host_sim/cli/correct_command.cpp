@@ -1,9 +1,9 @@
 #include <iostream>
-#include <map>
 #include <memory>
 #include <string>
 
 #include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -13,28 +13,36 @@ void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
     CLI::App* cmd =
         app.add_subcommand("correct", "correct every solution of a recorded file (aberration, then thermal)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
-    cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused); '-': standard input")
+        ->required()
+        ->check(non_empty_path());
+    cmd->add_option("--out", opt->out, "corrected file (CSV), written whole or not at all; '-': standard output")
+        ->required()
+        ->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV); without it, no thermal stage")
         ->check(non_empty_path());
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
     cmd->add_flag("!--no-thermal", opt->thermal, "skip the thermal stage");
-    const std::map<std::string, host::ScalarKind> scalars{{"double", host::ScalarKind::kDouble},
-                                                          {"float", host::ScalarKind::kFloat},
-                                                          {"fixed", host::ScalarKind::kFixed}};
-    cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double, float or fixed")
-        ->transform(CLI::CheckedTransformer(scalars, CLI::ignore_case));
-    cmd->add_flag("--skip-bad", opt->skip_bad, "skip malformed rows (each is reported) instead of stopping");
+    cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double (default), float or fixed (any case)")
+        ->transform(one_of<host::ScalarKind>({{"double", host::ScalarKind::kDouble},
+                                              {"float", host::ScalarKind::kFloat},
+                                              {"fixed", host::ScalarKind::kFixed}}))
+        ->type_name("NAME");
+    cmd->add_flag("--skip-bad", opt->skip_bad,
+                  "skip malformed rows of --in and --states (each is reported) instead of stopping");
     cmd->add_option("--states", opt->states,
                     "spacecraft states (CSV t,x,y,z,vx,vy,vz): the velocity of rows without vx,vy,vz, computed by "
-                    "the on-board service in the --scalar chosen");
-    const std::map<std::string, bool> frames{{"itrf", false}, {"gcrs", true}};
-    cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs (uplinked)")
-        ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
+                    "the on-board service in the --scalar chosen; a file of which no state is accepted fails the run")
+        ->check(non_empty_path());
+    cmd->add_option("--states-frame", opt->states_gcrs,
+                    "frame of the states: itrf (GNSS, default) or gcrs (uplinked), any case")
+        ->transform(one_of<bool>({{"itrf", false}, {"gcrs", true}}))
+        ->type_name("NAME");
     cmd->add_option("--max-propagation", opt->max_propagation_s,
-                    "seconds a state may be propagated (default 21600); later rows get status 4+512")
-        ->check(real_number());
+                    "seconds a state may be propagated, (0, 604800] (default 21600); later rows get status 4+512")
+        ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';
     });

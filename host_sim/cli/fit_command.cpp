@@ -1,5 +1,5 @@
+#include <cmath>
 #include <iostream>
-#include <map>
 #include <memory>
 
 #include "ascorr_host/analysis/fit.hpp"
@@ -11,29 +11,32 @@ namespace ascorr::cli {
 void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
     CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
-    cmd->add_option("--out", opt->out, "model file to write (CSV)")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
+    cmd->add_option("--out", opt->out, "model file to write (CSV)")
+        ->required()
+        ->check(non_empty_path())
+        ->check(not_standard_output("standard output carries fit's report; give a path"));
     cmd->add_option("--from", opt->from, "start of the modelling period, s since J2000 TT")->check(real_number());
     cmd->add_option("--to", opt->to, "end of the modelling period, s since J2000 TT")->check(real_number());
-    cmd->add_option("--min-days", opt->min_span_days, "shortest accepted period in days (default 267)")
-        ->check(real_number());
+    cmd->add_option("--min-days", opt->min_span_days, "shortest accepted period in days, above 0 (default 267)")
+        ->check(real_in(0.0, HUGE_VAL, End::kOpen, End::kOpen));
     cmd->add_option("--min-orbits", opt->min_orbits, "fewest accepted orbit averages (default 100)")
         ->transform(integer_in<std::size_t>());
-    cmd->add_option("--max-condition", opt->max_condition, "largest accepted condition number (default 1e6)")
-        ->check(real_number());
-    cmd->add_option("--orbit-period", opt->orbit_period_s, "orbit period in s (default: from the velocity)")
-        ->check(real_number());
-    const std::map<std::string, host::Terms> terms{{"linear", host::Terms::kLinear},
-                                                   {"quadratic", host::Terms::kQuadratic}};
-    cmd->add_option("--terms", opt->terms, "linear (default) or quadratic: also c1_2, c2_2, c3_2")
-        ->transform(CLI::CheckedTransformer(terms));
+    cmd->add_option("--max-condition", opt->max_condition, "largest accepted condition number, above 0 (default 1e6)")
+        ->check(real_in(0.0, HUGE_VAL, End::kOpen));
+    cmd->add_option("--orbit-period", opt->orbit_period_s, "orbit period in s, 600..86400 (default: from the velocity)")
+        ->check(real_in(600.0, 86400.0));
+    cmd->add_option("--terms", opt->terms, "linear (default) or quadratic: also c1_2, c2_2, c3_2 (any case)")
+        ->transform(one_of<host::Terms>({{"linear", host::Terms::kLinear}, {"quadratic", host::Terms::kQuadratic}}))
+        ->type_name("NAME");
     cmd->add_option("--holdout", opt->holdout,
                     "fraction of the period (its end) held out for the model-selection report, 0..0.5 (default 0.25)")
-        ->check(real_number());
+        ->check(real_in(0.0, 0.5));
     cmd->add_option("--min-temperature-range", opt->min_temperature_range_c,
-                    "smallest range (degC) of each regressor for quadratic terms (default 2)")
-        ->check(real_number());
+                    "smallest range (degC) of each regressor for quadratic terms, 0 or more (default 2)")
+        ->check(real_in(0.0, HUGE_VAL, End::kClosed, End::kOpen));
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}});
         const host::FitReport r = host::fit_model(*opt);
         std::cout << host::describe(r);
         std::cerr << "ascorr fit: model written to " << opt->out << '\n';

@@ -171,23 +171,31 @@ inline CLI::Validator real_number() {
         "NUMBER");
 }
 
-// A real option in [lo, hi]: real_number()'s checks, and then NaN, the
-// infinities and finite values outside [lo, hi] are "out of range" with the
-// range (CLI::Range lets NaN through: every comparison with it is false).
-inline CLI::Validator real_in(double lo, double hi) {
+// Whether an end of a real option's range belongs to it.
+enum class End { kClosed, kOpen };
+
+// A real option in [lo, hi] (or with an open end: (0, 36600], (0, inf)):
+// real_number()'s checks, and then NaN, the infinities and finite values
+// outside the range are "out of range" with the range, the value as given
+// (CLI::Range lets NaN through: every comparison with it is false). A refused
+// value is a usage error (exit status 2) found before any input is read.
+inline CLI::Validator real_in(double lo, double hi, End lo_end = End::kClosed, End hi_end = End::kClosed) {
     return CLI::Validator(
-        [lo, hi](std::string& s) {
+        [lo, hi, lo_end, hi_end](std::string& s) {
             std::string why = real_number()(s);
             if (!why.empty()) {
                 return why;
             }
             double x = 0.0;
             detail::classify_real(s, x);
-            if (x >= lo && x <= hi) {
+            const bool above = lo_end == End::kOpen ? x > lo : x >= lo;
+            const bool below = hi_end == End::kOpen ? x < hi : x <= hi;
+            if (above && below) {
                 return std::string();
             }
-            char range[64];
-            std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+            char range[80];
+            std::snprintf(range, sizeof range, "%c%g, %g%c", lo_end == End::kOpen ? '(' : '[', lo, hi,
+                          hi_end == End::kOpen ? ')' : ']');
             return s + " is out of range: the range is " + range;
         },
         "NUMBER");

@@ -10,9 +10,11 @@ namespace ascorr::cli {
 void add_plot_command(CLI::App& app) {
     auto opt = std::make_shared<host::PlotOptions>();
     CLI::App* cmd = app.add_subcommand("plot", "PNG of the IBA per pair for the three stages (gnuplot)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV), raw")->required();
+    cmd->add_option("--in", opt->in, "solutions file (CSV), raw (a corrected file is refused: plot applies the stages)")
+        ->required()
+        ->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
-    cmd->add_option("--out", opt->out, "PNG file")->required();
+    cmd->add_option("--out", opt->out, "PNG file; '-': standard output")->required()->check(non_empty_path());
     CLI::Option* from =
         cmd->add_option("--from", opt->period_from, "start of the modelling period to shade, s since J2000 TT")
             ->check(real_number());
@@ -28,10 +30,11 @@ void add_plot_command(CLI::App& app) {
     CLI::Option* wto = cmd->add_option("--window-to", opt->window_to, "draw only up to this epoch (s since J2000 TT)")
                            ->check(real_number());
     cmd->add_option("--width", opt->width, "figure width in pixels, 400..4000 (default 1400; panels 2/7 of it high)")
-        ->transform(integer_in<int>());
+        ->transform(integer_in<int>(400, 4000));
     wfrom->needs(wto);
     wto->needs(wfrom);
     cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
         host::plot_iba(*opt, std::cerr);
         std::cerr << "ascorr plot: " << opt->out << '\n';
     });

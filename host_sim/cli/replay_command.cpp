@@ -1,8 +1,8 @@
 #include <iostream>
-#include <map>
 #include <memory>
 #include <string>
 
+#include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "commands.hpp"
@@ -18,26 +18,40 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--target", opt->target,
                     host::qemu_target_choices() + ", loopback-float, or a serial device such as /dev/ttyUSB0")
         ->required();
-    cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)");
-    cmd->add_option("--in", opt->in, "solutions file (CSV)")->required();
+    cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)")
+        ->check(non_empty_path());
+    cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
     cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
-    cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")->required();
+    cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")
+        ->required()
+        ->check(non_empty_path())
+        ->check(not_standard_output("standard output carries replay's summary (JSON); give a path"));
     cmd->add_option("--states", opt->states,
                     "spacecraft states (CSV t,x,y,z,vx,vy,vz), sent to the target in time order with the solutions; "
-                    "the target computes the velocity of rows without vx,vy,vz");
-    const std::map<std::string, bool> frames{{"itrf", false}, {"gcrs", true}};
-    cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs")
-        ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case));
+                    "the target computes the velocity of rows without vx,vy,vz; a file of which no state is accepted "
+                    "fails the run")
+        ->check(non_empty_path());
+    cmd->add_option("--states-frame", opt->states_gcrs, "frame of the states: itrf (GNSS, default) or gcrs, any case")
+        ->transform(one_of<bool>({{"itrf", false}, {"gcrs", true}}))
+        ->type_name("NAME");
+    cmd->add_option("--max-propagation", opt->max_propagation_s,
+                    "seconds a state may be propagated, (0, 604800]; a target's is its firmware's, 21600 (default): "
+                    "another value is refused")
+        ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));
-    cmd->add_option("--speed", *speed, "realtime (paced by t) or max")->check(CLI::IsMember({"realtime", "max"}));
+    cmd->add_option("--speed", *speed, "realtime (paced by t) or max (default), any case")
+        ->transform(one_of<std::string>({{"realtime", "realtime"}, {"max", "max"}}))
+        ->type_name("NAME");
     cmd->add_option("--timeout-ms", opt->timeout_ms, "answer time-out before a resend (default: 20 qemu, 500 serial)")
         ->transform(integer_in<int>(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
     cmd->callback([opt, speed]() {
         opt->realtime = *speed == "realtime";
+        read_dash_from_standard_input(
+            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
     });

@@ -9,6 +9,7 @@
 // row per configured channel and then one row per voted value (name t_chu,
 // t_029, t_032; role "voted"; t_chu is the --head's). faults is the '|'-joined
 // list of fault names (faults.hpp), empty when valid. A summary goes to stderr.
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -81,6 +82,29 @@ void print_row(std::FILE* out, std::uint64_t t_us, const char* name, const char*
                  c, o, t, faults == 0U ? 1 : 0, fault_list(faults).c_str());
 }
 
+// A fault whose window misses the history faults nothing: said, not silent.
+void warn_faults_outside(const ThermistorOptions& opt, const std::vector<hal::InjectedFault>& faults,
+                         const std::vector<hal::HistoryEpoch>& history) {
+    if (history.empty()) {
+        return;
+    }
+    double first = std::numeric_limits<double>::infinity();
+    double last = -first;
+    for (const hal::HistoryEpoch& e : history) {
+        const double t = static_cast<double>(e.t_us) * 1e-6;
+        first = std::min(first, t);
+        last = std::max(last, t);
+    }
+    for (std::size_t i = 0; i < faults.size(); ++i) {
+        if (faults[i].to_s < first || faults[i].from_s > last) {
+            char span[96];
+            std::snprintf(span, sizeof span, "[%.17g, %.17g] s", first, last);
+            std::cerr << "ascorr thermistors: warning: --inject " << opt.inject[i] << ": its window is outside the "
+                      << "history " << opt.simulate << " " << span << ": it faults nothing\n";
+        }
+    }
+}
+
 void run(const ThermistorOptions& opt) {
     host::refuse_output_over_input({{"--config", opt.config}, {"--replay", opt.replay}, {"--simulate", opt.simulate}},
                                    {}, true);
@@ -106,7 +130,9 @@ void run(const ThermistorOptions& opt) {
         for (const std::string& s : opt.inject) {
             faults.push_back(hal::parse_fault(s, acfg));
         }
-        source = std::make_unique<hal::SimulatedSource>(acfg, hal::read_history(opt.simulate), std::move(faults));
+        std::vector<hal::HistoryEpoch> history = hal::read_history(opt.simulate);
+        warn_faults_outside(opt, faults, history);
+        source = std::make_unique<hal::SimulatedSource>(acfg, std::move(history), std::move(faults));
     } else {
 #ifdef ASCORR_HAVE_GPIOD
         live_clock = std::make_unique<hal::SteadyClock>();
@@ -184,13 +210,25 @@ void add_thermistors_command(CLI::App& app) {
     auto opt = std::make_shared<ThermistorOptions>();
     CLI::App* cmd = app.add_subcommand(
         "thermistors", "acquire the thermistors (libgpiod board, replay or simulation); print values and validity");
-    cmd->add_option("--config", opt->config, "thermistor configuration file")->required();
-    cmd->add_option("--chip", opt->chip, "GPIO chip of the MCP3208 lines (overrides the configuration's)");
-    cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns");
-    cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate");
+    cmd->add_option("--config", opt->config, "thermistor configuration file")->required()->check(non_empty_path());
+    cmd->add_option("--chip", opt->chip, "GPIO chip of the MCP3208 lines (overrides the configuration's)")
+        ->check(non_empty_path());
+    CLI::Option* replay =
+        cmd->add_option("--replay", opt->replay, "recorded file: t and NAME (degC) or NAME.counts columns")
+            ->check(non_empty_path());
+    CLI::Option* simulate =
+        cmd->add_option("--simulate", opt->simulate, "temperature history (t,t_chu,t_029,t_032[,chu]) to simulate")
+            ->check(non_empty_path());
     cmd->add_option("--inject", opt->inject, "simulated fault NAME:KIND:FROM:TO[:VALUE] (repeatable)");
-    cmd->add_option("--frames", opt->frames, "live: frames to acquire")->transform(integer_in<unsigned>(1U, 1000000U));
-    cmd->add_option("--interval", opt->interval, "live: seconds between frames")->check(real_in(0.0, 3600.0));
+    // Live options: --replay and --simulate run their whole file, so they exclude them.
+    cmd->add_option("--frames", opt->frames, "live: frames to acquire (not with --replay or --simulate)")
+        ->transform(integer_in<unsigned>(1U, 1000000U))
+        ->excludes(replay)
+        ->excludes(simulate);
+    cmd->add_option("--interval", opt->interval, "live: seconds between frames (not with --replay or --simulate)")
+        ->check(real_in(0.0, 3600.0))
+        ->excludes(replay)
+        ->excludes(simulate);
     cmd->add_option("--head", opt->head,
                     "head whose T_CHU is voted and printed (" + std::string(kHeadChoices.text) + ")")
         ->check(CLI::Validator(
@@ -200,7 +238,11 @@ void add_thermistors_command(CLI::App& app) {
                            : s + " is out of range: a head is " + std::string(kHeadChoices.text);
             },
             kHeadChoices.text));
-    cmd->callback([opt]() { run(*opt); });
+    cmd->callback([opt]() {
+        read_dash_from_standard_input(
+            {{"--config", &opt->config}, {"--replay", &opt->replay}, {"--simulate", &opt->simulate}});
+        run(*opt);
+    });
 }
 
 }  // namespace ascorr::cli

@@ -25,6 +25,7 @@
 
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_text/csv_fields.hpp"
+#include "ascorr_text/line_limit.hpp"
 
 namespace ascorr::hal::linux_detail {
 
@@ -215,7 +216,9 @@ private:
 };
 
 // The whole text of a file. A file that cannot be opened or read, or a
-// directory: ConfigError "cannot open FILE: reason" (no line, no column).
+// directory: ConfigError "cannot open FILE: reason" (no line, no column). A
+// line beyond text::kMaxLineBytes: ConfigError at file:line, as soon as it is
+// read (/dev/zero fails at once, not when memory runs out).
 inline std::string read_text_file(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
@@ -225,12 +228,20 @@ inline std::string read_text_file(const std::string& path) {
     if (!in) {
         throw ConfigError::whole_file("cannot open " + path + ": " + std::strerror(errno));
     }
-    std::ostringstream ss;
-    ss << in.rdbuf();
+    std::string text;
+    text::LineLengthScan scan;
+    char buf[1 << 16];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+        const std::string_view piece(buf, static_cast<std::size_t>(in.gcount()));
+        if (!scan.feed(piece)) {
+            throw ConfigError(path, scan.too_long_line(), 0, text::line_too_long());
+        }
+        text.append(piece);
+    }
     if (in.bad()) {
         throw ConfigError::whole_file("cannot read " + path + ": " + std::strerror(errno));
     }
-    return ss.str();
+    return text;
 }
 
 // A field of a comma-separated line, as written (quotes included), and its

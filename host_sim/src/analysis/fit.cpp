@@ -11,6 +11,7 @@
 #include <sstream>
 #include <vector>
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/csv.hpp"
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
@@ -104,16 +105,16 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
     if (opt.from && !std::isfinite(*opt.from)) {
-        throw FitRefused("--from " + std::to_string(*opt.from) + ": not a finite time");
+        throw FitRefused("--from " + number_text(*opt.from) + ": not a finite time");
     }
     if (opt.to && !std::isfinite(*opt.to)) {
-        throw FitRefused("--to " + std::to_string(*opt.to) + ": not a finite time");
+        throw FitRefused("--to " + number_text(*opt.to) + ": not a finite time");
     }
     if (!(opt.min_span_days > 0.0 && std::isfinite(opt.min_span_days))) {
-        throw FitRefused("--min-days " + std::to_string(opt.min_span_days) + ": must be a positive number of days");
+        throw FitRefused("--min-days " + number_text(opt.min_span_days) + ": must be a positive number of days");
     }
     if (!(opt.max_condition > 0.0) || std::isnan(opt.max_condition)) {
-        throw FitRefused("--max-condition " + std::to_string(opt.max_condition) + ": must be positive");
+        throw FitRefused("--max-condition " + number_text(opt.max_condition) + ": must be positive");
     }
 }
 }  // namespace
@@ -138,11 +139,11 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     }
     if (!(opt.holdout >= 0.0 && opt.holdout <= 0.5)) {
         throw FitRefused("--holdout must be in [0, 0.5] (a fraction of the modelling period), got " +
-                         std::to_string(opt.holdout));
+                         number_text(opt.holdout));
     }
     if (!(opt.min_temperature_range_c >= 0.0 && std::isfinite(opt.min_temperature_range_c))) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
-                         std::to_string(opt.min_temperature_range_c));
+                         number_text(opt.min_temperature_range_c));
     }
     return fit_pass(opt, rows, std::nullopt);
 }

@@ -344,21 +344,31 @@ Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vecto
         if (!(l > 0.0 && q > 0.0)) {
             s.verdict = "no selection: a pair has no held-out epoch";
         } else {
-            const double gain = 1.0 - q / l;
             s.decided = true;
-            s.preferred = gain > kSelectionMargin ? Terms::kQuadratic : Terms::kLinear;
-            s.verdict = s.preferred == Terms::kQuadratic
-                            ? format(
-                                  "quadratic: its held-out IBA RMS (mean over the pairs) is %.2f %% lower than the "
-                                  "linear model's, more than the %.0f %% margin",
-                                  100.0 * gain, 100.0 * kSelectionMargin)
-                            : format(
-                                  "linear: the quadratic terms lower the held-out IBA RMS (mean over the pairs) by "
-                                  "%.2f %%, not more than the %.0f %% margin: they fit noise",
-                                  100.0 * gain, 100.0 * kSelectionMargin);
+            s.preferred = 1.0 - q / l > kSelectionMargin ? Terms::kQuadratic : Terms::kLinear;
+            s.verdict = selection_verdict(l, q);
         }
     }
     return s;
+}
+
+std::string selection_verdict(double linear_rms, double quadratic_rms) {
+    const double gain = 1.0 - quadratic_rms / linear_rms;
+    if (gain > kSelectionMargin) {
+        return format(
+            "quadratic: its held-out IBA RMS (mean over the pairs) is %.2f %% lower than the linear model's, more "
+            "than the %.0f %% margin",
+            100.0 * gain, 100.0 * kSelectionMargin);
+    }
+    if (gain >= 0.0) {
+        return format(
+            "linear: the quadratic terms lower the held-out IBA RMS (mean over the pairs) by %.2f %%, not more than "
+            "the %.0f %% margin: they fit noise",
+            100.0 * gain, 100.0 * kSelectionMargin);
+    }
+    return format(
+        "linear: the quadratic terms raise the held-out IBA RMS (mean over the pairs) by %.2f %%: they fit noise",
+        -100.0 * gain);
 }
 
 std::string describe_centring(const TermsFit& f) {
@@ -402,13 +412,15 @@ std::string describe_selection(const Selection& s) {
                         hf.residual_rms[1], hf.residual_rms[2]);
         }
         o << "\n            IBA RMS in the period";
+        // A pair without an epoch there has no RMS: "n/a", never 0.000.
+        const auto rms = [](const Rms& r) { return r.n == 0 ? std::string("n/a") : format("%.3f", r.rms); };
         for (std::size_t p = 0; p < kPairs; ++p) {
-            o << format(" %s %.3f", kPairNames[p], m.in[p].rms);
+            o << " " << kPairNames[p] << " " << rms(m.in[p]);
         }
         if (s.holdout > 0.0) {
             o << "; held out";
             for (std::size_t p = 0; p < kPairs; ++p) {
-                o << format(" %s %.3f", kPairNames[p], m.out[p].rms);
+                o << " " << kPairNames[p] << " " << rms(m.out[p]);
             }
         }
         o << '\n';

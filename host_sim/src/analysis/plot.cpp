@@ -19,6 +19,7 @@
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/csv.hpp"
 
 extern char** environ;
 
@@ -174,8 +175,8 @@ void check_window(const PlotOptions& opt) {
         throw std::runtime_error("a plot window needs both --window-from and --window-to");
     }
     if (!(std::isfinite(*opt.window_from) && std::isfinite(*opt.window_to) && *opt.window_from < *opt.window_to)) {
-        throw std::runtime_error("the plot window is empty: --window-from " + std::to_string(*opt.window_from) +
-                                 " is not before --window-to " + std::to_string(*opt.window_to));
+        throw std::runtime_error("the plot window is empty: --window-from " + number_text(*opt.window_from) +
+                                 " is not before --window-to " + number_text(*opt.window_to));
     }
 }
 
@@ -188,6 +189,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     so.in = opt.in;
     so.model = opt.model;
     so.keep_series = true;
+    so.log_empty_pairs = false;  // said once, below
     if (!(opt.width >= 400 && opt.width <= 4000)) {
         throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
     }
@@ -209,6 +211,11 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     }
     if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
         throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+    }
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        if (st.n[p] == 0) {
+            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+        }
     }
 
     TempDir dir;
@@ -237,6 +244,14 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         if (!f) {
             throw std::runtime_error("cannot write plot data in " + dir.path().string());
         }
+    }
+
+    // A single epoch (or several at one time) is drawn as a point on a time
+    // axis one smoothing window wide: gnuplot cannot scale an empty x range.
+    const bool one_time = !(t_hi > t_lo);
+    if (one_time) {
+        t_lo -= kSmoothingWindowS / 2.0;
+        t_hi += kSmoothingWindowS / 2.0;
     }
 
     const std::filesystem::path temps = dir.file("temperatures.dat");
@@ -295,7 +310,9 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                     std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
                 g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
-                  << "' using 1:" << k + 2 << " with lines lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
+                  << "' using 1:" << k + 2
+                  << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
+                  << " lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
             }
             g << '\n';
         }

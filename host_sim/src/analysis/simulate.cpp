@@ -225,14 +225,14 @@ struct Random {
 
 void refuse_bad_options(const SimulateOptions& opt) {
     if (!(opt.days > 0.0 && opt.days <= 36600.0)) {
-        throw std::invalid_argument("--days must be in (0, 36600], got " + std::to_string(opt.days));
+        throw std::invalid_argument("--days must be in (0, 36600], got " + number_text(opt.days));
     }
     if (!(opt.step_s >= 1.0 && opt.step_s <= 600.0)) {
         throw std::invalid_argument("--step must be in [1, 600] s (the orbit must be resolved), got " +
-                                    std::to_string(opt.step_s));
+                                    number_text(opt.step_s));
     }
     if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kDay)) {
-        throw std::invalid_argument("--start " + std::to_string(opt.start_t) +
+        throw std::invalid_argument("--start " + number_text(opt.start_t) +
                                     ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
     }
 }
@@ -571,7 +571,8 @@ private:
 SimulateSummary simulate(const SimulateOptions& opt) {
     refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
                                                         {"--out (truth model)", opt.out + ".truth.csv"},
-                                                        {"--out (noise floor)", opt.out + ".floor.json"}});
+                                                        {"--out (noise floor)", opt.out + ".floor.json"},
+                                                        {"--out (heater events)", opt.out + ".heaters.csv"}});
     refuse_bad_options(opt);
     const ModelFile truth_file = truth_model(opt);
     Mission mission(opt, truth_file);

@@ -101,12 +101,22 @@ std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t ro
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
     refuse_bad_time_range(opt.from, opt.to);
+    StatsOptions o = opt;
+    o.corrected_input = is_corrected_file(opt.in);
+    if (o.corrected_input) {
+        if (!opt.model.empty()) {
+            refuse_corrected_file(opt.in);  // the thermal stage would be applied a second time
+        }
+        log << opt.in
+            << ": a corrected file (status column): shown as it is, under \"original\"; no stage is "
+               "applied again\n";
+    }
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
         model = to_core<double>(read_model_file(opt.model));
     }
     return compute_stats(
-        opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
+        o, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
         model ? &*model : nullptr, log);
 }
 
@@ -115,7 +125,8 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     const CorrectionConfig<double> ab_only{true, nullptr};
     const CorrectionConfig<double> both{true, model};
     StatsResult r;
-    r.thermal = model != nullptr;
+    r.thermal = model != nullptr && !opt.corrected_input;
+    r.corrected_input = opt.corrected_input;
     EarthVelocity earth;
     Diagnostics diag(log);
 
@@ -167,8 +178,8 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         r.clean_rows += row.clean ? 1U : 0U;
         tally.clean += row.clean ? 1U : 0U;
         row.z[0] = boresight(rec.q_chu_icrf);
-        row.z[1] = boresight(c1.q_chu_icrf);
-        row.z[2] = boresight(c2.q_chu_icrf);
+        row.z[1] = opt.corrected_input ? row.z[0] : boresight(c1.q_chu_icrf);
+        row.z[2] = opt.corrected_input ? row.z[0] : boresight(c2.q_chu_icrf);
         epochs.add(rec.t, rec.head, rec.line, row);
     });
     epochs.finish();
@@ -194,7 +205,9 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         r.n[p] = s.t.size();
         if (r.n[p] == 0) {
             r.no_epochs_reason[p] = why_no_epochs(p, opt, rows_seen, r.rows, heads, both_present[p]);
-            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+            if (opt.log_empty_pairs) {
+                log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+            }
         }
         for (std::size_t st = 0; st < kStages; ++st) {
             r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
@@ -207,7 +220,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 }
 
 bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept {
-    return r.n[p] >= kMinEpochsForRms && (st != 2 || r.thermal);
+    return r.n[p] >= kMinEpochsForRms && (st != 2 || r.thermal) && (st == 0 || !r.corrected_input);
 }
 
 std::string stats_table(const StatsResult& r) {

@@ -308,7 +308,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         if (!max_propagation_acceptable(opt.max_propagation_s)) {
             throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
         }
-        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+        states =
+            read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag, opt.skip_bad);
     }
     const std::size_t workers = worker_count();
     std::optional<StatesVelocityTable<T>> table;
@@ -328,6 +329,12 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     CorrectSummary sum;
     if (table) {
         sum.service_cost = table->cost();
+    }
+    if (states) {
+        sum.states_given = true;
+        sum.states_accepted = states->accepted.size();
+        sum.states_refused = states->refused();
+        sum.states_malformed = states->malformed;
     }
     std::size_t empty_lines = 0;
     std::future<void> writing;  // declared after `out`: destroyed (joined) before it
@@ -422,6 +429,12 @@ std::string describe(const CorrectSummary& s) {
     }
     if (s.malformed != 0) {
         o << ", " << s.malformed << " malformed rows skipped";
+    }
+    if (s.states_given) {
+        o << "; states: " << s.states_accepted << " accepted, " << s.states_refused << " refused";
+        if (s.states_malformed != 0) {
+            o << ", " << s.states_malformed << " malformed skipped";
+        }
     }
     return o.str();
 }

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/line_limit.hpp"
 
 namespace ascorr::host {
 
@@ -34,8 +35,15 @@ std::string read_text_file(const std::string& path) {
     std::string data;
     char buf[1 << 16];
     std::size_t n = 0;
+    text::LineLengthScan scan;
     while ((n = std::fread(buf, 1, sizeof buf, f.get())) > 0) {
+        if (!scan.feed(std::string_view(buf, n))) {
+            throw InputError(path, scan.too_long_line(), 0, text::line_too_long());
+        }
         data.append(buf, n);
+        if (std::memchr(buf, '\0', n) != nullptr) {
+            break;  // binary data: refused below, without reading on (/dev/zero)
+        }
     }
     if (std::ferror(f.get()) != 0) {
         throw InputError(path, 0, 0, "read error");
@@ -102,6 +110,9 @@ bool BlockReader::next(std::string_view& block) {
             capacity_ = cap;
         }
         const std::size_t n = std::fread(buf_.get() + size_, 1, block_bytes_, f_);
+        if (!scan_.feed(std::string_view(buf_.get() + size_, n))) {
+            throw InputError(path_, scan_.too_long_line(), 0, text::line_too_long());
+        }
         size_ += n;
         if (n == 0) {
             if (std::ferror(f_) != 0) {
@@ -124,6 +135,12 @@ bool BlockReader::next(std::string_view& block) {
     }
     lines_in_last_ = count_line_ends(block) + (block.back() != '\n' ? 1 : 0);
     return true;
+}
+
+std::string number_text(double x) {
+    char buf[64];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
 }
 
 bool LineReader::next(std::string_view& line) noexcept {

@@ -154,6 +154,12 @@ void refuse_corrected_input(const SolutionsReader& header) {
     }
 }
 
+bool is_corrected_file(const std::string& path) {
+    BlockReader blocks(path, 4096);
+    std::string_view block;
+    return blocks.next(block) && SolutionsReader(path, block.substr(0, block.find('\n'))).header().index("status") >= 0;
+}
+
 void refuse_corrected_file(const std::string& path) {
     BlockReader blocks(path, 4096);
     std::string_view block;

@@ -20,12 +20,12 @@ const char* describe(StateVerdict v) noexcept {
         case StateVerdict::kTimeBackwards:
             return "time earlier than the previous accepted state's";
         case StateVerdict::kDuplicateTime:
-            return "same time as the previous accepted state (the first is kept)";
+            return "same time as the previous accepted state";
     }
     return "?";
 }
 
-StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag) {
+StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag, bool skip_bad) {
     const std::string text = read_text_file(path);
     LineReader lines(text);
     std::string_view line;
@@ -54,43 +54,59 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             continue;
         }
         const std::size_t n = lines.line_number();
-        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw InputError(path, n, bad + 1, why_split_failed(line, bad));
-        }
-        if (fields.size() != header.size()) {
-            throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
-                             "expected " + std::to_string(header.size()) + " fields as in the header, found " +
-                                 std::to_string(fields.size()) +
-                                 (fields.size() < header.size() ? " (truncated row?)" : ""));
-        }
-        double x[7] = {};
-        for (std::size_t i = 0; i < kNames.size(); ++i) {
-            const auto v = parse_double(fields[col[i]]);
-            if (!v) {
-                throw InputError(path, n, starts[col[i]] + 1,
-                                 std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
+        try {
+            if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+                throw InputError(path, n, bad + 1, why_split_failed(line, bad));
             }
-            x[i] = *v;
-        }
-        TtTime t{};
-        if (!tt_from_seconds(x[0], t)) {
-            throw InputError(path, n, starts[col[0]] + 1,
-                             "column 't': time must be finite and within 1e11 s of J2000, got '" +
-                                 std::string(fields[col[0]]) + "'");
-        }
-        const StateRecord rec{n, t, {x[1], x[2], x[3]}, {x[4], x[5], x[6]}};
-        const StateVerdict v = board.push_state(rec.t, rec.r_km, rec.v_kms, frame);
-        if (v == StateVerdict::kAccepted) {
-            out.accepted.push_back(rec);
-        } else {
-            diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
-                                             " (kept the previous one)");
+            if (fields.size() != header.size()) {
+                throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
+                                 "expected " + std::to_string(header.size()) + " fields as in the header, found " +
+                                     std::to_string(fields.size()) +
+                                     (fields.size() < header.size() ? " (truncated row?)" : ""));
+            }
+            double x[7] = {};
+            for (std::size_t i = 0; i < kNames.size(); ++i) {
+                const auto v = parse_double(fields[col[i]]);
+                if (!v) {
+                    throw InputError(path, n, starts[col[i]] + 1,
+                                     std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
+                }
+                x[i] = *v;
+            }
+            TtTime t{};
+            if (!tt_from_seconds(x[0], t)) {
+                throw InputError(path, n, starts[col[0]] + 1,
+                                 "column 't': time must be finite and within 1e11 s of J2000, got '" +
+                                     std::string(fields[col[0]]) + "'");
+            }
+            const StateRecord rec{n, t, {x[1], x[2], x[3]}, {x[4], x[5], x[6]}};
+            const StateVerdict v = board.push_state(rec.t, rec.r_km, rec.v_kms, frame);
+            if (v == StateVerdict::kAccepted) {
+                out.accepted.push_back(rec);
+            } else {
+                diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
+                                                 " (kept the previous one)");
+            }
+        } catch (const InputError& e) {
+            if (!skip_bad) {
+                throw;
+            }
+            diag.report("malformed states row", std::string(e.what()) + " (--skip-bad: row skipped)");
+            ++out.malformed;
         }
     }
     out.counts = board.counts();
     const StateCounts& c = out.counts;
-    if (c.accepted + c.not_finite + c.implausible + c.time_backwards + c.duplicate_time == 0U) {
+    if (c.accepted + out.refused() + out.malformed == 0U) {
         throw InputError(path, lines.line_number() + 1, 1, "the states file has no rows");
+    }
+    if (c.accepted == 0U) {
+        throw InputError(path, 0, 0,
+                         "no state of the file is usable: " + std::to_string(out.refused()) +
+                             " refused by the velocity service" +
+                             (out.malformed != 0 ? ", " + std::to_string(out.malformed) + " malformed (--skip-bad)"
+                                                 : std::string()) +
+                             "; no row would get a velocity from it (km and km/s in increasing time?)");
     }
     return out;
 }

@@ -231,10 +231,72 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
 
 }  // namespace
 
+namespace {
+
+// Refuses, naming the file and why, an image QEMU would fail on only after
+// starting (a register dump, then a closed link): not a 32-bit little-endian
+// ARM executable ELF, a hard-float image for a board without an FPU (the
+// toolchain's cpus with an FPU are named so: cortex-m4f), or an entry point outside the MPS2
+// boards' code memory, where the images are linked (__flash = 0, 4 MiB:
+// toolchain/arm-none-eabi-picolibc.cmake).
+void check_link_image(const std::string& path, const QemuTarget& board) {
+    constexpr std::uint32_t kCodeMemoryBytes = 0x400000U;
+    constexpr std::uint16_t kElfExecutable = 2U;
+    constexpr std::uint16_t kElfMachineArm = 40U;
+    constexpr std::uint32_t kArmFloatHard = 0x400U;  // EF_ARM_ABI_FLOAT_HARD
+    std::ifstream f(path, std::ios::binary);
+    unsigned char h[52] = {};
+    f.read(reinterpret_cast<char*>(h), sizeof h);
+    const auto u16 = [&](std::size_t at) { return static_cast<std::uint16_t>(h[at] | (h[at + 1] << 8)); };
+    const auto u32 = [&](std::size_t at) {
+        return static_cast<std::uint32_t>(h[at]) | (static_cast<std::uint32_t>(h[at + 1]) << 8) |
+               (static_cast<std::uint32_t>(h[at + 2]) << 16) | (static_cast<std::uint32_t>(h[at + 3]) << 24);
+    };
+    const std::string where = "--firmware " + path + ": not a link image for --target " + std::string(board.replay) +
+                              " (" + std::string(board.machine) + "): ";
+    if (f.gcount() < static_cast<std::streamsize>(sizeof h) || h[0] != 0x7F || h[1] != 'E' || h[2] != 'L' ||
+        h[3] != 'F') {
+        throw std::runtime_error(where + "not an ELF file");
+    }
+    if (h[4] != 1 || h[5] != 1) {
+        throw std::runtime_error(where + "not a 32-bit little-endian ELF (class " + std::to_string(h[4]) + ", data " +
+                                 std::to_string(h[5]) + ")");
+    }
+    if (u16(18) != kElfMachineArm) {
+        throw std::runtime_error(where + "ELF machine " + std::to_string(u16(18)) + ", not ARM (40)");
+    }
+    if (u16(16) != kElfExecutable) {
+        throw std::runtime_error(where + "ELF type " + std::to_string(u16(16)) + ", not an executable (2)");
+    }
+    const bool hard = (u32(36) & kArmFloatHard) != 0U;
+    const bool fpu = !board.cpu.empty() && board.cpu.back() == 'f';
+    if (hard && !fpu) {
+        throw std::runtime_error(where + "a hard-float image, and the board's cpu (" + std::string(board.cpu) +
+                                 ") has no FPU");
+    }
+    const std::uint32_t entry = u32(24);
+    if (entry >= kCodeMemoryBytes) {
+        char buf[120];
+        std::snprintf(buf, sizeof buf, "entry point 0x%08x is outside the board's code memory [0, 0x%x)", entry,
+                      kCodeMemoryBytes);
+        throw std::runtime_error(where + buf);
+    }
+}
+
+}  // namespace
+
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
     refuse_output_over_input(
         {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}},
         {{"--out", opt.out}}, true);
+    if (std::llround(opt.max_propagation_s * 1e6) != default_velocity_service_config().horizon_us) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf,
+                      "--max-propagation %.17g: a target propagates a state for %.17g s, the "
+                      "horizon built into its firmware; replay cannot change it (correct can)",
+                      opt.max_propagation_s, static_cast<double>(default_velocity_service_config().horizon_us) * 1e-6);
+        throw std::runtime_error(buf);
+    }
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never
@@ -252,6 +314,7 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         if (!std::ifstream(image).good()) {
             throw std::runtime_error(image + ": cannot read the link firmware image");
         }
+        check_link_image(image, *board);
         ProcessTransport qemu(qemu_link_command(std::string(board->machine), image));
         return fixed ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
     }

@@ -118,6 +118,11 @@ struct Selection {
     std::string verdict;  // one sentence: which model the data support, and why
 };
 
+// The verdict on two held-out IBA RMS (means over the pairs, both > 0): the
+// quadratic model when it is lower by more than the margin; otherwise the
+// linear, saying by how much the quadratic terms lower or raise the RMS.
+std::string selection_verdict(double linear_rms, double quadratic_rms);
+
 // Fits both models on the orbits before t_split and scores them on the
 // epochs before and after it. holdout 0: fits and scores on the whole period,
 // no verdict.

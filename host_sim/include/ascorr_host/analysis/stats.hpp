@@ -31,6 +31,11 @@ struct StatsOptions {
     std::optional<double> to;
     bool keep_series = false;                    // keep the IBA time series (for plots)
     std::string period_options = "--from/--to";  // the options that set from and to, for messages
+    // The rows are already corrected (a corrected file): no stage is applied;
+    // the "original" stage is the rows as they are, the others are null.
+    bool corrected_input = false;
+    // Log a line per pair without clean epochs (plot says it once, itself).
+    bool log_empty_pairs = true;
 };
 
 struct PairSeries {
@@ -40,6 +45,7 @@ struct PairSeries {
 
 struct StatsResult {
     bool thermal = false;
+    bool corrected_input = false;  // StatsOptions::corrected_input: only the "original" stage
     std::array<std::array<Rms, kStages>, kPairs> rms{};
     std::array<std::size_t, kPairs> n{};
     std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
@@ -56,6 +62,8 @@ bool is_clean(const SolutionRecord& rec) noexcept;
 
 // Throws InputError for a malformed input; log gets one line per rejected row
 // and one per pair without clean epochs ("FILE: pair A-C: no clean epochs: REASON").
+// A corrected file (a `status` column) is never corrected again: with a model it
+// is refused; without one it is shown as it is (corrected_input).
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 // The same on rows from elsewhere (opt.in names them in messages; opt.model is
 // not read: model, nullptr for no thermal stage).
@@ -64,7 +72,9 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 
 // Whether pair p has an RMS at stage st: two clean epochs at least (the RMS
 // of one epoch about itself is 0, not a measurement) and, for the thermal
-// stage, a model. Otherwise the table says "-", the JSON null, Python None.
+// stage, a model; for the aberration and thermal stages, a raw input (a
+// corrected file is shown as it is, under "original"). Otherwise the table
+// says "-", the JSON null, Python None.
 inline constexpr std::size_t kMinEpochsForRms = 2;
 bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept;
 

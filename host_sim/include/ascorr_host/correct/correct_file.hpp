@@ -42,6 +42,10 @@ struct CorrectSummary {
     std::size_t malformed = 0;                 // rows dropped (skip_bad only)
     std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
     ServiceCost service_cost;                  // the velocity service's work (--states)
+    bool states_given = false;                 // --states: the three counts below
+    std::size_t states_accepted = 0;
+    std::size_t states_refused = 0;    // by the velocity service's checks
+    std::size_t states_malformed = 0;  // skipped (skip_bad only)
 };
 
 // Throws InputError or std::runtime_error; writes nothing then.

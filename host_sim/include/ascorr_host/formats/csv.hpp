@@ -18,15 +18,19 @@
 #include <vector>
 
 #include "ascorr_text/csv_fields.hpp"
+#include "ascorr_text/line_limit.hpp"
 
 namespace ascorr::host {
 
-// The whole content of a file. Throws InputError (line 0) if it cannot be read.
+// The whole content of a file. Throws InputError (line 0) if it cannot be read,
+// and at file:line for a line beyond text::kMaxLineBytes or a NUL byte,
+// as soon as it is read.
 std::string read_text_file(const std::string& path);
 
 // Reads a file in blocks of whole lines, so that a recorded mission of any
 // size is processed in bounded memory. Each block ends at a line end (the last
-// one may lack it) and is free of NUL bytes (InputError otherwise).
+// one may lack it), is free of NUL bytes and has no line beyond
+// text::kMaxLineBytes (InputError at file:line otherwise).
 class BlockReader {
 public:
     static constexpr std::size_t kDefaultBlockBytes = 32U << 20;
@@ -52,6 +56,7 @@ private:
     std::size_t lines_before_ = 0;
     std::size_t lines_in_last_ = 0;
     bool eof_ = false;
+    text::LineLengthScan scan_;
 };
 
 // Number of line ends ('\n') in text; memchr-based, so it runs at memory speed.
@@ -98,6 +103,10 @@ std::string why_not_a_number(std::string_view field);
 // decimal digits beyond it (-1 for flags, 99999999999999999999), otherwise
 // "expected an integer in [lo, hi], got 'FIELD'".
 std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
+
+// The shortest decimal text that reads back as x ("0.50000001", "1e-05",
+// "nan", "inf"), for messages that repeat a refused value: never rounded.
+std::string number_text(double x);
 
 // Formats x with `decimals` digits after the point into out, returns the end.
 char* format_fixed(char* out, char* end, double x, int decimals) noexcept;

@@ -87,10 +87,12 @@ private:
 // Throws InputError when the header has a `status` column: the file is already
 // corrected (docs/contract.md), and correcting or fitting it again would apply the
 // corrections twice.
-// (`stats` and `plot` accept a corrected file: its "original" stage is then
-// the file as corrected.)
+// (`stats` without a model shows a corrected file as it is, its one stage;
+// `stats --model` and `plot` refuse it.)
 void refuse_corrected_input(const SolutionsReader& header);
 // The same check on a file's header line, read alone.
 void refuse_corrected_file(const std::string& path);
+// True when the file's header has a `status` column (a corrected file).
+bool is_corrected_file(const std::string& path);
 
 }  // namespace ascorr::host

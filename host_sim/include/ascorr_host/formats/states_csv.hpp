@@ -13,6 +13,11 @@
 // through Diagnostics with file:line and its verdict, and counted; the others
 // are kept. The verdicts are the on-board code's, applied in file order, so
 // the host keeps exactly the states a DPU given the same feed keeps.
+//
+// With skip_bad (--skip-bad), a malformed data row is reported through
+// Diagnostics with file:line:column and counted instead (the header stays
+// required). A file in which no state is accepted (every row refused or
+// skipped) gives the velocity of no row: it throws InputError naming the counts.
 #pragma once
 
 #include <array>
@@ -37,9 +42,15 @@ struct StatesFile {
     StateFrame frame = StateFrame::kItrf;
     std::vector<StateRecord> accepted;  // in increasing time
     StateCounts counts{};               // the on-board verdicts, file order
+    std::size_t malformed = 0;          // rows skipped (skip_bad only)
+
+    std::size_t refused() const noexcept {
+        return static_cast<std::size_t>(counts.not_finite) + counts.implausible + counts.time_backwards +
+               counts.duplicate_time;
+    }
 };
 
-StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag);
+StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnostics& diag, bool skip_bad = false);
 
 // "non-finite position or velocity", ... for messages.
 const char* describe(StateVerdict v) noexcept;

@@ -24,8 +24,11 @@ struct ReplayOptions {
     std::string in;
     std::string model;
     std::string out;
-    std::string states;          // --states: spacecraft states sent over the link in time order; empty: none
-    bool states_gcrs = false;    // --states-frame gcrs (default itrf)
+    std::string states;        // --states: spacecraft states sent over the link in time order; empty: none
+    bool states_gcrs = false;  // --states-frame gcrs (default itrf)
+    // --max-propagation: the target's horizon is its firmware's (the velocity
+    // service's default); another value is refused, not silently ignored.
+    double max_propagation_s = 21600.0;
     double inject_errors = 0.0;  // fraction of frames faulted, each direction
     bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
     int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
