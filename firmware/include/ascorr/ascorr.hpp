@@ -33,6 +33,9 @@
 //   nav/earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
 //   nav/sincos.hpp         sin/cos in double with the same bits on every platform
 //   nav/orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
+//   nav/state_gate.hpp     the verdicts on incoming states, the plausible orbit
+//   nav/earth_grid.hpp     the Earth series on a 60 s grid, linear between
+//   nav/velocity_node.hpp  the 10 s velocity node and its per-solution query
 //   nav/velocity_service.hpp   states in, ObserverVelocity<T> per solution out
 // The headers at this folder's top level but this one forward to their part's
 // header, so that includes written before the parts existed keep working.
