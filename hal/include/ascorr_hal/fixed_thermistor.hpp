@@ -169,7 +169,7 @@ constexpr double celsius_of_code(const Curve& t, std::uint16_t code) noexcept {
 }
 
 constexpr std::int32_t raw(double celsius) noexcept {
-    return fx::raw_from_double(celsius, QCelsius::kFracBits);
+    return fx::raw_from_double<QCelsius::kFracBits>(celsius);
 }
 
 // Slope of a segment, raw per code ·2⁸, rounded to nearest.

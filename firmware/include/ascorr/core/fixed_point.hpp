@@ -80,19 +80,28 @@ constexpr std::int64_t round_shift(std::int64_t v, int s) noexcept {
     return (v + (std::int64_t{1} << (s - 1))) >> s;
 }
 
-// x·2^frac as a raw value: round to nearest (ties away from zero), saturated;
-// NaN → kRawMax. Compile time for constants, host only otherwise.
-constexpr std::int32_t raw_from_double(double x, int frac) noexcept {
-    if (!(x == x)) {
-        return kRawMax;
+// 2^e as a double, exact for |e| ≤ 1022; folded at compile time.
+constexpr double pow2(int e) noexcept {
+    double p = 1.0;
+    for (int i = 0; i < e; ++i) {
+        p *= 2.0;
     }
-    double scale = 1.0;
-    for (int i = 0; i < frac; ++i) {  // exact powers of two; folded at compile time
-        scale *= 2.0;
+    for (int i = 0; i > e; --i) {
+        p *= 0.5;
     }
-    const double s = x * scale;
-    if (s >= 2147483647.0) {
-        return kRawMax;
+    return p;
+}
+
+// x·2^Frac as a raw value: one multiplication (by the exact constant 2^Frac),
+// rounded to nearest (ties away from zero), saturated to ±(2³¹ − 1); NaN →
+// kRawMax. At compile time for constants; at run time it costs one double
+// product, two comparisons and one conversion.
+template <int Frac>
+constexpr std::int32_t raw_from_double(double x) noexcept {
+    constexpr double kScale = pow2(Frac);
+    const double s = x * kScale;
+    if (!(s < 2147483647.0)) {
+        return kRawMax;  // also NaN
     }
     if (s <= -2147483647.0) {
         return -kRawMax;  // symmetric: −2 (raw INT32_MIN) is never produced
@@ -100,12 +109,11 @@ constexpr std::int32_t raw_from_double(double x, int frac) noexcept {
     return static_cast<std::int32_t>(s < 0.0 ? s - 0.5 : s + 0.5);
 }
 
-constexpr double raw_to_double(std::int32_t raw, int frac) noexcept {
-    double scale = 1.0;
-    for (int i = 0; i < frac; ++i) {
-        scale *= 0.5;
-    }
-    return static_cast<double>(raw) * scale;
+// raw·2^−Frac, exact.
+template <int Frac>
+constexpr double raw_to_double(std::int32_t raw) noexcept {
+    constexpr double kScale = pow2(-Frac);
+    return static_cast<double>(raw) * kScale;
 }
 
 constexpr std::int32_t add_sat(std::int32_t a, std::int32_t b) noexcept {
@@ -236,21 +244,21 @@ struct ScalarTraits<Q30> {
     using coefficient_type = QCoefficient;
     using quadratic_coefficient_type = QQuadraticCoefficient;
     using temperature_type = QCelsius;
-    static constexpr Q30 from_double(double x) noexcept { return {fx::raw_from_double(x, Q30::kFracBits)}; }
-    static constexpr double to_double(Q30 x) noexcept { return fx::raw_to_double(x.raw, Q30::kFracBits); }
-    static constexpr QCelsius celsius(double x) noexcept { return {fx::raw_from_double(x, QCelsius::kFracBits)}; }
-    static constexpr double to_double(QCelsius x) noexcept { return fx::raw_to_double(x.raw, QCelsius::kFracBits); }
+    static constexpr Q30 from_double(double x) noexcept { return {fx::raw_from_double<Q30::kFracBits>(x)}; }
+    static constexpr double to_double(Q30 x) noexcept { return fx::raw_to_double<Q30::kFracBits>(x.raw); }
+    static constexpr QCelsius celsius(double x) noexcept { return {fx::raw_from_double<QCelsius::kFracBits>(x)}; }
+    static constexpr double to_double(QCelsius x) noexcept { return fx::raw_to_double<QCelsius::kFracBits>(x.raw); }
     static constexpr QCoefficient coefficient(double x) noexcept {
-        return {fx::raw_from_double(x, QCoefficient::kFracBits)};
+        return {fx::raw_from_double<QCoefficient::kFracBits>(x)};
     }
     static constexpr double to_double(QCoefficient x) noexcept {
-        return fx::raw_to_double(x.raw, QCoefficient::kFracBits);
+        return fx::raw_to_double<QCoefficient::kFracBits>(x.raw);
     }
     static constexpr QQuadraticCoefficient quadratic_coefficient(double x) noexcept {
-        return {fx::raw_from_double(x, QQuadraticCoefficient::kFracBits)};
+        return {fx::raw_from_double<QQuadraticCoefficient::kFracBits>(x)};
     }
     static constexpr double to_double(QQuadraticCoefficient x) noexcept {
-        return fx::raw_to_double(x.raw, QQuadraticCoefficient::kFracBits);
+        return fx::raw_to_double<QQuadraticCoefficient::kFracBits>(x.raw);
     }
     // Largest coefficients the formats hold (rad, rad/°C; rad/°C²); a model
     // beyond them cannot be represented and must be refused by the loader.
@@ -258,7 +266,7 @@ struct ScalarTraits<Q30> {
     static constexpr double max_quadratic_coefficient = 0x1p-17;
     // Rounding a unit quaternion's components to 2⁻³¹ leaves |‖q‖² − 1| ≤ 4e-9;
     // the bound is the double path's, so both reject the same inputs.
-    static constexpr Q30 unit_norm_tolerance = {fx::raw_from_double(1e-6, Q30::kFracBits)};
+    static constexpr Q30 unit_norm_tolerance = {fx::raw_from_double<Q30::kFracBits>(1e-6)};
     // The core's series are specialised for Q30 below (aberration_rotation,
     // thermal_rotation), cut at the format's resolution.
     static constexpr bool double_precision = false;
@@ -516,7 +524,7 @@ constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quate
 // within ±kMaxBeta (then |βᵢ| < 2²², the squares are exact and small), then
 // |β|² against kMaxBeta² exactly, in units 2⁻⁶⁰.
 constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
-    constexpr std::int32_t lim = fx::raw_from_double(kMaxBeta, Q30::kFracBits);
+    constexpr std::int32_t lim = fx::raw_from_double<Q30::kFracBits>(kMaxBeta);
     constexpr auto lim2 = static_cast<std::int64_t>(kMaxBeta * kMaxBeta * 0x1p60);
     const auto within = [](Q30 c) { return c.raw <= lim && -lim <= c.raw; };
     return within(beta.x) && within(beta.y) && within(beta.z) &&
@@ -637,7 +645,7 @@ namespace fx {
 
 // tan(angle/2) in Q30, |angle| clamped to ≤ kMaxThermalAngleRad.
 constexpr std::int32_t tan_half_angle(Q30 angle) noexcept {
-    constexpr std::int32_t lim = raw_from_double(kMaxThermalAngleRad, Q30::kFracBits);
+    constexpr std::int32_t lim = raw_from_double<Q30::kFracBits>(kMaxThermalAngleRad);
     constexpr std::int32_t kSixth = 715827883;  // ⌈2³²/6⌉
     const std::int32_t a = unshared(angle.raw > lim ? lim : (angle.raw < -lim ? -lim : angle.raw));
     const std::int32_t h2 = round_shift_to_int32<32>(mul(a, a));  // (a/2)², Q30, < 2¹⁷

@@ -33,134 +33,104 @@
 
 namespace ascorr {
 
-inline constexpr std::int64_t kVelocityNodeUs =
-    10000000; // kPropagationStepS in µs
-static_assert(kPropagationStepS * 1e6 == static_cast<double>(kVelocityNodeUs),
-              "one node per RK4 step");
+inline constexpr std::int64_t kVelocityNodeUs = 10000000;  // kPropagationStepS in µs
+static_assert(kPropagationStepS * 1e6 == static_cast<double>(kVelocityNodeUs), "one node per RK4 step");
 
-template <typename T> struct ServiceVelocity {
-  ObserverVelocity<T> velocity;
-  StatusBits status; // 0, 4, 4|512 or 4|32 (velocity_service.hpp)
+template <typename T>
+struct ServiceVelocity {
+    ObserverVelocity<T> velocity;
+    StatusBits status;  // 0, 4, 4|512 or 4|32 (velocity_service.hpp)
 };
 
 // No velocity for a solution: zero β, 1/s = 1, not valid, with the status.
 template <typename T>
 constexpr ServiceVelocity<T> no_velocity(StatusBits status) noexcept {
-  constexpr T zero = constant<T>(
-      0.0); // constexpr: no conversion at run time (soft-float on the M3)
-  constexpr T one = constant<T>(1.0);
-  return {{{zero, zero, zero}, one, false}, status};
+    constexpr T zero = constant<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
+    constexpr T one = constant<T>(1.0);
+    return {{{zero, zero, zero}, one, false}, status};
 }
 
 // f = dt/10 s in the scalar: dt_us in [0, kVelocityNodeUs].
 constexpr double node_fraction(std::int32_t dt_us, double /*tag*/) noexcept {
-  return static_cast<double>(dt_us) *
-         (1.0 / static_cast<double>(kVelocityNodeUs));
+    return static_cast<double>(dt_us) * (1.0 / static_cast<double>(kVelocityNodeUs));
 }
 constexpr float node_fraction(std::int32_t dt_us, float /*tag*/) noexcept {
-  return static_cast<float>(dt_us) *
-         (1.0F / static_cast<float>(kVelocityNodeUs)); // dt_us < 2²⁴: exact
+    return static_cast<float>(dt_us) * (1.0F / static_cast<float>(kVelocityNodeUs));  // dt_us < 2²⁴: exact
 }
 // Q30: raw = dt_us · 2³⁰/10⁷, as dt_us · round(2⁶¹/10⁷) · 2⁻³¹ rounded to
 // nearest (multiplier 230584300921.37, relative error 1.6e-12; product
 // ≤ 10⁷ · 2.31e11 < 2⁶²: no overflow). Integer only.
 constexpr Q30 node_fraction(std::int32_t dt_us, Q30 /*tag*/) noexcept {
-  constexpr std::int64_t kMul = 230584300921LL;
-  return {static_cast<std::int32_t>(
-      fx::round_shift(std::int64_t{dt_us} * kMul, 31))};
+    constexpr std::int64_t kMul = 230584300921LL;
+    return {static_cast<std::int32_t>(fx::round_shift(std::int64_t{dt_us} * kMul, 31))};
 }
 
-// double → T at run time (node building, outside the per-solution path):
-// rounded to nearest. Q30: x·2³⁰ by one multiplication (fx::raw_from_double
-// builds 2³⁰ in a loop, fine for constants, 30 soft-float products on the M3),
-// saturated to ±(2 − 2⁻³⁰); the callers' values are ≤ 3.4e-3 (β) and ≤ 10 (1/s:
-// ≤ 1.02).
-constexpr double scalar_from_double(double x, double /*tag*/) noexcept {
-  return x;
-}
-constexpr float scalar_from_double(double x, float /*tag*/) noexcept {
-  return static_cast<float>(x);
-}
-constexpr Q30 scalar_from_double(double x, Q30 /*tag*/) noexcept {
-  const double s = x * 1073741824.0;
-  if (!(s < 2147483647.0)) {
-    return {fx::kRawMax}; // also NaN
-  }
-  if (s <= -2147483647.0) {
-    return {-fx::kRawMax};
-  }
-  return {static_cast<std::int32_t>(s < 0.0 ? s - 0.5 : s + 0.5)};
-}
-
-template <typename T> class VelocityNode {
+template <typename T>
+class VelocityNode {
 public:
-  // The node at t0 from the state y propagated to t0 (a_kms2: its J2
-  // acceleration) and the Earth there (e, e_rate_kms2; earth_ok: the series
-  // was inside its span). A node whose state left the plausible orbit
-  // (state_gate.hpp), whose Earth is unknown or whose β, Δβ or 1/s are out
-  // of range answers 4|32 (status::kVelocityInvalid).
-  void build(TtTime t0, const OrbitState &y, const Vector3<double> &a_kms2,
-             const EarthBarycentric &e, const Vector3<double> &e_rate_kms2,
-             bool earth_ok) noexcept {
-    t0_ = t0;
-    present_ = true;
-    status_ = 0U;
-    if (!(earth_ok && plausible_orbit(y))) {
-      status_ = status::kNoVelocity | status::kVelocityInvalid;
-      return;
+    // The node at t0 from the state y propagated to t0 (a_kms2: its J2
+    // acceleration) and the Earth there (e, e_rate_kms2; earth_ok: the series
+    // was inside its span). A node whose state left the plausible orbit
+    // (state_gate.hpp), whose Earth is unknown or whose β, Δβ or 1/s are out
+    // of range answers 4|32 (status::kVelocityInvalid).
+    void build(TtTime t0, const OrbitState& y, const Vector3<double>& a_kms2, const EarthBarycentric& e,
+               const Vector3<double>& e_rate_kms2, bool earth_ok) noexcept {
+        t0_ = t0;
+        present_ = true;
+        status_ = 0U;
+        if (!(earth_ok && plausible_orbit(y))) {
+            status_ = status::kNoVelocity | status::kVelocityInvalid;
+            return;
+        }
+        constexpr double inv_c = 1.0 / kSpeedOfLightKmS;
+        const Vector3<double> b0 = inv_c * (e.v_earth_icrf_kms + y.v_kms);
+        const Vector3<double> db = (inv_c * kPropagationStepS) * (e_rate_kms2 + a_kms2);  // over one node
+        const double inv_s = 1.0 / e.sun_distance_au;
+        if (!(squared_norm(b0) <= kMaxBeta * kMaxBeta && squared_norm(db) <= 1e-12 && inv_s > 0.1 && inv_s < 10.0)) {
+            status_ = status::kNoVelocity | status::kVelocityInvalid;
+            return;
+        }
+        // To T, rounded to nearest (ScalarTraits<T>::from_double): β ≤ 3.4e-3
+        // and Δβ ≤ 1e-6 are inside every scalar's range; 1/s ≤ 1.02 on the
+        // Earth's orbit (the check above admits < 10; Q30 saturates at 2).
+        const auto to_t = [](double x) { return ScalarTraits<T>::from_double(x); };
+        beta0_ = {to_t(b0.x), to_t(b0.y), to_t(b0.z)};
+        dbeta_ = {to_t(db.x), to_t(db.y), to_t(db.z)};
+        inv_sun_distance_ = to_t(inv_s);
     }
-    constexpr double inv_c = 1.0 / kSpeedOfLightKmS;
-    const Vector3<double> b0 = inv_c * (e.v_earth_icrf_kms + y.v_kms);
-    const Vector3<double> db =
-        (inv_c * kPropagationStepS) * (e_rate_kms2 + a_kms2); // over one node
-    const double inv_s = 1.0 / e.sun_distance_au;
-    if (!(squared_norm(b0) <= kMaxBeta * kMaxBeta &&
-          squared_norm(db) <= 1e-12 && inv_s > 0.1 && inv_s < 10.0)) {
-      status_ = status::kNoVelocity | status::kVelocityInvalid;
-      return;
-    }
-    beta0_ = {scalar_from_double(b0.x, T{}), scalar_from_double(b0.y, T{}),
-              scalar_from_double(b0.z, T{})};
-    dbeta_ = {scalar_from_double(db.x, T{}), scalar_from_double(db.y, T{}),
-              scalar_from_double(db.z, T{})};
-    inv_sun_distance_ = scalar_from_double(inv_s, T{});
-  }
 
-  // t in [t₀, t₀ + 10 s): this node is the one to build β at t from
-  // (integer compares only).
-  constexpr bool holds(TtTime t) const noexcept {
-    return present_ && t0_ <= t && t.us - t0_.us < kVelocityNodeUs;
-  }
+    // t in [t₀, t₀ + 10 s): this node is the one to build β at t from
+    // (integer compares only).
+    constexpr bool holds(TtTime t) const noexcept { return present_ && t0_ <= t && t.us - t0_.us < kVelocityNodeUs; }
 
-  // The per-solution query, in T (no double, no division): 4|512 when there
-  // is no node or t is outside [t₀, t₀ + 10 s], the node's 4|32, else 0.
-  constexpr ServiceVelocity<T> at(TtTime t) const noexcept {
-    ServiceVelocity<T> out =
-        no_velocity<T>(status::kNoVelocity | status::kStale);
-    const std::int64_t dt = t.us - t0_.us;
-    if (!present_ || dt < 0 || dt > kVelocityNodeUs) {
-      return out;
+    // The per-solution query, in T (no double, no division): 4|512 when there
+    // is no node or t is outside [t₀, t₀ + 10 s], the node's 4|32, else 0.
+    constexpr ServiceVelocity<T> at(TtTime t) const noexcept {
+        ServiceVelocity<T> out = no_velocity<T>(status::kNoVelocity | status::kStale);
+        const std::int64_t dt = t.us - t0_.us;
+        if (!present_ || dt < 0 || dt > kVelocityNodeUs) {
+            return out;
+        }
+        if (status_ != 0U) {
+            out.status = status_;
+            return out;
+        }
+        const T f = node_fraction(static_cast<std::int32_t>(dt), T{});
+        out.velocity = {beta0_ + f * dbeta_, inv_sun_distance_, true};
+        out.status = 0U;
+        return out;
     }
-    if (status_ != 0U) {
-      out.status = status_;
-      return out;
-    }
-    const T f = node_fraction(static_cast<std::int32_t>(dt), T{});
-    out.velocity = {beta0_ + f * dbeta_, inv_sun_distance_, true};
-    out.status = 0U;
-    return out;
-  }
 
-  // Forgets the node (a new state was accepted).
-  constexpr void clear() noexcept { present_ = false; }
+    // Forgets the node (a new state was accepted).
+    constexpr void clear() noexcept { present_ = false; }
 
 private:
-  bool present_ = false;
-  TtTime t0_{0};
-  Vector3<T> beta0_{};
-  Vector3<T> dbeta_{};
-  T inv_sun_distance_{};
-  StatusBits status_ = 0U;
+    bool present_ = false;
+    TtTime t0_{0};
+    Vector3<T> beta0_{};
+    Vector3<T> dbeta_{};
+    T inv_sun_distance_{};
+    StatusBits status_ = 0U;
 };
 
-} // namespace ascorr
+}  // namespace ascorr
