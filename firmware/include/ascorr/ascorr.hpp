@@ -21,8 +21,12 @@
 //   core/model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
 //   core/status.hpp         status bits of a corrected solution
 //   core/correct.hpp        correct_solution(): the per-solution entry point
-//   core/fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
-//                           coefficient formats and thermal_angle)
+//   core/q_formats.hpp      Q30, the fixed-point scalar, and its temperature and
+//                           coefficient formats (range, scaling, rounding, saturation)
+//   core/fx.hpp             the integer arithmetic under them: conversions,
+//                           exact products, the rounding helpers
+//   core/fixed_point.hpp    all of the fixed-point core (the Q30 kernels are
+//                           beside their generic versions, each with its guard)
 //   core/compiler.hpp       what the fixed-point core asks of the compiler, checked
 //   nav/earth_series.hpp    the Earth's barycentric velocity and Sun distance, a
 //                           series fitted to ERFA eraEpv00 (double; coefficients in

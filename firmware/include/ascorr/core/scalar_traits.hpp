@@ -99,7 +99,7 @@ using Celsius = typename ScalarTraits<T>::temperature_type;
 // format), at compile time and at run time alike: the host's readers, the
 // velocity node (nav/velocity_node.hpp) and the literals of the algorithms all
 // use it. For Q30 it is one product by the exact constant 2³⁰, two comparisons
-// and one conversion (fixed_point.hpp: fx::raw_from_double).
+// and one conversion (fx.hpp: fx::raw_from_double).
 //
 //   T       range                 rounding                     saturation
 //   double  any                   exact                        none

@@ -12,9 +12,9 @@
 // in LEO: ≤ 4.8e-3 m/s 1 s after a state, ≤ 0.48 m/s (3e-4″) at the end of a
 // node in a gap. Q30 rounds β₀, Δβ and f·Δβ to 2⁻³¹: ≤ 3 · 4.7e-10 · c
 // = 0.42 m/s (3e-4″).
-// build() is double (software on the Cortex-M3), once per node. at() is the
-// per-solution query: integer microseconds to f, one product and one sum per
-// component in T; no double, no division: free of soft-float
+// build() is double (software on the Cortex-M3), once per node. query() is
+// the per-solution query (VelocityService::velocity_at): integer microseconds to f, one product and
+// one sum per component in T; no double, no division: free of soft-float
 // (tests/target/check-no-soft-float).
 #pragma once
 
@@ -24,6 +24,7 @@
 #include "../core/constants.hpp"
 #include "../core/correct.hpp"
 #include "../core/fixed_point.hpp"
+#include "../core/fx.hpp"
 #include "../core/status.hpp"
 #include "../core/vector3.hpp"
 #include "earth_series.hpp"
@@ -33,22 +34,14 @@
 
 namespace ascorr {
 
-inline constexpr std::int64_t kVelocityNodeUs = 10000000;  // kPropagationStepS in µs
-static_assert(kPropagationStepS * 1e6 == static_cast<double>(kVelocityNodeUs), "one node per RK4 step");
-
 template <typename T>
 struct ServiceVelocity {
     ObserverVelocity<T> velocity;
     StatusBits status;  // 0, 4, 4|512 or 4|32 (velocity_service.hpp)
 };
 
-// No velocity for a solution: zero β, 1/s = 1, not valid, with the status.
-template <typename T>
-constexpr ServiceVelocity<T> no_velocity(StatusBits status) noexcept {
-    constexpr T zero = constant<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
-    constexpr T one = constant<T>(1.0);
-    return {{{zero, zero, zero}, one, false}, status};
-}
+inline constexpr std::int64_t kVelocityNodeUs = 10000000;  // kPropagationStepS in µs
+static_assert(kPropagationStepS * 1e6 == static_cast<double>(kVelocityNodeUs), "one node per RK4 step");
 
 // f = dt/10 s in the scalar: dt_us in [0, kVelocityNodeUs].
 constexpr double node_fraction(std::int32_t dt_us, double /*tag*/) noexcept {
@@ -62,7 +55,7 @@ constexpr float node_fraction(std::int32_t dt_us, float /*tag*/) noexcept {
 // ≤ 10⁷ · 2.31e11 < 2⁶²: no overflow). Integer only.
 constexpr Q30 node_fraction(std::int32_t dt_us, Q30 /*tag*/) noexcept {
     constexpr std::int64_t kMul = 230584300921LL;
-    return {static_cast<std::int32_t>(fx::round_shift(std::int64_t{dt_us} * kMul, 31))};
+    return {fx::narrow<31>(std::int64_t{dt_us} * kMul)};
 }
 
 template <typename T>
@@ -103,22 +96,22 @@ public:
     // (integer compares only).
     constexpr bool holds(TtTime t) const noexcept { return present_ && t0_ <= t && t.us - t0_.us < kVelocityNodeUs; }
 
-    // The per-solution query, in T (no double, no division): 4|512 when there
-    // is no node or t is outside [t₀, t₀ + 10 s], the node's 4|32, else 0.
-    constexpr ServiceVelocity<T> at(TtTime t) const noexcept {
-        ServiceVelocity<T> out = no_velocity<T>(status::kNoVelocity | status::kStale);
+    // The per-solution query, in T (no double, no division): out.status
+    // 4|512 when there is no node or t is outside [t₀, t₀ + 10 s], the node's
+    // 4|32 when build() refused it, else 0 with out.velocity = β₀ + f·Δβ.
+    constexpr void query(TtTime t, ServiceVelocity<T>& out) const noexcept {
         const std::int64_t dt = t.us - t0_.us;
         if (!present_ || dt < 0 || dt > kVelocityNodeUs) {
-            return out;
+            out.status = status::kNoVelocity | status::kStale;
+            return;
         }
         if (status_ != 0U) {
             out.status = status_;
-            return out;
+            return;
         }
         const T f = node_fraction(static_cast<std::int32_t>(dt), T{});
         out.velocity = {beta0_ + f * dbeta_, inv_sun_distance_, true};
         out.status = 0U;
-        return out;
     }
 
     // Forgets the node (a new state was accepted).

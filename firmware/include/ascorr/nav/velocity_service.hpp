@@ -39,6 +39,8 @@
 
 #include <cstdint>
 
+#include "../core/aberration.hpp"
+#include "../core/scalar_traits.hpp"
 #include "../core/status.hpp"
 #include "../core/vector3.hpp"
 #include "earth_frame.hpp"
@@ -147,13 +149,18 @@ public:
 
     // The per-solution query, in T (no double, no division). advance(t) first.
     constexpr ServiceVelocity<T> velocity_at(TtTime t) const noexcept {
+        constexpr T zero = constant<T>(0.0);  // constexpr: no conversion at run time (soft-float on the M3)
+        constexpr T one = constant<T>(1.0);
+        ServiceVelocity<T> out{{{zero, zero, zero}, one, false}, status::kNoVelocity};
         if (!gate_.has_state() || t < gate_.latest()) {
-            return no_velocity<T>(status::kNoVelocity);
+            return out;
         }
         if (t.us - gate_.latest().us > cfg_.horizon_us) {
-            return no_velocity<T>(status::kNoVelocity | status::kStale);
+            out.status = status::kNoVelocity | status::kStale;
+            return out;
         }
-        return node_.at(t);
+        node_.query(t, out);
+        return out;
     }
 
     constexpr const StateCounts& counts() const noexcept { return gate_.counts(); }
