@@ -112,7 +112,7 @@ constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const V
 }
 
 // ---- In Q30 (q_formats.hpp), each overload followed by its guard (vector3.hpp).
-// beta_in_domain (aberration.hpp) in Q30, for any input: each component
+// beta_in_domain (above) in Q30, for any input: each component
 // within ±kMaxBeta (then |βᵢ| < 2²², the squares are exact and small), then
 // |β|² against kMaxBeta² exactly, in units 2⁻⁶⁰.
 constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
@@ -125,7 +125,7 @@ constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
 template <>
 bool beta_in_domain<Q30>(const Vector3<Q30>&) noexcept = delete;
 
-// aberration_rotation (aberration.hpp) in Q30: the same q_ab, with the series
+// aberration_rotation (above) in Q30: the same q_ab, with the series
 // cut at the format's resolution (2⁻³⁰ = 9.3e-10). With c = z × β,
 // n = |c|² = sin²θ·(1 + p)²/(w1 + w2)² and p = z·β:
 //   f = (w1 + w2)/(1 + p) = 1 − p/2 + p²/2 + O(p³/2, p·β²/8, w2),

@@ -172,7 +172,7 @@ constexpr Q30 squared_norm(const Quaternion<Q30>& q) noexcept {
 template <>
 Q30 squared_norm<Q30>(const Quaternion<Q30>&) noexcept = delete;
 
-// Hamilton product a ⊗ b (quaternion.hpp), each component rounded once.
+// Hamilton product a ⊗ b (above), each component rounded once.
 constexpr Quaternion<Q30> operator*(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
     using fx::half_sum;
     using fx::mac2;
@@ -197,7 +197,7 @@ Quaternion<Q30> operator*<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&) n
 // difference, or with saturating steps in between, GCC 12 builds some products
 // from MUL/MLA/UMULL instead, three to four times the instructions.)
 
-// boresight (quaternion.hpp), the third row of R(q), in Q30: each component
+// boresight (above), the third row of R(q), in Q30: each component
 // a sum of two products, exact, doubled exactly (read in units 2⁻⁵⁹) and
 // rounded once. Range: q passed norm_within() (|qᵢ| ≤ 1 + 5e-7); then every
 // component is ≤ 1 + 1e-6 in magnitude.
@@ -214,7 +214,7 @@ constexpr Vector3<Q30> boresight(const Quaternion<Q30>& q) noexcept {
 template <>
 Vector3<Q30> boresight<Q30>(const Quaternion<Q30>&) noexcept = delete;
 
-// conjugate (quaternion.hpp) of a SmallRotation in Q30: plain negation, exact,
+// conjugate (above) of a SmallRotation in Q30: plain negation, exact,
 // since a rotation's vector part is within ±1 (never −2).
 constexpr SmallRotation<Q30> conjugate(const SmallRotation<Q30>& r) noexcept {
     return {r.dw, {{-r.v.x.raw}, {-r.v.y.raw}, {-r.v.z.raw}}};
@@ -222,7 +222,7 @@ constexpr SmallRotation<Q30> conjugate(const SmallRotation<Q30>& r) noexcept {
 template <>
 SmallRotation<Q30> conjugate<Q30>(const SmallRotation<Q30>&) noexcept = delete;
 
-// norm_within (quaternion.hpp) in Q30, exact and for any input: ‖q‖² − 1 in
+// norm_within (above) in Q30, exact and for any input: ‖q‖² − 1 in
 // units 2⁻⁶⁰. The four squares (each ≤ 2⁶²) are summed modulo 2⁶⁴: exact
 // below 2⁶⁴; the only sum that wraps (all four components −2) reads 0, and
 // any true ‖q‖² − 1 ≥ 2⁶³ (units 2⁻⁶⁰; some |component| > 1.4) reads
@@ -236,7 +236,7 @@ constexpr bool norm_within(const Quaternion<Q30>& q, Q30 tol) noexcept {
 template <>
 bool norm_within<Q30>(const Quaternion<Q30>&, const Q30&) noexcept = delete;
 
-// right_increment (quaternion.hpp): q ⊗ (r − 1) in Q30, each component
+// right_increment (above): q ⊗ (r − 1) in Q30, each component
 // rounded once. Range: q passed norm_within() (|qᵢ| ≤ 1 + 5e-7) and the
 // components of r − 1 are within ±2⁻⁴ (aberration: ≤ 1.7e-3); each
 // product ≤ 2⁵⁷, each result ≤ 2⁻² in magnitude.
@@ -258,7 +258,7 @@ constexpr Quaternion<Q30> right_increment(const Quaternion<Q30>& q, const SmallR
 template <>
 Quaternion<Q30> right_increment<Q30>(const Quaternion<Q30>&, const SmallRotation<Q30>&) noexcept = delete;
 
-// add_left_increment (quaternion.hpp): d + (r − 1) ⊗ (q + d) in Q30, each
+// add_left_increment (above): d + (r − 1) ⊗ (q + d) in Q30, each
 // component dᵢ·2³⁰ + Σ (r − 1)ⱼ·(q + d)ₖ exact in int64 and rounded once.
 // Range: q passed norm_within(), |dᵢ| ≤ 2⁻⁴ (the aberration increment,
 // ≤ 1.7e-3), the components of r − 1 within ±2⁻⁴ (thermal, angles ≤ 1°:
@@ -286,7 +286,7 @@ template <>
 Quaternion<Q30> add_left_increment<Q30>(const Quaternion<Q30>&, const SmallRotation<Q30>&,
                                         const Quaternion<Q30>&) noexcept = delete;
 
-// renormalized_sum (quaternion.hpp) in Q30: s = q + d (exact), ε = ‖s‖² − 1
+// renormalized_sum (above) in Q30: s = q + d (exact), ε = ‖s‖² − 1
 // exact in int64, and each component sᵢ·(1 + g) with the Newton step taken to
 // second order, g = −ε/2 + 3ε²/8 (1/√(1 + ε) = 1 − ε/2 + 3ε²/8 − …): then
 // ‖result‖² − 1 = 5ε³/8 + O(ε⁴), which stays below 2⁻³⁰ for |ε| ≤ 1.1e-3,

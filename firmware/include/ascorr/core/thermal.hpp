@@ -174,7 +174,7 @@ constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
 }  // namespace fx
 
 // The model angle in Q30 rad from QCoefficient / QQuadraticCoefficient
-// coefficients and QCelsius temperatures (thermal.hpp for the polynomial).
+// coefficients and QCelsius temperatures (above for the polynomial).
 // All products in int64:
 //   linear    c·T  : |c| < 2³¹, |T| ≤ 2²⁹ → < 2⁶⁰ each, units 2⁻⁵⁶ rad;
 //   quadratic c·T² : |c| < 2³¹, T² ≤ 2³⁰ (units 2⁻¹²) → < 2⁶¹ each, units 2⁻⁶⁰
@@ -209,7 +209,7 @@ template <>
     return {fx::narrow_sat<kSumFrac - Q30::kFracBits>(sum)};
 }
 
-// ---- The thermal rotation in Q30 (thermal.hpp: q_th = q3(γ) ⊗ q2(β) ⊗ q1(α)),
+// The thermal rotation in Q30 (above: q_th = q3(γ) ⊗ q2(β) ⊗ q1(α)),
 // in the format's own, cheaper form: q_th divided by c1c2c3 (cᵢ = cos hᵢ,
 // hᵢ = angleᵢ/2), a positive multiple of q_th and so the same rotation. With
 // tᵢ = tan hᵢ each factor is (1, −tᵢ·axisᵢ) and the product is exactly
