@@ -201,7 +201,7 @@ TEST(FixedPoint, RandomizedAgainstDoubleWithin0p01Arcsec) {
 // (the renormalisation takes the thermal rotation's scale out).
 // Bounds: the angle, 0.01" (Q30) and 0.05" (float), the bounds of the random
 // tests (measured here: 0.0014" and 0.032"). The norm: Q30, 2⁻²⁸ = 3.7e-9 from
-// fixed_point.hpp's renormalized_sum: g rounded twice (≤ 2⁻³⁰, a change of
+// quaternion.hpp's Q30 renormalized_sum: g rounded twice (≤ 2⁻³⁰, a change of
 // ‖r‖² ≤ 2·2⁻³⁰) and each component once (≤ 2⁻³¹, ≤ 2·‖s‖₁·2⁻³¹ ≤ 2⁻²⁹ with
 // ‖s‖₁ ≤ 2), truncation 5ε³/8 < 1e-11 (measured 2.9e-9; without the
 // second-order term of g it is 3.9e-8). Float: 4e-7, twice the measured

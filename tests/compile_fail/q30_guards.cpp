@@ -1,4 +1,4 @@
-// Compile-time guard check (fixed_point.hpp, "Guards"): naming a generic
+// Compile-time guard check (each kernel's guard, see vector3.hpp): naming a generic
 // kernel template for Q30, which is what a call resolves to when the Q30
 // overload's signature has drifted, must not compile. CTest compiles this file
 // once per kernel (ASCORR_KERNEL = 0 … 14) with ASCORR_SCALAR=Q30 and expects

@@ -21,8 +21,12 @@
 //   core/model_coefficients.hpp  a model as numbers (arcsec or rad) → ThermalModel<T>
 //   core/status.hpp         status bits of a corrected solution
 //   core/correct.hpp        correct_solution(): the per-solution entry point
-//   core/fixed_point.hpp    Q30, the fixed-point scalar (with its temperature and
-//                           coefficient formats and thermal_angle)
+//   core/q_formats.hpp      Q30, the fixed-point scalar, and its temperature and
+//                           coefficient formats (range, scaling, rounding, saturation)
+//   core/fx.hpp             the integer arithmetic under them: conversions,
+//                           exact products, the rounding helpers
+//   core/fixed_point.hpp    all of the fixed-point core (the Q30 kernels are
+//                           beside their generic versions, each with its guard)
 //   core/compiler.hpp       what the fixed-point core asks of the compiler, checked
 //   nav/earth_series.hpp    the Earth's barycentric velocity and Sun distance, a
 //                           series fitted to ERFA eraEpv00 (double; coefficients in
@@ -33,6 +37,9 @@
 //   nav/earth_frame.hpp    ITRF → GCRS (Earth rotation angle, IAU 2006 precession)
 //   nav/sincos.hpp         sin/cos in double with the same bits on every platform
 //   nav/orbit_propagation.hpp  J2 RK4 propagation of a spacecraft state
+//   nav/state_gate.hpp     the verdicts on incoming states, the plausible orbit
+//   nav/earth_grid.hpp     the Earth series on a 60 s grid, linear between
+//   nav/velocity_node.hpp  the 10 s velocity node and its per-solution query
 //   nav/velocity_service.hpp   states in, ObserverVelocity<T> per solution out
 // The headers at this folder's top level but this one forward to their part's
 // header, so that includes written before the parts existed keep working.

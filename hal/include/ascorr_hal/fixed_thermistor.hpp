@@ -169,7 +169,7 @@ constexpr double celsius_of_code(const Curve& t, std::uint16_t code) noexcept {
 }
 
 constexpr std::int32_t raw(double celsius) noexcept {
-    return fx::raw_from_double(celsius, QCelsius::kFracBits);
+    return fx::raw_from_double<QCelsius::kFracBits>(celsius);
 }
 
 // Slope of a segment, raw per code ·2⁸, rounded to nearest.
@@ -181,7 +181,7 @@ constexpr std::int64_t slope_of(std::int32_t t0, std::int32_t t1, std::uint16_t 
 
 constexpr std::int32_t interpolate(std::int32_t t0, std::int32_t slope, std::uint16_t c0, std::uint16_t c) noexcept {
     const std::int64_t d = static_cast<std::int64_t>(slope) * static_cast<std::int64_t>(c - c0);
-    return static_cast<std::int32_t>(t0 + fx::round_shift(d, kSlopeShift));
+    return static_cast<std::int32_t>(t0 + fx::round_shift<kSlopeShift>(d));
 }
 
 // Largest |interpolated − double| (raw) over the codes of segment [c0, c1]

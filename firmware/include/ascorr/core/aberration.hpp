@@ -26,7 +26,7 @@
 //   - 1/(2 cos θ/2) = (1 + x/8)/2 + O(3x²/128).
 //  In angle that is below 3e-9" at the domain limit and below 1e-12" for
 //  |v| ≤ 100 km/s. The solar term itself is ≤ 4e-7", which is why it stays.
-//  Without double precision (float; Q30 has its own, fixed_point.hpp) the
+//  Without double precision (float; Q30 has its own, below) the
 //  series stop where float's resolution (2⁻²⁴ = 6e-8 relative) does:
 //      f = 1 − pdv/2 + pdv²/2,   x = |c|²,
 //  dropping pdv³/2 ≤ 1.9e-8 and pdv·β²/8 ≤ 4.6e-9 (relative to f), the
@@ -36,7 +36,10 @@
 //  relative. Together ≤ 5e-8 of θ: 3.4e-5" at the domain limit.
 #pragma once
 
+#include <cstdint>
+
 #include "constants.hpp"
+#include "q_formats.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "vector3.hpp"
@@ -107,5 +110,57 @@ constexpr SmallRotation<T> aberration_rotation(const Vector3<T>& z_icrf, const V
     const T eighth_x = eighth * x;
     return {-eighth_x, (half * f * (one + eighth_x)) * c};
 }
+
+// ---- In Q30 (q_formats.hpp), each overload followed by its guard (vector3.hpp).
+// beta_in_domain (above) in Q30, for any input: each component
+// within ±kMaxBeta (then |βᵢ| < 2²², the squares are exact and small), then
+// |β|² against kMaxBeta² exactly, in units 2⁻⁶⁰.
+constexpr bool beta_in_domain(const Vector3<Q30>& beta) noexcept {
+    constexpr std::int32_t lim = fx::raw_from_double<Q30::kFracBits>(kMaxBeta);
+    constexpr auto lim2 = static_cast<std::int64_t>(kMaxBeta * kMaxBeta * 0x1p60);
+    const auto within = [](Q30 c) { return c.raw <= lim && -lim <= c.raw; };
+    return within(beta.x) && within(beta.y) && within(beta.z) &&
+           fx::mul(beta.x.raw, beta.x.raw) + fx::mul(beta.y.raw, beta.y.raw) + fx::mul(beta.z.raw, beta.z.raw) <= lim2;
+}
+template <>
+bool beta_in_domain<Q30>(const Vector3<Q30>&) noexcept = delete;
+
+// aberration_rotation (above) in Q30: the same q_ab, with the series
+// cut at the format's resolution (2⁻³⁰ = 9.3e-10). With c = z × β,
+// n = |c|² = sin²θ·(1 + p)²/(w1 + w2)² and p = z·β:
+//   f = (w1 + w2)/(1 + p) = 1 − p/2 + p²/2 + O(p³/2, p·β²/8, w2),
+//   q_ab = (−x/8, f/2·(1 + x/8)·c) with x = f²n = n·(1 + O(p)).
+// Dropped, relative to |c| ≤ kMaxBeta (3.34e-3), hence in absolute terms:
+// p³/2 ≤ 1.9e-8 → 6e-11; p·β²/8 ≤ 4.6e-9 → 1.5e-11; the solar term
+// w2 ≤ 2e-8/s → 7e-11 for s ≥ 1 au (the unused inv_sun_distance_au): each
+// below one LSB. In x/8 the O(p) is ≤ 4.6e-9 (5 LSB) in dw, a change of norm
+// only, which the renormalisation takes out, and 7.7e-12 in v. Precondition: beta_in_domain(β) and |zᵢ| ≤ 1 + 2e-6 (the
+// boresight of a quaternion that passed norm_within()); then |p|, |cᵢ| ≤
+// 3.35e-3 and n ≤ 1.2e-5, so nothing overflows.
+// Rounding: c, p, f, the scale and v once each (≤ 2⁻³¹ each; v's error
+// ≤ 2.1·2⁻³¹ absolute), n exact (units 2⁻⁶⁰).
+constexpr SmallRotation<Q30> aberration_rotation(const Vector3<Q30>& z_icrf, const Vector3<Q30>& beta_icrf,
+                                                 const Q30& /*inv_sun_distance_au*/) noexcept {
+    using fx::unshared;
+    const std::int32_t zx = unshared(z_icrf.x.raw);
+    const std::int32_t zy = unshared(z_icrf.y.raw);
+    const std::int32_t zz = unshared(z_icrf.z.raw);
+    const std::int32_t bx = unshared(beta_icrf.x.raw);
+    const std::int32_t by = unshared(beta_icrf.y.raw);
+    const std::int32_t bz = unshared(beta_icrf.z.raw);
+    const std::int32_t p = fx::narrow<30>(0, zx, bx, zy, by, zz, bz);
+    const std::int32_t cx = fx::narrow<30>(0, zy, bz, zz, -by);
+    const std::int32_t cy = fx::narrow<30>(0, zz, bx, zx, -bz);
+    const std::int32_t cz = fx::narrow<30>(0, zx, by, zy, -bx);
+    const std::int64_t n = fx::sum_products(cx, cx, cy, cy, cz, cz);  // units 2⁻⁶⁰
+    constexpr std::int32_t kOne = std::int32_t{1} << 30;
+    const std::int32_t f = kOne - fx::narrow<1>(p) + fx::narrow<31>(fx::mul(p, p));
+    const std::int32_t half_1_x8 = (kOne >> 1) + fx::narrow<34>(n);  // (1 + n/8)/2
+    const std::int32_t scale = fx::narrow<30>(0, f, half_1_x8);
+    return {{-fx::narrow<33>(n)},
+            {Q30{fx::narrow<30>(0, scale, cx)}, Q30{fx::narrow<30>(0, scale, cy)}, Q30{fx::narrow<30>(0, scale, cz)}}};
+}
+template <>
+SmallRotation<Q30> aberration_rotation<Q30>(const Vector3<Q30>&, const Vector3<Q30>&, const Q30&) noexcept = delete;
 
 }  // namespace ascorr

@@ -1,7 +1,8 @@
 // ascorr/core/compiler.hpp: what the core asks of the compiler, checked at compile time.
 //
-// The double and float core is plain C++17. The fixed-point core
-// (fixed_point.hpp) also needs:
+// The core is C++17. Its fixed-point formats (q_formats.hpp, fx.hpp), which
+// the headers with a Q30 kernel beside the generic version (vector3.hpp,
+// quaternion.hpp, aberration.hpp, thermal.hpp) include, also need:
 //  - GCC ≥ 9 or Clang ≥ 9: __builtin_add_overflow / __builtin_sub_overflow
 //    (saturating Q30 sums), __builtin_is_constant_evaluated (constant folding
 //    of the register barrier), GNU inline asm (that barrier, fx::unshared) and

@@ -5,8 +5,9 @@
 // point type (DPU without FPU). Everything the core needs to know about T lives
 // here, so the algorithms never name FLT_EPSILON or call std:: maths directly:
 //
-//  - constants are made with constant<T>() (ScalarTraits<T>::from_double(),
-//    see below), folded at compile time for every T;
+//  - values are converted by ScalarTraits<T>::from_double() (the one
+//    conversion, see below), constants by constant<T>(), folded at compile
+//    time for every T;
 //  - is_finite() is found by argument-dependent lookup (a fixed-point type is
 //    always finite and supplies its own);
 //  - the tolerances that decide "bad input" are per type, because what counts
@@ -93,15 +94,12 @@ using QuadraticCoefficient = typename ScalarTraits<T>::quadratic_coefficient_typ
 template <typename T>
 using Celsius = typename ScalarTraits<T>::temperature_type;
 
-// constant<T>(x): the double x as a constant of the core's scalar T, for the
-// literals of the algorithms (½, 1, series coefficients, domain limits). The
-// conversion is ScalarTraits<T>::from_double (one definition per type); this
-// name marks the use: every call is bound to a constexpr variable
-// (constexpr T half = constant<T>(0.5);), so the double → T conversion is
-// folded at every optimisation level and a -O0 build of the fixed-point core
-// references no soft-float routine (checked on the Cortex-M3 Debug image,
-// tests/target/target-tests.cmake). Run-time conversions use other functions
-// (velocity_service.hpp: scalar_from_double).
+// ScalarTraits<T>::from_double is the one conversion from double to T (and
+// to_double, celsius, coefficient, quadratic_coefficient the others of each
+// format), at compile time and at run time alike: the host's readers, the
+// velocity node (nav/velocity_node.hpp) and the literals of the algorithms all
+// use it. For Q30 it is one product by the exact constant 2³⁰, two comparisons
+// and one conversion (fx.hpp: fx::raw_from_double).
 //
 //   T       range                 rounding                     saturation
 //   double  any                   exact                        none
@@ -111,7 +109,13 @@ using Celsius = typename ScalarTraits<T>::temperature_type;
 //   Q30     [−2, 2 − 2⁻³⁰]        to nearest 2⁻³⁰, ties away   to ±(2 − 2⁻³⁰)
 //           (raw ±(2³¹ − 1))      from zero (error ≤ 2⁻³¹)     (raw ±(2³¹ − 1));
 //                                                              NaN → 2 − 2⁻³⁰
-//   (fixed_point.hpp: ScalarTraits<Q30>::from_double, fx::raw_from_double.)
+//
+// constant<T>(x): the same conversion, named for the literals of the
+// algorithms (½, 1, series coefficients, domain limits). Every call is bound
+// to a constexpr variable (constexpr T half = constant<T>(0.5);), so the
+// conversion is folded at every optimisation level and a -O0 build of the
+// fixed-point core references no soft-float routine (checked on the
+// Cortex-M3 Debug image, tests/target/target-tests.cmake).
 // Every constant of the core lies within ±1.7 (the largest: 1/0.6 au, the
 // Sun-distance domain), so none is rounded by more than 2⁻³¹ or saturated.
 template <typename T>
