@@ -34,8 +34,24 @@ void add_correct_command(CLI::App& app) {
     cmd->add_option("--max-propagation", opt->max_propagation_s,
                     "seconds a state may be propagated (default 21600); later rows get status 4+512")
         ->check(real_number());
+    cmd->add_flag("--self-calibrate", opt->self_calibrate,
+                  "estimate the thermal model from the rows themselves with the on-board estimator, causally in time "
+                  "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
+    cmd->add_option(
+           "--model-history", opt->model_history,
+           "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
+        ->check(non_empty_path());
+    cmd->add_option("--time-constant", opt->time_constant_days,
+                    "with --self-calibrate: the estimator's forgetting time constant in days (default 30)")
+        ->check(real_number());
     cmd->callback([opt]() {
+        if (!opt->self_calibrate && !opt->model_history.empty()) {
+            throw CLI::ValidationError("--model-history", "needs --self-calibrate");
+        }
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
+        if (!s.self_calibration.empty()) {
+            std::cerr << "ascorr correct: " << s.self_calibration << '\n';
+        }
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';
     });
 }

@@ -12,6 +12,8 @@
 #include <vector>
 #include "ascorr_host/atomic_file.hpp"
 
+#include "ascorr/calib/frame.hpp"
+#include "ascorr/calib/head_rotation.hpp"
 #include "ascorr/correct.hpp"
 #include "ascorr_host/earth_velocity.hpp"
 #include "ascorr_host/epochs.hpp"
@@ -41,10 +43,6 @@ struct OrbitSums {
     std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
-
-Eigen::Vector3d icrf_boresight(const Eigen::Quaterniond& q) {
-    return q.toRotationMatrix().row(2).transpose();
-}
 
 std::string time_text(double t) {
     char buf[64];
@@ -171,34 +169,29 @@ struct Pass {
     std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
 };
 
-// Frame F (eqs. 1–3) of heads A and C at one epoch, rows X_F, Y_F, Z_F in ICRF.
-Eigen::Quaterniond q_f_icrf_at(const Epoch<Row>& e) {
-    const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
-    const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
-    const Eigen::Vector3d z_f = za.cross(zc).normalized();
-    const Eigen::Vector3d x_f = (za + zc).normalized();
-    const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
-    Eigen::Matrix3d r_f_icrf;
-    r_f_icrf.row(0) = x_f.transpose();
-    r_f_icrf.row(1) = y_f.transpose();
-    r_f_icrf.row(2) = z_f.transpose();
-    return Eigen::Quaterniond(r_f_icrf);
+Quaternion<double> to_core_q(const Eigen::Quaterniond& q) {
+    return {q.w(), q.x(), q.y(), q.z()};
+}
+Eigen::Quaterniond to_eigen_q(const Quaternion<double>& q) {
+    return {q.w, q.x, q.y, q.z};
+}
+
+// Frame F (eqs. 1–3) of heads A and C at one epoch (calib/frame.hpp).
+Quaternion<double> q_f_icrf_at(const Epoch<Row>& e) {
+    return calib::q_f_icrf(to_core_q(e.head[0]->q), to_core_q(e.head[2]->q));
 }
 
 // Head h's rotation in F relative to its provisional reference (the first
-// one seen), and its regressors, into the orbit's sums.
-void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Eigen::Quaterniond& q_f_icrf, std::size_t h) {
-    const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
+// one seen), and its regressors, into the orbit's sums (calib/head_rotation.hpp).
+void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Quaternion<double>& q_f_icrf, std::size_t h) {
+    const Quaternion<double> q_head_f = calib::q_head_f(to_core_q(e.head[h]->q), q_f_icrf);
     if (!p.reference[h]) {
-        p.reference[h] = q_head_f;
+        p.reference[h] = to_eigen_q(q_head_f);
     }
-    Eigen::Quaterniond d = q_head_f * p.reference[h]->conjugate();
-    if (d.w() < 0.0) {
-        d.coeffs() = -d.coeffs();
-    }
-    o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+    const Quaternion<double> d = calib::relative_to(q_head_f, to_core_q(*p.reference[h]));
+    o.q[h] += Eigen::Vector4d(d.w, d.x, d.y, d.z);
     if (!p.any_epoch || e.t < p.earliest_epoch) {
-        p.earliest_a[h] = d;
+        p.earliest_a[h] = to_eigen_q(d);
     }
     const auto& t = e.head[h]->temp;
     o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
@@ -237,7 +230,7 @@ void add_epoch(Pass& p, const Epoch<Row>& e, bool selection_report) {
     if (!(e.head[0] && e.head[1] && e.head[2])) {
         return;
     }
-    const Eigen::Quaterniond q_f_icrf = q_f_icrf_at(e);
+    const Quaternion<double> q_f_icrf = q_f_icrf_at(e);
     const auto bin = static_cast<long long>(std::floor(e.t / *p.period));
     OrbitSums& o = p.orbits[bin];
     ++o.count;
@@ -312,11 +305,11 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
 // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
 void rebase_on_earliest_epoch(Pass& p) {
     for (std::size_t h = 0; h < 3 && p.r.epochs != 0; ++h) {
-        const Eigen::Quaterniond b_inv = p.earliest_a[h].conjugate();
+        const Quaternion<double> b_inv = conjugate(to_core_q(p.earliest_a[h]));
         for (auto& kv : p.orbits) {
             const Eigen::Vector4d& s = kv.second.q[h];
-            const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
-            kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
+            const Vector3<double> e = calib::small_angle(Quaternion<double>{s(0), s(1), s(2), s(3)} * b_inv);
+            kv.second.e[h] = Eigen::Vector3d(e.x, e.y, e.z) * kRadToArcsec;
         }
         p.reference[h] = (p.earliest_a[h] * *p.reference[h]).normalized();
     }

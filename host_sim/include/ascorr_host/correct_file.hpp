@@ -33,12 +33,19 @@ struct CorrectOptions {
     std::string states;
     bool states_gcrs = false;            // --states-frame gcrs (default itrf)
     double max_propagation_s = 21600.0;  // --max-propagation (the service's default horizon)
+    // --self-calibrate: the thermal model is the on-board estimator's, learnt
+    // from the rows themselves (self_calibration.hpp), starting from `model`
+    // (version 0) or from none; model_history: where its models go (empty: not written).
+    bool self_calibrate = false;
+    std::string model_history;
+    double time_constant_days = 30.0;  // --time-constant
 };
 
 struct CorrectSummary {
     std::size_t rows = 0;                      // rows written
     std::size_t malformed = 0;                 // rows dropped (skip_bad only)
     std::array<std::size_t, 16> status_bit{};  // rows with each status bit set
+    std::string self_calibration;              // --self-calibrate: the estimator's account
 };
 
 // Throws InputError or std::runtime_error; writes nothing then.

