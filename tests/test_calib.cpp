@@ -49,16 +49,48 @@ TEST(CalibFrame, SameBitsAsTheFitsEigenCode) {
     }
 }
 
+// The ground fit formed q_head_f = q_head_icrf ⊗ q_f_icrf⁻¹ and its re-basing
+// with Eigen's quaternion product; calib's double product groups its terms
+// the same way, so the fit keeps its bits (on x86-64, where Eigen vectorises
+// the product with SSE2; elsewhere they agree to rounding).
+TEST(CalibHeadRotation, SameBitsAsEigensProduct) {
+    std::mt19937_64 rng(12);
+    for (int i = 0; i < 20000; ++i) {
+        const Eigen::Quaterniond a = random_attitude(rng);
+        const Eigen::Quaterniond b = random_attitude(rng);
+        Eigen::Quaterniond ref = a * b.conjugate();
+        const Quaternion<double> got = calib::q_head_f(from_eigen(a), from_eigen(b));
+#ifdef EIGEN_VECTORIZE_SSE2
+        ASSERT_EQ(got.w, ref.w()) << i;
+        ASSERT_EQ(got.x, ref.x()) << i;
+        ASSERT_EQ(got.y, ref.y()) << i;
+        ASSERT_EQ(got.z, ref.z()) << i;
+#else
+        ASSERT_LT(angle_arcsec(to_eigen(got), ref), 1e-9) << i;
+#endif
+        if (ref.w() < 0.0) {
+            ref.coeffs() = -ref.coeffs();
+        }
+        const Quaternion<double> rel = calib::relative_to(from_eigen(a), from_eigen(b));
+        EXPECT_GE(rel.w, 0.0);
+        ASSERT_LT(angle_arcsec(to_eigen(rel), ref), 1e-9) << i;
+    }
+}
+
 // F relative to A from C relative to A is F_icrf ⊗ A_icrf⁻¹ (frame.hpp q_f_a).
 TEST(CalibFrame, FRelativeToHeadAIsTheSameFrame) {
     std::mt19937_64 rng(8);
     for (int i = 0; i < 2000; ++i) {
         const Eigen::Quaterniond qa = random_attitude(rng);
         const Eigen::Quaterniond qc = random_attitude(rng);
+        const double cos_ac = (qa.toRotationMatrix().row(2)).dot(qc.toRotationMatrix().row(2));
+        if (std::fabs(cos_ac) > 0.9) {
+            continue;  // the heads are 60-120 degrees apart; near-parallel boresights amplify rounding
+        }
         const Eigen::Quaterniond f_icrf = eigen_q_f_icrf(qa, qc);
         const Eigen::Quaterniond expect = f_icrf * qa.conjugate();
         const Quaternion<double> got = calib::q_f_a(from_eigen(qc * qa.conjugate()));
-        EXPECT_LT(angle_arcsec(to_eigen(got), expect), 1e-9) << i;
+        EXPECT_LT(angle_arcsec(to_eigen(got), expect), 1e-8) << i;
     }
 }
 
@@ -167,9 +199,11 @@ TEST(CalibModelIdentity, CrcOfTheDocumentedByteStream) {
 }
 
 // The per-cycle sums in float and Q30 give the double orbit means within
-// their formats' resolution (orbit_sums.hpp): 2e-4" for the rotations.
+// their formats' resolution (orbit_sums.hpp): for the rotations, Q30's
+// products round to 2^-31 (1e-4"); float's to 2^-24 relative per product
+// (0.012" each, 0.005" allowed for the mean of 5000).
 template <typename T>
-void expect_sums_close_to_double() {
+void expect_sums_close_to_double(double tol_arcsec) {
     std::mt19937_64 rng(11);
     std::normal_distribution<double> g;
     const Eigen::Quaterniond qa0 = random_attitude(rng);
@@ -225,7 +259,7 @@ void expect_sums_close_to_double() {
     const double n = 5000.0;
     for (std::size_t k = 0; k < 2; ++k) {
         for (std::size_t c = 0; c < 4; ++c) {
-            EXPECT_NEAR(st.dq[k][c].value() / n, sd.dq[k][c].value() / n, 2e-4 * kArcsecToRad) << k << c;
+            EXPECT_NEAR(st.dq[k][c].value() / n, sd.dq[k][c].value() / n, tol_arcsec * kArcsecToRad) << k << c;
         }
     }
     for (std::size_t h = 0; h < 3; ++h) {
@@ -236,10 +270,10 @@ void expect_sums_close_to_double() {
 }
 
 TEST(CalibOrbitSums, FloatMatchesDouble) {
-    expect_sums_close_to_double<float>();
+    expect_sums_close_to_double<float>(5e-3);
 }
 TEST(CalibOrbitSums, FixedPointMatchesDouble) {
-    expect_sums_close_to_double<Q30>();
+    expect_sums_close_to_double<Q30>(2e-4);
 }
 
 }  // namespace

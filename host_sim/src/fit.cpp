@@ -308,7 +308,8 @@ void rebase_on_earliest_epoch(Pass& p) {
         const Quaternion<double> b_inv = conjugate(to_core_q(p.earliest_a[h]));
         for (auto& kv : p.orbits) {
             const Eigen::Vector4d& s = kv.second.q[h];
-            const Vector3<double> e = calib::small_angle(Quaternion<double>{s(0), s(1), s(2), s(3)} * b_inv);
+            const Vector3<double> e =
+                calib::small_angle(calib::hamilton_product(Quaternion<double>{s(0), s(1), s(2), s(3)}, b_inv));
             kv.second.e[h] = Eigen::Vector3d(e.x, e.y, e.z) * kRadToArcsec;
         }
         p.reference[h] = (p.earliest_a[h] * *p.reference[h]).normalized();

@@ -72,7 +72,7 @@ inline Vector3<double> boresight_of(const Quaternion<double>& q) noexcept {
 // diagonal, the others from the off-diagonal sums and differences).
 inline Quaternion<double> quaternion_from(const Matrix3& r) noexcept {
     const auto& m = r.m;
-    const double t = m[0][0] + m[1][1] + m[2][2];
+    const double t = m[0][0] + (m[1][1] + m[2][2]);  // Eigen's unrolled trace
     if (t > 0.0) {
         double s = std::sqrt(t + 1.0);
         const double w = 0.5 * s;
