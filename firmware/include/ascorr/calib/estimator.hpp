@@ -57,8 +57,11 @@
 // (its angles minus the filter's prediction, common rotation removed) exceeds
 // outlier_gate × the running RMS is held back (a biased head, a thermistor
 // fault). When persistence_orbits orbits in a row are held back, the change
-// is taken as real (a settling bench): the held orbits still in the window
-// are fed to the filter, and the running RMS restarts.
+// is taken as real (a settling bench, a mount that shifted): the intercepts'
+// information is released (the slopes' kept), the held orbits still in the
+// window are fed to the filter, and the running RMS restarts. Without the
+// release, the least squares would explain the step by the slopes over the
+// temperatures of the weeks after it.
 //
 // Model versions: the model given at start (or none) is version 0; each
 // adopted or loaded model is the active version + 1. Its identity is the
@@ -98,11 +101,11 @@ struct EstimatorConfig {
     std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
     double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count
     double max_condition = 1e4;                    // per head, equilibrated information matrix
-    double adoption_margin = 0.02;                 // a candidate must beat the active model by 2 %
-    std::uint32_t window_orbits = 15;              // orbits of the residual comparison (≤ kWindow)
+    double adoption_margin = 0.03;                 // a candidate must beat the active model by 3 %
+    std::uint32_t window_orbits = 30;              // orbits of the residual comparison (≤ kWindow)
     double angle_check_margin_c = 30.0;            // °C around the recent temperatures
-    double outlier_gate = 5.0;                     // innovation RMS over the running RMS
-    std::uint32_t persistence_orbits = 30;         // held back in a row: a real change (≤ kWindow)
+    double outlier_gate = 3.0;                     // innovation RMS over the running RMS
+    std::uint32_t persistence_orbits = 24;         // held back in a row: a real change (≤ kWindow)
 };
 
 enum class Refusal : std::uint8_t {
@@ -135,6 +138,7 @@ struct EstimatorReport {
     std::uint32_t orbits_short;             // closed with too few epochs
     std::uint32_t orbits_held;              // held back as outliers (some fed later)
     std::uint32_t orbits_late;              // closed while the previous was still being processed
+    std::uint32_t changes;                  // persistent changes taken as real (intercepts released)
     double condition;                       // the worst head's, of the last candidate
     double residual_rms_arcsec;             // the active model over the window (NaN: none)
     double candidate_rms_arcsec;            // the last candidate over the window (NaN: none)
@@ -265,6 +269,7 @@ public:
         r.orbits_short = orbits_short_;
         r.orbits_held = orbits_held_;
         r.orbits_late = orbits_late_;
+        r.changes = changes_;
         r.condition = condition_;
         r.residual_rms_arcsec = active_rms_;
         r.candidate_rms_arcsec = candidate_rms_;
@@ -428,7 +433,13 @@ private:
             return;
         }
         if (o.held) {
-            // A real change: feed the held orbits still in the window, oldest first.
+            // A real change (a mount that shifted): the intercepts' information
+            // is released, the slopes' kept; then the held orbits still in the
+            // window are fed, oldest first.
+            for (auto& f : srif_) {
+                f.release_first();
+            }
+            ++changes_;
             for (std::size_t i = 0; i < ring_size_; ++i) {
                 OrbitRecord& r = ring_at(i);
                 if (r.held) {
@@ -621,10 +632,11 @@ private:
         }
     }
 
-    // RMS about its mean of a model's IBA residuals (orbit means, arcsec,
-    // iba_residuals) over the last window_orbits orbits fed to the filter.
+    // RMS of a model's IBA residuals (orbit means, arcsec, iba_residuals) over
+    // the last window_orbits orbits fed to the filter. Not about their mean:
+    // within a day the orbit means' temperatures hardly move, so a wrong slope
+    // shows as an offset there, and so does a shifted mount.
     double window_rms(const ModelCoefficients& m) const noexcept {
-        double sum[3] = {};
         double sq[3] = {};
         std::uint32_t n = 0;
         for (std::size_t i = ring_size_; i-- > 0 && n < cfg_.window_orbits;) {
@@ -641,7 +653,6 @@ private:
             double d[3];
             iba_residuals(r, d);
             for (std::size_t k = 0; k < 3; ++k) {
-                sum[k] += d[k];
                 sq[k] += d[k] * d[k];
             }
             ++n;
@@ -649,11 +660,7 @@ private:
         if (n < 2U) {
             return std::numeric_limits<double>::quiet_NaN();
         }
-        double ss = 0.0;
-        for (std::size_t k = 0; k < 3; ++k) {
-            ss += sq[k] - sum[k] * sum[k] / n;
-        }
-        return std::sqrt((ss > 0.0 ? ss : 0.0) / (3.0 * n));
+        return std::sqrt((sq[0] + sq[1] + sq[2]) / (3.0 * n));
     }
 
     void push_record(const OrbitRecord& o) noexcept {
@@ -725,6 +732,7 @@ private:
     std::uint32_t orbits_short_ = 0;
     std::uint32_t orbits_held_ = 0;
     std::uint32_t orbits_late_ = 0;
+    std::uint32_t changes_ = 0;
     double condition_ = std::numeric_limits<double>::quiet_NaN();
     double active_rms_ = std::numeric_limits<double>::quiet_NaN();
     double candidate_rms_ = std::numeric_limits<double>::quiet_NaN();

@@ -133,6 +133,16 @@ public:
         return lo > 0.0 ? hi / lo : std::numeric_limits<double>::infinity();
     }
 
+    // Forgets all information on unknown 0 and keeps the others' marginal
+    // information: with unknown 0 first, rows 1 … N−1 of [R | Z] hold exactly
+    // the information of unknowns 1 … N−1 with unknown 0 free, so row 0 is
+    // cleared. (A step in the intercept: the slopes stay.)
+    void release_first() noexcept {
+        for (std::size_t j = 0; j < N + M; ++j) {
+            rz_[0][j] = 0.0;
+        }
+    }
+
     // The information matrix's diagonal entry j (RᵀR)_jj.
     double information(std::size_t j) const noexcept {
         double s = 0.0;
