@@ -8,6 +8,7 @@
 // without the gate a corrupted week makes the model worse.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -341,6 +342,109 @@ TEST(SelfCalibration, GapsOfDaysAreBridged) {
     std::printf("gaps: days 110-200 %s, %zu models\n", text(after).c_str(), r.sc.history.size());
     EXPECT_LE(worst(after), 1.03);
     EXPECT_LE(worst(ratio(m, r.ibas, 30, 100)), 1.03);
+}
+
+// The per-cycle accumulation in the flight scalars (float on the M4F, Q30 on
+// the M3) learns models as good as double's.
+TEST(SelfCalibration, FlightScalarsReachTheFloor) {
+    const Mission m = simulate("scalars", 150.0, [](host::SimulateOptions&) {});
+    const Learnt d = run<double>(m, calib::EstimatorConfig{});
+    const Learnt f = run<float>(m, calib::EstimatorConfig{});
+    const Learnt q = run<Q30>(m, calib::EstimatorConfig{});
+    std::printf("days 30-150: double %s; float %s; Q30 %s\n", text(ratio(m, d.ibas, 30, 150)).c_str(),
+                text(ratio(m, f.ibas, 30, 150)).c_str(), text(ratio(m, q.ibas, 30, 150)).c_str());
+    EXPECT_LE(worst(ratio(m, d.ibas, 30, 150)), 1.03);
+    EXPECT_LE(worst(ratio(m, f.ibas, 30, 150)), 1.03);
+    EXPECT_LE(worst(ratio(m, q.ibas, 30, 150)), 1.03);
+    EXPECT_GE(f.sc.history.size(), 2U);
+    EXPECT_GE(q.sc.history.size(), 2U);
+}
+
+// Lines of a text, the first (header) apart.
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> out;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t nl = text.find('\n', start);
+        out.push_back(text.substr(start, nl - start));
+        start = nl == std::string::npos ? text.size() : nl + 1;
+    }
+    return out;
+}
+
+// The command line as the contract says: status 256 before the first adopted
+// model, the model history's form, any row order, --model as version 0, the
+// scalars, and the refusals.
+TEST(SelfCalibrationCli, CorrectSelfCalibrate) {
+    const Mission m = simulate("cli", 12.0, [](host::SimulateOptions&) {});
+    const CliRun r = run_in("correct --in mission.csv --out c.csv --self-calibrate --model-history h.csv", m.dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto hist = lines_of(slurp(m.dir / "h.csv"));
+    ASSERT_GE(hist.size(), 10U);
+    EXPECT_EQ(hist[0], "t,version,chu,axis,c0,c1,c2,c3,crc32c");
+    EXPECT_EQ(hist[1].substr(hist[1].find(',') + 1, 10), "1,A,alpha,");
+    const double t_first = std::stod(hist[1]);
+    // Rows before the first model: 256 and no thermal stage; after it, the thermal stage.
+    const auto rows = lines_of(slurp(m.dir / "c.csv"));
+    std::size_t before = 0;
+    std::size_t after_thermal = 0;
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+        const double t = std::stod(rows[i]);
+        const unsigned st = static_cast<unsigned>(std::stoul(rows[i].substr(rows[i].rfind(',') + 1)));
+        if (t < t_first) {
+            EXPECT_EQ(st & 2U, 0U) << rows[i];
+            before += (st & 256U) != 0U ? 1U : 0U;
+        } else {
+            after_thermal += (st & 2U) != 0U ? 1U : 0U;
+        }
+    }
+    EXPECT_GT(before, 100U);
+    EXPECT_GT(after_thermal, 1000U);
+    // Rows in reverse order: the same history, the same corrected rows.
+    {
+        const auto in = lines_of(slurp(m.dir / "mission.csv"));
+        std::ofstream f(m.dir / "reversed.csv");
+        f << in[0] << '\n';
+        for (std::size_t i = in.size() - 1; i >= 1; --i) {
+            f << in[i] << '\n';
+        }
+    }
+    const CliRun rr = run_in("correct --in reversed.csv --out cr.csv --self-calibrate --model-history hr.csv", m.dir);
+    ASSERT_EQ(rr.exit_code, 0) << rr.err;
+    EXPECT_EQ(slurp(m.dir / "hr.csv"), slurp(m.dir / "h.csv"));
+    auto a = lines_of(slurp(m.dir / "c.csv"));
+    auto b = lines_of(slurp(m.dir / "cr.csv"));
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    // --model: version 0 from the first row, its coefficients.
+    host::write_model_file((m.dir / "table2.csv").string(), host::table2_model());
+    const CliRun rm = run_in(
+        "correct --in mission.csv --out cm.csv --self-calibrate --model table2.csv --model-history hm.csv", m.dir);
+    ASSERT_EQ(rm.exit_code, 0) << rm.err;
+    const auto hm = lines_of(slurp(m.dir / "hm.csv"));
+    ASSERT_GE(hm.size(), 10U);
+    const std::string first_row = lines_of(slurp(m.dir / "mission.csv"))[1];
+    EXPECT_EQ(hm[1].substr(0, hm[1].find(',')), first_row.substr(0, first_row.find(',')));
+    EXPECT_EQ(hm[1].substr(hm[1].find(',') + 1, 10), "0,A,alpha,");
+    EXPECT_EQ(std::stod(hm[1].substr(hm[1].find("alpha,") + 6)), host::table2_model().coefficients[0][0][0]);
+    // The estimator in the flight scalars.
+    for (const char* scalar : {"float", "fixed"}) {
+        const CliRun rs = run_in(std::string("correct --in mission.csv --out cs.csv --self-calibrate --scalar ") +
+                                     scalar + " --model-history hs.csv",
+                                 m.dir);
+        ASSERT_EQ(rs.exit_code, 0) << rs.err;
+        EXPECT_GE(lines_of(slurp(m.dir / "hs.csv")).size(), 10U) << scalar;
+    }
+    // Refusals: nothing written.
+    const CliRun n1 = run_in("correct --in mission.csv --out x.csv --model-history hx.csv", m.dir);
+    EXPECT_NE(n1.exit_code, 0);
+    EXPECT_NE(n1.err.find("--model-history"), std::string::npos) << n1.err;
+    const CliRun n2 = run_in("correct --in mission.csv --out x.csv --self-calibrate --no-thermal", m.dir);
+    EXPECT_NE(n2.exit_code, 0);
+    EXPECT_NE(n2.err.find("--no-thermal"), std::string::npos) << n2.err;
+    EXPECT_FALSE(fs::exists(m.dir / "x.csv"));
+    EXPECT_FALSE(fs::exists(m.dir / "hx.csv"));
 }
 
 }  // namespace
