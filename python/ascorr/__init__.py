@@ -5,7 +5,7 @@ The same core and host library as the ``ascorr`` command line, on NumPy arrays
 since J2000.0 TT; quaternions Hamilton, scalar first, q_chu_icrf maps ICRF
 components into CHU components; velocities km/s; angles arcsec.
 
-Functions: read_model, correct, earth_velocity, iba, stats, fit,
+Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame. Classes: Model. Exceptions:
 InputError and FitRefused (both ValueError). HEADS: the head letters in
 index order (from the core's ascorr/heads.hpp).
@@ -22,6 +22,7 @@ from ._ascorr import (  # noqa: F401
     iba,
     read_model,
     read_solutions,
+    self_calibrate,
     stats,
     write_solutions,
 )
@@ -36,6 +37,7 @@ __all__ = [
     "iba",
     "read_model",
     "read_solutions",
+    "self_calibrate",
     "stats",
     "to_frame",
     "write_solutions",
