@@ -276,5 +276,90 @@ TEST(CalibOrbitSums, FixedPointMatchesDouble) {
     expect_sums_close_to_double<Q30>(2e-4);
 }
 
+// A synthetic bench (not the simulator's): head B turns about its x axis by
+// 0.3"/degC of its T_CHU, with three temperatures on incommensurate slow
+// periods, one cycle every 300 s.
+calib::CalibCycle<double> synthetic_cycle(long k) {
+    const double t = 300.0 * static_cast<double>(k);
+    const double day = 86400.0;
+    const double t1 = 10.0 + 4.0 * std::sin(2.0 * kPi * t / (3.0 * day));
+    const double t2 = 5.0 + 3.0 * std::sin(2.0 * kPi * t / (5.0 * day) + 1.0);
+    const double t3 = 2.0 * std::sin(2.0 * kPi * t / (7.0 * day) + 2.0);
+    const Eigen::Quaterniond qa = Eigen::Quaterniond(Eigen::AngleAxisd(1e-3 * t, Eigen::Vector3d::UnitZ())) *
+                                  Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5);
+    const Eigen::Quaterniond b_a(Eigen::AngleAxisd(1.3, Eigen::Vector3d(0.2, 0.9, 0.1).normalized()));
+    const Eigen::Quaterniond c_a(Eigen::AngleAxisd(1.7, Eigen::Vector3d(-0.7, 0.1, 0.6).normalized()));
+    const double bend = 0.3 * (t1 - 10.0) * kArcsecToRad;
+    const Eigen::Quaterniond qb = Eigen::Quaterniond(Eigen::AngleAxisd(bend, Eigen::Vector3d::UnitX())) * b_a * qa;
+    calib::CalibCycle<double> c{};
+    c.t_us = static_cast<std::int64_t>(t * 1e6);
+    c.q_chu_icrf[0] = from_eigen(qa);
+    c.q_chu_icrf[1] = from_eigen(qb.normalized());
+    c.q_chu_icrf[2] = from_eigen((c_a * qa).normalized());
+    for (auto& h : c.temperatures) {
+        h = {{t1, true}, {t2, true}, {t3, true}};
+    }
+    return c;
+}
+
+// The commands and the double buffer: a model becomes active only at the
+// next cycle; freeze stops the learning, resume restarts it, reset forgets
+// it and keeps the active model, load_model is active at the next cycle with
+// the next version and its CRC.
+TEST(CalibEstimator, CommandsAndTheDoubleBuffer) {
+    calib::Estimator<double> est;
+    long k = 0;
+    std::uint32_t version = 0;
+    const auto cycles = [&](long n) {
+        for (long i = 0; i < n; ++i, ++k) {
+            const calib::CalibCycle<double> c = synthetic_cycle(k);
+            (void)est.model_for_cycle(c.t_us);
+            est.accumulate(c);
+            bool stepped = false;
+            while (est.step()) {
+                stepped = true;
+            }
+            // An adoption in this step is not active before the next cycle.
+            if (stepped) {
+                EXPECT_EQ(est.report().active_version, version);
+            }
+            version = est.report().active_version;
+        }
+    };
+    EXPECT_EQ(est.model_for_cycle(0), nullptr);
+    cycles(288 * 15);  // 15 days
+    const calib::EstimatorReport r = est.report();
+    ASSERT_TRUE(r.has_active) << calib::refusal_name(r.last_refusal);
+    EXPECT_GE(r.active_version, 1U);
+    EXPECT_EQ(r.active_crc, calib::model_crc(*est.active_coefficients()));
+    // The slope it learnt: B's alpha, 0.3"/degC of T_CHU.
+    EXPECT_NEAR(est.active_coefficients()->coefficient[1][0][1], 0.3, 0.01);
+    // freeze: nothing is learnt.
+    est.freeze();
+    const std::uint32_t used = est.report().orbits_used;
+    cycles(288 * 2);
+    EXPECT_EQ(est.report().orbits_used, used);
+    EXPECT_TRUE(est.report().frozen);
+    est.resume();
+    cycles(288 * 2);
+    EXPECT_GT(est.report().orbits_used, used + 20U);
+    // reset: forgotten, the active model stays.
+    const std::uint32_t active = est.report().active_version;
+    est.reset();
+    EXPECT_EQ(est.report().orbits_used, 0U);
+    EXPECT_EQ(est.report().active_version, active);
+    // load_model: active at the next cycle, version + 1, its CRC.
+    ModelCoefficients m{};
+    m.present[0] = m.present[1] = m.present[2] = true;
+    m.coefficient[2][1][0] = 1.25;
+    est.load_model(m);
+    EXPECT_EQ(est.report().active_version, active);
+    const ThermalModel<double>* core = est.model_for_cycle(synthetic_cycle(k).t_us);
+    ASSERT_NE(core, nullptr);
+    EXPECT_EQ(est.report().active_version, active + 1U);
+    EXPECT_EQ(est.report().active_crc, calib::model_crc(m));
+    EXPECT_DOUBLE_EQ(core->head[2].beta.c0, 1.25 * kArcsecToRad);
+}
+
 }  // namespace
 }  // namespace ascorr::test

@@ -40,7 +40,8 @@
 // double, in step(): the orbit's means, F from the mean of C relative to A,
 // the heads' angles, an innovation test, the filter update, the candidate,
 // the gate, the swap. Each step() call does one phase (Phase), each phase a
-// fixed amount of work (the largest: kWindow orbits × 9 residuals × 2 models).
+// fixed amount of work (the largest: kWindow orbits × 3 IBA residuals × 2
+// models, or feeding up to kWindow held-back orbits).
 //
 // Safe adoption (a candidate becomes the active model only when all hold;
 // otherwise the active one stays and the reason is counted, Refusal):
@@ -50,11 +51,14 @@
 //   - kAngleLimit: a coefficient beyond the Q30 formats' range, or a model
 //     angle beyond the core's 1° (kMaxThermalAngleRad) at the recent orbits'
 //     temperatures ± angle_check_margin_c;
-//   - kNoGain: over the last window_orbits orbits, the RMS (about its mean) of
-//     the residuals with F's common rotation removed (common_rotation.hpp) is
-//     not below (1 − adoption_margin) × the active model's.
+//   - kNoGain: over the last window_orbits orbits, the RMS of the model's IBA
+//     residuals (orbit means; iba_residuals(): what the residual rotations do
+//     to the three IBAs, so a common rotation or a roll about a boresight
+//     counts for nothing) is not below (1 − adoption_margin) × the active
+//     model's. Not about their mean: within a window the orbit means'
+//     temperatures hardly move, so a wrong slope shows as an offset there.
 // Outlier orbits: once the filter has a model, an orbit whose innovation
-// (its angles minus the filter's prediction, common rotation removed) exceeds
+// (the IBA residuals of its angles against the filter's prediction) exceeds
 // outlier_gate × the running RMS is held back (a biased head, a thermistor
 // fault). When persistence_orbits orbits in a row are held back, the change
 // is taken as real (a settling bench, a mount that shifted): the intercepts'
@@ -63,8 +67,8 @@
 // release, the least squares would explain the step by the slopes over the
 // temperatures of the weeks after it.
 //
-// Model versions: the model given at start (or none) is version 0; each
-// adopted or loaded model is the active version + 1. Its identity is the
+// Model versions: the model given at start is version 0; each adopted or
+// loaded model is the active version + 1 (the first is 1 without one). Its identity is the
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
 // arcsec as ModelCoefficients and converted once into the core's
 // ThermalModel<T> (model_coefficients.hpp) when prepared, in the back buffer.
@@ -81,7 +85,6 @@
 #include "../model_coefficients.hpp"
 #include "../quaternion.hpp"
 #include "../thermal.hpp"
-#include "common_rotation.hpp"
 #include "frame.hpp"
 #include "head_rotation.hpp"
 #include "model_identity.hpp"
@@ -96,7 +99,7 @@ inline constexpr std::size_t kWindow = 32;     // recent orbits kept (gate and h
 
 struct EstimatorConfig {
     std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
-    double time_constant_days = 30.0;              // τ of the forgetting
+    double time_constant_days = 30.0;              // τ of the forgetting (chosen: README, Self-calibration)
     std::uint32_t min_orbits = 30;                 // orbits in the filter before a first model
     std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
     double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count
@@ -254,6 +257,7 @@ public:
         ms_count_ = 0;
         ms_ = 0.0;
         has_solution_ = false;
+        last_fed_valid_ = false;
         open_ = false;
         phase_ = Phase::kIdle;
     }
