@@ -202,10 +202,14 @@ public:
         if (frozen_) {
             return;
         }
-        const std::int64_t bin = floor_div(c.t_us, cfg_.orbit_period_us);
-        if (!open_ || bin != bin_) {
+        // Two comparisons per cycle; the 64-bit division (a library call on
+        // the M3) only when the orbit changes.
+        if (!open_ || c.t_us < orbit_start_us_ || c.t_us >= orbit_end_us_) {
+            const std::int64_t bin = floor_div(c.t_us, cfg_.orbit_period_us);
             close_orbit();
             open_orbit(bin, c);
+            orbit_start_us_ = bin * cfg_.orbit_period_us;
+            orbit_end_us_ = orbit_start_us_ + cfg_.orbit_period_us;
         }
         sums_.add(c.q_chu_icrf, c.temperatures, ref_);
     }
@@ -703,6 +707,8 @@ private:
     bool frozen_ = false;
     bool open_ = false;
     std::int64_t bin_ = 0;
+    std::int64_t orbit_start_us_ = 0;  // [start, end) of the current orbit
+    std::int64_t orbit_end_us_ = 0;
     OrbitSums<T> sums_{};
     OrbitReference<T> ref_{};
     bool ref_valid_ = false;
