@@ -418,7 +418,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
         const auto it = std::upper_bound(schedule.begin(), schedule.end(), rec.t,
                                          [](double x, const auto& e) { return x < e.first; });
         const CorrectionConfig<T> c{true, &(it - 1)->second};
-        const host::RowCorrection<T> row = host::correct_row(rec, &earth, c, nullptr);
+        const host::RowCorrection<T> row = host::correct_row<T>(rec, &earth, c, nullptr);
         double* q = q_out + 4 * i;
         q[0] = row.q_chu_icrf.w;
         q[1] = row.q_chu_icrf.x;
