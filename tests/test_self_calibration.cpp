@@ -208,6 +208,48 @@ TEST(SelfCalibration, SettlingMissionReachesTheFloor) {
     EXPECT_LE(worst(before), 1.03);
     EXPECT_LE(worst(after30), 1.15);
     EXPECT_LE(worst(later), 1.03);
+    // The simulator's heater events (a heat flow the seasons do not show): the
+    // IBA RMS from each heater on to a day after it is off, each window after
+    // day 30, over the floor of the same days.
+    std::ifstream heaters(m.data + ".heaters.csv");
+    std::string line;
+    std::getline(heaters, line);
+    std::array<double, kPairs> worst_heater{};
+    std::size_t events = 0;
+    while (std::getline(heaters, line)) {
+        const double on = std::stod(line);
+        const double off = std::stod(line.substr(line.find(',') + 1));
+        const auto a = static_cast<long long>(std::floor((on - m.t0) / kDay));
+        const auto b = static_cast<long long>(std::ceil((off - m.t0) / kDay)) + 1;
+        if (a < 30 || b > 600) {
+            continue;
+        }
+        const auto x = ratio(m, r.ibas, a, b);
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            worst_heater[p] = std::max(worst_heater[p], x[p]);
+        }
+        ++events;
+    }
+    std::printf("heater events (%zu): worst %s\n", events, text(worst_heater).c_str());
+    EXPECT_GE(events, 5U);
+    EXPECT_LE(worst(worst_heater), 1.03);
+}
+
+// A quadratic truth (B's alpha and beta 0.04 arcsec/degC^2 in T_CHU): the
+// linear model with forgetting follows the curvature over the seasons.
+TEST(SelfCalibration, AQuadraticTruthIsFollowed) {
+    const Mission m = simulate("quadratic", 300.0, [](host::SimulateOptions& o) {
+        host::ModelFile t = host::table2_model();
+        t.quadratic = true;
+        t.coefficients[1][0][4] = 0.04;
+        t.coefficients[1][1][4] = -0.04;
+        o.truth = (fs::path(o.out).parent_path() / "quadratic.csv").string();
+        host::write_model_file(o.truth, t);
+    });
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    const auto x = ratio(m, r.ibas, 30, 300);
+    std::printf("quadratic truth: days 30-300 %s\n", text(x).c_str());
+    EXPECT_LE(worst(x), 1.03);
 }
 
 // Mutation check: the same mission without forgetting (τ = 10⁹ days) keeps
