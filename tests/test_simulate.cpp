@@ -14,7 +14,9 @@
 #include <regex>
 #include <sstream>
 
+#include <Eigen/Geometry>
 #include "ascorr_host/analysis/plot.hpp"
+#include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
 #include "test_support.hpp"
@@ -264,6 +266,314 @@ TEST(Simulate, HeaterWindowsAreWhereTheTemperaturesRise) {
         ++events;
     }
     EXPECT_GE(events, 2);
+}
+
+// ---- The events for testing a self-calibrating model (--truth-change, --gap,
+// --thermistor-fault, --head-bias) and the daily floor. Each event is measured
+// against the same mission without it (same seed: the events draw no random
+// numbers, so every difference is the event's).
+
+constexpr double kStart = host::kDefaultSimStartT;
+constexpr double kDayS = 86400.0;
+
+// The floor of days [from, to) by `stats` with the truth (its clean epochs are the floor's).
+std::array<double, host::kPairs> stats_floor(const std::string& data, const std::string& model, double from_day,
+                                             double to_day) {
+    host::StatsOptions o;
+    o.in = data;
+    o.model = model;
+    o.from = kStart + from_day * kDayS;
+    o.to = kStart + to_day * kDayS - 5e-4;  // [from, to) of rows written to the millisecond
+    const host::StatsResult r = host::compute_stats(o, std::cerr);
+    std::array<double, host::kPairs> rms{};
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        rms[p] = r.rms[p][2].rms;
+    }
+    return rms;
+}
+
+TEST(SimulateEvents, DailyFloorGivesTheFloorOfTheMissionAndOfAnyWindowOfDays) {
+    const fs::path dir = scratch_dir("floor-daily");
+    const std::string data = (dir / "m.csv").string();
+    ASSERT_EQ(run_cli("simulate --days 4 --out " + data, dir), 0) << slurp(dir / "err.txt");
+    const std::string floor = slurp(data + ".floor.json");
+    const auto whole = host::floor_of_days(data + ".floor-daily.csv", 0, 5);
+    const auto window = host::floor_of_days(data + ".floor-daily.csv", 1, 3);
+    const auto by_stats = stats_floor(data, data + ".truth.csv", 1.0, 3.0);
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        const std::regex re(std::string("\"") + host::kPairNames[p] +
+                            "\": \\{\"rms\": ([0-9.]+), .*?\"n\": ([0-9]+)\\}");
+        std::smatch m;
+        ASSERT_TRUE(std::regex_search(floor, m, re)) << floor;
+        EXPECT_EQ(whole[p].n, std::stoul(m[2].str()));
+        EXPECT_NEAR(whole[p].rms, std::stod(m[1].str()), 1e-6);  // floor.json has 6 decimals
+        EXPECT_NEAR(window[p].rms, by_stats[p], 1e-6);
+        EXPECT_GT(window[p].n, 300U);
+        EXPECT_LT(window[p].n, whole[p].n * 2 / 3);
+    }
+    // A window without days has no floor; a malformed file names line and column.
+    EXPECT_TRUE(std::isnan(host::floor_of_days(data + ".floor-daily.csv", 10, 20)[0].rms));
+    std::ofstream(dir / "bad.csv") << "day,t_start,pair,n,sum,sum_sq\n0,1,A-B,3,x,4\n";
+    try {
+        host::floor_of_days((dir / "bad.csv").string(), 0, 1);
+        ADD_FAILURE() << "a malformed daily floor was accepted";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.csv:2:11"), std::string::npos) << e.what();
+    }
+}
+
+// Table 2 after a settling bench: head A's mount c0 shifted by 1.5" and 3",
+// head B's gains 35 % larger.
+std::string settled_model() {
+    host::ModelFile m = host::table2_model();
+    m.coefficients[0][0][0] += 1.5;
+    m.coefficients[0][1][0] += 3.0;
+    for (std::size_t a = 0; a < 3; ++a) {
+        for (std::size_t i = 1; i < 4; ++i) {
+            m.coefficients[1][a][i] *= 1.35;
+        }
+    }
+    return host::format_model(m);
+}
+
+TEST(SimulateEvents, TruthChangeHoldsFromItsDayAndIsInTheTruthHistory) {
+    const fs::path dir = scratch_dir("truth-change");
+    const std::string data = (dir / "m.csv").string();
+    const std::string settled = (dir / "settled.csv").string();
+    std::ofstream(settled) << settled_model();
+    std::ofstream(dir / "table2.csv") << host::format_model(host::table2_model());
+    ASSERT_EQ(run_cli("simulate --days 6 --truth-change 3:" + settled + " --out " + data, dir), 0)
+        << slurp(dir / "err.txt");
+    const std::string before = (dir / "table2.csv").string();
+    const auto floor_before = host::floor_of_days(data + ".floor-daily.csv", 0, 3);
+    const auto floor_after = host::floor_of_days(data + ".floor-daily.csv", 3, 7);
+    const auto old_before = stats_floor(data, before, 0.0, 3.0);
+    const auto old_after = stats_floor(data, before, 3.0, 7.0);
+    const auto new_after = stats_floor(data, settled, 3.0, 7.0);
+    // Across the change (days 2 to 4) neither truth alone reaches the floor:
+    // head A's mount steps by 1.5" and 3" on day 3 (an RMS about the mean sees
+    // a constant c0 only as such a step).
+    const auto floor_across = host::floor_of_days(data + ".floor-daily.csv", 2, 4);
+    const auto old_across = stats_floor(data, before, 2.0, 4.0);
+    const auto new_across = stats_floor(data, settled, 2.0, 4.0);
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        std::printf(
+            "%s floor %.4f / %.4f / across %.4f; old truth %.4f / %.4f / across %.4f; new truth after %.4f / "
+            "across %.4f\n",
+            host::kPairNames[p], floor_before[p].rms, floor_after[p].rms, floor_across[p].rms, old_before[p],
+            old_after[p], old_across[p], new_after[p], new_across[p]);
+        EXPECT_NEAR(old_before[p], floor_before[p].rms, 1e-6);
+        EXPECT_NEAR(new_after[p], floor_after[p].rms, 1e-6);
+        // A-B sees A's step most (A-C least: the projection), B-C B's gains.
+        const double ratio = p == 0 ? 1.3 : 1.02;
+        EXPECT_GT(old_across[p], ratio * floor_across[p].rms);
+        EXPECT_GT(new_across[p], ratio * floor_across[p].rms);
+    }
+    EXPECT_GT(std::fabs(old_after[2] - floor_after[2].rms), 1e-5);                    // head B's gains changed
+    EXPECT_EQ(slurp(data + ".truth.csv"), host::format_model(host::table2_model()));  // the initial truth
+    // The history: version 0 from the first epoch, version 1 from day 3, each a model file's rows.
+    std::string expected = "t,version,chu,axis,c0,c1,c2,c3\n";
+    const std::pair<const char*, std::string> versions[2] = {{"456148800.000,0,", slurp(before)},
+                                                             {"456408000.000,1,", settled_model()}};
+    for (const auto& v : versions) {
+        std::istringstream rows(v.second);
+        std::string row;
+        std::getline(rows, row);
+        while (std::getline(rows, row)) {
+            expected += v.first + row + "\n";
+        }
+    }
+    EXPECT_EQ(slurp(data + ".truth-history.csv"), expected);
+}
+
+// The lines of a file.
+std::vector<std::string> lines_of(const std::string& path) {
+    std::istringstream in(slurp(path));
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(in, line);) {
+        lines.push_back(line);
+    }
+    return lines;
+}
+
+TEST(SimulateEvents, GapRemovesItsRowsAndNothingElse) {
+    const fs::path dir = scratch_dir("gap");
+    const std::string plain = (dir / "plain.csv").string();
+    const std::string gapped = (dir / "gap.csv").string();
+    ASSERT_EQ(run_cli("simulate --days 4 --out " + plain, dir), 0) << slurp(dir / "err.txt");
+    ASSERT_EQ(run_cli("simulate --days 4 --gap 1:2.5 --gap 3.25:3.5 --out " + gapped, dir), 0)
+        << slurp(dir / "err.txt");
+    const auto in_gap = [](double t) {
+        const double day = (t - kStart) / kDayS;
+        return (day >= 1.0 && day < 2.5) || (day >= 3.25 && day < 3.5);
+    };
+    std::vector<std::string> kept;
+    std::size_t removed = 0;
+    for (const std::string& line : lines_of(plain)) {
+        const bool header = line[0] == 't';
+        if (!header && in_gap(std::stod(line))) {
+            ++removed;
+        } else {
+            kept.push_back(line);
+        }
+    }
+    EXPECT_GT(removed, 5000U);
+    EXPECT_EQ(lines_of(gapped), kept);
+    // The floor leaves the gap out too.
+    const auto daily = host::floor_of_days(gapped + ".floor-daily.csv", 1, 2);
+    EXPECT_EQ(daily[0].n, 0U);
+}
+
+TEST(SimulateEvents, ThermistorFaultsChangeTheRecordedTemperatureOnly) {
+    const fs::path dir = scratch_dir("thermistor-fault");
+    const std::string plain = (dir / "plain.csv").string();
+    const std::string faulty = (dir / "fault.csv").string();
+    ASSERT_EQ(run_cli("simulate --days 4 --out " + plain, dir), 0) << slurp(dir / "err.txt");
+    ASSERT_EQ(run_cli("simulate --days 4 --thermistor-fault A:t_chu:stuck:1:2 --thermistor-fault "
+                      "B:t_032:drift:2:3:4 --out " +
+                          faulty,
+                      dir),
+              0)
+        << slurp(dir / "err.txt");
+    std::string s1;
+    std::string s2;
+    const auto a = read_records(plain, s1);
+    const auto b = read_records(faulty, s2);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t stuck_rows = 0;
+    std::size_t drift_rows = 0;
+    double stuck_value = std::nan("");
+    double plain_min = 1e9;
+    double plain_max = -1e9;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const double day = (a[i].t - kStart) / kDayS;
+        ASSERT_EQ(a[i].t, b[i].t);
+        // The bench follows the real temperature: the attitudes are the same.
+        EXPECT_EQ(a[i].q_chu_icrf.w, b[i].q_chu_icrf.w);
+        EXPECT_EQ(a[i].q_chu_icrf.x, b[i].q_chu_icrf.x);
+        EXPECT_EQ(a[i].temperature_present, b[i].temperature_present);
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (!a[i].temperature_present[c]) {
+                continue;
+            }
+            const bool stuck = a[i].head == 0 && c == 0 && day >= 1.0 && day < 2.0;
+            const bool drift = a[i].head == 1 && c == 2 && day >= 2.0 && day < 3.0;
+            if (stuck) {
+                stuck_value = std::isnan(stuck_value) ? b[i].temperature[c] : stuck_value;
+                EXPECT_EQ(b[i].temperature[c], stuck_value) << "t = " << a[i].t;
+                plain_min = std::min(plain_min, a[i].temperature[c]);
+                plain_max = std::max(plain_max, a[i].temperature[c]);
+                ++stuck_rows;
+            } else if (drift) {
+                EXPECT_NEAR(b[i].temperature[c] - a[i].temperature[c], 4.0 * (day - 2.0), 1.5e-3);
+                ++drift_rows;
+            } else {
+                EXPECT_EQ(b[i].temperature[c], a[i].temperature[c]) << "t = " << a[i].t << " column " << c;
+            }
+        }
+    }
+    EXPECT_GT(stuck_rows, 1000U);
+    EXPECT_GT(drift_rows, 500U);
+    EXPECT_GT(plain_max - plain_min, 1.0);  // the real temperature moved meanwhile
+}
+
+TEST(SimulateEvents, HeadBiasShiftsItsPairsIbaByTheRotationInTheWindowOnly) {
+    const fs::path dir = scratch_dir("head-bias");
+    const std::string plain = (dir / "plain.csv").string();
+    const std::string biased = (dir / "bias.csv").string();
+    constexpr double kBias = 5.0;
+    ASSERT_EQ(run_cli("simulate --days 3 --out " + plain, dir), 0) << slurp(dir / "err.txt");
+    ASSERT_EQ(run_cli("simulate --days 3 --head-bias C:1:2:5 --out " + biased, dir), 0) << slurp(dir / "err.txt");
+    EXPECT_EQ(slurp(plain + ".floor.json"), slurp(biased + ".floor.json"));  // not in the floor
+    // Expected change of each pair's IBA: C's boresight rotated by kBias about C's x axis (body frame).
+    const Eigen::Matrix3d rotated =
+        Eigen::AngleAxisd(kBias * kArcsecToRad, Eigen::Vector3d::UnitX()).toRotationMatrix() * host::head_mounting(2);
+    const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+        return std::atan2(u.cross(v).norm(), u.dot(v)) / kArcsecToRad;
+    };
+    const std::array<double, host::kPairs> expected = {
+        0.0,
+        angle(host::head_mounting(0).row(2), rotated.row(2)) -
+            angle(host::head_mounting(0).row(2), host::head_mounting(2).row(2)),
+        angle(host::head_mounting(1).row(2), rotated.row(2)) -
+            angle(host::head_mounting(1).row(2), host::head_mounting(2).row(2))};
+    // Per epoch, the IBA of the biased run minus the plain run's (same noise).
+    std::string s1;
+    std::string s2;
+    const auto a = read_records(plain, s1);
+    const auto b = read_records(biased, s2);
+    ASSERT_EQ(a.size(), b.size());
+    std::map<std::pair<double, std::size_t>, Eigen::Vector3d> za;
+    std::map<std::pair<double, std::size_t>, Eigen::Vector3d> zb;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const auto z = [](const host::SolutionRecord& r) {
+            const Eigen::Quaterniond q(r.q_chu_icrf.w, r.q_chu_icrf.x, r.q_chu_icrf.y, r.q_chu_icrf.z);
+            return Eigen::Vector3d(q.normalized().toRotationMatrix().row(2).transpose());
+        };
+        za[{a[i].t, a[i].head}] = z(a[i]);
+        zb[{b[i].t, b[i].head}] = z(b[i]);
+    }
+    std::array<double, host::kPairs> worst_in{};
+    std::array<double, host::kPairs> worst_out{};
+    std::array<std::size_t, host::kPairs> n_in{};
+    for (const auto& kv : za) {
+        const double t = kv.first.first;
+        const bool in = t >= kStart + kDayS && t < kStart + 2.0 * kDayS;
+        for (std::size_t p = 0; p < host::kPairs; ++p) {
+            const auto i = host::kPairHeads[p][0];
+            const auto j = host::kPairHeads[p][1];
+            if (kv.first.second != i || za.count({t, j}) == 0) {
+                continue;
+            }
+            const double shift = angle(zb[{t, i}], zb[{t, j}]) - angle(za[{t, i}], za[{t, j}]);
+            double& worst = in ? worst_in[p] : worst_out[p];
+            worst = std::max(worst, std::fabs(shift - (in ? expected[p] : 0.0)));
+            n_in[p] += in ? 1U : 0U;
+        }
+    }
+    for (std::size_t p = 0; p < host::kPairs; ++p) {
+        std::printf("%s: expected shift %.4f\", worst deviation in the window %.2e\", outside %.2e\"\n",
+                    host::kPairNames[p], expected[p], worst_in[p], worst_out[p]);
+        EXPECT_GT(n_in[p], 200U);
+        EXPECT_LT(worst_in[p], 0.01);  // the aberration of the rotated boresight differs by ~1e-4 of 5"
+        EXPECT_LT(worst_out[p], 1e-6);
+    }
+    EXPECT_GT(std::fabs(expected[1]) + std::fabs(expected[2]), 0.5 * kBias);
+}
+
+TEST(SimulateEvents, MalformedEventOptionsAreUsageErrorsThatWriteNothing) {
+    const fs::path dir = scratch_dir("bad-events");
+    const std::string data = (dir / "m.csv").string();
+    std::ofstream(dir / "settled.csv") << settled_model();
+    const std::string settled = (dir / "settled.csv").string();
+    const std::pair<std::string, std::string> cases[] = {
+        {"--truth-change 5", "--truth-change: 5 is not DAY:MODEL"},
+        {"--truth-change x:" + settled, "is not DAY:MODEL"},
+        {"--truth-change 3:" + settled + " --truth-change 2:" + settled, "DAY increasing"},
+        {"--truth-change 9:" + settled, "DAY in (0, 4)"},
+        {"--gap 3", "--gap: 3 is not FROM_DAY:TO_DAY"},
+        {"--gap 2:1", "--gap 2:1: expected FROM_DAY:TO_DAY with 0 <= FROM_DAY < TO_DAY <= 4"},
+        {"--gap 1:nan", "must be finite numbers"},
+        {"--thermistor-fault D:t_chu:stuck:1:2", "HEAD must be A, B or C"},
+        {"--thermistor-fault A:t_999:stuck:1:2", "CHANNEL must be t_chu, t_029 or t_032"},
+        {"--thermistor-fault A:t_chu:melt:1:2", "the kind must be stuck or drift"},
+        {"--thermistor-fault A:t_chu:drift:1:2", "a drift needs RATE"},
+        {"--thermistor-fault A:t_chu:stuck:1:2:3", "stuck takes none"},
+        {"--thermistor-fault A:t_chu:drift:1:2:500", "RATE 500: expected a drift's RATE in [-100, 100]"},
+        {"--head-bias A:1:2", "--head-bias: A:1:2 is not HEAD:FROM_DAY:TO_DAY:ARCSEC"},
+        {"--head-bias A:1:2:1e999", "ARCSEC must be a finite number"},
+        {"--head-bias A:1:2:5000", "ARCSEC 5000: expected a rotation in [-3600, 3600]"},
+        {"--head-bias B:3:5:1", "<= 4 (--days)"},
+    };
+    for (const auto& c : cases) {
+        EXPECT_EQ(run_cli("simulate --days 4 " + c.first + " --out " + data, dir), 2) << c.first;
+        const std::string err = slurp(dir / "err.txt");
+        EXPECT_NE(err.find(c.second), std::string::npos) << c.first << ": " << err;
+        EXPECT_NE(err.find("Run with --help"), std::string::npos) << c.first << ": " << err;
+    }
+    for (const char* suffix : {"", ".truth.csv", ".truth-history.csv", ".floor.json", ".floor-daily.csv"}) {
+        EXPECT_FALSE(fs::exists(data + suffix)) << suffix;
+    }
 }
 
 }  // namespace

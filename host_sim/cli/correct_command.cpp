@@ -41,9 +41,25 @@ void add_correct_command(CLI::App& app) {
     cmd->add_option("--max-propagation", opt->max_propagation_s,
                     "seconds a state may be propagated, (0, 604800] (default 21600); later rows get status 4+512")
         ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
+    cmd->add_flag("--self-calibrate", opt->self_calibrate,
+                  "estimate the thermal model from the rows themselves with the on-board estimator, causally in time "
+                  "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
+    cmd->add_option(
+           "--model-history", opt->model_history,
+           "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
+        ->check(non_empty_path());
+    cmd->add_option("--time-constant", opt->time_constant_days,
+                    "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] (default 30)")
+        ->check(real_in(1.0, 10000.0));
     cmd->callback([opt]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
+        if (!opt->self_calibrate && !opt->model_history.empty()) {
+            throw CLI::ValidationError("--model-history", "needs --self-calibrate");
+        }
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
+        if (!s.self_calibration.empty()) {
+            std::cerr << "ascorr correct: " << s.self_calibration << '\n';
+        }
         std::cerr << "ascorr correct: " << opt->out << ": " << host::describe(s) << '\n';
     });
 }

@@ -5,7 +5,7 @@ The same core and host library as the ``ascorr`` command line, on NumPy arrays
 since J2000.0 TT; quaternions Hamilton, scalar first, q_chu_icrf maps ICRF
 components into CHU components; velocities km/s; angles arcsec.
 
-Functions: read_model, correct, earth_velocity, iba, stats, fit,
+Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame, from_frame. Classes: Model. Exceptions:
 InputError and FitRefused (both ValueError). HEADS: the head letters in
 index order (from the core's ascorr/heads.hpp).
@@ -71,6 +71,7 @@ fit = _checked(_ascorr.fit, "fit")
 iba = _checked(_ascorr.iba, "iba")
 read_model = _checked(_ascorr.read_model, "read_model")
 read_solutions = _checked(_ascorr.read_solutions, "read_solutions")
+self_calibrate = _checked(_ascorr.self_calibrate, "self_calibrate")
 stats = _checked(_ascorr.stats, "stats")
 write_solutions = _checked(_ascorr.write_solutions, "write_solutions")
 Model.__init__ = _checked(Model.__init__, "Model", method=True)
@@ -87,6 +88,7 @@ __all__ = [
     "iba",
     "read_model",
     "read_solutions",
+    "self_calibrate",
     "stats",
     "to_frame",
     "write_solutions",

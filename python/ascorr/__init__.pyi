@@ -94,6 +94,24 @@ def fit(
     holdout: float = ...,
     min_temperature_range: float = ...,
 ) -> tuple[Model, dict[str, Any]]: ...
+class _ActiveModel(TypedDict):
+    t: float
+    version: int
+    crc32c: int
+    model: Model
+
+def self_calibrate(
+    t: _Real,
+    chu: npt.ArrayLike,
+    q: _Real,
+    temps: Optional[_Real],
+    v: Optional[_Real],
+    flags: Optional[npt.ArrayLike] = ...,
+    confidence: Optional[_Real] = ...,
+    model: Optional[Model] = ...,
+    scalar: Literal["double", "float", "fixed"] = ...,
+    time_constant: float = ...,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]: ...
 def read_solutions(path: _Path) -> dict[str, Any]: ...  # arrays, and "extra": dict[str, NDArray[str_]]
 def write_solutions(
     path: _Path,

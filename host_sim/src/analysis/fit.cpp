@@ -13,6 +13,8 @@
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
 
+#include "ascorr/calib/frame.hpp"
+#include "ascorr/calib/head_rotation.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
@@ -43,10 +45,6 @@ struct OrbitSums {
     std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
 
-Eigen::Vector3d icrf_boresight(const Eigen::Quaterniond& q) {
-    return q.toRotationMatrix().row(2).transpose();
-}
-
 std::string time_text(double t) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.3f", t);
@@ -54,50 +52,6 @@ std::string time_text(double t) {
 }
 
 }  // namespace
-
-Drop fit_selection(const SolutionRecord& rec) noexcept {
-    if ((rec.flags & 1) != 0) {
-        return Drop::kHighRate;
-    }
-    if ((rec.flags & 2) != 0) {
-        return Drop::kBrightObject;
-    }
-    if ((rec.flags & 4) != 0) {
-        return Drop::kInvalid;
-    }
-    if (rec.confidence > 5.0) {
-        return Drop::kConfidence;
-    }
-    if (!(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2])) {
-        return Drop::kTemperature;
-    }
-    if (rec.velocity_components != 3) {
-        return Drop::kVelocity;
-    }
-    return Drop::kNone;
-}
-
-const char* drop_name(Drop d) noexcept {
-    switch (d) {
-        case Drop::kNone:
-            return "selected";
-        case Drop::kHighRate:
-            return "high-rate mode";
-        case Drop::kBrightObject:
-            return "bright object";
-        case Drop::kInvalid:
-            return "invalid";
-        case Drop::kConfidence:
-            return "confidence > 5";
-        case Drop::kTemperature:
-            return "temperature missing";
-        case Drop::kVelocity:
-            return "velocity missing";
-        case Drop::kRejected:
-            return "not correctable";
-    }
-    return "?";
-}
 
 namespace {
 FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period);
@@ -172,34 +126,29 @@ struct Pass {
     std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
 };
 
-// Frame F (eqs. 1–3) of heads A and C at one epoch, rows X_F, Y_F, Z_F in ICRF.
-Eigen::Quaterniond q_f_icrf_at(const Epoch<Row>& e) {
-    const Eigen::Vector3d za = icrf_boresight(e.head[0]->q);
-    const Eigen::Vector3d zc = icrf_boresight(e.head[2]->q);
-    const Eigen::Vector3d z_f = za.cross(zc).normalized();
-    const Eigen::Vector3d x_f = (za + zc).normalized();
-    const Eigen::Vector3d y_f = z_f.cross(x_f).normalized();
-    Eigen::Matrix3d r_f_icrf;
-    r_f_icrf.row(0) = x_f.transpose();
-    r_f_icrf.row(1) = y_f.transpose();
-    r_f_icrf.row(2) = z_f.transpose();
-    return Eigen::Quaterniond(r_f_icrf);
+Quaternion<double> to_core_q(const Eigen::Quaterniond& q) {
+    return {q.w(), q.x(), q.y(), q.z()};
+}
+Eigen::Quaterniond to_eigen_q(const Quaternion<double>& q) {
+    return {q.w, q.x, q.y, q.z};
+}
+
+// Frame F (eqs. 1–3) of heads A and C at one epoch (calib/frame.hpp).
+Quaternion<double> q_f_icrf_at(const Epoch<Row>& e) {
+    return calib::q_f_icrf(to_core_q(e.head[0]->q), to_core_q(e.head[2]->q));
 }
 
 // Head h's rotation in F relative to its provisional reference (the first
-// one seen), and its regressors, into the orbit's sums.
-void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Eigen::Quaterniond& q_f_icrf, std::size_t h) {
-    const Eigen::Quaterniond q_head_f = e.head[h]->q * q_f_icrf.conjugate();
+// one seen), and its regressors, into the orbit's sums (calib/head_rotation.hpp).
+void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Quaternion<double>& q_f_icrf, std::size_t h) {
+    const Quaternion<double> q_head_f = calib::q_head_f(to_core_q(e.head[h]->q), q_f_icrf);
     if (!p.reference[h]) {
-        p.reference[h] = q_head_f;
+        p.reference[h] = to_eigen_q(q_head_f);
     }
-    Eigen::Quaterniond d = q_head_f * p.reference[h]->conjugate();
-    if (d.w() < 0.0) {
-        d.coeffs() = -d.coeffs();
-    }
-    o.q[h] += Eigen::Vector4d(d.w(), d.x(), d.y(), d.z());
+    const Quaternion<double> d = calib::relative_to(q_head_f, to_core_q(*p.reference[h]));
+    o.q[h] += Eigen::Vector4d(d.w, d.x, d.y, d.z);
     if (!p.any_epoch || e.t < p.earliest_epoch) {
-        p.earliest_a[h] = d;
+        p.earliest_a[h] = to_eigen_q(d);
     }
     const auto& t = e.head[h]->temp;
     o.x[h] += Eigen::Vector3d(t[0], t[1] - t[0], t[2] - t[0]);
@@ -238,7 +187,7 @@ void add_epoch(Pass& p, const Epoch<Row>& e, bool selection_report) {
     if (!(e.head[0] && e.head[1] && e.head[2])) {
         return;
     }
-    const Eigen::Quaterniond q_f_icrf = q_f_icrf_at(e);
+    const Quaternion<double> q_f_icrf = q_f_icrf_at(e);
     const auto bin = static_cast<long long>(std::floor(e.t / *p.period));
     OrbitSums& o = p.orbits[bin];
     ++o.count;
@@ -313,11 +262,12 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
 // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
 void rebase_on_earliest_epoch(Pass& p) {
     for (std::size_t h = 0; h < 3 && p.r.epochs != 0; ++h) {
-        const Eigen::Quaterniond b_inv = p.earliest_a[h].conjugate();
+        const Quaternion<double> b_inv = conjugate(to_core_q(p.earliest_a[h]));
         for (auto& kv : p.orbits) {
             const Eigen::Vector4d& s = kv.second.q[h];
-            const Eigen::Quaterniond sum(s(0), s(1), s(2), s(3));
-            kv.second.e[h] = 2.0 * (sum * b_inv).vec() * kRadToArcsec;
+            const Vector3<double> e =
+                calib::small_angle(calib::hamilton_product(Quaternion<double>{s(0), s(1), s(2), s(3)}, b_inv));
+            kv.second.e[h] = Eigen::Vector3d(e.x, e.y, e.z) * kRadToArcsec;
         }
         p.reference[h] = (p.earliest_a[h] * *p.reference[h]).normalized();
     }

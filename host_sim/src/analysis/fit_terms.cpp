@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "ascorr/calib/common_rotation.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -109,11 +110,23 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
 
     // The joint design (fit.hpp): each orbit's 9 equations projected
     // orthogonally to F's own rotation, P = I − G·Gᵀ/3.
-    Eigen::Matrix<double, 9, 3> g;
+    // (calib/common_rotation.hpp).
+    calib::Matrix3 n_core[3];
     for (std::size_t h = 0; h < 3; ++h) {
-        g.block<3, 3>(static_cast<Eigen::Index>(3 * h), 0) = n_ref[h];
+        for (Eigen::Index r = 0; r < 3; ++r) {
+            for (Eigen::Index c = 0; c < 3; ++c) {
+                n_core[h].m[r][c] = n_ref[h](r, c);
+            }
+        }
     }
-    const Eigen::Matrix<double, 9, 9> proj = Eigen::Matrix<double, 9, 9>::Identity() - g * g.transpose() / 3.0;
+    double p_core[9][9];
+    calib::common_rotation_projector(n_core, p_core);
+    Eigen::Matrix<double, 9, 9> proj;
+    for (Eigen::Index r = 0; r < 9; ++r) {
+        for (Eigen::Index c = 0; c < 9; ++c) {
+            proj(r, c) = p_core[r][c];
+        }
+    }
     Eigen::MatrixXd y(n, 9);
     for (Eigen::Index k = 0; k < n; ++k) {
         for (std::size_t h = 0; h < 3; ++h) {

@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -204,8 +205,11 @@ std::string describe(const SimulateSummary& s) {
                       s.floor[p].rms_smoothed);
         o << buf;
     }
-    o << "\ntruth model: " << s.truth_path << "\nfloor: " << s.floor_path << "\nheater events (" << s.heaters.size()
-      << "): " << s.heaters_path;
+    o << "\ntruth model: " << s.truth_path << " (history: " << s.truth_history_path << ")\nfloor: " << s.floor_path
+      << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path;
+    if (s.gap_epochs != 0) {
+        o << "\nepochs without rows (--gap): " << s.gap_epochs;
+    }
     return o.str();
 }
 
@@ -223,6 +227,142 @@ struct Random {
     double unit() { return uniform(engine); }
 };
 
+std::string truth_name(const std::string& path) {
+    return path.empty() ? std::string("truth model (Table 2)") : path;
+}
+
+// A model file (empty path: Table 2); heads A, B and C must all have coefficients.
+ModelFile truth_model(const std::string& path) {
+    ModelFile truth_file = path.empty() ? table2_model() : read_model_file(path);
+    for (std::size_t h = 0; h < 3; ++h) {
+        if (!truth_file.present[h]) {
+            throw std::invalid_argument((path.empty() ? std::string("truth model") : path) +
+                                        ": no coefficients for CHU " + head_name(static_cast<std::uint8_t>(h)));
+        }
+    }
+    return truth_file;
+}
+
+// The truth from t_from (s since J2000 TT, as written) on.
+struct Truth {
+    ModelFile file;
+    ThermalModel<double> model;
+    std::string name;
+    double t_from = 0.0;
+};
+
+// --truth (from the first epoch), then each --truth-change.
+std::vector<Truth> truth_models(const SimulateOptions& opt) {
+    std::vector<Truth> truths;
+    const auto add = [&truths](const std::string& path, double t_from) {
+        ModelFile file = truth_model(path);
+        ThermalModel<double> model = to_core<double>(file);
+        truths.push_back({std::move(file), model, truth_name(path), t_from});
+    };
+    add(opt.truth, std::round(opt.start_t * 1000.0) / 1000.0);
+    for (const TruthChange& c : opt.truth_changes) {
+        add(c.model, std::round((opt.start_t + c.day * kDay) * 1000.0) / 1000.0);
+    }
+    return truths;
+}
+
+// The truths as a model history (docs/contract.md, "Self-calibration"):
+// version v's rows are its model file's rows after t and v.
+std::string truth_history_csv(const std::vector<Truth>& truths) {
+    bool quadratic = false;
+    for (const Truth& t : truths) {
+        quadratic = quadratic || t.file.quadratic;
+    }
+    std::string s = quadratic ? "t,version,chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "t,version,chu,axis,c0,c1,c2,c3\n";
+    for (std::size_t v = 0; v < truths.size(); ++v) {
+        ModelFile m = truths[v].file;
+        m.quadratic = quadratic;
+        const std::string rows = format_model(m);
+        char prefix[64];
+        std::snprintf(prefix, sizeof prefix, "%.3f,%zu,", truths[v].t_from, v);
+        for (std::size_t at = rows.find('\n') + 1; at < rows.size();) {
+            const std::size_t end = rows.find('\n', at) + 1;
+            s += prefix;
+            s.append(rows, at, end - at);
+            at = end;
+        }
+    }
+    return s;
+}
+
+bool in_window(const DayWindow& w, double day) {
+    return day >= w.from_day && day < w.to_day;
+}
+
+// "OPTION FROM:TO: ..." for a window outside [0, days] or empty.
+void refuse_window(const char* option, const char* form, const DayWindow& w, double days) {
+    if (!(w.from_day >= 0.0 && w.from_day < w.to_day && w.to_day <= days)) {
+        char what[256];
+        std::snprintf(what, sizeof what, "%s %g:%g: expected %s with 0 <= FROM_DAY < TO_DAY <= %g (--days)", option,
+                      w.from_day, w.to_day, form, days);
+        throw std::invalid_argument(what);
+    }
+}
+
+void refuse_bad_head(const char* option, std::size_t head) {
+    if (head > 2) {
+        throw std::invalid_argument(std::string(option) + ": HEAD must be A, B or C, got index " +
+                                    std::to_string(head));
+    }
+}
+
+void refuse_bad_truth_changes(const SimulateOptions& opt) {
+    double previous = 0.0;
+    for (const TruthChange& c : opt.truth_changes) {
+        if (!(c.day > previous && c.day < opt.days) || c.model.empty()) {
+            char what[256];
+            std::snprintf(what, sizeof what,
+                          "--truth-change %g:%s: expected DAY:MODEL, a model file from DAY in (0, %g) (--days), "
+                          "DAY increasing from one change to the next (the previous: %g)",
+                          c.day, c.model.c_str(), opt.days, previous);
+            throw std::invalid_argument(what);
+        }
+        previous = c.day;
+    }
+}
+
+void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
+    constexpr const char* kOption = "--thermistor-fault";
+    for (const ThermistorFault& f : opt.thermistor_faults) {
+        refuse_bad_head(kOption, f.head);
+        if (f.channel > 2) {
+            throw std::invalid_argument(std::string(kOption) + ": CHANNEL must be t_chu, t_029 or t_032");
+        }
+        refuse_window(kOption, "HEAD:CHANNEL:stuck|drift:FROM_DAY:TO_DAY[:RATE]", f.window, opt.days);
+        const bool drift = f.kind == ThermistorFaultKind::kDrift;
+        if (!(std::fabs(f.rate_c_per_day) <= 100.0) || (!drift && f.rate_c_per_day != 0.0)) {
+            char what[160];
+            std::snprintf(what, sizeof what,
+                          "%s: RATE %g: expected a drift's RATE in [-100, 100] degC/day; a stuck channel has none",
+                          kOption, f.rate_c_per_day);
+            throw std::invalid_argument(what);
+        }
+    }
+}
+
+void refuse_bad_event_options(const SimulateOptions& opt) {
+    refuse_bad_truth_changes(opt);
+    for (const DayWindow& g : opt.gaps) {
+        refuse_window("--gap", "FROM_DAY:TO_DAY", g, opt.days);
+    }
+    refuse_bad_thermistor_faults(opt);
+    for (const HeadBias& b : opt.head_biases) {
+        refuse_bad_head("--head-bias", b.head);
+        refuse_window("--head-bias", "HEAD:FROM_DAY:TO_DAY:ARCSEC", b.window, opt.days);
+        if (!(std::fabs(b.arcsec) <= 3600.0)) {
+            char what[120];
+            std::snprintf(what, sizeof what, "--head-bias: ARCSEC %g: expected a rotation in [-3600, 3600] arcsec",
+                          b.arcsec);
+            throw std::invalid_argument(what);
+        }
+    }
+}
+
 void refuse_bad_options(const SimulateOptions& opt) {
     if (!(opt.days > 0.0 && opt.days <= 36600.0)) {
         throw std::invalid_argument("--days must be in (0, 36600], got " + number_text(opt.days));
@@ -235,22 +375,7 @@ void refuse_bad_options(const SimulateOptions& opt) {
         throw std::invalid_argument("--start " + number_text(opt.start_t) +
                                     ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
     }
-}
-
-std::string truth_name(const SimulateOptions& opt) {
-    return opt.truth.empty() ? std::string("truth model (Table 2)") : opt.truth;
-}
-
-// --truth, or Table 2; heads A, B and C must all have coefficients.
-ModelFile truth_model(const SimulateOptions& opt) {
-    ModelFile truth_file = opt.truth.empty() ? table2_model() : read_model_file(opt.truth);
-    for (std::size_t h = 0; h < 3; ++h) {
-        if (!truth_file.present[h]) {
-            throw std::invalid_argument((opt.truth.empty() ? std::string("truth model") : opt.truth) +
-                                        ": no coefficients for CHU " + head_name(static_cast<std::uint8_t>(h)));
-        }
-    }
-    return truth_file;
+    refuse_bad_event_options(opt);
 }
 
 // The circular orbit (header: Sun-synchronous-like node drift) and the
@@ -387,11 +512,35 @@ struct HeadSolution {
     Vector3<double> z_floor{};  // boresight with noise only: for the noise floor
 };
 
-// Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), then the
-// raw attitude before the aberration correction.
+// A truth model whose angle exceeds 1 degree: the first such axis names the
+// model row (line) to look at.
+[[noreturn]] void refuse_truth_angle(std::size_t h, const EpochState& e, const HeadTemperatures<double>& ht,
+                                     const Truth& truth) {
+    const HeadThermalModel<double>& m = truth.model.head[h];
+    const AxisPolynomial<double>* axes[3] = {&m.alpha, &m.beta, &m.gamma};
+    std::size_t axis = 0;
+    double angle = 0.0;
+    for (std::size_t a = 0; a < 3; ++a) {
+        angle = thermal_angle(*axes[a], ht.t_chu.value, ht.t_029.value, ht.t_032.value);
+        axis = a;
+        if (!(std::fabs(angle) <= kMaxThermalAngleRad)) {
+            break;
+        }
+    }
+    char what[240];
+    std::snprintf(what, sizeof what,
+                  "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
+                  "T029 %g, T032 %g degC)",
+                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, e.temp[h],
+                  e.temp[3], e.temp[4]);
+    throw InputError(truth.name, truth.file.line[h][axis], 0, what);
+}
+
+// Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), rotated
+// by bias_rad about the head's x axis (--head-bias), then the raw attitude
+// before the aberration correction.
 HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moon_deg, const EpochState& e,
-                        const ThermalModel<double>& truth, const std::string& truth_file, const ModelFile& truth_rows,
-                        EarthVelocity& earth, Random& rnd) {
+                        const Truth& truth, double bias_rad, EarthVelocity& earth, Random& rnd) {
     HeadSolution out;
     out.quality = draw_quality(moon_deg, rnd);
     const bool bad = out.quality.bad;
@@ -406,29 +555,15 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     const Eigen::Quaterniond q_noisy_true = (q_noise * q_true).normalized();
 
     HeadTemperatures<double> ht{{e.temp[h], true}, {e.temp[3], true}, {e.temp[4], true}};
-    const ThermalStage<double> th = thermal_stage(truth, static_cast<std::uint8_t>(h), ht);
+    const ThermalStage<double> th = thermal_stage(truth.model, static_cast<std::uint8_t>(h), ht);
     if (th.skip != 0U) {
-        // The first axis beyond 1 degree names the model row (line) to look at.
-        const HeadThermalModel<double>& m = truth.head[h];
-        const AxisPolynomial<double>* axes[3] = {&m.alpha, &m.beta, &m.gamma};
-        std::size_t axis = 0;
-        double angle = 0.0;
-        for (std::size_t a = 0; a < 3; ++a) {
-            angle = thermal_angle(*axes[a], ht.t_chu.value, ht.t_029.value, ht.t_032.value);
-            axis = a;
-            if (!(std::fabs(angle) <= kMaxThermalAngleRad)) {
-                break;
-            }
-        }
-        char what[240];
-        std::snprintf(what, sizeof what,
-                      "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
-                      "T029 %g, T032 %g degC)",
-                      head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, e.temp[h],
-                      e.temp[3], e.temp[4]);
-        throw InputError(truth_file, truth_rows.line[h][axis], 0, what);
+        refuse_truth_angle(h, e, ht, truth);
     }
-    const Quaternion<double> q_meas = renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
+    Quaternion<double> q_meas = renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
+    if (bias_rad != 0.0) {
+        const Eigen::Quaterniond q_bias(Eigen::AngleAxisd(bias_rad, Eigen::Vector3d::UnitX()));
+        q_meas = renormalized(from_eigen(q_bias) * q_meas);
+    }
     out.q_raw = raw_attitude(q_meas, e.t, h, e.orbit.v_sc, earth);
     const Eigen::Vector3d zf = q_noisy_true.toRotationMatrix().row(2).transpose();
     out.z_floor = {zf.x(), zf.y(), zf.z()};
@@ -436,7 +571,9 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
 }
 
 // The row of docs/contract.md's solutions file.
-void append_row(std::string& buf, const EpochState& e, std::size_t h, const HeadSolution& s) {
+// temps: the recorded t_chu, t_029, t_032 of head h.
+void append_row(std::string& buf, const EpochState& e, std::size_t h, const HeadSolution& s,
+                const std::array<double, 3>& temps) {
     char line[256];
     char* p = line;
     char* const end = line + sizeof line;
@@ -449,9 +586,8 @@ void append_row(std::string& buf, const EpochState& e, std::size_t h, const Head
     }
     for (std::size_t i = 0; i < 3; ++i) {
         *p++ = ',';
-        const double value = i == 0 ? e.temp[h] : e.temp[i + 2];
         if (!(e.no_temperature || (i == 0 && s.quality.chu_temperature_missing))) {
-            p = put(p, end, value, 3);
+            p = put(p, end, temps[i], 3);
         }
     }
     for (int i = 0; i < 3; ++i) {
@@ -469,14 +605,13 @@ void append_row(std::string& buf, const EpochState& e, std::size_t h, const Head
 // The mission, epoch by epoch: everything simulate() writes and counts.
 class Mission {
 public:
-    Mission(const SimulateOptions& opt, const ModelFile& truth_file)
+    Mission(const SimulateOptions& opt, const std::vector<Truth>& truths)
         : opt_(opt),
-          truth_file_(truth_file),
-          truth_(to_core<double>(truth_file)),
-          truth_name_(truth_name(opt)),
+          truths_(truths),
           rnd_(opt.seed),
           orbit_(opt.start_t, sky_),
-          heaters_(opt.start_t, rnd_.engine) {
+          heaters_(opt.start_t, rnd_.engine),
+          stuck_(opt.thermistor_faults.size()) {
         for (int h = 0; h < 3; ++h) {
             mount_[static_cast<std::size_t>(h)] = head_mounting(h);
         }
@@ -496,29 +631,27 @@ public:
         e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
         e.no_velocity = gps_gap_.step(1e-4, 5, 60, rnd_.engine);
 
-        std::array<bool, 3> clean{};  // written and clean
-        std::array<Vector3<double>, 3> z_floor{};
-        for (std::size_t h = 0; h < 3; ++h) {
-            const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
-            const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
-            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDeg;
-            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDeg;
-            if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
-                ++sum_.outage_rows[h];  // blinded: no solution
-                continue;
-            }
-            const HeadSolution s = solve_head(h, r_true, moon_deg, e, truth_, truth_name_, truth_file_, earth_, rnd_);
-            append_row(buf, e, h, s);
-            count(e, s);
-            clean[h] = !s.quality.bad && !(e.no_temperature || s.quality.chu_temperature_missing) && !e.no_velocity;
-            z_floor[h] = s.z_floor;
+        const double day = dt / kDay;
+        const auto day_index = static_cast<std::size_t>(std::floor(day));
+        daily_.resize(std::max(daily_.size(), day_index + 1));
+        const bool gap =
+            std::any_of(opt_.gaps.begin(), opt_.gaps.end(), [day](const DayWindow& w) { return in_window(w, day); });
+        const HeadsAtEpoch heads = solve_heads(e, dt, recorded_temperatures(e, day), gap, buf);
+        if (gap) {
+            ++sum_.gap_epochs;
+            return;
         }
         for (std::size_t pr = 0; pr < kPairs; ++pr) {
             const auto i = kPairHeads[pr][0];
             const auto j = kPairHeads[pr][1];
-            if (clean[i] && clean[j]) {
+            if (heads.clean[i] && heads.clean[j]) {
+                const double iba = angle_arcsec(heads.z_floor[i], heads.z_floor[j]);
                 floor_t_[pr].push_back(e.t);
-                floor_v_[pr].push_back(angle_arcsec(z_floor[i], z_floor[j]));
+                floor_v_[pr].push_back(iba);
+                FloorSums& f = daily_[day_index][pr];
+                ++f.n;
+                f.sum += iba;
+                f.sum_sq += static_cast<long double>(iba) * iba;
             }
         }
         ++sum_.epochs;
@@ -530,7 +663,9 @@ public:
             sum_.floor[pr] = rms_about_mean(floor_t_[pr], floor_v_[pr]);
         }
         sum_.truth_path = opt_.out + ".truth.csv";
+        sum_.truth_history_path = opt_.out + ".truth-history.csv";
         sum_.floor_path = opt_.out + ".floor.json";
+        sum_.floor_daily_path = opt_.out + ".floor-daily.csv";
         sum_.heaters_path = opt_.out + ".heaters.csv";
         for (const HeaterEvent& ev : heaters_.events()) {
             if (ev.start <= t_last) {
@@ -540,7 +675,84 @@ public:
         return sum_;
     }
 
+    const DailyFloor& daily() const { return daily_; }
+
 private:
+    // Which heads are written and clean at an epoch, and their floor boresights.
+    struct HeadsAtEpoch {
+        std::array<bool, 3> clean{};
+        std::array<Vector3<double>, 3> z_floor{};
+    };
+
+    // Every head's solution at the epoch (drawn in a gap too: the random
+    // streams stay those of a mission without gaps), written outside gaps.
+    HeadsAtEpoch solve_heads(const EpochState& e, double dt, const std::array<std::array<double, 3>, 3>& recorded,
+                             bool gap, std::string& buf) {
+        HeadsAtEpoch out;
+        const Truth& truth = truth_at(e.t);
+        for (std::size_t h = 0; h < 3; ++h) {
+            const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
+            const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
+            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDeg;
+            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDeg;
+            if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
+                sum_.outage_rows[h] += gap ? 0U : 1U;  // blinded: no solution
+                continue;
+            }
+            const HeadSolution s = solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kDay), earth_, rnd_);
+            if (gap) {
+                continue;
+            }
+            append_row(buf, e, h, s, recorded[h]);
+            count(e, s);
+            out.clean[h] = !s.quality.bad && !(e.no_temperature || s.quality.chu_temperature_missing) && !e.no_velocity;
+            out.z_floor[h] = s.z_floor;
+        }
+        return out;
+    }
+
+    // The truth in force at t: the last whose t_from is not after t.
+    const Truth& truth_at(double t) const {
+        std::size_t v = 0;
+        while (v + 1 < truths_.size() && truths_[v + 1].t_from <= t) {
+            ++v;
+        }
+        return truths_[v];
+    }
+
+    // --head-bias: the rotation of head h at `day`, radians (the sum of the windows holding it).
+    double bias_rad(std::size_t h, double day) const {
+        double arcsec = 0.0;
+        for (const HeadBias& b : opt_.head_biases) {
+            arcsec += b.head == h && in_window(b.window, day) ? b.arcsec : 0.0;
+        }
+        return arcsec * kArcsecToRad;
+    }
+
+    // The temperatures as each head's row records them: the real ones, but
+    // for --thermistor-fault (stuck at the window's first value, or drifting),
+    // rounded as written.
+    std::array<std::array<double, 3>, 3> recorded_temperatures(const EpochState& e, double day) {
+        std::array<std::array<double, 3>, 3> rec{};
+        for (std::size_t h = 0; h < 3; ++h) {
+            rec[h] = {e.temp[h], e.temp[3], e.temp[4]};
+        }
+        for (std::size_t i = 0; i < opt_.thermistor_faults.size(); ++i) {
+            const ThermistorFault& f = opt_.thermistor_faults[i];
+            if (!in_window(f.window, day)) {
+                continue;
+            }
+            double& x = rec[f.head][f.channel];
+            if (f.kind == ThermistorFaultKind::kStuck) {
+                stuck_[i] = stuck_[i].value_or(x);
+                x = *stuck_[i];
+            } else {
+                x = std::round((x + f.rate_c_per_day * (day - f.window.from_day)) * 1000.0) / 1000.0;
+            }
+        }
+        return rec;
+    }
+
     void count(const EpochState& e, const HeadSolution& s) {
         ++sum_.rows;
         sum_.flagged_rows += s.quality.bad ? 1U : 0U;
@@ -549,9 +761,7 @@ private:
     }
 
     const SimulateOptions& opt_;
-    const ModelFile& truth_file_;
-    ThermalModel<double> truth_;
-    std::string truth_name_;
+    const std::vector<Truth>& truths_;
     Random rnd_;
     SunMoon sky_;
     Orbit orbit_;
@@ -564,18 +774,30 @@ private:
     SimulateSummary sum_;
     std::array<std::vector<double>, kPairs> floor_t_;
     std::array<std::vector<double>, kPairs> floor_v_;
+    DailyFloor daily_;
+    std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
 };
 
 }  // namespace
 
+void refuse_bad_events(const SimulateOptions& opt) {
+    refuse_bad_event_options(opt);
+}
+
 SimulateSummary simulate(const SimulateOptions& opt) {
-    refuse_output_over_input({{"--truth", opt.truth}}, {{"--out", opt.out},
-                                                        {"--out (truth model)", opt.out + ".truth.csv"},
-                                                        {"--out (noise floor)", opt.out + ".floor.json"},
-                                                        {"--out (heater events)", opt.out + ".heaters.csv"}});
+    std::vector<NamedPath> inputs = {{"--truth", opt.truth}};
+    for (const TruthChange& c : opt.truth_changes) {
+        inputs.push_back({"--truth-change", c.model});
+    }
+    refuse_output_over_input(inputs, {{"--out", opt.out},
+                                      {"--out (truth model)", opt.out + ".truth.csv"},
+                                      {"--out (truth history)", opt.out + ".truth-history.csv"},
+                                      {"--out (noise floor)", opt.out + ".floor.json"},
+                                      {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
+                                      {"--out (heater events)", opt.out + ".heaters.csv"}});
     refuse_bad_options(opt);
-    const ModelFile truth_file = truth_model(opt);
-    Mission mission(opt, truth_file);
+    const std::vector<Truth> truths = truth_models(opt);
+    Mission mission(opt, truths);
 
     AtomicFile out(opt.out);
     std::string buf;
@@ -597,8 +819,10 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     progress.done();
     const SimulateSummary sum = mission.finish(opt.start_t + static_cast<double>(epochs - 1) * opt.step_s);
     out.commit();
-    write_model_file(sum.truth_path, truth_file);
+    write_model_file(sum.truth_path, truths.front().file);
+    write_file_atomically(sum.truth_history_path, truth_history_csv(truths));
     write_file_atomically(sum.floor_path, floor_json(sum.floor));
+    write_file_atomically(sum.floor_daily_path, floor_daily_csv(mission.daily(), opt.start_t));
     write_file_atomically(sum.heaters_path, heaters_csv(sum.heaters));
     return sum;
 }

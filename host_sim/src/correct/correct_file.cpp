@@ -4,7 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <future>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -18,6 +20,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -126,6 +129,13 @@ struct ChunkResult {
     std::size_t empty_lines = 0;
 };
 
+// --self-calibrate: the models in turn, each active from t_from on.
+template <typename T>
+struct ScheduledModel {
+    double t_from;
+    ThermalModel<T> model;
+};
+
 template <typename T>
 struct Job {
     const CorrectOptions& opt;
@@ -134,8 +144,23 @@ struct Job {
     const RowWriter& writer;
     const StatesFile* states;  // nullptr: no --states
     VelocityServiceConfig service;
-    const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
+    const StatesVelocityTable<T>* table;             // the rows' velocities from the states, in time order
+    const std::vector<ScheduledModel<T>>* schedule;  // nullptr: cfg's model for every row
 };
+
+// The configuration of one row: with a schedule, the model active at its t.
+template <typename T>
+CorrectionConfig<T> config_at(const Job<T>& job, double t) {
+    if (job.schedule == nullptr) {
+        return job.cfg;
+    }
+    const auto& s = *job.schedule;
+    auto it =
+        std::upper_bound(s.begin(), s.end(), t, [](double x, const ScheduledModel<T>& m) { return x < m.t_from; });
+    // Rows before the first entry (t = −∞, no head present) do not occur.
+    const ThermalModel<T>* m = it == s.begin() ? &s.front().model : &(it - 1)->model;
+    return {job.cfg.aberration, job.cfg.thermal != nullptr ? m : nullptr};
+}
 
 // With --states, a row without its own velocity gets the service's
 // (correct_row); the status bits the service adds (4, 4|512, 4|32) are
@@ -182,7 +207,8 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
             continue;
         }
-        const RowCorrection<T> row = correct_row(rec, &earth, job.cfg, states ? &*states : nullptr);
+        const CorrectionConfig<T> cfg = config_at(job, rec.t);
+        const RowCorrection<T> row = correct_row(rec, &earth, cfg, states ? &*states : nullptr);
         const StatusBits st = row.status;
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);
@@ -280,17 +306,54 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
     return out;
 }
 
+void refuse_self_calibration_options(const CorrectOptions& opt) {
+    if (!opt.thermal) {
+        throw std::runtime_error("--self-calibrate estimates the thermal model: it cannot go with --no-thermal");
+    }
+    if (!opt.aberration) {
+        throw std::runtime_error(
+            "--self-calibrate learns from aberration-corrected solutions: it cannot go with --no-aberration");
+    }
+    if (opt.skip_bad) {
+        throw std::runtime_error("--self-calibrate reads every row in time order: it cannot go with --skip-bad");
+    }
+    if (!(opt.time_constant_days >= 1.0 && opt.time_constant_days <= 10000.0)) {
+        throw std::runtime_error("--time-constant must be in [1, 10000] days, got " +
+                                 std::to_string(opt.time_constant_days));
+    }
+}
+
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
-                             {{"--out", opt.out}});
+                             {{"--out", opt.out}, {"--model-history", opt.model_history}});
     std::optional<ThermalModel<T>> model;
+    std::optional<ModelFile> model_file;
     if (opt.thermal && !opt.model.empty()) {
-        const ModelFile m = read_model_file(opt.model);
+        model_file = read_model_file(opt.model);
         if constexpr (std::is_same_v<T, Q30>) {
-            check_fixed_point_range(m, opt.model);
+            check_fixed_point_range(*model_file, opt.model);
         }
-        model = to_core<T>(m);
+        model = to_core<T>(*model_file);
+    }
+    std::vector<ScheduledModel<T>> schedule;
+    std::string history;
+    std::string account;
+    if (opt.self_calibrate) {
+        refuse_self_calibration_options(opt);
+        calib::EstimatorConfig ecfg;
+        ecfg.time_constant_days = opt.time_constant_days;
+        const SelfCalibration sc = self_calibrate<T>(
+            opt.in,
+            [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
+            model_file, ecfg, std::nullopt);
+        schedule.push_back({-std::numeric_limits<double>::infinity(), ThermalModel<T>{}});  // no head: 256
+        for (const ActiveModel& a : sc.history) {
+            schedule.push_back({a.t, to_core<T>(a.model)});
+        }
+        history = format_model_history(sc.history);
+        account = describe(sc);
+        model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
 
@@ -322,7 +385,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                      writer,
                      states ? &*states : nullptr,
                      service_config(opt.max_propagation_s),
-                     table ? &*table : nullptr};
+                     table ? &*table : nullptr,
+                     opt.self_calibrate && opt.thermal ? &schedule : nullptr};
 
     AtomicFile out(opt.out);
     out.write(writer.header_line());
@@ -401,7 +465,16 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                          "every one of the " + std::to_string(sum.malformed) +
                              " data rows is malformed (--skip-bad dropped them all): nothing written");
     }
+    std::optional<AtomicFile> history_file;
+    if (opt.self_calibrate && !opt.model_history.empty()) {
+        history_file.emplace(opt.model_history);
+        history_file->write(history);
+    }
+    if (history_file) {
+        history_file->commit();
+    }
     out.commit();
+    sum.self_calibration = account;
     return sum;
 }
 

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <mutex>
 
@@ -118,6 +119,14 @@ double clenshaw(const std::array<double, kCoefficients>& c, double x) noexcept {
 }  // namespace
 
 EarthState EarthVelocity::at(double t) const {
+    // The heads of one epoch share their t: each thread keeps its last answer,
+    // which is a function of t alone, so a repeated t costs one comparison and
+    // gives the same bits (NaN never equals the kept t).
+    thread_local double last_t = std::numeric_limits<double>::quiet_NaN();
+    thread_local EarthState last{};
+    if (t == last_t) {
+        return last;
+    }
     if (!in_ephemeris_span(t)) {
         return {{0.0, 0.0, 0.0}, 1.0, false};
     }
@@ -126,7 +135,9 @@ EarthState EarthVelocity::at(double t) const {
     const auto i = std::min(static_cast<std::size_t>(fl), kSegments - 1);
     const double x = 2.0 * (u - static_cast<double>(i)) - 1.0;
     const Segment& s = table().segment(i);
-    return {{clenshaw(s.c[0], x), clenshaw(s.c[1], x), clenshaw(s.c[2], x)}, clenshaw(s.c[3], x), true};
+    last = {{clenshaw(s.c[0], x), clenshaw(s.c[1], x), clenshaw(s.c[2], x)}, clenshaw(s.c[3], x), true};
+    last_t = t;
+    return last;
 }
 
 }  // namespace ascorr::host

@@ -2,9 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <system_error>
 
+#include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/progress.hpp"
 
 namespace ascorr::host {
 
@@ -165,6 +169,38 @@ void refuse_corrected_file(const std::string& path) {
     std::string_view block;
     if (blocks.next(block)) {
         refuse_corrected_input(SolutionsReader(path, block.substr(0, block.find('\n'))));
+    }
+}
+
+void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
+                       const std::string& label) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    BlockReader blocks(path);
+    std::string_view block;
+    if (!blocks.next(block)) {
+        throw InputError(path, 1, 1, "empty file: expected a header line");
+    }
+    const std::size_t nl = block.find('\n');
+    const SolutionsReader header(path, block.substr(0, nl));
+    block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+    std::size_t lines_before = 1;
+    double done_bytes = static_cast<double>(nl == std::string_view::npos ? 0 : nl + 1);
+    Progress progress(label + ": reading " + path);
+    SolutionRecord rec;
+    for (;;) {
+        SolutionsReader reader(header, block, lines_before);
+        while (reader.next(rec)) {
+            fn(rec);
+        }
+        done_bytes += static_cast<double>(block.size());
+        if (!ec && size > 0) {
+            progress.update(done_bytes / static_cast<double>(size));
+        }
+        if (!blocks.next(block)) {
+            break;
+        }
+        lines_before = blocks.lines_before();
     }
 }
 

@@ -1,6 +1,7 @@
 // ascorr_host/analysis/epochs.hpp: reading a solutions file epoch by epoch.
 //
-// for_each_solution() streams a file of any size in blocks of whole lines.
+// for_each_solution() (formats/solutions_csv.hpp) streams a file of any size
+// in blocks of whole lines.
 // EpochAssembler groups the rows of heads A, B and C that share an epoch
 // (t to the millisecond, docs/contract.md), in any row order: an epoch is handed on
 // as soon as all three heads are in, the incomplete ones at the end. A second
@@ -23,16 +24,6 @@
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
-
-// Calls fn for every data row of the file, in file order. Throws InputError
-// for a malformed row. label: shown with the progress on a terminal.
-void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
-                       const std::string& label);
-
-// Where rows come from: calls its argument for every row, in order. A file is
-// [&](auto& fn) { for_each_solution(path, fn, label); }; the Python module
-// passes arrays (python/src/module.cpp).
-using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
 
 // Refuses a NaN or infinite --from/--to and --from not before --to
 // (std::invalid_argument naming the options), for stats and plot (fit has its

@@ -44,6 +44,7 @@
 
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/fit_terms.hpp"
+#include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -67,12 +68,6 @@ struct FitOptions {
     double min_temperature_range_c = kDefaultMinTemperatureRange;  // of each regressor, for quadratic terms
     bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
 };
-
-// Why a row is left out of the fit (the first reason that applies).
-enum class Drop { kNone, kHighRate, kBrightObject, kInvalid, kConfidence, kTemperature, kVelocity, kRejected };
-inline constexpr std::size_t kDropKinds = 8;
-Drop fit_selection(const SolutionRecord& rec) noexcept;
-const char* drop_name(Drop d) noexcept;
 
 inline constexpr int kUnknowns = 36;  // linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
 inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032

@@ -23,7 +23,15 @@
 //    heater on; the temperatures relax for a few days after) are written
 //    beside the data.
 //  - The floor: the IBA RMS per pair of q_noise ⊗ q_true over the clean
-//    epochs (docs/contract.md), written beside the data.
+//    epochs (docs/contract.md), written beside the data, and per day as
+//    sums from which the floor of any window of whole days follows.
+//  - Events for testing a self-calibrating model (none by default; windows are
+//    [from, to) in days after the start, judged on the epoch's offset k·step):
+//    the truth model changes on given days; data outages (no rows); a
+//    thermistor whose recorded value sticks or drifts while the bench follows
+//    the real temperature; a head whose measured attitude is rotated about its
+//    x axis (not in the truth model, not in the floor). They draw no random
+//    numbers: outside its window an event leaves every row as without it.
 #pragma once
 
 #include <Eigen/Core>
@@ -43,6 +51,38 @@ inline constexpr double kPlaneSunPeriodDays = 267.0;
 inline constexpr double kSimAltitudeKm = 460.0;
 inline constexpr double kSimInclinationDeg = 87.4;
 
+// Days [from_day, to_day) after the start.
+struct DayWindow {
+    double from_day = 0.0;
+    double to_day = 0.0;
+};
+
+// From `day` days after the start the truth is the model file `model`.
+struct TruthChange {
+    double day = 0.0;
+    std::string model;
+};
+
+enum class ThermistorFaultKind { kStuck, kDrift };
+
+// The recorded temperature `channel` (0 t_chu, 1 t_029, 2 t_032) of head
+// `head`'s rows in the window: stuck at its value at the window's first epoch,
+// or the real value plus rate_c_per_day per day since from_day.
+struct ThermistorFault {
+    std::size_t head = 0;
+    std::size_t channel = 0;
+    ThermistorFaultKind kind = ThermistorFaultKind::kStuck;
+    DayWindow window;
+    double rate_c_per_day = 0.0;  // kDrift only
+};
+
+// Head `head`'s measured attitude rotated by `arcsec` about its x axis in the window.
+struct HeadBias {
+    std::size_t head = 0;
+    DayWindow window;
+    double arcsec = 0.0;
+};
+
 struct SimulateOptions {
     std::string out;
     double days = 920.0;  // 2.5 years
@@ -50,7 +90,17 @@ struct SimulateOptions {
     std::uint64_t seed = 1;
     std::string truth;  // model file; empty: the embedded Table 2
     double start_t = kDefaultSimStartT;
+    std::vector<TruthChange> truth_changes;  // increasing day
+    std::vector<DayWindow> gaps;
+    std::vector<ThermistorFault> thermistor_faults;
+    std::vector<HeadBias> head_biases;
 };
+
+// Throws std::invalid_argument, naming the option (--truth-change, --gap,
+// --thermistor-fault, --head-bias) and what it accepts, for events outside the
+// mission [0, days], empty or reversed windows, truth changes not in increasing
+// days, heads other than A, B, C, non-finite values.
+void refuse_bad_events(const SimulateOptions& opt);
 
 struct HeaterEvent {
     double start = 0.0;        // heater on, s since J2000 TT
@@ -68,12 +118,18 @@ struct SimulateSummary {
     std::array<Rms, kPairs> floor{};
     std::string truth_path;
     std::string floor_path;
+    std::string floor_daily_path;
+    std::string truth_history_path;
+    std::size_t gap_epochs = 0;        // epochs without rows (--gap)
     std::vector<HeaterEvent> heaters;  // those starting before the last epoch
     std::string heaters_path;
 };
 
-// Writes opt.out, opt.out + ".truth.csv", opt.out + ".floor.json" and
-// opt.out + ".heaters.csv" (start,end,heater: operational or survival).
+// Writes opt.out, opt.out + ".truth.csv" (the initial truth),
+// opt.out + ".truth-history.csv" (the truth as a model history: version 0 from
+// the first epoch, one version per change), opt.out + ".floor.json",
+// opt.out + ".floor-daily.csv" and opt.out + ".heaters.csv" (start,end,heater:
+// operational or survival).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
 SimulateSummary simulate(const SimulateOptions& opt);
 
@@ -83,5 +139,27 @@ Eigen::Matrix3d head_mounting(int head);
 std::string describe(const SimulateSummary& s);
 std::string floor_json(const std::array<Rms, kPairs>& floor);
 std::string heaters_csv(const std::vector<HeaterEvent>& events);
+
+// OUT.floor-daily.csv: `day,t_start,pair,n,sum,sum_sq`, a row per day since
+// the start (the last may be partial) and pair: the number, sum and sum of
+// squares of the floor IBAs (arcsec) of the day's clean epochs. The sums are
+// accumulated in long double and written with 21 significant digits, as the
+// RMS of a window needs them (IBA ~324000", RMS ~2").
+struct FloorSums {
+    std::size_t n = 0;
+    long double sum = 0.0L;
+    long double sum_sq = 0.0L;
+};
+using DailyFloor = std::vector<std::array<FloorSums, kPairs>>;  // [day][pair]
+std::string floor_daily_csv(const DailyFloor& days, double start_t);
+
+// The floor per pair over days [from_day, to_day) of an OUT.floor-daily.csv:
+// rms about the mean (NaN without epochs) and n. Throws InputError
+// (file:line:column) for a malformed file.
+struct WindowFloor {
+    double rms = 0.0;
+    std::size_t n = 0;
+};
+std::array<WindowFloor, kPairs> floor_of_days(const std::string& path, long long from_day, long long to_day);
 
 }  // namespace ascorr::host

@@ -35,6 +35,12 @@ struct CorrectOptions {
     std::string states;
     bool states_gcrs = false;            // --states-frame gcrs (default itrf)
     double max_propagation_s = 21600.0;  // --max-propagation (the service's default horizon)
+    // --self-calibrate: the thermal model is the on-board estimator's, learnt
+    // from the rows themselves (self_calibration.hpp), starting from `model`
+    // (version 0) or from none; model_history: where its models go (empty: not written).
+    bool self_calibrate = false;
+    std::string model_history;
+    double time_constant_days = 30.0;  // --time-constant
 };
 
 struct CorrectSummary {
@@ -46,6 +52,7 @@ struct CorrectSummary {
     std::size_t states_accepted = 0;
     std::size_t states_refused = 0;    // by the velocity service's checks
     std::size_t states_malformed = 0;  // skipped (skip_bad only)
+    std::string self_calibration;      // --self-calibrate: the estimator's account
 };
 
 // Throws InputError or std::runtime_error; writes nothing then.

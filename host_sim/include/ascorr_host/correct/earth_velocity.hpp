@@ -16,7 +16,8 @@
 // filled on first use (kDegree + 1 = 16 eraEpv00 calls per segment touched,
 // one per day, once per process) and shared by all threads (a segment is
 // filled under one of 64 striped mutexes and published with a release store;
-// readers check it with an acquire load).
+// readers check it with an acquire load). The heads of one epoch share their
+// t: each thread keeps the last t it was asked and its answer.
 //
 // Truncation: the fastest terms of the Earth's barycentric velocity are the
 // lunar ones (monthly, 0.0126 km/s; half-monthly, ~1e-4 km/s); for

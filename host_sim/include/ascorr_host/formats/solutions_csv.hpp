@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -94,5 +95,15 @@ void refuse_corrected_input(const SolutionsReader& header);
 void refuse_corrected_file(const std::string& path);
 // True when the file's header has a `status` column (a corrected file).
 bool is_corrected_file(const std::string& path);
+
+// Where rows come from: calls its argument for every row, in order. A file is
+// [&](auto& fn) { for_each_solution(path, fn, label); }; the Python module
+// passes arrays (python/src/module.cpp).
+using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
+
+// Calls fn for every data row of the file, in file order. Throws InputError
+// for a malformed row. label: shown with the progress on a terminal.
+void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
+                       const std::string& label);
 
 }  // namespace ascorr::host

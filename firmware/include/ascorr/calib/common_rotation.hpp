@@ -1,0 +1,59 @@
+// ascorr/calib/common_rotation.hpp: what the inter-boresight angles cannot
+// see, and the projection that removes it per orbit.
+//
+// Conventions: an orbit's equations stack the three heads' small angles e_h
+// (head_rotation.hpp), each in its head's frame: y = [e_A; e_B; e_C] (9).
+// A small rotation ω of the frame F common to all heads appears in head h as
+// N_h·ω, N_h = R(reference of head h in F) (3 × 3, orthonormal), so it spans
+// the columns of G = [N_A; N_B; N_C] (9 × 3). GᵀG = 3·I, hence
+//   P = I − G·Gᵀ/3
+// is the orthogonal projector onto what the inter-boresight angles see; the
+// ground fit applies P to each orbit's equations and treats F's own rotation
+// as a nuisance (self-calibration.md).
+// The model's regressors are per head [1, T1, T2 − T1, T3 − T1]; only T2 and
+// T3 (THT00029, THT00032) are shared by all heads, so a common rotation
+// w0 + w2·T2 + w3·T3 (3 × 3 = 9 numbers) changes no IBA: 9 of the 36 linear
+// coefficients are unobservable and 27 observable. Of the equivalent models,
+// the ground fit writes the one with the smallest corrections.
+// Double only (per orbit); fixed trip counts, no allocation.
+#pragma once
+
+#include "frame.hpp"
+
+namespace ascorr::calib {
+
+// y ← P·y, P = I − G·Gᵀ/3 (see the top).
+inline void remove_common_rotation(const Matrix3 (&n)[3], double (&y)[9]) noexcept {
+    double g[3] = {0.0, 0.0, 0.0};  // Gᵀ·y
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t r = 0; r < 3; ++r) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                g[c] += n[h].m[r][c] * y[3 * h + r];
+            }
+        }
+    }
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t r = 0; r < 3; ++r) {
+            double s = 0.0;
+            for (std::size_t c = 0; c < 3; ++c) {
+                s += n[h].m[r][c] * g[c];
+            }
+            y[3 * h + r] -= s / 3.0;
+        }
+    }
+}
+
+// The projector P itself (9 × 9), for a design built column by column.
+inline void common_rotation_projector(const Matrix3 (&n)[3], double (&p)[9][9]) noexcept {
+    for (std::size_t i = 0; i < 9; ++i) {
+        for (std::size_t j = 0; j < 9; ++j) {
+            double s = 0.0;
+            for (std::size_t c = 0; c < 3; ++c) {
+                s += n[i / 3].m[i % 3][c] * n[j / 3].m[j % 3][c];
+            }
+            p[i][j] = (i == j ? 1.0 : 0.0) - s / 3.0;
+        }
+    }
+}
+
+}  // namespace ascorr::calib

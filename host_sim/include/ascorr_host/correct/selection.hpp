@@ -1,0 +1,23 @@
+// ascorr_host/correct/selection.hpp: the rows a thermal-model estimate learns
+// from: the ground fit's selection (`ascorr fit`), which the on-board
+// estimator's run over a file (self_calibration.hpp) applies too.
+//
+// A row is selected when it is clean as docs/contract.md's Statistics says
+// (flags 0, confidence <= 5 arcsec, the three temperatures and the velocity
+// present); the caller adds the last condition, that the core applied the
+// aberration stage (Drop::kRejected otherwise).
+#pragma once
+
+#include <cstddef>
+
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+// Why a row is left out of the fit (the first reason that applies).
+enum class Drop { kNone, kHighRate, kBrightObject, kInvalid, kConfidence, kTemperature, kVelocity, kRejected };
+inline constexpr std::size_t kDropKinds = 8;
+Drop fit_selection(const SolutionRecord& rec) noexcept;
+const char* drop_name(Drop d) noexcept;
+
+}  // namespace ascorr::host

@@ -1,0 +1,46 @@
+"""ascorr.self_calibrate against `ascorr correct --self-calibrate`: the same
+numbers, status bits and model history, in every scalar, on a simulated mission."""
+
+import numpy as np
+import pytest
+
+import ascorr
+from conftest import read_csv_text, run_cli
+
+
+@pytest.fixture(scope="module")
+def mission(exe, tmp_path_factory):
+    d = tmp_path_factory.mktemp("selfcal")
+    run_cli(exe, "simulate", "--out", d / "m.csv", "--days", "8", "--step", "300", "--seed", "4")
+    return d
+
+
+@pytest.mark.parametrize("scalar", ["double", "float", "fixed"])
+def test_same_as_the_command_line(exe, mission, scalar):
+    out = mission / f"c_{scalar}.csv"
+    hist = mission / f"h_{scalar}.csv"
+    run_cli(exe, "correct", "--in", mission / "m.csv", "--out", out, "--self-calibrate", "--scalar", scalar,
+            "--model-history", hist)
+    header, rows = read_csv_text(out)
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    q, status, history = ascorr.self_calibrate(
+        s["t"], s["chu"], s["q"], s["temps"], s["v"], flags=s["flags"], confidence=s["confidence"], scalar=scalar)
+    st_col = header.index("status")
+    assert [int(r[st_col]) for r in rows] == [int(x) for x in status]
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    cli_q = np.array([[float(r[c]) for c in cols] for r in rows])
+    assert np.max(np.abs(cli_q - q)) <= 1e-15
+    assert (status & 256).sum() > 0, "rows before the first model get 256"
+    h_header, h_rows = read_csv_text(hist)
+    assert h_header[:2] == ["t", "version"]
+    versions = sorted({int(r[1]) for r in h_rows})
+    assert versions == [h["version"] for h in history]
+    assert [f"{h['crc32c']:08x}" for h in history] == [r[-1] for r in h_rows[::9]]
+
+
+def test_bad_arguments(mission):
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    with pytest.raises(ValueError, match="time_constant"):
+        ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], time_constant=0.5)
+    with pytest.raises(ValueError, match="scalar"):
+        ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], scalar="half")

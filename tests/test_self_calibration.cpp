@@ -1,0 +1,493 @@
+// The on-board estimator (calib/estimator.hpp) on simulated missions it did
+// not produce (host simulate: its truth, its noise floor per day), scored as
+// the ground team would: the thermal-stage IBA RMS per pair of each window,
+// about its mean, over the simulator's noise floor of the same days.
+// Scenarios: a bench that settles (truth change), heater events, a stuck and a
+// drifting thermistor, a head biased for a day, gaps of days, and the done-when
+// mission; mutation checks: without forgetting the settling case fails,
+// without the gate a corrupted week makes the model worse.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr_host/analysis/fit.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/analysis/simulate.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/embedded_model.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDay = 86400.0;
+using host::kPairHeads;
+using host::kPairs;
+
+struct Mission {
+    fs::path dir;
+    std::string data;
+    double t0 = 0.0;
+    std::string storage;
+    std::vector<host::SolutionRecord> records;
+};
+
+// A 300 s-step mission of `days` days (seed fixed) with the simulator's events.
+Mission simulate(const std::string& name, double days, const std::function<void(host::SimulateOptions&)>& events) {
+    Mission m;
+    m.dir = scratch_dir(name);
+    host::SimulateOptions o;
+    o.out = (m.dir / "mission.csv").string();
+    o.days = days;
+    o.step_s = 300.0;
+    o.seed = 5;
+    events(o);
+    host::simulate(o);
+    m.data = o.out;
+    m.t0 = o.start_t;
+    m.records = read_records(m.data, m.storage);
+    return m;
+}
+
+host::RowSource rows_of(const Mission& m) {
+    return [&m](const std::function<void(const host::SolutionRecord&)>& fn) {
+        for (const auto& r : m.records) {
+            fn(r);
+        }
+    };
+}
+
+// The thermal-stage IBAs of the clean epochs, each row corrected with the
+// model active at its t (double path).
+struct Ibas {
+    std::array<std::vector<double>, kPairs> t;
+    std::array<std::vector<double>, kPairs> v;
+};
+
+Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& history) {
+    std::vector<std::pair<double, ThermalModel<double>>> schedule;
+    for (const auto& a : history) {
+        schedule.emplace_back(a.t, host::to_core<double>(a.model));
+    }
+    host::EarthVelocity earth;
+    std::map<double, std::array<std::optional<Vector3<double>>, 3>> epochs;
+    for (const auto& rec : m.records) {
+        if (rec.head > 2 || host::fit_selection(rec) != host::Drop::kNone) {
+            continue;
+        }
+        auto it = std::upper_bound(schedule.begin(), schedule.end(), rec.t,
+                                   [](double x, const auto& s) { return x < s.first; });
+        if (it == schedule.begin()) {
+            continue;  // no model yet
+        }
+        const CorrectionConfig<double> cfg{true, &(it - 1)->second};
+        const CorrectedSolution<double> c = correct_solution(host::to_core_input<double>(rec, &earth), cfg);
+        if ((c.status & status::kThermalApplied) != 0U) {
+            epochs[rec.t][rec.head] = boresight(c.q_chu_icrf);
+        }
+    }
+    Ibas out;
+    for (const auto& [t, z] : epochs) {
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            const auto& a = z[kPairHeads[p][0]];
+            const auto& b = z[kPairHeads[p][1]];
+            if (a && b) {
+                out.t[p].push_back(t);
+                out.v[p].push_back(host::angle_arcsec(*a, *b));
+            }
+        }
+    }
+    return out;
+}
+
+// Per pair: IBA RMS about its mean over days [a, b) / the floor's.
+std::array<double, kPairs> ratio(const Mission& m, const Ibas& ibas, long long a, long long b) {
+    const auto floor = host::floor_of_days(m.data + ".floor-daily.csv", a, b);
+    std::array<double, kPairs> r{};
+    for (std::size_t p = 0; p < kPairs; ++p) {
+        double s = 0.0;
+        double s2 = 0.0;
+        std::size_t n = 0;
+        const double ref = ibas.v[p].empty() ? 0.0 : ibas.v[p].front();
+        for (std::size_t i = 0; i < ibas.t[p].size(); ++i) {
+            const double d = (ibas.t[p][i] - m.t0) / kDay;
+            if (d >= static_cast<double>(a) && d < static_cast<double>(b)) {
+                s += ibas.v[p][i] - ref;
+                s2 += (ibas.v[p][i] - ref) * (ibas.v[p][i] - ref);
+                ++n;
+            }
+        }
+        const double rms =
+            n > 1 ? std::sqrt(std::max(
+                        0.0, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n))))
+                  : std::nan("");
+        r[p] = rms / floor[p].rms;
+    }
+    return r;
+}
+
+double worst(const std::array<double, kPairs>& r) {
+    double w = 0.0;
+    for (double x : r) {
+        w = std::isnan(x) ? x : std::max(w, x);
+    }
+    return w;
+}
+
+std::string text(const std::array<double, kPairs>& r) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "A-B %.3f, A-C %.3f, B-C %.3f", r[0], r[1], r[2]);
+    return buf;
+}
+
+// The settled bench: head B's mount shifts by 1.5" (alpha) and 3" (beta),
+// some of its and A's gains change by 30-40 % (cross-boresight axes: the IBAs see them).
+std::string settled_truth(const fs::path& dir) {
+    host::ModelFile m = host::table2_model();
+    m.coefficients[1][0][0] += 1.5;
+    m.coefficients[1][1][0] += 3.0;
+    m.coefficients[1][0][1] *= 1.35;
+    m.coefficients[1][1][1] *= 1.4;
+    m.coefficients[1][0][3] *= 0.7;
+    m.coefficients[0][1][3] *= 1.3;
+    const std::string path = (dir / "settled.csv").string();
+    host::write_model_file(path, m);
+    return path;
+}
+
+struct Learnt {
+    host::SelfCalibration sc;
+    Ibas ibas;
+};
+
+template <typename T = double>
+Learnt run(const Mission& m, const calib::EstimatorConfig& cfg) {
+    Learnt r;
+    r.sc = host::self_calibrate<T>(m.data, rows_of(m), std::nullopt, cfg, std::nullopt);
+    r.ibas = thermal_ibas(m, r.sc.history);
+    return r;
+}
+
+// The done-when mission: 600 days, gaps, the simulator's bad rows, no model at
+// the start, the bench settles on day 400.
+Mission settling_mission(const std::string& name) {
+    return simulate(name, 600.0, [](host::SimulateOptions& o) {
+        const fs::path dir = fs::path(o.out).parent_path();
+        o.truth_changes.push_back({400.0, settled_truth(dir)});
+        o.gaps.push_back({150.0, 153.0});
+        o.gaps.push_back({470.0, 472.0});
+    });
+}
+
+TEST(SelfCalibration, SettlingMissionReachesTheFloor) {
+    const Mission m = settling_mission("settling");
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    const auto before = ratio(m, r.ibas, 30, 400);
+    const auto after30 = ratio(m, r.ibas, 400, 430);
+    const auto later = ratio(m, r.ibas, 430, 600);
+    std::printf("settling, tau %.0f d: days 30-400 %s; 400-430 %s; 430-600 %s; %zu models\n",
+                calib::EstimatorConfig{}.time_constant_days, text(before).c_str(), text(after30).c_str(),
+                text(later).c_str(), r.sc.history.size());
+    std::printf("%s\n", host::describe(r.sc).c_str());
+    EXPECT_LE(worst(before), 1.03);
+    EXPECT_LE(worst(after30), 1.15);
+    EXPECT_LE(worst(later), 1.03);
+    // The simulator's heater events (a heat flow the seasons do not show): the
+    // IBA RMS from each heater on to a day after it is off, each window after
+    // day 30, over the floor of the same days.
+    std::ifstream heaters(m.data + ".heaters.csv");
+    std::string line;
+    std::getline(heaters, line);
+    std::array<double, kPairs> worst_heater{};
+    std::size_t events = 0;
+    while (std::getline(heaters, line)) {
+        const double on = std::stod(line);
+        const double off = std::stod(line.substr(line.find(',') + 1));
+        const auto a = static_cast<long long>(std::floor((on - m.t0) / kDay));
+        const auto b = static_cast<long long>(std::ceil((off - m.t0) / kDay)) + 1;
+        if (a < 30 || b > 600) {
+            continue;
+        }
+        const auto x = ratio(m, r.ibas, a, b);
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            worst_heater[p] = std::max(worst_heater[p], x[p]);
+        }
+        ++events;
+    }
+    std::printf("heater events (%zu): worst %s\n", events, text(worst_heater).c_str());
+    EXPECT_GE(events, 5U);
+    EXPECT_LE(worst(worst_heater), 1.03);
+}
+
+// A quadratic truth (B's alpha and beta 0.04 arcsec/degC^2 in T_CHU): the
+// linear model with forgetting follows the curvature over the seasons.
+TEST(SelfCalibration, AQuadraticTruthIsFollowed) {
+    const Mission m = simulate("quadratic", 300.0, [](host::SimulateOptions& o) {
+        host::ModelFile t = host::table2_model();
+        t.quadratic = true;
+        t.coefficients[1][0][4] = 0.04;
+        t.coefficients[1][1][4] = -0.04;
+        o.truth = (fs::path(o.out).parent_path() / "quadratic.csv").string();
+        host::write_model_file(o.truth, t);
+    });
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    const auto x = ratio(m, r.ibas, 30, 300);
+    std::printf("quadratic truth: days 30-300 %s\n", text(x).c_str());
+    EXPECT_LE(worst(x), 1.03);
+}
+
+// Mutation check: the same mission without forgetting (τ = 10⁹ days) keeps
+// the old bench in its model for the rest of the mission.
+TEST(SelfCalibration, WithoutForgettingTheSettlingFails) {
+    const Mission m = settling_mission("no-forgetting");
+    calib::EstimatorConfig c;
+    c.time_constant_days = 1e9;
+    const Learnt r = run(m, c);
+    const auto later = ratio(m, r.ibas, 430, 600);
+    std::printf("no forgetting: days 430-600 %s\n", text(later).c_str());
+    EXPECT_GT(worst(later), 1.03);
+}
+
+// The corrupted week's outcome: every model adopted from its start to 30
+// days after its end, applied to the same mission without the corruption,
+// has an IBA RMS over that period at most 1.05 × the model active when the
+// week began (each model held fixed over the whole period).
+struct WeekOutcome {
+    double worst_ratio = 0.0;  // max over models and pairs of RMS(model) / RMS(before)
+    std::size_t models = 0;    // adopted in the period
+};
+
+WeekOutcome corrupted_week(const std::string& name, const calib::EstimatorConfig& cfg,
+                           const std::function<void(host::SimulateOptions&)>& corruption, double from_day,
+                           double to_day) {
+    const Mission clean = simulate(name + "-clean", 200.0, [](host::SimulateOptions&) {});
+    const Mission bad = simulate(name, 200.0, corruption);
+    const Learnt r = run(bad, cfg);
+    const double t_from = bad.t0 + from_day * kDay;
+    const double t_end = bad.t0 + (to_day + 30.0) * kDay;
+    const host::ActiveModel* before = nullptr;
+    std::vector<const host::ActiveModel*> during;
+    for (const auto& a : r.sc.history) {
+        if (a.t <= t_from) {
+            before = &a;
+        } else if (a.t < t_end) {
+            during.push_back(&a);
+        }
+    }
+    EXPECT_NE(before, nullptr) << "no model before the corrupted week";
+    WeekOutcome out;
+    if (before == nullptr) {
+        return out;
+    }
+    Mission period;  // the clean mission's rows of the period only (records point into clean.storage)
+    period.data = clean.data;
+    period.t0 = clean.t0;
+    for (const auto& rec : clean.records) {
+        if (rec.t >= t_from && rec.t < t_end) {
+            period.records.push_back(rec);
+        }
+    }
+    const auto rms_of = [&](const host::ActiveModel& a) {
+        host::ActiveModel fixed = a;
+        fixed.t = clean.t0;
+        const Ibas ibas = thermal_ibas(period, {fixed});
+        return ratio(clean, ibas, static_cast<long long>(from_day), static_cast<long long>(to_day + 30.0));
+    };
+    const auto ref = rms_of(*before);
+    out.models = during.size();
+    for (const auto* a : during) {
+        const auto x = rms_of(*a);
+        for (std::size_t p = 0; p < kPairs; ++p) {
+            out.worst_ratio = std::max(out.worst_ratio, x[p] / ref[p]);
+        }
+    }
+    return out;
+}
+
+// Days 120-127: head B's T_CHU stuck, and head C biased by 5" all week.
+void stuck_and_biased(host::SimulateOptions& o) {
+    o.thermistor_faults.push_back({1, 0, host::ThermistorFaultKind::kStuck, {120.0, 127.0}, 0.0});
+    o.head_biases.push_back({2, {120.0, 127.0}, 5.0});
+}
+
+TEST(SelfCalibration, ACorruptedWeekNeverMakesTheModelWorse) {
+    const WeekOutcome w = corrupted_week("corrupted", calib::EstimatorConfig{}, stuck_and_biased, 120.0, 127.0);
+    std::printf("corrupted week: %zu models adopted, worst IBA RMS %.4f x the model before\n", w.models, w.worst_ratio);
+    EXPECT_LE(w.worst_ratio, 1.05);
+}
+
+// Mutation check: without the gate (no hold-back of outlier orbits, every
+// candidate adopted), the same week makes the model worse.
+TEST(SelfCalibration, WithoutTheGateACorruptedWeekMakesTheModelWorse) {
+    calib::EstimatorConfig c;
+    c.outlier_gate = 1e9;
+    c.adoption_margin = -1e9;
+    const WeekOutcome w = corrupted_week("ungated", c, stuck_and_biased, 120.0, 127.0);
+    std::printf("corrupted week, no gate: %zu models adopted, worst IBA RMS %.4f x the model before\n", w.models,
+                w.worst_ratio);
+    EXPECT_GT(w.worst_ratio, 1.05);
+}
+
+// A thermistor drifting by 1 degC/day for a week (head A's T029): the same outcome.
+TEST(SelfCalibration, ADriftingThermistorNeverMakesTheModelWorse) {
+    const WeekOutcome w = corrupted_week(
+        "drift", calib::EstimatorConfig{},
+        [](host::SimulateOptions& o) {
+            o.thermistor_faults.push_back({0, 1, host::ThermistorFaultKind::kDrift, {120.0, 127.0}, 1.0});
+        },
+        120.0, 127.0);
+    std::printf("drifting thermistor: %zu models adopted, worst IBA RMS %.4f x the model before\n", w.models,
+                w.worst_ratio);
+    EXPECT_LE(w.worst_ratio, 1.05);
+}
+
+// A head biased by 4" for one day: most of its orbits are held back (fewer
+// than the persistence), no change is taken as real, and the IBAs after it
+// stay at the floor.
+TEST(SelfCalibration, AHeadBiasedForADayIsHeldBack) {
+    const Mission m = simulate("bias-day", 200.0, [](host::SimulateOptions& o) {
+        o.head_biases.push_back({1, {150.0, 151.0}, 4.0});
+    });
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    std::printf("biased day: %u orbits held back, %u changes; days 151-200 %s\n", r.sc.report.orbits_held,
+                r.sc.report.changes, text(ratio(m, r.ibas, 151, 200)).c_str());
+    EXPECT_GE(r.sc.report.orbits_held, 5U);
+    EXPECT_EQ(r.sc.report.changes, 0U);
+    EXPECT_LE(worst(ratio(m, r.ibas, 151, 200)), 1.03);
+}
+
+// Gaps of days: 10 days without rows; the forgetting spans the gap (exp(-10/30)),
+// the model before it stays active through it, and the IBAs after it are at the floor.
+TEST(SelfCalibration, GapsOfDaysAreBridged) {
+    const Mission m = simulate("gaps", 200.0, [](host::SimulateOptions& o) {
+        o.gaps.push_back({100.0, 110.0});
+        o.gaps.push_back({140.0, 143.0});
+    });
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    const auto after = ratio(m, r.ibas, 110, 200);
+    std::printf("gaps: days 110-200 %s, %zu models\n", text(after).c_str(), r.sc.history.size());
+    EXPECT_LE(worst(after), 1.03);
+    EXPECT_LE(worst(ratio(m, r.ibas, 30, 100)), 1.03);
+}
+
+// The per-cycle accumulation in the flight scalars (float on the M4F, Q30 on
+// the M3) learns models as good as double's.
+TEST(SelfCalibration, FlightScalarsReachTheFloor) {
+    const Mission m = simulate("scalars", 150.0, [](host::SimulateOptions&) {});
+    const Learnt d = run<double>(m, calib::EstimatorConfig{});
+    const Learnt f = run<float>(m, calib::EstimatorConfig{});
+    const Learnt q = run<Q30>(m, calib::EstimatorConfig{});
+    std::printf("days 30-150: double %s; float %s; Q30 %s\n", text(ratio(m, d.ibas, 30, 150)).c_str(),
+                text(ratio(m, f.ibas, 30, 150)).c_str(), text(ratio(m, q.ibas, 30, 150)).c_str());
+    EXPECT_LE(worst(ratio(m, d.ibas, 30, 150)), 1.03);
+    EXPECT_LE(worst(ratio(m, f.ibas, 30, 150)), 1.03);
+    EXPECT_LE(worst(ratio(m, q.ibas, 30, 150)), 1.03);
+    EXPECT_GE(f.sc.history.size(), 2U);
+    EXPECT_GE(q.sc.history.size(), 2U);
+}
+
+// Lines of a text, the first (header) apart.
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> out;
+    std::size_t start = 0;
+    while (start < text.size()) {
+        const std::size_t nl = text.find('\n', start);
+        out.push_back(text.substr(start, nl - start));
+        start = nl == std::string::npos ? text.size() : nl + 1;
+    }
+    return out;
+}
+
+// The command line as the contract says: status 256 before the first adopted
+// model, the model history's form, any row order, --model as version 0, the
+// scalars, and the refusals.
+TEST(SelfCalibrationCli, CorrectSelfCalibrate) {
+    const Mission m = simulate("cli", 12.0, [](host::SimulateOptions&) {});
+    const CliRun r = run_in("correct --in mission.csv --out c.csv --self-calibrate --model-history h.csv", m.dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto hist = lines_of(slurp(m.dir / "h.csv"));
+    ASSERT_GE(hist.size(), 10U);
+    EXPECT_EQ(hist[0], "t,version,chu,axis,c0,c1,c2,c3,crc32c");
+    EXPECT_EQ(hist[1].substr(hist[1].find(',') + 1, 10), "1,A,alpha,");
+    const double t_first = std::stod(hist[1]);
+    // Rows before the first model: 256 and no thermal stage; after it, the thermal stage.
+    const auto rows = lines_of(slurp(m.dir / "c.csv"));
+    std::size_t before = 0;
+    std::size_t after_thermal = 0;
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+        const double t = std::stod(rows[i]);
+        const unsigned st = static_cast<unsigned>(std::stoul(rows[i].substr(rows[i].rfind(',') + 1)));
+        if (t < t_first) {
+            EXPECT_EQ(st & 2U, 0U) << rows[i];
+            before += (st & 256U) != 0U ? 1U : 0U;
+        } else {
+            after_thermal += (st & 2U) != 0U ? 1U : 0U;
+        }
+    }
+    EXPECT_GT(before, 100U);
+    EXPECT_GT(after_thermal, 1000U);
+    // Rows in reverse order: the same history, the same corrected rows.
+    {
+        const auto in = lines_of(slurp(m.dir / "mission.csv"));
+        std::ofstream f(m.dir / "reversed.csv");
+        f << in[0] << '\n';
+        for (std::size_t i = in.size() - 1; i >= 1; --i) {
+            f << in[i] << '\n';
+        }
+    }
+    const CliRun rr = run_in("correct --in reversed.csv --out cr.csv --self-calibrate --model-history hr.csv", m.dir);
+    ASSERT_EQ(rr.exit_code, 0) << rr.err;
+    EXPECT_EQ(slurp(m.dir / "hr.csv"), slurp(m.dir / "h.csv"));
+    auto a = lines_of(slurp(m.dir / "c.csv"));
+    auto b = lines_of(slurp(m.dir / "cr.csv"));
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a, b);
+    // --model: version 0 from the first row, its coefficients.
+    host::write_model_file((m.dir / "table2.csv").string(), host::table2_model());
+    const CliRun rm = run_in(
+        "correct --in mission.csv --out cm.csv --self-calibrate --model table2.csv --model-history hm.csv", m.dir);
+    ASSERT_EQ(rm.exit_code, 0) << rm.err;
+    const auto hm = lines_of(slurp(m.dir / "hm.csv"));
+    ASSERT_GE(hm.size(), 10U);
+    const std::string first_row = lines_of(slurp(m.dir / "mission.csv"))[1];
+    EXPECT_EQ(hm[1].substr(0, hm[1].find(',')), first_row.substr(0, first_row.find(',')));
+    EXPECT_EQ(hm[1].substr(hm[1].find(',') + 1, 10), "0,A,alpha,");
+    EXPECT_EQ(std::stod(hm[1].substr(hm[1].find("alpha,") + 6)), host::table2_model().coefficients[0][0][0]);
+    // The estimator in the flight scalars.
+    for (const char* scalar : {"float", "fixed"}) {
+        const CliRun rs = run_in(std::string("correct --in mission.csv --out cs.csv --self-calibrate --scalar ") +
+                                     scalar + " --model-history hs.csv",
+                                 m.dir);
+        ASSERT_EQ(rs.exit_code, 0) << rs.err;
+        EXPECT_GE(lines_of(slurp(m.dir / "hs.csv")).size(), 10U) << scalar;
+    }
+    // Refusals: nothing written.
+    const CliRun n1 = run_in("correct --in mission.csv --out x.csv --model-history hx.csv", m.dir);
+    EXPECT_NE(n1.exit_code, 0);
+    EXPECT_NE(n1.err.find("--model-history"), std::string::npos) << n1.err;
+    const CliRun n2 = run_in("correct --in mission.csv --out x.csv --self-calibrate --no-thermal", m.dir);
+    EXPECT_NE(n2.exit_code, 0);
+    EXPECT_NE(n2.err.find("--no-thermal"), std::string::npos) << n2.err;
+    EXPECT_FALSE(fs::exists(m.dir / "x.csv"));
+    EXPECT_FALSE(fs::exists(m.dir / "hx.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::test
