@@ -434,10 +434,10 @@ TEST(CliProbe, ReplayMaxPropagationIsTheFirmwaresHorizon) {
 
 TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt) {
     const fs::path dir = scratch_dir("probe-dash");
-    // simulate writes four files: '-' is refused naming why, and nothing is created.
+    // simulate writes six files: '-' is refused naming why, and nothing is created.
     const CliRun sim = run_in("simulate --days 0.01 --out -", dir);
     EXPECT_EQ(sim.exit_code, 2) << sim.err;
-    EXPECT_TRUE(has(sim.err, "simulate writes four files")) << sim.err;
+    EXPECT_TRUE(has(sim.err, "simulate writes six files")) << sim.err;
     EXPECT_TRUE(fs::is_empty(dir) || !fs::exists(dir / "-.truth.csv"));
     EXPECT_FALSE(fs::exists(dir / "-"));
     EXPECT_FALSE(fs::exists(dir / "-.heaters.csv"));

@@ -650,8 +650,8 @@ public:
                 floor_v_[pr].push_back(iba);
                 FloorSums& f = daily_[day_index][pr];
                 ++f.n;
-                f.sum += iba;
-                f.sum_sq += static_cast<long double>(iba) * iba;
+                f.sum += static_cast<long double>(iba);
+                f.sum_sq += static_cast<long double>(iba) * static_cast<long double>(iba);
             }
         }
         ++sum_.epochs;
