@@ -3,12 +3,24 @@ CTest) and the worked examples (tests/data/)."""
 
 import os
 import pathlib
+import re
 import subprocess
 
 import pytest
 
 SOURCE = pathlib.Path(os.environ.get("ASCORR_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 DATA = SOURCE / "tests" / "data"
+
+
+def core_constant(name):
+    """A physical constant as the firmware side defines it (a decimal literal in
+    ascorr/core/constants.hpp or ascorr/nav/orbit_propagation.hpp): one place."""
+    for header in ("core/constants.hpp", "nav/orbit_propagation.hpp"):
+        text = (SOURCE / "firmware" / "include" / "ascorr" / header).read_text()
+        m = re.search(rf"^inline constexpr double {name} = ([0-9.eE+-]+);", text, re.M)
+        if m:
+            return float(m.group(1))
+    raise KeyError(name)
 
 
 @pytest.fixture(scope="session")

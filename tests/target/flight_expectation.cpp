@@ -87,10 +87,9 @@ StatusBits temperatures_merge_status(std::uint8_t head, StatusBits core) noexcep
 namespace {
 
 using ascorr::kMaxHeads;
+using ascorr::kRadToArcsec;
 using ascorr::app::Scalar;
 using ascorr::app::SolutionRecord;
-
-constexpr double kRadToArcsec = 180.0 / 3.14159265358979323846 * 3600.0;
 
 // One corrected solution as printed: status and the components' bit patterns.
 struct Printed {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "ascorr/core/correct.hpp"
+#include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -26,11 +27,6 @@
 namespace ascorr::host {
 
 namespace {
-
-constexpr double kMuEarth = 398600.4418;  // km³/s²
-constexpr double kEarthRadiusKm = 6378.137;
-constexpr double kDay = 86400.0;
-constexpr double kDeg = kPi / 180.0;
 
 // Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
 constexpr double kNoiseCrossArcsec = 1.5;
@@ -56,10 +52,10 @@ public:
             const double tc = static_cast<double>(hour) * 3600.0 + 1800.0;
             double pvh[2][3];
             double pvb[2][3];
-            eraEpv00(ERFA_DJ00, tc / kDay, pvh, pvb);
+            eraEpv00(ERFA_DJ00, tc / kSecondsPerDay, pvh, pvb);
             sun_ = -Eigen::Vector3d(pvh[0][0], pvh[0][1], pvh[0][2]).normalized();
             double pv[2][3];
-            eraMoon98(ERFA_DJ00, tc / kDay, pv);
+            eraMoon98(ERFA_DJ00, tc / kSecondsPerDay, pv);
             moon_ = Eigen::Vector3d(pv[0][0], pv[0][1], pv[0][2]).normalized();
         }
         sun = sun_;
@@ -108,10 +104,10 @@ public:
     }
 
 private:
-    static constexpr double kTau = 0.5 * kDay;
+    static constexpr double kTau = 0.5 * kSecondsPerDay;
     void schedule(double after) {
-        std::uniform_real_distribution<double> gap(40.0 * kDay, 80.0 * kDay);
-        std::uniform_real_distribution<double> len(3.0 * kDay, 5.0 * kDay);
+        std::uniform_real_distribution<double> gap(40.0 * kSecondsPerDay, 80.0 * kSecondsPerDay);
+        std::uniform_real_distribution<double> len(3.0 * kSecondsPerDay, 5.0 * kSecondsPerDay);
         start_ = after + gap(rng_);
         end_ = start_ + len(rng_);
         operational_ = !operational_;
@@ -151,7 +147,7 @@ char* put(char* p, char* end, double x, int decimals) {
 Eigen::Matrix3d head_mounting(int head) {
     static constexpr double kAzimuthDeg[3] = {90.0, 210.0, 330.0};
     const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
-    const double az = kAzimuthDeg[head] * kDeg;
+    const double az = kAzimuthDeg[head] * kDegToRad;
     const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir
     const Eigen::Vector3d z = std::sin(zeta) * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0) + std::cos(zeta) * up;
     const Eigen::Vector3d x = up.cross(z).normalized();
@@ -231,7 +227,7 @@ void refuse_bad_options(const SimulateOptions& opt) {
         throw std::invalid_argument("--step must be in [1, 600] s (the orbit must be resolved), got " +
                                     std::to_string(opt.step_s));
     }
-    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kDay)) {
+    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kSecondsPerDay)) {
         throw std::invalid_argument("--start " + std::to_string(opt.start_t) +
                                     ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
     }
@@ -269,7 +265,7 @@ public:
         Eigen::Vector3d sun0;
         Eigen::Vector3d moon0;
         sky.at(start_t, sun0, moon0);
-        node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDeg;
+        node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDegToRad;
     }
     OrbitState at(double dt) const {
         OrbitState o;
@@ -290,10 +286,10 @@ public:
     }
 
 private:
-    double a_ = kEarthRadiusKm + kSimAltitudeKm;
-    double n_ = std::sqrt(kMuEarth / (a_ * a_ * a_));
-    double inc_ = kSimInclinationDeg * kDeg;
-    double node_rate_ = 2.0 * kPi / (365.2422 * kDay) - 2.0 * kPi / (kPlaneSunPeriodDays * kDay);
+    double a_ = kEarthEquatorialRadiusKm + kSimAltitudeKm;
+    double n_ = std::sqrt(kEarthGmKm3S2 / (a_ * a_ * a_));
+    double inc_ = kSimInclinationDeg * kDegToRad;
+    double node_rate_ = 2.0 * kPi / (365.2422 * kSecondsPerDay) - 2.0 * kPi / (kPlaneSunPeriodDays * kSecondsPerDay);
     double node0_ = 0.0;
 };
 
@@ -305,7 +301,7 @@ std::array<double, 5> temperatures(const OrbitState& o, const Eigen::Vector3d& s
     const double sinb = sun.dot(o.P.cross(o.Q));
     const double orb = o.r_hat.dot(sun);
     for (auto& w : wander) {
-        w.step(step_s, 3.0 * kDay, 0.6, rnd.engine);
+        w.step(step_s, 3.0 * kSecondsPerDay, 0.6, rnd.engine);
     }
     const double s2 = sinb * sinb;
     std::array<double, 5> temp = {
@@ -501,8 +497,8 @@ public:
         for (std::size_t h = 0; h < 3; ++h) {
             const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
             const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
-            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDeg;
-            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDeg;
+            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDegToRad;
+            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDegToRad;
             if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
                 ++sum_.outage_rows[h];  // blinded: no solution
                 continue;
@@ -580,7 +576,7 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     std::string buf;
     buf.reserve(2U << 20);
     buf += "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
-    const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kDay / opt.step_s)) + 1;
+    const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
         if ((k & 4095U) == 0) {
