@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/numbers.hpp"
 
 namespace ascorr::host {
 
@@ -267,17 +268,10 @@ std::string why_not_a_number(std::string_view field) {
     if (!text.empty() && text[0] == '"') {
         return text::csv::quoted_field_refusal(text);
     }
-    const char* first = text.c_str();
-    if (*first == '+') {
-        ++first;
-    }
     double x = 0.0;
-    const auto [ptr, ec] = std::from_chars(first, text.c_str() + text.size(), x);
-    if (!text.empty() && ec == std::errc::result_out_of_range && ptr == text.c_str() + text.size()) {
-        const double huge = std::strtod(text.c_str(), nullptr);  // from_chars leaves x unset
-        return "'" + text + "' is out of range: " +
-               (std::isinf(huge) ? std::string("a number's magnitude is at most 1.797693e+308")
-                                 : std::string("a nonzero number's magnitude is at least 4.940656e-324 (write 0)"));
+    const std::string words = text::out_of_range_words(text::classify_real(text, x, text::LeadingPlus::kAccepted));
+    if (!words.empty()) {
+        return "'" + text + "' is out of range: " + words;
     }
     return "expected a number, got '" + text + "'";
 }
