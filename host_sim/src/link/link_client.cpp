@@ -185,47 +185,62 @@ typename LinkClient<T>::Heard LinkClient<T>::await(const Request& r, std::vector
             return Heard::kResend;
         }
         for (std::size_t i = 0; i < n; ++i) {
-            switch (decoder_.push(buf[i])) {
-                case link::FrameDecoder::Event::kNone:
-                    break;
-                case link::FrameDecoder::Event::kError:
-                    ++stats_.broken_answers;
-                    break;  // its answer may still follow intact; otherwise the time-out resends
-                case link::FrameDecoder::Event::kFrame: {
-                    const link::Frame& f = decoder_.frame();
-                    const auto t = static_cast<link::MessageType>(f.type);
-                    if (t == link::MessageType::kNak) {
-                        ++stats_.naks;
-                        return Heard::kResend;  // at once
-                    }
-                    // The target's unprompted HELLO: it has restarted.
-                    if (t == link::MessageType::kHello && f.seq == 0U && r.answer != link::MessageType::kHello) {
-                        link::Hello h{};
-                        if (link::decode(f.payload, f.length, h)) {
-                            boot_id_ = h.boot_id;
-                            return Heard::kRestart;
-                        }
-                        ++stats_.stale_answers;
-                        break;
-                    }
-                    if (f.seq == r.seq && t == r.answer) {
-                        answer.assign(f.payload, f.payload + f.length);
-                        return Heard::kAnswer;
-                    }
-                    if (f.seq == r.seq && t == link::MessageType::kAck) {
-                        link::Ack a{};
-                        if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
-                            throw LinkError("request type " + std::to_string(static_cast<int>(r.answer)) +
-                                            " refused by the target (result " +
-                                            std::to_string(static_cast<int>(a.result)) + ")");
-                        }
-                    }
-                    ++stats_.stale_answers;
-                    break;
-                }
+            if (const std::optional<Heard> heard = hear(r, buf[i], answer)) {
+                return *heard;
             }
         }
     }
+}
+
+// One byte into the frame decoder; what it completes, if that ends the wait.
+template <typename T>
+std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear(const Request& r, std::uint8_t byte,
+                                                                 std::vector<std::uint8_t>& answer) {
+    switch (decoder_.push(byte)) {
+        case link::FrameDecoder::Event::kNone:
+            break;
+        case link::FrameDecoder::Event::kError:
+            ++stats_.broken_answers;
+            break;  // its answer may still follow intact; otherwise the time-out resends
+        case link::FrameDecoder::Event::kFrame:
+            return hear_frame(r, decoder_.frame(), answer);
+    }
+    return std::nullopt;
+}
+
+// A whole frame: r's answer, a NAK, the target's restart, a refusal (thrown),
+// or anything else (stale: the wait goes on).
+template <typename T>
+std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear_frame(const Request& r, const link::Frame& f,
+                                                                       std::vector<std::uint8_t>& answer) {
+    const auto t = static_cast<link::MessageType>(f.type);
+    if (t == link::MessageType::kNak) {
+        ++stats_.naks;
+        return Heard::kResend;  // at once
+    }
+    // The target's unprompted HELLO: it has restarted.
+    if (t == link::MessageType::kHello && f.seq == 0U && r.answer != link::MessageType::kHello) {
+        link::Hello h{};
+        if (link::decode(f.payload, f.length, h)) {
+            boot_id_ = h.boot_id;
+            return Heard::kRestart;
+        }
+        ++stats_.stale_answers;
+        return std::nullopt;
+    }
+    if (f.seq == r.seq && t == r.answer) {
+        answer.assign(f.payload, f.payload + f.length);
+        return Heard::kAnswer;
+    }
+    if (f.seq == r.seq && t == link::MessageType::kAck) {
+        link::Ack a{};
+        if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
+            throw LinkError("request type " + std::to_string(static_cast<int>(r.answer)) +
+                            " refused by the target (result " + std::to_string(static_cast<int>(a.result)) + ")");
+        }
+    }
+    ++stats_.stale_answers;
+    return std::nullopt;
 }
 
 // ---------------------------------------------------------------------------

@@ -113,6 +113,8 @@ private:
     Request begin(const Message& m, link::MessageType answer);
     std::optional<std::vector<std::uint8_t>> exchange(Request& r);
     Heard await(const Request& r, std::vector<std::uint8_t>& answer);
+    std::optional<Heard> hear(const Request& r, std::uint8_t byte, std::vector<std::uint8_t>& answer);
+    std::optional<Heard> hear_frame(const Request& r, const link::Frame& f, std::vector<std::uint8_t>& answer);
 
     // The session.
     std::vector<std::uint8_t> request(const Message& m, link::MessageType answer);
