@@ -1,6 +1,6 @@
 // host_sim/cli/number_options.hpp: the text of every numeric option is checked
 // before CLI11 converts it, so that no value is wrapped, truncated or turned
-// into infinity on the way in (issue 11).
+// into infinity on the way in.
 //
 // CLI11 2.1 converts integers with strtoull/strtoll in base 0 and reals with
 // strtold: `--seed -1` became 18446744073709551615, `--seed 010` became 8,

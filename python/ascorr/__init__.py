@@ -25,6 +25,7 @@ from ._ascorr import (  # noqa: F401
     stats,
     write_solutions,
 )
+from ._version import __version__  # noqa: F401
 
 __all__ = [
     "FitRefused",

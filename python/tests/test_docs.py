@@ -53,3 +53,10 @@ def test_readme_example_runs(exe, tmp_path):
     p = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     assert "A-B" in p.stdout and "rows" in p.stdout
+
+
+def test_version_is_the_cmake_projects(exe):
+    """ascorr.__version__ and `ascorr --version` are CMake's project(VERSION)."""
+    assert ascorr.__version__ == os.environ["ASCORR_VERSION"]
+    out = subprocess.run([exe, "--version"], check=True, capture_output=True, text=True).stdout
+    assert out == f"ascorr {ascorr.__version__}\n"

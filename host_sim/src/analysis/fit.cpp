@@ -398,7 +398,7 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     r.model = r.fit.model;
 }
 
-// Row order must not matter (issue 11). The reference N_i is the earliest
+// Row order must not matter. The reference N_i is the earliest
 // epoch's (re-based exactly at the end), and the orbit period, when not
 // given, comes from the earliest selected row: if that is not the first one
 // read, the file is read again with that period (unordered files only).

@@ -251,7 +251,7 @@ ModelFile truth_model(const SimulateOptions& opt) {
 
 // The circular orbit (header: Sun-synchronous-like node drift) and the
 // spacecraft's attitude at dt seconds after the start.
-struct OrbitState {
+struct SpacecraftPose {
     Eigen::Vector3d P;      // node direction (ICRF)
     Eigen::Vector3d Q;      // 90° ahead in the orbital plane
     Eigen::Vector3d r_hat;  // position direction
@@ -267,8 +267,8 @@ public:
         sky.at(start_t, sun0, moon0);
         node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDegToRad;
     }
-    OrbitState at(double dt) const {
-        OrbitState o;
+    SpacecraftPose at(double dt) const {
+        SpacecraftPose o;
         const double u = n_ * dt;
         const double node = node0_ + node_rate_ * dt;
         o.P = Eigen::Vector3d(std::cos(node), std::sin(node), 0.0);
@@ -296,7 +296,7 @@ private:
 // T_CHU A, B, C, T029, T032 (°C, rounded as written): seasonal (sine of the
 // Sun's angle to the orbital plane), orbital (sunlit side), independent
 // wander, heater events, read noise.
-std::array<double, 5> temperatures(const OrbitState& o, const Eigen::Vector3d& sun, double op, double surv,
+std::array<double, 5> temperatures(const SpacecraftPose& o, const Eigen::Vector3d& sun, double op, double surv,
                                    std::array<Wander, 5>& wander, double step_s, Random& rnd) {
     const double sinb = sun.dot(o.P.cross(o.Q));
     const double orb = o.r_hat.dot(sun);
@@ -368,7 +368,7 @@ Quaternion<double> raw_attitude(const Quaternion<double>& q_meas, double t, std:
 // Everything one epoch shares between its heads.
 struct EpochState {
     double t = 0.0;
-    OrbitState orbit;
+    SpacecraftPose orbit;
     Eigen::Vector3d sun;
     Eigen::Vector3d moon;
     std::array<double, 5> temp{};

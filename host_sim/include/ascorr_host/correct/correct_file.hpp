@@ -13,12 +13,9 @@
 #include <iosfwd>
 #include <string>
 
-namespace ascorr::host {
+#include "ascorr_host/correct/scalar_kind.hpp"
 
-// Which scalar the core is instantiated with (--scalar). A kind, not the type:
-// the firmware's type is firmware/app/app_scalar.hpp's Scalar, and a target
-// reports its kind in the link's HELLO (scalar_kind).
-enum class ScalarKind { kDouble, kFloat, kFixed };
+namespace ascorr::host {
 
 struct CorrectOptions {
     std::string in;
