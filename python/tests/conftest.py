@@ -3,8 +3,8 @@ CTest) and the worked examples (tests/data/)."""
 
 import os
 import pathlib
-import re
 import subprocess
+import sys
 
 import pytest
 
@@ -12,15 +12,8 @@ SOURCE = pathlib.Path(os.environ.get("ASCORR_SOURCE_DIR", pathlib.Path(__file__)
 DATA = SOURCE / "tests" / "data"
 
 
-def core_constant(name):
-    """A physical constant as the firmware side defines it (a decimal literal in
-    ascorr/core/constants.hpp or ascorr/nav/orbit_propagation.hpp): one place."""
-    for header in ("core/constants.hpp", "nav/orbit_propagation.hpp"):
-        text = (SOURCE / "firmware" / "include" / "ascorr" / header).read_text()
-        m = re.search(rf"^inline constexpr double {name} = ([0-9.eE+-]+);", text, re.M)
-        if m:
-            return float(m.group(1))
-    raise KeyError(name)
+sys.path.insert(0, str(SOURCE / "tools"))
+from core_constants import core_constant  # noqa: E402,F401  (the firmware side's constants)
 
 
 @pytest.fixture(scope="session")

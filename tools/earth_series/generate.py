@@ -30,7 +30,6 @@ packages, same table.
 import argparse
 import itertools
 import os
-import re
 import subprocess
 import sys
 
@@ -39,13 +38,8 @@ import numpy as np
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 
-
-def core_constant(name):
-    """A constant of firmware/include/ascorr/core/constants.hpp (one place)."""
-    with open(os.path.join(REPO, "firmware", "include", "ascorr", "core", "constants.hpp")) as f:
-        m = re.search(rf"^inline constexpr double {name} = ([0-9.eE+-]+);", f.read(), re.M)
-    return float(m.group(1))
-
+sys.path.insert(0, os.path.join(REPO, "tools"))
+from core_constants import core_constant  # noqa: E402
 
 AU_KM = core_constant("kAstronomicalUnitKm")
 DAY = core_constant("kSecondsPerDay")
