@@ -23,6 +23,7 @@
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
+#include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 
 namespace ascorr::test {
@@ -119,8 +120,8 @@ inline Generated generate(const std::string& path, const GeneratorOptions& o) {
     }
     const Eigen::Matrix3d yaw = Eigen::AngleAxisd(20.0 * deg, Eigen::Vector3d::UnitZ()).toRotationMatrix();
 
-    const double mu = 398600.4418;
-    const double a = 6378.137 + 800.0;
+    const double mu = kEarthGmKm3S2;
+    const double a = kEarthEquatorialRadiusKm + 800.0;
     const double n = std::sqrt(mu / (a * a * a));
     const double inc = 98.6 * deg;
     const double season = 180.0 * 86400.0;

@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kDay = 86400.0;
+constexpr double kDay = kSecondsPerDay;
 
 // One data set shared by the tests of this file (generating it takes a second).
 struct Shared {

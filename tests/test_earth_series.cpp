@@ -15,12 +15,13 @@
 #include <random>
 #include <vector>
 
+#include "ascorr/core/constants.hpp"
 #include "ascorr/nav/earth_series.hpp"
 
 namespace ascorr {
 namespace {
 
-constexpr double kDay = 86400.0;
+constexpr double kDay = kSecondsPerDay;
 constexpr double kKmPerAu = kAstronomicalUnitKm;
 constexpr double kVelocityBoundMs = 3.0;   // the issue's requirement
 constexpr double kDistanceBoundAu = 1e-5;  // the issue asks 1e-4 au; the series reaches 9.1e-6

@@ -1,4 +1,4 @@
-// tests/test_facts.cpp: one place for each fact (issue 14). The heads
+// tests/test_facts.cpp: one place for each fact. The heads
 // (ascorr/heads.hpp) are defined once; what can include them derives from them,
 // and what cannot (documentation, the HAL's role names) is checked here against
 // them, so a copy that drifts fails this test.

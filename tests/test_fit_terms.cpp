@@ -23,7 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kDay = 86400.0;
+constexpr double kDay = kSecondsPerDay;
 constexpr double kQuadraticTruth = 0.04;  // arcsec/°C²: ±2.6" over the ±8 °C seasons
 
 struct DataSet {

@@ -1,4 +1,4 @@
-// The host tools never destroy data (issue 11, items 1 and 2): an output that
+// The host tools never destroy data: an output that
 // is an input is refused before anything is read; outputs that are not regular
 // files are written as streams; links and permissions are kept; a corrected
 // file is not corrected again; a run ended by a signal leaves no temporary
@@ -170,7 +170,7 @@ TEST(OutputSafety, FitPlotSimulateReplayAndThermistorsRefuseToOverwriteAnInput) 
 
 // ---- item 1: outputs that are not regular files, links, permissions ---------
 
-// The states file is an input too (issue 12's --states): correct and replay
+// The states file is an input too (--states): correct and replay
 // refuse to write over it.
 TEST(OutputSafety, TheStatesFileIsAnInputCorrectAndReplayDoNotOverwrite) {
     const fs::path dir = scratch_dir("same-states");

@@ -1,5 +1,5 @@
-// Silent wrong results become flagged, and bad options are refused (issue 11,
-// items 4 and 5), through the `ascorr` executable.
+// Silent wrong results become flagged, and bad options are refused,
+// through the `ascorr` executable.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -230,7 +230,7 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
 namespace ascorr::test {
 namespace {
 
-// Issue 11, item 5: a seed is an unsigned 64-bit integer, in decimal. On
+// A seed is an unsigned 64-bit integer, in decimal. On
 // ed4f56e `--seed -1` ran with seed 2^64 − 1, `--seed 99999999999999999999`
 // with 2^64 − 1 and `--seed 010` with 8 (CLI11 reads base 0), all silently.
 TEST(Refusals, OutOfRangeSeedsAreRefusedNamingTheOptionAndTheRange) {
@@ -272,7 +272,7 @@ TEST(Refusals, OutOfRangeSeedsAreRefusedNamingTheOptionAndTheRange) {
     EXPECT_NE(slurp(dir / "ten0.csv"), slurp(dir / "eight.csv"));  // mutation check: seeds do change the file
 }
 
-// Issue 11, item 5: a number that is a number but beyond its range says "out of
+// A number that is a number but beyond its range says "out of
 // range" and gives the range, in options and in every CSV reader (on ed4f56e:
 // "expected a number", "Could not convert", or 1e999 taken as infinity).
 TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
@@ -354,7 +354,7 @@ TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
 namespace ascorr::test {
 namespace {
 
-// Issue 11, item 5: a model beyond a range names file:line:column and its
+// A model beyond a range names file:line:column and its
 // numbers in %g (on ed4f56e: "m.csv: A beta c1 = 1000000000.000000 is beyond
 // the fixed-point coefficient range (+-...)" without a line, and a truth model
 // beyond 1 degree named neither file nor line).
@@ -400,7 +400,7 @@ TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
 namespace ascorr::test {
 namespace {
 
-// Issue 11, item 5: RFC 4180 quoting in columns ascorr ignores is accepted
+// RFC 4180 quoting in columns ascorr ignores is accepted
 // and copied verbatim (on ed4f56e a comma inside quotes split the field: "expected
 // 15 fields as in the header, found 16"); in a column it reads it is refused,
 // naming the column; a line break inside quotes is refused as unterminated.
@@ -484,7 +484,7 @@ std::string three_heads(int n, int c_flags, double c_dt) {
     return s.str();
 }
 
-// Issue 11, item 5: `stats` and `plot` say why a pair has no epochs, and
+// `stats` and `plot` say why a pair has no epochs, and
 // `plot` draws the pairs it has (on ed4f56e: stats printed "0" and "-" without
 // a reason; plot failed with "no clean epoch for pair A-C: nothing to plot").
 TEST(Refusals, StatsAndPlotSayWhyAPairHasNoEpochsAndPlotDrawsTheOthers) {

@@ -316,7 +316,7 @@ TEST(Replay, HelpOffersEveryQemuTargetOfTheTableWithItsScalar) {
     }
     for (const host::QemuTarget& t : host::kQemuTargets) {
         const std::string choice =
-            std::string(t.replay) + (t.scalar == host::TargetScalar::kFixed ? " (Q30)" : " (float)");
+            std::string(t.replay) + (t.scalar == host::ScalarKind::kFixed ? " (Q30)" : " (float)");
         EXPECT_NE(squeezed.find(choice), std::string::npos) << choice << " not in:\n" << help;
     }
     EXPECT_NE(squeezed.find(host::qemu_target_choices() + ", loopback-float"), std::string::npos) << help;

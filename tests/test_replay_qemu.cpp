@@ -37,7 +37,7 @@ constexpr int kRows = 10000;
 // The bound of the board's scalar against the double reference, arcsec
 // (tests/target/accuracy-bounds.txt, compile definitions of tests/CMakeLists.txt).
 double bound_arcsec(const host::QemuTarget& board) {
-    return board.scalar == host::TargetScalar::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
+    return board.scalar == host::ScalarKind::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
 }
 
 std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
@@ -96,7 +96,7 @@ TEST_P(ReplayQemu, OnePercentFaults) {
 // the model, velocity and temperatures, and every answer stays exact.
 template <typename T>
 void survive_restart(const host::QemuTarget* board, const std::string& name) {
-    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
+    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::ScalarKind::kFixed : host::ScalarKind::kFloat));
     constexpr int kRestartRows = 1200;
     const auto dir = scratch_dir(name);
     const std::string rec = make_recording(dir, kRestartRows);
@@ -133,7 +133,7 @@ void survive_restart(const host::QemuTarget* board, const std::string& name) {
 }
 
 TEST_P(ReplayQemu, RestartMidRunIsRecovered) {
-    if (GetParam().scalar == host::TargetScalar::kFixed) {
+    if (GetParam().scalar == host::ScalarKind::kFixed) {
         survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
     } else {
         survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));

@@ -144,7 +144,7 @@ void expect_complete(const host::ReplaySummary& s, double bound) {
 // the bound of its scalar (tests/target/accuracy-bounds.txt, compile
 // definitions of tests/CMakeLists.txt).
 double bound_arcsec(const host::QemuTarget& board) {
-    return board.scalar == host::TargetScalar::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
+    return board.scalar == host::ScalarKind::kFixed ? ASCORR_BOUND_FIXED_ARCSEC : ASCORR_BOUND_FLOAT_ARCSEC;
 }
 
 std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
@@ -172,7 +172,7 @@ TEST_P(ReplayStatesQemu, OnePercentFaults) {
 // and the latest accepted state, and every answer stays exact.
 template <typename T>
 void survive_restart(const host::QemuTarget* board, const std::string& name) {
-    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::TargetScalar::kFixed : host::TargetScalar::kFloat));
+    ASSERT_EQ(board->scalar, (std::is_same_v<T, Q30> ? host::ScalarKind::kFixed : host::ScalarKind::kFloat));
     constexpr int kRestartRows = 600;
     const auto dir = scratch_dir(name);
     const StatesRecording rec = make_states_recording(dir, kRestartRows);
@@ -230,7 +230,7 @@ void survive_restart(const host::QemuTarget* board, const std::string& name) {
 }
 
 TEST_P(ReplayStatesQemu, RestartRestoresTheState) {
-    if (GetParam().scalar == host::TargetScalar::kFixed) {
+    if (GetParam().scalar == host::ScalarKind::kFixed) {
         survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
     } else {
         survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));

@@ -1,4 +1,4 @@
-// Results do not depend on row order (issue 11, item 3): `fit` on a shuffled
+// Results do not depend on row order: `fit` on a shuffled
 // copy of a simulated mission gives the same model as on the file in time
 // order, up to the rounding of sums taken in another order.
 #include <gtest/gtest.h>

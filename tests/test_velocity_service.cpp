@@ -30,8 +30,8 @@ namespace {
 using V3 = Vector3<double>;
 
 constexpr double kAuKm = kAstronomicalUnitKm;
-constexpr double kDayS = 86400.0;
-constexpr double kDj00 = 2451545.0;  // J2000.0 as a Julian date
+constexpr double kDayS = kSecondsPerDay;
+constexpr double kDj00 = kJ2000JulianDate;
 // 1.45 m/s of velocity is 0.001" of aberration (v/c in rad).
 constexpr double kMsToArcsec = 1e-3 / kSpeedOfLightKmS * kRadToArcsec;
 

@@ -17,7 +17,7 @@
 //   std::uint32_t now() noexcept;                    a time stamp
 //   void add(Part part, std::uint32_t start) noexcept;  the part just done since `start`
 //
-// SolutionRecord: per head, the cycles with both corrections applied, every
+// CorrectionLog: per head, the cycles with both corrections applied, every
 // status bit seen, the last corrected solution, and a CRC-32C (crc32c.hpp)
 // over every cycle's corrected solution (the four components' bit patterns,
 // then the status; little-endian); and every head's solution at each
@@ -83,7 +83,7 @@ inline std::uint32_t bits_of(float x) noexcept {
     return u;
 }
 
-class SolutionRecord {
+class CorrectionLog {
 public:
     static constexpr std::uint32_t kSampleEvery = 16U;
     static constexpr std::uint32_t kMaxSamples = 32U;
@@ -245,7 +245,7 @@ public:
     const VelocityService<Scalar>& service() const noexcept { return service_; }
     std::uint32_t states_skipped() const noexcept { return states_skipped_; }
     std::uint32_t states_refused() const noexcept { return states_refused_; }
-    const SolutionRecord& record() const noexcept { return record_; }
+    const CorrectionLog& record() const noexcept { return record_; }
 
 private:
     VelocityService<Scalar> service_{kServiceConfig};
@@ -253,7 +253,7 @@ private:
     CorrectedSolution<Scalar> corrected_[kMaxHeads]{};  // latest corrected solution per head
     std::uint32_t states_skipped_ = 0U;
     std::uint32_t states_refused_ = 0U;
-    SolutionRecord record_;
+    CorrectionLog record_;
 };
 
 template <typename Meter>

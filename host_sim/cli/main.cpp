@@ -7,8 +7,10 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/version.hpp"
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
@@ -17,7 +19,7 @@ int main(int argc, char** argv) {
     ascorr::host::install_signal_cleanup();
     CLI::App app{"ascorr: thermal and aberration correction of uASC star-tracker attitude solutions"};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "ascorr 0.1.0");
+    app.set_version_flag("--version", std::string("ascorr ") + ascorr::cli::kVersion);
     ascorr::cli::add_correct_command(app);
     ascorr::cli::add_replay_command(app);
     ascorr::cli::add_thermistors_command(app);

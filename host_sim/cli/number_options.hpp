@@ -1,6 +1,6 @@
 // host_sim/cli/number_options.hpp: the text of every numeric option is checked
 // before CLI11 converts it, so that no value is wrapped, truncated or turned
-// into infinity on the way in (issue 11).
+// into infinity on the way in.
 //
 // CLI11 2.1 converts integers with strtoull/strtoll in base 0 and reals with
 // strtold: `--seed -1` became 18446744073709551615, `--seed 010` became 8,
@@ -17,44 +17,23 @@
 
 #include <CLI/CLI.hpp>
 
-#include <cerrno>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <string>
-#include <system_error>
+
+#include "ascorr_text/numbers.hpp"
 
 namespace ascorr::cli {
 
 namespace detail {
 
-// What a piece of text is, as a real number (std::from_chars, with an optional
-// leading '+'; no spaces, no hexadecimal).
-enum class RealText { kNumber, kNotANumber, kOverflow, kUnderflow };
-
+// What a piece of text is, as a real number (ascorr_text/numbers.hpp), with an
+// optional leading '+'.
+using text::RealText;
 inline RealText classify_real(const std::string& s, double& value) {
-    const char* first = s.data();
-    const char* const last = s.data() + s.size();
-    if (first != last && *first == '+') {
-        ++first;
-    }
-    if (first == last || *first == '+') {
-        return RealText::kNotANumber;
-    }
-    const auto [ptr, ec] = std::from_chars(first, last, value);
-    if (ptr != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
-        return RealText::kNotANumber;
-    }
-    if (ec == std::errc::result_out_of_range) {
-        // from_chars leaves value unset: strtod tells overflow (±HUGE_VAL) from underflow.
-        errno = 0;
-        const double x = std::strtod(s.c_str(), nullptr);
-        return std::isinf(x) ? RealText::kOverflow : RealText::kUnderflow;
-    }
-    return RealText::kNumber;
+    return text::classify_real(s, value, text::LeadingPlus::kAccepted);
 }
 
 // Decimal digits with an optional sign, as sign and magnitude; false for any
@@ -156,13 +135,13 @@ inline CLI::Validator real_number() {
     return CLI::Validator(
         [](std::string& s) {
             double x = 0.0;
-            switch (detail::classify_real(s, x)) {
+            const detail::RealText kind = detail::classify_real(s, x);
+            switch (kind) {
                 case detail::RealText::kNumber:
                     return std::string();
                 case detail::RealText::kOverflow:
-                    return s + " is out of range: a number's magnitude is at most 1.797693e+308";
                 case detail::RealText::kUnderflow:
-                    return s + " is out of range: a nonzero number's magnitude is at least 4.940656e-324 (write 0)";
+                    return s + " is out of range: " + text::out_of_range_words(kind);
                 case detail::RealText::kNotANumber:
                     break;
             }

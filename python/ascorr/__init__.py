@@ -22,6 +22,7 @@ import inspect as _inspect
 
 from . import _ascorr
 from ._ascorr import HEADS, FitRefused, InputError, Model  # noqa: F401
+from ._version import __version__  # noqa: F401
 
 
 def _signature(f):

@@ -9,6 +9,7 @@ import numpy.typing as npt
 _Real = npt.ArrayLike  # any real dtype; float64 C-contiguous is used in place
 _Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pathlib.Path)
 
+__version__: str  # project(VERSION) of the CMake build
 HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
 
 class InputError(ValueError): ...

@@ -4,11 +4,16 @@ CTest) and the worked examples (tests/data/)."""
 import os
 import pathlib
 import subprocess
+import sys
 
 import pytest
 
 SOURCE = pathlib.Path(os.environ.get("ASCORR_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
 DATA = SOURCE / "tests" / "data"
+
+
+sys.path.insert(0, str(SOURCE / "tools"))
+from core_constants import core_constant  # noqa: E402,F401  (the firmware side's constants)
 
 
 @pytest.fixture(scope="session")

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 import ascorr
-from conftest import DATA, run_cli
+from conftest import DATA, core_constant, run_cli
 
 T0 = 456148800.0  # the simulation's first epoch
+DAY = core_constant("kSecondsPerDay")
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +49,7 @@ def test_fit_refuses_too_short_a_period(mission):
         ascorr.fit(*as_args(d), t_from=T0 + 10, t_to=T0)
 
 
-@pytest.mark.parametrize("period", [(None, None), (T0 + 5 * 86400, T0 + 20 * 86400)])
+@pytest.mark.parametrize("period", [(None, None), (T0 + 5 * DAY, T0 + 20 * DAY)])
 def test_stats_on_arrays_is_ascorr_stats(exe, mission, period):
     model_path = DATA / "model_table2.csv"
     options = ["--model", model_path, "--json"]
@@ -95,9 +96,9 @@ def test_iba_duplicate_epoch_is_an_input_error(mission):
 
 def test_earth_velocity_against_pyerfa():
     erfa = pytest.importorskip("erfa")  # python3-erfa (toolchain/debian-packages.txt)
-    t = np.linspace(0.0, 25 * 365.25 * 86400, 2001) + 123.456
-    au_per_day = 149597870.7 / 86400.0
-    pvh, pvb = erfa.epv00(2451545.0, t / 86400.0)
+    t = np.linspace(0.0, 25 * 365.25 * DAY, 2001) + 123.456
+    au_per_day = core_constant("kAstronomicalUnitKm") / DAY
+    pvh, pvb = erfa.epv00(core_constant("kJ2000JulianDate"), t / DAY)
     v_ref = pvb["v"] * au_per_day
     d_ref = np.linalg.norm(pvh["p"], axis=1)
     v, dist = ascorr.earth_velocity(t, exact=True)

@@ -86,3 +86,10 @@ def test_readme_example_runs_and_draws_its_figure(exe, tmp_path):
         hits = int((np.abs(rgb - want).max(axis=2) < 0.02).sum())
         assert hits > 2000, f"{colour}: {hits} pixels"
     assert (rgb.min(axis=2) < 0.9).mean() > 0.02, "the figure is blank"
+
+
+def test_version_is_the_cmake_projects(exe):
+    """ascorr.__version__ and `ascorr --version` are CMake's project(VERSION)."""
+    assert ascorr.__version__ == os.environ["ASCORR_VERSION"]
+    out = subprocess.run([exe, "--version"], check=True, capture_output=True, text=True).stdout
+    assert out == f"ascorr {ascorr.__version__}\n"

@@ -5,17 +5,17 @@ import numpy as np
 import pytest
 
 import ascorr
-from conftest import DATA, read_csv_text, run_cli
+from conftest import DATA, core_constant, read_csv_text, run_cli
 from test_correct import assert_same_as_cli, random_solutions, write_csv_exact
 
 T0 = 801964800.184  # 2025-06-01, inside the Earth series' span (2000-2050)
-MU = 398600.4418    # km^3/s^2
+MU = core_constant("kEarthGmKm3S2")  # km^3/s^2
 
 
 def write_states(path, bad_line=False):
     """GCRS states every 10 s for 10 minutes of a circular 460 km orbit inclined
     87.4 deg (written here, not by ascorr); optionally one implausible state."""
-    r0 = 6378.137 + 460.0
+    r0 = core_constant("kEarthEquatorialRadiusKm") + 460.0
     w = np.sqrt(MU / r0**3)
     inc = np.radians(87.4)
     lines = ["t,x,y,z,vx,vy,vz"]

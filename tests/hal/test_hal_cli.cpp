@@ -73,7 +73,7 @@ TEST(HalConfigFile, ErrorsNameLineAndColumn) {
               "board.cfg:2:45: unknown channel key 'colour'");
 }
 
-// Issue 11: a curve that is not an NTC's (T must fall as R rises, 1/T > 0) on
+// A curve that is not an NTC's (T must fall as R rises, 1/T > 0) on
 // the resistances the channel converts is refused, naming where it fails.
 TEST(HalConfigFile, NonMonotonicSteinhartHartIsRefusedWithItsRange) {
     const std::string line = "channel name=T1 adc=0 role=t029 a=1.129241e-3 b=2.341077e-4 ";
@@ -104,7 +104,7 @@ TEST(HalConfigFile, NonMonotonicSteinhartHartIsRefusedWithItsRange) {
     EXPECT_EQ(config_error(line + "c=0\n"), "no error");
 }
 
-// Issue 11: injected values that are not numbers, and noise that is not
+// Injected values that are not numbers, and noise that is not
 // positive, are refused naming the fault; so are non-finite history values.
 TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
@@ -179,7 +179,7 @@ TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
     EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
 }
 
-// Issue 11: a well-formed number beyond double's range says "out of range"
+// A well-formed number beyond double's range says "out of range"
 // (as the host's readers do) in every HAL file and in --inject; malformed
 // text keeps its own message (the control: 'warm', 'x').
 TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
@@ -225,7 +225,7 @@ TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
               "fault 'THT00057:open:x:20': FROM and TO must be finite numbers with FROM < TO");
 }
 
-// Issue 14 item 8 split parse_history; what it reads is unchanged (this test
+// parse_history was split; what it reads is unchanged (this test
 // passes on the earlier, single-function reader too).
 TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {
     const std::vector<hal::HistoryRow> a =
@@ -395,7 +395,7 @@ std::vector<std::string> lines_with(const std::string& text, const std::string& 
     return out;
 }
 
-// Issue 11: one frame per epoch with every head's truth, at the epoch's time.
+// One frame per epoch with every head's truth, at the epoch's time.
 // Each row used to be a frame, 16 ms after the previous one, so a one-count
 // step of CHU_B between the rows of A and B read as ~1.5 °C/s: a rate fault
 // every two or three seconds on a history warming at 0.5 °C/min.
@@ -441,7 +441,7 @@ TEST(HalCli, RowsOfOneEpochThatDisagreeAreRefused) {
     EXPECT_NE(ok.err.find("2 frames"), std::string::npos) << ok.err;
 }
 
-// Issue 11: a file that cannot be opened was "file:0:0: cannot open: ...".
+// A file that cannot be opened was "file:0:0: cannot open: ...".
 // No message cites line or column 0; each reader names its file.
 TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
     const fs::path dir = scratch_dir("hal-cli");
@@ -472,7 +472,7 @@ TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
     EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
 }
 
-// Issue 11: binary data in a configuration, replay or history file is refused
+// Binary data in a configuration, replay or history file is refused
 // at file:line:column, and its bytes never reach the terminal (an escaped
 // excerpt at most).
 TEST(HalCli, BinaryInputIsRefusedAtItsLineAndNeverEchoed) {

@@ -1,4 +1,4 @@
-// Issue 14 item 6: the thermistor channel defaults exist once, in
+// The thermistor channel defaults exist once, in
 // hal/include/ascorr_hal/channel_defaults.hpp. Every copy is derived from it
 // or checked here against it: the board configuration's optional keys
 // (config_file.cpp), the example hal/examples/board.cfg (text), the flight

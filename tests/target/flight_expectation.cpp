@@ -14,7 +14,7 @@
 // microseconds, far within the acquisition's margins: boom_temperatures.hpp).
 //
 // check: compares the image's report (REPORT: its standard output) with the
-// host's record (SolutionRecord): per head the cycles with both corrections
+// host's record (CorrectionLog): per head the cycles with both corrections
 // applied, every status bit seen, the last solution, every sample (every
 // 16th cycle) and, for BOUND_ARCSEC = 0, the CRC-32C over every cycle's
 // solution and status. BOUND_ARCSEC = 0: bit for bit. Otherwise statuses and
@@ -87,10 +87,9 @@ StatusBits temperatures_merge_status(std::uint8_t head, StatusBits core) noexcep
 namespace {
 
 using ascorr::kMaxHeads;
+using ascorr::kRadToArcsec;
+using ascorr::app::CorrectionLog;
 using ascorr::app::Scalar;
-using ascorr::app::SolutionRecord;
-
-constexpr double kRadToArcsec = 180.0 / 3.14159265358979323846 * 3600.0;
 
 // One corrected solution as printed: status and the components' bit patterns.
 struct Printed {
@@ -122,11 +121,11 @@ Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
             {bits_of(c.q_chu_icrf.w), bits_of(c.q_chu_icrf.x), bits_of(c.q_chu_icrf.y), bits_of(c.q_chu_icrf.z)}};
 }
 
-Report from_record(const SolutionRecord& r, std::uint32_t cycles) {
+Report from_record(const CorrectionLog& r, std::uint32_t cycles) {
     Report out;
     out.cycles = cycles;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        const SolutionRecord::Head& hd = r.head(h);
+        const CorrectionLog::Head& hd = r.head(h);
         out.head_seen[h] = true;
         out.applied[h] = hd.applied;
         out.status_seen[h] = hd.status_union;
@@ -137,7 +136,7 @@ Report from_record(const SolutionRecord& r, std::uint32_t cycles) {
     }
     for (std::uint32_t i = 0; i < r.samples_taken(); ++i) {
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            out.samples.push_back({i * SolutionRecord::kSampleEvery, h, printed(r.sample(i, h))});
+            out.samples.push_back({i * CorrectionLog::kSampleEvery, h, printed(r.sample(i, h))});
         }
     }
     return out;

@@ -97,8 +97,8 @@ foreach(t ${ASCORR_TARGET_LIST})
     PASS_REGULAR_EXPRESSION "${scalar_name_${s}} core, ${firmware_expect}.*service within the correction's cost.*${flight_match_${s}}")
 endforeach()
 
-# No soft-float routine in the M3's per-solution path. Scope: since issue 12
-# the application image holds the velocity service's software-double part
+# No soft-float routine in the M3's per-solution path. Scope: the
+# application image holds the velocity service's software-double part
 # (frame conversion, propagation, Earth series, once per state / node /
 # minute, outside the per-solution path), so the check names the objects of
 # the per-solution and per-cycle code; the image is the negative control.

@@ -37,8 +37,12 @@ import erfa
 import numpy as np
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-AU_KM = 149597870.7
-DAY = 86400.0
+
+sys.path.insert(0, os.path.join(REPO, "tools"))
+from core_constants import core_constant  # noqa: E402
+
+AU_KM = core_constant("kAstronomicalUnitKm")
+DAY = core_constant("kSecondsPerDay")
 JULIAN_CENTURY_S = 36525.0 * DAY
 
 # Fundamental arguments (ERFA function, name in the header, what it is).
@@ -86,7 +90,7 @@ def reference(t):
     v = np.empty((len(t), 3))
     r = np.empty(len(t))
     for i, ti in enumerate(t):
-        (ph, _), (_, vb) = erfa.epv00(2451545.0, ti / DAY)
+        (ph, _), (_, vb) = erfa.epv00(core_constant("kJ2000JulianDate"), ti / DAY)
         v[i] = vb
         r[i] = np.linalg.norm(ph)
     return v * (AU_KM / DAY), r

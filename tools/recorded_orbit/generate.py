@@ -14,15 +14,22 @@ Run from the repository root (not by CI; the flight loop's target test is):
     /usr/bin/python3 tools/recorded_orbit/generate.py && clang-format -i firmware/app/recorded_orbit.hpp
 Needs python3-erfa and python3-numpy. Deterministic.
 """
+import os
+import sys
+
 import erfa
 import numpy as np
 
-MU = 398600.4418
-RE = 6378.137
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from core_constants import core_constant  # noqa: E402
+
+MU = core_constant("kEarthGmKm3S2")
+RE = core_constant("kEarthEquatorialRadiusKm")
 J = {2: 1.08262668e-3, 3: -2.53265649e-6, 4: -1.61962159e-6}
-DJ00 = 2451545.0
+DJ00 = core_constant("kJ2000JulianDate")
+DAY = core_constant("kSecondsPerDay")
 T0 = 801964800.184  # 2025-06-01 12:00:00.184 TT, the flight loop's start
-OMEGA = 2.0 * np.pi * 1.00273781191135448 / 86400.0
+OMEGA = 2.0 * np.pi * 1.00273781191135448 / DAY
 
 
 def accel(r, pole):
@@ -46,7 +53,7 @@ def rk4(r, v, pole, h):
 
 
 def main():
-    pole = erfa.pnm06a(DJ00, T0 / 86400.0)[2]
+    pole = erfa.pnm06a(DJ00, T0 / DAY)[2]
     rad = RE + 460.0
     inc, raan = np.radians(87.4), 0.7
     node = np.array([np.cos(raan), np.sin(raan), 0.0])
@@ -57,7 +64,7 @@ def main():
     for k in range(24):
         if not 3 <= k - 1 <= 14:
             ut1 = t - 69.184 - 0.15
-            c2t = erfa.c2t06a(DJ00, t / 86400.0, DJ00, ut1 / 86400.0, np.radians(0.12 / 3600), np.radians(0.35 / 3600))
+            c2t = erfa.c2t06a(DJ00, t / DAY, DJ00, ut1 / DAY, np.radians(0.12 / 3600), np.radians(0.35 / 3600))
             ri = c2t @ r
             vi = c2t @ v - np.cross([0.0, 0.0, OMEGA], ri)
             rows.append((round(t * 1e6), ri, vi))

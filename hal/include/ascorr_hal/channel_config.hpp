@@ -28,7 +28,8 @@ enum class Role : std::uint8_t { kMonitor = 0, kChuA, kChuB, kChuC, kChuD, kT029
 inline constexpr std::uint8_t kRoleCount = 7;
 inline constexpr const char* kRoleNames[kRoleCount] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
 // One CHU role per head of ascorr/heads.hpp, in head order, named chu_<letter>
-// (tests/test_heads.cpp checks the names): a head added there needs its role here.
+// (Heads.HalRolesAreOnePerHeadNamedByItsLetter in tests/test_facts.cpp checks the
+// names): a head added there needs its role here.
 static_assert(static_cast<std::uint8_t>(Role::kT029) == static_cast<std::uint8_t>(Role::kChuA) + ascorr::kMaxHeads,
               "one Role::kChu<letter> per head of ascorr/heads.hpp");
 

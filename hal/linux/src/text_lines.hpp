@@ -26,25 +26,18 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_text/csv_fields.hpp"
 #include "ascorr_text/line_limit.hpp"
+#include "ascorr_text/numbers.hpp"
 
 namespace ascorr::hal::linux_detail {
 
 // Why a field is not a usable number when it is a well-formed decimal beyond
 // double's range ("1e999", "1e-999"): "'1e999' is out of range: ..." in the
-// host readers' words (host_sim/src/formats/csv.cpp, why_not_a_number). Empty for any
+// words of ascorr_text/numbers.hpp, as the host's readers say it. Empty for any
 // other field, so the caller keeps its own message for malformed text.
 inline std::string out_of_range_reason(std::string_view v) {
     double x = 0.0;
-    const char* end = v.data() + v.size();
-    const auto r = std::from_chars(v.data(), end, x);
-    if (v.empty() || r.ec != std::errc::result_out_of_range || r.ptr != end) {
-        return {};
-    }
-    const std::string text(v);
-    const bool huge = std::isinf(std::strtod(text.c_str(), nullptr));  // from_chars leaves x unset
-    return "'" + text + "' is out of range: " +
-           (huge ? std::string("a number's magnitude is at most 1.797693e+308")
-                 : std::string("a nonzero number's magnitude is at least 4.940656e-324 (write 0)"));
+    const std::string words = text::out_of_range_words(text::classify_real(v, x, text::LeadingPlus::kRefused));
+    return words.empty() ? words : "'" + std::string(v) + "' is out of range: " + words;
 }
 
 // `what` unless v is a number beyond double's range: then `prefix` and

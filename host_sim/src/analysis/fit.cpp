@@ -16,6 +16,7 @@
 #include "ascorr/calib/frame.hpp"
 #include "ascorr/calib/head_rotation.hpp"
 #include "ascorr/core/correct.hpp"
+#include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -23,9 +24,6 @@
 namespace ascorr::host {
 
 namespace {
-
-constexpr double kMuEarth = 398600.4418;  // km³/s²
-constexpr double kDay = 86400.0;
 
 struct Row {
     Eigen::Quaterniond q;        // aberration-corrected, ICRF into head
@@ -88,7 +86,7 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("the modelling period is empty: --from " + time_text(*opt.from) + " is not before --to " +
                          time_text(*opt.to));
     }
-    if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= 86400.0)) {
+    if (opt.orbit_period_s && !(*opt.orbit_period_s >= 600.0 && *opt.orbit_period_s <= kSecondsPerDay)) {
         throw FitRefused("--orbit-period must be in [600, 86400] s");
     }
     if (!(opt.holdout >= 0.0 && opt.holdout <= 0.5)) {
@@ -229,7 +227,7 @@ void note_selected_row(Pass& p, const SolutionRecord& rec) {
         p.earliest_row = rec.t;
         p.earliest_row_speed = v;
         p.earliest_row_line = rec.line;
-        p.earliest_row_period = plausible ? 2.0 * kPi * kMuEarth / (v * v * v) : 0.0;
+        p.earliest_row_period = plausible ? 2.0 * kPi * kEarthGmKm3S2 / (v * v * v) : 0.0;
         if (!p.period) {
             p.period = plausible ? p.earliest_row_period : kPlaceholderPeriodS;
         }
@@ -278,7 +276,7 @@ void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::s
         throw FitRefused(opt.in +
                          ": no epoch in the modelling period has solutions of A, B and C that pass the selection");
     }
-    const double span_days = (r.t_last - r.t_first) / kDay;
+    const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
         char buf[200];
         std::snprintf(buf, sizeof buf,
@@ -351,7 +349,7 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     r.model = r.fit.model;
 }
 
-// Row order must not matter (issue 11). The reference N_i is the earliest
+// Row order must not matter. The reference N_i is the earliest
 // epoch's (re-based exactly at the end), and the orbit period, when not
 // given, comes from the earliest selected row: if that is not the first one
 // read, the file is read again with that period (unordered files only).
@@ -396,7 +394,7 @@ std::string describe(const FitReport& r) {
     std::ostringstream o;
     char buf[400];
     std::snprintf(buf, sizeof buf, "modelling period t = %.3f .. %.3f (%.1f days), orbit period %.1f s\n", r.t_first,
-                  r.t_last, (r.t_last - r.t_first) / kDay, r.orbit_period_s);
+                  r.t_last, (r.t_last - r.t_first) / kSecondsPerDay, r.orbit_period_s);
     o << buf;
     o << "rows in the period " << r.rows << ", selected " << r.dropped[0] << "; dropped:";
     for (std::size_t d = 1; d < kDropKinds; ++d) {

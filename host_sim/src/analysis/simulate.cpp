@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "ascorr/core/correct.hpp"
+#include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -27,11 +28,6 @@
 namespace ascorr::host {
 
 namespace {
-
-constexpr double kMuEarth = 398600.4418;  // km³/s²
-constexpr double kEarthRadiusKm = 6378.137;
-constexpr double kDay = 86400.0;
-constexpr double kDeg = kPi / 180.0;
 
 // Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
 constexpr double kNoiseCrossArcsec = 1.5;
@@ -57,10 +53,10 @@ public:
             const double tc = static_cast<double>(hour) * 3600.0 + 1800.0;
             double pvh[2][3];
             double pvb[2][3];
-            eraEpv00(ERFA_DJ00, tc / kDay, pvh, pvb);
+            eraEpv00(ERFA_DJ00, tc / kSecondsPerDay, pvh, pvb);
             sun_ = -Eigen::Vector3d(pvh[0][0], pvh[0][1], pvh[0][2]).normalized();
             double pv[2][3];
-            eraMoon98(ERFA_DJ00, tc / kDay, pv);
+            eraMoon98(ERFA_DJ00, tc / kSecondsPerDay, pv);
             moon_ = Eigen::Vector3d(pv[0][0], pv[0][1], pv[0][2]).normalized();
         }
         sun = sun_;
@@ -109,10 +105,10 @@ public:
     }
 
 private:
-    static constexpr double kTau = 0.5 * kDay;
+    static constexpr double kTau = 0.5 * kSecondsPerDay;
     void schedule(double after) {
-        std::uniform_real_distribution<double> gap(40.0 * kDay, 80.0 * kDay);
-        std::uniform_real_distribution<double> len(3.0 * kDay, 5.0 * kDay);
+        std::uniform_real_distribution<double> gap(40.0 * kSecondsPerDay, 80.0 * kSecondsPerDay);
+        std::uniform_real_distribution<double> len(3.0 * kSecondsPerDay, 5.0 * kSecondsPerDay);
         start_ = after + gap(rng_);
         end_ = start_ + len(rng_);
         operational_ = !operational_;
@@ -152,7 +148,7 @@ char* put(char* p, char* end, double x, int decimals) {
 Eigen::Matrix3d head_mounting(int head) {
     static constexpr double kAzimuthDeg[3] = {90.0, 210.0, 330.0};
     const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
-    const double az = kAzimuthDeg[head] * kDeg;
+    const double az = kAzimuthDeg[head] * kDegToRad;
     const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir
     const Eigen::Vector3d z = std::sin(zeta) * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0) + std::cos(zeta) * up;
     const Eigen::Vector3d x = up.cross(z).normalized();
@@ -261,7 +257,7 @@ std::vector<Truth> truth_models(const SimulateOptions& opt) {
     };
     add(opt.truth, std::round(opt.start_t * 1000.0) / 1000.0);
     for (const TruthChange& c : opt.truth_changes) {
-        add(c.model, std::round((opt.start_t + c.day * kDay) * 1000.0) / 1000.0);
+        add(c.model, std::round((opt.start_t + c.day * kSecondsPerDay) * 1000.0) / 1000.0);
     }
     return truths;
 }
@@ -371,7 +367,7 @@ void refuse_bad_options(const SimulateOptions& opt) {
         throw std::invalid_argument("--step must be in [1, 600] s (the orbit must be resolved), got " +
                                     number_text(opt.step_s));
     }
-    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kDay)) {
+    if (!in_ephemeris_span(opt.start_t) || !in_ephemeris_span(opt.start_t + opt.days * kSecondsPerDay)) {
         throw std::invalid_argument("--start " + number_text(opt.start_t) +
                                     ": the mission must lie within the Earth ephemeris (1900-2100; s since J2000 TT)");
     }
@@ -380,7 +376,7 @@ void refuse_bad_options(const SimulateOptions& opt) {
 
 // The circular orbit (header: Sun-synchronous-like node drift) and the
 // spacecraft's attitude at dt seconds after the start.
-struct OrbitState {
+struct SpacecraftPose {
     Eigen::Vector3d P;      // node direction (ICRF)
     Eigen::Vector3d Q;      // 90° ahead in the orbital plane
     Eigen::Vector3d r_hat;  // position direction
@@ -394,10 +390,10 @@ public:
         Eigen::Vector3d sun0;
         Eigen::Vector3d moon0;
         sky.at(start_t, sun0, moon0);
-        node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDeg;
+        node0_ = std::atan2(sun0.y(), sun0.x()) + 30.0 * kDegToRad;
     }
-    OrbitState at(double dt) const {
-        OrbitState o;
+    SpacecraftPose at(double dt) const {
+        SpacecraftPose o;
         const double u = n_ * dt;
         const double node = node0_ + node_rate_ * dt;
         o.P = Eigen::Vector3d(std::cos(node), std::sin(node), 0.0);
@@ -415,22 +411,22 @@ public:
     }
 
 private:
-    double a_ = kEarthRadiusKm + kSimAltitudeKm;
-    double n_ = std::sqrt(kMuEarth / (a_ * a_ * a_));
-    double inc_ = kSimInclinationDeg * kDeg;
-    double node_rate_ = 2.0 * kPi / (365.2422 * kDay) - 2.0 * kPi / (kPlaneSunPeriodDays * kDay);
+    double a_ = kEarthEquatorialRadiusKm + kSimAltitudeKm;
+    double n_ = std::sqrt(kEarthGmKm3S2 / (a_ * a_ * a_));
+    double inc_ = kSimInclinationDeg * kDegToRad;
+    double node_rate_ = 2.0 * kPi / (365.2422 * kSecondsPerDay) - 2.0 * kPi / (kPlaneSunPeriodDays * kSecondsPerDay);
     double node0_ = 0.0;
 };
 
 // T_CHU A, B, C, T029, T032 (°C, rounded as written): seasonal (sine of the
 // Sun's angle to the orbital plane), orbital (sunlit side), independent
 // wander, heater events, read noise.
-std::array<double, 5> temperatures(const OrbitState& o, const Eigen::Vector3d& sun, double op, double surv,
+std::array<double, 5> temperatures(const SpacecraftPose& o, const Eigen::Vector3d& sun, double op, double surv,
                                    std::array<Wander, 5>& wander, double step_s, Random& rnd) {
     const double sinb = sun.dot(o.P.cross(o.Q));
     const double orb = o.r_hat.dot(sun);
     for (auto& w : wander) {
-        w.step(step_s, 3.0 * kDay, 0.6, rnd.engine);
+        w.step(step_s, 3.0 * kSecondsPerDay, 0.6, rnd.engine);
     }
     const double s2 = sinb * sinb;
     std::array<double, 5> temp = {
@@ -497,7 +493,7 @@ Quaternion<double> raw_attitude(const Quaternion<double>& q_meas, double t, std:
 // Everything one epoch shares between its heads.
 struct EpochState {
     double t = 0.0;
-    OrbitState orbit;
+    SpacecraftPose orbit;
     Eigen::Vector3d sun;
     Eigen::Vector3d moon;
     std::array<double, 5> temp{};
@@ -631,7 +627,7 @@ public:
         e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
         e.no_velocity = gps_gap_.step(1e-4, 5, 60, rnd_.engine);
 
-        const double day = dt / kDay;
+        const double day = dt / kSecondsPerDay;
         const auto day_index = static_cast<std::size_t>(std::floor(day));
         daily_.resize(std::max(daily_.size(), day_index + 1));
         const bool gap =
@@ -693,13 +689,14 @@ private:
         for (std::size_t h = 0; h < 3; ++h) {
             const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
             const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
-            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDeg;
-            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDeg;
+            const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDegToRad;
+            const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDegToRad;
             if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
                 sum_.outage_rows[h] += gap ? 0U : 1U;  // blinded: no solution
                 continue;
             }
-            const HeadSolution s = solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kDay), earth_, rnd_);
+            const HeadSolution s =
+                solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kSecondsPerDay), earth_, rnd_);
             if (gap) {
                 continue;
             }
@@ -803,7 +800,7 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     std::string buf;
     buf.reserve(2U << 20);
     buf += "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
-    const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kDay / opt.step_s)) + 1;
+    const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
         if ((k & 4095U) == 0) {

@@ -17,11 +17,10 @@ namespace ascorr::host {
 EarthState earth_state_exact(double t) {
     double pvh[2][3];
     double pvb[2][3];
-    constexpr double kJ2000 = 2451545.0;
     // Split the date so that the fraction keeps full precision.
-    const double days = t / 86400.0;
-    (void)eraEpv00(kJ2000, days, pvh, pvb);  // status 1 (outside 1900–2100): `valid` below
-    constexpr double kAuPerDayToKmS = kAstronomicalUnitKm / 86400.0;
+    const double days = t / kSecondsPerDay;
+    (void)eraEpv00(kJ2000JulianDate, days, pvh, pvb);  // status 1 (outside 1900–2100): `valid` below
+    constexpr double kAuPerDayToKmS = kAstronomicalUnitKm / kSecondsPerDay;
     EarthState s;
     s.v_bary_kms = {pvb[1][0] * kAuPerDayToKmS, pvb[1][1] * kAuPerDayToKmS, pvb[1][2] * kAuPerDayToKmS};
     s.sun_distance_au = std::sqrt(pvh[0][0] * pvh[0][0] + pvh[0][1] * pvh[0][1] + pvh[0][2] * pvh[0][2]);

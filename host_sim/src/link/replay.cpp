@@ -304,7 +304,7 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         return run<float>(o, target.transport(), log);
     }
     if (const QemuTarget* board = find_qemu_target(opt.target)) {  // toolchain/targets.txt
-        const bool fixed = board->scalar == TargetScalar::kFixed;
+        const bool fixed = board->scalar == ScalarKind::kFixed;
         // QEMU answers within a few milliseconds; a lost frame is resent soon after
         // (a late answer only costs a resend, answered from the cache).
         // With states the target's double propagation and Earth series (software

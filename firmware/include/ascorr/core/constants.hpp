@@ -13,6 +13,9 @@ inline constexpr double kAstronomicalUnitKm = 149597870.7;  // km (IAU 2012, exa
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kArcsecToRad = kPi / (180.0 * 3600.0);
 inline constexpr double kRadToArcsec = 1.0 / kArcsecToRad;
+inline constexpr double kDegToRad = kPi / 180.0;
+inline constexpr double kSecondsPerDay = 86400.0;      // s, the day of Julian dates and of TT
+inline constexpr double kJ2000JulianDate = 2451545.0;  // J2000.0 (2000 January 1, 12h TT) as a Julian date
 // Schwarzschild radius of the Sun in au (ERFA_SRS), for the solar-potential
 // term of stellar aberration.
 inline constexpr double kSunSchwarzschildRadiusAu = 1.97412574336e-8;

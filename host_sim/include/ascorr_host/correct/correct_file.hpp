@@ -13,14 +13,10 @@
 #include <iosfwd>
 #include <string>
 
+#include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 
 namespace ascorr::host {
-
-// Which scalar the core is instantiated with (--scalar). A kind, not the type:
-// the firmware's type is firmware/app/app_scalar.hpp's Scalar, and a target
-// reports its kind in the link's HELLO (scalar_kind).
-enum class ScalarKind { kDouble, kFloat, kFixed };
 
 struct CorrectOptions {
     std::string in;

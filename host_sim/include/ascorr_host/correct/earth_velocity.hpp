@@ -31,6 +31,7 @@
 
 #include <cstdint>
 
+#include "ascorr/core/constants.hpp"
 #include "ascorr/core/vector3.hpp"
 
 namespace ascorr::host {
@@ -42,8 +43,8 @@ struct EarthState {
 };
 
 // 1900-01-01 0h and 2100-01-01 0h TT, s since J2000.0 (the span of eraEpv00).
-inline constexpr double kEphemerisFirstT = (2415020.5 - 2451545.0) * 86400.0;
-inline constexpr double kEphemerisEndT = (2488069.5 - 2451545.0) * 86400.0;
+inline constexpr double kEphemerisFirstT = (2415020.5 - kJ2000JulianDate) * kSecondsPerDay;
+inline constexpr double kEphemerisEndT = (2488069.5 - kJ2000JulianDate) * kSecondsPerDay;
 
 // Direct evaluation of eraEpv00 at t (s since J2000.0, TT); valid as above.
 EarthState earth_state_exact(double t);
@@ -54,7 +55,7 @@ bool in_ephemeris_span(double t) noexcept;
 class EarthVelocity {
 public:
     static constexpr int kDegree = 15;
-    static constexpr double kSegmentS = 16.0 * 86400.0;
+    static constexpr double kSegmentS = 16.0 * kSecondsPerDay;
     // Thread-safe; all instances share one table.
     EarthState at(double t) const;
 };

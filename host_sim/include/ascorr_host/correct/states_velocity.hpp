@@ -30,7 +30,7 @@ namespace ascorr::host {
 // The longest `--max-propagation` the host accepts (7 days): beyond it the J2
 // propagation is far outside its accuracy (0.98 m/s after 6 h), and one
 // advance() of horizon/10 s RK4 steps stays bounded.
-inline constexpr double kMaxPropagationLimitS = 7.0 * 86400.0;
+inline constexpr double kMaxPropagationLimitS = 7.0 * kSecondsPerDay;
 
 // Whether `--max-propagation` (or the Python module's max_propagation) is
 // acceptable: above 0 and at most kMaxPropagationLimitS; NaN is not.

@@ -1,0 +1,364 @@
+#include "ascorr_host/link/link_client.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/status.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+// A request is given up after max_attempts and at least this long: a target
+// that is booting (QEMU takes 0.3–1 s on a loaded machine, before its first
+// byte) must not exhaust a few short time-outs.
+constexpr int kMinPatienceMs = 3000;
+
+// Byte equality: at worst (padding that differs) an update is sent twice.
+template <typename A>
+bool same(const A& a, const A& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+template <typename M>
+std::vector<std::uint8_t> encoded(const M& m) {
+    std::uint8_t p[link::kMaxPayload];
+    const std::size_t n = link::encode(m, p);
+    return {p, p + n};
+}
+
+void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
+    link::Ack a{};
+    if (!link::decode(p.data(), p.size(), a) || a.result != link::AckResult::kOk) {
+        throw LinkError(std::string(what) + " refused by the target (result " +
+                        std::to_string(static_cast<int>(a.result)) + ")");
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// The caller's requests.
+
+template <typename T>
+link::Hello LinkClient<T>::request_hello() {
+    const auto p = request({link::MessageType::kHelloRequest, {}, "hello request"}, link::MessageType::kHello);
+    link::Hello h{};
+    link::decode(p.data(), p.size(), h);
+    if (h.protocol != link::kProtocolVersion) {
+        throw LinkError("target speaks link protocol " + std::to_string(h.protocol) + ", this host " +
+                        std::to_string(link::kProtocolVersion));
+    }
+    return h;
+}
+
+template <typename T>
+link::Hello LinkClient<T>::connect() {
+    const link::Hello h = request_hello();
+    if (h.scalar_kind != link::WireTraits<T>::kKind) {
+        throw LinkError("target computes in scalar kind " + std::to_string(h.scalar_kind) + ", the host expected " +
+                        std::to_string(link::WireTraits<T>::kKind));
+    }
+    boot_id_ = h.boot_id;
+    return h;
+}
+
+template <typename T>
+void LinkClient<T>::upload_model(const ThermalModel<T>& model) {
+    model_ = model;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        update(model_message(h));
+    }
+}
+
+template <typename T>
+void LinkClient<T>::set_velocity(const ObserverVelocity<T>& v) {
+    if (velocity_ && same(*velocity_, v)) {
+        return;
+    }
+    velocity_ = v;
+    update(velocity_message());
+}
+
+template <typename T>
+void LinkClient<T>::set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t) {
+    if (head >= kMaxHeads) {
+        return;  // the target would refuse it; the solution itself carries the bad head
+    }
+    if (temperatures_[head] && same(*temperatures_[head], t)) {
+        return;
+    }
+    temperatures_[head] = t;
+    update(temperatures_message(head));
+}
+
+template <typename T>
+void LinkClient<T>::send_state(const link::StateUpdate& s, bool accepted) {
+    if (accepted) {
+        state_ = s;
+    }
+    update(state_message(s));
+}
+
+template <typename T>
+link::SolutionOut<T> LinkClient<T>::correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q, TtTime t,
+                                            bool from_states, bool velocity_expected) {
+    const Message m{link::MessageType::kSolutionIn,
+                    encoded(link::SolutionIn<T>{id, head, q, t, static_cast<std::uint8_t>(from_states ? 1U : 0U)}),
+                    "solution"};
+    from_states_ = from_states;
+    velocity_expected_ = velocity_expected;
+    for (int attempt = 0; attempt < max_attempts_; ++attempt) {
+        const auto a = request(m, link::MessageType::kSolutionOut);
+        link::SolutionOut<T> out{};
+        if (!link::decode(a.data(), a.size(), out) || out.id != id || out.head != head) {
+            ++stats_.stale_answers;  // well framed but not ours: ask again
+            ++stats_.retries;
+            continue;
+        }
+        if (answer_shows_restart(out)) {
+            restore();  // a restart whose HELLO was lost on the link
+            continue;
+        }
+        return out;
+    }
+    throw LinkError("no acceptable answer for solution " + std::to_string(id) + " after " +
+                    std::to_string(max_attempts_) + " attempts");
+}
+
+// ---------------------------------------------------------------------------
+// Transactions: one request in flight, its resends, and what is heard.
+
+template <typename T>
+typename LinkClient<T>::Request LinkClient<T>::begin(const Message& m, link::MessageType answer) {
+    seq_ = static_cast<std::uint16_t>(seq_ == 0xFFFFU ? 1U : seq_ + 1U);  // 0 is the target's unprompted HELLO
+    ++stats_.requests;
+    std::uint8_t wire[link::kMaxWire];
+    const std::size_t w = link::encode_frame(static_cast<std::uint8_t>(m.type), seq_, m.payload.data(),
+                                             m.payload.size(), wire, sizeof wire);
+    return Request{answer,
+                   seq_,
+                   {wire, wire + w},
+                   0,
+                   std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs)};
+}
+
+// Sends r until its answer arrives (returned) or the target announces a
+// restart (empty: r is suspended; the resend that resumes it is the same
+// attempt, since a restart is not the request's failure).
+template <typename T>
+std::optional<std::vector<std::uint8_t>> LinkClient<T>::exchange(Request& r) {
+    while (r.attempt < max_attempts_ || std::chrono::steady_clock::now() < r.give_up_after) {
+        if (r.attempt > 0) {
+            ++stats_.retries;
+        }
+        transport_.write(r.wire.data(), r.wire.size());
+        std::vector<std::uint8_t> answer;
+        switch (await(r, answer)) {
+            case Heard::kAnswer:
+                return answer;
+            case Heard::kRestart:
+                return std::nullopt;
+            case Heard::kResend:
+                ++r.attempt;
+                break;
+        }
+    }
+    throw LinkError("no answer from the target after " + std::to_string(max_attempts_) + " attempts");
+}
+
+// Reads until r's answer, a restart, or the time-out.
+template <typename T>
+typename LinkClient<T>::Heard LinkClient<T>::await(const Request& r, std::vector<std::uint8_t>& answer) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms_);
+    std::uint8_t buf[256];
+    for (;;) {
+        // Read what is there even when the time is up: an answer that has
+        // arrived is never thrown away for a resend.
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+        const std::size_t n = transport_.read(buf, sizeof buf, static_cast<int>(std::max<long long>(0, left.count())));
+        if (n == 0) {
+            ++stats_.timeouts;
+            return Heard::kResend;
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            if (const std::optional<Heard> heard = hear(r, buf[i], answer)) {
+                return *heard;
+            }
+        }
+    }
+}
+
+// One byte into the frame decoder; what it completes, if that ends the wait.
+template <typename T>
+std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear(const Request& r, std::uint8_t byte,
+                                                                 std::vector<std::uint8_t>& answer) {
+    switch (decoder_.push(byte)) {
+        case link::FrameDecoder::Event::kNone:
+            break;
+        case link::FrameDecoder::Event::kError:
+            ++stats_.broken_answers;
+            break;  // its answer may still follow intact; otherwise the time-out resends
+        case link::FrameDecoder::Event::kFrame:
+            return hear_frame(r, decoder_.frame(), answer);
+    }
+    return std::nullopt;
+}
+
+// A whole frame: r's answer, a NAK, the target's restart, a refusal (thrown),
+// or anything else (stale: the wait goes on).
+template <typename T>
+std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear_frame(const Request& r, const link::Frame& f,
+                                                                       std::vector<std::uint8_t>& answer) {
+    const auto t = static_cast<link::MessageType>(f.type);
+    if (t == link::MessageType::kNak) {
+        ++stats_.naks;
+        return Heard::kResend;  // at once
+    }
+    // The target's unprompted HELLO: it has restarted.
+    if (t == link::MessageType::kHello && f.seq == 0U && r.answer != link::MessageType::kHello) {
+        link::Hello h{};
+        if (link::decode(f.payload, f.length, h)) {
+            boot_id_ = h.boot_id;
+            return Heard::kRestart;
+        }
+        ++stats_.stale_answers;
+        return std::nullopt;
+    }
+    if (f.seq == r.seq && t == r.answer) {
+        answer.assign(f.payload, f.payload + f.length);
+        return Heard::kAnswer;
+    }
+    if (f.seq == r.seq && t == link::MessageType::kAck) {
+        link::Ack a{};
+        if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
+            throw LinkError("request type " + std::to_string(static_cast<int>(r.answer)) +
+                            " refused by the target (result " + std::to_string(static_cast<int>(a.result)) + ")");
+        }
+    }
+    ++stats_.stale_answers;
+    return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------
+// The session: what the target was given, given again after a restart.
+
+// m's answer; a restart on the way restores the session, then m resumes.
+template <typename T>
+std::vector<std::uint8_t> LinkClient<T>::request(const Message& m, link::MessageType answer) {
+    Request r = begin(m, answer);
+    for (;;) {
+        if (auto a = exchange(r)) {
+            return *std::move(a);
+        }
+        restore();
+    }
+}
+
+template <typename T>
+void LinkClient<T>::update(const Message& m) {
+    expect_ok(request(m, link::MessageType::kAck), m.what);
+}
+
+// In the order a restore sends them: models, velocity, state, temperatures.
+template <typename T>
+std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
+    std::vector<Message> s;
+    if (model_) {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            s.push_back(model_message(h));
+        }
+    }
+    if (velocity_) {
+        s.push_back(velocity_message());
+    }
+    if (state_) {
+        s.push_back(state_message(*state_));
+    }
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (temperatures_[h]) {
+            s.push_back(temperatures_message(h));
+        }
+    }
+    return s;
+}
+
+// The target restarted: give it back everything it had, in rounds, until a
+// round passes without another restart.
+template <typename T>
+void LinkClient<T>::restore() {
+    for (int round = 0; round < max_attempts_; ++round) {
+        ++stats_.restarts;
+        if (!restore_round()) {
+            return;
+        }
+    }
+    throw LinkError("the target restarted " + std::to_string(max_attempts_) + " times while being restored");
+}
+
+// One round of the session's messages; true if the target restarted during
+// it (each message interrupted by the restart is resent, then the round goes
+// on: the next round sends everything again).
+template <typename T>
+bool LinkClient<T>::restore_round() {
+    bool restarted = false;
+    for (const Message& m : session()) {
+        Request r = begin(m, link::MessageType::kAck);
+        std::optional<std::vector<std::uint8_t>> a;
+        while (!(a = exchange(r))) {
+            restarted = true;
+        }
+        expect_ok(*a, m.what);
+    }
+    return restarted;
+}
+
+// ---------------------------------------------------------------------------
+// Restart detection from an answer: the target corrected without the model
+// or velocity this client gave it, so it has restarted and its HELLO did not
+// arrive. Such an answer is not accepted.
+
+template <typename T>
+bool LinkClient<T>::answer_shows_restart(const link::SolutionOut<T>& out) const {
+    const bool no_model = (out.status & status::kNoModelForHead) != 0U && model_ && out.head < kMaxHeads &&
+                          model_->head[out.head].present;
+    const bool no_velocity = (out.status & (status::kNoVelocity | status::kVelocityInvalid)) == status::kNoVelocity &&
+                             velocity_ && velocity_->valid && !from_states_;
+    const bool no_state =
+        from_states_ && velocity_expected_ &&
+        (out.status & (status::kNoVelocity | status::kVelocityInvalid | status::kStale)) == status::kNoVelocity;
+    return no_model || no_velocity || no_state;
+}
+
+// ---------------------------------------------------------------------------
+// The messages.
+
+template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::model_message(std::uint8_t head) const {
+    return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head]}), "model upload"};
+}
+
+template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::velocity_message() const {
+    return {link::MessageType::kVelocityUpdate, encoded(*velocity_), "velocity update"};
+}
+
+template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::state_message(const link::StateUpdate& s) const {
+    return {link::MessageType::kStateUpdate, encoded(s), "state update"};
+}
+
+template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t head) const {
+    return {link::MessageType::kTemperatureUpdate, encoded(link::TemperatureUpdate<T>{head, *temperatures_[head]}),
+            "temperature update"};
+}
+
+// The scalars the targets compute in.
+template class LinkClient<float>;
+template class LinkClient<Q30>;
+
+}  // namespace ascorr::host
