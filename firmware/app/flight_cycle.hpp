@@ -29,11 +29,14 @@
 #include <cstring>
 
 #include "app_scalar.hpp"
+#include "ascorr/calib/estimator.hpp"
 #include "ascorr/correct.hpp"
 #include "ascorr/status.hpp"
 #include "ascorr/velocity_service.hpp"
 #include "ascorr_link/crc32c.hpp"
+#include "calib_entry.hpp"
 #include "core_entry.hpp"
+#include "flight_bench.hpp"
 #include "flight_data.hpp"
 #include "gnss_feed.hpp"
 #include "loop_rate.hpp"
@@ -67,6 +70,8 @@ enum class Part : std::uint8_t {
     kNode,     // an advance() call that built a node (force, RK4 steps, Earth series; double)
     kQuery,    // velocity_at(): the per-solution query (scalar)
     kCorrect,  // the core
+    kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
+    kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
 };
 
 struct NoMeter {
@@ -187,6 +192,68 @@ private:
     std::uint32_t samples_taken_ = 0U;
 };
 
+// The models the estimator made active, in turn (the first kMaxModels): the
+// cycle from which each was used, its version and CRC-32C (model_identity.hpp)
+// and its coefficients (arcsec; printed as the bits of each double).
+class ModelHistory {
+public:
+    static constexpr std::uint32_t kMaxModels = 4U;
+    struct Entry {
+        std::uint32_t cycle;
+        std::uint32_t version;
+        std::uint32_t crc;
+        ModelCoefficients model;
+    };
+
+    void add(std::uint32_t cycle, const calib::EstimatorReport& r, const ModelCoefficients& m) noexcept {
+        if (size_ < kMaxModels) {
+            entries_[size_] = {cycle, r.active_version, r.active_crc, m};
+            ++size_;
+        }
+    }
+    std::uint32_t size() const noexcept { return size_; }
+    const Entry& entry(std::uint32_t i) const noexcept { return entries_[i < kMaxModels ? i : 0U]; }
+
+    // Per model: "model version V from cycle C crc32c X", then per head and
+    // axis "model version V head H axis A c HHHHHHHHLLLLLLLL ..." (c0..c3).
+    void print() const noexcept {
+        using namespace report;
+        for (std::uint32_t i = 0; i < size_; ++i) {
+            const Entry& e = entries_[i];
+            text("model version ");
+            u32(e.version);
+            text(" from cycle ");
+            u32(e.cycle);
+            text(" crc32c ");
+            hex32(e.crc);
+            text("\n");
+            for (std::uint32_t h = 0; h < calib::kCalibHeads; ++h) {
+                for (std::uint32_t a = 0; a < kModelAxes; ++a) {
+                    text("model version ");
+                    u32(e.version);
+                    text(" head ");
+                    u32(h);
+                    text(" axis ");
+                    u32(a);
+                    text(" c");
+                    for (std::uint32_t t = 0; t < kLinearModelTerms; ++t) {
+                        std::uint64_t b = 0U;
+                        std::memcpy(&b, &e.model.coefficient[h][a][t], sizeof b);
+                        text(" ");
+                        hex32(static_cast<std::uint32_t>(b >> 32U));
+                        hex32(static_cast<std::uint32_t>(b));
+                    }
+                    text("\n");
+                }
+            }
+        }
+    }
+
+private:
+    Entry entries_[kMaxModels]{};
+    std::uint32_t size_ = 0U;
+};
+
 class FlightCycle {
 public:
     // One cycle: the temperatures (temperature_source.hpp), the states, the
@@ -218,10 +285,13 @@ public:
     // One corrected solution per head, in head order (fixed trip count).
     template <typename Meter>
     void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
-        const CorrectionConfig<Scalar> cfg{true, &kThermalModel};
+        std::uint32_t start = meter.now();
+        const ThermalModel<Scalar>* model = calib_model(estimator_, calib_time_us(cycle));
+        meter.add(Part::kCalibCycle, start);
+        const CorrectionConfig<Scalar> cfg{true, model};
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
-            std::uint32_t start = meter.now();
+            start = meter.now();
             const std::uint32_t nodes_before = service_.nodes_built();
             service_.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
             if (service_.nodes_built() != nodes_before) {
@@ -230,12 +300,34 @@ public:
             start = meter.now();
             const ServiceVelocity<Scalar> v = velocity_query(service_, t);
             meter.add(Part::kQuery, start);
-            const SolutionInput<Scalar> in{kRawAttitude[h], h, temperatures_of(h), v.velocity};
+            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), v.velocity};
             start = meter.now();
             corrected_[h] = correct(in, cfg);
             meter.add(Part::kCorrect, start);
             corrected_[h].status = with_service_status(corrected_[h].status, v.status, cfg.aberration);
             corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
+        }
+        const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
+                                                                    &temperatures_of(2U)};
+        start = meter.now();
+        (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
+        meter.add(Part::kCalibCycle, start);
+        if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
+            model_ = model;
+            if (model != nullptr) {
+                history_.add(cycle, estimator_.report(), *estimator_.active_coefficients());
+            }
+        }
+    }
+
+    // Idle time after the cycle's solutions: one bounded step of the
+    // estimator's per-orbit update (at most one per cycle: the same on the DPU
+    // and the host, whatever the time left).
+    template <typename Meter>
+    void idle(Meter& meter) noexcept {
+        const std::uint32_t start = meter.now();
+        if (calib_step(estimator_)) {
+            meter.add(Part::kCalibStep, start);
         }
     }
 
@@ -246,6 +338,8 @@ public:
     std::uint32_t states_skipped() const noexcept { return states_skipped_; }
     std::uint32_t states_refused() const noexcept { return states_refused_; }
     const SolutionRecord& record() const noexcept { return record_; }
+    const calib::Estimator<Scalar>& estimator() const noexcept { return estimator_; }
+    const ModelHistory& history() const noexcept { return history_; }
 
 private:
     VelocityService<Scalar> service_{kServiceConfig};
@@ -254,6 +348,10 @@ private:
     std::uint32_t states_skipped_ = 0U;
     std::uint32_t states_refused_ = 0U;
     SolutionRecord record_;
+    // The estimator, starting from the model in flash (version 0).
+    calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
+    ModelHistory history_;
 };
 
 template <typename Meter>
@@ -261,6 +359,7 @@ void FlightCycle::run(std::uint32_t cycle, Meter& meter, bool record) noexcept {
     temperatures_update(cycle);
     take_states(cycle, meter);
     correct_heads(cycle, meter);
+    idle(meter);
     for (std::uint8_t h = 0; record && h < kMaxHeads; ++h) {  // fixed trip count
         record_.add(cycle, h, corrected_[h]);
     }

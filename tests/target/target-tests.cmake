@@ -9,6 +9,7 @@
 #   target_<t>_no_soft_float       on a fixed-point target (no FPU), the
 #                                  per-solution and per-cycle code (the
 #                                  core's entry, the velocity query,
+#                                  the estimator's per-cycle part,
 #                                  firmware/app/*_entry_fixed.cpp, and the
 #                                  fixed-point thermistor acquisition,
 #                                  hal_temperatures.cpp) references no
@@ -33,7 +34,9 @@ target_compile_definitions(ascorr_target_vectors PRIVATE ASCORR_TEST_DATA="${PRO
 foreach(scalar fixed float)
   add_executable(ascorr_flight_expectation_${scalar} ${PROJECT_SOURCE_DIR}/tests/target/flight_expectation.cpp
                  ${PROJECT_SOURCE_DIR}/firmware/app/core_entry_${scalar}.cpp
-                 ${PROJECT_SOURCE_DIR}/firmware/app/velocity_entry_${scalar}.cpp)
+                 ${PROJECT_SOURCE_DIR}/firmware/app/velocity_entry_${scalar}.cpp
+                 ${PROJECT_SOURCE_DIR}/firmware/app/calib_entry_${scalar}.cpp
+                 ${PROJECT_SOURCE_DIR}/firmware/app/calib_idle_${scalar}.cpp)
   target_include_directories(ascorr_flight_expectation_${scalar} PRIVATE ${PROJECT_SOURCE_DIR}/firmware/app)
   target_link_libraries(ascorr_flight_expectation_${scalar} PRIVATE ascorr_core ascorr::hal ascorr_warnings)
   target_compile_options(ascorr_flight_expectation_${scalar} PRIVATE -ffp-contract=off)
@@ -75,8 +78,8 @@ set(scalar_name_float "float")
 # of 73 m/s or a T032 error of 0.03 degC (head C: 2.25"/degC) would exceed.
 set(flight_bound_fixed 0)
 set(flight_bound_float ${bound_float})
-set(flight_match_fixed "solutions match the host core's bit for bit.*mutated expectation refused")
-set(flight_match_float "solutions match the host core's within the bound.*mutated expectation refused")
+set(flight_match_fixed "solutions match the host core's bit for bit.*model history .* matches the host's bit for bit.*mutated expectation refused")
+set(flight_match_float "solutions match the host core's within the bound.*model history .* matches the host's within the bound.*mutated expectation refused")
 
 foreach(t ${ASCORR_TARGET_LIST})
   set(bin ${ASCORR_TARGET_${t}_BINARY_DIR})
@@ -94,7 +97,7 @@ foreach(t ${ASCORR_TARGET_LIST})
                    ${machine} ${bin}/firmware/app/ascorr_firmware.elf ${flight_bound_${s}}
                    ${CMAKE_BINARY_DIR}/target-runs/${t}-firmware)
   set_tests_properties(target_${t}_firmware PROPERTIES LABELS target TIMEOUT 60
-    PASS_REGULAR_EXPRESSION "${scalar_name_${s}} core, ${firmware_expect}.*service within the correction's cost.*${flight_match_${s}}")
+    PASS_REGULAR_EXPRESSION "${scalar_name_${s}} core, ${firmware_expect}.*service within the correction's cost.*estimator within the correction's cost.*${flight_match_${s}}")
 endforeach()
 
 # No soft-float routine in the M3's per-solution path. Scope: since issue 12
@@ -114,6 +117,7 @@ foreach(build ${no_fpu_builds} ${ASCORR_TARGET_DEBUG_BUILDS})
   add_test(NAME target_${build}_no_soft_float
            COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM}
                    ${entry_objs}/core_entry_fixed.cpp.obj ${entry_objs}/velocity_entry_fixed.cpp.obj
+                   ${entry_objs}/calib_entry_fixed.cpp.obj
                    ${app}/CMakeFiles/ascorr_firmware.dir/hal_temperatures.cpp.obj)
   add_test(NAME target_${build}_no_soft_float_control
            COMMAND ${PROJECT_SOURCE_DIR}/tests/target/check-no-soft-float ${ASCORR_ARM_NM} ${app}/ascorr_firmware.elf)

@@ -1,0 +1,90 @@
+// firmware/app/flight_bench.hpp: the simulated bench of the flight loop, which
+// deforms with temperature, and the on-board estimator's place in the loop.
+//
+// Conventions: the bench's truth is a thermal model in the contract's form
+// (arcsec, ascorr/thermal.hpp) that is not the one in flash: Table 2 with head
+// B's slopes 40 % larger and head C's mount 3″ further in α (a bench that has
+// settled since the ground fit). Each head's raw solution at second s of the
+// 16-s temperature profile is the truth's thermal rotation at that second's
+// true temperatures (boom_channels.hpp, boom_temperatures.hpp) undone from the
+// head's undeformed attitude (flight_data.hpp): q_raw = q_th⁻¹ ⊗ q_0, so that
+// the correction with the truth would give q_0 back. Computed in double at
+// compile time and stored in the core's scalar: no work in the loop. Head D
+// has no model and does not deform.
+//
+// Accelerated time: the estimator sees one orbit (EstimatorConfig's default
+// period, 5640 s) per kCalibCyclesPerOrbit cycles, so the 352 cycles of a test
+// run are 44 orbits (2.9 days) and its default 30-day forgetting, 30 orbits
+// before a first model and 30-orbit window apply as in flight.
+#pragma once
+
+#include <cstdint>
+
+#include "app_scalar.hpp"
+#include "ascorr/calib/estimator.hpp"
+#include "ascorr/constants.hpp"
+#include "ascorr/thermal.hpp"
+#include "ascorr/model_coefficients.hpp"
+#include "ascorr/table2.hpp"
+#include "boom_channels.hpp"
+#include "boom_temperatures.hpp"
+#include "flight_data.hpp"
+#include "loop_rate.hpp"
+
+namespace ascorr::app {
+
+inline constexpr std::uint32_t kCalibCyclesPerOrbit = 8U;
+inline constexpr calib::EstimatorConfig kCalibConfig{};
+inline constexpr std::int64_t kCalibCycleUs =
+    kCalibConfig.orbit_period_us / static_cast<std::int64_t>(kCalibCyclesPerOrbit);
+
+// The estimator's time of cycle `cycle` (accelerated), µs.
+constexpr std::int64_t calib_time_us(std::uint32_t cycle) noexcept {
+    return static_cast<std::int64_t>(cycle) * kCalibCycleUs;
+}
+
+constexpr ModelCoefficients make_bench_truth() {
+    ModelCoefficients m = kTable2;
+    for (std::size_t a = 0; a < kModelAxes; ++a) {
+        for (std::size_t t = 1; t < kLinearModelTerms; ++t) {
+            m.coefficient[1][a][t] *= 1.4;
+        }
+    }
+    m.coefficient[2][0][0] += 3.0;
+    return m;
+}
+inline constexpr ModelCoefficients kBenchTruth = make_bench_truth();
+
+struct BenchAttitudes {
+    Quaternion<Scalar> q[boom::kProfileSeconds][kMaxHeads];
+};
+
+constexpr BenchAttitudes make_bench_attitudes() {
+    constexpr ThermalModel<double> truth = thermal_model<double>(kBenchTruth, kArcsecToRad);
+    BenchAttitudes b{};
+    for (std::uint32_t sec = 0; sec < boom::kProfileSeconds; ++sec) {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            const HeadThermalModel<double>& m = truth.head[h];
+            const double t1 = chu_celsius(h, sec);
+            const double t2 = boom::profile_celsius(0U, sec);
+            const double t3 = boom::profile_celsius(3U, sec);
+            const Quaternion<double> q =
+                m.present ? to_quaternion(conjugate(thermal_rotation(thermal_angle(m.alpha, t1, t2, t3),
+                                                                     thermal_angle(m.beta, t1, t2, t3),
+                                                                     thermal_angle(m.gamma, t1, t2, t3)))) *
+                                kHeadAttitude[h]
+                          : kHeadAttitude[h];
+            b.q[sec][h] = {s(q.w), s(q.x), s(q.y), s(q.z)};
+        }
+    }
+    return b;
+}
+
+inline constexpr BenchAttitudes kBenchAttitudes = make_bench_attitudes();
+
+// Head h's raw solution in cycle `cycle` of a loop at kRateHz.
+constexpr const Quaternion<Scalar>& bench_attitude(std::uint32_t cycle, std::uint8_t h) noexcept {
+    return kBenchAttitudes.q[(cycle / kRateHz) % boom::kProfileSeconds][h < kMaxHeads ? h : 0U];
+}
+
+}  // namespace ascorr::app
