@@ -309,9 +309,11 @@ public:
         }
         const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
                                                                     &temperatures_of(2U)};
-        start = meter.now();
-        (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
-        meter.add(Part::kCalibCycle, start);
+        if (cycle % kCalibFeedEvery == 0U) {
+            start = meter.now();
+            (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
+            meter.add(Part::kCalibCycle, start);
+        }
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
             model_ = model;
             if (model != nullptr) {

@@ -156,9 +156,10 @@ void cost(const char* name, const Cost& c) noexcept {
     text("\n");
 }
 
-// The estimator: its state, its costs against the correction of three heads
-// (per cycle, its worst cycle: the per-cycle part is two calls, so the worst
-// call twice bounds it), its per-orbit update and its RAM.
+// The estimator: its state, its per-cycle cost (the mean of this run; the
+// worst cycle: at most two calls, so the worst call twice bounds it) against
+// the correction's own in this loop (four heads per cycle) and of three heads,
+// its per-orbit update and its RAM.
 void print_estimator(std::uint32_t correction3) noexcept {
     using namespace report;
     const calib::EstimatorReport r = g_flight.estimator().report();
@@ -201,10 +202,14 @@ void print_estimator(std::uint32_t correction3) noexcept {
     u32(g_costs.calib_step.worst * 40U);
     text("), RAM ");
     u32(static_cast<std::uint32_t>(sizeof(calib::Estimator<Scalar>)));
-    text(" bytes; correction of three heads ");
+    const std::uint32_t correction =
+        g_stats.cycles == 0U ? 0U : (g_costs.correct.total * 40U + g_stats.cycles / 2U) / g_stats.cycles;
+    text(" bytes; correction per cycle ");
+    u32(correction);
+    text(" (three heads ");
     u32(correction3);
-    text(worst_cycle <= correction3 ? " (estimator within the correction's cost)\n"
-                                    : " (estimator above the correction's cost)\n");
+    text(per_cycle <= correction ? ") (estimator within the correction's cost)\n"
+                                 : ") (estimator above the correction's cost)\n");
 }
 
 void print_report() noexcept {
