@@ -6,7 +6,7 @@
 // measured and checked alone:
 //  - calib_entry_<scalar>.cpp, the per-cycle part: the cycle's model (a
 //    pending swap applied between solutions) and the cycle's feed
-//    (feed_estimator below: the selection, each head's aberration-corrected
+//    (feed_estimator, ascorr/calib/feed.hpp: the selection, each head's aberration-corrected
 //    solution, the orbit accumulation). Integer code on the M3: checked free
 //    of soft-float with the core's entry (tests/target/target-tests.cmake).
 //  - calib_idle_<scalar>.cpp, the idle-time part: one step() of the per-orbit
@@ -16,42 +16,11 @@
 #include <cstdint>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/feed.hpp"
 #include "ascorr/correct.hpp"
 #include "ascorr/fixed_point.hpp"
-#include "ascorr/status.hpp"
 
 namespace ascorr::app {
-
-// The cycle's feed to the estimator. A cycle counts when heads A, B and C all
-// have the aberration stage applied and three valid temperatures (the ground
-// fit's selection; the loop's solutions carry no flags or confidence). Each
-// head's solution without its thermal stage is q_ab = q_th⁻¹ ⊗ q_corr, with
-// q_th the stage the core applied (thermal_stage(), correct.hpp, the same
-// model and temperatures), formed as the core forms it: the increment
-// (q_th⁻¹ − 1) ⊗ q_corr from small terms, one renormalised sum
-// (quaternion.hpp). False: the cycle did not count.
-template <typename T>
-bool feed_estimator(calib::Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
-                    const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
-    calib::CalibCycle<T> c{};
-    c.t_us = t_us;
-    for (std::uint8_t h = 0; h < calib::kCalibHeads; ++h) {
-        const CorrectedSolution<T>& s = corrected[h];
-        const HeadTemperatures<T>& tp = *temperatures[h];
-        if ((s.status & status::kAberrationApplied) == 0U || (s.status & status::kRejected) != 0U ||
-            !(tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid)) {
-            return false;
-        }
-        c.q_chu_icrf[h] = s.q_chu_icrf;
-        if ((s.status & status::kThermalApplied) != 0U && model != nullptr) {
-            const ThermalStage<T> th = thermal_stage(*model, h, tp);
-            c.q_chu_icrf[h] = renormalized_sum(s.q_chu_icrf, increment(conjugate(th.q_th)) * s.q_chu_icrf);
-        }
-        c.temperatures[h] = tp;
-    }
-    e.accumulate(c);
-    return true;
-}
 
 // Per cycle (calib_entry_<scalar>.cpp).
 const ThermalModel<Q30>* calib_model_fixed(calib::Estimator<Q30>& e, std::int64_t t_us) noexcept;

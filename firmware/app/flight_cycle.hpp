@@ -79,6 +79,9 @@ struct NoMeter {
     void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
 };
 
+// No coefficients for any head (the estimator without a model: status 256).
+inline constexpr ThermalModel<Scalar> kNoModel{};
+
 inline std::uint32_t bits_of(Q30 x) noexcept {
     return static_cast<std::uint32_t>(x.raw);
 }
@@ -288,7 +291,7 @@ public:
         std::uint32_t start = meter.now();
         const ThermalModel<Scalar>* model = calib_model(estimator_, calib_time_us(cycle));
         meter.add(Part::kCalibCycle, start);
-        const CorrectionConfig<Scalar> cfg{true, model};
+        const CorrectionConfig<Scalar> cfg{true, model != nullptr ? model : &kNoModel};  // none: status 256
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
             start = meter.now();

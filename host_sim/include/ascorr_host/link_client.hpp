@@ -1,4 +1,4 @@
-// ascorr_host/link_client.hpp: the host end of the link (protocol v2).
+// ascorr_host/link_client.hpp: the host end of the link (protocol v3).
 //
 // One request in flight. Each request keeps its sequence number across
 // retries, so the target can recognise a resend and answer from its cache.
@@ -11,6 +11,8 @@
 // it last sent (the velocity service's answers depend on that state only),
 // then resends the request in flight. So is a solution corrected without the model or velocity the
 // client gave the target (a restart whose HELLO was lost on the link).
+// A restart while the target's estimator runs (start_calibration) is an
+// error: what it had learnt is lost with it.
 #pragma once
 
 #include <algorithm>
@@ -137,6 +139,36 @@ public:
                         std::to_string(max_attempts_) + " attempts");
     }
 
+    // Self-calibration (protocol v3). `initial`: the estimator's version 0
+    // (staged head by head, then started with it); none: no model.
+    void start_calibration(std::int64_t orbit_period_us, double time_constant_days,
+                           const ModelCoefficients* initial) {
+        if (initial != nullptr) {
+            send_calib_model(*initial, false);
+        }
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(
+            link::CalibStart{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U)}, p);
+        expect_ok(transact(link::MessageType::kCalibStart, {p, p + n}, link::MessageType::kAck), "calibration start");
+        calibrating_ = true;
+    }
+    void calib_command(link::CalibCommand c) {
+        std::uint8_t p[link::kMaxPayload];
+        const std::size_t n = link::encode(c, p);
+        expect_ok(transact(link::MessageType::kCalibCommand, {p, p + n}, link::MessageType::kAck),
+                  "calibration command");
+    }
+    // A model for the estimator, active from the next epoch (version + 1).
+    void load_calib_model(const ModelCoefficients& m) { send_calib_model(m, true); }
+    calib::EstimatorReport calib_report() {
+        const auto a = transact(link::MessageType::kCalibReportRequest, {}, link::MessageType::kCalibReport);
+        calib::EstimatorReport r{};
+        if (!link::decode(a.data(), a.size(), r)) {
+            throw LinkError("malformed calibration report from the target (" + std::to_string(a.size()) + " bytes)");
+        }
+        return r;
+    }
+
     const LinkStats& stats() const { return stats_; }
 
 private:
@@ -183,6 +215,25 @@ private:
                   "temperature update");
     }
 
+    // Heads A..D of m, one frame each; the last with `load`.
+    void send_calib_model(const ModelCoefficients& m, bool load) {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            link::CalibModelLoad f{};
+            f.head = h;
+            f.present = m.present[h] ? 1U : 0U;
+            f.load = load && h + 1U == kMaxHeads ? 1U : 0U;
+            for (std::size_t a = 0; a < kModelAxes; ++a) {
+                for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+                    f.c[a][t] = m.present[h] ? m.coefficient[h][a][t] : 0.0;
+                }
+            }
+            std::uint8_t p[link::kMaxPayload];
+            const std::size_t n = link::encode(f, p);
+            expect_ok(transact(link::MessageType::kCalibModelLoad, {p, p + n}, link::MessageType::kAck),
+                      "calibration model load");
+        }
+    }
+
     static void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
         link::Ack a{};
         if (!link::decode(p.data(), p.size(), a) || a.result != link::AckResult::kOk) {
@@ -196,6 +247,9 @@ private:
         if (restoring_) {
             restart_again_ = true;  // a restart during restore: the outer restore starts over
             return;
+        }
+        if (calibrating_) {
+            throw LinkError("the target restarted during self-calibration: its estimator's state is lost");
         }
         restoring_ = true;
         for (int round = 0;; ++round) {
@@ -329,6 +383,7 @@ private:
     std::optional<link::StateUpdate> state_;  // the latest accepted spacecraft state
     bool from_states_ = false;
     bool velocity_expected_ = false;
+    bool calibrating_ = false;
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
     LinkStats stats_;
 };
