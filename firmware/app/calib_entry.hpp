@@ -26,7 +26,8 @@ namespace ascorr::app {
 const ThermalModel<Q30>* calib_model_fixed(calib::Estimator<Q30>& e, std::int64_t t_us) noexcept;
 const ThermalModel<float>* calib_model_float(calib::Estimator<float>& e, std::int64_t t_us) noexcept;
 bool calib_feed_fixed(calib::Estimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                      const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures) noexcept;
+                      const CorrectedSolution<Q30>* corrected,
+                      const HeadTemperatures<Q30>* const* temperatures) noexcept;
 bool calib_feed_float(calib::Estimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
                       const CorrectedSolution<float>* corrected,
                       const HeadTemperatures<float>* const* temperatures) noexcept;
@@ -42,7 +43,8 @@ inline const ThermalModel<float>* calib_model(calib::Estimator<float>& e, std::i
     return calib_model_float(e, t_us);
 }
 inline bool calib_feed(calib::Estimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                       const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures) noexcept {
+                       const CorrectedSolution<Q30>* corrected,
+                       const HeadTemperatures<Q30>* const* temperatures) noexcept {
     return calib_feed_fixed(e, t_us, model, corrected, temperatures);
 }
 inline bool calib_feed(calib::Estimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,

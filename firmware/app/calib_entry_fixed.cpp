@@ -8,7 +8,8 @@ const ThermalModel<Q30>* calib_model_fixed(calib::Estimator<Q30>& e, std::int64_
 }
 
 bool calib_feed_fixed(calib::Estimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                    const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures) noexcept {
+                      const CorrectedSolution<Q30>* corrected,
+                      const HeadTemperatures<Q30>* const* temperatures) noexcept {
     return feed_estimator(e, t_us, model, corrected, temperatures);
 }
 

@@ -8,7 +8,8 @@ const ThermalModel<float>* calib_model_float(calib::Estimator<float>& e, std::in
 }
 
 bool calib_feed_float(calib::Estimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
-                    const CorrectedSolution<float>* corrected, const HeadTemperatures<float>* const* temperatures) noexcept {
+                      const CorrectedSolution<float>* corrected,
+                      const HeadTemperatures<float>* const* temperatures) noexcept {
     return feed_estimator(e, t_us, model, corrected, temperatures);
 }
 

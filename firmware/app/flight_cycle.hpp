@@ -5,12 +5,16 @@
 //
 // Conventions: the loop runs at kRateHz. Each cycle takes the GNSS states that
 // arrived (gnss_feed.hpp) into the velocity service (velocity_service.hpp:
-// frame conversion and propagation in double, bounded per cycle), then
-// corrects one raw solution per camera head (flight_data.hpp) with the core in
-// the build's scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
+// frame conversion and propagation in double, bounded per cycle), takes the
+// on-board estimator's active model (calib_entry.hpp; a new one starts
+// between cycles), then corrects one raw solution per camera head (the
+// simulated deforming bench, flight_bench.hpp) with the core in the build's
+// scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
 // temperature_source.hpp and the velocity the service gives for that
-// solution's own time (velocity_entry.hpp). Times are TT µs (integers: no time
-// in the scalar). Every loop has a fixed trip count.
+// solution's own time (velocity_entry.hpp); every kCalibFeedEvery-th cycle
+// feeds heads A, B and C to the estimator, and after the solutions one
+// bounded step of its per-orbit update runs (idle()). Times are TT µs
+// (integers: no time in the scalar). Every loop has a fixed trip count.
 //
 // The cost of each part is measured by the caller's Meter (main.cpp: SysTick
 // counts; the host: NoMeter), which sees the work but never changes it:
@@ -66,10 +70,10 @@ inline constexpr VelocityServiceConfig kServiceConfig{kDefaultHorizonUs, kDefaul
 inline constexpr std::int64_t kStateIntervalUs = 10 * kMicrosecondsPerSecond;
 
 enum class Part : std::uint8_t {
-    kState,    // push_state: checks + ITRF → GCRS (double)
-    kNode,     // an advance() call that built a node (force, RK4 steps, Earth series; double)
-    kQuery,    // velocity_at(): the per-solution query (scalar)
-    kCorrect,  // the core
+    kState,       // push_state: checks + ITRF → GCRS (double)
+    kNode,        // an advance() call that built a node (force, RK4 steps, Earth series; double)
+    kQuery,       // velocity_at(): the per-solution query (scalar)
+    kCorrect,     // the core
     kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
     kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
 };
@@ -311,7 +315,7 @@ public:
             corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
         }
         const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
-                                                                    &temperatures_of(2U)};
+                                                                     &temperatures_of(2U)};
         if (cycle % kCalibFeedEvery == 0U) {
             start = meter.now();
             (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);

@@ -5,7 +5,8 @@
 // states that arrived (gnss_feed.hpp) into the velocity service
 // (velocity_service.hpp: frame conversion and propagation in double, bounded
 // per cycle), then corrects one raw solution per camera head with the core in
-// the build's scalar (app_scalar.hpp), the model in flash (flight_data.hpp)
+// the build's scalar (app_scalar.hpp), the on-board estimator's active model
+// (starting from the one in flash, flight_data.hpp; flight_bench.hpp)
 // and the observer velocity the service gives for that solution's own time
 // (velocity_entry.hpp), and keeps the corrected solutions for telemetry (the
 // cycle's computation: flight_cycle.hpp, shared with the host's prediction of
@@ -53,10 +54,10 @@ struct Cost {
     }
 };
 struct VelocityCosts {
-    Cost states;   // push_state: checks + ITRF → GCRS (double)
-    Cost advance;  // advance() calls that built a node (force, RK4 steps, Earth series; double)
-    Cost query;    // velocity_at(): the per-solution query (scalar)
-    Cost correct;  // the core, for comparison
+    Cost states;       // push_state: checks + ITRF → GCRS (double)
+    Cost advance;      // advance() calls that built a node (force, RK4 steps, Earth series; double)
+    Cost query;        // velocity_at(): the per-solution query (scalar)
+    Cost correct;      // the core, for comparison
     Cost calib_cycle;  // the estimator's per-cycle part (two calls per cycle: the model, the feed)
     Cost calib_step;   // one step() of the estimator's per-orbit update (idle time)
 };

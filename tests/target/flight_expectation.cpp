@@ -207,8 +207,8 @@ bool parse_report(const std::string& path, Report& out) {
             out.crc_seen[h] = true;
             out.crc_cycles[h] = c;
             out.crc[h] = p.bits[0];
-        } else if (std::sscanf(line.c_str(), "model version %u from cycle %u crc32c %8x%c", &a, &c, &p.bits[0], &rest) ==
-                   3) {
+        } else if (std::sscanf(line.c_str(), "model version %u from cycle %u crc32c %8x%c", &a, &c, &p.bits[0],
+                               &rest) == 3) {
             Report::Model m;
             m.version = a;
             m.cycle = c;
@@ -500,9 +500,8 @@ int main(int argc, char** argv) {
         const ascorr::calib::EstimatorReport r = flight.estimator().report();
         std::cout << "self-calibration: orbits used " << r.orbits_used << " short " << r.orbits_short << " held "
                   << r.orbits_held << " late " << r.orbits_late << ", last refusal "
-                  << ascorr::calib::refusal_name(r.last_refusal) << ", condition " << r.condition
-                  << ", residual RMS " << r.residual_rms_arcsec << " arcsec, active version " << r.active_version
-                  << "\n";
+                  << ascorr::calib::refusal_name(r.last_refusal) << ", condition " << r.condition << ", residual RMS "
+                  << r.residual_rms_arcsec << " arcsec, active version " << r.active_version << "\n";
         return 0;
     }
     if (argc != 4 || std::strcmp(argv[1], "check") != 0) {
@@ -536,7 +535,8 @@ int main(int argc, char** argv) {
     std::cout << "; CRC-32C over every cycle " << (bound == 0.0 ? "compared" : "not compared (not bit for bit)")
               << "\n";
     if (o.differences != 0 || host.samples.empty()) {
-        std::cout << "  " << o.differences << " differences: the image's solutions or model history are not the host's\n";
+        std::cout << "  " << o.differences
+                  << " differences: the image's solutions or model history are not the host's\n";
         return 1;
     }
     if (host.models.size() < 2U || host.models.back().version < 1U) {

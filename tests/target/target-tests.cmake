@@ -4,8 +4,9 @@
 # boards and scalars of toolchain/targets.txt):
 #   target_<t>_accuracy_<scalar>   worked examples + random set vs the double core
 #   target_<t>_firmware            the 22 Hz loop for 352 cycles, no overrun, its
-#                                  report as below and its solutions those of
-#                                  the host core (check-flight-solutions)
+#                                  report as below, its solutions those of
+#                                  the host core and its estimator's model
+#                                  history the host's (check-flight-solutions)
 #   target_<t>_no_soft_float       on a fixed-point target (no FPU), the
 #                                  per-solution and per-cycle code (the
 #                                  core's entry, the velocity query,

@@ -71,21 +71,21 @@ template <>
 struct WireTraits<QQuadraticCoefficient> : RawWire<QQuadraticCoefficient> {};
 
 enum class MessageType : std::uint8_t {
-    kHello = 1,              // target → host: boot id, protocol, scalar kind
-    kModelUpload = 2,        // host → target: one head's thermal model
-    kVelocityUpdate = 3,     // host → target: observer velocity (v/c) and 1/s
-    kTemperatureUpdate = 4,  // host → target: one head's temperatures with validity
-    kSolutionIn = 5,         // host → target: a raw attitude solution
-    kSolutionOut = 6,        // target → host: the corrected solution, status, cost
-    kAck = 7,                // target → host: a request without data reply was applied (or why not)
-    kHelloRequest = 8,       // host → target: answer with kHello
-    kNak = 9,                // target → host: a frame arrived broken; resend
-    kStateUpdate = 10,       // host → target: a spacecraft state for the velocity service (v2)
-    kCalibStart = 11,        // host → target: run the estimator on the solutions, its configuration (v3)
-    kCalibCommand = 12,      // host → target: freeze, resume or reset the estimator (v3)
-    kCalibModelLoad = 13,    // host → target: one head of a model for the estimator, staged or loaded (v3)
+    kHello = 1,                // target → host: boot id, protocol, scalar kind
+    kModelUpload = 2,          // host → target: one head's thermal model
+    kVelocityUpdate = 3,       // host → target: observer velocity (v/c) and 1/s
+    kTemperatureUpdate = 4,    // host → target: one head's temperatures with validity
+    kSolutionIn = 5,           // host → target: a raw attitude solution
+    kSolutionOut = 6,          // target → host: the corrected solution, status, cost
+    kAck = 7,                  // target → host: a request without data reply was applied (or why not)
+    kHelloRequest = 8,         // host → target: answer with kHello
+    kNak = 9,                  // target → host: a frame arrived broken; resend
+    kStateUpdate = 10,         // host → target: a spacecraft state for the velocity service (v2)
+    kCalibStart = 11,          // host → target: run the estimator on the solutions, its configuration (v3)
+    kCalibCommand = 12,        // host → target: freeze, resume or reset the estimator (v3)
+    kCalibModelLoad = 13,      // host → target: one head of a model for the estimator, staged or loaded (v3)
     kCalibReportRequest = 14,  // host → target: answer with kCalibReport (v3)
-    kCalibReport = 15,       // target → host: the estimator's state (v3)
+    kCalibReport = 15,         // target → host: the estimator's state (v3)
 };
 
 enum class AckResult : std::uint8_t {
@@ -533,9 +533,8 @@ inline bool decode(const std::uint8_t* p, std::size_t n, calib::EstimatorReport&
     std::uint8_t refusal = 0;
     std::uint8_t frozen = 0;
     bool ok = r.u32(m.orbits_used) && r.u32(m.orbits_short) && r.u32(m.orbits_held) && r.u32(m.orbits_late) &&
-              r.u32(m.changes) && r.f64(m.condition) && r.f64(m.residual_rms_arcsec) &&
-              r.f64(m.candidate_rms_arcsec) && r.u8(has) && r.u32(m.active_version) && r.u32(m.active_crc) &&
-              r.u8(refusal);
+              r.u32(m.changes) && r.f64(m.condition) && r.f64(m.residual_rms_arcsec) && r.f64(m.candidate_rms_arcsec) &&
+              r.u8(has) && r.u32(m.active_version) && r.u32(m.active_crc) && r.u8(refusal);
     m.refusals[0] = 0U;
     for (std::size_t i = 1; ok && i < calib::kRefusalKinds; ++i) {
         ok = r.u32(m.refusals[i]);

@@ -196,7 +196,8 @@ private:
                 }
                 // Self-calibrating without a model yet: no head has coefficients (status 256).
                 const ThermalModel<T>* model = calibrating_ ? epoch_model(s.t) : &model_;
-                CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
+                CorrectedSolution<T> c =
+                    correct_solution(in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
                 const std::uint32_t cost = counter_() - start;
                 c.status = with_service_status(c.status, service_status, true);
                 ++solutions_;

@@ -141,8 +141,7 @@ public:
 
     // Self-calibration (protocol v3). `initial`: the estimator's version 0
     // (staged head by head, then started with it); none: no model.
-    void start_calibration(std::int64_t orbit_period_us, double time_constant_days,
-                           const ModelCoefficients* initial) {
+    void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial) {
         if (initial != nullptr) {
             send_calib_model(*initial, false);
         }
