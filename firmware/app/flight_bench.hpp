@@ -63,6 +63,22 @@ struct BenchAttitudes {
     Quaternion<Scalar> q[boom::kProfileSeconds][kMaxHeads];
 };
 
+// The star tracker's noise: a fixed pseudo-random rotation per head and
+// second of the profile, up to kNoiseArcsec about each axis (a 64-bit LCG,
+// Knuth's MMIX constants), so that the models' residuals are at a noise level
+// and the adoption gate compares real differences, not roundings.
+inline constexpr double kNoiseArcsec = 0.5;
+constexpr Quaternion<double> measurement_noise(std::uint32_t sec, std::uint8_t h) {
+    std::uint64_t x = 0x9E3779B97F4A7C15ULL ^ (static_cast<std::uint64_t>(sec) * 4U + h);
+    double a[3] = {};
+    for (double& v : a) {
+        x = x * 6364136223846793005ULL + 1442695040888963407ULL;
+        const double u = static_cast<double>(x >> 11U) * 0x1p-53;  // [0, 1)
+        v = (2.0 * u - 1.0) * kNoiseArcsec * kArcsecToRad * 0.5;   // half-angle
+    }
+    return {1.0 - 0.5 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]), a[0], a[1], a[2]};
+}
+
 constexpr BenchAttitudes make_bench_attitudes() {
     constexpr ThermalModel<double> truth = thermal_model<double>(kBenchTruth, kArcsecToRad);
     BenchAttitudes b{};
@@ -78,7 +94,9 @@ constexpr BenchAttitudes make_bench_attitudes() {
                                                                      thermal_angle(m.gamma, t1, t2, t3)))) *
                                 kHeadAttitude[h]
                           : kHeadAttitude[h];
-            b.q[sec][h] = {s(q.w), s(q.x), s(q.y), s(q.z)};
+            const Quaternion<double> n = measurement_noise(sec, h);
+            const Quaternion<double> qn = n * q;
+            b.q[sec][h] = {s(qn.w), s(qn.x), s(qn.y), s(qn.z)};
         }
     }
     return b;

@@ -69,19 +69,25 @@ set(scalar_name_fixed "fixed-point")
 set(scalar_name_float "float")
 
 # The loop's solutions and the estimator's model history against the host
-# in the image's scalar (tests/target/check-flight-solutions), bit for bit on
-# both: Q30 is integer arithmetic; the service's and the estimator's double is
-# IEEE software double on both targets and SSE2 on the host, sin/cos from
-# sincos.hpp, exp and hypot from calib/portable_math.hpp; the M4F image is
-# built without fused multiply-adds (firmware/app/CMakeLists.txt), like the
-# host. The flight loop runs the estimator on a bench that deforms with
-# temperature (firmware/app/flight_bench.hpp): 44 accelerated orbits, a first
+# in the image's scalar (tests/target/check-flight-solutions). Q30 bit for
+# bit: integer arithmetic; the service's and the estimator's double is IEEE
+# software double on the target and SSE2 on the host, sin/cos from
+# sincos.hpp, exp and hypot from calib/portable_math.hpp. The M4F image's
+# float code is compiled with GCC's default contraction into fused
+# multiply-adds (the host's, like the link image, without:
+# -ffp-contract=off), which skips roundings: measured, 23 of 92 printed
+# solutions differ, by at most 0.026", and the model history has the same
+# versions from the same cycles, its models' angles within the bound of each
+# other at the loop's temperatures. Bound: the float path's own, bound_float
+# (vs the double core), which a velocity error of 73 m/s or a T032 error of
+# 0.03 degC (head C: 2.25"/degC) would exceed. The flight loop runs the
+# estimator on a bench that deforms with temperature and has the star
+# tracker's noise (firmware/app/flight_bench.hpp): 44 accelerated orbits, a
 # model adopted after 30 (the check fails when none is).
 set(flight_bound_fixed 0)
-set(flight_bound_float 0)
-set(flight_match "solutions match the host core's bit for bit.*model history .* matches the host's bit for bit.*mutated expectation refused")
-set(flight_match_fixed "${flight_match}")
-set(flight_match_float "${flight_match}")
+set(flight_bound_float ${bound_float})
+set(flight_match_fixed "solutions match the host core's bit for bit.*model history .* matches the host's bit for bit.*mutated expectation refused")
+set(flight_match_float "solutions match the host core's within the bound.*model history .* matches the host's within the bound.*mutated expectation refused")
 
 foreach(t ${ASCORR_TARGET_LIST})
   set(bin ${ASCORR_TARGET_${t}_BINARY_DIR})
