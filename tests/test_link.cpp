@@ -2,10 +2,14 @@
 // including every kind of corruption the replay must survive.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
+#include <utility>
 #include <vector>
 
+#include "ascorr/core/table2.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_link/server.hpp"
 #include "test_support.hpp"
@@ -313,5 +317,130 @@ TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
     EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 9, none)), AckResult::kOk);
 }
 
+// Self-calibration on the link (protocol v3): the commands act on the
+// estimator, a loaded model corrects from the next epoch, and every bad
+// payload is refused with kBadPayload and changes nothing (the report, bit
+// for bit, and the staged model: a later load gives the same CRC).
+TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
+    Loop loop;
+    loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
+    std::uint16_t seq = 2;
+    const auto ack_of = [](const Decoded& d) {
+        Ack ack{};
+        EXPECT_TRUE(d.frames.size() == 1U && decode(d.payloads[0].data(), d.payloads[0].size(), ack));
+        return ack.result;
+    };
+    const auto report_bytes = [&loop, &seq]() {
+        const Decoded r = loop.send(wire_frame(MessageType::kCalibReportRequest, seq++, {}));
+        EXPECT_EQ(r.frames.size(), 1U);
+        EXPECT_EQ(r.frames.at(0).type, static_cast<std::uint8_t>(MessageType::kCalibReport));
+        return r.payloads.at(0);
+    };
+    const auto report = [&report_bytes]() {
+        const Bytes b = report_bytes();
+        calib::EstimatorReport r{};
+        EXPECT_TRUE(decode(b.data(), b.size(), r));
+        return r;
+    };
+    const auto solution = [&loop, &seq](std::uint8_t head, std::int64_t t_us) {
+        loop.request(MessageType::kTemperatureUpdate, seq++,
+                     TemperatureUpdate<float>{head, {{12.0F, true}, {-5.0F, true}, {-20.0F, true}}});
+        loop.request(MessageType::kVelocityUpdate, seq++, ObserverVelocity<float>{{1e-4F, 0.0F, 0.0F}, 1.0F, true});
+        const Decoded r = loop.request(MessageType::kSolutionIn, seq++,
+                                       SolutionIn<float>{seq, head, {0.5F, 0.5F, 0.5F, 0.5F}, {t_us}, 0});
+        SolutionOut<float> out{};
+        EXPECT_TRUE(r.frames.size() == 1U && decode(r.payloads[0].data(), r.payloads[0].size(), out));
+        return out;
+    };
+
+    const CalibStart start{5'640'000'000, 30.0, 0};
+    EXPECT_EQ(ack_of(loop.request(MessageType::kCalibStart, seq++, start)), AckResult::kOk);
+    EXPECT_NE(solution(0, 1'000'000).status & status::kNoModelForHead, 0U);  // no model yet: 256
+    const Bytes before = report_bytes();
+
+    // Bad payloads: each refused, nothing changed.
+    std::vector<std::pair<MessageType, Bytes>> bad;
+    bad.emplace_back(MessageType::kCalibCommand, Bytes{0});
+    bad.emplace_back(MessageType::kCalibCommand, Bytes{4});
+    bad.emplace_back(MessageType::kCalibCommand, Bytes{1, 0});
+    bad.emplace_back(MessageType::kCalibCommand, Bytes{});
+    bad.emplace_back(MessageType::kCalibReportRequest, Bytes{0});
+    for (const CalibStart& s : {CalibStart{0, 30.0, 0}, CalibStart{-5, 30.0, 0}, CalibStart{1000, 0.0, 0},
+                                CalibStart{1000, std::nan(""), 0}, CalibStart{1000, 30.0, 2}}) {
+        std::uint8_t p[kMaxPayload];
+        bad.emplace_back(MessageType::kCalibStart, Bytes(p, p + encode(s, p)));
+    }
+    CalibModelLoad good{};
+    good.head = 0;
+    good.present = 1;
+    good.load = 1;
+    for (std::size_t a = 0; a < kModelAxes; ++a) {
+        for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+            good.c[a][t] = kTable2.coefficient[0][a][t];
+        }
+    }
+    std::vector<CalibModelLoad> bad_models(6, good);
+    bad_models[0].head = 4;
+    bad_models[1].present = 2;
+    bad_models[2].load = 2;
+    bad_models[3].c[1][2] = std::nan("");
+    bad_models[4].c[2][0] = kMaxLoadCoefficient;
+    bad_models[5].c[0][3] = -std::numeric_limits<double>::infinity();
+    for (const CalibModelLoad& m : bad_models) {
+        std::uint8_t p[kMaxPayload];
+        bad.emplace_back(MessageType::kCalibModelLoad, Bytes(p, p + encode(m, p)));
+    }
+    {
+        std::uint8_t p[kMaxPayload];
+        const std::size_t n = encode(good, p);
+        bad.emplace_back(MessageType::kCalibModelLoad, Bytes(p, p + n - 1));  // truncated
+        Bytes longer(p, p + n);
+        longer.push_back(0);
+        bad.emplace_back(MessageType::kCalibModelLoad, longer);  // a byte too many
+    }
+    for (const auto& [type, payload] : bad) {
+        EXPECT_EQ(ack_of(loop.send(wire_frame(type, seq++, payload))), AckResult::kBadPayload);
+    }
+    EXPECT_EQ(report_bytes(), before);
+
+    // Commands.
+    EXPECT_EQ(ack_of(loop.request(MessageType::kCalibCommand, seq++, CalibCommand::kFreeze)), AckResult::kOk);
+    EXPECT_TRUE(report().frozen);
+    EXPECT_EQ(ack_of(loop.request(MessageType::kCalibCommand, seq++, CalibCommand::kResume)), AckResult::kOk);
+    EXPECT_FALSE(report().frozen);
+    EXPECT_EQ(ack_of(loop.request(MessageType::kCalibCommand, seq++, CalibCommand::kReset)), AckResult::kOk);
+
+    // Load Table 2 (linear), head by head: active from the next epoch, version 1.
+    ModelCoefficients want{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        CalibModelLoad m = good;
+        m.head = h;
+        m.present = kTable2.present[h] ? 1U : 0U;
+        m.load = h == kMaxHeads - 1U ? 1U : 0U;
+        want.present[h] = kTable2.present[h];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+                m.c[a][t] = kTable2.present[h] ? kTable2.coefficient[h][a][t] : 0.0;
+                want.coefficient[h][a][t] = m.c[a][t];
+            }
+        }
+        EXPECT_EQ(ack_of(loop.request(MessageType::kCalibModelLoad, seq++, m)), AckResult::kOk);
+    }
+    const SolutionOut<float> out = solution(1, 2'000'000);
+    const ThermalModel<float> model = thermal_model<float>(want, kArcsecToRad);
+    SolutionInput<float> in{};
+    in.q_chu_icrf = {0.5F, 0.5F, 0.5F, 0.5F};
+    in.head = 1;
+    in.temperatures = {{12.0F, true}, {-5.0F, true}, {-20.0F, true}};
+    in.velocity = {{1e-4F, 0.0F, 0.0F}, 1.0F, true};
+    const CorrectedSolution<float> c = correct_solution(in, CorrectionConfig<float>{true, &model});
+    EXPECT_EQ(out.status, c.status);
+    EXPECT_EQ(out.status, status::kAberrationApplied | status::kThermalApplied);
+    EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &c.q_chu_icrf, sizeof c.q_chu_icrf), 0);
+    const calib::EstimatorReport r = report();
+    EXPECT_TRUE(r.has_active);
+    EXPECT_EQ(r.active_version, 1U);
+    EXPECT_EQ(r.active_crc, calib::model_crc(want));
+}
 }  // namespace
 }  // namespace ascorr::link

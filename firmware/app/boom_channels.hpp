@@ -106,16 +106,20 @@ constexpr double ramp(std::uint32_t s) {
 }
 
 // The boom's temperature at second s of the profile, per channel (°C):
-// triplet members read almost the same.
+// triplet members read almost the same. THT00032's triplet runs 4 s behind
+// THT00029's, and T_CHU has a shape of its own (boom_temperatures.hpp), so
+// that the thermal model's regressors [1, T1, T2 − T1, T3 − T1] are linearly
+// independent over the 16 s: the on-board estimator can identify the bench's
+// deformation from them (flight_bench.hpp).
 constexpr double profile_celsius(std::uint8_t channel, std::uint32_t s) {
-    const double r = ramp(s);
     const double spread = 0.05 * static_cast<double>(channel % 3U);
     if (channel < 3U) {
-        return -6.5 + 0.5 * r + spread;
+        return -6.5 + 0.5 * ramp(s) + spread;
     }
     if (channel < 6U) {
-        return -20.0 + 0.25 * r + spread;
+        return -20.0 + 0.25 * ramp((s + kProfileSeconds - 4U) % kProfileSeconds) + spread;
     }
+    const double r = ramp(s);
     return 10.0 + 2.5 * static_cast<double>(channel - 6U) + r;  // CHU_A, CHU_B (benchmark only)
 }
 

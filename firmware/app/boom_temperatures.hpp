@@ -35,8 +35,13 @@
 
 namespace ascorr::app {
 
-// T_CHU from each head's housekeeping (°C, a stepped profile of 16 seconds;
-// head D: none), in the core's format at compile time.
+// T_CHU from each head's housekeeping (°C, a stepped profile of 16 seconds,
+// a sawtooth of 4 s unlike the boom's ramps, boom_channels.hpp; head D: none),
+// in the core's format at compile time.
+constexpr double chu_celsius(std::uint32_t head, std::uint32_t s) {
+    return 10.0 + 2.5 * static_cast<double>(head) + 0.5 * static_cast<double>(s % 4U);
+}
+
 struct ChuProfile {
     Celsius<Scalar> t[kMaxHeads][boom::kProfileSeconds];
 };
@@ -45,7 +50,7 @@ constexpr ChuProfile make_chu_profile() {
     ChuProfile p{};
     for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
         for (std::uint32_t s = 0; s < boom::kProfileSeconds; ++s) {
-            p.t[h][s] = ScalarTraits<Scalar>::celsius(10.0 + 2.5 * static_cast<double>(h) + boom::ramp(s));
+            p.t[h][s] = ScalarTraits<Scalar>::celsius(chu_celsius(h, s));
         }
     }
     return p;

@@ -5,12 +5,16 @@
 //
 // Conventions: the loop runs at kRateHz. Each cycle takes the GNSS states that
 // arrived (gnss_feed.hpp) into the velocity service (velocity_service.hpp:
-// frame conversion and propagation in double, bounded per cycle), then
-// corrects one raw solution per camera head (flight_data.hpp) with the core in
-// the build's scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
+// frame conversion and propagation in double, bounded per cycle), takes the
+// on-board estimator's active model (calib_entry.hpp; a new one starts
+// between cycles), then corrects one raw solution per camera head (the
+// simulated deforming bench, flight_bench.hpp) with the core in the build's
+// scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
 // temperature_source.hpp and the velocity the service gives for that
-// solution's own time (velocity_entry.hpp). Times are TT µs (integers: no time
-// in the scalar). Every loop has a fixed trip count.
+// solution's own time (velocity_entry.hpp); every kCalibFeedEvery-th cycle
+// feeds heads A, B and C to the estimator, and after the solutions one
+// bounded step of its per-orbit update runs (idle()). Times are TT µs
+// (integers: no time in the scalar). Every loop has a fixed trip count.
 //
 // The cost of each part is measured by the caller's Meter (main.cpp: SysTick
 // counts; the host: NoMeter), which sees the work but never changes it:
@@ -29,11 +33,14 @@
 #include <cstring>
 
 #include "app_scalar.hpp"
+#include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr/nav/velocity_service.hpp"
 #include "ascorr_link/crc32c.hpp"
+#include "calib_entry.hpp"
 #include "core_entry.hpp"
+#include "flight_bench.hpp"
 #include "flight_data.hpp"
 #include "gnss_feed.hpp"
 #include "loop_rate.hpp"
@@ -63,16 +70,21 @@ inline constexpr VelocityServiceConfig kServiceConfig{kDefaultHorizonUs, kDefaul
 inline constexpr std::int64_t kStateIntervalUs = 10 * kMicrosecondsPerSecond;
 
 enum class Part : std::uint8_t {
-    kState,    // push_state: checks + ITRF → GCRS (double)
-    kNode,     // an advance() call that built a node (force, RK4 steps, Earth series; double)
-    kQuery,    // velocity_at(): the per-solution query (scalar)
-    kCorrect,  // the core
+    kState,       // push_state: checks + ITRF → GCRS (double)
+    kNode,        // an advance() call that built a node (force, RK4 steps, Earth series; double)
+    kQuery,       // velocity_at(): the per-solution query (scalar)
+    kCorrect,     // the core
+    kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
+    kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
 };
 
 struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
     void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
 };
+
+// No coefficients for any head (the estimator without a model: status 256).
+inline constexpr ThermalModel<Scalar> kNoModel{};
 
 inline std::uint32_t bits_of(Q30 x) noexcept {
     return static_cast<std::uint32_t>(x.raw);
@@ -187,6 +199,68 @@ private:
     std::uint32_t samples_taken_ = 0U;
 };
 
+// The models the estimator made active, in turn (the first kMaxModels): the
+// cycle from which each was used, its version and CRC-32C (model_identity.hpp)
+// and its coefficients (arcsec; printed as the bits of each double).
+class ModelHistory {
+public:
+    static constexpr std::uint32_t kMaxModels = 4U;
+    struct Entry {
+        std::uint32_t cycle;
+        std::uint32_t version;
+        std::uint32_t crc;
+        ModelCoefficients model;
+    };
+
+    void add(std::uint32_t cycle, const calib::EstimatorReport& r, const ModelCoefficients& m) noexcept {
+        if (size_ < kMaxModels) {
+            entries_[size_] = {cycle, r.active_version, r.active_crc, m};
+            ++size_;
+        }
+    }
+    std::uint32_t size() const noexcept { return size_; }
+    const Entry& entry(std::uint32_t i) const noexcept { return entries_[i < kMaxModels ? i : 0U]; }
+
+    // Per model: "model version V from cycle C crc32c X", then per head and
+    // axis "model version V head H axis A c HHHHHHHHLLLLLLLL ..." (c0..c3).
+    void print() const noexcept {
+        using namespace report;
+        for (std::uint32_t i = 0; i < size_; ++i) {
+            const Entry& e = entries_[i];
+            text("model version ");
+            u32(e.version);
+            text(" from cycle ");
+            u32(e.cycle);
+            text(" crc32c ");
+            hex32(e.crc);
+            text("\n");
+            for (std::uint32_t h = 0; h < calib::kCalibHeads; ++h) {
+                for (std::uint32_t a = 0; a < kModelAxes; ++a) {
+                    text("model version ");
+                    u32(e.version);
+                    text(" head ");
+                    u32(h);
+                    text(" axis ");
+                    u32(a);
+                    text(" c");
+                    for (std::uint32_t t = 0; t < kLinearModelTerms; ++t) {
+                        std::uint64_t b = 0U;
+                        std::memcpy(&b, &e.model.coefficient[h][a][t], sizeof b);
+                        text(" ");
+                        hex32(static_cast<std::uint32_t>(b >> 32U));
+                        hex32(static_cast<std::uint32_t>(b));
+                    }
+                    text("\n");
+                }
+            }
+        }
+    }
+
+private:
+    Entry entries_[kMaxModels]{};
+    std::uint32_t size_ = 0U;
+};
+
 class FlightCycle {
 public:
     // One cycle: the temperatures (temperature_source.hpp), the states, the
@@ -218,10 +292,13 @@ public:
     // One corrected solution per head, in head order (fixed trip count).
     template <typename Meter>
     void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
-        const CorrectionConfig<Scalar> cfg{true, &kThermalModel};
+        std::uint32_t start = meter.now();
+        const ThermalModel<Scalar>* model = calib_model(estimator_, calib_time_us(cycle));
+        meter.add(Part::kCalibCycle, start);
+        const CorrectionConfig<Scalar> cfg{true, model != nullptr ? model : &kNoModel};  // none: status 256
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
-            std::uint32_t start = meter.now();
+            start = meter.now();
             const std::uint32_t nodes_before = service_.nodes_built();
             service_.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
             if (service_.nodes_built() != nodes_before) {
@@ -230,12 +307,36 @@ public:
             start = meter.now();
             const ServiceVelocity<Scalar> v = velocity_query(service_, t);
             meter.add(Part::kQuery, start);
-            const SolutionInput<Scalar> in{kRawAttitude[h], h, temperatures_of(h), v.velocity};
+            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), v.velocity};
             start = meter.now();
             corrected_[h] = correct(in, cfg);
             meter.add(Part::kCorrect, start);
             corrected_[h].status = with_service_status(corrected_[h].status, v.status, cfg.aberration);
             corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
+        }
+        const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
+                                                                     &temperatures_of(2U)};
+        if (cycle % kCalibFeedEvery == 0U) {
+            start = meter.now();
+            (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
+            meter.add(Part::kCalibCycle, start);
+        }
+        if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
+            model_ = model;
+            if (model != nullptr) {
+                history_.add(cycle, estimator_.report(), *estimator_.active_coefficients());
+            }
+        }
+    }
+
+    // Idle time after the cycle's solutions: one bounded step of the
+    // estimator's per-orbit update (at most one per cycle: the same on the DPU
+    // and the host, whatever the time left).
+    template <typename Meter>
+    void idle(Meter& meter) noexcept {
+        const std::uint32_t start = meter.now();
+        if (calib_step(estimator_)) {
+            meter.add(Part::kCalibStep, start);
         }
     }
 
@@ -246,6 +347,8 @@ public:
     std::uint32_t states_skipped() const noexcept { return states_skipped_; }
     std::uint32_t states_refused() const noexcept { return states_refused_; }
     const CorrectionLog& record() const noexcept { return record_; }
+    const calib::Estimator<Scalar>& estimator() const noexcept { return estimator_; }
+    const ModelHistory& history() const noexcept { return history_; }
 
 private:
     VelocityService<Scalar> service_{kServiceConfig};
@@ -254,6 +357,10 @@ private:
     std::uint32_t states_skipped_ = 0U;
     std::uint32_t states_refused_ = 0U;
     CorrectionLog record_;
+    // The estimator, starting from the model in flash (version 0).
+    calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
+    ModelHistory history_;
 };
 
 template <typename Meter>
@@ -261,6 +368,7 @@ void FlightCycle::run(std::uint32_t cycle, Meter& meter, bool record) noexcept {
     temperatures_update(cycle);
     take_states(cycle, meter);
     correct_heads(cycle, meter);
+    idle(meter);
     for (std::uint8_t h = 0; record && h < kMaxHeads; ++h) {  // fixed trip count
         record_.add(cycle, h, corrected_[h]);
     }

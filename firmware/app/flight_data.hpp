@@ -8,8 +8,6 @@
 // in flash. The
 // observer velocity is not here: the velocity service (velocity_service.hpp,
 // fed by gnss_feed.hpp) computes it for each solution's time.
-// The raw attitudes stand in for the star tracker's solutions (simulated: the
-// worked examples' raw quaternions of heads A, B, C).
 #pragma once
 
 #include "app_scalar.hpp"
@@ -28,13 +26,16 @@ constexpr Scalar s(double x) {
     return ScalarTraits<Scalar>::from_double(x);
 }
 
-// Simulated raw solutions, one per head (D has no model: thermal skipped, status 256).
-constexpr Quaternion<Scalar> kRawAttitude[] = {
-    {s(0.188173755763194), s(-0.642227588171342), s(0.463430603055416), s(0.580832539365081)},
-    {s(0.536911789185323), s(0.045581161688435), s(0.778137527156088), s(0.322722910814147)},
-    {s(0.904730389821686), s(-0.114358111360624), s(-0.316980035977685), s(-0.260593171228098)},
-    {s(0.533209592857951), s(-0.403609172093452), s(-0.739738302419800), s(0.074661973047649)},
+// The heads' undeformed attitudes, one per head (simulated: the worked
+// examples' raw quaternions of heads A, B, C; D has no model: thermal skipped,
+// status 256). The raw solutions the loop corrects are these deformed by the
+// simulated bench (flight_bench.hpp).
+constexpr Quaternion<double> kHeadAttitude[] = {
+    {0.188173755763194, -0.642227588171342, 0.463430603055416, 0.580832539365081},
+    {0.536911789185323, 0.045581161688435, 0.778137527156088, 0.322722910814147},
+    {0.904730389821686, -0.114358111360624, -0.316980035977685, -0.260593171228098},
+    {0.533209592857951, -0.403609172093452, -0.739738302419800, 0.074661973047649},
 };
-static_assert(sizeof(kRawAttitude) / sizeof(kRawAttitude[0]) == kMaxHeads, "one raw attitude per head (heads.hpp)");
+static_assert(sizeof(kHeadAttitude) / sizeof(kHeadAttitude[0]) == kMaxHeads, "one attitude per head (heads.hpp)");
 
 }  // namespace ascorr::app

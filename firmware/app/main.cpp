@@ -5,7 +5,8 @@
 // states that arrived (gnss_feed.hpp) into the velocity service
 // (velocity_service.hpp: frame conversion and propagation in double, bounded
 // per cycle), then corrects one raw solution per camera head with the core in
-// the build's scalar (app_scalar.hpp), the model in flash (flight_data.hpp)
+// the build's scalar (app_scalar.hpp), the on-board estimator's active model
+// (starting from the one in flash, flight_data.hpp; flight_bench.hpp)
 // and the observer velocity the service gives for that solution's own time
 // (velocity_entry.hpp), and keeps the corrected solutions for telemetry (the
 // cycle's computation: flight_cycle.hpp, shared with the host's prediction of
@@ -53,10 +54,12 @@ struct Cost {
     }
 };
 struct VelocityCosts {
-    Cost states;   // push_state: checks + ITRF → GCRS (double)
-    Cost advance;  // advance() calls that built a node (force, RK4 steps, Earth series; double)
-    Cost query;    // velocity_at(): the per-solution query (scalar)
-    Cost correct;  // the core, for comparison
+    Cost states;       // push_state: checks + ITRF → GCRS (double)
+    Cost advance;      // advance() calls that built a node (force, RK4 steps, Earth series; double)
+    Cost query;        // velocity_at(): the per-solution query (scalar)
+    Cost correct;      // the core, for comparison
+    Cost calib_cycle;  // the estimator's per-cycle part (two calls per cycle: the model, the feed)
+    Cost calib_step;   // one step() of the estimator's per-orbit update (idle time)
 };
 VelocityCosts g_costs{};
 
@@ -84,6 +87,12 @@ struct SysTickMeter {
                 break;
             case Part::kCorrect:
                 g_costs.correct.add(c);
+                break;
+            case Part::kCalibCycle:
+                g_costs.calib_cycle.add(c);
+                break;
+            case Part::kCalibStep:
+                g_costs.calib_step.add(c);
                 break;
         }
     }
@@ -148,6 +157,62 @@ void cost(const char* name, const Cost& c) noexcept {
     text("\n");
 }
 
+// The estimator: its state, its per-cycle cost (the mean of this run; the
+// worst cycle: at most two calls, so the worst call twice bounds it) against
+// the correction's own in this loop (four heads per cycle) and of three heads,
+// its per-orbit update and its RAM.
+void print_estimator(std::uint32_t correction3) noexcept {
+    using namespace report;
+    const calib::EstimatorReport r = g_flight.estimator().report();
+    text("self-calibration: orbits used ");
+    u32(r.orbits_used);
+    text(" short ");
+    u32(r.orbits_short);
+    text(" held ");
+    u32(r.orbits_held);
+    text(" late ");
+    u32(r.orbits_late);
+    text(", refusals few orbits ");
+    u32(r.refusals[static_cast<std::size_t>(calib::Refusal::kFewOrbits)]);
+    text(" condition ");
+    u32(r.refusals[static_cast<std::size_t>(calib::Refusal::kCondition)]);
+    text(" angle ");
+    u32(r.refusals[static_cast<std::size_t>(calib::Refusal::kAngleLimit)]);
+    text(" no gain ");
+    u32(r.refusals[static_cast<std::size_t>(calib::Refusal::kNoGain)]);
+    text(", active version ");
+    u32(r.active_version);
+    text(" crc32c ");
+    hex32(r.active_crc);
+    text("\n");
+    cost("  estimator per cycle (model, feed)", g_costs.calib_cycle);
+    cost("  estimator per-orbit step (idle)", g_costs.calib_step);
+    const std::uint32_t per_cycle =
+        g_stats.cycles == 0U ? 0U : (g_costs.calib_cycle.total * 40U + g_stats.cycles / 2U) / g_stats.cycles;
+    const std::uint32_t worst_cycle = 2U * g_costs.calib_cycle.worst * 40U;
+    const std::uint32_t orbits = r.orbits_used + r.orbits_short + r.orbits_held;
+    text("estimator: per cycle ");
+    u32(per_cycle);
+    text(" instructions (worst ");
+    u32(worst_cycle);
+    text("), per orbit ");
+    u32(orbits == 0U ? 0U : (g_costs.calib_step.total * 40U + orbits / 2U) / orbits);
+    text(" instructions in ");
+    u32(orbits == 0U ? 0U : (g_costs.calib_step.calls + orbits / 2U) / orbits);
+    text(" idle steps (worst step ");
+    u32(g_costs.calib_step.worst * 40U);
+    text("), RAM ");
+    u32(static_cast<std::uint32_t>(sizeof(calib::Estimator<Scalar>)));
+    const std::uint32_t correction =
+        g_stats.cycles == 0U ? 0U : (g_costs.correct.total * 40U + g_stats.cycles / 2U) / g_stats.cycles;
+    text(" bytes; correction per cycle ");
+    u32(correction);
+    text(" (three heads ");
+    u32(correction3);
+    text(per_cycle <= correction ? ") (estimator within the correction's cost)\n"
+                                 : ") (estimator above the correction's cost)\n");
+}
+
 void print_report() noexcept {
     using namespace report;
     text(ASCORR_APP_SCALAR_NAME " core, ");
@@ -206,6 +271,7 @@ void print_report() noexcept {
     u32(correction3);
     text(amortised <= correction3 ? " (service within the correction's cost)\n"
                                   : " (service above the correction's cost)\n");
+    print_estimator(correction3);
 }
 
 }  // namespace
@@ -241,5 +307,6 @@ int main() {
     }
     print_report();
     g_flight.record().print_solutions();
+    g_flight.history().print();
     return g_stats.overruns == 0U ? 0 : 1;
 }

@@ -1,12 +1,13 @@
 // Writes seed inputs for fuzz_link_server: the bytes the host's LinkClient
-// sends in real protocol-v2 sessions with an in-process LinkServer (model,
+// sends in real protocol-v2 and v3 sessions with an in-process LinkServer (model,
 // velocity, temperatures, ITRF and GCRS spacecraft states, time-tagged
-// solutions with and without the service's velocity, a refused state). The
+// solutions with and without the service's velocity, a refused state; the
+// estimator's start, commands, model load and report). The
 // fuzzer mutates from whole, valid conversations, so it reaches the decoders
 // of every message type; tests/fuzz/run writes these seeds afresh each run,
 // so they follow the protocol as it changes.
 //
-// Usage: link_corpus DIR   (writes DIR/v2_*.bin)
+// Usage: link_corpus DIR   (writes DIR/v2_*.bin, DIR/v3_*.bin)
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/table2.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/link/link_client.hpp"
@@ -98,6 +100,26 @@ int main(int argc, char** argv) {
         s.client.send_state(state(kT0Us + 2'000'000, 1), false);
         s.client.correct(3, 0, q, TtTime{kT0Us + 60'000'000}, true, true);
         write(dir + "/v2_states.bin", s.sent);
+    }
+    // Self-calibration (v3): started with Table 2 as version 0, epochs of
+    // heads A, B and C, the commands, a model loaded, the report.
+    {
+        Session s;
+        s.client.connect();
+        s.client.set_velocity(ObserverVelocity<float>{{1.0e-4F, -2.0e-5F, 3.0e-6F}, 1.0F, true});
+        s.client.start_calibration(5'640'000'000, 30.0, &kTable2);
+        for (std::uint32_t epoch = 0; epoch < 4; ++epoch) {
+            for (std::uint8_t h = 0; h < 3; ++h) {
+                s.client.set_temperatures(h, temps);
+                s.client.correct(3 * epoch + h, h, q, TtTime{kT0Us + epoch * 2'000'000'000LL});
+            }
+        }
+        s.client.calib_command(link::CalibCommand::kFreeze);
+        s.client.calib_command(link::CalibCommand::kResume);
+        s.client.calib_command(link::CalibCommand::kReset);
+        s.client.load_calib_model(kTable2);
+        (void)s.client.calib_report();
+        write(dir + "/v3_self_calibration.bin", s.sent);
     }
     return 0;
 }

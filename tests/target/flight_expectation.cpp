@@ -113,6 +113,15 @@ struct Report {
     bool crc_seen[kMaxHeads] = {};
     unsigned crc_cycles[kMaxHeads] = {};
     std::uint32_t crc[kMaxHeads] = {};
+    // The estimator's model history (flight_cycle.hpp ModelHistory).
+    struct Model {
+        unsigned version = 0U;
+        unsigned cycle = 0U;
+        std::uint32_t crc = 0U;
+        std::uint64_t bits[ascorr::calib::kCalibHeads][ascorr::kModelAxes][ascorr::kLinearModelTerms] = {};
+        bool row_seen[ascorr::calib::kCalibHeads][ascorr::kModelAxes] = {};
+    };
+    std::vector<Model> models;
 };
 
 Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
@@ -140,6 +149,25 @@ Report from_record(const CorrectionLog& r, std::uint32_t cycles) {
         }
     }
     return out;
+}
+
+void add_history(const ascorr::app::ModelHistory& hist, Report& out) {
+    for (std::uint32_t i = 0; i < hist.size(); ++i) {
+        const ascorr::app::ModelHistory::Entry& e = hist.entry(i);
+        Report::Model m;
+        m.version = e.version;
+        m.cycle = e.cycle;
+        m.crc = e.crc;
+        for (std::size_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+            for (std::size_t a = 0; a < ascorr::kModelAxes; ++a) {
+                m.row_seen[h][a] = true;
+                for (std::size_t t = 0; t < ascorr::kLinearModelTerms; ++t) {
+                    std::memcpy(&m.bits[h][a][t], &e.model.coefficient[h][a][t], sizeof(double));
+                }
+            }
+        }
+        out.models.push_back(m);
+    }
 }
 
 bool parse_report(const std::string& path, Report& out) {
@@ -178,7 +206,24 @@ bool parse_report(const std::string& path, Report& out) {
             out.crc_seen[h] = true;
             out.crc_cycles[h] = c;
             out.crc[h] = p.bits[0];
-        } else if (line.rfind("head ", 0) == 0 || line.rfind("sample ", 0) == 0 || line.rfind("solutions ", 0) == 0) {
+        } else if (std::sscanf(line.c_str(), "model version %u from cycle %u crc32c %8x%c", &a, &c, &p.bits[0],
+                               &rest) == 3) {
+            Report::Model m;
+            m.version = a;
+            m.cycle = c;
+            m.crc = p.bits[0];
+            out.models.push_back(m);
+        } else if (unsigned long long w[4] = {};
+                   std::sscanf(line.c_str(), "model version %u head %u axis %u c %16llx %16llx %16llx %16llx%c", &a, &h,
+                               &c, &w[0], &w[1], &w[2], &w[3], &rest) == 7 &&
+                   h < ascorr::calib::kCalibHeads && c < ascorr::kModelAxes && !out.models.empty() &&
+                   out.models.back().version == a) {
+            for (std::size_t t = 0; t < ascorr::kLinearModelTerms; ++t) {
+                out.models.back().bits[h][c][t] = w[t];
+            }
+            out.models.back().row_seen[h][c] = true;
+        } else if (line.rfind("head ", 0) == 0 || line.rfind("sample ", 0) == 0 || line.rfind("solutions ", 0) == 0 ||
+                   line.rfind("model ", 0) == 0) {
             std::cerr << path << ":" << n << ": malformed line: " << line << "\n";
             return false;
         }
@@ -255,6 +300,72 @@ void compare_one(const std::string& what, const Printed& host, const Printed& im
     }
 }
 
+// The largest difference two models' angles make over the loop's temperatures
+// (each second of the profile, per head and axis), arcsec.
+double model_difference(const Report::Model& a, const Report::Model& b) {
+    using ascorr::app::chu_celsius;
+    using ascorr::app::boom::profile_celsius;
+    double worst = 0.0;
+    for (std::uint32_t sec = 0; sec < ascorr::app::boom::kProfileSeconds; ++sec) {
+        for (std::uint8_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+            const double t1 = chu_celsius(h, sec);
+            const double x[4] = {1.0, t1, profile_celsius(0U, sec) - t1, profile_celsius(3U, sec) - t1};
+            for (std::size_t ax = 0; ax < ascorr::kModelAxes; ++ax) {
+                double d = 0.0;
+                for (std::size_t t = 0; t < ascorr::kLinearModelTerms; ++t) {
+                    double ca = 0.0;
+                    double cb = 0.0;
+                    std::memcpy(&ca, &a.bits[h][ax][t], sizeof ca);
+                    std::memcpy(&cb, &b.bits[h][ax][t], sizeof cb);
+                    d += (ca - cb) * x[t];
+                }
+                worst = std::fabs(d) > worst || std::isnan(d) ? std::fabs(d) : worst;
+            }
+        }
+    }
+    return worst;
+}
+
+// The model histories: the same versions from the same cycles; bit for bit
+// (CRC-32C and every coefficient) for BOUND 0, else the models' angles within
+// BOUND of each other at every temperature of the loop (model_difference).
+template <typename Differ>
+void compare_models(const Report& host, const Report& image, double bound, Differ&& differ) {
+    if (image.models.size() != host.models.size()) {
+        differ(std::to_string(image.models.size()) + " models in the image's history, host " +
+               std::to_string(host.models.size()));
+    }
+    for (std::size_t i = 0; i < host.models.size() && i < image.models.size(); ++i) {
+        const Report::Model& e = host.models[i];
+        const Report::Model& g = image.models[i];
+        const std::string what = "model history entry " + std::to_string(i) + " (host: version " +
+                                 std::to_string(e.version) + " from cycle " + std::to_string(e.cycle) + ")";
+        if (g.version != e.version || g.cycle != e.cycle) {
+            differ(what + ": the image's is version " + std::to_string(g.version) + " from cycle " +
+                   std::to_string(g.cycle));
+            continue;
+        }
+        bool rows = true;
+        for (std::size_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+            for (std::size_t a = 0; a < ascorr::kModelAxes; ++a) {
+                rows = rows && g.row_seen[h][a];
+            }
+        }
+        if (!rows) {
+            differ(what + ": coefficient rows missing in the image's report");
+            continue;
+        }
+        if (bound == 0.0) {
+            if (g.crc != e.crc || std::memcmp(g.bits, e.bits, sizeof e.bits) != 0) {
+                differ(what + ": crc32c " + hex(g.crc) + ", host " + hex(e.crc) + " (bit for bit expected)");
+            }
+        } else if (const double d = model_difference(e, g); !(d <= bound)) {
+            differ(what + ": angles up to " + std::to_string(d) + " arcsec from the host's (bound " +
+                   std::to_string(bound) + ")");
+        }
+    }
+}
+
 Outcome compare(const Report& host, const Report& image, double bound, bool loud) {
     Outcome o;
     auto differ = [&](const std::string& msg) {
@@ -297,6 +408,7 @@ Outcome compare(const Report& host, const Report& image, double bound, bool loud
         }
         compare_one(what, e.s, g.s, true, bound, loud, o);
     }
+    compare_models(host, image, bound, differ);
     return o;
 }
 
@@ -307,6 +419,7 @@ Report mutated(Report r, double bound) {
     if (r.samples.empty()) {
         return r;
     }
+    r.models.clear();  // compared alone: mutated_model()
     Printed& p = r.samples.front().s;
     if (bound == 0.0) {
         p.bits[0] ^= 1U;
@@ -327,6 +440,26 @@ Report mutated(Report r, double bound) {
             p.bits[i] = static_cast<std::uint32_t>(static_cast<std::int32_t>(std::lround(m[i] * 1073741824.0)));
         }
     }
+    return r;
+}
+
+// The last model of the history, its c0 of head A's α off by one bit (bit for
+// bit) or by twice the bound (arcsec); the solutions left out (compared alone:
+// mutated()).
+Report mutated_model(Report r, double bound) {
+    r.samples.clear();
+    if (r.models.empty()) {
+        return r;
+    }
+    std::uint64_t& b = r.models.back().bits[0][0][0];
+    if (bound == 0.0) {
+        b ^= 1U;
+        return r;
+    }
+    double c = 0.0;
+    std::memcpy(&c, &b, sizeof c);
+    c += 2.0 * bound;
+    std::memcpy(&b, &c, sizeof c);
     return r;
 }
 
@@ -362,6 +495,12 @@ int main(int argc, char** argv) {
         const ascorr::app::FlightCycle& flight = run(static_cast<std::uint32_t>(cycles));
         flight.record().print_heads();
         flight.record().print_solutions();
+        flight.history().print();
+        const ascorr::calib::EstimatorReport r = flight.estimator().report();
+        std::cout << "self-calibration: orbits used " << r.orbits_used << " short " << r.orbits_short << " held "
+                  << r.orbits_held << " late " << r.orbits_late << ", last refusal "
+                  << ascorr::calib::refusal_name(r.last_refusal) << ", condition " << r.condition << ", residual RMS "
+                  << r.residual_rms_arcsec << " arcsec, active version " << r.active_version << "\n";
         return 0;
     }
     if (argc != 4 || std::strcmp(argv[1], "check") != 0) {
@@ -381,7 +520,9 @@ int main(int argc, char** argv) {
         std::cerr << argv[2] << ": " << image.cycles << " cycles: more than this check runs (100000)\n";
         return 1;
     }
-    const Report host = from_record(run(image.cycles).record(), image.cycles);
+    const ascorr::app::FlightCycle& flight = run(image.cycles);
+    Report host = from_record(flight.record(), image.cycles);
+    add_history(flight.history(), host);
     std::cout << "flight loop vs the host core (" << (bound == 0.0 ? "bit for bit" : "within the bound") << "), "
               << image.cycles << " cycles:\n";
     const Outcome o = compare(host, image, bound, true);
@@ -393,13 +534,30 @@ int main(int argc, char** argv) {
     std::cout << "; CRC-32C over every cycle " << (bound == 0.0 ? "compared" : "not compared (not bit for bit)")
               << "\n";
     if (o.differences != 0 || host.samples.empty()) {
-        std::cout << "  " << o.differences << " differences: the image's solutions are not the host core's\n";
+        std::cout << "  " << o.differences
+                  << " differences: the image's solutions or model history are not the host's\n";
+        return 1;
+    }
+    if (host.models.size() < 2U || host.models.back().version < 1U) {
+        std::cout << "  the estimator adopted no model in " << image.cycles << " cycles\n";
         return 1;
     }
     std::cout << "solutions match the host core's" << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
-    const Outcome m = compare(mutated(host, bound), image, bound, false);
+    std::cout << "model history (" << host.models.size() << " models, the last version " << host.models.back().version
+              << " from cycle " << host.models.back().cycle << ") matches the host's"
+              << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
+    Report image_solutions = image;
+    image_solutions.models.clear();
+    Report image_models = image;
+    image_models.samples.clear();
+    const Outcome m = compare(mutated(host, bound), image_solutions, bound, false);
     if (m.differences == 0) {
         std::cout << "  a mutated expectation (first sample perturbed) still matches: the comparison is vacuous\n";
+        return 1;
+    }
+    const Outcome mm = compare(mutated_model(host, bound), image_models, bound, false);
+    if (mm.differences == 0) {
+        std::cout << "  a mutated expectation (last model perturbed) still matches: the comparison is vacuous\n";
         return 1;
     }
     std::cout << "mutated expectation refused\n";

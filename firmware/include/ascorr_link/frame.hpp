@@ -22,7 +22,7 @@
 
 namespace ascorr::link {
 
-inline constexpr std::uint8_t kProtocolVersion = 2;  // 2: STATE_UPDATE, time-tagged SOLUTION_IN
+inline constexpr std::uint8_t kProtocolVersion = 3;  // 2: STATE_UPDATE, time-tagged SOLUTION_IN; 3: self-calibration
 inline constexpr std::size_t kHeaderBytes = 6;
 inline constexpr std::size_t kCrcBytes = 4;
 inline constexpr std::size_t kMaxPayload = 120;

@@ -10,11 +10,13 @@
 // and returns false rather than accept a frame it cannot fully account for.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
 
+#include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/velocity_service.hpp"
@@ -69,16 +71,21 @@ template <>
 struct WireTraits<QQuadraticCoefficient> : RawWire<QQuadraticCoefficient> {};
 
 enum class MessageType : std::uint8_t {
-    kHello = 1,              // target → host: boot id, protocol, scalar kind
-    kModelUpload = 2,        // host → target: one head's thermal model
-    kVelocityUpdate = 3,     // host → target: observer velocity (v/c) and 1/s
-    kTemperatureUpdate = 4,  // host → target: one head's temperatures with validity
-    kSolutionIn = 5,         // host → target: a raw attitude solution
-    kSolutionOut = 6,        // target → host: the corrected solution, status, cost
-    kAck = 7,                // target → host: a request without data reply was applied (or why not)
-    kHelloRequest = 8,       // host → target: answer with kHello
-    kNak = 9,                // target → host: a frame arrived broken; resend
-    kStateUpdate = 10,       // host → target: a spacecraft state for the velocity service (v2)
+    kHello = 1,                // target → host: boot id, protocol, scalar kind
+    kModelUpload = 2,          // host → target: one head's thermal model
+    kVelocityUpdate = 3,       // host → target: observer velocity (v/c) and 1/s
+    kTemperatureUpdate = 4,    // host → target: one head's temperatures with validity
+    kSolutionIn = 5,           // host → target: a raw attitude solution
+    kSolutionOut = 6,          // target → host: the corrected solution, status, cost
+    kAck = 7,                  // target → host: a request without data reply was applied (or why not)
+    kHelloRequest = 8,         // host → target: answer with kHello
+    kNak = 9,                  // target → host: a frame arrived broken; resend
+    kStateUpdate = 10,         // host → target: a spacecraft state for the velocity service (v2)
+    kCalibStart = 11,          // host → target: run the estimator on the solutions, its configuration (v3)
+    kCalibCommand = 12,        // host → target: freeze, resume or reset the estimator (v3)
+    kCalibModelLoad = 13,      // host → target: one head of a model for the estimator, staged or loaded (v3)
+    kCalibReportRequest = 14,  // host → target: answer with kCalibReport (v3)
+    kCalibReport = 15,         // target → host: the estimator's state (v3)
 };
 
 enum class AckResult : std::uint8_t {
@@ -133,6 +140,39 @@ struct Ack {
     std::uint16_t seq;  // the request's sequence number
     AckResult result;
 };
+
+// ---- self-calibration (ascorr/calib/estimator.hpp), protocol v3
+
+// Starts (or restarts from nothing) the estimator: from then on each
+// solution is corrected with its active model and heads A, B and C at the
+// same time tag feed it (server.hpp). initial = 1: the staged model
+// (kCalibModelLoad without `load`) is version 0; 0: no model.
+struct CalibStart {
+    std::int64_t orbit_period_us;  // > 0
+    double time_constant_days;     // finite, > 0
+    std::uint8_t initial;          // 0 or 1
+};
+
+enum class CalibCommand : std::uint8_t {
+    kFreeze = 1,
+    kResume = 2,
+    kReset = 3,
+};
+
+// One head's linear model in arcsec, arcsec/°C (the model file's c0..c3 per
+// axis α, β, γ; the estimator's models are linear). load = 1: the staged
+// model, with this head, becomes the estimator's (load_model: active from
+// the next epoch, version + 1); 0: staged only.
+struct CalibModelLoad {
+    std::uint8_t head;
+    std::uint8_t present;  // 0 or 1
+    std::uint8_t load;     // 0 or 1
+    double c[kModelAxes][kLinearModelTerms];
+};
+
+// The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
+// coefficient format's range, 2⁻⁵ rad (ScalarTraits<Q30>::max_coefficient).
+inline constexpr double kMaxLoadCoefficient = 0x1p-5 * kRadToArcsec;
 
 // ---- encoding helpers
 class Writer {
@@ -409,6 +449,100 @@ inline bool decode(const std::uint8_t* p, std::size_t n, Ack& m) noexcept {
     std::uint8_t result = 0;
     const bool ok = r.u16(m.seq) && r.u8(result) && r.done() && result <= 2U;
     m.result = static_cast<AckResult>(result);
+    return ok;
+}
+
+inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
+    w.f64(m.time_constant_days);
+    w.u8(m.initial);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
+    Reader r(p, n);
+    return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
+           m.orbit_period_us > 0 && std::isfinite(m.time_constant_days) && m.time_constant_days > 0.0 &&
+           m.initial <= 1U;
+}
+
+inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {
+    out[0] = static_cast<std::uint8_t>(m);
+    return 1;
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibCommand& m) noexcept {
+    if (n != 1U || p[0] < 1U || p[0] > 3U) {
+        return false;
+    }
+    m = static_cast<CalibCommand>(p[0]);
+    return true;
+}
+
+inline std::size_t encode(const CalibModelLoad& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u8(m.present);
+    w.u8(m.load);
+    for (const auto& axis : m.c) {
+        for (const double x : axis) {
+            w.f64(x);
+        }
+    }
+    return w.size();
+}
+// Refused: a head beyond D, a flag other than 0 or 1, a coefficient not
+// finite or beyond kMaxLoadCoefficient.
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibModelLoad& m) noexcept {
+    Reader r(p, n);
+    if (!(r.u8(m.head) && r.u8(m.present) && r.u8(m.load)) || m.head >= kMaxHeads || m.present > 1U || m.load > 1U) {
+        return false;
+    }
+    for (auto& axis : m.c) {
+        for (double& x : axis) {
+            if (!r.f64(x) || !(std::fabs(x) < kMaxLoadCoefficient)) {  // false for NaN
+                return false;
+            }
+        }
+    }
+    return r.done();
+}
+
+inline std::size_t encode(const calib::EstimatorReport& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.orbits_used);
+    w.u32(m.orbits_short);
+    w.u32(m.orbits_held);
+    w.u32(m.orbits_late);
+    w.u32(m.changes);
+    w.f64(m.condition);
+    w.f64(m.residual_rms_arcsec);
+    w.f64(m.candidate_rms_arcsec);
+    w.u8(m.has_active ? 1U : 0U);
+    w.u32(m.active_version);
+    w.u32(m.active_crc);
+    w.u8(static_cast<std::uint8_t>(m.last_refusal));
+    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
+        w.u32(m.refusals[i]);
+    }
+    w.u8(m.frozen ? 1U : 0U);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, calib::EstimatorReport& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t has = 0;
+    std::uint8_t refusal = 0;
+    std::uint8_t frozen = 0;
+    bool ok = r.u32(m.orbits_used) && r.u32(m.orbits_short) && r.u32(m.orbits_held) && r.u32(m.orbits_late) &&
+              r.u32(m.changes) && r.f64(m.condition) && r.f64(m.residual_rms_arcsec) && r.f64(m.candidate_rms_arcsec) &&
+              r.u8(has) && r.u32(m.active_version) && r.u32(m.active_crc) && r.u8(refusal);
+    m.refusals[0] = 0U;
+    for (std::size_t i = 1; ok && i < calib::kRefusalKinds; ++i) {
+        ok = r.u32(m.refusals[i]);
+    }
+    ok = ok && r.u8(frozen) && r.done() && has <= 1U && frozen <= 1U && refusal < calib::kRefusalKinds;
+    m.has_active = has == 1U;
+    m.frozen = frozen == 1U;
+    m.last_refusal = static_cast<calib::Refusal>(refusal < calib::kRefusalKinds ? refusal : 0U);
     return ok;
 }
 

@@ -13,17 +13,35 @@
 //   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>, with
 //                        the last velocity update or, if from_states, the
 //                        service's velocity at the solution's time tag)
+//   kCalibStart        → kAck: from then on the estimator (ascorr/calib/
+//                        estimator.hpp) runs on the solutions: each epoch (a
+//                        time tag) is corrected with the model it holds
+//                        active at that epoch (model_for_cycle at the epoch's
+//                        first solution, so a new model never changes within
+//                        an epoch), and once heads A, B and C of an epoch are
+//                        corrected they feed it (calib/feed.hpp) and its
+//                        per-orbit update runs to its end (at most four
+//                        bounded steps). Before: the uploaded model.
+//   kCalibCommand      → kAck (freeze, resume, reset)
+//   kCalibModelLoad    → kAck (a head staged; with `load`, the staged model
+//                        becomes the estimator's, active from the next epoch)
+//   kCalibReportRequest → kCalibReport (the estimator's report)
 //   broken frame       → kNak with the FrameError, so the host resends at once
 //   unknown type       → kAck kUnknownType
 // A request whose sequence number equals the last one served is a duplicate
 // (the host resent because a response was lost): the cached response is sent
 // again and nothing is applied twice. kHelloRequest starts a host session and
 // forgets the last sequence number. Every call is bounded; nothing allocates.
+// A refused payload (kBadPayload) changes nothing.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <new>
+#include <type_traits>
 
+#include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/velocity_service.hpp"
 #include "frame.hpp"
@@ -107,6 +125,54 @@ private:
                 update<TemperatureUpdate<T>>(
                     f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
                 return;
+            case MessageType::kCalibStart:
+                update<CalibStart>(f, sink, [this](const CalibStart& m) {
+                    calib::EstimatorConfig cfg{};
+                    cfg.orbit_period_us = m.orbit_period_us;
+                    cfg.time_constant_days = m.time_constant_days;
+                    // In place: no 10-KiB temporary on the stack (trivially destructible).
+                    new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
+                    calibrating_ = true;
+                    have_epoch_ = false;
+                });
+                return;
+            case MessageType::kCalibCommand:
+                update<CalibCommand>(f, sink, [this](CalibCommand c) {
+                    switch (c) {
+                        case CalibCommand::kFreeze:
+                            estimator_.freeze();
+                            return;
+                        case CalibCommand::kResume:
+                            estimator_.resume();
+                            return;
+                        case CalibCommand::kReset:
+                            estimator_.reset();
+                            return;
+                    }
+                });
+                return;
+            case MessageType::kCalibModelLoad:
+                update<CalibModelLoad>(f, sink, [this](const CalibModelLoad& m) {
+                    staged_.present[m.head] = m.present == 1U;
+                    for (std::size_t a = 0; a < kModelAxes; ++a) {
+                        for (std::size_t t = 0; t < kModelTerms; ++t) {
+                            staged_.coefficient[m.head][a][t] = t < kLinearModelTerms ? m.c[a][t] : 0.0;
+                        }
+                    }
+                    if (m.load == 1U) {
+                        estimator_.load_model(staged_);
+                    }
+                });
+                return;
+            case MessageType::kCalibReportRequest: {
+                if (f.length != 0U) {
+                    ack(f.seq, AckResult::kBadPayload, sink);
+                    return;
+                }
+                std::uint8_t p[kMaxPayload];
+                emit(MessageType::kCalibReport, f.seq, p, encode(estimator_.report(), p), sink, true);
+                return;
+            }
             case MessageType::kSolutionIn: {
                 SolutionIn<T> s{};
                 if (!decode(f.payload, f.length, s)) {
@@ -128,22 +194,62 @@ private:
                     in.velocity = v.velocity;
                     service_status = v.status;
                 }
-                CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, &model_});
+                // Self-calibrating without a model yet: no head has coefficients (status 256).
+                const ThermalModel<T>* model = calibrating_ ? epoch_model(s.t) : &model_;
+                CorrectedSolution<T> c =
+                    correct_solution(in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
                 const std::uint32_t cost = counter_() - start;
                 c.status = with_service_status(c.status, service_status, true);
                 ++solutions_;
+                if (calibrating_) {
+                    calibrate(s.head, c, in.temperatures, model);
+                }
                 const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost};
                 std::uint8_t p[kMaxPayload];
                 emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
                 return;
             }
             case MessageType::kHello:
+            case MessageType::kCalibReport:
             case MessageType::kSolutionOut:
             case MessageType::kAck:
             case MessageType::kNak:
                 break;
         }
         ack(f.seq, AckResult::kUnknownType, sink);
+    }
+
+    // The estimator's model for the epoch at t: taken at the epoch's first
+    // solution (a pending swap applies there, between epochs).
+    const ThermalModel<T>* epoch_model(TtTime t) noexcept {
+        if (!have_epoch_ || t.us != epoch_t_us_) {
+            have_epoch_ = true;
+            epoch_t_us_ = t.us;
+            epoch_heads_ = 0U;
+            epoch_model_ = estimator_.model_for_cycle(t.us);
+        }
+        return epoch_model_;
+    }
+
+    // Head h's corrected solution of the current epoch; with A, B and C
+    // there, the epoch feeds the estimator and its per-orbit update runs.
+    void calibrate(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& temps,
+                   const ThermalModel<T>* model) noexcept {
+        if (h >= calib::kCalibHeads || epoch_heads_ == kEpochFed) {
+            return;
+        }
+        epoch_solutions_[h] = c;
+        epoch_temperatures_[h] = temps;
+        epoch_heads_ = static_cast<std::uint8_t>(epoch_heads_ | (1U << h));
+        if (epoch_heads_ != 7U) {
+            return;
+        }
+        const HeadTemperatures<T>* t[calib::kCalibHeads] = {&epoch_temperatures_[0], &epoch_temperatures_[1],
+                                                            &epoch_temperatures_[2]};
+        (void)calib::feed_estimator(estimator_, epoch_t_us_, model, epoch_solutions_, t);
+        epoch_heads_ = kEpochFed;
+        for (int i = 0; i < 8 && estimator_.step(); ++i) {  // four phases at most
+        }
     }
 
     // Decodes a state update, applies it only if it decoded exactly and
@@ -208,6 +314,19 @@ private:
     std::uint32_t frame_errors_ = 0;
     std::uint32_t duplicates_ = 0;
     std::uint32_t solutions_ = 0;
+    // Self-calibration (kCalibStart).
+    static_assert(std::is_trivially_destructible_v<calib::Estimator<T>>, "restarted in place");
+    static constexpr std::uint8_t kEpochFed = 0x80U;
+    calib::Estimator<T> estimator_{};
+    ModelCoefficients staged_{};
+    ThermalModel<T> no_model_{};  // every head absent
+    bool calibrating_ = false;
+    bool have_epoch_ = false;
+    std::int64_t epoch_t_us_ = 0;
+    std::uint8_t epoch_heads_ = 0U;  // bit h: head h corrected; kEpochFed: fed
+    const ThermalModel<T>* epoch_model_ = nullptr;
+    CorrectedSolution<T> epoch_solutions_[calib::kCalibHeads]{};
+    HeadTemperatures<T> epoch_temperatures_[calib::kCalibHeads]{};
 };
 
 }  // namespace ascorr::link

@@ -290,6 +290,9 @@ std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
 // round passes without another restart.
 template <typename T>
 void LinkClient<T>::restore() {
+    if (calibrating_) {
+        throw LinkError("the target restarted during self-calibration: its estimator's state is lost");
+    }
     for (int round = 0; round < max_attempts_; ++round) {
         ++stats_.restarts;
         if (!restore_round()) {
@@ -355,6 +358,57 @@ template <typename T>
 typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t head) const {
     return {link::MessageType::kTemperatureUpdate, encoded(link::TemperatureUpdate<T>{head, *temperatures_[head]}),
             "temperature update"};
+}
+
+// ---------------------------------------------------------------------------
+// Self-calibration (protocol v3).
+
+template <typename T>
+void LinkClient<T>::start_calibration(std::int64_t orbit_period_us, double time_constant_days,
+                                      const ModelCoefficients* initial) {
+    if (initial != nullptr) {
+        send_calib_model(*initial, false);
+    }
+    const link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U)};
+    update({link::MessageType::kCalibStart, encoded(start), "calibration start"});
+    calibrating_ = true;
+}
+
+template <typename T>
+void LinkClient<T>::calib_command(link::CalibCommand c) {
+    update({link::MessageType::kCalibCommand, encoded(c), "calibration command"});
+}
+
+template <typename T>
+void LinkClient<T>::load_calib_model(const ModelCoefficients& m) {
+    send_calib_model(m, true);
+}
+
+template <typename T>
+calib::EstimatorReport LinkClient<T>::calib_report() {
+    const std::vector<std::uint8_t> a =
+        request({link::MessageType::kCalibReportRequest, {}, "calibration report"}, link::MessageType::kCalibReport);
+    calib::EstimatorReport r{};
+    if (!link::decode(a.data(), a.size(), r)) {
+        throw LinkError("malformed calibration report from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return r;
+}
+
+template <typename T>
+void LinkClient<T>::send_calib_model(const ModelCoefficients& m, bool load) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        link::CalibModelLoad f{};
+        f.head = h;
+        f.present = m.present[h] ? 1U : 0U;
+        f.load = load && h + 1U == kMaxHeads ? 1U : 0U;
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+                f.c[a][t] = m.present[h] ? m.coefficient[h][a][t] : 0.0;
+            }
+        }
+        update({link::MessageType::kCalibModelLoad, encoded(f), "calibration model load"});
+    }
 }
 
 // The scalars the targets compute in.

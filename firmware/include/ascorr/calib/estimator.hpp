@@ -466,7 +466,7 @@ private:
         if (last_fed_valid_ && o.bin > last_fed_bin_) {
             const double dt_days = static_cast<double>(o.bin - last_fed_bin_) *
                                    (static_cast<double>(cfg_.orbit_period_us) * 1e-6 / 86400.0);
-            const double lambda = std::exp(-dt_days / cfg_.time_constant_days);
+            const double lambda = exp_nonpositive(-dt_days / cfg_.time_constant_days);  // portable_math.hpp
             for (auto& s : srif_) {
                 s.forget(lambda);
             }

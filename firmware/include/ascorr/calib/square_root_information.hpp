@@ -34,6 +34,8 @@
 #include <cstddef>
 #include <limits>
 
+#include "portable_math.hpp"
+
 namespace ascorr::calib {
 
 template <std::size_t N, std::size_t M>
@@ -69,7 +71,7 @@ public:
             if (q == 0.0) {
                 continue;
             }
-            const double r = std::hypot(p, q);
+            const double r = hypot2(p, q);  // portable_math.hpp: the same bits on the DPU
             const double c = p / r;
             const double s = q / r;
             for (std::size_t j = i; j < N + M; ++j) {

@@ -1,4 +1,4 @@
-// ascorr_host/link/link_client.hpp: the host end of the link (protocol v2).
+// ascorr_host/link/link_client.hpp: the host end of the link (protocol v3).
 //
 // One request in flight. Each request keeps its sequence number across
 // retries, so the target can recognise a resend and answer from its cache.
@@ -82,6 +82,16 @@ public:
     link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q, TtTime t = {0},
                                  bool from_states = false, bool velocity_expected = false);
 
+    // Self-calibration (protocol v3). `initial`: the estimator's version 0
+    // (staged head by head, then started with it); none: no model. A restart
+    // while the target's estimator runs is an error (restore() refuses it):
+    // what it had learnt is lost with it.
+    void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial);
+    void calib_command(link::CalibCommand c);
+    // A model for the estimator, active from the next epoch (version + 1).
+    void load_calib_model(const ModelCoefficients& m);
+    calib::EstimatorReport calib_report();
+
     const LinkStats& stats() const { return stats_; }
 
 private:
@@ -130,6 +140,8 @@ private:
     Message velocity_message() const;
     Message state_message(const link::StateUpdate& s) const;
     Message temperatures_message(std::uint8_t head) const;
+    // Heads A..D of m, one frame each; the last with `load`.
+    void send_calib_model(const ModelCoefficients& m, bool load);
 
     Transport& transport_;
     int timeout_ms_;
@@ -143,6 +155,7 @@ private:
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
     bool from_states_ = false;  // of the solution in flight
     bool velocity_expected_ = false;
+    bool calibrating_ = false;  // start_calibration() sent: a restart is an error
     LinkStats stats_;
 };
 

@@ -1,0 +1,46 @@
+// ascorr/calib/feed.hpp: one epoch's corrected solutions into the on-board
+// estimator (estimator.hpp), for the flight loop (firmware/app/flight_cycle.hpp)
+// and the link server (ascorr_link/server.hpp).
+#pragma once
+
+#include <cstdint>
+
+#include "../correct.hpp"
+#include "../quaternion.hpp"
+#include "../status.hpp"
+#include "estimator.hpp"
+
+namespace ascorr::calib {
+
+// The cycle's feed to the estimator. A cycle counts when heads A, B and C all
+// have the aberration stage applied and three valid temperatures (the ground
+// fit's selection; the loop's solutions carry no flags or confidence). Each
+// head's solution without its thermal stage is q_ab = q_th⁻¹ ⊗ q_corr, with
+// q_th the stage the core applied (thermal_stage(), correct.hpp, the same
+// model and temperatures), formed as the core forms it: the increment
+// (q_th⁻¹ − 1) ⊗ q_corr from small terms, one renormalised sum
+// (quaternion.hpp). False: the cycle did not count.
+template <typename T>
+bool feed_estimator(Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
+                    const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
+    CalibCycle<T> c{};
+    c.t_us = t_us;
+    for (std::uint8_t h = 0; h < kCalibHeads; ++h) {
+        const CorrectedSolution<T>& s = corrected[h];
+        const HeadTemperatures<T>& tp = *temperatures[h];
+        if ((s.status & status::kAberrationApplied) == 0U || (s.status & status::kRejected) != 0U ||
+            !(tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid)) {
+            return false;
+        }
+        c.q_chu_icrf[h] = s.q_chu_icrf;
+        if ((s.status & status::kThermalApplied) != 0U && model != nullptr) {
+            const ThermalStage<T> th = thermal_stage(*model, h, tp);
+            c.q_chu_icrf[h] = renormalized_sum(s.q_chu_icrf, increment(conjugate(th.q_th)) * s.q_chu_icrf);
+        }
+        c.temperatures[h] = tp;
+    }
+    e.accumulate(c);
+    return true;
+}
+
+}  // namespace ascorr::calib

@@ -1,0 +1,58 @@
+// ascorr/calib/portable_math.hpp: the two elementary functions the estimator
+// needs beyond +, −, ×, ÷ and √, written with those alone, so that the DPU
+// (picolibc, software double on the M3) and the host (glibc, SSE2) compute
+// the same bits: IEEE 754 rounds each basic operation and √ correctly
+// everywhere, while libm's exp and hypot are not correctly rounded and differ
+// between libraries in the last bit. The on-board model history is checked
+// bit for bit against the host's (tests/target/flight_expectation.cpp).
+#pragma once
+
+#include <cmath>
+
+namespace ascorr::calib {
+
+// e^x for x ≤ 0 (the forgetting factor): x halved k times until |x/2^k| ≤
+// 2⁻¹⁰ (k ≤ 20 for x ≥ −745, below which e^x is 0 in double), a Taylor
+// polynomial of degree 5 (truncation |y|⁶/720 ≤ 2e-21), then squared k times
+// (relative error ≲ 2^k·2⁻⁵³ ≤ 1.2e-10 at the longest gaps, 2e-16 for an
+// orbit). NaN stays NaN; x > 0 is not its domain and gives 1.
+inline double exp_nonpositive(double x) noexcept {
+    if (std::isnan(x)) {
+        return x;
+    }
+    if (!(x < 0.0)) {
+        return 1.0;
+    }
+    if (x < -745.0) {
+        return 0.0;
+    }
+    int k = 0;
+    double y = x;
+    for (; k < 64 && y < -0x1p-10; ++k) {  // bounded: 745 < 2^10
+        y *= 0.5;
+    }
+    double e = 1.0 + y * (1.0 + y / 2.0 * (1.0 + y / 3.0 * (1.0 + y / 4.0 * (1.0 + y / 5.0))));
+    for (int i = 0; i < k; ++i) {
+        e *= e;
+    }
+    return e;
+}
+
+// √(p² + q²) without overflow or underflow of the squares: a·√(1 + (b/a)²),
+// a = max(|p|, |q|), b = min (within 2 ulp of the exact value).
+inline double hypot2(double p, double q) noexcept {
+    double a = std::fabs(p);
+    double b = std::fabs(q);
+    if (a < b) {
+        const double t = a;
+        a = b;
+        b = t;
+    }
+    if (a == 0.0 || !std::isfinite(a)) {
+        return a + b;  // 0, ∞ or NaN
+    }
+    const double t = b / a;
+    return a * std::sqrt(1.0 + t * t);
+}
+
+}  // namespace ascorr::calib
