@@ -77,3 +77,15 @@ def test_notebook_draws_the_iba_and_temperature_figures(executed):
     for _, png in images:
         width, height = png_size(png)
         assert width > 500 and height > 300 and len(png) > 20000, (width, height, len(png))
+
+
+def test_notebook_compares_the_self_calibrated_model_with_the_ground_fit(executed):
+    (cell,) = [c for c in executed["cells"] if "comparison.to_string" in "".join(c["source"])]
+    lines = text_of(cell).splitlines()
+    assert "models adopted" in lines[0], lines[0]
+    rows = {line.split()[0]: [float(x) for x in line.split()[1:]]
+            for line in lines if line[:3] in ("A-B", "A-C", "B-C")}
+    assert rows.keys() == {"A-B", "A-C", "B-C"}
+    for pair, (fitted, learnt, floor) in rows.items():
+        # Learnt on board from nothing, it reaches the floor as the ground fit does.
+        assert abs(fitted / floor - 1) < 0.02 and abs(learnt / floor - 1) < 0.03, (pair, fitted, learnt, floor)
