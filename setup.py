@@ -1,7 +1,8 @@
 """The build backend's CMake step (pyproject.toml): `pip install .` configures
 this tree with the project's CMake for the interpreter that runs pip, builds
 the target ascorr_python (the same core and host library as the command line)
-and puts the compiled module next to python/ascorr/'s files in the wheel.
+and puts the compiled module and the version CMake writes (_version.py) next
+to python/ascorr/'s files in the wheel.
 
 ASCORR_BUILD_DIR=DIR: the build directory, kept and reused (CMake in DIR/cmake,
 setuptools' staging and metadata in DIR/setuptools), e.g. build/pip as the
@@ -81,6 +82,8 @@ class CMakeBuild(build_ext):
         target = pathlib.Path(self.get_ext_fullpath(ext.name))
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(built[0], target)
+        # ascorr/_version.py: written by CMake from project(VERSION), beside the module.
+        shutil.copy2(cmake_build / "python" / "ascorr" / "_version.py", target.parent / "_version.py")
 
 
 staging = BUILD / "setuptools"
