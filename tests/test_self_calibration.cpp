@@ -485,6 +485,16 @@ TEST(SelfCalibrationCli, CorrectSelfCalibrate) {
     const CliRun n2 = run_in("correct --in mission.csv --out x.csv --self-calibrate --no-thermal", m.dir);
     EXPECT_NE(n2.exit_code, 0);
     EXPECT_NE(n2.err.find("--no-thermal"), std::string::npos) << n2.err;
+    // --time-constant needs --self-calibrate; --states and a history at --out's path are refused.
+    const CliRun n3 = run_in("correct --in mission.csv --out x.csv --time-constant 20", m.dir);
+    EXPECT_EQ(n3.exit_code, 2);
+    EXPECT_NE(n3.err.find("--time-constant"), std::string::npos) << n3.err;
+    const CliRun n4 = run_in("correct --in mission.csv --out x.csv --self-calibrate --states mission.csv", m.dir);
+    EXPECT_NE(n4.exit_code, 0);
+    EXPECT_NE(n4.err.find("--states"), std::string::npos) << n4.err;
+    const CliRun n5 = run_in("correct --in mission.csv --out x.csv --self-calibrate --model-history ./x.csv", m.dir);
+    EXPECT_NE(n5.exit_code, 0);
+    EXPECT_NE(n5.err.find("is also --out"), std::string::npos) << n5.err;
     EXPECT_FALSE(fs::exists(m.dir / "x.csv"));
     EXPECT_FALSE(fs::exists(m.dir / "hx.csv"));
 }

@@ -48,13 +48,18 @@ void add_correct_command(CLI::App& app) {
            "--model-history", opt->model_history,
            "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
         ->check(non_empty_path());
-    cmd->add_option("--time-constant", opt->time_constant_days,
-                    "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] (default 30)")
-        ->check(real_in(1.0, 10000.0));
-    cmd->callback([opt]() {
+    CLI::Option* time_constant =
+        cmd->add_option(
+               "--time-constant", opt->time_constant_days,
+               "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] (default 30)")
+            ->check(real_in(1.0, 10000.0));
+    cmd->callback([opt, time_constant]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
+        }
+        if (!opt->self_calibrate && time_constant->count() > 0) {
+            throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
         }
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         if (!s.self_calibration.empty()) {

@@ -14,7 +14,7 @@ void add_replay_command(CLI::App& app) {
     auto opt = std::make_shared<host::ReplayOptions>();
     auto speed = std::make_shared<std::string>("max");
     CLI::App* cmd = app.add_subcommand("replay", "replay a recorded file through a target over the serial link");
-    // The QEMU boards come from toolchain/targets.txt (the generated ascorr_host/qemu_targets.hpp).
+    // The QEMU boards come from toolchain/targets.txt (the generated ascorr_host/link/qemu_targets.hpp).
     cmd->add_option("--target", opt->target,
                     host::qemu_target_choices() + ", loopback-float, or a serial device such as /dev/ttyUSB0")
         ->required();

@@ -12,7 +12,7 @@ namespace ascorr::cli {
 namespace {
 
 // The event options' text, FIELD:FIELD:..., as the structures of
-// ascorr_host/simulate.hpp. Each parser returns what is wrong ("" when
+// ascorr_host/analysis/simulate.hpp. Each parser returns what is wrong ("" when
 // nothing), in the words of number_options.hpp; the ranges that depend on
 // --days are host::refuse_bad_events()'s.
 

@@ -1,4 +1,4 @@
-// OUT.floor-daily.csv (ascorr_host/simulate.hpp): the floor's per-day sums,
+// OUT.floor-daily.csv (ascorr_host/analysis/simulate.hpp): the floor's per-day sums,
 // and the floor of a window of days from them.
 #include <algorithm>
 #include <cerrno>

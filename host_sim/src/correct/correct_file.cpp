@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <future>
 #include <limits>
@@ -320,6 +321,22 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
     if (!(opt.time_constant_days >= 1.0 && opt.time_constant_days <= 10000.0)) {
         throw std::runtime_error("--time-constant must be in [1, 10000] days, got " +
                                  std::to_string(opt.time_constant_days));
+    }
+    if (!opt.states.empty()) {
+        // The estimator's pass reads the rows' own velocities only: rows whose
+        // velocity would come from the states would never be learnt from.
+        throw std::runtime_error(
+            "--self-calibrate learns from rows with their own vx,vy,vz: it cannot go with --states");
+    }
+    if (!opt.model_history.empty()) {
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        const fs::path a = fs::weakly_canonical(fs::absolute(opt.out), ec);
+        const fs::path b = fs::weakly_canonical(fs::absolute(opt.model_history), ec);
+        if (opt.out == opt.model_history || (!ec && a == b)) {
+            throw std::runtime_error("--model-history " + opt.model_history +
+                                     " is also --out: the two files need two paths");
+        }
     }
 }
 

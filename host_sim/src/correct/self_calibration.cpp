@@ -7,6 +7,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -15,8 +16,6 @@
 namespace ascorr::host {
 
 namespace {
-
-constexpr double kMuEarthKm3S2 = 398600.4418;
 
 // One row as the estimator needs it; q and the temperatures in T, kept as
 // doubles (exact for float and Q30) until the cycle is formed.
@@ -61,7 +60,10 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
     bool any_selected = false;
     rows([&](const SolutionRecord& rec) {
         CalibRow r{rec.t, rec.line, rec.head, false, {}, {}};
-        if (rec.head < calib::kCalibHeads && fit_selection(rec) == Drop::kNone) {
+        // The clean epochs of docs/contract.md's Statistics: the fit's selection,
+        // and no flag bit at all, and a confidence that is a number <= 5.
+        const bool clean = fit_selection(rec) == Drop::kNone && rec.flags == 0 && rec.confidence <= 5.0;
+        if (rec.head < calib::kCalibHeads && clean) {
             const SolutionInput<T> in = to_core_input<T>(rec, &earth);
             const CorrectedSolution<T> c = correct_solution(in, ab_only);
             if ((c.status & status::kAberrationApplied) != 0U) {
@@ -96,7 +98,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
                                  " km/s is not that of an Earth orbit: the orbit period for the self-calibration "
                                  "cannot be derived");
         }
-        out.orbit_period_s = 2.0 * kPi * kMuEarthKm3S2 / (earliest_speed * earliest_speed * earliest_speed);
+        out.orbit_period_s = 2.0 * kPi * kEarthGmKm3S2 / (earliest_speed * earliest_speed * earliest_speed);
     } else {
         out.orbit_period_s = 5640.0;  // no selected row: nothing is learnt, the period is not used
     }

@@ -81,10 +81,10 @@
 #include <cstdint>
 #include <limits>
 
-#include "../constants.hpp"
-#include "../model_coefficients.hpp"
-#include "../quaternion.hpp"
-#include "../thermal.hpp"
+#include "../core/constants.hpp"
+#include "../core/model_coefficients.hpp"
+#include "../core/quaternion.hpp"
+#include "../core/thermal.hpp"
 #include "frame.hpp"
 #include "head_rotation.hpp"
 #include "model_identity.hpp"

@@ -5,9 +5,9 @@
 
 #include <cstdint>
 
-#include "../correct.hpp"
-#include "../quaternion.hpp"
-#include "../status.hpp"
+#include "../core/correct.hpp"
+#include "../core/quaternion.hpp"
+#include "../core/status.hpp"
 #include "estimator.hpp"
 
 namespace ascorr::calib {

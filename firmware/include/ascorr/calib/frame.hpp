@@ -24,8 +24,8 @@
 
 #include <cmath>
 
-#include "../quaternion.hpp"
-#include "../vector3.hpp"
+#include "../core/quaternion.hpp"
+#include "../core/vector3.hpp"
 
 namespace ascorr::calib {
 

@@ -13,7 +13,7 @@
 // the model's α, β, γ (thermal.hpp): the correction turns the head back by e.
 #pragma once
 
-#include "../quaternion.hpp"
+#include "../core/quaternion.hpp"
 
 namespace ascorr::calib {
 

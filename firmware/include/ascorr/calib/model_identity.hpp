@@ -14,8 +14,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "../core/model_coefficients.hpp"
 #include "../crc32c.hpp"
-#include "../model_coefficients.hpp"
 
 namespace ascorr::calib {
 

@@ -34,9 +34,9 @@
 
 #include <cstdint>
 
-#include "../fixed_point.hpp"
-#include "../quaternion.hpp"
-#include "../thermal.hpp"
+#include "../core/fixed_point.hpp"
+#include "../core/quaternion.hpp"
+#include "../core/thermal.hpp"
 #include "head_rotation.hpp"
 
 namespace ascorr::calib {

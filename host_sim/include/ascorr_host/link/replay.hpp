@@ -19,7 +19,7 @@
 namespace ascorr::host {
 
 struct ReplayOptions {
-    std::string target;    // a replay name of ascorr_host/qemu_targets.hpp, loopback-float, or a serial device
+    std::string target;    // a replay name of ascorr_host/link/qemu_targets.hpp, loopback-float, or a serial device
     std::string firmware;  // qemu targets: the link image; empty: the one of this build tree
     std::string in;
     std::string model;
