@@ -33,8 +33,11 @@ def test_same_as_the_command_line(exe, mission, scalar):
     assert (status & 256).sum() > 0, "rows before the first model get 256"
     h_header, h_rows = read_csv_text(hist)
     assert h_header[:2] == ["t", "version"]
+    assert len(history) >= 1, "no model adopted: the comparison below would be empty"
     versions = sorted({int(r[1]) for r in h_rows})
     assert versions == [h["version"] for h in history]
+    assert [float(r[0]) for r in h_rows[::9]] == pytest.approx([h["t"] for h in history], abs=5e-4)
+    assert (status[s["t"] >= history[0]["t"]] & 256).sum() == 0, "every row from the first model on has one"
     assert [f"{h['crc32c']:08x}" for h in history] == [r[-1] for r in h_rows[::9]]
 
 
