@@ -290,7 +290,7 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}},
         {{"--out", opt.out}}, true);
     if (std::llround(opt.max_propagation_s * 1e6) != default_velocity_service_config().horizon_us) {
-        char buf[160];
+        char buf[256];
         std::snprintf(buf, sizeof buf,
                       "--max-propagation %.17g: a target propagates a state for %.17g s, the "
                       "horizon built into its firmware; replay cannot change it (correct can)",
