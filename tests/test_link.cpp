@@ -225,7 +225,7 @@ TEST(LinkServer, CorrectsLikeTheHostCoreBitForBit) {
         loop.request(MessageType::kTemperatureUpdate, seq++, TemperatureUpdate<float>{in.head, in.temperatures});
         const Decoded r =
             loop.request(MessageType::kSolutionIn, seq++,
-                         SolutionIn<float>{static_cast<std::uint32_t>(i), in.head, in.q_chu_icrf, {0}, 0});
+                         SolutionIn<float>{static_cast<std::uint32_t>(i), in.head, in.q_chu_icrf, {0}, 0, 0});
         ASSERT_EQ(r.frames.size(), 1U);
         ASSERT_EQ(r.frames[0].type, static_cast<std::uint8_t>(MessageType::kSolutionOut));
         SolutionOut<float> out{};
@@ -241,7 +241,7 @@ TEST(LinkServer, CorrectsLikeTheHostCoreBitForBit) {
 TEST(LinkServer, DuplicatesAreAnsweredFromCacheAndNotReapplied) {
     Loop loop;
     loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
-    const SolutionIn<float> s{7, 0, {1.0F, 0.0F, 0.0F, 0.0F}, {0}, 0};
+    const SolutionIn<float> s{7, 0, {1.0F, 0.0F, 0.0F, 0.0F}, {0}, 0, 0};
     const Decoded first = loop.request(MessageType::kSolutionIn, 2, s);
     const Decoded again = loop.request(MessageType::kSolutionIn, 2, s);
     ASSERT_EQ(first.frames.size(), 1U);
@@ -293,7 +293,7 @@ TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
     };
     const auto status_of = [&loop](std::uint16_t seq) {
         const Decoded r =
-            loop.request(MessageType::kSolutionIn, seq, SolutionIn<float>{seq, 0, {1.0F, 0, 0, 0}, {0}, 0});
+            loop.request(MessageType::kSolutionIn, seq, SolutionIn<float>{seq, 0, {1.0F, 0, 0, 0}, {0}, 0, 0});
         SolutionOut<float> out{};
         EXPECT_TRUE(decode(r.payloads.at(0).data(), r.payloads.at(0).size(), out));
         EXPECT_NE(out.status & status::kNoModelForHead, 0U);  // no model uploaded: thermal skipped
@@ -347,7 +347,7 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
                      TemperatureUpdate<float>{head, {{12.0F, true}, {-5.0F, true}, {-20.0F, true}}});
         loop.request(MessageType::kVelocityUpdate, seq++, ObserverVelocity<float>{{1e-4F, 0.0F, 0.0F}, 1.0F, true});
         const Decoded r = loop.request(MessageType::kSolutionIn, seq++,
-                                       SolutionIn<float>{seq, head, {0.5F, 0.5F, 0.5F, 0.5F}, {t_us}, 0});
+                                       SolutionIn<float>{seq, head, {0.5F, 0.5F, 0.5F, 0.5F}, {t_us}, 0, 0});
         SolutionOut<float> out{};
         EXPECT_TRUE(r.frames.size() == 1U && decode(r.payloads[0].data(), r.payloads[0].size(), out));
         return out;

@@ -534,18 +534,12 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     cfg.time_constant_days = time_constant_days;
     const host::SelfCalibration sc = host::self_calibrate<T>(
         kArrayRows, source_of(r), m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, std::nullopt);
-    std::vector<std::pair<double, ThermalModel<T>>> schedule;
-    schedule.emplace_back(-std::numeric_limits<double>::infinity(), ThermalModel<T>{});  // no head: 256
-    for (const host::ActiveModel& a : sc.history) {
-        schedule.emplace_back(a.t, host::to_core<T>(a.model));
-    }
+    const host::ModelSchedule<T> schedule(sc.history);
     host::EarthVelocity earth;
     SolutionRecord rec;
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
-        const auto it = std::upper_bound(schedule.begin(), schedule.end(), rec.t,
-                                         [](double x, const auto& e) { return x < e.first; });
-        const CorrectionConfig<T> c{true, &(it - 1)->second};
+        const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
         const host::RowCorrection<T> row = host::correct_row<T>(rec, &earth, c, nullptr);
         double* q = q_out + 4 * i;
         q[0] = row.q_chu_icrf.w;

@@ -86,6 +86,9 @@ enum class MessageType : std::uint8_t {
     kCalibModelLoad = 13,      // host → target: one head of a model for the estimator, staged or loaded (v3)
     kCalibReportRequest = 14,  // host → target: answer with kCalibReport (v3)
     kCalibReport = 15,         // target → host: the estimator's state (v3)
+    kCalibModelRequest = 16,   // host → target: answer with kCalibModel for a head (v4)
+    kCalibModel = 17,          // target → host: one head of the estimator's active model (v4)
+    kServiceConfig = 18,       // host → target: the velocity service's horizon (v4)
 };
 
 enum class AckResult : std::uint8_t {
@@ -115,7 +118,16 @@ struct SolutionIn {
     Quaternion<T> q_chu_icrf;
     TtTime t;                  // the solution's time tag (v2)
     std::uint8_t from_states;  // 1: velocity from the target's service at t; 0: the last VELOCITY_UPDATE
+    std::uint8_t calib;        // kCalibClean | kCalibNoTime, or 0 (v4; used while the estimator runs)
 };
+
+// SolutionIn::calib. kCalibClean: the solution passes its source's
+// selection (flags 1, 2, 4 clear, confidence ≤ 5: what the camera head says
+// of itself), so it may feed the estimator. kCalibNoTime: its time tag is not
+// one the on-board clock holds (t is then 0): it belongs to no epoch and is
+// corrected without a model (status 256) while the estimator runs.
+inline constexpr std::uint8_t kCalibClean = 1U;
+inline constexpr std::uint8_t kCalibNoTime = 2U;
 
 // A spacecraft state (velocity_service.hpp): TT µs, ITRF (0) or GCRS (1),
 // position km, velocity km/s, as IEEE binary64 on the wire (the service's
@@ -133,8 +145,11 @@ struct SolutionOut {
     std::uint8_t head;
     StatusBits status;
     Quaternion<T> q_chu_icrf;
-    std::uint32_t instructions;  // cost of correct_solution on the target
+    std::uint32_t instructions;   // cost of correct_solution on the target
+    std::uint32_t model_version;  // the estimator's model used (v4); kNoModelVersion: none, or not running
 };
+
+inline constexpr std::uint32_t kNoModelVersion = 0xFFFFFFFFU;
 
 struct Ack {
     std::uint16_t seq;  // the request's sequence number
@@ -148,10 +163,19 @@ struct Ack {
 // same time tag feed it (server.hpp). initial = 1: the staged model
 // (kCalibModelLoad without `load`) is version 0; 0: no model.
 struct CalibStart {
-    std::int64_t orbit_period_us;  // > 0
-    double time_constant_days;     // finite, > 0
+    std::int64_t orbit_period_us;  // [kMinOrbitPeriodUs, kMaxOrbitPeriodUs]
+    double time_constant_days;     // [kMinTimeConstantDays, kMaxTimeConstantDays]
     std::uint8_t initial;          // 0 or 1
 };
+
+// What CALIB_START accepts: an orbit of 10 min to a day (an Earth orbit's
+// period is 88 min to 24 h; shorter bins would hold too few epochs), a
+// forgetting time constant of a day to 10 000 days (beyond, forgetting is
+// nil within any mission).
+inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
+inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
+inline constexpr double kMinTimeConstantDays = 1.0;
+inline constexpr double kMaxTimeConstantDays = 10000.0;
 
 enum class CalibCommand : std::uint8_t {
     kFreeze = 1,
@@ -168,6 +192,28 @@ struct CalibModelLoad {
     std::uint8_t present;  // 0 or 1
     std::uint8_t load;     // 0 or 1
     double c[kModelAxes][kLinearModelTerms];
+};
+
+// One head of the estimator's active model (answer to kCalibModelRequest,
+// whose payload is the head u8): version and CRC-32C as in the report, the
+// time tag of the first epoch it was active in, and the coefficients as in
+// kCalibModelLoad. No active model: present 0, version kNoModelVersion, all
+// else 0.
+struct CalibModel {
+    std::uint8_t head;
+    std::uint8_t present;  // 0 or 1
+    std::uint32_t version;
+    std::uint32_t crc;
+    std::int64_t active_from_us;
+    double c[kModelAxes][kLinearModelTerms];
+};
+
+// The velocity service's configuration the host may set (kServiceConfig):
+// the propagation horizon, (0, kMaxHorizonUs] (velocity_service.hpp).
+// Applying it restarts the service (its states are dropped: send it before
+// the states).
+struct ServiceConfig {
+    std::int64_t horizon_us;
 };
 
 // The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
@@ -386,6 +432,7 @@ std::size_t encode(const SolutionIn<T>& m, std::uint8_t* out) noexcept {
     w.u8(m.head);
     w.u64(static_cast<std::uint64_t>(m.t.us));
     w.u8(m.from_states);
+    w.u8(m.calib);
     w.word(m.q_chu_icrf.w);
     w.word(m.q_chu_icrf.x);
     w.word(m.q_chu_icrf.y);
@@ -398,7 +445,7 @@ template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
     Reader r(p, n);
     return r.u32(m.id) && r.u8(m.head) && r.i64(m.t.us) && r.u8(m.from_states) && m.from_states <= 1U &&
-           r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) &&
+           r.u8(m.calib) && (m.calib & ~(kCalibClean | kCalibNoTime)) == 0U && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) &&
            r.done();
 }
 
@@ -429,13 +476,14 @@ std::size_t encode(const SolutionOut<T>& m, std::uint8_t* out) noexcept {
     w.word(m.q_chu_icrf.y);
     w.word(m.q_chu_icrf.z);
     w.u32(m.instructions);
+    w.u32(m.model_version);
     return w.size();
 }
 template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionOut<T>& m) noexcept {
     Reader r(p, n);
     return r.u32(m.id) && r.u8(m.head) && r.u16(m.status) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) &&
-           r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.done();
+           r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.u32(m.model_version) && r.done();
 }
 
 inline std::size_t encode(const Ack& m, std::uint8_t* out) noexcept {
@@ -462,7 +510,8 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
     Reader r(p, n);
     return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
-           m.orbit_period_us > 0 && std::isfinite(m.time_constant_days) && m.time_constant_days > 0.0 &&
+           m.orbit_period_us >= kMinOrbitPeriodUs && m.orbit_period_us <= kMaxOrbitPeriodUs &&
+           m.time_constant_days >= kMinTimeConstantDays && m.time_constant_days <= kMaxTimeConstantDays &&  // no NaN
            m.initial <= 1U;
 }
 
@@ -544,6 +593,44 @@ inline bool decode(const std::uint8_t* p, std::size_t n, calib::EstimatorReport&
     m.frozen = frozen == 1U;
     m.last_refusal = static_cast<calib::Refusal>(refusal < calib::kRefusalKinds ? refusal : 0U);
     return ok;
+}
+
+inline std::size_t encode(const CalibModel& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u8(m.present);
+    w.u32(m.version);
+    w.u32(m.crc);
+    w.u64(static_cast<std::uint64_t>(m.active_from_us));
+    for (const auto& axis : m.c) {
+        for (const double x : axis) {
+            w.f64(x);
+        }
+    }
+    return w.size();
+}
+// The host reads what the target holds: any finite or non-finite value
+// decodes (a comparison, not a use, follows).
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibModel& m) noexcept {
+    Reader r(p, n);
+    bool ok = r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
+              m.head < kMaxHeads && m.present <= 1U;
+    for (auto& axis : m.c) {
+        for (double& x : axis) {
+            ok = ok && r.f64(x);
+        }
+    }
+    return ok && r.done();
+}
+
+inline std::size_t encode(const ServiceConfig& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u64(static_cast<std::uint64_t>(m.horizon_us));
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, ServiceConfig& m) noexcept {
+    Reader r(p, n);
+    return r.i64(m.horizon_us) && r.done() && m.horizon_us > 0 && m.horizon_us <= kMaxHorizonUs;
 }
 
 }  // namespace ascorr::link

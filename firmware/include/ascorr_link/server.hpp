@@ -13,19 +13,24 @@
 //   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>, with
 //                        the last velocity update or, if from_states, the
 //                        service's velocity at the solution's time tag)
+//   kServiceConfig     → kAck: the velocity service restarts with the horizon
+//                        (its states are dropped)
 //   kCalibStart        → kAck: from then on the estimator (ascorr/calib/
-//                        estimator.hpp) runs on the solutions: each epoch (a
-//                        time tag) is corrected with the model it holds
-//                        active at that epoch (model_for_cycle at the epoch's
-//                        first solution, so a new model never changes within
-//                        an epoch), and once heads A, B and C of an epoch are
-//                        corrected they feed it (calib/feed.hpp) and its
-//                        per-orbit update runs to its end (at most four
-//                        bounded steps). Before: the uploaded model.
+//                        estimator.hpp) runs on the solutions, one at a time
+//                        through calib::EpochFeed (calib/feed.hpp): each epoch
+//                        (a time tag) is corrected with the model the
+//                        estimator holds active at the epoch's first solution,
+//                        so a new model never changes within an epoch; the
+//                        first clean, usable solution of each of A, B and C
+//                        feeds it, and its per-orbit update runs to its end
+//                        (four bounded steps). A solution flagged
+//                        kCalibNoTime is corrected without a model. Before
+//                        kCalibStart: the uploaded model.
 //   kCalibCommand      → kAck (freeze, resume, reset)
 //   kCalibModelLoad    → kAck (a head staged; with `load`, the staged model
 //                        becomes the estimator's, active from the next epoch)
 //   kCalibReportRequest → kCalibReport (the estimator's report)
+//   kCalibModelRequest → kCalibModel (one head of the active model)
 //   broken frame       → kNak with the FrameError, so the host resends at once
 //   unknown type       → kAck kUnknownType
 // A request whose sequence number equals the last one served is a duplicate
@@ -133,9 +138,23 @@ private:
                     // In place: no 10-KiB temporary on the stack (trivially destructible).
                     new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
                     calibrating_ = true;
-                    have_epoch_ = false;
+                    feed_.reset();
                 });
                 return;
+            case MessageType::kServiceConfig:
+                update<ServiceConfig>(f, sink, [this](const ServiceConfig& m) {
+                    new (&service_) VelocityService<T>(velocity_service_config(m.horizon_us));
+                });
+                return;
+            case MessageType::kCalibModelRequest: {
+                if (f.length != 1U || f.payload[0] >= kMaxHeads) {
+                    ack(f.seq, AckResult::kBadPayload, sink);
+                    return;
+                }
+                std::uint8_t p[kMaxPayload];
+                emit(MessageType::kCalibModel, f.seq, p, encode(active_model(f.payload[0]), p), sink, true);
+                return;
+            }
             case MessageType::kCalibCommand:
                 update<CalibCommand>(f, sink, [this](CalibCommand c) {
                     switch (c) {
@@ -194,23 +213,28 @@ private:
                     in.velocity = v.velocity;
                     service_status = v.status;
                 }
-                // Self-calibrating without a model yet: no head has coefficients (status 256).
-                const ThermalModel<T>* model = calibrating_ ? epoch_model(s.t) : &model_;
+                // Self-calibrating without a model yet (or for a solution
+                // without a time tag): no head has coefficients (status 256).
+                const bool timed = (s.calib & kCalibNoTime) == 0U;
+                const ThermalModel<T>* model =
+                    !calibrating_ ? &model_ : (timed ? feed_.model_at(estimator_, s.t.us) : nullptr);
                 CorrectedSolution<T> c =
                     correct_solution(in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
                 const std::uint32_t cost = counter_() - start;
                 c.status = with_service_status(c.status, service_status, true);
                 ++solutions_;
-                if (calibrating_) {
-                    calibrate(s.head, c, in.temperatures, model);
+                if (calibrating_ && timed) {
+                    (void)feed_.take(estimator_, s.head, c, in.temperatures, (s.calib & kCalibClean) != 0U);
                 }
-                const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost};
+                const std::uint32_t version = calibrating_ && model != nullptr ? feed_.version() : kNoModelVersion;
+                const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost, version};
                 std::uint8_t p[kMaxPayload];
                 emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
                 return;
             }
             case MessageType::kHello:
             case MessageType::kCalibReport:
+            case MessageType::kCalibModel:
             case MessageType::kSolutionOut:
             case MessageType::kAck:
             case MessageType::kNak:
@@ -219,37 +243,23 @@ private:
         ack(f.seq, AckResult::kUnknownType, sink);
     }
 
-    // The estimator's model for the epoch at t: taken at the epoch's first
-    // solution (a pending swap applies there, between epochs).
-    const ThermalModel<T>* epoch_model(TtTime t) noexcept {
-        if (!have_epoch_ || t.us != epoch_t_us_) {
-            have_epoch_ = true;
-            epoch_t_us_ = t.us;
-            epoch_heads_ = 0U;
-            epoch_model_ = estimator_.model_for_cycle(t.us);
+    // Head h of the estimator's active model, as kCalibModel.
+    CalibModel active_model(std::uint8_t h) const noexcept {
+        CalibModel m{};
+        m.head = h;
+        m.version = kNoModelVersion;
+        if (const ModelCoefficients* c = estimator_.active_coefficients()) {
+            m.present = c->present[h] ? 1U : 0U;
+            m.version = estimator_.active_version();
+            m.crc = estimator_.active_crc();
+            m.active_from_us = estimator_.adopted_at_us();
+            for (std::size_t a = 0; a < kModelAxes; ++a) {
+                for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+                    m.c[a][t] = c->coefficient[h][a][t];
+                }
+            }
         }
-        return epoch_model_;
-    }
-
-    // Head h's corrected solution of the current epoch; with A, B and C
-    // there, the epoch feeds the estimator and its per-orbit update runs.
-    void calibrate(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& temps,
-                   const ThermalModel<T>* model) noexcept {
-        if (h >= calib::kCalibHeads || epoch_heads_ == kEpochFed) {
-            return;
-        }
-        epoch_solutions_[h] = c;
-        epoch_temperatures_[h] = temps;
-        epoch_heads_ = static_cast<std::uint8_t>(epoch_heads_ | (1U << h));
-        if (epoch_heads_ != 7U) {
-            return;
-        }
-        const HeadTemperatures<T>* t[calib::kCalibHeads] = {&epoch_temperatures_[0], &epoch_temperatures_[1],
-                                                            &epoch_temperatures_[2]};
-        (void)calib::feed_estimator(estimator_, epoch_t_us_, model, epoch_solutions_, t);
-        epoch_heads_ = kEpochFed;
-        for (int i = 0; i < 8 && estimator_.step(); ++i) {  // four phases at most
-        }
+        return m;
     }
 
     // Decodes a state update, applies it only if it decoded exactly and
@@ -304,7 +314,7 @@ private:
     FrameDecoder decoder_;
     ThermalModel<T> model_{};
     ObserverVelocity<T> velocity_{};
-    // Catches up to any solution within the horizon in one call (≤ 2161 RK4 steps).
+    // Catches up to any solution within the horizon in one call (horizon / 10 s + 1 RK4 steps).
     VelocityService<T> service_{default_velocity_service_config()};
     HeadTemperatures<T> temperatures_[kMaxHeads];
     std::uint8_t last_response_[kMaxWire] = {};
@@ -316,17 +326,12 @@ private:
     std::uint32_t solutions_ = 0;
     // Self-calibration (kCalibStart).
     static_assert(std::is_trivially_destructible_v<calib::Estimator<T>>, "restarted in place");
-    static constexpr std::uint8_t kEpochFed = 0x80U;
+    static_assert(std::is_trivially_destructible_v<VelocityService<T>>, "restarted in place");
     calib::Estimator<T> estimator_{};
+    calib::EpochFeed<T> feed_{};
     ModelCoefficients staged_{};
     ThermalModel<T> no_model_{};  // every head absent
     bool calibrating_ = false;
-    bool have_epoch_ = false;
-    std::int64_t epoch_t_us_ = 0;
-    std::uint8_t epoch_heads_ = 0U;  // bit h: head h corrected; kEpochFed: fed
-    const ThermalModel<T>* epoch_model_ = nullptr;
-    CorrectedSolution<T> epoch_solutions_[calib::kCalibHeads]{};
-    HeadTemperatures<T> epoch_temperatures_[calib::kCalibHeads]{};
 };
 
 }  // namespace ascorr::link

@@ -130,13 +130,6 @@ struct ChunkResult {
     std::size_t empty_lines = 0;
 };
 
-// --self-calibrate: the models in turn, each active from t_from on.
-template <typename T>
-struct ScheduledModel {
-    double t_from;
-    ThermalModel<T> model;
-};
-
 template <typename T>
 struct Job {
     const CorrectOptions& opt;
@@ -146,7 +139,7 @@ struct Job {
     const StatesFile* states;  // nullptr: no --states
     VelocityServiceConfig service;
     const StatesVelocityTable<T>* table;             // the rows' velocities from the states, in time order
-    const std::vector<ScheduledModel<T>>* schedule;  // nullptr: cfg's model for every row
+    const ModelSchedule<T>* schedule;  // --self-calibrate; nullptr: cfg's model for every row
 };
 
 // The configuration of one row: with a schedule, the model active at its t.
@@ -155,11 +148,7 @@ CorrectionConfig<T> config_at(const Job<T>& job, double t) {
     if (job.schedule == nullptr) {
         return job.cfg;
     }
-    const auto& s = *job.schedule;
-    auto it =
-        std::upper_bound(s.begin(), s.end(), t, [](double x, const ScheduledModel<T>& m) { return x < m.t_from; });
-    // Rows before the first entry (t = −∞, no head present) do not occur.
-    const ThermalModel<T>* m = it == s.begin() ? &s.front().model : &(it - 1)->model;
+    const ThermalModel<T>* m = &job.schedule->at(t);
     return {job.cfg.aberration, job.cfg.thermal != nullptr ? m : nullptr};
 }
 
@@ -353,7 +342,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         }
         model = to_core<T>(*model_file);
     }
-    std::vector<ScheduledModel<T>> schedule;
+    std::optional<ModelSchedule<T>> schedule;
     std::string history;
     std::string account;
     if (opt.self_calibrate) {
@@ -364,10 +353,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             opt.in,
             [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
             model_file, ecfg, std::nullopt);
-        schedule.push_back({-std::numeric_limits<double>::infinity(), ThermalModel<T>{}});  // no head: 256
-        for (const ActiveModel& a : sc.history) {
-            schedule.push_back({a.t, to_core<T>(a.model)});
-        }
+        schedule.emplace(sc.history);
         history = format_model_history(sc.history);
         account = describe(sc);
         model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
@@ -403,7 +389,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                      states ? &*states : nullptr,
                      service_config(opt.max_propagation_s),
                      table ? &*table : nullptr,
-                     opt.self_calibrate && opt.thermal ? &schedule : nullptr};
+                     opt.self_calibrate && opt.thermal ? &*schedule : nullptr};
 
     AtomicFile out(opt.out);
     out.write(writer.header_line());

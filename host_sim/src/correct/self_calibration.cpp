@@ -7,7 +7,9 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/calib/feed.hpp"
 #include "ascorr/nav/orbit_propagation.hpp"
+#include "ascorr/nav/tt_time.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -17,16 +19,15 @@ namespace ascorr::host {
 
 namespace {
 
-// One row as the estimator needs it; q and the temperatures in T, kept as
-// doubles (exact for float and Q30) until the cycle is formed.
-struct CalibRow {
-    double t;
+// A row's place in time order; `input`: its index among the clean rows of
+// A, B and C kept for the estimator, or kNotFed.
+struct RowKey {
+    std::int64_t t_us;
     std::size_t line;
-    std::uint8_t head;
-    bool selected;
-    double q[4];
-    double temp[3];
+    std::uint32_t input;
+    double t;
 };
+constexpr std::uint32_t kNotFed = 0xFFFFFFFFU;
 
 ModelFile model_file_of(const ModelCoefficients& c) {
     ModelFile m;
@@ -41,57 +42,47 @@ ModelFile model_file_of(const ModelCoefficients& c) {
     return m;
 }
 
-std::int64_t to_us(double t) {
-    return static_cast<std::int64_t>(std::llround(t * 1e6));
-}
-
 }  // namespace
 
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg_in, std::optional<double> orbit_period_s) {
-    using Tr = ScalarTraits<T>;
     EarthVelocity earth;
     const CorrectionConfig<T> ab_only{true, nullptr};
-    std::vector<CalibRow> all;
+    std::vector<RowKey> keys;
+    std::vector<SolutionInput<T>> inputs;  // the clean rows of A, B and C whose aberration stage applies
     double earliest = 0.0;
     double earliest_speed = 0.0;
     std::size_t earliest_line = 0;
-    bool any_selected = false;
+    SelfCalibration out;
     rows([&](const SolutionRecord& rec) {
-        CalibRow r{rec.t, rec.line, rec.head, false, {}, {}};
-        // The clean epochs of docs/contract.md's Statistics: the fit's selection,
-        // and no flag bit at all, and a confidence that is a number <= 5.
-        const bool clean = fit_selection(rec) == Drop::kNone && rec.flags == 0 && rec.confidence <= 5.0;
-        if (rec.head < calib::kCalibHeads && clean) {
+        TtTime t{};
+        if (!tt_from_seconds(rec.t, t)) {
+            ++out.untimed;  // no epoch: corrected without a model (256)
+            return;
+        }
+        RowKey k{t.us, rec.line, kNotFed, rec.t};
+        if (rec.head < calib::kCalibHeads && calibration_clean(rec)) {
             const SolutionInput<T> in = to_core_input<T>(rec, &earth);
-            const CorrectedSolution<T> c = correct_solution(in, ab_only);
-            if ((c.status & status::kAberrationApplied) != 0U) {
-                r.selected = true;
-                r.q[0] = Tr::to_double(c.q_chu_icrf.w);
-                r.q[1] = Tr::to_double(c.q_chu_icrf.x);
-                r.q[2] = Tr::to_double(c.q_chu_icrf.y);
-                r.q[3] = Tr::to_double(c.q_chu_icrf.z);
-                r.temp[0] = Tr::to_double(in.temperatures.t_chu.value);
-                r.temp[1] = Tr::to_double(in.temperatures.t_029.value);
-                r.temp[2] = Tr::to_double(in.temperatures.t_032.value);
-                if (!any_selected || rec.t < earliest) {
+            if ((correct_solution(in, ab_only).status & status::kAberrationApplied) != 0U) {
+                if (inputs.empty() || rec.t < earliest) {
                     earliest = rec.t;
                     earliest_speed = std::sqrt(squared_norm(rec.v_sc_kms));
                     earliest_line = rec.line;
                 }
-                any_selected = true;
+                k.input = static_cast<std::uint32_t>(inputs.size());
+                inputs.push_back(in);
             }
         }
-        all.push_back(r);
+        keys.push_back(k);
     });
-    std::sort(all.begin(), all.end(),
-              [](const CalibRow& a, const CalibRow& b) { return a.t < b.t || (a.t == b.t && a.line < b.line); });
+    std::sort(keys.begin(), keys.end(), [](const RowKey& a, const RowKey& b) {
+        return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
+    });
 
-    SelfCalibration out;
     if (orbit_period_s) {
         out.orbit_period_s = *orbit_period_s;
-    } else if (any_selected) {
+    } else if (!inputs.empty()) {
         if (!(earliest_speed > 1.0 && earliest_speed < 12.0)) {
             throw InputError(file, earliest_line, 1,
                              "spacecraft speed " + std::to_string(earliest_speed) +
@@ -103,52 +94,33 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         out.orbit_period_s = 5640.0;  // no selected row: nothing is learnt, the period is not used
     }
     calib::EstimatorConfig cfg = cfg_in;
-    cfg.orbit_period_us = to_us(out.orbit_period_s);
+    cfg.orbit_period_us = static_cast<std::int64_t>(std::llround(out.orbit_period_s * 1e6));
 
     std::optional<ModelCoefficients> init_c;
     if (initial) {
         init_c = coefficients_of(*initial);
     }
     calib::Estimator<T> est(cfg, init_c ? &*init_c : nullptr);
+    calib::EpochFeed<T> feed;
+    const ThermalModel<T> no_model{};
     bool had = false;
     std::uint32_t version = 0;
-    for (std::size_t i = 0; i < all.size();) {
-        std::size_t j = i;
-        while (j < all.size() && all[j].t == all[i].t) {
-            ++j;
-        }
-        const double t = all[i].t;
-        const std::int64_t t_us = to_us(t);
-        (void)est.model_for_cycle(t_us);
-        const calib::EstimatorReport rep = est.report();
-        if (rep.has_active && (!had || rep.active_version != version)) {
-            out.history.push_back({t, rep.active_version, rep.active_crc, model_file_of(*est.active_coefficients())});
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        const RowKey& k = keys[i];
+        const ThermalModel<T>* model = feed.model_at(est, k.t_us);
+        if (model != nullptr && (!had || feed.version() != version)) {
+            out.history.push_back(
+                {k.t, k.t_us, feed.version(), est.active_crc(), model_file_of(*est.active_coefficients())});
             had = true;
-            version = rep.active_version;
+            version = feed.version();
         }
-        const CalibRow* head[calib::kCalibHeads] = {nullptr, nullptr, nullptr};
-        for (std::size_t k = i; k < j; ++k) {
-            if (all[k].selected && head[all[k].head] == nullptr) {
-                head[all[k].head] = &all[k];
+        if (k.input != kNotFed) {
+            const SolutionInput<T>& in = inputs[k.input];
+            const CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, model ? model : &no_model});
+            if (feed.take(est, in.head, c, in.temperatures, true)) {
+                ++out.cycles;
             }
         }
-        if (head[0] != nullptr && head[1] != nullptr && head[2] != nullptr) {
-            calib::CalibCycle<T> c{};
-            c.t_us = t_us;
-            for (std::size_t h = 0; h < calib::kCalibHeads; ++h) {
-                const CalibRow& r = *head[h];
-                c.q_chu_icrf[h] = {Tr::from_double(r.q[0]), Tr::from_double(r.q[1]), Tr::from_double(r.q[2]),
-                                   Tr::from_double(r.q[3])};
-                c.temperatures[h].t_chu = {Tr::celsius(r.temp[0]), true};
-                c.temperatures[h].t_029 = {Tr::celsius(r.temp[1]), true};
-                c.temperatures[h].t_032 = {Tr::celsius(r.temp[2]), true};
-            }
-            est.accumulate(c);
-            ++out.cycles;
-        }
-        while (est.step()) {
-        }
-        i = j;
     }
     out.report = est.report();
     return out;
@@ -160,6 +132,39 @@ template SelfCalibration self_calibrate<float>(const std::string&, const RowSour
                                                const calib::EstimatorConfig&, std::optional<double>);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>);
+
+template <typename T>
+ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {
+    for (const ActiveModel& a : history) {
+        from_us_.push_back(a.t_us);
+        version_.push_back(a.version);
+        model_.push_back(to_core<T>(a.model));
+    }
+}
+
+template <typename T>
+std::size_t ModelSchedule<T>::index_at(double t) const noexcept {
+    TtTime tt{};
+    if (!tt_from_seconds(t, tt)) {
+        return 0;  // no epoch
+    }
+    return static_cast<std::size_t>(std::upper_bound(from_us_.begin(), from_us_.end(), tt.us) - from_us_.begin());
+}
+
+template <typename T>
+const ThermalModel<T>& ModelSchedule<T>::at(double t) const noexcept {
+    return model_[index_at(t)];
+}
+
+template <typename T>
+std::optional<std::uint32_t> ModelSchedule<T>::version_at(double t) const noexcept {
+    const std::size_t k = index_at(t);
+    return k == 0 ? std::nullopt : std::optional<std::uint32_t>(version_[k - 1]);
+}
+
+template class ModelSchedule<double>;
+template class ModelSchedule<float>;
+template class ModelSchedule<Q30>;
 
 std::string format_model_history(const std::vector<ActiveModel>& history) {
     std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c\n";
@@ -201,6 +206,9 @@ std::string describe(const SelfCalibration& s) {
         o << buf;
     } else {
         o << "; no model adopted";
+    }
+    if (s.untimed > 0) {
+        o << "; " << s.untimed << " row(s) with a t the on-board clock cannot hold: no model (256)";
     }
     o << "; refusals:";
     for (std::size_t k = 1; k < calib::kRefusalKinds; ++k) {

@@ -95,6 +95,12 @@ void LinkClient<T>::set_temperatures(std::uint8_t head, const HeadTemperatures<T
 }
 
 template <typename T>
+void LinkClient<T>::set_service_horizon(std::int64_t horizon_us) {
+    horizon_us_ = horizon_us;
+    update(service_message());
+}
+
+template <typename T>
 void LinkClient<T>::send_state(const link::StateUpdate& s, bool accepted) {
     if (accepted) {
         state_ = s;
@@ -104,10 +110,11 @@ void LinkClient<T>::send_state(const link::StateUpdate& s, bool accepted) {
 
 template <typename T>
 link::SolutionOut<T> LinkClient<T>::correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q, TtTime t,
-                                            bool from_states, bool velocity_expected) {
-    const Message m{link::MessageType::kSolutionIn,
-                    encoded(link::SolutionIn<T>{id, head, q, t, static_cast<std::uint8_t>(from_states ? 1U : 0U)}),
-                    "solution"};
+                                            bool from_states, bool velocity_expected, std::uint8_t calib) {
+    const Message m{
+        link::MessageType::kSolutionIn,
+        encoded(link::SolutionIn<T>{id, head, q, t, static_cast<std::uint8_t>(from_states ? 1U : 0U), calib}),
+        "solution"};
     from_states_ = from_states;
     velocity_expected_ = velocity_expected;
     for (int attempt = 0; attempt < max_attempts_; ++attempt) {
@@ -263,7 +270,7 @@ void LinkClient<T>::update(const Message& m) {
     expect_ok(request(m, link::MessageType::kAck), m.what);
 }
 
-// In the order a restore sends them: models, velocity, state, temperatures.
+// In the order a restore sends them: models, velocity, the service's horizon, state, temperatures.
 template <typename T>
 std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
     std::vector<Message> s;
@@ -274,6 +281,9 @@ std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
     }
     if (velocity_) {
         s.push_back(velocity_message());
+    }
+    if (horizon_us_) {
+        s.push_back(service_message());  // it restarts the service: before the state
     }
     if (state_) {
         s.push_back(state_message(*state_));
@@ -350,6 +360,11 @@ typename LinkClient<T>::Message LinkClient<T>::velocity_message() const {
 }
 
 template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::service_message() const {
+    return {link::MessageType::kServiceConfig, encoded(link::ServiceConfig{*horizon_us_}), "service configuration"};
+}
+
+template <typename T>
 typename LinkClient<T>::Message LinkClient<T>::state_message(const link::StateUpdate& s) const {
     return {link::MessageType::kStateUpdate, encoded(s), "state update"};
 }
@@ -361,7 +376,7 @@ typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t
 }
 
 // ---------------------------------------------------------------------------
-// Self-calibration (protocol v3).
+// Self-calibration (protocol v3; the model request v4).
 
 template <typename T>
 void LinkClient<T>::start_calibration(std::int64_t orbit_period_us, double time_constant_days,
@@ -393,6 +408,18 @@ calib::EstimatorReport LinkClient<T>::calib_report() {
         throw LinkError("malformed calibration report from the target (" + std::to_string(a.size()) + " bytes)");
     }
     return r;
+}
+
+template <typename T>
+link::CalibModel LinkClient<T>::calib_model(std::uint8_t head) {
+    const std::vector<std::uint8_t> a =
+        request({link::MessageType::kCalibModelRequest, {head}, "calibration model request"},
+                link::MessageType::kCalibModel);
+    link::CalibModel m{};
+    if (!link::decode(a.data(), a.size(), m) || m.head != head) {
+        throw LinkError("malformed calibration model from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return m;
 }
 
 template <typename T>

@@ -282,8 +282,8 @@ public:
         r.residual_rms_arcsec = active_rms_;
         r.candidate_rms_arcsec = candidate_rms_;
         r.has_active = has_[active_];
-        r.active_version = has_[active_] ? version_[active_] : 0U;
-        r.active_crc = has_[active_] ? crc_[active_] : 0U;
+        r.active_version = active_version();
+        r.active_crc = active_crc();
         r.last_refusal = last_refusal_;
         for (std::size_t i = 0; i < kRefusalKinds; ++i) {
             r.refusals[i] = refusals_[i];
@@ -294,6 +294,9 @@ public:
 
     // The active model's coefficients (arcsec), nullptr: none.
     const ModelCoefficients* active_coefficients() const noexcept { return has_[active_] ? &model_[active_] : nullptr; }
+    // The active model's version and CRC-32C (model_crc); 0 when there is none.
+    std::uint32_t active_version() const noexcept { return has_[active_] ? version_[active_] : 0U; }
+    std::uint32_t active_crc() const noexcept { return has_[active_] ? crc_[active_] : 0U; }
     // When the active model became active (the t of the first cycle using it).
     std::int64_t adopted_at_us() const noexcept { return adopted_at_us_; }
     const EstimatorConfig& config() const noexcept { return cfg_; }

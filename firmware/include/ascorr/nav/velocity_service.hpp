@@ -71,10 +71,19 @@ struct VelocityServiceConfig {
     std::uint32_t max_steps_per_advance;  // RK4 steps one advance() may take (≥ 1)
 };
 
+// The longest horizon a configuration may have (7 days): beyond it the J2
+// propagation is far outside its accuracy, and one advance() of
+// horizon / kVelocityNodeUs + 1 RK4 steps (60 481) stays bounded.
+inline constexpr std::int64_t kMaxHorizonUs = 7LL * 86400LL * kMicrosecondsPerSecond;
+
+// The configuration for a horizon in (0, kMaxHorizonUs] (the callers check
+// it): one advance() can reach the horizon (horizon / 10 s steps + 1).
+constexpr VelocityServiceConfig velocity_service_config(std::int64_t horizon_us) noexcept {
+    return {horizon_us, kDefaultTtMinusUt1Us, static_cast<std::uint32_t>(horizon_us / kVelocityNodeUs + 1)};
+}
+
 constexpr VelocityServiceConfig default_velocity_service_config() noexcept {
-    // One advance() can reach the horizon: 2160 steps + 1.
-    return {kDefaultHorizonUs, kDefaultTtMinusUt1Us,
-            static_cast<std::uint32_t>(kDefaultHorizonUs / kVelocityNodeUs + 1)};
+    return velocity_service_config(kDefaultHorizonUs);
 }
 
 template <typename T>

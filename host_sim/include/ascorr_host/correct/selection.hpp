@@ -20,4 +20,12 @@ inline constexpr std::size_t kDropKinds = 8;
 Drop fit_selection(const SolutionRecord& rec) noexcept;
 const char* drop_name(Drop d) noexcept;
 
+// The clean epochs of docs/contract.md's Statistics, which self-calibration
+// learns from: the fit's selection, no flag bit at all, and a confidence that
+// is a number <= 5 (what the camera head says of its solution: on board it is
+// known with the solution, over the link it is SOLUTION_IN's kCalibClean).
+inline bool calibration_clean(const SolutionRecord& rec) noexcept {
+    return fit_selection(rec) == Drop::kNone && rec.flags == 0 && rec.confidence <= 5.0;
+}
+
 }  // namespace ascorr::host

@@ -2,15 +2,20 @@
 // run over a recorded file, as `ascorr correct --self-calibrate` and the
 // Python module do it (docs/contract.md, "Self-calibration").
 //
-// The rows are read once, in any order; the estimator is fed in time order
-// (t, then line), one cycle per distinct t: at each, the model for the cycle
-// is taken first (a model adopted after an earlier cycle becomes active here),
-// then the cycle's selected solutions of A, B and C (the ground fit's
-// selection, fit_selection(), and the aberration stage in the scalar T) are
-// accumulated, then the idle-time work runs to its end. The result is the
-// schedule of active models: each row is corrected with the model active at
-// its t. Before the first one, rows get a model with no head present, so the
-// core sets 256 (no model coefficients) and skips the thermal stage.
+// The rows are read once, in any order; they are taken in time order (TT µs
+// of the on-board clock, then line) one at a time, as the link server takes
+// them (ascorr_link/server.hpp), through the same calib::EpochFeed: each
+// epoch (a distinct time tag) takes the model the estimator holds active at
+// its first row (a model adopted after an earlier epoch becomes active
+// there); the epoch's clean rows of A, B and C (calibration_clean(),
+// selection.hpp) are corrected with that model in the scalar T and the first
+// usable one of each head feeds the estimator (calib/feed.hpp: the thermal
+// stage taken off again), whose per-orbit work then runs to its end. The
+// result is the schedule of active models: each row is corrected with the
+// model active at its time tag. Before the first one, and for a row whose t
+// the on-board clock cannot hold (NaN, |t| > 1e11 s: no epoch), rows get a
+// model with no head present, so the core sets 256 (no model coefficients)
+// and skips the thermal stage.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +31,7 @@ namespace ascorr::host {
 
 struct ActiveModel {
     double t;               // active from this time on (the first cycle using it)
+    std::int64_t t_us;      // t on the on-board clock (tt_from_seconds)
     std::uint32_t version;  // 0: the model given at start
     std::uint32_t crc;      // calib::model_crc
     ModelFile model;
@@ -35,7 +41,8 @@ struct SelfCalibration {
     std::vector<ActiveModel> history;  // in time order
     calib::EstimatorReport report;     // at the end of the file
     double orbit_period_s = 0.0;
-    std::size_t cycles = 0;  // selected epochs with A, B and C
+    std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
+    std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
 };
 
 // kind: "double", "float" or "fixed" is chosen by T. initial: --model.
@@ -44,6 +51,24 @@ struct SelfCalibration {
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s);
+
+// The models of a history in turn, for correcting rows: at(t) is the model
+// active at t's epoch (TT µs of the on-board clock), or one with no head
+// present (256) before the first and for a t the clock cannot hold.
+template <typename T>
+class ModelSchedule {
+public:
+    explicit ModelSchedule(const std::vector<ActiveModel>& history);
+    const ThermalModel<T>& at(double t) const noexcept;
+    // The version active at t; nullopt: none.
+    std::optional<std::uint32_t> version_at(double t) const noexcept;
+
+private:
+    std::size_t index_at(double t) const noexcept;  // 0: none, k: history[k − 1]
+    std::vector<std::int64_t> from_us_;
+    std::vector<std::uint32_t> version_;
+    std::vector<ThermalModel<T>> model_;  // [0]: no head present
+};
 
 // The model history file (docs/contract.md): header
 // t,version,chu,axis,c0,c1,c2,c3,crc32c and one row per head and axis of each model.

@@ -27,10 +27,9 @@
 
 namespace ascorr::host {
 
-// The longest `--max-propagation` the host accepts (7 days): beyond it the J2
-// propagation is far outside its accuracy (0.98 m/s after 6 h), and one
-// advance() of horizon/10 s RK4 steps stays bounded.
-inline constexpr double kMaxPropagationLimitS = 7.0 * kSecondsPerDay;
+// The longest `--max-propagation` the host accepts: the on-board service's
+// longest horizon (kMaxHorizonUs, velocity_service.hpp: 7 days).
+inline constexpr double kMaxPropagationLimitS = static_cast<double>(kMaxHorizonUs) * 1e-6;
 
 // Whether `--max-propagation` (or the Python module's max_propagation) is
 // acceptable: above 0 and at most kMaxPropagationLimitS; NaN is not.
@@ -45,10 +44,7 @@ static_assert(kMaxPropagationLimitS == 604800.0, "kMaxPropagationRule states the
 // Service configuration for `--max-propagation SECONDS` (max_propagation_acceptable;
 // InputError-free: the callers check it): advance() catches up in one call.
 inline VelocityServiceConfig service_config(double max_propagation_s) {
-    VelocityServiceConfig c = default_velocity_service_config();
-    c.horizon_us = static_cast<std::int64_t>(std::llround(max_propagation_s * 1e6));
-    c.max_steps_per_advance = static_cast<std::uint32_t>(c.horizon_us / kVelocityNodeUs + 1);
-    return c;
+    return velocity_service_config(static_cast<std::int64_t>(std::llround(max_propagation_s * 1e6)));
 }
 
 // The velocity service's work for a set of rows: states pushed, RK4 steps,

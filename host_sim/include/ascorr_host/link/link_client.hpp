@@ -1,4 +1,4 @@
-// ascorr_host/link/link_client.hpp: the host end of the link (protocol v3).
+// ascorr_host/link/link_client.hpp: the host end of the link (protocol v4).
 //
 // One request in flight. Each request keeps its sequence number across
 // retries, so the target can recognise a resend and answer from its cache.
@@ -79,8 +79,14 @@ public:
     // t and from_states: the solution's time tag and whether the target takes
     // the velocity from its service (then velocity_expected: the caller's
     // mirror of the service has one, so an answer without is a lost restart).
+    // calib: link::kCalibClean | link::kCalibNoTime (used while the target's
+    // estimator runs).
     link::SolutionOut<T> correct(std::uint32_t id, std::uint8_t head, const Quaternion<T>& q, TtTime t = {0},
-                                 bool from_states = false, bool velocity_expected = false);
+                                 bool from_states = false, bool velocity_expected = false, std::uint8_t calib = 0U);
+
+    // The velocity service's horizon (µs, (0, kMaxHorizonUs]); the target's
+    // service restarts: call before the first state.
+    void set_service_horizon(std::int64_t horizon_us);
 
     // Self-calibration (protocol v3). `initial`: the estimator's version 0
     // (staged head by head, then started with it); none: no model. A restart
@@ -91,6 +97,8 @@ public:
     // A model for the estimator, active from the next epoch (version + 1).
     void load_calib_model(const ModelCoefficients& m);
     calib::EstimatorReport calib_report();
+    // Head h of the estimator's active model (protocol v4).
+    link::CalibModel calib_model(std::uint8_t head);
 
     const LinkStats& stats() const { return stats_; }
 
@@ -139,6 +147,7 @@ private:
     Message model_message(std::uint8_t head) const;
     Message velocity_message() const;
     Message state_message(const link::StateUpdate& s) const;
+    Message service_message() const;
     Message temperatures_message(std::uint8_t head) const;
     // Heads A..D of m, one frame each; the last with `load`.
     void send_calib_model(const ModelCoefficients& m, bool load);
@@ -151,6 +160,7 @@ private:
     std::uint32_t boot_id_ = 0;
     std::optional<ThermalModel<T>> model_;
     std::optional<ObserverVelocity<T>> velocity_;
+    std::optional<std::int64_t> horizon_us_;  // set_service_horizon()
     std::optional<link::StateUpdate> state_;  // the latest accepted spacecraft state
     std::optional<HeadTemperatures<T>> temperatures_[kMaxHeads];
     bool from_states_ = false;  // of the solution in flight
