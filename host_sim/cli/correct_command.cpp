@@ -2,6 +2,7 @@
 #include <memory>
 #include <string>
 
+#include "ascorr/calib/estimator.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "commands.hpp"
@@ -52,7 +53,7 @@ void add_correct_command(CLI::App& app) {
         cmd->add_option(
                "--time-constant", opt->time_constant_days,
                "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] (default 30)")
-            ->check(real_in(1.0, 10000.0));
+            ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
     cmd->callback([opt, time_constant]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {

@@ -2,6 +2,7 @@
 #include <memory>
 #include <string>
 
+#include "ascorr/calib/estimator.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
@@ -21,7 +22,9 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)")
         ->check(non_empty_path());
     cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
-    cmd->add_option("--model", opt->model, "thermal model file (CSV)")->required()->check(non_empty_path());
+    cmd->add_option("--model", opt->model,
+                    "thermal model file (CSV); with --self-calibrate the estimator's first model (optional)")
+        ->check(non_empty_path());
     cmd->add_option("--out", opt->out, "corrected file (CSV) as returned by the target")
         ->required()
         ->check(non_empty_path())
@@ -35,9 +38,21 @@ void add_replay_command(CLI::App& app) {
         ->transform(one_of<bool>({{"itrf", false}, {"gcrs", true}}))
         ->type_name("NAME");
     cmd->add_option("--max-propagation", opt->max_propagation_s,
-                    "seconds a state may be propagated, (0, 604800]; a target's is its firmware's, 21600 (default): "
-                    "another value is refused")
+                    "seconds the target's velocity service may propagate a state, (0, 604800] (default: its "
+                    "firmware's, 21600); later rows get status 4+512")
         ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
+    cmd->add_flag("--self-calibrate", opt->self_calibrate,
+                  "the target runs its estimator of the thermal model on the solutions, starting from --model or from "
+                  "none; its answers, model versions, models and final report are compared with the host's run "
+                  "(ascorr correct --self-calibrate) bit for bit");
+    cmd->add_option("--model-history", opt->model_history,
+                    "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
+        ->check(non_empty_path());
+    CLI::Option* time_constant =
+        cmd->add_option("--time-constant", opt->time_constant_days,
+                        "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] "
+                        "(default 30)")
+            ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));
@@ -48,8 +63,17 @@ void add_replay_command(CLI::App& app) {
         ->transform(integer_in<int>(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
-    cmd->callback([opt, speed]() {
+    cmd->callback([opt, speed, time_constant]() {
         opt->realtime = *speed == "realtime";
+        if (!opt->self_calibrate && opt->model.empty()) {
+            throw CLI::RequiredError("--model (or --self-calibrate)");
+        }
+        if (!opt->self_calibrate && !opt->model_history.empty()) {
+            throw CLI::ValidationError("--model-history", "needs --self-calibrate");
+        }
+        if (!opt->self_calibrate && time_constant->count() > 0) {
+            throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
+        }
         read_dash_from_standard_input(
             {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);

@@ -566,7 +566,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     const host::ModelFile* m = model_arg(model);
     const std::string scalar = choice_arg(scalar_obj, "scalar", {"double", "float", "fixed"});
     const double time_constant = real_arg(time_constant_obj, "time_constant");
-    if (!(time_constant >= 1.0 && time_constant <= 10000.0)) {
+    if (!(time_constant >= calib::kMinTimeConstantDays && time_constant <= calib::kMaxTimeConstantDays)) {
         bad_argument("time_constant", "expected days in [1, 10000], got " + value_text(time_constant_obj));
     }
     if (scalar == "fixed" && m != nullptr) {

@@ -163,19 +163,10 @@ struct Ack {
 // same time tag feed it (server.hpp). initial = 1: the staged model
 // (kCalibModelLoad without `load`) is version 0; 0: no model.
 struct CalibStart {
-    std::int64_t orbit_period_us;  // [kMinOrbitPeriodUs, kMaxOrbitPeriodUs]
-    double time_constant_days;     // [kMinTimeConstantDays, kMaxTimeConstantDays]
+    std::int64_t orbit_period_us;  // within the estimator's limits (calib::kMinOrbitPeriodUs ...)
+    double time_constant_days;     // within calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays
     std::uint8_t initial;          // 0 or 1
 };
-
-// What CALIB_START accepts: an orbit of 10 min to a day (an Earth orbit's
-// period is 88 min to 24 h; shorter bins would hold too few epochs), a
-// forgetting time constant of a day to 10 000 days (beyond, forgetting is
-// nil within any mission).
-inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
-inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
-inline constexpr double kMinTimeConstantDays = 1.0;
-inline constexpr double kMaxTimeConstantDays = 10000.0;
 
 enum class CalibCommand : std::uint8_t {
     kFreeze = 1,
@@ -510,9 +501,7 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
     Reader r(p, n);
     return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
-           m.orbit_period_us >= kMinOrbitPeriodUs && m.orbit_period_us <= kMaxOrbitPeriodUs &&
-           m.time_constant_days >= kMinTimeConstantDays && m.time_constant_days <= kMaxTimeConstantDays &&  // no NaN
-           m.initial <= 1U;
+           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U;
 }
 
 inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {

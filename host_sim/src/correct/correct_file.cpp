@@ -307,7 +307,8 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
     if (opt.skip_bad) {
         throw std::runtime_error("--self-calibrate reads every row in time order: it cannot go with --skip-bad");
     }
-    if (!(opt.time_constant_days >= 1.0 && opt.time_constant_days <= 10000.0)) {
+    if (!(opt.time_constant_days >= calib::kMinTimeConstantDays &&
+          opt.time_constant_days <= calib::kMaxTimeConstantDays)) {
         throw std::runtime_error("--time-constant must be in [1, 10000] days, got " +
                                  std::to_string(opt.time_constant_days));
     }
@@ -318,14 +319,7 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
             "--self-calibrate learns from rows with their own vx,vy,vz: it cannot go with --states");
     }
     if (!opt.model_history.empty()) {
-        namespace fs = std::filesystem;
-        std::error_code ec;
-        const fs::path a = fs::weakly_canonical(fs::absolute(opt.out), ec);
-        const fs::path b = fs::weakly_canonical(fs::absolute(opt.model_history), ec);
-        if (opt.out == opt.model_history || (!ec && a == b)) {
-            throw std::runtime_error("--model-history " + opt.model_history +
-                                     " is also --out: the two files need two paths");
-        }
+        refuse_same_output({"--out", opt.out}, {"--model-history", opt.model_history});
     }
 }
 

@@ -83,13 +83,18 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
     if (orbit_period_s) {
         out.orbit_period_s = *orbit_period_s;
     } else if (!inputs.empty()) {
-        if (!(earliest_speed > 1.0 && earliest_speed < 12.0)) {
+        // A circular orbit's period at that speed (vis-viva); the estimator's
+        // limits (10 min to a day) are speeds of 3.3 to 16 km/s: beyond 12
+        // km/s nothing is bound to the Earth.
+        const double v = earliest_speed;
+        const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
+        if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
             throw InputError(file, earliest_line, 1,
                              "spacecraft speed " + std::to_string(earliest_speed) +
-                                 " km/s is not that of an Earth orbit: the orbit period for the self-calibration "
-                                 "cannot be derived");
+                                 " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
+                                 "self-calibration cannot be derived");
         }
-        out.orbit_period_s = 2.0 * kPi * kEarthGmKm3S2 / (earliest_speed * earliest_speed * earliest_speed);
+        out.orbit_period_s = period_s;
     } else {
         out.orbit_period_s = 5640.0;  // no selected row: nothing is learnt, the period is not used
     }

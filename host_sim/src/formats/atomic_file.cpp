@@ -1,5 +1,7 @@
 #include "ascorr_host/formats/atomic_file.hpp"
 
+#include <filesystem>
+
 #include <fcntl.h>
 #include <limits.h>
 #include <sys/stat.h>
@@ -219,6 +221,17 @@ void write_file_atomically(const std::string& path, std::string_view data) {
 }
 
 // ---- same-file checks -----------------------------------------------------
+
+void refuse_same_output(const NamedPath& first, const NamedPath& second) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path a = fs::weakly_canonical(fs::absolute(first.path), ec);
+    const fs::path b = fs::weakly_canonical(fs::absolute(second.path), ec);
+    if (first.path == second.path || (!ec && a == b)) {
+        throw std::runtime_error(second.option + " " + second.path + " is also " + first.option +
+                                 ": the two files need two paths");
+    }
+}
 
 void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs,
                               bool check_stdout) {

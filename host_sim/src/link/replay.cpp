@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -16,7 +17,10 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr_host/correct/selection.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/corrected_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
@@ -65,17 +69,136 @@ private:
     LoopbackTransport transport_;
 };
 
+// Whether two doubles are the same value: bit for bit, or both NaN (the
+// targets' and the host's default NaNs differ in sign).
+bool same_double(double a, double b) {
+    return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+bool same_report(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
+    bool same = a.orbits_used == b.orbits_used && a.orbits_short == b.orbits_short &&
+                a.orbits_held == b.orbits_held && a.orbits_late == b.orbits_late && a.changes == b.changes &&
+                same_double(a.condition, b.condition) && same_double(a.residual_rms_arcsec, b.residual_rms_arcsec) &&
+                same_double(a.candidate_rms_arcsec, b.candidate_rms_arcsec) && a.has_active == b.has_active &&
+                a.active_version == b.active_version && a.active_crc == b.active_crc &&
+                a.last_refusal == b.last_refusal && a.frozen == b.frozen;
+    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
+        same = same && a.refusals[i] == b.refusals[i];
+    }
+    return same;
+}
+
+// The target's model `version`, head by head (CALIB_MODEL), as a history entry
+// active from t (the first solution corrected with it).
+template <typename T>
+ActiveModel target_model(LinkClient<T>& client, double t) {
+    ActiveModel a{t, 0, 0, 0, ModelFile{}};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const link::CalibModel m = client.calib_model(h);
+        a.t_us = m.active_from_us;
+        a.version = m.version;
+        a.crc = m.crc;
+        a.model.present[h] = m.present == 1U;
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
+                a.model.coefficients[h][x][i] = m.c[x][i];
+            }
+        }
+    }
+    return a;
+}
+
+// Whether two history entries are the same model, active from the same epoch.
+bool same_model(const ActiveModel& a, const ActiveModel& b) {
+    bool same = a.t_us == b.t_us && a.version == b.version && a.crc == b.crc;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        same = same && a.model.present[h] == b.model.present[h];
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                same = same && same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i]);
+            }
+        }
+    }
+    return same;
+}
+
+constexpr std::size_t kMaxCalibMessages = 20;  // per kind, as the diagnostics of `ascorr correct`
+
+// A solution's model version on the target against the host's schedule; a
+// version the target uses for the first time is fetched (CALIB_MODEL) and
+// compared with the host's model of that version.
+template <typename T>
+void check_model_version(LinkClient<T>& client, const std::string& file, const SolutionRecord& rec, std::uint32_t got,
+                         ReplaySummary& sum, std::vector<ActiveModel>& target_history, std::ostream& log,
+                         const SelfCalibration& host_sc, const ModelSchedule<T>& schedule) {
+    const std::optional<std::uint32_t> want = schedule.version_at(rec.t);
+    const bool same = want ? got == *want : got == link::kNoModelVersion;
+    if (!same && ++sum.version_mismatches <= kMaxCalibMessages) {
+        log << file << ":" << rec.line << ": the target corrected with model version "
+            << (got == link::kNoModelVersion ? std::string("none") : std::to_string(got)) << ", the host with "
+            << (want ? std::to_string(*want) : std::string("none")) << "\n";
+    }
+    if (got == link::kNoModelVersion || (!target_history.empty() && target_history.back().version == got)) {
+        return;
+    }
+    target_history.push_back(target_model(client, rec.t));
+    const ActiveModel& mine = target_history.back();
+    const auto host = std::find_if(host_sc.history.begin(), host_sc.history.end(),
+                                   [&](const ActiveModel& a) { return a.version == mine.version; });
+    if (host == host_sc.history.end() || !same_model(*host, mine)) {
+        if (++sum.history_mismatches <= kMaxCalibMessages) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "model version %u (crc32c %08x, active from TT %lld us) differs from the host's%s\n",
+                          mine.version, mine.crc, static_cast<long long>(mine.t_us),
+                          host == host_sc.history.end() ? " (the host has no such version)" : "");
+            log << "ascorr replay: the target's " << buf;
+        }
+    }
+}
+
+// The end of a self-calibrating replay: the host's models the target never
+// used, and the final report.
+template <typename T>
+void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const std::vector<ActiveModel>& target_history,
+                             std::ostream& log, const SelfCalibration& host_sc) {
+    sum.models = target_history.size();
+    for (const ActiveModel& a : host_sc.history) {
+        const bool seen = std::any_of(target_history.begin(), target_history.end(),
+                                      [&](const ActiveModel& b) { return b.version == a.version; });
+        if (!seen && ++sum.history_mismatches <= kMaxCalibMessages) {
+            log << "ascorr replay: the host's model version " << a.version << " was never used by the target\n";
+        }
+    }
+    const calib::EstimatorReport r = client.calib_report();
+    sum.report_matches = same_report(r, host_sc.report);
+    if (!sum.report_matches) {
+        log << "ascorr replay: the target's estimator report differs from the host's: target " << r.orbits_used
+            << " orbits used, active version " << r.active_version << "; host " << host_sc.report.orbits_used
+            << " orbits used, active version " << host_sc.report.active_version << "\n";
+    }
+    SelfCalibration on_target = host_sc;
+    on_target.history = target_history;
+    on_target.report = r;
+    log << "ascorr replay: on the target, " << describe(on_target) << "\n";
+}
+
 template <typename T>
 ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const std::string text = read_text_file(opt.in);
     SolutionsReader reader(opt.in, text);
     refuse_corrected_input(reader);
-    const ModelFile mf = read_model_file(opt.model);
-    if constexpr (std::is_same_v<T, Q30>) {
-        check_fixed_point_range(mf, opt.model);  // refused before the target sees it, as by `correct`
+    // The thermal model: --model's, or with --self-calibrate the estimator's
+    // (--model, if given, is its version 0).
+    std::optional<ModelFile> mf;
+    if (!opt.model.empty()) {
+        mf = read_model_file(opt.model);
+        if constexpr (std::is_same_v<T, Q30>) {
+            check_fixed_point_range(*mf, opt.model);  // refused before the target sees it, as by `correct`
+        }
     }
-    const ThermalModel<T> model_t = to_core<T>(mf);
-    const ThermalModel<double> model_d = to_core<double>(mf);
+    const ThermalModel<T> model_t = mf ? to_core<T>(*mf) : ThermalModel<T>{};
+    const ThermalModel<double> model_d = mf ? to_core<double>(*mf) : ThermalModel<double>{};
 
     std::unique_ptr<FaultInjector> injector;
     Transport* transport = &raw;
@@ -87,7 +210,6 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const link::Hello hello = client.connect();
     log << "ascorr replay: target " << opt.target << " (boot id " << hello.boot_id << ", scalar kind "
         << static_cast<int>(hello.scalar_kind) << ")\n";
-    client.upload_model(model_t);
     std::optional<StatesFile> states;
     if (!opt.states.empty()) {
         Diagnostics diag(log);
@@ -95,15 +217,19 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         diag.summarize();
     }
     // The target's velocity service, mirrored in its scalar and in double.
-    VelocityService<T> mirror(default_velocity_service_config());
-    VelocityService<double> mirror_d(default_velocity_service_config());
+    const VelocityServiceConfig service =
+        opt.max_propagation_s ? service_config(*opt.max_propagation_s) : default_velocity_service_config();
+    if (opt.max_propagation_s) {
+        client.set_service_horizon(service.horizon_us);
+    }
+    VelocityService<T> mirror(service);
+    VelocityService<double> mirror_d(service);
     std::size_t next_state = 0;
 
     const RowWriter writer(reader);
     AtomicFile out(opt.out);
     out.write(writer.header_line());
     std::string buf;
-    ReplaySummary sum;
     EarthVelocity earth;
     SolutionRecord record;
     double instructions = 0.0;
@@ -120,6 +246,36 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     std::vector<SolutionRecord> rows;
     while (reader.next(record)) {
         rows.push_back(record);
+    }
+    // --self-calibrate: the host's run of the estimator over the file, and
+    // the target's started alike.
+    ReplaySummary sum;
+    std::optional<SelfCalibration> host_sc;
+    std::optional<ModelSchedule<T>> schedule;
+    std::optional<ModelSchedule<double>> schedule_d;
+    std::vector<ActiveModel> target_history;
+    if (opt.self_calibrate) {
+        calib::EstimatorConfig ecfg;
+        ecfg.time_constant_days = opt.time_constant_days;
+        host_sc = self_calibrate<T>(
+            opt.in,
+            [&](const std::function<void(const SolutionRecord&)>& fn) {
+                for (const SolutionRecord& r : rows) {
+                    fn(r);
+                }
+            },
+            mf, ecfg, std::nullopt);
+        schedule.emplace(host_sc->history);
+        schedule_d.emplace(host_sc->history);
+        std::optional<ModelCoefficients> initial;
+        if (mf) {
+            initial = coefficients_of(*mf);
+        }
+        client.start_calibration(std::llround(host_sc->orbit_period_s * 1e6), opt.time_constant_days,
+                                 initial ? &*initial : nullptr);
+        sum.self_calibrate = true;
+    } else {
+        client.upload_model(model_t);
     }
     const auto key = [&](std::size_t i) { return std::isnan(rows[i].t) ? HUGE_VAL : rows[i].t; };
     std::vector<std::size_t> order(rows.size());
@@ -141,8 +297,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         SolutionInput<T> in = to_core_input<T>(rec, &earth);
         SolutionInput<double> in_d = to_core_input<double>(rec, &earth);
         TtTime t{};
+        const bool timed = tt_from_seconds(rec.t, t);
         const bool wants_states = states && rec.velocity_components == 0;
-        const bool from_states = wants_states && tt_from_seconds(rec.t, t);
+        const bool from_states = wants_states && timed;
         // A time the on-board clock cannot hold (|t| > 1e11 s): the states
         // cannot give a velocity, 4|32 as in `ascorr correct --states`.
         const bool time_unusable = wants_states && !from_states;
@@ -171,12 +328,21 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         }
         client.set_temperatures(in.head, in.temperatures);
         ++sum.frames;
-        const link::SolutionOut<T> got =
-            client.correct(id, in.head, in.q_chu_icrf, t, from_states, from_states && in.velocity.valid);
+        std::uint8_t calib_use = 0U;
+        if (opt.self_calibrate) {
+            calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
+        }
+        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0},
+                                                        from_states, from_states && in.velocity.valid, calib_use);
         ++sum.returned;
-        CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &model_t});
+        const ThermalModel<T>& host_model = schedule ? schedule->at(rec.t) : model_t;
+        CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &host_model});
         host.status = with_service_status(host.status, service_status, from_states);
-        CorrectedSolution<double> ref = correct_solution(in_d, CorrectionConfig<double>{true, &model_d});
+        if (opt.self_calibrate) {
+            check_model_version(client, opt.in, rec, got.model_version, sum, target_history, log, *host_sc, *schedule);
+        }
+        CorrectedSolution<double> ref =
+            correct_solution(in_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
         ref.status = with_service_status(ref.status, service_status_d, from_states);
         const bool same =
             got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
@@ -217,7 +383,18 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         writer.row(again, written_rows[k].q, written_rows[k].status, buf);
     }
     out.write(buf);
+    std::optional<AtomicFile> history_file;
+    if (opt.self_calibrate) {
+        finish_self_calibration(client, sum, target_history, log, *host_sc);
+        if (!opt.model_history.empty()) {
+            history_file.emplace(opt.model_history);
+            history_file->write(format_model_history(target_history));
+        }
+    }
     out.commit();
+    if (history_file) {
+        history_file->commit();
+    }
     const LinkStats& st = client.stats();
     sum.crc_errors = st.naks + st.broken_answers;
     sum.retries = st.retries;
@@ -286,16 +463,38 @@ void check_link_image(const std::string& path, const QemuTarget& board) {
 }  // namespace
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    std::vector<NamedPath> outputs = {{"--out", opt.out}};
+    if (!opt.model_history.empty()) {
+        outputs.push_back({"--model-history", opt.model_history});
+    }
     refuse_output_over_input(
-        {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}},
-        {{"--out", opt.out}}, true);
-    if (std::llround(opt.max_propagation_s * 1e6) != default_velocity_service_config().horizon_us) {
-        char buf[256];
-        std::snprintf(buf, sizeof buf,
-                      "--max-propagation %.17g: a target propagates a state for %.17g s, the "
-                      "horizon built into its firmware; replay cannot change it (correct can)",
-                      opt.max_propagation_s, static_cast<double>(default_velocity_service_config().horizon_us) * 1e-6);
-        throw std::runtime_error(buf);
+        {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}}, outputs,
+        true);
+    if (opt.max_propagation_s && !max_propagation_acceptable(*opt.max_propagation_s)) {
+        throw std::runtime_error("--max-propagation " + number_text(*opt.max_propagation_s) + ": " +
+                                 kMaxPropagationRule);
+    }
+    if (opt.self_calibrate) {
+        if (!opt.states.empty()) {  // as `ascorr correct --self-calibrate`
+            throw std::runtime_error(
+                "--self-calibrate learns from rows with their own vx,vy,vz: it cannot go with --states");
+        }
+        if (!opt.model_history.empty()) {
+            refuse_same_output({"--out", opt.out}, {"--model-history", opt.model_history});
+        }
+        if (!(opt.time_constant_days >= calib::kMinTimeConstantDays &&
+              opt.time_constant_days <= calib::kMaxTimeConstantDays)) {
+            throw std::runtime_error("--time-constant " + number_text(opt.time_constant_days) +
+                                     ": must be in [1, 10000] days");
+        }
+    } else {
+        if (opt.model.empty()) {
+            throw std::runtime_error("--model is needed (the thermal model the target corrects with), unless "
+                                     "--self-calibrate");
+        }
+        if (!opt.model_history.empty()) {
+            throw std::runtime_error("--model-history needs --self-calibrate");
+        }
     }
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
@@ -386,10 +585,18 @@ std::string to_json(const ReplaySummary& s) {
     std::snprintf(buf, sizeof buf,
                   "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
                   "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
-                  "\"injected_faults\": %zu}",
+                  "\"injected_faults\": %zu",
                   s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
                   s.instructions_per_solution, s.restarts, s.injected);
-    return buf;
+    std::string out = buf;
+    if (s.self_calibrate) {
+        std::snprintf(buf, sizeof buf,
+                      ", \"self_calibration\": {\"models\": %zu, \"version_mismatches\": %zu, "
+                      "\"history_mismatches\": %zu, \"report_matches\": %s}",
+                      s.models, s.version_mismatches, s.history_mismatches, s.report_matches ? "true" : "false");
+        out += buf;
+    }
+    return out + "}";
 }
 
 }  // namespace ascorr::host

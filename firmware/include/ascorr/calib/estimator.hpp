@@ -97,6 +97,20 @@ inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the 
 inline constexpr std::size_t kUnknowns = 4;    // [1, T1, T2 − T1, T3 − T1] per axis
 inline constexpr std::size_t kWindow = 32;     // recent orbits kept (gate and held-back orbits)
 
+// The orbit periods and time constants the estimator is meant for: an orbit
+// of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins
+// would hold too few epochs), a forgetting time constant of a day to
+// 10 000 days (beyond, forgetting is nil within any mission). The link's
+// CALIB_START and the host's options refuse others.
+inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
+inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
+inline constexpr double kMinTimeConstantDays = 1.0;
+inline constexpr double kMaxTimeConstantDays = 10000.0;
+constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double time_constant_days) noexcept {
+    return orbit_period_us >= kMinOrbitPeriodUs && orbit_period_us <= kMaxOrbitPeriodUs &&
+           time_constant_days >= kMinTimeConstantDays && time_constant_days <= kMaxTimeConstantDays;  // no NaN
+}
+
 struct EstimatorConfig {
     std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
     double time_constant_days = 30.0;              // τ of the forgetting (chosen: README, Self-calibration)

@@ -75,6 +75,11 @@ struct NamedPath {
 void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs,
                               bool check_stdout = false);
 
+// Throws std::runtime_error when two outputs name the same file, whether it
+// exists or not (the same text, or the same canonical path): "<second> is also
+// <first>: the two files need two paths".
+void refuse_same_output(const NamedPath& first, const NamedPath& second);
+
 // Installs the handlers of SIGINT, SIGTERM, SIGHUP and SIGPIPE (once; call it
 // from main before any thread starts).
 void install_signal_cleanup();

@@ -9,10 +9,21 @@
 // solution at or after their time, and rows without their own velocity ask the
 // target to compute it; the host mirrors the target's service in the same
 // scalar (and in double for the reference) with the same states in the same order.
+//
+// With self_calibrate the target runs its estimator on the solutions (link
+// CALIB_START; each solution says whether it is clean and whether its t is
+// one the on-board clock holds), starting from the model if one is given,
+// otherwise from none. The host runs the same estimator over the file
+// (self_calibration.hpp, the run of `ascorr correct --self-calibrate` in the
+// target's scalar) and compares, for each solution, the answer and the model
+// version used; for each model the target adopts, its coefficients, CRC and
+// time (CALIB_MODEL); and at the end the estimator's report. The target's
+// model history is written to model_history, when given.
 #pragma once
 
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,9 +37,12 @@ struct ReplayOptions {
     std::string out;
     std::string states;        // --states: spacecraft states sent over the link in time order; empty: none
     bool states_gcrs = false;  // --states-frame gcrs (default itrf)
-    // --max-propagation: the target's horizon is its firmware's (the velocity
-    // service's default); another value is refused, not silently ignored.
-    double max_propagation_s = 21600.0;
+    // --max-propagation: the target's velocity service's horizon (SERVICE_CONFIG);
+    // nullopt: its firmware's (21600 s).
+    std::optional<double> max_propagation_s;
+    bool self_calibrate = false;     // --self-calibrate
+    std::string model_history;       // --model-history: the target's models; empty: not written
+    double time_constant_days = 30;  // --time-constant (calib::EstimatorConfig's default)
     double inject_errors = 0.0;  // fraction of frames faulted, each direction
     bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
     int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
@@ -47,6 +61,12 @@ struct ReplaySummary {
     double instructions_per_solution = 0.0;  // mean over solutions with both stages applied
     std::size_t restarts = 0;
     std::size_t injected = 0;
+    // --self-calibrate: what the target's estimator did, against the host's.
+    bool self_calibrate = false;
+    std::size_t models = 0;                // models the target made active (its history's versions)
+    std::size_t version_mismatches = 0;    // solutions corrected with another model version than the host's
+    std::size_t history_mismatches = 0;    // models differing from the host's (coefficients, CRC, time) or missing
+    bool report_matches = false;           // the final report equals the host's, field for field
 };
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
