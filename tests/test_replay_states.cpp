@@ -85,6 +85,37 @@ TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
     EXPECT_NE(replayed.find(",3\n"), std::string::npos);  // 1 | 2
 }
 
+// --max-propagation goes to the target (SERVICE_CONFIG): with a 10 s horizon
+// the rows in the recording's 40 s gap more than 10 s after the last state
+// are stale on the target (4|512, thermal applied: 518), as by `ascorr
+// correct --states --max-propagation 10`, byte for byte; with the default
+// horizon none is (the control).
+TEST(ReplayStates, LoopbackMaxPropagationEqualsCorrect) {
+    const auto dir = scratch_dir("replay_states_horizon");
+    const StatesRecording rec = make_states_recording(dir, 1000);  // epochs to 98 s: through the gap
+    host::ReplayOptions o;
+    o.target = "loopback-float";
+    o.in = rec.solutions;
+    o.states = rec.states;
+    o.model = data_path("model_table2.csv");
+    o.out = (dir / "default.csv").string();
+    std::ostringstream log;
+    EXPECT_EQ(host::replay(o, log).mismatches, 0U) << log.str();
+    EXPECT_EQ(slurp((dir / "default.csv").string()).find(",518\n"), std::string::npos);
+    o.max_propagation_s = 10.0;
+    o.out = (dir / "out.csv").string();
+    const host::ReplaySummary s = host::replay(o, log);
+    EXPECT_EQ(s.returned, 1000U);
+    EXPECT_EQ(s.mismatches, 0U) << log.str();
+    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + rec.solutions + " --out " +
+                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
+                            " --states " + rec.states + " --max-propagation 10 2>/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string replayed = slurp((dir / "out.csv").string());
+    EXPECT_EQ(replayed, slurp((dir / "correct.csv").string()));
+    EXPECT_NE(replayed.find(",518\n"), std::string::npos);
+}
+
 // Rows out of time order: replay sends them to the target in time order (the
 // service is causal) and writes them in file order, so the replayed file still
 // equals `ascorr correct --states` of the same rows (before, a row earlier than

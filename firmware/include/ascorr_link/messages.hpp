@@ -436,8 +436,8 @@ template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
     Reader r(p, n);
     return r.u32(m.id) && r.u8(m.head) && r.i64(m.t.us) && r.u8(m.from_states) && m.from_states <= 1U &&
-           r.u8(m.calib) && (m.calib & ~(kCalibClean | kCalibNoTime)) == 0U && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) &&
-           r.done();
+           r.u8(m.calib) && (m.calib & ~(kCalibClean | kCalibNoTime)) == 0U && r.word(m.q_chu_icrf.w) &&
+           r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.done();
 }
 
 inline std::size_t encode(const StateUpdate& m, std::uint8_t* out) noexcept {
@@ -474,7 +474,8 @@ template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionOut<T>& m) noexcept {
     Reader r(p, n);
     return r.u32(m.id) && r.u8(m.head) && r.u16(m.status) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) &&
-           r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.u32(m.model_version) && r.done();
+           r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.u32(m.model_version) &&
+           r.done();
 }
 
 inline std::size_t encode(const Ack& m, std::uint8_t* out) noexcept {

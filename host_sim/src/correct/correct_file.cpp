@@ -138,8 +138,8 @@ struct Job {
     const RowWriter& writer;
     const StatesFile* states;  // nullptr: no --states
     VelocityServiceConfig service;
-    const StatesVelocityTable<T>* table;             // the rows' velocities from the states, in time order
-    const ModelSchedule<T>* schedule;  // --self-calibrate; nullptr: cfg's model for every row
+    const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
+    const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
 };
 
 // The configuration of one row: with a schedule, the model active at its t.

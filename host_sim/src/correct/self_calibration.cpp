@@ -5,9 +5,9 @@
 #include <cstdio>
 #include <sstream>
 
+#include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
-#include "ascorr/calib/feed.hpp"
 #include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr/nav/tt_time.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"

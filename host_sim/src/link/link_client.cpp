@@ -412,9 +412,8 @@ calib::EstimatorReport LinkClient<T>::calib_report() {
 
 template <typename T>
 link::CalibModel LinkClient<T>::calib_model(std::uint8_t head) {
-    const std::vector<std::uint8_t> a =
-        request({link::MessageType::kCalibModelRequest, {head}, "calibration model request"},
-                link::MessageType::kCalibModel);
+    const std::vector<std::uint8_t> a = request(
+        {link::MessageType::kCalibModelRequest, {head}, "calibration model request"}, link::MessageType::kCalibModel);
     link::CalibModel m{};
     if (!link::decode(a.data(), a.size(), m) || m.head != head) {
         throw LinkError("malformed calibration model from the target (" + std::to_string(a.size()) + " bytes)");

@@ -76,9 +76,9 @@ bool same_double(double a, double b) {
 }
 
 bool same_report(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
-    bool same = a.orbits_used == b.orbits_used && a.orbits_short == b.orbits_short &&
-                a.orbits_held == b.orbits_held && a.orbits_late == b.orbits_late && a.changes == b.changes &&
-                same_double(a.condition, b.condition) && same_double(a.residual_rms_arcsec, b.residual_rms_arcsec) &&
+    bool same = a.orbits_used == b.orbits_used && a.orbits_short == b.orbits_short && a.orbits_held == b.orbits_held &&
+                a.orbits_late == b.orbits_late && a.changes == b.changes && same_double(a.condition, b.condition) &&
+                same_double(a.residual_rms_arcsec, b.residual_rms_arcsec) &&
                 same_double(a.candidate_rms_arcsec, b.candidate_rms_arcsec) && a.has_active == b.has_active &&
                 a.active_version == b.active_version && a.active_crc == b.active_crc &&
                 a.last_refusal == b.last_refusal && a.frozen == b.frozen;
@@ -332,8 +332,8 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         if (opt.self_calibrate) {
             calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
         }
-        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0},
-                                                        from_states, from_states && in.velocity.valid, calib_use);
+        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0}, from_states,
+                                                        from_states && in.velocity.valid, calib_use);
         ++sum.returned;
         const ThermalModel<T>& host_model = schedule ? schedule->at(rec.t) : model_t;
         CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &host_model});
@@ -462,7 +462,10 @@ void check_link_image(const std::string& path, const QemuTarget& board) {
 
 }  // namespace
 
-ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+namespace {
+
+// The options' refusals that need no input read (nothing was written).
+void check_options(const ReplayOptions& opt) {
     std::vector<NamedPath> outputs = {{"--out", opt.out}};
     if (!opt.model_history.empty()) {
         outputs.push_back({"--model-history", opt.model_history});
@@ -489,13 +492,41 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         }
     } else {
         if (opt.model.empty()) {
-            throw std::runtime_error("--model is needed (the thermal model the target corrects with), unless "
-                                     "--self-calibrate");
+            throw std::runtime_error(
+                "--model is needed (the thermal model the target corrects with), unless "
+                "--self-calibrate");
         }
         if (!opt.model_history.empty()) {
             throw std::runtime_error("--model-history needs --self-calibrate");
         }
     }
+}
+
+// The session over a transport already open: the target's HELLO says which
+// scalar it computes in, and the session speaks that one.
+ReplaySummary run_as_announced(const ReplayOptions& o, Transport& transport, std::ostream& log) {
+    const std::uint8_t kind = LinkClient<float>(transport, o.timeout_ms, o.max_attempts).request_hello().scalar_kind;
+    if (kind == link::WireTraits<Q30>::kKind) {
+        return run<Q30>(o, transport, log);
+    }
+    if (kind == link::WireTraits<float>::kKind) {
+        return run<float>(o, transport, log);
+    }
+    throw LinkError(o.target + ": the target computes in scalar kind " + std::to_string(kind) +
+                    ", which this host does not speak (1 = float, 2 = Q30)");
+}
+
+}  // namespace
+
+ReplaySummary replay_over(const ReplayOptions& opt, Transport& transport, std::ostream& log) {
+    check_options(opt);
+    ReplayOptions o = opt;
+    o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
+    return run_as_announced(o, transport, log);
+}
+
+ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    check_options(opt);
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never
@@ -520,17 +551,7 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
     if (opt.target.rfind("/dev/", 0) == 0) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
         SerialTransport serial(opt.target, opt.baud);
-        // The target says in its HELLO which core it runs (float or Q30); the
-        // session then speaks that scalar.
-        const std::uint8_t kind = LinkClient<float>(serial, o.timeout_ms, o.max_attempts).request_hello().scalar_kind;
-        if (kind == link::WireTraits<Q30>::kKind) {
-            return run<Q30>(o, serial, log);
-        }
-        if (kind == link::WireTraits<float>::kKind) {
-            return run<float>(o, serial, log);
-        }
-        throw LinkError(opt.target + ": the target computes in scalar kind " + std::to_string(kind) +
-                        ", which this host does not speak (1 = float, 2 = Q30)");
+        return run_as_announced(o, serial, log);
     }
     throw std::runtime_error("--target " + opt.target + ": unknown target (loopback-float, " + qemu_target_names() +
                              " or a serial device such as /dev/ttyUSB0)");

@@ -43,9 +43,9 @@ struct ReplayOptions {
     bool self_calibrate = false;     // --self-calibrate
     std::string model_history;       // --model-history: the target's models; empty: not written
     double time_constant_days = 30;  // --time-constant (calib::EstimatorConfig's default)
-    double inject_errors = 0.0;  // fraction of frames faulted, each direction
-    bool realtime = false;       // pace by the rows' t instead of as fast as the link allows
-    int timeout_ms = 0;          // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
+    double inject_errors = 0.0;      // fraction of frames faulted, each direction
+    bool realtime = false;           // pace by the rows' t instead of as fast as the link allows
+    int timeout_ms = 0;              // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
     int max_attempts = 20;
     std::uint64_t seed = 1;
     unsigned baud = 115200;
@@ -63,13 +63,18 @@ struct ReplaySummary {
     std::size_t injected = 0;
     // --self-calibrate: what the target's estimator did, against the host's.
     bool self_calibrate = false;
-    std::size_t models = 0;                // models the target made active (its history's versions)
-    std::size_t version_mismatches = 0;    // solutions corrected with another model version than the host's
-    std::size_t history_mismatches = 0;    // models differing from the host's (coefficients, CRC, time) or missing
-    bool report_matches = false;           // the final report equals the host's, field for field
+    std::size_t models = 0;              // models the target made active (its history's versions)
+    std::size_t version_mismatches = 0;  // solutions corrected with another model version than the host's
+    std::size_t history_mismatches = 0;  // models differing from the host's (coefficients, CRC, time) or missing
+    bool report_matches = false;         // the final report equals the host's, field for field
 };
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
+// The same over a transport already open (a link a caller set up, a test
+// double); opt.target only names it in messages. The target's HELLO says its
+// scalar; timeout_ms 0 means 500.
+class Transport;
+ReplaySummary replay_over(const ReplayOptions& opt, Transport& transport, std::ostream& log);
 // The QEMU command line that runs a link image with UART0 on stdin/stdout.
 std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image);
 // The link image of this build tree for a target (a cpu of toolchain/targets.txt).

@@ -1,0 +1,208 @@
+// `ascorr replay --self-calibrate`: the target runs the on-board estimator on
+// the replayed solutions (link protocol v4), and the host compares every
+// answer and model version, every model the target adopts and its final
+// report with its own run over the file in the target's scalar. The data come
+// from `ascorr simulate` (a bench that deforms with temperature), which the
+// estimator did not produce. In process (loopback, float) the replayed file
+// and model history must equal `ascorr correct --self-calibrate --scalar
+// float` byte for byte, and a target that is told no solution is clean must
+// be caught; under QEMU (label target) each board against its own scalar.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/link/link_transport.hpp"
+#include "ascorr_host/link/qemu_targets.hpp"
+#include "ascorr_host/link/replay.hpp"
+#include "ascorr_link/frame.hpp"
+#include "ascorr_link/messages.hpp"
+#include "ascorr_link/server.hpp"
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::host {
+// GoogleTest shows a board by its replay name (not its bytes) in test names.
+inline void PrintTo(const QemuTarget& board, std::ostream* os) {
+    *os << board.replay;
+}
+}  // namespace ascorr::host
+
+namespace ascorr::test {
+namespace {
+
+// Four simulated days at 300 s (2751 rows): enough orbits (≥ 30 with ≥ 4
+// epochs each) for the estimator to adopt a model on day 3.
+std::filesystem::path simulated(const std::string& name) {
+    const auto dir = scratch_dir(name);
+    const CliRun r = run_in("simulate --out sim.csv --days 4 --step 300 --seed 3", dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return dir;
+}
+
+host::ReplayOptions options(const std::filesystem::path& dir, const std::string& target) {
+    host::ReplayOptions o;
+    o.target = target;
+    o.in = (dir / "sim.csv").string();
+    o.out = (dir / "replayed.csv").string();
+    o.model_history = (dir / "replayed.history.csv").string();
+    o.self_calibrate = true;
+    return o;
+}
+
+// What the host says, for the same rows in the target's scalar.
+void expect_same_as_correct(const std::filesystem::path& dir, const std::string& scalar) {
+    const CliRun r = run_in("correct --in sim.csv --out corrected.csv --self-calibrate --scalar " + scalar +
+                                " --model-history corrected.history.csv",
+                            dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string history = slurp(dir / "corrected.history.csv");
+    EXPECT_GT(history.size(), 40U) << "no model was adopted: the comparison would be vacuous";
+    EXPECT_EQ(slurp(dir / "replayed.history.csv"), history);
+    EXPECT_EQ(slurp(dir / "replayed.csv"), slurp(dir / "corrected.csv"));
+}
+
+void expect_agreement(const host::ReplaySummary& s) {
+    EXPECT_TRUE(s.self_calibrate);
+    EXPECT_EQ(s.returned, 2751U);
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_GE(s.models, 1U);
+    EXPECT_EQ(s.version_mismatches, 0U);
+    EXPECT_EQ(s.history_mismatches, 0U);
+    EXPECT_TRUE(s.report_matches);
+}
+
+TEST(ReplaySelfCalibration, LoopbackEqualsCorrectSelfCalibrate) {
+    const auto dir = simulated("replay_sc_loop");
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(options(dir, "loopback-float"), log);
+    std::cout << host::to_json(s) << "\n" << log.str();
+    expect_agreement(s);
+    expect_same_as_correct(dir, "float");
+}
+
+// The target's LinkServer in process, behind a link that clears the clean
+// bit of some SOLUTION_INs (every head-B solution from `from_id` on): the
+// target learns from other epochs than the host, which the comparison must
+// see.
+class CleanBitEraser {
+public:
+    explicit CleanBitEraser(std::uint32_t from_id)
+        : from_id_(from_id),
+          server_(0x54455354U, [] { return std::uint32_t{0}; }),
+          transport_([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
+              for (std::size_t i = 0; i < n; ++i) {
+                  pass(p[i], reply);
+              }
+          }) {}
+    host::Transport& transport() { return transport_; }
+    std::size_t erased() const { return erased_; }
+
+private:
+    void pass(std::uint8_t b, const host::LoopbackTransport::Reply& reply) {
+        if (decoder_.push(b) != link::FrameDecoder::Event::kFrame) {
+            return;
+        }
+        const link::Frame& f = decoder_.frame();
+        std::uint8_t payload[link::kMaxPayload];
+        std::size_t n = f.length;
+        std::copy(f.payload, f.payload + n, payload);
+        link::SolutionIn<float> s{};
+        if (f.type == static_cast<std::uint8_t>(link::MessageType::kSolutionIn) && link::decode(payload, n, s) &&
+            s.head == 1U && s.id >= from_id_ && (s.calib & link::kCalibClean) != 0U) {
+            s.calib = static_cast<std::uint8_t>(s.calib & ~link::kCalibClean);
+            n = link::encode(s, payload);
+            ++erased_;
+        }
+        std::uint8_t wire[link::kMaxWire];
+        const std::size_t w = link::encode_frame(f.type, f.seq, payload, n, wire, sizeof wire);
+        for (std::size_t i = 0; i < w; ++i) {
+            server_.on_byte(wire[i], reply);
+        }
+    }
+
+    using Counter = std::uint32_t (*)();
+    std::uint32_t from_id_;
+    link::FrameDecoder decoder_;
+    link::LinkServer<float, Counter> server_;
+    host::LoopbackTransport transport_;
+    std::size_t erased_ = 0;
+};
+
+TEST(ReplaySelfCalibration, UntouchedLinkDoubleAgrees) {
+    // The control of the mutation below: the same double, erasing nothing.
+    const auto dir = simulated("replay_sc_double");
+    CleanBitEraser target(0xFFFFFFFFU);
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay_over(options(dir, "link double"), target.transport(), log);
+    EXPECT_EQ(target.erased(), 0U);
+    expect_agreement(s);
+}
+
+TEST(ReplaySelfCalibration, ATargetThatLearnsOtherwiseIsCaught) {
+    const auto dir = simulated("replay_sc_mutant");
+    CleanBitEraser target(1500U);  // day 2 on: the estimator loses head B
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay_over(options(dir, "link double"), target.transport(), log);
+    std::cout << host::to_json(s) << "\n" << log.str();
+    EXPECT_GT(target.erased(), 100U);
+    EXPECT_EQ(s.returned, 2751U);
+    EXPECT_FALSE(s.report_matches);
+    EXPECT_GT(s.version_mismatches + s.history_mismatches, 0U);
+    EXPECT_GT(s.mismatches, 0U);  // rows corrected with no model instead of the host's
+    EXPECT_NE(log.str().find("differs from the host's"), std::string::npos) << log.str();
+}
+
+TEST(ReplaySelfCalibration, OptionsAreChecked) {
+    const auto dir = scratch_dir("replay_sc_options");
+    host::ReplayOptions o = options(dir, "loopback-float");
+    std::ostringstream log;
+    o.model_history = o.out;
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);  // two outputs, one path
+    o = options(dir, "loopback-float");
+    o.states = data_path("model_table2.csv");
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);  // --states: refused as by correct
+    o = options(dir, "loopback-float");
+    o.time_constant_days = 0.5;
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);
+    o = options(dir, "loopback-float");
+    o.self_calibrate = false;
+    EXPECT_THROW(host::replay(o, log), std::runtime_error);  // no --model, no --self-calibrate
+    EXPECT_FALSE(std::filesystem::exists(o.out));
+}
+
+#ifdef ASCORR_REPLAY_QEMU
+class ReplaySelfCalibrationQemu : public ::testing::TestWithParam<host::QemuTarget> {};
+
+// Each board against the host in its own scalar (Q30 on the M3, float on the
+// M4F, whose link image does not fuse multiply-adds), bit for bit.
+TEST_P(ReplaySelfCalibrationQemu, SameModelsAndAnswersAsTheHost) {
+    const host::QemuTarget& board = GetParam();
+    std::string name = "replay_sc_" + std::string(board.replay);
+    for (char& c : name) {
+        c = c == '-' ? '_' : c;
+    }
+    const auto dir = simulated(name);
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(options(dir, std::string(board.replay)), log);
+    std::cout << board.replay << ": " << host::to_json(s) << "\n" << log.str();
+    expect_agreement(s);
+    EXPECT_EQ(s.restarts, 0U);
+    expect_same_as_correct(dir, board.scalar == host::ScalarKind::kFixed ? "fixed" : "float");
+}
+
+INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets),
+                         [](const ::testing::TestParamInfo<host::QemuTarget>& info) {
+                             std::string n(info.param.replay);
+                             for (char& c : n) {
+                                 c = c == '-' ? '_' : c;
+                             }
+                             return n;
+                         });
+#endif
+
+}  // namespace
+}  // namespace ascorr::test
