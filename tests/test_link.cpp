@@ -365,11 +365,22 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     bad.emplace_back(MessageType::kCalibCommand, Bytes{1, 0});
     bad.emplace_back(MessageType::kCalibCommand, Bytes{});
     bad.emplace_back(MessageType::kCalibReportRequest, Bytes{0});
-    for (const CalibStart& s : {CalibStart{0, 30.0, 0}, CalibStart{-5, 30.0, 0}, CalibStart{1000, 0.0, 0},
-                                CalibStart{1000, std::nan(""), 0}, CalibStart{1000, 30.0, 2}}) {
+    constexpr std::int64_t kOrbit = 5'640'000'000;
+    for (const CalibStart& s :
+         {CalibStart{0, 30.0, 0}, CalibStart{-5, 30.0, 0}, CalibStart{calib::kMinOrbitPeriodUs - 1, 30.0, 0},
+          CalibStart{calib::kMaxOrbitPeriodUs + 1, 30.0, 0}, CalibStart{kOrbit, 0.0, 0}, CalibStart{kOrbit, 0.999, 0},
+          CalibStart{kOrbit, 10000.001, 0}, CalibStart{kOrbit, std::nan(""), 0}, CalibStart{kOrbit, 30.0, 2}}) {
         std::uint8_t p[kMaxPayload];
         bad.emplace_back(MessageType::kCalibStart, Bytes(p, p + encode(s, p)));
     }
+    for (const ServiceConfig& c : {ServiceConfig{0}, ServiceConfig{-1}, ServiceConfig{kMaxHorizonUs + 1}}) {
+        std::uint8_t p[kMaxPayload];
+        bad.emplace_back(MessageType::kServiceConfig, Bytes(p, p + encode(c, p)));
+    }
+    bad.emplace_back(MessageType::kServiceConfig, Bytes{1, 2, 3});
+    bad.emplace_back(MessageType::kCalibModelRequest, Bytes{4});     // a head beyond D
+    bad.emplace_back(MessageType::kCalibModelRequest, Bytes{0, 0});  // a byte too many
+    bad.emplace_back(MessageType::kCalibModelRequest, Bytes{});
     CalibModelLoad good{};
     good.head = 0;
     good.present = 1;
@@ -437,6 +448,23 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     EXPECT_EQ(out.status, c.status);
     EXPECT_EQ(out.status, status::kAberrationApplied | status::kThermalApplied);
     EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &c.q_chu_icrf, sizeof c.q_chu_icrf), 0);
+    EXPECT_EQ(out.model_version, 1U);  // the loaded model: version 1
+    {
+        // CALIB_MODEL: head B of the active model, as loaded.
+        const Decoded d = loop.send(wire_frame(MessageType::kCalibModelRequest, seq++, Bytes{1}));
+        CalibModel m{};
+        ASSERT_EQ(d.frames.size(), 1U);
+        ASSERT_EQ(d.frames.at(0).type, static_cast<std::uint8_t>(MessageType::kCalibModel));
+        ASSERT_TRUE(decode(d.payloads.at(0).data(), d.payloads.at(0).size(), m));
+        EXPECT_EQ(m.head, 1U);
+        EXPECT_EQ(m.version, 1U);
+        EXPECT_EQ(m.active_from_us, 2'000'000);
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
+                EXPECT_EQ(m.c[a][t], want.coefficient[1][a][t]);
+            }
+        }
+    }
     const calib::EstimatorReport r = report();
     EXPECT_TRUE(r.has_active);
     EXPECT_EQ(r.active_version, 1U);
