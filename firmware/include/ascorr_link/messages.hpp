@@ -312,6 +312,28 @@ private:
     std::size_t i_ = 0;
 };
 
+// One head's linear coefficients (α, β, γ × c0..c3) as 12 IEEE binary64;
+// `acceptable` judges each one read.
+using LinearCoefficients = double[kModelAxes][kLinearModelTerms];
+inline void put_linear(Writer& w, const LinearCoefficients& c) noexcept {
+    for (const auto& axis : c) {
+        for (const double x : axis) {
+            w.f64(x);
+        }
+    }
+}
+template <typename Acceptable>
+bool get_linear(Reader& r, LinearCoefficients& c, Acceptable acceptable) noexcept {
+    for (auto& axis : c) {
+        for (double& x : axis) {
+            if (!r.f64(x) || !acceptable(x)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 // ---- messages (encode returns the payload size; buffers of kMaxPayload suffice)
 inline std::size_t encode(const Hello& m, std::uint8_t* out) noexcept {
     Writer w(out);
@@ -522,11 +544,7 @@ inline std::size_t encode(const CalibModelLoad& m, std::uint8_t* out) noexcept {
     w.u8(m.head);
     w.u8(m.present);
     w.u8(m.load);
-    for (const auto& axis : m.c) {
-        for (const double x : axis) {
-            w.f64(x);
-        }
-    }
+    put_linear(w, m.c);
     return w.size();
 }
 // Refused: a head beyond D, a flag other than 0 or 1, a coefficient not
@@ -536,14 +554,8 @@ inline bool decode(const std::uint8_t* p, std::size_t n, CalibModelLoad& m) noex
     if (!(r.u8(m.head) && r.u8(m.present) && r.u8(m.load)) || m.head >= kMaxHeads || m.present > 1U || m.load > 1U) {
         return false;
     }
-    for (auto& axis : m.c) {
-        for (double& x : axis) {
-            if (!r.f64(x) || !(std::fabs(x) < kMaxLoadCoefficient)) {  // false for NaN
-                return false;
-            }
-        }
-    }
-    return r.done();
+    return get_linear(r, m.c, [](double x) { return std::fabs(x) < kMaxLoadCoefficient; }) &&  // false for NaN
+           r.done();
 }
 
 inline std::size_t encode(const calib::EstimatorReport& m, std::uint8_t* out) noexcept {
@@ -592,25 +604,15 @@ inline std::size_t encode(const CalibModel& m, std::uint8_t* out) noexcept {
     w.u32(m.version);
     w.u32(m.crc);
     w.u64(static_cast<std::uint64_t>(m.active_from_us));
-    for (const auto& axis : m.c) {
-        for (const double x : axis) {
-            w.f64(x);
-        }
-    }
+    put_linear(w, m.c);
     return w.size();
 }
 // The host reads what the target holds: any finite or non-finite value
 // decodes (a comparison, not a use, follows).
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibModel& m) noexcept {
     Reader r(p, n);
-    bool ok = r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
-              m.head < kMaxHeads && m.present <= 1U;
-    for (auto& axis : m.c) {
-        for (double& x : axis) {
-            ok = ok && r.f64(x);
-        }
-    }
-    return ok && r.done();
+    return r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
+           m.head < kMaxHeads && m.present <= 1U && get_linear(r, m.c, [](double) { return true; }) && r.done();
 }
 
 inline std::size_t encode(const ServiceConfig& m, std::uint8_t* out) noexcept {

@@ -467,10 +467,10 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         history_file.emplace(opt.model_history);
         history_file->write(history);
     }
+    out.commit();  // the corrected file first, then the history that explains it (as replay)
     if (history_file) {
         history_file->commit();
     }
-    out.commit();
     sum.self_calibration = account;
     return sum;
 }
