@@ -233,8 +233,8 @@ TEST(Fit, FitAndCorrectReachTheNoiseFloorInsideAndOutsideThePeriod) {
             const double fl = floor_rms(s.gen.floor[p], *so.from, *so.to);
             const double got = r.rms[p][0].rms;
             std::printf("%s %s: floor %.3f\", aberration-corrected %.3f\", fit+correct %.3f\" (%+.2f %%)\n",
-                        period == 0 ? "inside " : "outside", host::kPaperPairs.pair[p].name, fl, r_raw.rms[p][1].rms, got,
-                        100.0 * (got / fl - 1.0));
+                        period == 0 ? "inside " : "outside", host::kPaperPairs.pair[p].name, fl, r_raw.rms[p][1].rms,
+                        got, 100.0 * (got / fl - 1.0));
             EXPECT_EQ(r.n[p], r_raw.n[p]);
             EXPECT_LT(std::fabs(got / fl - 1.0), 0.03) << host::kPaperPairs.pair[p].name << " period " << period;
         }

@@ -279,8 +279,8 @@ constexpr double kStart = host::kDefaultSimStartT;
 constexpr double kDayS = 86400.0;
 
 // The floor of days [from, to) by `stats` with the truth (its clean epochs are the floor's).
-std::array<double, host::kPaperPairs.count> stats_floor(const std::string& data, const std::string& model, double from_day,
-                                             double to_day) {
+std::array<double, host::kPaperPairs.count> stats_floor(const std::string& data, const std::string& model,
+                                                        double from_day, double to_day) {
     host::StatsOptions o;
     o.in = data;
     o.model = model;

@@ -59,8 +59,7 @@ std::string time_text(double t) {
 }  // namespace
 
 namespace {
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period,
-                   HeadSet heads);
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads);
 
 HeadSet frame_set(const FitOptions& opt) {
     return head_bit(opt.frame_heads[0]) | head_bit(opt.frame_heads[1]);
@@ -125,9 +124,9 @@ constexpr double kPlaceholderPeriodS = 5400.0;
 // when the rows are out of time order).
 struct Pass {
     FitReport r;
-    HeadSet with_rows = 0U;  // heads with rows in the modelling period
-    std::optional<double> period;                                // bins the epochs into orbits
-    bool period_given = false;                                   // --orbit-period, or the second reading
+    HeadSet with_rows = 0U;                                              // heads with rows in the modelling period
+    std::optional<double> period;                                        // bins the epochs into orbits
+    bool period_given = false;                                           // --orbit-period, or the second reading
     std::array<std::optional<Eigen::Quaterniond>, kMaxHeads> reference;  // provisional r, then N_i
     std::array<Eigen::Quaterniond, kMaxHeads> earliest_a;                // the earliest epoch's a
     bool any_epoch = false;
@@ -389,8 +388,7 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // (earliest_period: that second reading.) Likewise the heads: a reading
 // assumes them (A, B, C and F's first); when the period holds rows of others,
 // the rows are read again with those too.
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period,
-                   HeadSet heads) {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads) {
     EarthVelocity earth;
     Pass p;
     p.r.heads = heads;
@@ -443,10 +441,11 @@ std::string describe(const FitReport& r) {
     for (std::size_t d = 1; d < kDropKinds; ++d) {
         o << (d > 1 ? "," : "") << ' ' << drop_name(static_cast<Drop>(d)) << ' ' << r.dropped[d];
     }
-    o << "\nepochs with " << head_words(r.heads) << " selected " << r.epochs << "; orbit averages used " << r.orbits_used
-      << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
+    o << "\nepochs with " << head_words(r.heads) << " selected " << r.epochs << "; orbit averages used "
+      << r.orbits_used << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
     o << "fitted: the heads' rotations relative to the frame F of heads " << head_name(r.frame_heads[0]) << " and "
-      << head_name(r.frame_heads[1]) << " (eqs. 1-3), orbit-averaged,\n"
+      << head_name(r.frame_heads[1])
+      << " (eqs. 1-3), orbit-averaged,\n"
          "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their "
          "squares),\n"
          "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by "
@@ -457,8 +456,9 @@ std::string describe(const FitReport& r) {
     std::snprintf(buf, sizeof buf,
                   "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
                   "observable), condition number %.1f; unobservable directions at %.1e\n",
-                  terms_name(r.terms), 3 * heads_of(r.heads).count * r.orbits_used, r.fit.unknowns, r.singular_values.front(),
-                  r.singular_values[rank - 1], r.fit.rank, r.condition, r.singular_values[rank]);
+                  terms_name(r.terms), 3 * heads_of(r.heads).count * r.orbits_used, r.fit.unknowns,
+                  r.singular_values.front(), r.singular_values[rank - 1], r.fit.rank, r.condition,
+                  r.singular_values[rank]);
     o << buf;
     o << describe_centring(r.fit);
     o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";

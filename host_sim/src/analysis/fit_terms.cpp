@@ -55,8 +55,8 @@ const char* terms_name(Terms t) noexcept {
     return t == Terms::kLinear ? "linear" : "quadratic";
 }
 
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads,
-                     Terms terms, double max_condition, double min_range_c) {
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
+                     double max_condition, double min_range_c) {
     TermsFit f;
     f.terms = terms;
     f.heads = heads;
@@ -147,7 +147,8 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
     Eigen::VectorXd target(rows * n);
     Eigen::MatrixXd a(rows, unknowns);
     // Three heads: P fixed-size, the products as they always were, bit for bit.
-    const Eigen::Matrix<double, 9, 9> proj3 = rows == 9 ? Eigen::Matrix<double, 9, 9>(proj) : Eigen::Matrix<double, 9, 9>::Zero();
+    const Eigen::Matrix<double, 9, 9> proj3 =
+        rows == 9 ? Eigen::Matrix<double, 9, 9>(proj) : Eigen::Matrix<double, 9, 9>::Zero();
     for (Eigen::Index k = 0; k < n; ++k) {
         a.setZero();
         for (std::size_t i = 0; i < list.count; ++i) {
@@ -284,8 +285,8 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
     return f;
 }
 
-std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from,
-                                             double to, const ModelFile& m) {
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
+                                             const ModelFile& m) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
     const HeadList list = heads_of(heads);

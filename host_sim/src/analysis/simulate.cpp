@@ -327,7 +327,8 @@ void refuse_window(const char* option, const char* form, const DayWindow& w, dou
 void refuse_bad_head(const char* option, std::size_t head, HeadSet heads) {
     if (head >= kMaxHeads || !has_head(heads, static_cast<std::uint8_t>(head))) {
         throw std::invalid_argument(std::string(option) + ": HEAD must be " + head_words(heads, " or ") +
-                                    " (the heads simulated, --heads), got " + head_name(static_cast<std::uint8_t>(head)));
+                                    " (the heads simulated, --heads), got " +
+                                    head_name(static_cast<std::uint8_t>(head)));
     }
 }
 
@@ -517,8 +518,7 @@ std::array<double, 5> temperatures(const SpacecraftPose& o, const Eigen::Vector3
 
 // The recorded T_CHU of a head beyond C: its response, its own wander and
 // read noise, drawn from its own stream (Mission::extra_).
-double extra_chu_temperature(std::size_t h, const Exposure& x, double op, Wander& wander, double step_s,
-                             Random& rnd) {
+double extra_chu_temperature(std::size_t h, const Exposure& x, double op, Wander& wander, double step_s, Random& rnd) {
     wander.step(step_s, 3.0 * kSecondsPerDay, 0.6, rnd.engine);
     const double t = chu_temperature(h, x, wander.x, op);
     return std::round((t + 0.02 * rnd.gauss()) * 1000.0) / 1000.0;  // as written
@@ -581,7 +581,7 @@ struct EpochState {
     std::array<double, 5> temp{};               // T_CHU A, B, C, T029, T032
     std::array<double, kMaxHeads> extra_chu{};  // T_CHU of the heads beyond C, by head index
     bool no_temperature = false;                // telemetry gap
-    bool no_velocity = false;     // GPS gap
+    bool no_velocity = false;                   // GPS gap
 };
 
 // Head h's T_CHU at the epoch.
@@ -729,8 +729,8 @@ public:
         e.temp = temperatures(e.orbit, e.sun, op, surv, wander_, opt_.step_s, rnd_);
         for (std::size_t h = 3; h < kMaxHeads; ++h) {
             if (extra_[h]) {
-                e.extra_chu[h] = extra_chu_temperature(h, exposure(e.orbit, e.sun), op, extra_wander_[h], opt_.step_s,
-                                                       *extra_[h]);
+                e.extra_chu[h] =
+                    extra_chu_temperature(h, exposure(e.orbit, e.sun), op, extra_wander_[h], opt_.step_s, *extra_[h]);
             }
         }
         e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
@@ -880,7 +880,7 @@ private:
     std::array<Eigen::Matrix3d, kMaxHeads> mount_;
     EarthVelocity earth_;
     Heaters heaters_;
-    std::array<Wander, 5> wander_;  // T_CHU A, B, C, T029, T032
+    std::array<Wander, 5> wander_;                        // T_CHU A, B, C, T029, T032
     std::array<std::optional<Random>, kMaxHeads> extra_;  // the streams of the heads beyond C simulated
     std::array<Wander, kMaxHeads> extra_wander_;          // their T_CHU
     Gap telemetry_gap_;
@@ -890,8 +890,8 @@ private:
     std::array<std::vector<double>, kMaxPairs> floor_v_;
     DailyFloor daily_;
     std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
-    HeadSet solved_;  // A, B, C and the heads simulated
-    PairList pairs_;  // of the heads simulated
+    HeadSet solved_;                            // A, B, C and the heads simulated
+    PairList pairs_;                            // of the heads simulated
 };
 
 }  // namespace

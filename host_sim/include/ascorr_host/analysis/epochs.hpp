@@ -23,8 +23,8 @@
 #include <cstdio>
 #include <functional>
 #include <optional>
-#include <string>
 #include <set>
+#include <string>
 #include <unordered_map>
 #include <utility>
 

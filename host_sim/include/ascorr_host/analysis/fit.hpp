@@ -89,14 +89,14 @@ struct FitReport {
     double orbit_period_s = 0.0;
     std::size_t rows = 0;  // in [from, to]
     std::array<std::size_t, kDropKinds> dropped{};
-    HeadSet heads = kPaperHeads;                  // the heads fitted
+    HeadSet heads = kPaperHeads;                    // the heads fitted
     std::array<std::uint8_t, 2> frame_heads{0, 2};  // F's
     std::size_t epochs = 0;                         // with all of them selected
     std::size_t orbits_used = 0;
     std::size_t orbits_left_out = 0;
     Terms terms = Terms::kLinear;
-    std::vector<double> singular_values;  // of the joint design with unit-norm columns, descending
-    double condition = 0.0;               // largest / smallest observable singular value
+    std::vector<double> singular_values;    // of the joint design with unit-norm columns, descending
+    double condition = 0.0;                 // largest / smallest observable singular value
     std::array<HeadFit, kMaxHeads> head{};  // by head index
     ModelFile model;
     TermsFit fit;         // the written model's fit: centring, rank

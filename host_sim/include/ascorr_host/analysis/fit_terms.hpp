@@ -71,7 +71,7 @@ struct Centring {
 struct TermsFit {
     Terms terms = Terms::kLinear;
     HeadSet heads = kPaperHeads;  // the heads fitted, jointly
-    std::string refused;  // non-empty: the data do not support this model (why); no model
+    std::string refused;          // non-empty: the data do not support this model (why); no model
     int unknowns = 0;
     int rank = 0;                         // observable directions: unknowns − 9 (the gauge)
     std::vector<double> singular_values;  // of the centred, unit-norm-column design, descending
@@ -89,8 +89,8 @@ struct TermsFit {
 // over the orbit averages, and any model whose condition number exceeds
 // max_condition, naming the head and term of the weakest direction.
 using HeadOrientations = std::array<Eigen::Matrix3d, kMaxHeads>;  // N_i by head index
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads,
-                     Terms terms, double max_condition, double min_range_c);
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
+                     double max_condition, double min_range_c);
 
 // One epoch with all the fit's heads selected: the aberration-corrected
 // attitudes and each head's (T1, T2, T3), by head index.
@@ -103,8 +103,8 @@ struct FitEpoch {
 // IBA RMS per pair of `heads` (pairs_of, by position) of the epochs with t in
 // [from, to), thermally corrected by m (the core, double). Epochs the core
 // does not correct are left out. epochs must be sorted by t.
-std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from,
-                                             double to, const ModelFile& m);
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
+                                             const ModelFile& m);
 
 struct ModelScore {
     TermsFit fit;                      // fitted on the part of the period before t_split
@@ -114,7 +114,7 @@ struct ModelScore {
 
 struct Selection {
     PairList pairs = kPaperPairs;  // of the fit's heads
-    double holdout = 0.0;  // fraction of the period held out (its end)
+    double holdout = 0.0;          // fraction of the period held out (its end)
     double t_split = 0.0;
     std::size_t orbits_fitted = 0;
     std::vector<ModelScore> models;  // linear first, then quadratic

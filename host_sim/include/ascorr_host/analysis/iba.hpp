@@ -59,9 +59,9 @@ constexpr HeadSet analysis_heads(HeadSet with_rows, HeadSet needed = 0U) noexcep
 inline constexpr std::size_t kMaxPairs = std::size_t{kMaxHeads} * (kMaxHeads - 1U) / 2U;
 
 struct HeadPair {
-    std::uint8_t first = 0;   // first < second
+    std::uint8_t first = 0;  // first < second
     std::uint8_t second = 0;
-    char name[4] = {};        // "A-B"
+    char name[4] = {};  // "A-B"
 };
 
 // The heads of a set in heads.hpp's order, and its pairs.

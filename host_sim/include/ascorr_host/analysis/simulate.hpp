@@ -127,7 +127,7 @@ struct SimulateSummary {
     HeadSet heads = kPaperHeads;                       // simulated
     PairList pairs = kPaperPairs;                      // pairs_of(heads): floor is indexed by position in it
     std::array<std::size_t, kMaxHeads> outage_rows{};  // per head, not written (Sun or Moon in view)
-    std::size_t flagged_rows = 0;              // flags != 0 or confidence > 5
+    std::size_t flagged_rows = 0;                      // flags != 0 or confidence > 5
     std::size_t rows_without_temperature = 0;
     std::size_t rows_without_velocity = 0;
     std::array<Rms, kMaxPairs> floor{};

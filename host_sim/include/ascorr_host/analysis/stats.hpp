@@ -47,12 +47,12 @@ struct PairSeries {
 struct StatsResult {
     bool thermal = false;
     bool corrected_input = false;  // StatsOptions::corrected_input: only the "original" stage
-    HeadSet heads = kPaperHeads;  // analysis_heads of the heads with rows in the file
+    HeadSet heads = kPaperHeads;   // analysis_heads of the heads with rows in the file
     PairList pairs = kPaperPairs;  // pairs_of(heads): the arrays below are indexed by position in it
     std::array<std::array<Rms, kStages>, kMaxPairs> rms{};
     std::array<std::size_t, kMaxPairs> n{};
     std::array<PairSeries, kMaxPairs> series;  // sorted by t; filled when keep_series
-    std::size_t rows = 0;                   // rows in [from, to]
+    std::size_t rows = 0;                      // rows in [from, to]
     std::size_t clean_rows = 0;
     // For a pair without clean epochs (n == 0), why, in words: no rows in the
     // file or in [from, to], a head without rows or without clean rows (and
