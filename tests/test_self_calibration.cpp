@@ -37,8 +37,8 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr double kDay = 86400.0;
-using host::kPairHeads;
-using host::kPairs;
+
+constexpr std::size_t kPairs = host::kPaperPairs.count;  // A-B, A-C, B-C
 
 struct Mission {
     fs::path dir;
@@ -105,8 +105,8 @@ Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& histor
     Ibas out;
     for (const auto& [t, z] : epochs) {
         for (std::size_t p = 0; p < kPairs; ++p) {
-            const auto& a = z[kPairHeads[p][0]];
-            const auto& b = z[kPairHeads[p][1]];
+            const auto& a = z[host::kPaperPairs.pair[p].first];
+            const auto& b = z[host::kPaperPairs.pair[p].second];
             if (a && b) {
                 out.t[p].push_back(t);
                 out.v[p].push_back(host::angle_arcsec(*a, *b));

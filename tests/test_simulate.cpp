@@ -66,8 +66,8 @@ TEST(Simulate, CorrectWithTheTruthGivesTheNoiseFloor) {
     o.model = data.string() + ".truth.csv";
     const host::StatsResult r = host::compute_stats(o, std::cerr);
     const std::string floor = slurp(data.string() + ".floor.json");
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
-        const std::regex re(std::string("\"") + host::kPairNames[p] +
+    for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
+        const std::regex re(std::string("\"") + host::kPaperPairs.pair[p].name +
                             "\": \\{\"rms\": ([0-9.]+), \"rms_200s\": ([0-9.]+), \"n\": ([0-9]+)\\}");
         std::smatch m;
         ASSERT_TRUE(std::regex_search(floor, m, re)) << floor;
@@ -187,10 +187,12 @@ TEST(Plot, TemperatureSeriesAreBinMeansOfTheRows) {
     // The same means, computed here from the rows.
     std::string storage;
     const auto recs = read_records(data.string(), storage);
-    std::map<long long, std::array<std::pair<double, int>, 5>> ref;
+    // Columns: T_CHU by head index (heads.hpp), T029, T032.
+    constexpr std::size_t kSeries = kMaxHeads + 2U;
+    std::map<long long, std::array<std::pair<double, int>, kSeries>> ref;
     for (const auto& r : recs) {
         auto& b = ref[static_cast<long long>(std::floor(r.t / 3600.0))];
-        const std::pair<std::size_t, std::size_t> cols[3] = {{r.head, 0}, {3, 1}, {4, 2}};
+        const std::pair<std::size_t, std::size_t> cols[3] = {{r.head, 0}, {kMaxHeads, 1}, {kMaxHeads + 1U, 2}};
         for (const auto& c : cols) {
             if (r.temperature_present[c.second]) {
                 b[c.first].first += r.temperature[c.second];
@@ -204,7 +206,7 @@ TEST(Plot, TemperatureSeriesAreBinMeansOfTheRows) {
     for (const auto& kv : ref) {
         double t = 0.0;
         f >> t;
-        for (std::size_t i = 0; i < 5; ++i) {
+        for (std::size_t i = 0; i < kSeries; ++i) {
             std::string v;
             f >> v;
             if (kv.second[i].second == 0) {
@@ -277,16 +279,16 @@ constexpr double kStart = host::kDefaultSimStartT;
 constexpr double kDayS = 86400.0;
 
 // The floor of days [from, to) by `stats` with the truth (its clean epochs are the floor's).
-std::array<double, host::kPairs> stats_floor(const std::string& data, const std::string& model, double from_day,
-                                             double to_day) {
+std::array<double, host::kPaperPairs.count> stats_floor(const std::string& data, const std::string& model,
+                                                        double from_day, double to_day) {
     host::StatsOptions o;
     o.in = data;
     o.model = model;
     o.from = kStart + from_day * kDayS;
     o.to = kStart + to_day * kDayS - 5e-4;  // [from, to) of rows written to the millisecond
     const host::StatsResult r = host::compute_stats(o, std::cerr);
-    std::array<double, host::kPairs> rms{};
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
+    std::array<double, host::kPaperPairs.count> rms{};
+    for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
         rms[p] = r.rms[p][2].rms;
     }
     return rms;
@@ -300,8 +302,8 @@ TEST(SimulateEvents, DailyFloorGivesTheFloorOfTheMissionAndOfAnyWindowOfDays) {
     const auto whole = host::floor_of_days(data + ".floor-daily.csv", 0, 5);
     const auto window = host::floor_of_days(data + ".floor-daily.csv", 1, 3);
     const auto by_stats = stats_floor(data, data + ".truth.csv", 1.0, 3.0);
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
-        const std::regex re(std::string("\"") + host::kPairNames[p] +
+    for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
+        const std::regex re(std::string("\"") + host::kPaperPairs.pair[p].name +
                             "\": \\{\"rms\": ([0-9.]+), .*?\"n\": ([0-9]+)\\}");
         std::smatch m;
         ASSERT_TRUE(std::regex_search(floor, m, re)) << floor;
@@ -356,11 +358,11 @@ TEST(SimulateEvents, TruthChangeHoldsFromItsDayAndIsInTheTruthHistory) {
     const auto floor_across = host::floor_of_days(data + ".floor-daily.csv", 2, 4);
     const auto old_across = stats_floor(data, before, 2.0, 4.0);
     const auto new_across = stats_floor(data, settled, 2.0, 4.0);
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
+    for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
         std::printf(
             "%s floor %.4f / %.4f / across %.4f; old truth %.4f / %.4f / across %.4f; new truth after %.4f / "
             "across %.4f\n",
-            host::kPairNames[p], floor_before[p].rms, floor_after[p].rms, floor_across[p].rms, old_before[p],
+            host::kPaperPairs.pair[p].name, floor_before[p].rms, floor_after[p].rms, floor_across[p].rms, old_before[p],
             old_after[p], old_across[p], new_after[p], new_across[p]);
         EXPECT_NEAR(old_before[p], floor_before[p].rms, 1e-6);
         EXPECT_NEAR(new_after[p], floor_after[p].rms, 1e-6);
@@ -491,7 +493,7 @@ TEST(SimulateEvents, HeadBiasShiftsItsPairsIbaByTheRotationInTheWindowOnly) {
     const auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
         return std::atan2(u.cross(v).norm(), u.dot(v)) / kArcsecToRad;
     };
-    const std::array<double, host::kPairs> expected = {
+    const std::array<double, host::kPaperPairs.count> expected = {
         0.0,
         angle(host::head_mounting(0).row(2), rotated.row(2)) -
             angle(host::head_mounting(0).row(2), host::head_mounting(2).row(2)),
@@ -513,15 +515,15 @@ TEST(SimulateEvents, HeadBiasShiftsItsPairsIbaByTheRotationInTheWindowOnly) {
         za[{a[i].t, a[i].head}] = z(a[i]);
         zb[{b[i].t, b[i].head}] = z(b[i]);
     }
-    std::array<double, host::kPairs> worst_in{};
-    std::array<double, host::kPairs> worst_out{};
-    std::array<std::size_t, host::kPairs> n_in{};
+    std::array<double, host::kPaperPairs.count> worst_in{};
+    std::array<double, host::kPaperPairs.count> worst_out{};
+    std::array<std::size_t, host::kPaperPairs.count> n_in{};
     for (const auto& kv : za) {
         const double t = kv.first.first;
         const bool in = t >= kStart + kDayS && t < kStart + 2.0 * kDayS;
-        for (std::size_t p = 0; p < host::kPairs; ++p) {
-            const auto i = host::kPairHeads[p][0];
-            const auto j = host::kPairHeads[p][1];
+        for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
+            const auto i = host::kPaperPairs.pair[p].first;
+            const auto j = host::kPaperPairs.pair[p].second;
             if (kv.first.second != i || za.count({t, j}) == 0) {
                 continue;
             }
@@ -531,9 +533,9 @@ TEST(SimulateEvents, HeadBiasShiftsItsPairsIbaByTheRotationInTheWindowOnly) {
             n_in[p] += in ? 1U : 0U;
         }
     }
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
+    for (std::size_t p = 0; p < host::kPaperPairs.count; ++p) {
         std::printf("%s: expected shift %.4f\", worst deviation in the window %.2e\", outside %.2e\"\n",
-                    host::kPairNames[p], expected[p], worst_in[p], worst_out[p]);
+                    host::kPaperPairs.pair[p].name, expected[p], worst_in[p], worst_out[p]);
         EXPECT_GT(n_in[p], 200U);
         EXPECT_LT(worst_in[p], 0.01);  // the aberration of the rotated boresight differs by ~1e-4 of 5"
         EXPECT_LT(worst_out[p], 1e-6);

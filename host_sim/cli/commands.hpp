@@ -7,12 +7,34 @@
 #include <CLI/CLI.hpp>
 
 #include <cctype>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "ascorr/core/heads.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+
 namespace ascorr::cli {
+
+// Heads by their letters (--heads ABCD, --frame-heads AC): heads.hpp's, in its
+// order, none twice, at least `min` and at most `max` of them. A refused value
+// is a usage error (exit 2), found before any input is read.
+inline CLI::Validator head_letters_in(std::size_t min, std::size_t max) {
+    return CLI::Validator(
+        [min, max](std::string& s) {
+            const std::optional<host::HeadSet> set = host::parse_head_letters(s);
+            const std::size_t n = set ? host::head_count(*set) : 0;
+            if (set && n >= min && n <= max) {
+                return std::string();
+            }
+            const std::string count = min == max ? std::to_string(min) : std::to_string(min) + " or more";
+            return "'" + s + "' is not " + count + " of the heads " + kHeadLetters +
+                   " (their letters, in that order, none twice)";
+        },
+        "LETTERS");
+}
 
 // Refuses an empty path (--model "", --states ""), which would otherwise read
 // as "no model", "no states".

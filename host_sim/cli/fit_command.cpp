@@ -10,6 +10,7 @@ namespace ascorr::cli {
 
 void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
+    auto frame = std::make_shared<std::string>("AC");
     CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
     cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "model file to write (CSV)")
@@ -35,7 +36,12 @@ void add_fit_command(CLI::App& app) {
     cmd->add_option("--min-temperature-range", opt->min_temperature_range_c,
                     "smallest range (degC) of each regressor for quadratic terms, 0 or more (default 2)")
         ->check(real_in(0.0, HUGE_VAL, End::kClosed, End::kOpen));
-    cmd->callback([opt]() {
+    cmd->add_option("--frame-heads", *frame,
+                    "the two heads of frame F (eqs. 1-3), in heads' order, the first in A's role, the second in C's "
+                    "(default AC); the fit's heads are A, B, C, these two and every head with rows")
+        ->check(head_letters_in(2, 2));
+    cmd->callback([opt, frame]() {
+        opt->frame_heads = {head_index((*frame)[0]), head_index((*frame)[1])};  // checked already
         read_dash_from_standard_input({{"--in", &opt->in}});
         const host::FitReport r = host::fit_model(*opt);
         std::cout << host::describe(r);

@@ -32,11 +32,12 @@ bool finite_real(const std::string& s, double& x) {
     return detail::classify_real(s, x) == detail::RealText::kNumber && std::isfinite(x);
 }
 
+// A head's letter (heads.hpp); whether it is simulated is refuse_bad_events'.
 bool head_of(const std::string& s, std::size_t& head) {
-    if (s.size() != 1 || s[0] < 'A' || s[0] > 'C') {
+    if (s.size() != 1 || head_index(s[0]) == kUnknownHead) {
         return false;
     }
-    head = static_cast<std::size_t>(s[0] - 'A');
+    head = head_index(s[0]);
     return true;
 }
 
@@ -69,7 +70,7 @@ std::string parse_thermistor_fault(const std::string& s, host::ThermistorFault& 
         return s + form + "expected 5 fields, or 6 for a drift";
     }
     if (!head_of(parts[0], out.head)) {
-        return s + form + "HEAD must be A, B or C";
+        return s + form + "HEAD must be " + kHeadChoices.text;
     }
     const char* const channels[3] = {"t_chu", "t_029", "t_032"};
     out.channel = 3;
@@ -101,7 +102,7 @@ std::string parse_head_bias(const std::string& s, host::HeadBias& out) {
         return s + form + "expected 4 fields";
     }
     if (!head_of(parts[0], out.head)) {
-        return s + form + "HEAD must be A, B or C";
+        return s + form + "HEAD must be " + kHeadChoices.text;
     }
     const std::string why = parse_window(parts, 1, out.window);
     if (!why.empty()) {
@@ -135,6 +136,7 @@ struct EventTexts {
     std::vector<std::string> gaps;
     std::vector<std::string> thermistor_faults;
     std::vector<std::string> head_biases;
+    std::string heads = "ABC";
 };
 
 void add_event_options(CLI::App* cmd, EventTexts& t) {
@@ -177,9 +179,15 @@ void add_simulate_command(CLI::App& app) {
         ->check(non_empty_path());
     cmd->add_option("--start", opt->start_t, "first epoch, s since J2000 TT (default 2014-06-16)")
         ->check(real_number());
+    cmd->add_option("--heads", events->heads,
+                    std::string("the heads simulated: two or more of ") + kHeadLetters +
+                        ", in that order (default ABC); a head beyond C is derived from the one three before it "
+                        "(docs/contract.md)")
+        ->check(head_letters_in(2, kMaxHeads));
     add_event_options(cmd, *events);
     cmd->callback([opt, events]() {
         read_dash_from_standard_input({{"--truth", &opt->truth}});
+        opt->heads = host::parse_head_letters(events->heads).value_or(host::kPaperHeads);  // checked already
         opt->truth_changes = parsed(events->truth_changes, &parse_truth_change);
         opt->gaps = parsed(events->gaps, &parse_gap);
         opt->thermistor_faults = parsed(events->thermistor_faults, &parse_thermistor_fault);

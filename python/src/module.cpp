@@ -622,8 +622,11 @@ py::tuple earth_velocity(const py::object& t_obj, const py::object& exact_obj) {
 
 py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     const Rows r = rows_of(t, chu, q, py::none(), py::none());
-    std::array<std::vector<double>, host::kPairs> pt;
-    std::array<std::vector<double>, host::kPairs> pv;
+    // Every pair of kMaxHeads while reading; those of the rows' heads at the end (as stats()).
+    constexpr host::PairList kAllPairs = host::pairs_of(host::kAllHeads);
+    host::HeadSet with_rows = 0U;
+    std::array<std::vector<double>, host::kMaxPairs> pt;
+    std::array<std::vector<double>, host::kMaxPairs> pv;
     // A row whose quaternion the core rejects (not finite, not unit: status 16
     // in correct()) takes no part in any IBA, as in stats(); it still counts
     // for the one-row-per-head-and-epoch rule.
@@ -632,9 +635,9 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
         bool accepted;
     };
     host::EpochAssembler<Boresight> epochs(kArrayRows, [&](const host::Epoch<Boresight>& e) {
-        for (std::size_t p = 0; p < host::kPairs; ++p) {
-            const auto& a = e.head[host::kPairHeads[p][0]];
-            const auto& b = e.head[host::kPairHeads[p][1]];
+        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+            const auto& a = e.head[kAllPairs.pair[p].first];
+            const auto& b = e.head[kAllPairs.pair[p].second];
             if (a && b && a->accepted && b->accepted) {
                 pt[p].push_back(e.t);
                 pv[p].push_back(host::angle_arcsec(a->z, b->z));
@@ -646,7 +649,8 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     SolutionRecord rec;
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
-        if (rec.head <= 2) {
+        if (rec.head < kMaxHeads) {
+            with_rows |= host::head_bit(rec.head);
             SolutionInput<double> in{};
             in.q_chu_icrf = rec.q_chu_icrf;
             in.head = rec.head;
@@ -665,7 +669,12 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
         throw py::error_already_set();
     }
     py::dict out;
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
+    for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+        const host::HeadPair& pair = kAllPairs.pair[p];
+        const host::HeadSet heads = host::analysis_heads(with_rows);
+        if (!host::has_head(heads, pair.first) || !host::has_head(heads, pair.second)) {
+            continue;
+        }
         std::vector<std::size_t> idx(pt[p].size());
         std::iota(idx.begin(), idx.end(), std::size_t{0});
         std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return pt[p][i] < pt[p][j]; });
@@ -675,7 +684,7 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
             ta.mutable_data()[i] = pt[p][idx[i]];
             va.mutable_data()[i] = pv[p][idx[i]];
         }
-        out[host::kPairNames[p]] = py::make_tuple(ta, va);
+        out[pair.name] = py::make_tuple(ta, va);
     }
     return out;
 }
@@ -714,7 +723,7 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     std::ostringstream log;
     const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log);
     py::dict pairs;
-    for (std::size_t p = 0; p < host::kPairs; ++p) {
+    for (std::size_t p = 0; p < s.pairs.count; ++p) {
         py::dict d;
         for (std::size_t st = 0; st < host::kStages; ++st) {
             const bool have = host::rms_defined(s, p, st);
@@ -723,7 +732,7 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
                 have ? py::object(py::float_(s.rms[p][st].rms_smoothed)) : py::object(py::none());
         }
         d["n"] = s.n[p];
-        pairs[host::kPairNames[p]] = d;
+        pairs[s.pairs.pair[p].name] = d;
     }
     py::dict out;
     out["pairs"] = pairs;
@@ -824,14 +833,18 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["orbits_left_out"] = rep.orbits_left_out;
     d["singular_values"] = rep.singular_values;
     d["condition"] = rep.condition;
-    py::array_t<double> res({py::ssize_t{3}, py::ssize_t{3}});
-    py::array_t<double> sig({py::ssize_t{3}, py::ssize_t{3}});
-    for (std::size_t h = 0; h < 3; ++h) {
+    // A row per head fitted (d["heads"], in heads.hpp's order), a column per axis.
+    const host::HeadList heads = host::heads_of(rep.heads);
+    const auto n_heads = static_cast<py::ssize_t>(heads.count);
+    py::array_t<double> res({n_heads, py::ssize_t{3}});
+    py::array_t<double> sig({n_heads, py::ssize_t{3}});
+    for (std::size_t i = 0; i < heads.count; ++i) {
         for (std::size_t a = 0; a < 3; ++a) {
-            res.mutable_data()[3 * h + a] = rep.head[h].residual_rms[a];
-            sig.mutable_data()[3 * h + a] = rep.head[h].signal_rms[a];
+            res.mutable_data()[3 * i + a] = rep.head[heads.head[i]].residual_rms[a];
+            sig.mutable_data()[3 * i + a] = rep.head[heads.head[i]].signal_rms[a];
         }
     }
+    d["heads"] = host::head_letters(rep.heads);
     d["residual_rms"] = res;
     d["signal_rms"] = sig;
     d["terms"] = host::terms_name(rep.terms);
@@ -1374,8 +1387,9 @@ case, as --terms); holdout: the fraction of the period (its end) held out for th
 model-selection report, 0..0.5; min_temperature_range: the smallest range (degC)
 of each regressor for quadratic terms. Returns (model, report): model an
 ascorr.Model (model.write(path) writes the model file), report a dict (rows,
-dropped, epochs, orbits_used, condition, singular_values, terms, residual_rms
-and signal_rms (3, 3) arcsec [head A..C][alpha, beta, gamma], text).
+dropped, epochs, orbits_used, condition, singular_values, terms, heads (the
+letters of the heads fitted: A, B, C and any other with rows), residual_rms and
+signal_rms (len(heads), 3) arcsec [head][alpha, beta, gamma], text).
 Raises ascorr.FitRefused (a ValueError) when the data cannot determine the model
 (period shorter than min_days, fewer than min_orbits orbits, condition number
 above max_condition, too small a temperature range for quadratic terms) or a

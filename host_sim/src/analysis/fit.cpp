@@ -35,12 +35,19 @@ struct Row {
 // end, the small angles relative to the final reference, derived exactly from
 // q (rebase_on_earliest_epoch), so that the result does not depend on which
 // epoch came first; x, x2: the regressors and their squares.
+// By head index.
 struct OrbitSums {
+    OrbitSums() {
+        q.fill(Eigen::Vector4d::Zero());
+        e.fill(Eigen::Vector3d::Zero());
+        x.fill(Eigen::Vector3d::Zero());
+        x2.fill(Eigen::Vector3d::Zero());
+    }
     std::size_t count = 0;
-    std::array<Eigen::Vector4d, 3> q{Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
-    std::array<Eigen::Vector3d, 3> e{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-    std::array<Eigen::Vector3d, 3> x{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-    std::array<Eigen::Vector3d, 3> x2{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::array<Eigen::Vector4d, kMaxHeads> q;
+    std::array<Eigen::Vector3d, kMaxHeads> e;
+    std::array<Eigen::Vector3d, kMaxHeads> x;
+    std::array<Eigen::Vector3d, kMaxHeads> x2;
 };
 
 std::string time_text(double t) {
@@ -52,7 +59,11 @@ std::string time_text(double t) {
 }  // namespace
 
 namespace {
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period);
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads);
+
+HeadSet frame_set(const FitOptions& opt) {
+    return head_bit(opt.frame_heads[0]) | head_bit(opt.frame_heads[1]);
+}
 
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
@@ -67,6 +78,11 @@ void refuse_bad_fit_options(const FitOptions& opt) {
     }
     if (!(opt.max_condition > 0.0) || std::isnan(opt.max_condition)) {
         throw FitRefused("--max-condition " + number_text(opt.max_condition) + ": must be positive");
+    }
+    if (opt.frame_heads[0] >= kMaxHeads || opt.frame_heads[1] >= kMaxHeads ||
+        opt.frame_heads[0] == opt.frame_heads[1]) {
+        throw FitRefused(std::string("--frame-heads ") + head_name(opt.frame_heads[0]) + head_name(opt.frame_heads[1]) +
+                         ": two different heads of " + kHeadChoices.text + " are needed");
     }
 }
 }  // namespace
@@ -97,7 +113,7 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          number_text(opt.min_temperature_range_c));
     }
-    return fit_pass(opt, rows, std::nullopt);
+    return fit_pass(opt, rows, std::nullopt, analysis_heads(0U, frame_set(opt)));
 }
 
 namespace {
@@ -108,10 +124,11 @@ constexpr double kPlaceholderPeriodS = 5400.0;
 // when the rows are out of time order).
 struct Pass {
     FitReport r;
-    std::optional<double> period;                                // bins the epochs into orbits
-    bool period_given = false;                                   // --orbit-period, or the second reading
-    std::array<std::optional<Eigen::Quaterniond>, 3> reference;  // provisional r, then N_i
-    std::array<Eigen::Quaterniond, 3> earliest_a;                // the earliest epoch's a
+    HeadSet with_rows = 0U;                                              // heads with rows in the modelling period
+    std::optional<double> period;                                        // bins the epochs into orbits
+    bool period_given = false;                                           // --orbit-period, or the second reading
+    std::array<std::optional<Eigen::Quaterniond>, kMaxHeads> reference;  // provisional r, then N_i
+    std::array<Eigen::Quaterniond, kMaxHeads> earliest_a;                // the earliest epoch's a
     bool any_epoch = false;
     double earliest_epoch = 0.0;
     // The earliest selected row: its speed gives the orbit period.
@@ -131,9 +148,9 @@ Eigen::Quaterniond to_eigen_q(const Quaternion<double>& q) {
     return {q.w, q.x, q.y, q.z};
 }
 
-// Frame F (eqs. 1–3) of heads A and C at one epoch (calib/frame.hpp).
-Quaternion<double> q_f_icrf_at(const Epoch<Row>& e) {
-    return calib::q_f_icrf(to_core_q(e.head[0]->q), to_core_q(e.head[2]->q));
+// Frame F (eqs. 1–3) of its two heads at one epoch (calib/frame.hpp).
+Quaternion<double> q_f_icrf_at(const Epoch<Row>& e, const std::array<std::uint8_t, 2>& frame) {
+    return calib::q_f_icrf(to_core_q(e.head[frame[0]]->q), to_core_q(e.head[frame[1]]->q));
 }
 
 // Head h's rotation in F relative to its provisional reference (the first
@@ -153,10 +170,12 @@ void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Quaternion<doubl
     o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
 }
 
-FitEpoch fit_epoch_of(const Epoch<Row>& e) {
+FitEpoch fit_epoch_of(const Epoch<Row>& e, HeadSet heads) {
     FitEpoch fe{};
     fe.t = e.t;
-    for (std::size_t h = 0; h < 3; ++h) {
+    const HeadList list = heads_of(heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         const Eigen::Quaterniond& q = e.head[h]->q;
         fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
         fe.temp[h] = e.head[h]->temp;
@@ -179,27 +198,30 @@ void note_epoch_time(Pass& p, double t) {
     p.any_epoch = true;
 }
 
-// One epoch into its orbit's sums. F needs A and C; the same epochs serve all
-// heads, so an epoch without all three is left out.
-void add_epoch(Pass& p, const Epoch<Row>& e, bool selection_report) {
-    if (!(e.head[0] && e.head[1] && e.head[2])) {
-        return;
+// One epoch into its orbit's sums. F needs its two heads; the same epochs
+// serve all heads, so an epoch without all the fit's heads is left out.
+void add_epoch(Pass& p, const Epoch<Row>& e, const FitOptions& opt) {
+    const HeadList list = heads_of(p.r.heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        if (!e.head[list.head[i]]) {
+            return;
+        }
     }
-    const Quaternion<double> q_f_icrf = q_f_icrf_at(e);
+    const Quaternion<double> q_f_icrf = q_f_icrf_at(e, opt.frame_heads);
     const auto bin = static_cast<long long>(std::floor(e.t / *p.period));
     OrbitSums& o = p.orbits[bin];
     ++o.count;
-    for (std::size_t h = 0; h < 3; ++h) {
-        add_head(p, o, e, q_f_icrf, h);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        add_head(p, o, e, q_f_icrf, list.head[i]);
     }
-    if (selection_report) {
-        p.fit_epochs.push_back(fit_epoch_of(e));
+    if (opt.selection_report) {
+        p.fit_epochs.push_back(fit_epoch_of(e, p.r.heads));
     }
     note_epoch_time(p, e.t);
 }
 
 bool in_modelling_period(const FitOptions& opt, const SolutionRecord& rec) {
-    return !((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head > 2);
+    return !((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to) || rec.head >= kMaxHeads);
 }
 
 // The selection (fit_selection), then the aberration correction into c;
@@ -241,6 +263,10 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
     if (!in_modelling_period(opt, rec)) {
         return;
     }
+    p.with_rows |= head_bit(rec.head);
+    if (!has_head(p.r.heads, rec.head)) {
+        return;  // a head this pass does not fit: fit_pass reads the rows again with it
+    }
     ++p.r.rows;
     CorrectedSolution<double> c{};
     const Drop d = select_and_correct(rec, earth, c);
@@ -259,7 +285,9 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
 // angle is 2·vec(a ⊗ b⁻¹), bilinear in a, so an orbit's sum is exactly
 // 2·vec(Σa ⊗ b⁻¹) (Σa as an unnormalised quaternion). Small angle: error ~ θ³/24.
 void rebase_on_earliest_epoch(Pass& p) {
-    for (std::size_t h = 0; h < 3 && p.r.epochs != 0; ++h) {
+    const HeadList list = heads_of(p.r.heads);
+    for (std::size_t i = 0; i < list.count && p.r.epochs != 0; ++i) {
+        const std::size_t h = list.head[i];
         const Quaternion<double> b_inv = conjugate(to_core_q(p.earliest_a[h]));
         for (auto& kv : p.orbits) {
             const Eigen::Vector4d& s = kv.second.q[h];
@@ -273,8 +301,8 @@ void rebase_on_earliest_epoch(Pass& p) {
 
 void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::string& period_text) {
     if (r.epochs == 0) {
-        throw FitRefused(opt.in +
-                         ": no epoch in the modelling period has solutions of A, B and C that pass the selection");
+        throw FitRefused(opt.in + ": no epoch in the modelling period has solutions of " + head_words(r.heads) +
+                         " that pass the selection");
     }
     const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
@@ -301,7 +329,8 @@ std::size_t min_epochs_per_orbit(const std::map<long long, OrbitSums>& orbits) {
 
 // The averages of the orbits with at least min_count epochs.
 std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& orbits, std::size_t min_count,
-                                         double period) {
+                                         double period, HeadSet heads) {
+    const HeadList list = heads_of(heads);
     std::vector<OrbitAverage> averages;
     for (const auto& kv : orbits) {
         if (kv.second.count < min_count) {
@@ -310,7 +339,8 @@ std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& o
         OrbitAverage& a = averages.emplace_back();
         const double w = 1.0 / static_cast<double>(kv.second.count);
         a.t_mid = (static_cast<double>(kv.first) + 0.5) * period;
-        for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const std::size_t h = list.head[i];
             a.e[h] = kv.second.e[h] * w;
             a.x[h] = kv.second.x[h] * w;
             a.x2[h] = kv.second.x2[h] * w;
@@ -323,12 +353,14 @@ std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& o
 // refused as solve_terms says; then the model-selection report.
 void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& averages, const std::string& period_text) {
     FitReport& r = p.r;
-    std::array<Eigen::Matrix3d, 3> n_ref;
-    for (std::size_t h = 0; h < 3; ++h) {
-        n_ref[h] = p.reference[h]->toRotationMatrix();
+    HeadOrientations n_ref;
+    n_ref.fill(Eigen::Matrix3d::Identity());
+    const HeadList list = heads_of(r.heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        n_ref[list.head[i]] = p.reference[list.head[i]]->toRotationMatrix();
     }
     r.terms = opt.terms;
-    r.fit = solve_terms(averages, n_ref, opt.terms, opt.max_condition, opt.min_temperature_range_c);
+    r.fit = solve_terms(averages, n_ref, r.heads, opt.terms, opt.max_condition, opt.min_temperature_range_c);
     if (!r.fit.refused.empty()) {
         if (opt.terms == Terms::kQuadratic) {
             throw FitRefused(opt.in + ": quadratic terms not supported by the data in the modelling period (" +
@@ -340,8 +372,8 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     }
     std::sort(p.fit_epochs.begin(), p.fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
     if (opt.selection_report) {
-        r.selection = select_terms(averages, p.fit_epochs, n_ref, r.t_first, r.t_last, opt.holdout, opt.max_condition,
-                                   opt.min_temperature_range_c);
+        r.selection = select_terms(averages, p.fit_epochs, n_ref, r.heads, r.t_first, r.t_last, opt.holdout,
+                                   opt.max_condition, opt.min_temperature_range_c);
     }
     r.singular_values = r.fit.singular_values;
     r.condition = r.fit.condition;
@@ -353,15 +385,23 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // epoch's (re-based exactly at the end), and the orbit period, when not
 // given, comes from the earliest selected row: if that is not the first one
 // read, the file is read again with that period (unordered files only).
-// (earliest_period: that second reading.)
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period) {
+// (earliest_period: that second reading.) Likewise the heads: a reading
+// assumes them (A, B, C and F's first); when the period holds rows of others,
+// the rows are read again with those too.
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads) {
     EarthVelocity earth;
     Pass p;
+    p.r.heads = heads;
+    p.r.frame_heads = opt.frame_heads;
     p.period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
     p.period = earliest_period ? earliest_period : opt.orbit_period_s;
-    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt.selection_report); });
+    EpochAssembler<Row> epochs(
+        opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt); }, heads);
     rows([&](const SolutionRecord& rec) { add_row(p, opt, earth, epochs, rec); });
     epochs.finish();
+    if ((p.with_rows & ~heads) != 0U) {
+        return fit_pass(opt, rows, earliest_period, analysis_heads(p.with_rows, frame_set(opt)));
+    }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
         throw InputError(opt.in, p.earliest_row_line, 1,
                          "spacecraft speed " + std::to_string(p.earliest_row_speed) +
@@ -369,14 +409,15 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     }
     if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
         // Rows out of time order: again, with the earliest row's period.
-        return fit_pass(opt, rows, p.earliest_row_period);
+        return fit_pass(opt, rows, p.earliest_row_period, heads);
     }
     p.r.orbit_period_s = p.period.value_or(0.0);
     rebase_on_earliest_epoch(p);
 
     const std::string period_text = "t = " + time_text(p.r.t_first) + " .. " + time_text(p.r.t_last);
     refuse_short_period(opt, p.r, period_text);
-    const std::vector<OrbitAverage> averages = orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period);
+    const std::vector<OrbitAverage> averages =
+        orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period, p.r.heads);
     p.r.orbits_used = averages.size();
     p.r.orbits_left_out = p.orbits.size() - averages.size();
     if (averages.size() < opt.min_orbits) {
@@ -400,9 +441,11 @@ std::string describe(const FitReport& r) {
     for (std::size_t d = 1; d < kDropKinds; ++d) {
         o << (d > 1 ? "," : "") << ' ' << drop_name(static_cast<Drop>(d)) << ' ' << r.dropped[d];
     }
-    o << "\nepochs with A, B and C selected " << r.epochs << "; orbit averages used " << r.orbits_used
-      << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
-    o << "fitted: the heads' rotations relative to the frame F of heads A and C (eqs. 1-3), orbit-averaged,\n"
+    o << "\nepochs with " << head_words(r.heads) << " selected " << r.epochs << "; orbit averages used "
+      << r.orbits_used << " (left out, too few epochs: " << r.orbits_left_out << ")\n";
+    o << "fitted: the heads' rotations relative to the frame F of heads " << head_name(r.frame_heads[0]) << " and "
+      << head_name(r.frame_heads[1])
+      << " (eqs. 1-3), orbit-averaged,\n"
          "jointly against [1, T_CHU, T029 - T_CHU, T032 - T_CHU] of each head (--terms quadratic: and their "
          "squares),\n"
          "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by "
@@ -413,12 +456,15 @@ std::string describe(const FitReport& r) {
     std::snprintf(buf, sizeof buf,
                   "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
                   "observable), condition number %.1f; unobservable directions at %.1e\n",
-                  terms_name(r.terms), 9 * r.orbits_used, r.fit.unknowns, r.singular_values.front(),
-                  r.singular_values[rank - 1], r.fit.rank, r.condition, r.singular_values[rank]);
+                  terms_name(r.terms), 3 * heads_of(r.heads).count * r.orbits_used, r.fit.unknowns,
+                  r.singular_values.front(), r.singular_values[rank - 1], r.fit.rank, r.condition,
+                  r.singular_values[rank]);
     o << buf;
     o << describe_centring(r.fit);
     o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";
-    for (std::size_t h = 0; h < 3; ++h) {
+    const HeadList list = heads_of(r.heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         const HeadFit& f = r.head[h];
         std::snprintf(buf, sizeof buf, "%c    %6.3f %6.3f %6.3f                      %6.3f %6.3f %6.3f\n",
                       head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1], f.residual_rms[2],

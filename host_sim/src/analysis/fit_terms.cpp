@@ -55,12 +55,16 @@ const char* terms_name(Terms t) noexcept {
     return t == Terms::kLinear ? "linear" : "quadratic";
 }
 
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<Eigen::Matrix3d, 3>& n_ref, Terms terms,
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
                      double max_condition, double min_range_c) {
     TermsFit f;
     f.terms = terms;
+    f.heads = heads;
+    const HeadList list = heads_of(heads);
+    const auto nh = static_cast<Eigen::Index>(list.count);
+    const Eigen::Index rows = 3 * nh;  // an orbit's equations: 3 per head
     const int per_axis = terms_per_axis(terms);
-    const int unknowns = 9 * per_axis;
+    const int unknowns = static_cast<int>(rows) * per_axis;
     f.unknowns = unknowns;
     f.rank = unknowns - kGauge;
     const auto n = static_cast<Eigen::Index>(orbits.size());
@@ -70,7 +74,8 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
     }
 
     // Centring and scaling of each head's regressors over the orbit averages.
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         for (std::size_t j = 0; j < 3; ++j) {
             const auto ji = static_cast<Eigen::Index>(j);
             double sum = 0.0;
@@ -93,7 +98,8 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
         }
     }
     if (terms == Terms::kQuadratic) {
-        for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const std::size_t h = list.head[i];
             for (std::size_t j = 0; j < 3; ++j) {
                 if (!(f.centring.range[h][j] >= min_range_c)) {
                     f.refused = format(
@@ -108,48 +114,58 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
         }
     }
 
-    // The joint design (fit.hpp): each orbit's 9 equations projected
-    // orthogonally to F's own rotation, P = I − G·Gᵀ/3.
+    // The joint design (fit.hpp): each orbit's 3·heads equations projected
+    // orthogonally to F's own rotation, P = I − G·Gᵀ/heads
     // (calib/common_rotation.hpp).
-    calib::Matrix3 n_core[3];
-    for (std::size_t h = 0; h < 3; ++h) {
+    std::array<calib::Matrix3, kMaxHeads> n_core{};
+    for (std::size_t i = 0; i < list.count; ++i) {
         for (Eigen::Index r = 0; r < 3; ++r) {
             for (Eigen::Index c = 0; c < 3; ++c) {
-                n_core[h].m[r][c] = n_ref[h](r, c);
+                n_core[i].m[r][c] = n_ref[list.head[i]](r, c);
             }
         }
     }
-    double p_core[9][9];
-    calib::common_rotation_projector(n_core, p_core);
-    Eigen::Matrix<double, 9, 9> proj;
-    for (Eigen::Index r = 0; r < 9; ++r) {
-        for (Eigen::Index c = 0; c < 9; ++c) {
-            proj(r, c) = p_core[r][c];
+    std::vector<double> p_core(static_cast<std::size_t>(rows * rows));
+    calib::common_rotation_projector(n_core.data(), list.count, p_core.data());
+    Eigen::MatrixXd proj(rows, rows);
+    for (Eigen::Index r = 0; r < rows; ++r) {
+        for (Eigen::Index c = 0; c < rows; ++c) {
+            proj(r, c) = p_core[static_cast<std::size_t>(r * rows + c)];
         }
     }
-    Eigen::MatrixXd y(n, 9);
+    Eigen::MatrixXd y(n, rows);
     for (Eigen::Index k = 0; k < n; ++k) {
-        for (std::size_t h = 0; h < 3; ++h) {
-            y.block<1, 3>(k, static_cast<Eigen::Index>(3 * h)) = orbits[static_cast<std::size_t>(k)].e[h].transpose();
+        for (std::size_t i = 0; i < list.count; ++i) {
+            y.block<1, 3>(k, static_cast<Eigen::Index>(3 * i)) =
+                orbits[static_cast<std::size_t>(k)].e[list.head[i]].transpose();
         }
     }
     // Centre e on its mean, so that c0 refers to the mean orientation.
     const Eigen::RowVectorXd mean = y.colwise().mean();
     y.rowwise() -= mean;
-    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(9 * n, unknowns);
-    Eigen::VectorXd target(9 * n);
-    Eigen::MatrixXd a(9, unknowns);
+    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(rows * n, unknowns);
+    Eigen::VectorXd target(rows * n);
+    Eigen::MatrixXd a(rows, unknowns);
+    // Three heads: P fixed-size, the products as they always were, bit for bit.
+    const Eigen::Matrix<double, 9, 9> proj3 =
+        rows == 9 ? Eigen::Matrix<double, 9, 9>(proj) : Eigen::Matrix<double, 9, 9>::Zero();
     for (Eigen::Index k = 0; k < n; ++k) {
         a.setZero();
-        for (std::size_t h = 0; h < 3; ++h) {
-            const Eigen::VectorXd r = regressors(orbits[static_cast<std::size_t>(k)], h, f.centring, per_axis);
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const Eigen::VectorXd r =
+                regressors(orbits[static_cast<std::size_t>(k)], list.head[i], f.centring, per_axis);
             for (Eigen::Index ax = 0; ax < 3; ++ax) {
-                const Eigen::Index row = 3 * static_cast<Eigen::Index>(h) + ax;
+                const Eigen::Index row = 3 * static_cast<Eigen::Index>(i) + ax;
                 a.block(row, row * per_axis, 1, per_axis) = r.transpose();
             }
         }
-        design.block(9 * k, 0, 9, unknowns) = proj * a;
-        target.segment<9>(9 * k) = proj * y.row(k).transpose();
+        if (rows == 9) {
+            design.block(9 * k, 0, 9, unknowns) = proj3 * a;
+            target.segment<9>(9 * k) = proj3 * y.row(k).transpose();
+        } else {
+            design.block(rows * k, 0, rows, unknowns) = proj * a;
+            target.segment(rows * k, rows) = proj * y.row(k).transpose();
+        }
     }
     Eigen::VectorXd scale = design.colwise().norm().transpose();
     for (Eigen::Index i = 0; i < scale.size(); ++i) {
@@ -164,23 +180,24 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
     if (!(f.condition <= max_condition)) {
         // Name the head, and the term, whose coefficients dominate the weakest direction.
         const Eigen::VectorXd weakest = svd.matrixV().col(rank - 1);
-        std::array<double, 3> head_share{};
-        std::array<std::array<double, 7>, 3> term_share{};
+        std::array<double, kMaxHeads> head_share{};  // by position in list
+        std::array<std::array<double, 7>, kMaxHeads> term_share{};
         for (Eigen::Index i = 0; i < unknowns; ++i) {
             const auto h = static_cast<std::size_t>(i / (3 * per_axis));
             const auto t = static_cast<std::size_t>(i % per_axis);
             head_share[h] += weakest(i) * weakest(i);
             term_share[h][t] += weakest(i) * weakest(i);
         }
-        const auto head =
-            static_cast<std::size_t>(std::max_element(head_share.begin(), head_share.end()) - head_share.begin());
+        const auto head = static_cast<std::size_t>(
+            std::max_element(head_share.begin(), head_share.begin() + static_cast<long>(list.count)) -
+            head_share.begin());
         const auto term = static_cast<std::size_t>(
             std::max_element(term_share[head].begin(), term_share[head].begin() + per_axis) - term_share[head].begin());
         f.refused = format(
             "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, the largest "
             "%.3g; the weakest direction is mostly CHU %c's coefficients, most of all %s)",
             f.condition, max_condition, static_cast<int>(rank), unknowns, sv(rank - 1), sv(0),
-            head_name(static_cast<std::uint8_t>(head)), kCoefficientNames[term]);
+            head_name(list.head[head]), kCoefficientNames[term]);
         return f;
     }
     // Least squares on the observable directions only (truncated SVD).
@@ -190,12 +207,13 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
 
     // Residuals, with each orbit's common rotation removed (as in the fit).
     const Eigen::VectorXd res = target - design * c_scaled;
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         for (std::size_t ax = 0; ax < 3; ++ax) {
             double ss = 0.0;
             double sy = 0.0;
             for (Eigen::Index k = 0; k < n; ++k) {
-                const Eigen::Index row = 9 * k + static_cast<Eigen::Index>(3 * h + ax);
+                const Eigen::Index row = rows * k + static_cast<Eigen::Index>(3 * i + ax);
                 ss += res(row) * res(row);
                 sy += target(row) * target(row);
             }
@@ -206,11 +224,13 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
 
     // Back into the contract's form (see the header).
     ModelFile& m = f.model;
-    m.present = {true, true, true, false};
+    m.present = {};
     m.quadratic = terms == Terms::kQuadratic;
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
+        m.present[h] = true;
         for (std::size_t ax = 0; ax < 3; ++ax) {
-            const Eigen::Index base = static_cast<Eigen::Index>(3 * h + ax) * per_axis;
+            const Eigen::Index base = static_cast<Eigen::Index>(3 * i + ax) * per_axis;
             auto& c = m.coefficients[h][ax];
             c = {};
             c[0] = b(base);
@@ -230,25 +250,26 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
     // The gauge: of all models the star trackers cannot tell apart (c plus a
     // common rotation w0 + w2·T029 + w3·T032), write the one whose corrections
     // are smallest (RMS over the orbits of the period).
-    Eigen::MatrixXd gd(9 * n, 9);
-    Eigen::VectorXd gt(9 * n);
+    Eigen::MatrixXd gd(rows * n, kGauge);
+    Eigen::VectorXd gt(rows * n);
     for (Eigen::Index k = 0; k < n; ++k) {
         const OrbitAverage& o = orbits[static_cast<std::size_t>(k)];
-        for (Eigen::Index h = 0; h < 3; ++h) {
-            const auto hs = static_cast<std::size_t>(h);
+        for (Eigen::Index i = 0; i < nh; ++i) {
+            const std::size_t hs = list.head[static_cast<std::size_t>(i)];
             const double t2 = o.x[hs](0) + o.x[hs](1);
             const double t3 = o.x[hs](0) + o.x[hs](2);
-            const Eigen::Matrix3d nh = n_ref[hs];
-            gd.block<3, 3>(9 * k + 3 * h, 0) = nh;
-            gd.block<3, 3>(9 * k + 3 * h, 3) = nh * t2;
-            gd.block<3, 3>(9 * k + 3 * h, 6) = nh * t3;
+            const Eigen::Matrix3d n_h = n_ref[hs];
+            gd.block<3, 3>(rows * k + 3 * i, 0) = n_h;
+            gd.block<3, 3>(rows * k + 3 * i, 3) = n_h * t2;
+            gd.block<3, 3>(rows * k + 3 * i, 6) = n_h * t3;
             for (std::size_t ax = 0; ax < 3; ++ax) {
-                gt(9 * k + 3 * h + static_cast<Eigen::Index>(ax)) = -predicted(m.coefficients[hs][ax], o, hs);
+                gt(rows * k + 3 * i + static_cast<Eigen::Index>(ax)) = -predicted(m.coefficients[hs][ax], o, hs);
             }
         }
     }
     const Eigen::VectorXd wv = gd.bdcSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(gt);
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         const Eigen::Vector3d w0 = n_ref[h] * wv.segment<3>(0);
         const Eigen::Vector3d w2 = n_ref[h] * wv.segment<3>(3);
         const Eigen::Vector3d w3 = n_ref[h] * wv.segment<3>(6);
@@ -264,19 +285,22 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<E
     return f;
 }
 
-std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, double from, double to,
-                                          const ModelFile& m) {
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
+                                             const ModelFile& m) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
-    std::array<std::vector<double>, kPairs> t;
-    std::array<std::vector<double>, kPairs> v;
+    const HeadList list = heads_of(heads);
+    const PairList pairs = pairs_of(heads);
+    std::array<std::vector<double>, kMaxPairs> t;
+    std::array<std::vector<double>, kMaxPairs> v;
     for (const FitEpoch& e : epochs) {
         if (!(e.t >= from && e.t < to)) {
             continue;
         }
-        std::array<Vector3<double>, 3> z{};
-        std::array<bool, 3> ok{};
-        for (std::size_t h = 0; h < 3; ++h) {
+        std::array<Vector3<double>, kMaxHeads> z{};
+        std::array<bool, kMaxHeads> ok{};
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const std::size_t h = list.head[i];
             SolutionInput<double> in{};
             in.q_chu_icrf = e.q_chu_icrf[h];
             in.head = static_cast<std::uint8_t>(h);
@@ -288,17 +312,17 @@ std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, d
             ok[h] = (c.status & status::kThermalApplied) != 0U;
             z[h] = boresight(c.q_chu_icrf);
         }
-        for (std::size_t p = 0; p < kPairs; ++p) {
-            const auto i = kPairHeads[p][0];
-            const auto j = kPairHeads[p][1];
+        for (std::size_t p = 0; p < pairs.count; ++p) {
+            const auto i = pairs.pair[p].first;
+            const auto j = pairs.pair[p].second;
             if (ok[i] && ok[j]) {
                 t[p].push_back(e.t);
                 v[p].push_back(angle_arcsec(z[i], z[j]));
             }
         }
     }
-    std::array<Rms, kPairs> out{};
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    std::array<Rms, kMaxPairs> out{};
+    for (std::size_t p = 0; p < pairs.count; ++p) {
         if (!t[p].empty()) {
             out[p] = rms_about_mean(t[p], v[p]);
         }
@@ -307,9 +331,10 @@ std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, d
 }
 
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
-                       const std::array<Eigen::Matrix3d, 3>& n_ref, double t_first, double t_last, double holdout,
+                       const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
                        double max_condition, double min_range_c) {
     Selection s;
+    s.pairs = pairs_of(heads);
     s.holdout = holdout;
     const double inf = std::numeric_limits<double>::infinity();
     s.t_split = holdout > 0.0 ? t_first + (1.0 - holdout) * (t_last - t_first) : inf;
@@ -322,26 +347,26 @@ Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vecto
     s.orbits_fitted = fitted.size();
     for (Terms terms : {Terms::kLinear, Terms::kQuadratic}) {
         ModelScore ms;
-        ms.fit = solve_terms(fitted, n_ref, terms, max_condition, min_range_c);
+        ms.fit = solve_terms(fitted, n_ref, heads, terms, max_condition, min_range_c);
         if (ms.fit.refused.empty()) {
-            ms.in = corrected_iba_rms(epochs, -inf, s.t_split, ms.fit.model);
+            ms.in = corrected_iba_rms(epochs, heads, -inf, s.t_split, ms.fit.model);
             if (holdout > 0.0) {
-                ms.out = corrected_iba_rms(epochs, s.t_split, inf, ms.fit.model);
+                ms.out = corrected_iba_rms(epochs, heads, s.t_split, inf, ms.fit.model);
             }
         }
         s.models.push_back(ms);
     }
     const ModelScore& lin = s.models[0];
     const ModelScore& quad = s.models[1];
-    const auto mean_out = [](const ModelScore& m) {
+    const auto mean_out = [&s](const ModelScore& m) {
         double sum = 0.0;
-        for (const Rms& r : m.out) {
-            if (r.n == 0) {
+        for (std::size_t p = 0; p < s.pairs.count; ++p) {
+            if (m.out[p].n == 0) {
                 return std::numeric_limits<double>::quiet_NaN();
             }
-            sum += r.rms;
+            sum += m.out[p].rms;
         }
-        return sum / static_cast<double>(kPairs);
+        return sum / static_cast<double>(s.pairs.count);
     };
     if (!lin.fit.refused.empty()) {
         s.verdict = "no selection: the linear model is not supported either (" + lin.fit.refused + ")";
@@ -387,7 +412,9 @@ std::string selection_verdict(double linear_rms, double quadratic_rms) {
 std::string describe_centring(const TermsFit& f) {
     std::ostringstream o;
     o << "regressors centred and scaled per head (mean +- standard deviation over the orbit averages, degC):\n";
-    for (std::size_t h = 0; h < 3; ++h) {
+    const HeadList list = heads_of(f.heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
         o << "  CHU " << head_name(static_cast<std::uint8_t>(h)) << ':';
         for (std::size_t j = 0; j < 3; ++j) {
             o << format("  %s %.2f +- %.2f (range %.2f)", kRegressorNames[j], f.centring.mean[h][j],
@@ -419,7 +446,9 @@ std::string describe_selection(const Selection& s) {
             continue;
         }
         o << format("condition number %.1f; residual RMS alpha/beta/gamma (orbit averages, arcsec):", m.fit.condition);
-        for (std::size_t h = 0; h < 3; ++h) {
+        const HeadList list = heads_of(m.fit.heads);
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const std::size_t h = list.head[i];
             const HeadFit& hf = m.fit.head[h];
             o << format(" %c %.3f/%.3f/%.3f", head_name(static_cast<std::uint8_t>(h)), hf.residual_rms[0],
                         hf.residual_rms[1], hf.residual_rms[2]);
@@ -427,13 +456,13 @@ std::string describe_selection(const Selection& s) {
         o << "\n            IBA RMS in the period";
         // A pair without an epoch there has no RMS: "n/a", never 0.000.
         const auto rms = [](const Rms& r) { return r.n == 0 ? std::string("n/a") : format("%.3f", r.rms); };
-        for (std::size_t p = 0; p < kPairs; ++p) {
-            o << " " << kPairNames[p] << " " << rms(m.in[p]);
+        for (std::size_t p = 0; p < s.pairs.count; ++p) {
+            o << " " << s.pairs.pair[p].name << " " << rms(m.in[p]);
         }
         if (s.holdout > 0.0) {
             o << "; held out";
-            for (std::size_t p = 0; p < kPairs; ++p) {
-                o << " " << kPairNames[p] << " " << rms(m.out[p]);
+            for (std::size_t p = 0; p < s.pairs.count; ++p) {
+                o << " " << s.pairs.pair[p].name << " " << rms(m.out[p]);
             }
         }
         o << '\n';

@@ -55,21 +55,23 @@ long double number(const std::string& path, std::size_t line, const Fields& f, s
 
 }  // namespace
 
-std::string floor_daily_csv(const DailyFloor& days, double start_t) {
+std::string floor_daily_csv(const DailyFloor& days, double start_t, const PairList& pairs) {
     std::string s = std::string(kFloorDailyHeader) + '\n';
     char line[192];
     for (std::size_t d = 0; d < days.size(); ++d) {
-        for (std::size_t p = 0; p < kPairs; ++p) {
+        for (std::size_t p = 0; p < pairs.count; ++p) {
             const FloorSums& f = days[d][p];
             std::snprintf(line, sizeof line, "%zu,%.3f,%s,%zu,%.21Lg,%.21Lg\n", d,
-                          start_t + static_cast<double>(d) * 86400.0, kPairNames[p], f.n, f.sum, f.sum_sq);
+                          start_t + static_cast<double>(d) * 86400.0, pairs.pair[p].name, f.n, f.sum, f.sum_sq);
             s += line;
         }
     }
     return s;
 }
 
-std::array<WindowFloor, kPairs> floor_of_days(const std::string& path, long long from_day, long long to_day) {
+std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long long from_day, long long to_day,
+                                                 const PairList& pairs) {
+    constexpr PairList kAllPairs = pairs_of(kAllHeads);
     std::ifstream in(path);
     if (!in) {
         throw InputError(path, 0, 0, "cannot open the daily floor file");
@@ -79,19 +81,24 @@ std::array<WindowFloor, kPairs> floor_of_days(const std::string& path, long long
     if (!std::getline(in, line) || line != kFloorDailyHeader) {
         throw InputError(path, 1, 1, std::string("expected the header ") + kFloorDailyHeader);
     }
-    std::array<FloorSums, kPairs> total{};
+    std::array<FloorSums, kMaxPairs> total{};
     while (std::getline(in, line)) {
         ++number_of_line;
         const Fields f = split(line);
         if (f.count != 6) {
             throw InputError(path, number_of_line, 1, "expected 6 fields (" + std::string(kFloorDailyHeader) + ")");
         }
-        std::size_t pair = kPairs;
-        for (std::size_t p = 0; p < kPairs; ++p) {
-            pair = f.text[2] == kPairNames[p] ? p : pair;
+        bool known = false;
+        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+            known = known || f.text[2] == kAllPairs.pair[p].name;
         }
-        if (pair == kPairs) {
-            throw InputError(path, number_of_line, f.column[2], "pair '" + f.text[2] + "' is not A-B, A-C or B-C");
+        if (!known) {
+            throw InputError(path, number_of_line, f.column[2],
+                             "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
+        }
+        std::size_t pair = pairs.count;  // its position in pairs; pairs.count: not one of them
+        for (std::size_t p = 0; p < pairs.count; ++p) {
+            pair = f.text[2] == pairs.pair[p].name ? p : pair;
         }
         const long double day = number(path, number_of_line, f, 0);
         const long double n = number(path, number_of_line, f, 3);
@@ -99,14 +106,14 @@ std::array<WindowFloor, kPairs> floor_of_days(const std::string& path, long long
             throw InputError(path, number_of_line, f.column[day < 0 || day != std::floor(day) ? 0 : 3],
                              "day and n must be non-negative integers");
         }
-        if (day >= static_cast<long double>(from_day) && day < static_cast<long double>(to_day)) {
+        if (pair < pairs.count && day >= static_cast<long double>(from_day) && day < static_cast<long double>(to_day)) {
             total[pair].n += static_cast<std::size_t>(n);
             total[pair].sum += number(path, number_of_line, f, 4);
             total[pair].sum_sq += number(path, number_of_line, f, 5);
         }
     }
-    std::array<WindowFloor, kPairs> out{};
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    std::array<WindowFloor, kMaxPairs> out{};
+    for (std::size_t p = 0; p < pairs.count; ++p) {
         const FloorSums& t = total[p];
         out[p].n = t.n;
         if (t.n == 0) {

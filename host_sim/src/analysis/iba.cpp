@@ -12,6 +12,42 @@ double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept
     return std::atan2(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
 }
 
+std::string head_letters(HeadSet s) {
+    std::string out;
+    const HeadList l = heads_of(s);
+    for (std::size_t i = 0; i < l.count; ++i) {
+        out += kHeadLetters[l.head[i]];
+    }
+    return out;
+}
+
+std::string head_words(HeadSet s, const char* last) {
+    const std::string letters = head_letters(s);
+    std::string out;
+    for (std::size_t i = 0; i < letters.size(); ++i) {
+        out += i == 0 ? "" : i + 1 == letters.size() ? last : ", ";
+        out += letters[i];
+    }
+    return out;
+}
+
+std::optional<HeadSet> parse_head_letters(const std::string& letters) {
+    HeadSet s = 0;
+    int last = -1;
+    for (const char c : letters) {
+        const std::uint8_t h = head_index(c);
+        if (h == kUnknownHead || static_cast<int>(h) <= last) {
+            return std::nullopt;
+        }
+        last = h;
+        s |= head_bit(h);
+    }
+    if (letters.empty()) {
+        return std::nullopt;
+    }
+    return s;
+}
+
 std::int64_t epoch_key(double t) noexcept {
     return static_cast<std::int64_t>(std::llround(t * 1000.0));
 }

@@ -204,24 +204,27 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
 
     // A pair without clean epochs gets an empty panel that says why
     // (compute_stats has logged it); with none at all there is nothing to plot.
+    const PairList& pairs = st.pairs;  // a panel per pair of the file's heads
     std::string why_nothing;
-    for (std::size_t p = 0; p < kPairs; ++p) {
-        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + kPairNames[p] +
+    bool any_epoch = false;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + pairs.pair[p].name +
                        (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
+        any_epoch = any_epoch || st.n[p] != 0;
     }
-    if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
+    if (!any_epoch) {
         throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
     }
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    for (std::size_t p = 0; p < pairs.count; ++p) {
         if (st.n[p] == 0) {
-            log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+            log << opt.in << ": pair " << pairs.pair[p].name << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
         }
     }
 
     TempDir dir;
     double t_lo = std::numeric_limits<double>::infinity();
     double t_hi = -std::numeric_limits<double>::infinity();
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    for (std::size_t p = 0; p < pairs.count; ++p) {
         const PairSeries& s = st.series[p];
         if (s.t.empty()) {
             continue;
@@ -259,7 +262,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
                                  kJ2000Unix);
     }
-    const std::size_t rows = kPairs + (opt.temperatures ? 2 : 0);
+    const std::size_t rows = pairs.count + (opt.temperatures ? 2 : 0);
 
     const std::filesystem::path png = dir.file("plot.png");
     const auto write_script = [&](const char* terminal) {
@@ -288,15 +291,15 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
               << ", graph 0.95 offset 1,0 front\n";
         }
         const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
-        for (std::size_t p = 0; p < kPairs; ++p) {
+        for (std::size_t p = 0; p < pairs.count; ++p) {
             if (st.n[p] == 0) {  // an empty panel with the reason in it
-                g << "set title 'pair " << kPairNames[p] << ": no clean epochs'\n";
+                g << "set title 'pair " << pairs.pair[p].name << ": no clean epochs'\n";
                 g << "set label 99 '" << gnuplot_quoted(st.no_epochs_reason[p])
                   << "' at graph 0.5, graph 0.5 center\nset yrange [-1:1]\nplot 2 notitle\n";
                 g << "unset label 99\nset autoscale y\n";
                 continue;
             }
-            g << "set title 'pair " << kPairNames[p] << " (" << st.n[p] << " clean epochs)'\n";
+            g << "set title 'pair " << pairs.pair[p].name << " (" << st.n[p] << " clean epochs)'\n";
             g << "plot ";
             for (std::size_t k = 0; k < kStages; ++k) {
                 if (k == 2 && !st.thermal) {
@@ -320,12 +323,15 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
             const std::string f = "'" + temps.string() + "'";
             g << "set ylabel 'temperature (degC)'\n";
             g << "set title 'T_CHU (T1) of each head'\n";
-            g << "plot " << f << " using 1:2 with lines lw 1.5 title 'T_CHU A', " << f
-              << " using 1:3 with lines lw 1.5 title 'T_CHU B', " << f
-              << " using 1:4 with lines lw 1.5 title 'T_CHU C'\n";
-            g << "set title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
-            g << "plot " << f << " using 1:5 with lines lw 1.5 title 'T029', " << f
-              << " using 1:6 with lines lw 1.5 title 'T032'\n";
+            const HeadList heads = heads_of(st.heads);  // columns: t, T_CHU by head index, T029, T032
+            g << "plot ";
+            for (std::size_t i = 0; i < heads.count; ++i) {
+                g << (i ? ", " : "") << f << " using 1:" << 2 + heads.head[i] << " with lines lw 1.5 title 'T_CHU "
+                  << head_name(heads.head[i]) << "'";
+            }
+            g << "\nset title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
+            g << "plot " << f << " using 1:" << 2 + kMaxHeads << " with lines lw 1.5 title 'T029', " << f
+              << " using 1:" << 3 + kMaxHeads << " with lines lw 1.5 title 'T032'\n";
         }
         g << "unset multiplot\n";
     };

@@ -10,12 +10,13 @@ namespace ascorr::host {
 
 namespace {
 
-// Sums of one bin: T_CHU of A, B, C, T029, T032 and their counts.
+// Sums of one bin: T_CHU of each head (by index), T029, T032 and their counts.
+constexpr std::size_t kSeries = kMaxHeads + 2U;
 struct TemperatureBin {
     double sum_t = 0.0;
     std::size_t rows = 0;
-    std::array<double, 5> sum{};
-    std::array<std::size_t, 5> n{};
+    std::array<double, kSeries> sum{};
+    std::array<std::size_t, kSeries> n{};
 };
 
 }  // namespace
@@ -26,7 +27,7 @@ std::size_t write_temperature_series(const std::string& in, const std::string& p
     for_each_solution(
         in,
         [&](const SolutionRecord& rec) {
-            if ((from && rec.t < *from) || (to && rec.t > *to) || rec.head > 2) {
+            if ((from && rec.t < *from) || (to && rec.t > *to) || rec.head >= kMaxHeads) {
                 return;
             }
             TemperatureBin& b = bins[static_cast<long long>(std::floor(rec.t / bin_s))];
@@ -39,8 +40,8 @@ std::size_t write_temperature_series(const std::string& in, const std::string& p
                 }
             };
             add(rec.head, 0);
-            add(3, 1);
-            add(4, 2);
+            add(kMaxHeads, 1);
+            add(kMaxHeads + 1U, 2);
         },
         "plot");
     std::ofstream f(path);
@@ -48,7 +49,7 @@ std::size_t write_temperature_series(const std::string& in, const std::string& p
     for (const auto& kv : bins) {
         const TemperatureBin& b = kv.second;
         f << b.sum_t / static_cast<double>(b.rows) + time_offset;
-        for (std::size_t i = 0; i < 5; ++i) {
+        for (std::size_t i = 0; i < kSeries; ++i) {
             f << ' ';
             if (b.n[i] > 0) {
                 f << b.sum[i] / static_cast<double>(b.n[i]);

@@ -148,7 +148,10 @@ char* put(char* p, char* end, double x, int decimals) {
 Eigen::Matrix3d head_mounting(int head) {
     static constexpr double kAzimuthDeg[3] = {90.0, 210.0, 330.0};
     const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
-    const double az = kAzimuthDeg[head] * kDegToRad;
+    // A head beyond C (index h ≥ 3): halfway in azimuth between heads h − 3
+    // and h − 2 (D between A and B, at 150°), at the same zenith distance.
+    const double az_deg = head < 3 ? kAzimuthDeg[head] : kAzimuthDeg[(head - 3) % 3] + 60.0;
+    const double az = az_deg * kDegToRad;
     const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir
     const Eigen::Vector3d z = std::sin(zeta) * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0) + std::cos(zeta) * up;
     const Eigen::Vector3d x = up.cross(z).normalized();
@@ -170,11 +173,11 @@ std::string heaters_csv(const std::vector<HeaterEvent>& events) {
     return s;
 }
 
-std::string floor_json(const std::array<Rms, kPairs>& floor) {
+std::string floor_json(const std::array<Rms, kMaxPairs>& floor, const PairList& pairs) {
     std::ostringstream s;
     s.precision(6);
     s << std::fixed << "{\"floor\": {";
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    for (std::size_t p = 0; p < pairs.count; ++p) {
         // A pair without clean epochs has no RMS: null (JSON has no NaN either).
         const auto value = [n = floor[p].n](double x) {
             std::ostringstream v;
@@ -182,7 +185,7 @@ std::string floor_json(const std::array<Rms, kPairs>& floor) {
             v << std::fixed << x;
             return n != 0 && std::isfinite(x) ? v.str() : std::string("null");
         };
-        s << (p ? ", " : "") << '"' << kPairNames[p] << "\": {\"rms\": " << value(floor[p].rms)
+        s << (p ? ", " : "") << '"' << pairs.pair[p].name << "\": {\"rms\": " << value(floor[p].rms)
           << ", \"rms_200s\": " << value(floor[p].rms_smoothed) << ", \"n\": " << floor[p].n << '}';
     }
     s << "}}\n";
@@ -191,13 +194,20 @@ std::string floor_json(const std::array<Rms, kPairs>& floor) {
 
 std::string describe(const SimulateSummary& s) {
     std::ostringstream o;
-    o << s.epochs << " epochs, " << s.rows << " rows; blinded (Sun/Moon) rows A/B/C: " << s.outage_rows[0] << '/'
-      << s.outage_rows[1] << '/' << s.outage_rows[2] << "; flagged " << s.flagged_rows << ", without temperatures "
-      << s.rows_without_temperature << ", without velocity " << s.rows_without_velocity
-      << "\nnoise floor (IBA RMS, arcsec):";
+    const HeadList heads = heads_of(s.heads);
+    o << s.epochs << " epochs, " << s.rows << " rows; blinded (Sun/Moon) rows ";
+    for (std::size_t i = 0; i < heads.count; ++i) {
+        o << (i ? "/" : "") << head_name(heads.head[i]);
+    }
+    o << ':';
+    for (std::size_t i = 0; i < heads.count; ++i) {
+        o << (i ? '/' : ' ') << s.outage_rows[heads.head[i]];
+    }
+    o << "; flagged " << s.flagged_rows << ", without temperatures " << s.rows_without_temperature
+      << ", without velocity " << s.rows_without_velocity << "\nnoise floor (IBA RMS, arcsec):";
     char buf[96];
-    for (std::size_t p = 0; p < kPairs; ++p) {
-        std::snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", kPairNames[p], s.floor[p].rms,
+    for (std::size_t p = 0; p < s.pairs.count; ++p) {
+        std::snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", s.pairs.pair[p].name, s.floor[p].rms,
                       s.floor[p].rms_smoothed);
         o << buf;
     }
@@ -216,6 +226,7 @@ namespace {
 // there is one, used by every draw below, never a copy.
 struct Random {
     explicit Random(std::uint64_t seed) : engine(seed) {}
+    explicit Random(std::seed_seq& seq) : engine(seq) {}
     std::mt19937_64 engine;
     std::normal_distribution<double> normal{0.0, 1.0};
     std::uniform_real_distribution<double> uniform{0.0, 1.0};
@@ -227,13 +238,26 @@ std::string truth_name(const std::string& path) {
     return path.empty() ? std::string("truth model (Table 2)") : path;
 }
 
-// A model file (empty path: Table 2); heads A, B and C must all have coefficients.
-ModelFile truth_model(const std::string& path) {
+// A model file (empty path: Table 2); heads A, B and C must all have
+// coefficients. A head beyond C (index h ≥ 3) simulated that the file has
+// none for takes head h − 3's with the opposite sign (D: −A's): a deformation
+// of its own, not a rotation common to the heads.
+ModelFile truth_model(const std::string& path, HeadSet heads) {
     ModelFile truth_file = path.empty() ? table2_model() : read_model_file(path);
     for (std::size_t h = 0; h < 3; ++h) {
         if (!truth_file.present[h]) {
             throw std::invalid_argument((path.empty() ? std::string("truth model") : path) +
                                         ": no coefficients for CHU " + head_name(static_cast<std::uint8_t>(h)));
+        }
+    }
+    for (std::size_t h = 3; h < kMaxHeads; ++h) {
+        if (!truth_file.present[h] && has_head(heads, static_cast<std::uint8_t>(h))) {
+            truth_file.present[h] = true;
+            for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
+                for (std::size_t c = 0; c < kModelTerms; ++c) {
+                    truth_file.coefficients[h][ax][c] = -truth_file.coefficients[h - 3][ax][c];
+                }
+            }
         }
     }
     return truth_file;
@@ -250,8 +274,8 @@ struct Truth {
 // --truth (from the first epoch), then each --truth-change.
 std::vector<Truth> truth_models(const SimulateOptions& opt) {
     std::vector<Truth> truths;
-    const auto add = [&truths](const std::string& path, double t_from) {
-        ModelFile file = truth_model(path);
+    const auto add = [&truths, &opt](const std::string& path, double t_from) {
+        ModelFile file = truth_model(path, opt.heads);
         ThermalModel<double> model = to_core<double>(file);
         truths.push_back({std::move(file), model, truth_name(path), t_from});
     };
@@ -300,10 +324,11 @@ void refuse_window(const char* option, const char* form, const DayWindow& w, dou
     }
 }
 
-void refuse_bad_head(const char* option, std::size_t head) {
-    if (head > 2) {
-        throw std::invalid_argument(std::string(option) + ": HEAD must be A, B or C, got index " +
-                                    std::to_string(head));
+void refuse_bad_head(const char* option, std::size_t head, HeadSet heads) {
+    if (head >= kMaxHeads || !has_head(heads, static_cast<std::uint8_t>(head))) {
+        throw std::invalid_argument(std::string(option) + ": HEAD must be " + head_words(heads, " or ") +
+                                    " (the heads simulated, --heads), got " +
+                                    head_name(static_cast<std::uint8_t>(head)));
     }
 }
 
@@ -325,7 +350,7 @@ void refuse_bad_truth_changes(const SimulateOptions& opt) {
 void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
     constexpr const char* kOption = "--thermistor-fault";
     for (const ThermistorFault& f : opt.thermistor_faults) {
-        refuse_bad_head(kOption, f.head);
+        refuse_bad_head(kOption, f.head, opt.heads);
         if (f.channel > 2) {
             throw std::invalid_argument(std::string(kOption) + ": CHANNEL must be t_chu, t_029 or t_032");
         }
@@ -342,13 +367,17 @@ void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
 }
 
 void refuse_bad_event_options(const SimulateOptions& opt) {
+    if ((opt.heads & ~kAllHeads) != 0U || head_count(opt.heads) < 2) {
+        throw std::invalid_argument("--heads " + head_letters(opt.heads) + ": expected two or more of the heads " +
+                                    kHeadLetters + ", in that order");
+    }
     refuse_bad_truth_changes(opt);
     for (const DayWindow& g : opt.gaps) {
         refuse_window("--gap", "FROM_DAY:TO_DAY", g, opt.days);
     }
     refuse_bad_thermistor_faults(opt);
     for (const HeadBias& b : opt.head_biases) {
-        refuse_bad_head("--head-bias", b.head);
+        refuse_bad_head("--head-bias", b.head, opt.heads);
         refuse_window("--head-bias", "HEAD:FROM_DAY:TO_DAY:ARCSEC", b.window, opt.days);
         if (!(std::fabs(b.arcsec) <= 3600.0)) {
             char what[120];
@@ -418,28 +447,81 @@ private:
     double node0_ = 0.0;
 };
 
+// A CHU's temperature response (°C): mean, per sine of the Sun's angle to the
+// orbital plane (sinb), per sinb², per cosine of the Sun from the position
+// (the sunlit side), per operational heater on.
+struct ChuResponse {
+    double mean;
+    double season;
+    double season2;
+    double orbit;
+    double heater;
+};
+constexpr ChuResponse kChuResponse[3] = {
+    {10.0, 5.0, 2.0, 0.8, 2.5},   // A
+    {14.0, -7.0, 1.0, 1.2, 3.0},  // B
+    {8.0, -4.0, 3.0, 0.6, 2.0},   // C
+};
+
+// The response of head h: A, B, C's above; a head beyond C (h ≥ 3) has head
+// h − 3's mirrored, as mounted on the other side: the seasonal (sinb) and
+// orbital terms change sign.
+ChuResponse chu_response(std::size_t h) {
+    if (h < 3) {
+        return kChuResponse[h];
+    }
+    ChuResponse r = kChuResponse[(h - 3) % 3];
+    r.season = -r.season;
+    r.orbit = -r.orbit;
+    return r;
+}
+
+// The geometry the temperatures follow at an epoch.
+struct Exposure {
+    double sinb = 0.0;  // sine of the Sun's angle to the orbital plane
+    double orb = 0.0;   // cosine of the Sun from the position
+};
+
+Exposure exposure(const SpacecraftPose& o, const Eigen::Vector3d& sun) {
+    return {sun.dot(o.P.cross(o.Q)), o.r_hat.dot(sun)};
+}
+
+double chu_temperature(std::size_t h, const Exposure& x, double wander, double op) {
+    const ChuResponse r = chu_response(h);
+    return r.mean + r.season * x.sinb + r.season2 * (x.sinb * x.sinb) + r.orbit * x.orb + wander + r.heater * op;
+}
+
 // T_CHU A, B, C, T029, T032 (°C, rounded as written): seasonal (sine of the
 // Sun's angle to the orbital plane), orbital (sunlit side), independent
 // wander, heater events, read noise.
 std::array<double, 5> temperatures(const SpacecraftPose& o, const Eigen::Vector3d& sun, double op, double surv,
                                    std::array<Wander, 5>& wander, double step_s, Random& rnd) {
-    const double sinb = sun.dot(o.P.cross(o.Q));
-    const double orb = o.r_hat.dot(sun);
+    const Exposure x = exposure(o, sun);
+    const double sinb = x.sinb;
+    const double orb = x.orb;
     for (auto& w : wander) {
         w.step(step_s, 3.0 * kSecondsPerDay, 0.6, rnd.engine);
     }
     const double s2 = sinb * sinb;
     std::array<double, 5> temp = {
-        10.0 + 5.0 * sinb + 2.0 * s2 + 0.8 * orb + wander[0].x + 2.5 * op,
-        14.0 - 7.0 * sinb + 1.0 * s2 + 1.2 * orb + wander[1].x + 3.0 * op,
-        8.0 - 4.0 * sinb + 3.0 * s2 + 0.6 * orb + wander[2].x + 2.0 * op,
+        chu_temperature(0, x, wander[0].x, op),
+        chu_temperature(1, x, wander[1].x, op),
+        chu_temperature(2, x, wander[2].x, op),
         -9.0 + 3.0 * sinb - 2.0 * s2 + 0.3 * orb + wander[3].x + 3.0 * surv,
         -20.0 + 2.0 * sinb + 4.0 * s2 + 0.2 * orb + wander[4].x + 2.0 * op,
     };
-    for (double& x : temp) {
-        x = std::round((x + 0.02 * rnd.gauss()) * 1000.0) / 1000.0;  // as written
+    for (double& t : temp) {
+        t = std::round((t + 0.02 * rnd.gauss()) * 1000.0) / 1000.0;  // as written
     }
     return temp;
+}
+
+// The recorded T_CHU of a head beyond C: its response, its own wander and
+// read noise, drawn from its own stream (Mission::extra_).
+double extra_chu_temperature(std::size_t h, const Exposure& x, double op, Wander& wander, double step_s, Random& rnd) {
+    wander.step(step_s, 3.0 * kSecondsPerDay, 0.6, rnd.engine);
+    const double t = chu_temperature(h, x, wander.x, op);
+    return std::round((t + 0.02 * rnd.gauss()) * 1000.0) / 1000.0;  // as written
 }
 
 // Flags, confidence and a missing T_CHU of one head's solution.
@@ -496,10 +578,16 @@ struct EpochState {
     SpacecraftPose orbit;
     Eigen::Vector3d sun;
     Eigen::Vector3d moon;
-    std::array<double, 5> temp{};
-    bool no_temperature = false;  // telemetry gap
-    bool no_velocity = false;     // GPS gap
+    std::array<double, 5> temp{};               // T_CHU A, B, C, T029, T032
+    std::array<double, kMaxHeads> extra_chu{};  // T_CHU of the heads beyond C, by head index
+    bool no_temperature = false;                // telemetry gap
+    bool no_velocity = false;                   // GPS gap
 };
+
+// Head h's T_CHU at the epoch.
+double t_chu(const EpochState& e, std::size_t h) {
+    return h < 3 ? e.temp[h] : e.extra_chu[h];
+}
 
 // One head's solution at an epoch (when the head is not blinded).
 struct HeadSolution {
@@ -527,7 +615,7 @@ struct HeadSolution {
     std::snprintf(what, sizeof what,
                   "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
                   "T029 %g, T032 %g degC)",
-                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, e.temp[h],
+                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
                   e.temp[3], e.temp[4]);
     throw InputError(truth.name, truth.file.line[h][axis], 0, what);
 }
@@ -550,7 +638,7 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     const Eigen::Quaterniond q_true(r_true);
     const Eigen::Quaterniond q_noisy_true = (q_noise * q_true).normalized();
 
-    HeadTemperatures<double> ht{{e.temp[h], true}, {e.temp[3], true}, {e.temp[4], true}};
+    HeadTemperatures<double> ht{{t_chu(e, h), true}, {e.temp[3], true}, {e.temp[4], true}};
     const ThermalStage<double> th = thermal_stage(truth.model, static_cast<std::uint8_t>(h), ht);
     if (th.skip != 0U) {
         refuse_truth_angle(h, e, ht, truth);
@@ -598,6 +686,9 @@ void append_row(std::string& buf, const EpochState& e, std::size_t h, const Head
     buf.append(line, static_cast<std::size_t>(p - line));
 }
 
+// The temperatures each head's row records, by head index: t_chu, t_029, t_032.
+using RecordedTemperatures = std::array<std::array<double, 3>, kMaxHeads>;
+
 // The mission, epoch by epoch: everything simulate() writes and counts.
 class Mission {
 public:
@@ -607,10 +698,22 @@ public:
           rnd_(opt.seed),
           orbit_(opt.start_t, sky_),
           heaters_(opt.start_t, rnd_.engine),
-          stuck_(opt.thermistor_faults.size()) {
-        for (int h = 0; h < 3; ++h) {
+          stuck_(opt.thermistor_faults.size()),
+          solved_(kPaperHeads | opt.heads),
+          pairs_(pairs_of(opt.heads)) {
+        for (int h = 0; h < kMaxHeads; ++h) {
             mount_[static_cast<std::size_t>(h)] = head_mounting(h);
         }
+        // A head beyond C draws from its own stream, mt19937_64 seeded by
+        // seed_seq{seed, h}: A, B and C's rows do not depend on which other heads are simulated.
+        for (std::uint8_t h = 3; h < kMaxHeads; ++h) {
+            if (has_head(opt.heads, h)) {
+                std::seed_seq seq{static_cast<std::uint64_t>(opt.seed), static_cast<std::uint64_t>(h)};
+                extra_[h].emplace(seq);
+            }
+        }
+        sum_.heads = opt.heads;
+        sum_.pairs = pairs_;
     }
 
     // Appends epoch k's rows to buf.
@@ -624,6 +727,12 @@ public:
         double surv = 0.0;
         heaters_.at(e.t, op, surv);
         e.temp = temperatures(e.orbit, e.sun, op, surv, wander_, opt_.step_s, rnd_);
+        for (std::size_t h = 3; h < kMaxHeads; ++h) {
+            if (extra_[h]) {
+                e.extra_chu[h] =
+                    extra_chu_temperature(h, exposure(e.orbit, e.sun), op, extra_wander_[h], opt_.step_s, *extra_[h]);
+            }
+        }
         e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
         e.no_velocity = gps_gap_.step(1e-4, 5, 60, rnd_.engine);
 
@@ -637,9 +746,9 @@ public:
             ++sum_.gap_epochs;
             return;
         }
-        for (std::size_t pr = 0; pr < kPairs; ++pr) {
-            const auto i = kPairHeads[pr][0];
-            const auto j = kPairHeads[pr][1];
+        for (std::size_t pr = 0; pr < pairs_.count; ++pr) {
+            const auto i = pairs_.pair[pr].first;
+            const auto j = pairs_.pair[pr].second;
             if (heads.clean[i] && heads.clean[j]) {
                 const double iba = angle_arcsec(heads.z_floor[i], heads.z_floor[j]);
                 floor_t_[pr].push_back(e.t);
@@ -655,7 +764,7 @@ public:
 
     // The summary, once every epoch is in (t_last: the last epoch's time).
     SimulateSummary finish(double t_last) {
-        for (std::size_t pr = 0; pr < kPairs; ++pr) {
+        for (std::size_t pr = 0; pr < pairs_.count; ++pr) {
             sum_.floor[pr] = rms_about_mean(floor_t_[pr], floor_v_[pr]);
         }
         sum_.truth_path = opt_.out + ".truth.csv";
@@ -676,28 +785,34 @@ public:
 private:
     // Which heads are written and clean at an epoch, and their floor boresights.
     struct HeadsAtEpoch {
-        std::array<bool, 3> clean{};
-        std::array<Vector3<double>, 3> z_floor{};
+        std::array<bool, kMaxHeads> clean{};
+        std::array<Vector3<double>, kMaxHeads> z_floor{};
     };
 
     // Every head's solution at the epoch (drawn in a gap too: the random
     // streams stay those of a mission without gaps), written outside gaps.
-    HeadsAtEpoch solve_heads(const EpochState& e, double dt, const std::array<std::array<double, 3>, 3>& recorded,
-                             bool gap, std::string& buf) {
+    // A, B and C are drawn even when not simulated (--heads), so that the
+    // others' draws stay the same; only the heads simulated are written.
+    HeadsAtEpoch solve_heads(const EpochState& e, double dt, const RecordedTemperatures& recorded, bool gap,
+                             std::string& buf) {
         HeadsAtEpoch out;
         const Truth& truth = truth_at(e.t);
-        for (std::size_t h = 0; h < 3; ++h) {
+        const HeadList solved = heads_of(solved_);
+        for (std::size_t i = 0; i < solved.count; ++i) {
+            const std::size_t h = solved.head[i];
+            const bool written = has_head(opt_.heads, static_cast<std::uint8_t>(h));
             const Eigen::Matrix3d r_true = mount_[h] * e.orbit.body_icrf;
             const Eigen::Vector3d z_icrf = r_true.row(2).transpose();
             const double sun_deg = std::acos(std::clamp(z_icrf.dot(e.sun), -1.0, 1.0)) / kDegToRad;
             const double moon_deg = std::acos(std::clamp(z_icrf.dot(e.moon), -1.0, 1.0)) / kDegToRad;
             if (sun_deg < kSunExclusionDeg || moon_deg < kMoonExclusionDeg) {
-                sum_.outage_rows[h] += gap ? 0U : 1U;  // blinded: no solution
+                sum_.outage_rows[h] += gap || !written ? 0U : 1U;  // blinded: no solution
                 continue;
             }
+            Random& rnd = h < 3 ? rnd_ : *extra_[h];
             const HeadSolution s =
-                solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kSecondsPerDay), earth_, rnd_);
-            if (gap) {
+                solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kSecondsPerDay), earth_, rnd);
+            if (gap || !written) {
                 continue;
             }
             append_row(buf, e, h, s, recorded[h]);
@@ -729,10 +844,10 @@ private:
     // The temperatures as each head's row records them: the real ones, but
     // for --thermistor-fault (stuck at the window's first value, or drifting),
     // rounded as written.
-    std::array<std::array<double, 3>, 3> recorded_temperatures(const EpochState& e, double day) {
-        std::array<std::array<double, 3>, 3> rec{};
-        for (std::size_t h = 0; h < 3; ++h) {
-            rec[h] = {e.temp[h], e.temp[3], e.temp[4]};
+    RecordedTemperatures recorded_temperatures(const EpochState& e, double day) {
+        RecordedTemperatures rec{};
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            rec[h] = {t_chu(e, h), e.temp[3], e.temp[4]};
         }
         for (std::size_t i = 0; i < opt_.thermistor_faults.size(); ++i) {
             const ThermistorFault& f = opt_.thermistor_faults[i];
@@ -762,17 +877,21 @@ private:
     Random rnd_;
     SunMoon sky_;
     Orbit orbit_;
-    std::array<Eigen::Matrix3d, 3> mount_;
+    std::array<Eigen::Matrix3d, kMaxHeads> mount_;
     EarthVelocity earth_;
     Heaters heaters_;
-    std::array<Wander, 5> wander_;  // T_CHU A, B, C, T029, T032
+    std::array<Wander, 5> wander_;                        // T_CHU A, B, C, T029, T032
+    std::array<std::optional<Random>, kMaxHeads> extra_;  // the streams of the heads beyond C simulated
+    std::array<Wander, kMaxHeads> extra_wander_;          // their T_CHU
     Gap telemetry_gap_;
     Gap gps_gap_;
     SimulateSummary sum_;
-    std::array<std::vector<double>, kPairs> floor_t_;
-    std::array<std::vector<double>, kPairs> floor_v_;
+    std::array<std::vector<double>, kMaxPairs> floor_t_;
+    std::array<std::vector<double>, kMaxPairs> floor_v_;
     DailyFloor daily_;
     std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
+    HeadSet solved_;                            // A, B, C and the heads simulated
+    PairList pairs_;                            // of the heads simulated
 };
 
 }  // namespace
@@ -818,8 +937,8 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     out.commit();
     write_model_file(sum.truth_path, truths.front().file);
     write_file_atomically(sum.truth_history_path, truth_history_csv(truths));
-    write_file_atomically(sum.floor_path, floor_json(sum.floor));
-    write_file_atomically(sum.floor_daily_path, floor_daily_csv(mission.daily(), opt.start_t));
+    write_file_atomically(sum.floor_path, floor_json(sum.floor, sum.pairs));
+    write_file_atomically(sum.floor_daily_path, floor_daily_csv(mission.daily(), opt.start_t, sum.pairs));
     write_file_atomically(sum.heaters_path, heaters_csv(sum.heaters));
     return sum;
 }

@@ -59,8 +59,9 @@ std::string head_without_clean_rows(char name, const HeadTally& h) {
 }
 
 // Why pair p has no clean epoch; the tests are in the order a reader would check.
-std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t rows_seen, std::size_t rows_in_period,
-                          const std::array<HeadTally, 3>& heads, std::size_t both_present) {
+std::string why_no_epochs(const HeadPair& pair, const StatsOptions& opt, std::size_t rows_seen,
+                          std::size_t rows_in_period, const std::array<HeadTally, kMaxHeads>& heads,
+                          std::size_t both_present) {
     const bool period = opt.from.has_value() || opt.to.has_value();
     const auto t = [](double x) {
         char buf[40];
@@ -77,18 +78,19 @@ std::string why_no_epochs(std::size_t p, const StatsOptions& opt, std::size_t ro
     if (rows_in_period == 0) {
         return "no rows" + in_period + " (the file has " + std::to_string(rows_seen) + ")";
     }
-    for (const std::uint8_t h : kPairHeads[p]) {
+    const std::uint8_t pair_heads[2] = {pair.first, pair.second};
+    for (const std::uint8_t h : pair_heads) {
         if (heads[h].rows == 0) {
             return std::string("CHU ") + head_name(h) + " has no rows" + in_period;
         }
     }
-    for (const std::uint8_t h : kPairHeads[p]) {
+    for (const std::uint8_t h : pair_heads) {
         if (heads[h].clean == 0) {
             return head_without_clean_rows(head_name(h), heads[h]);
         }
     }
-    const char a = head_name(kPairHeads[p][0]);
-    const char b = head_name(kPairHeads[p][1]);
+    const char a = head_name(pair.first);
+    const char b = head_name(pair.second);
     if (both_present == 0) {
         return std::string("CHU ") + a + " and CHU " + b + " never have a row at the same epoch (t to the millisecond)";
     }
@@ -130,30 +132,35 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     EarthVelocity earth;
     Diagnostics diag(log);
 
+    // Every pair of kMaxHeads while reading; those of the file's heads at the end.
+    constexpr PairList kAllPairs = pairs_of(kAllHeads);
     std::size_t rows_seen = 0;
-    std::array<HeadTally, 3> heads{};
-    std::array<std::size_t, kPairs> both_present{};
+    HeadSet with_rows = 0U;
+    std::array<HeadTally, kMaxHeads> heads{};
+    std::array<std::size_t, kMaxPairs> both_present{};
+    std::array<PairSeries, kMaxPairs> series;
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
-        for (std::size_t p = 0; p < kPairs; ++p) {
-            const auto& a = e.head[kPairHeads[p][0]];
-            const auto& b = e.head[kPairHeads[p][1]];
+        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+            const auto& a = e.head[kAllPairs.pair[p].first];
+            const auto& b = e.head[kAllPairs.pair[p].second];
             both_present[p] += a && b ? 1U : 0U;
             if (a && b && a->clean && b->clean) {
-                r.series[p].t.push_back(e.t);
+                series[p].t.push_back(e.t);
                 for (std::size_t s = 0; s < kStages; ++s) {
-                    r.series[p].iba[s].push_back(angle_arcsec(a->z[s], b->z[s]));
+                    series[p].iba[s].push_back(angle_arcsec(a->z[s], b->z[s]));
                 }
             }
         }
     });
     rows([&](const SolutionRecord& rec) {
         ++rows_seen;
+        with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : 0U;
         if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
             return;
         }
         ++r.rows;
-        if (rec.head > 2) {
-            return;  // not in any pair (head D, or unknown: left to `correct` to report)
+        if (rec.head >= kMaxHeads) {
+            return;  // not in any pair (an unknown head: left to `correct` to report)
         }
         HeadTally& tally = heads[rec.head];
         ++tally.rows;
@@ -185,8 +192,16 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     epochs.finish();
     diag.summarize();
 
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    r.heads = analysis_heads(with_rows);
+    r.pairs = pairs_of(r.heads);
+    for (std::size_t p = 0; p < r.pairs.count; ++p) {
+        std::size_t all = 0;  // the pair's index in kAllPairs
+        while (kAllPairs.pair[all].first != r.pairs.pair[p].first ||
+               kAllPairs.pair[all].second != r.pairs.pair[p].second) {
+            ++all;
+        }
         PairSeries& s = r.series[p];
+        s = std::move(series[all]);
         // Incomplete epochs arrive last and unordered: sort by time for smoothing.
         std::vector<std::size_t> idx(s.t.size());
         std::iota(idx.begin(), idx.end(), std::size_t{0});
@@ -204,9 +219,10 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         }
         r.n[p] = s.t.size();
         if (r.n[p] == 0) {
-            r.no_epochs_reason[p] = why_no_epochs(p, opt, rows_seen, r.rows, heads, both_present[p]);
+            r.no_epochs_reason[p] = why_no_epochs(r.pairs.pair[p], opt, rows_seen, r.rows, heads, both_present[all]);
             if (opt.log_empty_pairs) {
-                log << opt.in << ": pair " << kPairNames[p] << ": no clean epochs: " << r.no_epochs_reason[p] << '\n';
+                log << opt.in << ": pair " << r.pairs.pair[p].name << ": no clean epochs: " << r.no_epochs_reason[p]
+                    << '\n';
             }
         }
         for (std::size_t st = 0; st < kStages; ++st) {
@@ -230,7 +246,7 @@ std::string stats_table(const StatsResult& r) {
     std::snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
                   "thermal");
     o << buf;
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    for (std::size_t p = 0; p < r.pairs.count; ++p) {
         std::string cells[kStages];
         for (std::size_t s = 0; s < kStages; ++s) {
             if (!rms_defined(r, p, s)) {
@@ -241,7 +257,7 @@ std::string stats_table(const StatsResult& r) {
                 cells[s] = c;
             }
         }
-        std::snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", kPairNames[p], r.n[p], cells[0].c_str(),
+        std::snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p], cells[0].c_str(),
                       cells[1].c_str(), cells[2].c_str());
         o << buf;
     }
@@ -256,9 +272,9 @@ std::string stats_json(const StatsResult& r) {
         return std::string(c);
     };
     o << "{\"pairs\": {";
-    for (std::size_t p = 0; p < kPairs; ++p) {
+    for (std::size_t p = 0; p < r.pairs.count; ++p) {
         const auto cell = [&](std::size_t st) { return rms_defined(r, p, st) ? num(r.rms[p][st].rms) : "null"; };
-        o << (p ? ", " : "") << '"' << kPairNames[p] << "\": {";
+        o << (p ? ", " : "") << '"' << r.pairs.pair[p].name << "\": {";
         o << "\"original\": " << cell(0);
         o << ", \"aberration\": " << cell(1);
         o << ", \"thermal\": " << cell(2);

@@ -43,17 +43,25 @@ inline void remove_common_rotation(const Matrix3 (&n)[3], double (&y)[9]) noexce
     }
 }
 
-// The projector P itself (9 × 9), for a design built column by column.
-inline void common_rotation_projector(const Matrix3 (&n)[3], double (&p)[9][9]) noexcept {
-    for (std::size_t i = 0; i < 9; ++i) {
-        for (std::size_t j = 0; j < 9; ++j) {
+// The projector for any number of heads (the ground fit's heads, two or
+// more): n[0 … heads − 1], G = [N_0; …], GᵀG = heads·I, P = I − G·Gᵀ/heads,
+// written row-major into p[(3·heads)²]. Trip counts fixed by `heads`.
+inline void common_rotation_projector(const Matrix3* n, std::size_t heads, double* p) noexcept {
+    const std::size_t rows = 3 * heads;
+    for (std::size_t i = 0; i < rows; ++i) {
+        for (std::size_t j = 0; j < rows; ++j) {
             double s = 0.0;
             for (std::size_t c = 0; c < 3; ++c) {
                 s += n[i / 3].m[i % 3][c] * n[j / 3].m[j % 3][c];
             }
-            p[i][j] = (i == j ? 1.0 : 0.0) - s / 3.0;
+            p[i * rows + j] = (i == j ? 1.0 : 0.0) - s / static_cast<double>(heads);
         }
     }
+}
+
+// The projector P itself (9 × 9) of three heads, for a design built column by column.
+inline void common_rotation_projector(const Matrix3 (&n)[3], double (&p)[9][9]) noexcept {
+    common_rotation_projector(n, 3, &p[0][0]);
 }
 
 }  // namespace ascorr::calib

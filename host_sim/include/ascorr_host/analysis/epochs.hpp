@@ -2,10 +2,18 @@
 //
 // for_each_solution() (formats/solutions_csv.hpp) streams a file of any size
 // in blocks of whole lines.
-// EpochAssembler groups the rows of heads A, B and C that share an epoch
-// (t to the millisecond, docs/contract.md), in any row order: an epoch is handed on
-// as soon as all three heads are in, the incomplete ones at the end. A second
-// row of the same head at the same epoch is an input error.
+// EpochAssembler groups the rows of the heads that share an epoch (t to the
+// millisecond, docs/contract.md), in any row order. Which heads make an epoch
+// complete:
+//  - a given HeadSet (fit: the heads of its analysis): the epoch is handed on
+//    as soon as all of them are in;
+//  - or the heads the file has shown so far (stats, plot: they do not know
+//    the file's heads beforehand): the epoch is handed on once it holds every
+//    head seen so far and a row of a later epoch has been read (in a file in
+//    time order, when the next epoch begins). A head whose first row comes
+//    after an epoch was handed on is missing from that epoch.
+// The incomplete ones are handed on at the end. A second row of the same head
+// at the same epoch is an input error.
 #pragma once
 
 #include <array>
@@ -15,6 +23,7 @@
 #include <cstdio>
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -34,53 +43,99 @@ void refuse_bad_time_range(const std::optional<double>& from, const std::optiona
 template <typename Payload>
 struct Epoch {
     double t = 0.0;
-    std::array<std::optional<Payload>, 3> head;  // A, B, C
-    std::array<std::size_t, 3> line{};           // where each head's row is
+    std::array<std::optional<Payload>, kMaxHeads> head;  // by head index (heads.hpp)
+    std::array<std::size_t, kMaxHeads> line{};           // where each head's row is
 };
 
 template <typename Payload>
 class EpochAssembler {
 public:
     using Sink = std::function<void(const Epoch<Payload>&)>;
-    EpochAssembler(std::string file, Sink sink) : file_(std::move(file)), sink_(std::move(sink)) {}
+    // Complete with the heads of `complete`.
+    EpochAssembler(std::string file, Sink sink, HeadSet complete)
+        : file_(std::move(file)), sink_(std::move(sink)), complete_(complete), open_(false) {}
+    // Complete with the heads seen so far.
+    EpochAssembler(std::string file, Sink sink) : file_(std::move(file)), sink_(std::move(sink)), open_(true) {}
 
-    // head 0..2; other heads are not part of any pair and are left out by the caller.
+    // head < kMaxHeads; the caller leaves out the heads it does not analyse.
     void add(double t, std::uint8_t head, std::size_t line, Payload p) {
         if (!(std::abs(t) < kMaxEpochTimeS)) {
             return;  // no millisecond key: in no epoch (iba.hpp)
         }
         const std::int64_t key = epoch_key(t);
-        Epoch<Payload>& e = pending_[key];
-        if (e.head[head]) {
+        Entry& e = pending_[key];
+        if (e.epoch.head[head]) {
             char when[32];
             std::snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
             throw InputError(file_, line, 1,
                              std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
-                                 " (the first is on line " + std::to_string(e.line[head]) + ")");
+                                 " (the first is on line " + std::to_string(e.epoch.line[head]) + ")");
         }
-        if (!e.head[0] && !e.head[1] && !e.head[2]) {
-            e.t = t;
+        if (e.heads == 0U) {
+            e.epoch.t = t;
         }
-        e.head[head] = std::move(p);
-        e.line[head] = line;
-        if (e.head[0] && e.head[1] && e.head[2]) {
-            sink_(e);
-            pending_.erase(key);
+        e.epoch.head[head] = std::move(p);
+        e.epoch.line[head] = line;
+        e.heads |= head_bit(head);
+        if (!open_) {
+            if ((e.heads & complete_) == complete_) {
+                sink_(e.epoch);
+                pending_.erase(key);
+            }
+            return;
+        }
+        if (!has_head(complete_, head)) {
+            complete_ |= head_bit(head);  // a new head: the epochs held without it are not complete
+            held_.clear();
+        }
+        if ((e.heads & complete_) == complete_) {
+            held_.insert(key);
+        }
+        if (!any_key_ || key > last_key_) {
+            last_key_ = key;
+            any_key_ = true;
+        }
+        while (!held_.empty() && *held_.begin() < last_key_) {
+            hand_on(*held_.begin());
         }
     }
 
-    // Hands on the epochs still missing a head (sink order is not time order).
+    // Hands on the epochs still pending: the complete ones in time order, then
+    // those missing a head (in no particular order).
     void finish() {
+        while (!held_.empty()) {
+            hand_on(*held_.begin());
+        }
         for (const auto& kv : pending_) {
-            sink_(kv.second);
+            sink_(kv.second.epoch);
         }
         pending_.clear();
     }
 
+    // The heads of the rows added so far (open), or the set given.
+    HeadSet heads() const noexcept { return complete_; }
+
 private:
+    struct Entry {
+        Epoch<Payload> epoch;
+        HeadSet heads = 0U;
+    };
+
+    void hand_on(std::int64_t key) {
+        held_.erase(key);
+        const auto it = pending_.find(key);
+        sink_(it->second.epoch);
+        pending_.erase(it);
+    }
+
     std::string file_;
     Sink sink_;
-    std::unordered_map<std::int64_t, Epoch<Payload>> pending_;
+    HeadSet complete_ = 0U;
+    bool open_ = false;
+    std::unordered_map<std::int64_t, Entry> pending_;
+    std::set<std::int64_t> held_;  // open: complete, waiting for a later epoch
+    std::int64_t last_key_ = 0;
+    bool any_key_ = false;
 };
 
 }  // namespace ascorr::host

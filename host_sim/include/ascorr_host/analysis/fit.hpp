@@ -4,14 +4,16 @@
 //  1. selection: rows with flags high-rate (1), bright object (2), invalid (4),
 //     confidence > 5, a temperature or the velocity missing are dropped;
 //  2. aberration correction by the core;
-//  3. at each epoch with A, B and C selected, the frame F of heads A and C
-//     (eqs. 1–3) and each head's rotation relative to it, as the small
+//  3. at each epoch with all the fit's heads selected, the frame F of two of
+//     them (FitOptions::frame_heads, --frame-heads; A and C by default, the
+//     paper's eqs. 1–3 with the first in A's role, the second in C's) and each
+//     head's rotation relative to it, as the small
 //     rotation vector e_i (head axes, arcsec) with R_i·R_Fᵀ = exp([e_i×])·N_i,
 //     N_i the head's orientation in F at the first such epoch;
 //  4. averages of e_i and of the temperatures over each orbit (the same
 //     epochs on both sides, so the linear model holds for the averages);
 //  5. least squares by SVD (Eigen BDCSVD, columns centred, scaled, then
-//     normalised: fit_terms.hpp) of the 9 orbit-averaged angles against each
+//     normalised: fit_terms.hpp) of the 3 orbit-averaged angles per head against each
 //     head's [1, T1, T2−T1, T3−T1] (T1 = the head's T_CHU, T2 = T029,
 //     T3 = T032), with --terms quadratic also their squares, all heads jointly;
 //  6. the model-selection report (fit_terms.hpp): linear and quadratic models
@@ -21,7 +23,12 @@
 //     period with the terms asked for.
 // The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
 //
-// What is fitted, precisely. F moves with the A and C boresights, hence with
+// The fit's heads: A, B, C, every head with rows in the modelling period and
+// F's two (iba.hpp, analysis_heads); two or more, up to kMaxHeads. The model
+// file has a row per axis of each of them.
+//
+// What is fitted, precisely (three heads; with N heads, 3·N equations per
+// orbit and 12·N coefficients, the gauge the same 9). F moves with the A and C boresights, hence with
 // their temperatures, and this motion shows in every head's e_i alike (as
 // N_i·g in head axes). A per-head fit would push A's and C's temperature
 // response into B's model, where it does not fit; so F's rotation g_k in each
@@ -37,6 +44,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -67,9 +75,12 @@ struct FitOptions {
     double holdout = kDefaultHoldout;  // fraction of the period (its end) held out for the selection report
     double min_temperature_range_c = kDefaultMinTemperatureRange;  // of each regressor, for quadratic terms
     bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
+    // The heads of frame F (eqs. 1–3): the first in head A's role, the second
+    // in C's; two different heads (--frame-heads, default AC).
+    std::array<std::uint8_t, 2> frame_heads{0, 2};
 };
 
-inline constexpr int kUnknowns = 36;  // linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
+inline constexpr int kUnknowns = 36;  // three heads, linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
 inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032
 
 struct FitReport {
@@ -78,13 +89,15 @@ struct FitReport {
     double orbit_period_s = 0.0;
     std::size_t rows = 0;  // in [from, to]
     std::array<std::size_t, kDropKinds> dropped{};
-    std::size_t epochs = 0;  // with A, B and C selected
+    HeadSet heads = kPaperHeads;                    // the heads fitted
+    std::array<std::uint8_t, 2> frame_heads{0, 2};  // F's
+    std::size_t epochs = 0;                         // with all of them selected
     std::size_t orbits_used = 0;
     std::size_t orbits_left_out = 0;
     Terms terms = Terms::kLinear;
-    std::vector<double> singular_values;  // of the joint design with unit-norm columns, descending
-    double condition = 0.0;               // largest / smallest observable singular value
-    std::array<HeadFit, 3> head{};
+    std::vector<double> singular_values;    // of the joint design with unit-norm columns, descending
+    double condition = 0.0;                 // largest / smallest observable singular value
+    std::array<HeadFit, kMaxHeads> head{};  // by head index
     ModelFile model;
     TermsFit fit;         // the written model's fit: centring, rank
     Selection selection;  // the model-selection report

@@ -54,62 +54,67 @@ struct HeadFit {
     std::array<double, 3> signal_rms{};    // orbit-averaged angle about its mean
 };
 
-// One orbit's averages, per head (A, B, C).
+// One orbit's averages, per head (by head index; the fit's heads are filled).
 struct OrbitAverage {
-    double t_mid = 0.0;                   // s since J2000 TT
-    std::array<Eigen::Vector3d, 3> e{};   // rotation relative to F, head axes, arcsec
-    std::array<Eigen::Vector3d, 3> x{};   // (x1, x2, x3), °C
-    std::array<Eigen::Vector3d, 3> x2{};  // (x1², x2², x3²), °C²
+    double t_mid = 0.0;                           // s since J2000 TT
+    std::array<Eigen::Vector3d, kMaxHeads> e{};   // rotation relative to F, head axes, arcsec
+    std::array<Eigen::Vector3d, kMaxHeads> x{};   // (x1, x2, x3), °C
+    std::array<Eigen::Vector3d, kMaxHeads> x2{};  // (x1², x2², x3²), °C²
 };
 
 struct Centring {
-    std::array<std::array<double, 3>, 3> mean{};   // [head][regressor], °C
-    std::array<std::array<double, 3>, 3> scale{};  // standard deviation, °C
-    std::array<std::array<double, 3>, 3> range{};  // max − min over the orbit averages, °C
+    std::array<std::array<double, 3>, kMaxHeads> mean{};   // [head][regressor], °C
+    std::array<std::array<double, 3>, kMaxHeads> scale{};  // standard deviation, °C
+    std::array<std::array<double, 3>, kMaxHeads> range{};  // max − min over the orbit averages, °C
 };
 
 struct TermsFit {
     Terms terms = Terms::kLinear;
-    std::string refused;  // non-empty: the data do not support this model (why); no model
+    HeadSet heads = kPaperHeads;  // the heads fitted, jointly
+    std::string refused;          // non-empty: the data do not support this model (why); no model
     int unknowns = 0;
-    int rank = 0;                         // observable directions: unknowns − 9
+    int rank = 0;                         // observable directions: unknowns − 9 (the gauge)
     std::vector<double> singular_values;  // of the centred, unit-norm-column design, descending
     double condition = 0.0;               // largest / smallest observable singular value
     Centring centring;
-    std::array<HeadFit, 3> head{};
+    std::array<HeadFit, kMaxHeads> head{};  // by head index
     ModelFile model;
 };
 
 // Joint least squares over the orbits (fit.hpp explains the model and the
-// gauge). n_ref: the heads' orientations N_i in F. Refuses (TermsFit::refused)
+// gauge). heads: the heads fitted (two or more); n_ref: their orientations N_i
+// in F (by head index). Each orbit contributes 3 equations per head, in
+// heads.hpp's order. Refuses (TermsFit::refused)
 // a quadratic model when a regressor of a head spans less than min_range_c
 // over the orbit averages, and any model whose condition number exceeds
 // max_condition, naming the head and term of the weakest direction.
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const std::array<Eigen::Matrix3d, 3>& n_ref, Terms terms,
+using HeadOrientations = std::array<Eigen::Matrix3d, kMaxHeads>;  // N_i by head index
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
                      double max_condition, double min_range_c);
 
-// One epoch with A, B and C selected: the aberration-corrected attitudes and
-// each head's (T1, T2, T3).
+// One epoch with all the fit's heads selected: the aberration-corrected
+// attitudes and each head's (T1, T2, T3), by head index.
 struct FitEpoch {
     double t = 0.0;
-    std::array<Quaternion<double>, 3> q_chu_icrf{};
-    std::array<std::array<double, 3>, 3> temp{};
+    std::array<Quaternion<double>, kMaxHeads> q_chu_icrf{};
+    std::array<std::array<double, 3>, kMaxHeads> temp{};
 };
 
-// IBA RMS per pair of the epochs with t in [from, to), thermally corrected by
-// m (the core, double). Epochs the core does not correct are left out.
-// epochs must be sorted by t.
-std::array<Rms, kPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, double from, double to,
-                                          const ModelFile& m);
+// IBA RMS per pair of `heads` (pairs_of, by position) of the epochs with t in
+// [from, to), thermally corrected by m (the core, double). Epochs the core
+// does not correct are left out. epochs must be sorted by t.
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
+                                             const ModelFile& m);
 
 struct ModelScore {
-    TermsFit fit;                   // fitted on the part of the period before t_split
-    std::array<Rms, kPairs> in{};   // IBA RMS, t < t_split
-    std::array<Rms, kPairs> out{};  // IBA RMS, t ≥ t_split (held out)
+    TermsFit fit;                      // fitted on the part of the period before t_split
+    std::array<Rms, kMaxPairs> in{};   // IBA RMS, t < t_split, by position in Selection::pairs
+    std::array<Rms, kMaxPairs> out{};  // IBA RMS, t ≥ t_split (held out)
 };
 
 struct Selection {
-    double holdout = 0.0;  // fraction of the period held out (its end)
+    PairList pairs = kPaperPairs;  // of the fit's heads
+    double holdout = 0.0;          // fraction of the period held out (its end)
     double t_split = 0.0;
     std::size_t orbits_fitted = 0;
     std::vector<ModelScore> models;  // linear first, then quadratic
@@ -127,7 +132,7 @@ std::string selection_verdict(double linear_rms, double quadratic_rms);
 // epochs before and after it. holdout 0: fits and scores on the whole period,
 // no verdict.
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
-                       const std::array<Eigen::Matrix3d, 3>& n_ref, double t_first, double t_last, double holdout,
+                       const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
                        double max_condition, double min_range_c);
 
 std::string describe_centring(const TermsFit& f);

@@ -1,7 +1,12 @@
 // ascorr_host/analysis/iba.hpp: inter-boresight angles and their statistics.
 //
 // Conventions (docs/contract.md, "Statistics"):
-//  - pairs in the paper's order: 0 = A–B, 1 = A–C, 2 = B–C;
+//  - the heads of an analysis are a HeadSet (bit h: head h of heads.hpp); its
+//    pairs are every two of them in heads.hpp's order, pairs_of() below, the
+//    one place that derives them: A–B, A–C, A–D, B–C, B–D, C–D for A–D, the
+//    paper's A–B, A–C, B–C for A, B, C. Results are indexed by the position of
+//    the pair in that list;
+//  - which heads an analysis holds: analysis_heads() below;
 //  - the IBA of a pair is the angle between the two boresights (the third rows
 //    of R(q_chu_icrf)) at the same epoch, in arcsec;
 //  - RMS is about the mean; the smoothed RMS is that of the running mean over
@@ -12,16 +17,101 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
+#include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/vector3.hpp"
 
 namespace ascorr::host {
 
-inline constexpr std::size_t kPairs = 3;
-inline constexpr std::array<std::array<std::uint8_t, 2>, kPairs> kPairHeads{{{0, 1}, {0, 2}, {1, 2}}};
-inline constexpr const char* kPairNames[kPairs] = {"A-B", "A-C", "B-C"};
+// A set of heads: bit h is head h (heads.hpp).
+using HeadSet = std::uint32_t;
+static_assert(kMaxHeads <= 16, "a HeadSet holds every head");
+inline constexpr HeadSet kAllHeads = (HeadSet{1} << kMaxHeads) - 1U;
+// A, B and C, the paper's heads: always in an analysis, so that a missing one is
+// named (no rows, no clean rows) rather than silently left out.
+inline constexpr HeadSet kPaperHeads = 0x7U;
+static_assert(kMaxHeads >= 3, "the paper's three heads");
+
+constexpr HeadSet head_bit(std::uint8_t head) noexcept {
+    return HeadSet{1} << head;
+}
+constexpr bool has_head(HeadSet s, std::uint8_t head) noexcept {
+    return (s & head_bit(head)) != 0U;
+}
+constexpr std::size_t head_count(HeadSet s) noexcept {
+    std::size_t n = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        n += has_head(s, h) ? 1U : 0U;
+    }
+    return n;
+}
+
+// The heads an analysis holds: the paper's A, B, C, every head with rows in
+// the data (with_rows), and the heads it needs besides (e.g. frame F's).
+constexpr HeadSet analysis_heads(HeadSet with_rows, HeadSet needed = 0U) noexcept {
+    return (kPaperHeads | with_rows | needed) & kAllHeads;
+}
+
+inline constexpr std::size_t kMaxPairs = std::size_t{kMaxHeads} * (kMaxHeads - 1U) / 2U;
+
+struct HeadPair {
+    std::uint8_t first = 0;  // first < second
+    std::uint8_t second = 0;
+    char name[4] = {};  // "A-B"
+};
+
+// The heads of a set in heads.hpp's order, and its pairs.
+struct HeadList {
+    std::array<std::uint8_t, kMaxHeads> head{};
+    std::size_t count = 0;
+};
+struct PairList {
+    std::array<HeadPair, kMaxPairs> pair{};
+    std::size_t count = 0;
+};
+
+constexpr HeadList heads_of(HeadSet s) noexcept {
+    HeadList l{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(s, h)) {
+            l.head[l.count++] = h;
+        }
+    }
+    return l;
+}
+
+// Every two heads of s, in heads.hpp's order (the one place pairs are derived).
+constexpr PairList pairs_of(HeadSet s) noexcept {
+    PairList l{};
+    for (std::uint8_t i = 0; i < kMaxHeads; ++i) {
+        for (std::uint8_t j = i + 1U; j < kMaxHeads; ++j) {
+            if (has_head(s, i) && has_head(s, j)) {
+                HeadPair& p = l.pair[l.count++];
+                p.first = i;
+                p.second = j;
+                p.name[0] = kHeadLetters[i];
+                p.name[1] = '-';
+                p.name[2] = kHeadLetters[j];
+                p.name[3] = '\0';
+            }
+        }
+    }
+    return l;
+}
+
+inline constexpr PairList kPaperPairs = pairs_of(kPaperHeads);  // A-B, A-C, B-C
+
+// The letters of the heads of s, "ABD"; and in words, "A, B and D" (last: " or ": "A, B or D").
+std::string head_letters(HeadSet s);
+std::string head_words(HeadSet s, const char* last = " and ");
+// The set named by letters ("ABCD": each a head of heads.hpp, in its order, none
+// twice); std::nullopt for anything else.
+std::optional<HeadSet> parse_head_letters(const std::string& letters);
+
 inline constexpr double kSmoothingWindowS = 200.0;
 
 // Angle between two unit vectors in arcsec, precise for any angle.

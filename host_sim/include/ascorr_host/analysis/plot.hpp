@@ -41,9 +41,9 @@ struct PlotOptions {
 // window that is empty or has no clean epoch).
 void plot_iba(const PlotOptions& opt, std::ostream& log);
 
-// Writes "t+time_offset T_CHU_A T_CHU_B T_CHU_C T029 T032" per bin of bin_s
-// seconds with data in [from, to] (means over the rows of heads A-C; NaN
-// where a bin has none of a temperature). Returns the number of bins.
+// Writes "t+time_offset T_CHU_A … T_CHU_<last head of heads.hpp> T029 T032"
+// per bin of bin_s seconds with data in [from, to] (means over the rows of
+// each head; NaN where a bin has none of a temperature). Returns the number of bins.
 std::size_t write_temperature_series(const std::string& in, const std::string& path, double bin_s,
                                      std::optional<double> from, std::optional<double> to, double time_offset);
 

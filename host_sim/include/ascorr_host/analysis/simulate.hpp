@@ -10,6 +10,18 @@
 //  - Heads: boresights 54.7° from the zenith at azimuths 90° (A), 210° (B),
 //    330° (C) from +x towards +y, hence mutually 90° apart. head_mounting(h)
 //    maps body into head components, so q_chu_icrf = R_head_body·R_body_icrf.
+//  - The heads simulated (--heads, default ABC): two or more of heads.hpp's.
+//    A head beyond C (index h ≥ 3, D) is derived from head h − 3 (A for D),
+//    so that A, B and C's rows are those of a mission without it:
+//      mounting: halfway in azimuth between heads h − 3 and h − 2 (D: 150°),
+//      the same zenith distance;
+//      temperature: T_CHU with head h − 3's response mirrored (the seasonal
+//      and orbital terms of the opposite sign), its own wander and read
+//      noise; T029 and T032 are the bench's, shared by every head;
+//      truth: head h − 3's coefficients with the opposite sign, unless the
+//      truth model file has its own;
+//      random draws (temperature, flags, noise): its own stream, mt19937_64
+//      seeded by seed_seq{seed, h}.
 //  - Truth: the rigid attitude. The head really points along the deformed,
 //    noisy attitude q_meas = q_th* ⊗ q_noise ⊗ q_true, with q_th the thermal
 //    correction of the truth model for the recorded temperatures; the raw
@@ -94,12 +106,13 @@ struct SimulateOptions {
     std::vector<DayWindow> gaps;
     std::vector<ThermistorFault> thermistor_faults;
     std::vector<HeadBias> head_biases;
+    HeadSet heads = kPaperHeads;  // the heads simulated (--heads)
 };
 
 // Throws std::invalid_argument, naming the option (--truth-change, --gap,
 // --thermistor-fault, --head-bias) and what it accepts, for events outside the
 // mission [0, days], empty or reversed windows, truth changes not in increasing
-// days, heads other than A, B, C, non-finite values.
+// days, heads not simulated, fewer than two heads (--heads), non-finite values.
 void refuse_bad_events(const SimulateOptions& opt);
 
 struct HeaterEvent {
@@ -111,11 +124,13 @@ struct HeaterEvent {
 struct SimulateSummary {
     std::size_t epochs = 0;
     std::size_t rows = 0;
-    std::array<std::size_t, 3> outage_rows{};  // per head, not written (Sun or Moon in view)
-    std::size_t flagged_rows = 0;              // flags != 0 or confidence > 5
+    HeadSet heads = kPaperHeads;                       // simulated
+    PairList pairs = kPaperPairs;                      // pairs_of(heads): floor is indexed by position in it
+    std::array<std::size_t, kMaxHeads> outage_rows{};  // per head, not written (Sun or Moon in view)
+    std::size_t flagged_rows = 0;                      // flags != 0 or confidence > 5
     std::size_t rows_without_temperature = 0;
     std::size_t rows_without_velocity = 0;
-    std::array<Rms, kPairs> floor{};
+    std::array<Rms, kMaxPairs> floor{};
     std::string truth_path;
     std::string floor_path;
     std::string floor_daily_path;
@@ -133,11 +148,11 @@ struct SimulateSummary {
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
 SimulateSummary simulate(const SimulateOptions& opt);
 
-// Body into head components for head 0..2 (A, B, C).
+// Body into head components for head 0 … kMaxHeads − 1 (see the top).
 Eigen::Matrix3d head_mounting(int head);
 
 std::string describe(const SimulateSummary& s);
-std::string floor_json(const std::array<Rms, kPairs>& floor);
+std::string floor_json(const std::array<Rms, kMaxPairs>& floor, const PairList& pairs);
 std::string heaters_csv(const std::vector<HeaterEvent>& events);
 
 // OUT.floor-daily.csv: `day,t_start,pair,n,sum,sum_sq`, a row per day since
@@ -150,16 +165,18 @@ struct FloorSums {
     long double sum = 0.0L;
     long double sum_sq = 0.0L;
 };
-using DailyFloor = std::vector<std::array<FloorSums, kPairs>>;  // [day][pair]
-std::string floor_daily_csv(const DailyFloor& days, double start_t);
+using DailyFloor = std::vector<std::array<FloorSums, kMaxPairs>>;  // [day][position in pairs]
+std::string floor_daily_csv(const DailyFloor& days, double start_t, const PairList& pairs);
 
-// The floor per pair over days [from_day, to_day) of an OUT.floor-daily.csv:
-// rms about the mean (NaN without epochs) and n. Throws InputError
-// (file:line:column) for a malformed file.
+// The floor per pair of `pairs` (by position in it) over days [from_day,
+// to_day) of an OUT.floor-daily.csv: rms about the mean (NaN without epochs)
+// and n; rows of other pairs are skipped. Throws InputError
+// (file:line:column) for a malformed file (a pair that is not two heads of heads.hpp).
 struct WindowFloor {
     double rms = 0.0;
     std::size_t n = 0;
 };
-std::array<WindowFloor, kPairs> floor_of_days(const std::string& path, long long from_day, long long to_day);
+std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long long from_day, long long to_day,
+                                                 const PairList& pairs = kPaperPairs);
 
 }  // namespace ascorr::host

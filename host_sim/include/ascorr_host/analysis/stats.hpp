@@ -1,6 +1,7 @@
 // ascorr_host/analysis/stats.hpp: IBA statistics of a recorded file (`ascorr stats`).
 //
-// Per pair (A–B, A–C, B–C) and stage (original, aberration-corrected,
+// Per pair of the heads the file holds (iba.hpp: analysis_heads, pairs_of;
+// A–B, A–C, B–C for three heads) and stage (original, aberration-corrected,
 // aberration- and thermal-corrected), the IBA RMS about the mean over the
 // clean epochs of docs/contract.md: both rows with flags == 0, confidence <= 5,
 // all three temperatures and the velocity present (and accepted by the core),
@@ -46,15 +47,17 @@ struct PairSeries {
 struct StatsResult {
     bool thermal = false;
     bool corrected_input = false;  // StatsOptions::corrected_input: only the "original" stage
-    std::array<std::array<Rms, kStages>, kPairs> rms{};
-    std::array<std::size_t, kPairs> n{};
-    std::array<PairSeries, kPairs> series;  // sorted by t; filled when keep_series
-    std::size_t rows = 0;                   // rows in [from, to]
+    HeadSet heads = kPaperHeads;   // analysis_heads of the heads with rows in the file
+    PairList pairs = kPaperPairs;  // pairs_of(heads): the arrays below are indexed by position in it
+    std::array<std::array<Rms, kStages>, kMaxPairs> rms{};
+    std::array<std::size_t, kMaxPairs> n{};
+    std::array<PairSeries, kMaxPairs> series;  // sorted by t; filled when keep_series
+    std::size_t rows = 0;                      // rows in [from, to]
     std::size_t clean_rows = 0;
     // For a pair without clean epochs (n == 0), why, in words: no rows in the
     // file or in [from, to], a head without rows or without clean rows (and
     // what kept them out), or the two heads' clean rows never at one epoch.
-    std::array<std::string, kPairs> no_epochs_reason;
+    std::array<std::string, kMaxPairs> no_epochs_reason;
 };
 
 // docs/contract.md's clean solution (before the core has seen it).
