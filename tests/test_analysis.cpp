@@ -233,10 +233,11 @@ TEST(Fit, FitAndCorrectReachTheNoiseFloorInsideAndOutsideThePeriod) {
             const double fl = floor_rms(s.gen.floor[p], *so.from, *so.to);
             const double got = r.rms[p][0].rms;
             std::printf("%s %s: floor %.3f\", aberration-corrected %.3f\", fit+correct %.3f\" (%+.2f %%)\n",
-                        period == 0 ? "inside " : "outside", host::kPaperPairs.pair[p].name, fl, r_raw.rms[p][1].rms,
-                        got, 100.0 * (got / fl - 1.0));
+                        period == 0 ? "inside " : "outside", host::pair_name(host::kPaperPairs.pair[p]).c_str(), fl,
+                        r_raw.rms[p][1].rms, got, 100.0 * (got / fl - 1.0));
             EXPECT_EQ(r.n[p], r_raw.n[p]);
-            EXPECT_LT(std::fabs(got / fl - 1.0), 0.03) << host::kPaperPairs.pair[p].name << " period " << period;
+            EXPECT_LT(std::fabs(got / fl - 1.0), 0.03)
+                << host::pair_name(host::kPaperPairs.pair[p]) << " period " << period;
         }
     }
 }
@@ -253,7 +254,7 @@ TEST(Stats, AgreesWithAnIndependentIbaComputation) {
         << slurp(err);
     const std::string json = slurp(out);
     for (std::size_t p = 0; p < 3; ++p) {
-        const std::regex re(std::string("\"") + host::kPaperPairs.pair[p].name +
+        const std::regex re(std::string("\"") + host::pair_name(host::kPaperPairs.pair[p]) +
                             "\": \\{\"original\": ([0-9.]+), \"aberration\": ([0-9.]+), \"thermal\": ([0-9.]+), "
                             "\"n\": ([0-9]+)\\}");
         std::smatch m;
@@ -261,7 +262,8 @@ TEST(Stats, AgreesWithAnIndependentIbaComputation) {
         EXPECT_EQ(std::stoul(m[4].str()), n[p]);
         for (std::size_t st = 0; st < 3; ++st) {
             const double got = std::stod(m[st + 1].str());
-            EXPECT_LT(std::fabs(got / ref[p][st] - 1.0), 0.005) << host::kPaperPairs.pair[p].name << ' ' << st;
+            EXPECT_LT(std::fabs(got / ref[p][st] - 1.0), 0.005)
+                << host::pair_name(host::kPaperPairs.pair[p]) << ' ' << st;
         }
         // With the truth model the thermal stage is the noise alone.
         EXPECT_NEAR(std::stod(m[3].str()), floor_rms(s.gen.floor[p], 0.0, 1e12), 1e-4);

@@ -103,8 +103,8 @@ std::array<std::array<double, 3>, 2> excess_over_floor(const DataSet& d, const f
             const double fl = floor_rms(d.gen.floor[p], *so.from, *so.to);
             out[static_cast<std::size_t>(period)][p] = r.rms[p][0].rms / fl - 1.0;
             std::printf("%-9s %s %s: floor %.3f\", fit+correct %.3f\" (%+.2f %%)\n", label,
-                        period == 0 ? "inside " : "outside", host::kPaperPairs.pair[p].name, fl, r.rms[p][0].rms,
-                        100.0 * (r.rms[p][0].rms / fl - 1.0));
+                        period == 0 ? "inside " : "outside", host::pair_name(host::kPaperPairs.pair[p]).c_str(), fl,
+                        r.rms[p][0].rms, 100.0 * (r.rms[p][0].rms / fl - 1.0));
         }
     }
     return out;
@@ -128,8 +128,8 @@ TEST(FitTerms, QuadraticTruth) {
     EXPECT_GT(rep.singular_values[53], 1e-3 * rep.singular_values[0]);
     const auto ex = excess_over_floor(d, model, "quadratic");
     for (std::size_t p = 0; p < 3; ++p) {
-        EXPECT_LT(std::fabs(ex[0][p]), 0.03) << host::kPaperPairs.pair[p].name << " inside";
-        EXPECT_LT(std::fabs(ex[1][p]), 0.03) << host::kPaperPairs.pair[p].name << " outside";
+        EXPECT_LT(std::fabs(ex[0][p]), 0.03) << host::pair_name(host::kPaperPairs.pair[p]) << " inside";
+        EXPECT_LT(std::fabs(ex[1][p]), 0.03) << host::pair_name(host::kPaperPairs.pair[p]) << " outside";
     }
     // The quadratic coefficients are observable (the gauge is linear): the
     // fit recovers the truth's to a fraction of their size.
@@ -210,8 +210,8 @@ TEST(FitTerms, LinearTruth) {
     // still at the floor.
     const auto ex = excess_over_floor(d, model, "quadratic");
     for (std::size_t p = 0; p < 3; ++p) {
-        EXPECT_LT(std::fabs(ex[0][p]), 0.03) << host::kPaperPairs.pair[p].name << " inside";
-        EXPECT_LT(std::fabs(ex[1][p]), 0.03) << host::kPaperPairs.pair[p].name << " outside";
+        EXPECT_LT(std::fabs(ex[0][p]), 0.03) << host::pair_name(host::kPaperPairs.pair[p]) << " inside";
+        EXPECT_LT(std::fabs(ex[1][p]), 0.03) << host::pair_name(host::kPaperPairs.pair[p]) << " outside";
     }
     // The holdout changes the report, never the model written.
     host::FitOptions o;

@@ -106,3 +106,24 @@ def test_earth_velocity_against_pyerfa():
     v, dist = ascorr.earth_velocity(t)  # the series the correction uses
     assert np.max(np.abs(v - v_ref)) < 1e-7  # km/s: below 4e-8 arcsec of aberration
     assert np.max(np.abs(dist - d_ref)) < 1e-9
+
+
+def test_four_heads_fit_stats_and_iba_are_the_command_lines(exe, tmp_path):
+    """A mission of heads A-D (simulate --heads ABCD): fit, stats and iba return
+    every head and its six pairs, as the command line does."""
+    path = tmp_path / "four.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 40, "--step", 120, "--heads", "ABCD")
+    out = tmp_path / "model.csv"
+    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30)
+    d = ascorr.read_solutions(str(path))
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    assert model.to_csv() == out.read_text() and model.heads == "ABCD"
+    assert report["heads"] == "ABCD" and report["residual_rms"].shape == (4, 3)
+    six = ["A-B", "A-C", "A-D", "B-C", "B-D", "C-D"]
+    cli = json.loads(run_cli(exe, "stats", "--in", path, "--model", out, "--json").stdout)
+    s = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
+    assert list(cli["pairs"]) == list(s["pairs"]) == six
+    for pair, want in cli["pairs"].items():
+        assert s["pairs"][pair]["n"] == want["n"] > 1000
+        assert f"{s['pairs'][pair]['thermal']:.6f}" == f"{want['thermal']:.6f}", pair
+    assert list(ascorr.iba(d["t"], d["chu"], d["q"])) == six

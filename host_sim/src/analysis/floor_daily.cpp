@@ -53,6 +53,25 @@ long double number(const std::string& path, std::size_t line, const Fields& f, s
     return x;
 }
 
+// The position of the line's pair in `pairs`, pairs.count for another pair of
+// heads.hpp's heads; InputError for a name that is no pair of them.
+std::size_t pair_position(const std::string& path, std::size_t line, const Fields& f, const PairList& pairs) {
+    constexpr PairList kAllPairs = pairs_of(kAllHeads);
+    bool known = false;
+    for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+        known = known || f.text[2] == kAllPairs.pair[p].name;
+    }
+    if (!known) {
+        throw InputError(path, line, f.column[2],
+                         "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
+    }
+    std::size_t position = pairs.count;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        position = f.text[2] == pairs.pair[p].name ? p : position;
+    }
+    return position;
+}
+
 }  // namespace
 
 std::string floor_daily_csv(const DailyFloor& days, double start_t, const PairList& pairs) {
@@ -71,7 +90,6 @@ std::string floor_daily_csv(const DailyFloor& days, double start_t, const PairLi
 
 std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long long from_day, long long to_day,
                                                  const PairList& pairs) {
-    constexpr PairList kAllPairs = pairs_of(kAllHeads);
     std::ifstream in(path);
     if (!in) {
         throw InputError(path, 0, 0, "cannot open the daily floor file");
@@ -88,18 +106,7 @@ std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long l
         if (f.count != 6) {
             throw InputError(path, number_of_line, 1, "expected 6 fields (" + std::string(kFloorDailyHeader) + ")");
         }
-        bool known = false;
-        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
-            known = known || f.text[2] == kAllPairs.pair[p].name;
-        }
-        if (!known) {
-            throw InputError(path, number_of_line, f.column[2],
-                             "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
-        }
-        std::size_t pair = pairs.count;  // its position in pairs; pairs.count: not one of them
-        for (std::size_t p = 0; p < pairs.count; ++p) {
-            pair = f.text[2] == pairs.pair[p].name ? p : pair;
-        }
+        const std::size_t pair = pair_position(path, number_of_line, f, pairs);
         const long double day = number(path, number_of_line, f, 0);
         const long double n = number(path, number_of_line, f, 3);
         if (day < 0 || day != std::floor(day) || n < 0 || n != std::floor(n)) {

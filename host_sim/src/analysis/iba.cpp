@@ -12,6 +12,10 @@ double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept
     return std::atan2(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
 }
 
+std::string pair_name(const HeadPair& p) {
+    return std::string(1, kHeadLetters[p.first]) + '-' + kHeadLetters[p.second];
+}
+
 std::string head_letters(HeadSet s) {
     std::string out;
     const HeadList l = heads_of(s);

@@ -29,6 +29,10 @@ namespace ascorr::host {
 
 namespace {
 
+// A, B and C, the heads the simulator models itself; a head beyond them
+// (index h ≥ kOwnHeads) is derived from head h − kOwnHeads (simulate.hpp).
+constexpr std::size_t kOwnHeads = head_count(kPaperHeads);
+
 // Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
 constexpr double kNoiseCrossArcsec = 1.5;
 constexpr double kNoiseAboutArcsec = 10.0;
@@ -150,7 +154,8 @@ Eigen::Matrix3d head_mounting(int head) {
     const double zeta = std::acos(1.0 / std::sqrt(3.0));  // from the zenith: three mutually orthogonal boresights
     // A head beyond C (index h ≥ 3): halfway in azimuth between heads h − 3
     // and h − 2 (D between A and B, at 150°), at the same zenith distance.
-    const double az_deg = head < 3 ? kAzimuthDeg[head] : kAzimuthDeg[(head - 3) % 3] + 60.0;
+    const auto h = static_cast<std::size_t>(head);
+    const double az_deg = h < kOwnHeads ? kAzimuthDeg[h] : kAzimuthDeg[(h - kOwnHeads) % kOwnHeads] + 60.0;
     const double az = az_deg * kDegToRad;
     const Eigen::Vector3d up(0.0, 0.0, -1.0);  // body z is nadir
     const Eigen::Vector3d z = std::sin(zeta) * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0) + std::cos(zeta) * up;
@@ -244,18 +249,18 @@ std::string truth_name(const std::string& path) {
 // of its own, not a rotation common to the heads.
 ModelFile truth_model(const std::string& path, HeadSet heads) {
     ModelFile truth_file = path.empty() ? table2_model() : read_model_file(path);
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t h = 0; h < kOwnHeads; ++h) {
         if (!truth_file.present[h]) {
             throw std::invalid_argument((path.empty() ? std::string("truth model") : path) +
                                         ": no coefficients for CHU " + head_name(static_cast<std::uint8_t>(h)));
         }
     }
-    for (std::size_t h = 3; h < kMaxHeads; ++h) {
+    for (std::size_t h = kOwnHeads; h < kMaxHeads; ++h) {
         if (!truth_file.present[h] && has_head(heads, static_cast<std::uint8_t>(h))) {
             truth_file.present[h] = true;
             for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
                 for (std::size_t c = 0; c < kModelTerms; ++c) {
-                    truth_file.coefficients[h][ax][c] = -truth_file.coefficients[h - 3][ax][c];
+                    truth_file.coefficients[h][ax][c] = -truth_file.coefficients[h - kOwnHeads][ax][c];
                 }
             }
         }
@@ -457,7 +462,7 @@ struct ChuResponse {
     double orbit;
     double heater;
 };
-constexpr ChuResponse kChuResponse[3] = {
+constexpr ChuResponse kChuResponse[kOwnHeads] = {
     {10.0, 5.0, 2.0, 0.8, 2.5},   // A
     {14.0, -7.0, 1.0, 1.2, 3.0},  // B
     {8.0, -4.0, 3.0, 0.6, 2.0},   // C
@@ -467,10 +472,10 @@ constexpr ChuResponse kChuResponse[3] = {
 // h − 3's mirrored, as mounted on the other side: the seasonal (sinb) and
 // orbital terms change sign.
 ChuResponse chu_response(std::size_t h) {
-    if (h < 3) {
+    if (h < kOwnHeads) {
         return kChuResponse[h];
     }
-    ChuResponse r = kChuResponse[(h - 3) % 3];
+    ChuResponse r = kChuResponse[(h - kOwnHeads) % kOwnHeads];
     r.season = -r.season;
     r.orbit = -r.orbit;
     return r;
@@ -586,7 +591,7 @@ struct EpochState {
 
 // Head h's T_CHU at the epoch.
 double t_chu(const EpochState& e, std::size_t h) {
-    return h < 3 ? e.temp[h] : e.extra_chu[h];
+    return h < kOwnHeads ? e.temp[h] : e.extra_chu[h];
 }
 
 // One head's solution at an epoch (when the head is not blinded).
@@ -706,7 +711,7 @@ public:
         }
         // A head beyond C draws from its own stream, mt19937_64 seeded by
         // seed_seq{seed, h}: A, B and C's rows do not depend on which other heads are simulated.
-        for (std::uint8_t h = 3; h < kMaxHeads; ++h) {
+        for (std::uint8_t h = kOwnHeads; h < kMaxHeads; ++h) {
             if (has_head(opt.heads, h)) {
                 std::seed_seq seq{static_cast<std::uint64_t>(opt.seed), static_cast<std::uint64_t>(h)};
                 extra_[h].emplace(seq);
@@ -727,7 +732,7 @@ public:
         double surv = 0.0;
         heaters_.at(e.t, op, surv);
         e.temp = temperatures(e.orbit, e.sun, op, surv, wander_, opt_.step_s, rnd_);
-        for (std::size_t h = 3; h < kMaxHeads; ++h) {
+        for (std::size_t h = kOwnHeads; h < kMaxHeads; ++h) {
             if (extra_[h]) {
                 e.extra_chu[h] =
                     extra_chu_temperature(h, exposure(e.orbit, e.sun), op, extra_wander_[h], opt_.step_s, *extra_[h]);
@@ -809,7 +814,7 @@ private:
                 sum_.outage_rows[h] += gap || !written ? 0U : 1U;  // blinded: no solution
                 continue;
             }
-            Random& rnd = h < 3 ? rnd_ : *extra_[h];
+            Random& rnd = h < kOwnHeads ? rnd_ : *extra_[h];
             const HeadSolution s =
                 solve_head(h, r_true, moon_deg, e, truth, bias_rad(h, dt / kSecondsPerDay), earth_, rnd);
             if (gap || !written) {

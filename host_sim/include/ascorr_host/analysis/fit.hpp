@@ -6,15 +6,15 @@
 //  2. aberration correction by the core;
 //  3. at each epoch with all the fit's heads selected, the frame F of two of
 //     them (FitOptions::frame_heads, --frame-heads; A and C by default, the
-//     paper's eqs. 1–3 with the first in A's role, the second in C's) and each
-//     head's rotation relative to it, as the small
-//     rotation vector e_i (head axes, arcsec) with R_i·R_Fᵀ = exp([e_i×])·N_i,
+//     paper's eqs. 1–3 with the first in A's role, the second in C's) and
+//     each head's rotation relative to it, as the small rotation vector e_i
+//     (head axes, arcsec) with R_i·R_Fᵀ = exp([e_i×])·N_i,
 //     N_i the head's orientation in F at the first such epoch;
 //  4. averages of e_i and of the temperatures over each orbit (the same
 //     epochs on both sides, so the linear model holds for the averages);
 //  5. least squares by SVD (Eigen BDCSVD, columns centred, scaled, then
-//     normalised: fit_terms.hpp) of the 3 orbit-averaged angles per head against each
-//     head's [1, T1, T2−T1, T3−T1] (T1 = the head's T_CHU, T2 = T029,
+//     normalised: fit_terms.hpp) of the 3 orbit-averaged angles per head
+//     against each head's [1, T1, T2−T1, T3−T1] (T1 = the head's T_CHU, T2 = T029,
 //     T3 = T032), with --terms quadratic also their squares, all heads jointly;
 //  6. the model-selection report (fit_terms.hpp): linear and quadratic models
 //     fitted on the period without its held-out end (--holdout), their
@@ -24,13 +24,14 @@
 // The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
 //
 // The fit's heads: A, B, C, every head with rows in the modelling period and
-// F's two (iba.hpp, analysis_heads); two or more, up to kMaxHeads. The model
-// file has a row per axis of each of them.
+// F's two (iba.hpp, analysis_heads), up to kMaxHeads. The model file has a
+// row per axis of each of them.
 //
-// What is fitted, precisely (three heads; with N heads, 3·N equations per
-// orbit and 12·N coefficients, the gauge the same 9). F moves with the A and C boresights, hence with
-// their temperatures, and this motion shows in every head's e_i alike (as
-// N_i·g in head axes). A per-head fit would push A's and C's temperature
+// What is fitted, precisely, told for three heads (with N: 3·N equations per
+// orbit, 12·N linear coefficients, the same 9 unobservable directions). F
+// moves with the A and C boresights, hence with their temperatures, and this
+// motion shows in every head's e_i alike (as N_i·g in head axes). A per-head
+// fit would push A's and C's temperature
 // response into B's model, where it does not fit; so F's rotation g_k in each
 // orbit is a nuisance parameter, eliminated by projecting each orbit's 9
 // equations orthogonally to it. The data then fix the 36 coefficients up to a

@@ -105,6 +105,9 @@ constexpr PairList pairs_of(HeadSet s) noexcept {
 
 inline constexpr PairList kPaperPairs = pairs_of(kPaperHeads);  // A-B, A-C, B-C
 
+// The pair's name ("A-B") as a string.
+std::string pair_name(const HeadPair& p);
+
 // The letters of the heads of s, "ABD"; and in words, "A, B and D" (last: " or ": "A, B or D").
 std::string head_letters(HeadSet s);
 std::string head_words(HeadSet s, const char* last = " and ");
