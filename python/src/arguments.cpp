@@ -34,15 +34,12 @@ const char* docstring(const char* text) {
     throw py::value_error("argument '" + name + "': " + what);
 }
 
-// A number for a message: the shortest text that reads back exactly (1e+300,
-// never 300 digits), nan and inf as such.
 std::string number_text(double x) {
     char buf[40];
     const auto r = std::to_chars(buf, buf + sizeof buf, x);
     return {buf, static_cast<std::size_t>(r.ptr - buf)};
 }
 
-// What a Python value is, for messages: its repr (cut short) and its type.
 std::string value_text(const py::handle& x) {
     std::string s = py::repr(x);
     if (s.size() > 40) {
@@ -51,9 +48,8 @@ std::string value_text(const py::handle& x) {
     return s + " (" + std::string(py::str(py::type::handle_of(x).attr("__name__"))) + ")";
 }
 
-// An enumeration's value: one of names, in any case, as on the command line
-// ("names, case-insensitive"). Numbers are not names.
 namespace {
+// One of names, in any case; numbers are not names.
 std::string choice(const py::handle& x, const char* name, const std::vector<std::string_view>& names) {
     if (py::isinstance<py::str>(x)) {
         std::string s = x.cast<std::string>();
@@ -87,7 +83,6 @@ host::ScalarKind scalar_arg(const py::handle& x) {
     return *host::scalar_from_name(choice(x, "scalar", names));
 }
 
-// True or False (Python's bool or NumPy's bool_); None and numbers are refused.
 bool bool_arg(const py::handle& x, const char* name) {
     if (py::isinstance<py::bool_>(x) || py::isinstance(x, py::module_::import("numpy").attr("bool_"))) {
         return py::cast<bool>(x);
@@ -95,7 +90,6 @@ bool bool_arg(const py::handle& x, const char* name) {
     bad_argument(name, "expected True or False, got " + value_text(x));
 }
 
-// A real number (int, float, NumPy real scalar); not a bool, a string or None.
 double real_arg(const py::handle& x, const char* name) {
     const py::module_ np = py::module_::import("numpy");
     const bool real = py::isinstance<py::int_>(x) || py::isinstance<py::float_>(x) ||
@@ -111,7 +105,6 @@ double real_arg(const py::handle& x, const char* name) {
     return d;
 }
 
-// A non-negative integer (int or NumPy integer; not a bool or a float).
 std::size_t count_arg(const py::handle& x, const char* name) {
     const py::module_ np = py::module_::import("numpy");
     if ((py::isinstance<py::int_>(x) || py::isinstance(x, np.attr("integer"))) && !py::isinstance<py::bool_>(x)) {
@@ -123,7 +116,6 @@ std::size_t count_arg(const py::handle& x, const char* name) {
     bad_argument(name, "expected a non-negative integer, got " + value_text(x));
 }
 
-// A path: str or os.PathLike (pathlib.Path); bytes and the rest are refused.
 std::string path_arg(const py::handle& x, const char* name) {
     if (py::isinstance<py::str>(x) || py::hasattr(x, "__fspath__")) {
         const py::object p = py::module_::import("os").attr("fspath")(x);
@@ -146,9 +138,6 @@ py::array as_numpy(const py::handle& obj) {
     return py::module_::import("numpy").attr("asarray")(obj);
 }
 
-// A real-valued array of shape (n,) (cols == 0) or (n, cols) as float64,
-// C-contiguous: the same buffer when it already is, else one converted copy.
-// n < 0: any length (it is then taken from this argument).
 Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols) {
     if (obj.is_none()) {
         bad_argument(name, "expected an array of real numbers, got None");
@@ -186,6 +175,16 @@ Doubles time_array(const py::handle& obj, const std::string& name) {
     return real_array(a, name, -1, 0);
 }
 
+std::string head_letter_range() {
+    return std::string("'") + kHeadLetters[0] + "'..'" + kHeadLetters[kMaxHeads - 1] + "'";
+}
+
+std::string head_index_range() {
+    return "0.." + std::to_string(kMaxHeads - 1);
+}
+
+namespace {
+
 // Optional (n, cols) argument: None means "all missing" (NaN).
 Doubles optional_real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols,
                             double fill) {
@@ -195,15 +194,6 @@ Doubles optional_real_array(const py::handle& obj, const std::string& name, py::
         return a;
     }
     return real_array(obj, name, n, cols);
-}
-
-// The heads for messages and docstrings, from ascorr/heads.hpp: "'A'..'D'" and "0..3".
-std::string head_letter_range() {
-    return std::string("'") + kHeadLetters[0] + "'..'" + kHeadLetters[kMaxHeads - 1] + "'";
-}
-
-std::string head_index_range() {
-    return "0.." + std::to_string(kMaxHeads - 1);
 }
 
 // chu: head letters (kHeadLetters; anything else is an unknown head, status 16)
@@ -277,6 +267,8 @@ std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
     return heads;
 }
 
+}  // namespace
+
 Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, const py::handle& temps,
              const py::handle& v, const py::handle& flags, const py::handle& confidence) {
     Rows r;
@@ -316,8 +308,6 @@ Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, co
     return r;
 }
 
-// Row i as the solutions reader would have read it from a file holding the
-// same values: NaN is "not available", as `nan` in a file.
 void record_of(const Rows& r, py::ssize_t i, SolutionRecord& rec) {
     const auto k = static_cast<std::size_t>(i);
     rec.line = k + 1;
