@@ -5,9 +5,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
@@ -245,6 +249,96 @@ TEST(ModelFile, MalformedModels) {
     EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,alpha,1,2,3,4\n").find("second row for A alpha"), std::string::npos);
     EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,beta,1,2,3,4\n").find("head A has no gamma row"), std::string::npos);
     EXPECT_NE(err(h + "A,alpha,1,2,3\n").find("expected 6 fields"), std::string::npos);
+}
+
+// The writer's header is its column list, and a row it writes reads back
+// exactly: the shortest digits, "nan" temperatures, empty velocity and
+// confidence where not available.
+TEST(SolutionsWriter, RowsReadBackExactly) {
+    std::string joined;
+    for (const std::string_view c : kSolutionsColumns) {
+        joined += (joined.empty() ? "" : ",") + std::string(c);
+    }
+    EXPECT_EQ(joined, kSolutionsHeader);
+    EXPECT_TRUE(is_solutions_column("confidence"));
+    EXPECT_TRUE(is_solutions_column(kStatusColumn));
+    EXPECT_FALSE(is_solutions_column("note"));
+    EXPECT_FALSE(is_solutions_column("T"));
+
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    SolutionValues a;
+    a.t = 447534187.831;
+    a.chu = "B";
+    a.q_chu_icrf = {0.1, -0.7, 1.0 / 3.0, 0.6};
+    a.temperature = {20.25, nan, -1e-300};
+    a.v_sc_kms = {nan, nan, nan};
+    a.flags = 12;
+    a.confidence = nan;
+    SolutionValues b = a;
+    b.chu = "D";
+    b.temperature = {nan, nan, nan};
+    b.v_sc_kms = {7.5, -0.0, 1.0 / 7.0};
+    b.confidence = 3.25;
+    std::string text(kSolutionsHeader);
+    text += '\n';
+    for (const SolutionValues& row : {a, b}) {
+        append_solution_fields(text, row);
+        text += '\n';
+    }
+    EXPECT_EQ(text.substr(text.find('\n') + 1, text.find('\n', text.find('\n') + 1) - text.find('\n') - 1),
+              "447534187.831,B,0.1,-0.7,0.3333333333333333,0.6,20.25,nan,-1e-300,,,,12,");
+    const std::vector<SolutionRecord> rows = parse_all(text);
+    ASSERT_EQ(rows.size(), 2U);
+    EXPECT_EQ(rows[0].t, a.t);
+    EXPECT_EQ(rows[0].head, 1);
+    EXPECT_EQ(rows[0].q_chu_icrf.y, 1.0 / 3.0);
+    EXPECT_EQ(rows[0].q_chu_icrf.z, 0.6);
+    EXPECT_EQ(rows[0].temperature[0], 20.25);
+    EXPECT_FALSE(rows[0].temperature_present[1]);
+    EXPECT_EQ(rows[0].temperature[2], -1e-300);
+    EXPECT_EQ(rows[0].velocity_components, 0);
+    EXPECT_EQ(rows[0].flags, 12);
+    EXPECT_FALSE(rows[0].confidence_present);
+    EXPECT_EQ(rows[1].head, 3);
+    EXPECT_EQ(rows[1].velocity_components, 3);
+    EXPECT_EQ(rows[1].v_sc_kms.z, 1.0 / 7.0);
+    EXPECT_TRUE(std::signbit(rows[1].v_sc_kms.y));
+    EXPECT_EQ(rows[1].confidence, 3.25);
+    EXPECT_FALSE(rows[1].temperature_present[0]);
+}
+
+// for_each_solution_row: the header first, then every row with its fields as
+// written (an extra column included), in file order, line numbers kept.
+TEST(SolutionsReader, RowsWithTheirFields) {
+    const auto dir = test::scratch_dir("rows");
+    const std::string path = (dir / "s.csv").string();
+    std::ofstream(path) << "t,chu,qw,qx,qy,qz,note\n1,A,1,0,0,0,first\n\n2,C,1,0,0,0,\"x, y\"\n";
+    std::vector<std::string> seen;
+    int headers = 0;
+    for_each_solution_row(
+        path,
+        [&](const SolutionsReader& header) {
+            ++headers;
+            EXPECT_EQ(header.header().index("note"), 6);
+            EXPECT_TRUE(seen.empty());
+        },
+        [&](const SolutionsReader& reader, const SolutionRecord& rec) {
+            seen.push_back(std::to_string(rec.line) + ":" + std::string(rec.chu) + ":" +
+                           std::string(reader.fields()[6]));
+        },
+        "");
+    EXPECT_EQ(headers, 1);
+    EXPECT_EQ(seen, (std::vector<std::string>{"2:A:first", "4:C:\"x, y\""}));
+    std::ofstream(path) << "t,chu,qw,qx,qy,qz\n1,A,1,0,0,0\n2,C,1,0,zero,0\n";
+    try {
+        for_each_solution_row(
+            path, [](const SolutionsReader&) {}, [](const SolutionsReader&, const SolutionRecord&) {}, "");
+        ADD_FAILURE() << "a malformed row passed";
+    } catch (const InputError& e) {
+        EXPECT_EQ(e.line(), 3U);
+        EXPECT_EQ(e.column(), 9U);
+    }
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

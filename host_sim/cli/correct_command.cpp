@@ -1,14 +1,30 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
 namespace ascorr::cli {
+
+namespace {
+
+// --scalar's names: the host's (scalar_kind.hpp), as Python's scalar= takes them.
+std::vector<std::pair<std::string, host::ScalarKind>> scalar_names() {
+    std::vector<std::pair<std::string, host::ScalarKind>> names;
+    for (const host::ScalarName& n : host::kScalarNames) {
+        names.emplace_back(std::string(n.name), n.kind);
+    }
+    return names;
+}
+
+}  // namespace
 
 void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
@@ -25,9 +41,7 @@ void add_correct_command(CLI::App& app) {
     cmd->add_flag("!--no-aberration", opt->aberration, "skip the aberration stage");
     cmd->add_flag("!--no-thermal", opt->thermal, "skip the thermal stage");
     cmd->add_option("--scalar", opt->scalar, "scalar type of the core: double (default), float or fixed (any case)")
-        ->transform(one_of<host::ScalarKind>({{"double", host::ScalarKind::kDouble},
-                                              {"float", host::ScalarKind::kFloat},
-                                              {"fixed", host::ScalarKind::kFixed}}))
+        ->transform(one_of(scalar_names()))
         ->type_name("NAME");
     cmd->add_flag("--skip-bad", opt->skip_bad,
                   "skip malformed rows of --in and --states (each is reported) instead of stopping");

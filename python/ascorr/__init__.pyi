@@ -1,7 +1,9 @@
 # Type stub of the ascorr package (the compiled module ascorr._ascorr and
-# ascorr.to_frame, ascorr.from_frame). Docstrings: help(ascorr.correct) etc.
+# ascorr.to_frame, ascorr.from_frame). The docstrings are the module's, word for
+# word (python/src/docstrings.hpp and ascorr/__init__.py; python/tests/test_docs.py
+# fails when they differ).
 from os import PathLike
-from typing import Any, Optional, TypedDict, Union
+from typing import Any, Literal, Optional, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -12,25 +14,44 @@ _Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pa
 __version__: str  # project(VERSION) of the CMake build
 HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
 
-class InputError(ValueError): ...
-class FitRefused(ValueError): ...
+class InputError(ValueError):
+    """A malformed input file or rows (a ValueError); the message starts with file:line:column."""
+class FitRefused(ValueError):
+    """fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError)."""
 
 class Model:
+    """A thermal model: per head and axis, angles in arcsec linear (and
+    optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
+
+    Model(coefficients, heads="ABCD"): coefficients of shape (4, 3, 4) or (4, 3, 7),
+    indexed [head 'A'..'D'][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
+    in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
+    coefficients (a head not listed gets status 256 in correct())."""
     def __init__(self, coefficients: npt.ArrayLike, heads: Optional[str] = ...) -> None: ...
+    # (len(HEADS), 3, 7) arcsec
     @property
-    def coefficients(self) -> npt.NDArray[np.float64]: ...  # (len(HEADS), 3, 7) arcsec
+    def coefficients(self) -> npt.NDArray[np.float64]:
+        """Coefficients, float64 (4, 3, 7): [head 'A'..'D'][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], arcsec (a copy)."""
     @property
-    def heads(self) -> str: ...
+    def heads(self) -> str:
+        """The heads with coefficients, e.g. 'ABC'."""
     @property
-    def quadratic(self) -> bool: ...
-    def write(self, path: _Path) -> None: ...
-    def to_csv(self) -> str: ...
-    def __eq__(self, other: object) -> bool: ...  # the same model file; Model pickles
+    def quadratic(self) -> bool:
+        """True when the model has (and its file will carry) the quadratic columns."""
+    def write(self, path: _Path) -> None:
+        """Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike."""
+    def to_csv(self) -> str:
+        """The model file's text."""
+    # the same model file; Model pickles
+    def __eq__(self, other: object) -> bool:
+        """Equal when both would write the same model file (heads, coefficients, columns)."""
     def __getstate__(self) -> tuple[npt.NDArray[np.float64], str, bool]: ...
     def __setstate__(self, state: tuple[npt.NDArray[np.float64], str, bool]) -> None: ...
 
 # Enumerations are names in any case ("GCRS" is "gcrs"), as on the command line.
-def read_model(path: _Path) -> Model: ...
+def read_model(path: _Path) -> Model:
+    """Read a model file (docs/contract.md, "Model file"). A malformed file raises ascorr.InputError
+    (a ValueError) with file:line:column, as the command line reports it."""
 def correct(
     t: _Real,
     chu: npt.ArrayLike,
@@ -43,11 +64,51 @@ def correct(
     states: Optional[_Path] = ...,
     states_frame: str = ...,  # "itrf" or "gcrs", any case
     max_propagation: float = ...,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16]]: ...
-def earth_velocity(t: _Real, exact: bool = ...) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16]]:
+    """Correct solutions: aberration, then the thermal model; the numbers and status bits of
+    `ascorr correct` on the same rows, bit for bit, in every scalar.
+
+    t: float64 (n,), s since J2000.0 TT. chu: (n,) strings 'A'..'D' or head indices
+    0..3. q: (n, 4) q_chu_icrf (w, x, y, z). temps: (n, 3) t_chu, t_029, t_032 in
+    degC, NaN where missing. v: (n, 3) spacecraft velocity, km/s GCRS, NaN where
+    missing. temps and v may be None (all missing). model: an ascorr.Model, or None
+    for no thermal stage. scalar: 'double', 'float' or 'fixed' (the core's Q30).
+    aberration: True or False (False skips the aberration stage; None is refused).
+    states: the path (str or os.PathLike) of a states file
+    (t,x,y,z,vx,vy,vz; `ascorr correct --states`): a row without its own velocity
+    (all three NaN) gets the on-board velocity service's, propagated from the
+    latest state at or before it (status 4 before the first state, 4+512 beyond
+    max_propagation seconds, 4+32 off a plausible orbit); states_frame 'itrf' (GNSS)
+    or 'gcrs' (uplinked). States the service refuses are reported as a warning.
+    The names of scalar and states_frame are those of the command line, in any
+    case ('GCRS' is 'gcrs'); numbers are not names.
+
+    Returns (q_corrected float64 (n, 4), status uint16 (n,)). Every row comes back;
+    a row that cannot be corrected keeps its quaternion exactly and says why in its
+    status bits (1 aberration, 2 thermal, 4 no velocity, 8 temperatures missing,
+    16 rejected, 32 velocity unusable, 64 temperature unusable, 128 model angle
+    beyond 1 deg, 256 no model for the head). A time outside the Earth ephemeris
+    (1900-2100, e.g. 1e300 s or a time in ms) is a row like any other: with a
+    velocity it gets 4+32, as on the command line. Raises ValueError naming the
+    argument and what it accepts for a wrong shape, dtype or value, or a time that
+    is not finite (the command line refuses such a row as malformed)."""
+def earth_velocity(t: _Real, exact: bool = ...) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t
+    (s since J2000.0 TT), from ERFA's eraEpv00: as the correction uses it (Chebyshev
+    series of degree 15 on 16-day segments, within 5e-9 km/s and 5e-12 au of
+    eraEpv00), or with exact=True (True or False) a direct call for each t.
+    eraEpv00 spans 1900-2100: outside it (and for NaN) the row is NaN, velocity and
+    distance (the correction then has no velocity: status 4+32).
+    Returns (v float64 (n, 3), sun_distance_au float64 (n,))."""
 def iba(
     t: _Real, chu: npt.ArrayLike, q: _Real
-) -> dict[str, tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]: ...
+) -> dict[str, tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+    """Inter-boresight angles: for each pair 'A-B', 'A-C', 'B-C', the angle in arcsec between the
+    two heads' boresights at every epoch (t to the millisecond) where both have a row.
+    Returns {pair: (t float64 (m,), iba float64 (m,))}, sorted by t. A row whose
+    quaternion the core rejects (not finite or not unit, status 16 in correct(),
+    a zero quaternion included) takes part in no IBA, as in stats(); a UserWarning
+    names such rows. A second row of one head at one epoch raises ascorr.InputError."""
 
 class _PairStats(TypedDict):
     original: Optional[float]
@@ -76,7 +137,16 @@ def stats(
     model: Optional[Model] = ...,
     t_from: Optional[float] = ...,
     t_to: Optional[float] = ...,
-) -> _Stats: ...
+) -> _Stats:
+    """IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
+    IBA RMS about the mean over the clean epochs (flags 0, confidence <= 5 or missing,
+    temperatures and velocity present and accepted), and after 200 s smoothing.
+    flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN or None when
+    missing; t_from, t_to: the period (inclusive).
+    Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
+    (arcsec; None with fewer than two clean epochs, or thermal without a model, as
+    null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),
+    "messages" (rows left out, one line each)}."""
 def fit(
     t: _Real,
     chu: npt.ArrayLike,
@@ -94,7 +164,21 @@ def fit(
     terms: str = ...,  # "linear" or "quadratic", any case
     holdout: float = ...,
     min_temperature_range: float = ...,
-) -> tuple[Model, dict[str, Any]]: ...
+) -> tuple[Model, dict[str, Any]]:
+    """Fit the thermal model as `ascorr fit` (the paper's procedure; see the README), with its
+    defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2; any
+    case, as --terms); holdout: the fraction of the period (its end) held out for the
+    model-selection report, 0..0.5; min_temperature_range: the smallest range (degC)
+    of each regressor for quadratic terms. Returns (model, report): model an
+    ascorr.Model (model.write(path) writes the model file), report a dict (rows,
+    dropped, epochs, orbits_used, condition, singular_values, terms, heads (the
+    letters of the heads fitted: A, B, C and any other with rows), residual_rms and
+    signal_rms (len(heads), 3) arcsec [head][alpha, beta, gamma], text).
+    Raises ascorr.FitRefused (a ValueError) when the data cannot determine the model
+    (period shorter than min_days, fewer than min_orbits orbits, condition number
+    above max_condition, too small a temperature range for quadratic terms) or a
+    setting is out of its range; its text, and the report's, name the settings as
+    this function's keywords (min_temperature_range, not --min-temperature-range)."""
 class _ActiveModel(TypedDict):
     t: float
     version: int
@@ -112,8 +196,25 @@ def self_calibrate(
     model: Optional[Model] = ...,
     scalar: Literal["double", "float", "fixed"] = ...,
     time_constant: float = ...,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]: ...
-def read_solutions(path: _Path) -> dict[str, Any]: ...  # arrays, and "extra": dict[str, NDArray[str_]]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
+    """Correct with a thermal model the on-board estimator learns from the rows themselves, as
+    `ascorr correct --self-calibrate`: causally in time order (any row order), from the
+    epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec or
+    None), after the aberration stage, in `scalar`, starting from `model` (version 0)
+    or from none (rows before the first adopted model get status 256).
+    time_constant: the estimator's forgetting in days. Returns (q_corrected float64
+    (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
+    "model"} for every model that became active, in time order."""
+# arrays, and "extra": dict[str, NDArray[str_]]
+def read_solutions(path: _Path) -> dict[str, Any]:
+    """Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),
+    "q" (n, 4), "temps" (n, 3), "v" (n, 3) (NaN where not available), "flags" (0 when
+    absent), "confidence" (NaN when absent)} plus "status" for a corrected file, and "extra":
+    {column name as written: (n,) str, the fields as written} for every other column
+    (kept, as `ascorr correct` keeps them). The keys are write_solutions()'s argument
+    names: write_solutions(path2, **read_solutions(path1)) writes every column.
+    path: str or os.PathLike. Malformed rows raise ascorr.InputError with
+    file:line:column, as the command line."""
 def write_solutions(
     path: _Path,
     t: _Real,
@@ -125,6 +226,35 @@ def write_solutions(
     confidence: Optional[_Real] = ...,
     status: Optional[npt.ArrayLike] = ...,
     extra: Optional[dict[str, npt.ArrayLike]] = ...,
-) -> None: ...
-def to_frame(solutions: dict[str, npt.NDArray[Any]]) -> Any: ...  # pandas.DataFrame
-def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]: ...  # frame: pandas.DataFrame
+) -> None:
+    """Write a solutions file (or, with status, a corrected file) from arrays, as the command
+    line writes its outputs: atomically (a temporary file renamed over the output,
+    whose permission bits and symbolic links are kept; on an error the existing file
+    is left as it was). path: str or os.PathLike. Columns: t, chu, qw..qz, t_chu,
+    t_029, t_032, vx, vy, vz, flags, confidence, then extra's columns in its order
+    ({name: (n,) values}, each value written as str(value), verbatim; what read_solutions()
+    returned), then status. Numbers are written with the fewest digits that read
+    back exactly; NaN temperatures as 'nan', NaN velocities and confidences as empty
+    fields. Nothing is written that read_solutions() would refuse: a status outside
+    0..65535 or with bits correct() never sets together, a row whose chu is not a
+    camera head with a status other than 16, a value that is not one CSV field raise
+    ValueError naming the argument (or column) and the row."""
+# pandas.DataFrame
+def to_frame(solutions: dict[str, npt.NDArray[Any]]) -> Any:
+    """A pandas DataFrame with the file's column names (t, chu, qw..qz, t_chu,
+    t_029, t_032, vx, vy, vz, flags, confidence[, status], and the extra
+    columns) from the dict that read_solutions() returns. Needs pandas
+    (ImportError otherwise)."""
+# frame: pandas.DataFrame
+def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]:
+    """The dict of arrays that read_solutions() returns (keys are correct()'s,
+    stats()'s, fit()'s and write_solutions()'s argument names) from a pandas
+    DataFrame with the file's column names, in any order: to_frame()'s
+    inverse. t, chu and qw..qz are required (ValueError naming the missing
+    ones); absent t_chu/t_029/t_032, vx/vy/vz or confidence are NaN and absent
+    flags 0, as in a file without them; missing values (NaN, None, pd.NA) are
+    NaN, except in chu, flags and status, where they are refused. chu holds
+    head letters (strings) or head indices (integers); "status" is kept when
+    present (a corrected file); every other column goes under "extra" as text,
+    as read_solutions() keeps the columns it does not know. Rows are taken in
+    the frame's order; its index only names rows in messages."""

@@ -24,6 +24,7 @@
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/progress.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
 
@@ -923,7 +924,8 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     AtomicFile out(opt.out);
     std::string buf;
     buf.reserve(2U << 20);
-    buf += "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    buf += kSolutionsHeader;
+    buf += '\n';
     const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {

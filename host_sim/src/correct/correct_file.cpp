@@ -13,7 +13,6 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -24,6 +23,7 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/correct/workers.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/corrected_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
@@ -240,11 +240,6 @@ std::vector<std::string_view> split_at_lines(std::string_view block, std::size_t
     return parts;
 }
 
-std::size_t worker_count() {
-    const unsigned hw = std::thread::hardware_concurrency();
-    return std::clamp<std::size_t>(hw == 0 ? 1 : hw, 1, 8);
-}
-
 // The TtTime (µs) of every row that will ask the states for its velocity (no
 // vx,vy,vz; a usable t), read ahead of the correction so that the service
 // answers in time order (StatesVelocityTable), whatever the rows' order.
@@ -279,16 +274,7 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
             std::sort(times[i].begin(), times[i].end());  // the heads of an epoch: one time
             times[i].erase(std::unique(times[i].begin(), times[i].end()), times[i].end());
         };
-        std::vector<std::thread> threads;
-        for (std::size_t i = 1; i < parts.size(); ++i) {
-            threads.emplace_back(scan, i);
-        }
-        if (!parts.empty()) {
-            scan(0);
-        }
-        for (auto& t : threads) {
-            t.join();
-        }
+        run_workers(parts.size(), scan);
         for (const auto& ts : times) {
             out.insert(out.end(), ts.begin(), ts.end());
         }
@@ -414,18 +400,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
             first_line[i] = first_line[i - 1] + count_line_ends(parts[i - 1]);
         }
         std::vector<ChunkResult> results(parts.size());
-        {
-            std::vector<std::thread> threads;
-            for (std::size_t i = 1; i < parts.size(); ++i) {
-                threads.emplace_back([&, i] { correct_chunk(job, parts[i], first_line[i], results[i]); });
-            }
-            if (!parts.empty()) {
-                correct_chunk(job, parts[0], first_line[0], results[0]);
-            }
-            for (auto& t : threads) {
-                t.join();
-            }
-        }
+        run_workers(parts.size(), [&](std::size_t i) { correct_chunk(job, parts[i], first_line[i], results[i]); });
         for (const ChunkResult& r : results) {  // in file order
             r.diag.replay(diag);
             if (r.error) {

@@ -1,6 +1,6 @@
 #include "ascorr_host/correct/states_velocity.hpp"
 
-#include <thread>
+#include "ascorr_host/correct/workers.hpp"
 
 namespace ascorr::host {
 
@@ -48,14 +48,7 @@ StatesVelocityTable<T>::StatesVelocityTable(const StatesFile& states, const Velo
         }
         costs[k] = sv.cost();
     };
-    std::vector<std::thread> threads;
-    for (std::size_t k = 1; k + 1 < cut.size(); ++k) {
-        threads.emplace_back(run, k);
-    }
-    run(0);
-    for (auto& t : threads) {
-        t.join();
-    }
+    run_workers(cut.size() - 1, run);
     for (const ServiceCost& c : costs) {
         cost_ += c;
     }

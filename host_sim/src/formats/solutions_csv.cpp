@@ -1,9 +1,12 @@
 #include "ascorr_host/formats/solutions_csv.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <system_error>
 
 #include "ascorr_host/formats/csv.hpp"
@@ -174,6 +177,14 @@ void refuse_corrected_file(const std::string& path) {
 
 void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
                        const std::string& label) {
+    for_each_solution_row(
+        path, [](const SolutionsReader&) {}, [&fn](const SolutionsReader&, const SolutionRecord& rec) { fn(rec); },
+        label);
+}
+
+void for_each_solution_row(const std::string& path, const std::function<void(const SolutionsReader& header)>& on_header,
+                           const std::function<void(const SolutionsReader& reader, const SolutionRecord&)>& fn,
+                           const std::string& label) {
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     BlockReader blocks(path);
@@ -183,25 +194,74 @@ void for_each_solution(const std::string& path, const std::function<void(const S
     }
     const std::size_t nl = block.find('\n');
     const SolutionsReader header(path, block.substr(0, nl));
+    on_header(header);
     block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
     std::size_t lines_before = 1;
     double done_bytes = static_cast<double>(nl == std::string_view::npos ? 0 : nl + 1);
-    Progress progress(label + ": reading " + path);
+    std::optional<Progress> progress;
+    if (!label.empty()) {
+        progress.emplace(label + ": reading " + path);
+    }
     SolutionRecord rec;
     for (;;) {
         SolutionsReader reader(header, block, lines_before);
         while (reader.next(rec)) {
-            fn(rec);
+            fn(reader, rec);
         }
         done_bytes += static_cast<double>(block.size());
-        if (!ec && size > 0) {
-            progress.update(done_bytes / static_cast<double>(size));
+        if (progress && !ec && size > 0) {
+            progress->update(done_bytes / static_cast<double>(size));
         }
         if (!blocks.next(block)) {
             break;
         }
         lines_before = blocks.lines_before();
     }
+}
+
+bool is_solutions_column(std::string_view name) noexcept {
+    return name == kStatusColumn ||
+           std::find(kSolutionsColumns.begin(), kSolutionsColumns.end(), name) != kSolutionsColumns.end();
+}
+
+namespace {
+void append_number(std::string& out, double x) {
+    if (std::isnan(x)) {
+        out += "nan";
+        return;
+    }
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);  // the shortest text that reads back exactly
+    out.append(buf, static_cast<std::size_t>(r.ptr - buf));
+}
+
+void append_optional(std::string& out, double x) {  // empty when not available
+    if (!std::isnan(x)) {
+        append_number(out, x);
+    }
+}
+}  // namespace
+
+void append_solution_fields(std::string& out, const SolutionValues& row) {
+    append_number(out, row.t);
+    out += ',';
+    out += row.chu;
+    for (const double c : {row.q_chu_icrf.w, row.q_chu_icrf.x, row.q_chu_icrf.y, row.q_chu_icrf.z}) {
+        out += ',';
+        append_number(out, c);
+    }
+    for (const double c : row.temperature) {
+        out += ',';
+        append_number(out, c);
+    }
+    for (const double c : row.v_sc_kms) {
+        out += ',';
+        append_optional(out, c);
+    }
+    out += ',';
+    out += std::to_string(row.flags);
+    out += ',';
+    append_optional(out, row.confidence);
 }
 
 }  // namespace ascorr::host

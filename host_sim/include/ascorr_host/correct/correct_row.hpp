@@ -2,7 +2,7 @@
 // `ascorr correct` does it.
 //
 // The per-row code path shared by `ascorr correct` (correct_file.cpp) and the
-// Python module (python/src/module.cpp): the row's inputs converted once to
+// Python module (python/src/bind_correct.cpp): the row's inputs converted once to
 // the scalar T (solution_input.hpp), with --states the on-board velocity
 // service's velocity for a row without its own (states_velocity.hpp), the
 // core, and the status bits the core cannot know (a velocity with 1 or 2 of

@@ -98,12 +98,52 @@ bool is_corrected_file(const std::string& path);
 
 // Where rows come from: calls its argument for every row, in order. A file is
 // [&](auto& fn) { for_each_solution(path, fn, label); }; the Python module
-// passes arrays (python/src/module.cpp).
+// passes arrays (python/src/arguments.cpp, source_of).
 using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
 
 // Calls fn for every data row of the file, in file order. Throws InputError
 // for a malformed row. label: shown with the progress on a terminal.
 void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
                        const std::string& label);
+
+// The same reading, for a caller that needs more than the record: on_header
+// is called once with the header (its columns, before any row), fn for every
+// row with the reader that read it (its fields() are the row's fields as
+// written). The file is read in blocks (BlockReader): memory bounded whatever
+// its size. label: shown with the progress on a terminal; empty: no progress.
+void for_each_solution_row(const std::string& path, const std::function<void(const SolutionsReader& header)>& on_header,
+                           const std::function<void(const SolutionsReader& reader, const SolutionRecord&)>& fn,
+                           const std::string& label);
+
+// ---- Writing (docs/contract.md, "Solutions file")
+
+// The columns of a solutions file in the order ascorr writes them (simulate,
+// Python's write_solutions()); a corrected file adds kStatusColumn last.
+inline constexpr std::array<std::string_view, 14> kSolutionsColumns = {
+    "t", "chu", "qw", "qx", "qy", "qz", "t_chu", "t_029", "t_032", "vx", "vy", "vz", "flags", "confidence"};
+inline constexpr std::string_view kStatusColumn = "status";
+// Their header line, without its line end.
+inline constexpr std::string_view kSolutionsHeader = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence";
+// True for a column of kSolutionsColumns or kStatusColumn: one a writer
+// writes from its own values (any other column is an extra one, kept as written).
+bool is_solutions_column(std::string_view name) noexcept;
+
+// One row's values, NaN where not available.
+struct SolutionValues {
+    double t = 0.0;
+    std::string_view chu;  // written as given: one plain CSV field
+    Quaternion<double> q_chu_icrf{};
+    std::array<double, 3> temperature{};  // t_chu, t_029, t_032
+    std::array<double, 3> v_sc_kms{};     // vx, vy, vz
+    long long flags = 0;
+    double confidence = 0.0;  // arcsec
+};
+
+// Appends the row's fields in kSolutionsColumns' order, without a line end
+// (a caller appends its extra columns, a status and '\n'). Numbers are written
+// with the fewest digits that read back exactly (std::to_chars); NaN
+// temperatures as "nan", NaN velocities and confidence as empty fields, as the
+// contract writes "not available"; NaN time or quaternion components as "nan".
+void append_solution_fields(std::string& out, const SolutionValues& row);
 
 }  // namespace ascorr::host

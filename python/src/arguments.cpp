@@ -1,0 +1,355 @@
+// python/src/arguments.cpp: the argument checks of bind.hpp, and the
+// docstrings' placeholders.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <list>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ascorr/core/heads.hpp"
+#include "bind.hpp"
+
+namespace ascorr::python {
+
+using host::SolutionRecord;
+
+const char* docstring(const char* text) {
+    static std::list<std::string> kept;  // stable addresses: pybind11 may keep the pointer
+    std::string s(text);
+    const auto fill = [&s](std::string_view key, const std::string& value) {
+        for (std::size_t at = s.find(key); at != std::string::npos; at = s.find(key, at + value.size())) {
+            s.replace(at, key.size(), value);
+        }
+    };
+    fill("@HEADS@", std::string(kHeadLetters));
+    fill("@N_HEADS@", std::to_string(kMaxHeads));
+    fill("@HEAD_LETTERS@", head_letter_range());
+    fill("@HEAD_INDICES@", head_index_range());
+    return kept.emplace_back(std::move(s)).c_str();
+}
+
+[[noreturn]] void bad_argument(const std::string& name, const std::string& what) {
+    throw py::value_error("argument '" + name + "': " + what);
+}
+
+std::string number_text(double x) {
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return {buf, static_cast<std::size_t>(r.ptr - buf)};
+}
+
+std::string value_text(const py::handle& x) {
+    std::string s = py::repr(x);
+    if (s.size() > 40) {
+        s = s.substr(0, 37) + "...";
+    }
+    return s + " (" + std::string(py::str(py::type::handle_of(x).attr("__name__"))) + ")";
+}
+
+namespace {
+// One of names, in any case; numbers are not names.
+std::string choice(const py::handle& x, const char* name, const std::vector<std::string_view>& names) {
+    if (py::isinstance<py::str>(x)) {
+        std::string s = x.cast<std::string>();
+        std::transform(s.begin(), s.end(), s.begin(),
+                       [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; });
+        for (const std::string_view n : names) {
+            if (s == n) {
+                return s;
+            }
+        }
+    }
+    std::string list;
+    std::size_t k = 0;
+    for (const std::string_view n : names) {
+        list += std::string(k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + "'" + std::string(n) + "'";
+        ++k;
+    }
+    bad_argument(name, "expected " + list + " (a name, in any case), got " + value_text(x));
+}
+}  // namespace
+
+std::string choice_arg(const py::handle& x, const char* name, std::initializer_list<const char*> names) {
+    return choice(x, name, std::vector<std::string_view>(names.begin(), names.end()));
+}
+
+host::ScalarKind scalar_arg(const py::handle& x) {
+    std::vector<std::string_view> names;
+    for (const host::ScalarName& n : host::kScalarNames) {
+        names.push_back(n.name);
+    }
+    return *host::scalar_from_name(choice(x, "scalar", names));
+}
+
+bool bool_arg(const py::handle& x, const char* name) {
+    if (py::isinstance<py::bool_>(x) || py::isinstance(x, py::module_::import("numpy").attr("bool_"))) {
+        return py::cast<bool>(x);
+    }
+    bad_argument(name, "expected True or False, got " + value_text(x));
+}
+
+double real_arg(const py::handle& x, const char* name) {
+    const py::module_ np = py::module_::import("numpy");
+    const bool real = py::isinstance<py::int_>(x) || py::isinstance<py::float_>(x) ||
+                      py::isinstance(x, np.attr("integer")) || py::isinstance(x, np.attr("floating"));
+    if (!real || py::isinstance<py::bool_>(x)) {
+        bad_argument(name, "expected a real number, got " + value_text(x));
+    }
+    const double d = PyFloat_AsDouble(x.ptr());
+    if (d == -1.0 && PyErr_Occurred() != nullptr) {
+        PyErr_Clear();
+        bad_argument(name, "expected a real number within the range of a double, got " + value_text(x));
+    }
+    return d;
+}
+
+std::size_t count_arg(const py::handle& x, const char* name) {
+    const py::module_ np = py::module_::import("numpy");
+    if ((py::isinstance<py::int_>(x) || py::isinstance(x, np.attr("integer"))) && !py::isinstance<py::bool_>(x)) {
+        const py::int_ i(py::reinterpret_borrow<py::object>(x));
+        if (!(i < py::int_(0)) && !(i > py::int_(std::numeric_limits<long long>::max()))) {
+            return static_cast<std::size_t>(i.cast<long long>());
+        }
+    }
+    bad_argument(name, "expected a non-negative integer, got " + value_text(x));
+}
+
+std::string path_arg(const py::handle& x, const char* name) {
+    if (py::isinstance<py::str>(x) || py::hasattr(x, "__fspath__")) {
+        const py::object p = py::module_::import("os").attr("fspath")(x);
+        if (py::isinstance<py::str>(p)) {
+            return p.cast<std::string>();
+        }
+    }
+    bad_argument(name, "expected a path (str or os.PathLike such as pathlib.Path), got " + value_text(x));
+}
+
+std::string shape_text(const py::array& a) {
+    std::string s = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) {
+        s += (i ? ", " : "") + std::to_string(a.shape(i));
+    }
+    return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+py::array as_numpy(const py::handle& obj) {
+    return py::module_::import("numpy").attr("asarray")(obj);
+}
+
+Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols) {
+    if (obj.is_none()) {
+        bad_argument(name, "expected an array of real numbers, got None");
+    }
+    const py::array a = as_numpy(obj);
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+        bad_argument(name, "expected real numbers, got dtype " + std::string(py::str(a.dtype())));
+    }
+    const bool shape_ok = cols == 0 ? a.ndim() == 1 : a.ndim() == 2 && a.shape(1) == cols;
+    if (!shape_ok) {
+        bad_argument(name, "expected shape " + std::string(cols == 0 ? "(n,)" : "(n, " + std::to_string(cols) + ")") +
+                               ", got " + shape_text(a));
+    }
+    if (n >= 0 && a.shape(0) != n) {
+        bad_argument(name, "expected " + std::to_string(n) + " rows (as t), got " + std::to_string(a.shape(0)));
+    }
+    return Doubles::ensure(a);
+}
+
+// Times (s since J2000.0): float64 or integers. float32 (and float16) are
+// refused: 24 bits of mantissa hold a time of 2020 to ~32 s, so the rows
+// would be matched and corrected at the wrong time.
+Doubles time_array(const py::handle& obj, const std::string& name) {
+    if (obj.is_none()) {
+        bad_argument(name, "expected an array of float64 (or integer) times, got None");
+    }
+    const py::array a = as_numpy(obj);
+    if (a.dtype().kind() == 'f' && a.itemsize() < 8) {
+        bad_argument(name, "expected float64 (or integer) times, got dtype " + std::string(py::str(a.dtype())) +
+                               ": its " + std::to_string(a.itemsize() == 4 ? 24 : 11) +
+                               "-bit mantissa holds a time since J2000 to tens of seconds or worse (convert the "
+                               "times from their source as float64)");
+    }
+    return real_array(a, name, -1, 0);
+}
+
+std::string head_letter_range() {
+    return std::string("'") + kHeadLetters[0] + "'..'" + kHeadLetters[kMaxHeads - 1] + "'";
+}
+
+std::string head_index_range() {
+    return "0.." + std::to_string(kMaxHeads - 1);
+}
+
+namespace {
+
+// Optional (n, cols) argument: None means "all missing" (NaN).
+Doubles optional_real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols,
+                            double fill) {
+    if (obj.is_none()) {
+        Doubles a(cols == 0 ? std::vector<py::ssize_t>{n} : std::vector<py::ssize_t>{n, cols});
+        std::fill(a.mutable_data(), a.mutable_data() + a.size(), fill);
+        return a;
+    }
+    return real_array(obj, name, n, cols);
+}
+
+// chu: head letters (kHeadLetters; anything else is an unknown head, status 16)
+// or integer head indices (below kMaxHeads; anything else: status 16), as the
+// reader maps them.
+std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
+    if (obj.is_none()) {
+        bad_argument("chu", "expected (n,) strings " + head_letter_range() + " or integers " + head_index_range() +
+                                ", got None");
+    }
+    const py::array a = as_numpy(obj);
+    if (a.ndim() != 1) {
+        bad_argument("chu", "expected shape (n,), got " + shape_text(a));
+    }
+    if (a.shape(0) != n) {
+        bad_argument("chu", "expected " + std::to_string(n) + " rows (as t), got " + std::to_string(a.shape(0)));
+    }
+    std::vector<std::uint8_t> heads(static_cast<std::size_t>(n), host::kUnknownHead);
+    const char kind = a.dtype().kind();
+    if (kind == 'i' || kind == 'u') {
+        const auto idx = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        const std::int64_t* p = idx.data();
+        for (py::ssize_t i = 0; i < n; ++i) {
+            if (p[i] >= 0 && p[i] < static_cast<std::int64_t>(kMaxHeads)) {
+                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(p[i]);
+            }
+        }
+    } else if (kind == 'U' || kind == 'S') {
+        // Fixed-width strings, read in place: UCS-4 code points or bytes, NUL-padded.
+        const py::array c = py::array::ensure(a, py::array::c_style);
+        const auto width = static_cast<std::size_t>(c.itemsize());
+        const std::size_t unit = kind == 'U' ? 4 : 1;
+        const auto* base = static_cast<const unsigned char*>(c.data());
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const unsigned char* e = base + static_cast<std::size_t>(i) * width;
+            std::uint32_t first = 0;  // assembled byte by byte: the elements need not be aligned
+            std::uint32_t second = 0;
+            if (width >= unit) {
+                for (std::size_t b = 0; b < unit; ++b) {
+                    first |= static_cast<std::uint32_t>(e[b]) << (8 * (kind == 'U' ? b : 0));
+                }
+            }
+            if (width >= 2 * unit) {
+                for (std::size_t b = 0; b < unit; ++b) {
+                    second |= static_cast<std::uint32_t>(e[unit + b]) << (8 * (kind == 'U' ? b : 0));
+                }
+            }
+            if (second == 0 && first < 0x80U) {
+                heads[static_cast<std::size_t>(i)] = head_index(static_cast<char>(first));
+            }
+        }
+    } else if (kind == 'O') {
+        for (py::ssize_t i = 0; i < n; ++i) {
+            const py::object x = a[py::int_(i)];
+            if (py::isinstance<py::str>(x)) {
+                heads[static_cast<std::size_t>(i)] = host::head_from_name(x.cast<std::string>());
+            } else if (py::isinstance<py::int_>(x)) {
+                const long long h = x.cast<long long>();
+                if (h >= 0 && h < static_cast<long long>(kMaxHeads)) {
+                    heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(h);
+                }
+            } else {
+                bad_argument("chu", "row " + std::to_string(i) + ": expected a string or an integer, got " +
+                                        std::string(py::str(x.get_type())));
+            }
+        }
+    } else {
+        bad_argument("chu", "expected strings " + head_letter_range() + " or integers " + head_index_range() +
+                                ", got dtype " + std::string(py::str(a.dtype())));
+    }
+    return heads;
+}
+
+}  // namespace
+
+Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, const py::handle& temps,
+             const py::handle& v, const py::handle& flags, const py::handle& confidence) {
+    Rows r;
+    r.t = time_array(t, "t");
+    r.n = r.t.shape(0);
+    const double* tp = r.t.data();
+    // As the solutions reader: a time that is not finite makes the row
+    // malformed; any finite time is a row (outside the Earth ephemeris,
+    // 1900-2100, with a velocity: status 4+32, as `ascorr correct`).
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        if (!std::isfinite(tp[i])) {
+            bad_argument("t", "row " + std::to_string(i) + ": time " + number_text(tp[i]) +
+                                  " is not finite (the command line refuses such a row as malformed)");
+        }
+    }
+    r.head = heads_of(chu, r.n);
+    r.q = real_array(q, "q", r.n, 4);
+    r.temps = optional_real_array(temps, "temps", r.n, 3, kNaN);
+    r.v = optional_real_array(v, "v", r.n, 3, kNaN);
+    r.confidence = optional_real_array(confidence, "confidence", r.n, 0, kNaN);
+    r.flags.assign(static_cast<std::size_t>(r.n), 0);
+    if (!flags.is_none()) {
+        const py::array a = as_numpy(flags);
+        const char kind = a.dtype().kind();
+        if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
+            bad_argument("flags", "expected " + std::to_string(r.n) + " non-negative integers, shape (n,), got dtype " +
+                                      std::string(py::str(a.dtype())) + " shape " + shape_text(a));
+        }
+        const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (py::ssize_t i = 0; i < r.n; ++i) {
+            if (f.data()[i] < 0) {
+                bad_argument("flags", "row " + std::to_string(i) + ": negative flags");
+            }
+            r.flags[static_cast<std::size_t>(i)] = f.data()[i];
+        }
+    }
+    return r;
+}
+
+void record_of(const Rows& r, py::ssize_t i, SolutionRecord& rec) {
+    const auto k = static_cast<std::size_t>(i);
+    rec.line = k + 1;
+    rec.t = r.t.data()[i];
+    rec.head = r.head[k];
+    rec.chu = rec.head < kMaxHeads ? std::string_view(&kHeadLetters[rec.head], 1) : std::string_view("?");
+    const double* q = r.q.data() + 4 * i;
+    rec.q_chu_icrf = {q[0], q[1], q[2], q[3]};
+    const double* tc = r.temps.data() + 3 * i;
+    for (std::size_t j = 0; j < 3; ++j) {
+        rec.temperature[j] = tc[j];
+        rec.temperature_present[j] = !std::isnan(tc[j]);
+    }
+    const double* v = r.v.data() + 3 * i;
+    rec.v_sc_kms = {v[0], v[1], v[2]};
+    rec.velocity_components =
+        static_cast<int>(!std::isnan(v[0])) + static_cast<int>(!std::isnan(v[1])) + static_cast<int>(!std::isnan(v[2]));
+    rec.flags = r.flags[k];
+    const double c = r.confidence.data()[i];
+    rec.confidence_present = !std::isnan(c);
+    rec.confidence = rec.confidence_present ? c : 0.0;
+}
+
+host::RowSource source_of(const Rows& r) {
+    return [&r](const std::function<void(const SolutionRecord&)>& fn) {
+        SolutionRecord rec;
+        for (py::ssize_t i = 0; i < r.n; ++i) {
+            record_of(r, i, rec);
+            fn(rec);
+        }
+    };
+}
+
+const host::ModelFile* model_arg(const py::object& model) {
+    if (model.is_none()) {
+        return nullptr;
+    }
+    if (!py::isinstance<host::ModelFile>(model)) {
+        bad_argument("model", "expected an ascorr.Model (read_model() or fit()) or None, got " +
+                                  std::string(py::str(model.get_type())));
+    }
+    return &model.cast<const host::ModelFile&>();
+}
+
+}  // namespace ascorr::python

@@ -1,0 +1,106 @@
+// python/src/bind.hpp: what every part of the bindings shares: the checks that
+// turn a Python argument into what the host library takes, with the module's
+// one form of message ("argument 'NAME': expected WHAT, got REPR (TYPE)"), the
+// rows of arrays as the solutions reader would have read them, and the
+// docstrings (docstrings.hpp) with the heads filled in.
+//
+// Arrays: float64 C-contiguous inputs are used in place; other real dtypes
+// (float32, integers) and non-contiguous arrays are converted once; times
+// must be float64 or integers. Every argument is a py::object checked here, so
+// that a wrong one raises ValueError, never pybind11's cast error
+// (python/ascorr/__init__.py turns a missing or unknown argument into Python's
+// own TypeError). Enumerations are the command line's names in any case; paths
+// are str or os.PathLike.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/correct/scalar_kind.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::python {
+
+namespace py = pybind11;
+
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The label of array rows in messages (InputError's "file:line:column").
+inline constexpr const char* kArrayRows = "<arrays, 1-based row>";
+
+// A docstring of docstrings.hpp with its placeholders filled in; the text
+// lives as long as the module.
+const char* docstring(const char* text);
+
+// ---- the parts of the module, each adding its names (module.cpp calls them)
+void bind_model(py::module_& mod);  // first: the others' signatures name ascorr.Model
+void bind_formats(py::module_& mod);
+void bind_correct(py::module_& mod);
+void bind_self_calibration(py::module_& mod);
+void bind_analysis(py::module_& mod);
+
+// ---- arguments (arguments.cpp)
+
+[[noreturn]] void bad_argument(const std::string& name, const std::string& what);
+// A number for a message: the shortest text that reads back exactly (1e+300,
+// never 300 digits), nan and inf as such.
+std::string number_text(double x);
+// What a Python value is, for messages: its repr (cut short) and its type.
+std::string value_text(const py::handle& x);
+// An enumeration's value: one of names, in any case, as on the command line
+// ("names, case-insensitive"). Numbers are not names.
+std::string choice_arg(const py::handle& x, const char* name, std::initializer_list<const char*> names);
+// The scalar= argument: one of the host's scalar names (scalar_kind.hpp).
+host::ScalarKind scalar_arg(const py::handle& x);
+// True or False (Python's bool or NumPy's bool_); None and numbers are refused.
+bool bool_arg(const py::handle& x, const char* name);
+// A real number (int, float, NumPy real scalar); not a bool, a string or None.
+double real_arg(const py::handle& x, const char* name);
+// A non-negative integer (int or NumPy integer; not a bool or a float).
+std::size_t count_arg(const py::handle& x, const char* name);
+// A path: str or os.PathLike (pathlib.Path); bytes and the rest are refused.
+std::string path_arg(const py::handle& x, const char* name);
+// An ascorr.Model or None (nullptr).
+const host::ModelFile* model_arg(const py::object& model);
+
+std::string shape_text(const py::array& a);
+py::array as_numpy(const py::handle& obj);
+// A real-valued array of shape (n,) (cols == 0) or (n, cols) as float64,
+// C-contiguous: the same buffer when it already is, else one converted copy.
+// n < 0: any length (it is then taken from this argument).
+Doubles real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols);
+// Times (s since J2000.0): float64 or integers; float32 is refused.
+Doubles time_array(const py::handle& obj, const std::string& name);
+// The heads for messages: "'A'..'D'" and "0..3".
+std::string head_letter_range();
+std::string head_index_range();
+
+// The columns of a set of solutions, validated, as the core's caller needs them.
+struct Rows {
+    py::ssize_t n = 0;
+    Doubles t, q, temps, v, confidence;
+    std::vector<std::uint8_t> head;
+    std::vector<long long> flags;
+};
+
+// The rows' columns, checked; temps, v, flags and confidence may be None (all
+// missing, flags 0).
+Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, const py::handle& temps,
+             const py::handle& v, const py::handle& flags = py::none(), const py::handle& confidence = py::none());
+// Row i as the solutions reader would have read it from a file holding the
+// same values: NaN is "not available", as `nan` in a file.
+void record_of(const Rows& r, py::ssize_t i, host::SolutionRecord& rec);
+// The rows as the host's analyses take a file's (for_each_solution).
+host::RowSource source_of(const Rows& r);
+
+}  // namespace ascorr::python

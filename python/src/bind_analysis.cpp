@@ -1,0 +1,280 @@
+// python/src/bind_analysis.cpp: iba(), stats() and fit(): the host's
+// analyses (ascorr_host/analysis/) over the rows of arrays, as `ascorr stats`
+// and `ascorr fit` run them over a file's.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/fit.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/formats/diagnostics.hpp"
+#include "bind.hpp"
+#include "docstrings.hpp"
+
+namespace ascorr::python {
+
+using host::SolutionRecord;
+using namespace pybind11::literals;
+
+namespace {
+
+py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
+    const Rows r = rows_of(t, chu, q, py::none(), py::none());
+    // Every pair of kMaxHeads while reading; those of the rows' heads at the end (as stats()).
+    constexpr host::PairList kAllPairs = host::pairs_of(host::kAllHeads);
+    host::HeadSet with_rows = 0U;
+    std::array<std::vector<double>, host::kMaxPairs> pt;
+    std::array<std::vector<double>, host::kMaxPairs> pv;
+    // A row whose quaternion the core rejects (not finite, not unit: status 16
+    // in correct()) takes no part in any IBA, as in stats(); it still counts
+    // for the one-row-per-head-and-epoch rule.
+    struct Boresight {
+        Vector3<double> z;
+        bool accepted;
+    };
+    host::EpochAssembler<Boresight> epochs(kArrayRows, [&](const host::Epoch<Boresight>& e) {
+        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+            const auto& a = e.head[kAllPairs.pair[p].first];
+            const auto& b = e.head[kAllPairs.pair[p].second];
+            if (a && b && a->accepted && b->accepted) {
+                pt[p].push_back(e.t);
+                pv[p].push_back(host::angle_arcsec(a->z, b->z));
+            }
+        }
+    });
+    std::ostringstream log;
+    host::Diagnostics diag(log);
+    SolutionRecord rec;
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        if (rec.head < kMaxHeads) {
+            with_rows |= host::head_bit(rec.head);
+            SolutionInput<double> in{};
+            in.q_chu_icrf = rec.q_chu_icrf;
+            in.head = rec.head;
+            const Rejection why = check_solution(in);
+            if (why != Rejection::kNone) {
+                diag.report("rejected", std::string(kArrayRows) + ":" + std::to_string(rec.line) + ": quaternion " +
+                                            (why == Rejection::kQuaternionNotFinite ? "not finite" : "not unit") +
+                                            ": left out of the IBA (status 16 in correct())");
+            }
+            epochs.add(rec.t, rec.head, rec.line, Boresight{boresight(rec.q_chu_icrf), why == Rejection::kNone});
+        }
+    }
+    epochs.finish();
+    diag.summarize();
+    if (!log.str().empty() && PyErr_WarnEx(PyExc_UserWarning, log.str().c_str(), 1) != 0) {
+        throw py::error_already_set();
+    }
+    py::dict out;
+    for (std::size_t p = 0; p < kAllPairs.count; ++p) {
+        const host::HeadPair& pair = kAllPairs.pair[p];
+        const host::HeadSet heads = host::analysis_heads(with_rows);
+        if (!host::has_head(heads, pair.first) || !host::has_head(heads, pair.second)) {
+            continue;
+        }
+        std::vector<std::size_t> idx(pt[p].size());
+        std::iota(idx.begin(), idx.end(), std::size_t{0});
+        std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return pt[p][i] < pt[p][j]; });
+        py::array_t<double> ta(static_cast<py::ssize_t>(idx.size()));
+        py::array_t<double> va(static_cast<py::ssize_t>(idx.size()));
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+            ta.mutable_data()[i] = pt[p][idx[i]];
+            va.mutable_data()[i] = pv[p][idx[i]];
+        }
+        out[pair.name] = py::make_tuple(ta, va);
+    }
+    return out;
+}
+
+std::optional<double> time_arg(const py::object& x, const char* name) {
+    if (x.is_none()) {
+        return std::nullopt;
+    }
+    if (py::isinstance(x, py::module_::import("numpy").attr("floating")) &&
+        x.attr("dtype").attr("itemsize").cast<int>() < 8) {
+        bad_argument(name, "expected a float64 (or integer) time, got " + value_text(x) +
+                               ": too few bits for a time since J2000");
+    }
+    const double d = real_arg(x, name);
+    if (std::isnan(d)) {
+        bad_argument(name, "must not be NaN");
+    }
+    return d;
+}
+
+py::dict stats(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+               const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
+               const py::object& t_from, const py::object& t_to) {
+    const host::ModelFile* m = model_arg(model);
+    host::StatsOptions opt;
+    opt.in = kArrayRows;
+    opt.from = time_arg(t_from, "t_from");
+    opt.to = time_arg(t_to, "t_to");
+    opt.period_options = "t_from/t_to";
+    host::refuse_bad_time_range(opt.from, opt.to, "t_from", "t_to");  // as `ascorr stats`: an empty period is refused
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    std::optional<ThermalModel<double>> core_model;
+    if (m != nullptr) {
+        core_model = host::to_core<double>(*m);
+    }
+    std::ostringstream log;
+    const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log);
+    py::dict pairs;
+    for (std::size_t p = 0; p < s.pairs.count; ++p) {
+        py::dict d;
+        for (std::size_t st = 0; st < host::kStages; ++st) {
+            const bool have = host::rms_defined(s, p, st);
+            d[host::kStageNames[st]] = have ? py::object(py::float_(s.rms[p][st].rms)) : py::object(py::none());
+            d[(std::string(host::kStageNames[st]) + "_smoothed").c_str()] =
+                have ? py::object(py::float_(s.rms[p][st].rms_smoothed)) : py::object(py::none());
+        }
+        d["n"] = s.n[p];
+        pairs[s.pairs.pair[p].name] = d;
+    }
+    py::dict out;
+    out["pairs"] = pairs;
+    out["rows"] = s.rows;
+    out["clean_rows"] = s.clean_rows;
+    out["table"] = host::stats_table(s);
+    out["messages"] = log.str();
+    return out;
+}
+
+// The value after "--terms " or "--holdout " at text[i], as a keyword's:
+// "='linear'", "=0"; empty (and i unchanged) when none follows.
+std::string keyword_value(const std::string& name, const std::string& text, std::size_t& i) {
+    if ((name != "terms" && name != "holdout") || i >= text.size() || text[i] != ' ') {
+        return {};
+    }
+    std::size_t v = i + 1;
+    while (v < text.size() &&
+           ((text[v] >= 'a' && text[v] <= 'z') || (text[v] >= '0' && text[v] <= '9') || text[v] == '.')) {
+        ++v;
+    }
+    const std::string value = text.substr(i + 1, v - i - 1);
+    if (name == "terms" && (value == "linear" || value == "quadratic")) {
+        i = v;
+        return "='" + value + "'";
+    }
+    if (name == "holdout" && !value.empty() && value[0] >= '0' && value[0] <= '9') {
+        i = v;
+        return "=" + value;
+    }
+    return {};
+}
+
+// The host's fit names its settings as the command line's options; from
+// Python they are fit()'s keywords: "--min-temperature-range" is
+// "min_temperature_range", "--from" "t_from", "--terms linear" "terms='linear'".
+std::string as_keywords(const std::string& text) {
+    std::string out;
+    for (std::size_t i = 0; i < text.size();) {
+        if (text.compare(i, 2, "--") != 0 || i + 2 >= text.size() || text[i + 2] < 'a' || text[i + 2] > 'z') {
+            out += text[i++];
+            continue;
+        }
+        std::size_t e = i + 2;
+        while (e < text.size() && ((text[e] >= 'a' && text[e] <= 'z') || text[e] == '-')) {
+            ++e;
+        }
+        std::string name = text.substr(i + 2, e - i - 2);
+        i = e;
+        if (name == "from" || name == "to") {
+            name = "t_" + name;
+        }
+        std::replace(name.begin(), name.end(), '-', '_');
+        out += name + keyword_value(name, text, i);
+    }
+    return out;
+}
+
+py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+              const py::object& v, const py::object& flags, const py::object& confidence, const py::object& t_from,
+              const py::object& t_to, const py::object& min_days, const py::object& min_orbits,
+              const py::object& max_condition, const py::object& orbit_period, const py::object& terms,
+              const py::object& holdout, const py::object& min_temperature_range) {
+    host::FitOptions opt;
+    opt.in = kArrayRows;
+    opt.from = time_arg(t_from, "t_from");
+    opt.to = time_arg(t_to, "t_to");
+    opt.min_span_days = real_arg(min_days, "min_days");
+    opt.min_orbits = count_arg(min_orbits, "min_orbits");
+    opt.max_condition = real_arg(max_condition, "max_condition");
+    if (!orbit_period.is_none()) {
+        opt.orbit_period_s = real_arg(orbit_period, "orbit_period");
+    }
+    opt.terms = choice_arg(terms, "terms", {"linear", "quadratic"}) == "linear" ? host::Terms::kLinear
+                                                                                : host::Terms::kQuadratic;
+    opt.holdout = real_arg(holdout, "holdout");
+    opt.min_temperature_range_c = real_arg(min_temperature_range, "min_temperature_range");
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    const host::FitReport rep = [&] {
+        try {
+            return host::fit_model(opt, source_of(r));
+        } catch (const host::FitRefused& e) {
+            throw host::FitRefused(as_keywords(e.what()));
+        }
+    }();
+    py::dict d;
+    d["t_first"] = rep.t_first;
+    d["t_last"] = rep.t_last;
+    d["orbit_period_s"] = rep.orbit_period_s;
+    d["rows"] = rep.rows;
+    py::dict dropped;
+    for (std::size_t k = 0; k < host::kDropKinds; ++k) {
+        dropped[host::drop_name(static_cast<host::Drop>(k))] = rep.dropped[k];
+    }
+    d["dropped"] = dropped;
+    d["epochs"] = rep.epochs;
+    d["orbits_used"] = rep.orbits_used;
+    d["orbits_left_out"] = rep.orbits_left_out;
+    d["singular_values"] = rep.singular_values;
+    d["condition"] = rep.condition;
+    // A row per head fitted (d["heads"], in heads.hpp's order), a column per axis.
+    const host::HeadList heads = host::heads_of(rep.heads);
+    const auto n_heads = static_cast<py::ssize_t>(heads.count);
+    py::array_t<double> res({n_heads, py::ssize_t{3}});
+    py::array_t<double> sig({n_heads, py::ssize_t{3}});
+    for (std::size_t i = 0; i < heads.count; ++i) {
+        for (std::size_t a = 0; a < 3; ++a) {
+            res.mutable_data()[3 * i + a] = rep.head[heads.head[i]].residual_rms[a];
+            sig.mutable_data()[3 * i + a] = rep.head[heads.head[i]].signal_rms[a];
+        }
+    }
+    d["heads"] = host::head_letters(rep.heads);
+    d["residual_rms"] = res;
+    d["signal_rms"] = sig;
+    d["terms"] = host::terms_name(rep.terms);
+    d["text"] = as_keywords(host::describe(rep));
+    return py::make_tuple(py::cast(rep.model), d);
+}
+
+}  // namespace
+
+void bind_analysis(py::module_& mod) {
+    mod.def("iba", &iba, "t"_a, "chu"_a, "q"_a, docstring(docs::kIba));
+    mod.def("stats", &stats, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
+            "confidence"_a = py::none(), "model"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
+            docstring(docs::kStats));
+    mod.def("fit", &fit, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(), "confidence"_a = py::none(),
+            "t_from"_a = py::none(), "t_to"_a = py::none(), "min_days"_a = host::kDefaultMinSpanDays,
+            "min_orbits"_a = host::kDefaultMinOrbits, "max_condition"_a = host::kDefaultMaxCondition,
+            "orbit_period"_a = py::none(), "terms"_a = "linear", "holdout"_a = host::kDefaultHoldout,
+            "min_temperature_range"_a = host::kDefaultMinTemperatureRange, docstring(docs::kFit));
+}
+
+}  // namespace ascorr::python

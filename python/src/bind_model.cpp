@@ -1,0 +1,144 @@
+// python/src/bind_model.cpp: ascorr.Model (the host's ModelFile) and
+// read_model(): the model file of docs/contract.md, read and written by the
+// host's model_csv.hpp.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "ascorr_host/formats/model_csv.hpp"
+#include "bind.hpp"
+#include "docstrings.hpp"
+
+namespace ascorr::python {
+
+using namespace pybind11::literals;
+
+namespace {
+
+py::array_t<double> model_coefficients(const host::ModelFile& m) {
+    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{3}, py::ssize_t{7}});
+    double* p = a.mutable_data();
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t c = 0; c < 7; ++c) {
+                *p++ = m.coefficients[h][ax][c];
+            }
+        }
+    }
+    return a;
+}
+
+host::ModelFile model_from(const py::object& coefficients, const py::object& heads) {
+    const py::array a = as_numpy(coefficients);
+    const char kind = a.dtype().kind();
+    if (kind != 'f' && kind != 'i' && kind != 'u') {
+        bad_argument("coefficients", "expected real numbers, got dtype " + std::string(py::str(a.dtype())));
+    }
+    if (a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} || a.shape(1) != 3 ||
+        (a.shape(2) != 4 && a.shape(2) != 7)) {
+        bad_argument("coefficients", "expected shape (" + std::to_string(kMaxHeads) + ", 3, 4) or (" +
+                                         std::to_string(kMaxHeads) + ", 3, 7) (head " + head_letter_range() +
+                                         ", axis alpha/beta/gamma, c0 c1 c2 c3 [c1_2 c2_2 c3_2]), got " +
+                                         shape_text(a));
+    }
+    const Doubles c = Doubles::ensure(a);
+    const auto k = static_cast<std::size_t>(a.shape(2));
+    host::ModelFile m;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t j = 0; j < k; ++j) {
+                const double x = c.data()[(h * 3 + ax) * k + j];
+                if (!std::isfinite(x)) {
+                    bad_argument("coefficients", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) +
+                                                     " " + host::kAxisNames[ax] + " " + host::kCoefficientNames[j] +
+                                                     " is not finite");
+                }
+                m.coefficients[h][ax][j] = x;
+                m.quadratic = m.quadratic || (j >= 4 && x != 0.0);
+            }
+        }
+    }
+    if (!heads.is_none() && !py::isinstance<py::str>(heads)) {
+        bad_argument("heads", "expected a string of head letters (" + std::string(kHeadChoices.text) +
+                                  ") or None, got " + value_text(heads));
+    }
+    const std::string names = heads.is_none() ? std::string(kHeadLetters) : heads.cast<std::string>();
+    for (const char ch : names) {
+        const std::uint8_t h = host::head_from_name(std::string_view(&ch, 1));
+        if (h == host::kUnknownHead) {
+            bad_argument("heads", std::string("'") + ch + "' is not a camera head (" + kHeadChoices.text + ")");
+        }
+        m.present[h] = true;
+    }
+    return m;
+}
+
+std::string model_heads(const host::ModelFile& m) {
+    std::string s;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        if (m.present[h]) {
+            s += host::head_name(static_cast<std::uint8_t>(h));
+        }
+    }
+    return s;
+}
+
+// Two models are equal when they would write the same model file: the same
+// heads, coefficients and columns (where they were read from is no part of it).
+bool models_equal(const host::ModelFile& a, const host::ModelFile& b) {
+    return a.present == b.present && a.coefficients == b.coefficients && a.quadratic == b.quadratic;
+}
+
+// Pickling: (coefficients (heads, 3, 7), heads, quadratic), rebuilt by Model().
+py::tuple model_state(const host::ModelFile& m) {
+    return py::make_tuple(model_coefficients(m), model_heads(m), m.quadratic);
+}
+
+host::ModelFile model_from_state(const py::tuple& state) {
+    if (state.size() != 3) {
+        throw py::value_error("ascorr.Model: a pickled state is (coefficients, heads, quadratic)");
+    }
+    host::ModelFile m = model_from(state[0], state[1]);
+    m.quadratic = state[2].cast<bool>();
+    return m;
+}
+
+}  // namespace
+
+void bind_model(py::module_& mod) {
+    py::class_<host::ModelFile>(mod, "Model", docstring(docs::kModel))
+        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none())
+        .def_property_readonly("coefficients", &model_coefficients, docstring(docs::kModelCoefficients))
+        .def_property_readonly("heads", &model_heads, docstring(docs::kModelHeads))
+        .def_property_readonly(
+            "quadratic", [](const host::ModelFile& m) { return m.quadratic; }, docstring(docs::kModelQuadratic))
+        .def(
+            "write",
+            [](const host::ModelFile& m, const py::object& path) { host::write_model_file(path_arg(path, "path"), m); },
+            "path"_a, docstring(docs::kModelWrite))
+        .def("to_csv", &host::format_model, docstring(docs::kModelToCsv))
+        .def(
+            "__eq__",
+            [](const host::ModelFile& m, const py::object& other) -> py::object {
+                if (!py::isinstance<host::ModelFile>(other)) {
+                    return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+                }
+                return py::bool_(models_equal(m, other.cast<const host::ModelFile&>()));
+            },
+            py::is_operator(), docstring(docs::kModelEq))
+        .def(py::pickle(&model_state, &model_from_state))
+        .def("__repr__", [](const host::ModelFile& m) {
+            return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") + ">";
+        });
+
+    mod.def(
+        "read_model", [](const py::object& path) { return host::read_model_file(path_arg(path, "path")); }, "path"_a,
+        docstring(docs::kReadModel));
+}
+
+}  // namespace ascorr::python

@@ -1,0 +1,104 @@
+// python/src/bind_self_calibration.cpp: self_calibrate(), `ascorr correct
+// --self-calibrate` on arrays: the host's run of the on-board estimator
+// (self_calibration.hpp), then each row corrected with the model active at its
+// time, through host::correct_row() as on the command line.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "ascorr/core/correct.hpp"
+#include "ascorr/core/fixed_point.hpp"
+#include "ascorr_host/correct/correct_row.hpp"
+#include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
+#include "bind.hpp"
+#include "docstrings.hpp"
+
+namespace ascorr::python {
+
+using host::SolutionRecord;
+using namespace pybind11::literals;
+
+namespace {
+
+template <typename T>
+py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days, double* q_out,
+                              std::uint16_t* st_out) {
+    calib::EstimatorConfig cfg;
+    cfg.time_constant_days = time_constant_days;
+    const host::SelfCalibration sc = host::self_calibrate<T>(
+        kArrayRows, source_of(r), m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, std::nullopt);
+    const host::ModelSchedule<T> schedule(sc.history);
+    host::EarthVelocity earth;
+    SolutionRecord rec;
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
+        const host::RowCorrection<T> row = host::correct_row<T>(rec, &earth, c, nullptr);
+        double* q = q_out + 4 * i;
+        q[0] = row.q_chu_icrf.w;
+        q[1] = row.q_chu_icrf.x;
+        q[2] = row.q_chu_icrf.y;
+        q[3] = row.q_chu_icrf.z;
+        st_out[i] = row.status;
+    }
+    py::list history;
+    for (const host::ActiveModel& a : sc.history) {
+        py::dict d;
+        d["t"] = a.t;
+        d["version"] = a.version;
+        d["crc32c"] = a.crc;
+        d["model"] = py::cast(a.model);
+        history.append(d);
+    }
+    return history;
+}
+
+py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
+                         const py::object& v, const py::object& flags, const py::object& confidence,
+                         const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj) {
+    const host::ModelFile* m = model_arg(model);
+    const host::ScalarKind scalar = scalar_arg(scalar_obj);
+    const double time_constant = real_arg(time_constant_obj, "time_constant");
+    if (!(time_constant >= calib::kMinTimeConstantDays && time_constant <= calib::kMaxTimeConstantDays)) {
+        bad_argument("time_constant", "expected days in [1, 10000], got " + value_text(time_constant_obj));
+    }
+    if (scalar == host::ScalarKind::kFixed && m != nullptr) {
+        try {
+            host::check_fixed_point_range(*m, "model");
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
+        }
+    }
+    const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
+    py::array_t<double> q_out({r.n, py::ssize_t{4}});
+    py::array_t<std::uint16_t> st_out(r.n);
+    py::list history;
+    if (scalar == host::ScalarKind::kDouble) {
+        history = self_calibrated_rows<double>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+    } else if (scalar == host::ScalarKind::kFloat) {
+        history = self_calibrated_rows<float>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+    } else {
+        history = self_calibrated_rows<Q30>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+    }
+    return py::make_tuple(q_out, st_out, history);
+}
+
+}  // namespace
+
+void bind_self_calibration(py::module_& mod) {
+    mod.def("self_calibrate", &self_calibrate, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
+            "confidence"_a = py::none(), "model"_a = py::none(), "scalar"_a = "double", "time_constant"_a = 30.0,
+            docstring(docs::kSelfCalibrate));
+}
+
+}  // namespace ascorr::python

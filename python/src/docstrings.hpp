@@ -1,0 +1,158 @@
+// python/src/docstrings.hpp: the docstrings of the compiled module, the one
+// place they are written. The type stub (python/ascorr/__init__.pyi) carries
+// the same text, and python/tests/test_docs.py fails when the two differ.
+//
+// Placeholders, filled from the core's ascorr/core/heads.hpp by docstring()
+// (bind.hpp): @HEADS@ the head letters ("ABCD"), @N_HEADS@ their number,
+// @HEAD_LETTERS@ "'A'..'D'", @HEAD_INDICES@ "0..3".
+#pragma once
+
+namespace ascorr::python::docs {
+
+inline constexpr const char* kModule = "Compiled part of the ascorr package (see help(ascorr)).";
+
+inline constexpr const char* kInputError =
+    "A malformed input file or rows (a ValueError); the message starts with file:line:column.";
+inline constexpr const char* kFitRefused =
+    "fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError).";
+
+// ---- Model (bind_model.cpp)
+
+inline constexpr const char* kModel = R"doc(A thermal model: per head and axis, angles in arcsec linear (and
+optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
+
+Model(coefficients, heads="@HEADS@"): coefficients of shape (@N_HEADS@, 3, 4) or (@N_HEADS@, 3, 7),
+indexed [head @HEAD_LETTERS@][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
+in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
+coefficients (a head not listed gets status 256 in correct()).)doc";
+
+inline constexpr const char* kModelCoefficients =
+    "Coefficients, float64 (@N_HEADS@, 3, 7): [head @HEAD_LETTERS@][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, "
+    "c3_2], arcsec (a copy).";
+inline constexpr const char* kModelHeads = "The heads with coefficients, e.g. 'ABC'.";
+inline constexpr const char* kModelQuadratic =
+    "True when the model has (and its file will carry) the quadratic columns.";
+inline constexpr const char* kModelWrite =
+    "Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike.";
+inline constexpr const char* kModelToCsv = "The model file's text.";
+inline constexpr const char* kModelEq =
+    "Equal when both would write the same model file (heads, coefficients, columns).";
+
+inline constexpr const char* kReadModel =
+    R"doc(Read a model file (docs/contract.md, "Model file"). A malformed file raises ascorr.InputError
+(a ValueError) with file:line:column, as the command line reports it.)doc";
+
+// ---- correction (bind_correct.cpp, bind_self_calibration.cpp)
+
+inline constexpr const char* kCorrect =
+    R"doc(Correct solutions: aberration, then the thermal model; the numbers and status bits of
+`ascorr correct` on the same rows, bit for bit, in every scalar.
+
+t: float64 (n,), s since J2000.0 TT. chu: (n,) strings @HEAD_LETTERS@ or head indices
+@HEAD_INDICES@. q: (n, 4) q_chu_icrf (w, x, y, z). temps: (n, 3) t_chu, t_029, t_032 in
+degC, NaN where missing. v: (n, 3) spacecraft velocity, km/s GCRS, NaN where
+missing. temps and v may be None (all missing). model: an ascorr.Model, or None
+for no thermal stage. scalar: 'double', 'float' or 'fixed' (the core's Q30).
+aberration: True or False (False skips the aberration stage; None is refused).
+states: the path (str or os.PathLike) of a states file
+(t,x,y,z,vx,vy,vz; `ascorr correct --states`): a row without its own velocity
+(all three NaN) gets the on-board velocity service's, propagated from the
+latest state at or before it (status 4 before the first state, 4+512 beyond
+max_propagation seconds, 4+32 off a plausible orbit); states_frame 'itrf' (GNSS)
+or 'gcrs' (uplinked). States the service refuses are reported as a warning.
+The names of scalar and states_frame are those of the command line, in any
+case ('GCRS' is 'gcrs'); numbers are not names.
+
+Returns (q_corrected float64 (n, 4), status uint16 (n,)). Every row comes back;
+a row that cannot be corrected keeps its quaternion exactly and says why in its
+status bits (1 aberration, 2 thermal, 4 no velocity, 8 temperatures missing,
+16 rejected, 32 velocity unusable, 64 temperature unusable, 128 model angle
+beyond 1 deg, 256 no model for the head). A time outside the Earth ephemeris
+(1900-2100, e.g. 1e300 s or a time in ms) is a row like any other: with a
+velocity it gets 4+32, as on the command line. Raises ValueError naming the
+argument and what it accepts for a wrong shape, dtype or value, or a time that
+is not finite (the command line refuses such a row as malformed).)doc";
+
+inline constexpr const char* kSelfCalibrate =
+    R"doc(Correct with a thermal model the on-board estimator learns from the rows themselves, as
+`ascorr correct --self-calibrate`: causally in time order (any row order), from the
+epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec or
+None), after the aberration stage, in `scalar`, starting from `model` (version 0)
+or from none (rows before the first adopted model get status 256).
+time_constant: the estimator's forgetting in days. Returns (q_corrected float64
+(n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
+"model"} for every model that became active, in time order.)doc";
+
+inline constexpr const char* kEarthVelocity =
+    R"doc(The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t
+(s since J2000.0 TT), from ERFA's eraEpv00: as the correction uses it (Chebyshev
+series of degree 15 on 16-day segments, within 5e-9 km/s and 5e-12 au of
+eraEpv00), or with exact=True (True or False) a direct call for each t.
+eraEpv00 spans 1900-2100: outside it (and for NaN) the row is NaN, velocity and
+distance (the correction then has no velocity: status 4+32).
+Returns (v float64 (n, 3), sun_distance_au float64 (n,)).)doc";
+
+// ---- analysis (bind_analysis.cpp)
+
+inline constexpr const char* kIba =
+    R"doc(Inter-boresight angles: for each pair 'A-B', 'A-C', 'B-C', the angle in arcsec between the
+two heads' boresights at every epoch (t to the millisecond) where both have a row.
+Returns {pair: (t float64 (m,), iba float64 (m,))}, sorted by t. A row whose
+quaternion the core rejects (not finite or not unit, status 16 in correct(),
+a zero quaternion included) takes part in no IBA, as in stats(); a UserWarning
+names such rows. A second row of one head at one epoch raises ascorr.InputError.)doc";
+
+inline constexpr const char* kStats =
+    R"doc(IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
+IBA RMS about the mean over the clean epochs (flags 0, confidence <= 5 or missing,
+temperatures and velocity present and accepted), and after 200 s smoothing.
+flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN or None when
+missing; t_from, t_to: the period (inclusive).
+Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
+(arcsec; None with fewer than two clean epochs, or thermal without a model, as
+null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),
+"messages" (rows left out, one line each)}.)doc";
+
+inline constexpr const char* kFit =
+    R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see the README), with its
+defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2; any
+case, as --terms); holdout: the fraction of the period (its end) held out for the
+model-selection report, 0..0.5; min_temperature_range: the smallest range (degC)
+of each regressor for quadratic terms. Returns (model, report): model an
+ascorr.Model (model.write(path) writes the model file), report a dict (rows,
+dropped, epochs, orbits_used, condition, singular_values, terms, heads (the
+letters of the heads fitted: A, B, C and any other with rows), residual_rms and
+signal_rms (len(heads), 3) arcsec [head][alpha, beta, gamma], text).
+Raises ascorr.FitRefused (a ValueError) when the data cannot determine the model
+(period shorter than min_days, fewer than min_orbits orbits, condition number
+above max_condition, too small a temperature range for quadratic terms) or a
+setting is out of its range; its text, and the report's, name the settings as
+this function's keywords (min_temperature_range, not --min-temperature-range).)doc";
+
+// ---- files (bind_formats.cpp)
+
+inline constexpr const char* kReadSolutions =
+    R"doc(Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),
+"q" (n, 4), "temps" (n, 3), "v" (n, 3) (NaN where not available), "flags" (0 when
+absent), "confidence" (NaN when absent)} plus "status" for a corrected file, and "extra":
+{column name as written: (n,) str, the fields as written} for every other column
+(kept, as `ascorr correct` keeps them). The keys are write_solutions()'s argument
+names: write_solutions(path2, **read_solutions(path1)) writes every column.
+path: str or os.PathLike. Malformed rows raise ascorr.InputError with
+file:line:column, as the command line.)doc";
+
+inline constexpr const char* kWriteSolutions =
+    R"doc(Write a solutions file (or, with status, a corrected file) from arrays, as the command
+line writes its outputs: atomically (a temporary file renamed over the output,
+whose permission bits and symbolic links are kept; on an error the existing file
+is left as it was). path: str or os.PathLike. Columns: t, chu, qw..qz, t_chu,
+t_029, t_032, vx, vy, vz, flags, confidence, then extra's columns in its order
+({name: (n,) values}, each value written as str(value), verbatim; what read_solutions()
+returned), then status. Numbers are written with the fewest digits that read
+back exactly; NaN temperatures as 'nan', NaN velocities and confidences as empty
+fields. Nothing is written that read_solutions() would refuse: a status outside
+0..65535 or with bits correct() never sets together, a row whose chu is not a
+camera head with a status other than 16, a value that is not one CSV field raise
+ValueError naming the argument (or column) and the row.)doc";
+
+}  // namespace ascorr::python::docs
