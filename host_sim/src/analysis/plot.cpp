@@ -20,6 +20,7 @@
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_text/input_name.hpp"
 
 extern char** environ;
 
@@ -210,7 +211,7 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                        (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
     }
     if (st.n[0] == 0 && st.n[1] == 0 && st.n[2] == 0) {
-        throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+        throw std::runtime_error(text::input_name(opt.in) + ": nothing to plot:\n" + why_nothing);
     }
     for (std::size_t p = 0; p < kPairs; ++p) {
         if (st.n[p] == 0) {

@@ -9,6 +9,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/progress.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -186,7 +187,7 @@ void for_each_solution(const std::string& path, const std::function<void(const S
     block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
     std::size_t lines_before = 1;
     double done_bytes = static_cast<double>(nl == std::string_view::npos ? 0 : nl + 1);
-    Progress progress(label + ": reading " + path);
+    Progress progress(label + ": reading " + text::input_name(path));
     SolutionRecord rec;
     for (;;) {
         SolutionsReader reader(header, block, lines_before);

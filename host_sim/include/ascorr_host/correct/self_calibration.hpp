@@ -2,7 +2,8 @@
 // run over a recorded file, as `ascorr correct --self-calibrate` and the
 // Python module do it (docs/contract.md, "Self-calibration").
 //
-// The rows are read once, in any order; the estimator is fed in time order
+// The rows are read once (twice when they are not in time order), in any
+// order; only the selected ones are kept. The estimator is fed in time order
 // (t, then line), one cycle per distinct t: at each, the model for the cycle
 // is taken first (a model adopted after an earlier cycle becomes active here),
 // then the cycle's selected solutions of A, B and C (the ground fit's
@@ -36,6 +37,9 @@ struct SelfCalibration {
     calib::EstimatorReport report;     // at the end of the file
     double orbit_period_s = 0.0;
     std::size_t cycles = 0;  // selected epochs with A, B and C
+    // Rows whose t the on-board clock cannot hold (tt_from_seconds: |t| >
+    // 1e11 s): neither learnt from nor a time at which a model becomes active.
+    std::size_t rows_unclocked = 0;
 };
 
 // kind: "double", "float" or "fixed" is chosen by T. initial: --model.
