@@ -11,7 +11,9 @@
 // accumulated, then the idle-time work runs to its end. The result is the
 // schedule of active models: each row is corrected with the model active at
 // its t. Before the first one, rows get a model with no head present, so the
-// core sets 256 (no model coefficients) and skips the thermal stage.
+// core sets 256 (no model coefficients) and skips the thermal stage. A row
+// whose t the on-board clock cannot hold (nav/tt_time.hpp: |t| > 1e11 s) is
+// no cycle and no time at which a model becomes active; it is only counted.
 #pragma once
 
 #include <cstdint>
