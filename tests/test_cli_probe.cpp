@@ -463,6 +463,39 @@ TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt
     EXPECT_TRUE(has(two.err, "--model -: standard input is already --in")) << two.err;
 }
 
+// Every message about standard input names it "standard input", with the
+// line and column, never the private copy the readers open (which it named
+// before: /tmp/ascorr-stdin-XXXXXX/standard-input:3:15: ...).
+TEST(CliProbe, MessagesNameStandardInputNotItsCopy) {
+    const fs::path dir = scratch_dir("probe-stdin-names");
+    const std::string header = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
+    std::ofstream(dir / "bad.csv") << header << "750000000.0,A,0.5,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n"
+                                   << "750000000.0,A,x,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "hot.csv") << header << "750000000.0,A,0.5,0.5,0.5,0.5,1000.25,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\nA,alpha,1e400,0,0,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n";
+    std::ofstream(dir / "one.csv") << header << "750000000.0,A,0.5,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "bad.cfg") << "channel name=T1 adc=0 role=t029 a=1e999 b=2 c=3\n";
+    const struct {
+        std::string args;
+        std::string message;
+    } cases[] = {
+        {"correct --in - --out o.csv < bad.csv", "standard input:3:15: column 'qw': expected a number, got 'x'"},
+        {"correct --in - --out o.csv --model " + kModel + " < hot.csv",
+         "standard input:2: temperature outside +-"},  // a diagnostic, not an error
+        {"correct --in " + kSolutions + " --model - --out o.csv < m.csv", "standard input:2:9: column 'c0': '1e400'"},
+        {"stats --in - < bad.csv", "standard input:3:15: column 'qw'"},
+        {"fit --in - --out o.csv < one.csv", "standard input: "},
+        {"thermistors --config - --head B < bad.cfg", "standard input:1:35: 'a': '1e999' is out of range"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args, dir);
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("stdin-"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("standard-input"), std::string::npos) << r.err;
+    }
+}
+
 // ---- thermistors: live options, fault windows -------------------------------------
 
 TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheHistory) {

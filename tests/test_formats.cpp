@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <charconv>
+#include <clocale>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +19,7 @@
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/numbers.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::host {
@@ -165,6 +168,99 @@ TEST(Csv, NumbersAndFormatting) {
     EXPECT_FALSE(parse_double("1e999"));
     char buf[64];
     EXPECT_EQ(std::string(buf, format_fixed(buf, buf + 64, -0.642227588171342, 15)), "-0.642227588171342");
+}
+
+// The syntax of a real number (ascorr_text/numbers.hpp): std::from_chars's,
+// a leading '+' only where the caller accepts one, and a number beyond
+// double's range told apart as too large or too small from its digits.
+TEST(Numbers, SyntaxAndRangeAreFromCharsAndTheDigits) {
+    using text::classify_real;
+    using text::LeadingPlus;
+    using text::RealText;
+    const struct {
+        const char* s;
+        RealText plus_refused;
+        RealText plus_accepted;
+    } cases[] = {
+        {"1.5", RealText::kNumber, RealText::kNumber},
+        {".5", RealText::kNumber, RealText::kNumber},
+        {"5.", RealText::kNumber, RealText::kNumber},
+        {"-1e-3", RealText::kNumber, RealText::kNumber},
+        {"inf", RealText::kNumber, RealText::kNumber},
+        {"-Infinity", RealText::kNumber, RealText::kNumber},
+        {"nan", RealText::kNumber, RealText::kNumber},
+        {"+2", RealText::kNotANumber, RealText::kNumber},
+        {"++2", RealText::kNotANumber, RealText::kNotANumber},
+        {"-+2", RealText::kNotANumber, RealText::kNotANumber},
+        {"0x1p3", RealText::kNotANumber, RealText::kNotANumber},  // no hexadecimal
+        {"1p3", RealText::kNotANumber, RealText::kNotANumber},
+        {" 1", RealText::kNotANumber, RealText::kNotANumber},  // no spaces
+        {"1 ", RealText::kNotANumber, RealText::kNotANumber},
+        {"1,5", RealText::kNotANumber, RealText::kNotANumber},  // a decimal comma is no number
+        {"1e", RealText::kNotANumber, RealText::kNotANumber},
+        {"", RealText::kNotANumber, RealText::kNotANumber},
+        {"1e999", RealText::kOverflow, RealText::kOverflow},
+        {"-1.5e999", RealText::kOverflow, RealText::kOverflow},
+        {"+1e999", RealText::kNotANumber, RealText::kOverflow},
+        {"10000e305", RealText::kOverflow, RealText::kOverflow},
+        {"0.0001e313", RealText::kOverflow, RealText::kOverflow},
+        {"1e99999999999999999999999", RealText::kOverflow, RealText::kOverflow},
+        {"1e-999", RealText::kUnderflow, RealText::kUnderflow},
+        {"-0.000001e-318", RealText::kUnderflow, RealText::kUnderflow},
+        {"100000000000000000000e-344", RealText::kUnderflow, RealText::kUnderflow},
+        {"1e-99999999999999999999999", RealText::kUnderflow, RealText::kUnderflow},
+        {"0.000e99999", RealText::kNumber, RealText::kNumber},  // zero is never out of range
+        {"1000e305", RealText::kNumber, RealText::kNumber},
+    };
+    for (const auto& c : cases) {
+        double x = 0.0;
+        EXPECT_EQ(classify_real(c.s, x, LeadingPlus::kRefused), c.plus_refused) << c.s;
+        EXPECT_EQ(classify_real(c.s, x, LeadingPlus::kAccepted), c.plus_accepted) << c.s;
+    }
+    double x = 0.0;
+    ASSERT_EQ(classify_real("1000e305", x, LeadingPlus::kRefused), RealText::kNumber);
+    EXPECT_EQ(x, 1e308);
+}
+
+// A locale whose decimal point is a comma, as a host program or a Python user
+// may set (locale.setlocale(locale.LC_NUMERIC, "de_DE")): de_DE.UTF-8 if the
+// system has it, else compiled from the `locales` package's definitions
+// (toolchain/debian-packages.txt) into the test's folder. Empty if neither.
+std::string comma_decimal_locale() {
+    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8"}) {
+        if (std::setlocale(LC_NUMERIC, name) != nullptr) {
+            return name;
+        }
+    }
+    const auto dir = test::scratch_dir("locale");
+    const std::string command = "localedef -i de_DE -f UTF-8 " + (dir / "de_DE.UTF-8").string() + " 2>/dev/null";
+    if (std::system(command.c_str()) != 0) {
+        return {};
+    }
+    ::setenv("LOCPATH", dir.c_str(), 1);  // glibc reads it at each setlocale
+    return std::setlocale(LC_NUMERIC, "de_DE.UTF-8") != nullptr ? "de_DE.UTF-8" : "";
+}
+
+// Under a comma-decimal C locale every number still reads with a point: a
+// number beyond double's range is still too large (strtod, which the range
+// was once told with, reads "1.5e999" as 1 there: too small).
+TEST(Numbers, ReadAlikeUnderACommaDecimalLocale) {
+    const std::string name = comma_decimal_locale();
+    ASSERT_FALSE(name.empty()) << "no comma-decimal locale: install the Debian package locales";
+    ASSERT_STREQ(std::localeconv()->decimal_point, ",") << name;
+    double x = 0.0;
+    EXPECT_EQ(text::classify_real("1.5e999", x, text::LeadingPlus::kRefused), text::RealText::kOverflow);
+    EXPECT_EQ(text::classify_real("-2.5e400", x, text::LeadingPlus::kAccepted), text::RealText::kOverflow);
+    EXPECT_EQ(text::classify_real("2.5e-400", x, text::LeadingPlus::kAccepted), text::RealText::kUnderflow);
+    EXPECT_EQ(text::classify_real("1,5", x, text::LeadingPlus::kAccepted), text::RealText::kNotANumber);
+    ASSERT_EQ(text::classify_real("1.5", x, text::LeadingPlus::kAccepted), text::RealText::kNumber);
+    EXPECT_EQ(x, 1.5);
+    EXPECT_EQ(*parse_double("-0.642227588171342"), -0.642227588171342);
+    EXPECT_NE(why_not_a_number("1.5e999").find("at most 1.797693e+308"), std::string::npos)
+        << why_not_a_number("1.5e999");
+    EXPECT_EQ(error_of(std::string(kHeader) + "1.5,A,1.5e999,0,0,0,1.5,2.5,3.5,,,,0,1.5\n"),
+              "2:7: f.csv:2:7: column 'qw': '1.5e999' is out of range: a number's magnitude is at most 1.797693e+308");
+    std::setlocale(LC_NUMERIC, "C");
 }
 
 // The fast decimal path must give the very bits std::from_chars gives.

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/correct/correct_file.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -270,6 +271,70 @@ TEST(Refusals, OutOfRangeSeedsAreRefusedNamingTheOptionAndTheRange) {
     ASSERT_EQ(run_in("simulate --days 0.01 --out eight.csv --seed 8", dir).exit_code, 0);
     EXPECT_EQ(slurp(dir / "ten0.csv"), slurp(dir / "ten.csv"));
     EXPECT_NE(slurp(dir / "ten0.csv"), slurp(dir / "eight.csv"));  // mutation check: seeds do change the file
+}
+
+// A refused value is printed as number_text prints it: the shortest text
+// that reads back as the value, never rounded to six decimals (std::to_string
+// printed 0.500000 and 0.000000 and a 1e300 with 300 digits).
+TEST(Refusals, RefusedValuesArePrintedExactly) {
+    const fs::path dir = scratch_dir("refused-values");
+    // One clean epoch of A, B and C at 0.5 km/s and one at 1.0000001e-7 km/s:
+    // no Earth orbit. The earliest row, on line 2, is the slow one.
+    std::ofstream f(dir / "slow.csv");
+    f << kHeader;
+    for (const char* head : {"A", "B", "C"}) {
+        f << "750000000.0," << head << "," << kRow << ",1.0000001e-7,0,0,0,1.00\n";
+    }
+    for (const char* head : {"A", "B", "C"}) {
+        f << "750000001.0," << head << "," << kRow << ",0.5,0,0,0,1.00\n";
+    }
+    f.close();
+    std::ofstream(dir / "hot.csv") << kHeader
+                                   << "750000000.0,A,0.5,0.5,0.5,0.5,1000.123456789,-8.0,-19.0,1,2,3,0,1.00\n";
+    std::ofstream(dir / "m.csv") << "chu,axis,c0,c1,c2,c3\n"
+                                 << "A,alpha,0,0,0,0\nA,beta,0,1.23456789e9,0,0\nA,gamma,0,0,0,0\n";
+    const std::string in = data_path("solutions.csv");
+    const struct {
+        std::string args;
+        std::string message;
+    } cases[] = {
+        {"correct --in slow.csv --out o.csv --self-calibrate",
+         "slow.csv:2:1: spacecraft speed 1.0000001e-07 km/s is not that of an Earth orbit"},
+        {"fit --in slow.csv --out o.csv",
+         "slow.csv:2:1: spacecraft speed 1.0000001e-07 km/s is not that of an Earth orbit"},
+        {"correct --scalar fixed --in " + in + " --model m.csv --out o.csv",
+         "m.csv:3:10: A beta c1 = 1234567890 arcsec/degC is beyond the fixed-point coefficient range (|c1| < "},
+        // A diagnostic (the row is kept, exit 0), with the temperatures as given.
+        {"correct --in hot.csv --model m.csv --out hot-out.csv", "hot.csv:2: temperature outside +-"},
+        {"correct --in hot.csv --model m.csv --out hot-out.csv", "(t_chu=1000.123456789, t_029=-8, t_032=-19)"},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.args);
+        const CliRun r = run_in(c.args, dir);
+        EXPECT_EQ(r.exit_code == 0, c.args.find("hot-out.csv") != std::string::npos) << r.err;
+        EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
+    // The library's own check of the time constant (the command line's option
+    // refuses it first, with the text as given).
+    for (const auto& [days, text] : {std::pair<double, const char*>{0.123456789, "got 0.123456789"},
+                                     std::pair<double, const char*>{1e300, "got 1e+300"}}) {
+        host::CorrectOptions opt;
+        opt.in = in;
+        opt.out = (dir / "o.csv").string();
+        opt.self_calibrate = true;
+        opt.time_constant_days = days;
+        std::ostringstream log;
+        try {
+            host::correct_file(opt, log);
+            ADD_FAILURE() << days << " accepted";
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find(std::string("--time-constant must be in [1, 10000] days, ") + text),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir / "o.csv"));
 }
 
 // A number that is a number but beyond its range says "out of

@@ -499,5 +499,64 @@ TEST(SelfCalibrationCli, CorrectSelfCalibrate) {
     EXPECT_FALSE(fs::exists(m.dir / "hx.csv"));
 }
 
+// Rows whose t the on-board clock cannot hold (|t| > 1e11 s, tt_from_seconds)
+// take no part in the estimation: the history and every other row are as
+// without them, in each scalar; each such row belongs to no epoch, gets no
+// model (256, also with --model) and is counted on the terminal.
+// (Before: t * 1e6 went through llround unchecked, and --model's version 0
+// was active "from t = -1e300", a 300-digit time in the history.)
+TEST(SelfCalibrationCli, TimesTheClockCannotHoldTakeNoPart) {
+    const Mission m = simulate("clock", 4.0, [](host::SimulateOptions&) {});
+    host::write_model_file((m.dir / "table2.csv").string(), host::table2_model());
+    const auto in = lines_of(slurp(m.dir / "mission.csv"));
+    const std::string first_row = in[1];
+    const auto with_t = [&](const std::string& t) { return t + first_row.substr(first_row.find(',')); };
+    {
+        std::ofstream f(m.dir / "unclocked.csv");
+        f << in[0] << '\n' << with_t("-1e300") << '\n';
+        for (std::size_t i = 1; i < in.size(); ++i) {
+            f << in[i] << '\n';
+            if (i == in.size() / 2) {
+                f << with_t("1.0000001e11") << '\n';
+            }
+        }
+        f << with_t("1e300") << '\n';
+    }
+    for (const char* scalar : {"double", "float", "fixed"}) {
+        SCOPED_TRACE(scalar);
+        for (const std::string model : {"", " --model table2.csv"}) {
+            SCOPED_TRACE(model);
+            const std::string opts = std::string(" --self-calibrate --scalar ") + scalar + model;
+            const CliRun a = run_in("correct --in mission.csv --out a.csv --model-history ha.csv" + opts, m.dir);
+            ASSERT_EQ(a.exit_code, 0) << a.err;
+            const CliRun b = run_in("correct --in unclocked.csv --out b.csv --model-history hb.csv" + opts, m.dir);
+            ASSERT_EQ(b.exit_code, 0) << b.err;
+            EXPECT_NE(b.err.find("3 row(s) with a time the on-board clock cannot hold (|t| > 1e11 s) left out of "
+                                 "the estimation: no model for them (256)"),
+                      std::string::npos)
+                << b.err;
+            EXPECT_EQ(slurp(m.dir / "hb.csv"), slurp(m.dir / "ha.csv"));
+            EXPECT_GE(lines_of(slurp(m.dir / "ha.csv")).size(), model.empty() ? 2U : 10U);
+            const auto ra = lines_of(slurp(m.dir / "a.csv"));
+            auto rb = lines_of(slurp(m.dir / "b.csv"));
+            ASSERT_EQ(rb.size(), ra.size() + 3U);
+            const auto status = [](const std::string& row) {
+                return static_cast<unsigned>(std::stoul(row.substr(row.rfind(',') + 1)));
+            };
+            EXPECT_EQ(rb[1].substr(0, 7), "-1e300,");
+            EXPECT_NE(status(rb[1]) & 256U, 0U) << rb[1];  // before the first model
+            EXPECT_EQ(status(rb[1]) & 36U, 36U) << rb[1];  // outside the ephemeris, as in correct
+            EXPECT_EQ(rb.back().substr(0, 6), "1e300,");
+            EXPECT_NE(status(rb.back()) & 256U, 0U) << rb.back();  // no epoch: no model
+            EXPECT_EQ(status(rb.back()) & 36U, 36U) << rb.back();
+            rb.erase(rb.begin() + 1);
+            rb.pop_back();
+            rb.erase(std::find_if(rb.begin(), rb.end(),
+                                  [](const std::string& r) { return r.rfind("1.0000001e11,", 0) == 0; }));
+            EXPECT_EQ(rb, ra);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace ascorr::test

@@ -5,7 +5,8 @@
 // again), which a pipe cannot give. So standard input is first copied into
 // a private temporary folder, as a file named "standard-input", and the input
 // is that file. The folder is in the signal-cleanup table (atomic_file.hpp)
-// while it exists and is removed when the process returns from main.
+// while it exists and is removed when the process returns from main. Every
+// message names that file "standard input" (text::input_name), never its path.
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include <system_error>
 
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_text/input_name.hpp"
 #include "commands.hpp"
 
 namespace ascorr::cli {
@@ -50,6 +52,7 @@ public:
         if (std::ferror(stdin) != 0 || std::fflush(out.get()) != 0) {
             throw std::runtime_error("cannot read standard input: " + std::string(std::strerror(errno)));
         }
+        text::show_input_as(path_, "standard input");
     }
     ~StandardInputCopy() {
         std::error_code ec;

@@ -25,6 +25,7 @@
 
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_text/csv_fields.hpp"
+#include "ascorr_text/input_name.hpp"
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/numbers.hpp"
 
@@ -215,11 +216,11 @@ private:
 inline std::string read_text_file(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
-        throw ConfigError::whole_file("cannot open " + path + ": is a directory, not a file");
+        throw ConfigError::whole_file("cannot open " + text::input_name(path) + ": is a directory, not a file");
     }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        throw ConfigError::whole_file("cannot open " + path + ": " + std::strerror(errno));
+        throw ConfigError::whole_file("cannot open " + text::input_name(path) + ": " + std::strerror(errno));
     }
     std::string text;
     text::LineLengthScan scan;
@@ -232,7 +233,7 @@ inline std::string read_text_file(const std::string& path) {
         text.append(piece);
     }
     if (in.bad()) {
-        throw ConfigError::whole_file("cannot read " + path + ": " + std::strerror(errno));
+        throw ConfigError::whole_file("cannot read " + text::input_name(path) + ": " + std::strerror(errno));
     }
     return text;
 }

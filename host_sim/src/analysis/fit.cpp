@@ -20,6 +20,7 @@
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -301,8 +302,8 @@ void rebase_on_earliest_epoch(Pass& p) {
 
 void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::string& period_text) {
     if (r.epochs == 0) {
-        throw FitRefused(opt.in + ": no epoch in the modelling period has solutions of " + head_words(r.heads) +
-                         " that pass the selection");
+        throw FitRefused(text::input_name(opt.in) + ": no epoch in the modelling period has solutions of " +
+                         head_words(r.heads) + " that pass the selection");
     }
     const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
@@ -311,7 +312,7 @@ void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::s
                       "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
                       "thermal period; --min-days) are needed",
                       span_days, period_text.c_str(), opt.min_span_days);
-        throw FitRefused(opt.in + ": " + buf);
+        throw FitRefused(text::input_name(opt.in) + ": " + buf);
     }
 }
 
@@ -363,10 +364,11 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     r.fit = solve_terms(averages, n_ref, r.heads, opt.terms, opt.max_condition, opt.min_temperature_range_c);
     if (!r.fit.refused.empty()) {
         if (opt.terms == Terms::kQuadratic) {
-            throw FitRefused(opt.in + ": quadratic terms not supported by the data in the modelling period (" +
-                             period_text + "): " + r.fit.refused + "; use --terms linear");
+            throw FitRefused(text::input_name(opt.in) +
+                             ": quadratic terms not supported by the data in the modelling period (" + period_text +
+                             "): " + r.fit.refused + "; use --terms linear");
         }
-        throw FitRefused(opt.in + ": " + r.fit.refused +
+        throw FitRefused(text::input_name(opt.in) + ": " + r.fit.refused +
                          ": T_CHU, T029 - T_CHU and T032 - T_CHU do not vary independently in the modelling period (" +
                          period_text + ")");
     }
@@ -404,7 +406,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
         throw InputError(opt.in, p.earliest_row_line, 1,
-                         "spacecraft speed " + std::to_string(p.earliest_row_speed) +
+                         "spacecraft speed " + number_text(p.earliest_row_speed) +
                              " km/s is not that of an Earth orbit: give --orbit-period");
     }
     if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
@@ -421,7 +423,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     p.r.orbits_used = averages.size();
     p.r.orbits_left_out = p.orbits.size() - averages.size();
     if (averages.size() < opt.min_orbits) {
-        throw FitRefused(opt.in + ": too few orbits in the modelling period (" + period_text +
+        throw FitRefused(text::input_name(opt.in) + ": too few orbits in the modelling period (" + period_text +
                          "): " + std::to_string(averages.size()) + " with enough data, at least " +
                          std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
     }

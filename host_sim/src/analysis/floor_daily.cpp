@@ -1,13 +1,13 @@
 // OUT.floor-daily.csv (ascorr_host/analysis/simulate.hpp): the floor's per-day sums,
 // and the floor of a window of days from them.
 #include <algorithm>
-#include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <system_error>
 
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/formats/input_error.hpp"
@@ -41,14 +41,14 @@ Fields split(const std::string& line) {
     return f;
 }
 
-// The whole field as a long double (strtold), else InputError.
+// The whole field as a finite long double (std::from_chars: whatever the C
+// locale's decimal point), else InputError.
 long double number(const std::string& path, std::size_t line, const Fields& f, std::size_t i) {
-    const char* s = f.text[i].c_str();
-    char* end = nullptr;
-    errno = 0;
-    const long double x = std::strtold(s, &end);
-    if (f.text[i].empty() || *end != '\0' || errno == ERANGE || !std::isfinite(x)) {
-        throw InputError(path, line, f.column[i], "'" + f.text[i] + "' is not a finite number");
+    const std::string& s = f.text[i];
+    long double x = 0.0L;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
+    if (s.empty() || ptr != s.data() + s.size() || ec != std::errc() || !std::isfinite(x)) {
+        throw InputError(path, line, f.column[i], "'" + s + "' is not a finite number");
     }
     return x;
 }

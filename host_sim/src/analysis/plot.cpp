@@ -20,6 +20,7 @@
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_text/input_name.hpp"
 
 extern char** environ;
 
@@ -213,11 +214,11 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
         any_epoch = any_epoch || st.n[p] != 0;
     }
     if (!any_epoch) {
-        throw std::runtime_error(opt.in + ": nothing to plot:\n" + why_nothing);
+        throw std::runtime_error(text::input_name(opt.in) + ": nothing to plot:\n" + why_nothing);
     }
     for (std::size_t p = 0; p < pairs.count; ++p) {
         if (st.n[p] == 0) {
-            log << opt.in << ": pair " << pairs.pair[p].name << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+            log << text::input_name(opt.in) << ": pair " << pairs.pair[p].name << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
         }
     }
 

@@ -15,6 +15,7 @@
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -176,7 +177,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         const CorrectedSolution<double> c2 = correct_solution(in, both);
         const bool thermal_ok = !model || (c2.status & status::kThermalApplied) != 0U;
         if (row.clean && ((c1.status & status::kAberrationApplied) == 0U || !thermal_ok)) {
-            diag.report("not corrected", opt.in + ":" + std::to_string(rec.line) +
+            diag.report("not corrected", text::input_name(opt.in) + ":" + std::to_string(rec.line) +
                                              ": clean row the core did not correct (status " +
                                              std::to_string(c2.status) + "): left out of the statistics");
             row.clean = false;

@@ -32,13 +32,14 @@
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_host/formats/states_csv.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
 namespace {
 
 std::string where(const std::string& file, const SolutionRecord& rec) {
-    return file + ":" + std::to_string(rec.line) + ": ";
+    return text::input_name(file) + ":" + std::to_string(rec.line) + ": ";
 }
 
 // Explains, once per affected row, the status bits that mean "bad input".
@@ -93,10 +94,10 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
         }
     }
     if ((st & status::kTemperatureInvalid) != 0U) {
-        char buf[160];
-        std::snprintf(buf, sizeof buf, "temperature outside +-%.0f C (t_chu=%g, t_029=%g, t_032=%g): thermal skipped",
-                      kMaxAbsTemperatureC, rec.temperature[0], rec.temperature[1], rec.temperature[2]);
-        diag.report("temperature invalid", where(file, rec) + buf);
+        diag.report("temperature invalid",
+                    where(file, rec) + "temperature outside +-" + number_text(kMaxAbsTemperatureC) +
+                        " C (t_chu=" + number_text(rec.temperature[0]) + ", t_029=" + number_text(rec.temperature[1]) +
+                        ", t_032=" + number_text(rec.temperature[2]) + "): thermal skipped");
     }
     if ((st & status::kThermalOutOfRange) != 0U) {
         diag.report("thermal out of range",
@@ -296,7 +297,7 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
     if (!(opt.time_constant_days >= calib::kMinTimeConstantDays &&
           opt.time_constant_days <= calib::kMaxTimeConstantDays)) {
         throw std::runtime_error("--time-constant must be in [1, 10000] days, got " +
-                                 std::to_string(opt.time_constant_days));
+                                 number_text(opt.time_constant_days));
     }
     if (!opt.states.empty()) {
         // The estimator's pass reads the rows' own velocities only: rows whose

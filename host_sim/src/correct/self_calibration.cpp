@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 #include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
@@ -13,6 +14,7 @@
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 
 namespace ascorr::host {
@@ -90,7 +92,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
         if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
             throw InputError(file, earliest_line, 1,
-                             "spacecraft speed " + std::to_string(earliest_speed) +
+                             "spacecraft speed " + number_text(earliest_speed) +
                                  " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
                                  "self-calibration cannot be derived");
         }
@@ -99,6 +101,11 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         out.orbit_period_s = 5640.0;  // no selected row: nothing is learnt, the period is not used
     }
     calib::EstimatorConfig cfg = cfg_in;
+    if (!(out.orbit_period_s * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
+          out.orbit_period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
+        throw std::invalid_argument("orbit period " + number_text(out.orbit_period_s) +
+                                    " s is outside the estimator's 600 s to 1 day");
+    }
     cfg.orbit_period_us = static_cast<std::int64_t>(std::llround(out.orbit_period_s * 1e6));
 
     std::optional<ModelCoefficients> init_c;
@@ -213,7 +220,9 @@ std::string describe(const SelfCalibration& s) {
         o << "; no model adopted";
     }
     if (s.untimed > 0) {
-        o << "; " << s.untimed << " row(s) with a t the on-board clock cannot hold: no model (256)";
+        o << "; " << s.untimed
+          << " row(s) with a time the on-board clock cannot hold (|t| > 1e11 s) left out of the estimation: no "
+             "model for them (256)";
     }
     o << "; refusals:";
     for (std::size_t k = 1; k < calib::kRefusalKinds; ++k) {

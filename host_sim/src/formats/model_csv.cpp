@@ -9,6 +9,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -22,15 +23,16 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                 const double lim =
                     i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
                 if (!(std::abs(c * kArcsecToRad) < lim)) {
-                    char what[200];
-                    std::snprintf(what, sizeof what,
-                                  "%c %s %s = %g %s is beyond the fixed-point coefficient range (|%s| < %g %s)",
-                                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[a], kCoefficientNames[i], c,
-                                  kUnits[i], kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
+                    char limit[160];
+                    std::snprintf(limit, sizeof limit, " is beyond the fixed-point coefficient range (|%s| < %g %s)",
+                                  kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
+                    const std::string what = std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
+                                             kAxisNames[a] + " " + kCoefficientNames[i] + " = " + number_text(c) + " " +
+                                             kUnits[i] + limit;
                     if (m.line[h][a] != 0) {
                         throw InputError(path, m.line[h][a], m.column[h][a][i], what);
                     }
-                    throw std::runtime_error(path + ": " + what);
+                    throw std::runtime_error(text::input_name(path) + ": " + what);
                 }
             }
         }

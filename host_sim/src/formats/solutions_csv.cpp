@@ -12,6 +12,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/progress.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -200,7 +201,7 @@ void for_each_solution_row(const std::string& path, const std::function<void(con
     double done_bytes = static_cast<double>(nl == std::string_view::npos ? 0 : nl + 1);
     std::optional<Progress> progress;
     if (!label.empty()) {
-        progress.emplace(label + ": reading " + path);
+        progress.emplace(label + ": reading " + text::input_name(path));
     }
     SolutionRecord rec;
     for (;;) {

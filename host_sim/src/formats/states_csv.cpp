@@ -6,6 +6,7 @@
 
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
@@ -84,8 +85,8 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
             if (v == StateVerdict::kAccepted) {
                 out.accepted.push_back(rec);
             } else {
-                diag.report("state refused", path + ":" + std::to_string(n) + ": state refused: " + describe(v) +
-                                                 " (kept the previous one)");
+                diag.report("state refused", text::input_name(path) + ":" + std::to_string(n) +
+                                                 ": state refused: " + describe(v) + " (kept the previous one)");
             }
         } catch (const InputError& e) {
             if (!skip_bad) {

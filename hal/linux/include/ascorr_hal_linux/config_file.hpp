@@ -26,6 +26,7 @@
 
 #include "ascorr_hal/channel_config.hpp"
 #include "ascorr_hal/voting.hpp"
+#include "ascorr_text/input_name.hpp"
 
 namespace ascorr::hal {
 
@@ -46,9 +47,10 @@ private:
     explicit ConfigError(const std::string& message) : std::runtime_error(message), line_(0), column_(0) {}
     static std::string where(const std::string& file, std::size_t line, std::size_t column) {
         if (line == 0U) {
-            return file + ": ";
+            return text::input_name(file) + ": ";
         }
-        return file + ":" + std::to_string(line) + (column == 0U ? "" : ":" + std::to_string(column)) + ": ";
+        return text::input_name(file) + ":" + std::to_string(line) +
+               (column == 0U ? "" : ":" + std::to_string(column)) + ": ";
     }
     std::size_t line_;
     std::size_t column_;

@@ -8,10 +8,8 @@
 // "inf" spelt out); a leading '+' only where the caller accepts one.
 #pragma once
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -21,8 +19,52 @@ namespace ascorr::text {
 enum class RealText { kNumber, kNotANumber, kOverflow, kUnderflow };
 enum class LeadingPlus { kRefused, kAccepted };
 
+namespace detail {
+
+// For a text from_chars read whole but found out of range: true when its
+// magnitude is too large (overflow), false when too small (underflow). The
+// text is [-]digits[.digits][(e|E)[+|-]digits] with a nonzero digit (a zero
+// is never out of range); its value is 0.d₁d₂… × 10^k with d₁ the first
+// nonzero digit, and it is too large exactly when k > 0 (double's range,
+// 4.9e-324 to 1.8e308, holds every magnitude with k from −322 to 308).
+// Digits only, no strtod: the C locale's decimal point plays no part.
+constexpr bool magnitude_above_one(std::string_view s) noexcept {
+    std::size_t i = s.empty() || s[0] != '-' ? 0 : 1;
+    long long k = 0;  // the decimal exponent of the first nonzero digit, before the exponent part
+    bool seen_nonzero = false;
+    for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+        seen_nonzero = seen_nonzero || s[i] != '0';
+        k += seen_nonzero && k < (1LL << 40) ? 1 : 0;
+    }
+    if (i < s.size() && s[i] == '.') {
+        for (++i; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+            if (!seen_nonzero && s[i] == '0') {
+                k -= k > -(1LL << 40) ? 1 : 0;
+            }
+            seen_nonzero = seen_nonzero || s[i] != '0';
+        }
+    }
+    long long e = 0;  // the exponent part, saturated far beyond any digit count above
+    if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+        ++i;
+        bool negative = false;
+        if (i < s.size() && (s[i] == '-' || s[i] == '+')) {
+            negative = s[i] == '-';
+            ++i;
+        }
+        for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+            e = e < (1LL << 50) ? e * 10 + (s[i] - '0') : e;
+        }
+        e = negative ? -e : e;
+    }
+    return k + e > 0;
+}
+
+}  // namespace detail
+
 // kNumber with value set; kOverflow and kUnderflow for a number whose
 // magnitude is beyond double's range (value unset); kNotANumber otherwise.
+// Independent of the C and C++ locales (std::from_chars).
 inline RealText classify_real(std::string_view s, double& value, LeadingPlus plus) {
     const char* first = s.data();
     const char* const last = s.data() + s.size();
@@ -36,11 +78,10 @@ inline RealText classify_real(std::string_view s, double& value, LeadingPlus plu
     if (ptr != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
         return RealText::kNotANumber;
     }
-    if (ec == std::errc::result_out_of_range) {
-        // from_chars leaves value unset: strtod tells overflow (±HUGE_VAL) from underflow.
-        const std::string text(s);
-        errno = 0;
-        return std::isinf(std::strtod(text.c_str(), nullptr)) ? RealText::kOverflow : RealText::kUnderflow;
+    if (ec == std::errc::result_out_of_range) {  // from_chars leaves value unset
+        return detail::magnitude_above_one(std::string_view(first, static_cast<std::size_t>(last - first)))
+                   ? RealText::kOverflow
+                   : RealText::kUnderflow;
     }
     return RealText::kNumber;
 }

@@ -8,16 +8,20 @@
 #include <stdexcept>
 #include <string>
 
+#include "ascorr_text/input_name.hpp"
+
 namespace ascorr::host {
 
 // line or column 0 means "not about a line" (or column): it is left out of
-// the message, which then reads file: or file:line:, never file:0:0:.
+// the message, which then reads file: or file:line:, never file:0:0:. The
+// file is named as messages show it (text::input_name: "standard input" for
+// the copy of standard input).
 class InputError : public std::runtime_error {
 public:
-    InputError(std::string file, std::size_t line, std::size_t column, const std::string& what)
-        : std::runtime_error(file + (line == 0 ? std::string() : ":" + std::to_string(line)) +
+    InputError(const std::string& file, std::size_t line, std::size_t column, const std::string& what)
+        : std::runtime_error(text::input_name(file) + (line == 0 ? std::string() : ":" + std::to_string(line)) +
                              (line == 0 || column == 0 ? std::string() : ":" + std::to_string(column)) + ": " + what),
-          file_(std::move(file)),
+          file_(text::input_name(file)),
           line_(line),
           column_(column) {}
 
