@@ -21,16 +21,6 @@ namespace ascorr::host {
 
 namespace {
 
-// A row's place in time order; `input`: its index among the clean rows of
-// A, B and C kept for the estimator, or kNotFed.
-struct RowKey {
-    std::int64_t t_us;
-    std::size_t line;
-    std::uint32_t input;
-    double t;
-};
-constexpr std::uint32_t kNotFed = 0xFFFFFFFFU;
-
 ModelFile model_file_of(const ModelCoefficients& c) {
     ModelFile m;
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -44,98 +34,217 @@ ModelFile model_file_of(const ModelCoefficients& c) {
     return m;
 }
 
+// One row as the run needs it: its epoch, and for a clean row of A, B or C
+// whose aberration stage applies, its input to the core.
+template <typename T>
+struct CalibRow {
+    std::int64_t t_us;
+    double t;
+    std::size_t line;
+    bool fed;
+    double speed_kms;  // fed rows: |v_sc|, for the orbit period
+    SolutionInput<T> in;
+};
+
+// The estimator over rows taken in time order (t_us, then line), one at a
+// time, as the link server takes them. The orbit period comes from the first
+// fed row's speed unless given: epochs before it wait (their times only) and
+// are replayed when the estimator starts.
+template <typename T>
+class Run {
+public:
+    Run(const std::string& file, const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
+        std::optional<double> orbit_period_s)
+        : file_(file), cfg_(cfg) {
+        if (initial) {
+            initial_ = coefficients_of(*initial);
+        }
+        if (orbit_period_s) {
+            start(*orbit_period_s);
+        }
+    }
+
+    void take(const CalibRow<T>& r) {
+        if (!est_) {
+            if (!r.fed) {
+                if (waiting_.empty() || waiting_.back().first != r.t_us) {
+                    waiting_.emplace_back(r.t_us, r.t);
+                }
+                return;
+            }
+            start(period_from_speed(r));
+        }
+        const ThermalModel<T>* model = epoch(r.t_us, r.t);
+        if (r.fed) {
+            const CorrectedSolution<T> c =
+                correct_solution(r.in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
+            if (feed_.take(*est_, r.in.head, c, r.in.temperatures, true)) {
+                ++out_.cycles;
+            }
+        }
+    }
+
+    SelfCalibration finish(std::size_t untimed) {
+        if (!est_) {
+            start(5640.0);  // no row to learn from: nothing is learnt, the period is not used
+        }
+        out_.report = est_->report();
+        out_.untimed = untimed;
+        return out_;
+    }
+
+private:
+    // A circular orbit's period at the first fed row's speed (vis-viva); the
+    // estimator's limits (10 min to a day) are speeds of 3.3 to 16 km/s:
+    // beyond 12 km/s nothing is bound to the Earth.
+    double period_from_speed(const CalibRow<T>& r) const {
+        const double v = r.speed_kms;
+        const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
+        if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
+            throw InputError(file_, r.line, 1,
+                             "spacecraft speed " + number_text(v) +
+                                 " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
+                                 "self-calibration cannot be derived");
+        }
+        return period_s;
+    }
+
+    void start(double period_s) {
+        if (!(period_s * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
+              period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
+            throw std::invalid_argument("orbit period " + number_text(period_s) +
+                                        " s is outside the estimator's 600 s to 1 day");
+        }
+        out_.orbit_period_s = period_s;
+        cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
+        est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
+        for (const auto& [t_us, t] : waiting_) {
+            (void)epoch(t_us, t);
+        }
+        waiting_.clear();
+        waiting_.shrink_to_fit();
+    }
+
+    // The epoch's model (a new epoch when t_us changes), and the history.
+    const ThermalModel<T>* epoch(std::int64_t t_us, double t) {
+        const ThermalModel<T>* model = feed_.model_at(*est_, t_us);
+        if (model != nullptr && (!had_ || feed_.version() != version_)) {
+            out_.history.push_back(
+                {t, t_us, feed_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
+            had_ = true;
+            version_ = feed_.version();
+        }
+        return model;
+    }
+
+    const std::string& file_;
+    calib::EstimatorConfig cfg_;
+    std::optional<ModelCoefficients> initial_;
+    std::optional<calib::Estimator<T>> est_;
+    calib::EpochFeed<T> feed_;
+    const ThermalModel<T> no_model_{};
+    std::vector<std::pair<std::int64_t, double>> waiting_;  // epochs before the orbit period is known
+    bool had_ = false;
+    std::uint32_t version_ = 0;
+    SelfCalibration out_;
+};
+
 }  // namespace
 
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg_in, std::optional<double> orbit_period_s) {
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s) {
     EarthVelocity earth;
-    const CorrectionConfig<T> ab_only{true, nullptr};
-    std::vector<RowKey> keys;
-    std::vector<SolutionInput<T>> inputs;  // the clean rows of A, B and C whose aberration stage applies
-    double earliest = 0.0;
-    double earliest_speed = 0.0;
-    std::size_t earliest_line = 0;
-    SelfCalibration out;
-    rows([&](const SolutionRecord& rec) {
+    // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
+    const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {
         TtTime t{};
         if (!tt_from_seconds(rec.t, t)) {
-            ++out.untimed;  // no epoch: corrected without a model (256)
+            return false;
+        }
+        r.t_us = t.us;
+        r.t = rec.t;
+        r.line = rec.line;
+        r.fed = false;
+        if (rec.head < calib::kCalibHeads && calibration_clean(rec)) {
+            r.in = to_core_input<T>(rec, &earth);
+            r.fed =
+                (correct_solution(r.in, CorrectionConfig<T>{true, nullptr}).status & status::kAberrationApplied) != 0U;
+            r.speed_kms = std::sqrt(squared_norm(rec.v_sc_kms));
+        }
+        return true;
+    };
+    const auto before = [](const CalibRow<T>& a, const CalibRow<T>& b) {
+        return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
+    };
+    // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
+
+    // Rows in time order (the usual file) are taken as they are read; at the
+    // first row out of order the run stops, and the rows are read again, kept
+    // (the epoch of each, the input of those fed) and sorted.
+    {
+        Run<T> run(file, initial, cfg, orbit_period_s);
+        std::size_t untimed = 0;
+        bool ordered = true;
+        CalibRow<T> r{};
+        CalibRow<T> last{};
+        bool any = false;
+        rows([&](const SolutionRecord& rec) {
+            if (!ordered) {
+                return;
+            }
+            if (!calib_row(rec, r)) {
+                ++untimed;
+                return;
+            }
+            if (any && before(r, last)) {
+                ordered = false;
+                return;
+            }
+            run.take(r);
+            last = r;
+            any = true;
+        });
+        if (ordered) {
+            return run.finish(untimed);
+        }
+    }
+    struct Key {  // 24 bytes a row; the input only for the rows fed
+        std::int64_t t_us;
+        double t;
+        std::uint32_t line;
+        std::uint32_t fed;  // index in `fed`, or kNone
+    };
+    constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+    std::vector<Key> keys;
+    std::vector<CalibRow<T>> fed;
+    std::size_t untimed = 0;
+    rows([&](const SolutionRecord& rec) {
+        CalibRow<T> r{};
+        if (!calib_row(rec, r)) {
+            ++untimed;
             return;
         }
-        RowKey k{t.us, rec.line, kNotFed, rec.t};
-        if (rec.head < calib::kCalibHeads && calibration_clean(rec)) {
-            const SolutionInput<T> in = to_core_input<T>(rec, &earth);
-            if ((correct_solution(in, ab_only).status & status::kAberrationApplied) != 0U) {
-                if (inputs.empty() || rec.t < earliest) {
-                    earliest = rec.t;
-                    earliest_speed = std::sqrt(squared_norm(rec.v_sc_kms));
-                    earliest_line = rec.line;
-                }
-                k.input = static_cast<std::uint32_t>(inputs.size());
-                inputs.push_back(in);
-            }
+        keys.push_back(
+            {r.t_us, r.t, static_cast<std::uint32_t>(r.line), r.fed ? static_cast<std::uint32_t>(fed.size()) : kNone});
+        if (r.fed) {
+            fed.push_back(r);
         }
-        keys.push_back(k);
     });
-    std::sort(keys.begin(), keys.end(), [](const RowKey& a, const RowKey& b) {
-        return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
-    });
-
-    if (orbit_period_s) {
-        out.orbit_period_s = *orbit_period_s;
-    } else if (!inputs.empty()) {
-        // A circular orbit's period at that speed (vis-viva); the estimator's
-        // limits (10 min to a day) are speeds of 3.3 to 16 km/s: beyond 12
-        // km/s nothing is bound to the Earth.
-        const double v = earliest_speed;
-        const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
-        if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw InputError(file, earliest_line, 1,
-                             "spacecraft speed " + number_text(earliest_speed) +
-                                 " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
-                                 "self-calibration cannot be derived");
-        }
-        out.orbit_period_s = period_s;
-    } else {
-        out.orbit_period_s = 5640.0;  // no selected row: nothing is learnt, the period is not used
-    }
-    calib::EstimatorConfig cfg = cfg_in;
-    if (!(out.orbit_period_s * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
-          out.orbit_period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-        throw std::invalid_argument("orbit period " + number_text(out.orbit_period_s) +
-                                    " s is outside the estimator's 600 s to 1 day");
-    }
-    cfg.orbit_period_us = static_cast<std::int64_t>(std::llround(out.orbit_period_s * 1e6));
-
-    std::optional<ModelCoefficients> init_c;
-    if (initial) {
-        init_c = coefficients_of(*initial);
-    }
-    calib::Estimator<T> est(cfg, init_c ? &*init_c : nullptr);
-    calib::EpochFeed<T> feed;
-    const ThermalModel<T> no_model{};
-    bool had = false;
-    std::uint32_t version = 0;
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-        const RowKey& k = keys[i];
-        const ThermalModel<T>* model = feed.model_at(est, k.t_us);
-        if (model != nullptr && (!had || feed.version() != version)) {
-            out.history.push_back(
-                {k.t, k.t_us, feed.version(), est.active_crc(), model_file_of(*est.active_coefficients())});
-            had = true;
-            version = feed.version();
-        }
-        if (k.input != kNotFed) {
-            const SolutionInput<T>& in = inputs[k.input];
-            const CorrectedSolution<T> c = correct_solution(in, CorrectionConfig<T>{true, model ? model : &no_model});
-            if (feed.take(est, in.head, c, in.temperatures, true)) {
-                ++out.cycles;
-            }
+    std::sort(keys.begin(), keys.end(),
+              [](const Key& a, const Key& b) { return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line); });
+    Run<T> run(file, initial, cfg, orbit_period_s);
+    for (const Key& k : keys) {
+        if (k.fed != kNone) {
+            run.take(fed[k.fed]);
+        } else {
+            CalibRow<T> r{};
+            r.t_us = k.t_us;
+            r.t = k.t;
+            r.line = k.line;
+            run.take(r);
         }
     }
-    out.report = est.report();
-    return out;
+    return run.finish(untimed);
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
