@@ -1,11 +1,11 @@
 // ascorr_link/messages.hpp: the messages of the host–DPU link.
 //
 // Payload layouts are little-endian; a "word" is one scalar of the target's
-// type in its 32-bit wire form (WireTraits below), so host and target exchange
-// exactly the values the core computes with: a float target gets IEEE binary32
-// bit patterns, a fixed-point target its raw Q integers. The host converts with
-// the same ScalarTraits as its own core in that type, which is why a replayed
-// solution can be compared bit for bit with the host core.
+// type in its 32-bit wire form (wire.hpp), so host and target exchange
+// exactly the values the core computes with. The host converts with the same
+// ScalarTraits as its own core in that type, which is why a replayed solution
+// can be compared bit for bit with the host core. The self-calibration
+// messages are in calib_messages.hpp (included here).
 // Every decode_* checks the exact payload length and every enumerated field,
 // and returns false rather than accept a frame it cannot fully account for.
 #pragma once
@@ -16,59 +16,14 @@
 #include <cstring>
 #include <initializer_list>
 
-#include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "calib_messages.hpp"
 #include "frame.hpp"
+#include "wire.hpp"
 
 namespace ascorr::link {
-
-// 32-bit wire form of a scalar type. kKind identifies the representation in
-// HELLO, so that a host never talks float to a fixed-point target.
-template <typename U>
-struct WireTraits;
-
-template <>
-struct WireTraits<float> {
-    static constexpr std::uint8_t kKind = 1;  // IEEE 754 binary32
-    static std::uint32_t encode(float x) noexcept {
-        std::uint32_t w = 0;
-        std::memcpy(&w, &x, sizeof w);
-        return w;
-    }
-    static float decode(std::uint32_t w) noexcept {
-        float x = 0.0F;
-        std::memcpy(&x, &w, sizeof x);
-        return x;
-    }
-};
-
-// Fixed-point types travel as their raw two's-complement integers, so the
-// target computes with exactly the values the host's fixed-point core uses.
-template <typename U>
-struct RawWire {
-    static std::uint32_t encode(U x) noexcept {
-        std::uint32_t w = 0;
-        std::memcpy(&w, &x.raw, sizeof w);
-        return w;
-    }
-    static U decode(std::uint32_t w) noexcept {
-        U x{};
-        std::memcpy(&x.raw, &w, sizeof w);
-        return x;
-    }
-};
-template <>
-struct WireTraits<Q30> : RawWire<Q30> {
-    static constexpr std::uint8_t kKind = 2;  // Q30 core (fixed_point.hpp)
-};
-template <>
-struct WireTraits<QCelsius> : RawWire<QCelsius> {};
-template <>
-struct WireTraits<QCoefficient> : RawWire<QCoefficient> {};
-template <>
-struct WireTraits<QQuadraticCoefficient> : RawWire<QQuadraticCoefficient> {};
 
 enum class MessageType : std::uint8_t {
     kHello = 1,                // target → host: boot id, protocol, scalar kind
@@ -156,49 +111,6 @@ struct Ack {
     AckResult result;
 };
 
-// ---- self-calibration (ascorr/calib/estimator.hpp), protocol v3
-
-// Starts (or restarts from nothing) the estimator: from then on each
-// solution is corrected with its active model and heads A, B and C at the
-// same time tag feed it (server.hpp). initial = 1: the staged model
-// (kCalibModelLoad without `load`) is version 0; 0: no model.
-struct CalibStart {
-    std::int64_t orbit_period_us;  // within the estimator's limits (calib::kMinOrbitPeriodUs ...)
-    double time_constant_days;     // within calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays
-    std::uint8_t initial;          // 0 or 1
-};
-
-enum class CalibCommand : std::uint8_t {
-    kFreeze = 1,
-    kResume = 2,
-    kReset = 3,
-};
-
-// One head's linear model in arcsec, arcsec/°C (the model file's c0..c3 per
-// axis α, β, γ; the estimator's models are linear). load = 1: the staged
-// model, with this head, becomes the estimator's (load_model: active from
-// the next epoch, version + 1); 0: staged only.
-struct CalibModelLoad {
-    std::uint8_t head;
-    std::uint8_t present;  // 0 or 1
-    std::uint8_t load;     // 0 or 1
-    double c[kModelAxes][kLinearModelTerms];
-};
-
-// One head of the estimator's active model (answer to kCalibModelRequest,
-// whose payload is the head u8): version and CRC-32C as in the report, the
-// time tag of the first epoch it was active in, and the coefficients as in
-// kCalibModelLoad. No active model: present 0, version kNoModelVersion, all
-// else 0.
-struct CalibModel {
-    std::uint8_t head;
-    std::uint8_t present;  // 0 or 1
-    std::uint32_t version;
-    std::uint32_t crc;
-    std::int64_t active_from_us;
-    double c[kModelAxes][kLinearModelTerms];
-};
-
 // The velocity service's configuration the host may set (kServiceConfig):
 // the propagation horizon, (0, kMaxHorizonUs] (velocity_service.hpp).
 // Applying it restarts the service (its states are dropped: send it before
@@ -206,133 +118,6 @@ struct CalibModel {
 struct ServiceConfig {
     std::int64_t horizon_us;
 };
-
-// The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
-// coefficient format's range, 2⁻⁵ rad (ScalarTraits<Q30>::max_coefficient).
-inline constexpr double kMaxLoadCoefficient = 0x1p-5 * kRadToArcsec;
-
-// ---- encoding helpers
-class Writer {
-public:
-    explicit Writer(std::uint8_t* p) noexcept : p_(p) {}
-    void u8(std::uint8_t v) noexcept { p_[n_++] = v; }
-    void u16(std::uint16_t v) noexcept {
-        put_u16(p_ + n_, v);
-        n_ += 2;
-    }
-    void u32(std::uint32_t v) noexcept {
-        put_u32(p_ + n_, v);
-        n_ += 4;
-    }
-    template <typename U>
-    void word(const U& v) noexcept {
-        u32(WireTraits<U>::encode(v));
-    }
-    void u64(std::uint64_t v) noexcept {
-        u32(static_cast<std::uint32_t>(v));
-        u32(static_cast<std::uint32_t>(v >> 32));
-    }
-    void f64(double x) noexcept {
-        std::uint64_t v = 0;
-        std::memcpy(&v, &x, sizeof v);
-        u64(v);
-    }
-    std::size_t size() const noexcept { return n_; }
-
-private:
-    std::uint8_t* p_;
-    std::size_t n_ = 0;
-};
-
-class Reader {
-public:
-    Reader(const std::uint8_t* p, std::size_t n) noexcept : p_(p), n_(n) {}
-    bool u8(std::uint8_t& v) noexcept {
-        if (i_ + 1 > n_) {
-            return false;
-        }
-        v = p_[i_++];
-        return true;
-    }
-    bool u16(std::uint16_t& v) noexcept {
-        if (i_ + 2 > n_) {
-            return false;
-        }
-        v = get_u16(p_ + i_);
-        i_ += 2;
-        return true;
-    }
-    bool u32(std::uint32_t& v) noexcept {
-        if (i_ + 4 > n_) {
-            return false;
-        }
-        v = get_u32(p_ + i_);
-        i_ += 4;
-        return true;
-    }
-    template <typename U>
-    bool word(U& v) noexcept {
-        std::uint32_t w = 0;
-        if (!u32(w)) {
-            return false;
-        }
-        v = WireTraits<U>::decode(w);
-        return true;
-    }
-    bool u64(std::uint64_t& v) noexcept {
-        std::uint32_t lo = 0;
-        std::uint32_t hi = 0;
-        if (!(u32(lo) && u32(hi))) {
-            return false;
-        }
-        v = (std::uint64_t{hi} << 32) | lo;
-        return true;
-    }
-    bool f64(double& x) noexcept {
-        std::uint64_t v = 0;
-        if (!u64(v)) {
-            return false;
-        }
-        std::memcpy(&x, &v, sizeof x);
-        return true;
-    }
-    bool i64(std::int64_t& x) noexcept {
-        std::uint64_t v = 0;
-        if (!u64(v)) {
-            return false;
-        }
-        std::memcpy(&x, &v, sizeof x);
-        return true;
-    }
-    bool done() const noexcept { return i_ == n_; }
-
-private:
-    const std::uint8_t* p_;
-    std::size_t n_;
-    std::size_t i_ = 0;
-};
-
-// One head's linear coefficients (α, β, γ × c0..c3) as 12 IEEE binary64;
-// `acceptable` judges each one read.
-using LinearCoefficients = double[kModelAxes][kLinearModelTerms];
-inline void put_linear(Writer& w, const LinearCoefficients& c) noexcept {
-    for (const auto& axis : c) {
-        for (const double x : axis) {
-            w.f64(x);
-        }
-    }
-}
-template <typename Acceptable>
-bool get_linear(Reader& r, LinearCoefficients& c, Acceptable acceptable) noexcept {
-    for (auto& axis : c) {
-        for (double& x : axis) {
-            if (!r.f64(x) || !acceptable(x)) {
-                return false;
-            }
-        }
-    }
-    return true;
-}
 
 // ---- messages (encode returns the payload size; buffers of kMaxPayload suffice)
 inline std::size_t encode(const Hello& m, std::uint8_t* out) noexcept {
@@ -512,107 +297,6 @@ inline bool decode(const std::uint8_t* p, std::size_t n, Ack& m) noexcept {
     const bool ok = r.u16(m.seq) && r.u8(result) && r.done() && result <= 2U;
     m.result = static_cast<AckResult>(result);
     return ok;
-}
-
-inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
-    Writer w(out);
-    w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
-    w.f64(m.time_constant_days);
-    w.u8(m.initial);
-    return w.size();
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
-    Reader r(p, n);
-    return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
-           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U;
-}
-
-inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {
-    out[0] = static_cast<std::uint8_t>(m);
-    return 1;
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, CalibCommand& m) noexcept {
-    if (n != 1U || p[0] < 1U || p[0] > 3U) {
-        return false;
-    }
-    m = static_cast<CalibCommand>(p[0]);
-    return true;
-}
-
-inline std::size_t encode(const CalibModelLoad& m, std::uint8_t* out) noexcept {
-    Writer w(out);
-    w.u8(m.head);
-    w.u8(m.present);
-    w.u8(m.load);
-    put_linear(w, m.c);
-    return w.size();
-}
-// Refused: a head beyond D, a flag other than 0 or 1, a coefficient not
-// finite or beyond kMaxLoadCoefficient.
-inline bool decode(const std::uint8_t* p, std::size_t n, CalibModelLoad& m) noexcept {
-    Reader r(p, n);
-    if (!(r.u8(m.head) && r.u8(m.present) && r.u8(m.load)) || m.head >= kMaxHeads || m.present > 1U || m.load > 1U) {
-        return false;
-    }
-    return get_linear(r, m.c, [](double x) { return std::fabs(x) < kMaxLoadCoefficient; }) &&  // false for NaN
-           r.done();
-}
-
-inline std::size_t encode(const calib::EstimatorReport& m, std::uint8_t* out) noexcept {
-    Writer w(out);
-    w.u32(m.orbits_used);
-    w.u32(m.orbits_short);
-    w.u32(m.orbits_held);
-    w.u32(m.orbits_late);
-    w.u32(m.changes);
-    w.f64(m.condition);
-    w.f64(m.residual_rms_arcsec);
-    w.f64(m.candidate_rms_arcsec);
-    w.u8(m.has_active ? 1U : 0U);
-    w.u32(m.active_version);
-    w.u32(m.active_crc);
-    w.u8(static_cast<std::uint8_t>(m.last_refusal));
-    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
-        w.u32(m.refusals[i]);
-    }
-    w.u8(m.frozen ? 1U : 0U);
-    return w.size();
-}
-inline bool decode(const std::uint8_t* p, std::size_t n, calib::EstimatorReport& m) noexcept {
-    Reader r(p, n);
-    std::uint8_t has = 0;
-    std::uint8_t refusal = 0;
-    std::uint8_t frozen = 0;
-    bool ok = r.u32(m.orbits_used) && r.u32(m.orbits_short) && r.u32(m.orbits_held) && r.u32(m.orbits_late) &&
-              r.u32(m.changes) && r.f64(m.condition) && r.f64(m.residual_rms_arcsec) && r.f64(m.candidate_rms_arcsec) &&
-              r.u8(has) && r.u32(m.active_version) && r.u32(m.active_crc) && r.u8(refusal);
-    m.refusals[0] = 0U;
-    for (std::size_t i = 1; ok && i < calib::kRefusalKinds; ++i) {
-        ok = r.u32(m.refusals[i]);
-    }
-    ok = ok && r.u8(frozen) && r.done() && has <= 1U && frozen <= 1U && refusal < calib::kRefusalKinds;
-    m.has_active = has == 1U;
-    m.frozen = frozen == 1U;
-    m.last_refusal = static_cast<calib::Refusal>(refusal < calib::kRefusalKinds ? refusal : 0U);
-    return ok;
-}
-
-inline std::size_t encode(const CalibModel& m, std::uint8_t* out) noexcept {
-    Writer w(out);
-    w.u8(m.head);
-    w.u8(m.present);
-    w.u32(m.version);
-    w.u32(m.crc);
-    w.u64(static_cast<std::uint64_t>(m.active_from_us));
-    put_linear(w, m.c);
-    return w.size();
-}
-// The host reads what the target holds: any finite or non-finite value
-// decodes (a comparison, not a use, follows).
-inline bool decode(const std::uint8_t* p, std::size_t n, CalibModel& m) noexcept {
-    Reader r(p, n);
-    return r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
-           m.head < kMaxHeads && m.present <= 1U && get_linear(r, m.c, [](double) { return true; }) && r.done();
 }
 
 inline std::size_t encode(const ServiceConfig& m, std::uint8_t* out) noexcept {

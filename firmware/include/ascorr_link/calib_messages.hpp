@@ -1,0 +1,167 @@
+// ascorr_link/calib_messages.hpp: the self-calibration messages of the link
+// (protocol v3, CALIB_MODEL v4): their payloads and codecs. The estimator is
+// ascorr/calib/estimator.hpp; the server's handling, server.hpp.
+// Every decode checks the exact payload length and every enumerated or
+// bounded field, and returns false rather than accept what it cannot account
+// for.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "ascorr/calib/estimator.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/heads.hpp"
+#include "wire.hpp"
+
+namespace ascorr::link {
+
+// Starts (or restarts from nothing) the estimator: from then on each
+// solution is corrected with its active model and heads A, B and C at the
+// same time tag feed it (server.hpp). initial = 1: the staged model
+// (kCalibModelLoad without `load`) is version 0; 0: no model.
+struct CalibStart {
+    std::int64_t orbit_period_us;  // within the estimator's limits (calib::kMinOrbitPeriodUs ...)
+    double time_constant_days;     // within calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays
+    std::uint8_t initial;          // 0 or 1
+};
+
+enum class CalibCommand : std::uint8_t {
+    kFreeze = 1,
+    kResume = 2,
+    kReset = 3,
+};
+
+// One head's linear model in arcsec, arcsec/°C (the model file's c0..c3 per
+// axis α, β, γ; the estimator's models are linear). load = 1: the staged
+// model, with this head, becomes the estimator's (load_model: active from
+// the next epoch, version + 1); 0: staged only.
+struct CalibModelLoad {
+    std::uint8_t head;
+    std::uint8_t present;  // 0 or 1
+    std::uint8_t load;     // 0 or 1
+    double c[kModelAxes][kLinearModelTerms];
+};
+
+// One head of the estimator's active model (answer to kCalibModelRequest,
+// whose payload is the head u8): version and CRC-32C as in the report, the
+// time tag of the first epoch it was active in, and the coefficients as in
+// kCalibModelLoad. No active model: present 0, version kNoModelVersion, all
+// else 0.
+struct CalibModel {
+    std::uint8_t head;
+    std::uint8_t present;  // 0 or 1
+    std::uint32_t version;
+    std::uint32_t crc;
+    std::int64_t active_from_us;
+    double c[kModelAxes][kLinearModelTerms];
+};
+
+// The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
+// coefficient format's range, 2⁻⁵ rad (ScalarTraits<Q30>::max_coefficient).
+inline constexpr double kMaxLoadCoefficient = 0x1p-5 * kRadToArcsec;
+
+// ---- codecs (encode returns the payload size; buffers of kMaxPayload suffice)
+inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
+    w.f64(m.time_constant_days);
+    w.u8(m.initial);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
+    Reader r(p, n);
+    return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
+           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U;
+}
+
+inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {
+    out[0] = static_cast<std::uint8_t>(m);
+    return 1;
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibCommand& m) noexcept {
+    if (n != 1U || p[0] < 1U || p[0] > 3U) {
+        return false;
+    }
+    m = static_cast<CalibCommand>(p[0]);
+    return true;
+}
+
+inline std::size_t encode(const CalibModelLoad& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u8(m.present);
+    w.u8(m.load);
+    put_linear(w, m.c);
+    return w.size();
+}
+// Refused: a head beyond D, a flag other than 0 or 1, a coefficient not
+// finite or beyond kMaxLoadCoefficient.
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibModelLoad& m) noexcept {
+    Reader r(p, n);
+    if (!(r.u8(m.head) && r.u8(m.present) && r.u8(m.load)) || m.head >= kMaxHeads || m.present > 1U || m.load > 1U) {
+        return false;
+    }
+    return get_linear(r, m.c, [](double x) { return std::fabs(x) < kMaxLoadCoefficient; }) &&  // false for NaN
+           r.done();
+}
+
+inline std::size_t encode(const calib::EstimatorReport& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.orbits_used);
+    w.u32(m.orbits_short);
+    w.u32(m.orbits_held);
+    w.u32(m.orbits_late);
+    w.u32(m.changes);
+    w.f64(m.condition);
+    w.f64(m.residual_rms_arcsec);
+    w.f64(m.candidate_rms_arcsec);
+    w.u8(m.has_active ? 1U : 0U);
+    w.u32(m.active_version);
+    w.u32(m.active_crc);
+    w.u8(static_cast<std::uint8_t>(m.last_refusal));
+    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
+        w.u32(m.refusals[i]);
+    }
+    w.u8(m.frozen ? 1U : 0U);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, calib::EstimatorReport& m) noexcept {
+    Reader r(p, n);
+    std::uint8_t has = 0;
+    std::uint8_t refusal = 0;
+    std::uint8_t frozen = 0;
+    bool ok = r.u32(m.orbits_used) && r.u32(m.orbits_short) && r.u32(m.orbits_held) && r.u32(m.orbits_late) &&
+              r.u32(m.changes) && r.f64(m.condition) && r.f64(m.residual_rms_arcsec) && r.f64(m.candidate_rms_arcsec) &&
+              r.u8(has) && r.u32(m.active_version) && r.u32(m.active_crc) && r.u8(refusal);
+    m.refusals[0] = 0U;
+    for (std::size_t i = 1; ok && i < calib::kRefusalKinds; ++i) {
+        ok = r.u32(m.refusals[i]);
+    }
+    ok = ok && r.u8(frozen) && r.done() && has <= 1U && frozen <= 1U && refusal < calib::kRefusalKinds;
+    m.has_active = has == 1U;
+    m.frozen = frozen == 1U;
+    m.last_refusal = static_cast<calib::Refusal>(refusal < calib::kRefusalKinds ? refusal : 0U);
+    return ok;
+}
+
+inline std::size_t encode(const CalibModel& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u8(m.present);
+    w.u32(m.version);
+    w.u32(m.crc);
+    w.u64(static_cast<std::uint64_t>(m.active_from_us));
+    put_linear(w, m.c);
+    return w.size();
+}
+// The host reads what the target holds: any finite or non-finite value
+// decodes (a comparison, not a use, follows).
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibModel& m) noexcept {
+    Reader r(p, n);
+    return r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
+           m.head < kMaxHeads && m.present <= 1U && get_linear(r, m.c, [](double) { return true; }) && r.done();
+}
+
+}  // namespace ascorr::link
