@@ -85,95 +85,16 @@
 #include "../core/model_coefficients.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/thermal.hpp"
+#include "estimator_types.hpp"
 #include "frame.hpp"
 #include "head_rotation.hpp"
+#include "model_checks.hpp"
 #include "model_identity.hpp"
 #include "orbit_sums.hpp"
+#include "orbit_window.hpp"
 #include "square_root_information.hpp"
 
 namespace ascorr::calib {
-
-inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the IBAs all three
-inline constexpr std::size_t kUnknowns = 4;    // [1, T1, T2 − T1, T3 − T1] per axis
-inline constexpr std::size_t kWindow = 32;     // recent orbits kept (gate and held-back orbits)
-
-// The orbit periods and time constants the estimator is meant for: an orbit
-// of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins
-// would hold too few epochs), a forgetting time constant of a day to
-// 10 000 days (beyond, forgetting is nil within any mission). The link's
-// CALIB_START and the host's options refuse others.
-inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
-inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
-inline constexpr double kMinTimeConstantDays = 1.0;
-inline constexpr double kMaxTimeConstantDays = 10000.0;
-constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double time_constant_days) noexcept {
-    return orbit_period_us >= kMinOrbitPeriodUs && orbit_period_us <= kMaxOrbitPeriodUs &&
-           time_constant_days >= kMinTimeConstantDays && time_constant_days <= kMaxTimeConstantDays;  // no NaN
-}
-
-struct EstimatorConfig {
-    std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
-    double time_constant_days = 30.0;              // τ of the forgetting (chosen: README, Self-calibration)
-    std::uint32_t min_orbits = 30;                 // orbits in the filter before a first model
-    std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
-    double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count
-    double max_condition = 1e4;                    // per head, equilibrated information matrix
-    double adoption_margin = 0.03;                 // a candidate must beat the active model by 3 %
-    std::uint32_t window_orbits = 30;              // orbits of the residual comparison (≤ kWindow)
-    double angle_check_margin_c = 30.0;            // °C around the recent temperatures
-    double outlier_gate = 3.0;                     // innovation RMS over the running RMS
-    std::uint32_t persistence_orbits = 24;         // held back in a row: a real change (≤ kWindow)
-};
-
-enum class Refusal : std::uint8_t {
-    kNone = 0,
-    kFewOrbits = 1,
-    kCondition = 2,
-    kAngleLimit = 3,
-    kNoGain = 4,
-};
-inline constexpr std::size_t kRefusalKinds = 5;
-
-inline const char* refusal_name(Refusal r) noexcept {
-    switch (r) {
-        case Refusal::kNone:
-            return "none";
-        case Refusal::kFewOrbits:
-            return "too few orbits";
-        case Refusal::kCondition:
-            return "condition number";
-        case Refusal::kAngleLimit:
-            return "angle beyond the core's limits";
-        case Refusal::kNoGain:
-            return "no gain over the active model";
-    }
-    return "?";
-}
-
-struct EstimatorReport {
-    std::uint32_t orbits_used;              // orbits in the filter since start or reset
-    std::uint32_t orbits_short;             // closed with too few epochs
-    std::uint32_t orbits_held;              // held back as outliers (some fed later)
-    std::uint32_t orbits_late;              // closed while the previous was still being processed
-    std::uint32_t changes;                  // persistent changes taken as real (intercepts released)
-    double condition;                       // the worst head's, of the last candidate
-    double residual_rms_arcsec;             // the active model over the window (NaN: none)
-    double candidate_rms_arcsec;            // the last candidate over the window (NaN: none)
-    bool has_active;                        // false: no model (status 256)
-    std::uint32_t active_version;           // 0: the model given at start
-    std::uint32_t active_crc;               // model_crc() of the active model (0: none)
-    Refusal last_refusal;                   // of the last candidate
-    std::uint32_t refusals[kRefusalKinds];  // counts per reason (index 0 unused)
-    bool frozen;
-};
-
-// One cycle's selected solutions of A, B and C at the same instant.
-template <typename T>
-struct CalibCycle {
-    std::int64_t t_us;                              // time of the epoch, µs
-    Quaternion<T> q_chu_icrf[kCalibHeads];          // aberration-corrected, unit
-    HeadTemperatures<T> temperatures[kCalibHeads];  // all valid
-};
 
 template <typename T>
 class Estimator {
@@ -270,7 +191,7 @@ public:
         }
         n_valid_ = false;
         orbits_used_ = 0;
-        ring_size_ = 0;
+        window_.clear();
         held_run_ = 0;
         ms_count_ = 0;
         ms_ = 0.0;
@@ -316,13 +237,6 @@ public:
     const EstimatorConfig& config() const noexcept { return cfg_; }
 
 private:
-    struct OrbitRecord {
-        std::int64_t bin;
-        double e[kCalibHeads][3];  // arcsec, relative to N_h
-        double x[kCalibHeads][3];  // T1, T2 − T1, T3 − T1 (°C), orbit means
-        bool held;                 // held back as an outlier, not (yet) in the filter
-    };
-
     static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
         const std::int64_t q = a / b;
         return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
@@ -439,9 +353,9 @@ private:
         OrbitRecord& o = record_;
         if (has_solution_) {
             double nu[9];
-            residual(b_, o, nu);
+            residual(b_, centre_, o, nu);
             double d[3];
-            iba_residuals(nu, d);
+            iba_residuals(n_mat_, nu, d);
             const double ss = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
             if (ms_count_ >= 15U && ss > cfg_.outlier_gate * cfg_.outlier_gate * ms_) {
                 o.held = true;
@@ -453,7 +367,7 @@ private:
                 ++ms_count_;
             }
         }
-        push_record(o);
+        window_.push(o);
         if (o.held && held_run_ < cfg_.persistence_orbits) {
             return;
         }
@@ -465,8 +379,8 @@ private:
                 f.release_first();
             }
             ++changes_;
-            for (std::size_t i = 0; i < ring_size_; ++i) {
-                OrbitRecord& r = ring_at(i);
+            for (std::size_t i = 0; i < window_.size(); ++i) {
+                OrbitRecord& r = window_.at(i);
                 if (r.held) {
                     r.held = false;
                     feed(r);
@@ -476,7 +390,7 @@ private:
             ms_count_ = 0;
             return;
         }
-        feed(ring_at(ring_size_ - 1U));
+        feed(window_.at(window_.size() - 1U));
     }
 
     void feed(const OrbitRecord& o) noexcept {
@@ -528,7 +442,7 @@ private:
             }
         }
         has_solution_ = true;
-        to_model(b_, cand_);
+        centred_to_model(b_, centre_, cand_);
         if (!within_limits(cand_)) {
             refuse(Refusal::kAngleLimit);
             return false;
@@ -557,44 +471,15 @@ private:
         ++refusals_[static_cast<std::size_t>(r)];
     }
 
-    // The centred solution b as a model in the contract's form (arcsec).
-    void to_model(const double (&b)[kCalibHeads][kUnknowns][3], ModelCoefficients& m) const noexcept {
-        m = ModelCoefficients{};
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            m.present[h] = true;
-            for (std::size_t a = 0; a < 3; ++a) {
-                double* c = m.coefficient[h][a];
-                c[0] = b[h][0][a];
-                for (std::size_t j = 0; j < 3; ++j) {
-                    c[1 + j] = b[h][1 + j][a];
-                    c[0] -= b[h][1 + j][a] * centre_[h][j];
-                }
-            }
-        }
-    }
-
-    static double model_angle(const ModelCoefficients& m, std::size_t h, std::size_t a, const double (&x)[3]) noexcept {
-        const double* c = m.coefficient[h][a];
-        return c[0] + c[1] * x[0] + c[2] * x[1] + c[3] * x[2] + c[4] * x[0] * x[0] + c[5] * x[1] * x[1] +
-               c[6] * x[2] * x[2];
-    }
-
     bool within_limits(const ModelCoefficients& m) const noexcept {
         constexpr double max_arcsec = kMaxThermalAngleRad * kRadToArcsec;
-        const double max_coef = 0x1p-5 * kRadToArcsec;  // ScalarTraits<Q30>::max_coefficient
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            for (std::size_t a = 0; a < 3; ++a) {
-                for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
-                    if (!(std::fabs(m.coefficient[h][a][t]) < max_coef)) {
-                        return false;
-                    }
-                }
-            }
+        if (!coefficients_within_q30(m)) {
+            return false;
         }
-        if (ring_size_ == 0U) {
+        if (window_.size() == 0U) {
             return true;
         }
-        const OrbitRecord& o = ring_at(ring_size_ - 1U);
+        const OrbitRecord& o = window_.at(window_.size() - 1U);
         for (std::size_t h = 0; h < kCalibHeads; ++h) {
             for (std::size_t corner = 0; corner < 8U; ++corner) {
                 double x[3];
@@ -612,51 +497,6 @@ private:
         return true;
     }
 
-    // An orbit's angle residuals (arcsec, per head and axis) against the
-    // centred solution b.
-    void residual(const double (&b)[kCalibHeads][kUnknowns][3], const OrbitRecord& o, double (&r)[9]) const noexcept {
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            for (std::size_t a = 0; a < 3; ++a) {
-                double p = b[h][0][a];
-                for (std::size_t j = 0; j < 3; ++j) {
-                    p += b[h][1 + j][a] * (o.x[h][j] - centre_[h][j]);
-                }
-                r[3 * h + a] = o.e[h][a] - p;
-            }
-        }
-    }
-
-    // What residual rotations r_h (head frames, arcsec) do to the three IBAs
-    // (arcsec), to first order: head h's boresight in F is N_hᵀ·e_z, turned by
-    // r_h into N_hᵀ·(e_z + e_z × r_h); an IBA θ_ij = acos(z_i·z_j) changes by
-    // −(dz_i·z_j + z_i·dz_j)/sin θ_ij. A rotation common to all heads changes
-    // none (common_rotation.hpp), a roll about a head's boresight neither.
-    void iba_residuals(const double (&r)[9], double (&d)[3]) const noexcept {
-        double z[kCalibHeads][3];
-        double dz[kCalibHeads][3];
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            const double v[3] = {-r[3 * h + 1], r[3 * h], 0.0};  // e_z × r_h
-            for (std::size_t c = 0; c < 3; ++c) {
-                z[h][c] = n_mat_[h].m[2][c];
-                dz[h][c] = n_mat_[h].m[0][c] * v[0] + n_mat_[h].m[1][c] * v[1];
-            }
-        }
-        constexpr std::size_t kPair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-        for (std::size_t p = 0; p < 3; ++p) {
-            const auto& zi = z[kPair[p][0]];
-            const auto& zj = z[kPair[p][1]];
-            const auto& di = dz[kPair[p][0]];
-            const auto& dj = dz[kPair[p][1]];
-            const double cx = zi[1] * zj[2] - zi[2] * zj[1];
-            const double cy = zi[2] * zj[0] - zi[0] * zj[2];
-            const double cz = zi[0] * zj[1] - zi[1] * zj[0];
-            const double sin_t = std::sqrt(cx * cx + cy * cy + cz * cz);
-            const double num =
-                di[0] * zj[0] + di[1] * zj[1] + di[2] * zj[2] + zi[0] * dj[0] + zi[1] * dj[1] + zi[2] * dj[2];
-            d[p] = -num / sin_t;
-        }
-    }
-
     // RMS of a model's IBA residuals (orbit means, arcsec, iba_residuals) over
     // the last window_orbits orbits fed to the filter. Not about their mean:
     // within a day the orbit means' temperatures hardly move, so a wrong slope
@@ -664,8 +504,8 @@ private:
     double window_rms(const ModelCoefficients& m) const noexcept {
         double sq[3] = {};
         std::uint32_t n = 0;
-        for (std::size_t i = ring_size_; i-- > 0 && n < cfg_.window_orbits;) {
-            const OrbitRecord& o = ring_at(i);
+        for (std::size_t i = window_.size(); i-- > 0 && n < cfg_.window_orbits;) {
+            const OrbitRecord& o = window_.at(i);
             if (o.held) {
                 continue;
             }
@@ -676,7 +516,7 @@ private:
                 }
             }
             double d[3];
-            iba_residuals(r, d);
+            iba_residuals(n_mat_, r, d);
             for (std::size_t k = 0; k < 3; ++k) {
                 sq[k] += d[k] * d[k];
             }
@@ -687,18 +527,6 @@ private:
         }
         return std::sqrt((sq[0] + sq[1] + sq[2]) / (3.0 * n));
     }
-
-    void push_record(const OrbitRecord& o) noexcept {
-        if (ring_size_ < kWindow) {
-            ring_[(ring_first_ + ring_size_) % kWindow] = o;
-            ++ring_size_;
-        } else {
-            ring_[ring_first_] = o;
-            ring_first_ = (ring_first_ + 1U) % kWindow;
-        }
-    }
-    OrbitRecord& ring_at(std::size_t i) noexcept { return ring_[(ring_first_ + i) % kWindow]; }
-    const OrbitRecord& ring_at(std::size_t i) const noexcept { return ring_[(ring_first_ + i) % kWindow]; }
 
     // The back buffer: coefficients, the core's form, version and CRC.
     void prepare(const ModelCoefficients& m, std::uint32_t version) noexcept {
@@ -751,9 +579,7 @@ private:
     double ms_ = 0.0;
     std::uint32_t ms_count_ = 0;
     std::uint32_t held_run_ = 0;
-    OrbitRecord ring_[kWindow]{};
-    std::size_t ring_first_ = 0;
-    std::size_t ring_size_ = 0;
+    OrbitWindow window_{};
     // Counters and the report.
     std::uint32_t orbits_used_ = 0;
     std::uint32_t orbits_short_ = 0;

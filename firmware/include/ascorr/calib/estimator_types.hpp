@@ -1,0 +1,98 @@
+// ascorr/calib/estimator_types.hpp: what the on-board estimator
+// (estimator.hpp) is given and gives: its configuration and limits, the
+// reasons it refuses a candidate, its report, and one cycle's solutions.
+// Plain data, no allocation; the link (ascorr_link/calib_messages.hpp) and the
+// host read them without the estimator's state.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "../core/quaternion.hpp"
+#include "../core/thermal.hpp"
+
+namespace ascorr::calib {
+
+inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the IBAs all three
+inline constexpr std::size_t kUnknowns = 4;    // [1, T1, T2 − T1, T3 − T1] per axis
+inline constexpr std::size_t kWindow = 32;     // recent orbits kept (gate and held-back orbits)
+
+// The orbit periods and time constants the estimator is meant for: an orbit
+// of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins
+// would hold too few epochs), a forgetting time constant of a day to
+// 10 000 days (beyond, forgetting is nil within any mission). The link's
+// CALIB_START and the host's options refuse others.
+inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
+inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
+inline constexpr double kMinTimeConstantDays = 1.0;
+inline constexpr double kMaxTimeConstantDays = 10000.0;
+constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double time_constant_days) noexcept {
+    return orbit_period_us >= kMinOrbitPeriodUs && orbit_period_us <= kMaxOrbitPeriodUs &&
+           time_constant_days >= kMinTimeConstantDays && time_constant_days <= kMaxTimeConstantDays;  // no NaN
+}
+
+struct EstimatorConfig {
+    std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
+    double time_constant_days = 30.0;              // τ of the forgetting (chosen: README, Self-calibration)
+    std::uint32_t min_orbits = 30;                 // orbits in the filter before a first model
+    std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
+    double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count
+    double max_condition = 1e4;                    // per head, equilibrated information matrix
+    double adoption_margin = 0.03;                 // a candidate must beat the active model by 3 %
+    std::uint32_t window_orbits = 30;              // orbits of the residual comparison (≤ kWindow)
+    double angle_check_margin_c = 30.0;            // °C around the recent temperatures
+    double outlier_gate = 3.0;                     // innovation RMS over the running RMS
+    std::uint32_t persistence_orbits = 24;         // held back in a row: a real change (≤ kWindow)
+};
+
+enum class Refusal : std::uint8_t {
+    kNone = 0,
+    kFewOrbits = 1,
+    kCondition = 2,
+    kAngleLimit = 3,
+    kNoGain = 4,
+};
+inline constexpr std::size_t kRefusalKinds = 5;
+
+inline const char* refusal_name(Refusal r) noexcept {
+    switch (r) {
+        case Refusal::kNone:
+            return "none";
+        case Refusal::kFewOrbits:
+            return "too few orbits";
+        case Refusal::kCondition:
+            return "condition number";
+        case Refusal::kAngleLimit:
+            return "angle beyond the core's limits";
+        case Refusal::kNoGain:
+            return "no gain over the active model";
+    }
+    return "?";
+}
+
+struct EstimatorReport {
+    std::uint32_t orbits_used;              // orbits in the filter since start or reset
+    std::uint32_t orbits_short;             // closed with too few epochs
+    std::uint32_t orbits_held;              // held back as outliers (some fed later)
+    std::uint32_t orbits_late;              // closed while the previous was still being processed
+    std::uint32_t changes;                  // persistent changes taken as real (intercepts released)
+    double condition;                       // the worst head's, of the last candidate
+    double residual_rms_arcsec;             // the active model over the window (NaN: none)
+    double candidate_rms_arcsec;            // the last candidate over the window (NaN: none)
+    bool has_active;                        // false: no model (status 256)
+    std::uint32_t active_version;           // 0: the model given at start
+    std::uint32_t active_crc;               // model_crc() of the active model (0: none)
+    Refusal last_refusal;                   // of the last candidate
+    std::uint32_t refusals[kRefusalKinds];  // counts per reason (index 0 unused)
+    bool frozen;
+};
+
+// One cycle's selected solutions of A, B and C at the same instant.
+template <typename T>
+struct CalibCycle {
+    std::int64_t t_us;                              // time of the epoch, µs
+    Quaternion<T> q_chu_icrf[kCalibHeads];          // aberration-corrected, unit
+    HeadTemperatures<T> temperatures[kCalibHeads];  // all valid
+};
+
+}  // namespace ascorr::calib

@@ -1,0 +1,46 @@
+// ascorr/calib/orbit_window.hpp: the recent orbits the on-board estimator
+// (estimator.hpp) keeps, for the adoption gate's residual comparison and for
+// the orbits held back as outliers: a ring of kWindow records, the oldest
+// overwritten. Fixed size, no allocation.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "estimator_types.hpp"
+
+namespace ascorr::calib {
+
+// One orbit as the filter sees it.
+struct OrbitRecord {
+    std::int64_t bin;
+    double e[kCalibHeads][3];  // arcsec, relative to N_h
+    double x[kCalibHeads][3];  // T1, T2 − T1, T3 − T1 (°C), orbit means
+    bool held;                 // held back as an outlier, not (yet) in the filter
+};
+
+class OrbitWindow {
+public:
+    void clear() noexcept { size_ = 0; }
+    std::size_t size() const noexcept { return size_; }
+    // The i-th oldest record, i < size().
+    OrbitRecord& at(std::size_t i) noexcept { return ring_[(first_ + i) % kWindow]; }
+    const OrbitRecord& at(std::size_t i) const noexcept { return ring_[(first_ + i) % kWindow]; }
+    // Appends o; when full, o replaces the oldest.
+    void push(const OrbitRecord& o) noexcept {
+        if (size_ < kWindow) {
+            ring_[(first_ + size_) % kWindow] = o;
+            ++size_;
+        } else {
+            ring_[first_] = o;
+            first_ = (first_ + 1U) % kWindow;
+        }
+    }
+
+private:
+    OrbitRecord ring_[kWindow]{};
+    std::size_t first_ = 0;
+    std::size_t size_ = 0;
+};
+
+}  // namespace ascorr::calib
