@@ -25,8 +25,9 @@ inline constexpr std::uint8_t kMaxChannels = 8;
 inline constexpr std::uint8_t kNameLength = 16;  // including the terminating NUL
 
 enum class Role : std::uint8_t { kMonitor = 0, kChuA, kChuB, kChuC, kChuD, kT029, kT032 };
-inline constexpr std::uint8_t kRoleCount = 7;
-inline constexpr const char* kRoleNames[kRoleCount] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
+inline constexpr std::uint8_t kRoleCount = static_cast<std::uint8_t>(static_cast<std::uint8_t>(Role::kT032) + 1U);
+inline constexpr const char* kRoleNames[] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
+static_assert(sizeof(kRoleNames) / sizeof(kRoleNames[0]) == kRoleCount, "one name per role");
 // One CHU role per head of ascorr/heads.hpp, in head order, named chu_<letter>
 // (Heads.HalRolesAreOnePerHeadNamedByItsLetter in tests/test_facts.cpp checks the
 // names): a head added there needs its role here.

@@ -224,7 +224,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
 
 namespace {
 
-static_assert(static_cast<int>(Role::kChuD) - static_cast<int>(Role::kChuA) + 1 == kHistoryHeads,
+static_assert(static_cast<int>(Role::kT029) - static_cast<int>(Role::kChuA) == kHistoryHeads,
               "one history head per chu role");
 
 // The epoch key of a time: t to the millisecond (t is within [0, 1e12] s).

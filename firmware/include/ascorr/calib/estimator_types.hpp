@@ -33,7 +33,7 @@ constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double tim
 
 struct EstimatorConfig {
     std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
-    double time_constant_days = 30.0;              // τ of the forgetting (chosen: README, Self-calibration)
+    double time_constant_days = 30.0;              // τ of the forgetting (chosen: docs/ground.md, Self-calibration)
     std::uint32_t min_orbits = 30;                 // orbits in the filter before a first model
     std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
     double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count

@@ -6,8 +6,8 @@
 // tables (thermal.hpp), the link protocol, the HAL's roles (static_asserted),
 // the host's file formats and messages, the Python module (ascorr.HEADS) and
 // the tests take them from here; the documentation's statements of them are
-// checked by the test Heads.* (tests/test_heads.cpp). Adding a head: append its
-// letter to kHeadLetters (DEVELOPERS.md, "Adding a head").
+// checked by the test Heads.* (tests/test_facts.cpp). Adding a head: append its
+// letter to kHeadLetters (DEVELOPERS.md, "Add a head").
 #pragma once
 
 #include <cstdint>

@@ -36,9 +36,9 @@
 namespace ascorr {
 
 // dθ/dt of the Earth rotation angle (IAU 2000): 2π · 1.00273781191135448 per UT1 day.
-inline constexpr double kEarthRotationRateRadS = 2.0 * kPi * 1.00273781191135448 / 86400.0;
-inline constexpr double kSecondsPerJulianCentury = 3155760000.0;
-inline constexpr std::int64_t kMicrosecondsPerDay = 86400LL * 1000000LL;
+inline constexpr double kEarthRotationRateRadS = 2.0 * kPi * 1.00273781191135448 / kSecondsPerDay;
+inline constexpr double kSecondsPerJulianCentury = 36525.0 * kSecondsPerDay;
+inline constexpr std::int64_t kMicrosecondsPerDay = static_cast<std::int64_t>(kSecondsPerDay) * kMicrosecondsPerSecond;
 
 struct Matrix3 {
     Vector3<double> row[3];

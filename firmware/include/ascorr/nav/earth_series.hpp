@@ -54,8 +54,8 @@
 // 4.9 mm/s (barycentric velocity) and 11.2 km (heliocentric position) of JPL
 // DE405 over 1900–2100 (its documentation).
 //
-// Cost (bench/target_bench.cpp, QEMU -icount): README.md, "On-board Earth
-// ephemeris": about 79,000 instructions per evaluation on the M4F and the M3.
+// Cost per evaluation on the targets (bench/target_bench.cpp, QEMU -icount):
+// docs/figures.md, "Earth series".
 // On board the service evaluates it every N seconds and interpolates linearly;
 // the chord error is ≤ N²/8·max|y''|. |v''| ≤ 1.4e-9 m/s³: the Earth–Moon
 // barycentre's GM☉·v/r³ = 1.26e-9 at perihelion plus the Earth about the
