@@ -13,35 +13,12 @@
 //
 // The selection is the ground fit's (`ascorr fit`): a head's solution counts
 // when flags 1, 2 and 4 are clear, confidence ≤ 5, its three temperatures are
-// valid, and the aberration stage was applied; its aberration-corrected
-// quaternion is what is given. A cycle counts when A, B and C all do.
+// valid, and the aberration stage was applied; its quaternion without the
+// thermal stage is what is given (feed.hpp forms it, for the flight loop, the
+// link server and the host alike). A cycle counts when A, B and C all do.
 //
-// The estimate (per head h of A, B, C, and per axis α, β, γ):
-//   e_h(orbit) = b_h0 + b_h1·(T1 − T̄1) + b_h2·(D2 − D̄2) + b_h3·(D3 − D̄3),
-//   D2 = T029 − T_CHU, D3 = T032 − T_CHU,
-// where e_h is the orbit mean of head h's small rotation in the frame F of A
-// and C (frame.hpp eqs. 1–3, head_rotation.hpp) relative to its orientation
-// N_h in the first orbit used, in arcsec, and T̄ are that orbit's mean
-// temperatures (the centre: the intercept and slopes are then nearly
-// orthogonal, condition ≈ 10–40 instead of hundreds). Each head is one
-// 4-unknown least-squares problem with three right-hand sides (the axes),
-// kept as a square-root information filter (square_root_information.hpp)
-// with exponential forgetting exp(−Δt/τ) per orbit (Δt the time since the
-// previous update: a gap forgets too). Per head relative to F, not jointly
-// with F's rotation as a nuisance (the ground fit): predicting every head's
-// rotation relative to F is all an IBA needs (self-calibration.md), the
-// three small problems are independent and well conditioned, and the 9
-// unobservable directions never enter (F is defined by A and C). Linear terms
-// only: quadratic ones are supported by the data only over long, wide
-// temperature ranges, which forgetting does not keep.
-//
-// Per cycle: orbit_sums.hpp (four quaternion products in T, seventeen sums; no
-// division, no square root, no floating point for Q30). Once per orbit, in
-// double, in step(): the orbit's means, F from the mean of C relative to A,
-// the heads' angles, an innovation test, the filter update, the candidate,
-// the gate, the swap. Each step() call does one phase (Phase), each phase a
-// fixed amount of work (the largest: kWindow orbits × 3 IBA residuals × 2
-// models, or feeding up to kWindow held-back orbits).
+// The estimate, its numerics and the per-cycle and per-orbit work: README.md
+// in this folder ("The estimator").
 //
 // Safe adoption (a candidate becomes the active model only when all hold;
 // otherwise the active one stays and the reason is counted, Refusal):
@@ -57,15 +34,8 @@
 //     counts for nothing) is not below (1 − adoption_margin) × the active
 //     model's. Not about their mean: within a window the orbit means'
 //     temperatures hardly move, so a wrong slope shows as an offset there.
-// Outlier orbits: once the filter has a model, an orbit whose innovation
-// (the IBA residuals of its angles against the filter's prediction) exceeds
-// outlier_gate × the running RMS is held back (a biased head, a thermistor
-// fault). When persistence_orbits orbits in a row are held back, the change
-// is taken as real (a settling bench, a mount that shifted): the intercepts'
-// information is released (the slopes' kept), the held orbits still in the
-// window are fed to the filter, and the running RMS restarts. Without the
-// release, the least squares would explain the step by the slopes over the
-// temperatures of the weeks after it.
+// Outlier orbits are held back, and a persistent change is taken as real
+// (README.md, "Outliers and changes").
 //
 // Model versions: the model given at start is version 0; each adopted or
 // loaded model is the active version + 1 (the first is 1 without one). Its identity is the
