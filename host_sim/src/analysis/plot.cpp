@@ -218,7 +218,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     }
     for (std::size_t p = 0; p < pairs.count; ++p) {
         if (st.n[p] == 0) {
-            log << text::input_name(opt.in) << ": pair " << pairs.pair[p].name << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+            log << text::input_name(opt.in) << ": pair " << pairs.pair[p].name
+                << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
         }
     }
 
