@@ -27,6 +27,7 @@
 #include "ascorr_text/csv_fields.hpp"
 #include "ascorr_text/input_name.hpp"
 #include "ascorr_text/line_limit.hpp"
+#include "ascorr_text/line_reader.hpp"
 #include "ascorr_text/numbers.hpp"
 
 namespace ascorr::hal::linux_detail {
@@ -167,31 +168,17 @@ public:
         if (text_.substr(0, 3) == "\xEF\xBB\xBF") {
             text_.remove_prefix(3);
         }
+        lines_ = text::LineReader(text_);
     }
 
     // The next line, without its end; false at the end of the text.
-    bool next(std::string_view& line) {
-        if (pos_ >= text_.size()) {
-            return false;
-        }
-        std::size_t end = text_.find('\n', pos_);
-        if (end == std::string_view::npos) {
-            end = text_.size();
-        }
-        line = text_.substr(pos_, end - pos_);
-        pos_ = end + 1;
-        ++number_;
-        if (!line.empty() && line.back() == '\r') {
-            line.remove_suffix(1);
-        }
-        return true;
-    }
+    bool next(std::string_view& line) { return lines_.next(line); }
 
     // True when the line last returned was the text's last.
-    bool at_end() const { return pos_ >= text_.size(); }
+    bool at_end() const { return lines_.at_end(); }
 
     // The number of the line last returned by next().
-    std::size_t number() const { return number_; }
+    std::size_t number() const { return lines_.line_number(); }
 
     // The line on which the text ends: where a message about something
     // missing from the whole file points (after a final '\n', the line after).
@@ -205,8 +192,7 @@ public:
 
 private:
     std::string_view text_;
-    std::size_t pos_ = 0;
-    std::size_t number_ = 0;
+    text::LineReader lines_{std::string_view{}};
 };
 
 // The whole text of a file. A file that cannot be opened or read, or a

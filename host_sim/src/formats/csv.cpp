@@ -144,23 +144,6 @@ std::string number_text(double x) {
     return std::string(buf, r.ptr);
 }
 
-bool LineReader::next(std::string_view& line) noexcept {
-    if (pos_ >= text_.size()) {
-        return false;
-    }
-    std::size_t end = text_.find('\n', pos_);
-    if (end == std::string_view::npos) {
-        end = text_.size();
-    }
-    line = text_.substr(pos_, end - pos_);
-    if (!line.empty() && line.back() == '\r') {
-        line.remove_suffix(1);
-    }
-    pos_ = end + 1;
-    ++line_;
-    return true;
-}
-
 namespace {
 // Clinger's fast path: a plain decimal [-]ddd.ddd with at most 15 significant
 // digits is m / 10^k with m < 2^53 and k ≤ 22, both exact doubles, so one

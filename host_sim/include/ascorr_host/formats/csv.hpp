@@ -19,6 +19,7 @@
 
 #include "ascorr_text/csv_fields.hpp"
 #include "ascorr_text/line_limit.hpp"
+#include "ascorr_text/line_reader.hpp"
 
 namespace ascorr::host {
 
@@ -63,20 +64,9 @@ private:
 std::size_t count_line_ends(std::string_view text) noexcept;
 
 // Iterates the lines of a buffer, keeping 1-based line numbers.
-class LineReader {
-public:
-    // lines_before: how many lines of the file precede text (for numbering).
-    explicit LineReader(std::string_view text, std::size_t lines_before = 0) noexcept
-        : text_(text), line_(lines_before) {}
-    // Next line without its line end; false at the end of the buffer.
-    bool next(std::string_view& line) noexcept;
-    std::size_t line_number() const noexcept { return line_; }
-
-private:
-    std::string_view text_;
-    std::size_t pos_ = 0;
-    std::size_t line_ = 0;
-};
+// The line splitting: one copy, in the HAL's text library
+// (ascorr_text/line_reader.hpp), which the HAL's readers use too.
+using text::LineReader;
 
 // The field splitter and unquoting of the dialect: one copy, in the HAL
 // (ascorr_text/csv_fields.hpp), which the HAL's readers use too. A quoted
