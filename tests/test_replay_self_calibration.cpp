@@ -195,8 +195,8 @@ TEST_P(ReplaySelfCalibrationQemu, SameModelsAndAnswersAsTheHost) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets),
-                         [](const ::testing::TestParamInfo<host::QemuTarget>& info) {
-                             std::string n(info.param.replay);
+                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) {
+                             std::string n(i.param.replay);
                              for (char& c : n) {
                                  c = c == '-' ? '_' : c;
                              }
