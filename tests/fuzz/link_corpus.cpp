@@ -1,8 +1,9 @@
 // Writes seed inputs for fuzz_link_server: the bytes the host's LinkClient
-// sends in real protocol-v2 and v3 sessions with an in-process LinkServer (model,
+// sends in real protocol-v2 to v4 sessions with an in-process LinkServer (model,
 // velocity, temperatures, ITRF and GCRS spacecraft states, time-tagged
 // solutions with and without the service's velocity, a refused state; the
-// estimator's start, commands, model load and report). The
+// estimator's start, commands, model load, report and model; the
+// service's horizon; the solutions' calibration use). The
 // fuzzer mutates from whole, valid conversations, so it reaches the decoders
 // of every message type; tests/fuzz/run writes these seeds afresh each run,
 // so they follow the protocol as it changes.
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
         Session s;
         s.client.connect();
         s.client.upload_model(model);
+        s.client.set_service_horizon(3'600'000'000);  // v4: SERVICE_CONFIG before the states
         s.client.set_temperatures(0, temps);
         s.client.correct(1, 0, q, TtTime{kT0Us - 5'000'000}, true, false);
         s.client.send_state(state(kT0Us, 0), true);
@@ -111,7 +113,10 @@ int main(int argc, char** argv) {
         for (std::uint32_t epoch = 0; epoch < 4; ++epoch) {
             for (std::uint8_t h = 0; h < 3; ++h) {
                 s.client.set_temperatures(h, temps);
-                s.client.correct(3 * epoch + h, h, q, TtTime{kT0Us + epoch * 2'000'000'000LL});
+                // v4: the calibration use (clean; the last epoch's B without a time tag).
+                const bool timed = epoch < 3 || h != 1;
+                s.client.correct(3 * epoch + h, h, q, TtTime{timed ? kT0Us + epoch * 2'000'000'000LL : 0}, false, false,
+                                 timed ? link::kCalibClean : link::kCalibNoTime);
             }
         }
         s.client.calib_command(link::CalibCommand::kFreeze);
@@ -119,6 +124,7 @@ int main(int argc, char** argv) {
         s.client.calib_command(link::CalibCommand::kReset);
         s.client.load_calib_model(kTable2);
         (void)s.client.calib_report();
+        (void)s.client.calib_model(0);  // v4: CALIB_MODEL_REQUEST
         write(dir + "/v3_self_calibration.bin", s.sent);
     }
     return 0;
