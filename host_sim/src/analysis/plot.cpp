@@ -38,12 +38,23 @@ int run_gnuplot(const std::string& exe, const std::string& script, const std::st
     posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
     std::vector<char*> argv{const_cast<char*>(exe.c_str()), const_cast<char*>(script.c_str()), nullptr};
     pid_t pid = 0;
-    const int rc = posix_spawnp(&pid, exe.c_str(), &fa, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&fa);
-    if (rc != 0) {
-        return -1;
+    int slot = -1;
+    {
+        // Started and registered with the cleanup signals held: a signal in
+        // between still finds gnuplot to kill (gnuplot runs with our mask).
+        const CleanupSignalsHeld held;
+        posix_spawnattr_t attr;
+        posix_spawnattr_init(&attr);
+        posix_spawnattr_setsigmask(&attr, &held.previous());
+        posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK);
+        const int rc = posix_spawnp(&pid, exe.c_str(), &fa, &attr, argv.data(), environ);
+        posix_spawnattr_destroy(&attr);
+        posix_spawn_file_actions_destroy(&fa);
+        if (rc != 0) {
+            return -1;
+        }
+        slot = cleanup_register_child(pid);  // killed, should a signal end us
     }
-    const int slot = cleanup_register_child(pid);  // killed, should a signal end us
     int st = 0;
     const pid_t waited = waitpid(pid, &st, 0);
     cleanup_release(slot);

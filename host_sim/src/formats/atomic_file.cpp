@@ -303,6 +303,19 @@ void install_signal_cleanup() {
 int cleanup_register_file(const std::string& path) {
     return claim(kFile, path, 0);
 }
+CleanupSignalsHeld::CleanupSignalsHeld() noexcept {
+    sigset_t hold;
+    sigemptyset(&hold);
+    for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+        sigaddset(&hold, sig);
+    }
+    pthread_sigmask(SIG_BLOCK, &hold, &previous_);
+}
+
+CleanupSignalsHeld::~CleanupSignalsHeld() {
+    pthread_sigmask(SIG_SETMASK, &previous_, nullptr);  // a signal held meanwhile is handled now
+}
+
 int cleanup_register_folder(const std::string& path) {
     return claim(kFolder, path, 0);
 }

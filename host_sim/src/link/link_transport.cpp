@@ -146,11 +146,15 @@ void ProcessTransport::start() {
     }
     args.push_back(nullptr);
     const pid_t parent = ::getpid();
+    // Forked and registered with the cleanup signals held: a signal in
+    // between still finds the child to kill.
+    const CleanupSignalsHeld held;
     pid_ = ::fork();
     if (pid_ < 0) {
         sys_error("fork");
     }
     if (pid_ == 0) {
+        ::pthread_sigmask(SIG_SETMASK, &held.previous(), nullptr);  // the emulator runs with our mask
         // Die with the parent, even when it is SIGKILLed; if it died before
         // prctl took effect, we have been reparented already: leave now.
         if (::prctl(PR_SET_PDEATHSIG, SIGKILL) != 0 || ::getppid() != parent) {

@@ -29,6 +29,8 @@
 // functions (unlink, rmdir, kill, waitpid, sigaction, raise) on a fixed table.
 #pragma once
 
+#include <csignal>
+
 #include <sys/types.h>
 
 #include <cstdio>
@@ -83,6 +85,24 @@ void refuse_same_output(const NamedPath& first, const NamedPath& second);
 // Installs the handlers of SIGINT, SIGTERM, SIGHUP and SIGPIPE (once; call it
 // from main before any thread starts).
 void install_signal_cleanup();
+
+// Holds the cleanup signals (SIGINT, SIGTERM, SIGHUP, SIGPIPE) in this
+// thread while it lives, so that a child started and then registered
+// (cleanup_register_child) cannot be missed by a signal that comes between
+// the two: the signal waits, and its handler finds the child in the table.
+// A child takes previous() as its mask (posix_spawnattr_setsigmask, or
+// pthread_sigmask after fork), so that it does not inherit the hold.
+class CleanupSignalsHeld {
+public:
+    CleanupSignalsHeld() noexcept;
+    ~CleanupSignalsHeld();
+    CleanupSignalsHeld(const CleanupSignalsHeld&) = delete;
+    CleanupSignalsHeld& operator=(const CleanupSignalsHeld&) = delete;
+    const sigset_t& previous() const noexcept { return previous_; }
+
+private:
+    sigset_t previous_{};
+};
 
 // Registers what the signal handler removes or kills; each returns a slot to
 // release when the thing is gone or committed. Throws when the table is full
