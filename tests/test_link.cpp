@@ -342,12 +342,12 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
         EXPECT_TRUE(decode(b.data(), b.size(), r));
         return r;
     };
-    const auto solution = [&loop, &seq](std::uint8_t head, std::int64_t t_us) {
+    const auto solution = [&loop, &seq](std::uint8_t head, std::int64_t t_us, std::uint8_t calib = 0U) {
         loop.request(MessageType::kTemperatureUpdate, seq++,
                      TemperatureUpdate<float>{head, {{12.0F, true}, {-5.0F, true}, {-20.0F, true}}});
         loop.request(MessageType::kVelocityUpdate, seq++, ObserverVelocity<float>{{1e-4F, 0.0F, 0.0F}, 1.0F, true});
         const Decoded r = loop.request(MessageType::kSolutionIn, seq++,
-                                       SolutionIn<float>{seq, head, {0.5F, 0.5F, 0.5F, 0.5F}, {t_us}, 0, 0});
+                                       SolutionIn<float>{seq, head, {0.5F, 0.5F, 0.5F, 0.5F}, {t_us}, 0, calib});
         SolutionOut<float> out{};
         EXPECT_TRUE(r.frames.size() == 1U && decode(r.payloads[0].data(), r.payloads[0].size(), out));
         return out;
@@ -378,6 +378,14 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
         bad.emplace_back(MessageType::kServiceConfig, Bytes(p, p + encode(c, p)));
     }
     bad.emplace_back(MessageType::kServiceConfig, Bytes{1, 2, 3});
+    // SOLUTION_IN: a calibration bit beyond the two defined; "no time" with a
+    // time tag or with the service's velocity.
+    for (const SolutionIn<float>& in : {SolutionIn<float>{9, 0, {1.0F, 0, 0, 0}, {5}, 0, 4},
+                                        SolutionIn<float>{9, 0, {1.0F, 0, 0, 0}, {5}, 0, kCalibNoTime},
+                                        SolutionIn<float>{9, 0, {1.0F, 0, 0, 0}, {0}, 1, kCalibNoTime}}) {
+        std::uint8_t p[kMaxPayload];
+        bad.emplace_back(MessageType::kSolutionIn, Bytes(p, p + encode(in, p)));
+    }
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{4});     // a head beyond D
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{0, 0});  // a byte too many
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{});
@@ -449,6 +457,11 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     EXPECT_EQ(out.status, status::kAberrationApplied | status::kThermalApplied);
     EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &c.q_chu_icrf, sizeof c.q_chu_icrf), 0);
     EXPECT_EQ(out.model_version, 1U);  // the loaded model: version 1
+    // A solution without a time tag belongs to no epoch: no model (256), no version.
+    const SolutionOut<float> untimed = solution(1, 0, kCalibNoTime);
+    EXPECT_NE(untimed.status & status::kNoModelForHead, 0U);
+    EXPECT_EQ(untimed.status & status::kThermalApplied, 0U);
+    EXPECT_EQ(untimed.model_version, kNoModelVersion);
     {
         // CALIB_MODEL: head B of the active model, as loaded.
         const Decoded d = loop.send(wire_frame(MessageType::kCalibModelRequest, seq++, Bytes{1}));

@@ -9,12 +9,17 @@
 // be caught; under QEMU (label target) each board against its own scalar.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
@@ -82,6 +87,88 @@ TEST(ReplaySelfCalibration, LoopbackEqualsCorrectSelfCalibrate) {
     std::cout << host::to_json(s) << "\n" << log.str();
     expect_agreement(s);
     expect_same_as_correct(dir, "float");
+}
+
+// Starting from a model (version 0, active from the first epoch: its epoch
+// must agree too), with the rows shuffled and, every 50th epoch, a second row
+// of head A within the same microsecond (0.3 µs earlier, later in the file):
+// target and host take the rows in the on-board clock's order (TT µs, then
+// line), so the same row feeds the estimator on both sides.
+TEST(ReplaySelfCalibration, FromAModelWithRowsOutOfOrderAndWithinAMicrosecond) {
+    const auto dir = simulated("replay_sc_model");
+    {
+        const auto lines = [&] {
+            std::vector<std::string> v;
+            std::istringstream in(slurp(dir / "sim.csv"));
+            for (std::string l; std::getline(in, l);) {
+                v.push_back(l);
+            }
+            return v;
+        }();
+        std::vector<std::string> rows(lines.begin() + 1, lines.end());
+        std::vector<std::string> extra;
+        for (std::size_t i = 0; i < rows.size(); i += 150) {  // 3 rows an epoch: every 50th epoch's A
+            const std::string& r = rows[i];
+            const std::size_t comma = r.find(',');
+            if (r.compare(comma + 1, 2, "A,") != 0) {
+                continue;
+            }
+            char t[64];
+            std::snprintf(t, sizeof t, "%.7f", std::stod(r.substr(0, comma)) - 3e-7);
+            std::string twin = t + r.substr(comma);
+            twin[twin.find(",A,") + 10] ^= 1;  // another quaternion (a digit of qw)
+            extra.push_back(twin);
+        }
+        std::mt19937 rng(11);
+        std::shuffle(rows.begin(), rows.end(), rng);
+        std::ofstream out(dir / "sim.csv");
+        out << lines[0] << '\n';
+        for (const std::string& r : rows) {
+            out << r << '\n';
+        }
+        for (const std::string& r : extra) {
+            out << r << '\n';
+        }
+    }
+    host::write_model_file((dir / "initial.csv").string(), host::read_model_file(data_path("model_table2.csv")));
+    host::ReplayOptions o = options(dir, "loopback-float");
+    o.model = (dir / "initial.csv").string();
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    std::cout << host::to_json(s) << "\n" << log.str();
+    EXPECT_EQ(s.mismatches, 0U) << log.str();
+    EXPECT_EQ(s.version_mismatches, 0U);
+    EXPECT_EQ(s.history_mismatches, 0U);
+    EXPECT_TRUE(s.report_matches);
+    const CliRun r = run_in(
+        "correct --in sim.csv --out corrected.csv --self-calibrate --scalar float --model "
+        "initial.csv --model-history corrected.history.csv",
+        dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "replayed.history.csv"), slurp(dir / "corrected.history.csv"));
+    EXPECT_EQ(slurp(dir / "replayed.csv"), slurp(dir / "corrected.csv"));
+    EXPECT_NE(slurp(dir / "corrected.history.csv").find(",0,A,alpha,"), std::string::npos);  // version 0
+}
+
+// A quadratic model cannot start the target's estimator (CALIB_MODEL_LOAD
+// carries c0..c3): refused, naming the file and the term.
+TEST(ReplaySelfCalibration, AQuadraticInitialModelIsRefused) {
+    const auto dir = simulated("replay_sc_quadratic");
+    host::ModelFile m = host::read_model_file(data_path("model_table2.csv"));
+    m.coefficients[1][2][5] = 1e-3;  // B gamma c2_2
+    m.quadratic = true;
+    host::write_model_file((dir / "quadratic.csv").string(), m);
+    host::ReplayOptions o = options(dir, "loopback-float");
+    o.model = (dir / "quadratic.csv").string();
+    std::ostringstream log;
+    try {
+        (void)host::replay(o, log);
+        ADD_FAILURE() << "accepted";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("head B gamma has a quadratic term (c2_2)"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(o.out));
 }
 
 // The target's LinkServer in process, behind a link that clears the clean

@@ -8,6 +8,7 @@
 
 #include <cctype>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -17,6 +18,14 @@
 #include "ascorr_host/analysis/iba.hpp"
 
 namespace ascorr::cli {
+
+// A command that ran to its end and wrote every output, whose result is a
+// failure (replay: the target disagrees with the host): main() prints the
+// message and exits 3.
+class FailedResult : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
 
 // Heads by their letters (--heads ABCD, --frame-heads AC): heads.hpp's, in its
 // order, none twice, at least `min` and at most `max` of them. A refused value

@@ -54,8 +54,8 @@ void add_correct_command(CLI::App& app) {
         ->transform(one_of<bool>({{"itrf", false}, {"gcrs", true}}))
         ->type_name("NAME");
     cmd->add_option("--max-propagation", opt->max_propagation_s,
-                    "seconds a state may be propagated, (0, 604800] (default 21600); later rows get status 4+512")
-        ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
+                    "seconds a state may be propagated, [1e-06, 604800] (default 21600); later rows get status 4+512")
+        ->check(real_in(host::kMinPropagationS, host::kMaxPropagationLimitS));
     cmd->add_flag("--self-calibrate", opt->self_calibrate,
                   "estimate the thermal model from the rows themselves with the on-board estimator, causally in time "
                   "order, starting from --model (version 0) or from none (rows before the first model: status 256)");

@@ -1,7 +1,9 @@
 // ascorr: thermal and aberration correction of µASC attitude solutions.
 //
 // Exit status: 0 when every output is complete; 1 for bad input or an I/O
-// error (the message names file, line and column); 2 for a usage error;
+// error (the message names file, line and column); 2 for a usage error; 3
+// when the outputs are complete but say the run failed (replay: the target's
+// answers, models or report differ from the host's);
 // ended by SIGINT, SIGTERM, SIGHUP or SIGPIPE: that signal (128 + signal in a
 // shell), with no temporary output left behind.
 #include <cstdio>
@@ -36,6 +38,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         app.exit(e);
         return 2;
+    } catch (const ascorr::cli::FailedResult& e) {
+        std::cerr << "ascorr: " << e.what() << '\n';
+        return 3;
     } catch (const std::exception& e) {
         std::cerr << "ascorr: " << e.what() << '\n';
         return 1;

@@ -38,9 +38,9 @@ void add_replay_command(CLI::App& app) {
         ->transform(one_of<bool>({{"itrf", false}, {"gcrs", true}}))
         ->type_name("NAME");
     cmd->add_option("--max-propagation", opt->max_propagation_s,
-                    "seconds the target's velocity service may propagate a state, (0, 604800] (default: its "
+                    "seconds the target's velocity service may propagate a state, [1e-06, 604800] (default: its "
                     "firmware's, 21600); later rows get status 4+512")
-        ->check(real_in(0.0, host::kMaxPropagationLimitS, End::kOpen));
+        ->check(real_in(host::kMinPropagationS, host::kMaxPropagationLimitS));
     cmd->add_flag("--self-calibrate", opt->self_calibrate,
                   "the target runs its estimator of the thermal model on the solutions, starting from --model or from "
                   "none; its answers, model versions, models and final report are compared with the host's run "
@@ -78,6 +78,9 @@ void add_replay_command(CLI::App& app) {
             {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
+        if (!host::agrees(s)) {
+            throw FailedResult(host::disagreement(s));
+        }
     });
 }
 

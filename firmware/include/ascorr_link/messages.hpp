@@ -243,7 +243,8 @@ template <typename T>
 bool decode(const std::uint8_t* p, std::size_t n, SolutionIn<T>& m) noexcept {
     Reader r(p, n);
     return r.u32(m.id) && r.u8(m.head) && r.i64(m.t.us) && r.u8(m.from_states) && m.from_states <= 1U &&
-           r.u8(m.calib) && (m.calib & ~(kCalibClean | kCalibNoTime)) == 0U && r.word(m.q_chu_icrf.w) &&
+           r.u8(m.calib) && (m.calib & ~(kCalibClean | kCalibNoTime)) == 0U &&
+           ((m.calib & kCalibNoTime) == 0U || (m.t.us == 0 && m.from_states == 0U)) && r.word(m.q_chu_icrf.w) &&
            r.word(m.q_chu_icrf.x) && r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.done();
 }
 

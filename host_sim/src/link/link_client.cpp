@@ -117,6 +117,7 @@ link::SolutionOut<T> LinkClient<T>::correct(std::uint32_t id, std::uint8_t head,
         "solution"};
     from_states_ = from_states;
     velocity_expected_ = velocity_expected;
+    calib_ = calib;
     for (int attempt = 0; attempt < max_attempts_; ++attempt) {
         const auto a = request(m, link::MessageType::kSolutionOut);
         link::SolutionOut<T> out{};
@@ -129,6 +130,7 @@ link::SolutionOut<T> LinkClient<T>::correct(std::uint32_t id, std::uint8_t head,
             restore();  // a restart whose HELLO was lost on the link
             continue;
         }
+        had_version_ = had_version_ || out.model_version != link::kNoModelVersion;
         return out;
     }
     throw LinkError("no acceptable answer for solution " + std::to_string(id) + " after " +
@@ -343,7 +345,11 @@ bool LinkClient<T>::answer_shows_restart(const link::SolutionOut<T>& out) const 
     const bool no_state =
         from_states_ && velocity_expected_ &&
         (out.status & (status::kNoVelocity | status::kVelocityInvalid | status::kStale)) == status::kNoVelocity;
-    return no_model || no_velocity || no_state;
+    // Self-calibrating: a timed solution corrected without any model once the
+    // target has had one (its estimator never drops its active model).
+    const bool no_estimator = calibrating_ && had_version_ && (calib_ & link::kCalibNoTime) == 0U &&
+                              out.model_version == link::kNoModelVersion;
+    return no_model || no_velocity || no_state || no_estimator;
 }
 
 // ---------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <optional>
@@ -75,6 +76,45 @@ bool same_double(double a, double b) {
     return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
 }
 
+// The first field in which a (the target's) and b (the host's) differ, with
+// both values.
+std::string first_report_difference(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
+    const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
+        return x == y ? std::string()
+                      : std::string(name) + ": target " + std::to_string(x) + ", host " + std::to_string(y);
+    };
+    const auto d = [](const char* name, double x, double y) {
+        return same_double(x, y) ? std::string()
+                                 : std::string(name) + ": target " + number_text(x) + ", host " + number_text(y);
+    };
+    const std::string fields[] = {
+        u("orbits used", a.orbits_used, b.orbits_used),
+        u("orbits short", a.orbits_short, b.orbits_short),
+        u("orbits held back", a.orbits_held, b.orbits_held),
+        u("orbits late", a.orbits_late, b.orbits_late),
+        u("changes", a.changes, b.changes),
+        d("condition", a.condition, b.condition),
+        d("residual RMS", a.residual_rms_arcsec, b.residual_rms_arcsec),
+        d("candidate RMS", a.candidate_rms_arcsec, b.candidate_rms_arcsec),
+        u("has a model", a.has_active, b.has_active),
+        u("active version", a.active_version, b.active_version),
+        u("active CRC-32C", a.active_crc, b.active_crc),
+        u("last refusal", static_cast<unsigned>(a.last_refusal), static_cast<unsigned>(b.last_refusal)),
+        u("frozen", a.frozen, b.frozen)};
+    for (const std::string& f : fields) {
+        if (!f.empty()) {
+            return f;
+        }
+    }
+    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
+        if (a.refusals[i] != b.refusals[i]) {
+            return std::string("refusals '") + calib::refusal_name(static_cast<calib::Refusal>(i)) + "': target " +
+                   std::to_string(a.refusals[i]) + ", host " + std::to_string(b.refusals[i]);
+        }
+    }
+    return "no field";
+}
+
 bool same_report(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
     bool same = a.orbits_used == b.orbits_used && a.orbits_short == b.orbits_short && a.orbits_held == b.orbits_held &&
                 a.orbits_late == b.orbits_late && a.changes == b.changes && same_double(a.condition, b.condition) &&
@@ -106,6 +146,33 @@ ActiveModel target_model(LinkClient<T>& client, double t) {
         }
     }
     return a;
+}
+
+// What differs first between a (the target's) and b (the host's) model of
+// one version: the epoch, the CRC, a head's presence or a coefficient.
+std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
+    if (a.t_us != b.t_us) {
+        return "active from TT " + std::to_string(a.t_us) + " us on the target, " + std::to_string(b.t_us) +
+               " us on the host";
+    }
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        const std::string head(1, head_name(static_cast<std::uint8_t>(h)));
+        if (a.model.present[h] != b.model.present[h]) {
+            return "head " + head + (a.model.present[h] ? " present" : " absent") + " on the target only";
+        }
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                if (!same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i])) {
+                    return "head " + head + " " + kAxisNames[x] + " c" + std::to_string(i) + ": target " +
+                           number_text(a.model.coefficients[h][x][i]) + ", host " +
+                           number_text(b.model.coefficients[h][x][i]);
+                }
+            }
+        }
+    }
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
+    return buf;
 }
 
 // Whether two history entries are the same model, active from the same epoch.
@@ -148,11 +215,12 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     if (host == host_sc.history.end() || !same_model(*host, mine)) {
         if (++sum.history_mismatches <= kMaxCalibMessages) {
             char buf[200];
-            std::snprintf(buf, sizeof buf,
-                          "model version %u (crc32c %08x, active from TT %lld us) differs from the host's%s\n",
-                          mine.version, mine.crc, static_cast<long long>(mine.t_us),
-                          host == host_sc.history.end() ? " (the host has no such version)" : "");
-            log << "ascorr replay: the target's " << buf;
+            std::snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
+                          mine.crc);
+            log << "ascorr replay: the target's " << buf
+                << (host == host_sc.history.end() ? std::string("the host has no such version")
+                                                  : first_model_difference(mine, *host))
+                << "\n";
         }
     }
 }
@@ -173,14 +241,33 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     const calib::EstimatorReport r = client.calib_report();
     sum.report_matches = same_report(r, host_sc.report);
     if (!sum.report_matches) {
-        log << "ascorr replay: the target's estimator report differs from the host's: target " << r.orbits_used
-            << " orbits used, active version " << r.active_version << "; host " << host_sc.report.orbits_used
-            << " orbits used, active version " << host_sc.report.active_version << "\n";
+        log << "ascorr replay: the target's estimator report differs from the host's: "
+            << first_report_difference(r, host_sc.report) << "\n";
     }
     SelfCalibration on_target = host_sc;
     on_target.history = target_history;
     on_target.report = r;
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
+}
+
+// The estimator's models are linear, and CALIB_MODEL_LOAD carries c0..c3:
+// a --model with quadratic terms would start the target from another model
+// than the host's. Refused, naming the file and the term.
+void refuse_quadratic_initial_model(const ModelFile& m, const std::string& path) {
+    static constexpr const char* kQuadratic[] = {"c1_2", "c2_2", "c3_2"};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
+                if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
+                    throw std::runtime_error(
+                        path + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
+                        kAxisNames[a] + " has a quadratic term (" + kQuadratic[i - kLinearModelTerms] +
+                        "): replay --self-calibrate starts the target from a linear model "
+                        "(CALIB_MODEL_LOAD carries c0..c3)");
+                }
+            }
+        }
+    }
 }
 
 template <typename T>
@@ -196,6 +283,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         if constexpr (std::is_same_v<T, Q30>) {
             check_fixed_point_range(*mf, opt.model);  // refused before the target sees it, as by `correct`
         }
+    }
+    if (opt.self_calibrate && mf) {
+        refuse_quadratic_initial_model(*mf, opt.model);
     }
     const ThermalModel<T> model_t = mf ? to_core<T>(*mf) : ThermalModel<T>{};
     const ThermalModel<double> model_d = mf ? to_core<double>(*mf) : ThermalModel<double>{};
@@ -277,7 +367,13 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     } else {
         client.upload_model(model_t);
     }
-    const auto key = [&](std::size_t i) { return std::isnan(rows[i].t) ? HUGE_VAL : rows[i].t; };
+    // Time order is the on-board clock's (TT µs; rows within one microsecond
+    // in file order, as the target and the host's self-calibration take
+    // them); rows whose t the clock cannot hold come last.
+    const auto key = [&](std::size_t i) {
+        TtTime tt{};
+        return tt_from_seconds(rows[i].t, tt) ? tt.us : std::numeric_limits<std::int64_t>::max();
+    };
     std::vector<std::size_t> order(rows.size());
     std::iota(order.begin(), order.end(), std::size_t{0});
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
@@ -599,6 +695,21 @@ std::string default_link_firmware(const std::string& target) {
     throw std::runtime_error("no link firmware image for " + target +
                              " in this build (configured without ASCORR_TARGETS): pass --firmware");
 #endif
+}
+
+bool agrees(const ReplaySummary& s) {
+    return s.mismatches == 0 &&
+           (!s.self_calibrate || (s.version_mismatches == 0 && s.history_mismatches == 0 && s.report_matches));
+}
+
+std::string disagreement(const ReplaySummary& s) {
+    std::string out = "replay: the target disagrees with the host: " + std::to_string(s.mismatches) + " answer(s)";
+    if (s.self_calibrate) {
+        out += ", " + std::to_string(s.version_mismatches) + " model version(s), " +
+               std::to_string(s.history_mismatches) + " model(s), the report " +
+               (s.report_matches ? "agrees" : "differs");
+    }
+    return out + " (the outputs are written; see the messages above)";
 }
 
 std::string to_json(const ReplaySummary& s) {

@@ -87,6 +87,7 @@ public:
             prepare(*initial, 0U);
             active_ = back();
             swap_pending_ = false;
+            initial_unused_ = true;  // active from the first cycle: its time is taken there
         }
     }
 
@@ -94,6 +95,10 @@ public:
 
     // The model for this cycle's corrections; applies a pending swap first.
     const ThermalModel<T>* model_for_cycle(std::int64_t t_us) noexcept {
+        if (initial_unused_) {
+            initial_unused_ = false;
+            adopted_at_us_ = t_us;
+        }
         if (swap_pending_) {
             active_ = back();
             swap_pending_ = false;
@@ -570,6 +575,7 @@ private:
     bool has_[2]{};
     std::size_t active_ = 0;
     bool swap_pending_ = false;
+    bool initial_unused_ = false;  // the model given at start, before its first cycle
     std::int64_t adopted_at_us_ = 0;
 };
 

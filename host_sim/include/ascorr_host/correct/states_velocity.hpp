@@ -32,13 +32,16 @@ namespace ascorr::host {
 inline constexpr double kMaxPropagationLimitS = static_cast<double>(kMaxHorizonUs) * 1e-6;
 
 // Whether `--max-propagation` (or the Python module's max_propagation) is
-// acceptable: above 0 and at most kMaxPropagationLimitS; NaN is not.
+// acceptable: at least the on-board clock's microsecond (a shorter horizon
+// would round to none) and at most kMaxPropagationLimitS; NaN is not.
+inline constexpr double kMinPropagationS = 1e-6;
 inline bool max_propagation_acceptable(double max_propagation_s) {
-    return max_propagation_s > 0.0 && max_propagation_s <= kMaxPropagationLimitS;
+    return max_propagation_s >= kMinPropagationS && max_propagation_s <= kMaxPropagationLimitS;
 }
 
 // The refusal text for an unacceptable value, one wording for CLI and Python.
-inline constexpr const char* kMaxPropagationRule = "must be above 0 and at most 604800 s (7 days)";
+inline constexpr const char* kMaxPropagationRule =
+    "must be at least 1e-06 s (one microsecond) and at most 604800 s (7 days)";
 static_assert(kMaxPropagationLimitS == 604800.0, "kMaxPropagationRule states the limit in seconds");
 
 // Service configuration for `--max-propagation SECONDS` (max_propagation_acceptable;

@@ -166,6 +166,8 @@ private:
     bool from_states_ = false;  // of the solution in flight
     bool velocity_expected_ = false;
     bool calibrating_ = false;  // start_calibration() sent: a restart is an error
+    std::uint8_t calib_ = 0U;   // of the solution in flight (link::kCalibClean, kCalibNoTime)
+    bool had_version_ = false;  // an answer carried a model version
     LinkStats stats_;
 };
 

@@ -80,5 +80,10 @@ std::vector<std::string> qemu_link_command(const std::string& machine, const std
 // The link image of this build tree for a target (a cpu of toolchain/targets.txt).
 std::string default_link_firmware(const std::string& target);
 std::string to_json(const ReplaySummary& s);
+// Whether the target agreed with the host in everything compared (answers;
+// with self-calibration, model versions, models and the report); and, if not,
+// one line saying in what.
+bool agrees(const ReplaySummary& s);
+std::string disagreement(const ReplaySummary& s);
 
 }  // namespace ascorr::host
