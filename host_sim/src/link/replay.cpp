@@ -77,7 +77,7 @@ bool same_double(double a, double b) {
 }
 
 // The first field in which a (the target's) and b (the host's) differ, with
-// both values.
+// both values; empty when they are the same (doubles: same_double).
 std::string first_report_difference(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
     const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
         return x == y ? std::string()
@@ -112,20 +112,7 @@ std::string first_report_difference(const calib::EstimatorReport& a, const calib
                    std::to_string(a.refusals[i]) + ", host " + std::to_string(b.refusals[i]);
         }
     }
-    return "no field";
-}
-
-bool same_report(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
-    bool same = a.orbits_used == b.orbits_used && a.orbits_short == b.orbits_short && a.orbits_held == b.orbits_held &&
-                a.orbits_late == b.orbits_late && a.changes == b.changes && same_double(a.condition, b.condition) &&
-                same_double(a.residual_rms_arcsec, b.residual_rms_arcsec) &&
-                same_double(a.candidate_rms_arcsec, b.candidate_rms_arcsec) && a.has_active == b.has_active &&
-                a.active_version == b.active_version && a.active_crc == b.active_crc &&
-                a.last_refusal == b.last_refusal && a.frozen == b.frozen;
-    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
-        same = same && a.refusals[i] == b.refusals[i];
-    }
-    return same;
+    return {};
 }
 
 // The target's model `version`, head by head (CALIB_MODEL), as a history entry
@@ -149,7 +136,8 @@ ActiveModel target_model(LinkClient<T>& client, double t) {
 }
 
 // What differs first between a (the target's) and b (the host's) model of
-// one version: the epoch, the CRC, a head's presence or a coefficient.
+// one version: the epoch, a head's presence, a coefficient or the CRC; empty
+// when they are the same model, active from the same epoch.
 std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
     if (a.t_us != b.t_us) {
         return "active from TT " + std::to_string(a.t_us) + " us on the target, " + std::to_string(b.t_us) +
@@ -170,23 +158,12 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
             }
         }
     }
+    if (a.crc == b.crc) {
+        return {};
+    }
     char buf[64];
     std::snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
     return buf;
-}
-
-// Whether two history entries are the same model, active from the same epoch.
-bool same_model(const ActiveModel& a, const ActiveModel& b) {
-    bool same = a.t_us == b.t_us && a.version == b.version && a.crc == b.crc;
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        same = same && a.model.present[h] == b.model.present[h];
-        for (std::size_t x = 0; x < kModelAxes; ++x) {
-            for (std::size_t i = 0; i < kModelTerms; ++i) {
-                same = same && same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i]);
-            }
-        }
-    }
-    return same;
 }
 
 constexpr std::size_t kMaxCalibMessages = 20;  // per kind, as the diagnostics of `ascorr correct`
@@ -212,15 +189,14 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     const ActiveModel& mine = target_history.back();
     const auto host = std::find_if(host_sc.history.begin(), host_sc.history.end(),
                                    [&](const ActiveModel& a) { return a.version == mine.version; });
-    if (host == host_sc.history.end() || !same_model(*host, mine)) {
+    const std::string difference =
+        host == host_sc.history.end() ? "the host has no such version" : first_model_difference(mine, *host);
+    if (!difference.empty()) {
         if (++sum.history_mismatches <= kMaxCalibMessages) {
             char buf[200];
             std::snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
                           mine.crc);
-            log << "ascorr replay: the target's " << buf
-                << (host == host_sc.history.end() ? std::string("the host has no such version")
-                                                  : first_model_difference(mine, *host))
-                << "\n";
+            log << "ascorr replay: the target's " << buf << difference << "\n";
         }
     }
 }
@@ -239,10 +215,10 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
         }
     }
     const calib::EstimatorReport r = client.calib_report();
-    sum.report_matches = same_report(r, host_sc.report);
+    const std::string difference = first_report_difference(r, host_sc.report);
+    sum.report_matches = difference.empty();
     if (!sum.report_matches) {
-        log << "ascorr replay: the target's estimator report differs from the host's: "
-            << first_report_difference(r, host_sc.report) << "\n";
+        log << "ascorr replay: the target's estimator report differs from the host's: " << difference << "\n";
     }
     SelfCalibration on_target = host_sc;
     on_target.history = target_history;
