@@ -60,7 +60,7 @@
 #include "head_rotation.hpp"
 #include "model_checks.hpp"
 #include "model_identity.hpp"
-#include "orbit_sums.hpp"
+#include "orbit_collector.hpp"
 #include "orbit_window.hpp"
 #include "square_root_information.hpp"
 
@@ -73,7 +73,7 @@ public:
 
     explicit Estimator(const EstimatorConfig& cfg = EstimatorConfig{},
                        const ModelCoefficients* initial = nullptr) noexcept
-        : cfg_(cfg) {
+        : cfg_(cfg), orbit_(cfg.orbit_period_us) {
         if (cfg_.window_orbits > kWindow) {
             cfg_.window_orbits = kWindow;
         }
@@ -112,16 +112,11 @@ public:
         if (frozen_) {
             return;
         }
-        // Two comparisons per cycle; the 64-bit division (a library call on
-        // the M3) only when the orbit changes.
-        if (!open_ || c.t_us < orbit_start_us_ || c.t_us >= orbit_end_us_) {
-            const std::int64_t bin = floor_div(c.t_us, cfg_.orbit_period_us);
+        if (orbit_.starts_orbit(c.t_us)) {
             close_orbit();
-            open_orbit(bin, c);
-            orbit_start_us_ = bin * cfg_.orbit_period_us;
-            orbit_end_us_ = orbit_start_us_ + cfg_.orbit_period_us;
+            orbit_.open(c);
         }
-        sums_.add(c.q_chu_icrf, c.temperatures, ref_);
+        orbit_.add(c);
     }
 
     // Ends the current orbit now (the end of a recording; a command).
@@ -156,7 +151,7 @@ public:
 
     void freeze() noexcept {
         frozen_ = true;
-        open_ = false;
+        orbit_.drop();
     }
     void resume() noexcept { frozen_ = false; }
     // Forget everything learnt; the active model stays.
@@ -172,7 +167,7 @@ public:
         ms_ = 0.0;
         has_solution_ = false;
         last_fed_valid_ = false;
-        open_ = false;
+        orbit_.drop();
         phase_ = Phase::kIdle;
     }
     // Active from the next cycle (between solutions); version = active + 1.
@@ -212,75 +207,35 @@ public:
     const EstimatorConfig& config() const noexcept { return cfg_; }
 
 private:
-    static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
-        const std::int64_t q = a / b;
-        return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
-    }
-
     std::size_t back() const noexcept { return active_ ^ 1U; }
 
-    void open_orbit(std::int64_t bin, const CalibCycle<T>& c) noexcept {
-        bin_ = bin;
-        open_ = true;
-        sums_ = OrbitSums<T>{};
-        if (next_ref_ready_) {
-            ref_ = next_ref_;
-            next_ref_ready_ = false;
-        } else if (!ref_valid_) {
-            // The first cycle is its own reference (the exact value of d_h).
-            const Quaternion<T> q_icrf_a = conjugate(c.q_chu_icrf[0]);
-            ref_.r[0] = c.q_chu_icrf[1] * q_icrf_a;
-            ref_.r[1] = c.q_chu_icrf[2] * q_icrf_a;
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
-                ref_.t_ref[h][0] = c.temperatures[h].t_chu.value;
-                ref_.t_ref[h][1] = c.temperatures[h].t_029.value;
-                ref_.t_ref[h][2] = c.temperatures[h].t_032.value;
-            }
-        }
-        ref_valid_ = true;
-    }
-
     void close_orbit() noexcept {
-        if (!open_) {
+        if (!orbit_.is_open()) {
             return;
         }
-        open_ = false;
         if (phase_ != Phase::kIdle) {
+            orbit_.drop();
             ++orbits_late_;  // the previous orbit is still being processed
             return;
         }
-        closed_ = sums_;
-        closed_ref_ = ref_;
-        closed_bin_ = bin_;
+        orbit_.close(closed_);
         phase_ = Phase::kAverages;
     }
 
     // Phase 1: the orbit's means, F, the heads' angles; the next reference.
     bool averages() noexcept {
-        closed_.flush();
-        const std::uint32_t n = closed_.count;
+        closed_.sums.flush();
+        const std::uint32_t n = closed_.sums.count;
         const double cover = cfg_.min_coverage * static_cast<double>(typical_count_);
         typical_count_ = n > typical_count_ ? n : typical_count_ - typical_count_ / 16U;
         if (n < cfg_.min_epochs_per_orbit || static_cast<double>(n) < cover || n == 0U) {
             ++orbits_short_;
             return false;
         }
-        const double inv = 1.0 / static_cast<double>(n);
-        Quaternion<double> d[2];
-        for (std::size_t k = 0; k < 2; ++k) {
-            const Quaternion<double> mean{closed_.dq[k][0].value() * inv, closed_.dq[k][1].value() * inv,
-                                          closed_.dq[k][2].value() * inv, closed_.dq[k][3].value() * inv};
-            const double s = 1.0 / std::sqrt(squared_norm(mean));
-            const Quaternion<T>& r = closed_ref_.r[k];
-            const Quaternion<double> rd{to_d(r.w), to_d(r.x), to_d(r.y), to_d(r.z)};
-            const Quaternion<double> unit{mean.w * s, mean.x * s, mean.y * s, mean.z * s};
-            const Quaternion<double> dk = unit * rd;
-            const double sn = 1.0 / std::sqrt(squared_norm(dk));
-            d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
-        }
-        const Quaternion<double> q_f_in_a = q_f_a(d[1]);
-        const Quaternion<double> q_head_in_f[kCalibHeads] = {conjugate(q_f_in_a), q_head_f(d[0], q_f_in_a),
-                                                             q_head_f(d[1], q_f_in_a)};
+        const OrbitMeans means = orbit_means(closed_);
+        const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);
+        const Quaternion<double> q_head_in_f[kCalibHeads] = {conjugate(q_f_in_a), q_head_f(means.d[0], q_f_in_a),
+                                                             q_head_f(means.d[1], q_f_in_a)};
         if (!n_valid_) {
             for (std::size_t h = 0; h < kCalibHeads; ++h) {
                 n_ref_[h] = q_head_in_f[h];
@@ -288,20 +243,16 @@ private:
             }
         }
         OrbitRecord& o = record_;
-        o.bin = closed_bin_;
+        o.bin = closed_.bin;
         o.held = false;
-        double t_mean[kCalibHeads][3];
         for (std::size_t h = 0; h < kCalibHeads; ++h) {
             const Vector3<double> e = small_angle(relative_to(q_head_in_f[h], n_ref_[h]));
             o.e[h][0] = e.x * kRadToArcsec;
             o.e[h][1] = e.y * kRadToArcsec;
             o.e[h][2] = e.z * kRadToArcsec;
-            for (std::size_t j = 0; j < 3; ++j) {
-                t_mean[h][j] = to_d(closed_ref_.t_ref[h][j]) + closed_.dt[h][j].value() * inv;
-            }
-            o.x[h][0] = t_mean[h][0];
-            o.x[h][1] = t_mean[h][1] - t_mean[h][0];
-            o.x[h][2] = t_mean[h][2] - t_mean[h][0];
+            o.x[h][0] = means.t[h][0];
+            o.x[h][1] = means.t[h][1] - means.t[h][0];
+            o.x[h][2] = means.t[h][2] - means.t[h][0];
         }
         if (!n_valid_) {
             for (std::size_t h = 0; h < kCalibHeads; ++h) {
@@ -311,15 +262,7 @@ private:
             }
             n_valid_ = true;
         }
-        // The next orbits' references: this orbit's means (in T).
-        next_ref_.r[0] = from_d(d[0]);
-        next_ref_.r[1] = from_d(d[1]);
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            for (std::size_t j = 0; j < 3; ++j) {
-                next_ref_.t_ref[h][j] = ScalarTraits<T>::celsius(t_mean[h][j]);
-            }
-        }
-        next_ref_ready_ = true;
+        orbit_.set_next_reference(reference_from<T>(means));  // the next orbit's references
         return true;
     }
 
@@ -418,7 +361,7 @@ private:
         }
         has_solution_ = true;
         centred_to_model(b_, centre_, cand_);
-        if (!within_limits(cand_)) {
+        if (!within_limits(cand_, window_, cfg_.angle_check_margin_c)) {
             refuse(Refusal::kAngleLimit);
             return false;
         }
@@ -427,9 +370,9 @@ private:
 
     // Phase 4: the comparison with the active model; the back buffer and swap.
     void gate() noexcept {
-        candidate_rms_ = window_rms(cand_);
+        candidate_rms_ = window_rms(cand_, window_, n_mat_, cfg_.window_orbits);
         if (has_[active_]) {
-            active_rms_ = window_rms(model_[active_]);
+            active_rms_ = window_rms(model_[active_], window_, n_mat_, cfg_.window_orbits);
             if (!(candidate_rms_ <= (1.0 - cfg_.adoption_margin) * active_rms_)) {
                 refuse(Refusal::kNoGain);
                 return;
@@ -446,63 +389,6 @@ private:
         ++refusals_[static_cast<std::size_t>(r)];
     }
 
-    bool within_limits(const ModelCoefficients& m) const noexcept {
-        constexpr double max_arcsec = kMaxThermalAngleRad * kRadToArcsec;
-        if (!coefficients_within_q30(m)) {
-            return false;
-        }
-        if (window_.size() == 0U) {
-            return true;
-        }
-        const OrbitRecord& o = window_.at(window_.size() - 1U);
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            for (std::size_t corner = 0; corner < 8U; ++corner) {
-                double x[3];
-                for (std::size_t j = 0; j < 3; ++j) {
-                    x[j] = o.x[h][j] +
-                           (((corner >> j) & 1U) != 0U ? cfg_.angle_check_margin_c : -cfg_.angle_check_margin_c);
-                }
-                for (std::size_t a = 0; a < 3; ++a) {
-                    if (!(std::fabs(model_angle(m, h, a, x)) < max_arcsec)) {
-                        return false;
-                    }
-                }
-            }
-        }
-        return true;
-    }
-
-    // RMS of a model's IBA residuals (orbit means, arcsec, iba_residuals) over
-    // the last window_orbits orbits fed to the filter. Not about their mean:
-    // within a day the orbit means' temperatures hardly move, so a wrong slope
-    // shows as an offset there, and so does a shifted mount.
-    double window_rms(const ModelCoefficients& m) const noexcept {
-        double sq[3] = {};
-        std::uint32_t n = 0;
-        for (std::size_t i = window_.size(); i-- > 0 && n < cfg_.window_orbits;) {
-            const OrbitRecord& o = window_.at(i);
-            if (o.held) {
-                continue;
-            }
-            double r[9];
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
-                for (std::size_t a = 0; a < 3; ++a) {
-                    r[3 * h + a] = o.e[h][a] - model_angle(m, h, a, o.x[h]);
-                }
-            }
-            double d[3];
-            iba_residuals(n_mat_, r, d);
-            for (std::size_t k = 0; k < 3; ++k) {
-                sq[k] += d[k] * d[k];
-            }
-            ++n;
-        }
-        if (n < 2U) {
-            return std::numeric_limits<double>::quiet_NaN();
-        }
-        return std::sqrt((sq[0] + sq[1] + sq[2]) / (3.0 * n));
-    }
-
     // The back buffer: coefficients, the core's form, version and CRC.
     void prepare(const ModelCoefficients& m, std::uint32_t version) noexcept {
         const std::size_t k = back();
@@ -513,32 +399,13 @@ private:
         has_[k] = true;
     }
 
-    template <typename X>
-    static double to_d(const X& x) noexcept {
-        return ScalarTraits<T>::to_double(x);
-    }
-    static Quaternion<T> from_d(const Quaternion<double>& q) noexcept {
-        using Tr = ScalarTraits<T>;
-        return {Tr::from_double(q.w), Tr::from_double(q.x), Tr::from_double(q.y), Tr::from_double(q.z)};
-    }
-
     EstimatorConfig cfg_;
     // The cycle's side.
     bool frozen_ = false;
-    bool open_ = false;
-    std::int64_t bin_ = 0;
-    std::int64_t orbit_start_us_ = 0;  // [start, end) of the current orbit
-    std::int64_t orbit_end_us_ = 0;
-    OrbitSums<T> sums_{};
-    OrbitReference<T> ref_{};
-    bool ref_valid_ = false;
-    OrbitReference<T> next_ref_{};
-    bool next_ref_ready_ = false;
+    OrbitCollector<T> orbit_;
     // The closed orbit being processed.
     Phase phase_ = Phase::kIdle;
-    OrbitSums<T> closed_{};
-    OrbitReference<T> closed_ref_{};
-    std::int64_t closed_bin_ = 0;
+    ClosedOrbit<T> closed_{};
     std::uint32_t typical_count_ = 0;
     OrbitRecord record_{};
     // The filter.

@@ -1,11 +1,13 @@
 // ascorr/calib/model_checks.hpp: what the on-board estimator (estimator.hpp)
 // asks of a model before adopting it: its angles, that its coefficients fit
-// the Q30 formats, and what residual rotations do to the inter-boresight
-// angles. Pure functions in double, bounded loops, no allocation.
+// the Q30 formats, what residual rotations do to the inter-boresight angles,
+// and its residuals over the recent orbits. Pure functions in double, bounded loops, no allocation.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 
 #include "../core/constants.hpp"
 #include "../core/model_coefficients.hpp"
@@ -102,6 +104,69 @@ inline void residual(const double (&b)[kCalibHeads][kUnknowns][3], const double 
             r[3 * h + a] = o.e[h][a] - p;
         }
     }
+}
+
+// Whether model m may be adopted as to its size: its coefficients fit the Q30
+// formats (coefficients_within_q30) and, at the newest orbit's temperatures
+// in window ± margin_c (the 8 corners of the box per head), every angle is
+// within the core's 1° (kMaxThermalAngleRad). An empty window checks the
+// coefficients only.
+inline bool within_limits(const ModelCoefficients& m, const OrbitWindow& window, double margin_c) noexcept {
+    constexpr double max_arcsec = kMaxThermalAngleRad * kRadToArcsec;
+    if (!coefficients_within_q30(m)) {
+        return false;
+    }
+    if (window.size() == 0U) {
+        return true;
+    }
+    const OrbitRecord& o = window.at(window.size() - 1U);
+    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t corner = 0; corner < 8U; ++corner) {
+            double x[3];
+            for (std::size_t j = 0; j < 3; ++j) {
+                x[j] = o.x[h][j] + (((corner >> j) & 1U) != 0U ? margin_c : -margin_c);
+            }
+            for (std::size_t a = 0; a < 3; ++a) {
+                if (!(std::fabs(model_angle(m, h, a, x)) < max_arcsec)) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+// RMS of model m's IBA residuals (orbit means, arcsec, iba_residuals) over the
+// newest orbits (at most max_orbits) of window that are not held back; NaN
+// with fewer than two. Not about their mean: within a day the orbit means'
+// temperatures hardly move, so a wrong slope shows as an offset there, and so
+// does a shifted mount.
+inline double window_rms(const ModelCoefficients& m, const OrbitWindow& window, const Matrix3 (&n_mat)[kCalibHeads],
+                         std::uint32_t max_orbits) noexcept {
+    double sq[3] = {};
+    std::uint32_t n = 0;
+    for (std::size_t i = window.size(); i-- > 0 && n < max_orbits;) {
+        const OrbitRecord& o = window.at(i);
+        if (o.held) {
+            continue;
+        }
+        double r[9];
+        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                r[3 * h + a] = o.e[h][a] - model_angle(m, h, a, o.x[h]);
+            }
+        }
+        double d[3];
+        iba_residuals(n_mat, r, d);
+        for (std::size_t k = 0; k < 3; ++k) {
+            sq[k] += d[k] * d[k];
+        }
+        ++n;
+    }
+    if (n < 2U) {
+        return std::numeric_limits<double>::quiet_NaN();
+    }
+    return std::sqrt((sq[0] + sq[1] + sq[2]) / (3.0 * n));
 }
 
 }  // namespace ascorr::calib

@@ -1,0 +1,164 @@
+// ascorr/calib/orbit_collector.hpp: the cycle side of the on-board estimator
+// (estimator.hpp): which orbit a selected cycle belongs to, that orbit's sums
+// (orbit_sums.hpp) and their references; and, once per orbit in double, the
+// closed orbit's means (orbit_means()) and the next orbit's references.
+//
+// Orbits are bins of the on-board clock: orbit k is [k·P, (k+1)·P) µs, P the
+// configured orbit period, k = floor(t/P) (negative times included). A cycle
+// costs two comparisons; the 64-bit division (a library call on the M3) only
+// when the orbit changes.
+//
+// References (OrbitReference): the first orbit's are its first cycle (the
+// exact d_h and temperatures); each later orbit takes the means of the last
+// orbit the estimator processed (set_next_reference), or, when that orbit was
+// too short or still being processed, keeps the one before. Any reference
+// within arcseconds of the orbit's d_h gives full precision (orbit_sums.hpp).
+//
+// No allocation, no division but the orbit change's, fixed-size state.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "../core/quaternion.hpp"
+#include "../core/scalar_traits.hpp"
+#include "estimator_types.hpp"
+#include "head_rotation.hpp"
+#include "orbit_sums.hpp"
+
+namespace ascorr::calib {
+
+// An orbit handed from the cycle to the per-orbit work.
+template <typename T>
+struct ClosedOrbit {
+    OrbitSums<T> sums{};
+    OrbitReference<T> ref{};
+    std::int64_t bin = 0;  // floor(t / P)
+};
+
+template <typename T>
+class OrbitCollector {
+public:
+    // period_us > 0 (EstimatorConfig's bounds, estimator_types.hpp).
+    explicit OrbitCollector(std::int64_t period_us) noexcept : period_us_(period_us) {}
+
+    bool is_open() const noexcept { return open_; }
+
+    // Whether a cycle at t_us starts an orbit: none is open, or t_us is
+    // outside the open one. Two comparisons.
+    bool starts_orbit(std::int64_t t_us) const noexcept { return !open_ || t_us < start_us_ || t_us >= end_us_; }
+
+    // Opens the orbit of cycle c (the current one must have been closed or
+    // dropped) with empty sums and the references (see the top).
+    void open(const CalibCycle<T>& c) noexcept {
+        bin_ = floor_div(c.t_us, period_us_);
+        start_us_ = bin_ * period_us_;
+        end_us_ = start_us_ + period_us_;
+        open_ = true;
+        sums_ = OrbitSums<T>{};
+        if (next_ref_ready_) {
+            ref_ = next_ref_;
+            next_ref_ready_ = false;
+        } else if (!ref_valid_) {
+            const Quaternion<T> q_icrf_a = conjugate(c.q_chu_icrf[0]);
+            ref_.r[0] = c.q_chu_icrf[1] * q_icrf_a;
+            ref_.r[1] = c.q_chu_icrf[2] * q_icrf_a;
+            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+                ref_.t_ref[h][0] = c.temperatures[h].t_chu.value;
+                ref_.t_ref[h][1] = c.temperatures[h].t_029.value;
+                ref_.t_ref[h][2] = c.temperatures[h].t_032.value;
+            }
+        }
+        ref_valid_ = true;
+    }
+
+    // One cycle of the open orbit (starts_orbit(c.t_us) false).
+    void add(const CalibCycle<T>& c) noexcept { sums_.add(c.q_chu_icrf, c.temperatures, ref_); }
+
+    // Ends the open orbit, handing it over.
+    void close(ClosedOrbit<T>& out) noexcept {
+        open_ = false;
+        out.sums = sums_;
+        out.ref = ref_;
+        out.bin = bin_;
+    }
+
+    // Ends the open orbit, dropping its sums (frozen, reset, or the previous
+    // orbit still being processed).
+    void drop() noexcept { open_ = false; }
+
+    // The references of the next orbit opened.
+    void set_next_reference(const OrbitReference<T>& r) noexcept {
+        next_ref_ = r;
+        next_ref_ready_ = true;
+    }
+
+private:
+    static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
+        const std::int64_t q = a / b;
+        return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
+    }
+
+    std::int64_t period_us_;
+    bool open_ = false;
+    std::int64_t bin_ = 0;
+    std::int64_t start_us_ = 0;  // [start, end) of the open orbit
+    std::int64_t end_us_ = 0;
+    OrbitSums<T> sums_{};
+    OrbitReference<T> ref_{};
+    bool ref_valid_ = false;
+    OrbitReference<T> next_ref_{};
+    bool next_ref_ready_ = false;
+};
+
+// A closed orbit's means, in double: d_B and d_C (unit; the mean of δ_h,
+// normalised, times r_h, normalised again) and the nine mean temperatures (°C).
+struct OrbitMeans {
+    Quaternion<double> d[2];
+    double t[kCalibHeads][3];
+};
+
+// The means of o's sums over n = o.sums.count > 0 cycles (o.sums flushed);
+// why means of d_h suffice: orbit_sums.hpp, at the top.
+template <typename T>
+OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
+    using Tr = ScalarTraits<T>;
+    const double inv = 1.0 / static_cast<double>(o.sums.count);
+    OrbitMeans m{};
+    for (std::size_t k = 0; k < 2; ++k) {
+        const auto& s = o.sums.dq[k];
+        const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv, s[3].value() * inv};
+        const double sm = 1.0 / std::sqrt(squared_norm(mean));
+        const Quaternion<T>& r = o.ref.r[k];
+        const Quaternion<double> rd{Tr::to_double(r.w), Tr::to_double(r.x), Tr::to_double(r.y), Tr::to_double(r.z)};
+        const Quaternion<double> unit{mean.w * sm, mean.x * sm, mean.y * sm, mean.z * sm};
+        const Quaternion<double> dk = unit * rd;
+        const double sn = 1.0 / std::sqrt(squared_norm(dk));
+        m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
+    }
+    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t j = 0; j < 3; ++j) {
+            m.t[h][j] = Tr::to_double(o.ref.t_ref[h][j]) + o.sums.dt[h][j].value() * inv;
+        }
+    }
+    return m;
+}
+
+// The references an orbit's means give the next orbit (rounded to T).
+template <typename T>
+OrbitReference<T> reference_from(const OrbitMeans& m) noexcept {
+    using Tr = ScalarTraits<T>;
+    OrbitReference<T> r{};
+    for (std::size_t k = 0; k < 2; ++k) {
+        r.r[k] = {Tr::from_double(m.d[k].w), Tr::from_double(m.d[k].x), Tr::from_double(m.d[k].y),
+                  Tr::from_double(m.d[k].z)};
+    }
+    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t j = 0; j < 3; ++j) {
+            r.t_ref[h][j] = Tr::celsius(m.t[h][j]);
+        }
+    }
+    return r;
+}
+
+}  // namespace ascorr::calib
