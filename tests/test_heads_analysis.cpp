@@ -1,7 +1,8 @@
 // The analysis of more heads than the paper's three: a simulated four-head
 // mission (`simulate --heads ABCD`) fitted, corrected and scored against the
 // noise floor the simulator writes; the pairs derived from the heads present;
-// frame F's heads an option; usage errors for --heads and --frame-heads.
+// frame F's heads an option; a mission without head C fitted on the heads it
+// has (fit --heads); usage errors for --heads and --frame-heads.
 // Everything is written under the build tree (ASCORR_TEST_WORK_DIR).
 #include <gtest/gtest.h>
 
@@ -165,6 +166,65 @@ TEST(HeadsAnalysis, FrameHeadsAreAnOptionAndChangeNoIba) {
             EXPECT_LT(std::fabs(got / fl - 1.0), kFloorTolerance) << frame << ' ' << pair << ": " << got;
         }
     }
+}
+
+// A mission that never had head C (A, B and D flew): the default fit (A, B,
+// C and F = A, C) is refused, naming C and the options that fit the heads
+// flown; with them, the three pairs reach the floor. Then two of its heads
+// alone, and the usage errors of --heads.
+TEST(HeadsAnalysis, AMissionWithoutCIsFittedOnTheHeadsItHas) {
+    const fs::path dir = work_dir("without-c");
+    const std::string data = (dir / "m.csv").string();
+    const std::string model = (dir / "model.csv").string();
+    ASSERT_EQ(run_cli("simulate --heads ABD --days 120 --step 120 --out " + data, dir), 0) << slurp(dir / "err.txt");
+    EXPECT_EQ(run_cli("fit --in " + data + " --out " + model + kFitLimits, dir), 1);
+    const std::string refusal = slurp(dir / "err.txt");
+    EXPECT_NE(refusal.find("C has no rows there"), std::string::npos) << refusal;
+    EXPECT_NE(refusal.find("(e.g. --heads ABD --frame-heads AD)"), std::string::npos) << refusal;
+    EXPECT_FALSE(fs::exists(model));
+
+    ASSERT_EQ(run_cli("fit --heads ABD --frame-heads AD --in " + data + " --out " + model + kFitLimits, dir), 0)
+        << slurp(dir / "err.txt");
+    EXPECT_NE(slurp(dir / "out.txt").find("epochs with A, B and D selected"), std::string::npos);
+    const host::ModelFile m = host::read_model_file(model);
+    EXPECT_TRUE(m.present[0] && m.present[1] && m.present[3]);
+    EXPECT_FALSE(m.present[2]);
+    ASSERT_EQ(run_cli("stats --json --in " + data + " --model " + model, dir), 0) << slurp(dir / "err.txt");
+    const std::string stats = slurp(dir / "out.txt");
+    const std::string floor = slurp(data + ".floor.json");
+    EXPECT_EQ(json_pairs(floor), (std::vector<std::string>{"A-B", "A-D", "B-D"}));
+    double worst_uncorrected = 0.0;
+    for (const std::string& pair : json_pairs(floor)) {
+        const double got = json_value(stats, pair, "thermal");
+        const double fl = json_value(floor, pair, "rms");
+        std::printf("  %s: thermal %.3f\" vs floor %.3f\" (%+.2f %%)\n", pair.c_str(), got, fl,
+                    100.0 * (got / fl - 1.0));
+        EXPECT_LT(std::fabs(got / fl - 1.0), kFloorTolerance) << pair << ": " << got << " vs floor " << fl;
+        worst_uncorrected = std::max(worst_uncorrected, json_value(stats, pair, "aberration") / fl - 1.0);
+    }
+    // Control: without the thermal stage the bound fails (the check can).
+    EXPECT_GT(worst_uncorrected, kFloorTolerance);
+    // The pairs with C are still listed, without epochs (the contract's
+    // "A, B and C always").
+    EXPECT_EQ(json_value(stats, "A-C", "n"), 0.0) << stats;
+
+    // Two heads: F of A and B, one pair.
+    const std::string two = (dir / "two.csv").string();
+    ASSERT_EQ(run_cli("fit --heads AB --frame-heads AB --in " + data + " --out " + two + kFitLimits, dir), 0)
+        << slurp(dir / "err.txt");
+    const host::ModelFile m2 = host::read_model_file(two);
+    EXPECT_TRUE(m2.present[0] && m2.present[1]);
+    EXPECT_FALSE(m2.present[2] || m2.present[3]);
+    EXPECT_NE(slurp(dir / "out.txt").find("rows in the period"), std::string::npos);
+    ASSERT_EQ(run_cli("stats --json --in " + data + " --model " + two, dir), 0) << slurp(dir / "err.txt");
+    const double ab = json_value(slurp(dir / "out.txt"), "A-B", "thermal");
+    EXPECT_LT(std::fabs(ab / json_value(floor, "A-B", "rms") - 1.0), kFloorTolerance) << ab;
+
+    // Usage: F's heads must be among --heads; --heads is two or more letters.
+    EXPECT_EQ(run_cli("fit --heads ABD --in " + data + " --out " + model + kFitLimits, dir), 2);
+    EXPECT_NE(slurp(dir / "err.txt").find("frame F's heads AC (--frame-heads) are not among them"), std::string::npos)
+        << slurp(dir / "err.txt");
+    EXPECT_EQ(run_cli("fit --heads A --frame-heads AB --in " + data + " --out " + model + kFitLimits, dir), 2);
 }
 
 TEST(HeadsAnalysis, HeadsBeyondCLeaveTheOthersRowsAsTheyWere) {

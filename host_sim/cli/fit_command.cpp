@@ -10,7 +10,8 @@ namespace ascorr::cli {
 
 void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
-    auto frame = std::make_shared<std::string>("AC");
+    auto frame = std::make_shared<std::string>(host::frame_heads_text(host::kDefaultFrameHeads));
+    auto heads = std::make_shared<std::string>();
     CLI::App* cmd = app.add_subcommand("fit", "fit the thermal model on a modelling period (the paper's procedure)");
     cmd->add_option("--in", opt->in, "solutions file (CSV); '-': standard input")->required()->check(non_empty_path());
     cmd->add_option("--out", opt->out, "model file to write (CSV)")
@@ -38,10 +39,24 @@ void add_fit_command(CLI::App& app) {
         ->check(real_in(0.0, HUGE_VAL, End::kClosed, End::kOpen));
     cmd->add_option("--frame-heads", *frame,
                     "the two heads of frame F (eqs. 1-3), in heads' order, the first in A's role, the second in C's "
-                    "(default AC); the fit's heads are A, B, C, these two and every head with rows")
+                    "(default " +
+                        host::frame_heads_text(host::kDefaultFrameHeads) +
+                        "); without --heads the fit's heads are A, B, C, these two and every head with rows")
         ->check(head_letters_in(2, 2));
-    cmd->callback([opt, frame]() {
+    cmd->add_option("--heads", *heads,
+                    "the heads to fit, two or more in heads' order, frame F's among them; rows of others are left "
+                    "out (default: A, B, C, F's two and every head with rows)")
+        ->check(head_letters_in(2, kMaxHeads));
+    cmd->callback([opt, frame, heads]() {
         opt->frame_heads = {head_index((*frame)[0]), head_index((*frame)[1])};  // checked already
+        if (!heads->empty()) {
+            opt->heads = host::parse_head_letters(*heads);  // checked already
+            const host::HeadSet frame_set = host::head_bit(opt->frame_heads[0]) | host::head_bit(opt->frame_heads[1]);
+            if ((frame_set & ~*opt->heads) != 0U) {
+                throw CLI::ValidationError("--heads " + *heads,
+                                           "frame F's heads " + *frame + " (--frame-heads) are not among them");
+            }
+        }
         read_dash_from_standard_input({{"--in", &opt->in}});
         const host::FitReport r = host::fit_model(*opt);
         std::cout << host::describe(r);

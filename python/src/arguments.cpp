@@ -83,6 +83,18 @@ host::ScalarKind scalar_arg(const py::handle& x) {
     return *host::scalar_from_name(choice(x, "scalar", names));
 }
 
+host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max) {
+    const std::optional<host::HeadSet> set =
+        py::isinstance<py::str>(x) ? host::parse_head_letters(x.cast<std::string>()) : std::nullopt;
+    const std::size_t n = set ? host::head_count(*set) : 0U;
+    if (!set || n < min || n > max) {
+        const std::string count = min == max ? std::to_string(min) : std::to_string(min) + " or more";
+        bad_argument(name, "expected " + count + " of the heads " + kHeadLetters +
+                               " as a string of their letters, in that order, none twice; got " + value_text(x));
+    }
+    return *set;
+}
+
 bool bool_arg(const py::handle& x, const char* name) {
     if (py::isinstance<py::bool_>(x) || py::isinstance(x, py::module_::import("numpy").attr("bool_"))) {
         return py::cast<bool>(x);

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -70,6 +71,10 @@ double real_arg(const py::handle& x, const char* name);
 std::size_t count_arg(const py::handle& x, const char* name);
 // A path: str or os.PathLike (pathlib.Path); bytes and the rest are refused.
 std::string path_arg(const py::handle& x, const char* name);
+// Heads by their letters, as the command line's --heads and --frame-heads
+// (iba.hpp parse_head_letters: heads.hpp's, in its order, none twice), at
+// least min and at most max of them; a str, else refused.
+host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
 // An ascorr.Model or None (nullptr).
 const host::ModelFile* model_arg(const py::object& model);
 

@@ -154,10 +154,26 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     return out;
 }
 
-// The value after "--terms " or "--holdout " at text[i], as a keyword's:
-// "='linear'", "=0"; empty (and i unchanged) when none follows.
+// The value after "--terms ", "--holdout ", "--heads " or "--frame-heads "
+// at text[i], as a keyword's: "='linear'", "=0", "='ABD'"; empty (and i
+// unchanged) when none follows.
 std::string keyword_value(const std::string& name, const std::string& text, std::size_t& i) {
-    if ((name != "terms" && name != "holdout") || i >= text.size() || text[i] != ' ') {
+    if (i >= text.size() || text[i] != ' ') {
+        return {};
+    }
+    if (name == "heads" || name == "frame_heads") {
+        std::size_t v = i + 1;
+        while (v < text.size() && text[v] >= 'A' && text[v] <= 'Z') {
+            ++v;
+        }
+        if (v == i + 1) {
+            return {};
+        }
+        const std::string value = text.substr(i + 1, v - i - 1);
+        i = v;
+        return "='" + value + "'";
+    }
+    if (name != "terms" && name != "holdout") {
         return {};
     }
     std::size_t v = i + 1;
@@ -206,7 +222,8 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
               const py::object& v, const py::object& flags, const py::object& confidence, const py::object& t_from,
               const py::object& t_to, const py::object& min_days, const py::object& min_orbits,
               const py::object& max_condition, const py::object& orbit_period, const py::object& terms,
-              const py::object& holdout, const py::object& min_temperature_range) {
+              const py::object& holdout, const py::object& min_temperature_range, const py::object& frame_heads,
+              const py::object& heads) {
     host::FitOptions opt;
     opt.in = kArrayRows;
     opt.from = time_arg(t_from, "t_from");
@@ -221,6 +238,11 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
                                                                                 : host::Terms::kQuadratic;
     opt.holdout = real_arg(holdout, "holdout");
     opt.min_temperature_range_c = real_arg(min_temperature_range, "min_temperature_range");
+    const host::HeadList frame = host::heads_of(heads_arg(frame_heads, "frame_heads", 2U, 2U));
+    opt.frame_heads = {frame.head[0], frame.head[1]};
+    if (!heads.is_none()) {
+        opt.heads = heads_arg(heads, "heads", 2U, kMaxHeads);
+    }
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
         try {
@@ -245,14 +267,14 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["singular_values"] = rep.singular_values;
     d["condition"] = rep.condition;
     // A row per head fitted (d["heads"], in heads.hpp's order), a column per axis.
-    const host::HeadList heads = host::heads_of(rep.heads);
-    const auto n_heads = static_cast<py::ssize_t>(heads.count);
+    const host::HeadList fitted = host::heads_of(rep.heads);
+    const auto n_heads = static_cast<py::ssize_t>(fitted.count);
     py::array_t<double> res({n_heads, py::ssize_t{3}});
     py::array_t<double> sig({n_heads, py::ssize_t{3}});
-    for (std::size_t i = 0; i < heads.count; ++i) {
+    for (std::size_t i = 0; i < fitted.count; ++i) {
         for (std::size_t a = 0; a < 3; ++a) {
-            res.mutable_data()[3 * i + a] = rep.head[heads.head[i]].residual_rms[a];
-            sig.mutable_data()[3 * i + a] = rep.head[heads.head[i]].signal_rms[a];
+            res.mutable_data()[3 * i + a] = rep.head[fitted.head[i]].residual_rms[a];
+            sig.mutable_data()[3 * i + a] = rep.head[fitted.head[i]].signal_rms[a];
         }
     }
     d["heads"] = host::head_letters(rep.heads);
@@ -274,7 +296,9 @@ void bind_analysis(py::module_& mod) {
             "t_from"_a = py::none(), "t_to"_a = py::none(), "min_days"_a = host::kDefaultMinSpanDays,
             "min_orbits"_a = host::kDefaultMinOrbits, "max_condition"_a = host::kDefaultMaxCondition,
             "orbit_period"_a = py::none(), "terms"_a = "linear", "holdout"_a = host::kDefaultHoldout,
-            "min_temperature_range"_a = host::kDefaultMinTemperatureRange, docstring(docs::kFit));
+            "min_temperature_range"_a = host::kDefaultMinTemperatureRange,
+            "frame_heads"_a = host::frame_heads_text(host::kDefaultFrameHeads), "heads"_a = py::none(),
+            docstring(docs::kFit));
 }
 
 }  // namespace ascorr::python

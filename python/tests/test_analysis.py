@@ -127,3 +127,28 @@ def test_four_heads_fit_stats_and_iba_are_the_command_lines(exe, tmp_path):
         assert s["pairs"][pair]["n"] == want["n"] > 1000
         assert f"{s['pairs'][pair]['thermal']:.6f}" == f"{want['thermal']:.6f}", pair
     assert list(ascorr.iba(d["t"], d["chu"], d["q"])) == six
+
+
+def test_a_mission_without_c_is_fitted_on_its_heads_as_the_command_line(exe, tmp_path):
+    """Heads A, B and D flew (no C): the default fit is refused naming C and the
+    keywords that fit the others; frame_heads and heads give the command line's
+    model byte for byte; bad head letters are refused naming the keyword."""
+    path = tmp_path / "abd.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 40, "--step", 120, "--heads", "ABD")
+    d = ascorr.read_solutions(str(path))
+    with pytest.raises(ascorr.FitRefused, match=r"C has no rows there: heads and frame_heads name the heads "
+                                               r"to fit \(e\.g\. heads='ABD' frame_heads='AD'\)"):
+        ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    out = tmp_path / "model.csv"
+    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30, "--heads", "ABD", "--frame-heads", "AD")
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, heads="ABD",
+                               frame_heads="AD")
+    assert model.to_csv() == out.read_text() and model.heads == "ABD"
+    assert report["heads"] == "ABD" and report["residual_rms"].shape == (3, 3)
+    assert "frame F of heads A and D" in report["text"]
+    with pytest.raises(ascorr.FitRefused, match=r"heads='ABD': frame F's heads AC are not among them"):
+        ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, heads="ABD")
+    for keyword, value in [("frame_heads", "CA"), ("frame_heads", "ABC"), ("frame_heads", 2), ("heads", "A"),
+                           ("heads", "ABE"), ("heads", b"AB")]:
+        with pytest.raises(ValueError, match=f"argument '{keyword}': expected .* of the heads ABCD"):
+            ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, **{keyword: value})

@@ -66,6 +66,12 @@ HeadSet frame_set(const FitOptions& opt) {
     return head_bit(opt.frame_heads[0]) | head_bit(opt.frame_heads[1]);
 }
 
+// The heads a reading assumes: the given ones, else the analysis's with the
+// heads seen with rows so far.
+HeadSet fit_heads(const FitOptions& opt, HeadSet with_rows) {
+    return opt.heads ? *opt.heads : analysis_heads(with_rows, frame_set(opt));
+}
+
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
     if (opt.from && !std::isfinite(*opt.from)) {
@@ -84,6 +90,16 @@ void refuse_bad_fit_options(const FitOptions& opt) {
         opt.frame_heads[0] == opt.frame_heads[1]) {
         throw FitRefused(std::string("--frame-heads ") + head_name(opt.frame_heads[0]) + head_name(opt.frame_heads[1]) +
                          ": two different heads of " + kHeadChoices.text + " are needed");
+    }
+    if (opt.heads) {
+        const std::string given = "--heads " + head_letters(*opt.heads);
+        if (head_count(*opt.heads) < 2U || (*opt.heads & ~kAllHeads) != 0U) {
+            throw FitRefused(given + ": two or more heads of " + kHeadChoices.text + " are needed");
+        }
+        if ((frame_set(opt) & ~*opt.heads) != 0U) {
+            throw FitRefused(given + ": frame F's heads " + head_letters(frame_set(opt)) +
+                             " are not among them (--frame-heads)");
+        }
     }
 }
 }  // namespace
@@ -114,7 +130,7 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          number_text(opt.min_temperature_range_c));
     }
-    return fit_pass(opt, rows, std::nullopt, analysis_heads(0U, frame_set(opt)));
+    return fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U));
 }
 
 namespace {
@@ -300,10 +316,22 @@ void rebase_on_earliest_epoch(Pass& p) {
     }
 }
 
-void refuse_short_period(const FitOptions& opt, const FitReport& r, const std::string& period_text) {
+void refuse_short_period(const FitOptions& opt, const FitReport& r, HeadSet with_rows, const std::string& period_text) {
     if (r.epochs == 0) {
-        throw FitRefused(text::input_name(opt.in) + ": no epoch in the modelling period has solutions of " +
-                         head_words(r.heads) + " that pass the selection");
+        std::string why = text::input_name(opt.in) + ": no epoch in the modelling period has solutions of " +
+                          head_words(r.heads) + " that pass the selection";
+        const HeadSet without_rows = r.heads & ~with_rows;
+        if (without_rows != 0U) {
+            const HeadList rest = heads_of(r.heads & with_rows);
+            std::string example = "--heads " + head_letters(r.heads & with_rows);
+            if (rest.count >= 2U && (frame_set(opt) & without_rows) != 0U) {
+                example +=
+                    std::string(" --frame-heads ") + head_name(rest.head[0]) + head_name(rest.head[rest.count - 1U]);
+            }
+            why += "; " + head_words(without_rows) + (head_count(without_rows) == 1U ? " has" : " have") +
+                   " no rows there: --heads and --frame-heads name the heads to fit (e.g. " + example + ")";
+        }
+        throw FitRefused(why);
     }
     const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
@@ -401,8 +429,8 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
         opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt); }, heads);
     rows([&](const SolutionRecord& rec) { add_row(p, opt, earth, epochs, rec); });
     epochs.finish();
-    if ((p.with_rows & ~heads) != 0U) {
-        return fit_pass(opt, rows, earliest_period, analysis_heads(p.with_rows, frame_set(opt)));
+    if (!opt.heads && (p.with_rows & ~heads) != 0U) {
+        return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows));
     }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
         throw InputError(opt.in, p.earliest_row_line, 1,
@@ -417,7 +445,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     rebase_on_earliest_epoch(p);
 
     const std::string period_text = "t = " + time_text(p.r.t_first) + " .. " + time_text(p.r.t_last);
-    refuse_short_period(opt, p.r, period_text);
+    refuse_short_period(opt, p.r, p.with_rows, period_text);
     const std::vector<OrbitAverage> averages =
         orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period, p.r.heads);
     p.r.orbits_used = averages.size();

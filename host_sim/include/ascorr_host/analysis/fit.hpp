@@ -23,9 +23,10 @@
 //     period with the terms asked for.
 // The correction angles (α, β, γ) are e_i: R3(γ)R2(β)R1(α) ≈ I − [e×].
 //
-// The fit's heads: A, B, C, every head with rows in the modelling period and
-// F's two (iba.hpp, analysis_heads), up to kMaxHeads. The model file has a
-// row per axis of each of them.
+// The fit's heads: FitOptions::heads when given (--heads: a mission without
+// one of A, B, C; a subset of the heads), else A, B, C, every head with rows
+// in the modelling period and F's two (iba.hpp, analysis_heads), up to
+// kMaxHeads. The model file has a row per axis of each of them.
 //
 // What is fitted, precisely, told for three heads (with N: 3·N equations per
 // orbit, 12·N linear coefficients, the same 9 unobservable directions). F
@@ -61,7 +62,13 @@ namespace ascorr::host {
 
 inline constexpr double kDefaultMinSpanDays = 267.0;  // one thermal period of Swarm Alpha
 inline constexpr std::size_t kDefaultMinOrbits = 100;
-inline constexpr double kDefaultMaxCondition = 1e6;  // of the column-scaled design
+inline constexpr double kDefaultMaxCondition = 1e6;                     // of the column-scaled design
+inline constexpr std::array<std::uint8_t, 2> kDefaultFrameHeads{0, 2};  // A and C, the paper's
+
+// Frame F's heads as the command line writes them ("AC").
+inline std::string frame_heads_text(const std::array<std::uint8_t, 2>& f) {
+    return {head_letter(f[0]), head_letter(f[1])};
+}
 
 struct FitOptions {
     std::string in;
@@ -78,7 +85,11 @@ struct FitOptions {
     bool selection_report = true;  // false: skip the model-selection report (two more fits), e.g. in tests
     // The heads of frame F (eqs. 1–3): the first in head A's role, the second
     // in C's; two different heads (--frame-heads, default AC).
-    std::array<std::uint8_t, 2> frame_heads{0, 2};
+    std::array<std::uint8_t, 2> frame_heads = kDefaultFrameHeads;
+    // The fit's heads (--heads), two or more, F's among them; rows of other
+    // heads are left out. Default: A, B, C, F's two and every head with rows
+    // in the modelling period (analysis_heads).
+    std::optional<HeadSet> heads;
 };
 
 inline constexpr int kUnknowns = 36;  // three heads, linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
@@ -90,9 +101,9 @@ struct FitReport {
     double orbit_period_s = 0.0;
     std::size_t rows = 0;  // in [from, to]
     std::array<std::size_t, kDropKinds> dropped{};
-    HeadSet heads = kPaperHeads;                    // the heads fitted
-    std::array<std::uint8_t, 2> frame_heads{0, 2};  // F's
-    std::size_t epochs = 0;                         // with all of them selected
+    HeadSet heads = kPaperHeads;                                   // the heads fitted
+    std::array<std::uint8_t, 2> frame_heads = kDefaultFrameHeads;  // F's
+    std::size_t epochs = 0;                                        // with all of them selected
     std::size_t orbits_used = 0;
     std::size_t orbits_left_out = 0;
     Terms terms = Terms::kLinear;
