@@ -1,6 +1,6 @@
 // tests/cli_run.hpp: runs the `ascorr` executable under test (ASCORR_EXE), in
-// a scratch folder (run_in) or in the test's directory (run_here), for the
-// tests of its command-line behaviour.
+// a scratch folder (run_in) or in the test's directory (run_here, run_cli),
+// for the tests of its command-line behaviour.
 #pragma once
 
 #include <sys/wait.h>
@@ -43,6 +43,19 @@ inline CliRun run_in(const std::string& args, const std::filesystem::path& dir) 
 // working directory's; dir only receives stderr.txt.
 inline CliRun run_here(const std::string& args, const std::filesystem::path& dir) {
     return run_shell(std::string(ASCORR_EXE) + " " + args, dir);
+}
+
+// Runs `ascorr ARGS` with its standard output in `out` and its standard
+// error in `err`; its exit code, -1 when it did not exit normally.
+inline int run_cli(const std::string& args, const std::filesystem::path& out, const std::filesystem::path& err) {
+    const std::string cmd = std::string(ASCORR_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
+    const int rc = std::system(cmd.c_str());
+    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+// The same with dir/out.txt and dir/err.txt.
+inline int run_cli(const std::string& args, const std::filesystem::path& dir) {
+    return run_cli(args, dir / "out.txt", dir / "err.txt");
 }
 
 }  // namespace ascorr::test

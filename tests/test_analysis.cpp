@@ -17,6 +17,7 @@
 #include "analysis_generator.hpp"
 #include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/analysis/stats.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -138,19 +139,6 @@ std::array<std::array<double, 3>, 3> independent_rms(const fs::path& data, const
         }
     }
     return out;
-}
-
-int run_cli(const std::string& args, const fs::path& out, const fs::path& err) {
-    const std::string cmd = std::string(ASCORR_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
 }
 
 TEST(Fit, RecoversTheIbaObservablePartOfAKnownTruth) {

@@ -16,6 +16,7 @@
 #include "analysis_generator.hpp"
 #include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/analysis/stats.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -68,19 +69,6 @@ host::FitReport fit(const DataSet& d, const fs::path& model, host::Terms terms) 
     o.to = d.t_split;
     o.terms = terms;
     return host::fit_model(o);
-}
-
-int run_cli(const std::string& args, const fs::path& out, const fs::path& err) {
-    const std::string cmd = std::string(ASCORR_EXE) + " " + args + " > " + out.string() + " 2> " + err.string();
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
 }
 
 // `correct` with the model, then the IBA RMS of the corrected file against

@@ -22,6 +22,7 @@
 #include "ascorr/core/heads.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "cli_run.hpp"
 
 namespace ascorr::test {
 namespace {
@@ -35,20 +36,6 @@ fs::path work_dir(const std::string& name) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
-}
-
-int run_cli(const std::string& args, const fs::path& dir) {
-    const std::string cmd =
-        std::string(ASCORR_EXE) + " " + args + " > " + (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string();
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
 }
 
 // The value of `key` in the object of pair `pair` of a stats or floor JSON;

@@ -26,6 +26,7 @@
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
+#include "cli_run.hpp"
 #include "states_recording.hpp"
 #include "test_support.hpp"
 
@@ -38,13 +39,6 @@ inline void PrintTo(const QemuTarget& board, std::ostream* os) {
 
 namespace ascorr::test {
 namespace {
-
-std::string slurp(const std::string& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
 
 host::ReplaySummary replay_states(const std::string& target, double inject, int rows, const std::string& name,
                                   StatesRecording* rec_out = nullptr) {

@@ -19,26 +19,13 @@
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-int run_cli(const std::string& args, const fs::path& dir) {
-    const std::string cmd =
-        std::string(ASCORR_EXE) + " " + args + " > " + (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string();
-    const int rc = std::system(cmd.c_str());
-    return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
 
 TEST(Simulate, EmbeddedTruthIsTable2) {
     const host::ModelFile a = host::table2_model();

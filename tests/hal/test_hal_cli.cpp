@@ -16,6 +16,7 @@
 #include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_hal_linux/replay_source.hpp"
 #include "ascorr_hal_linux/simulated_source.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -303,13 +304,6 @@ struct CliRun {
     std::string out;
     std::string err;
 };
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream ss;
-    ss << f.rdbuf();
-    return ss.str();
-}
 
 CliRun run(const std::string& args, const fs::path& dir) {
     const std::string cmd = std::string(ASCORR_EXE) + " thermistors " + args + " > " + (dir / "out").string() + " 2> " +
