@@ -302,6 +302,62 @@ calib::CalibCycle<double> synthetic_cycle(long k) {
     return c;
 }
 
+// The orbit collector (orbit_collector.hpp): orbits are bins floor(t / P)
+// with [start, end) bounds, negative times included; the first orbit's
+// references are its first cycle, a later one's those set by
+// set_next_reference (once), else the ones before; dropping an orbit keeps
+// them. orbit_means() of n equal cycles is that cycle's d_h and temperatures.
+TEST(CalibOrbitCollector, BinsReferencesAndMeans) {
+    constexpr std::int64_t kP = 5'000'000;  // 5 s orbits
+    calib::OrbitCollector<double> col(kP);
+    calib::CalibCycle<double> c = synthetic_cycle(3);
+    EXPECT_TRUE(col.starts_orbit(c.t_us));
+    c.t_us = -1;  // bin -1: [-P, 0)
+    col.open(c);
+    EXPECT_TRUE(col.is_open());
+    EXPECT_FALSE(col.starts_orbit(-kP));
+    EXPECT_FALSE(col.starts_orbit(-1));
+    EXPECT_TRUE(col.starts_orbit(0));
+    EXPECT_TRUE(col.starts_orbit(-kP - 1));
+    for (int k = 0; k < 4; ++k) {
+        col.add(c);
+    }
+    calib::ClosedOrbit<double> o;
+    col.close(o);
+    EXPECT_FALSE(col.is_open());
+    EXPECT_EQ(o.bin, -1);
+    EXPECT_EQ(o.sums.count, 4U);
+    // The first cycle is its own reference: every δ is the identity, every ΔT 0.
+    const Quaternion<double> d_b = c.q_chu_icrf[1] * conjugate(c.q_chu_icrf[0]);
+    EXPECT_EQ(o.ref.r[0].w, d_b.w);
+    EXPECT_EQ(o.ref.t_ref[2][1], c.temperatures[2].t_029.value);
+    const calib::OrbitMeans m = calib::orbit_means(o);
+    EXPECT_LT(angle_arcsec(m.d[0], d_b), 1e-9);
+    EXPECT_NEAR(m.t[1][0], c.temperatures[1].t_chu.value, 1e-12);
+
+    // The next orbit keeps the references (none was set) even after a drop...
+    calib::CalibCycle<double> c2 = synthetic_cycle(400);
+    c2.t_us = 0;
+    col.open(c2);
+    col.drop();
+    c2.t_us = 7 * kP + 3;
+    col.open(c2);
+    col.add(c2);
+    col.close(o);
+    EXPECT_EQ(o.bin, 7);
+    EXPECT_EQ(o.ref.r[0].w, d_b.w);
+    // ... and takes a set one once, at the next open.
+    calib::OrbitReference<double> next = calib::reference_from<double>(calib::orbit_means(o));
+    col.set_next_reference(next);
+    col.open(c2);
+    col.close(o);
+    EXPECT_EQ(o.ref.r[1].x, next.r[1].x);
+    EXPECT_EQ(o.ref.t_ref[0][2], next.t_ref[0][2]);
+    col.open(c2);
+    col.close(o);
+    EXPECT_EQ(o.ref.r[1].x, next.r[1].x);  // kept, not reset to the cycle
+}
+
 // The commands and the double buffer: a model becomes active only at the
 // next cycle; freeze stops the learning, resume restarts it, reset forgets
 // it and keeps the active model, load_model is active at the next cycle with

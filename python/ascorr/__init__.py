@@ -1,7 +1,7 @@
 """ascorr: thermal and aberration correction of uASC star-tracker attitude solutions.
 
 The same core and host library as the ``ascorr`` command line, on NumPy arrays
-(one row per solution, nothing dropped). Conventions (README.md): times in s
+(one row per solution, nothing dropped). Conventions (docs/contract.md): times in s
 since J2000.0 TT; quaternions Hamilton, scalar first, q_chu_icrf maps ICRF
 components into CHU components; velocities km/s; angles arcsec.
 
