@@ -353,9 +353,12 @@ TEST(CalibOrbitCollector, BinsReferencesAndMeans) {
     col.close(o);
     EXPECT_EQ(o.ref.r[1].x, next.r[1].x);
     EXPECT_EQ(o.ref.t_ref[0][2], next.t_ref[0][2]);
-    col.open(c2);
+    const calib::CalibCycle<double> c3 = synthetic_cycle(800);  // B bent differently, other temperatures
+    col.open(c3);
     col.close(o);
-    EXPECT_EQ(o.ref.r[1].x, next.r[1].x);  // kept, not reset to the cycle
+    EXPECT_EQ(o.ref.r[0].x, next.r[0].x);  // kept, not taken from the cycle
+    EXPECT_EQ(o.ref.t_ref[0][0], next.t_ref[0][0]);
+    EXPECT_NE(next.t_ref[0][0], c3.temperatures[0].t_chu.value);  // (the check can fail)
 }
 
 // The commands and the double buffer: a model becomes active only at the

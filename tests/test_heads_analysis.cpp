@@ -207,6 +207,44 @@ TEST(HeadsAnalysis, AMissionWithoutCIsFittedOnTheHeadsItHas) {
     const double ab = json_value(slurp(dir / "out.txt"), "A-B", "thermal");
     EXPECT_LT(std::fabs(ab / json_value(floor, "A-B", "rms") - 1.0), kFloorTolerance) << ab;
 
+    // A head with rows in part of the period only (D failed on day 20): the
+    // refusal names it and C, and the heads left; --heads fits them and
+    // counts D's rows as left out.
+    std::ifstream in(data);
+    std::string cut;
+    double t0 = std::nan("");
+    std::size_t d_rows = 0;
+    for (std::string line; std::getline(in, line);) {
+        const bool row = !line.empty() && line[0] != 't';
+        if (row && std::isnan(t0)) {
+            t0 = std::stod(line);
+        }
+        if (row && line.find(",D,") != std::string::npos && std::stod(line) > t0 + 20.0 * 86400.0) {
+            continue;
+        }
+        d_rows += row && line.find(",D,") != std::string::npos ? 1U : 0U;
+        cut += line + '\n';
+    }
+    const std::string failed = (dir / "d-failed.csv").string();
+    std::ofstream(failed) << cut;
+    EXPECT_EQ(run_cli("fit --in " + failed + " --out " + model + kFitLimits, dir), 1);
+    const std::string partial = slurp(dir / "err.txt");
+    EXPECT_NE(partial.find("C has no rows there, D's rows span only t = "), std::string::npos) << partial;
+    EXPECT_NE(partial.find("(e.g. --heads AB --frame-heads AB)"), std::string::npos) << partial;
+    ASSERT_EQ(run_cli("fit --heads AB --frame-heads AB --in " + failed + " --out " + model + kFitLimits, dir), 0)
+        << slurp(dir / "err.txt");
+    EXPECT_NE(slurp(dir / "out.txt").find("; rows of other heads left out (--heads) " + std::to_string(d_rows) + "\n"),
+              std::string::npos)
+        << slurp(dir / "out.txt");
+    // One head with rows among those named: no suggestion that would be refused.
+    EXPECT_EQ(run_cli("fit --heads CD --frame-heads CD --in " + data + " --out " + model + kFitLimits, dir), 1);
+    EXPECT_NE(slurp(dir / "err.txt").find("C has no rows there: a fit needs two heads with rows"), std::string::npos)
+        << slurp(dir / "err.txt");
+    // No rows at all in the period: the message as it always was.
+    EXPECT_EQ(run_cli("fit --from 1e9 --in " + data + " --out " + model + kFitLimits, dir), 1);
+    EXPECT_NE(slurp(dir / "err.txt").find("solutions of A, B and C that pass the selection\n"), std::string::npos)
+        << slurp(dir / "err.txt");
+
     // Usage: F's heads must be among --heads; --heads is two or more letters.
     EXPECT_EQ(run_cli("fit --heads ABD --in " + data + " --out " + model + kFitLimits, dir), 2);
     EXPECT_NE(slurp(dir / "err.txt").find("frame F's heads AC (--frame-heads) are not among them"), std::string::npos)

@@ -256,6 +256,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["t_last"] = rep.t_last;
     d["orbit_period_s"] = rep.orbit_period_s;
     d["rows"] = rep.rows;
+    d["rows_other_heads"] = rep.rows_other_heads;
     py::dict dropped;
     for (std::size_t k = 0; k < host::kDropKinds; ++k) {
         dropped[host::drop_name(static_cast<host::Drop>(k))] = rep.dropped[k];

@@ -114,23 +114,22 @@ null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the comman
 "messages" (rows left out, one line each)}.)doc";
 
 inline constexpr const char* kFit =
-    R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md), with
-its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2; any
-case, as --terms); holdout: the fraction of the period (its end) held out for the
-model-selection report, 0..0.5; min_temperature_range: the smallest range (degC)
-of each regressor for quadratic terms; frame_heads: frame F's two heads, e.g. 'AD'
-(as --frame-heads); heads: the heads to fit, F's among them, e.g. 'ABD' for a
-mission without C (as --heads; None: A, B, C, F's two and every other head with
-rows). Returns (model, report): model an
-ascorr.Model (model.write(path) writes the model file), report a dict (rows,
-dropped, epochs, orbits_used, condition, singular_values, terms, heads (the
-letters of the heads fitted), residual_rms and
-signal_rms (len(heads), 3) arcsec [head][alpha, beta, gamma], text).
-Raises ascorr.FitRefused (a ValueError) when the data cannot determine the model
-(period shorter than min_days, fewer than min_orbits orbits, condition number
-above max_condition, too small a temperature range for quadratic terms) or a
-setting is out of its range; its text, and the report's, name the settings as
-this function's keywords (min_temperature_range, not --min-temperature-range).)doc";
+    R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),
+with its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2;
+any case, as --terms); holdout: the fraction of the period (its end) held out for the
+model-selection report, 0..0.5; min_temperature_range: the smallest range (degC) of
+each regressor for quadratic terms; frame_heads: frame F's two heads, e.g. 'AD' (as
+--frame-heads); heads: the heads to fit, F's among them, e.g. 'ABD' for a mission
+without C (as --heads; None: A, B, C, F's two and every other head with rows). Returns
+(model, report): model an ascorr.Model (model.write(path) writes the model file),
+report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
+dropped, epochs, orbits_used, condition, singular_values, terms, heads (the letters of
+the heads fitted), residual_rms and signal_rms (len(heads), 3) arcsec [head][alpha,
+beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+determine the model (period shorter than min_days, fewer than min_orbits orbits,
+condition number above max_condition, too small a temperature range for quadratic
+terms) or a setting is out of its range; its text, and the report's, name the settings
+as this function's keywords (min_temperature_range, not --min-temperature-range).)doc";
 
 // ---- files (bind_formats.cpp)
 

@@ -142,6 +142,8 @@ constexpr double kPlaceholderPeriodS = 5400.0;
 struct Pass {
     FitReport r;
     HeadSet with_rows = 0U;                                              // heads with rows in the modelling period
+    std::array<double, kMaxHeads> first_row{};                           // per head in with_rows: its rows' first t
+    std::array<double, kMaxHeads> last_row{};                            //   and last t in the period
     std::optional<double> period;                                        // bins the epochs into orbits
     bool period_given = false;                                           // --orbit-period, or the second reading
     std::array<std::optional<Eigen::Quaterniond>, kMaxHeads> reference;  // provisional r, then N_i
@@ -280,9 +282,17 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
     if (!in_modelling_period(opt, rec)) {
         return;
     }
+    if (!has_head(p.with_rows, rec.head) || rec.t < p.first_row[rec.head]) {
+        p.first_row[rec.head] = rec.t;
+    }
+    if (!has_head(p.with_rows, rec.head) || rec.t > p.last_row[rec.head]) {
+        p.last_row[rec.head] = rec.t;
+    }
     p.with_rows |= head_bit(rec.head);
     if (!has_head(p.r.heads, rec.head)) {
-        return;  // a head this pass does not fit: fit_pass reads the rows again with it
+        // A head this pass does not fit: left out (--heads), or fit_pass reads the rows again with it.
+        p.r.rows_other_heads += opt.heads ? 1U : 0U;
+        return;
     }
     ++p.r.rows;
     CorrectedSolution<double> c{};
@@ -316,22 +326,54 @@ void rebase_on_earliest_epoch(Pass& p) {
     }
 }
 
-void refuse_short_period(const FitOptions& opt, const FitReport& r, HeadSet with_rows, const std::string& period_text) {
-    if (r.epochs == 0) {
-        std::string why = text::input_name(opt.in) + ": no epoch in the modelling period has solutions of " +
-                          head_words(r.heads) + " that pass the selection";
-        const HeadSet without_rows = r.heads & ~with_rows;
-        if (without_rows != 0U) {
-            const HeadList rest = heads_of(r.heads & with_rows);
-            std::string example = "--heads " + head_letters(r.heads & with_rows);
-            if (rest.count >= 2U && (frame_set(opt) & without_rows) != 0U) {
-                example +=
-                    std::string(" --frame-heads ") + head_name(rest.head[0]) + head_name(rest.head[rest.count - 1U]);
-            }
-            why += "; " + head_words(without_rows) + (head_count(without_rows) == 1U ? " has" : " have") +
-                   " no rows there: --heads and --frame-heads name the heads to fit (e.g. " + example + ")";
+// Why a refused period may be a head's doing: a fitted head without rows in
+// the period, or whose rows span less than half the longest span of the
+// fitted heads' rows (a head that failed for good; an epoch needs every
+// fitted head). Names them and, when two or more heads are left, the
+// --heads and --frame-heads that fit those; empty when no head is to blame.
+std::string heads_hint(const FitOptions& opt, const Pass& p) {
+    const FitReport& r = p.r;
+    const HeadSet present = r.heads & p.with_rows;
+    const HeadList listed = heads_of(present);
+    double longest = 0.0;
+    for (std::size_t i = 0; i < listed.count; ++i) {
+        longest = std::max(longest, p.last_row[listed.head[i]] - p.first_row[listed.head[i]]);
+    }
+    HeadSet brief = 0U;
+    std::string why;
+    for (std::size_t i = 0; i < listed.count; ++i) {
+        const std::uint8_t h = listed.head[i];
+        if (p.last_row[h] - p.first_row[h] < 0.5 * longest) {
+            brief |= head_bit(h);
+            why += std::string(why.empty() ? "" : ", ") + head_name(h) +
+                   "'s rows span only t = " + time_text(p.first_row[h]) + " .. " + time_text(p.last_row[h]);
         }
-        throw FitRefused(why);
+    }
+    const HeadSet without_rows = r.heads & ~p.with_rows;
+    if (without_rows != 0U) {
+        why = head_words(without_rows) + (head_count(without_rows) == 1U ? " has" : " have") + " no rows there" +
+              (why.empty() ? "" : ", ") + why;
+    }
+    if (present == 0U || why.empty()) {
+        return {};
+    }
+    const HeadSet keep = present & ~brief;
+    const HeadList kept = heads_of(keep);
+    if (kept.count < 2U) {
+        return "; " + why + ": a fit needs two heads with rows";
+    }
+    std::string example = "--heads " + head_letters(keep);
+    if ((frame_set(opt) & ~keep) != 0U) {
+        example += std::string(" --frame-heads ") + head_name(kept.head[0]) + head_name(kept.head[kept.count - 1U]);
+    }
+    return "; " + why + ": --heads and --frame-heads name the heads to fit (e.g. " + example + ")";
+}
+
+void refuse_short_period(const FitOptions& opt, const Pass& p, const std::string& period_text) {
+    const FitReport& r = p.r;
+    if (r.epochs == 0) {
+        throw FitRefused(text::input_name(opt.in) + ": no epoch in the modelling period has solutions of " +
+                         head_words(r.heads) + " that pass the selection" + heads_hint(opt, p));
     }
     const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
@@ -340,7 +382,7 @@ void refuse_short_period(const FitOptions& opt, const FitReport& r, HeadSet with
                       "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
                       "thermal period; --min-days) are needed",
                       span_days, period_text.c_str(), opt.min_span_days);
-        throw FitRefused(text::input_name(opt.in) + ": " + buf);
+        throw FitRefused(text::input_name(opt.in) + ": " + buf + heads_hint(opt, p));
     }
 }
 
@@ -415,9 +457,9 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // epoch's (re-based exactly at the end), and the orbit period, when not
 // given, comes from the earliest selected row: if that is not the first one
 // read, the file is read again with that period (unordered files only).
-// (earliest_period: that second reading.) Likewise the heads: a reading
-// assumes them (A, B, C and F's first); when the period holds rows of others,
-// the rows are read again with those too.
+// (earliest_period: that second reading.) Likewise the heads, unless
+// --heads names them: a reading assumes them (A, B, C and F's first); when
+// the period holds rows of others, the rows are read again with those too.
 FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads) {
     EarthVelocity earth;
     Pass p;
@@ -445,7 +487,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     rebase_on_earliest_epoch(p);
 
     const std::string period_text = "t = " + time_text(p.r.t_first) + " .. " + time_text(p.r.t_last);
-    refuse_short_period(opt, p.r, p.with_rows, period_text);
+    refuse_short_period(opt, p, period_text);
     const std::vector<OrbitAverage> averages =
         orbit_averages(p.orbits, min_epochs_per_orbit(p.orbits), *p.period, p.r.heads);
     p.r.orbits_used = averages.size();
@@ -453,7 +495,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     if (averages.size() < opt.min_orbits) {
         throw FitRefused(text::input_name(opt.in) + ": too few orbits in the modelling period (" + period_text +
                          "): " + std::to_string(averages.size()) + " with enough data, at least " +
-                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)");
+                         std::to_string(opt.min_orbits) + " are needed (--min-orbits)" + heads_hint(opt, p));
     }
     solve(opt, p, averages, period_text);
     return p.r;
@@ -470,6 +512,9 @@ std::string describe(const FitReport& r) {
     o << "rows in the period " << r.rows << ", selected " << r.dropped[0] << "; dropped:";
     for (std::size_t d = 1; d < kDropKinds; ++d) {
         o << (d > 1 ? "," : "") << ' ' << drop_name(static_cast<Drop>(d)) << ' ' << r.dropped[d];
+    }
+    if (r.rows_other_heads != 0U) {
+        o << "; rows of other heads left out (--heads) " << r.rows_other_heads;
     }
     o << "\nepochs with " << head_words(r.heads) << " selected " << r.epochs << "; orbit averages used "
       << r.orbits_used << " (left out, too few epochs: " << r.orbits_left_out << ")\n";

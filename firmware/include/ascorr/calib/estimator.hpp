@@ -262,7 +262,7 @@ private:
             }
             n_valid_ = true;
         }
-        orbit_.set_next_reference(reference_from<T>(means));  // the next orbit's references
+        orbit_.set_next_reference(reference_from<T>(means));  // the references of the next orbit opened
         return true;
     }
 

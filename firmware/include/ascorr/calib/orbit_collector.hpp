@@ -1,7 +1,8 @@
 // ascorr/calib/orbit_collector.hpp: the cycle side of the on-board estimator
 // (estimator.hpp): which orbit a selected cycle belongs to, that orbit's sums
 // (orbit_sums.hpp) and their references; and, once per orbit in double, the
-// closed orbit's means (orbit_means()) and the next orbit's references.
+// closed orbit's means (orbit_means()) and the references they give the
+// next orbit opened (reference_from()).
 //
 // Orbits are bins of the on-board clock: orbit k is [k·P, (k+1)·P) µs, P the
 // configured orbit period, k = floor(t/P) (negative times included). A cycle

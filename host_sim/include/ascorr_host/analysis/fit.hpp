@@ -99,7 +99,8 @@ struct FitReport {
     double t_first = 0.0;
     double t_last = 0.0;
     double orbit_period_s = 0.0;
-    std::size_t rows = 0;  // in [from, to]
+    std::size_t rows = 0;              // of the heads fitted, in [from, to]
+    std::size_t rows_other_heads = 0;  // of other heads in [from, to], left out (FitOptions::heads)
     std::array<std::size_t, kDropKinds> dropped{};
     HeadSet heads = kPaperHeads;                                   // the heads fitted
     std::array<std::uint8_t, 2> frame_heads = kDefaultFrameHeads;  // F's
