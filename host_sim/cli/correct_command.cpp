@@ -7,7 +7,9 @@
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/csv.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -64,9 +66,10 @@ void add_correct_command(CLI::App& app) {
            "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
         ->check(non_empty_path());
     CLI::Option* time_constant =
-        cmd->add_option(
-               "--time-constant", opt->time_constant_days,
-               "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] (default 30)")
+        cmd->add_option("--time-constant", opt->time_constant_days,
+                        "with --self-calibrate: the estimator's forgetting time constant in days, " +
+                            host::time_constant_range() + " (default " +
+                            host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
             ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
     cmd->callback([opt, time_constant]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});

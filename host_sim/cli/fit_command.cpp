@@ -51,8 +51,7 @@ void add_fit_command(CLI::App& app) {
         opt->frame_heads = {head_index((*frame)[0]), head_index((*frame)[1])};  // checked already
         if (!heads->empty()) {
             opt->heads = host::parse_head_letters(*heads);  // checked already
-            const host::HeadSet frame_set = host::head_bit(opt->frame_heads[0]) | host::head_bit(opt->frame_heads[1]);
-            if ((frame_set & ~*opt->heads) != 0U) {
+            if ((host::frame_set(opt->frame_heads) & ~*opt->heads) != 0U) {
                 throw CLI::ValidationError("--heads " + *heads,
                                            "frame F's heads " + *frame + " (--frame-heads) are not among them");
             }

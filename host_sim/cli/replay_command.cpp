@@ -3,7 +3,9 @@
 #include <string>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "commands.hpp"
@@ -50,8 +52,9 @@ void add_replay_command(CLI::App& app) {
         ->check(non_empty_path());
     CLI::Option* time_constant =
         cmd->add_option("--time-constant", opt->time_constant_days,
-                        "with --self-calibrate: the estimator's forgetting time constant in days, [1, 10000] "
-                        "(default 30)")
+                        "with --self-calibrate: the estimator's forgetting time constant in days, " +
+                            host::time_constant_range() + " (default " +
+                            host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
             ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 

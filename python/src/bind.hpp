@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -105,6 +106,17 @@ Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, co
 // Row i as the solutions reader would have read it from a file holding the
 // same values: NaN is "not available", as `nan` in a file.
 void record_of(const Rows& r, py::ssize_t i, host::SolutionRecord& rec);
+// Row i of the output arrays (q: (n, 4) w, x, y, z; status: (n,)) from a
+// corrected row.
+template <typename T>
+void put_row(const host::RowCorrection<T>& c, py::ssize_t i, double* q_out, std::uint16_t* st_out) {
+    double* q = q_out + 4 * i;
+    q[0] = c.q_chu_icrf.w;
+    q[1] = c.q_chu_icrf.x;
+    q[2] = c.q_chu_icrf.y;
+    q[3] = c.q_chu_icrf.z;
+    st_out[i] = c.status;
+}
 // The rows as the host's analyses take a file's (for_each_solution).
 host::RowSource source_of(const Rows& r);
 

@@ -72,13 +72,7 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
         SolutionRecord rec;
         for (auto i = static_cast<py::ssize_t>(begin); i < static_cast<py::ssize_t>(end); ++i) {
             record_of(r, i, rec);
-            const host::RowCorrection<T> c = host::correct_row(rec, &earth, cfg, service ? &*service : nullptr);
-            double* q = q_out + 4 * i;
-            q[0] = c.q_chu_icrf.w;
-            q[1] = c.q_chu_icrf.x;
-            q[2] = c.q_chu_icrf.y;
-            q[3] = c.q_chu_icrf.z;
-            st_out[i] = c.status;
+            put_row(host::correct_row(rec, &earth, cfg, service ? &*service : nullptr), i, q_out, st_out);
         }
     });
 }

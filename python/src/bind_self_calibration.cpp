@@ -43,13 +43,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
         const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
-        const host::RowCorrection<T> row = host::correct_row<T>(rec, &earth, c, nullptr);
-        double* q = q_out + 4 * i;
-        q[0] = row.q_chu_icrf.w;
-        q[1] = row.q_chu_icrf.x;
-        q[2] = row.q_chu_icrf.y;
-        q[3] = row.q_chu_icrf.z;
-        st_out[i] = row.status;
+        put_row(host::correct_row<T>(rec, &earth, c, nullptr), i, q_out, st_out);
     }
     py::list history;
     for (const host::ActiveModel& a : sc.history) {
@@ -69,8 +63,9 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     const host::ModelFile* m = model_arg(model);
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
     const double time_constant = real_arg(time_constant_obj, "time_constant");
-    if (!(time_constant >= calib::kMinTimeConstantDays && time_constant <= calib::kMaxTimeConstantDays)) {
-        bad_argument("time_constant", "expected days in [1, 10000], got " + value_text(time_constant_obj));
+    if (!calib::time_constant_acceptable(time_constant)) {
+        bad_argument("time_constant",
+                     "expected days in " + host::time_constant_range() + ", got " + value_text(time_constant_obj));
     }
     if (scalar == host::ScalarKind::kFixed && m != nullptr) {
         try {

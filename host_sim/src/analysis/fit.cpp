@@ -62,14 +62,10 @@ std::string time_text(double t) {
 namespace {
 FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads);
 
-HeadSet frame_set(const FitOptions& opt) {
-    return head_bit(opt.frame_heads[0]) | head_bit(opt.frame_heads[1]);
-}
-
 // The heads a reading assumes: the given ones, else the analysis's with the
 // heads seen with rows so far.
 HeadSet fit_heads(const FitOptions& opt, HeadSet with_rows) {
-    return opt.heads ? *opt.heads : analysis_heads(with_rows, frame_set(opt));
+    return opt.heads ? *opt.heads : analysis_heads(with_rows, frame_set(opt.frame_heads));
 }
 
 // NaN, zero or negative thresholds would silently accept or refuse everything.
@@ -96,8 +92,8 @@ void refuse_bad_fit_options(const FitOptions& opt) {
         if (head_count(*opt.heads) < 2U || (*opt.heads & ~kAllHeads) != 0U) {
             throw FitRefused(given + ": two or more heads of " + kHeadChoices.text + " are needed");
         }
-        if ((frame_set(opt) & ~*opt.heads) != 0U) {
-            throw FitRefused(given + ": frame F's heads " + head_letters(frame_set(opt)) +
+        if ((frame_set(opt.frame_heads) & ~*opt.heads) != 0U) {
+            throw FitRefused(given + ": frame F's heads " + head_letters(frame_set(opt.frame_heads)) +
                              " are not among them (--frame-heads)");
         }
     }
@@ -363,7 +359,7 @@ std::string heads_hint(const FitOptions& opt, const Pass& p) {
         return "; " + why + ": a fit needs two heads with rows";
     }
     std::string example = "--heads " + head_letters(keep);
-    if ((frame_set(opt) & ~keep) != 0U) {
+    if ((frame_set(opt.frame_heads) & ~keep) != 0U) {
         example += std::string(" --frame-heads ") + head_name(kept.head[0]) + head_name(kept.head[kept.count - 1U]);
     }
     return "; " + why + ": --heads and --frame-heads name the heads to fit (e.g. " + example + ")";

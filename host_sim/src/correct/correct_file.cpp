@@ -294,9 +294,8 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
     if (opt.skip_bad) {
         throw std::runtime_error("--self-calibrate reads every row in time order: it cannot go with --skip-bad");
     }
-    if (!(opt.time_constant_days >= calib::kMinTimeConstantDays &&
-          opt.time_constant_days <= calib::kMaxTimeConstantDays)) {
-        throw std::runtime_error("--time-constant must be in [1, 10000] days, got " +
+    if (!calib::time_constant_acceptable(opt.time_constant_days)) {
+        throw std::runtime_error("--time-constant must be in " + time_constant_range() + " days, got " +
                                  number_text(opt.time_constant_days));
     }
     if (!opt.states.empty()) {

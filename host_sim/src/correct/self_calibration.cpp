@@ -311,6 +311,10 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
     return out;
 }
 
+std::string time_constant_range() {
+    return "[" + number_text(calib::kMinTimeConstantDays) + ", " + number_text(calib::kMaxTimeConstantDays) + "]";
+}
+
 std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];

@@ -557,10 +557,9 @@ void check_options(const ReplayOptions& opt) {
         if (!opt.model_history.empty()) {
             refuse_same_output({"--out", opt.out}, {"--model-history", opt.model_history});
         }
-        if (!(opt.time_constant_days >= calib::kMinTimeConstantDays &&
-              opt.time_constant_days <= calib::kMaxTimeConstantDays)) {
-            throw std::runtime_error("--time-constant " + number_text(opt.time_constant_days) +
-                                     ": must be in [1, 10000] days");
+        if (!calib::time_constant_acceptable(opt.time_constant_days)) {
+            throw std::runtime_error("--time-constant " + number_text(opt.time_constant_days) + ": must be in " +
+                                     time_constant_range() + " days");
         }
     } else {
         if (opt.model.empty()) {

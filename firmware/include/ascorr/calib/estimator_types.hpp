@@ -26,9 +26,12 @@ inline constexpr std::int64_t kMinOrbitPeriodUs = 600'000'000;
 inline constexpr std::int64_t kMaxOrbitPeriodUs = 86'400'000'000;
 inline constexpr double kMinTimeConstantDays = 1.0;
 inline constexpr double kMaxTimeConstantDays = 10000.0;
+constexpr bool time_constant_acceptable(double days) noexcept {
+    return days >= kMinTimeConstantDays && days <= kMaxTimeConstantDays;  // false for NaN
+}
 constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double time_constant_days) noexcept {
     return orbit_period_us >= kMinOrbitPeriodUs && orbit_period_us <= kMaxOrbitPeriodUs &&
-           time_constant_days >= kMinTimeConstantDays && time_constant_days <= kMaxTimeConstantDays;  // no NaN
+           time_constant_acceptable(time_constant_days);
 }
 
 struct EstimatorConfig {

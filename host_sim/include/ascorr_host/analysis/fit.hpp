@@ -65,9 +65,12 @@ inline constexpr std::size_t kDefaultMinOrbits = 100;
 inline constexpr double kDefaultMaxCondition = 1e6;                     // of the column-scaled design
 inline constexpr std::array<std::uint8_t, 2> kDefaultFrameHeads{0, 2};  // A and C, the paper's
 
-// Frame F's heads as the command line writes them ("AC").
+// Frame F's heads as the command line writes them ("AC"), and as a set.
 inline std::string frame_heads_text(const std::array<std::uint8_t, 2>& f) {
     return {head_letter(f[0]), head_letter(f[1])};
+}
+constexpr HeadSet frame_set(const std::array<std::uint8_t, 2>& f) noexcept {
+    return head_bit(f[0]) | head_bit(f[1]);
 }
 
 struct FitOptions {

@@ -74,6 +74,10 @@ private:
 // t,version,chu,axis,c0,c1,c2,c3,crc32c and one row per head and axis of each model.
 std::string format_model_history(const std::vector<ActiveModel>& history);
 
+// The forgetting time constants the estimator takes
+// (calib::time_constant_acceptable) as messages write them: "[1, 10000]".
+std::string time_constant_range();
+
 // One line per model and the estimator's state, for the terminal.
 std::string describe(const SelfCalibration& s);
 
