@@ -21,19 +21,6 @@ namespace ascorr::host {
 
 namespace {
 
-ModelFile model_file_of(const ModelCoefficients& c) {
-    ModelFile m;
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        m.present[h] = c.present[h];
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t i = 0; i < kModelTerms; ++i) {
-                m.coefficients[h][a][i] = c.coefficient[h][a][i];
-            }
-        }
-    }
-    return m;
-}
-
 // One row as the run needs it: its epoch, and for a clean row of A, B or C
 // whose aberration stage applies, its input to the core.
 template <typename T>
@@ -86,7 +73,8 @@ public:
 
     SelfCalibration finish(std::size_t untimed) {
         if (!est_) {
-            start(5640.0);  // no row to learn from: nothing is learnt, the period is not used
+            // No row to learn from: nothing is learnt, the period is not used.
+            start(static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
         }
         out_.report = est_->report();
         out_.untimed = untimed;
@@ -173,7 +161,8 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         }
         return true;
     };
-    const auto before = [](const CalibRow<T>& a, const CalibRow<T>& b) {
+    // The on-board clock's order: TT µs, then the line (rows and their keys).
+    const auto before = [](const auto& a, const auto& b) {
         return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
     };
     // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
@@ -230,8 +219,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
             fed.push_back(r);
         }
     });
-    std::sort(keys.begin(), keys.end(),
-              [](const Key& a, const Key& b) { return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line); });
+    std::sort(keys.begin(), keys.end(), before);
     Run<T> run(file, initial, cfg, orbit_period_s);
     for (const Key& k : keys) {
         if (k.fed != kNone) {

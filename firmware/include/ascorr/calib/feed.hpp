@@ -58,7 +58,8 @@ bool feed_estimator(Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* m
 template <typename T>
 class EpochFeed {
 public:
-    static constexpr int kPhases = 4;  // Estimator::step()'s phases after a closed orbit
+    // Estimator::step()'s phases after a closed orbit (kAverages .. kGate).
+    static constexpr int kPhases = static_cast<int>(Estimator<T>::Phase::kGate);
 
     // Forget the current epoch (a restarted estimator).
     void reset() noexcept {

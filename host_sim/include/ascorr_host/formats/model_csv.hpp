@@ -56,6 +56,21 @@ inline ModelCoefficients coefficients_of(const ModelFile& m) {
     return c;
 }
 
+// Its inverse: a model file of the core's numbers (written linear: quadratic
+// false; not read from a file: line and column 0).
+inline ModelFile model_file_of(const ModelCoefficients& c) {
+    ModelFile m;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        m.present[h] = c.present[h];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                m.coefficients[h][a][i] = c.coefficient[h][a][i];
+            }
+        }
+    }
+    return m;
+}
+
 // The model in the core's units (radians), for scalar T: the core's one
 // conversion (ascorr/model_coefficients.hpp).
 template <typename T>
