@@ -106,6 +106,9 @@ void add_replay_command(CLI::App& app);
 void add_thermistors_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_fit_command(CLI::App& app);
+// --time-constant DAYS of `correct` and `replay` --self-calibrate (its range
+// and default from the estimator's; correct_command.cpp).
+CLI::Option* add_time_constant_option(CLI::App& cmd, double& days);
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 

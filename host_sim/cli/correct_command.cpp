@@ -28,6 +28,15 @@ std::vector<std::pair<std::string, host::ScalarKind>> scalar_names() {
 
 }  // namespace
 
+CLI::Option* add_time_constant_option(CLI::App& cmd, double& days) {
+    return cmd
+        .add_option("--time-constant", days,
+                    "with --self-calibrate: the estimator's forgetting time constant in days, " +
+                        host::time_constant_range() + " (default " +
+                        host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
+        ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
+}
+
 void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
     CLI::App* cmd =
@@ -65,12 +74,7 @@ void add_correct_command(CLI::App& app) {
            "--model-history", opt->model_history,
            "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
         ->check(non_empty_path());
-    CLI::Option* time_constant =
-        cmd->add_option("--time-constant", opt->time_constant_days,
-                        "with --self-calibrate: the estimator's forgetting time constant in days, " +
-                            host::time_constant_range() + " (default " +
-                            host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
-            ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
+    CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     cmd->callback([opt, time_constant]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {

@@ -2,10 +2,7 @@
 #include <memory>
 #include <string>
 
-#include "ascorr/calib/estimator.hpp"
-#include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
-#include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "commands.hpp"
@@ -50,12 +47,7 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--model-history", opt->model_history,
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());
-    CLI::Option* time_constant =
-        cmd->add_option("--time-constant", opt->time_constant_days,
-                        "with --self-calibrate: the estimator's forgetting time constant in days, " +
-                            host::time_constant_range() + " (default " +
-                            host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
-            ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
+    CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));
