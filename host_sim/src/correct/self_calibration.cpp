@@ -6,11 +6,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr/nav/tt_time.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -61,13 +61,12 @@ public:
             }
             start(period_from_speed(r));
         }
-        const ThermalModel<T>* model = epoch(r.t_us, r.t);
+        (void)epoch(r.t_us, r.t);
         if (r.fed) {
-            const CorrectedSolution<T> c =
-                correct_solution(r.in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
-            if (feed_.take(*est_, r.in.head, c, r.in.temperatures, true)) {
-                ++out_.cycles;
-            }
+            const std::uint32_t feeds = pipeline_.feeds();
+            (void)pipeline_.solution(
+                r.in, [&r] { return pipeline::given_velocity(r.in.velocity); }, true);
+            out_.cycles += pipeline_.feeds() - feeds;
         }
     }
 
@@ -106,6 +105,7 @@ private:
         out_.orbit_period_s = period_s;
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
+        pipeline_.use_estimator(&*est_);
         for (const auto& [t_us, t] : waiting_) {
             (void)epoch(t_us, t);
         }
@@ -115,12 +115,12 @@ private:
 
     // The epoch's model (a new epoch when t_us changes), and the history.
     const ThermalModel<T>* epoch(std::int64_t t_us, double t) {
-        const ThermalModel<T>* model = feed_.model_at(*est_, t_us);
-        if (model != nullptr && (!had_ || feed_.version() != version_)) {
+        const ThermalModel<T>* model = pipeline_.begin(t_us);
+        if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
             out_.history.push_back(
-                {t, t_us, feed_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
+                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
             had_ = true;
-            version_ = feed_.version();
+            version_ = pipeline_.version();
         }
         return model;
     }
@@ -129,8 +129,7 @@ private:
     calib::EstimatorConfig cfg_;
     std::optional<ModelCoefficients> initial_;
     std::optional<calib::Estimator<T>> est_;
-    calib::EpochFeed<T> feed_;
-    const ThermalModel<T> no_model_{};
+    pipeline::EpochPipeline<T> pipeline_;
     std::vector<std::pair<std::int64_t, double>> waiting_;  // epochs before the orbit period is known
     bool had_ = false;
     std::uint32_t version_ = 0;
