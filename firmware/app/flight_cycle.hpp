@@ -5,14 +5,16 @@
 //
 // Conventions: the loop runs at kRateHz. Each cycle takes the GNSS states that
 // arrived (gnss_feed.hpp) into the velocity service (velocity_service.hpp:
-// frame conversion and propagation in double, bounded per cycle), takes the
-// on-board estimator's active model (calib_entry.hpp; a new one starts
-// between cycles), then corrects one raw solution per camera head (the
-// simulated deforming bench, flight_bench.hpp) with the core in the build's
-// scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
-// temperature_source.hpp and the velocity the service gives for that
-// solution's own time (velocity_entry.hpp); every kCalibFeedEvery-th cycle
-// feeds heads A, B and C to the estimator, and after the solutions one
+// frame conversion and propagation in double, bounded per cycle), then runs
+// the cycle as one epoch of the epoch pipeline (pipeline/epoch_pipeline.hpp),
+// with the image's out-of-line entries (EntryCalls): the on-board
+// estimator's active model (calib_entry.hpp; a new one starts between
+// cycles), then one raw solution per camera head (the simulated deforming
+// bench, flight_bench.hpp) with the velocity the service gives for that
+// solution's own time (velocity_entry.hpp), the core in the build's scalar
+// (app_scalar.hpp, core_entry.hpp), the temperatures of
+// temperature_source.hpp and their status bits; every kCalibFeedEvery-th
+// cycle heads A, B and C feed the estimator, and after the solutions one
 // bounded step of its per-orbit update runs (idle()). Times are TT µs
 // (integers: no time in the scalar). Every loop has a fixed trip count.
 //
@@ -37,6 +39,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_link/crc32c.hpp"
 #include "calib_entry.hpp"
 #include "core_entry.hpp"
@@ -82,9 +85,6 @@ struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
     void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
 };
-
-// No coefficients for any head (the estimator without a model: status 256).
-inline constexpr ThermalModel<Scalar> kNoModel{};
 
 inline std::uint32_t bits_of(Q30 x) noexcept {
     return static_cast<std::uint32_t>(x.raw);
@@ -261,8 +261,54 @@ private:
     std::uint32_t size_ = 0U;
 };
 
+// The pipeline's calls: the image's out-of-line entries (core_entry.hpp,
+// calib_entry.hpp, each measured alone) and the temperatures' status bits.
+struct EntryCalls {
+    static const ThermalModel<Scalar>* model_for_epoch(calib::Estimator<Scalar>& e, std::int64_t t_us) noexcept {
+        return calib_model(e, t_us);
+    }
+    static CorrectedSolution<Scalar> correct(const SolutionInput<Scalar>& in,
+                                             const CorrectionConfig<Scalar>& cfg) noexcept {
+        return app::correct(in, cfg);
+    }
+    static bool feed(calib::Estimator<Scalar>& e, std::int64_t t_us, const ThermalModel<Scalar>* model,
+                     const CorrectedSolution<Scalar>* corrected,
+                     const HeadTemperatures<Scalar>* const* temperatures) noexcept {
+        return calib_feed(e, t_us, model, corrected, temperatures);
+    }
+    static bool step(calib::Estimator<Scalar>& e) noexcept { return calib_step(e); }
+    static StatusBits status(std::uint8_t head, StatusBits s) noexcept { return temperatures_merge_status(head, s); }
+};
+
+// The pipeline's stages as the loop's parts.
+constexpr Part part_of(pipeline::Stage stage) noexcept {
+    switch (stage) {
+        case pipeline::Stage::kVelocity:
+            return Part::kQuery;
+        case pipeline::Stage::kCorrect:
+            return Part::kCorrect;
+        case pipeline::Stage::kStep:
+            return Part::kCalibStep;
+        case pipeline::Stage::kModel:
+        case pipeline::Stage::kFeed:
+            break;
+    }
+    return Part::kCalibCycle;
+}
+
+template <typename Meter>
+struct StageMeter {
+    Meter& meter;
+    std::uint32_t now() noexcept { return meter.now(); }
+    void add(pipeline::Stage stage, std::uint32_t start) noexcept { meter.add(part_of(stage), start); }
+};
+
 class FlightCycle {
 public:
+    FlightCycle() noexcept { pipeline_.use_estimator(&estimator_); }
+    FlightCycle(const FlightCycle&) = delete;
+    FlightCycle& operator=(const FlightCycle&) = delete;
+
     // One cycle: the temperatures (temperature_source.hpp), the states, the
     // heads, and (record: a bounded test run, whose report prints it) their
     // solutions into the record; a flight run (record false) does no
@@ -289,37 +335,25 @@ public:
         }
     }
 
-    // One corrected solution per head, in head order (fixed trip count).
+    // One corrected solution per head, in head order (fixed trip count),
+    // through the epoch pipeline (the cycle is the epoch): the cycle's model,
+    // then per head the service's velocity at the head's own time, the core,
+    // the status, and the estimator's feed on the schedule's cycles.
     template <typename Meter>
     void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
-        std::uint32_t start = meter.now();
-        const ThermalModel<Scalar>* model = calib_model(estimator_, calib_time_us(cycle));
-        meter.add(Part::kCalibCycle, start);
-        const CorrectionConfig<Scalar> cfg{true, model != nullptr ? model : &kNoModel};  // none: status 256
+        StageMeter<Meter> stages{meter};
+        const ThermalModel<Scalar>* model = pipeline_.begin(calib_time_us(cycle), stages);
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
-            start = meter.now();
+            const std::uint32_t start = meter.now();
             const std::uint32_t nodes_before = service_.nodes_built();
             service_.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
             if (service_.nodes_built() != nodes_before) {
                 meter.add(Part::kNode, start);
             }
-            start = meter.now();
-            const ServiceVelocity<Scalar> v = velocity_query(service_, t);
-            meter.add(Part::kQuery, start);
-            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), v.velocity};
-            start = meter.now();
-            corrected_[h] = correct(in, cfg);
-            meter.add(Part::kCorrect, start);
-            corrected_[h].status = with_service_status(corrected_[h].status, v.status, cfg.aberration);
-            corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
-        }
-        const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
-                                                                     &temperatures_of(2U)};
-        if (cycle % kCalibFeedEvery == 0U) {
-            start = meter.now();
-            (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
-            meter.add(Part::kCalibCycle, start);
+            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), {}};
+            corrected_[h] = pipeline_.solution(
+                in, [&] { return pipeline::from_service(velocity_query(service_, t)); }, true, true, stages);
         }
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
             model_ = model;
@@ -334,10 +368,8 @@ public:
     // and the host, whatever the time left).
     template <typename Meter>
     void idle(Meter& meter) noexcept {
-        const std::uint32_t start = meter.now();
-        if (calib_step(estimator_)) {
-            meter.add(Part::kCalibStep, start);
-        }
+        StageMeter<Meter> stages{meter};
+        (void)pipeline_.idle(stages);
     }
 
     const CorrectedSolution<Scalar>& corrected(std::uint8_t head) const noexcept {
@@ -357,8 +389,10 @@ private:
     std::uint32_t states_skipped_ = 0U;
     std::uint32_t states_refused_ = 0U;
     CorrectionLog record_;
-    // The estimator, starting from the model in flash (version 0).
+    // The estimator, starting from the model in flash (version 0), fed every
+    // kCalibFeedEvery-th cycle; its per-orbit update steps in idle time.
     calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    pipeline::EpochPipeline<Scalar, EntryCalls> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
     const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
     ModelHistory history_;
 };
