@@ -18,6 +18,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -168,14 +169,13 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
 
 constexpr std::size_t kMaxCalibMessages = 20;  // per kind, as the diagnostics of `ascorr correct`
 
-// A solution's model version on the target against the host's schedule; a
+// A solution's model version on the target against the host's (`want`); a
 // version the target uses for the first time is fetched (CALIB_MODEL) and
 // compared with the host's model of that version.
 template <typename T>
 void check_model_version(LinkClient<T>& client, const std::string& file, const SolutionRecord& rec, std::uint32_t got,
-                         ReplaySummary& sum, std::vector<ActiveModel>& target_history, std::ostream& log,
-                         const SelfCalibration& host_sc, const ModelSchedule<T>& schedule) {
-    const std::optional<std::uint32_t> want = schedule.version_at(rec.t);
+                         const std::optional<std::uint32_t>& want, ReplaySummary& sum,
+                         std::vector<ActiveModel>& target_history, std::ostream& log, const SelfCalibration& host_sc) {
     const bool same = want ? got == *want : got == link::kNoModelVersion;
     if (!same && ++sum.version_mismatches <= kMaxCalibMessages) {
         log << file << ":" << rec.line << ": the target corrected with model version "
@@ -317,8 +317,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     // the target's started alike.
     ReplaySummary sum;
     std::optional<SelfCalibration> host_sc;
-    std::optional<ModelSchedule<T>> schedule;
-    std::optional<ModelSchedule<double>> schedule_d;
+    std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
+    std::optional<calib::Estimator<T>> host_estimator;
+    pipeline::EpochPipeline<T> host_pipeline;
     std::vector<ActiveModel> target_history;
     if (opt.self_calibrate) {
         calib::EstimatorConfig ecfg;
@@ -331,17 +332,22 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
                 }
             },
             mf, ecfg, std::nullopt);
-        schedule.emplace(host_sc->history);
         schedule_d.emplace(host_sc->history);
         std::optional<ModelCoefficients> initial;
         if (mf) {
             initial = coefficients_of(*mf);
         }
-        client.start_calibration(std::llround(host_sc->orbit_period_s * 1e6), opt.time_constant_days,
-                                 initial ? &*initial : nullptr);
+        const std::int64_t period_us = std::llround(host_sc->orbit_period_s * 1e6);
+        client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr);
+        calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
+        host_cfg.orbit_period_us = period_us;
+        host_cfg.time_constant_days = opt.time_constant_days;
+        host_estimator.emplace(host_cfg, initial ? &*initial : nullptr);
+        host_pipeline.use_estimator(&*host_estimator);
         sum.self_calibrate = true;
     } else {
         client.upload_model(model_t);
+        host_pipeline.use_model(&model_t);
     }
     // Time order is the on-board clock's (TT µs; rows within one microsecond
     // in file order, as the target and the host's self-calibration take
@@ -407,15 +413,28 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0}, from_states,
                                                         from_states && in.velocity.valid, calib_use);
         ++sum.returned;
-        const ThermalModel<T>& host_model = schedule ? schedule->at(rec.t) : model_t;
-        CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &host_model});
-        host.status = with_service_status(host.status, service_status, from_states);
-        if (opt.self_calibrate) {
-            check_model_version(client, opt.in, rec, got.model_version, sum, target_history, log, *host_sc, *schedule);
+        // The host's answer: the target's pipeline on the host, fed alike.
+        const pipeline::VelocityAnswer<T> velocity{in.velocity, service_status, from_states};
+        const auto answer = [&velocity] { return velocity; };
+        CorrectedSolution<T> host{};
+        std::optional<std::uint32_t> host_version;
+        if (host_pipeline.calibrating() && !timed) {
+            host = host_pipeline.untimed_solution(in, answer);
+        } else {
+            (void)host_pipeline.begin(timed ? t.us : 0);
+            host = host_pipeline.solution(in, answer, (calib_use & link::kCalibClean) != 0U);
+            if (host_pipeline.calibrating() && host_pipeline.model() != nullptr) {
+                host_version = host_pipeline.version();
+            }
         }
-        CorrectedSolution<double> ref =
-            correct_solution(in_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
-        ref.status = with_service_status(ref.status, service_status_d, from_states);
+        if (opt.self_calibrate) {
+            check_model_version(client, opt.in, rec, got.model_version, host_version, sum, target_history, log,
+                                *host_sc);
+        }
+        // The reference: the same rows and models in double.
+        const pipeline::VelocityAnswer<double> velocity_d{in_d.velocity, service_status_d, from_states};
+        const CorrectedSolution<double> ref = pipeline::correct_stage(
+            in_d, velocity_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
         const bool same =
             got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
         if (!same) {
