@@ -14,8 +14,10 @@
 // solution's own time (velocity_entry.hpp), the core in the build's scalar
 // (app_scalar.hpp, core_entry.hpp), the temperatures of
 // temperature_source.hpp and their status bits; every kCalibFeedEvery-th
-// cycle heads A, B and C feed the estimator, and after the solutions one
-// bounded step of its per-orbit update runs (idle()). Times are TT µs
+// cycle heads A, B and C feed the estimator; then the cycle's heads are
+// combined into the bench's attitude (combine_entry.hpp, the mountings
+// kBenchMountings of flight_bench.hpp); after the solutions one bounded step
+// of the estimator's per-orbit update runs (idle()). Times are TT µs
 // (integers: no time in the scalar). Every loop has a fixed trip count.
 //
 // The cost of each part is measured by the caller's Meter (main.cpp: SysTick
@@ -42,6 +44,7 @@
 #include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_link/crc32c.hpp"
 #include "calib_entry.hpp"
+#include "combine_entry.hpp"
 #include "core_entry.hpp"
 #include "flight_bench.hpp"
 #include "flight_data.hpp"
@@ -79,6 +82,7 @@ enum class Part : std::uint8_t {
     kCorrect,     // the core
     kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
     kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
+    kCombine,     // the combined attitude of the cycle's heads (combine_entry.hpp)
 };
 
 struct NoMeter {
@@ -99,12 +103,97 @@ class CorrectionLog {
 public:
     static constexpr std::uint32_t kSampleEvery = 16U;
     static constexpr std::uint32_t kMaxSamples = 32U;
+    // Records: one per head, then the cycle's combined attitude (kCombined).
+    static constexpr std::uint8_t kCombined = kMaxHeads;
+    static constexpr std::uint8_t kRecords = kMaxHeads + 1U;
 
     // Head `head`'s corrected solution of cycle `cycle` (cycles in order from 0).
     void add(std::uint32_t cycle, std::uint8_t head, const CorrectedSolution<Scalar>& c) noexcept {
-        if (head >= kMaxHeads) {
+        if (head < kMaxHeads) {
+            add_record(cycle, head, c, c.status == (status::kAberrationApplied | status::kThermalApplied));
+        }
+    }
+
+    // The cycle's combined attitude, as a record whose status is the
+    // combined status with the heads used in bits 8..8+kMaxHeads−1, and
+    // "applied" when two or more heads were averaged.
+    void add_combined(std::uint32_t cycle, const combine::CombinedAttitude<Scalar>& a) noexcept {
+        const auto st = static_cast<StatusBits>(a.status | (static_cast<unsigned>(a.used) << 8U));
+        add_record(cycle, kCombined, {a.q_crf_icrf, st},
+                   (a.status & combine::combined_status::kTwoOrMoreHeads) != 0U);
+    }
+
+    struct Head {
+        std::uint32_t applied;    // cycles with both corrections applied (combined: two or more heads)
+        StatusBits status_union;  // every status bit seen
+        std::uint32_t solutions;  // cycles recorded
+        std::uint32_t crc;        // CRC-32C over every cycle's solution and status
+        CorrectedSolution<Scalar> last;
+    };
+    const Head& head(std::uint8_t h) const noexcept { return heads_[h < kRecords ? h : 0U]; }
+    std::uint32_t samples_taken() const noexcept { return samples_taken_; }
+    // Record h's solution of cycle i·kSampleEvery, i < samples_taken().
+    const CorrectedSolution<Scalar>& sample(std::uint32_t i, std::uint8_t h) const noexcept {
+        return samples_[i < kMaxSamples ? i : 0U][h < kRecords ? h : 0U];
+    }
+
+    // Per record: "head H: applied N status seen S last q W X Y Z"
+    // ("combined: ..." for the combined attitude).
+    void print_heads() const noexcept {
+        using namespace report;
+        for (std::uint8_t h = 0; h < kRecords; ++h) {
+            const Head& r = heads_[h];
+            name(h);
+            text(": applied ");
+            u32(r.applied);
+            text(" status seen ");
+            u32(r.status_union);
+            text(" last q ");
+            quaternion(r.last.q_chu_icrf);
+            text("\n");
+        }
+    }
+
+    // "sample cycle C head H status S q W X Y Z" per sample and record, then
+    // "solutions head H cycles N crc32c X" per record ("combined" for head H
+    // of the combined attitude).
+    void print_solutions() const noexcept {
+        using namespace report;
+        for (std::uint32_t i = 0; i < samples_taken_; ++i) {
+            for (std::uint8_t h = 0; h < kRecords; ++h) {
+                text("sample cycle ");
+                u32(i * kSampleEvery);
+                text(" ");
+                name(h);
+                text(" status ");
+                u32(samples_[i][h].status);
+                text(" q ");
+                quaternion(samples_[i][h].q_chu_icrf);
+                text("\n");
+            }
+        }
+        for (std::uint8_t h = 0; h < kRecords; ++h) {
+            text("solutions ");
+            name(h);
+            text(" cycles ");
+            u32(heads_[h].solutions);
+            text(" crc32c ");
+            hex32(heads_[h].crc);
+            text("\n");
+        }
+    }
+
+private:
+    static void name(std::uint8_t h) noexcept {
+        if (h == kCombined) {
+            report::text("combined");
             return;
         }
+        report::text("head ");
+        report::u32(h);
+    }
+
+    void add_record(std::uint32_t cycle, std::uint8_t head, const CorrectedSolution<Scalar>& c, bool applied) noexcept {
         Head& r = heads_[head];
         const std::uint32_t words[5] = {bits_of(c.q_chu_icrf.w), bits_of(c.q_chu_icrf.x), bits_of(c.q_chu_icrf.y),
                                         bits_of(c.q_chu_icrf.z), c.status};
@@ -116,7 +205,7 @@ public:
         r.solutions = cycle + 1U;
         r.last = c;
         r.status_union = static_cast<StatusBits>(r.status_union | c.status);
-        if (c.status == (status::kAberrationApplied | status::kThermalApplied)) {
+        if (applied) {
             ++r.applied;
         }
         if (cycle % kSampleEvery == 0U && cycle / kSampleEvery < kMaxSamples) {
@@ -125,66 +214,6 @@ public:
         }
     }
 
-    struct Head {
-        std::uint32_t applied;    // cycles with both corrections applied
-        StatusBits status_union;  // every status bit seen
-        std::uint32_t solutions;  // cycles recorded
-        std::uint32_t crc;        // CRC-32C over every cycle's solution and status
-        CorrectedSolution<Scalar> last;
-    };
-    const Head& head(std::uint8_t h) const noexcept { return heads_[h < kMaxHeads ? h : 0U]; }
-    std::uint32_t samples_taken() const noexcept { return samples_taken_; }
-    // Head h's solution of cycle i·kSampleEvery, i < samples_taken().
-    const CorrectedSolution<Scalar>& sample(std::uint32_t i, std::uint8_t h) const noexcept {
-        return samples_[i < kMaxSamples ? i : 0U][h < kMaxHeads ? h : 0U];
-    }
-
-    // Per head: "head H: applied N status seen S last q W X Y Z".
-    void print_heads() const noexcept {
-        using namespace report;
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            const Head& r = heads_[h];
-            text("head ");
-            u32(h);
-            text(": applied ");
-            u32(r.applied);
-            text(" status seen ");
-            u32(r.status_union);
-            text(" last q ");
-            quaternion(r.last.q_chu_icrf);
-            text("\n");
-        }
-    }
-
-    // "sample cycle C head H status S q W X Y Z" per sample and head, then
-    // "solutions head H cycles N crc32c X" per head.
-    void print_solutions() const noexcept {
-        using namespace report;
-        for (std::uint32_t i = 0; i < samples_taken_; ++i) {
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                text("sample cycle ");
-                u32(i * kSampleEvery);
-                text(" head ");
-                u32(h);
-                text(" status ");
-                u32(samples_[i][h].status);
-                text(" q ");
-                quaternion(samples_[i][h].q_chu_icrf);
-                text("\n");
-            }
-        }
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            text("solutions head ");
-            u32(h);
-            text(" cycles ");
-            u32(heads_[h].solutions);
-            text(" crc32c ");
-            hex32(heads_[h].crc);
-            text("\n");
-        }
-    }
-
-private:
     static void quaternion(const Quaternion<Scalar>& q) noexcept {
         report::hex32(bits_of(q.w));
         report::text(" ");
@@ -194,8 +223,8 @@ private:
         report::text(" ");
         report::hex32(bits_of(q.z));
     }
-    Head heads_[kMaxHeads]{};
-    CorrectedSolution<Scalar> samples_[kMaxSamples][kMaxHeads]{};
+    Head heads_[kRecords]{};
+    CorrectedSolution<Scalar> samples_[kMaxSamples][kRecords]{};
     std::uint32_t samples_taken_ = 0U;
 };
 
@@ -278,6 +307,11 @@ struct EntryCalls {
     }
     static bool step(calib::Estimator<Scalar>& e) noexcept { return calib_step(e); }
     static StatusBits status(std::uint8_t head, StatusBits s) noexcept { return temperatures_merge_status(head, s); }
+    static combine::CombinedAttitude<Scalar> combine(const combine::Combiner<Scalar>& c,
+                                                     const combine::HeadAttitude<Scalar>* heads,
+                                                     std::uint8_t n) noexcept {
+        return combine_epoch(c, heads, n);
+    }
 };
 
 // The pipeline's stages as the loop's parts.
@@ -289,6 +323,8 @@ constexpr Part part_of(pipeline::Stage stage) noexcept {
             return Part::kCorrect;
         case pipeline::Stage::kStep:
             return Part::kCalibStep;
+        case pipeline::Stage::kCombine:
+            return Part::kCombine;
         case pipeline::Stage::kModel:
         case pipeline::Stage::kFeed:
             break;
@@ -305,7 +341,10 @@ struct StageMeter {
 
 class FlightCycle {
 public:
-    FlightCycle() noexcept { pipeline_.use_estimator(&estimator_); }
+    FlightCycle() noexcept {
+        pipeline_.use_estimator(&estimator_);
+        pipeline_.use_combiner(&combiner_);
+    }
     FlightCycle(const FlightCycle&) = delete;
     FlightCycle& operator=(const FlightCycle&) = delete;
 
@@ -355,6 +394,7 @@ public:
             corrected_[h] = pipeline_.solution(
                 in, [&] { return pipeline::from_service(velocity_query(service_, t)); }, true, true, stages);
         }
+        combined_ = pipeline_.close(stages);
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
             model_ = model;
             if (model != nullptr) {
@@ -372,6 +412,8 @@ public:
         (void)pipeline_.idle(stages);
     }
 
+    // The cycle's combined attitude of the bench (kBenchMountings).
+    const combine::CombinedAttitude<Scalar>& combined() const noexcept { return combined_; }
     const CorrectedSolution<Scalar>& corrected(std::uint8_t head) const noexcept {
         return corrected_[head < kMaxHeads ? head : 0U];
     }
@@ -393,6 +435,9 @@ private:
     // kCalibFeedEvery-th cycle; its per-orbit update steps in idle time.
     calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
     pipeline::EpochPipeline<Scalar, EntryCalls> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
+    // The combination's tables, built once from the mountings in flash.
+    combine::Combiner<Scalar> combiner_{kBenchMountings};
+    combine::CombinedAttitude<Scalar> combined_{};
     const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
     ModelHistory history_;
 };
@@ -405,6 +450,9 @@ void FlightCycle::run(std::uint32_t cycle, Meter& meter, bool record) noexcept {
     idle(meter);
     for (std::uint8_t h = 0; record && h < kMaxHeads; ++h) {  // fixed trip count
         record_.add(cycle, h, corrected_[h]);
+    }
+    if (record) {
+        record_.add_combined(cycle, combined_);
     }
 }
 

@@ -16,7 +16,12 @@
 //                calibrated heads is kept; when all are there and the epoch is
 //                one the schedule feeds (every feed_every-th), they feed the
 //                estimator (calib::feed_estimator) and its per-orbit update
-//                runs steps_after_feed bounded steps; idle() runs one more.
+//                runs steps_after_feed bounded steps; idle() runs one more;
+//   6. combination (use_combiner; close()): the corrected solutions since the
+//                last close() (the caller's epoch of the bench: a flight
+//                cycle, the host's millisecond epoch) combined into the
+//                attitude of the common reference frame (combine/combiner.hpp),
+//                each head usable or not by combine/usable.hpp.
 // The link server, the flight loop, the host's self-calibration run and
 // replay's host side all drive this class, so they take the same decisions
 // in the same order; `ascorr correct` (rows in any order, on many threads)
@@ -33,12 +38,15 @@
 
 #include "../calib/estimator.hpp"
 #include "../calib/feed.hpp"
+#include "../combine/combined_status.hpp"
+#include "../combine/combiner.hpp"
+#include "../combine/usable.hpp"
 #include "../core/correct.hpp"
 #include "solution_stage.hpp"
 
 namespace ascorr::pipeline {
 
-enum class Stage : std::uint8_t { kModel, kVelocity, kCorrect, kFeed, kStep };
+enum class Stage : std::uint8_t { kModel, kVelocity, kCorrect, kFeed, kStep, kCombine };
 
 struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
@@ -58,6 +66,10 @@ struct InlineCalls {
         return calib::feed_estimator(e, t_us, model, corrected, temperatures);
     }
     static bool step(calib::Estimator<T>& e) noexcept { return e.step(); }
+    static combine::CombinedAttitude<T> combine(const combine::Combiner<T>& c, const combine::HeadAttitude<T>* heads,
+                                                std::uint8_t n) noexcept {
+        return c.combine(heads, n);
+    }
     // The caller's own status bits for head `head` (none here).
     static StatusBits status(std::uint8_t /*head*/, StatusBits s) noexcept { return s; }
 };
@@ -96,6 +108,41 @@ public:
     }
 
     bool calibrating() const noexcept { return estimator_ != nullptr; }
+
+    // Stage 6's combiner (nullptr: no combination); forgets the solutions
+    // not combined yet.
+    void use_combiner(const combine::Combiner<T>* c) noexcept {
+        combiner_ = c;
+        combined_n_ = 0U;
+        overflow_ = false;
+    }
+    const combine::Combiner<T>* combiner() const noexcept { return combiner_; }
+
+    // Stage 6: the solutions since the last close() combined (use_combiner
+    // came first: without a combiner, no head, status 8). More solutions than
+    // kCombineSlots in one epoch: the rest are left out (bit 4).
+    template <typename Meter = NoMeter>
+    combine::CombinedAttitude<T> close(Meter& meter) noexcept {
+        combine::CombinedAttitude<T> r{};
+        if (combiner_ == nullptr) {
+            r.q_crf_icrf = {constant<T>(1.0), constant<T>(0.0), constant<T>(0.0), constant<T>(0.0)};
+            r.status = combine::combined_status::kNoHead;
+            return r;
+        }
+        const std::uint32_t start = meter.now();
+        r = Calls::combine(*combiner_, combined_, combined_n_);
+        meter.add(Stage::kCombine, start);
+        if (overflow_) {
+            r.status = static_cast<combine::CombinedStatus>(r.status | combine::combined_status::kHeadLeftOut);
+        }
+        combined_n_ = 0U;
+        overflow_ = false;
+        return r;
+    }
+    combine::CombinedAttitude<T> close() noexcept {
+        NoMeter m;
+        return close(m);
+    }
 
     // Stage 1: epoch t_us, unless it is the current one; its model.
     template <typename Meter = NoMeter>
@@ -148,6 +195,9 @@ public:
         if (estimator_ != nullptr && clean) {
             keep(in.head, c, in.temperatures, meter);
         }
+        if (combiner_ != nullptr) {
+            to_combine(in.head, c, clean);
+        }
         return c;
     }
     template <typename Velocity>
@@ -195,6 +245,17 @@ private:
         return {aberration, model_ != nullptr ? model_ : &kNoModel};
     }
 
+    // Stage 6's input: every solution, usable or not (the combiner accounts
+    // for each one it is given).
+    void to_combine(std::uint8_t head, const CorrectedSolution<T>& c, bool clean) noexcept {
+        if (combined_n_ == kCombineSlots) {
+            overflow_ = true;
+            return;
+        }
+        combined_[combined_n_] = {c.q_chu_icrf, head, combine::usable_for_combination(c.status, clean)};
+        ++combined_n_;
+    }
+
     static bool usable(const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp) noexcept {
         return (c.status & status::kAberrationApplied) != 0U && (c.status & status::kRejected) == 0U &&
                tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid;
@@ -229,6 +290,9 @@ private:
 
     static constexpr std::uint8_t kAll = (1U << calib::kCalibHeads) - 1U;
     static constexpr std::uint8_t kFed = 0x80U;
+    // Two solutions of every head: room for a repeated head, whose second
+    // solution the combiner leaves out.
+    static constexpr std::uint8_t kCombineSlots = 2U * kMaxHeads;
 
     FeedSchedule schedule_;
     const ThermalModel<T>* fixed_ = nullptr;
@@ -242,6 +306,10 @@ private:
     std::uint32_t feeds_ = 0U;
     CorrectedSolution<T> solutions_[calib::kCalibHeads]{};
     HeadTemperatures<T> temperatures_[calib::kCalibHeads]{};
+    const combine::Combiner<T>* combiner_ = nullptr;
+    combine::HeadAttitude<T> combined_[kCombineSlots]{};
+    std::uint8_t combined_n_ = 0U;
+    bool overflow_ = false;
 };
 
 }  // namespace ascorr::pipeline
