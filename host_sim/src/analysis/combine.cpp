@@ -319,6 +319,11 @@ struct CombineStage::Impl {
     }
 
     void emit(std::vector<Kept>& rows) {
+        // Heads in index order (then lines): the combiner's reference and sums,
+        // hence the bits, are the same in any row order.
+        std::sort(rows.begin(), rows.end(), [](const Kept& a, const Kept& b) {
+            return a.head < b.head || (a.head == b.head && a.line < b.line);
+        });
         mark_duplicates(rows);
         mark_missing_stages(rows);
         combine::HeadAttitude<double> heads[kMaxHeads];
@@ -344,7 +349,10 @@ struct CombineStage::Impl {
             report_left_out(k);
         }
         AttitudeRow row;
-        row.t = rows.front().t;  // the epoch's first row's, as written
+        row.t = rows.front().t;  // the epoch's earliest t, as written: the same in any row order
+        for (const Kept& k : rows) {
+            row.t = std::min(row.t, k.t);
+        }
         row.status = static_cast<unsigned>(c.status | (left_out ? cs::kHeadLeftOut : 0U));
         row.has_q = (c.status & cs::kNoHead) == 0U;
         if (row.has_q) {
