@@ -12,6 +12,7 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
@@ -266,14 +267,6 @@ struct CombineStage::Impl {
         }
     }
 
-    // θ of a ⊗ b* (arcsec, CRF axes: R_a = R(θ) R_b).
-    static std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) {
-        const Quaternion<double> d = canonical(a * conjugate(b));
-        const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-        const double k = s > 0.0 ? 2.0 * std::atan2(s, d.w) / s * kRadToArcsec : 2.0 * kRadToArcsec;
-        return {d.x * k, d.y * k, d.z * k};
-    }
-
     // The full set's epoch combined again with each proper subset (HeadSetStep).
     void add_steps(const combine::HeadAttitude<double>* heads, std::uint8_t n, const Quaternion<double>& q_full,
                    double t) {
@@ -442,7 +435,8 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
 CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, std::ostream& log,
                             CombineStage::Mode mode) {
     CombineStage stage(m, opt.out, opt.in, log, mode);
-    for_each_corrected_row(opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
+    for_each_corrected_row(
+        opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
     stage.finish();
     CombineSummary s = stage.summary();
     stage.commit();
