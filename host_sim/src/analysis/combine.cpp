@@ -112,17 +112,21 @@ std::string describe(const CombineSummary& s) {
     if (s.out_of_order) {
         o << "; rows out of time order: sorted";
     }
-    bool header = false;
+    // Most heads first (AB, AC, BC, then A, B, C).
+    std::vector<std::uint32_t> sets;
     for (std::uint32_t set = 1; set < s.steps.size(); ++set) {
+        if (s.steps[set].days != 0) {
+            sets.push_back(set);
+        }
+    }
+    std::stable_sort(sets.begin(), sets.end(),
+                     [](std::uint32_t a, std::uint32_t b) { return head_count(a) > head_count(b); });
+    if (!sets.empty()) {
+        o << "\nsteps from " << head_letters(s.full)
+          << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
+    }
+    for (const std::uint32_t set : sets) {
         const HeadSetStep& st = s.steps[set];
-        if (st.days == 0) {
-            continue;
-        }
-        if (!header) {
-            o << "\nsteps from " << head_letters(s.full)
-              << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
-            header = true;
-        }
         char buf[128];
         std::snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(), st.rms_daily_mean[0],
                       st.rms_daily_mean[1], st.rms_daily_mean[2], st.days);
