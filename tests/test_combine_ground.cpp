@@ -254,6 +254,22 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "cor.csv"), slurp(dir / "cor2.csv"));
     EXPECT_EQ(slurp(dir / "comb.csv"), slurp(dir / "comb2.csv"));
+    // Rows out of time order: the run is made again with the rows kept; the
+    // combined file is the same bits, the corrected one keeps the input order.
+    std::vector<std::string> rows = lines_of(dir / "sim.csv");
+    std::string reversed = rows[0] + "\n";
+    for (std::size_t i = rows.size() - 1; i >= 1; --i) {
+        reversed += rows[i] + "\n";
+    }
+    write(dir / "reversed.csv", reversed);
+    r = run_in(
+        "correct --in reversed.csv --out rcor.csv --model sim.csv.truth.csv --mountings sim.csv.mountings.csv "
+        "--combined rcomb.csv",
+        dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "rcomb.csv"), slurp(dir / "comb.csv"));
+    EXPECT_EQ(lines_of(dir / "rcor.csv").size(), lines_of(dir / "cor.csv").size());
+    EXPECT_TRUE(has(r.err, "rows out of time order: sorted")) << r.err;
     // A malformed row: neither output.
     std::string text = slurp(dir / "sim.csv");
     text.insert(text.find('\n', text.size() / 2) + 1, "1e9,A,x,0,0,0,,,,,,,0,1\n");
@@ -456,6 +472,52 @@ TEST(CombineAccuracy, StepsWithoutTheThermalStageAreLargerThanWithIt) {
         EXPECT_GT(without_max, 0.5) << host::head_set_name(set);  // the deformation the thermal stage removes
         EXPECT_EQ(with.steps[set].days, 8U);
     }
+}
+
+TEST(CombineCli, StatsAndPlotOfACombinedFile) {
+    const Mission& ms = mission();
+    ASSERT_EQ(run_in("combine --in cor.csv --mountings sim.csv.mountings.csv --out c2.csv", ms.dir).exit_code, 0);
+    // Counts per head set without a truth; the table names each set.
+    CliRun r = run_in("stats --combined c2.csv > counts.txt", ms.dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string counts = slurp(ms.dir / "counts.txt");
+    EXPECT_TRUE(has(counts, "ABC ") && has(counts, "AB ") && has(counts, "AC ")) << counts;
+    // --truth-attitude needs --combined; --combined excludes --in.
+    EXPECT_EQ(run_in("stats --in sim.csv --truth-attitude sim.csv.attitude.csv", ms.dir).exit_code, 2);
+    EXPECT_EQ(run_in("stats --in sim.csv --combined c2.csv", ms.dir).exit_code, 2);
+    // A combined file out of time order, a truth out of time order: refused at their lines.
+    std::vector<std::string> rows = lines_of(ms.dir / "c2.csv");
+    std::swap(rows[5], rows[6]);
+    std::string text;
+    for (const std::string& l : rows) {
+        text += l + "\n";
+    }
+    write(ms.dir / "c2_swapped.csv", text);
+    r = run_in("stats --combined c2_swapped.csv", ms.dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "c2_swapped.csv:7:1: a combined file has one row per epoch, in time order")) << r.err;
+    rows = lines_of(ms.dir / "sim.csv.attitude.csv");
+    std::swap(rows[5], rows[6]);
+    text.clear();
+    for (const std::string& l : rows) {
+        text += l + "\n";
+    }
+    write(ms.dir / "truth_swapped.csv", text);
+    r = run_in("stats --combined c2.csv --truth-attitude truth_swapped.csv", ms.dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
+    // The figure: three days, a PNG (when gnuplot is installed).
+    r = run_in(
+        "plot --combined c2.csv --truth-attitude sim.csv.attitude.csv --window-from 456148800 --window-to "
+        "456408000 --width 600 --out c2.png",
+        ms.dir);
+    if (r.exit_code == 1 && has(r.err, "cannot run 'gnuplot'")) {
+        GTEST_SKIP() << "gnuplot is not installed";
+    }
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(ms.dir / "c2.png").substr(1, 3), "PNG");
+    EXPECT_EQ(run_in("plot --combined c2.csv --truth-attitude sim.csv.attitude.csv --out c3.png", ms.dir).exit_code,
+              2);  // the window is required
 }
 
 }  // namespace
