@@ -270,6 +270,14 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
     EXPECT_EQ(slurp(dir / "rcomb.csv"), slurp(dir / "comb.csv"));
     EXPECT_EQ(lines_of(dir / "rcor.csv").size(), lines_of(dir / "cor.csv").size());
     EXPECT_TRUE(has(r.err, "rows out of time order: sorted")) << r.err;
+    // The corrected rows to standard output: written once (the rows kept from the start).
+    r = run_in(
+        "correct --in reversed.csv --out - --model sim.csv.truth.csv --mountings sim.csv.mountings.csv "
+        "--combined scomb.csv > scor.csv",
+        dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "scor.csv"), slurp(dir / "rcor.csv"));
+    EXPECT_EQ(slurp(dir / "scomb.csv"), slurp(dir / "comb.csv"));
     // A malformed row: neither output.
     std::string text = slurp(dir / "sim.csv");
     text.insert(text.find('\n', text.size() / 2) + 1, "1e9,A,x,0,0,0,,,,,,,0,1\n");

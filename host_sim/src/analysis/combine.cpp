@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -469,6 +470,22 @@ void for_each_corrected_row(const std::string& path, const std::function<void(co
         label);
 }
 
+namespace {
+
+// Whether the corrected file goes to a stream (standard output, a device, a
+// FIFO: atomic_file.hpp's rule): it cannot be written twice, so the rows are
+// kept from the start instead of a second run on rows out of order.
+bool streamed_output(const std::string& path) {
+    if (path == "-" || path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0) {
+        return true;
+    }
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+}
+
+}  // namespace
+
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, std::ostream& log) {
     refuse_output_over_input(
@@ -484,6 +501,9 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
         r.combined = stage.summary();
         return r;
     };
+    if (streamed_output(opt.out)) {
+        return pass(CombineStage::Mode::kKeep, log);
+    }
     std::ostringstream first;
     try {
         CorrectAndCombine r = pass(CombineStage::Mode::kStream, first);
