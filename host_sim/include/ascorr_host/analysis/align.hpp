@@ -49,13 +49,17 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
+#include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
 
 namespace ascorr::host {
 
@@ -161,5 +165,82 @@ struct Alignment {
 // std::invalid_argument naming a head that shares no epoch with the others.
 Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information);
+
+// ---- `ascorr align`: the passes over a file
+//
+// Which rows: those in [from, to] that the combination would average in
+// (combine.hpp: clean, no stage skipped, the epoch's stages), of heads in the
+// mountings; an epoch counts when two or more heads have such a row. Every
+// head of the mountings must have clean epochs with another head. The
+// estimate is iterated: each pass sums the data with the current mountings,
+// estimates the noise and the δ_i, and turns the mountings by them, until the
+// largest δ is below kAlignToleranceArcsec (the first pass removes all but
+// the second-order terms, about δ² ≈ 0.005" for 30"), at most kMaxAlignPasses.
+
+inline constexpr double kAlignToleranceArcsec = 1e-3;
+inline constexpr std::size_t kMaxAlignPasses = 5;
+
+struct AlignOptions {
+    std::string in;         // corrected file (or solutions file: raw attitudes as they are)
+    std::string mountings;  // mountings file; sigmas, if any, are reported, not used
+    std::string out;        // M2
+    std::optional<double> from;
+    std::optional<double> to;
+    double noise_window_s = kDefaultNoiseWindowS;
+    std::size_t min_epochs = kMinAlignEpochs;
+};
+
+struct HeadAlignment {
+    std::size_t epochs = 0;                                        // clean epochs with another head
+    Eigen::Vector3d rotation_arcsec = Eigen::Vector3d::Zero();     // M2's mounting = M's ⊗ exp(rotation), CRF axes
+    Eigen::Vector3d rotation_sd_arcsec = Eigen::Vector3d::Zero();  // formal 1σ per axis
+    HeadNoise noise;
+    double given_sigma_cross_arcsec = 0.0;  // M's, NaN when it has none
+    double given_sigma_about_arcsec = 0.0;
+};
+
+struct AlignReport {
+    std::string in;
+    std::string mountings;
+    std::string out;
+    std::optional<double> from;
+    std::optional<double> to;
+    HeadSet heads = 0U;  // of the mountings: every one aligned
+    std::array<HeadAlignment, kMaxHeads> head{};
+    NoiseEstimate noise;
+    std::size_t rows = 0;                                    // all rows of the input
+    std::size_t rows_in_period = 0;                          // with t in [from, to]
+    std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // in the period, by LeftOut (kUsed: used)
+    std::size_t epochs = 0;                                  // in the period
+    std::size_t joint_epochs = 0;                            // with two or more usable heads
+    std::size_t single_epochs = 0;                           // with one
+    std::size_t passes = 0;
+    double last_update_arcsec = 0.0;                                 // the largest δ of the last pass
+    Eigen::Vector3d weighted_mean_arcsec = Eigen::Vector3d::Zero();  // (ΣW)⁻¹ Σ W_i rotation_i, W of M2
+    double noise_window_s = kDefaultNoiseWindowS;
+    MountingsFile aligned;  // M2: the new mountings with the estimated sigmas
+};
+
+// Rows from a file or from arrays (Python): calls its argument for every row,
+// in order, each time it is called (align reads its input once per pass).
+using CombineRowSource = std::function<void(const std::function<void(const CombineRow&)>&)>;
+
+// Refusals of align (the command line exits 2): the input's InputError
+// (file:line:column), and AlignRefused for an empty period, too few epochs,
+// a head without clean epochs, noise or mountings the data do not determine.
+class AlignRefused : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// The estimate from rows (file: the input's name in messages); writes nothing.
+AlignReport align_rows(const CombineRowSource& rows, const std::string& file, const MountingsFile& m,
+                       const AlignOptions& opt);
+// `ascorr align`: reads opt.in and opt.mountings, writes opt.out (atomically).
+AlignReport align_file(const AlignOptions& opt);
+// The rows of a corrected or solutions file as the combination takes them.
+CombineRowSource rows_of_file(const std::string& path);
+// The report on standard output (see docs/ground.md).
+std::string describe(const AlignReport& r);
 
 }  // namespace ascorr::host
