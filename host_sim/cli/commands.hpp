@@ -119,6 +119,7 @@ void add_fit_command(CLI::App& app);
 CLI::Option* add_time_constant_option(CLI::App& cmd, double& days);
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
+void add_combine_command(CLI::App& app);
 void add_align_command(CLI::App& app);
 
 }  // namespace ascorr::cli

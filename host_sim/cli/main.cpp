@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     ascorr::cli::add_fit_command(app);
     ascorr::cli::add_stats_command(app);
     ascorr::cli::add_plot_command(app);
+    ascorr::cli::add_combine_command(app);
     ascorr::cli::add_align_command(app);
     try {
         app.parse(argc, argv);
