@@ -221,11 +221,11 @@ struct FullEpoch {
 
 std::vector<FullEpoch> full_epochs(const std::string& path, const MountingsFile& m) {
     std::vector<FullEpoch> out;
-    EpochAssembler<CombineRow> epochs(path, [&](const Epoch<CombineRow>& e) {
+    EpochAssembler<CorrectedRow> epochs(path, [&](const Epoch<CorrectedRow>& e) {
         FullEpoch f;
         f.t = e.t;
         for (std::uint8_t h = 0; h < 3; ++h) {
-            const std::optional<CombineRow>& r = e.head[h];
+            const std::optional<CorrectedRow>& r = e.head[h];
             const StatusBits bad = status::kRejected | status::kNoVelocity | status::kNoTemperature |
                                    status::kThermalOutOfRange | status::kNoModelForHead;
             if (!r || r->flags != 0 || !(r->confidence <= 5.0) || (r->status & bad) != 0U) {
@@ -235,7 +235,7 @@ std::vector<FullEpoch> full_epochs(const std::string& path, const MountingsFile&
         }
         out.push_back(f);
     });
-    rows_of_file(path)([&](const CombineRow& r) {
+    rows_of_file(path)([&](const CorrectedRow& r) {
         if (r.head < 3) {
             epochs.add(r.t, r.head, r.line, r);
         }

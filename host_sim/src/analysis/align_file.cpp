@@ -21,28 +21,16 @@ namespace ascorr::host {
 namespace {
 
 constexpr StatusBits kStages = status::kAberrationApplied | status::kThermalApplied;
-constexpr StatusBits kSkipped =
-    status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
 
-// Why a row cannot be averaged in, on its own (combine.hpp's rule); the
-// epoch's stage mix is decided afterwards (LeftOut::kStageMissing).
-LeftOut why_left_out(const CombineRow& r) noexcept {
-    if (r.flags != 0) {
-        return LeftOut::kFlagged;
+// Why a row cannot be averaged in, on its own: combine.hpp's rule, and a
+// quaternion the combiner would refuse (not unit, not finite); the epoch's
+// stage mix is decided afterwards (LeftOut::kStageMissing).
+LeftOut why_left_out(const CorrectedRow& r, const MountingsFile& m) noexcept {
+    const LeftOut why = why_unusable(r, m);
+    if (why == LeftOut::kUsed && !norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)) {
+        return LeftOut::kNotUnit;
     }
-    if (!(r.confidence <= 5.0)) {
-        return LeftOut::kConfidence;
-    }
-    if (r.corrected && (r.status & status::kRejected) != 0U) {
-        return LeftOut::kRejected;
-    }
-    if (!norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)) {
-        return LeftOut::kRejected;  // as the core rejects it (status 16)
-    }
-    if (r.corrected && (r.status & kSkipped) != 0U) {
-        return LeftOut::kStageSkipped;
-    }
-    return LeftOut::kUsed;
+    return why;
 }
 
 std::string time_text(double t) {
@@ -74,16 +62,20 @@ struct PassCounts {
 
 using CurrentMountings = std::array<Quaternion<double>, kMaxHeads>;
 
-// One epoch into the sums: the usable rows, the epoch's stages, each head's CRF attitude.
-void add_epoch(const Epoch<CombineRow>& e, const CurrentMountings& q_chu_crf, AlignSums& sums, PassCounts& c) {
-    std::array<LeftOut, kMaxHeads> why{};
+// A row of an epoch and why it is left out on its own.
+struct Judged {
+    CorrectedRow row;
+    LeftOut why;
+};
+
+// One epoch into the sums: the epoch's stages (those applied to any usable
+// row: a usable row without one is left out, combine.hpp), each usable head's
+// CRF attitude.
+void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, AlignSums& sums, PassCounts& c) {
     StatusBits stages = 0U;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (e.head[h]) {
-            why[h] = why_left_out(*e.head[h]);
-            if (why[h] == LeftOut::kUsed && e.head[h]->corrected) {
-                stages |= e.head[h]->status & kStages;
-            }
+    for (const std::optional<Judged>& j : e.head) {
+        if (j && j->why == LeftOut::kUsed && j->row.corrected) {
+            stages |= j->row.status & kStages;
         }
     }
     std::array<std::optional<Quaternion<double>>, kMaxHeads> q_crf_icrf{};
@@ -91,13 +83,14 @@ void add_epoch(const Epoch<CombineRow>& e, const CurrentMountings& q_chu_crf, Al
         if (!e.head[h]) {
             continue;
         }
-        const CombineRow& r = *e.head[h];
-        if (why[h] == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
-            why[h] = LeftOut::kStageMissing;
+        const CorrectedRow& r = e.head[h]->row;
+        LeftOut why = e.head[h]->why;
+        if (why == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
+            why = LeftOut::kStageMissing;
         }
-        ++c.left_out[static_cast<std::size_t>(why[h])];
-        ++c.head_left_out[h][static_cast<std::size_t>(why[h])];
-        if (why[h] == LeftOut::kUsed) {
+        ++c.left_out[static_cast<std::size_t>(why)];
+        ++c.head_left_out[h][static_cast<std::size_t>(why)];
+        if (why == LeftOut::kUsed) {
             q_crf_icrf[h] = conjugate(q_chu_crf[h]) * r.q_chu_icrf;
         }
     }
@@ -105,29 +98,26 @@ void add_epoch(const Epoch<CombineRow>& e, const CurrentMountings& q_chu_crf, Al
     sums.add(e.t, q_crf_icrf);
 }
 
-// One pass over the rows with the current mountings.
-void run_pass(const CombineRowSource& rows, const std::string& file, HeadSet heads, const CurrentMountings& q_chu_crf,
-              const AlignOptions& opt, AlignSums& sums, PassCounts& c) {
-    EpochAssembler<CombineRow> epochs(file, [&](const Epoch<CombineRow>& e) { add_epoch(e, q_chu_crf, sums, c); });
-    rows([&](const CombineRow& r) {
+// One pass over the rows with the current mountings. Two rows of one head in
+// one epoch: the assembler's InputError (both lines named).
+void run_pass(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
+              const CurrentMountings& q_chu_crf, const AlignOptions& opt, AlignSums& sums, PassCounts& c) {
+    EpochAssembler<Judged> epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, sums, c); });
+    rows([&](const CorrectedRow& r) {
         ++c.rows;
         if (!in_period(r.t, opt)) {
             return;
         }
         ++c.rows_in_period;
-        LeftOut why = LeftOut::kUsed;
-        if (r.head >= kMaxHeads) {
-            why = LeftOut::kNotAHead;
-        } else if (!has_head(heads, r.head)) {
-            why = LeftOut::kNotInMountings;
-        } else if (!(std::abs(r.t) < kMaxEpochTimeS)) {
+        LeftOut why = why_left_out(r, m);
+        if (why != LeftOut::kNotAHead && why != LeftOut::kNotInMountings && !(std::abs(r.t) < kMaxEpochTimeS)) {
             why = LeftOut::kNoEpoch;
         }
-        if (why != LeftOut::kUsed) {
+        if (why == LeftOut::kNotAHead || why == LeftOut::kNotInMountings || why == LeftOut::kNoEpoch) {
             ++c.left_out[static_cast<std::size_t>(why)];
             return;
         }
-        epochs.add(r.t, r.head, r.line, r);
+        epochs.add(r.t, r.head, r.line, Judged{r, why});
     });
     epochs.finish();
     sums.finish();
@@ -190,7 +180,7 @@ HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
 
 }  // namespace
 
-AlignReport align_rows(const CombineRowSource& rows, const std::string& file, const MountingsFile& m,
+AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
                        const AlignOptions& opt) {
     try {
         refuse_bad_time_range(opt.from, opt.to);
@@ -217,7 +207,7 @@ AlignReport align_rows(const CombineRowSource& rows, const std::string& file, co
     for (r.passes = 1; r.passes <= kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec); ++r.passes) {
         AlignSums sums(opt.noise_window_s);
         PassCounts c;
-        run_pass(rows, file, r.heads, q, opt, sums, c);
+        run_pass(rows, file, m, q, opt, sums, c);
         if (r.passes == 1) {
             refuse_thin_data(file, sums, c, r.heads, opt);
             r.rows = c.rows;
@@ -283,36 +273,8 @@ AlignReport align_rows(const CombineRowSource& rows, const std::string& file, co
     return r;
 }
 
-CombineRowSource rows_of_file(const std::string& path) {
-    return [path](const std::function<void(const CombineRow&)>& fn) {
-        int status_col = -1;
-        for_each_solution_row(
-            path, [&](const SolutionsReader& header) { status_col = header.header().index(kStatusColumn); },
-            [&](const SolutionsReader& reader, const SolutionRecord& rec) {
-                CombineRow r;
-                r.t = rec.t;
-                r.line = rec.line;
-                r.head = rec.head;
-                r.q_chu_icrf = rec.q_chu_icrf;
-                r.flags = rec.flags;
-                r.confidence = rec.confidence;
-                r.confidence_present = rec.confidence_present;
-                if (status_col >= 0) {
-                    const std::string_view f = reader.fields()[static_cast<std::size_t>(status_col)];
-                    const std::optional<long long> s = parse_integer(f);
-                    if (!s || *s < 0 || *s > 0xFFFF || !status::status_consistent(static_cast<StatusBits>(*s))) {
-                        throw InputError(path, rec.line, static_cast<std::size_t>(status_col) + 1U,
-                                         "column 'status': expected the status bits of a corrected row "
-                                         "(docs/contract.md, section 4), got '" +
-                                             std::string(f) + "'");
-                    }
-                    r.corrected = true;
-                    r.status = static_cast<StatusBits>(*s);
-                }
-                fn(r);
-            },
-            "align");
-    };
+CorrectedRowSource rows_of_file(const std::string& path) {
+    return [path](const std::function<void(const CorrectedRow&)>& fn) { for_each_corrected_row(path, fn, "align"); };
 }
 
 AlignReport align_file(const AlignOptions& opt) {

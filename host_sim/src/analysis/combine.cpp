@@ -56,7 +56,9 @@ struct Kept {
     std::uint8_t stages;  // status & (1|2) of a corrected row; 0 for a raw one
 };
 
-LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) {
+}  // namespace
+
+LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept {
     if (r.head >= kMaxHeads) {
         return LeftOut::kNotAHead;
     }
@@ -77,6 +79,8 @@ LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) {
     }
     return LeftOut::kUsed;
 }
+
+namespace {
 
 std::string time_text(double t) {
     char buf[48];
@@ -430,9 +434,20 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
 CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, std::ostream& log,
                             CombineStage::Mode mode) {
     CombineStage stage(m, opt.out, opt.in, log, mode);
+    for_each_corrected_row(opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
+    stage.finish();
+    CombineSummary s = stage.summary();
+    stage.commit();
+    return s;
+}
+
+}  // namespace
+
+void for_each_corrected_row(const std::string& path, const std::function<void(const CorrectedRow&)>& fn,
+                            const std::string& label) {
     int status_col = -1;
     for_each_solution_row(
-        opt.in, [&status_col](const SolutionsReader& h) { status_col = h.header().index(kStatusColumn); },
+        path, [&status_col](const SolutionsReader& h) { status_col = h.header().index(kStatusColumn); },
         [&](const SolutionsReader& reader, const SolutionRecord& rec) {
             CorrectedRow r;
             r.t = rec.t;
@@ -443,16 +458,10 @@ CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, s
             r.confidence = rec.confidence;
             r.corrected = status_col >= 0;
             r.status = r.corrected ? status_of(reader, rec, status_col) : StatusBits{0};
-            stage.add(r);
+            fn(r);
         },
-        "combine");
-    stage.finish();
-    CombineSummary s = stage.summary();
-    stage.commit();
-    return s;
+        label);
 }
-
-}  // namespace
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, std::ostream& log) {

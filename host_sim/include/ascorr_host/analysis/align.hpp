@@ -223,7 +223,7 @@ struct AlignReport {
 
 // Rows from a file or from arrays (Python): calls its argument for every row,
 // in order, each time it is called (align reads its input once per pass).
-using CombineRowSource = std::function<void(const std::function<void(const CombineRow&)>&)>;
+using CorrectedRowSource = std::function<void(const std::function<void(const CorrectedRow&)>&)>;
 
 // Refusals of align (the command line exits 2): the input's InputError
 // (file:line:column), and AlignRefused for an empty period, too few epochs,
@@ -234,12 +234,12 @@ public:
 };
 
 // The estimate from rows (file: the input's name in messages); writes nothing.
-AlignReport align_rows(const CombineRowSource& rows, const std::string& file, const MountingsFile& m,
+AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
                        const AlignOptions& opt);
 // `ascorr align`: reads opt.in and opt.mountings, writes opt.out (atomically).
 AlignReport align_file(const AlignOptions& opt);
 // The rows of a corrected or solutions file as the combination takes them.
-CombineRowSource rows_of_file(const std::string& path);
+CorrectedRowSource rows_of_file(const std::string& path);
 // The report on standard output (see docs/ground.md).
 std::string describe(const AlignReport& r);
 

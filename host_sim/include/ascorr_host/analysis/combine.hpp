@@ -33,6 +33,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <string>
@@ -61,6 +62,18 @@ enum class LeftOut : std::uint8_t {
 };
 inline constexpr std::size_t kLeftOutKinds = 12;
 const char* left_out_name(LeftOut why) noexcept;
+
+// Why a row is left out on its own (kUsed: usable so far); the epoch decides
+// the rest (stage missing, two rows of one head, the combiner's refusals).
+// Also align's rule (align.hpp).
+LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept;
+
+// Every row of a corrected or solutions file as the combination takes it, in
+// file order (status: the corrected file's column; InputError at
+// file:line:column when it is not an integer in [0, 65535]). label: for the
+// progress on a terminal.
+void for_each_corrected_row(const std::string& path, const std::function<void(const CorrectedRow&)>& fn,
+                            const std::string& label);
 
 // The step at head-set changes, without a truth: at every epoch where the
 // full set (every mounted head) is averaged in, the epoch is combined again
