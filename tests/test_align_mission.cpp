@@ -169,8 +169,8 @@ TEST(AlignMission, CombinedErrorWithEstimatedNoiseIsWithinFivePercentOfTheBound)
 // The true mountings with head A's turned by 20" (CRF axes): align removes the
 // relative error. Every head's M2 is then the truth turned by one common
 // rotation c, the datum's: c = (Σ W)⁻¹ W_A p (the weighted mean of the
-// corrections is zero, and only A's was not). Bound: 0.05" per axis (formal
-// σ of the mountings about 0.01").
+// corrections is zero, and only A's was not). Bound: 4 formal σ of the
+// estimate per axis (each below 0.1").
 TEST(AlignMission, RecoversAKnownPerturbationAndKeepsTheCrf) {
     const NoiseMission& m = noise_mission();
     const Eigen::Vector3d p(12.0, -16.0, 0.0);  // 20"
@@ -182,7 +182,7 @@ TEST(AlignMission, RecoversAKnownPerturbationAndKeepsTheCrf) {
     opt.in = m.corrected;
     opt.mountings = (dir / "given.csv").string();
     opt.out = (dir / "aligned.csv").string();
-    (void)align_file(opt);
+    const AlignReport r = align_file(opt);
     const MountingsFile m2 = read_mountings_file(opt.out);
     Eigen::Matrix3d w_sum = Eigen::Matrix3d::Zero();
     for (std::uint8_t h = 0; h < 3; ++h) {
@@ -196,7 +196,10 @@ TEST(AlignMission, RecoversAKnownPerturbationAndKeepsTheCrf) {
             conjugate(m.truth.mountings.head[h].q_chu_crf) * m2.mountings.head[h].q_chu_crf, {1.0, 0.0, 0.0, 0.0});
         std::printf("CHU %c: M2 from the truth %+.4f %+.4f %+.4f, expected %+.4f %+.4f %+.4f\n", kHeadLetters[h],
                     from_truth.x(), from_truth.y(), from_truth.z(), c.x(), c.y(), c.z());
-        EXPECT_LT((from_truth - c).cwiseAbs().maxCoeff(), 0.05);
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_NEAR(from_truth(axis), c(axis), 4.0 * r.head[h].rotation_sd_arcsec(axis)) << axis;
+            EXPECT_LT(r.head[h].rotation_sd_arcsec(axis), 0.1);
+        }
         const Eigen::Vector3d from_given = rotation_arcsec(
             conjugate(given.mountings.head[h].q_chu_crf) * m2.mountings.head[h].q_chu_crf, {1.0, 0.0, 0.0, 0.0});
         weighted += information_of(m2.mountings.head[h]) * from_given;
@@ -296,7 +299,7 @@ double largest_step(const std::vector<FullEpoch>& epochs, const MountingsFile& m
 // steps are the bench's deformation: larger, and the test says by how much.
 TEST(AlignMission, FittedModelAndAlignLeaveNoStepWhenAHeadDrops) {
     const fs::path dir = scratch("steps");
-    const std::string raw = simulate_mission(dir, 30.0, 300.0, 5);
+    const std::string raw = simulate_mission(dir, 30.0, 120.0, 5);
     FitOptions f;
     f.in = raw;
     f.out = (dir / "fitted.csv").string();
@@ -310,7 +313,7 @@ TEST(AlignMission, FittedModelAndAlignLeaveNoStepWhenAHeadDrops) {
         const std::string in = corrected(raw, stage == 0 ? f.out : std::string(), stage == 0 ? "th.csv" : "ab.csv");
         AlignReport r = run_align(in, nominal);
         const std::vector<FullEpoch> epochs = full_epochs(in, r.aligned);
-        ASSERT_GT(epochs.size(), 4000U);
+        ASSERT_GT(epochs.size(), 3000U);
         step[stage] = largest_step(epochs, r.aligned);
         std::printf("%s: largest step when a head drops %.3f arcsec (RMS over days of the daily mean, %zu epochs)\n",
                     names[stage], step[stage], epochs.size());

@@ -396,7 +396,8 @@ void refuse_unconnected(const AlignSums& sums, HeadSet heads) {
 }  // namespace
 
 Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
-                          const std::array<Eigen::Matrix3d, kMaxHeads>& information) {
+                          const std::array<Eigen::Matrix3d, kMaxHeads>& information,
+                          const std::array<Eigen::Vector3d, kMaxHeads>& turned_arcsec) {
     refuse_unconnected(sums, heads);
     const HeadList all = heads_of(heads);
     const auto n3 = static_cast<Eigen::Index>(3U * all.count);
@@ -445,11 +446,18 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
     }
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n3 + 3);
     rhs.head(n3) = r;
+    for (std::size_t i = 0; i < all.count; ++i) {
+        rhs.tail<3>() -= information[all.head[i]] * turned_arcsec[all.head[i]];
+    }
     const Eigen::PartialPivLU<Eigen::MatrixXd> lu(k);
     const Eigen::MatrixXd k_inv = lu.inverse();
     const Eigen::VectorXd sol = k_inv * rhs;
     Alignment a;
     a.heads = heads;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {  // Eigen's types start uninitialised
+        a.delta_arcsec[h].setZero();
+        a.covariance[h].setZero();
+    }
     Eigen::Matrix3d w_total = Eigen::Matrix3d::Zero();
     Eigen::Vector3d wd = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < all.count; ++i) {
@@ -458,10 +466,19 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
         // The constrained cofactor block is the covariance of the solution (minimal datum).
         a.covariance[h] = k_inv.block<3, 3>(pos[h], pos[h]);
         w_total += information[h];
-        wd += information[h] * a.delta_arcsec[h];
+        wd += information[h] * (turned_arcsec[h] + a.delta_arcsec[h]);
     }
     a.weighted_mean_arcsec = w_total.inverse() * wd;
     return a;
+}
+
+Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+                          const std::array<Eigen::Matrix3d, kMaxHeads>& information) {
+    std::array<Eigen::Vector3d, kMaxHeads> zero{};
+    for (Eigen::Vector3d& z : zero) {
+        z.setZero();
+    }
+    return solve_alignment(sums, heads, information, zero);
 }
 
 }  // namespace ascorr::host

@@ -1,5 +1,6 @@
 // `ascorr align`: the passes over the rows, the refusals, the report
 // (ascorr_host/analysis/align.hpp).
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -75,7 +76,7 @@ void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, AlignS
     StatusBits stages = 0U;
     for (const std::optional<Judged>& j : e.head) {
         if (j && j->why == LeftOut::kUsed && j->row.corrected) {
-            stages |= j->row.status & kStages;
+            stages = static_cast<StatusBits>(stages | (j->row.status & kStages));
         }
     }
     std::array<std::optional<Quaternion<double>>, kMaxHeads> q_crf_icrf{};
@@ -170,6 +171,11 @@ double largest(const Alignment& a) {
     return m;
 }
 
+// The rotation (CRF axes, arcsec) head h's current mounting is turned by from the given one.
+Eigen::Vector3d turned_from(const MountingsFile& m, const CurrentMountings& q, std::uint8_t h) noexcept {
+    return rotation_arcsec(conjugate(m.mountings.head[h].q_chu_crf) * q[h], {1.0, 0.0, 0.0, 0.0});
+}
+
 HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
     HeadSet s = 0U;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
@@ -229,7 +235,11 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
             for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
                 w[h] = information_crf(q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec);
             }
-            a = solve_alignment(sums, r.heads, w);
+            std::array<Eigen::Vector3d, kMaxHeads> turned{};
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                turned[h] = has_head(r.heads, h) ? turned_from(m, q, h) : Eigen::Vector3d::Zero();
+            }
+            a = solve_alignment(sums, r.heads, w, turned);
         } catch (const std::invalid_argument& e) {
             throw AlignRefused(e.what());
         }
@@ -264,7 +274,7 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
         ha.noise = r.noise.head[h];
         ha.given_sigma_cross_arcsec = m.sigmas ? given.sigma_cross_arcsec : std::nan("");
         ha.given_sigma_about_arcsec = m.sigmas ? given.sigma_about_arcsec : std::nan("");
-        ha.rotation_arcsec = rotation_arcsec(conjugate(given.q_chu_crf) * q[h], {1.0, 0.0, 0.0, 0.0});
+        ha.rotation_arcsec = turned_from(m, q, h);
         ha.rotation_sd_arcsec = a.covariance[h].diagonal().cwiseMax(0.0).cwiseSqrt();
         w_sum += w[h];
         wr += w[h] * ha.rotation_arcsec;

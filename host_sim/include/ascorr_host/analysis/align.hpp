@@ -158,11 +158,18 @@ struct Alignment {
     HeadSet heads = 0U;
     std::array<Eigen::Vector3d, kMaxHeads> delta_arcsec{};           // δ_i, CRF axes
     std::array<Eigen::Matrix3d, kMaxHeads> covariance{};             // of δ_i, arcsec²
-    Eigen::Vector3d weighted_mean_arcsec = Eigen::Vector3d::Zero();  // (ΣW)⁻¹ Σ W_i δ_i, zero up to rounding
+    Eigen::Vector3d weighted_mean_arcsec = Eigen::Vector3d::Zero();  // (ΣW)⁻¹ Σ W_i (Δ_i + δ_i), zero up to rounding
 };
 
-// Least-squares δ_i under the datum Σ W_i δ_i = 0 (see the top). Throws
-// std::invalid_argument naming a head that shares no epoch with the others.
+// Least-squares δ_i under the datum Σ W_i (Δ_i + δ_i) = 0 (see the top),
+// Δ_i the rotations the mountings were already turned by (align's earlier
+// passes; zero: the datum Σ W_i δ_i = 0), so that the datum holds for the
+// total rotation with the latest weights. Throws std::invalid_argument naming
+// a head that shares no epoch with the others.
+Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+                          const std::array<Eigen::Matrix3d, kMaxHeads>& information,
+                          const std::array<Eigen::Vector3d, kMaxHeads>& turned_arcsec);
+// The same with every Δ_i zero.
 Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information);
 
