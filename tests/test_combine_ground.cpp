@@ -219,20 +219,27 @@ TEST(CombineCli, BadMountingsOrInputStopWithFileLineColumnAndWriteNothing) {
     write(dir / "in.csv", bad_input_file(b));
     write(dir / "bad.csv", "chu,qw,qx,qy,qz,sigma_cross,sigma_about\nA,1,0,0,0,1.5,10\nB,2,0,0,0,1.5,10\n");
     CliRun r = run_in("combine --in in.csv --mountings bad.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_TRUE(has(r.err, "bad.csv:3:3: the mounting of CHU B is not unit")) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
-    // Without sigmas: refused, saying what to give.
-    write(dir / "nosigma.csv", "chu,qw,qx,qy,qz\nA,1,0,0,0\n");
-    r = run_in("combine --in in.csv --mountings nosigma.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "nosigma.csv: the mountings have no sigma_cross,sigma_about")) << r.err;
+    // Without sigmas, on data too thin to estimate the noise: align's refusal, exit 2.
+    write(dir / "nosigma.csv", "chu,qw,qx,qy,qz\nA,1,0,0,0\nB,0,1,0,0\n");
+    write(dir / "thin.csv", std::string(kCorrectedHeader) + b.row(100, 'A', 0, 3) + b.row(100, 'B', 0, 3));
+    r = run_in("combine --in thin.csv --mountings nosigma.csv --out out.csv", dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_TRUE(has(r.err, "estimating the heads' noise")) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    // correct --combined cannot estimate it (the rows are not corrected yet): refused, saying what to do.
+    r = run_in("correct --in in.csv --out cor.csv --mountings nosigma.csv --combined comb.csv", dir);
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_TRUE(has(r.err, "nosigma.csv: the mountings have no sigma_cross,sigma_about")) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "cor.csv"));
+    EXPECT_FALSE(fs::exists(dir / "comb.csv"));
     // A status that is not an integer.
     host::write_mountings_file((dir / "m.csv").string(), b.m);
     write(dir / "badstatus.csv", std::string(kCorrectedHeader) + "100,A,1,0,0,0,0,1,x\n");
     r = run_in("combine --in badstatus.csv --mountings m.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_TRUE(has(r.err, "badstatus.csv:2:19: column 'status'")) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
     // --out over an input.
@@ -457,6 +464,43 @@ TEST(CombineAccuracy, TheCommandLineReportsTheErrorPerHeadSetAndSmallSteps) {
     const CliRun s = run_in("stats --combined comb.csv --truth-attitude sim.csv.attitude.csv --json > st.json", ms.dir);
     ASSERT_EQ(s.exit_code, 0) << s.err;
     EXPECT_TRUE(has(slurp(ms.dir / "st.json"), "\"full\": \"ABC\"")) << slurp(ms.dir / "st.json");
+}
+
+TEST(CombineAccuracy, WithTheNoiseEstimatedWithinFivePercentOfTheSameBound) {
+    // The true mountings without their sigmas: combine estimates the noise
+    // (align's estimator) and reports it; the error stays within 5 % of the
+    // bound of the true noise (the formal sigma of the combination with it).
+    const Mission& ms = mission();
+    MountingsFile m = host::simulated_mountings(0x7U);
+    m.sigmas = false;
+    host::write_mountings_file((ms.dir / "nosigma.csv").string(), m);
+    CliRun r = run_in("combine --in cor.csv --mountings nosigma.csv --out est.csv", ms.dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "has no sigmas: each head's noise estimated from the data")) << r.err;
+    r = run_in("combine --in cor.csv --mountings sim.csv.mountings.csv --out true.csv", ms.dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    host::CombinedStatsOptions opt;
+    opt.truth = (ms.dir / "sim.csv.attitude.csv").string();
+    opt.combined = (ms.dir / "true.csv").string();
+    const host::CombinedStats bound = host::combined_stats(opt);
+    opt.combined = (ms.dir / "est.csv").string();
+    const host::CombinedStats est = host::combined_stats(opt);
+    std::size_t checked = 0;
+    for (const host::HeadSetReport& e : est.sets) {
+        for (const host::HeadSetReport& b : bound.sets) {
+            if (b.heads != e.heads || e.with_truth < 3000) {
+                continue;
+            }
+            for (std::size_t a = 0; a < 3; ++a) {
+                EXPECT_NEAR(e.error_rms[a] / b.sigma_rms[a], 1.0, 0.05)
+                    << host::head_set_name(e.heads) << " axis " << a;
+                EXPECT_NEAR(e.sigma_rms[a] / b.sigma_rms[a], 1.0, 0.05)
+                    << host::head_set_name(e.heads) << " axis " << a;
+            }
+            ++checked;
+        }
+    }
+    EXPECT_GE(checked, 3U);
 }
 
 TEST(CombineAccuracy, StepsWithoutTheThermalStageAreLargerThanWithIt) {

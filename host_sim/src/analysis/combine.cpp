@@ -13,6 +13,7 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -141,7 +142,8 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) 
     if (!m.sigmas) {
         throw std::runtime_error(name +
                                  ": the mountings have no sigma_cross,sigma_about: give each head's noise (arcsec "
-                                 "across and about its boresight); estimating it from the data is `ascorr align`'s");
+                                 "across and about its boresight), or correct first and `ascorr combine` the "
+                                 "corrected file, which estimates it from the data");
     }
     std::uint8_t head = 0;
     const combine::MountingsProblem p = combine::check_mountings(m.mountings, &head);
@@ -519,9 +521,45 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
     return r;
 }
 
+namespace {
+
+// m with each head's noise estimated from the rows of `in` (align_rows), reported on log.
+MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in, const std::string& path,
+                                   std::ostream& log) {
+    AlignOptions ao;
+    ao.in = in;
+    ao.mountings = path;
+    const AlignReport r = align_rows(rows_of_file(in), in, m, ao);
+    MountingsFile out = m;
+    out.sigmas = true;
+    std::ostringstream o;
+    o << "ascorr combine: " << text::input_name(path)
+      << " has no sigmas: each head's noise estimated from the data (ascorr align's REML estimate, "
+      << noise_model_text(r.noise.model) << "; arcsec, +- 1 sigma):";
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!m.mountings.head[h].present) {
+            continue;
+        }
+        const HeadNoise& n = r.head[h].noise;
+        out.mountings.head[h].sigma_cross_arcsec = n.sigma_cross_arcsec;
+        out.mountings.head[h].sigma_about_arcsec = n.sigma_about_arcsec;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, " %c across %.3f +- %.3f, about %.3f +- %.3f;", head_name(h),
+                      n.sigma_cross_arcsec, n.sd_cross_arcsec, n.sigma_about_arcsec, n.sd_about_arcsec);
+        o << buf;
+    }
+    log << o.str() << '\n';
+    return out;
+}
+
+}  // namespace
+
 CombineSummary combine_file(const CombineOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
-    const MountingsFile m = read_mountings_file(opt.mountings);
+    MountingsFile m = read_mountings_file(opt.mountings);
+    if (!m.sigmas) {
+        m = with_estimated_noise(m, opt.in, opt.mountings, log);
+    }
     refuse_unusable_mountings(m, opt.mountings);
     // The first pass's messages wait: if it stops at a row out of order, the
     // second pass says them again.
