@@ -48,7 +48,7 @@ constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
                                                       "quaternion not unit",
                                                       "in no epoch"};
 
-// A row as kept between reading and combining (48 bytes): whether it is
+// A row as kept between reading and combining (48 bytes, 56 with its key): whether it is
 // usable is decided when it is read, from what needs no other row.
 struct Kept {
     double t;

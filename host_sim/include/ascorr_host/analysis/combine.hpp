@@ -25,7 +25,7 @@
 //
 // Memory: rows in time order (the usual file) are combined as they are read,
 // one epoch held. At the first row out of time order the pass stops and the
-// rows are read again, kept (48 bytes each) and sorted; a pass that cannot be
+// rows are read again, kept (56 bytes each with its epoch key) and sorted; a pass that cannot be
 // restarted (an output that is a stream, standard output or a FIFO) keeps
 // the rows from the start.
 #pragma once
