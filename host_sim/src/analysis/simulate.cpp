@@ -19,6 +19,7 @@
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
 #include "ascorr_host/formats/input_error.hpp"
@@ -34,9 +35,7 @@ namespace {
 // (index h ≥ kOwnHeads) is derived from head h − kOwnHeads (simulate.hpp).
 constexpr std::size_t kOwnHeads = head_count(kPaperHeads);
 
-// Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
-constexpr double kNoiseCrossArcsec = 1.5;
-constexpr double kNoiseAboutArcsec = 10.0;
+// Star-tracker noise of clean rows: kSimNoiseCrossArcsec, kSimNoiseAboutArcsec (simulate.hpp).
 constexpr double kFlaggedNoiseArcsec = 40.0;  // flagged solutions are bad in every axis
 // Exclusion angles from the boresight (head blinded: no solution).
 constexpr double kSunExclusionDeg = 40.0;
@@ -169,6 +168,21 @@ Eigen::Matrix3d head_mounting(int head) {
     return m;
 }
 
+MountingsFile simulated_mountings(HeadSet heads) {
+    MountingsFile m;
+    m.sigmas = true;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        combine::HeadMounting& hm = m.mountings.head[h];
+        hm.present = has_head(heads, h);
+        // The CRF is the body frame: R(q_chu_icrf) = R(q_chu_crf) R(q_crf_icrf) with
+        // R(q_chu_crf) = head_mounting(h) and R(q_crf_icrf) = R_body_icrf.
+        hm.q_chu_crf = canonical(from_eigen(Eigen::Quaterniond(head_mounting(h))));
+        hm.sigma_cross_arcsec = kSimNoiseCrossArcsec;
+        hm.sigma_about_arcsec = kSimNoiseAboutArcsec;
+    }
+    return m;
+}
+
 std::string heaters_csv(const std::vector<HeaterEvent>& events) {
     std::string s = "start,end,heater\n";
     char line[96];
@@ -218,7 +232,8 @@ std::string describe(const SimulateSummary& s) {
         o << buf;
     }
     o << "\ntruth model: " << s.truth_path << " (history: " << s.truth_history_path << ")\nfloor: " << s.floor_path
-      << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path;
+      << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path
+      << "\nmountings (true noise): " << s.mountings_path << "\ntrue CRF attitude: " << s.attitude_path;
     if (s.gap_epochs != 0) {
         o << "\nepochs without rows (--gap): " << s.gap_epochs;
     }
@@ -634,8 +649,8 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     HeadSolution out;
     out.quality = draw_quality(moon_deg, rnd);
     const bool bad = out.quality.bad;
-    const double sx = bad ? kFlaggedNoiseArcsec : kNoiseCrossArcsec;
-    const double sz = bad ? kFlaggedNoiseArcsec : kNoiseAboutArcsec;
+    const double sx = bad ? kFlaggedNoiseArcsec : kSimNoiseCrossArcsec;
+    const double sz = bad ? kFlaggedNoiseArcsec : kSimNoiseAboutArcsec;
     std::normal_distribution<double>& normal = rnd.normal;
     std::mt19937_64& rng = rnd.engine;
     const Eigen::Vector3d noise(sx * normal(rng), sx * normal(rng), sz * normal(rng));
@@ -722,12 +737,13 @@ public:
         sum_.pairs = pairs_;
     }
 
-    // Appends epoch k's rows to buf.
-    void epoch(std::size_t k, std::string& buf) {
+    // Appends epoch k's rows to buf and its true CRF attitude to attitude.
+    void epoch(std::size_t k, std::string& buf, std::string& attitude) {
         EpochState e;
         const double dt = static_cast<double>(k) * opt_.step_s;
         e.t = std::round((opt_.start_t + dt) * 1000.0) / 1000.0;  // as written
         e.orbit = orbit_.at(dt);
+        append_attitude_row(attitude, e.t, from_eigen(Eigen::Quaterniond(e.orbit.body_icrf)));
         sky_.at(e.t, e.sun, e.moon);
         double op = 0.0;
         double surv = 0.0;
@@ -778,6 +794,8 @@ public:
         sum_.floor_path = opt_.out + ".floor.json";
         sum_.floor_daily_path = opt_.out + ".floor-daily.csv";
         sum_.heaters_path = opt_.out + ".heaters.csv";
+        sum_.mountings_path = opt_.out + ".mountings.csv";
+        sum_.attitude_path = opt_.out + ".attitude.csv";
         for (const HeaterEvent& ev : heaters_.events()) {
             if (ev.start <= t_last) {
                 sum_.heaters.push_back(ev);
@@ -916,7 +934,9 @@ SimulateSummary simulate(const SimulateOptions& opt) {
                                       {"--out (truth history)", opt.out + ".truth-history.csv"},
                                       {"--out (noise floor)", opt.out + ".floor.json"},
                                       {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
-                                      {"--out (heater events)", opt.out + ".heaters.csv"}});
+                                      {"--out (heater events)", opt.out + ".heaters.csv"},
+                                      {"--out (mountings)", opt.out + ".mountings.csv"},
+                                      {"--out (true attitude)", opt.out + ".attitude.csv"}});
     refuse_bad_options(opt);
     const std::vector<Truth> truths = truth_models(opt);
     Mission mission(opt, truths);
@@ -926,22 +946,34 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     buf.reserve(2U << 20);
     buf += kSolutionsHeader;
     buf += '\n';
+    AtomicFile attitude(opt.out + ".attitude.csv");
+    std::string attitude_buf;
+    attitude_buf.reserve(2U << 20);
+    attitude_buf += kAttitudeHeader;
+    attitude_buf += '\n';
     const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
         if ((k & 4095U) == 0) {
             progress.update(static_cast<double>(k) / static_cast<double>(epochs));
         }
-        mission.epoch(k, buf);
+        mission.epoch(k, buf, attitude_buf);
         if (buf.size() > (1U << 20)) {
             out.write(buf);
             buf.clear();
         }
+        if (attitude_buf.size() > (1U << 20)) {
+            attitude.write(attitude_buf);
+            attitude_buf.clear();
+        }
     }
     out.write(buf);
+    attitude.write(attitude_buf);
     progress.done();
     const SimulateSummary sum = mission.finish(opt.start_t + static_cast<double>(epochs - 1) * opt.step_s);
     out.commit();
+    attitude.commit();
+    write_mountings_file(sum.mountings_path, simulated_mountings(opt.heads));
     write_model_file(sum.truth_path, truths.front().file);
     write_file_atomically(sum.truth_history_path, truth_history_csv(truths));
     write_file_atomically(sum.floor_path, floor_json(sum.floor, sum.pairs));
