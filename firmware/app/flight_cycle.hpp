@@ -119,8 +119,7 @@ public:
     // "applied" when two or more heads were averaged.
     void add_combined(std::uint32_t cycle, const combine::CombinedAttitude<Scalar>& a) noexcept {
         const auto st = static_cast<StatusBits>(a.status | (static_cast<unsigned>(a.used) << 8U));
-        add_record(cycle, kCombined, {a.q_crf_icrf, st},
-                   (a.status & combine::combined_status::kTwoOrMoreHeads) != 0U);
+        add_record(cycle, kCombined, {a.q_crf_icrf, st}, (a.status & combine::combined_status::kTwoOrMoreHeads) != 0U);
     }
 
     struct Head {

@@ -31,6 +31,13 @@
 //                        becomes the estimator's, active from the next epoch)
 //   kCalibReportRequest → kCalibReport (the estimator's report)
 //   kCalibModelRequest → kCalibModel (one head of the active model)
+//   kMountingLoad      → kAck (a head's mounting staged; with `build`, the
+//                        staged mountings become the combiner's, refused with
+//                        kBadPayload when not usable: combine::check_mountings)
+//   kCombineRequest    → kCombined: the solutions corrected since the last
+//                        request combined into the bench's attitude (the
+//                        epoch pipeline's stage 6; without mountings built,
+//                        status 8)
 //   broken frame       → kNak with the FrameError, so the host resends at once
 //   unknown type       → kAck kUnknownType
 // A request whose sequence number equals the last one served is a duplicate
@@ -203,7 +210,22 @@ private:
                 emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
                 return;
             }
+            case MessageType::kMountingLoad:
+                update<MountingLoad>(
+                    f, sink, [this](const MountingLoad& m) { load_mounting(m); },
+                    [this](const MountingLoad& m) { return m.build == 0U || buildable(m); });
+                return;
+            case MessageType::kCombineRequest: {
+                if (f.length != 0U) {
+                    ack(f.seq, AckResult::kBadPayload, sink);
+                    return;
+                }
+                std::uint8_t p[kMaxPayload];
+                emit(MessageType::kCombined, f.seq, p, encode(close_epoch(), p), sink, true);
+                return;
+            }
             case MessageType::kHello:
+            case MessageType::kCombined:
             case MessageType::kCalibReport:
             case MessageType::kCalibModel:
             case MessageType::kSolutionOut:
@@ -270,6 +292,42 @@ private:
         const std::uint32_t version =
             pipeline_.calibrating() && in_epoch && pipeline_.model() != nullptr ? pipeline_.version() : kNoModelVersion;
         return {s.id, s.head, c.status, c.q_chu_icrf, meter.cost, version};
+    }
+
+    static combine::HeadMounting mounting_of(const MountingLoad& m) noexcept {
+        return {m.present == 1U, m.q_chu_crf, m.sigma_cross_arcsec, m.sigma_about_arcsec};
+    }
+
+    // Whether the staged mountings with m's head are ones the combiner takes.
+    bool buildable(const MountingLoad& m) const noexcept {
+        combine::Mountings trial = staged_mountings_;
+        trial.head[m.head] = mounting_of(m);
+        std::uint8_t head = kUnknownHead;
+        return combine::check_mountings(trial, &head) == combine::MountingsProblem::kNone;
+    }
+
+    // Stages m's head; with `build`, the combiner's tables from the staged
+    // mountings (in place: no 5-KiB temporary on the stack).
+    void load_mounting(const MountingLoad& m) noexcept {
+        staged_mountings_.head[m.head] = mounting_of(m);
+        if (m.build == 1U) {
+            new (&combiner_) combine::Combiner<T>(staged_mountings_);
+            pipeline_.use_combiner(&combiner_);
+        }
+    }
+
+    // kCombineRequest: stage 6 of the pipeline over the solutions since the
+    // last request, and its cost.
+    Combined<T> close_epoch() noexcept {
+        struct WindowMeter {
+            CycleCounter& counter;
+            std::uint32_t start;
+            std::uint32_t cost;
+            std::uint32_t now() noexcept { return start = counter(); }
+            void add(pipeline::Stage /*stage*/, std::uint32_t /*start*/) noexcept { cost = counter() - start; }
+        } meter{counter_, 0U, 0U};
+        const combine::CombinedAttitude<T> a = pipeline_.close(meter);
+        return {a.status, a.used, a.left_out, a.inconsistent, a.q_crf_icrf, meter.cost};
     }
 
     // Head h of the estimator's active model, as kCalibModel.
@@ -360,6 +418,10 @@ private:
     ModelCoefficients staged_{};
     // Before kCalibStart: the uploaded model (use_model, in the constructor).
     pipeline::EpochPipeline<T> pipeline_{};
+    // The combination (kMountingLoad with build): none until then.
+    static_assert(std::is_trivially_destructible_v<combine::Combiner<T>>, "rebuilt in place");
+    combine::Mountings staged_mountings_{};
+    combine::Combiner<T> combiner_{combine::Mountings{}};
 };
 
 }  // namespace ascorr::link
