@@ -353,6 +353,23 @@ host::RowSource source_of(const Rows& r) {
     };
 }
 
+bool model_initialised(const py::handle& obj) {
+    return py::isinstance<host::ModelFile>(obj) &&
+           reinterpret_cast<py::detail::instance*>(obj.ptr())->get_value_and_holder().holder_constructed();
+}
+
+const host::ModelFile& model_of(const py::handle& obj, const std::string& what) {
+    if (!py::isinstance<host::ModelFile>(obj)) {
+        throw py::type_error(what + ": expected an ascorr.Model, got " + value_text(obj));
+    }
+    if (!model_initialised(obj)) {
+        throw py::type_error(what +
+                             ": an ascorr.Model that was never initialised (Model.__new__ without __init__); make "
+                             "models with read_model(), fit() or Model(coefficients)");
+    }
+    return obj.cast<const host::ModelFile&>();
+}
+
 const host::ModelFile* model_arg(const py::object& model) {
     if (model.is_none()) {
         return nullptr;
@@ -361,7 +378,7 @@ const host::ModelFile* model_arg(const py::object& model) {
         bad_argument("model", "expected an ascorr.Model (read_model() or fit()) or None, got " +
                                   std::string(py::str(model.get_type())));
     }
-    return &model.cast<const host::ModelFile&>();
+    return &model_of(model, "argument 'model'");
 }
 
 }  // namespace ascorr::python

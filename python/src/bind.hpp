@@ -78,6 +78,13 @@ std::string path_arg(const py::handle& x, const char* name);
 host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
 // An ascorr.Model or None (nullptr).
 const host::ModelFile* model_arg(const py::object& model);
+// obj, an ascorr.Model, as the host's model; TypeError naming `what` when it
+// is none or its __init__ never ran (model_initialised: false). pickle calls
+// Model.__new__ then __setstate__, and anyone may call __new__ alone: pybind11
+// would then hand a method raw memory (allocated on first use, never
+// constructed), so every use of a Model goes through here.
+bool model_initialised(const py::handle& obj);
+const host::ModelFile& model_of(const py::handle& obj, const std::string& what);
 
 std::string shape_text(const py::array& a);
 py::array as_numpy(const py::handle& obj);
