@@ -258,7 +258,10 @@ def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]:
     ones); absent t_chu/t_029/t_032, vx/vy/vz or confidence are NaN and absent
     flags 0, as in a file without them; missing values (NaN, None, pd.NA) are
     NaN, except in chu, flags and status, where they are refused. chu holds
-    head letters (strings) or head indices (integers); "status" is kept when
+    head letters (strings) or head indices; flags, head indices and status are
+    integers, or floats that are all integral, as correct() takes them (0.9 is
+    refused, never truncated); dates (datetime64) are refused, never read as
+    seconds since J2000. "status" is kept when
     present (a corrected file); every other column goes under "extra" as text,
     as read_solutions() keeps the columns it does not know. Rows are taken in
     the frame's order; its index only names rows in messages."""

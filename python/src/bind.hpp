@@ -98,6 +98,19 @@ Doubles time_array(const py::handle& obj, const std::string& name);
 std::string head_letter_range();
 std::string head_index_range();
 
+// Integers given as an array (flags; chu as head indices), one rule with the
+// solutions reader: an integer dtype, or floats that are all integral (pandas
+// makes an integer column float64 when it held a missing value); every value
+// within [lo, hi]. Otherwise the first row that is not, and why, in the
+// reader's words (why_not_an_integer: "'0.9' ..." names the range). The dtype
+// must be an integer or a float one (the caller checks).
+struct Integers {
+    std::vector<long long> values;
+    py::ssize_t bad_row = -1;
+    std::string why;
+};
+Integers integers_of(const py::array& a, long long lo, long long hi);
+
 // The columns of a set of solutions, validated, as the core's caller needs them.
 struct Rows {
     py::ssize_t n = 0;

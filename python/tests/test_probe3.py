@@ -49,3 +49,81 @@ def test_an_uninitialised_model_raises_type_error_on_every_use(ex):
     # __init__ after __new__, and pickling (which is __new__ then __setstate__), still work.
     m.__init__(ascorr.read_model(str(MODEL)).coefficients, "ABC")
     assert m == ascorr.read_model(str(MODEL)) and pickle.loads(pickle.dumps(m)) == m
+
+
+# ---- 9 and 19: integers by one rule (flags, head indices, status)
+
+def test_flags_beyond_long_long_name_the_range_as_the_command_line(ex, tmp_path, exe):
+    n = len(ex["t"])
+    for bad in (2**63, 2**64 - 1):
+        flags = np.zeros(n, np.uint64)
+        flags[2] = bad
+        with pytest.raises(ValueError) as e:
+            ascorr.stats(ex["t"], ex["chu"], ex["q"], ex["temps"], ex["v"], flags, ex["confidence"])
+        assert str(e.value) == (f"argument 'flags': row 2: '{bad}' is out of range: expected an integer in "
+                                f"[0, {LLONG_MAX}]")
+        assert "negative" not in str(e.value)
+    # The command line's words for the same value in a file.
+    text = SOLUTIONS.read_text().splitlines()
+    header = text[0].split(",")
+    row = text[1].split(",")
+    row[header.index("flags")] = str(2**63)
+    bad_file = tmp_path / "flags.csv"
+    bad_file.write_text("\n".join([text[0], ",".join(row)]) + "\n")
+    r = subprocess.run([exe, "stats", "--in", str(bad_file)], capture_output=True, text=True)
+    assert r.returncode != 0 and f"'{2**63}' is out of range: expected an integer in [0, {LLONG_MAX}]" in r.stderr
+    # Negative flags: the same words.
+    flags = np.zeros(n, np.int64)
+    flags[1] = -1
+    with pytest.raises(ValueError, match=r"row 1: '-1' is out of range: expected an integer in \[0, "):
+        ascorr.write_solutions(str(tmp_path / "x.csv"), ex["t"], ex["chu"], ex["q"], flags=flags)
+
+
+def test_flags_and_head_indices_as_floats_must_be_integral(ex):
+    n = len(ex["t"])
+    args = (ex["t"], ex["chu"], ex["q"], ex["temps"], ex["v"])
+    # Integral floats (pandas' fillna leaves float64) are the integers they hold.
+    as_float = ex["flags"].astype(np.float64)
+    assert ascorr.stats(*args, as_float, ex["confidence"]) == ascorr.stats(*args, ex["flags"], ex["confidence"])
+    for bad in (0.9, 4.9, 2.5, np.nan, np.inf, -1.0):
+        flags = np.zeros(n)
+        flags[3] = bad
+        with pytest.raises(ValueError, match=r"argument 'flags': row 3: .*expected an integer in \[0, "):
+            ascorr.stats(*args, flags, ex["confidence"])
+    indices = np.array([ascorr.HEADS.index(c) for c in ex["chu"]])
+    a = ascorr.correct(ex["t"], indices.astype(np.float64), ex["q"], ex["temps"], ex["v"])
+    b = ascorr.correct(ex["t"], ex["chu"], ex["q"], ex["temps"], ex["v"])
+    assert a[0].tobytes() == b[0].tobytes() and np.array_equal(a[1], b[1])
+    half = indices.astype(np.float64)
+    half[0] = 0.5
+    with pytest.raises(ValueError, match=r"argument 'chu': row 0: expected an integer .*got '0.5' \(a head index\)"):
+        ascorr.correct(ex["t"], half, ex["q"], ex["temps"], ex["v"])
+
+
+@pytest.mark.parametrize("column, values, message", [
+    ("flags", [0.9, 4.9, 2.5], "column 'flags': row 0: expected an integer in [0, 9223372036854775807], got '0.9'"),
+    ("flags", [0.0, 4.9, 2.0], "column 'flags': row 1: expected an integer in [0, 9223372036854775807], got '4.9'"),
+    ("flags", np.array([0, 2**63, 1], np.uint64),
+     "column 'flags': row 1: '9223372036854775808' is out of range: expected an integer in [0, 9223372036854775807]"),
+    ("chu", [0.0, 1.0, 2.5], "column 'chu': row 2: expected an integer"),
+    ("status", [3.0, 2.5, 3.0], "column 'status': row 1: expected an integer in [0, 65535], got '2.5'"),
+    ("t", pandas.to_datetime(["2020-01-01", "2020-01-02", "2020-01-03"]),
+     "column 't': dtype datetime64[ns] is not taken: times are float64 seconds since J2000.0 TT"),
+    ("qw", [True, False, True], "column 'qw': expected numbers, got dtype bool"),
+    ("chu", [1.5, "B", "C"], "column 'chu': expected head letters (strings) or head indices (integers)"),
+])
+def test_from_frame_takes_integers_as_the_arrays_rule_does(ex, column, values, message):
+    df = ascorr.to_frame(ex).iloc[:3].copy()
+    df[column] = values
+    with pytest.raises(ValueError) as e:
+        ascorr.from_frame(df)
+    assert message in str(e.value)
+
+
+def test_from_frame_takes_integral_floats_as_integers(ex):
+    df = ascorr.to_frame(ex)
+    df["flags"] = df["flags"].astype(np.float64)
+    df["chu"] = [float(ascorr.HEADS.index(c)) for c in ex["chu"]]
+    f = ascorr.from_frame(df)
+    assert f["flags"].dtype == np.int64 and np.array_equal(f["flags"], ex["flags"])
+    assert f["chu"].dtype == np.int64 and [ascorr.HEADS[i] for i in f["chu"]] == list(ex["chu"])
