@@ -4,6 +4,7 @@ status: 9 and 19), datetime64 times (9), near-miss column names (17), the
 locale (8) and the selection of clean rows (12)."""
 
 import pickle
+import re
 import subprocess
 
 import numpy as np
@@ -127,3 +128,99 @@ def test_from_frame_takes_integral_floats_as_integers(ex):
     f = ascorr.from_frame(df)
     assert f["flags"].dtype == np.int64 and np.array_equal(f["flags"], ex["flags"])
     assert f["chu"].dtype == np.int64 and [ascorr.HEADS[i] for i in f["chu"]] == list(ex["chu"])
+
+
+# ---- 8: the locale changes nothing
+
+def comma_decimal_locale(tmp_dir):
+    """The name of a locale whose decimal point is a comma, set for LC_ALL: the
+    system's de_DE/fr_FR if it has one, else de_DE compiled with localedef from
+    the `locales` package's definitions (toolchain/debian-packages.txt) into
+    tmp_dir (LOCPATH), as test_formats does. None when neither can be had."""
+    import locale
+    import os
+    import shutil
+
+    names = ("de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8")
+    for name in names:
+        try:
+            locale.setlocale(locale.LC_ALL, name)
+            return name
+        except locale.Error:
+            pass
+    if shutil.which("localedef") is None:
+        return None
+    target = tmp_dir / "de_DE.UTF-8"
+    r = subprocess.run(["localedef", "-i", "de_DE", "-f", "UTF-8", str(target)], capture_output=True, text=True)
+    if not target.is_dir():
+        return None
+    os.environ["LOCPATH"] = str(tmp_dir)  # glibc reads it at each setlocale
+    try:
+        locale.setlocale(locale.LC_ALL, "de_DE.UTF-8")
+        return "de_DE.UTF-8"
+    except locale.Error:
+        return None
+
+
+@pytest.fixture
+def comma_locale(tmp_path):
+    """Runs the test under a comma-decimal locale (LC_ALL); yields the locale
+    the interpreter had (its LC_CTYPE from the environment, the rest "C"),
+    which is restored afterwards (plain "C" would make open() ASCII)."""
+    import locale
+    import os
+
+    saved_locpath = os.environ.get("LOCPATH")
+    original = locale.setlocale(locale.LC_ALL)
+    try:
+        name = comma_decimal_locale(tmp_path)
+        if name is None:
+            pytest.skip("NO COMMA-DECIMAL LOCALE on this machine: install the Debian package `locales` "
+                        "(toolchain/debian-packages.txt); CI has it")
+        assert locale.localeconv()["decimal_point"] == ",", name
+        yield original
+    finally:
+        locale.setlocale(locale.LC_ALL, original)
+        if saved_locpath is None:
+            os.environ.pop("LOCPATH", None)
+        else:
+            os.environ["LOCPATH"] = saved_locpath
+
+
+@pytest.fixture(scope="module")
+def short_mission(exe, tmp_path_factory):
+    """20 simulated days, one solution per head every 120 s (enough for a fit)."""
+    path = tmp_path_factory.mktemp("mission3") / "mission.csv"
+    r = subprocess.run([exe, "simulate", "--out", str(path), "--days", "20", "--step", "120"], capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    return ascorr.read_solutions(str(path))
+
+
+def everything_written(d, tmp_path, tag):
+    """Every text the library writes for Python from the arrays d: the model file
+    (to_csv, write), the fit report, the stats table, a refusal's message."""
+    args = (d["t"], d["chu"], d["q"], d["temps"], d["v"], d["flags"], d["confidence"])
+    model, report = ascorr.fit(*args, min_days=19)
+    path = tmp_path / f"model-{tag}.csv"
+    model.write(str(path))
+    assert ascorr.read_model(str(path)) == model  # read_model refused '-4,67e-01'
+    s = ascorr.stats(*args, model=model)
+    try:
+        ascorr.fit(*args, min_days=25.5)
+    except ascorr.FitRefused as e:
+        refusal = str(e)
+    return {"to_csv": model.to_csv(), "write": path.read_text(), "fit report": report["text"],
+            "stats table": s["table"], "fit refusal": refusal}
+
+
+def test_a_comma_decimal_locale_changes_nothing(short_mission, tmp_path, comma_locale):
+    import locale
+
+    under_comma = everything_written(short_mission, tmp_path, "comma")
+    locale.setlocale(locale.LC_ALL, comma_locale)
+    assert locale.localeconv()["decimal_point"] == "."
+    under_c = everything_written(short_mission, tmp_path, "c")
+    for what, text in under_c.items():
+        assert re.search(r"\d\.\d", text), what  # the control: each text holds decimal numbers
+        assert under_comma[what] == text, what

@@ -15,6 +15,7 @@
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -66,7 +67,7 @@ std::string why_no_epochs(const HeadPair& pair, const StatsOptions& opt, std::si
     const bool period = opt.from.has_value() || opt.to.has_value();
     const auto t = [](double x) {
         char buf[40];
-        std::snprintf(buf, sizeof buf, "%.17g", x);
+        text::c_snprintf(buf, sizeof buf, "%.17g", x);
         return std::string(buf);
     };
     const std::string in_period = period ? " in [" + (opt.from ? t(*opt.from) : std::string("-inf")) + ", " +
@@ -244,8 +245,8 @@ std::string stats_table(const StatsResult& r) {
     std::ostringstream o;
     o << "IBA RMS about the mean, arcsec, over clean epochs (after 200 s smoothing in brackets)\n";
     char buf[200];
-    std::snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
-                  "thermal");
+    text::c_snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
+                     "thermal");
     o << buf;
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
         std::string cells[kStages];
@@ -254,12 +255,12 @@ std::string stats_table(const StatsResult& r) {
                 cells[s] = "-";
             } else {
                 char c[64];
-                std::snprintf(c, sizeof c, "%6.2f (%5.2f)", r.rms[p][s].rms, r.rms[p][s].rms_smoothed);
+                text::c_snprintf(c, sizeof c, "%6.2f (%5.2f)", r.rms[p][s].rms, r.rms[p][s].rms_smoothed);
                 cells[s] = c;
             }
         }
-        std::snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p], cells[0].c_str(),
-                      cells[1].c_str(), cells[2].c_str());
+        text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p],
+                         cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
         o << buf;
     }
     return o.str();
@@ -269,7 +270,7 @@ std::string stats_json(const StatsResult& r) {
     std::ostringstream o;
     const auto num = [](double x) {
         char c[32];
-        std::snprintf(c, sizeof c, "%.6f", x);
+        text::c_snprintf(c, sizeof c, "%.6f", x);
         return std::string(c);
     };
     o << "{\"pairs\": {";
