@@ -200,6 +200,9 @@ def from_frame(frame):
     import pandas
 
     columns = set(frame.columns)
+    near_miss = _ascorr._near_miss([str(c) for c in frame.columns])
+    if near_miss is not None:  # the file reader's rule and words
+        raise ValueError(f"from_frame: {near_miss[1]}")
     required = ["t", "chu", *_COLUMNS["q"]]
     missing = [c for c in required if c not in columns]
     if missing:

@@ -224,3 +224,39 @@ def test_a_comma_decimal_locale_changes_nothing(short_mission, tmp_path, comma_l
     for what, text in under_c.items():
         assert re.search(r"\d\.\d", text), what  # the control: each text holds decimal numbers
         assert under_comma[what] == text, what
+
+
+# ---- 17: a column that looks like one ascorr reads
+
+@pytest.mark.parametrize("known, written", [("t_chu", "T_CHU"), ("t_chu", "tchu"), ("confidence", "confidance"),
+                                            ("vx", "VX")])
+def test_a_near_miss_column_is_refused_alike_everywhere(exe, ex, tmp_path, known, written):
+    text = SOLUTIONS.read_text()
+    header, body = text.split("\n", 1)
+    names = header.split(",")
+    names[names.index(known)] = written
+    path = tmp_path / "misspelt.csv"
+    path.write_text(",".join(names) + "\n" + body)
+    column = 1 + sum(len(n) + 1 for n in names[:names.index(written)])
+    words = (f"column '{written}' is not a column ascorr reads, but looks like '{known}', which the header lacks "
+             f"(column names are case-sensitive, docs/contract.md, section 3): rename it '{known}', or give it a "
+             f"name unlike the columns ascorr reads")
+    out = tmp_path / "out.csv"
+    r = subprocess.run([exe, "correct", "--in", str(path), "--model", str(MODEL), "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode != 0 and f"{path}:1:{column}: {words}" in r.stderr, r.stderr
+    assert not out.exists()
+    with pytest.raises(ascorr.InputError) as e:
+        ascorr.read_solutions(str(path))
+    assert f"{path}:1:{column}: {words}" in str(e.value)
+    with pytest.raises(ValueError) as e:
+        ascorr.from_frame(ascorr.to_frame(ex).rename(columns={known: written}))
+    assert str(e.value) == f"from_frame: {words}"
+    # Control: the same file with the column as the contract spells it is read.
+    path.write_text(text)
+    assert len(ascorr.read_solutions(str(path))["t"]) == len(ex["t"])
+
+
+def test_unknown_columns_unlike_the_known_ones_are_kept(ex, tmp_path):
+    df = ascorr.to_frame(ex).assign(t_028=1.0, x=2.0, note="n")
+    assert set(ascorr.from_frame(df)["extra"]) == {"t_028", "x", "note"}
