@@ -260,3 +260,57 @@ def test_a_near_miss_column_is_refused_alike_everywhere(exe, ex, tmp_path, known
 def test_unknown_columns_unlike_the_known_ones_are_kept(ex, tmp_path):
     df = ascorr.to_frame(ex).assign(t_028=1.0, x=2.0, note="n")
     assert set(ascorr.from_frame(df)["extra"]) == {"t_028", "x", "note"}
+
+
+# ---- 12: a confidence that is not given is not clean, everywhere
+
+def cli_json(exe, *args):
+    r = subprocess.run([exe, *map(str, args)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return r
+
+
+def test_a_missing_confidence_is_not_clean_anywhere(exe, short_mission, tmp_path):
+    import json
+
+    d = dict(short_mission)
+    n = len(d["t"])
+    d["confidence"] = d["confidence"].copy()
+    gone = np.zeros(n, bool)
+    gone[::7] = True
+    gone &= (d["flags"] == 0) & (d["confidence"] <= 5)  # rows that were clean but for their confidence
+    assert gone.sum() > 100
+    d["confidence"][gone] = np.nan
+    args = (d["t"], d["chu"], d["q"], d["temps"], d["v"], d["flags"], d["confidence"])
+    empty = tmp_path / "empty.csv"  # NaN confidences are written as empty fields
+    ascorr.write_solutions(str(empty), *args)
+    header, *rows = empty.read_text().splitlines()
+    col = header.split(",").index("confidence")
+    nan = tmp_path / "nan.csv"
+    nan.write_text("\n".join([header] + [",".join(f if j != col or f else "nan" for j, f in
+                                                  enumerate(row.split(","))) for row in rows]) + "\n")
+    assert nan.read_text().count(",nan") >= gone.sum()
+
+    s = ascorr.stats(*args)
+    for path in (empty, nan):
+        j = json.loads(cli_json(exe, "stats", "--in", path, "--json").stdout)
+        assert {p: v["n"] for p, v in j["pairs"].items()} == {p: v["n"] for p, v in s["pairs"].items()}, path
+    clean = ascorr.stats(*args[:5], d["flags"], short_mission["confidence"])
+    assert all(s["pairs"][p]["n"] < clean["pairs"][p]["n"] for p in s["pairs"])  # the rows were left out
+
+    model, report = ascorr.fit(*args, min_days=19)
+    dropped = report["dropped"]["confidence > 5 or missing"]
+    assert dropped >= gone.sum()
+    for path in (empty, nan):
+        r = cli_json(exe, "fit", "--in", path, "--out", tmp_path / "m.csv", "--min-days", 19)
+        text = r.stdout + r.stderr
+        assert f"confidence > 5 or missing {dropped}" in text, text
+        assert ascorr.read_model(str(tmp_path / "m.csv")) == model
+
+    q, status, history = ascorr.self_calibrate(*args)
+    assert history, "no model adopted: the comparison would be empty"
+    for path in (empty, nan):
+        out = tmp_path / "sc.csv"
+        cli_json(exe, "correct", "--in", path, "--self-calibrate", "--out", out)
+        got = ascorr.read_solutions(str(out))["status"]
+        assert np.array_equal(got, status), path

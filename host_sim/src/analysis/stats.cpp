@@ -11,6 +11,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
@@ -21,7 +22,7 @@
 namespace ascorr::host {
 
 bool is_clean(const SolutionRecord& rec) noexcept {
-    return rec.flags == 0 && rec.confidence <= 5.0 && rec.temperature_present[0] && rec.temperature_present[1] &&
+    return rec.flags == 0 && confidence_clean(rec) && rec.temperature_present[0] && rec.temperature_present[1] &&
            rec.temperature_present[2] && rec.velocity_components == 3;
 }
 
@@ -37,7 +38,7 @@ struct HeadTally {
     std::size_t rows = 0;  // in [from, to]
     std::size_t clean = 0;
     std::size_t flagged = 0;
-    std::size_t low_confidence = 0;  // confidence > 5 or NaN
+    std::size_t low_confidence = 0;  // confidence above 5 or missing (confidence_clean)
     std::size_t no_temperatures = 0;
     std::size_t no_velocity = 0;
     std::size_t not_corrected = 0;
@@ -46,7 +47,7 @@ struct HeadTally {
 std::string head_without_clean_rows(char name, const HeadTally& h) {
     std::string s = std::string("none of CHU ") + name + "'s " + std::to_string(h.rows) + " rows is clean (";
     const std::pair<std::size_t, const char*> parts[] = {{h.flagged, "flags set"},
-                                                         {h.low_confidence, "confidence above 5 or nan"},
+                                                         {h.low_confidence, "confidence above 5 or missing"},
                                                          {h.no_temperatures, "temperatures missing"},
                                                          {h.no_velocity, "velocity missing"},
                                                          {h.not_corrected, "not corrected by the core"}};
@@ -167,7 +168,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         HeadTally& tally = heads[rec.head];
         ++tally.rows;
         tally.flagged += rec.flags != 0 ? 1U : 0U;
-        tally.low_confidence += !(rec.confidence <= 5.0) ? 1U : 0U;  // as is_clean
+        tally.low_confidence += !confidence_clean(rec) ? 1U : 0U;  // as is_clean
         tally.no_temperatures +=
             !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
         tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
