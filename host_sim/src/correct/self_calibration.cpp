@@ -16,6 +16,7 @@
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -283,14 +284,14 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                 continue;
             }
             for (std::size_t a = 0; a < kModelAxes; ++a) {
-                std::snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version, head_name(static_cast<std::uint8_t>(h)),
-                              kAxisNames[a]);
+                text::c_snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version,
+                                 head_name(static_cast<std::uint8_t>(h)), kAxisNames[a]);
                 out += buf;
                 for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
-                    std::snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
+                    text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                std::snprintf(buf, sizeof buf, ",%08x\n", m.crc);
+                text::c_snprintf(buf, sizeof buf, ",%08x\n", m.crc);
                 out += buf;
             }
         }
@@ -306,15 +307,17 @@ std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
     const calib::EstimatorReport& r = s.report;
-    std::snprintf(buf, sizeof buf,
-                  "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
-                  "%u, held back %u); %zu model(s) active in turn",
-                  s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
+    text::c_snprintf(
+        buf, sizeof buf,
+        "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
+        "%u, held back %u); %zu model(s) active in turn",
+        s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
     o << buf;
     if (r.has_active) {
-        std::snprintf(buf, sizeof buf,
-                      "; active version %u (crc32c %08x), residual RMS %.3f\" over the recent orbits, condition %.1f",
-                      r.active_version, r.active_crc, r.residual_rms_arcsec, r.condition);
+        text::c_snprintf(
+            buf, sizeof buf,
+            "; active version %u (crc32c %08x), residual RMS %.3f\" over the recent orbits, condition %.1f",
+            r.active_version, r.active_crc, r.residual_rms_arcsec, r.condition);
         o << buf;
     } else {
         o << "; no model adopted";

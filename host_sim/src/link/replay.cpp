@@ -36,6 +36,7 @@
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_link/server.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -167,7 +168,7 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
         return {};
     }
     char buf[64];
-    std::snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
+    text::c_snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
     return buf;
 }
 
@@ -198,8 +199,8 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     if (!difference.empty()) {
         if (++sum.history_mismatches <= kMaxCalibMessages) {
             char buf[200];
-            std::snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
-                          mine.crc);
+            text::c_snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
+                             mine.crc);
             log << "ascorr replay: the target's " << buf << difference << "\n";
         }
     }
@@ -666,8 +667,8 @@ void check_link_image(const std::string& path, const QemuTarget& board) {
     const std::uint32_t entry = u32(24);
     if (entry >= kCodeMemoryBytes) {
         char buf[120];
-        std::snprintf(buf, sizeof buf, "entry point 0x%08x is outside the board's code memory [0, 0x%x)", entry,
-                      kCodeMemoryBytes);
+        text::c_snprintf(buf, sizeof buf, "entry point 0x%08x is outside the board's code memory [0, 0x%x)", entry,
+                         kCodeMemoryBytes);
         throw std::runtime_error(where + buf);
     }
 }
@@ -848,18 +849,18 @@ std::string disagreement(const ReplaySummary& s) {
 
 std::string to_json(const ReplaySummary& s) {
     char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
-                  "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
-                  "\"injected_faults\": %zu",
-                  s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
-                  s.instructions_per_solution, s.restarts, s.injected);
+    text::c_snprintf(buf, sizeof buf,
+                     "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
+                     "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
+                     "\"injected_faults\": %zu",
+                     s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
+                     s.instructions_per_solution, s.restarts, s.injected);
     std::string out = buf;
     if (s.self_calibrate) {
-        std::snprintf(buf, sizeof buf,
-                      ", \"self_calibration\": {\"models\": %zu, \"version_mismatches\": %zu, "
-                      "\"history_mismatches\": %zu, \"report_matches\": %s}",
-                      s.models, s.version_mismatches, s.history_mismatches, s.report_matches ? "true" : "false");
+        text::c_snprintf(buf, sizeof buf,
+                         ", \"self_calibration\": {\"models\": %zu, \"version_mismatches\": %zu, "
+                         "\"history_mismatches\": %zu, \"report_matches\": %s}",
+                         s.models, s.version_mismatches, s.history_mismatches, s.report_matches ? "true" : "false");
         out += buf;
     }
     if (s.combined) {
