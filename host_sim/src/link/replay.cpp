@@ -864,9 +864,9 @@ std::string to_json(const ReplaySummary& s) {
         out += buf;
     }
     if (s.combined) {
-        std::snprintf(buf, sizeof buf,
-                      ", \"combined\": {\"epochs\": %zu, \"mismatches\": %zu, \"instructions_per_epoch\": %.1f}",
-                      s.combined_epochs, s.combined_mismatches, s.combination_instructions_per_epoch);
+        text::c_snprintf(buf, sizeof buf,
+                         ", \"combined\": {\"epochs\": %zu, \"mismatches\": %zu, \"instructions_per_epoch\": %.1f}",
+                         s.combined_epochs, s.combined_mismatches, s.combination_instructions_per_epoch);
         out += buf;
     }
     return out + "}";
