@@ -8,7 +8,7 @@ components into CHU components; velocities km/s; angles arcsec.
 Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame, from_frame. Classes: Model. Exceptions:
 InputError and FitRefused (both ValueError). HEADS: the head letters in
-index order (from the core's ascorr/heads.hpp).
+index order (from the core's ascorr/core/heads.hpp).
 
 Arguments: a wrong value raises ValueError "argument 'NAME': expected ..., got
 ..."; a missing or unknown argument raises TypeError naming it. Paths are str

@@ -12,7 +12,7 @@ _Real = npt.ArrayLike  # any real dtype; float64 C-contiguous is used in place
 _Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pathlib.Path)
 
 __version__: str  # project(VERSION) of the CMake build
-HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
+HEADS: str  # the head letters in index order, from the core (ascorr/core/heads.hpp)
 
 class InputError(ValueError):
     """A malformed input file or rows (a ValueError); the message starts with file:line:column."""

@@ -1,7 +1,7 @@
 // ascorr_host/formats/embedded_model.hpp: the paper's Table 2 (Swarm Alpha), built in.
 //
 // The default truth of `ascorr simulate`, so that the main job needs no file:
-// the core's ascorr/table2.hpp (the one copy in code) as a model file's
+// the core's ascorr/core/table2.hpp (the one copy in code) as a model file's
 // contents. Table2.* (tests/test_facts.cpp) checks that against the contract's
 // tests/data/model_table2.csv and host_sim/data/model_table2.csv.
 #pragma once
