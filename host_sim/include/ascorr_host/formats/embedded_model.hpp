@@ -12,17 +12,7 @@
 namespace ascorr::host {
 
 inline ModelFile table2_model() {
-    ModelFile m;
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        m.present[h] = kTable2.present[h];
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t i = 0; i < kModelTerms; ++i) {
-                m.coefficients[h][a][i] = kTable2.coefficient[h][a][i];
-            }
-        }
-    }
-    m.quadratic = false;  // Table 2 is linear
-    return m;
+    return model_file_of(kTable2);  // linear, as Table 2
 }
 
 }  // namespace ascorr::host
