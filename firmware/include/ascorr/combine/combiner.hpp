@@ -11,11 +11,14 @@
 //    whose noise is σc across and σa about their boresight;
 //  - q_crf_icrf has w ≥ 0; both signs of every input are the same attitude.
 //
-// Per epoch, for n heads: n quaternion products (the mountings), n − 1
-// half-angle differences to the reference, n − 1 gain products (3 × 3), n
-// gate statistics (six products and three squares), one quaternion update and
-// one renormalisation (a Newton step: no division, no square root). Every
-// table is built at construction in double (subset_tables.hpp).
+// Per epoch, for n heads (the usual epoch; the vote and the gate's rounds
+// only when a head is off): n quaternion products (the mountings), n − 1
+// half-angle differences to the reference, n − 1 gain products (3 × 3), per
+// head a quick gate (‖e‖² against a bound of the gate, three squares; the full
+// statistic, six products and three squares, only above it), one quaternion
+// update and one renormalisation (a Newton step: no division, no square
+// root). Every table is built at construction in double (subset_tables.hpp).
+// Instructions per epoch of three heads: docs/figures.md.
 //
 // Which heads are averaged (in this order):
 //  1. Left out, status 4 (not `inconsistent`): an entry whose head index is no
@@ -540,6 +543,10 @@ CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vec
         out.used = e.group == (1U << e.n) - 1U ? e.heads : heads_of(e, e.group);
         const Quaternion<T>& ref = e.c[e.ref].q;
         const Vector3<T> h = residual(est, bias_[out.used]);
+        // d = (0, h) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖h‖²
+        // (+ ref's own ≤ 1e-6): within Q30's range of renormalized_sum for any
+        // h of the accumulator's range (|hᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
+        // unit to 2⁻³⁰ for ‖h‖ ≤ 0.033 rad, which the gates keep it far below.
         out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(h, ref)));
         out.inconsistent = e.inconsistent;
     } else {
