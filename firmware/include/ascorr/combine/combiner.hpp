@@ -164,6 +164,7 @@ private:
 
     void build(const Mountings& m, const CombinerConfig& cfg) noexcept;
     bool build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept;
+    bool build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept;
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
@@ -244,6 +245,28 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
     }
 }
 
+// The gate factor of head h in subset s (|s| ≥ 2), its quick bound, in T;
+// false when a matrix is singular or a factor beyond kMaxGateFactor.
+template <typename T>
+bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept {
+    using F = CombineFormats<T>;
+    Matrix3 u{};
+    if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
+        return false;
+    }
+    for (const auto& row : u.m) {
+        for (double x : row) {
+            if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
+                return false;
+            }
+        }
+    }
+    quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
+    gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]), F::gate_from_double(u.m[0][2]),
+                   F::gate_from_double(u.m[1][1]), F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+    return true;
+}
+
 template <typename T>
 bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept {
     using F = CombineFormats<T>;
@@ -267,22 +290,8 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
             }
             bias[r] += g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
-        Matrix3 u{};
-        if (several) {
-            if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
-                return false;
-            }
-            for (const auto& row : u.m) {
-                for (double x : row) {
-                    if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
-                        return false;
-                    }
-                }
-            }
-            quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
-            gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]),
-                           F::gate_from_double(u.m[0][2]), F::gate_from_double(u.m[1][1]),
-                           F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+        if (several && !build_gate(m, s, h, cfg)) {
+            return false;
         }
     }
     bias_[s] = {ScalarTraits<T>::from_double(bias[0]), ScalarTraits<T>::from_double(bias[1]),
