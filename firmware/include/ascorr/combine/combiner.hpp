@@ -183,9 +183,10 @@ private:
     MountingsProblem problem_ = MountingsProblem::kNoHead;
     std::uint8_t problem_head_ = kUnknownHead;
     HeadMask mounted_ = 0;
-    T near2_{};                              // sin²(kGrossAngleRad/2)
-    T one_minus_near2_{};                    // cos²(kGrossAngleRad/2)
-    Quaternion<T> mount_conj_[kMaxHeads]{};  // q_chu_crf* (unit)
+    T near2_{};                                    // sin²(kGrossAngleRad/2)
+    T one_minus_near2_{};                          // cos²(kGrossAngleRad/2)
+    Quaternion<T> mount_conj_[kMaxHeads]{};        // q_chu_crf* (unit, rounded to T)
+    MountingFactor<T> mount_factor_[kMaxHeads]{};  // the same, as mounting_product() takes it
     GainMatrix<T> gain_[kSubsetCount][kMaxHeads]{};
     GateMatrix<T> gate_[kSubsetCount][kMaxHeads]{};
     QuickBound<T> quick_[kSubsetCount][kMaxHeads]{};  // 1/λ_max bound of UᵀU (kernels.hpp quick_gate)
@@ -234,6 +235,7 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
             const Quaternion<double> q = unit_mounting(m.head[h]);
             mount_conj_[h] = {ScalarTraits<T>::from_double(q.w), ScalarTraits<T>::from_double(-q.x),
                               ScalarTraits<T>::from_double(-q.y), ScalarTraits<T>::from_double(-q.z)};
+            mount_factor_[h] = CombineFormats<T>::mounting_from(mount_conj_[h]);
         }
     }
     for (unsigned sub = 1; sub < kSubsetCount; ++sub) {
@@ -350,7 +352,7 @@ void Combiner<T>::select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e)
             continue;
         }
         Candidate& c = e.c[count];
-        c.q = product(mount_conj_[a.head], a.q_chu_icrf);
+        c.q = mounting_product(mount_factor_[a.head], a.q_chu_icrf);
         c.head = a.head;
         taken = static_cast<HeadMask>(taken | bit);
         ++count;
@@ -368,11 +370,12 @@ std::uint8_t Combiner<T>::linearise(Epoch& e) const noexcept {
     constexpr T zero = constant<T>(0.0);
     auto near = static_cast<std::uint8_t>(1U << e.ref);
     e.c[e.ref].h = {zero, zero, zero};
+    const ReferenceFactor<T> rf = CombineFormats<T>::reference_from(e.c[e.ref].q);
     for (std::uint8_t i = 0; i < e.n; ++i) {
         if (i == e.ref || (e.group >> i & 1U) == 0U) {
             continue;
         }
-        const HalfDifference<T> d = half_difference(e.c[i].q, e.c[e.ref].q, near2_);
+        const HalfDifference<T> d = half_difference(e.c[i].q, rf, near2_);
         e.c[i].h = d.h;
         near = static_cast<std::uint8_t>(near | (d.near ? 1U << i : 0U));
     }
@@ -512,7 +515,7 @@ bool Combiner<T>::combine_group(Epoch& e, Vector3<T>* est) const noexcept {
     constexpr T zero = constant<T>(0.0);
     e.ref = 0;
     e.group = static_cast<std::uint8_t>((1U << e.n) - 1U);
-    const Quaternion<T> ref = e.c[0].q;
+    const ReferenceFactor<T> ref = CombineFormats<T>::reference_from(e.c[0].q);
     e.c[0].h = {zero, zero, zero};
     bool near = true;
     Accumulator<T> acc = zero_accumulator<T>();
