@@ -322,7 +322,7 @@ template <typename T>
 HeadMask Combiner<T>::heads_of(const Epoch& e, std::uint8_t group) const noexcept {
     HeadMask s = 0;
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) != 0U) {
+        if (in_mask(group, i)) {
             s = static_cast<HeadMask>(s | head_bit(e.c[i].head));
         }
     }
@@ -372,7 +372,7 @@ std::uint8_t Combiner<T>::linearise(Epoch& e) const noexcept {
     e.c[e.ref].h = {zero, zero, zero};
     const ReferenceFactor<T> rf = CombineFormats<T>::reference_from(e.c[e.ref].q);
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if (i == e.ref || (e.group >> i & 1U) == 0U) {
+        if (i == e.ref || !in_mask(e.group, i)) {
             continue;
         }
         const HalfDifference<T> d = half_difference(e.c[i].q, rf, near2_);
@@ -406,7 +406,7 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
     }
     const auto group = static_cast<std::uint8_t>(near[best] | 1U << best);
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) == 0U && count[i] == count[best]) {
+        if (!in_mask(group, i) && count[i] == count[best]) {
             return false;  // a group outside as large: ambiguous
         }
     }
@@ -424,7 +424,7 @@ template <typename T>
 Vector3<T> Combiner<T>::estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept {
     Accumulator<T> acc = zero_accumulator<T>();
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if (i != e.ref && (group >> i & 1U) != 0U) {  // the reference's difference is zero
+        if (i != e.ref && in_mask(group, i)) {  // the reference's difference is zero
             accumulate(acc, gain_[s][e.c[i].head], e.c[i].h);
         }
     }
@@ -438,7 +438,7 @@ typename Combiner<T>::GateResult Combiner<T>::gate_group(const Epoch& e, std::ui
                                                          const Vector3<T>& est) const noexcept {
     GateResult r{0, {}};
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) == 0U) {
+        if (!in_mask(group, i)) {
             continue;
         }
         const GateValue<T> v = gate_value(gate_[s][e.c[i].head], residual(e.c[i].h, est));
@@ -456,7 +456,7 @@ std::uint8_t Combiner<T>::odd_one_out(const Epoch& e, std::uint8_t failing) cons
     std::uint8_t best = 0xFF;
     GateValue<T> best_value{};
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((failing >> i & 1U) == 0U) {
+        if (!in_mask(failing, i)) {
             continue;
         }
         const auto rest = static_cast<std::uint8_t>(e.group & ~(1U << i));
@@ -494,7 +494,7 @@ bool Combiner<T>::gate(Epoch& e, Vector3<T>* est) const noexcept {
         e.inconsistent = static_cast<HeadMask>(e.inconsistent | head_bit(e.c[odd].head));
         if (odd == e.ref) {  // re-form the differences about a head that stays
             for (std::uint8_t i = 0; i < e.n; ++i) {
-                if ((e.group >> i & 1U) != 0U) {
+                if (in_mask(e.group, i)) {
                     e.ref = i;
                     break;
                 }
