@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/csv.hpp"
+
 namespace ascorr::host {
 
 namespace {
@@ -317,6 +319,11 @@ NoiseEstimate estimate_noise(const AlignSums& sums, HeadSet heads,
     est.heads = heads;
     Components c = components_of(heads, NoiseModel::kPerHead);
     std::vector<SetModel> sets = set_models(sums, c, boresight_crf);
+    if (sets.empty()) {
+        throw std::invalid_argument(
+            "the noise has no degree of freedom: no noise window (" + number_text(sums.noise_window_s()) +
+            " s) holds two epochs of the same heads; give a window longer than the data's step");
+    }
     Eigen::MatrixXd n;
     Eigen::VectorXd r;
     unweighted_equations(sets, n, r);
