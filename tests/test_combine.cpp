@@ -489,23 +489,24 @@ struct GateRun {
 };
 
 // n heads, head `bad` off by `offset_arcsec` in a random direction.
+template <typename T = double>
 GateRun run_gate(int n, double offset_arcsec, int epochs, std::uint32_t seed) {
     std::mt19937 rng(seed);
     GateRun run;
     for (int t = 0; t < epochs; ++t) {
         const List<Head> heads = near_orthogonal_heads(rng, n, 20.0);
-        const Combiner<double> comb(mountings_of(heads));
+        const Combiner<T> comb(mountings_of(heads));
         const Quat truth = random_rotation(rng);
         const int bad = t % n;
         std::normal_distribution<double> g(0.0, 1.0);
         const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
-        HeadAttitude<double> in[kMaxHeads];
+        HeadAttitude<T> in[kMaxHeads];
         List<Head> rest_h;
         List<Quat> rest_q;
         for (int i = 0; i < n; ++i) {
             const Vec3 off = i == bad ? Vec3(dir * offset_arcsec * kArcsecToRad) : Vec3::Zero();
             const Quat q = measure(heads[i], truth, rng, 1.0, off);
-            in[i] = attitude<double>(q, static_cast<std::uint8_t>(i));
+            in[i] = attitude<T>(q, static_cast<std::uint8_t>(i));
             if (i != bad) {
                 rest_h.push_back(heads[i]);
                 rest_q.push_back(q);
@@ -517,8 +518,8 @@ GateRun run_gate(int n, double offset_arcsec, int epochs, std::uint32_t seed) {
         if (out.inconsistent == (1U << bad) && out.used == (all & ~(1U << bad)) &&
             out.status == (cs::kTwoOrMoreHeads | cs::kHeadLeftOut)) {
             ++run.caught;
-            run.worst_rest =
-                std::max(run.worst_rest, error_arcsec(out.q_crf_icrf, reference_attitude(rest_h, rest_q)).norm());
+            run.worst_rest = std::max(
+                run.worst_rest, error_arcsec(to_double(out.q_crf_icrf), reference_attitude(rest_h, rest_q)).norm());
         }
     }
     return run;
@@ -529,6 +530,17 @@ TEST(Combine, GateLeavesOutAHead200ArcsecOffWithThreeAndFourHeads) {
         const GateRun r = run_gate(n, 200.0, 600, 8U + static_cast<std::uint32_t>(n));
         EXPECT_EQ(r.caught, r.epochs) << n << " heads";
         EXPECT_LT(r.worst_rest, 0.005);
+    }
+    // The same decisions in float and Q30 (within their rounding of the answer).
+    for (const int n : {3, 4}) {
+        const GateRun f = run_gate<float>(n, 200.0, 300, 50U + static_cast<std::uint32_t>(n));
+        EXPECT_EQ(f.caught, f.epochs) << n << " heads, float";
+        EXPECT_LT(f.worst_rest, 0.06);
+        const GateRun q = run_gate<Q30>(n, 200.0, 300, 50U + static_cast<std::uint32_t>(n));
+        EXPECT_EQ(q.caught, q.epochs) << n << " heads, Q30";
+        EXPECT_LT(q.worst_rest, 0.006);
+        EXPECT_EQ(run_gate<Q30>(n, 3.0, 300, 60U).caught, 0);
+        EXPECT_EQ(run_gate<float>(n, 3.0, 300, 60U).caught, 0);
     }
     // Gross errors (1°, 30°, 179°) whichever head has them, the reference included.
     for (const double off : {3600.0, 108000.0, 644400.0}) {
@@ -698,6 +710,13 @@ TEST(Combine, DISABLED_FloatIsWithin003ArcsecOfDouble) {
     EXPECT_LT(worst, 0.03);
     RecordProperty("worst_arcsec", std::to_string(worst));
     std::printf("float: worst %.4f arcsec from double over 20000 epochs\n", worst);
+}
+
+TEST(Combine, FixedPointIsWithin001ArcsecOfDouble) {
+    const double worst = worst_against_double<Q30>(20000, 14);
+    EXPECT_LT(worst, 0.01);
+    RecordProperty("worst_arcsec", std::to_string(worst));
+    std::printf("Q30: worst %.5f arcsec from double over 20000 epochs\n", worst);
 }
 
 // ---- No allocation.

@@ -11,6 +11,7 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -47,6 +48,13 @@ void add_combine_options(CLI::App& cmd, CombineTexts& t) {
 }
 
 void correct_and_combine(const host::CorrectOptions& opt, const CombineTexts& t) {
+    try {  // the mountings first: refused input exits 2 (as combine and align)
+        host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings);
+    } catch (const host::InputError& e) {
+        throw RefusedInput(e.what());
+    } catch (const std::runtime_error& e) {
+        throw RefusedInput(e.what());
+    }
     const host::CorrectAndCombine r = host::correct_and_combine(opt, t.mountings, t.combined, std::cerr);
     if (!r.corrected.self_calibration.empty()) {
         std::cerr << "ascorr correct: " << r.corrected.self_calibration << '\n';

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -12,6 +13,8 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
@@ -45,7 +48,7 @@ constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
                                                       "quaternion not unit",
                                                       "in no epoch"};
 
-// A row as kept between reading and combining (48 bytes): whether it is
+// A row as kept between reading and combining (48 bytes, 56 with its key): whether it is
 // usable is decided when it is read, from what needs no other row.
 struct Kept {
     double t;
@@ -111,17 +114,21 @@ std::string describe(const CombineSummary& s) {
     if (s.out_of_order) {
         o << "; rows out of time order: sorted";
     }
-    bool header = false;
+    // Most heads first (AB, AC, BC, then A, B, C).
+    std::vector<std::uint32_t> sets;
     for (std::uint32_t set = 1; set < s.steps.size(); ++set) {
+        if (s.steps[set].days != 0) {
+            sets.push_back(set);
+        }
+    }
+    std::stable_sort(sets.begin(), sets.end(),
+                     [](std::uint32_t a, std::uint32_t b) { return head_count(a) > head_count(b); });
+    if (!sets.empty()) {
+        o << "\nsteps from " << head_letters(s.full)
+          << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
+    }
+    for (const std::uint32_t set : sets) {
         const HeadSetStep& st = s.steps[set];
-        if (st.days == 0) {
-            continue;
-        }
-        if (!header) {
-            o << "\nsteps from " << head_letters(s.full)
-              << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
-            header = true;
-        }
         char buf[128];
         std::snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(), st.rms_daily_mean[0],
                       st.rms_daily_mean[1], st.rms_daily_mean[2], st.days);
@@ -135,7 +142,8 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) 
     if (!m.sigmas) {
         throw std::runtime_error(name +
                                  ": the mountings have no sigma_cross,sigma_about: give each head's noise (arcsec "
-                                 "across and about its boresight); estimating it from the data is `ascorr align`'s");
+                                 "across and about its boresight), or correct first and `ascorr combine` the "
+                                 "corrected file, which estimates it from the data");
     }
     std::uint8_t head = 0;
     const combine::MountingsProblem p = combine::check_mountings(m.mountings, &head);
@@ -266,14 +274,6 @@ struct CombineStage::Impl {
         }
     }
 
-    // θ of a ⊗ b* (arcsec, CRF axes: R_a = R(θ) R_b).
-    static std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) {
-        const Quaternion<double> d = canonical(a * conjugate(b));
-        const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-        const double k = s > 0.0 ? 2.0 * std::atan2(s, d.w) / s * kRadToArcsec : 2.0 * kRadToArcsec;
-        return {d.x * k, d.y * k, d.z * k};
-    }
-
     // The full set's epoch combined again with each proper subset (HeadSetStep).
     void add_steps(const combine::HeadAttitude<double>* heads, std::uint8_t n, const Quaternion<double>& q_full,
                    double t) {
@@ -323,6 +323,11 @@ struct CombineStage::Impl {
     }
 
     void emit(std::vector<Kept>& rows) {
+        // Heads in index order (then lines): the combiner's reference and sums,
+        // hence the bits, are the same in any row order.
+        std::sort(rows.begin(), rows.end(), [](const Kept& a, const Kept& b) {
+            return a.head < b.head || (a.head == b.head && a.line < b.line);
+        });
         mark_duplicates(rows);
         mark_missing_stages(rows);
         combine::HeadAttitude<double> heads[kMaxHeads];
@@ -348,7 +353,10 @@ struct CombineStage::Impl {
             report_left_out(k);
         }
         AttitudeRow row;
-        row.t = rows.front().t;  // the epoch's first row's, as written
+        row.t = rows.front().t;  // the epoch's earliest t, as written: the same in any row order
+        for (const Kept& k : rows) {
+            row.t = std::min(row.t, k.t);
+        }
         row.status = static_cast<unsigned>(c.status | (left_out ? cs::kHeadLeftOut : 0U));
         row.has_q = (c.status & cs::kNoHead) == 0U;
         if (row.has_q) {
@@ -434,7 +442,8 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
 CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, std::ostream& log,
                             CombineStage::Mode mode) {
     CombineStage stage(m, opt.out, opt.in, log, mode);
-    for_each_corrected_row(opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
+    for_each_corrected_row(
+        opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
     stage.finish();
     CombineSummary s = stage.summary();
     stage.commit();
@@ -463,6 +472,22 @@ void for_each_corrected_row(const std::string& path, const std::function<void(co
         label);
 }
 
+namespace {
+
+// Whether the corrected file goes to a stream (standard output, a device, a
+// FIFO: atomic_file.hpp's rule): it cannot be written twice, so the rows are
+// kept from the start instead of a second run on rows out of order.
+bool streamed_output(const std::string& path) {
+    if (path == "-" || path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0) {
+        return true;
+    }
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+}
+
+}  // namespace
+
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, std::ostream& log) {
     refuse_output_over_input(
@@ -478,6 +503,9 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
         r.combined = stage.summary();
         return r;
     };
+    if (streamed_output(opt.out)) {
+        return pass(CombineStage::Mode::kKeep, log);
+    }
     std::ostringstream first;
     try {
         CorrectAndCombine r = pass(CombineStage::Mode::kStream, first);
@@ -493,9 +521,45 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
     return r;
 }
 
+namespace {
+
+// m with each head's noise estimated from the rows of `in` (align_rows), reported on log.
+MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in, const std::string& path,
+                                   std::ostream& log) {
+    AlignOptions ao;
+    ao.in = in;
+    ao.mountings = path;
+    const AlignReport r = align_rows(rows_of_file(in), in, m, ao);
+    MountingsFile out = m;
+    out.sigmas = true;
+    std::ostringstream o;
+    o << "ascorr combine: " << text::input_name(path)
+      << " has no sigmas: each head's noise estimated from the data (ascorr align's REML estimate, "
+      << noise_model_text(r.noise.model) << "; arcsec, +- 1 sigma):";
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!m.mountings.head[h].present) {
+            continue;
+        }
+        const HeadNoise& n = r.head[h].noise;
+        out.mountings.head[h].sigma_cross_arcsec = n.sigma_cross_arcsec;
+        out.mountings.head[h].sigma_about_arcsec = n.sigma_about_arcsec;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, " %c across %.3f +- %.3f, about %.3f +- %.3f;", head_name(h),
+                      n.sigma_cross_arcsec, n.sd_cross_arcsec, n.sigma_about_arcsec, n.sd_about_arcsec);
+        o << buf;
+    }
+    log << o.str() << '\n';
+    return out;
+}
+
+}  // namespace
+
 CombineSummary combine_file(const CombineOptions& opt, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
-    const MountingsFile m = read_mountings_file(opt.mountings);
+    MountingsFile m = read_mountings_file(opt.mountings);
+    if (!m.sigmas) {
+        m = with_estimated_noise(m, opt.in, opt.mountings, log);
+    }
     refuse_unusable_mountings(m, opt.mountings);
     // The first pass's messages wait: if it stops at a row out of order, the
     // second pass says them again.

@@ -19,15 +19,6 @@ namespace {
 
 using Vec = std::array<double, 3>;
 
-// θ of q_est ⊗ q_true* (R_est = R(θ) R_true), arcsec.
-Vec error_arcsec(const Quaternion<double>& est, const Quaternion<double>& truth) {
-    const Quaternion<double> d = canonical(est * conjugate(truth));
-    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    const double angle = 2.0 * std::atan2(s, d.w);
-    const double k = s > 0.0 ? angle / s * kRadToArcsec : 2.0 * kRadToArcsec;
-    return {d.x * k, d.y * k, d.z * k};
-}
-
 struct Sums {
     std::size_t n = 0;
     Vec sum{};
@@ -147,6 +138,13 @@ void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedSt
 
 }  // namespace
 
+std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
+    const Quaternion<double> d = canonical(a * conjugate(b));
+    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const double k = s > 0.0 ? 2.0 * std::atan2(s, d.w) / s * kRadToArcsec : 2.0 * kRadToArcsec;
+    return {d.x * k, d.y * k, d.z * k};
+}
+
 std::string head_set_name(std::uint32_t heads) {
     return heads == 0 ? std::string("-") : head_letters(heads);
 }
@@ -189,7 +187,7 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
             ++s.epochs_without_truth;
             continue;
         }
-        const Vec e = error_arcsec(row.q_crf_icrf, tr->q_crf_icrf);
+        const Vec e = difference_arcsec(row.q_crf_icrf, tr->q_crf_icrf);
         a.error.add(e);
         a.sigma.add(row.sigma_arcsec);
         a.daily[static_cast<long long>(std::floor((row.t - t0) / kSecondsPerDay))].add(e);

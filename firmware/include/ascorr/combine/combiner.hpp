@@ -96,9 +96,10 @@ constexpr bool gate_config_valid(const CombinerConfig& c) noexcept {
 
 // The largest gate factor (per radian of half-angle) the tables accept in
 // every scalar, so that host and DPU refuse the same mountings: the Q30 gate
-// format's range (QGate: 2²⁹). With the default gate the factors are below
-// 7e3 times the leave-one-out amplification (≤ 50 for near-orthogonal heads).
-inline constexpr double kMaxGateFactor = 0x1p29;
+// format's range (kernels.hpp, QGate: 2²⁹, with a factor 2 of margin). With
+// the default gate the factors are below 7e3 times the leave-one-out
+// amplification (≤ 50 for near-orthogonal heads).
+inline constexpr double kMaxGateFactor = 0x1p28;
 
 // One head's corrected solution at the epoch.
 template <typename T>
@@ -180,10 +181,30 @@ private:
     Quaternion<T> mount_conj_[kMaxHeads]{};  // q_chu_crf* (unit)
     GainMatrix<T> gain_[kSubsetCount][kMaxHeads]{};
     GateMatrix<T> gate_[kSubsetCount][kMaxHeads]{};
+    Vector3<T> bias_[kSubsetCount]{};  // −Σ K_{S,i} vec(E_i): the mountings' rounding to T, taken out
     double sigma_[kSubsetCount][3]{};
 };
 
 // ---- Construction (double; division and sqrt allowed, never per epoch).
+
+// The rotation by which a mounting rounded to T turns a head's estimate, as
+// the half-angle vector in CRF axes: q_chu_crf* rounded is E ⊗ q_chu_crf* with
+// E = rounded ⊗ q_chu_crf (exact, double), so every estimate of that head
+// carries E on the left, and the combination Σ_i K_{S,i} vec(E_i) (Σ K = I
+// makes the reference's own part cancel to that too). Taken out per subset
+// (bias_): in float the rounding of a mounting (≤ 2⁻²⁵ per component) would
+// otherwise put up to 0.02″ of constant error per head set into the
+// attitude, a step at every head-set change; in Q30 (2⁻³¹) 3e-4″; zero in double.
+template <typename T>
+Vector3<double> rounding_rotation(const HeadMounting& h, const Quaternion<T>& conj_rounded) noexcept {
+    using Tr = ScalarTraits<T>;
+    const Quaternion<double> q = unit_mounting(h);
+    const Quaternion<double> r{Tr::to_double(conj_rounded.w), Tr::to_double(conj_rounded.x),
+                               Tr::to_double(conj_rounded.y), Tr::to_double(conj_rounded.z)};
+    const Quaternion<double> e = r * q;  // rounded conj ⊗ q_chu_crf: the identity but for the rounding
+    const double sign = e.w < 0.0 ? -1.0 : 1.0;
+    return {sign * e.x, sign * e.y, sign * e.z};
+}
 
 template <typename T>
 void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept {
@@ -226,15 +247,18 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
     for (int a = 0; a < 3; ++a) {
         sigma_[s][a] = g.sigma_arcsec[a];
     }
+    double bias[3] = {0.0, 0.0, 0.0};
     const bool several = head_count(s) >= 2;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if ((s & head_bit(h)) == 0U) {
             continue;
         }
+        const Vector3<double> e = rounding_rotation(m.head[h], mount_conj_[h]);
         for (int r = 0; r < 3; ++r) {
             for (int c = 0; c < 3; ++c) {
                 gain_[s][h].k[r][c] = F::gain_from_double(g.gain[h].m[r][c]);
             }
+            bias[r] -= g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
         Matrix3 u{};
         if (several) {
@@ -253,6 +277,8 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
                            F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
         }
     }
+    bias_[s] = {ScalarTraits<T>::from_double(bias[0]), ScalarTraits<T>::from_double(bias[1]),
+                ScalarTraits<T>::from_double(bias[2])};
     return true;
 }
 
@@ -288,7 +314,7 @@ void Combiner<T>::select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e)
             e.left_out_any = true;
             continue;
         }
-        e.c[e.n] = {mount_conj_[a.head] * a.q_chu_icrf, {}, a.head};
+        e.c[e.n] = {product(mount_conj_[a.head], a.q_chu_icrf), {}, a.head};
         ++e.n;
     }
 }
@@ -486,6 +512,7 @@ CombinedAttitude<T> Combiner<T>::combine(const HeadAttitude<T>* heads, std::uint
     if (combined) {
         e.out.used = heads_of(e, e.group);
         const Quaternion<T>& ref = e.c[e.ref].q;
+        est = est + bias_[e.out.used];
         e.out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(est, ref)));
     }
     e.out.inconsistent = static_cast<HeadMask>(e.out.inconsistent & all);

@@ -50,6 +50,41 @@ using GateFactor = typename CombineFormats<T>::gate;
 template <typename T>
 using GateValue = typename CombineFormats<T>::gate_value;
 
+// In Q30 (q_formats.hpp; fx.hpp's exact products and rounding), the
+// formats of the tables (each kernel's Q30 version is beside its generic one):
+//
+//  QGain (a gain K_{S,i}): signed, value = raw·2⁻²⁵, range ±64, resolution
+//    3e-8. Gains are bounded by kMaxGainRowSum = 60 (mountings.hpp), so a gain
+//    never saturates; gains above 1 are common (two heads 20° apart: ~10),
+//    hence the six integer bits. The resolution changes the estimate by at
+//    most 60·2⁻²⁶·|h| (5e-12 rad at |h| = 3e-4).
+//  QGate (a gate factor U_{S,i}, per radian of half-angle): signed, value =
+//    raw·2⁻², range ±2²⁹, resolution 0.25. The combiner refuses tables with a
+//    factor beyond kMaxGateFactor = 2²⁸ (combiner.hpp); with the default gate
+//    the factors are below ~4e5. The resolution changes d/k by at most
+//    3·2⁻³·|e| (1e-4 of the gate at |e| = 3e-4).
+//  Gate statistic: ‖y‖² with y = U e in Q19.12 (value = raw·2⁻¹², range
+//    ±2¹⁹, saturated), as std::uint64_t in units 2⁻²⁴; the gate trips above
+//    2²⁴ (d/k = 1). A saturated component is ≥ 2¹⁹ ≫ 1: it always trips.
+struct QGain {
+    static constexpr int kFracBits = 25;
+    std::int32_t raw;
+};
+struct QGate {
+    static constexpr int kFracBits = 2;
+    std::int32_t raw;
+};
+
+template <>
+struct CombineFormats<Q30> {
+    using gain = QGain;
+    using gate = QGate;
+    using gate_value = std::uint64_t;
+    // Rounded to nearest, ties away from zero, saturated (fx::raw_from_double).
+    static constexpr gain gain_from_double(double x) noexcept { return {fx::raw_from_double<QGain::kFracBits>(x)}; }
+    static constexpr gate gate_from_double(double x) noexcept { return {fx::raw_from_double<QGate::kFracBits>(x)}; }
+};
+
 // K_{S,i} (subset_tables.hpp), row-major.
 template <typename T>
 struct GainMatrix {
@@ -62,6 +97,36 @@ struct GateMatrix {
     GateFactor<T> u00, u01, u02, u11, u12, u22;
 };
 
+// a ⊗ b (quaternion.hpp's Hamilton product); fixed point has its own below.
+template <typename T>
+constexpr Quaternion<T> product(const Quaternion<T>& a, const Quaternion<T>& b) noexcept {
+    return a * b;
+}
+
+// product (above), a ⊗ b in Q30: each component one chain of four exact
+// products (SMULL, SMLAL) rounded once to Q30 (≤ 2⁻³¹), without saturation.
+// Range: |aᵢ|, |bᵢ| ≤ 1 + 1e-6 (unit quaternions that passed norm_within or
+// the mountings' check): each component of a ⊗ b is ≤ ‖a‖‖b‖ ≤ 1 + 2e-6 in
+// magnitude, its sum in units 2⁻⁶⁰ below 2⁶¹. A subtracted product is the
+// product with the negated operand (exact: |aᵢ| < 2).
+constexpr Quaternion<Q30> product(const Quaternion<Q30>& a, const Quaternion<Q30>& b) noexcept {
+    using fx::unshared;
+    const std::int32_t aw = unshared(a.w.raw);
+    const std::int32_t ax = unshared(a.x.raw);
+    const std::int32_t ay = unshared(a.y.raw);
+    const std::int32_t az = unshared(a.z.raw);
+    const std::int32_t bw = unshared(b.w.raw);
+    const std::int32_t bx = unshared(b.x.raw);
+    const std::int32_t by = unshared(b.y.raw);
+    const std::int32_t bz = unshared(b.z.raw);
+    return {Q30{fx::narrow<30>(0, aw, bw, -ax, bx, -ay, by, -az, bz)},
+            Q30{fx::narrow<30>(0, aw, bx, ax, bw, ay, bz, -az, by)},
+            Q30{fx::narrow<30>(0, aw, by, -ax, bz, ay, bw, az, bx)},
+            Q30{fx::narrow<30>(0, aw, bz, ax, by, -ay, bx, az, bw)}};
+}
+template <>
+Quaternion<Q30> product<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&) noexcept = delete;
+
 // q ⊗ ref* as the half-angle vector h (above), and whether the rotation is
 // within the gross gate: ‖h‖² ≤ near2 (near2 = sin²(φ_max/2)).
 template <typename T>
@@ -73,7 +138,7 @@ struct HalfDifference {
 template <typename T>
 constexpr HalfDifference<T> half_difference(const Quaternion<T>& q, const Quaternion<T>& ref, const T& near2) noexcept {
     constexpr T zero = constant<T>(0.0);
-    const Quaternion<T> d = q * conjugate(ref);
+    const Quaternion<T> d = product(q, conjugate(ref));
     const Vector3<T> h = d.w < zero ? Vector3<T>{-d.x, -d.y, -d.z} : Vector3<T>{d.x, d.y, d.z};
     return {h, squared_norm(h) <= near2};
 }
@@ -135,5 +200,86 @@ constexpr Quaternion<T> left_increment(const Vector3<T>& h, const Quaternion<T>&
     const Vector3<T> v = q.w * h + cross(h, qv);
     return {-dot(h, qv), v.x, v.y, v.z};
 }
+
+// ---- The remaining kernels in Q30, each with its guard.
+
+// Σ K h in Q30: three int64 sums of exact products of a QGain and a Q30
+// (units 2⁻⁵⁵). Range: |K| ≤ 60 (raw < 2³¹), |h| ≤ 2⁻⁸ (the gross gate:
+// half-angles within 2⁻⁸ of the reference after a re-formation) so each
+// product is below 2⁵³ and a sum over kMaxHeads heads below 2⁵⁷; the result
+// (result()) is at most kMaxGainRowSum·2⁻⁸ < 0.24 in magnitude.
+template <>
+struct Accumulator<Q30> {
+    std::int64_t sum[3];
+};
+
+template <>
+constexpr Accumulator<Q30> zero_accumulator<Q30>() noexcept {
+    return {{0, 0, 0}};
+}
+
+constexpr void accumulate(Accumulator<Q30>& a, const GainMatrix<Q30>& g, const Vector3<Q30>& h) noexcept {
+    using fx::unshared;
+    const std::int32_t hx = unshared(h.x.raw);
+    const std::int32_t hy = unshared(h.y.raw);
+    const std::int32_t hz = unshared(h.z.raw);
+    for (int r = 0; r < 3; ++r) {
+        a.sum[r] = fx::accumulate_products(a.sum[r], g.k[r][0].raw, hx, g.k[r][1].raw, hy, g.k[r][2].raw, hz);
+    }
+}
+template <>
+void accumulate<Q30>(Accumulator<Q30>&, const GainMatrix<Q30>&, const Vector3<Q30>&) noexcept = delete;
+
+// The sums rounded once to Q30 (≤ 2⁻³¹), not saturated (range above).
+constexpr Vector3<Q30> result(const Accumulator<Q30>& a) noexcept {
+    constexpr int kShift = QGain::kFracBits;
+    return {Q30{fx::narrow<kShift>(a.sum[0])}, Q30{fx::narrow<kShift>(a.sum[1])}, Q30{fx::narrow<kShift>(a.sum[2])}};
+}
+template <>
+Vector3<Q30> result<Q30>(const Accumulator<Q30>&) noexcept = delete;
+
+// ‖U e‖² in Q30 (the statistic's format above): y = U e with exact products
+// of a QGate and a Q30 (units 2⁻³²), rounded once to Q19.12 and saturated;
+// the squares summed exactly in uint64. Range: any e (|eᵢ| < 2, each
+// product < 2⁶², a sum of three < 2⁶³ as |U| ≤ 2²⁸ keeps it below 1.5·2⁶¹);
+// each square ≤ 2⁶², three < 2⁶⁴.
+constexpr std::uint64_t gate_value(const GateMatrix<Q30>& u, const Vector3<Q30>& e) noexcept {
+    using fx::unshared;
+    const std::int32_t ex = unshared(e.x.raw);
+    const std::int32_t ey = unshared(e.y.raw);
+    const std::int32_t ez = unshared(e.z.raw);
+    constexpr int kShift = QGate::kFracBits + Q30::kFracBits - 12;
+    const std::int32_t y0 = fx::narrow_sat<kShift>(fx::sum_products(u.u00.raw, ex, u.u01.raw, ey, u.u02.raw, ez));
+    const std::int32_t y1 = fx::narrow_sat<kShift>(fx::sum_products(u.u11.raw, ey, u.u12.raw, ez));
+    const std::int32_t y2 = fx::narrow_sat<kShift>(fx::mul(u.u22.raw, ez));
+    const auto sq = [](std::int32_t y) { return static_cast<std::uint64_t>(fx::mul(y, y)); };
+    return sq(y0) + sq(y1) + sq(y2);
+}
+template <>
+std::uint64_t gate_value<Q30>(const GateMatrix<Q30>&, const Vector3<Q30>&) noexcept = delete;
+
+// The statistic beyond the gate: ‖y‖² > 1, i.e. > 2²⁴ in units 2⁻²⁴. Exact.
+constexpr bool gate_exceeds(std::uint64_t v) noexcept {
+    return v > (std::uint64_t{1} << 24);
+}
+
+// left_increment (above), (0, h) ⊗ q in Q30, each component one chain of
+// three exact products rounded once (≤ 2⁻³¹), without saturation. Range:
+// q unit (|qᵢ| ≤ 1 + 1e-6), |hᵢ| < 0.24 (Accumulator's range): each component
+// < 0.73 in magnitude.
+constexpr Quaternion<Q30> left_increment(const Vector3<Q30>& h, const Quaternion<Q30>& q) noexcept {
+    using fx::unshared;
+    const std::int32_t hx = unshared(h.x.raw);
+    const std::int32_t hy = unshared(h.y.raw);
+    const std::int32_t hz = unshared(h.z.raw);
+    const std::int32_t qw = unshared(q.w.raw);
+    const std::int32_t qx = unshared(q.x.raw);
+    const std::int32_t qy = unshared(q.y.raw);
+    const std::int32_t qz = unshared(q.z.raw);
+    return {Q30{fx::narrow<30>(0, -hx, qx, -hy, qy, -hz, qz)}, Q30{fx::narrow<30>(0, qw, hx, hy, qz, -hz, qy)},
+            Q30{fx::narrow<30>(0, qw, hy, hz, qx, -hx, qz)}, Q30{fx::narrow<30>(0, qw, hz, hx, qy, -hy, qx)}};
+}
+template <>
+Quaternion<Q30> left_increment<Q30>(const Vector3<Q30>&, const Quaternion<Q30>&) noexcept = delete;
 
 }  // namespace ascorr::combine

@@ -25,7 +25,7 @@
 //
 // Memory: rows in time order (the usual file) are combined as they are read,
 // one epoch held. At the first row out of time order the pass stops and the
-// rows are read again, kept (48 bytes each) and sorted; a pass that cannot be
+// rows are read again, kept (56 bytes each with its epoch key) and sorted; a pass that cannot be
 // restarted (an output that is a stream, standard output or a FIFO) keeps
 // the rows from the start.
 #pragma once
@@ -137,13 +137,16 @@ struct CombineOptions {
     std::string out;
 };
 
-// `ascorr combine`. Throws InputError (file:line:column) for a malformed
-// input or mountings file; std::runtime_error for unusable mountings and
-// mountings without sigmas; writes nothing then.
+// `ascorr combine`. Mountings without sigmas: each head's noise is estimated
+// from the input (align.hpp's estimator, align_rows; its refusals are
+// AlignRefused) and reported on log. Throws InputError (file:line:column) for
+// a malformed input or mountings file, std::runtime_error for unusable
+// mountings; writes nothing then.
 CombineSummary combine_file(const CombineOptions& opt, std::ostream& log);
 
 // Refuses mountings the combiner cannot use (InputError at the head's line,
-// or std::runtime_error for the head set), or without sigmas.
+// or std::runtime_error for the head set), or without sigmas
+// (correct --combined: the noise cannot be estimated before the rows are corrected).
 void refuse_unusable_mountings(const MountingsFile& m, const std::string& path);
 
 // `ascorr correct ... --mountings M --combined A`: corrects (correct_file) and

@@ -8,7 +8,7 @@
 //    CRF, OUT.attitude.csv), the combined file's first five columns.
 // Numbers as the corrected file writes them: q with 15 decimals (2e-10
 // arcsec); t and the sigmas in the shortest text that reads back exactly
-// (t as the epoch's first row had it, to the bit); an epoch without a usable
+// (t the earliest of the epoch's rows', to the bit); an epoch without a usable
 // head has empty q, heads and sigmas.
 #pragma once
 
