@@ -24,6 +24,7 @@
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 extern char** environ;
@@ -324,10 +325,10 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                 }
                 char t[96];
                 if (window) {
-                    std::snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
-                                  st.rms[p][k].rms_smoothed);
+                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
+                                     st.rms[p][k].rms_smoothed);
                 } else {
-                    std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
                 g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
                   << "' using 1:" << k + 2
