@@ -16,6 +16,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -36,7 +37,7 @@ LeftOut why_left_out(const CorrectedRow& r, const MountingsFile& m) noexcept {
 
 std::string time_text(double t) {
     char buf[48];
-    std::snprintf(buf, sizeof buf, "%.3f", t);
+    text::c_snprintf(buf, sizeof buf, "%.3f", t);
     return buf;
 }
 
@@ -324,7 +325,7 @@ namespace {
 
 std::string fixed(double x, int decimals) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+    text::c_snprintf(buf, sizeof buf, "%.*f", decimals, x);
     return buf;
 }
 
@@ -350,13 +351,13 @@ std::string describe(const AlignReport& r) {
         }
         const HeadAlignment& a = r.head[h];
         char line[400];
-        std::snprintf(line, sizeof line,
-                      "%c     %7zu  %+10.3f +- %.3f  %+10.3f +- %.3f  %+10.3f +- %.3f    %7.3f +- %.3f     %7.3f +- "
-                      "%.3f\n",
-                      kHeadLetters[h], a.epochs, a.rotation_arcsec.x(), a.rotation_sd_arcsec.x(), a.rotation_arcsec.y(),
-                      a.rotation_sd_arcsec.y(), a.rotation_arcsec.z(), a.rotation_sd_arcsec.z(),
-                      a.noise.sigma_cross_arcsec, a.noise.sd_cross_arcsec, a.noise.sigma_about_arcsec,
-                      a.noise.sd_about_arcsec);
+        text::c_snprintf(line, sizeof line,
+                         "%c     %7zu  %+10.3f +- %.3f  %+10.3f +- %.3f  %+10.3f +- %.3f    %7.3f +- %.3f     %7.3f +- "
+                         "%.3f\n",
+                         kHeadLetters[h], a.epochs, a.rotation_arcsec.x(), a.rotation_sd_arcsec.x(),
+                         a.rotation_arcsec.y(), a.rotation_sd_arcsec.y(), a.rotation_arcsec.z(),
+                         a.rotation_sd_arcsec.z(), a.noise.sigma_cross_arcsec, a.noise.sd_cross_arcsec,
+                         a.noise.sigma_about_arcsec, a.noise.sd_about_arcsec);
         s << line;
     }
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {

@@ -22,6 +22,7 @@
 #include "ascorr_host/formats/diagnostics.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -87,7 +88,7 @@ namespace {
 
 std::string time_text(double t) {
     char buf[48];
-    std::snprintf(buf, sizeof buf, "%.3f", t);
+    text::c_snprintf(buf, sizeof buf, "%.3f", t);
     return buf;
 }
 
@@ -130,8 +131,8 @@ std::string describe(const CombineSummary& s) {
     for (const std::uint32_t set : sets) {
         const HeadSetStep& st = s.steps[set];
         char buf[128];
-        std::snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(), st.rms_daily_mean[0],
-                      st.rms_daily_mean[1], st.rms_daily_mean[2], st.days);
+        text::c_snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(),
+                         st.rms_daily_mean[0], st.rms_daily_mean[1], st.rms_daily_mean[2], st.days);
         o << buf;
     }
     return o.str();
@@ -544,8 +545,8 @@ MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in
         out.mountings.head[h].sigma_cross_arcsec = n.sigma_cross_arcsec;
         out.mountings.head[h].sigma_about_arcsec = n.sigma_about_arcsec;
         char buf[160];
-        std::snprintf(buf, sizeof buf, " %c across %.3f +- %.3f, about %.3f +- %.3f;", head_name(h),
-                      n.sigma_cross_arcsec, n.sd_cross_arcsec, n.sigma_about_arcsec, n.sd_about_arcsec);
+        text::c_snprintf(buf, sizeof buf, " %c across %.3f +- %.3f, about %.3f +- %.3f;", head_name(h),
+                         n.sigma_cross_arcsec, n.sd_cross_arcsec, n.sigma_about_arcsec, n.sd_about_arcsec);
         o << buf;
     }
     log << o.str() << '\n';

@@ -12,6 +12,7 @@
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -228,7 +229,7 @@ std::string triple(const Vec& v, const char* format) {
             out += a == 0 ? "       -" : "        -";
             continue;
         }
-        std::snprintf(buf, sizeof buf, format, a == 0 ? "" : " ", v[a]);
+        text::c_snprintf(buf, sizeof buf, format, a == 0 ? "" : " ", v[a]);
         out += buf;
     }
     return out;
@@ -239,7 +240,7 @@ std::string json_triple(const Vec& v) {
         return "null";
     }
     char buf[96];
-    std::snprintf(buf, sizeof buf, "[%.6f, %.6f, %.6f]", v[0], v[1], v[2]);
+    text::c_snprintf(buf, sizeof buf, "[%.6f, %.6f, %.6f]", v[0], v[1], v[2]);
     return buf;
 }
 
@@ -253,7 +254,7 @@ std::string combined_stats_table(const CombinedStats& s) {
         o << "heads  epochs\n";
         for (const HeadSetReport& r : s.sets) {
             char line[64];
-            std::snprintf(line, sizeof line, "%-5s %7zu\n", head_set_name(r.heads).c_str(), r.epochs);
+            text::c_snprintf(line, sizeof line, "%-5s %7zu\n", head_set_name(r.heads).c_str(), r.epochs);
             o << line;
         }
         return o.str();
@@ -265,11 +266,11 @@ std::string combined_stats_table(const CombinedStats& s) {
          "step (x y z)        days\n";
     for (const HeadSetReport& r : s.sets) {
         char head[32];
-        std::snprintf(head, sizeof head, "%-5s %7zu", head_set_name(r.heads).c_str(), r.epochs);
+        text::c_snprintf(head, sizeof head, "%-5s %7zu", head_set_name(r.heads).c_str(), r.epochs);
         o << head << " | " << triple(r.error_rms, "%s%8.3f") << " | " << triple(r.error_mean, "%s%8.3f") << " | "
           << triple(r.sigma_rms, "%s%8.3f") << " | " << triple(r.step, "%s%8.3f");
         char days[24];
-        std::snprintf(days, sizeof days, " %5zu\n", r.step_days);
+        text::c_snprintf(days, sizeof days, " %5zu\n", r.step_days);
         o << days;
     }
     if (s.epochs_without_truth != 0) {

@@ -26,6 +26,7 @@
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/progress.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -187,7 +188,8 @@ std::string heaters_csv(const std::vector<HeaterEvent>& events) {
     std::string s = "start,end,heater\n";
     char line[96];
     for (const HeaterEvent& e : events) {
-        std::snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end, e.operational ? "operational" : "survival");
+        text::c_snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end,
+                         e.operational ? "operational" : "survival");
         s += line;
     }
     return s;
@@ -227,8 +229,8 @@ std::string describe(const SimulateSummary& s) {
       << ", without velocity " << s.rows_without_velocity << "\nnoise floor (IBA RMS, arcsec):";
     char buf[96];
     for (std::size_t p = 0; p < s.pairs.count; ++p) {
-        std::snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", s.pairs.pair[p].name, s.floor[p].rms,
-                      s.floor[p].rms_smoothed);
+        text::c_snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", s.pairs.pair[p].name, s.floor[p].rms,
+                         s.floor[p].rms_smoothed);
         o << buf;
     }
     o << "\ntruth model: " << s.truth_path << " (history: " << s.truth_history_path << ")\nfloor: " << s.floor_path
@@ -320,7 +322,7 @@ std::string truth_history_csv(const std::vector<Truth>& truths) {
         m.quadratic = quadratic;
         const std::string rows = format_model(m);
         char prefix[64];
-        std::snprintf(prefix, sizeof prefix, "%.3f,%zu,", truths[v].t_from, v);
+        text::c_snprintf(prefix, sizeof prefix, "%.3f,%zu,", truths[v].t_from, v);
         for (std::size_t at = rows.find('\n') + 1; at < rows.size();) {
             const std::size_t end = rows.find('\n', at) + 1;
             s += prefix;
@@ -339,8 +341,8 @@ bool in_window(const DayWindow& w, double day) {
 void refuse_window(const char* option, const char* form, const DayWindow& w, double days) {
     if (!(w.from_day >= 0.0 && w.from_day < w.to_day && w.to_day <= days)) {
         char what[256];
-        std::snprintf(what, sizeof what, "%s %g:%g: expected %s with 0 <= FROM_DAY < TO_DAY <= %g (--days)", option,
-                      w.from_day, w.to_day, form, days);
+        text::c_snprintf(what, sizeof what, "%s %g:%g: expected %s with 0 <= FROM_DAY < TO_DAY <= %g (--days)", option,
+                         w.from_day, w.to_day, form, days);
         throw std::invalid_argument(what);
     }
 }
@@ -358,10 +360,10 @@ void refuse_bad_truth_changes(const SimulateOptions& opt) {
     for (const TruthChange& c : opt.truth_changes) {
         if (!(c.day > previous && c.day < opt.days) || c.model.empty()) {
             char what[256];
-            std::snprintf(what, sizeof what,
-                          "--truth-change %g:%s: expected DAY:MODEL, a model file from DAY in (0, %g) (--days), "
-                          "DAY increasing from one change to the next (the previous: %g)",
-                          c.day, c.model.c_str(), opt.days, previous);
+            text::c_snprintf(what, sizeof what,
+                             "--truth-change %g:%s: expected DAY:MODEL, a model file from DAY in (0, %g) (--days), "
+                             "DAY increasing from one change to the next (the previous: %g)",
+                             c.day, c.model.c_str(), opt.days, previous);
             throw std::invalid_argument(what);
         }
         previous = c.day;
@@ -379,9 +381,9 @@ void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
         const bool drift = f.kind == ThermistorFaultKind::kDrift;
         if (!(std::fabs(f.rate_c_per_day) <= 100.0) || (!drift && f.rate_c_per_day != 0.0)) {
             char what[160];
-            std::snprintf(what, sizeof what,
-                          "%s: RATE %g: expected a drift's RATE in [-100, 100] degC/day; a stuck channel has none",
-                          kOption, f.rate_c_per_day);
+            text::c_snprintf(what, sizeof what,
+                             "%s: RATE %g: expected a drift's RATE in [-100, 100] degC/day; a stuck channel has none",
+                             kOption, f.rate_c_per_day);
             throw std::invalid_argument(what);
         }
     }
@@ -402,8 +404,8 @@ void refuse_bad_event_options(const SimulateOptions& opt) {
         refuse_window("--head-bias", "HEAD:FROM_DAY:TO_DAY:ARCSEC", b.window, opt.days);
         if (!(std::fabs(b.arcsec) <= 3600.0)) {
             char what[120];
-            std::snprintf(what, sizeof what, "--head-bias: ARCSEC %g: expected a rotation in [-3600, 3600] arcsec",
-                          b.arcsec);
+            text::c_snprintf(what, sizeof what, "--head-bias: ARCSEC %g: expected a rotation in [-3600, 3600] arcsec",
+                             b.arcsec);
             throw std::invalid_argument(what);
         }
     }
@@ -633,11 +635,11 @@ struct HeadSolution {
         }
     }
     char what[240];
-    std::snprintf(what, sizeof what,
-                  "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
-                  "T029 %g, T032 %g degC)",
-                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
-                  e.temp[3], e.temp[4]);
+    text::c_snprintf(what, sizeof what,
+                     "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
+                     "T029 %g, T032 %g degC)",
+                     head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
+                     e.temp[3], e.temp[4]);
     throw InputError(truth.name, truth.file.line[h][axis], 0, what);
 }
 
@@ -701,7 +703,7 @@ void append_row(std::string& buf, const EpochState& e, std::size_t h, const Head
             p = put(p, end, e.orbit.v_sc[i], 6);
         }
     }
-    p += std::snprintf(p, static_cast<std::size_t>(end - p), ",%lld,", s.quality.flags);
+    p += text::c_snprintf(p, static_cast<std::size_t>(end - p), ",%lld,", s.quality.flags);
     p = put(p, end, s.quality.confidence, 2);
     *p++ = '\n';
     buf.append(line, static_cast<std::size_t>(p - line));

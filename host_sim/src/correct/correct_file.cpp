@@ -32,6 +32,7 @@
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_host/formats/states_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -59,9 +60,9 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
             case Rejection::kQuaternionNotUnit: {
                 const auto& q = rec.q_chu_icrf;
                 char buf[96];
-                std::snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
-                              q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
-                              ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
+                text::c_snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
+                                 q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
+                                 ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
                 why = buf;
                 break;
             }
@@ -82,14 +83,14 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
             char buf[128];
-            std::snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped", speed,
-                          kMaxObserverSpeedKmS);
+            text::c_snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped",
+                             speed, kMaxObserverSpeedKmS);
             diag.report("velocity invalid", where(file, rec) + buf);
         } else {
             char buf[160];
-            std::snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
-                          ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
-                          kMaxSunDistanceAu);
+            text::c_snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
+                             ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
+                             kMaxSunDistanceAu);
             diag.report("velocity invalid", where(file, rec) + buf);
         }
     }

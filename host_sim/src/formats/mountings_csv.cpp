@@ -11,6 +11,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -100,9 +101,9 @@ Quaternion<double> quaternion_of(const Row& r, const Columns& c, char head) {
     const double n2 = squared_norm(out);
     if (!(std::fabs(n2 - 1.0) <= combine::kMountingNormTolerance)) {
         char what[200];
-        std::snprintf(what, sizeof what,
-                      "the mounting of CHU %c is %s (|q|^2 = %.9g, tolerance %.1g): q_chu_crf is a unit quaternion",
-                      head, n2 == 0.0 ? "zero" : "not unit", n2, combine::kMountingNormTolerance);
+        text::c_snprintf(what, sizeof what,
+                         "the mounting of CHU %c is %s (|q|^2 = %.9g, tolerance %.1g): q_chu_crf is a unit quaternion",
+                         head, n2 == 0.0 ? "zero" : "not unit", n2, combine::kMountingNormTolerance);
         r.fail(c.q[0], what);
     }
     return out;
@@ -127,8 +128,8 @@ double sigma_of(const Row& r, int col, const char* name) {
     const double s = finite_number(r, col, name);
     if (!(s >= combine::kMinSigmaArcsec && s <= combine::kMaxSigmaArcsec)) {
         char range[96];
-        std::snprintf(range, sizeof range, ": a head's noise is a positive number of arcsec, in [%g, %g]",
-                      combine::kMinSigmaArcsec, combine::kMaxSigmaArcsec);
+        text::c_snprintf(range, sizeof range, ": a head's noise is a positive number of arcsec, in [%g, %g]",
+                         combine::kMinSigmaArcsec, combine::kMaxSigmaArcsec);
         r.fail(col, std::string("column '") + name + "' = " + number_text(s) + range);
     }
     return s;

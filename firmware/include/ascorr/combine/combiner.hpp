@@ -11,11 +11,14 @@
 //    whose noise is σc across and σa about their boresight;
 //  - q_crf_icrf has w ≥ 0; both signs of every input are the same attitude.
 //
-// Per epoch, for n heads: n quaternion products (the mountings), n − 1
-// half-angle differences to the reference, n − 1 gain products (3 × 3), n
-// gate statistics (six products and three squares), one quaternion update and
-// one renormalisation (a Newton step: no division, no square root). Every
-// table is built at construction in double (subset_tables.hpp).
+// Per epoch, for n heads (the usual epoch; the vote and the gate's rounds
+// only when a head is off): n quaternion products (the mountings), n − 1
+// half-angle differences to the reference, n − 1 gain products (3 × 3), per
+// head a quick gate (‖e‖² against a bound of the gate, three squares; the full
+// statistic, six products and three squares, only above it), one quaternion
+// update and one renormalisation (a Newton step: no division, no square
+// root). Every table is built at construction in double (subset_tables.hpp).
+// Instructions per epoch of three heads: docs/figures.md.
 //
 // Which heads are averaged (in this order):
 //  1. Left out, status 4 (not `inconsistent`): an entry whose head index is no
@@ -150,15 +153,18 @@ private:
     };
     struct Epoch {
         Candidate c[kMaxHeads];
-        std::uint8_t n;      // candidates
-        std::uint8_t ref;    // index of the reference candidate
-        std::uint8_t group;  // candidate-index mask of the heads still in
-        CombinedAttitude<T> out;
-        bool left_out_any;  // also entries that name no head
+        std::uint8_t n;         // candidates
+        std::uint8_t ref;       // index of the reference candidate
+        std::uint8_t group;     // candidate-index mask of the heads still in
+        HeadMask heads;         // the candidates' heads
+        HeadMask left_out;      // step 1's
+        HeadMask inconsistent;  // steps 2 and 3's
+        bool left_out_any;      // also entries that name no head
     };
 
     void build(const Mountings& m, const CombinerConfig& cfg) noexcept;
     bool build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept;
+    bool build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept;
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
@@ -166,22 +172,25 @@ private:
         std::uint8_t failing;  // candidate-index mask beyond the gate
         GateValue<T> largest;  // the largest statistic
     };
-    Vector3<T> estimate(const Epoch& e, std::uint8_t group) const noexcept;
-    GateResult gate_group(const Epoch& e, std::uint8_t group, const Vector3<T>& est) const noexcept;
+    Vector3<T> estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept;
+    GateResult gate_group(const Epoch& e, std::uint8_t group, HeadMask s, const Vector3<T>& est) const noexcept;
     std::uint8_t odd_one_out(const Epoch& e, std::uint8_t failing) const noexcept;
     bool gate(Epoch& e, Vector3<T>* est) const noexcept;
-    void refuse_all(Epoch& e) const noexcept;
+    bool combine_group(Epoch& e, Vector3<T>* est) const noexcept;
     HeadMask heads_of(const Epoch& e, std::uint8_t group) const noexcept;
+    CombinedAttitude<T> finish(const Epoch& e, bool combined, const Vector3<T>& est) const noexcept;
 
     MountingsProblem problem_ = MountingsProblem::kNoHead;
     std::uint8_t problem_head_ = kUnknownHead;
     HeadMask mounted_ = 0;
-    T near2_{};                              // sin²(kGrossAngleRad/2)
-    T one_minus_near2_{};                    // cos²(kGrossAngleRad/2)
-    Quaternion<T> mount_conj_[kMaxHeads]{};  // q_chu_crf* (unit)
+    T near2_{};                                    // sin²(kGrossAngleRad/2)
+    T one_minus_near2_{};                          // cos²(kGrossAngleRad/2)
+    Quaternion<T> mount_conj_[kMaxHeads]{};        // q_chu_crf* (unit, rounded to T)
+    MountingFactor<T> mount_factor_[kMaxHeads]{};  // the same, as mounting_product() takes it
     GainMatrix<T> gain_[kSubsetCount][kMaxHeads]{};
     GateMatrix<T> gate_[kSubsetCount][kMaxHeads]{};
-    Vector3<T> bias_[kSubsetCount]{};  // −Σ K_{S,i} vec(E_i): the mountings' rounding to T, taken out
+    QuickBound<T> quick_[kSubsetCount][kMaxHeads]{};  // 1/λ_max bound of UᵀU (kernels.hpp quick_gate)
+    Vector3<T> bias_[kSubsetCount]{};                 // Σ K_{S,i} vec(E_i): the mountings' rounding to T, subtracted
     double sigma_[kSubsetCount][3]{};
 };
 
@@ -226,6 +235,7 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
             const Quaternion<double> q = unit_mounting(m.head[h]);
             mount_conj_[h] = {ScalarTraits<T>::from_double(q.w), ScalarTraits<T>::from_double(-q.x),
                               ScalarTraits<T>::from_double(-q.y), ScalarTraits<T>::from_double(-q.z)};
+            mount_factor_[h] = CombineFormats<T>::mounting_from(mount_conj_[h]);
         }
     }
     for (unsigned sub = 1; sub < kSubsetCount; ++sub) {
@@ -235,6 +245,28 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
             return;
         }
     }
+}
+
+// The gate factor of head h in subset s (|s| ≥ 2), its quick bound, in T;
+// false when a matrix is singular or a factor beyond kMaxGateFactor.
+template <typename T>
+bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept {
+    using F = CombineFormats<T>;
+    Matrix3 u{};
+    if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
+        return false;
+    }
+    for (const auto& row : u.m) {
+        for (double x : row) {
+            if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
+                return false;
+            }
+        }
+    }
+    quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
+    gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]), F::gate_from_double(u.m[0][2]),
+                   F::gate_from_double(u.m[1][1]), F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+    return true;
 }
 
 template <typename T>
@@ -258,23 +290,10 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
             for (int c = 0; c < 3; ++c) {
                 gain_[s][h].k[r][c] = F::gain_from_double(g.gain[h].m[r][c]);
             }
-            bias[r] -= g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
+            bias[r] += g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
-        Matrix3 u{};
-        if (several) {
-            if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
-                return false;
-            }
-            for (const auto& row : u.m) {
-                for (double x : row) {
-                    if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
-                        return false;
-                    }
-                }
-            }
-            gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]),
-                           F::gate_from_double(u.m[0][2]), F::gate_from_double(u.m[1][1]),
-                           F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+        if (several && !build_gate(m, s, h, cfg)) {
+            return false;
         }
     }
     bias_[s] = {ScalarTraits<T>::from_double(bias[0]), ScalarTraits<T>::from_double(bias[1]),
@@ -283,6 +302,21 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
 }
 
 // ---- Per epoch.
+
+namespace detail {
+struct HeadCounts {
+    std::uint8_t n[kSubsetCount];
+};
+constexpr HeadCounts make_head_counts() noexcept {
+    HeadCounts t{};
+    for (unsigned s = 0; s < kSubsetCount; ++s) {
+        t.n[s] = head_count(static_cast<HeadMask>(s));
+    }
+    return t;
+}
+// The number of heads of each mask: a table, as Armv7-M has no population count.
+inline constexpr HeadCounts kHeadCounts = make_head_counts();
+}  // namespace detail
 
 template <typename T>
 HeadMask Combiner<T>::heads_of(const Epoch& e, std::uint8_t group) const noexcept {
@@ -300,23 +334,33 @@ template <typename T>
 void Combiner<T>::select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept {
     constexpr T tol = ScalarTraits<T>::unit_norm_tolerance;
     HeadMask seen = 0;
+    HeadMask taken = 0;
+    HeadMask left_out = 0;
+    std::uint8_t count = 0;
+    bool unknown = false;
     for (std::uint8_t k = 0; k < n; ++k) {
         const HeadAttitude<T>& a = heads[k];
         if (a.head >= kMaxHeads) {
-            e.left_out_any = true;
+            unknown = true;
             continue;
         }
         const HeadMask bit = head_bit(a.head);
         const bool first = (seen & bit) == 0U;
         seen = static_cast<HeadMask>(seen | bit);
         if (!first || !a.usable || (mounted_ & bit) == 0U || !norm_within(a.q_chu_icrf, tol)) {
-            e.out.left_out = static_cast<HeadMask>(e.out.left_out | bit);
-            e.left_out_any = true;
+            left_out = static_cast<HeadMask>(left_out | bit);
             continue;
         }
-        e.c[e.n] = {product(mount_conj_[a.head], a.q_chu_icrf), {}, a.head};
-        ++e.n;
+        Candidate& c = e.c[count];
+        c.q = mounting_product(mount_factor_[a.head], a.q_chu_icrf);
+        c.head = a.head;
+        taken = static_cast<HeadMask>(taken | bit);
+        ++count;
     }
+    e.n = count;
+    e.heads = taken;
+    e.left_out = left_out;
+    e.left_out_any = unknown;
 }
 
 // Half-angle differences of the group to the reference; returns the
@@ -324,17 +368,14 @@ void Combiner<T>::select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e)
 template <typename T>
 std::uint8_t Combiner<T>::linearise(Epoch& e) const noexcept {
     constexpr T zero = constant<T>(0.0);
-    std::uint8_t near = 0;
+    auto near = static_cast<std::uint8_t>(1U << e.ref);
+    e.c[e.ref].h = {zero, zero, zero};
+    const ReferenceFactor<T> rf = CombineFormats<T>::reference_from(e.c[e.ref].q);
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((e.group >> i & 1U) == 0U) {
+        if (i == e.ref || (e.group >> i & 1U) == 0U) {
             continue;
         }
-        if (i == e.ref) {
-            e.c[i].h = {zero, zero, zero};
-            near = static_cast<std::uint8_t>(near | 1U << i);
-            continue;
-        }
-        const HalfDifference<T> d = half_difference(e.c[i].q, e.c[e.ref].q, near2_);
+        const HalfDifference<T> d = half_difference(e.c[i].q, rf, near2_);
         e.c[i].h = d.h;
         near = static_cast<std::uint8_t>(near | (d.near ? 1U << i : 0U));
     }
@@ -350,7 +391,7 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
     std::uint8_t near[kMaxHeads] = {};  // candidate-index masks, self excluded
     std::uint8_t count[kMaxHeads] = {};
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        for (std::uint8_t j = static_cast<std::uint8_t>(i + 1); j < e.n; ++j) {
+        for (auto j = static_cast<std::uint8_t>(i + 1); j < e.n; ++j) {
             if (near_each_other(e.c[i].q, e.c[j].q, one_minus_near2_)) {
                 near[i] = static_cast<std::uint8_t>(near[i] | 1U << j);
                 near[j] = static_cast<std::uint8_t>(near[j] | 1U << i);
@@ -366,44 +407,42 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
     const auto group = static_cast<std::uint8_t>(near[best] | 1U << best);
     for (std::uint8_t i = 0; i < e.n; ++i) {
         if ((group >> i & 1U) == 0U && count[i] == count[best]) {
-            return false;  // a disjoint group as large: ambiguous
+            return false;  // a group outside as large: ambiguous
         }
     }
     if (count[best] == 0) {
         return false;
     }
     e.ref = best;
+    e.inconsistent = static_cast<HeadMask>(e.inconsistent | heads_of(e, static_cast<std::uint8_t>(e.group & ~group)));
     e.group = group;
-    const auto all = static_cast<std::uint8_t>((1U << e.n) - 1U);
-    e.out.inconsistent = static_cast<HeadMask>(e.out.inconsistent | heads_of(e, all & ~group));
     return true;
 }
 
+// Σ K_{S,i} h_i over the group (s: its heads).
 template <typename T>
-Vector3<T> Combiner<T>::estimate(const Epoch& e, std::uint8_t group) const noexcept {
-    const HeadMask s = heads_of(e, group);
+Vector3<T> Combiner<T>::estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept {
     Accumulator<T> acc = zero_accumulator<T>();
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) != 0U && i != e.ref) {  // the reference's difference is zero
+        if (i != e.ref && (group >> i & 1U) != 0U) {  // the reference's difference is zero
             accumulate(acc, gain_[s][e.c[i].head], e.c[i].h);
         }
     }
     return result(acc);
 }
 
-// The gate of the heads of `group` about their estimate `est`: the mask of
-// those beyond it, and the largest statistic.
+// The gate of the heads of `group` (s: its heads) about their estimate
+// `est`: the mask of those beyond it, and the largest statistic.
 template <typename T>
-typename Combiner<T>::GateResult Combiner<T>::gate_group(const Epoch& e, std::uint8_t group,
+typename Combiner<T>::GateResult Combiner<T>::gate_group(const Epoch& e, std::uint8_t group, HeadMask s,
                                                          const Vector3<T>& est) const noexcept {
-    const HeadMask s = heads_of(e, group);
     GateResult r{0, {}};
     for (std::uint8_t i = 0; i < e.n; ++i) {
         if ((group >> i & 1U) == 0U) {
             continue;
         }
-        const GateValue<T> v = gate_value(gate_[s][e.c[i].head], e.c[i].h - est);
-        r.largest = (i == 0 || r.largest < v) ? v : r.largest;
+        const GateValue<T> v = gate_value(gate_[s][e.c[i].head], residual(e.c[i].h, est));
+        r.largest = r.largest < v ? v : r.largest;
         r.failing = static_cast<std::uint8_t>(r.failing | (gate_exceeds(v) ? 1U << i : 0U));
     }
     return r;
@@ -421,7 +460,8 @@ std::uint8_t Combiner<T>::odd_one_out(const Epoch& e, std::uint8_t failing) cons
             continue;
         }
         const auto rest = static_cast<std::uint8_t>(e.group & ~(1U << i));
-        const GateValue<T> v = gate_group(e, rest, estimate(e, rest)).largest;
+        const HeadMask s = heads_of(e, rest);
+        const GateValue<T> v = gate_group(e, rest, s, estimate(e, rest, s)).largest;
         if (best == 0xFF || v < best_value) {
             best = i;
             best_value = v;
@@ -430,17 +470,19 @@ std::uint8_t Combiner<T>::odd_one_out(const Epoch& e, std::uint8_t failing) cons
     return best;
 }
 
-// Step 3: the consistency gate; *est receives the group's combined half-angle
-// vector. False: two heads left that disagree (no combination).
+// Step 3: the consistency gate, round after round; *est receives the
+// group's combined half-angle vector. False: two heads left that disagree
+// (no combination).
 template <typename T>
 bool Combiner<T>::gate(Epoch& e, Vector3<T>* est) const noexcept {
     for (std::uint8_t round = 0; round < kMaxHeads; ++round) {
-        *est = estimate(e, e.group);
-        const std::uint8_t size = head_count(heads_of(e, e.group));
+        const HeadMask s = heads_of(e, e.group);
+        *est = estimate(e, e.group, s);
+        const std::uint8_t size = detail::kHeadCounts.n[s];
         if (size < 2) {
             return true;
         }
-        const GateResult g = gate_group(e, e.group, *est);
+        const GateResult g = gate_group(e, e.group, s, *est);
         if (g.failing == 0U) {
             return true;
         }
@@ -449,7 +491,7 @@ bool Combiner<T>::gate(Epoch& e, Vector3<T>* est) const noexcept {
         }
         const std::uint8_t odd = odd_one_out(e, g.failing);
         e.group = static_cast<std::uint8_t>(e.group & ~(1U << odd));
-        e.out.inconsistent = static_cast<HeadMask>(e.out.inconsistent | head_bit(e.c[odd].head));
+        e.inconsistent = static_cast<HeadMask>(e.inconsistent | head_bit(e.c[odd].head));
         if (odd == e.ref) {  // re-form the differences about a head that stays
             for (std::uint8_t i = 0; i < e.n; ++i) {
                 if ((e.group >> i & 1U) != 0U) {
@@ -463,68 +505,98 @@ bool Combiner<T>::gate(Epoch& e, Vector3<T>* est) const noexcept {
     return true;  // not reached: each round removes a head
 }
 
-// No combination: every candidate inconsistent, status 4 | 8.
+// Steps 2 and 3 for the candidates of an epoch (e.n ≥ 1). The usual epoch
+// (every head within the gross gate of the first, none beyond the
+// consistency gate) is one pass over the candidates for the differences and
+// the estimate and one for the gate; the vote and the rounds run only when a
+// head is off. False: no combination.
 template <typename T>
-void Combiner<T>::refuse_all(Epoch& e) const noexcept {
-    const HeadMask all = heads_of(e, static_cast<std::uint8_t>((1U << e.n) - 1U));
-    e.out.inconsistent = static_cast<HeadMask>(e.out.inconsistent | all);
-    e.out.used = 0;
-    e.group = 0;
+bool Combiner<T>::combine_group(Epoch& e, Vector3<T>* est) const noexcept {
+    constexpr T zero = constant<T>(0.0);
+    e.ref = 0;
+    e.group = static_cast<std::uint8_t>((1U << e.n) - 1U);
+    const ReferenceFactor<T> ref = CombineFormats<T>::reference_from(e.c[0].q);
+    e.c[0].h = {zero, zero, zero};
+    bool near = true;
+    Accumulator<T> acc = zero_accumulator<T>();
+    for (std::uint8_t i = 1; i < e.n; ++i) {
+        const HalfDifference<T> d = half_difference(e.c[i].q, ref, near2_);
+        e.c[i].h = d.h;
+        near = near && d.near;
+        accumulate(acc, gain_[e.heads][e.c[i].head], d.h);
+    }
+    if (near) {
+        *est = result(acc);
+        bool failing = false;
+        for (std::uint8_t i = 0; i < e.n && e.n >= 2; ++i) {
+            const Vector3<T> r = residual(e.c[i].h, *est);
+            const std::uint8_t h = e.c[i].head;
+            failing = failing || (!quick_gate(r, quick_[e.heads][h]) && gate_exceeds(gate_value(gate_[e.heads][h], r)));
+        }
+        if (!failing) {
+            return true;
+        }
+        return gate(e, est);
+    }
+    if (!vote(e)) {
+        return false;
+    }
+    static_cast<void>(linearise(e));
+    return gate(e, est);
+}
+
+// Step 4: the combined attitude and its masks and status.
+template <typename T>
+CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vector3<T>& est) const noexcept {
+    constexpr T zero = constant<T>(0.0);
+    constexpr T one = constant<T>(1.0);
+    CombinedAttitude<T> out{{one, zero, zero, zero}, 0, 0, 0, 0, 0};
+    if (combined) {
+        out.used = e.group == (1U << e.n) - 1U ? e.heads : heads_of(e, e.group);
+        const Quaternion<T>& ref = e.c[e.ref].q;
+        const Vector3<T> h = residual(est, bias_[out.used]);
+        // d = (0, h) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖h‖²
+        // (+ ref's own ≤ 1e-6): within Q30's range of renormalized_sum for any
+        // h of the accumulator's range (|hᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
+        // unit to 2⁻³⁰ for ‖h‖ ≤ 0.033 rad, which the gates keep it far below.
+        out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(h, ref)));
+        out.inconsistent = e.inconsistent;
+    } else {
+        out.inconsistent = static_cast<HeadMask>(e.inconsistent | e.heads);  // no combination: all refused
+    }
+    out.left_out = static_cast<HeadMask>(e.left_out | (e.heads & ~out.used));
+    out.subset = out.used;
+    const std::uint8_t used = detail::kHeadCounts.n[out.used];
+    out.status = used >= 2 ? combined_status::kTwoOrMoreHeads
+                           : (used == 1 ? combined_status::kOneHead : combined_status::kNoHead);
+    if (e.left_out_any || out.left_out != 0U) {
+        out.status = static_cast<CombinedStatus>(out.status | combined_status::kHeadLeftOut);
+    }
+    return out;
 }
 
 template <typename T>
 CombinedAttitude<T> Combiner<T>::combine(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept {
     constexpr T zero = constant<T>(0.0);
-    constexpr T one = constant<T>(1.0);
-    Epoch e{};
-    e.out.q_crf_icrf = {one, zero, zero, zero};
+    Epoch e;  // the candidates are written as they are found
+    e.n = 0;
+    e.ref = 0;
+    e.group = 0;
+    e.heads = 0;
+    e.left_out = 0;
+    e.inconsistent = 0;
+    e.left_out_any = false;
     if (valid()) {
         select(heads, n, e);
     } else {
         for (std::uint8_t k = 0; k < n; ++k) {
-            e.out.left_out =
-                static_cast<HeadMask>(e.out.left_out | (heads[k].head < kMaxHeads ? head_bit(heads[k].head) : 0U));
+            e.left_out = static_cast<HeadMask>(e.left_out | (heads[k].head < kMaxHeads ? head_bit(heads[k].head) : 0U));
         }
         e.left_out_any = n > 0;
     }
-    bool combined = false;
     Vector3<T> est{zero, zero, zero};
-    if (e.n > 0) {
-        e.ref = 0;
-        e.group = static_cast<std::uint8_t>((1U << e.n) - 1U);
-        const std::uint8_t near = linearise(e);
-        bool ok = true;
-        if (near != e.group) {
-            ok = vote(e);
-            if (ok) {
-                static_cast<void>(linearise(e));
-            }
-        }
-        if (ok) {
-            ok = gate(e, &est);
-        }
-        combined = ok;
-        if (!ok) {
-            refuse_all(e);
-        }
-    }
-    const auto all = heads_of(e, static_cast<std::uint8_t>((1U << e.n) - 1U));
-    if (combined) {
-        e.out.used = heads_of(e, e.group);
-        const Quaternion<T>& ref = e.c[e.ref].q;
-        est = est + bias_[e.out.used];
-        e.out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(est, ref)));
-    }
-    e.out.inconsistent = static_cast<HeadMask>(e.out.inconsistent & all);
-    e.out.left_out = static_cast<HeadMask>(e.out.left_out | (all & ~e.out.used));
-    e.out.subset = e.out.used;
-    const std::uint8_t used = head_count(e.out.used);
-    e.out.status = used >= 2 ? combined_status::kTwoOrMoreHeads
-                             : (used == 1 ? combined_status::kOneHead : combined_status::kNoHead);
-    if (e.left_out_any || e.out.left_out != 0U) {
-        e.out.status = static_cast<CombinedStatus>(e.out.status | combined_status::kHeadLeftOut);
-    }
-    return e.out;
+    const bool combined = e.n > 0 && combine_group(e, &est);
+    return finish(e, combined, est);
 }
 
 }  // namespace ascorr::combine

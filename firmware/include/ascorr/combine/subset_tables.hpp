@@ -131,6 +131,17 @@ inline bool subset_gate(const Mountings& m, HeadMask s, std::uint8_t i, double k
     return true;
 }
 
+// An upper bound of λ_max(UᵀU) for U of subset_gate: the smaller of the trace
+// and the largest absolute row sum (Gershgorin) of UᵀU, both ≥ λ_max.
+inline double gate_norm_bound(const Matrix3& u) noexcept {
+    const Matrix3 h = transpose(u) * u;
+    double rows = 0.0;
+    for (const auto& row : h.m) {
+        rows = std::fmax(rows, std::fabs(row[0]) + std::fabs(row[1]) + std::fabs(row[2]));
+    }
+    return std::fmin(h.m[0][0] + h.m[1][1] + h.m[2][2], rows);
+}
+
 // Mountings usable for the combination? kNone, or the first problem found
 // (mountings.hpp's MountingsProblem): each present head in index order
 // (quaternion, then sigma_cross, then sigma_about), then no head at all, then
