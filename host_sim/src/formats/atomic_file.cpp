@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <random>
 #include <stdexcept>
 
 namespace ascorr::host {
@@ -121,6 +122,47 @@ std::string final_target(const std::string& path, bool& special) {
     throw std::runtime_error(path + ": cannot write the output: " + std::strerror(errno));
 }
 
+// Eight random letters and digits: with the pid, a name no other run picks.
+std::string random_suffix() {
+    static constexpr char kChars[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+    std::random_device rd;
+    std::string s(8, '0');
+    for (char& c : s) {
+        c = kChars[rd() % (sizeof kChars - 1)];
+    }
+    return s;
+}
+
+// Creates REAL.tmp-PID-XXXXXXXX as a new file (O_EXCL: never an existing file
+// of that name, which is left alone) and registers it for the signal cleanup in
+// one step (the signals held: none can find it created and not registered).
+// Returns the descriptor, or -1 with errno (EEXIST when every name was taken).
+int create_temporary(const std::string& real, std::string& temp, int& slot) {
+    constexpr int kTries = 64;
+    for (int i = 0; i < kTries; ++i) {
+        std::string name = real + ".tmp-" + std::to_string(::getpid()) + "-" + random_suffix();
+        const CleanupSignalsHeld held;
+        const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd < 0) {
+            if (errno == EEXIST) {
+                continue;
+            }
+            return -1;
+        }
+        try {
+            slot = cleanup_register_file(name);
+        } catch (...) {
+            ::close(fd);
+            ::unlink(name.c_str());
+            throw;
+        }
+        temp = std::move(name);
+        return fd;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 }  // namespace
 
 // ---- AtomicFile ------------------------------------------------------------
@@ -148,9 +190,7 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
         }
         return;
     }
-    temp_ = real_ + ".tmp-" + std::to_string(::getpid());
-    cleanup_slot_ = cleanup_register_file(temp_);  // before it exists: no window for a signal
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+    const int fd = create_temporary(real_, temp_, cleanup_slot_);
     if (fd < 0) {
         fail("cannot create a temporary file beside the output");
     }

@@ -8,6 +8,11 @@
 //   exception, a signal), the temporary file is removed and an existing output
 //   is left as it was. An existing output keeps its permission bits (and, for
 //   root, its owner).
+// - The temporary file is OUT.tmp-PID-XXXXXXXX (eight random letters and
+//   digits), created with O_CREAT|O_EXCL|O_NOFOLLOW: always a new file of this
+//   run, never an existing file of that name (an input, a link), which is
+//   neither truncated, renamed nor removed; a name that exists is passed over
+//   for another (64 tries, then the output is refused).
 // - A path reached through symbolic links replaces the links' final target and
 //   keeps the links (the chain is followed by readlink, at most 40 hops, also
 //   when the final target does not exist yet).
