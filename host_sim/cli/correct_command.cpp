@@ -76,14 +76,16 @@ void add_correct_command(CLI::App& app) {
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     cmd->callback([opt, time_constant]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
         }
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
         }
-        const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
+        host::OutputSet outputs = open_run_files(
+            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}}, host::correct_outputs(*opt));
+        const host::CorrectSummary s = host::correct_file(*opt, outputs, std::cerr);
+        outputs.commit();
         if (!s.self_calibration.empty()) {
             std::cerr << "ascorr correct: " << s.self_calibration << '\n';
         }

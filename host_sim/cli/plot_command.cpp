@@ -34,8 +34,9 @@ void add_plot_command(CLI::App& app) {
     wfrom->needs(wto);
     wto->needs(wfrom);
     cmd->callback([opt]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
-        host::plot_iba(*opt, std::cerr);
+        host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--model", &opt->model}}, {{"--out", opt->out}});
+        host::plot_iba(*opt, outputs, std::cerr);
+        outputs.commit();
         std::cerr << "ascorr plot: " << opt->out << '\n';
     });
 }

@@ -22,9 +22,11 @@ void add_stats_command(CLI::App& app) {
     cmd->add_option("--to", opt->to, "last epoch, s since J2000 TT")->check(real_number());
     cmd->add_flag("--json", *json, "print JSON (docs/contract.md) instead of the table");
     cmd->callback([opt, json]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
+        host::OutputSet outputs =
+            open_run_files({{"--in", &opt->in}, {"--model", &opt->model}}, {host::kStandardOutput});
         const host::StatsResult r = host::compute_stats(*opt, std::cerr);
-        std::cout << (*json ? host::stats_json(r) : host::stats_table(r));
+        outputs[host::kStandardOutput.option].write(*json ? host::stats_json(r) : host::stats_table(r));
+        outputs.commit();
     });
 }
 

@@ -195,6 +195,12 @@ void check_window(const PlotOptions& opt) {
 }  // namespace
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
+    OutputSet outputs({{"--out", opt.out}}, {{"--in", opt.in}, {"--model", opt.model}});
+    plot_iba(opt, outputs, log);
+    outputs.commit();
+}
+
+void plot_iba(const PlotOptions& opt, OutputSet& outputs, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
     refuse_bad_time_range(opt.period_from, opt.period_to);
     StatsOptions so;
@@ -361,8 +367,8 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     if (rc != 0 || !std::filesystem::exists(png)) {
         throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
     }
-    // Whole or absent, through links, into streams (AtomicFile).
-    write_file_atomically(opt.out, read_all(png));
+    // Whole or absent, through links, into streams (OutputSet).
+    outputs["--out"].write(read_all(png));
 }
 
 }  // namespace ascorr::host

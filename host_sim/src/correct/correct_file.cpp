@@ -310,7 +310,7 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
 }
 
 template <typename T>
-CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     std::optional<ThermalModel<T>> model;
@@ -371,7 +371,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                      table ? &*table : nullptr,
                      opt.self_calibrate && opt.thermal ? &*schedule : nullptr};
 
-    AtomicFile out(opt.out);
+    AtomicFile& out = outputs["--out"];
     out.write(writer.header_line());
     CorrectSummary sum;
     if (table) {
@@ -437,14 +437,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                          "every one of the " + std::to_string(sum.malformed) +
                              " data rows is malformed (--skip-bad dropped them all): nothing written");
     }
-    std::optional<AtomicFile> history_file;
-    if (opt.self_calibrate && !opt.model_history.empty()) {
-        history_file.emplace(opt.model_history);
-        history_file->write(history);
-    }
-    out.commit();  // the corrected file first, then the history that explains it (as replay)
-    if (history_file) {
-        history_file->commit();
+    if (outputs.has("--model-history")) {
+        outputs["--model-history"].write(history);
     }
     sum.self_calibration = account;
     return sum;
@@ -452,16 +446,35 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
 
 }  // namespace
 
-CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
+std::vector<NamedPath> correct_inputs(const CorrectOptions& opt) {
+    return {{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}};
+}
+
+std::vector<NamedPath> correct_outputs(const CorrectOptions& opt) {
+    std::vector<NamedPath> outputs = {{"--out", opt.out}};
+    if (opt.self_calibrate && !opt.model_history.empty()) {
+        outputs.push_back({"--model-history", opt.model_history});
+    }
+    return outputs;
+}
+
+CorrectSummary correct_file(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log) {
     switch (opt.scalar) {
         case ScalarKind::kDouble:
-            return run<double>(opt, log);
+            return run<double>(opt, outputs, log);
         case ScalarKind::kFloat:
-            return run<float>(opt, log);
+            return run<float>(opt, outputs, log);
         case ScalarKind::kFixed:
-            return run<Q30>(opt, log);
+            return run<Q30>(opt, outputs, log);
     }
     throw std::logic_error("correct_file: unknown scalar type");
+}
+
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
+    OutputSet outputs(correct_outputs(opt), correct_inputs(opt));
+    const CorrectSummary s = correct_file(opt, outputs, log);
+    outputs.commit();
+    return s;
 }
 
 std::string describe(const CorrectSummary& s) {

@@ -55,6 +55,7 @@
 #include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 
 namespace ascorr::host {
 
@@ -146,7 +147,15 @@ struct SimulateSummary {
 // opt.out + ".floor-daily.csv" and opt.out + ".heaters.csv" (start,end,heater:
 // operational or survival).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
+// The six files are one OutputSet (atomic_file.hpp): all written or none.
 SimulateSummary simulate(const SimulateOptions& opt);
+// The command's files: its inputs, and its six outputs by option ("--out",
+// "--out (truth model)", "--out (truth history)", "--out (noise floor)",
+// "--out (daily noise floor)", "--out (heater events)").
+std::vector<NamedPath> simulate_inputs(const SimulateOptions& opt);
+std::vector<NamedPath> simulate_outputs(const SimulateOptions& opt);
+// Writes into outputs (opened from simulate_outputs, committed by the caller).
+SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs);
 
 // Body into head components for head 0 … kMaxHeads − 1 (see the top).
 Eigen::Matrix3d head_mounting(int head);

@@ -3,7 +3,7 @@
 // Reads a solutions file, corrects every row with the core in the chosen
 // scalar type, and writes the corrected file (docs/contract.md): every input row in
 // input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
-// Output is all or nothing (AtomicFile). A malformed row stops the run with
+// Output is all or nothing (atomic_file.hpp's OutputSet). A malformed row stops the run with
 // file:line:column, unless skip_bad, which reports and drops it. With
 // states, rows without their own velocity get the on-board service's.
 #pragma once
@@ -12,9 +12,11 @@
 #include <cstddef>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 
 namespace ascorr::host {
 
@@ -51,7 +53,16 @@ struct CorrectSummary {
     std::string self_calibration;      // --self-calibrate: the estimator's account
 };
 
-// Throws InputError or std::runtime_error; writes nothing then.
+// The command's files (atomic_file.hpp's OutputSet): its inputs, and its
+// outputs by option: "--out", and "--model-history" with self_calibrate.
+std::vector<NamedPath> correct_inputs(const CorrectOptions& opt);
+std::vector<NamedPath> correct_outputs(const CorrectOptions& opt);
+
+// Writes into outputs (opened from correct_outputs, committed by the caller).
+// Throws InputError or std::runtime_error; the caller's outputs are then not
+// committed: nothing is written.
+CorrectSummary correct_file(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log);
+// The same with its own OutputSet, committed at the end.
 CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log);
 
 // A one-paragraph account of a summary, for the terminal.

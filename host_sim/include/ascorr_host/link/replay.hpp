@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/atomic_file.hpp"
+
 namespace ascorr::host {
 
 struct ReplayOptions {
@@ -69,6 +71,14 @@ struct ReplaySummary {
     bool report_matches = false;         // the final report equals the host's, field for field
 };
 
+// The command's files (atomic_file.hpp's OutputSet): its inputs, and its
+// outputs by option: "--out", and "--model-history" with self_calibrate.
+std::vector<NamedPath> replay_inputs(const ReplayOptions& opt);
+std::vector<NamedPath> replay_outputs(const ReplayOptions& opt);
+
+// Writes into outputs (opened from replay_outputs, committed by the caller).
+ReplaySummary replay(const ReplayOptions& opt, OutputSet& outputs, std::ostream& log);
+// The same with its own OutputSet, committed at the end.
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
 // The same over a transport already open (a link a caller set up, a test
 // double); opt.target only names it in messages. The target's HELLO says its
