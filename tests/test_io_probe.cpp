@@ -132,6 +132,44 @@ TEST(IoProbe, SimulateCommitsItsSixFilesTogether) {
     EXPECT_NE(slurp(dir / "s.csv.truth-history.csv"), before[2]);
 }
 
+// ---- item 2: results on standard output are written or the run fails --------
+
+TEST(IoProbe, AResultThatCannotReachStandardOutputFailsTheRun) {
+    const fs::path dir = scratch_dir("io-stdout");
+    const std::vector<std::string> commands = {
+        "stats --in " + sim() + " --json",
+        "stats --in " + sim() + " --model " + truth(),
+        "replay --target loopback-float --in " + sim() + " --model " + truth() + " --out r.csv",
+        "fit --in " + sim() + " --out m.csv --min-days 0.5 --min-orbits 10",
+        "correct --in " + sim() + " --out -",
+        "thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --replay " +
+            std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv",
+        "--help",
+    };
+    for (const std::string& c : commands) {
+        SCOPED_TRACE(c);
+        const CliRun ok = run_in(c + " > out.txt", dir);
+        ASSERT_EQ(ok.exit_code, 0) << ok.err;  // control: the same run into a file
+        ASSERT_FALSE(slurp(dir / "out.txt").empty());
+        fs::remove(dir / "r.csv");
+        fs::remove(dir / "m.csv");
+        const CliRun full = run_in(c + " > /dev/full", dir);
+        EXPECT_EQ(full.exit_code, 1);
+        EXPECT_TRUE(has(full.err, "standard output")) << full.err;
+        // With the reason, when the failure is the flush's (thermistors' rows fill the buffer before it).
+        EXPECT_TRUE(has(full.err, "write failed: No space left on device") ||
+                    (has(c, "thermistors") && has(full.err, "write failed (an earlier write to it failed)")))
+            << full.err;
+        // The report is one of the run's outputs: the files are not written either.
+        EXPECT_FALSE(fs::exists(dir / "r.csv"));
+        EXPECT_FALSE(fs::exists(dir / "m.csv"));
+    }
+    // simulate's report is on standard error: lost, the run fails (no message can be read).
+    const std::string simulate = "cd " + dir.string() + " && " + ASCORR_EXE + " simulate --days 0.1 --out s.csv";
+    const int rc = std::system((simulate + " 2> /dev/full").c_str());
+    EXPECT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1) << rc;
+}
+
 // ---- item 10: two outputs onto one stream -------------------------------------
 
 TEST(IoProbe, TwoOutputsOntoOneStreamAreRefused) {
