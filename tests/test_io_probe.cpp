@@ -196,6 +196,56 @@ TEST(IoProbe, TwoOutputsOntoOneStreamAreRefused) {
     EXPECT_EQ(null.exit_code, 0) << null.err;
 }
 
+// ---- item 14: a stream given by path is read once --------------------------------
+
+TEST(IoProbe, APipeOrFifoGivenByPathIsReadOnceLikeStandardInput) {
+    const fs::path dir = scratch_dir("io-streams");
+    const std::string fit_options = " --min-days 0.5 --min-orbits 10";
+    struct Case {
+        std::string reference;  // with the regular file IN
+        std::string output;     // the file compared
+    };
+    const std::vector<Case> cases = {
+        {"stats --in IN --json > OUT", "OUT"},
+        {"stats --in IN --model " + truth() + " > OUT", "OUT"},
+        {"correct --in IN --self-calibrate --out OUT --model-history OUT.history", "OUT"},
+        {"fit --in IN --out OUT" + fit_options + " > OUT.report", "OUT"},
+        {"plot --in IN --model " + truth() + " --out OUT", "OUT"},
+        {"correct --in IN --out OUT", "OUT"},
+    };
+    ASSERT_EQ(::mkfifo((dir / "in.fifo").c_str(), 0644), 0);
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.reference);
+        const auto with = [&](const std::string& in, const std::string& out) {
+            std::string s = c.reference;
+            s.replace(s.find("IN"), 2, in);
+            for (std::size_t at; (at = s.find("OUT")) != std::string::npos;) {
+                s.replace(at, 3, out);
+            }
+            return s;
+        };
+        const CliRun ref = bash_in(with(sim(), "ref"), dir);
+        ASSERT_EQ(ref.exit_code, 0) << ref.err;
+        // The stream's path, and what the shell adds after the command.
+        const std::vector<std::pair<std::string, std::string>> streams = {
+            {"<(cat " + sim() + ")", ""},                            // a pipe by path (/dev/fd/63)
+            {"/dev/stdin", " < <(cat " + sim() + ")"},               // standard input by path, a pipe
+            {"in.fifo", " & cat " + sim() + " > in.fifo; wait $!"},  // a named FIFO, its writer in the shell
+        };
+        for (const auto& [in, after] : streams) {
+            SCOPED_TRACE(in);
+            fs::remove(dir / "got");
+            const std::string cmd = with(in, "got") + after;
+            const CliRun r = bash_in(cmd, dir);
+            EXPECT_EQ(r.exit_code, 0) << r.err;
+            EXPECT_FALSE(has(r.err, "empty file")) << r.err;
+            EXPECT_FALSE(has(r.err, "ascorr-stdin-")) << r.err;  // messages name the input as given
+            EXPECT_TRUE(slurp(dir / "got") == slurp(dir / "ref"));
+            EXPECT_FALSE(slurp(dir / "got").empty());
+        }
+    }
+}
+
 // ---- item 18: every output path checked before the work -------------------------
 
 // The input is malformed at its last row: a run that checked its outputs only

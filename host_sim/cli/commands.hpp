@@ -99,10 +99,11 @@ CLI::Validator one_of(std::vector<std::pair<std::string, T>> names) {
 // The files of one run, before its work (standard_input.cpp), the same for
 // every command: the outputs checked against the inputs and each other and
 // opened (host::OutputSet: a path that cannot be written fails now, before any
-// input is read); then an input "-" (standard input) read whole into a private
-// temporary file, whose path replaces it (inputs may be read twice). Two inputs
-// "-" are a usage error. The command writes into the set, then commits it: all
-// its outputs or none.
+// input is read); then every input that is a stream ("-" is standard input; a
+// pipe, a FIFO or a socket given by path) read once,
+// whole, into a private temporary file, whose path replaces the input's
+// (inputs may be read twice). Two inputs "-" are a usage error. The command
+// writes into the set, then commits it: all its outputs or none.
 host::OutputSet open_run_files(const std::vector<std::pair<const char*, std::string*>>& inputs,
                                std::vector<host::NamedPath> outputs);
 // The second half of open_run_files alone.

@@ -4,13 +4,18 @@
 // outputs and opened (host::OutputSet, atomic_file.hpp), so that a path that
 // cannot be written fails before any input is read.
 //
-// Then "-" (standard input): the readers open their inputs by path and some
-// read one twice (stats and plot look at the header, then at the rows), which a
-// pipe cannot give. So standard input is first read whole into a private
-// temporary folder, and the input is that copy. The folder is in the
-// signal-cleanup table while it exists and is removed when the process returns
-// from main. Every message names it "standard input" (text::input_name), never
-// its path.
+// Then the inputs that are streams: "-" (standard input) and every input path
+// that names a pipe (/dev/stdin, /dev/fd/N, a shell's <(cmd)), a named FIFO
+// or a socket. The readers open their inputs by path and some read one
+// twice (stats and plot look at the header, then at the rows; self-calibration
+// and --states pass over the rows twice), which a stream cannot give: the
+// second pass of a pipe is empty, the second open of a FIFO waits forever. So
+// each stream is read once, whole, into a private temporary folder, and the
+// input is that copy. The folder is in the signal-cleanup table while it
+// exists and is removed when the process returns from main. Every message
+// names a copy as the user gave it ("standard input" for "-",
+// text::input_name), never by its path. One stream given twice (/dev/stdin and
+// "-") is read once.
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -32,9 +37,18 @@
 namespace ascorr::cli {
 namespace {
 
-// "-": standard input.
+// "-", or a pipe, FIFO or socket by path: what a reader cannot open twice.
+// A character device is left to the readers: /dev/null reads empty each
+// time, and /dev/zero must meet their line bound, not fill the disk.
 bool is_stream(const std::string& path) {
-    return path == "-";
+    if (path == "-") {
+        return true;
+    }
+    struct stat st {};
+    if (path.empty() || ::stat(path.c_str(), &st) != 0) {
+        return false;  // the reader says why it cannot open it
+    }
+    return S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode);
 }
 
 class StreamCopies {
