@@ -369,6 +369,39 @@ TEST(OutputSafety, ASignalledCorrectRemovesItsTemporaryFileAndKeepsTheOldOutput)
     }
 }
 
+// Issue 30 items 1 and 18: every output of a run is open before its input is
+// read, and a signal leaves every one as it was. The input is a FIFO whose
+// writer never closes it: the run is provably inside the copy of its input,
+// its two temporary outputs open.
+TEST(OutputSafety, ASignalBeforeTheCommitLeavesEveryOutputOfTheRunAsItWas) {
+    const fs::path dir = scratch_dir("signal-set");
+    fs::create_directories(dir / "tmp");
+    write(dir / "out.csv", "the previous output\n");
+    write(dir / "history.csv", "the previous history\n");
+    ASSERT_EQ(::mkfifo((dir / "in.csv").c_str(), 0644), 0);
+    const pid_t pid = spawn({"correct", "--in", (dir / "in.csv").string(), "--self-calibrate", "--out",
+                             (dir / "out.csv").string(), "--model-history", (dir / "history.csv").string()},
+                            dir, "", (dir / "tmp").string());
+    const int wr = ::open((dir / "in.csv").c_str(), O_WRONLY);
+    ASSERT_GE(wr, 0);
+    const std::string rows = slurp(kSolutions);
+    ASSERT_EQ(::write(wr, rows.data(), rows.size()), static_cast<ssize_t>(rows.size()));
+    EXPECT_TRUE(eventually([&] {
+        return temporary_of(dir / "out.csv", pid).has_value() && temporary_of(dir / "history.csv", pid).has_value() &&
+               !fs::is_empty(dir / "tmp");
+    }));
+    ASSERT_EQ(::kill(pid, SIGTERM), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ::close(wr);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    EXPECT_EQ(slurp(dir / "out.csv"), "the previous output\n");
+    EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
+    EXPECT_TRUE(fs::is_empty(dir / "tmp"));  // the copy of the input too
+    EXPECT_EQ(names_in(dir),
+              (std::vector<std::string>{"history.csv", "in.csv", "out.csv", "stderr.txt", "stdout.txt", "tmp"}));
+}
+
 TEST(OutputSafety, ASignalledPlotRemovesItsTemporaryFolderAndGnuplot) {
     const fs::path dir = scratch_dir("plot");
     ASSERT_EQ(run_in("simulate --days 1 --out sim.csv", dir).exit_code, 0);
