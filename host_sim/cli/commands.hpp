@@ -106,8 +106,10 @@ CLI::Validator one_of(std::vector<std::pair<std::string, T>> names) {
 // writes into the set, then commits it: all its outputs or none.
 host::OutputSet open_run_files(const std::vector<std::pair<const char*, std::string*>>& inputs,
                                std::vector<host::NamedPath> outputs);
-// The second half of open_run_files alone.
-void read_streams_once(const std::vector<std::pair<const char*, std::string*>>& inputs);
+// The second half of open_run_files alone: "-" and every other stream read
+// once (the name is older than the streams; it is kept for the callers that
+// have no outputs yet in a set).
+void read_dash_from_standard_input(const std::vector<std::pair<const char*, std::string*>>& inputs);
 
 void add_correct_command(CLI::App& app);
 void add_replay_command(CLI::App& app);

@@ -151,7 +151,7 @@ void refuse_two_dashes(const std::vector<std::pair<const char*, std::string*>>& 
 
 }  // namespace
 
-void read_streams_once(const std::vector<std::pair<const char*, std::string*>>& inputs) {
+void read_dash_from_standard_input(const std::vector<std::pair<const char*, std::string*>>& inputs) {
     refuse_two_dashes(inputs);
     static StreamCopies copies;  // removed when main returns
     for (const auto& [option, path] : inputs) {
@@ -171,7 +171,7 @@ host::OutputSet open_run_files(const std::vector<std::pair<const char*, std::str
         }
     }
     host::OutputSet set(std::move(outputs), named);
-    read_streams_once(inputs);
+    read_dash_from_standard_input(inputs);
     return set;
 }
 
