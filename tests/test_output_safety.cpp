@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -105,6 +106,17 @@ void stand_in(const fs::path& bin, const std::string& name, const fs::path& mark
     write(bin / name, "#!/bin/sh\necho $$ > " + marker.string() + ".tmp && mv " + marker.string() + ".tmp " +
                           marker.string() + "\nexec sleep 1000000\n");
     fs::permissions(bin / name, fs::perms::owner_all);
+}
+
+// The temporary file of OUT written by process pid (OUT.tmp-PID-XXXXXXXX), if any.
+std::optional<fs::path> temporary_of(const fs::path& out, pid_t pid) {
+    const std::string prefix = out.filename().string() + ".tmp-" + std::to_string(pid) + "-";
+    for (const auto& e : fs::directory_iterator(out.parent_path())) {
+        if (e.path().filename().string().rfind(prefix, 0) == 0) {
+            return e.path();
+        }
+    }
+    return std::nullopt;
 }
 
 pid_t pid_in(const fs::path& marker) {
@@ -272,6 +284,34 @@ TEST(OutputSafety, ACorrectedFileFedBackIsRefused) {
     }
 }
 
+// Issue 30 item 3: the temporary output was OUT.tmp-PID, opened with O_TRUNC
+// and without O_EXCL: an input of exactly that name was truncated, then
+// removed. The run is started by a child that knows its own pid (the one exec
+// keeps) and names its input after it.
+TEST(OutputSafety, AnInputNamedLikeTheTemporaryOutputIsNeverTouched) {
+    const fs::path dir = scratch_dir("temp-name");
+    ASSERT_EQ(run_in("correct --in " + kSolutions + " --out ref.csv", dir).exit_code, 0);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        const std::string in = (dir / ("out.csv.tmp-" + std::to_string(::getpid()))).string();
+        std::error_code ec;
+        fs::copy_file(kSolutions, in, ec);
+        const int err = ::open((dir / "stderr.txt").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        ::dup2(err, STDERR_FILENO);
+        ::execl(ASCORR_EXE, ASCORR_EXE, "correct", "--in", in.c_str(), "--out", (dir / "out.csv").c_str(),
+                static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    const fs::path in = dir / ("out.csv.tmp-" + std::to_string(pid));
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status << slurp(dir / "stderr.txt");
+    ASSERT_TRUE(fs::exists(in));
+    EXPECT_EQ(slurp(in), slurp(kSolutions));  // neither truncated nor removed
+    EXPECT_EQ(slurp(dir / "out.csv"), slurp(dir / "ref.csv"));
+    EXPECT_EQ(names_in(dir), (std::vector<std::string>{"out.csv", in.filename().string(), "ref.csv", "stderr.txt"}));
+}
+
 // ---- item 2: interrupted runs leave nothing behind ---------------------------
 
 // The input is a FIFO: after one block (32 MiB) the run waits for more, its
@@ -315,8 +355,7 @@ TEST(OutputSafety, ASignalledCorrectRemovesItsTemporaryFileAndKeepsTheOldOutput)
                 sent += chunk.size();
             }
         });
-        const fs::path temp = dir / ("out.csv.tmp-" + std::to_string(pid));
-        const bool started = eventually([&] { return fs::exists(temp); });
+        const bool started = eventually([&] { return temporary_of(dir / "out.csv", pid).has_value(); });
         EXPECT_TRUE(started);
         ASSERT_EQ(::kill(pid, sig), 0);
         int status = 0;
@@ -328,6 +367,39 @@ TEST(OutputSafety, ASignalledCorrectRemovesItsTemporaryFileAndKeepsTheOldOutput)
         EXPECT_EQ(slurp(dir / "out.csv"), "the previous output\n");
         fs::remove_all(dir);
     }
+}
+
+// Issue 30 items 1 and 18: every output of a run is open before its input is
+// read, and a signal leaves every one as it was. The input is a FIFO whose
+// writer never closes it: the run is provably inside the copy of its input,
+// its two temporary outputs open.
+TEST(OutputSafety, ASignalBeforeTheCommitLeavesEveryOutputOfTheRunAsItWas) {
+    const fs::path dir = scratch_dir("signal-set");
+    fs::create_directories(dir / "tmp");
+    write(dir / "out.csv", "the previous output\n");
+    write(dir / "history.csv", "the previous history\n");
+    ASSERT_EQ(::mkfifo((dir / "in.csv").c_str(), 0644), 0);
+    const pid_t pid = spawn({"correct", "--in", (dir / "in.csv").string(), "--self-calibrate", "--out",
+                             (dir / "out.csv").string(), "--model-history", (dir / "history.csv").string()},
+                            dir, "", (dir / "tmp").string());
+    const int wr = ::open((dir / "in.csv").c_str(), O_WRONLY);
+    ASSERT_GE(wr, 0);
+    const std::string rows = slurp(kSolutions);
+    ASSERT_EQ(::write(wr, rows.data(), rows.size()), static_cast<ssize_t>(rows.size()));
+    EXPECT_TRUE(eventually([&] {
+        return temporary_of(dir / "out.csv", pid).has_value() && temporary_of(dir / "history.csv", pid).has_value() &&
+               !fs::is_empty(dir / "tmp");
+    }));
+    ASSERT_EQ(::kill(pid, SIGTERM), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ::close(wr);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    EXPECT_EQ(slurp(dir / "out.csv"), "the previous output\n");
+    EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
+    EXPECT_TRUE(fs::is_empty(dir / "tmp"));  // the copy of the input too
+    EXPECT_EQ(names_in(dir),
+              (std::vector<std::string>{"history.csv", "in.csv", "out.csv", "stderr.txt", "stdout.txt", "tmp"}));
 }
 
 TEST(OutputSafety, ASignalledPlotRemovesItsTemporaryFolderAndGnuplot) {

@@ -36,10 +36,12 @@ void add_align_command(CLI::App& app) {
            "fewest epochs with two or more usable heads (default " + std::to_string(host::kMinAlignEpochs) + ")")
         ->transform(integer_in<std::size_t>(2));
     cmd->callback([opt]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--mountings", &opt->mountings}});
+        host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}},
+                                                 {{"--out", opt->out}, host::kStandardOutput});
         try {
-            const host::AlignReport r = host::align_file(*opt);
-            std::cout << host::describe(r);
+            const host::AlignReport r = host::align_file(*opt, outputs);
+            outputs[host::kStandardOutput.option].write(host::describe(r));
+            outputs.commit();
             std::cerr << "ascorr align: mountings written to " << opt->out << '\n';
         } catch (const host::InputError& e) {
             throw RefusedInput(e.what());

@@ -27,9 +27,11 @@ void add_combine_command(CLI::App& app) {
         ->required()
         ->check(non_empty_path());
     cmd->callback([opt]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--mountings", &opt->mountings}});
+        host::OutputSet outputs =
+            open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}}, host::combine_outputs(*opt));
         try {
-            const host::CombineSummary s = host::combine_file(*opt, std::cerr);
+            const host::CombineSummary s = host::combine_file(*opt, outputs, std::cerr);
+            outputs.commit();
             std::cerr << "ascorr combine: " << opt->out << ": " << host::describe(s) << '\n';
         } catch (const host::InputError& e) {
             throw RefusedInput(e.what());  // as align: refused input exits 2

@@ -16,6 +16,7 @@
 
 #include "ascorr/core/heads.hpp"
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 
 namespace ascorr::cli {
 
@@ -103,10 +104,19 @@ CLI::Validator one_of(std::vector<std::pair<std::string, T>> names) {
         "{" + list + "}");
 }
 
-// "-" is a stream on both sides: as an output, standard output (atomic_file.hpp);
-// as an input, standard input, read whole into a temporary file first (inputs
-// may be read twice). Replaces the path of the one input given as "-" (option,
-// path pairs); two inputs "-" are a usage error.
+// The files of one run, before its work (standard_input.cpp), the same for
+// every command: the outputs checked against the inputs and each other and
+// opened (host::OutputSet: a path that cannot be written fails now, before any
+// input is read); then every input that is a stream ("-" is standard input; a
+// pipe, a FIFO or a socket given by path) read once,
+// whole, into a private temporary file, whose path replaces the input's
+// (inputs may be read twice). Two inputs "-" are a usage error. The command
+// writes into the set, then commits it: all its outputs or none.
+host::OutputSet open_run_files(const std::vector<std::pair<const char*, std::string*>>& inputs,
+                               std::vector<host::NamedPath> outputs);
+// The second half of open_run_files alone: "-" and every other stream read
+// once (the name is older than the streams; it is kept for the callers that
+// have no outputs yet in a set).
 void read_dash_from_standard_input(const std::vector<std::pair<const char*, std::string*>>& inputs);
 
 void add_correct_command(CLI::App& app);

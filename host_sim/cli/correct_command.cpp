@@ -47,7 +47,10 @@ void add_combine_options(CLI::App& cmd, CombineTexts& t) {
     combined->needs(mountings);
 }
 
-void correct_and_combine(const host::CorrectOptions& opt, const CombineTexts& t) {
+void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
+    host::OutputSet outputs = open_run_files(
+        {{"--in", &opt.in}, {"--model", &opt.model}, {"--states", &opt.states}, {"--mountings", &t.mountings}},
+        host::correct_and_combine_outputs(opt, t.combined));
     try {  // the mountings first: refused input exits 2 (as combine and align)
         host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings);
     } catch (const host::InputError& e) {
@@ -55,7 +58,8 @@ void correct_and_combine(const host::CorrectOptions& opt, const CombineTexts& t)
     } catch (const std::runtime_error& e) {
         throw RefusedInput(e.what());
     }
-    const host::CorrectAndCombine r = host::correct_and_combine(opt, t.mountings, t.combined, std::cerr);
+    const host::CorrectAndCombine r = host::correct_and_combine(opt, t.mountings, t.combined, outputs, std::cerr);
+    outputs.commit();
     if (!r.corrected.self_calibration.empty()) {
         std::cerr << "ascorr correct: " << r.corrected.self_calibration << '\n';
     }
@@ -115,10 +119,6 @@ void add_correct_command(CLI::App& app) {
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
     cmd->callback([opt, time_constant, combine]() {
-        read_dash_from_standard_input({{"--in", &opt->in},
-                                       {"--model", &opt->model},
-                                       {"--states", &opt->states},
-                                       {"--mountings", &combine->mountings}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
         }
@@ -129,7 +129,10 @@ void add_correct_command(CLI::App& app) {
             correct_and_combine(*opt, *combine);
             return;
         }
-        const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
+        host::OutputSet outputs = open_run_files(
+            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}}, host::correct_outputs(*opt));
+        const host::CorrectSummary s = host::correct_file(*opt, outputs, std::cerr);
+        outputs.commit();
         if (!s.self_calibration.empty()) {
             std::cerr << "ascorr correct: " << s.self_calibration << '\n';
         }

@@ -56,9 +56,10 @@ void add_fit_command(CLI::App& app) {
                                            "frame F's heads " + *frame + " (--frame-heads) are not among them");
             }
         }
-        read_dash_from_standard_input({{"--in", &opt->in}});
-        const host::FitReport r = host::fit_model(*opt);
-        std::cout << host::describe(r);
+        host::OutputSet outputs = open_run_files({{"--in", &opt->in}}, {{"--out", opt->out}, host::kStandardOutput});
+        const host::FitReport r = host::fit_model(*opt, outputs);
+        outputs[host::kStandardOutput.option].write(host::describe(r));
+        outputs.commit();
         std::cerr << "ascorr fit: model written to " << opt->out << '\n';
     });
 }

@@ -60,17 +60,19 @@ void add_plot_command(CLI::App& app) {
             combined->from = *opt->window_from;
             combined->to = *opt->window_to;
             combined->width = opt->width;
-            read_dash_from_standard_input(
-                {{"--combined", &combined->combined}, {"--truth-attitude", &combined->truth}});
-            host::plot_combined(*combined, std::cerr);
+            host::OutputSet outputs = open_run_files(
+                {{"--combined", &combined->combined}, {"--truth-attitude", &combined->truth}}, {{"--out", opt->out}});
+            host::plot_combined(*combined, outputs, std::cerr);
+            outputs.commit();
             std::cerr << "ascorr plot: " << opt->out << '\n';
             return;
         }
         if (in->count() == 0 || model->count() == 0) {
             throw CLI::RequiredError(in->count() == 0 ? "--in" : "--model");
         }
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
-        host::plot_iba(*opt, std::cerr);
+        host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--model", &opt->model}}, {{"--out", opt->out}});
+        host::plot_iba(*opt, outputs, std::cerr);
+        outputs.commit();
         std::cerr << "ascorr plot: " << opt->out << '\n';
     });
 }

@@ -1,6 +1,8 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
@@ -81,13 +83,17 @@ void add_replay_command(CLI::App& app) {
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
         }
-        read_dash_from_standard_input({{"--in", &opt->in},
-                                       {"--model", &opt->model},
-                                       {"--states", &opt->states},
-                                       {"--firmware", &opt->firmware},
-                                       {"--mountings", &opt->mountings}});
-        const host::ReplaySummary s = host::replay(*opt, std::cerr);
-        std::cout << host::to_json(s) << std::endl;
+        std::vector<host::NamedPath> outputs = host::replay_outputs(*opt);
+        outputs.push_back(host::kStandardOutput);  // the summary
+        host::OutputSet files = open_run_files({{"--in", &opt->in},
+                                                {"--model", &opt->model},
+                                                {"--states", &opt->states},
+                                                {"--firmware", &opt->firmware},
+                                                {"--mountings", &opt->mountings}},
+                                               std::move(outputs));
+        const host::ReplaySummary s = host::replay(*opt, files, std::cerr);
+        files[host::kStandardOutput.option].write(host::to_json(s) + "\n");
+        files.commit();
         if (!host::agrees(s)) {
             throw FailedResult(host::disagreement(s));
         }

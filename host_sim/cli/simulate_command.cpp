@@ -1,6 +1,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ascorr_host/analysis/simulate.hpp"
@@ -187,7 +188,6 @@ void add_simulate_command(CLI::App& app) {
         ->check(head_letters_in(2, kMaxHeads));
     add_event_options(cmd, *events);
     cmd->callback([opt, events]() {
-        read_dash_from_standard_input({{"--truth", &opt->truth}});
         opt->heads = host::parse_head_letters(events->heads).value_or(host::kPaperHeads);  // checked already
         opt->truth_changes = parsed(events->truth_changes, &parse_truth_change);
         opt->gaps = parsed(events->gaps, &parse_gap);
@@ -198,7 +198,13 @@ void add_simulate_command(CLI::App& app) {
         } catch (const std::invalid_argument& e) {
             throw CLI::ValidationError(e.what());  // a usage error, as CLI11's own: exit 2
         }
-        const host::SimulateSummary s = host::simulate(*opt);
+        std::vector<std::pair<const char*, std::string*>> inputs = {{"--truth", &opt->truth}};
+        for (host::TruthChange& c : opt->truth_changes) {
+            inputs.emplace_back("--truth-change", &c.model);
+        }
+        host::OutputSet outputs = open_run_files(inputs, host::simulate_outputs(*opt));
+        const host::SimulateSummary s = host::simulate(*opt, outputs);
+        outputs.commit();
         std::cerr << "ascorr simulate: " << opt->out << ": " << host::describe(s) << '\n';
     });
 }

@@ -43,15 +43,19 @@ void add_stats_command(CLI::App& app) {
             throw CLI::RequiredError("--in (or --combined)");
         }
         if (comb->count() != 0) {
-            read_dash_from_standard_input(
-                {{"--combined", &combined->combined}, {"--truth-attitude", &combined->truth}});
+            host::OutputSet outputs = open_run_files(
+                {{"--combined", &combined->combined}, {"--truth-attitude", &combined->truth}}, {host::kStandardOutput});
             const host::CombinedStats s = host::combined_stats(*combined);
-            std::cout << (*json ? host::combined_stats_json(s) : host::combined_stats_table(s));
+            outputs[host::kStandardOutput.option].write(*json ? host::combined_stats_json(s)
+                                                              : host::combined_stats_table(s));
+            outputs.commit();
             return;
         }
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}});
+        host::OutputSet outputs =
+            open_run_files({{"--in", &opt->in}, {"--model", &opt->model}}, {host::kStandardOutput});
         const host::StatsResult r = host::compute_stats(*opt, std::cerr);
-        std::cout << (*json ? host::stats_json(r) : host::stats_table(r));
+        outputs[host::kStandardOutput.option].write(*json ? host::stats_json(r) : host::stats_table(r));
+        outputs.commit();
     });
 }
 

@@ -240,9 +240,11 @@ void add_thermistors_command(CLI::App& app) {
             },
             kHeadChoices.text));
     cmd->callback([opt]() {
-        read_dash_from_standard_input(
-            {{"--config", &opt->config}, {"--replay", &opt->replay}, {"--simulate", &opt->simulate}});
+        host::OutputSet outputs =
+            open_run_files({{"--config", &opt->config}, {"--replay", &opt->replay}, {"--simulate", &opt->simulate}},
+                           {host::kStandardOutput});  // the rows, printed as they come (checked at the commit)
         run(*opt);
+        outputs.commit();
     });
 }
 

@@ -211,10 +211,11 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
     const ScratchFile file;
     std::ostringstream log;
     {
-        host::CombineStage stage(m, file.path(), kArrayRows, log, host::CombineStage::Mode::kKeep);
+        host::OutputSet outputs({{"combined rows", file.path()}});
+        host::CombineStage stage(m, outputs["combined rows"], kArrayRows, log, host::CombineStage::Mode::kKeep);
         rows_source(rows)([&stage](const host::CorrectedRow& r) { stage.add(r); });
         stage.finish();
-        stage.commit();
+        outputs.commit();
     }
     warn(log.str());
     std::vector<host::AttitudeRow> out;

@@ -312,12 +312,19 @@ CorrectedRowSource rows_of_file(const std::string& path) {
 }
 
 AlignReport align_file(const AlignOptions& opt) {
+    OutputSet outputs({{"--out", opt.out}}, {{"--in", opt.in}, {"--mountings", opt.mountings}});
+    AlignReport r = align_file(opt, outputs);
+    outputs.commit();
+    return r;
+}
+
+AlignReport align_file(const AlignOptions& opt, OutputSet& outputs) {
     refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
     const MountingsFile m = read_mountings_file(opt.mountings);
     AlignReport r = align_rows(rows_of_file(opt.in), opt.in, m, opt);
     r.mountings = opt.mountings;
     r.out = opt.out;
-    write_mountings_file(opt.out, r.aligned);
+    outputs["--out"].write(format_mountings(r.aligned));
     return r;
 }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -159,11 +158,10 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) 
 }
 
 struct CombineStage::Impl {
-    Impl(const MountingsFile& mountings, const std::string& out_path, std::string file_name, std::ostream& log,
-         Mode mode_)
+    Impl(const MountingsFile& mountings, AtomicFile& out_file, std::string file_name, std::ostream& log, Mode mode_)
         : m(mountings),
           combiner(mountings.mountings),
-          out(out_path),
+          out(out_file),
           file(std::move(file_name)),
           diag(log),
           mode(out.streamed() ? Mode::kKeep : mode_) {
@@ -382,7 +380,7 @@ struct CombineStage::Impl {
 
     const MountingsFile& m;
     combine::Combiner<double> combiner;
-    AtomicFile out;
+    AtomicFile& out;
     std::string file;
     Diagnostics diag;
     Mode mode;
@@ -402,8 +400,7 @@ struct CombineStage::Impl {
     bool any_epoch = false;
 };
 
-CombineStage::CombineStage(const MountingsFile& m, const std::string& out, std::string file, std::ostream& log,
-                           Mode mode)
+CombineStage::CombineStage(const MountingsFile& m, AtomicFile& out, std::string file, std::ostream& log, Mode mode)
     : impl_(std::make_unique<Impl>(m, out, std::move(file), log, mode)) {}
 
 CombineStage::~CombineStage() = default;
@@ -418,10 +415,6 @@ void CombineStage::finish() {
 
 const CombineSummary& CombineStage::summary() const noexcept {
     return impl_->sum;
-}
-
-void CombineStage::commit() {
-    impl_->out.commit();
 }
 
 namespace {
@@ -440,15 +433,13 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
     return static_cast<StatusBits>(*v);
 }
 
-CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, std::ostream& log,
+CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, OutputSet& outputs, std::ostream& log,
                             CombineStage::Mode mode) {
-    CombineStage stage(m, opt.out, opt.in, log, mode);
+    CombineStage stage(m, outputs["--out"], opt.in, log, mode);
     for_each_corrected_row(
         opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
     stage.finish();
-    CombineSummary s = stage.summary();
-    stage.commit();
-    return s;
+    return stage.summary();
 }
 
 }  // namespace
@@ -473,38 +464,41 @@ void for_each_corrected_row(const std::string& path, const std::function<void(co
         label);
 }
 
-namespace {
-
-// Whether the corrected file goes to a stream (standard output, a device, a
-// FIFO: atomic_file.hpp's rule): it cannot be written twice, so the rows are
-// kept from the start instead of a second run on rows out of order.
-bool streamed_output(const std::string& path) {
-    if (path == "-" || path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0) {
-        return true;
-    }
-    std::error_code ec;
-    const std::filesystem::file_status st = std::filesystem::status(path, ec);
-    return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+std::vector<NamedPath> correct_and_combine_inputs(const CorrectOptions& opt, const std::string& mountings) {
+    std::vector<NamedPath> inputs = correct_inputs(opt);
+    inputs.push_back({"--mountings", mountings});
+    return inputs;
 }
 
-}  // namespace
+std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, const std::string& combined) {
+    std::vector<NamedPath> outputs = correct_outputs(opt);
+    outputs.push_back({"--combined", combined});
+    return outputs;
+}
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, std::ostream& log) {
-    refuse_output_over_input(
-        {{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}, {"--mountings", mountings}},
-        {{"--out", opt.out}, {"--model-history", opt.model_history}, {"--combined", combined}});
-    refuse_same_output({"--out", opt.out}, {"--combined", combined});
+    OutputSet outputs(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
+    CorrectAndCombine r = correct_and_combine(opt, mountings, combined, outputs, log);
+    outputs.commit();
+    return r;
+}
+
+CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
+                                      const std::string& combined, OutputSet& outputs, std::ostream& log) {
+    refuse_output_over_input(correct_and_combine_inputs(opt, mountings), correct_and_combine_outputs(opt, combined));
     const MountingsFile m = read_mountings_file(mountings);
     refuse_unusable_mountings(m, mountings);
     const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
-        CombineStage stage(m, combined, opt.in, to, mode);
+        CombineStage stage(m, outputs["--combined"], opt.in, to, mode);
         CorrectAndCombine r;
-        r.corrected = correct_file(opt, to, &stage);
+        r.corrected = correct_file(opt, outputs, to, &stage);
         r.combined = stage.summary();
         return r;
     };
-    if (streamed_output(opt.out)) {
+    // A corrected file that goes to a stream cannot be written twice: the
+    // rows are kept from the start instead of a second run.
+    if (outputs["--out"].streamed()) {
         return pass(CombineStage::Mode::kKeep, log);
     }
     std::ostringstream first;
@@ -517,6 +511,8 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
         log << first.str();
         throw;
     }
+    // The first run's temporary files removed, the outputs opened anew.
+    outputs = OutputSet(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
     CorrectAndCombine r = pass(CombineStage::Mode::kKeep, log);
     r.combined.out_of_order = true;
     return r;
@@ -555,18 +551,33 @@ MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in
 
 }  // namespace
 
+std::vector<NamedPath> combine_inputs(const CombineOptions& opt) {
+    return {{"--in", opt.in}, {"--mountings", opt.mountings}};
+}
+
+std::vector<NamedPath> combine_outputs(const CombineOptions& opt) {
+    return {{"--out", opt.out}};
+}
+
 CombineSummary combine_file(const CombineOptions& opt, std::ostream& log) {
-    refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
+    OutputSet outputs(combine_outputs(opt), combine_inputs(opt));
+    const CombineSummary s = combine_file(opt, outputs, log);
+    outputs.commit();
+    return s;
+}
+
+CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::ostream& log) {
+    refuse_output_over_input(combine_inputs(opt), combine_outputs(opt));
     MountingsFile m = read_mountings_file(opt.mountings);
     if (!m.sigmas) {
         m = with_estimated_noise(m, opt.in, opt.mountings, log);
     }
     refuse_unusable_mountings(m, opt.mountings);
     // The first pass's messages wait: if it stops at a row out of order, the
-    // second pass says them again.
+    // second pass says them again (into the outputs opened anew).
     std::ostringstream first;
     try {
-        CombineSummary s = combine_pass(opt, m, first, CombineStage::Mode::kStream);
+        CombineSummary s = combine_pass(opt, m, outputs, first, CombineStage::Mode::kStream);
         log << first.str();
         return s;
     } catch (const RowsOutOfOrder&) {
@@ -574,7 +585,8 @@ CombineSummary combine_file(const CombineOptions& opt, std::ostream& log) {
         log << first.str();
         throw;
     }
-    CombineSummary s = combine_pass(opt, m, log, CombineStage::Mode::kKeep);
+    outputs = OutputSet(combine_outputs(opt), combine_inputs(opt));
+    CombineSummary s = combine_pass(opt, m, outputs, log, CombineStage::Mode::kKeep);
     s.out_of_order = true;
     return s;
 }

@@ -101,12 +101,19 @@ void refuse_bad_fit_options(const FitOptions& opt) {
 }
 }  // namespace
 
-FitReport fit_model(const FitOptions& opt) {
+FitReport fit_model(const FitOptions& opt, OutputSet& outputs) {
     refuse_output_over_input({{"--in", opt.in}}, {{"--out", opt.out}}, true);
     refuse_corrected_file(opt.in);  // fit applies the aberration itself: never twice
     FitReport r = fit_model(
         opt, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "fit"); });
-    write_model_file(opt.out, r.model);
+    outputs["--out"].write(format_model(r.model));
+    return r;
+}
+
+FitReport fit_model(const FitOptions& opt) {
+    OutputSet outputs({{"--out", opt.out}}, {{"--in", opt.in}});
+    FitReport r = fit_model(opt, outputs);
+    outputs.commit();
     return r;
 }
 

@@ -200,6 +200,12 @@ void check_window(const PlotOptions& opt) {
 }  // namespace
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
+    OutputSet outputs({{"--out", opt.out}}, {{"--in", opt.in}, {"--model", opt.model}});
+    plot_iba(opt, outputs, log);
+    outputs.commit();
+}
+
+void plot_iba(const PlotOptions& opt, OutputSet& outputs, std::ostream& log) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {{"--out", opt.out}});
     refuse_bad_time_range(opt.period_from, opt.period_to);
     StatsOptions so;
@@ -366,16 +372,16 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     if (rc != 0 || !std::filesystem::exists(png)) {
         throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
     }
-    // Whole or absent, through links, into streams (AtomicFile).
-    write_file_atomically(opt.out, read_all(png));
+    // Whole or absent, through links, into streams (OutputSet).
+    outputs["--out"].write(read_all(png));
 }
 
 namespace {
 
 // Runs the script `write_script(terminal)` wrote into dir, pngcairo first, then
-// png (a gnuplot built without cairo); the PNG into out, whole or absent.
+// png (a gnuplot built without cairo); the PNG into out (committed by the caller).
 template <typename WriteScript>
-void draw(TempDir& dir, const std::string& gnuplot, const std::filesystem::path& png, const std::string& out,
+void draw(TempDir& dir, const std::string& gnuplot, const std::filesystem::path& png, AtomicFile& out,
           const WriteScript& write_script) {
     const std::string gp_log = (dir.file("gnuplot.log")).string();
     write_script("pngcairo");
@@ -390,12 +396,18 @@ void draw(TempDir& dir, const std::string& gnuplot, const std::filesystem::path&
     if (rc != 0 || !std::filesystem::exists(png)) {
         throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
     }
-    write_file_atomically(out, read_all(png));
+    out.write(read_all(png));
 }
 
 }  // namespace
 
 void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
+    OutputSet outputs({{"--out", opt.out}}, {{"--combined", opt.combined}, {"--truth-attitude", opt.truth}});
+    plot_combined(opt, outputs, log);
+    outputs.commit();
+}
+
+void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostream& log) {
     refuse_output_over_input({{"--combined", opt.combined}, {"--truth-attitude", opt.truth}}, {{"--out", opt.out}});
     if (!(opt.from < opt.to)) {
         throw std::runtime_error("the plot window is empty: --window-from " + number_text(opt.from) +
@@ -491,7 +503,7 @@ void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
         }
         g << "unset multiplot\n";
     };
-    draw(dir, opt.gnuplot, png, opt.out, write_script);
+    draw(dir, opt.gnuplot, png, outputs["--out"], write_script);
 }
 
 }  // namespace ascorr::host

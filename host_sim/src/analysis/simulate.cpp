@@ -926,29 +926,37 @@ void refuse_bad_events(const SimulateOptions& opt) {
     refuse_bad_event_options(opt);
 }
 
-SimulateSummary simulate(const SimulateOptions& opt) {
+std::vector<NamedPath> simulate_inputs(const SimulateOptions& opt) {
     std::vector<NamedPath> inputs = {{"--truth", opt.truth}};
     for (const TruthChange& c : opt.truth_changes) {
         inputs.push_back({"--truth-change", c.model});
     }
-    refuse_output_over_input(inputs, {{"--out", opt.out},
-                                      {"--out (truth model)", opt.out + ".truth.csv"},
-                                      {"--out (truth history)", opt.out + ".truth-history.csv"},
-                                      {"--out (noise floor)", opt.out + ".floor.json"},
-                                      {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
-                                      {"--out (heater events)", opt.out + ".heaters.csv"},
-                                      {"--out (mountings)", opt.out + ".mountings.csv"},
-                                      {"--out (true attitude)", opt.out + ".attitude.csv"}});
+    return inputs;
+}
+
+std::vector<NamedPath> simulate_outputs(const SimulateOptions& opt) {
+    return {{"--out", opt.out},
+            {"--out (truth model)", opt.out + ".truth.csv"},
+            {"--out (truth history)", opt.out + ".truth-history.csv"},
+            {"--out (noise floor)", opt.out + ".floor.json"},
+            {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
+            {"--out (heater events)", opt.out + ".heaters.csv"},
+            {"--out (mountings)", opt.out + ".mountings.csv"},
+            {"--out (true attitude)", opt.out + ".attitude.csv"}};
+}
+
+SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
+    refuse_output_over_input(simulate_inputs(opt), simulate_outputs(opt));
     refuse_bad_options(opt);
     const std::vector<Truth> truths = truth_models(opt);
     Mission mission(opt, truths);
 
-    AtomicFile out(opt.out);
+    AtomicFile& out = outputs["--out"];
     std::string buf;
     buf.reserve(2U << 20);
     buf += kSolutionsHeader;
     buf += '\n';
-    AtomicFile attitude(opt.out + ".attitude.csv");
+    AtomicFile& attitude = outputs["--out (true attitude)"];
     std::string attitude_buf;
     attitude_buf.reserve(2U << 20);
     attitude_buf += kAttitudeHeader;
@@ -973,14 +981,19 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     attitude.write(attitude_buf);
     progress.done();
     const SimulateSummary sum = mission.finish(opt.start_t + static_cast<double>(epochs - 1) * opt.step_s);
-    out.commit();
-    attitude.commit();
-    write_mountings_file(sum.mountings_path, simulated_mountings(opt.heads));
-    write_model_file(sum.truth_path, truths.front().file);
-    write_file_atomically(sum.truth_history_path, truth_history_csv(truths));
-    write_file_atomically(sum.floor_path, floor_json(sum.floor, sum.pairs));
-    write_file_atomically(sum.floor_daily_path, floor_daily_csv(mission.daily(), opt.start_t, sum.pairs));
-    write_file_atomically(sum.heaters_path, heaters_csv(sum.heaters));
+    outputs["--out (mountings)"].write(format_mountings(simulated_mountings(opt.heads)));
+    outputs["--out (truth model)"].write(format_model(truths.front().file));
+    outputs["--out (truth history)"].write(truth_history_csv(truths));
+    outputs["--out (noise floor)"].write(floor_json(sum.floor, sum.pairs));
+    outputs["--out (daily noise floor)"].write(floor_daily_csv(mission.daily(), opt.start_t, sum.pairs));
+    outputs["--out (heater events)"].write(heaters_csv(sum.heaters));
+    return sum;
+}
+
+SimulateSummary simulate(const SimulateOptions& opt) {
+    OutputSet outputs(simulate_outputs(opt), simulate_inputs(opt));
+    const SimulateSummary sum = simulate(opt, outputs);
+    outputs.commit();
     return sum;
 }
 

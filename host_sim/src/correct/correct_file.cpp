@@ -318,7 +318,7 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
 }
 
 template <typename T>
-CorrectSummary run(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink) {
+CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     std::optional<ThermalModel<T>> model;
@@ -380,7 +380,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log, CorrectedRowSin
                      opt.self_calibrate && opt.thermal ? &*schedule : nullptr,
                      sink != nullptr};
 
-    AtomicFile out(opt.out);
+    AtomicFile& out = outputs["--out"];
     out.write(writer.header_line());
     CorrectSummary sum;
     if (table) {
@@ -449,20 +449,11 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log, CorrectedRowSin
                          "every one of the " + std::to_string(sum.malformed) +
                              " data rows is malformed (--skip-bad dropped them all): nothing written");
     }
-    std::optional<AtomicFile> history_file;
-    if (opt.self_calibrate && !opt.model_history.empty()) {
-        history_file.emplace(opt.model_history);
-        history_file->write(history);
+    if (outputs.has("--model-history")) {
+        outputs["--model-history"].write(history);
     }
     if (sink != nullptr) {
-        sink->finish();
-    }
-    out.commit();  // the corrected file first, then what explains or follows from it (as replay)
-    if (history_file) {
-        history_file->commit();
-    }
-    if (sink != nullptr) {
-        sink->commit();
+        sink->finish();  // into its own output of the set
     }
     sum.self_calibration = account;
     return sum;
@@ -470,16 +461,35 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log, CorrectedRowSin
 
 }  // namespace
 
-CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink) {
+std::vector<NamedPath> correct_inputs(const CorrectOptions& opt) {
+    return {{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}};
+}
+
+std::vector<NamedPath> correct_outputs(const CorrectOptions& opt) {
+    std::vector<NamedPath> outputs = {{"--out", opt.out}};
+    if (opt.self_calibrate && !opt.model_history.empty()) {
+        outputs.push_back({"--model-history", opt.model_history});
+    }
+    return outputs;
+}
+
+CorrectSummary correct_file(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     switch (opt.scalar) {
         case ScalarKind::kDouble:
-            return run<double>(opt, log, sink);
+            return run<double>(opt, outputs, log, sink);
         case ScalarKind::kFloat:
-            return run<float>(opt, log, sink);
+            return run<float>(opt, outputs, log, sink);
         case ScalarKind::kFixed:
-            return run<Q30>(opt, log, sink);
+            return run<Q30>(opt, outputs, log, sink);
     }
     throw std::logic_error("correct_file: unknown scalar type");
+}
+
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
+    OutputSet outputs(correct_outputs(opt), correct_inputs(opt));
+    const CorrectSummary s = correct_file(opt, outputs, log);
+    outputs.commit();
+    return s;
 }
 
 std::string describe(const CorrectSummary& s) {

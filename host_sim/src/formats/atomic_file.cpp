@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <random>
 #include <stdexcept>
 
 namespace ascorr::host {
@@ -68,7 +69,20 @@ void run_cleanup() noexcept {
     }
 }
 
+// The commit of an OutputSet and the handler exclude each other: whichever
+// moves the phase from kIdle first goes on. A signal during the renames is
+// noted (g_deferred) and raised again by the commit after its last rename; a
+// commit that finds the cleanup under way waits for the end of the process.
+enum Phase : int { kIdle = 0, kCommitting, kCleaning };
+std::atomic<int> g_phase{kIdle};
+std::atomic<int> g_deferred{0};
+
 extern "C" void on_cleanup_signal(int sig) {
+    g_deferred.store(sig);  // before the exchange: a commit ending now sees it
+    int idle = kIdle;
+    if (!g_phase.compare_exchange_strong(idle, kCleaning)) {
+        return;  // a commit is renaming (it raises sig when done), or another thread is cleaning up
+    }
     run_cleanup();
     struct sigaction dfl {};
     dfl.sa_handler = SIG_DFL;
@@ -80,6 +94,26 @@ extern "C" void on_cleanup_signal(int sig) {
     ::pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
     ::raise(sig);  // default action: the process ends by this signal
 }
+
+// While it lives, the cleanup signals wait (see Phase).
+class CommitWindow {
+public:
+    CommitWindow() noexcept {
+        int idle = kIdle;
+        while (!g_phase.compare_exchange_strong(idle, kCommitting)) {
+            ::pause();  // a handler is cleaning up: the process ends by its signal
+            idle = kIdle;
+        }
+    }
+    ~CommitWindow() {
+        g_phase.store(kIdle);
+        if (const int sig = g_deferred.exchange(0); sig != 0) {
+            ::raise(sig);  // the handler now runs as it would have: outputs complete, the process ends
+        }
+    }
+    CommitWindow(const CommitWindow&) = delete;
+    CommitWindow& operator=(const CommitWindow&) = delete;
+};
 
 // ---- paths ---------------------------------------------------------------
 
@@ -121,15 +155,72 @@ std::string final_target(const std::string& path, bool& special) {
     throw std::runtime_error(path + ": cannot write the output: " + std::strerror(errno));
 }
 
+bool is_null_device(const std::string& path) {
+    struct stat st {};
+    struct stat null {};
+    return ::stat(path.c_str(), &st) == 0 && S_ISCHR(st.st_mode) && ::stat("/dev/null", &null) == 0 &&
+           st.st_rdev == null.st_rdev;
+}
+
+// Eight random letters and digits: with the pid, a name no other run picks.
+std::string random_suffix() {
+    static constexpr char kChars[] = "abcdefghijklmnopqrstuvwxyz0123456789";
+    std::random_device rd;
+    std::string s(8, '0');
+    for (char& c : s) {
+        c = kChars[rd() % (sizeof kChars - 1)];
+    }
+    return s;
+}
+
+// Creates REAL.tmp-PID-XXXXXXXX as a new file (O_EXCL: never an existing file
+// of that name, which is left alone) and registers it for the signal cleanup in
+// one step (the signals held: none can find it created and not registered).
+// Returns the descriptor, or -1 with errno (EEXIST when every name was taken).
+int create_temporary(const std::string& real, std::string& temp, int& slot) {
+    constexpr int kTries = 64;
+    for (int i = 0; i < kTries; ++i) {
+        std::string name = real + ".tmp-" + std::to_string(::getpid()) + "-" + random_suffix();
+        const CleanupSignalsHeld held;
+        const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd < 0) {
+            if (errno == EEXIST) {
+                continue;
+            }
+            return -1;
+        }
+        try {
+            slot = cleanup_register_file(name);
+        } catch (...) {
+            ::close(fd);
+            ::unlink(name.c_str());
+            throw;
+        }
+        temp = std::move(name);
+        return fd;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
 }  // namespace
 
 // ---- AtomicFile ------------------------------------------------------------
 
-void AtomicFile::fail(const std::string& what) const {
-    throw std::runtime_error(target_ + ": " + what + ": " + std::strerror(errno));
+std::string AtomicFile::name() const {
+    if (target_ == "-") {
+        return option_.empty() || option_ == kStandardOutput.option ? kStandardOutput.option
+                                                                    : option_ + " - (standard output)";
+    }
+    return option_.empty() ? target_ : option_ + " " + target_;
 }
 
-AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
+void AtomicFile::fail(const std::string& what) const {
+    throw std::runtime_error(name() + ": " + what + ": " + std::strerror(errno));
+}
+
+AtomicFile::AtomicFile(std::string target, std::string option)
+    : target_(std::move(target)), option_(std::move(option)) {
     if (target_ == "-") {
         f_ = stdout;
         return;
@@ -139,7 +230,7 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
     struct stat st {};
     const bool exists = ::stat(real_.c_str(), &st) == 0;
     if (exists && S_ISDIR(st.st_mode)) {
-        throw std::runtime_error(target_ + ": is a directory: the output must be a file");
+        throw std::runtime_error(name() + ": is a directory: the output must be a file");
     }
     if (special || (exists && !S_ISREG(st.st_mode))) {  // a stream: written in place
         f_ = std::fopen(real_.c_str(), "wb");
@@ -148,16 +239,18 @@ AtomicFile::AtomicFile(std::string target) : target_(std::move(target)) {
         }
         return;
     }
-    temp_ = real_ + ".tmp-" + std::to_string(::getpid());
-    cleanup_slot_ = cleanup_register_file(temp_);  // before it exists: no window for a signal
-    const int fd = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+    open_temporary(exists ? &st : nullptr);
+}
+
+void AtomicFile::open_temporary(const struct ::stat* existing) {
+    const int fd = create_temporary(real_, temp_, cleanup_slot_);
     if (fd < 0) {
         fail("cannot create a temporary file beside the output");
     }
-    if (exists) {  // keep the output's permissions (and owner, when we may)
-        (void)::fchmod(fd, st.st_mode & 07777);
+    if (existing != nullptr) {  // keep the output's permissions (and owner, when we may)
+        (void)::fchmod(fd, existing->st_mode & 07777);
         if (::geteuid() == 0) {
-            (void)::fchown(fd, st.st_uid, st.st_gid);
+            (void)::fchown(fd, existing->st_uid, existing->st_gid);
         }
     }
     f_ = ::fdopen(fd, "wb");
@@ -171,7 +264,7 @@ AtomicFile::~AtomicFile() {
     if (f_ != nullptr && f_ != stdout) {
         std::fclose(f_);
     }
-    if (!committed_ && !temp_.empty()) {
+    if (!committed_ && !kept_ && !temp_.empty()) {
         ::unlink(temp_.c_str());
     }
     if (cleanup_slot_ >= 0) {
@@ -185,22 +278,21 @@ void AtomicFile::write(std::string_view data) {
     }
 }
 
-void AtomicFile::commit() {
+void AtomicFile::complete() {
+    if (completed_) {
+        return;
+    }
+    if (f_ == stdout && std::ferror(stdout) != 0) {  // a write by another path (printf, iostream) failed
+        throw std::runtime_error(name() + ": write failed (an earlier write to it failed)");
+    }
     if (std::fflush(f_) != 0) {
         fail("write failed");
     }
-    if (temp_.empty()) {  // a stream: nothing to rename
-        if (f_ != stdout) {
-            const int rc = std::fclose(f_);
-            f_ = nullptr;
-            if (rc != 0) {
-                fail("close failed");
-            }
-        }
-        committed_ = true;
+    if (f_ == stdout) {
+        completed_ = true;
         return;
     }
-    if (::fsync(::fileno(f_)) != 0) {
+    if (!temp_.empty() && ::fsync(::fileno(f_)) != 0) {
         fail("write failed");
     }
     const int rc = std::fclose(f_);
@@ -208,10 +300,49 @@ void AtomicFile::commit() {
     if (rc != 0) {
         fail("close failed");
     }
-    if (std::rename(temp_.c_str(), real_.c_str()) != 0) {
+    completed_ = true;
+}
+
+void AtomicFile::install() {
+    if (!completed_) {
+        throw std::logic_error(name() + ": install() before complete()");
+    }
+    if (!temp_.empty() && std::rename(temp_.c_str(), real_.c_str()) != 0) {
         fail("cannot rename the temporary file into place");
     }
     committed_ = true;
+    cleanup_release(cleanup_slot_);  // its name is gone: nothing for a signal to remove
+    cleanup_slot_ = -1;
+}
+
+void AtomicFile::commit() {
+    complete();
+    install();
+}
+
+void AtomicFile::keep_temporary() noexcept {
+    kept_ = true;
+    cleanup_release(cleanup_slot_);  // a signal must not remove it either
+    cleanup_slot_ = -1;
+}
+
+AtomicFile::Identity AtomicFile::identity() const {
+    Identity id;
+    struct stat st {};
+    const bool has = f_ != nullptr && temp_.empty() ? ::fstat(::fileno(f_), &st) == 0 : ::stat(real_.c_str(), &st) == 0;
+    if (has) {
+        id.has_inode = true;
+        id.dev = st.st_dev;
+        id.ino = st.st_ino;
+        struct stat null {};
+        id.null_device = S_ISCHR(st.st_mode) && ::stat("/dev/null", &null) == 0 && st.st_rdev == null.st_rdev;
+    }
+    if (!temp_.empty()) {
+        std::error_code ec;
+        const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(real_), ec);
+        id.path = ec ? real_ : p.string();
+    }
+    return id;
 }
 
 void write_file_atomically(const std::string& path, std::string_view data) {
@@ -220,10 +351,90 @@ void write_file_atomically(const std::string& path, std::string_view data) {
     f.commit();
 }
 
+// ---- OutputSet -------------------------------------------------------------
+
+namespace {
+
+bool same_output(const AtomicFile::Identity& a, const AtomicFile::Identity& b) {
+    if (a.has_inode && b.has_inode && a.dev == b.dev && a.ino == b.ino) {
+        return !(a.null_device && b.null_device);
+    }
+    return !a.path.empty() && a.path == b.path;
+}
+
+}  // namespace
+
+OutputSet::OutputSet(std::vector<NamedPath> outputs, const std::vector<NamedPath>& inputs)
+    : names_(std::move(outputs)) {
+    refuse_output_over_input(inputs, names_);
+    std::vector<AtomicFile::Identity> ids;
+    for (const NamedPath& n : names_) {
+        files_.push_back(std::make_unique<AtomicFile>(n.path, n.option));
+        ids.push_back(files_.back()->identity());
+        for (std::size_t i = 0; i + 1 < ids.size(); ++i) {
+            if (same_output(ids[i], ids.back())) {
+                throw std::runtime_error(files_.back()->name() + " is also " + files_[i]->name() +
+                                         ": the same file or stream; two outputs need two files (nothing was written)");
+            }
+        }
+    }
+}
+
+AtomicFile& OutputSet::operator[](std::string_view option) {
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+        if (names_[i].option == option) {
+            return *files_[i];
+        }
+    }
+    throw std::logic_error("no output " + std::string(option) + " was declared");
+}
+
+bool OutputSet::has(std::string_view option) const noexcept {
+    for (const NamedPath& n : names_) {
+        if (n.option == option) {
+            return true;
+        }
+    }
+    return false;
+}
+
+void OutputSet::commit() {
+    for (const auto& f : files_) {  // every write complete before any rename
+        f->complete();
+    }
+    const CommitWindow window;  // no cleanup signal acts between two renames
+    for (std::size_t i = 0; i < files_.size(); ++i) {
+        try {
+            files_[i]->install();
+        } catch (const std::runtime_error& e) {
+            if (i == 0) {
+                throw;  // nothing replaced: the temporary files go as usual
+            }
+            std::string replaced;
+            std::string left;
+            for (std::size_t k = 0; k < files_.size(); ++k) {
+                if (k < i) {
+                    replaced += (replaced.empty() ? "" : ", ") + files_[k]->name();
+                } else if (!files_[k]->streamed()) {
+                    files_[k]->keep_temporary();
+                    left += (left.empty() ? "" : ", ") + files_[k]->name() + " (complete in " + files_[k]->temporary() +
+                            ")";
+                }
+            }
+            throw std::runtime_error(std::string(e.what()) + "; replaced already: " + replaced +
+                                     "; left as they were: " + left +
+                                     ": rename each temporary file over its output to complete the run's outputs");
+        }
+    }
+}
+
 // ---- same-file checks -----------------------------------------------------
 
 void refuse_same_output(const NamedPath& first, const NamedPath& second) {
     namespace fs = std::filesystem;
+    if (is_null_device(first.path) && is_null_device(second.path)) {
+        return;  // nothing to splice: any number of outputs may go there
+    }
     std::error_code ec;
     const fs::path a = fs::weakly_canonical(fs::absolute(first.path), ec);
     const fs::path b = fs::weakly_canonical(fs::absolute(second.path), ec);
@@ -243,7 +454,9 @@ void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::v
     std::vector<Id> in_ids;
     for (const NamedPath& p : inputs) {
         struct stat st {};
-        if (!p.path.empty() && ::stat(p.path.c_str(), &st) == 0) {
+        const bool is_stdin = p.path == "-";
+        if (!p.path.empty() && (is_stdin ? ::fstat(STDIN_FILENO, &st) : ::stat(p.path.c_str(), &st)) == 0 &&
+            !S_ISCHR(st.st_mode)) {  // a terminal or /dev/null holds nothing an output could destroy
             in_ids.push_back({&p, st.st_dev, st.st_ino});
         }
     }
@@ -260,8 +473,10 @@ void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::v
         }
         for (const Id& o : out_ids) {
             if (o.dev == st.st_dev && o.ino == st.st_ino) {
-                throw std::runtime_error(out.option + " " + out.path + " is the same file as the output " +
-                                         o.named->option + " " + o.named->path);
+                throw std::runtime_error(
+                    (out.path == "-" ? std::string("standard output") : out.option + " " + out.path) + " is also " +
+                    o.named->option + " " + o.named->path +
+                    ": the same file or stream; two outputs need two files (nothing was written)");
             }
         }
     };

@@ -346,7 +346,7 @@ private:
 };
 
 template <typename T>
-ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
+ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, std::ostream& log) {
     const std::string text = read_text_file(opt.in);
     SolutionsReader reader(opt.in, text);
     refuse_corrected_input(reader);
@@ -392,7 +392,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     std::size_t next_state = 0;
 
     const RowWriter writer(reader);
-    AtomicFile out(opt.out);
+    AtomicFile& out = outputs["--out"];
     out.write(writer.header_line());
     std::string buf;
     EarthVelocity earth;
@@ -587,26 +587,15 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         writer.row(again, written_rows[k].q, written_rows[k].status, buf);
     }
     out.write(buf);
-    std::optional<AtomicFile> history_file;
     if (opt.self_calibrate) {
         finish_self_calibration(client, sum, target_history, log, *host_sc);
-        if (!opt.model_history.empty()) {
-            history_file.emplace(opt.model_history);
-            history_file->write(format_model_history(target_history));
+        if (outputs.has("--model-history")) {
+            outputs["--model-history"].write(format_model_history(target_history));
         }
     }
-    std::optional<AtomicFile> combined_file;
     if (combination) {
         combination->finish(sum);
-        combined_file.emplace(opt.combined);
-        combined_file->write(combination->text());
-    }
-    out.commit();
-    if (history_file) {
-        history_file->commit();
-    }
-    if (combined_file) {
-        combined_file->commit();
+        outputs["--combined"].write(combination->text());
     }
     const LinkStats& st = client.stats();
     sum.crc_errors = st.naks + st.broken_answers;
@@ -731,13 +720,13 @@ void check_options(const ReplayOptions& opt) {
 
 // The session over a transport already open: the target's HELLO says which
 // scalar it computes in, and the session speaks that one.
-ReplaySummary run_as_announced(const ReplayOptions& o, Transport& transport, std::ostream& log) {
+ReplaySummary run_as_announced(const ReplayOptions& o, Transport& transport, OutputSet& outputs, std::ostream& log) {
     const std::uint8_t kind = LinkClient<float>(transport, o.timeout_ms, o.max_attempts).request_hello().scalar_kind;
     if (kind == link::WireTraits<Q30>::kKind) {
-        return run<Q30>(o, transport, log);
+        return run<Q30>(o, transport, outputs, log);
     }
     if (kind == link::WireTraits<float>::kKind) {
-        return run<float>(o, transport, log);
+        return run<float>(o, transport, outputs, log);
     }
     throw LinkError(o.target + ": the target computes in scalar kind " + std::to_string(kind) +
                     ", which this host does not speak (1 = float, 2 = Q30)");
@@ -745,20 +734,50 @@ ReplaySummary run_as_announced(const ReplayOptions& o, Transport& transport, std
 
 }  // namespace
 
+std::vector<NamedPath> replay_inputs(const ReplayOptions& opt) {
+    return {{"--in", opt.in},
+            {"--model", opt.model},
+            {"--firmware", opt.firmware},
+            {"--states", opt.states},
+            {"--mountings", opt.mountings}};
+}
+
+std::vector<NamedPath> replay_outputs(const ReplayOptions& opt) {
+    std::vector<NamedPath> outputs = {{"--out", opt.out}};
+    if (opt.self_calibrate && !opt.model_history.empty()) {
+        outputs.push_back({"--model-history", opt.model_history});
+    }
+    if (!opt.combined.empty()) {
+        outputs.push_back({"--combined", opt.combined});
+    }
+    return outputs;
+}
+
 ReplaySummary replay_over(const ReplayOptions& opt, Transport& transport, std::ostream& log) {
     check_options(opt);
+    OutputSet outputs(replay_outputs(opt), replay_inputs(opt));
     ReplayOptions o = opt;
     o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
-    return run_as_announced(o, transport, log);
+    const ReplaySummary s = run_as_announced(o, transport, outputs, log);
+    outputs.commit();
+    return s;
 }
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
+    check_options(opt);
+    OutputSet outputs(replay_outputs(opt), replay_inputs(opt));
+    const ReplaySummary s = replay(opt, outputs, log);
+    outputs.commit();
+    return s;
+}
+
+ReplaySummary replay(const ReplayOptions& opt, OutputSet& outputs, std::ostream& log) {
     check_options(opt);
     ReplayOptions o = opt;
     if (opt.target == "loopback-float") {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never
         LoopbackTarget<float> target;
-        return run<float>(o, target.transport(), log);
+        return run<float>(o, target.transport(), outputs, log);
     }
     if (const QemuTarget* board = find_qemu_target(opt.target)) {  // toolchain/targets.txt
         const bool fixed = board->scalar == ScalarKind::kFixed;
@@ -773,12 +792,12 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
         }
         check_link_image(image, *board);
         ProcessTransport qemu(qemu_link_command(std::string(board->machine), image));
-        return fixed ? run<Q30>(o, qemu, log) : run<float>(o, qemu, log);
+        return fixed ? run<Q30>(o, qemu, outputs, log) : run<float>(o, qemu, outputs, log);
     }
     if (opt.target.rfind("/dev/", 0) == 0) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 500;
         SerialTransport serial(opt.target, opt.baud);
-        return run_as_announced(o, serial, log);
+        return run_as_announced(o, serial, outputs, log);
     }
     throw std::runtime_error("--target " + opt.target + ": unknown target (loopback-float, " + qemu_target_names() +
                              " or a serial device such as /dev/ttyUSB0)");

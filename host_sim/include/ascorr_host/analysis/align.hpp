@@ -246,6 +246,8 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
                        const AlignOptions& opt);
 // `ascorr align`: reads opt.in and opt.mountings, writes opt.out (atomically).
 AlignReport align_file(const AlignOptions& opt);
+// The same into outputs["--out"] (atomic_file.hpp's OutputSet, committed by the caller).
+AlignReport align_file(const AlignOptions& opt, OutputSet& outputs);
 // The rows of a corrected or solutions file as the combination takes them.
 CorrectedRowSource rows_of_file(const std::string& path);
 // The report on standard output (see docs/ground.md).

@@ -37,6 +37,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
@@ -109,9 +110,10 @@ struct RowsOutOfOrder {
 class CombineStage : public CorrectedRowSink {
 public:
     enum class Mode { kStream, kKeep };
-    // Writes `out` (AtomicFile) when commit() is called; m: usable mountings
-    // with sigmas. file: the input's name, for messages.
-    CombineStage(const MountingsFile& m, const std::string& out, std::string file, std::ostream& log, Mode mode);
+    // Writes into out (an output of the run's OutputSet, committed by the
+    // caller); m: usable mountings with sigmas. file: the input's name, for
+    // messages.
+    CombineStage(const MountingsFile& m, AtomicFile& out, std::string file, std::ostream& log, Mode mode);
     ~CombineStage() override;
     CombineStage(const CombineStage&) = delete;
     CombineStage& operator=(const CombineStage&) = delete;
@@ -121,9 +123,8 @@ public:
     // a streamed output keeps the rows instead.
     void add(const CorrectedRow& row) override;
     // Combines what is held, writes the last rows, prints the summary of
-    // messages cut short; then commit() makes the file appear.
+    // messages cut short.
     void finish() override;
-    void commit() override;
     const CombineSummary& summary() const noexcept;
 
 private:
@@ -143,6 +144,12 @@ struct CombineOptions {
 // a malformed input or mountings file, std::runtime_error for unusable
 // mountings; writes nothing then.
 CombineSummary combine_file(const CombineOptions& opt, std::ostream& log);
+// The command's files (atomic_file.hpp's OutputSet): "--in", "--mountings"; "--out".
+std::vector<NamedPath> combine_inputs(const CombineOptions& opt);
+std::vector<NamedPath> combine_outputs(const CombineOptions& opt);
+// The same into outputs (opened from combine_outputs, committed by the
+// caller; a run made again on rows out of order opens them anew).
+CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::ostream& log);
 
 // Refuses mountings the combiner cannot use (InputError at the head's line,
 // or std::runtime_error for the head set), or without sigmas
@@ -150,14 +157,21 @@ CombineSummary combine_file(const CombineOptions& opt, std::ostream& log);
 void refuse_unusable_mountings(const MountingsFile& m, const std::string& path);
 
 // `ascorr correct ... --mountings M --combined A`: corrects (correct_file) and
-// combines the corrected rows in the same pass; the corrected file is
-// committed first, then the combined one. Rows out of time order: the run
-// is made again with the rows kept (the first run's messages are dropped).
+// combines the corrected rows in the same pass; the corrected file, the model
+// history and the combined file are one OutputSet, committed together. Rows
+// out of time order: the run is made again with the rows kept, into the
+// outputs opened anew (the first run's messages and files are dropped).
 struct CorrectAndCombine {
     CorrectSummary corrected;
     CombineSummary combined;
 };
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, std::ostream& log);
+// The run's files: correct_inputs and "--mountings"; correct_outputs and "--combined".
+std::vector<NamedPath> correct_and_combine_inputs(const CorrectOptions& opt, const std::string& mountings);
+std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, const std::string& combined);
+// The same into outputs (opened from correct_and_combine_outputs, committed by the caller).
+CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
+                                      const std::string& combined, OutputSet& outputs, std::ostream& log);
 
 }  // namespace ascorr::host

@@ -55,6 +55,7 @@
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/fit_terms.hpp"
 #include "ascorr_host/correct/selection.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -128,6 +129,8 @@ public:
 
 // Fits and writes opt.out (atomically). Throws FitRefused, InputError.
 FitReport fit_model(const FitOptions& opt);
+// The same into outputs["--out"] (atomic_file.hpp's OutputSet, committed by the caller).
+FitReport fit_model(const FitOptions& opt, OutputSet& outputs);
 // The same on rows from elsewhere (opt.in names them in messages); writes nothing.
 FitReport fit_model(const FitOptions& opt, const RowSource& rows);
 

@@ -20,6 +20,8 @@
 #include <optional>
 #include <string>
 
+#include "ascorr_host/formats/atomic_file.hpp"
+
 namespace ascorr::host {
 
 inline constexpr double kPlotBinS = 5400.0;
@@ -40,6 +42,8 @@ struct PlotOptions {
 // Throws InputError, std::runtime_error (gnuplot missing or failing, a
 // window that is empty or has no clean epoch).
 void plot_iba(const PlotOptions& opt, std::ostream& log);
+// The same into outputs["--out"] (atomic_file.hpp's OutputSet, committed by the caller).
+void plot_iba(const PlotOptions& opt, OutputSet& outputs, std::ostream& log);
 
 // The combined attitude's error against the truth in a window (`plot
 // --combined A --truth-attitude T --window-from --window-to`): three panels,
@@ -56,6 +60,8 @@ struct CombinedPlotOptions {
     std::string gnuplot = "gnuplot";
 };
 void plot_combined(const CombinedPlotOptions& opt, std::ostream& log);
+// The same into outputs["--out"] (atomic_file.hpp's OutputSet, committed by the caller).
+void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostream& log);
 
 // Writes "t+time_offset T_CHU_A … T_CHU_<last head of heads.hpp> T029 T032"
 // per bin of bin_s seconds with data in [from, to] (means over the rows of

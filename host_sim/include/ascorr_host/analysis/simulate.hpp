@@ -62,6 +62,7 @@
 #include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
 
 namespace ascorr::host {
@@ -158,7 +159,16 @@ struct SimulateSummary {
 // and opt.out + ".attitude.csv" (t,qw,qx,qy,qz: q_crf_icrf at every epoch k·step,
 // in --gap too; combined_csv.hpp).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
+// The eight files are one OutputSet (atomic_file.hpp): all written or none.
 SimulateSummary simulate(const SimulateOptions& opt);
+// The command's files: its inputs, and its eight outputs by option ("--out",
+// "--out (truth model)", "--out (truth history)", "--out (noise floor)",
+// "--out (daily noise floor)", "--out (heater events)", "--out (mountings)",
+// "--out (true attitude)").
+std::vector<NamedPath> simulate_inputs(const SimulateOptions& opt);
+std::vector<NamedPath> simulate_outputs(const SimulateOptions& opt);
+// Writes into outputs (opened from simulate_outputs, committed by the caller).
+SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs);
 
 // Body into head components for head 0 … kMaxHeads − 1 (see the top).
 Eigen::Matrix3d head_mounting(int head);

@@ -3,7 +3,7 @@
 // Reads a solutions file, corrects every row with the core in the chosen
 // scalar type, and writes the corrected file (docs/contract.md): every input row in
 // input order, all its fields verbatim except qw,qx,qy,qz, plus `status`.
-// Output is all or nothing (AtomicFile). A malformed row stops the run with
+// Output is all or nothing (atomic_file.hpp's OutputSet). A malformed row stops the run with
 // file:line:column, unless skip_bad, which reports and drops it. With
 // states, rows without their own velocity get the on-board service's.
 #pragma once
@@ -13,11 +13,13 @@
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
@@ -68,19 +70,29 @@ struct CorrectedRow {
     StatusBits status = 0;
 };
 
-// Takes every corrected row in file order; finish() after the last, then
-// commit() after the corrected file's (the outputs of one run appear together).
+// Takes every corrected row in file order; finish() after the last, which
+// writes what the sink makes into its output of the run's OutputSet (the
+// caller commits the set: the outputs of one run appear together).
 class CorrectedRowSink {
 public:
     virtual ~CorrectedRowSink() = default;
     virtual void add(const CorrectedRow& row) = 0;
     virtual void finish() = 0;
-    virtual void commit() = 0;
 };
 
-// Throws InputError or std::runtime_error; writes nothing then. sink: the
-// corrected rows also go there (correct --combined).
-CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink = nullptr);
+// The command's files (atomic_file.hpp's OutputSet): its inputs, and its
+// outputs by option: "--out", and "--model-history" with self_calibrate.
+std::vector<NamedPath> correct_inputs(const CorrectOptions& opt);
+std::vector<NamedPath> correct_outputs(const CorrectOptions& opt);
+
+// Writes into outputs (opened from correct_outputs, committed by the caller).
+// Throws InputError or std::runtime_error; the caller's outputs are then not
+// committed: nothing is written. sink: the corrected rows also go there
+// (correct --combined), its finish() called after the last.
+CorrectSummary correct_file(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log,
+                            CorrectedRowSink* sink = nullptr);
+// The same with its own OutputSet, committed at the end.
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log);
 
 // A one-paragraph account of a summary, for the terminal.
 std::string describe(const CorrectSummary& s);

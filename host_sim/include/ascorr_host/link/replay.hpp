@@ -34,6 +34,8 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/atomic_file.hpp"
+
 namespace ascorr::host {
 
 struct ReplayOptions {
@@ -83,6 +85,14 @@ struct ReplaySummary {
     double combination_instructions_per_epoch = 0;  // mean over epochs of two or more heads
 };
 
+// The command's files (atomic_file.hpp's OutputSet): its inputs, and its
+// outputs by option: "--out", and "--model-history" with self_calibrate.
+std::vector<NamedPath> replay_inputs(const ReplayOptions& opt);
+std::vector<NamedPath> replay_outputs(const ReplayOptions& opt);
+
+// Writes into outputs (opened from replay_outputs, committed by the caller).
+ReplaySummary replay(const ReplayOptions& opt, OutputSet& outputs, std::ostream& log);
+// The same with its own OutputSet, committed at the end.
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);
 // The same over a transport already open (a link a caller set up, a test
 // double); opt.target only names it in messages. The target's HELLO says its

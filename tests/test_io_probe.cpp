@@ -1,0 +1,284 @@
+// The command line against the third hostile probe's I/O items (issue 30):
+// the outputs of one run committed together or not at all (1, 4), results on
+// standard output checked to the last flush (2), two outputs onto one stream
+// refused (10), a pipe or FIFO given by path read once (14), and every output
+// path checked before the work (18). Each case is a row of DEVELOPERS.md's
+// bad-input table. Nothing here waits on a clock: `timeout` only guards
+// against a hang, it measures nothing.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool has(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
+
+void write(const fs::path& p, const std::string& text) {
+    std::ofstream(p, std::ios::binary) << text;
+}
+
+// One simulated day (sim.csv, its truth model sim.csv.truth.csv), made once.
+const fs::path& simulated_day() {
+    static const fs::path dir = [] {
+        const fs::path d = fs::temp_directory_path() / ("ascorr-test-" + std::to_string(::getpid()) + "-io-sim");
+        fs::remove_all(d);
+        fs::create_directories(d);
+        const CliRun r = run_in("simulate --days 1 --out sim.csv", d);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return d;
+    }();
+    return dir;
+}
+
+std::string sim() {
+    return (simulated_day() / "sim.csv").string();
+}
+std::string truth() {
+    return (simulated_day() / "sim.csv.truth.csv").string();
+}
+
+// `ascorr ARGS` through bash (process substitution, pipes) in dir, with a hang
+// guard; standard error in dir/stderr.txt.
+CliRun bash_in(const std::string& args, const fs::path& dir) {
+    const std::string script =
+        "set -o pipefail; cd " + dir.string() + " || exit 99; timeout 60 " + std::string(ASCORR_EXE) + " " + args;
+    return run_shell("bash -c '" + script + "'", dir);
+}
+
+// The names in dir that are temporary outputs (OUT.tmp-PID-XXXXXXXX).
+std::vector<std::string> temporaries_in(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (has(e.path().filename().string(), ".tmp-")) {
+            names.push_back(e.path().filename().string());
+        }
+    }
+    return names;
+}
+
+// ---- items 1 and 4: the outputs of one run, together or not at all ----------
+
+// The history to /dev/full: its write fails at the flush, after the corrected
+// rows are complete. The corrected file was renamed first and the run said
+// nothing of it; now nothing is renamed. And the other way round.
+TEST(IoProbe, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound) {
+    const fs::path dir = scratch_dir("io-history");
+    const std::vector<std::string> commands = {
+        "correct --in " + sim() + " --self-calibrate",
+        "replay --target loopback-float --in " + sim() + " --self-calibrate",
+    };
+    for (const std::string& c : commands) {
+        SCOPED_TRACE(c);
+        write(dir / "out.csv", "the previous corrected file\n");
+        write(dir / "history.csv", "the previous history\n");
+        const CliRun a = run_in(c + " --out out.csv --model-history /dev/full > summary.json", dir);
+        EXPECT_EQ(a.exit_code, 1);
+        EXPECT_TRUE(has(a.err, "--model-history /dev/full: write failed: No space left on device")) << a.err;
+        EXPECT_EQ(slurp(dir / "out.csv"), "the previous corrected file\n");
+        const CliRun b = run_in(c + " --out /dev/full --model-history history.csv > summary.json", dir);
+        EXPECT_EQ(b.exit_code, 1);
+        EXPECT_TRUE(has(b.err, "--out /dev/full: write failed: No space left on device")) << b.err;
+        EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
+        EXPECT_TRUE(temporaries_in(dir).empty());
+        // Control: with both writable, both are replaced.
+        const CliRun ok = run_in(c + " --out out.csv --model-history history.csv > summary.json", dir);
+        EXPECT_EQ(ok.exit_code, 0) << ok.err;
+        EXPECT_TRUE(has(slurp(dir / "out.csv"), ",status\n"));
+        EXPECT_TRUE(has(slurp(dir / "history.csv"), "t,version,chu,axis"));
+    }
+}
+
+// simulate's six files: the heater list cannot be written (a link to /dev/full,
+// a stream); the five others keep the previous run's contents. Simulate
+// renamed them one by one, the solutions first.
+TEST(IoProbe, SimulateCommitsItsSixFilesTogether) {
+    const fs::path dir = scratch_dir("io-simulate");
+    ASSERT_EQ(run_in("simulate --days 0.1 --seed 1 --out s.csv", dir).exit_code, 0);
+    const std::vector<std::string> kept = {"s.csv", "s.csv.truth.csv", "s.csv.truth-history.csv", "s.csv.floor.json",
+                                           "s.csv.floor-daily.csv"};
+    std::vector<std::string> before;
+    for (const std::string& f : kept) {
+        before.push_back(slurp(dir / f));
+    }
+    fs::remove(dir / "s.csv.heaters.csv");
+    fs::create_symlink("/dev/full", dir / "s.csv.heaters.csv");
+    const CliRun r = run_in("simulate --days 0.1 --seed 2 --truth-change 0.05:" + truth() + " --out s.csv", dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "--out (heater events) s.csv.heaters.csv: write failed")) << r.err;
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        EXPECT_EQ(slurp(dir / kept[i]), before[i]) << kept[i];
+    }
+    EXPECT_TRUE(temporaries_in(dir).empty());
+    // Control: the same run with a writable heater list replaces all six.
+    fs::remove(dir / "s.csv.heaters.csv");
+    ASSERT_EQ(run_in("simulate --days 0.1 --seed 2 --truth-change 0.05:" + truth() + " --out s.csv", dir).exit_code, 0);
+    EXPECT_NE(slurp(dir / "s.csv"), before[0]);
+    EXPECT_NE(slurp(dir / "s.csv.truth-history.csv"), before[2]);
+}
+
+// ---- item 2: results on standard output are written or the run fails --------
+
+TEST(IoProbe, AResultThatCannotReachStandardOutputFailsTheRun) {
+    const fs::path dir = scratch_dir("io-stdout");
+    const std::vector<std::string> commands = {
+        "stats --in " + sim() + " --json",
+        "stats --in " + sim() + " --model " + truth(),
+        "replay --target loopback-float --in " + sim() + " --model " + truth() + " --out r.csv",
+        "fit --in " + sim() + " --out m.csv --min-days 0.5 --min-orbits 10",
+        "correct --in " + sim() + " --out -",
+        "thermistors --config " + std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg --replay " +
+            std::string(ASCORR_HAL_EXAMPLES) + "/replay.csv",
+        "--help",
+    };
+    for (const std::string& c : commands) {
+        SCOPED_TRACE(c);
+        const CliRun ok = run_in(c + " > out.txt", dir);
+        ASSERT_EQ(ok.exit_code, 0) << ok.err;  // control: the same run into a file
+        ASSERT_FALSE(slurp(dir / "out.txt").empty());
+        fs::remove(dir / "r.csv");
+        fs::remove(dir / "m.csv");
+        const CliRun full = run_in(c + " > /dev/full", dir);
+        EXPECT_EQ(full.exit_code, 1);
+        EXPECT_TRUE(has(full.err, "standard output")) << full.err;
+        // With the reason, when the failure is the flush's (thermistors' rows fill the buffer before it).
+        EXPECT_TRUE(has(full.err, "write failed: No space left on device") ||
+                    (has(c, "thermistors") && has(full.err, "write failed (an earlier write to it failed)")))
+            << full.err;
+        // The report is one of the run's outputs: the files are not written either.
+        EXPECT_FALSE(fs::exists(dir / "r.csv"));
+        EXPECT_FALSE(fs::exists(dir / "m.csv"));
+    }
+    // simulate's report is on standard error: lost, the run fails (no message can be read).
+    const std::string simulate = "cd " + dir.string() + " && " + ASCORR_EXE + " simulate --days 0.1 --out s.csv";
+    const int rc = std::system((simulate + " 2> /dev/full").c_str());
+    EXPECT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 1) << rc;
+}
+
+// ---- item 10: two outputs onto one stream -------------------------------------
+
+TEST(IoProbe, TwoOutputsOntoOneStreamAreRefused) {
+    const fs::path dir = scratch_dir("io-one-stream");
+    const std::string self = "correct --in " + sim() + " --self-calibrate ";
+    const std::vector<std::string> refused = {
+        self + "--out /dev/stdout --model-history /dev/fd/1 | cat > both.csv",
+        self + "--out - --model-history /dev/stdout > both.csv",
+        "fit --in " + sim() + " --out /dev/stdout --min-days 0.5 --min-orbits 10 | cat > both.csv",
+        "replay --target loopback-float --in " + sim() + " --model " + truth() + " --out /dev/fd/1 > both.csv",
+        "fit --in " + sim() + " --out both.csv --min-days 0.5 --min-orbits 10 > both.csv",
+    };
+    for (const std::string& c : refused) {
+        SCOPED_TRACE(c);
+        const CliRun r = bash_in(c, dir);  // pipefail: a pipeline's status is ascorr's
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_TRUE(has(r.err, " is also ")) << r.err;
+        EXPECT_TRUE(has(r.err, "two outputs need two files")) << r.err;
+        EXPECT_TRUE(!fs::exists(dir / "both.csv") || fs::file_size(dir / "both.csv") == 0);
+        fs::remove(dir / "both.csv");
+    }
+    // The null device takes any number of outputs.
+    const CliRun null = run_in(self + "--out /dev/null --model-history /dev/null", dir);
+    EXPECT_EQ(null.exit_code, 0) << null.err;
+}
+
+// ---- item 14: a stream given by path is read once --------------------------------
+
+TEST(IoProbe, APipeOrFifoGivenByPathIsReadOnceLikeStandardInput) {
+    const fs::path dir = scratch_dir("io-streams");
+    const std::string fit_options = " --min-days 0.5 --min-orbits 10";
+    struct Case {
+        std::string reference;  // with the regular file IN
+        std::string output;     // the file compared
+    };
+    const std::vector<Case> cases = {
+        {"stats --in IN --json > OUT", "OUT"},
+        {"stats --in IN --model " + truth() + " > OUT", "OUT"},
+        {"correct --in IN --self-calibrate --out OUT --model-history OUT.history", "OUT"},
+        {"fit --in IN --out OUT" + fit_options + " > OUT.report", "OUT"},
+        {"plot --in IN --model " + truth() + " --out OUT", "OUT"},
+        {"correct --in IN --out OUT", "OUT"},
+    };
+    ASSERT_EQ(::mkfifo((dir / "in.fifo").c_str(), 0644), 0);
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.reference);
+        const auto with = [&](const std::string& in, const std::string& out) {
+            std::string s = c.reference;
+            s.replace(s.find("IN"), 2, in);
+            for (std::size_t at; (at = s.find("OUT")) != std::string::npos;) {
+                s.replace(at, 3, out);
+            }
+            return s;
+        };
+        const CliRun ref = bash_in(with(sim(), "ref"), dir);
+        ASSERT_EQ(ref.exit_code, 0) << ref.err;
+        // The stream's path, and what the shell adds after the command.
+        const std::vector<std::pair<std::string, std::string>> streams = {
+            {"<(cat " + sim() + ")", ""},                            // a pipe by path (/dev/fd/63)
+            {"/dev/stdin", " < <(cat " + sim() + ")"},               // standard input by path, a pipe
+            {"in.fifo", " & cat " + sim() + " > in.fifo; wait $!"},  // a named FIFO, its writer in the shell
+        };
+        for (const auto& [in, after] : streams) {
+            SCOPED_TRACE(in);
+            fs::remove(dir / "got");
+            const std::string cmd = with(in, "got") + after;
+            const CliRun r = bash_in(cmd, dir);
+            EXPECT_EQ(r.exit_code, 0) << r.err;
+            EXPECT_FALSE(has(r.err, "empty file")) << r.err;
+            EXPECT_FALSE(has(r.err, "ascorr-stdin-")) << r.err;  // messages name the input as given
+            EXPECT_TRUE(slurp(dir / "got") == slurp(dir / "ref"));
+            EXPECT_FALSE(slurp(dir / "got").empty());
+        }
+    }
+}
+
+// ---- item 18: every output path checked before the work -------------------------
+
+// The input is malformed at its last row: a run that checked its outputs only
+// at the end stopped at that row and never said the output could not be
+// written; now the output is named first, before any input is read.
+TEST(IoProbe, AnOutputThatCannotBeWrittenFailsBeforeAnyInputIsRead) {
+    const fs::path dir = scratch_dir("io-early");
+    std::string text = slurp(sim());
+    text += "1.0,A,not-a-number\n";
+    write(dir / "bad.csv", text);
+    write(dir / "bad-model.csv", "chu,axis,c0\nA,x,nope\n");
+    fs::create_directories(dir / "a-folder");
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"correct --in bad.csv --self-calibrate --out ok.csv --model-history no/h.csv", "--model-history no/h.csv"},
+        {"correct --in bad.csv --out no/o.csv", "--out no/o.csv"},
+        {"correct --in bad.csv --self-calibrate --out ok.csv --model-history a-folder", "--model-history a-folder"},
+        {"replay --target loopback-float --in bad.csv --self-calibrate --out no/o.csv", "--out no/o.csv"},
+        {"replay --target loopback-float --in bad.csv --self-calibrate --out ok.csv --model-history no/h.csv",
+         "--model-history no/h.csv"},
+        {"fit --in bad.csv --out no/m.csv", "--out no/m.csv"},
+        {"plot --in bad.csv --model bad-model.csv --out no/p.png", "--out no/p.png"},
+        {"simulate --days 1 --truth bad-model.csv --out no/s.csv", "--out no/s.csv"},
+    };
+    for (const auto& [c, named] : cases) {
+        SCOPED_TRACE(c);
+        const CliRun r = run_in(c, dir);
+        EXPECT_EQ(r.exit_code, 1);
+        EXPECT_TRUE(has(r.err, "ascorr: " + named + ": ")) << r.err;
+        EXPECT_FALSE(has(r.err, "bad")) << r.err;  // no input was read
+        EXPECT_FALSE(fs::exists(dir / "ok.csv"));
+        EXPECT_TRUE(temporaries_in(dir).empty());
+    }
+}
+
+}  // namespace
+}  // namespace ascorr::test
