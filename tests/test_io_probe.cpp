@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -104,14 +105,19 @@ TEST(IoProbe, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound) {
     }
 }
 
-// simulate's six files: the heater list cannot be written (a link to /dev/full,
-// a stream); the five others keep the previous run's contents. Simulate
-// renamed them one by one, the solutions first.
-TEST(IoProbe, SimulateCommitsItsSixFilesTogether) {
+// simulate's eight files: the heater list cannot be written (a link to
+// /dev/full, a stream); the seven others keep the previous run's contents.
+// Simulate renamed them one by one, the solutions first.
+TEST(IoProbe, SimulateCommitsItsEightFilesTogether) {
     const fs::path dir = scratch_dir("io-simulate");
     ASSERT_EQ(run_in("simulate --days 0.1 --seed 1 --out s.csv", dir).exit_code, 0);
-    const std::vector<std::string> kept = {"s.csv", "s.csv.truth.csv", "s.csv.truth-history.csv", "s.csv.floor.json",
-                                           "s.csv.floor-daily.csv"};
+    const std::vector<std::string> kept = {"s.csv",
+                                           "s.csv.truth.csv",
+                                           "s.csv.truth-history.csv",
+                                           "s.csv.floor.json",
+                                           "s.csv.floor-daily.csv",
+                                           "s.csv.mountings.csv",
+                                           "s.csv.attitude.csv"};
     std::vector<std::string> before;
     for (const std::string& f : kept) {
         before.push_back(slurp(dir / f));
@@ -125,11 +131,48 @@ TEST(IoProbe, SimulateCommitsItsSixFilesTogether) {
         EXPECT_EQ(slurp(dir / kept[i]), before[i]) << kept[i];
     }
     EXPECT_TRUE(temporaries_in(dir).empty());
-    // Control: the same run with a writable heater list replaces all six.
+    // Control: the same run with a writable heater list replaces all eight.
     fs::remove(dir / "s.csv.heaters.csv");
     ASSERT_EQ(run_in("simulate --days 0.1 --seed 2 --truth-change 0.05:" + truth() + " --out s.csv", dir).exit_code, 0);
     EXPECT_NE(slurp(dir / "s.csv"), before[0]);
     EXPECT_NE(slurp(dir / "s.csv.truth-history.csv"), before[2]);
+}
+
+// correct --combined and replay --combined: the corrected file, the model
+// history and the combined file are one set. The combined file to /dev/full
+// (its write fails at the flush, after the corrected rows are complete) leaves
+// the corrected file and the history as they were; the corrected file to
+// /dev/full leaves the combined file as it was. The combined file was written
+// and committed on its own, after the corrected file.
+TEST(IoProbe, TheCombinedFileIsCommittedWithTheCorrectedFile) {
+    const fs::path dir = scratch_dir("io-combined");
+    const std::string m = sim() + ".mountings.csv";
+    const std::vector<std::string> commands = {
+        "correct --in " + sim() + " --model " + truth() + " --mountings " + m,
+        "correct --in " + sim() + " --self-calibrate --model-history history.csv --mountings " + m,
+        "replay --target loopback-float --in " + sim() + " --model " + truth() + " --mountings " + m,
+    };
+    for (const std::string& c : commands) {
+        SCOPED_TRACE(c);
+        write(dir / "out.csv", "the previous corrected file\n");
+        write(dir / "history.csv", "the previous history\n");
+        write(dir / "combined.csv", "the previous combined file\n");
+        const CliRun a = run_in(c + " --out out.csv --combined /dev/full > summary.json", dir);
+        EXPECT_EQ(a.exit_code, 1);
+        EXPECT_TRUE(has(a.err, "--combined /dev/full: write failed: No space left on device")) << a.err;
+        EXPECT_EQ(slurp(dir / "out.csv"), "the previous corrected file\n");
+        EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
+        const CliRun b = run_in(c + " --out /dev/full --combined combined.csv > summary.json", dir);
+        EXPECT_EQ(b.exit_code, 1);
+        EXPECT_TRUE(has(b.err, "--out /dev/full: write failed: No space left on device")) << b.err;
+        EXPECT_EQ(slurp(dir / "combined.csv"), "the previous combined file\n");
+        EXPECT_TRUE(temporaries_in(dir).empty());
+        // Control: with all writable, all are replaced.
+        const CliRun ok = run_in(c + " --out out.csv --combined combined.csv > summary.json", dir);
+        EXPECT_EQ(ok.exit_code, 0) << ok.err;
+        EXPECT_TRUE(has(slurp(dir / "out.csv"), ",status\n"));
+        EXPECT_TRUE(has(slurp(dir / "combined.csv"), "t,qw,qx,qy,qz,heads"));
+    }
 }
 
 // ---- item 2: results on standard output are written or the run fails --------
@@ -258,6 +301,20 @@ TEST(IoProbe, AnOutputThatCannotBeWrittenFailsBeforeAnyInputIsRead) {
     write(dir / "bad.csv", text);
     write(dir / "bad-model.csv", "chu,axis,c0\nA,x,nope\n");
     fs::create_directories(dir / "a-folder");
+    // The simulated heads' mountings, with and without the sigmas (combine
+    // then estimates the noise from --in: it reads it first).
+    const std::string m = slurp(sim() + ".mountings.csv");
+    write(dir / "m.csv", m);
+    std::string without;
+    std::istringstream lines(m);
+    for (std::string line; std::getline(lines, line);) {
+        std::size_t cut = 0;
+        for (int field = 0; field < 5 && cut != std::string::npos; ++field) {
+            cut = line.find(',', cut == 0 ? 0 : cut + 1);
+        }
+        without += line.substr(0, cut) + "\n";
+    }
+    write(dir / "m-without-sigmas.csv", without);
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"correct --in bad.csv --self-calibrate --out ok.csv --model-history no/h.csv", "--model-history no/h.csv"},
         {"correct --in bad.csv --out no/o.csv", "--out no/o.csv"},
@@ -268,6 +325,15 @@ TEST(IoProbe, AnOutputThatCannotBeWrittenFailsBeforeAnyInputIsRead) {
         {"fit --in bad.csv --out no/m.csv", "--out no/m.csv"},
         {"plot --in bad.csv --model bad-model.csv --out no/p.png", "--out no/p.png"},
         {"simulate --days 1 --truth bad-model.csv --out no/s.csv", "--out no/s.csv"},
+        {"correct --in bad.csv --out ok.csv --mountings m.csv --combined no/a.csv", "--combined no/a.csv"},
+        {"correct --in bad.csv --out no/o.csv --mountings m.csv --combined ok.csv", "--out no/o.csv"},
+        {"replay --target loopback-float --in bad.csv --self-calibrate --out ok.csv --mountings m.csv --combined "
+         "no/a.csv",
+         "--combined no/a.csv"},
+        {"combine --in bad.csv --mountings m-without-sigmas.csv --out no/a.csv", "--out no/a.csv"},
+        {"align --in bad.csv --mountings m.csv --out no/m.csv", "--out no/m.csv"},
+        {"plot --combined bad.csv --truth-attitude bad.csv --window-from 0 --window-to 1 --out no/p.png",
+         "--out no/p.png"},
     };
     for (const auto& [c, named] : cases) {
         SCOPED_TRACE(c);
