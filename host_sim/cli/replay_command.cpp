@@ -48,6 +48,18 @@ void add_replay_command(CLI::App& app) {
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
+    CLI::Option* mountings =
+        cmd->add_option("--mountings", opt->mountings,
+                        "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "
+                        "the target's combiner")
+            ->check(non_empty_path());
+    CLI::Option* combined =
+        cmd->add_option("--combined", opt->combined,
+                        "the target also combines each epoch into the bench's attitude; written here (CSV, as "
+                        "ascorr combine's) and compared with the host's bit for bit")
+            ->check(non_empty_path());
+    mountings->needs(combined);
+    combined->needs(mountings);
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));
@@ -69,8 +81,11 @@ void add_replay_command(CLI::App& app) {
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
         }
-        read_dash_from_standard_input(
-            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
+        read_dash_from_standard_input({{"--in", &opt->in},
+                                       {"--model", &opt->model},
+                                       {"--states", &opt->states},
+                                       {"--firmware", &opt->firmware},
+                                       {"--mountings", &opt->mountings}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
         if (!host::agrees(s)) {

@@ -26,7 +26,7 @@ PYBIND11_MODULE(_ascorr, mod) {
     py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") = docs::kInputError;
     py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") = docs::kFitRefused;
 
-    // The heads (ascorr/heads.hpp), for Python and for the docstrings.
+    // The heads (ascorr/core/heads.hpp), for Python and for the docstrings.
     mod.attr("HEADS") = py::str(kHeadLetters);
 
     bind_model(mod);
