@@ -67,6 +67,13 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
         bad_argument("time_constant",
                      "expected days in " + host::time_constant_range() + ", got " + value_text(time_constant_obj));
     }
+    if (m != nullptr) {
+        try {
+            host::refuse_quadratic_initial_model(*m, "the model given");
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", e.what());
+        }
+    }
     if (scalar == host::ScalarKind::kFixed && m != nullptr) {
         try {
             host::check_fixed_point_range(*m, "model");

@@ -47,3 +47,15 @@ def test_bad_arguments(mission):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], time_constant=0.5)
     with pytest.raises(ValueError, match="scalar"):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], scalar="half")
+
+
+def test_a_quadratic_model_is_refused_as_on_the_command_line(mission, tmp_path):
+    # One rule with `correct --self-calibrate` and `replay --self-calibrate`:
+    # the estimator starts from a linear model (refuse_quadratic_initial_model).
+    lines = (tmp_path / "q.csv")
+    lines.write_text("chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n"
+                     "A,alpha,0,0,0,0,0,0,0\nA,beta,0,0,0,0,0,0,0\nA,gamma,0,0,0,0,0,0,0\n"
+                     "B,alpha,0,0,0,0,0,0,0\nB,beta,0,0,0,0,0,0,0\nB,gamma,0,0,0,0,0,1e-3,0\n")
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    with pytest.raises(ValueError, match=r"argument 'model'.*head B gamma has a quadratic term \(c2_2\)"):
+        ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=ascorr.read_model(str(lines)))

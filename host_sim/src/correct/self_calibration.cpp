@@ -139,9 +139,28 @@ private:
 
 }  // namespace
 
+void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name) {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
+                if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
+                    throw std::runtime_error(
+                        name + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
+                        kAxisNames[a] + " has a quadratic term (" + kCoefficientNames[i] +
+                        "): self-calibration starts from a linear model (the on-board estimator's models are c0..c3, "
+                        "and the link's CALIB_MODEL_LOAD carries c0..c3); give the model without its quadratic terms");
+                }
+            }
+        }
+    }
+}
+
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s) {
+    if (initial) {
+        refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
+    }
     EarthVelocity earth;
     // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
     const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {

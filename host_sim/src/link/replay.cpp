@@ -226,26 +226,6 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }
 
-// The estimator's models are linear, and CALIB_MODEL_LOAD carries c0..c3:
-// a --model with quadratic terms would start the target from another model
-// than the host's. Refused, naming the file and the term.
-void refuse_quadratic_initial_model(const ModelFile& m, const std::string& path) {
-    static constexpr const char* kQuadratic[] = {"c1_2", "c2_2", "c3_2"};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
-                if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
-                    throw std::runtime_error(
-                        path + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
-                        kAxisNames[a] + " has a quadratic term (" + kQuadratic[i - kLinearModelTerms] +
-                        "): replay --self-calibrate starts the target from a linear model "
-                        "(CALIB_MODEL_LOAD carries c0..c3)");
-                }
-            }
-        }
-    }
-}
-
 template <typename T>
 ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     const std::string text = read_text_file(opt.in);

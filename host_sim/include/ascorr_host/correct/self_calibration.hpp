@@ -45,7 +45,18 @@ struct SelfCalibration {
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
 };
 
-// kind: "double", "float" or "fixed" is chosen by T. initial: --model.
+// Self-calibration starts from a linear model, on the host as on the target:
+// the estimator's models are linear (c0..c3) and the link's CALIB_MODEL_LOAD
+// carries c0..c3, so a model with a quadratic term would start the target
+// from another model than the host, and the history would list a model other
+// than the one that corrected. Throws std::runtime_error naming `name` (the
+// model's file or argument), the head, axis and term. One rule for `correct
+// --self-calibrate`, `replay --self-calibrate` and Python's self_calibrate()
+// (self_calibrate() below checks it too).
+void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name);
+
+// kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
+// (refuse_quadratic_initial_model).
 // orbit_period_s: when not given, from the earliest selected row's speed
 // (as `ascorr fit`). Throws InputError for a file whose rows cannot be read.
 template <typename T>
