@@ -34,6 +34,22 @@ fs::path simulated(const std::string& name, const std::string& extra = "") {
     return dir;
 }
 
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+        out.push_back(l);
+    }
+    return out;
+}
+
+void write_lines(const fs::path& p, const std::vector<std::string>& lines) {
+    std::ofstream f(p);
+    for (const std::string& l : lines) {
+        f << l << '\n';
+    }
+}
+
 // Class 5: a quadratic --model is refused for self-calibration, as replay
 // refuses it (one rule, refuse_quadratic_initial_model): the history could
 // only list c0..c3 beside the quadratic model's CRC, and the target could not
@@ -64,6 +80,95 @@ TEST(SelfCalibrationInputs, AQuadraticInitialModelIsRefusedAsReplayRefusesIt) {
         "correct --in sim.csv --out c.csv --self-calibrate --model zero_quadratic.csv --model-history h.csv", dir);
     EXPECT_EQ(z.exit_code, 0) << z.err;
     EXPECT_NE(slurp(dir / "h.csv").find(",0,A,alpha,"), std::string::npos);
+}
+
+// The rows of a solutions file as a RowSource (records point into storage).
+struct Rows {
+    std::string storage;
+    std::vector<host::SolutionRecord> records;
+    host::RowSource source() const {
+        return [this](const std::function<void(const host::SolutionRecord&)>& fn) {
+            for (const host::SolutionRecord& r : records) {
+                fn(r);
+            }
+        };
+    }
+};
+
+Rows rows_of(const fs::path& file) {
+    Rows r;
+    r.records = read_records(file.string(), r.storage);
+    return r;
+}
+
+// The rows' times moved by dt seconds (4 decimals).
+void shift_times(const fs::path& file, double dt) {
+    std::vector<std::string> lines = lines_of(slurp(file));
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+        const std::size_t comma = lines[i].find(',');
+        char t[40];
+        std::snprintf(t, sizeof t, "%.4f", std::stod(lines[i].substr(0, comma)) + dt);
+        lines[i] = t + lines[i].substr(comma);
+    }
+    write_lines(file, lines);
+}
+
+// Class 7: the history states exactly which rows each version covers. Times
+// at ...0006 s (22 Hz data are not on the millisecond): the version active at
+// a row (the run's schedule) is the last whose tt_us (TT µs of the on-board
+// clock, an integer column) is at or before the row's t rounded to the
+// microsecond. `t` keeps its 3 decimals (its meaning does not change): on its
+// own it says a row at ...0006 comes before a version that it uses.
+TEST(SelfCalibrationInputs, TheHistoryStatesExactlyWhichRowsAVersionCovers) {
+    const fs::path dir = simulated("sc_in_tt_us");
+    shift_times(dir / "sim.csv", 0.0006);
+    const CliRun r = run_in("correct --in sim.csv --out c.csv --self-calibrate --model-history h.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::vector<std::string> h = lines_of(slurp(dir / "h.csv"));
+    ASSERT_GE(h.size(), 10U);
+    const std::string header = h[0];
+    const std::size_t tt_col = static_cast<std::size_t>(
+        std::count(header.begin(), header.begin() + static_cast<std::ptrdiff_t>(header.find("tt_us")), ','));
+    ASSERT_NE(header.find(",tt_us"), std::string::npos) << header;
+    EXPECT_EQ(header.rfind("t,version,chu,axis,c0,c1,c2,c3,crc32c", 0), 0U) << header;  // t's meaning kept
+    const auto field = [](const std::string& line, std::size_t k) {
+        std::size_t at = 0;
+        for (std::size_t i = 0; i < k; ++i) {
+            at = line.find(',', at) + 1;
+        }
+        return line.substr(at, line.find(',', at) - at);
+    };
+    std::vector<std::pair<long long, unsigned>> from;  // (tt_us, version), in time order
+    std::vector<double> t_written;
+    for (std::size_t i = 1; i < h.size(); ++i) {
+        const long long us = std::stoll(field(h[i], tt_col));
+        const auto v = static_cast<unsigned>(std::stoul(field(h[i], 1)));
+        if (from.empty() || from.back().second != v) {
+            from.emplace_back(us, v);
+            t_written.push_back(std::stod(field(h[i], 0)));
+        }
+    }
+    const Rows rows = rows_of(dir / "sim.csv");
+    const host::SelfCalibration sc = host::self_calibrate<double>((dir / "sim.csv").string(), rows.source(),
+                                                                  std::nullopt, calib::EstimatorConfig{}, std::nullopt);
+    const host::ModelSchedule<double> schedule(sc.history);
+    std::size_t before_t = 0;  // rows using a version whose written t is after theirs
+    for (const host::SolutionRecord& rec : rows.records) {
+        const auto us = static_cast<long long>(std::llround(rec.t * 1e6));
+        std::optional<unsigned> by_column;
+        std::optional<double> t_of_version;
+        for (std::size_t k = 0; k < from.size() && from[k].first <= us; ++k) {
+            by_column = from[k].second;
+            t_of_version = t_written[k];
+        }
+        const std::optional<std::uint32_t> used = schedule.version_at(rec.t);
+        ASSERT_EQ(used.has_value(), by_column.has_value()) << rec.line;
+        if (used) {
+            EXPECT_EQ(*used, *by_column) << "line " << rec.line;
+            before_t += rec.t < *t_of_version ? 1U : 0U;
+        }
+    }
+    EXPECT_GT(before_t, 0U) << "no row at ...0006 uses a version: the check above would be vacuous";
 }
 
 }  // namespace

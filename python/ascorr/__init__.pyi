@@ -188,6 +188,7 @@ class _ActiveModel(TypedDict):
     version: int
     crc32c: int
     model: Model
+    tt_us: int
 
 def self_calibrate(
     t: _Real,
@@ -208,7 +209,8 @@ def self_calibrate(
     or from none (rows before the first adopted model get status 256).
     time_constant: the estimator's forgetting in days. Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
-    "model"} for every model that became active, in time order."""
+    "model", "tt_us"} for every model that became active, in time order (tt_us: when,
+    on the on-board clock: the rows whose t rounded to the microsecond is at least it)."""
 # arrays, and "extra": dict[str, NDArray[str_]]
 def read_solutions(path: _Path) -> dict[str, Any]:
     """Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),

@@ -49,6 +49,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     for (const host::ActiveModel& a : sc.history) {
         py::dict d;
         d["t"] = a.t;
+        d["tt_us"] = a.t_us;
         d["version"] = a.version;
         d["crc32c"] = a.crc;
         d["model"] = py::cast(a.model);

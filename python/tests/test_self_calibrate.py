@@ -38,7 +38,10 @@ def test_same_as_the_command_line(exe, mission, scalar):
     assert versions == [h["version"] for h in history]
     assert [float(r[0]) for r in h_rows[::9]] == pytest.approx([h["t"] for h in history], abs=5e-4)
     assert (status[s["t"] >= history[0]["t"]] & 256).sum() == 0, "every row from the first model on has one"
-    assert [f"{h['crc32c']:08x}" for h in history] == [r[-1] for r in h_rows[::9]]
+    crc = h_header.index("crc32c")
+    assert [f"{h['crc32c']:08x}" for h in history] == [r[crc] for r in h_rows[::9]]
+    tt_us = h_header.index("tt_us")
+    assert [int(r[tt_us]) for r in h_rows[::9]] == [h["tt_us"] for h in history]
 
 
 def test_bad_arguments(mission):

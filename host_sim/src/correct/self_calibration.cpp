@@ -295,7 +295,7 @@ template class ModelSchedule<float>;
 template class ModelSchedule<Q30>;
 
 std::string format_model_history(const std::vector<ActiveModel>& history) {
-    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c\n";
+    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us\n";
     char buf[96];
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -310,7 +310,7 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     std::snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                std::snprintf(buf, sizeof buf, ",%08x\n", m.crc);
+                std::snprintf(buf, sizeof buf, ",%08x,%lld\n", m.crc, static_cast<long long>(m.t_us));
                 out += buf;
             }
         }

@@ -82,7 +82,10 @@ private:
 };
 
 // The model history file (docs/contract.md): header
-// t,version,chu,axis,c0,c1,c2,c3,crc32c and one row per head and axis of each model.
+// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us and one row per head and axis
+// of each model. t (3 decimals) says when; tt_us (t_us: TT µs of the
+// on-board clock, an integer) says exactly which rows: those whose t rounds
+// (tt_from_seconds) to at least it, up to the next version's.
 std::string format_model_history(const std::vector<ActiveModel>& history);
 
 // The forgetting time constants the estimator takes
