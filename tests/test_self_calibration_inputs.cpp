@@ -171,5 +171,72 @@ TEST(SelfCalibrationInputs, TheHistoryStatesExactlyWhichRowsAVersionCovers) {
     EXPECT_GT(before_t, 0U) << "no row at ...0006 uses a version: the check above would be vacuous";
 }
 
+// The value of column `name` in each data line of a CSV text.
+std::vector<std::string> column(const std::vector<std::string>& lines, const std::string& name) {
+    std::vector<std::string> header;
+    {
+        std::istringstream h(lines.at(0));
+        for (std::string f; std::getline(h, f, ',');) {
+            header.push_back(f);
+        }
+    }
+    const auto k = static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+    std::vector<std::string> out;
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+        std::istringstream in(lines[i]);
+        std::string f;
+        for (std::size_t j = 0; j <= k && std::getline(in, f, ','); ++j) {
+        }
+        out.push_back(k < header.size() ? f : std::string("(no column ") + name + ")");
+    }
+    return out;
+}
+
+// Class 13: a head the estimator does not learn (D) keeps the given model's
+// coefficients in every adopted model, and the history says so (origin
+// "kept"; A, B, C "learnt"; version 0 "given"). Was: D's rows got 256 from
+// the first adopted model on.
+TEST(SelfCalibrationInputs, AHeadTheEstimatorDoesNotLearnKeepsTheGivenModel) {
+    const fs::path dir = simulated("sc_in_head_d", " --heads ABCD");
+    const CliRun r = run_in(
+        "correct --in sim.csv --out c.csv --self-calibrate --model sim.csv.truth.csv --model-history h.csv", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::vector<std::string> c = lines_of(slurp(dir / "c.csv"));
+    const std::vector<std::string> chu = column(c, "chu");
+    const std::vector<std::string> st = column(c, "status");
+    std::size_t d_rows = 0;
+    std::size_t d_thermal = 0;
+    for (std::size_t i = 0; i < chu.size(); ++i) {
+        if (chu[i] == "D") {
+            ++d_rows;
+            const unsigned s = static_cast<unsigned>(std::stoul(st[i]));
+            EXPECT_EQ(s & 256U, 0U) << "line " << i + 2;
+            d_thermal += (s & 2U) != 0U ? 1U : 0U;
+        }
+    }
+    EXPECT_GT(d_rows, 1000U);
+    EXPECT_GT(d_thermal, d_rows * 9 / 10);
+    const std::vector<std::string> h = lines_of(slurp(dir / "h.csv"));
+    const std::vector<std::string> version = column(h, "version");
+    const std::vector<std::string> head = column(h, "chu");
+    const std::vector<std::string> origin = column(h, "origin");
+    const std::vector<std::string> c1 = column(h, "c1");
+    std::vector<std::string> given_d;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < version.size(); ++i) {
+        const bool v0 = version[i] == "0";
+        EXPECT_EQ(origin[i], v0 ? "given" : (head[i] == "D" ? "kept" : "learnt")) << h[i + 1];
+        if (head[i] == "D") {
+            if (v0) {
+                given_d.push_back(c1[i]);
+            } else {
+                EXPECT_EQ(c1[i], given_d.at(kept % 3)) << h[i + 1];
+                ++kept;
+            }
+        }
+    }
+    EXPECT_GE(kept, 3U) << "no adopted model: the check above would be vacuous";
+}
+
 }  // namespace
 }  // namespace ascorr::test

@@ -70,9 +70,9 @@ void add_correct_command(CLI::App& app) {
     cmd->add_flag("--self-calibrate", opt->self_calibrate,
                   "estimate the thermal model from the rows themselves with the on-board estimator, causally in time "
                   "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
-    cmd->add_option(
-           "--model-history", opt->model_history,
-           "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c,tt_us)")
+    cmd->add_option("--model-history", opt->model_history,
+                    "with --self-calibrate: write every model that became active (CSV "
+                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     cmd->callback([opt, time_constant]() {

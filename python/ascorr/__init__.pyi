@@ -189,6 +189,7 @@ class _ActiveModel(TypedDict):
     crc32c: int
     model: Model
     tt_us: int
+    origin: dict[str, str]
 
 def self_calibrate(
     t: _Real,
@@ -209,8 +210,10 @@ def self_calibrate(
     or from none (rows before the first adopted model get status 256).
     time_constant: the estimator's forgetting in days. Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
-    "model", "tt_us"} for every model that became active, in time order (tt_us: when,
-    on the on-board clock: the rows whose t rounded to the microsecond is at least it)."""
+    "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,
+    on the on-board clock: the rows whose t rounded to the microsecond is at least it;
+    origin: per head present, "given" (version 0), "learnt" or "kept" (a head the estimator
+    does not learn keeps the active model's coefficients)."""
 # arrays, and "extra": dict[str, NDArray[str_]]
 def read_solutions(path: _Path) -> dict[str, Any]:
     """Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),

@@ -81,8 +81,10 @@ None), after the aberration stage, in `scalar`, starting from `model` (version 0
 or from none (rows before the first adopted model get status 256).
 time_constant: the estimator's forgetting in days. Returns (q_corrected float64
 (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
-"model", "tt_us"} for every model that became active, in time order (tt_us: when,
-on the on-board clock: the rows whose t rounded to the microsecond is at least it).)doc";
+"model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,
+on the on-board clock: the rows whose t rounded to the microsecond is at least it;
+origin: per head present, "given" (version 0), "learnt" or "kept" (a head the estimator
+does not learn keeps the active model's coefficients).)doc";
 
 inline constexpr const char* kEarthVelocity =
     R"doc(The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t

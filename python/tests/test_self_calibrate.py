@@ -42,6 +42,8 @@ def test_same_as_the_command_line(exe, mission, scalar):
     assert [f"{h['crc32c']:08x}" for h in history] == [r[crc] for r in h_rows[::9]]
     tt_us = h_header.index("tt_us")
     assert [int(r[tt_us]) for r in h_rows[::9]] == [h["tt_us"] for h in history]
+    origin = h_header.index("origin")
+    assert [r[origin] for r in h_rows[::9]] == [h["origin"]["A"] for h in history]
 
 
 def test_bad_arguments(mission):

@@ -294,8 +294,15 @@ template class ModelSchedule<double>;
 template class ModelSchedule<float>;
 template class ModelSchedule<Q30>;
 
+const char* head_origin(std::uint32_t version, std::size_t h) {
+    if (version == 0U) {
+        return "given";
+    }
+    return calib::learns_head(h) ? "learnt" : "kept";
+}
+
 std::string format_model_history(const std::vector<ActiveModel>& history) {
-    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us\n";
+    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin\n";
     char buf[96];
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -310,7 +317,8 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     std::snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                std::snprintf(buf, sizeof buf, ",%08x,%lld\n", m.crc, static_cast<long long>(m.t_us));
+                std::snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
+                              head_origin(m.version, h));
                 out += buf;
             }
         }

@@ -81,9 +81,15 @@ private:
     std::vector<ThermalModel<T>> model_;  // [0]: no head present
 };
 
+// How head h of a history's model `version` came to be: "given" (version 0,
+// the model given at start), "learnt" (estimated: calib::learns_head) or
+// "kept" (a head the estimator does not learn: the active model's
+// coefficients, carried into the adopted model, Estimator::gate).
+const char* head_origin(std::uint32_t version, std::size_t h);
+
 // The model history file (docs/contract.md): header
-// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us and one row per head and axis
-// of each model. t (3 decimals) says when; tt_us (t_us: TT µs of the
+// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
+// axis of each model (origin: head_origin). t (3 decimals) says when; tt_us (t_us: TT µs of the
 // on-board clock, an integer) says exactly which rows: those whose t rounds
 // (tt_from_seconds) to at least it, up to the next version's.
 std::string format_model_history(const std::vector<ActiveModel>& history);
