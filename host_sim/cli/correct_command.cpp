@@ -37,6 +37,15 @@ CLI::Option* add_time_constant_option(CLI::App& cmd, double& days) {
         ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
 }
 
+CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds) {
+    return cmd
+        .add_option("--orbit-period", seconds,
+                    "with --self-calibrate: the orbit period in s, " + host::orbit_period_range() +
+                        " (default: from the median speed of the first 99 rows learnt from)")
+        ->check(real_in(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6,
+                        static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6));
+}
+
 void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
     CLI::App* cmd =
@@ -75,13 +84,17 @@ void add_correct_command(CLI::App& app) {
                     "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
-    cmd->callback([opt, time_constant]() {
+    CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
+    cmd->callback([opt, time_constant, orbit_period]() {
         read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
         }
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
+        }
+        if (!opt->self_calibrate && orbit_period->count() > 0) {
+            throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
         }
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         if (!s.self_calibration.empty()) {

@@ -202,13 +202,16 @@ def self_calibrate(
     model: Optional[Model] = ...,
     scalar: Literal["double", "float", "fixed"] = ...,
     time_constant: float = ...,
+    orbit_period: Optional[float] = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
     epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec or
     None), after the aberration stage, in `scalar`, starting from `model` (version 0)
     or from none (rows before the first adopted model get status 256).
-    time_constant: the estimator's forgetting in days. Returns (q_corrected float64
+    time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
+    or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
+    Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,
     on the on-board clock: the rows whose t rounded to the microsecond is at least it;

@@ -52,6 +52,21 @@ def test_bad_arguments(mission):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], time_constant=0.5)
     with pytest.raises(ValueError, match="scalar"):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], scalar="half")
+    for bad in (599.0, float("nan"), 86401.0):
+        with pytest.raises(ValueError, match=r"argument 'orbit_period': expected seconds in \[600, 86400\]"):
+            ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], orbit_period=bad)
+
+
+def test_the_orbit_period_as_on_the_command_line(exe, mission):
+    hist = mission / "h_period.csv"
+    run_cli(exe, "correct", "--in", mission / "m.csv", "--out", mission / "c_period.csv", "--self-calibrate",
+            "--orbit-period", "6000", "--model-history", hist)
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    _, _, history = ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], flags=s["flags"],
+                                          confidence=s["confidence"], orbit_period=6000.0)
+    h_header, h_rows = read_csv_text(hist)
+    crc = h_header.index("crc32c")
+    assert [f"{h['crc32c']:08x}" for h in history] == [r[crc] for r in h_rows[::9]]
 
 
 def test_a_quadratic_model_is_refused_as_on_the_command_line(mission, tmp_path):

@@ -298,6 +298,10 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
         throw std::runtime_error("--time-constant must be in " + time_constant_range() + " days, got " +
                                  number_text(opt.time_constant_days));
     }
+    if (opt.orbit_period_s && !orbit_period_acceptable(*opt.orbit_period_s)) {
+        throw std::runtime_error("--orbit-period must be in " + orbit_period_range() + " s, got " +
+                                 number_text(*opt.orbit_period_s));
+    }
     if (!opt.states.empty()) {
         // The estimator's pass reads the rows' own velocities only: rows whose
         // velocity would come from the states would never be learnt from.
@@ -335,7 +339,7 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         const SelfCalibration sc = self_calibrate<T>(
             opt.in,
             [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
-            model_file, ecfg, std::nullopt);
+            model_file, ecfg, opt.orbit_period_s);
         schedule.emplace(sc.history);
         history = format_model_history(sc.history);
         account = describe(sc);

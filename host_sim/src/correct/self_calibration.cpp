@@ -33,10 +33,21 @@ struct CalibRow {
     SolutionInput<T> in;
 };
 
+// The orbit period, when not given, from the speeds of the first
+// kPeriodRows fed rows in time order (docs/contract.md, Self-calibration):
+// their median's circular orbit (vis-viva), so that no single row decides; a
+// set in which fewer than three quarters lie within kPeriodSpeedTolerance of
+// the median is refused (an eccentric orbit or corrupted velocities: give
+// --orbit-period).
+constexpr std::size_t kPeriodRows = 99;  // 33 epochs of A, B and C
+constexpr double kPeriodSpeedTolerance = 0.01;
+
 // The estimator over rows taken in time order (t_us, then line), one at a
-// time, as the link server takes them. The orbit period comes from the first
-// fed row's speed unless given: epochs before it wait (their times only) and
-// are replayed when the estimator starts.
+// time, as the link server takes them. Until the orbit period is known (given,
+// or kPeriodRows fed rows seen), rows are held and replayed when the
+// estimator starts: the fed rows whole, and of the epochs between two fed rows
+// only the first and the last (the others change nothing: no model becomes
+// pending without a fed epoch), so the rows held are bounded.
 template <typename T>
 class Run {
 public:
@@ -52,15 +63,27 @@ public:
     }
 
     void take(const CalibRow<T>& r) {
-        if (!est_) {
-            if (!r.fed) {
-                if (waiting_.empty() || waiting_.back().first != r.t_us) {
-                    waiting_.emplace_back(r.t_us, r.t);
-                }
-                return;
-            }
-            start(period_from_speed(r));
+        if (est_) {
+            process(r);
+        } else {
+            hold(r);
         }
+    }
+
+    SelfCalibration finish(std::size_t untimed) {
+        if (!est_) {
+            // Fewer than kPeriodRows fed rows: their period; none: nothing is
+            // learnt, the period is not used.
+            start(fed_held_ > 0 ? period_from_speeds()
+                                : static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
+        }
+        out_.report = est_->report();
+        out_.untimed = untimed;
+        return out_;
+    }
+
+private:
+    void process(const CalibRow<T>& r) {
         const ThermalModel<T>* model = epoch(r.t_us, r.t);
         if (r.fed) {
             const CorrectedSolution<T> c =
@@ -71,46 +94,70 @@ public:
         }
     }
 
-    SelfCalibration finish(std::size_t untimed) {
-        if (!est_) {
-            // No row to learn from: nothing is learnt, the period is not used.
-            start(static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
+    void hold(const CalibRow<T>& r) {
+        const std::size_t n = held_.size();
+        if (!r.fed && n >= 2 && !held_[n - 1].fed && !held_[n - 2].fed) {
+            if (r.t_us != held_[n - 1].t_us) {
+                held_[n - 1] = r;  // the last epoch between two fed rows so far
+            }
+            return;
         }
-        out_.report = est_->report();
-        out_.untimed = untimed;
-        return out_;
+        held_.push_back(r);
+        if (r.fed && ++fed_held_ == kPeriodRows) {
+            start(period_from_speeds());
+        }
     }
 
-private:
-    // A circular orbit's period at the first fed row's speed (vis-viva); the
-    // estimator's limits (10 min to a day) are speeds of 3.3 to 16 km/s:
-    // beyond 12 km/s nothing is bound to the Earth.
-    double period_from_speed(const CalibRow<T>& r) const {
-        const double v = r.speed_kms;
+    // A circular orbit's period at the median speed of the fed rows held
+    // (vis-viva); the estimator's limits (10 min to a day) are speeds of 3.3
+    // to 16 km/s: beyond 12 km/s nothing is bound to the Earth.
+    double period_from_speeds() const {
+        std::vector<const CalibRow<T>*> fed;
+        for (const CalibRow<T>& r : held_) {
+            if (r.fed) {
+                fed.push_back(&r);
+            }
+        }
+        const auto by_speed = [](const CalibRow<T>* a, const CalibRow<T>* b) { return a->speed_kms < b->speed_kms; };
+        const auto mid = fed.begin() + static_cast<std::ptrdiff_t>((fed.size() - 1) / 2);
+        std::nth_element(fed.begin(), mid, fed.end(), by_speed);
+        const CalibRow<T>& median = **mid;
+        const double v = median.speed_kms;
+        const std::size_t near = static_cast<std::size_t>(std::count_if(fed.begin(), fed.end(), [v](const auto* r) {
+            return std::fabs(r->speed_kms - v) <= kPeriodSpeedTolerance * v;
+        }));
+        if (4 * near < 3 * fed.size()) {
+            throw InputError(file_, median.line, 1,
+                             "the spacecraft speeds of the first " + std::to_string(fed.size()) +
+                                 " rows the self-calibration learns from disagree: " + std::to_string(near) +
+                                 " are within " + number_text(kPeriodSpeedTolerance * 100.0) + " % of their median " +
+                                 number_text(v) +
+                                 " km/s (three quarters must be): the orbit period cannot be derived; give "
+                                 "--orbit-period");
+        }
         const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
         if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw InputError(file_, r.line, 1,
+            throw InputError(file_, median.line, 1,
                              "spacecraft speed " + number_text(v) +
                                  " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
-                                 "self-calibration cannot be derived");
+                                 "self-calibration cannot be derived; give --orbit-period");
         }
         return period_s;
     }
 
     void start(double period_s) {
-        if (!(period_s * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
-              period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw std::invalid_argument("orbit period " + number_text(period_s) +
-                                        " s is outside the estimator's 600 s to 1 day");
+        if (!orbit_period_acceptable(period_s)) {
+            throw std::invalid_argument("orbit period " + number_text(period_s) + " s is outside the estimator's " +
+                                        orbit_period_range() + " s");
         }
         out_.orbit_period_s = period_s;
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
-        for (const auto& [t_us, t] : waiting_) {
-            (void)epoch(t_us, t);
+        for (const CalibRow<T>& r : held_) {
+            process(r);
         }
-        waiting_.clear();
-        waiting_.shrink_to_fit();
+        held_.clear();
+        held_.shrink_to_fit();
     }
 
     // The epoch's model (a new epoch when t_us changes), and the history.
@@ -131,7 +178,8 @@ private:
     std::optional<calib::Estimator<T>> est_;
     calib::EpochFeed<T> feed_;
     const ThermalModel<T> no_model_{};
-    std::vector<std::pair<std::int64_t, double>> waiting_;  // epochs before the orbit period is known
+    std::vector<CalibRow<T>> held_;  // rows before the orbit period is known (hold)
+    std::size_t fed_held_ = 0;
     bool had_ = false;
     std::uint32_t version_ = 0;
     SelfCalibration out_;
@@ -324,6 +372,16 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
         }
     }
     return out;
+}
+
+bool orbit_period_acceptable(double seconds) {
+    return seconds * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
+           seconds * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs);
+}
+
+std::string orbit_period_range() {
+    return "[" + number_text(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6) + ", " +
+           number_text(static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6) + "]";
 }
 
 std::string time_constant_range() {

@@ -310,7 +310,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
                     fn(r);
                 }
             },
-            mf, ecfg, std::nullopt);
+            mf, ecfg, opt.orbit_period_s);
         schedule.emplace(host_sc->history);
         schedule_d.emplace(host_sc->history);
         std::optional<ModelCoefficients> initial;
@@ -541,6 +541,10 @@ void check_options(const ReplayOptions& opt) {
             throw std::runtime_error("--time-constant " + number_text(opt.time_constant_days) + ": must be in " +
                                      time_constant_range() + " days");
         }
+        if (opt.orbit_period_s && !orbit_period_acceptable(*opt.orbit_period_s)) {
+            throw std::runtime_error("--orbit-period " + number_text(*opt.orbit_period_s) + ": must be in " +
+                                     orbit_period_range() + " s");
+        }
     } else {
         if (opt.model.empty()) {
             throw std::runtime_error(
@@ -549,6 +553,9 @@ void check_options(const ReplayOptions& opt) {
         }
         if (!opt.model_history.empty()) {
             throw std::runtime_error("--model-history needs --self-calibrate");
+        }
+        if (opt.orbit_period_s) {
+            throw std::runtime_error("--orbit-period needs --self-calibrate");
         }
     }
 }

@@ -57,8 +57,12 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 
 // kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
 // (refuse_quadratic_initial_model).
-// orbit_period_s: when not given, from the earliest selected row's speed
-// (as `ascorr fit`). Throws InputError for a file whose rows cannot be read.
+// orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
+// the circular orbit's at the median speed of the first 99 rows in time order
+// that feed the estimator; refused (InputError naming a row and
+// --orbit-period) when fewer than three quarters of them are within 1 % of
+// that median, or it is no Earth orbit of 10 min to a day (docs/contract.md).
+// Throws InputError for a file whose rows cannot be read.
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s);
@@ -93,6 +97,12 @@ const char* head_origin(std::uint32_t version, std::size_t h);
 // on-board clock, an integer) says exactly which rows: those whose t rounds
 // (tt_from_seconds) to at least it, up to the next version's.
 std::string format_model_history(const std::vector<ActiveModel>& history);
+
+// The orbit periods the estimator takes (calib::kMinOrbitPeriodUs ..
+// kMaxOrbitPeriodUs), in s; false for NaN. And as messages write them:
+// "[600, 86400]".
+bool orbit_period_acceptable(double seconds);
+std::string orbit_period_range();
 
 // The forgetting time constants the estimator takes
 // (calib::time_constant_acceptable) as messages write them: "[1, 10000]".
