@@ -1,10 +1,15 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
@@ -185,6 +190,216 @@ private:
     SelfCalibration out_;
 };
 
+// The clock's order: TT µs, then the line (rows and their keys).
+template <typename A, typename B>
+bool before(const A& a, const B& b) {
+    return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
+}
+
+// Rows sorted into the clock's order within a memory budget. Each row is a
+// 24-byte key, and a fed row also its input (CalibRow); a run is sorted in
+// memory. When a run fills the budget it is written, sorted, to an anonymous
+// temporary file (std::tmpfile: gone when closed, at exit and on a signal),
+// and each() merges the runs, each read through a small buffer: the memory
+// stays within about the budget whatever the number of rows (the disk holds
+// them). One run (the usual case) never touches the disk.
+template <typename T>
+class SortedRuns {
+public:
+    explicit SortedRuns(std::size_t budget_bytes) : budget_(std::max<std::size_t>(budget_bytes, 4096)) {}
+    SortedRuns(const SortedRuns&) = delete;
+    SortedRuns& operator=(const SortedRuns&) = delete;
+    ~SortedRuns() {
+        if (file_ != nullptr) {
+            (void)std::fclose(file_);
+        }
+    }
+
+    void add(const CalibRow<T>& r) {
+        // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
+        keys_.push_back(
+            {r.t_us, r.t, static_cast<std::uint32_t>(r.line), r.fed ? static_cast<std::uint32_t>(fed_.size()) : kNone});
+        if (r.fed) {
+            fed_.push_back(r);
+        }
+        if (bytes() >= budget_) {
+            spill();
+        }
+    }
+
+    // Calls fn for every row in the clock's order.
+    template <typename Fn>
+    void each(Fn&& fn) {
+        if (file_ == nullptr) {
+            sort_run();
+            for (const Key& k : keys_) {
+                fn(row_of(k));
+            }
+            return;
+        }
+        if (!keys_.empty()) {
+            spill();
+        }
+        merge(fn);
+    }
+
+    std::size_t count() const noexcept { return spilled_.empty() ? 1U : spilled_.size(); }
+
+private:
+    struct Key {
+        std::int64_t t_us;
+        double t;
+        std::uint32_t line;
+        std::uint32_t fed;  // index in fed_ (in a run file: 1 when the row's input follows), or kNone
+    };
+    static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+    static_assert(std::is_trivially_copyable_v<CalibRow<T>>, "rows are written to the run file as bytes");
+
+    // A spilled run: its bytes [begin, end) in the file, read through a buffer.
+    struct RunReader {
+        std::int64_t at;
+        std::int64_t end;
+        std::vector<char> buf;
+        std::size_t pos = 0;
+        std::size_t len = 0;
+        Key key{};
+        CalibRow<T> row{};
+    };
+
+    std::size_t bytes() const noexcept { return keys_.size() * sizeof(Key) + fed_.size() * sizeof(CalibRow<T>); }
+
+    void sort_run() {
+        std::sort(keys_.begin(), keys_.end(), [](const Key& a, const Key& b) { return before(a, b); });
+    }
+
+    CalibRow<T> row_of(const Key& k) const {
+        if (k.fed != kNone) {
+            return fed_[k.fed];
+        }
+        CalibRow<T> r{};
+        r.t_us = k.t_us;
+        r.t = k.t;
+        r.line = k.line;
+        return r;
+    }
+
+    void spill() {
+        sort_run();
+        if (file_ == nullptr) {
+            file_ = std::tmpfile();
+            if (file_ == nullptr) {
+                throw std::runtime_error(std::string("self-calibration: cannot open a temporary file for the rows "
+                                                     "out of time order: ") +
+                                         std::strerror(errno));
+            }
+        }
+        const std::int64_t begin = written_;
+        for (const Key& k : keys_) {
+            Key out = k;
+            out.fed = k.fed == kNone ? kNone : 1U;
+            put(&out, sizeof out);
+            if (k.fed != kNone) {
+                put(&fed_[k.fed], sizeof(CalibRow<T>));
+            }
+        }
+        if (std::fflush(file_) != 0) {
+            fail("write");
+        }
+        spilled_.emplace_back(begin, written_);
+        keys_.clear();
+        keys_.shrink_to_fit();
+        fed_.clear();
+        fed_.shrink_to_fit();
+    }
+
+    void put(const void* p, std::size_t n) {
+        if (std::fwrite(p, 1, n, file_) != n) {
+            fail("write");
+        }
+        written_ += static_cast<std::int64_t>(n);
+    }
+
+    [[noreturn]] static void fail(const char* what) {
+        throw std::runtime_error(std::string("self-calibration: cannot ") + what +
+                                 " the temporary file of the rows out of time order: " + std::strerror(errno));
+    }
+
+    void get(RunReader& r, void* p, std::size_t n) const {
+        char* out = static_cast<char*>(p);
+        while (n > 0) {
+            if (r.pos == r.len) {
+                const auto want = static_cast<std::size_t>(
+                    std::min<std::int64_t>(static_cast<std::int64_t>(r.buf.size()), r.end - r.at));
+                const ssize_t got = ::pread(fileno(file_), r.buf.data(), want, static_cast<off_t>(r.at));
+                if (got <= 0) {
+                    fail("read");
+                }
+                r.at += got;
+                r.len = static_cast<std::size_t>(got);
+                r.pos = 0;
+            }
+            const std::size_t k = std::min(n, r.len - r.pos);
+            std::memcpy(out, r.buf.data() + r.pos, k);
+            r.pos += k;
+            out += k;
+            n -= k;
+        }
+    }
+
+    // The next row of run r; false at its end.
+    bool next(RunReader& r) const {
+        if (r.at == r.end && r.pos == r.len) {
+            return false;
+        }
+        get(r, &r.key, sizeof r.key);
+        if (r.key.fed != kNone) {
+            get(r, &r.row, sizeof r.row);
+        } else {
+            r.row = CalibRow<T>{};
+            r.row.t_us = r.key.t_us;
+            r.row.t = r.key.t;
+            r.row.line = r.key.line;
+        }
+        return true;
+    }
+
+    template <typename Fn>
+    void merge(Fn&& fn) {
+        // The read buffers share the budget (at least 4 KiB each).
+        const std::size_t each_bytes = std::max<std::size_t>(4096, budget_ / spilled_.size());
+        std::vector<RunReader> readers;
+        readers.reserve(spilled_.size());
+        for (const auto& [begin, end] : spilled_) {
+            readers.push_back({begin, end, std::vector<char>(each_bytes)});
+        }
+        const auto later = [&readers](std::size_t a, std::size_t b) { return before(readers[b].key, readers[a].key); };
+        std::vector<std::size_t> heap;
+        for (std::size_t i = 0; i < readers.size(); ++i) {
+            if (next(readers[i])) {
+                heap.push_back(i);
+            }
+        }
+        std::make_heap(heap.begin(), heap.end(), later);
+        while (!heap.empty()) {
+            std::pop_heap(heap.begin(), heap.end(), later);
+            RunReader& r = readers[heap.back()];
+            fn(static_cast<const CalibRow<T>&>(r.row));
+            if (next(r)) {
+                std::push_heap(heap.begin(), heap.end(), later);
+            } else {
+                heap.pop_back();
+            }
+        }
+    }
+
+    std::size_t budget_;
+    std::vector<Key> keys_;
+    std::vector<CalibRow<T>> fed_;
+    std::FILE* file_ = nullptr;
+    std::int64_t written_ = 0;
+    std::vector<std::pair<std::int64_t, std::int64_t>> spilled_;
+};
+
 }  // namespace
 
 void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name) {
@@ -205,7 +420,8 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s) {
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
+                               std::size_t memory_budget_bytes) {
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
     }
@@ -228,15 +444,11 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         }
         return true;
     };
-    // The on-board clock's order: TT µs, then the line (rows and their keys).
-    const auto before = [](const auto& a, const auto& b) {
-        return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
-    };
-    // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
 
     // Rows in time order (the usual file) are taken as they are read; at the
-    // first row out of order the run stops, and the rows are read again, kept
-    // (the epoch of each, the input of those fed) and sorted.
+    // first row out of order the run stops, and the rows are read again and
+    // sorted (the epoch of each, the input of those fed) within the memory
+    // budget (SortedRuns).
     {
         Run<T> run(file, initial, cfg, orbit_period_s);
         std::size_t untimed = 0;
@@ -264,15 +476,10 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
             return run.finish(untimed);
         }
     }
-    struct Key {  // 24 bytes a row; the input only for the rows fed
-        std::int64_t t_us;
-        double t;
-        std::uint32_t line;
-        std::uint32_t fed;  // index in `fed`, or kNone
-    };
-    constexpr std::uint32_t kNone = 0xFFFFFFFFU;
-    std::vector<Key> keys;
-    std::vector<CalibRow<T>> fed;
+    // Out of order: the rows are sorted by the clock's order in runs that fit
+    // the memory budget; when there are more, each run is written sorted to an
+    // anonymous temporary file and the runs are merged (SortedRuns).
+    SortedRuns<T> runs(memory_budget_bytes);
     std::size_t untimed = 0;
     rows([&](const SolutionRecord& rec) {
         CalibRow<T> r{};
@@ -280,34 +487,21 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
             ++untimed;
             return;
         }
-        keys.push_back(
-            {r.t_us, r.t, static_cast<std::uint32_t>(r.line), r.fed ? static_cast<std::uint32_t>(fed.size()) : kNone});
-        if (r.fed) {
-            fed.push_back(r);
-        }
+        runs.add(r);
     });
-    std::sort(keys.begin(), keys.end(), before);
     Run<T> run(file, initial, cfg, orbit_period_s);
-    for (const Key& k : keys) {
-        if (k.fed != kNone) {
-            run.take(fed[k.fed]);
-        } else {
-            CalibRow<T> r{};
-            r.t_us = k.t_us;
-            r.t = k.t;
-            r.line = k.line;
-            run.take(r);
-        }
-    }
-    return run.finish(untimed);
+    runs.each([&run](const CalibRow<T>& r) { run.take(r); });
+    SelfCalibration out = run.finish(untimed);
+    out.runs = runs.count();
+    return out;
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                                const calib::EstimatorConfig&, std::optional<double>);
+                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                               const calib::EstimatorConfig&, std::optional<double>);
+                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                             const calib::EstimatorConfig&, std::optional<double>);
+                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {

@@ -43,7 +43,12 @@ struct SelfCalibration {
     double orbit_period_s = 0.0;
     std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
+    std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
 };
+
+// The memory self_calibrate() keeps rows out of time order in (the rest goes
+// to a temporary file in sorted runs): 64 MiB.
+inline constexpr std::size_t kSelfCalibrationMemoryBytes = std::size_t{64} << 20;
 
 // Self-calibration starts from a linear model, on the host as on the target:
 // the estimator's models are linear (c0..c3) and the link's CALIB_MODEL_LOAD
@@ -62,10 +67,14 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // that feed the estimator; refused (InputError naming a row and
 // --orbit-period) when fewer than three quarters of them are within 1 % of
 // that median, or it is no Earth orbit of 10 min to a day (docs/contract.md).
-// Throws InputError for a file whose rows cannot be read.
+// Rows in time order are taken as read; once one is out of order, the rows
+// are read again and sorted within memory_budget_bytes (beyond it, in sorted
+// runs on a temporary file, merged). Throws InputError for a file whose rows
+// cannot be read.
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s);
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
+                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes);
 
 // The models of a history in turn, for correcting rows: at(t) is the model
 // active at t's epoch (TT µs of the on-board clock), or one with no head
