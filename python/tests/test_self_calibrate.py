@@ -79,3 +79,16 @@ def test_a_quadratic_model_is_refused_as_on_the_command_line(mission, tmp_path):
     s = ascorr.read_solutions(str(mission / "m.csv"))
     with pytest.raises(ValueError, match=r"argument 'model'.*head B gamma has a quadratic term \(c2_2\)"):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=ascorr.read_model(str(lines)))
+
+
+def test_a_model_beyond_the_float_range_is_refused_for_float(mission, tmp_path):
+    # As on the command line (check_float_range): c1 = c2 = 6000"/degC, which
+    # fixed point accepts, cannot be evaluated in float within its bound.
+    p = tmp_path / "big.csv"
+    p.write_text("chu,axis,c0,c1,c2,c3\nA,alpha,0,6000,6000,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n")
+    m = ascorr.read_model(str(p))
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    for call in (ascorr.correct, ascorr.self_calibrate):
+        with pytest.raises(ValueError, match=r"argument 'model'.*beyond what the float core evaluates"):
+            call(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=m, scalar="float")
+    ascorr.correct(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=m, scalar="fixed")

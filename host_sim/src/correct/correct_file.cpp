@@ -324,6 +324,9 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         if constexpr (std::is_same_v<T, Q30>) {
             check_fixed_point_range(*model_file, opt.model);
         }
+        if constexpr (std::is_same_v<T, float>) {
+            check_float_range(*model_file, opt.model);
+        }
         if (opt.self_calibrate) {
             refuse_quadratic_initial_model(*model_file, opt.model);
         }

@@ -239,6 +239,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         if constexpr (std::is_same_v<T, Q30>) {
             check_fixed_point_range(*mf, opt.model);  // refused before the target sees it, as by `correct`
         }
+        if constexpr (std::is_same_v<T, float>) {
+            check_float_range(*mf, opt.model);
+        }
     }
     if (opt.self_calibrate && mf) {
         refuse_quadratic_initial_model(*mf, opt.model);
