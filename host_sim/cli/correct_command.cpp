@@ -41,7 +41,8 @@ CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& secon
     return cmd
         .add_option("--orbit-period", seconds,
                     "with --self-calibrate: the orbit period in s, " + host::orbit_period_range() +
-                        " (default: from the median speed of the first 99 rows learnt from)")
+                        " (default: from the median speed of the first " + std::to_string(host::kOrbitPeriodRows) +
+                        " rows learnt from)")
         ->check(real_in(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6,
                         static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6));
 }

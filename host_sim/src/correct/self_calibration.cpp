@@ -39,17 +39,16 @@ struct CalibRow {
 };
 
 // The orbit period, when not given, from the speeds of the first
-// kPeriodRows fed rows in time order (docs/contract.md, Self-calibration):
-// their median's circular orbit (vis-viva), so that no single row decides; a
-// set in which fewer than three quarters lie within kPeriodSpeedTolerance of
-// the median is refused (an eccentric orbit or corrupted velocities: give
-// --orbit-period).
-constexpr std::size_t kPeriodRows = 99;  // 33 epochs of A, B and C
+// kOrbitPeriodRows fed rows in time order (docs/contract.md,
+// Self-calibration): their median's circular orbit (vis-viva), so that no
+// single row decides; a set in which fewer than three quarters lie within
+// kPeriodSpeedTolerance of the median is refused (an eccentric orbit or
+// corrupted velocities: give --orbit-period).
 constexpr double kPeriodSpeedTolerance = 0.01;
 
 // The estimator over rows taken in time order (t_us, then line), one at a
 // time, as the link server takes them. Until the orbit period is known (given,
-// or kPeriodRows fed rows seen), rows are held and replayed when the
+// or kOrbitPeriodRows fed rows seen), rows are held and replayed when the
 // estimator starts: the fed rows whole, and of the epochs between two fed rows
 // only the first and the last (the others change nothing: no model becomes
 // pending without a fed epoch), so the rows held are bounded.
@@ -77,7 +76,7 @@ public:
 
     SelfCalibration finish(std::size_t untimed) {
         if (!est_) {
-            // Fewer than kPeriodRows fed rows: their period; none: nothing is
+            // Fewer than kOrbitPeriodRows fed rows: their period; none: nothing is
             // learnt, the period is not used.
             start(fed_held_ > 0 ? period_from_speeds()
                                 : static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
@@ -108,7 +107,7 @@ private:
             return;
         }
         held_.push_back(r);
-        if (r.fed && ++fed_held_ == kPeriodRows) {
+        if (r.fed && ++fed_held_ == kOrbitPeriodRows) {
             start(period_from_speeds());
         }
     }
@@ -266,7 +265,10 @@ private:
         CalibRow<T> row{};
     };
 
-    std::size_t bytes() const noexcept { return keys_.size() * sizeof(Key) + fed_.size() * sizeof(CalibRow<T>); }
+    // What the run holds, as allocated (a vector grows beyond its size).
+    std::size_t bytes() const noexcept {
+        return keys_.capacity() * sizeof(Key) + fed_.capacity() * sizeof(CalibRow<T>);
+    }
 
     void sort_run() {
         std::sort(keys_.begin(), keys_.end(), [](const Key& a, const Key& b) { return before(a, b); });

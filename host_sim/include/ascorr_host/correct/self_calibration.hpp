@@ -46,6 +46,10 @@ struct SelfCalibration {
     std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
 };
 
+// The fed rows (in time order) whose median speed gives the orbit period
+// when it is not given: 33 epochs of A, B and C.
+inline constexpr std::size_t kOrbitPeriodRows = 99;
+
 // The memory self_calibrate() keeps rows out of time order in (the rest goes
 // to a temporary file in sorted runs): 64 MiB.
 inline constexpr std::size_t kSelfCalibrationMemoryBytes = std::size_t{64} << 20;
@@ -63,7 +67,7 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
 // (refuse_quadratic_initial_model).
 // orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
-// the circular orbit's at the median speed of the first 99 rows in time order
+// the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
 // that feed the estimator; refused (InputError naming a row and
 // --orbit-period) when fewer than three quarters of them are within 1 % of
 // that median, or it is no Earth orbit of 10 min to a day (docs/contract.md).
