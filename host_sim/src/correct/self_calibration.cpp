@@ -122,7 +122,9 @@ private:
                 fed.push_back(&r);
             }
         }
-        const auto by_speed = [](const CalibRow<T>* a, const CalibRow<T>* b) { return a->speed_kms < b->speed_kms; };
+        const auto by_speed = [](const CalibRow<T>* a, const CalibRow<T>* b) {  // ties by line: one median row
+            return a->speed_kms < b->speed_kms || (a->speed_kms == b->speed_kms && a->line < b->line);
+        };
         const auto mid = fed.begin() + static_cast<std::ptrdiff_t>((fed.size() - 1) / 2);
         std::nth_element(fed.begin(), mid, fed.end(), by_speed);
         const CalibRow<T>& median = **mid;
