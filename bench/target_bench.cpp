@@ -19,6 +19,12 @@
 // evaluation at kSeriesRuns epochs spread over its span, against a function
 // that only writes its output; the series is the out-of-line entry of
 // firmware/app/earth_series_entry.cpp ("bench double earth_series <instructions>").
+// The combined attitude (ascorr/combine/, the out-of-line entry of
+// firmware/app/combine_entry_*.cpp) is measured per epoch of three usable,
+// consistent heads (bench/combination_fixture.hpp: near-orthogonal heads,
+// the contract's noise, the true attitudes those of the selected records),
+// against a function that only copies the first head's quaternion
+// ("bench <scalar> combination <instructions>").
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cstdint>
 #include <cstdio>
@@ -26,6 +32,8 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "baseline.hpp"
 #include "board.hpp"
+#include "combination_fixture.hpp"
+#include "combine_entry.hpp"
 #include "core_entry.hpp"
 #include "earth_series_entry.hpp"
 #include "systick_counter.hpp"
@@ -191,9 +199,71 @@ void bench_series(std::uint32_t ipc) {
     std::printf("bench double earth_series %u\n", static_cast<unsigned>(per));
 }
 
+// The combination: one epoch of three heads per call.
+template <typename T>
+using CombineFn = combine::CombinedAttitude<T> (*)(const combine::Combiner<T>&, const combine::HeadAttitude<T>*,
+                                                   std::uint8_t) noexcept;
+
+template <typename T>
+__attribute__((noinline)) combine::CombinedAttitude<T> combine_copy(const combine::Combiner<T>& /*c*/,
+                                                                    const combine::HeadAttitude<T>* heads,
+                                                                    std::uint8_t /*n*/) noexcept {
+    return {heads[0].q_chu_icrf, 0U, 0U, 0U, 0U, 0U};
+}
+
+template <typename T>
+__attribute__((noinline)) combine::CombinedAttitude<T> combine_call(const combine::Combiner<T>& c,
+                                                                    const combine::HeadAttitude<T>* heads,
+                                                                    std::uint8_t n) noexcept {
+    return app::combine_epoch(c, heads, n);
+}
+
+template <typename T>
+struct CombinationFixture {
+    combine::HeadAttitude<T> epoch[kInputs][bench::kCombinationHeads];
+};
+
+template <typename T>
+std::uint32_t run_combination(volatile CombineFn<T> fn, const combine::Combiner<T>& c,
+                              const CombinationFixture<T>& fx) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kRuns; ++i) {
+            g_sink_status = fn(c, fx.epoch[i % kInputs], bench::kCombinationHeads).status;
+        }
+    });
+}
+
+template <typename T>
+void bench_combination(const char* name, const combine::Combiner<T>& c, CombinationFixture<T>& fx, std::uint32_t ipc) {
+    using Tr = ScalarTraits<T>;
+    const combine::Mountings m = bench::combination_mountings();
+    std::uint32_t state = 1U;
+    for (std::uint32_t i = 0; i < kInputs; ++i) {
+        const double* q = g_records[i].q;
+        Quaternion<double> heads[bench::kCombinationHeads];
+        bench::combination_epoch(m, {q[0], q[1], q[2], q[3]}, &state, heads);
+        for (std::uint8_t h = 0; h < bench::kCombinationHeads; ++h) {
+            fx.epoch[i][h] = {{Tr::from_double(heads[h].w), Tr::from_double(heads[h].x), Tr::from_double(heads[h].y),
+                               Tr::from_double(heads[h].z)},
+                              h,
+                              true};
+        }
+        if (c.combine(fx.epoch[i], bench::kCombinationHeads).status != combine::combined_status::kTwoOrMoreHeads) {
+            std::printf("bench: %s combination epoch %u not combined from three heads\n", name,
+                        static_cast<unsigned>(i));
+        }
+    }
+    const std::uint32_t c0 = run_combination<T>(&combine_copy<T>, c, fx);
+    report(name, "combination", run_combination<T>(&combine_call<T>, c, fx), c0, ipc);
+}
+
 Fixture<Q30> g_fixed;
+combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
+CombinationFixture<Q30> g_combination_fixed;
 #if !defined(ASCORR_TARGET_FIXED)
 Fixture<float> g_float;
+combine::Combiner<float> g_combiner_float{bench::combination_mountings()};
+CombinationFixture<float> g_combination_float;
 #endif
 
 }  // namespace
@@ -233,8 +303,10 @@ int main() {
     std::printf("bench calibration %u instructions per SysTick count\n", static_cast<unsigned>(ipc));
 #if !defined(ASCORR_TARGET_FIXED)
     bench_scalar<float>("float", g_float, ipc);
+    bench_combination<float>("float", g_combiner_float, g_combination_float, ipc);
 #endif
     bench_scalar<Q30>("fixed", g_fixed, ipc);
+    bench_combination<Q30>("fixed", g_combiner_fixed, g_combination_fixed, ipc);
     bench_baseline(ipc);
     bench_series(ipc);
     return 0;

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -17,6 +18,7 @@
 #include "analysis_generator.hpp"
 #include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/correct/selection.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -80,7 +82,7 @@ std::array<std::array<double, 3>, 3> independent_rms(const fs::path& data, const
     const auto recs = read_records(data.string(), storage);
     std::map<long long, std::array<std::optional<std::array<Eigen::Vector3d, 3>>, 3>> epochs;
     for (const auto& r : recs) {
-        const bool clean = r.flags == 0 && r.confidence <= 5.0 && r.temperature_present[0] &&
+        const bool clean = r.flags == 0 && r.confidence_present && r.confidence <= 5.0 && r.temperature_present[0] &&
                            r.temperature_present[1] && r.temperature_present[2] && r.velocity_components == 3;
         if (!clean) {
             continue;
@@ -267,6 +269,7 @@ TEST(Selection, RulesOfThePaper) {
     r.temperature_present = {true, true, true};
     r.velocity_components = 3;
     r.confidence = 5.0;
+    r.confidence_present = true;
     EXPECT_EQ(host::fit_selection(r), host::Drop::kNone);
     EXPECT_TRUE(host::is_clean(r));
     const auto with = [&](auto change) {
@@ -284,6 +287,24 @@ TEST(Selection, RulesOfThePaper) {
     EXPECT_FALSE(host::is_clean(with([](auto& x) { x.confidence = 6.0; })));
     EXPECT_FALSE(host::is_clean(with([](auto& x) { x.temperature_present[0] = false; })));
     EXPECT_FALSE(host::is_clean(with([](auto& x) { x.velocity_components = 0; })));
+    // A confidence that is not given (no column, an empty field: 0 and not
+    // present; `nan`: NaN and not present) is not clean, in every selection
+    // alike (issue 30, class 12: the fit once took `nan` as clean).
+    const auto nan_confidence = with([](auto& x) {
+        x.confidence = std::numeric_limits<double>::quiet_NaN();
+        x.confidence_present = false;
+    });
+    const auto no_confidence = with([](auto& x) {
+        x.confidence = 0.0;
+        x.confidence_present = false;
+    });
+    for (const auto& x : {nan_confidence, no_confidence}) {
+        EXPECT_EQ(host::fit_selection(x), host::Drop::kConfidence);
+        EXPECT_FALSE(host::is_clean(x));
+        EXPECT_FALSE(host::calibration_clean(x));
+    }
+    EXPECT_TRUE(host::calibration_clean(r));
+    EXPECT_FALSE(host::calibration_clean(with([](auto& x) { x.confidence = 5.01; })));
 }
 
 TEST(Selection, DroppedRowsDoNotReachTheFit) {

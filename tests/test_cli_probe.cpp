@@ -433,10 +433,10 @@ TEST(CliProbe, ReplayMaxPropagationIsTheTargetsHorizon) {
 
 TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt) {
     const fs::path dir = scratch_dir("probe-dash");
-    // simulate writes six files: '-' is refused naming why, and nothing is created.
+    // simulate writes eight files: '-' is refused naming why, and nothing is created.
     const CliRun sim = run_in("simulate --days 0.01 --out -", dir);
     EXPECT_EQ(sim.exit_code, 2) << sim.err;
-    EXPECT_TRUE(has(sim.err, "simulate writes six files")) << sim.err;
+    EXPECT_TRUE(has(sim.err, "simulate writes eight files")) << sim.err;
     EXPECT_TRUE(fs::is_empty(dir) || !fs::exists(dir / "-.truth.csv"));
     EXPECT_FALSE(fs::exists(dir / "-"));
     EXPECT_FALSE(fs::exists(dir / "-.heaters.csv"));

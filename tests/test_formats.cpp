@@ -80,6 +80,47 @@ TEST(SolutionsReader, MissingValuesAndUnknownColumns) {
     EXPECT_FALSE(rows[1].confidence_present);
 }
 
+// A column that looks like one the reader reads, which the header lacks, is
+// refused where it stands (issue 30, class 17: a misspelt T_CHU left every row
+// without temperatures, exit 0); unknown columns unlike them are kept.
+TEST(SolutionsReader, NearMissColumnsAreRefused) {
+    const std::string row = "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n";
+    const auto header_with = [](const std::string& from, const std::string& to) {
+        std::string h = kHeader;
+        return h.replace(h.find(from), from.size(), to);
+    };
+    EXPECT_EQ(error_of(header_with("t_chu", "T_CHU") + row),
+              "1:19: f.csv:1:19: column 'T_CHU' is not a column ascorr reads, but looks like 't_chu', which the "
+              "header lacks (column names are case-sensitive, docs/contract.md, section 3): rename it 't_chu', or "
+              "give it a name unlike the columns ascorr reads");
+    const std::pair<const char*, const char*> misses[] = {
+        {"t_chu", "tchu"},
+        {"t_029", "t_29"},
+        {"t_032", "T_023"},
+        {"flags", "flag"},
+        {"confidence", "confidance"},
+        {"confidence", "Confidence"},
+        {"chu", "CHU"},
+        {"vx", "VX"},
+        {"qw", "Qw"},
+    };
+    for (const auto& [known, written] : misses) {
+        const std::string e = error_of(header_with(known, written) + row);
+        EXPECT_NE(e.find(std::string("column '") + written + "' is not a column ascorr reads, but looks like '" +
+                         known + "'"),
+                  std::string::npos)
+            << written << ": " << e;
+    }
+    // Not near misses: a name of the reader's present beside it, short names
+    // one or two edits from a short column, names far from every column.
+    for (const char* extra : {"t_028", "x", "id", "qa", "note", "temperature", "chu2"}) {
+        EXPECT_EQ(error_of(std::string(kHeader).insert(std::strlen(kHeader) - 1, std::string(",") + extra) +
+                           "1,A,1,0,0,0,1,2,3,1,2,3,0,1,v\n"),
+                  "")
+            << extra;
+    }
+}
+
 TEST(SolutionsReader, UnknownHeadIsDataNotSyntax) {
     const auto rows = parse_all(std::string(kHeader) + "1,X,1,0,0,0,1,2,3,1,2,3,0,1\n");
     ASSERT_EQ(rows.size(), 1U);

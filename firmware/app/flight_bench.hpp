@@ -22,6 +22,7 @@
 
 #include "app_scalar.hpp"
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/combine/mountings.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/model_coefficients.hpp"
 #include "ascorr/core/table2.hpp"
@@ -103,6 +104,20 @@ constexpr BenchAttitudes make_bench_attitudes() {
 }
 
 inline constexpr BenchAttitudes kBenchAttitudes = make_bench_attitudes();
+
+// The bench's mountings, in flash: its common reference frame (CRF) is head
+// A's undeformed frame, so q_chu_crf = q_chu_icrf ⊗ q_crf_icrf* of the heads'
+// undeformed attitudes (flight_data.hpp), and the µASC's nominal noise, 1.3″
+// across and 9″ about the boresight (docs/contract.md, "Combined attitude").
+constexpr combine::Mountings make_bench_mountings() {
+    combine::Mountings m{};
+    const Quaternion<double> q_crf_icrf = kHeadAttitude[0];
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        m.head[h] = {true, kHeadAttitude[h] * conjugate(q_crf_icrf), 1.3, 9.0};
+    }
+    return m;
+}
+inline constexpr combine::Mountings kBenchMountings = make_bench_mountings();
 
 // Head h's raw solution in cycle `cycle` of a loop at kRateHz.
 constexpr const Quaternion<Scalar>& bench_attitude(std::uint32_t cycle, std::uint8_t h) noexcept {

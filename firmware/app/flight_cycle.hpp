@@ -5,15 +5,19 @@
 //
 // Conventions: the loop runs at kRateHz. Each cycle takes the GNSS states that
 // arrived (gnss_feed.hpp) into the velocity service (velocity_service.hpp:
-// frame conversion and propagation in double, bounded per cycle), takes the
-// on-board estimator's active model (calib_entry.hpp; a new one starts
-// between cycles), then corrects one raw solution per camera head (the
-// simulated deforming bench, flight_bench.hpp) with the core in the build's
-// scalar (app_scalar.hpp, core_entry.hpp), the temperatures of
-// temperature_source.hpp and the velocity the service gives for that
-// solution's own time (velocity_entry.hpp); every kCalibFeedEvery-th cycle
-// feeds heads A, B and C to the estimator, and after the solutions one
-// bounded step of its per-orbit update runs (idle()). Times are TT µs
+// frame conversion and propagation in double, bounded per cycle), then runs
+// the cycle as one epoch of the epoch pipeline (pipeline/epoch_pipeline.hpp),
+// with the image's out-of-line entries (EntryCalls): the on-board
+// estimator's active model (calib_entry.hpp; a new one starts between
+// cycles), then one raw solution per camera head (the simulated deforming
+// bench, flight_bench.hpp) with the velocity the service gives for that
+// solution's own time (velocity_entry.hpp), the core in the build's scalar
+// (app_scalar.hpp, core_entry.hpp), the temperatures of
+// temperature_source.hpp and their status bits; every kCalibFeedEvery-th
+// cycle heads A, B and C feed the estimator; then the cycle's heads are
+// combined into the bench's attitude (combine_entry.hpp, the mountings
+// kBenchMountings of flight_bench.hpp); after the solutions one bounded step
+// of the estimator's per-orbit update runs (idle()). Times are TT µs
 // (integers: no time in the scalar). Every loop has a fixed trip count.
 //
 // The cost of each part is measured by the caller's Meter (main.cpp: SysTick
@@ -37,8 +41,10 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_link/crc32c.hpp"
 #include "calib_entry.hpp"
+#include "combine_entry.hpp"
 #include "core_entry.hpp"
 #include "flight_bench.hpp"
 #include "flight_data.hpp"
@@ -76,15 +82,13 @@ enum class Part : std::uint8_t {
     kCorrect,     // the core
     kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
     kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
+    kCombine,     // the combined attitude of the cycle's heads (combine_entry.hpp)
 };
 
 struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
     void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
 };
-
-// No coefficients for any head (the estimator without a model: status 256).
-inline constexpr ThermalModel<Scalar> kNoModel{};
 
 inline std::uint32_t bits_of(Q30 x) noexcept {
     return static_cast<std::uint32_t>(x.raw);
@@ -99,12 +103,96 @@ class CorrectionLog {
 public:
     static constexpr std::uint32_t kSampleEvery = 16U;
     static constexpr std::uint32_t kMaxSamples = 32U;
+    // Records: one per head, then the cycle's combined attitude (kCombined).
+    static constexpr std::uint8_t kCombined = kMaxHeads;
+    static constexpr std::uint8_t kRecords = kMaxHeads + 1U;
 
     // Head `head`'s corrected solution of cycle `cycle` (cycles in order from 0).
     void add(std::uint32_t cycle, std::uint8_t head, const CorrectedSolution<Scalar>& c) noexcept {
-        if (head >= kMaxHeads) {
+        if (head < kMaxHeads) {
+            add_record(cycle, head, c, c.status == (status::kAberrationApplied | status::kThermalApplied));
+        }
+    }
+
+    // The cycle's combined attitude, as a record whose status is the
+    // combined status with the heads used in bits 8..8+kMaxHeads−1, and
+    // "applied" when two or more heads were averaged.
+    void add_combined(std::uint32_t cycle, const combine::CombinedAttitude<Scalar>& a) noexcept {
+        const auto st = static_cast<StatusBits>(a.status | (static_cast<unsigned>(a.used) << 8U));
+        add_record(cycle, kCombined, {a.q_crf_icrf, st}, (a.status & combine::combined_status::kTwoOrMoreHeads) != 0U);
+    }
+
+    struct Head {
+        std::uint32_t applied;    // cycles with both corrections applied (combined: two or more heads)
+        StatusBits status_union;  // every status bit seen
+        std::uint32_t solutions;  // cycles recorded
+        std::uint32_t crc;        // CRC-32C over every cycle's solution and status
+        CorrectedSolution<Scalar> last;
+    };
+    const Head& head(std::uint8_t h) const noexcept { return heads_[h < kRecords ? h : 0U]; }
+    std::uint32_t samples_taken() const noexcept { return samples_taken_; }
+    // Record h's solution of cycle i·kSampleEvery, i < samples_taken().
+    const CorrectedSolution<Scalar>& sample(std::uint32_t i, std::uint8_t h) const noexcept {
+        return samples_[i < kMaxSamples ? i : 0U][h < kRecords ? h : 0U];
+    }
+
+    // Per record: "head H: applied N status seen S last q W X Y Z"
+    // ("combined: ..." for the combined attitude).
+    void print_heads() const noexcept {
+        using namespace report;
+        for (std::uint8_t h = 0; h < kRecords; ++h) {
+            const Head& r = heads_[h];
+            name(h);
+            text(": applied ");
+            u32(r.applied);
+            text(" status seen ");
+            u32(r.status_union);
+            text(" last q ");
+            quaternion(r.last.q_chu_icrf);
+            text("\n");
+        }
+    }
+
+    // "sample cycle C head H status S q W X Y Z" per sample and record, then
+    // "solutions head H cycles N crc32c X" per record ("combined" for head H
+    // of the combined attitude).
+    void print_solutions() const noexcept {
+        using namespace report;
+        for (std::uint32_t i = 0; i < samples_taken_; ++i) {
+            for (std::uint8_t h = 0; h < kRecords; ++h) {
+                text("sample cycle ");
+                u32(i * kSampleEvery);
+                text(" ");
+                name(h);
+                text(" status ");
+                u32(samples_[i][h].status);
+                text(" q ");
+                quaternion(samples_[i][h].q_chu_icrf);
+                text("\n");
+            }
+        }
+        for (std::uint8_t h = 0; h < kRecords; ++h) {
+            text("solutions ");
+            name(h);
+            text(" cycles ");
+            u32(heads_[h].solutions);
+            text(" crc32c ");
+            hex32(heads_[h].crc);
+            text("\n");
+        }
+    }
+
+private:
+    static void name(std::uint8_t h) noexcept {
+        if (h == kCombined) {
+            report::text("combined");
             return;
         }
+        report::text("head ");
+        report::u32(h);
+    }
+
+    void add_record(std::uint32_t cycle, std::uint8_t head, const CorrectedSolution<Scalar>& c, bool applied) noexcept {
         Head& r = heads_[head];
         const std::uint32_t words[5] = {bits_of(c.q_chu_icrf.w), bits_of(c.q_chu_icrf.x), bits_of(c.q_chu_icrf.y),
                                         bits_of(c.q_chu_icrf.z), c.status};
@@ -116,7 +204,7 @@ public:
         r.solutions = cycle + 1U;
         r.last = c;
         r.status_union = static_cast<StatusBits>(r.status_union | c.status);
-        if (c.status == (status::kAberrationApplied | status::kThermalApplied)) {
+        if (applied) {
             ++r.applied;
         }
         if (cycle % kSampleEvery == 0U && cycle / kSampleEvery < kMaxSamples) {
@@ -125,66 +213,6 @@ public:
         }
     }
 
-    struct Head {
-        std::uint32_t applied;    // cycles with both corrections applied
-        StatusBits status_union;  // every status bit seen
-        std::uint32_t solutions;  // cycles recorded
-        std::uint32_t crc;        // CRC-32C over every cycle's solution and status
-        CorrectedSolution<Scalar> last;
-    };
-    const Head& head(std::uint8_t h) const noexcept { return heads_[h < kMaxHeads ? h : 0U]; }
-    std::uint32_t samples_taken() const noexcept { return samples_taken_; }
-    // Head h's solution of cycle i·kSampleEvery, i < samples_taken().
-    const CorrectedSolution<Scalar>& sample(std::uint32_t i, std::uint8_t h) const noexcept {
-        return samples_[i < kMaxSamples ? i : 0U][h < kMaxHeads ? h : 0U];
-    }
-
-    // Per head: "head H: applied N status seen S last q W X Y Z".
-    void print_heads() const noexcept {
-        using namespace report;
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            const Head& r = heads_[h];
-            text("head ");
-            u32(h);
-            text(": applied ");
-            u32(r.applied);
-            text(" status seen ");
-            u32(r.status_union);
-            text(" last q ");
-            quaternion(r.last.q_chu_icrf);
-            text("\n");
-        }
-    }
-
-    // "sample cycle C head H status S q W X Y Z" per sample and head, then
-    // "solutions head H cycles N crc32c X" per head.
-    void print_solutions() const noexcept {
-        using namespace report;
-        for (std::uint32_t i = 0; i < samples_taken_; ++i) {
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                text("sample cycle ");
-                u32(i * kSampleEvery);
-                text(" head ");
-                u32(h);
-                text(" status ");
-                u32(samples_[i][h].status);
-                text(" q ");
-                quaternion(samples_[i][h].q_chu_icrf);
-                text("\n");
-            }
-        }
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            text("solutions head ");
-            u32(h);
-            text(" cycles ");
-            u32(heads_[h].solutions);
-            text(" crc32c ");
-            hex32(heads_[h].crc);
-            text("\n");
-        }
-    }
-
-private:
     static void quaternion(const Quaternion<Scalar>& q) noexcept {
         report::hex32(bits_of(q.w));
         report::text(" ");
@@ -194,8 +222,8 @@ private:
         report::text(" ");
         report::hex32(bits_of(q.z));
     }
-    Head heads_[kMaxHeads]{};
-    CorrectedSolution<Scalar> samples_[kMaxSamples][kMaxHeads]{};
+    Head heads_[kRecords]{};
+    CorrectedSolution<Scalar> samples_[kMaxSamples][kRecords]{};
     std::uint32_t samples_taken_ = 0U;
 };
 
@@ -261,8 +289,64 @@ private:
     std::uint32_t size_ = 0U;
 };
 
+// The pipeline's calls: the image's out-of-line entries (core_entry.hpp,
+// calib_entry.hpp, each measured alone) and the temperatures' status bits.
+struct EntryCalls {
+    static const ThermalModel<Scalar>* model_for_epoch(calib::Estimator<Scalar>& e, std::int64_t t_us) noexcept {
+        return calib_model(e, t_us);
+    }
+    static CorrectedSolution<Scalar> correct(const SolutionInput<Scalar>& in,
+                                             const CorrectionConfig<Scalar>& cfg) noexcept {
+        return app::correct(in, cfg);
+    }
+    static bool feed(calib::Estimator<Scalar>& e, std::int64_t t_us, const ThermalModel<Scalar>* model,
+                     const CorrectedSolution<Scalar>* corrected,
+                     const HeadTemperatures<Scalar>* const* temperatures) noexcept {
+        return calib_feed(e, t_us, model, corrected, temperatures);
+    }
+    static bool step(calib::Estimator<Scalar>& e) noexcept { return calib_step(e); }
+    static StatusBits status(std::uint8_t head, StatusBits s) noexcept { return temperatures_merge_status(head, s); }
+    static combine::CombinedAttitude<Scalar> combine(const combine::Combiner<Scalar>& c,
+                                                     const combine::HeadAttitude<Scalar>* heads,
+                                                     std::uint8_t n) noexcept {
+        return combine_epoch(c, heads, n);
+    }
+};
+
+// The pipeline's stages as the loop's parts.
+constexpr Part part_of(pipeline::Stage stage) noexcept {
+    switch (stage) {
+        case pipeline::Stage::kVelocity:
+            return Part::kQuery;
+        case pipeline::Stage::kCorrect:
+            return Part::kCorrect;
+        case pipeline::Stage::kStep:
+            return Part::kCalibStep;
+        case pipeline::Stage::kCombine:
+            return Part::kCombine;
+        case pipeline::Stage::kModel:
+        case pipeline::Stage::kFeed:
+            break;
+    }
+    return Part::kCalibCycle;
+}
+
+template <typename Meter>
+struct StageMeter {
+    Meter& meter;
+    std::uint32_t now() noexcept { return meter.now(); }
+    void add(pipeline::Stage stage, std::uint32_t start) noexcept { meter.add(part_of(stage), start); }
+};
+
 class FlightCycle {
 public:
+    FlightCycle() noexcept {
+        pipeline_.use_estimator(&estimator_);
+        pipeline_.use_combiner(&combiner_);
+    }
+    FlightCycle(const FlightCycle&) = delete;
+    FlightCycle& operator=(const FlightCycle&) = delete;
+
     // One cycle: the temperatures (temperature_source.hpp), the states, the
     // heads, and (record: a bounded test run, whose report prints it) their
     // solutions into the record; a flight run (record false) does no
@@ -289,38 +373,27 @@ public:
         }
     }
 
-    // One corrected solution per head, in head order (fixed trip count).
+    // One corrected solution per head, in head order (fixed trip count),
+    // through the epoch pipeline (the cycle is the epoch): the cycle's model,
+    // then per head the service's velocity at the head's own time, the core,
+    // the status, and the estimator's feed on the schedule's cycles.
     template <typename Meter>
     void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
-        std::uint32_t start = meter.now();
-        const ThermalModel<Scalar>* model = calib_model(estimator_, calib_time_us(cycle));
-        meter.add(Part::kCalibCycle, start);
-        const CorrectionConfig<Scalar> cfg{true, model != nullptr ? model : &kNoModel};  // none: status 256
+        StageMeter<Meter> stages{meter};
+        const ThermalModel<Scalar>* model = pipeline_.begin(calib_time_us(cycle), stages);
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
-            start = meter.now();
+            const std::uint32_t start = meter.now();
             const std::uint32_t nodes_before = service_.nodes_built();
             service_.advance(t, OnBoardEarth{});  // a no-op while t is in the current node
             if (service_.nodes_built() != nodes_before) {
                 meter.add(Part::kNode, start);
             }
-            start = meter.now();
-            const ServiceVelocity<Scalar> v = velocity_query(service_, t);
-            meter.add(Part::kQuery, start);
-            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), v.velocity};
-            start = meter.now();
-            corrected_[h] = correct(in, cfg);
-            meter.add(Part::kCorrect, start);
-            corrected_[h].status = with_service_status(corrected_[h].status, v.status, cfg.aberration);
-            corrected_[h].status = temperatures_merge_status(h, corrected_[h].status);
+            const SolutionInput<Scalar> in{bench_attitude(cycle, h), h, temperatures_of(h), {}};
+            corrected_[h] = pipeline_.solution(
+                in, [&] { return pipeline::from_service(velocity_query(service_, t)); }, true, true, stages);
         }
-        const HeadTemperatures<Scalar>* temps[calib::kCalibHeads] = {&temperatures_of(0U), &temperatures_of(1U),
-                                                                     &temperatures_of(2U)};
-        if (cycle % kCalibFeedEvery == 0U) {
-            start = meter.now();
-            (void)calib_feed(estimator_, calib_time_us(cycle), model, corrected_, temps);
-            meter.add(Part::kCalibCycle, start);
-        }
+        combined_ = pipeline_.close(stages);
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
             model_ = model;
             if (model != nullptr) {
@@ -334,12 +407,12 @@ public:
     // and the host, whatever the time left).
     template <typename Meter>
     void idle(Meter& meter) noexcept {
-        const std::uint32_t start = meter.now();
-        if (calib_step(estimator_)) {
-            meter.add(Part::kCalibStep, start);
-        }
+        StageMeter<Meter> stages{meter};
+        (void)pipeline_.idle(stages);
     }
 
+    // The cycle's combined attitude of the bench (kBenchMountings).
+    const combine::CombinedAttitude<Scalar>& combined() const noexcept { return combined_; }
     const CorrectedSolution<Scalar>& corrected(std::uint8_t head) const noexcept {
         return corrected_[head < kMaxHeads ? head : 0U];
     }
@@ -357,8 +430,13 @@ private:
     std::uint32_t states_skipped_ = 0U;
     std::uint32_t states_refused_ = 0U;
     CorrectionLog record_;
-    // The estimator, starting from the model in flash (version 0).
+    // The estimator, starting from the model in flash (version 0), fed every
+    // kCalibFeedEvery-th cycle; its per-orbit update steps in idle time.
     calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    pipeline::EpochPipeline<Scalar, EntryCalls> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
+    // The combination's tables, built once from the mountings in flash.
+    combine::Combiner<Scalar> combiner_{kBenchMountings};
+    combine::CombinedAttitude<Scalar> combined_{};
     const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
     ModelHistory history_;
 };
@@ -371,6 +449,9 @@ void FlightCycle::run(std::uint32_t cycle, Meter& meter, bool record) noexcept {
     idle(meter);
     for (std::uint8_t h = 0; record && h < kMaxHeads; ++h) {  // fixed trip count
         record_.add(cycle, h, corrected_[h]);
+    }
+    if (record) {
+        record_.add_combined(cycle, combined_);
     }
 }
 

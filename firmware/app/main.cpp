@@ -60,6 +60,7 @@ struct VelocityCosts {
     Cost correct;      // the core, for comparison
     Cost calib_cycle;  // the estimator's per-cycle part (two calls per cycle: the model, the feed)
     Cost calib_step;   // one step() of the estimator's per-orbit update (idle time)
+    Cost combine;      // the cycle's combined attitude (combine_entry.hpp)
 };
 VelocityCosts g_costs{};
 
@@ -93,6 +94,9 @@ struct SysTickMeter {
                 break;
             case Part::kCalibStep:
                 g_costs.calib_step.add(c);
+                break;
+            case Part::kCombine:
+                g_costs.combine.add(c);
                 break;
         }
     }
@@ -213,6 +217,20 @@ void print_estimator(std::uint32_t correction3) noexcept {
                                  : ") (estimator above the correction's cost)\n");
 }
 
+// "combination calls N ..." and the combination's cost per cycle of the
+// bench's heads (instructions under QEMU -icount), with its tables' RAM.
+void print_combination() noexcept {
+    using namespace report;
+    cost("  combination", g_costs.combine);
+    text("combination: per cycle ");
+    u32(g_costs.combine.calls == 0U ? 0U : (g_costs.combine.total * 40U) / g_costs.combine.calls);
+    text(" instructions (worst ");
+    u32(g_costs.combine.worst * 40U);
+    text("), tables ");
+    u32(static_cast<std::uint32_t>(sizeof(combine::Combiner<Scalar>)));
+    text(" bytes\n");
+}
+
 void print_report() noexcept {
     using namespace report;
     text(ASCORR_APP_SCALAR_NAME " core, ");
@@ -272,6 +290,7 @@ void print_report() noexcept {
     text(amortised <= correction3 ? " (service within the correction's cost)\n"
                                   : " (service above the correction's cost)\n");
     print_estimator(correction3);
+    print_combination();
 }
 
 }  // namespace

@@ -27,6 +27,14 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+// Input a command refuses (align: a malformed file, too few epochs, a head
+// without clean epochs): main() prints the message (file:line:column where
+// it has one) and exits 2, as for a usage error.
+class RefusedInput : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 // Heads by their letters (--heads ABCD, --frame-heads AC): heads.hpp's, in its
 // order, none twice, at least `min` and at most `max` of them. A refused value
 // is a usage error (exit 2), found before any input is read.
@@ -113,5 +121,7 @@ CLI::Option* add_time_constant_option(CLI::App& cmd, double& days);
 CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds);
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
+void add_combine_command(CLI::App& app);
+void add_align_command(CLI::App& app);
 
 }  // namespace ascorr::cli

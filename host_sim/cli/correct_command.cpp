@@ -5,11 +5,13 @@
 #include <vector>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -24,6 +26,41 @@ std::vector<std::pair<std::string, host::ScalarKind>> scalar_names() {
         names.emplace_back(std::string(n.name), n.kind);
     }
     return names;
+}
+
+// --mountings M --combined A: the combined attitude in the same pass (combine.hpp).
+struct CombineTexts {
+    std::string mountings;
+    std::string combined;
+};
+
+void add_combine_options(CLI::App& cmd, CombineTexts& t) {
+    CLI::Option* mountings =
+        cmd.add_option("--mountings", t.mountings,
+                       "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about)")
+            ->check(non_empty_path());
+    CLI::Option* combined = cmd.add_option("--combined", t.combined,
+                                           "also combine the corrected rows into the bench's attitude per epoch (CSV "
+                                           "t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status), committed with --out")
+                                ->check(non_empty_path());
+    mountings->needs(combined);
+    combined->needs(mountings);
+}
+
+void correct_and_combine(const host::CorrectOptions& opt, const CombineTexts& t) {
+    try {  // the mountings first: refused input exits 2 (as combine and align)
+        host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings);
+    } catch (const host::InputError& e) {
+        throw RefusedInput(e.what());
+    } catch (const std::runtime_error& e) {
+        throw RefusedInput(e.what());
+    }
+    const host::CorrectAndCombine r = host::correct_and_combine(opt, t.mountings, t.combined, std::cerr);
+    if (!r.corrected.self_calibration.empty()) {
+        std::cerr << "ascorr correct: " << r.corrected.self_calibration << '\n';
+    }
+    std::cerr << "ascorr correct: " << opt.out << ": " << host::describe(r.corrected) << '\n';
+    std::cerr << "ascorr correct: " << t.combined << ": " << host::describe(r.combined) << '\n';
 }
 
 }  // namespace
@@ -86,8 +123,13 @@ void add_correct_command(CLI::App& app) {
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
-    cmd->callback([opt, time_constant, orbit_period]() {
-        read_dash_from_standard_input({{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}});
+    auto combine = std::make_shared<CombineTexts>();
+    add_combine_options(*cmd, *combine);
+    cmd->callback([opt, time_constant, orbit_period, combine]() {
+        read_dash_from_standard_input({{"--in", &opt->in},
+                                       {"--model", &opt->model},
+                                       {"--states", &opt->states},
+                                       {"--mountings", &combine->mountings}});
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
         }
@@ -96,6 +138,10 @@ void add_correct_command(CLI::App& app) {
         }
         if (!opt->self_calibrate && orbit_period->count() > 0) {
             throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
+        }
+        if (!combine->combined.empty()) {
+            correct_and_combine(*opt, *combine);
+            return;
         }
         const host::CorrectSummary s = host::correct_file(*opt, std::cerr);
         if (!s.self_calibration.empty()) {

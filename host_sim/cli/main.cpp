@@ -1,7 +1,8 @@
 // ascorr: thermal and aberration correction of µASC attitude solutions.
 //
 // Exit status: 0 when every output is complete; 1 for bad input or an I/O
-// error (the message names file, line and column); 2 for a usage error; 3
+// error (the message names file, line and column); 2 for a usage error and
+// input a command refuses as such (align); 3
 // when the outputs are complete but say the run failed (replay: the target's
 // answers, models or report differ from the host's);
 // ended by SIGINT, SIGTERM, SIGHUP or SIGPIPE: that signal (128 + signal in a
@@ -29,6 +30,8 @@ int main(int argc, char** argv) {
     ascorr::cli::add_fit_command(app);
     ascorr::cli::add_stats_command(app);
     ascorr::cli::add_plot_command(app);
+    ascorr::cli::add_combine_command(app);
+    ascorr::cli::add_align_command(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -37,6 +40,9 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         app.exit(e);
+        return 2;
+    } catch (const ascorr::cli::RefusedInput& e) {
+        std::cerr << "ascorr: " << e.what() << '\n';
         return 2;
     } catch (const ascorr::cli::FailedResult& e) {
         std::cerr << "ascorr: " << e.what() << '\n';

@@ -23,6 +23,7 @@
 #include <limits>
 #include <string>
 
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/numbers.hpp"
 
 namespace ascorr::cli {
@@ -173,8 +174,8 @@ inline CLI::Validator real_in(double lo, double hi, End lo_end = End::kClosed, E
                 return std::string();
             }
             char range[80];
-            std::snprintf(range, sizeof range, "%c%g, %g%c", lo_end == End::kOpen ? '(' : '[', lo, hi,
-                          hi_end == End::kOpen ? ')' : ']');
+            text::c_snprintf(range, sizeof range, "%c%g, %g%c", lo_end == End::kOpen ? '(' : '[', lo, hi,
+                             hi_end == End::kOpen ? ')' : ']');
             return s + " is out of range: the range is " + range;
         },
         "NUMBER");

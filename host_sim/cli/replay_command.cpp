@@ -49,6 +49,18 @@ void add_replay_command(CLI::App& app) {
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
     CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
+    CLI::Option* mountings =
+        cmd->add_option("--mountings", opt->mountings,
+                        "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "
+                        "the target's combiner")
+            ->check(non_empty_path());
+    CLI::Option* combined =
+        cmd->add_option("--combined", opt->combined,
+                        "the target also combines each epoch into the bench's attitude; written here (CSV, as "
+                        "ascorr combine's) and compared with the host's bit for bit")
+            ->check(non_empty_path());
+    mountings->needs(combined);
+    combined->needs(mountings);
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));
@@ -73,8 +85,11 @@ void add_replay_command(CLI::App& app) {
         if (!opt->self_calibrate && orbit_period->count() > 0) {
             throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
         }
-        read_dash_from_standard_input(
-            {{"--in", &opt->in}, {"--model", &opt->model}, {"--states", &opt->states}, {"--firmware", &opt->firmware}});
+        read_dash_from_standard_input({{"--in", &opt->in},
+                                       {"--model", &opt->model},
+                                       {"--states", &opt->states},
+                                       {"--firmware", &opt->firmware},
+                                       {"--mountings", &opt->mountings}});
         const host::ReplaySummary s = host::replay(*opt, std::cerr);
         std::cout << host::to_json(s) << std::endl;
         if (!host::agrees(s)) {

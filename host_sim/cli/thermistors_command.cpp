@@ -31,6 +31,7 @@
 #include "number_options.hpp"
 #ifdef ASCORR_HAVE_GPIOD
 #include "ascorr_hal_linux/gpiod_backend.hpp"
+#include "ascorr_text/c_format.hpp"
 #endif
 
 namespace ascorr::cli {
@@ -68,18 +69,18 @@ void print_row(std::FILE* out, std::uint64_t t_us, const char* name, const char*
     char o[32] = "";
     char t[32] = "";
     if (counts >= 0) {
-        std::snprintf(c, sizeof c, "%ld", counts);
+        text::c_snprintf(c, sizeof c, "%ld", counts);
     }
     if (std::isfinite(ohm)) {
-        std::snprintf(o, sizeof o, "%.1f", ohm);
+        text::c_snprintf(o, sizeof o, "%.1f", ohm);
     } else if (std::isinf(ohm)) {
-        std::snprintf(o, sizeof o, "inf");
+        text::c_snprintf(o, sizeof o, "inf");
     }
     if (std::isfinite(celsius)) {
-        std::snprintf(t, sizeof t, "%.3f", celsius);
+        text::c_snprintf(t, sizeof t, "%.3f", celsius);
     }
-    std::fprintf(out, "%" PRIu64 ".%06" PRIu64 ",%s,%s,%s,%s,%s,%d,%s\n", t_us / 1000000U, t_us % 1000000U, name, role,
-                 c, o, t, faults == 0U ? 1 : 0, fault_list(faults).c_str());
+    text::c_fprintf(out, "%" PRIu64 ".%06" PRIu64 ",%s,%s,%s,%s,%s,%d,%s\n", t_us / 1000000U, t_us % 1000000U, name,
+                    role, c, o, t, faults == 0U ? 1 : 0, fault_list(faults).c_str());
 }
 
 // A fault whose window misses the history faults nothing: said, not silent.
@@ -98,7 +99,7 @@ void warn_faults_outside(const ThermistorOptions& opt, const std::vector<hal::In
     for (std::size_t i = 0; i < faults.size(); ++i) {
         if (faults[i].to_s < first || faults[i].from_s > last) {
             char span[96];
-            std::snprintf(span, sizeof span, "[%.17g, %.17g] s", first, last);
+            text::c_snprintf(span, sizeof span, "[%.17g, %.17g] s", first, last);
             std::cerr << "ascorr thermistors: warning: --inject " << opt.inject[i] << ": its window is outside the "
                       << "history " << opt.simulate << " " << span << ": it faults nothing\n";
         }
@@ -144,7 +145,7 @@ void run(const ThermistorOptions& opt) {
     const std::uint8_t head = head_index(opt.head);
     hal::TemperatureAcquisition<double> acq(acfg);
     std::FILE* out = stdout;
-    std::fprintf(out, "t,name,role,counts,ohm,celsius,valid,faults\n");
+    text::c_fprintf(out, "t,name,role,counts,ohm,celsius,valid,faults\n");
     std::size_t frames = 0;
     std::size_t invalid = 0;
     std::size_t per_fault[hal::fault::kCount] = {};

@@ -128,19 +128,57 @@ _OPTIONAL_GROUPS = ("temps", "v")
 
 def _column(frame, name, dtype):
     """frame[name] as a NumPy array of dtype; pandas' missing values (NaN, None,
-    pd.NA) become NaN in a real column and are refused in an integer one."""
+    pd.NA) become NaN in a real column and are refused in an integer one.
+    Dates, durations and booleans are refused, never read as numbers (a
+    datetime64 would give nanoseconds since 1970, not seconds since J2000)."""
     import numpy as np
 
     series = frame[name]
+    kind = getattr(series.dtype, "kind", "O")
+    if kind in "Mm":
+        what = "times are float64 seconds since J2000.0 TT (docs/contract.md, section 1): convert " \
+            "them explicitly" if name == "t" else "expected real numbers"
+        raise ValueError(f"from_frame: column '{name}': dtype {series.dtype} is not taken: {what}")
+    if kind == "b":
+        raise ValueError(f"from_frame: column '{name}': expected numbers, got dtype {series.dtype}")
     try:
         if np.dtype(dtype).kind == "f":
             return series.to_numpy(dtype=dtype, na_value=np.nan)
         missing = series.isna().to_numpy()
         if missing.any():
             raise ValueError(f"row {series.index[missing.argmax()]!r} is missing")
-        return series.to_numpy(dtype=dtype)
+        return _integer_column(series, name, dtype)
     except (TypeError, ValueError) as e:
+        if str(e).startswith("from_frame:"):
+            raise
         raise ValueError(f"from_frame: column '{name}': {e}") from None
+
+
+# The ranges of the integer columns, as the file reader takes them.
+_INT64 = (-(2**63), 2**63 - 1)
+_RANGES = {"flags": (0, 2**63 - 1), "status": (0, 65535), "chu": _INT64}
+
+
+def _integer_column(series, name, dtype):
+    """An integer column by the rule of correct()'s arrays (one rule, in the
+    compiled module): integers, or floats that are all integral (pandas makes an
+    integer column float64 once it held a missing value), within the column's
+    range; anything else is refused, naming the row's index label."""
+    import numpy as np
+    import pandas
+
+    if pandas.api.types.is_unsigned_integer_dtype(series.dtype):
+        values = series.to_numpy(dtype=np.uint64)
+    elif pandas.api.types.is_integer_dtype(series.dtype):
+        values = series.to_numpy(dtype=np.int64)
+    elif pandas.api.types.is_float_dtype(series.dtype):
+        values = series.to_numpy(dtype=np.float64)
+    else:
+        raise ValueError(f"expected integers, got dtype {series.dtype}")
+    out, bad, why = _ascorr._integers(values, *_RANGES.get(name, _INT64))
+    if bad >= 0:
+        raise ValueError(f"row {series.index[bad]!r}: {why}")
+    return out.astype(dtype)
 
 
 def from_frame(frame):
@@ -151,7 +189,10 @@ def from_frame(frame):
     ones); absent t_chu/t_029/t_032, vx/vy/vz or confidence are NaN and absent
     flags 0, as in a file without them; missing values (NaN, None, pd.NA) are
     NaN, except in chu, flags and status, where they are refused. chu holds
-    head letters (strings) or head indices (integers); "status" is kept when
+    head letters (strings) or head indices; flags, head indices and status are
+    integers, or floats that are all integral, as correct() takes them (0.9 is
+    refused, never truncated); dates (datetime64) are refused, never read as
+    seconds since J2000. "status" is kept when
     present (a corrected file); every other column goes under "extra" as text,
     as read_solutions() keeps the columns it does not know. Rows are taken in
     the frame's order; its index only names rows in messages."""
@@ -159,6 +200,9 @@ def from_frame(frame):
     import pandas
 
     columns = set(frame.columns)
+    near_miss = _ascorr._near_miss([str(c) for c in frame.columns])
+    if near_miss is not None:  # the file reader's rule and words
+        raise ValueError(f"from_frame: {near_miss[1]}")
     required = ["t", "chu", *_COLUMNS["q"]]
     missing = [c for c in required if c not in columns]
     if missing:
@@ -168,8 +212,11 @@ def from_frame(frame):
     chu = frame["chu"]
     if chu.isna().any():
         raise ValueError(f"from_frame: column 'chu': row {chu.index[chu.isna().to_numpy().argmax()]!r} is missing")
-    integer = pandas.api.types.is_integer_dtype(chu.dtype)
-    out["chu"] = _column(frame, "chu", np.int64) if integer else chu.to_numpy(dtype=str)
+    numeric = pandas.api.types.is_numeric_dtype(chu.dtype) and not pandas.api.types.is_bool_dtype(chu.dtype)
+    if not numeric and not all(isinstance(x, str) for x in chu):
+        raise ValueError(f"from_frame: column 'chu': expected head letters (strings) or head indices "
+                         f"(integers), got dtype {chu.dtype}")
+    out["chu"] = _column(frame, "chu", np.int64) if numeric else chu.to_numpy(dtype=str)
     for key in ("q", "temps", "v"):
         names = _COLUMNS[key]
         present = [c in columns for c in names]
@@ -183,12 +230,7 @@ def from_frame(frame):
     out["flags"] = _column(frame, "flags", np.int64) if "flags" in columns else np.zeros(n, np.int64)
     out["confidence"] = _column(frame, "confidence", np.float64) if "confidence" in columns else np.full(n, np.nan)
     if "status" in columns:
-        status = _column(frame, "status", np.int64)
-        bad = (status < 0) | (status > np.iinfo(np.uint16).max)
-        if bad.any():
-            raise ValueError(f"from_frame: column 'status': row {frame.index[bad.argmax()]!r} is not a status "
-                             f"(0 to 65535): {status[bad.argmax()]}")
-        out["status"] = status.astype(np.uint16)
+        out["status"] = _column(frame, "status", np.uint16)
     known = {"t", "chu", "flags", "confidence", "status", *(c for names in _COLUMNS.values() for c in names)}
     out["extra"] = {str(c): frame[c].to_numpy(dtype=str) for c in frame.columns if c not in known}
     return out

@@ -139,10 +139,11 @@ def stats(
     t_to: Optional[float] = ...,
 ) -> _Stats:
     """IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
-    IBA RMS about the mean over the clean epochs (flags 0, confidence <= 5 or missing,
+    IBA RMS about the mean over the clean epochs (flags 0, confidence a number <= 5,
     temperatures and velocity present and accepted), and after 200 s smoothing.
-    flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN or None when
-    missing; t_from, t_to: the period (inclusive).
+    flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN where not given;
+    None: none given (a row without a confidence is not clean, as in a file);
+    t_from, t_to: the period (inclusive).
     Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
     (arcsec; None with fewer than two clean epochs, or thermal without a model, as
     null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),
@@ -206,9 +207,10 @@ def self_calibrate(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
-    epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec or
-    None), after the aberration stage, in `scalar`, starting from `model` (version 0)
-    or from none (rows before the first adopted model get status 256).
+    epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec,
+    NaN or None where not given: not clean), after the aberration stage, in `scalar`,
+    starting from `model` (version 0) or from none (rows before the first adopted
+    model get status 256).
     time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
     or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
     Returns (q_corrected float64
@@ -266,7 +268,10 @@ def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]:
     ones); absent t_chu/t_029/t_032, vx/vy/vz or confidence are NaN and absent
     flags 0, as in a file without them; missing values (NaN, None, pd.NA) are
     NaN, except in chu, flags and status, where they are refused. chu holds
-    head letters (strings) or head indices (integers); "status" is kept when
+    head letters (strings) or head indices; flags, head indices and status are
+    integers, or floats that are all integral, as correct() takes them (0.9 is
+    refused, never truncated); dates (datetime64) are refused, never read as
+    seconds since J2000. "status" is kept when
     present (a corrected file); every other column goes under "extra" as text,
     as read_solutions() keeps the columns it does not know. Rows are taken in
     the frame's order; its index only names rows in messages."""

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "ascorr/core/heads.hpp"
+#include "ascorr_host/formats/csv.hpp"
 #include "bind.hpp"
 
 namespace ascorr::python {
@@ -197,6 +198,64 @@ std::string head_index_range() {
 
 namespace {
 
+// Marks row i of out as the first that is no integer in [lo, hi]; text is the
+// value as the reader would have read it.
+void refuse_integer(Integers& out, std::size_t i, const std::string& text, long long lo, long long hi) {
+    out.bad_row = static_cast<py::ssize_t>(i);
+    out.why = host::why_not_an_integer(text, lo, hi);
+}
+
+void integral_floats(const py::array& a, long long lo, long long hi, Integers& out) {
+    const auto x = Doubles::ensure(a);
+    for (std::size_t i = 0; i < out.values.size(); ++i) {
+        const double v = x.data()[i];
+        const bool integral = std::isfinite(v) && std::floor(v) == v;
+        if (!integral || v >= 0x1p63 || v < -0x1p63) {  // 2^63: the first double beyond long long
+            char buf[400];                              // an integral double in full: at most 309 digits
+            const auto r = integral ? std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 0)
+                                    : std::to_chars(buf, buf + sizeof buf, v);
+            return refuse_integer(out, i, std::string(buf, r.ptr), lo, hi);
+        }
+        out.values[i] = static_cast<long long>(v);
+        if (out.values[i] < lo || out.values[i] > hi) {
+            return refuse_integer(out, i, std::to_string(out.values[i]), lo, hi);
+        }
+    }
+}
+
+void integers(const py::array& a, long long lo, long long hi, Integers& out) {
+    if (a.dtype().kind() == 'u' && a.itemsize() >= 8) {  // beyond long long it would wrap to a negative number
+        const auto x = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+        for (std::size_t i = 0; i < out.values.size(); ++i) {
+            if (x.data()[i] > static_cast<std::uint64_t>(std::numeric_limits<long long>::max())) {
+                return refuse_integer(out, i, std::to_string(x.data()[i]), lo, hi);
+            }
+        }
+    }
+    const auto x = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(a);
+    for (std::size_t i = 0; i < out.values.size(); ++i) {
+        out.values[i] = x.data()[i];
+        if (out.values[i] < lo || out.values[i] > hi) {
+            return refuse_integer(out, i, std::to_string(out.values[i]), lo, hi);
+        }
+    }
+}
+
+}  // namespace
+
+Integers integers_of(const py::array& a, long long lo, long long hi) {
+    Integers out;
+    out.values.assign(static_cast<std::size_t>(a.size()), 0);
+    if (a.dtype().kind() == 'f') {
+        integral_floats(a, lo, hi, out);
+    } else {
+        integers(a, lo, hi, out);
+    }
+    return out;
+}
+
+namespace {
+
 // Optional (n, cols) argument: None means "all missing" (NaN).
 Doubles optional_real_array(const py::handle& obj, const std::string& name, py::ssize_t n, py::ssize_t cols,
                             double fill) {
@@ -225,12 +284,16 @@ std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
     }
     std::vector<std::uint8_t> heads(static_cast<std::size_t>(n), host::kUnknownHead);
     const char kind = a.dtype().kind();
-    if (kind == 'i' || kind == 'u') {
-        const auto idx = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(a);
-        const std::int64_t* p = idx.data();
+    if (kind == 'i' || kind == 'u' || kind == 'f') {
+        const Integers idx =
+            integers_of(a, std::numeric_limits<long long>::min(), std::numeric_limits<long long>::max());
+        if (idx.bad_row >= 0) {
+            bad_argument("chu", "row " + std::to_string(idx.bad_row) + ": " + idx.why + " (a head index)");
+        }
         for (py::ssize_t i = 0; i < n; ++i) {
-            if (p[i] >= 0 && p[i] < static_cast<std::int64_t>(kMaxHeads)) {
-                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(p[i]);
+            const long long h = idx.values[static_cast<std::size_t>(i)];
+            if (h >= 0 && h < static_cast<long long>(kMaxHeads)) {
+                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(h);
             }
         }
     } else if (kind == 'U' || kind == 'S') {
@@ -305,17 +368,15 @@ Rows rows_of(const py::handle& t, const py::handle& chu, const py::handle& q, co
     if (!flags.is_none()) {
         const py::array a = as_numpy(flags);
         const char kind = a.dtype().kind();
-        if ((kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != r.n) {
+        if ((kind != 'i' && kind != 'u' && kind != 'f') || a.ndim() != 1 || a.shape(0) != r.n) {
             bad_argument("flags", "expected " + std::to_string(r.n) + " non-negative integers, shape (n,), got dtype " +
                                       std::string(py::str(a.dtype())) + " shape " + shape_text(a));
         }
-        const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(a);
-        for (py::ssize_t i = 0; i < r.n; ++i) {
-            if (f.data()[i] < 0) {
-                bad_argument("flags", "row " + std::to_string(i) + ": negative flags");
-            }
-            r.flags[static_cast<std::size_t>(i)] = f.data()[i];
+        Integers f = integers_of(a, 0, std::numeric_limits<long long>::max());
+        if (f.bad_row >= 0) {
+            bad_argument("flags", "row " + std::to_string(f.bad_row) + ": " + f.why);
         }
+        r.flags = std::move(f.values);
     }
     return r;
 }
@@ -353,6 +414,23 @@ host::RowSource source_of(const Rows& r) {
     };
 }
 
+bool model_initialised(const py::handle& obj) {
+    return py::isinstance<host::ModelFile>(obj) &&
+           reinterpret_cast<py::detail::instance*>(obj.ptr())->get_value_and_holder().holder_constructed();
+}
+
+const host::ModelFile& model_of(const py::handle& obj, const std::string& what) {
+    if (!py::isinstance<host::ModelFile>(obj)) {
+        throw py::type_error(what + ": expected an ascorr.Model, got " + value_text(obj));
+    }
+    if (!model_initialised(obj)) {
+        throw py::type_error(what +
+                             ": an ascorr.Model that was never initialised (Model.__new__ without __init__); make "
+                             "models with read_model(), fit() or Model(coefficients)");
+    }
+    return obj.cast<const host::ModelFile&>();
+}
+
 const host::ModelFile* model_arg(const py::object& model) {
     if (model.is_none()) {
         return nullptr;
@@ -361,7 +439,7 @@ const host::ModelFile* model_arg(const py::object& model) {
         bad_argument("model", "expected an ascorr.Model (read_model() or fit()) or None, got " +
                                   std::string(py::str(model.get_type())));
     }
-    return &model.cast<const host::ModelFile&>();
+    return &model_of(model, "argument 'model'");
 }
 
 }  // namespace ascorr::python

@@ -78,6 +78,13 @@ std::string path_arg(const py::handle& x, const char* name);
 host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
 // An ascorr.Model or None (nullptr).
 const host::ModelFile* model_arg(const py::object& model);
+// obj, an ascorr.Model, as the host's model; TypeError naming `what` when it
+// is none or its __init__ never ran (model_initialised: false). pickle calls
+// Model.__new__ then __setstate__, and anyone may call __new__ alone: pybind11
+// would then hand a method raw memory (allocated on first use, never
+// constructed), so every use of a Model goes through here.
+bool model_initialised(const py::handle& obj);
+const host::ModelFile& model_of(const py::handle& obj, const std::string& what);
 
 std::string shape_text(const py::array& a);
 py::array as_numpy(const py::handle& obj);
@@ -90,6 +97,19 @@ Doubles time_array(const py::handle& obj, const std::string& name);
 // The heads for messages: "'A'..'D'" and "0..3".
 std::string head_letter_range();
 std::string head_index_range();
+
+// Integers given as an array (flags; chu as head indices), one rule with the
+// solutions reader: an integer dtype, or floats that are all integral (pandas
+// makes an integer column float64 when it held a missing value); every value
+// within [lo, hi]. Otherwise the first row that is not, and why, in the
+// reader's words (why_not_an_integer: "'0.9' ..." names the range). The dtype
+// must be an integer or a float one (the caller checks).
+struct Integers {
+    std::vector<long long> values;
+    py::ssize_t bad_row = -1;
+    std::string why;
+};
+Integers integers_of(const py::array& a, long long lo, long long hi);
 
 // The columns of a set of solutions, validated, as the core's caller needs them.
 struct Rows {

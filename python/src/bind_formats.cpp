@@ -286,6 +286,21 @@ void write_solutions(const py::object& path_obj, const py::object& t, const py::
 
 void bind_formats(py::module_& mod) {
     mod.def("read_solutions", &read_solutions, "path"_a, docstring(docs::kReadSolutions));
+    // For from_frame() (ascorr/__init__.py): the solutions reader's refusal of
+    // a column that looks like one it reads (near_miss_column), as (index,
+    // message), or None.
+    mod.def("_near_miss", [](const std::vector<std::string>& names) -> py::object {
+        const auto miss = host::near_miss_column(names);
+        return miss ? py::make_tuple(miss->column, miss->message) : py::object(py::none());
+    });
+    // For from_frame() (ascorr/__init__.py): a column of integers by the rule
+    // of the arrays (integers_of), as (int64 values, first bad row or -1, why).
+    mod.def("_integers", [](const py::array& values, long long lo, long long hi) {
+        const Integers r = integers_of(values, lo, hi);
+        py::array_t<std::int64_t> a(static_cast<py::ssize_t>(r.values.size()));
+        std::copy(r.values.begin(), r.values.end(), a.mutable_data());
+        return py::make_tuple(a, r.bad_row, r.why);
+    });
     mod.def("write_solutions", &write_solutions, "path"_a, "t"_a, "chu"_a, "q"_a, "temps"_a = py::none(),
             "v"_a = py::none(), "flags"_a = py::none(), "confidence"_a = py::none(), "status"_a = py::none(),
             "extra"_a = py::none(), docstring(docs::kWriteSolutions));

@@ -108,31 +108,48 @@ host::ModelFile model_from_state(const py::tuple& state) {
     return m;
 }
 
+// What a Model's methods call themselves in messages.
+constexpr const char* kSelf = "ascorr.Model";
+
 }  // namespace
 
 void bind_model(py::module_& mod) {
     py::class_<host::ModelFile>(mod, "Model", docstring(docs::kModel))
         .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none())
-        .def_property_readonly("coefficients", &model_coefficients, docstring(docs::kModelCoefficients))
-        .def_property_readonly("heads", &model_heads, docstring(docs::kModelHeads))
         .def_property_readonly(
-            "quadratic", [](const host::ModelFile& m) { return m.quadratic; }, docstring(docs::kModelQuadratic))
+            "coefficients", [](const py::object& self) { return model_coefficients(model_of(self, kSelf)); },
+            docstring(docs::kModelCoefficients))
+        .def_property_readonly(
+            "heads", [](const py::object& self) { return model_heads(model_of(self, kSelf)); },
+            docstring(docs::kModelHeads))
+        .def_property_readonly(
+            "quadratic", [](const py::object& self) { return model_of(self, kSelf).quadratic; },
+            docstring(docs::kModelQuadratic))
         .def(
             "write",
-            [](const host::ModelFile& m, const py::object& path) { host::write_model_file(path_arg(path, "path"), m); },
+            [](const py::object& self, const py::object& path) {
+                const host::ModelFile& m = model_of(self, kSelf);
+                host::write_model_file(path_arg(path, "path"), m);
+            },
             "path"_a, docstring(docs::kModelWrite))
-        .def("to_csv", &host::format_model, docstring(docs::kModelToCsv))
+        .def(
+            "to_csv", [](const py::object& self) { return host::format_model(model_of(self, kSelf)); },
+            docstring(docs::kModelToCsv))
         .def(
             "__eq__",
-            [](const host::ModelFile& m, const py::object& other) -> py::object {
+            [](const py::object& self, const py::object& other) -> py::object {
                 if (!py::isinstance<host::ModelFile>(other)) {
                     return py::reinterpret_borrow<py::object>(Py_NotImplemented);
                 }
-                return py::bool_(models_equal(m, other.cast<const host::ModelFile&>()));
+                return py::bool_(models_equal(model_of(self, kSelf), model_of(other, kSelf)));
             },
             py::is_operator(), docstring(docs::kModelEq))
-        .def(py::pickle(&model_state, &model_from_state))
-        .def("__repr__", [](const host::ModelFile& m) {
+        .def(py::pickle([](const py::object& self) { return model_state(model_of(self, kSelf)); }, &model_from_state))
+        .def("__repr__", [](const py::object& self) {
+            if (!model_initialised(self)) {
+                return std::string("<ascorr.Model, not initialised>");
+            }
+            const host::ModelFile& m = self.cast<const host::ModelFile&>();
             return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") + ">";
         });
 

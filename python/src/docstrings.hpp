@@ -76,9 +76,10 @@ is not finite (the command line refuses such a row as malformed).)doc";
 inline constexpr const char* kSelfCalibrate =
     R"doc(Correct with a thermal model the on-board estimator learns from the rows themselves, as
 `ascorr correct --self-calibrate`: causally in time order (any row order), from the
-epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec or
-None), after the aberration stage, in `scalar`, starting from `model` (version 0)
-or from none (rows before the first adopted model get status 256).
+epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec,
+NaN or None where not given: not clean), after the aberration stage, in `scalar`,
+starting from `model` (version 0) or from none (rows before the first adopted
+model get status 256).
 time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
 or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
 Returns (q_corrected float64
@@ -109,10 +110,11 @@ names such rows. A second row of one head at one epoch raises ascorr.InputError.
 
 inline constexpr const char* kStats =
     R"doc(IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
-IBA RMS about the mean over the clean epochs (flags 0, confidence <= 5 or missing,
+IBA RMS about the mean over the clean epochs (flags 0, confidence a number <= 5,
 temperatures and velocity present and accepted), and after 200 s smoothing.
-flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN or None when
-missing; t_from, t_to: the period (inclusive).
+flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN where not given;
+None: none given (a row without a confidence is not clean, as in a file);
+t_from, t_to: the period (inclusive).
 Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
 (arcsec; None with fewer than two clean epochs, or thermal without a model, as
 null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),

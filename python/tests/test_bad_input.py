@@ -32,7 +32,7 @@ def args(ex, **change):
         ("t", lambda ex: ex["t"].astype(str)),                     # strings
         ("t", lambda ex: ex["t"].astype(complex)),                 # complex
         ("chu", lambda ex: ex["chu"][:-1]),                        # n - 1 rows
-        ("chu", lambda ex: np.ones(len(ex["t"]))),                 # float
+        ("chu", lambda ex: np.full(len(ex["t"]), 0.5)),            # float, not integral
         ("chu", lambda ex: ex["chu"][:, None]),                    # 2-D
         ("q", lambda ex: ex["q"][:, :3]),                          # (n, 3)
         ("q", lambda ex: ex["q"][:-1]),                            # n - 1 rows

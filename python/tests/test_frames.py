@@ -121,7 +121,7 @@ def test_from_frame_head_indices_and_pandas_missing_values(files):
                                                                          dtype="Int64")),
      "column 'flags': row 1 is missing"),
     (lambda df: df.assign(qw=["x"] * len(df)), "column 'qw'"),
-    (lambda df: df.assign(status=[3, -1] + [3] * (len(df) - 2)), "column 'status': row 1 is not a status"),
+    (lambda df: df.assign(status=[3, -1] + [3] * (len(df) - 2)), "column 'status': row 1: '-1' is out of range: expected an integer in [0, 65535]"),
 ])
 def test_from_frame_refuses_what_it_cannot_take_naming_the_column(files, change, message):
     df = ascorr.to_frame(ascorr.read_solutions(str(files["worked example"])))

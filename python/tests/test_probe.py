@@ -200,7 +200,8 @@ def test_one_epoch_gives_no_rms(exe, mission, tmp_path):
     assert all(p["original"] is None and p["n"] == 1 for p in cli["pairs"].values())
     # Two epochs: a number again.
     two = np.isin(ex["t"], full[:2])
-    s2 = ascorr.stats(ex["t"][two], ex["chu"][two], ex["q"][two], ex["temps"][two], ex["v"][two])
+    s2 = ascorr.stats(ex["t"][two], ex["chu"][two], ex["q"][two], ex["temps"][two], ex["v"][two], ex["flags"][two],
+                      ex["confidence"][two])
     assert all(p["n"] == 2 and p["original"] is not None for p in s2["pairs"].values())
 
 

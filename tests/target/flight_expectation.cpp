@@ -34,6 +34,7 @@
 #include <iostream>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "ascorr_hal/clock.hpp"
@@ -89,6 +90,8 @@ namespace {
 using ascorr::kMaxHeads;
 using ascorr::kRadToArcsec;
 using ascorr::app::CorrectionLog;
+// The log's records: the heads, then the combined attitude (CorrectionLog::kCombined).
+constexpr unsigned kRecords = CorrectionLog::kRecords;
 using ascorr::app::Scalar;
 
 // One corrected solution as printed: status and the components' bit patterns.
@@ -100,19 +103,19 @@ struct Printed {
 // What a report says of the solutions.
 struct Report {
     std::uint32_t cycles = 0U;
-    bool head_seen[kMaxHeads] = {};
-    unsigned applied[kMaxHeads] = {};
-    unsigned status_seen[kMaxHeads] = {};
-    Printed last[kMaxHeads];
+    bool head_seen[kRecords] = {};
+    unsigned applied[kRecords] = {};
+    unsigned status_seen[kRecords] = {};
+    Printed last[kRecords];
     struct Sample {
         unsigned cycle;
         unsigned head;
         Printed s;
     };
     std::vector<Sample> samples;
-    bool crc_seen[kMaxHeads] = {};
-    unsigned crc_cycles[kMaxHeads] = {};
-    std::uint32_t crc[kMaxHeads] = {};
+    bool crc_seen[kRecords] = {};
+    unsigned crc_cycles[kRecords] = {};
+    std::uint32_t crc[kRecords] = {};
     // The estimator's model history (flight_cycle.hpp ModelHistory).
     struct Model {
         unsigned version = 0U;
@@ -133,7 +136,7 @@ Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
 Report from_record(const CorrectionLog& r, std::uint32_t cycles) {
     Report out;
     out.cycles = cycles;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+    for (std::uint8_t h = 0; h < kRecords; ++h) {
         const CorrectionLog::Head& hd = r.head(h);
         out.head_seen[h] = true;
         out.applied[h] = hd.applied;
@@ -144,7 +147,7 @@ Report from_record(const CorrectionLog& r, std::uint32_t cycles) {
         out.crc[h] = hd.crc;
     }
     for (std::uint32_t i = 0; i < r.samples_taken(); ++i) {
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        for (std::uint8_t h = 0; h < kRecords; ++h) {
             out.samples.push_back({i * CorrectionLog::kSampleEvery, h, printed(r.sample(i, h))});
         }
     }
@@ -170,6 +173,23 @@ void add_history(const ascorr::app::ModelHistory& hist, Report& out) {
     }
 }
 
+// The combined attitude's lines as the heads' (record kRecords − 1):
+// "combined: ..." → "head N: ...", "sample cycle C combined status" →
+// "... head N status", "solutions combined cycles" → "solutions head N cycles".
+std::string as_head_line(std::string line) {
+    const std::string record = "head " + std::to_string(CorrectionLog::kCombined);
+    const std::pair<std::string, std::string> forms[] = {{"combined: ", record + ": "},
+                                                         {" combined status ", " " + record + " status "},
+                                                         {"solutions combined ", "solutions " + record + " "}};
+    for (const auto& [from, to] : forms) {
+        if (const std::size_t at = line.find(from); at != std::string::npos) {
+            line.replace(at, from.size(), to);
+            break;
+        }
+    }
+    return line;
+}
+
 bool parse_report(const std::string& path, Report& out) {
     std::ifstream in(path);
     if (!in) {
@@ -178,6 +198,7 @@ bool parse_report(const std::string& path, Report& out) {
     }
     std::string line;
     for (int n = 1; std::getline(in, line); ++n) {
+        line = as_head_line(line);
         unsigned h = 0U;
         unsigned a = 0U;
         unsigned st = 0U;
@@ -190,7 +211,7 @@ bool parse_report(const std::string& path, Report& out) {
             out.cycles = cycles;
         } else if (std::sscanf(line.c_str(), "head %u: applied %u status seen %u last q %8x %8x %8x %8x%c", &h, &a, &st,
                                &p.bits[0], &p.bits[1], &p.bits[2], &p.bits[3], &rest) == 7 &&
-                   h < kMaxHeads) {
+                   h < kRecords) {
             out.head_seen[h] = true;
             out.applied[h] = a;
             out.status_seen[h] = st;
@@ -198,11 +219,11 @@ bool parse_report(const std::string& path, Report& out) {
             out.last[h] = p;
         } else if (std::sscanf(line.c_str(), "sample cycle %u head %u status %u q %8x %8x %8x %8x%c", &c, &h, &p.status,
                                &p.bits[0], &p.bits[1], &p.bits[2], &p.bits[3], &rest) == 7 &&
-                   h < kMaxHeads) {
+                   h < kRecords) {
             out.samples.push_back({c, h, p});
         } else if (std::sscanf(line.c_str(), "solutions head %u cycles %u crc32c %8x%c", &h, &c, &p.bits[0], &rest) ==
                        3 &&
-                   h < kMaxHeads) {
+                   h < kRecords) {
             out.crc_seen[h] = true;
             out.crc_cycles[h] = c;
             out.crc[h] = p.bits[0];
@@ -374,8 +395,8 @@ Outcome compare(const Report& host, const Report& image, double bound, bool loud
             std::cout << "  " << msg << "\n";
         }
     };
-    for (unsigned h = 0; h < kMaxHeads; ++h) {
-        const std::string head = "head " + std::to_string(h);
+    for (unsigned h = 0; h < kRecords; ++h) {
+        const std::string head = h == CorrectionLog::kCombined ? std::string("combined") : "head " + std::to_string(h);
         if (!image.head_seen[h]) {
             differ(head + ": no \"head\" line in the image's report");
             continue;

@@ -24,7 +24,7 @@ namespace ascorr::link {
 
 // 2: STATE_UPDATE, time-tagged SOLUTION_IN; 3: self-calibration; 4: the
 // solutions' calibration use and model version, CALIB_MODEL, SERVICE_CONFIG.
-inline constexpr std::uint8_t kProtocolVersion = 4;
+inline constexpr std::uint8_t kProtocolVersion = 5;
 inline constexpr std::size_t kHeaderBytes = 6;
 inline constexpr std::size_t kCrcBytes = 4;
 inline constexpr std::size_t kMaxPayload = 120;

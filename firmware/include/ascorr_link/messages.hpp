@@ -5,7 +5,8 @@
 // exactly the values the core computes with. The host converts with the same
 // ScalarTraits as its own core in that type, which is why a replayed solution
 // can be compared bit for bit with the host core. The self-calibration
-// messages are in calib_messages.hpp (included here).
+// messages are in calib_messages.hpp, the combined attitude's in
+// combine_messages.hpp (both included here).
 // Every decode_* checks the exact payload length and every enumerated field,
 // and returns false rather than accept a frame it cannot fully account for.
 #pragma once
@@ -20,6 +21,7 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/velocity_service.hpp"
 #include "calib_messages.hpp"
+#include "combine_messages.hpp"
 #include "frame.hpp"
 #include "wire.hpp"
 
@@ -44,6 +46,9 @@ enum class MessageType : std::uint8_t {
     kCalibModelRequest = 16,   // host → target: answer with kCalibModel for a head (v4)
     kCalibModel = 17,          // target → host: one head of the estimator's active model (v4)
     kServiceConfig = 18,       // host → target: the velocity service's horizon (v4)
+    kMountingLoad = 19,        // host → target: one head's mounting and noise, staged or built (v5)
+    kCombineRequest = 20,      // host → target: combine the solutions since the last request (v5)
+    kCombined = 21,            // target → host: the combined attitude of the bench (v5)
 };
 
 enum class AckResult : std::uint8_t {

@@ -17,7 +17,7 @@
 //                        (its states are dropped)
 //   kCalibStart        → kAck: from then on the estimator (ascorr/calib/
 //                        estimator.hpp) runs on the solutions, one at a time
-//                        through calib::EpochFeed (calib/feed.hpp): each epoch
+//                        through the epoch pipeline (pipeline/epoch_pipeline.hpp): each epoch
 //                        (a time tag) is corrected with the model the
 //                        estimator holds active at the epoch's first solution,
 //                        so a new model never changes within an epoch; the
@@ -31,6 +31,13 @@
 //                        becomes the estimator's, active from the next epoch)
 //   kCalibReportRequest → kCalibReport (the estimator's report)
 //   kCalibModelRequest → kCalibModel (one head of the active model)
+//   kMountingLoad      → kAck (a head's mounting staged; with `build`, the
+//                        staged mountings become the combiner's, refused with
+//                        kBadPayload when not usable: combine::check_mountings)
+//   kCombineRequest    → kCombined: the solutions corrected since the last
+//                        request combined into the bench's attitude (the
+//                        epoch pipeline's stage 6; without mountings built,
+//                        status 8)
 //   broken frame       → kNak with the FrameError, so the host resends at once
 //   unknown type       → kAck kUnknownType
 // A request whose sequence number equals the last one served is a duplicate
@@ -46,9 +53,9 @@
 #include <type_traits>
 
 #include "ascorr/calib/estimator.hpp"
-#include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "frame.hpp"
 #include "messages.hpp"
 
@@ -64,6 +71,7 @@ public:
             t = {};  // all readings invalid until the host sends them
         }
         velocity_.valid = false;
+        pipeline_.use_model(&model_);
     }
 
     // Sends kHello unprompted (at boot), so the host learns of a restart.
@@ -137,8 +145,7 @@ private:
                     cfg.time_constant_days = m.time_constant_days;
                     // In place: no 10-KiB temporary on the stack (trivially destructible).
                     new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
-                    calibrating_ = true;
-                    feed_.reset();
+                    pipeline_.use_estimator(&estimator_);
                 });
                 return;
             case MessageType::kServiceConfig:
@@ -198,41 +205,27 @@ private:
                     ack(f.seq, AckResult::kBadPayload, sink);
                     return;
                 }
-                SolutionInput<T> in{};
-                in.q_chu_icrf = s.q_chu_icrf;
-                in.head = s.head;
-                in.temperatures = temperatures_[s.head < kMaxHeads ? s.head : 0];
-                in.velocity = velocity_;
-                StatusBits service_status = 0U;
-                if (s.from_states == 1U) {
-                    service_.advance(s.t, OnBoardEarth{});  // double, before the measured part
-                }
-                const std::uint32_t start = counter_();
-                if (s.from_states == 1U) {
-                    const ServiceVelocity<T> v = service_.velocity_at(s.t);
-                    in.velocity = v.velocity;
-                    service_status = v.status;
-                }
-                // Self-calibrating without a model yet (or for a solution
-                // without a time tag): no head has coefficients (status 256).
-                const bool timed = (s.calib & kCalibNoTime) == 0U;
-                const ThermalModel<T>* model =
-                    !calibrating_ ? &model_ : (timed ? feed_.model_at(estimator_, s.t.us) : nullptr);
-                CorrectedSolution<T> c =
-                    correct_solution(in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
-                const std::uint32_t cost = counter_() - start;
-                c.status = with_service_status(c.status, service_status, true);
-                ++solutions_;
-                if (calibrating_ && timed) {
-                    (void)feed_.take(estimator_, s.head, c, in.temperatures, (s.calib & kCalibClean) != 0U);
-                }
-                const std::uint32_t version = calibrating_ && model != nullptr ? feed_.version() : kNoModelVersion;
-                const SolutionOut<T> out{s.id, s.head, c.status, c.q_chu_icrf, cost, version};
+                const SolutionOut<T> out = correct(s);
                 std::uint8_t p[kMaxPayload];
                 emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
                 return;
             }
+            case MessageType::kMountingLoad:
+                update<MountingLoad>(
+                    f, sink, [this](const MountingLoad& m) { load_mounting(m); },
+                    [this](const MountingLoad& m) { return m.build == 0U || buildable(m); });
+                return;
+            case MessageType::kCombineRequest: {
+                if (f.length != 0U) {
+                    ack(f.seq, AckResult::kBadPayload, sink);
+                    return;
+                }
+                std::uint8_t p[kMaxPayload];
+                emit(MessageType::kCombined, f.seq, p, encode(close_epoch(), p), sink, true);
+                return;
+            }
             case MessageType::kHello:
+            case MessageType::kCombined:
             case MessageType::kCalibReport:
             case MessageType::kCalibModel:
             case MessageType::kSolutionOut:
@@ -241,6 +234,100 @@ private:
                 break;
         }
         ack(f.seq, AckResult::kUnknownType, sink);
+    }
+
+    // The meter of a solution's cost: one window, from the first stage's
+    // start to the end of the correction (the model, velocity and correction
+    // stages; not the estimator's feed and steps), two counter reads.
+    struct CostMeter {
+        CycleCounter& counter;
+        bool started;
+        std::uint32_t first;
+        std::uint32_t cost;
+        std::uint32_t now() noexcept {
+            if (!started) {
+                started = true;
+                first = counter();
+            }
+            return 0U;
+        }
+        void add(pipeline::Stage stage, std::uint32_t /*start*/) noexcept {
+            if (stage == pipeline::Stage::kCorrect) {
+                cost = counter() - first;
+            }
+        }
+    };
+
+    // One SOLUTION_IN through the epoch pipeline (epoch_pipeline.hpp): the
+    // velocity of the last update or, if from_states, the service's at the
+    // solution's time tag; self-calibrating, the epoch's model and the feed
+    // (a solution flagged kCalibNoTime belongs to no epoch: no model, 256).
+    SolutionOut<T> correct(const SolutionIn<T>& s) noexcept {
+        SolutionInput<T> in{};
+        in.q_chu_icrf = s.q_chu_icrf;
+        in.head = s.head;
+        in.temperatures = temperatures_[s.head < kMaxHeads ? s.head : 0];
+        in.velocity = velocity_;
+        const bool from_states = s.from_states == 1U;
+        if (from_states) {
+            service_.advance(s.t, OnBoardEarth{});  // double, before the measured part
+        }
+        const auto velocity = [&]() {
+            return from_states ? pipeline::from_service(service_.velocity_at(s.t))
+                               : pipeline::given_velocity(velocity_);
+        };
+        const bool timed = (s.calib & kCalibNoTime) == 0U;
+        const bool in_epoch = timed || !pipeline_.calibrating();
+        CostMeter meter{counter_, false, 0U, 0U};
+        CorrectedSolution<T> c{};
+        if (in_epoch) {
+            (void)pipeline_.begin(s.t.us, meter);
+            c = pipeline_.solution(in, velocity, (s.calib & kCalibClean) != 0U, true, meter);
+        } else {
+            const std::uint32_t start = counter_();
+            c = pipeline_.untimed_solution(in, velocity);
+            meter.cost = counter_() - start;
+        }
+        ++solutions_;
+        const std::uint32_t version =
+            pipeline_.calibrating() && in_epoch && pipeline_.model() != nullptr ? pipeline_.version() : kNoModelVersion;
+        return {s.id, s.head, c.status, c.q_chu_icrf, meter.cost, version};
+    }
+
+    static combine::HeadMounting mounting_of(const MountingLoad& m) noexcept {
+        return {m.present == 1U, m.q_chu_crf, m.sigma_cross_arcsec, m.sigma_about_arcsec};
+    }
+
+    // Whether the staged mountings with m's head are ones the combiner takes.
+    bool buildable(const MountingLoad& m) const noexcept {
+        combine::Mountings trial = staged_mountings_;
+        trial.head[m.head] = mounting_of(m);
+        std::uint8_t head = kUnknownHead;
+        return combine::check_mountings(trial, &head) == combine::MountingsProblem::kNone;
+    }
+
+    // Stages m's head; with `build`, the combiner's tables from the staged
+    // mountings (in place: no 5-KiB temporary on the stack).
+    void load_mounting(const MountingLoad& m) noexcept {
+        staged_mountings_.head[m.head] = mounting_of(m);
+        if (m.build == 1U) {
+            new (&combiner_) combine::Combiner<T>(staged_mountings_);
+            pipeline_.use_combiner(&combiner_);
+        }
+    }
+
+    // kCombineRequest: stage 6 of the pipeline over the solutions since the
+    // last request, and its cost.
+    Combined<T> close_epoch() noexcept {
+        struct WindowMeter {
+            CycleCounter& counter;
+            std::uint32_t start;
+            std::uint32_t cost;
+            std::uint32_t now() noexcept { return start = counter(); }
+            void add(pipeline::Stage /*stage*/, std::uint32_t /*start*/) noexcept { cost = counter() - start; }
+        } meter{counter_, 0U, 0U};
+        const combine::CombinedAttitude<T> a = pipeline_.close(meter);
+        return {a.status, a.used, a.left_out, a.inconsistent, a.q_crf_icrf, meter.cost};
     }
 
     // Head h of the estimator's active model, as kCalibModel.
@@ -328,10 +415,13 @@ private:
     static_assert(std::is_trivially_destructible_v<calib::Estimator<T>>, "restarted in place");
     static_assert(std::is_trivially_destructible_v<VelocityService<T>>, "restarted in place");
     calib::Estimator<T> estimator_{};
-    calib::EpochFeed<T> feed_{};
     ModelCoefficients staged_{};
-    ThermalModel<T> no_model_{};  // every head absent
-    bool calibrating_ = false;
+    // Before kCalibStart: the uploaded model (use_model, in the constructor).
+    pipeline::EpochPipeline<T> pipeline_{};
+    // The combination (kMountingLoad with build): none until then.
+    static_assert(std::is_trivially_destructible_v<combine::Combiner<T>>, "rebuilt in place");
+    combine::Mountings staged_mountings_{};
+    combine::Combiner<T> combiner_{combine::Mountings{}};
 };
 
 }  // namespace ascorr::link

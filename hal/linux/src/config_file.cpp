@@ -3,6 +3,7 @@
 #include "text_lines.hpp"
 
 #include "ascorr_hal/channel_defaults.hpp"
+#include "ascorr_text/c_format.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -297,16 +298,16 @@ void check_channel_curve(const DirectiveLine& d, const LineParser& p, const Chan
     }
     char buf[320];
     if (k.no_temperature) {
-        std::snprintf(buf, sizeof buf,
-                      "channel '%s': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at R = %.6g ohm "
-                      "(the channel converts %.6g ... %.6g ohm)",
-                      c.name, k.r_from, r_lo, r_hi);
+        text::c_snprintf(buf, sizeof buf,
+                         "channel '%s': the Steinhart-Hart coefficients give no temperature (1/T <= 0) at R = %.6g ohm "
+                         "(the channel converts %.6g ... %.6g ohm)",
+                         c.name, k.r_from, r_lo, r_hi);
     } else {
-        std::snprintf(buf, sizeof buf,
-                      "channel '%s': the Steinhart-Hart coefficients are not monotonic (T does not fall as R rises) "
-                      "for R in [%.6g, %.6g] ohm (T %.6g ... %.6g degC); the channel converts %.6g ... %.6g ohm",
-                      c.name, k.r_from, k.r_to, celsius_from_resistance(c.sh, k.r_from),
-                      celsius_from_resistance(c.sh, k.r_to), r_lo, r_hi);
+        text::c_snprintf(buf, sizeof buf,
+                         "channel '%s': the Steinhart-Hart coefficients are not monotonic (T does not fall as R rises) "
+                         "for R in [%.6g, %.6g] ohm (T %.6g ... %.6g degC); the channel converts %.6g ... %.6g ohm",
+                         c.name, k.r_from, k.r_to, celsius_from_resistance(c.sh, k.r_from),
+                         celsius_from_resistance(c.sh, k.r_to), r_lo, r_hi);
     }
     p.fail(d.directive_col, buf);
 }

@@ -1,5 +1,6 @@
 // Simulated acquisition from temperature histories (simulated_source.hpp).
 #include "ascorr_hal_linux/simulated_source.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "text_lines.hpp"
 
 #include <algorithm>
@@ -248,8 +249,8 @@ void merge_value(const std::string& file, const HistoryRow& row, int k, const ch
         return;
     }
     char buf[160];
-    std::snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)", name,
-                  v, row.t, slot.value, slot.line);
+    text::c_snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)",
+                     name, v, row.t, slot.value, slot.line);
     throw ConfigError(file, row.line, row.column[k], buf);
 }
 

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "ascorr_hal_linux/config_file.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/csv_fields.hpp"
 #include "ascorr_text/input_name.hpp"
 #include "ascorr_text/line_limit.hpp"
@@ -142,7 +143,7 @@ inline void refuse_binary(const std::string& file, std::string_view text) {
             const std::string_view whole =
                 text.substr(line_start, end == std::string_view::npos ? end : end - line_start);
             char byte[8];
-            std::snprintf(byte, sizeof byte, "0x%02x", c);
+            text::c_snprintf(byte, sizeof byte, "0x%02x", c);
             const std::string starts = "line starts \"" + escaped_excerpt(whole) + "\"";
             std::string what;
             if (c >= 0x80U && printable_line(whole)) {

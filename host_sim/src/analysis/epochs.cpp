@@ -4,13 +4,15 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "ascorr_text/c_format.hpp"
+
 namespace ascorr::host {
 
 void refuse_bad_time_range(const std::optional<double>& from, const std::optional<double>& to, const char* from_name,
                            const char* to_name) {
     const auto text = [](double x) {
         char buf[48];
-        std::snprintf(buf, sizeof buf, "%.17g", x);
+        text::c_snprintf(buf, sizeof buf, "%.17g", x);
         return std::string(buf);
     };
     if (from && !std::isfinite(*from)) {

@@ -20,6 +20,7 @@
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -53,7 +54,7 @@ struct OrbitSums {
 
 std::string time_text(double t) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.3f", t);
+    text::c_snprintf(buf, sizeof buf, "%.3f", t);
     return buf;
 }
 
@@ -374,10 +375,10 @@ void refuse_short_period(const FitOptions& opt, const Pass& p, const std::string
     const double span_days = (r.t_last - r.t_first) / kSecondsPerDay;
     if (span_days < opt.min_span_days) {
         char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
-                      "thermal period; --min-days) are needed",
-                      span_days, period_text.c_str(), opt.min_span_days);
+        text::c_snprintf(buf, sizeof buf,
+                         "modelling period too short: the selected data span %.1f days (%s); at least %.1f days (one "
+                         "thermal period; --min-days) are needed",
+                         span_days, period_text.c_str(), opt.min_span_days);
         throw FitRefused(text::input_name(opt.in) + ": " + buf + heads_hint(opt, p));
     }
 }
@@ -502,8 +503,8 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
 std::string describe(const FitReport& r) {
     std::ostringstream o;
     char buf[400];
-    std::snprintf(buf, sizeof buf, "modelling period t = %.3f .. %.3f (%.1f days), orbit period %.1f s\n", r.t_first,
-                  r.t_last, (r.t_last - r.t_first) / kSecondsPerDay, r.orbit_period_s);
+    text::c_snprintf(buf, sizeof buf, "modelling period t = %.3f .. %.3f (%.1f days), orbit period %.1f s\n", r.t_first,
+                     r.t_last, (r.t_last - r.t_first) / kSecondsPerDay, r.orbit_period_s);
     o << buf;
     o << "rows in the period " << r.rows << ", selected " << r.dropped[0] << "; dropped:";
     for (std::size_t d = 1; d < kDropKinds; ++d) {
@@ -524,12 +525,12 @@ std::string describe(const FitReport& r) {
          "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
          "(9 directions), the one with the smallest corrections over the period is written.\n";
     const auto rank = static_cast<std::size_t>(r.fit.rank);
-    std::snprintf(buf, sizeof buf,
-                  "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
-                  "observable), condition number %.1f; unobservable directions at %.1e\n",
-                  terms_name(r.terms), 3 * heads_of(r.heads).count * r.orbits_used, r.fit.unknowns,
-                  r.singular_values.front(), r.singular_values[rank - 1], r.fit.rank, r.condition,
-                  r.singular_values[rank]);
+    text::c_snprintf(buf, sizeof buf,
+                     "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "
+                     "observable), condition number %.1f; unobservable directions at %.1e\n",
+                     terms_name(r.terms), 3 * heads_of(r.heads).count * r.orbits_used, r.fit.unknowns,
+                     r.singular_values.front(), r.singular_values[rank - 1], r.fit.rank, r.condition,
+                     r.singular_values[rank]);
     o << buf;
     o << describe_centring(r.fit);
     o << "CHU  residual RMS alpha/beta/gamma (arcsec)   signal RMS alpha/beta/gamma (arcsec), orbit averages\n";
@@ -537,9 +538,9 @@ std::string describe(const FitReport& r) {
     for (std::size_t i = 0; i < list.count; ++i) {
         const std::size_t h = list.head[i];
         const HeadFit& f = r.head[h];
-        std::snprintf(buf, sizeof buf, "%c    %6.3f %6.3f %6.3f                      %6.3f %6.3f %6.3f\n",
-                      head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1], f.residual_rms[2],
-                      f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
+        text::c_snprintf(buf, sizeof buf, "%c    %6.3f %6.3f %6.3f                      %6.3f %6.3f %6.3f\n",
+                         head_name(static_cast<std::uint8_t>(h)), f.residual_rms[0], f.residual_rms[1],
+                         f.residual_rms[2], f.signal_rms[0], f.signal_rms[1], f.signal_rms[2]);
         o << buf;
     }
     if (!r.selection.models.empty()) {

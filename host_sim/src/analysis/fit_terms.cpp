@@ -11,6 +11,7 @@
 #include "ascorr/calib/common_rotation.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -22,7 +23,7 @@ __attribute__((format(printf, 1, 2))) std::string format(const char* fmt, ...) {
     char buf[600];
     va_list ap;
     va_start(ap, fmt);
-    std::vsnprintf(buf, sizeof buf, fmt, ap);
+    text::c_vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
     return buf;
 }

@@ -11,6 +11,7 @@
 
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -80,8 +81,8 @@ std::string floor_daily_csv(const DailyFloor& days, double start_t, const PairLi
     for (std::size_t d = 0; d < days.size(); ++d) {
         for (std::size_t p = 0; p < pairs.count; ++p) {
             const FloorSums& f = days[d][p];
-            std::snprintf(line, sizeof line, "%zu,%.3f,%s,%zu,%.21Lg,%.21Lg\n", d,
-                          start_t + static_cast<double>(d) * 86400.0, pairs.pair[p].name, f.n, f.sum, f.sum_sq);
+            text::c_snprintf(line, sizeof line, "%zu,%.3f,%s,%zu,%.21Lg,%.21Lg\n", d,
+                             start_t + static_cast<double>(d) * 86400.0, pairs.pair[p].name, f.n, f.sum, f.sum_sq);
             s += line;
         }
     }

@@ -6,20 +6,25 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
 
+#include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 extern char** environ;
@@ -320,10 +325,10 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
                 }
                 char t[96];
                 if (window) {
-                    std::snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
-                                  st.rms[p][k].rms_smoothed);
+                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
+                                     st.rms[p][k].rms_smoothed);
                 } else {
-                    std::snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
                 }
                 g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
                   << "' using 1:" << k + 2
@@ -363,6 +368,127 @@ void plot_iba(const PlotOptions& opt, std::ostream& log) {
     }
     // Whole or absent, through links, into streams (AtomicFile).
     write_file_atomically(opt.out, read_all(png));
+}
+
+namespace {
+
+// Runs the script `write_script(terminal)` wrote into dir, pngcairo first, then
+// png (a gnuplot built without cairo); the PNG into out, whole or absent.
+template <typename WriteScript>
+void draw(TempDir& dir, const std::string& gnuplot, const std::filesystem::path& png, const std::string& out,
+          const WriteScript& write_script) {
+    const std::string gp_log = (dir.file("gnuplot.log")).string();
+    write_script("pngcairo");
+    int rc = run_gnuplot(gnuplot, (dir.file("plot.gp")).string(), gp_log);
+    if (rc == -1) {
+        throw std::runtime_error("cannot run '" + gnuplot + "' (Debian package gnuplot-nox)");
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        write_script("png");
+        rc = run_gnuplot(gnuplot, (dir.file("plot.gp")).string(), gp_log);
+    }
+    if (rc != 0 || !std::filesystem::exists(png)) {
+        throw std::runtime_error("gnuplot failed (exit " + std::to_string(rc) + "):\n" + read_all(gp_log));
+    }
+    write_file_atomically(out, read_all(png));
+}
+
+}  // namespace
+
+void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--combined", opt.combined}, {"--truth-attitude", opt.truth}}, {{"--out", opt.out}});
+    if (!(opt.from < opt.to)) {
+        throw std::runtime_error("the plot window is empty: --window-from " + number_text(opt.from) +
+                                 " is not before --window-to " + number_text(opt.to));
+    }
+    if (!(opt.width >= 400 && opt.width <= 4000)) {
+        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
+    }
+    // The truth of the window, by epoch key (a few days: a few thousand rows).
+    std::map<std::int64_t, Quaternion<double>> truth;
+    {
+        AttitudeReader r(opt.truth);
+        AttitudeRow row;
+        while (r.next(row)) {
+            if (row.t >= opt.from && row.t <= opt.to) {
+                truth[epoch_key(row.t)] = row.q_crf_icrf;
+            }
+        }
+    }
+    TempDir dir;
+    const std::filesystem::path data = dir.file("combined.dat");
+    std::ofstream f(data);
+    f.precision(12);
+    std::map<std::uint32_t, std::size_t> sets;  // head set -> epochs in the window
+    std::uint32_t full = 0;
+    double y_max = 0.0;
+    std::size_t without_truth = 0;
+    double step = std::numeric_limits<double>::infinity();  // the shading's box width
+    double t_previous = std::nan("");
+    AttitudeReader r(opt.combined);
+    if (!r.combined()) {
+        throw InputError(opt.combined, 1, 1, "expected a combined file (t,qw,qx,qy,qz,heads,...)");
+    }
+    AttitudeRow row;
+    while (r.next(row)) {
+        if (!(row.t >= opt.from && row.t <= opt.to) || !row.has_q) {
+            continue;
+        }
+        const auto it = truth.find(epoch_key(row.t));
+        if (it == truth.end()) {
+            ++without_truth;
+            continue;
+        }
+        const std::array<double, 3> e = difference_arcsec(row.q_crf_icrf, it->second);
+        step = row.t > t_previous ? std::min(step, row.t - t_previous) : step;
+        t_previous = row.t;
+        f << row.t + kJ2000Unix << ' ' << e[0] << ' ' << e[1] << ' ' << e[2] << ' ' << row.heads << '\n';
+        ++sets[row.heads];
+        full = head_count(row.heads) > head_count(full) ? row.heads : full;
+        for (const double v : e) {
+            y_max = std::max(y_max, std::fabs(v));
+        }
+    }
+    f.close();
+    if (sets.empty()) {
+        throw std::runtime_error(text::input_name(opt.combined) +
+                                 ": nothing to plot: no combined epoch with a truth row in the window");
+    }
+    if (without_truth != 0) {
+        log << text::input_name(opt.combined) << ": " << without_truth << " epochs without a truth row, not drawn\n";
+    }
+    y_max = std::max(1.0, std::ceil(y_max * 1.05));
+    const double half = std::isfinite(step) ? step / 2.0 : 30.0;
+    const std::filesystem::path png = dir.file("plot.png");
+    const auto write_script = [&](const char* terminal) {
+        std::ofstream g(dir.file("plot.gp"));
+        g.precision(12);
+        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 6 / 7 << "\n";
+        g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
+        g << "set multiplot layout 3,1 title 'Combined attitude: error against the truth, each epoch coloured by its "
+             "head set (grey: not the full set "
+          << head_set_name(full) << ")'\n";
+        g << "set xdata time\nset timefmt '%s'\nset format x \"%m-%d\\n%H:%M\"\nset grid\nset key outside right "
+             "top\n";
+        g << "set xrange ['" << opt.from + kJ2000Unix << "':'" << opt.to + kJ2000Unix << "']\n";
+        g << "set yrange [" << -y_max << ":" << y_max << "]\nset lmargin 10\nset rmargin 24\n";
+        g << "set style fill solid 0.5 noborder\n";
+        const char* axes[3] = {"x", "y", "z"};
+        for (int a = 0; a < 3; ++a) {
+            g << "set title 'about CRF " << axes[a] << "'\nset ylabel 'error (arcsec)'\n";
+            // The shading: a box per epoch without the full set, the epoch's step wide.
+            g << "plot '" << data.string() << "' using 1:(0):($1-" << half << "):($1+" << half << "):($5 != " << full
+              << " ? " << -y_max << " : 1/0):($5 != " << full << " ? " << y_max
+              << " : 1/0) with boxxyerror lc rgb '#d0d0d0' notitle";
+            for (const auto& [set, n] : sets) {
+                g << ", '" << data.string() << "' using 1:($5 == " << set << " ? $" << 2 + a
+                  << " : 1/0) with points pt 7 ps 0.3 title '" << head_set_name(set) << " (" << n << ")'";
+            }
+            g << "\n";
+        }
+        g << "unset multiplot\n";
+    };
+    draw(dir, opt.gnuplot, png, opt.out, write_script);
 }
 
 }  // namespace ascorr::host

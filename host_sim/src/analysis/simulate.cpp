@@ -19,12 +19,14 @@
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/progress.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -34,9 +36,7 @@ namespace {
 // (index h ≥ kOwnHeads) is derived from head h − kOwnHeads (simulate.hpp).
 constexpr std::size_t kOwnHeads = head_count(kPaperHeads);
 
-// Star-tracker noise (1σ per axis, arcsec): good across, worse about the boresight.
-constexpr double kNoiseCrossArcsec = 1.5;
-constexpr double kNoiseAboutArcsec = 10.0;
+// Star-tracker noise of clean rows: kSimNoiseCrossArcsec, kSimNoiseAboutArcsec (simulate.hpp).
 constexpr double kFlaggedNoiseArcsec = 40.0;  // flagged solutions are bad in every axis
 // Exclusion angles from the boresight (head blinded: no solution).
 constexpr double kSunExclusionDeg = 40.0;
@@ -169,11 +169,27 @@ Eigen::Matrix3d head_mounting(int head) {
     return m;
 }
 
+MountingsFile simulated_mountings(HeadSet heads) {
+    MountingsFile m;
+    m.sigmas = true;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        combine::HeadMounting& hm = m.mountings.head[h];
+        hm.present = has_head(heads, h);
+        // The CRF is the body frame: R(q_chu_icrf) = R(q_chu_crf) R(q_crf_icrf) with
+        // R(q_chu_crf) = head_mounting(h) and R(q_crf_icrf) = R_body_icrf.
+        hm.q_chu_crf = canonical(from_eigen(Eigen::Quaterniond(head_mounting(h))));
+        hm.sigma_cross_arcsec = kSimNoiseCrossArcsec;
+        hm.sigma_about_arcsec = kSimNoiseAboutArcsec;
+    }
+    return m;
+}
+
 std::string heaters_csv(const std::vector<HeaterEvent>& events) {
     std::string s = "start,end,heater\n";
     char line[96];
     for (const HeaterEvent& e : events) {
-        std::snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end, e.operational ? "operational" : "survival");
+        text::c_snprintf(line, sizeof line, "%.3f,%.3f,%s\n", e.start, e.end,
+                         e.operational ? "operational" : "survival");
         s += line;
     }
     return s;
@@ -213,12 +229,13 @@ std::string describe(const SimulateSummary& s) {
       << ", without velocity " << s.rows_without_velocity << "\nnoise floor (IBA RMS, arcsec):";
     char buf[96];
     for (std::size_t p = 0; p < s.pairs.count; ++p) {
-        std::snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", s.pairs.pair[p].name, s.floor[p].rms,
-                      s.floor[p].rms_smoothed);
+        text::c_snprintf(buf, sizeof buf, "  %s %.3f (200 s: %.3f)", s.pairs.pair[p].name, s.floor[p].rms,
+                         s.floor[p].rms_smoothed);
         o << buf;
     }
     o << "\ntruth model: " << s.truth_path << " (history: " << s.truth_history_path << ")\nfloor: " << s.floor_path
-      << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path;
+      << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path
+      << "\nmountings (true noise): " << s.mountings_path << "\ntrue CRF attitude: " << s.attitude_path;
     if (s.gap_epochs != 0) {
         o << "\nepochs without rows (--gap): " << s.gap_epochs;
     }
@@ -305,7 +322,7 @@ std::string truth_history_csv(const std::vector<Truth>& truths) {
         m.quadratic = quadratic;
         const std::string rows = format_model(m);
         char prefix[64];
-        std::snprintf(prefix, sizeof prefix, "%.3f,%zu,", truths[v].t_from, v);
+        text::c_snprintf(prefix, sizeof prefix, "%.3f,%zu,", truths[v].t_from, v);
         for (std::size_t at = rows.find('\n') + 1; at < rows.size();) {
             const std::size_t end = rows.find('\n', at) + 1;
             s += prefix;
@@ -324,8 +341,8 @@ bool in_window(const DayWindow& w, double day) {
 void refuse_window(const char* option, const char* form, const DayWindow& w, double days) {
     if (!(w.from_day >= 0.0 && w.from_day < w.to_day && w.to_day <= days)) {
         char what[256];
-        std::snprintf(what, sizeof what, "%s %g:%g: expected %s with 0 <= FROM_DAY < TO_DAY <= %g (--days)", option,
-                      w.from_day, w.to_day, form, days);
+        text::c_snprintf(what, sizeof what, "%s %g:%g: expected %s with 0 <= FROM_DAY < TO_DAY <= %g (--days)", option,
+                         w.from_day, w.to_day, form, days);
         throw std::invalid_argument(what);
     }
 }
@@ -343,10 +360,10 @@ void refuse_bad_truth_changes(const SimulateOptions& opt) {
     for (const TruthChange& c : opt.truth_changes) {
         if (!(c.day > previous && c.day < opt.days) || c.model.empty()) {
             char what[256];
-            std::snprintf(what, sizeof what,
-                          "--truth-change %g:%s: expected DAY:MODEL, a model file from DAY in (0, %g) (--days), "
-                          "DAY increasing from one change to the next (the previous: %g)",
-                          c.day, c.model.c_str(), opt.days, previous);
+            text::c_snprintf(what, sizeof what,
+                             "--truth-change %g:%s: expected DAY:MODEL, a model file from DAY in (0, %g) (--days), "
+                             "DAY increasing from one change to the next (the previous: %g)",
+                             c.day, c.model.c_str(), opt.days, previous);
             throw std::invalid_argument(what);
         }
         previous = c.day;
@@ -364,9 +381,9 @@ void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
         const bool drift = f.kind == ThermistorFaultKind::kDrift;
         if (!(std::fabs(f.rate_c_per_day) <= 100.0) || (!drift && f.rate_c_per_day != 0.0)) {
             char what[160];
-            std::snprintf(what, sizeof what,
-                          "%s: RATE %g: expected a drift's RATE in [-100, 100] degC/day; a stuck channel has none",
-                          kOption, f.rate_c_per_day);
+            text::c_snprintf(what, sizeof what,
+                             "%s: RATE %g: expected a drift's RATE in [-100, 100] degC/day; a stuck channel has none",
+                             kOption, f.rate_c_per_day);
             throw std::invalid_argument(what);
         }
     }
@@ -387,8 +404,8 @@ void refuse_bad_event_options(const SimulateOptions& opt) {
         refuse_window("--head-bias", "HEAD:FROM_DAY:TO_DAY:ARCSEC", b.window, opt.days);
         if (!(std::fabs(b.arcsec) <= 3600.0)) {
             char what[120];
-            std::snprintf(what, sizeof what, "--head-bias: ARCSEC %g: expected a rotation in [-3600, 3600] arcsec",
-                          b.arcsec);
+            text::c_snprintf(what, sizeof what, "--head-bias: ARCSEC %g: expected a rotation in [-3600, 3600] arcsec",
+                             b.arcsec);
             throw std::invalid_argument(what);
         }
     }
@@ -618,11 +635,11 @@ struct HeadSolution {
         }
     }
     char what[240];
-    std::snprintf(what, sizeof what,
-                  "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
-                  "T029 %g, T032 %g degC)",
-                  head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
-                  e.temp[3], e.temp[4]);
+    text::c_snprintf(what, sizeof what,
+                     "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
+                     "T029 %g, T032 %g degC)",
+                     head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
+                     e.temp[3], e.temp[4]);
     throw InputError(truth.name, truth.file.line[h][axis], 0, what);
 }
 
@@ -634,8 +651,8 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     HeadSolution out;
     out.quality = draw_quality(moon_deg, rnd);
     const bool bad = out.quality.bad;
-    const double sx = bad ? kFlaggedNoiseArcsec : kNoiseCrossArcsec;
-    const double sz = bad ? kFlaggedNoiseArcsec : kNoiseAboutArcsec;
+    const double sx = bad ? kFlaggedNoiseArcsec : kSimNoiseCrossArcsec;
+    const double sz = bad ? kFlaggedNoiseArcsec : kSimNoiseAboutArcsec;
     std::normal_distribution<double>& normal = rnd.normal;
     std::mt19937_64& rng = rnd.engine;
     const Eigen::Vector3d noise(sx * normal(rng), sx * normal(rng), sz * normal(rng));
@@ -686,7 +703,7 @@ void append_row(std::string& buf, const EpochState& e, std::size_t h, const Head
             p = put(p, end, e.orbit.v_sc[i], 6);
         }
     }
-    p += std::snprintf(p, static_cast<std::size_t>(end - p), ",%lld,", s.quality.flags);
+    p += text::c_snprintf(p, static_cast<std::size_t>(end - p), ",%lld,", s.quality.flags);
     p = put(p, end, s.quality.confidence, 2);
     *p++ = '\n';
     buf.append(line, static_cast<std::size_t>(p - line));
@@ -722,12 +739,13 @@ public:
         sum_.pairs = pairs_;
     }
 
-    // Appends epoch k's rows to buf.
-    void epoch(std::size_t k, std::string& buf) {
+    // Appends epoch k's rows to buf and its true CRF attitude to attitude.
+    void epoch(std::size_t k, std::string& buf, std::string& attitude) {
         EpochState e;
         const double dt = static_cast<double>(k) * opt_.step_s;
         e.t = std::round((opt_.start_t + dt) * 1000.0) / 1000.0;  // as written
         e.orbit = orbit_.at(dt);
+        append_attitude_row(attitude, e.t, from_eigen(Eigen::Quaterniond(e.orbit.body_icrf)));
         sky_.at(e.t, e.sun, e.moon);
         double op = 0.0;
         double surv = 0.0;
@@ -778,6 +796,8 @@ public:
         sum_.floor_path = opt_.out + ".floor.json";
         sum_.floor_daily_path = opt_.out + ".floor-daily.csv";
         sum_.heaters_path = opt_.out + ".heaters.csv";
+        sum_.mountings_path = opt_.out + ".mountings.csv";
+        sum_.attitude_path = opt_.out + ".attitude.csv";
         for (const HeaterEvent& ev : heaters_.events()) {
             if (ev.start <= t_last) {
                 sum_.heaters.push_back(ev);
@@ -916,7 +936,9 @@ SimulateSummary simulate(const SimulateOptions& opt) {
                                       {"--out (truth history)", opt.out + ".truth-history.csv"},
                                       {"--out (noise floor)", opt.out + ".floor.json"},
                                       {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
-                                      {"--out (heater events)", opt.out + ".heaters.csv"}});
+                                      {"--out (heater events)", opt.out + ".heaters.csv"},
+                                      {"--out (mountings)", opt.out + ".mountings.csv"},
+                                      {"--out (true attitude)", opt.out + ".attitude.csv"}});
     refuse_bad_options(opt);
     const std::vector<Truth> truths = truth_models(opt);
     Mission mission(opt, truths);
@@ -926,22 +948,34 @@ SimulateSummary simulate(const SimulateOptions& opt) {
     buf.reserve(2U << 20);
     buf += kSolutionsHeader;
     buf += '\n';
+    AtomicFile attitude(opt.out + ".attitude.csv");
+    std::string attitude_buf;
+    attitude_buf.reserve(2U << 20);
+    attitude_buf += kAttitudeHeader;
+    attitude_buf += '\n';
     const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
         if ((k & 4095U) == 0) {
             progress.update(static_cast<double>(k) / static_cast<double>(epochs));
         }
-        mission.epoch(k, buf);
+        mission.epoch(k, buf, attitude_buf);
         if (buf.size() > (1U << 20)) {
             out.write(buf);
             buf.clear();
         }
+        if (attitude_buf.size() > (1U << 20)) {
+            attitude.write(attitude_buf);
+            attitude_buf.clear();
+        }
     }
     out.write(buf);
+    attitude.write(attitude_buf);
     progress.done();
     const SimulateSummary sum = mission.finish(opt.start_t + static_cast<double>(epochs - 1) * opt.step_s);
     out.commit();
+    attitude.commit();
+    write_mountings_file(sum.mountings_path, simulated_mountings(opt.heads));
     write_model_file(sum.truth_path, truths.front().file);
     write_file_atomically(sum.truth_history_path, truth_history_csv(truths));
     write_file_atomically(sum.floor_path, floor_json(sum.floor, sum.pairs));

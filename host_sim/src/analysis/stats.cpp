@@ -11,16 +11,18 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
 
 bool is_clean(const SolutionRecord& rec) noexcept {
-    return rec.flags == 0 && rec.confidence <= 5.0 && rec.temperature_present[0] && rec.temperature_present[1] &&
+    return rec.flags == 0 && confidence_clean(rec) && rec.temperature_present[0] && rec.temperature_present[1] &&
            rec.temperature_present[2] && rec.velocity_components == 3;
 }
 
@@ -36,7 +38,7 @@ struct HeadTally {
     std::size_t rows = 0;  // in [from, to]
     std::size_t clean = 0;
     std::size_t flagged = 0;
-    std::size_t low_confidence = 0;  // confidence > 5 or NaN
+    std::size_t low_confidence = 0;  // confidence above 5 or missing (confidence_clean)
     std::size_t no_temperatures = 0;
     std::size_t no_velocity = 0;
     std::size_t not_corrected = 0;
@@ -45,7 +47,7 @@ struct HeadTally {
 std::string head_without_clean_rows(char name, const HeadTally& h) {
     std::string s = std::string("none of CHU ") + name + "'s " + std::to_string(h.rows) + " rows is clean (";
     const std::pair<std::size_t, const char*> parts[] = {{h.flagged, "flags set"},
-                                                         {h.low_confidence, "confidence above 5 or nan"},
+                                                         {h.low_confidence, "confidence above 5 or missing"},
                                                          {h.no_temperatures, "temperatures missing"},
                                                          {h.no_velocity, "velocity missing"},
                                                          {h.not_corrected, "not corrected by the core"}};
@@ -66,7 +68,7 @@ std::string why_no_epochs(const HeadPair& pair, const StatsOptions& opt, std::si
     const bool period = opt.from.has_value() || opt.to.has_value();
     const auto t = [](double x) {
         char buf[40];
-        std::snprintf(buf, sizeof buf, "%.17g", x);
+        text::c_snprintf(buf, sizeof buf, "%.17g", x);
         return std::string(buf);
     };
     const std::string in_period = period ? " in [" + (opt.from ? t(*opt.from) : std::string("-inf")) + ", " +
@@ -166,7 +168,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         HeadTally& tally = heads[rec.head];
         ++tally.rows;
         tally.flagged += rec.flags != 0 ? 1U : 0U;
-        tally.low_confidence += !(rec.confidence <= 5.0) ? 1U : 0U;  // as is_clean
+        tally.low_confidence += !confidence_clean(rec) ? 1U : 0U;  // as is_clean
         tally.no_temperatures +=
             !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
         tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
@@ -244,8 +246,8 @@ std::string stats_table(const StatsResult& r) {
     std::ostringstream o;
     o << "IBA RMS about the mean, arcsec, over clean epochs (after 200 s smoothing in brackets)\n";
     char buf[200];
-    std::snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
-                  "thermal");
+    text::c_snprintf(buf, sizeof buf, "%-5s %9s  %-18s %-18s %-18s\n", "pair", "epochs", "original", "aberration",
+                     "thermal");
     o << buf;
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
         std::string cells[kStages];
@@ -254,12 +256,12 @@ std::string stats_table(const StatsResult& r) {
                 cells[s] = "-";
             } else {
                 char c[64];
-                std::snprintf(c, sizeof c, "%6.2f (%5.2f)", r.rms[p][s].rms, r.rms[p][s].rms_smoothed);
+                text::c_snprintf(c, sizeof c, "%6.2f (%5.2f)", r.rms[p][s].rms, r.rms[p][s].rms_smoothed);
                 cells[s] = c;
             }
         }
-        std::snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p], cells[0].c_str(),
-                      cells[1].c_str(), cells[2].c_str());
+        text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p],
+                         cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
         o << buf;
     }
     return o.str();
@@ -269,7 +271,7 @@ std::string stats_json(const StatsResult& r) {
     std::ostringstream o;
     const auto num = [](double x) {
         char c[32];
-        std::snprintf(c, sizeof c, "%.6f", x);
+        text::c_snprintf(c, sizeof c, "%.6f", x);
         return std::string(c);
     };
     o << "{\"pairs\": {";

@@ -32,6 +32,7 @@
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_host/formats/states_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -59,9 +60,9 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
             case Rejection::kQuaternionNotUnit: {
                 const auto& q = rec.q_chu_icrf;
                 char buf[96];
-                std::snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
-                              q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
-                              ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
+                text::c_snprintf(buf, sizeof buf, "quaternion is not unit (|q|^2 = %.9g, tolerance %.1g)",
+                                 q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z,
+                                 ScalarTraits<T>::to_double(ScalarTraits<T>::unit_norm_tolerance));
                 why = buf;
                 break;
             }
@@ -82,14 +83,14 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
             const auto b = in.velocity.beta_icrf;
             const double speed = std::sqrt(ScalarTraits<T>::to_double(squared_norm(b))) * kSpeedOfLightKmS;
             char buf[128];
-            std::snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped", speed,
-                          kMaxObserverSpeedKmS);
+            text::c_snprintf(buf, sizeof buf, "observer speed %.6g km/s is not below %.0f km/s: aberration skipped",
+                             speed, kMaxObserverSpeedKmS);
             diag.report("velocity invalid", where(file, rec) + buf);
         } else {
             char buf[160];
-            std::snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
-                          ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
-                          kMaxSunDistanceAu);
+            text::c_snprintf(buf, sizeof buf, "Sun distance 1/%.6g au is outside [%g, %g] au: aberration skipped",
+                             ScalarTraits<T>::to_double(in.velocity.inv_sun_distance_au), kMinSunDistanceAu,
+                             kMaxSunDistanceAu);
             diag.report("velocity invalid", where(file, rec) + buf);
         }
     }
@@ -129,6 +130,7 @@ struct ChunkResult {
     DeferredDiagnostics diag;
     std::optional<InputError> error;  // the first malformed row, when not skipping
     std::size_t empty_lines = 0;
+    std::vector<CorrectedRow> rows;  // for the sink (correct --combined), in file order
 };
 
 template <typename T>
@@ -141,6 +143,7 @@ struct Job {
     VelocityServiceConfig service;
     const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
     const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
+    bool keep_rows;                       // a sink takes the corrected rows
 };
 
 // The configuration of one row: with a schedule, the model active at its t.
@@ -213,6 +216,11 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
         } else {
             job.writer.row(reader, row.q_chu_icrf, st, res.out);
+        }
+        if (job.keep_rows) {
+            res.rows.push_back({rec.t, rec.line, rec.head,
+                                (st & status::kRejected) != 0U ? rec.q_chu_icrf : as_written(row.q_chu_icrf), rec.flags,
+                                rec.confidence, true, st});
         }
         ++res.summary.rows;
         for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
@@ -314,7 +322,7 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
 }
 
 template <typename T>
-CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
+CorrectSummary run(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     std::optional<ThermalModel<T>> model;
@@ -379,7 +387,8 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                      states ? &*states : nullptr,
                      service_config(opt.max_propagation_s),
                      table ? &*table : nullptr,
-                     opt.self_calibrate && opt.thermal ? &*schedule : nullptr};
+                     opt.self_calibrate && opt.thermal ? &*schedule : nullptr,
+                     sink != nullptr};
 
     AtomicFile out(opt.out);
     out.write(writer.header_line());
@@ -423,6 +432,9 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
                 sum.status_bit[b] += r.summary.status_bit[b];
             }
             empty_lines += r.empty_lines;
+            for (const CorrectedRow& row : r.rows) {
+                sink->add(row);
+            }
         }
         // Write this block while the workers correct the next one; one block
         // in flight, its errors surface at the next block or at the end.
@@ -452,9 +464,15 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
         history_file.emplace(opt.model_history);
         history_file->write(history);
     }
-    out.commit();  // the corrected file first, then the history that explains it (as replay)
+    if (sink != nullptr) {
+        sink->finish();
+    }
+    out.commit();  // the corrected file first, then what explains or follows from it (as replay)
     if (history_file) {
         history_file->commit();
+    }
+    if (sink != nullptr) {
+        sink->commit();
     }
     sum.self_calibration = account;
     return sum;
@@ -462,14 +480,14 @@ CorrectSummary run(const CorrectOptions& opt, std::ostream& log) {
 
 }  // namespace
 
-CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log) {
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink) {
     switch (opt.scalar) {
         case ScalarKind::kDouble:
-            return run<double>(opt, log);
+            return run<double>(opt, log, sink);
         case ScalarKind::kFloat:
-            return run<float>(opt, log);
+            return run<float>(opt, log, sink);
         case ScalarKind::kFixed:
-            return run<Q30>(opt, log);
+            return run<Q30>(opt, log, sink);
     }
     throw std::logic_error("correct_file: unknown scalar type");
 }

@@ -1,5 +1,6 @@
 #include "ascorr_host/correct/correct_row.hpp"
 
+#include "ascorr/pipeline/solution_stage.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 
 namespace ascorr::host {
@@ -9,16 +10,13 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
                              StatesVelocity<T>* states) {
     RowCorrection<T> r{to_core_input<T>(rec, cfg.aberration ? earth : nullptr), 0, rec.q_chu_icrf, false, 0};
     r.from_states = states != nullptr && cfg.aberration && rec.velocity_components == 0;
-    if (r.from_states) {
-        const ServiceVelocity<T> v = states->at(rec.t);
-        r.in.velocity = v.velocity;
-        r.service = v.status;
-    }
-    const CorrectedSolution<T> c = correct_solution(r.in, cfg);
+    const pipeline::VelocityAnswer<T> v =
+        r.from_states ? pipeline::from_service(states->at(rec.t)) : pipeline::given_velocity(r.in.velocity);
+    r.service = v.service;
+    const CorrectedSolution<T> c = pipeline::correct_stage(r.in, v, cfg);
     // A velocity given but unusable before the core (1 or 2 of vx,vy,vz, a time
     // outside the ephemeris): the core saw "not available", the row gets 4|32.
     r.status = host_status(rec, cfg.aberration, c.status);
-    r.status = with_service_status(r.status, r.service, r.from_states);
     if ((r.status & status::kRejected) == 0U) {
         const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
         r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};

@@ -12,7 +12,7 @@ Drop fit_selection(const SolutionRecord& rec) noexcept {
     if ((rec.flags & 4) != 0) {
         return Drop::kInvalid;
     }
-    if (rec.confidence > 5.0) {
+    if (!confidence_clean(rec)) {
         return Drop::kConfidence;
     }
     if (!(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2])) {
@@ -35,7 +35,7 @@ const char* drop_name(Drop d) noexcept {
         case Drop::kInvalid:
             return "invalid";
         case Drop::kConfidence:
-            return "confidence > 5";
+            return "confidence > 5 or missing";
         case Drop::kTemperature:
             return "temperature missing";
         case Drop::kVelocity:

@@ -11,16 +11,17 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "ascorr/calib/feed.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr/nav/tt_time.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -51,7 +52,8 @@ constexpr double kPeriodSpeedTolerance = 0.01;
 // or kOrbitPeriodRows fed rows seen), rows are held and replayed when the
 // estimator starts: the fed rows whole, and of the epochs between two fed rows
 // only the first and the last (the others change nothing: no model becomes
-// pending without a fed epoch), so the rows held are bounded.
+// pending without a fed epoch, and the run's pipeline feeds every epoch, so
+// the epochs' count does not matter), so the rows held are bounded.
 template <typename T>
 class Run {
 public:
@@ -88,13 +90,12 @@ public:
 
 private:
     void process(const CalibRow<T>& r) {
-        const ThermalModel<T>* model = epoch(r.t_us, r.t);
+        (void)epoch(r.t_us, r.t);
         if (r.fed) {
-            const CorrectedSolution<T> c =
-                correct_solution(r.in, CorrectionConfig<T>{true, model != nullptr ? model : &no_model_});
-            if (feed_.take(*est_, r.in.head, c, r.in.temperatures, true)) {
-                ++out_.cycles;
-            }
+            const std::uint32_t feeds = pipeline_.feeds();
+            (void)pipeline_.solution(
+                r.in, [&r] { return pipeline::given_velocity(r.in.velocity); }, true);
+            out_.cycles += pipeline_.feeds() - feeds;
         }
     }
 
@@ -159,6 +160,7 @@ private:
         out_.orbit_period_s = period_s;
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
+        pipeline_.use_estimator(&*est_);
         for (const CalibRow<T>& r : held_) {
             process(r);
         }
@@ -168,12 +170,12 @@ private:
 
     // The epoch's model (a new epoch when t_us changes), and the history.
     const ThermalModel<T>* epoch(std::int64_t t_us, double t) {
-        const ThermalModel<T>* model = feed_.model_at(*est_, t_us);
-        if (model != nullptr && (!had_ || feed_.version() != version_)) {
+        const ThermalModel<T>* model = pipeline_.begin(t_us);
+        if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
             out_.history.push_back(
-                {t, t_us, feed_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
+                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
             had_ = true;
-            version_ = feed_.version();
+            version_ = pipeline_.version();
         }
         return model;
     }
@@ -182,8 +184,7 @@ private:
     calib::EstimatorConfig cfg_;
     std::optional<ModelCoefficients> initial_;
     std::optional<calib::Estimator<T>> est_;
-    calib::EpochFeed<T> feed_;
-    const ThermalModel<T> no_model_{};
+    pipeline::EpochPipeline<T> pipeline_;
     std::vector<CalibRow<T>> held_;  // rows before the orbit period is known (hold)
     std::size_t fed_held_ = 0;
     bool had_ = false;
@@ -556,15 +557,15 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                 continue;
             }
             for (std::size_t a = 0; a < kModelAxes; ++a) {
-                std::snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version, head_name(static_cast<std::uint8_t>(h)),
-                              kAxisNames[a]);
+                text::c_snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version,
+                                 head_name(static_cast<std::uint8_t>(h)), kAxisNames[a]);
                 out += buf;
                 for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
-                    std::snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
+                    text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                std::snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
-                              head_origin(m.version, h));
+                text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
+                                 head_origin(m.version, h));
                 out += buf;
             }
         }
@@ -590,15 +591,17 @@ std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
     const calib::EstimatorReport& r = s.report;
-    std::snprintf(buf, sizeof buf,
-                  "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
-                  "%u, held back %u); %zu model(s) active in turn",
-                  s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
+    text::c_snprintf(
+        buf, sizeof buf,
+        "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
+        "%u, held back %u); %zu model(s) active in turn",
+        s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
     o << buf;
     if (r.has_active) {
-        std::snprintf(buf, sizeof buf,
-                      "; active version %u (crc32c %08x), residual RMS %.3f\" over the recent orbits, condition %.1f",
-                      r.active_version, r.active_crc, r.residual_rms_arcsec, r.condition);
+        text::c_snprintf(
+            buf, sizeof buf,
+            "; active version %u (crc32c %08x), residual RMS %.3f\" over the recent orbits, condition %.1f",
+            r.active_version, r.active_crc, r.residual_rms_arcsec, r.condition);
         o << buf;
     } else {
         o << "; no model adopted";

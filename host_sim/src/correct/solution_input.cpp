@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -12,10 +13,10 @@ std::string velocity_problem(const SolutionRecord& rec) {
     }
     if (rec.velocity_components == 3 && !in_ephemeris_span(rec.t)) {
         char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      "t = %.17g s is outside the span of the Earth ephemeris (1900-2100, %.4g .. %.4g s since "
-                      "J2000 TT; a time in ms?)",
-                      rec.t, kEphemerisFirstT, kEphemerisEndT);
+        text::c_snprintf(buf, sizeof buf,
+                         "t = %.17g s is outside the span of the Earth ephemeris (1900-2100, %.4g .. %.4g s since "
+                         "J2000 TT; a time in ms?)",
+                         rec.t, kEphemerisFirstT, kEphemerisEndT);
         return buf;
     }
     return {};

@@ -57,4 +57,13 @@ void RowWriter::row(const SolutionsReader& reader, const std::optional<Quaternio
     buf += '\n';
 }
 
+Quaternion<double> as_written(const Quaternion<double>& q) noexcept {
+    const auto round_trip = [](double x) {
+        char num[64];
+        const char* end = format_fixed(num, num + sizeof num, x, 15);
+        return parse_double(std::string_view(num, static_cast<std::size_t>(end - num))).value_or(x);
+    };
+    return {round_trip(q.w), round_trip(q.x), round_trip(q.y), round_trip(q.z)};
+}
+
 }  // namespace ascorr::host

@@ -9,6 +9,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -24,8 +25,8 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                     i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
                 if (!(std::abs(c * kArcsecToRad) < lim)) {
                     char limit[160];
-                    std::snprintf(limit, sizeof limit, " is beyond the fixed-point coefficient range (|%s| < %g %s)",
-                                  kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
+                    text::c_snprintf(limit, sizeof limit, " is beyond the fixed-point coefficient range (|%s| < %g %s)",
+                                     kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
                     const std::string what = std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
                                              kAxisNames[a] + " " + kCoefficientNames[i] + " = " + number_text(c) + " " +
                                              kUnits[i] + limit;
@@ -49,11 +50,11 @@ void check_float_range(const ModelFile& m, const std::string& path) {
             const double s = float_term_sum(c, kArcsecToRad);
             if (!(s <= kFloatMaxTermSumRad)) {
                 char limit[200];
-                std::snprintf(limit, sizeof limit,
-                              " is beyond what the float core evaluates within %g arcsec over +-%g degC (%.0f arcsec): "
-                              "use --scalar double or fixed",
-                              kFloatAngleErrorRad * kRadToArcsec, kMaxAbsTemperatureC,
-                              kFloatMaxTermSumRad * kRadToArcsec);
+                text::c_snprintf(
+                    limit, sizeof limit,
+                    " is beyond what the float core evaluates within %g arcsec over +-%g degC (%.0f arcsec): "
+                    "use --scalar double or fixed",
+                    kFloatAngleErrorRad * kRadToArcsec, kMaxAbsTemperatureC, kFloatMaxTermSumRad * kRadToArcsec);
                 const std::string what =
                     std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " + kAxisNames[a] +
                     ": |c0| + 200|c1| + 400(|c2| + |c3|) + 200^2|c1_2| + 400^2(|c2_2| + |c3_2|) = " +
@@ -196,7 +197,7 @@ std::string format_model(const ModelFile& m) {
             out += kAxisNames[a];
             for (std::size_t i = 0; i < ncoef; ++i) {
                 // 17 significant digits: a model survives a write/read round trip exactly.
-                std::snprintf(buf, sizeof buf, ",%.16e", m.coefficients[h][a][i]);
+                text::c_snprintf(buf, sizeof buf, ",%.16e", m.coefficients[h][a][i]);
                 out += buf;
             }
             out += '\n';

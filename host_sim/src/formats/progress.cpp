@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include "ascorr_text/c_format.hpp"
+
 namespace ascorr::host {
 
 Progress::Progress(std::string label) : label_(std::move(label)), enabled_(::isatty(STDERR_FILENO) == 1) {}
@@ -20,14 +22,14 @@ void Progress::update(double fraction) {
     const int pct = fraction <= 0.0 ? 0 : fraction >= 1.0 ? 100 : static_cast<int>(fraction * 100.0);
     if (pct != shown_) {
         shown_ = pct;
-        std::fprintf(stderr, "\r%s: %3d%%", label_.c_str(), pct);
+        text::c_fprintf(stderr, "\r%s: %3d%%", label_.c_str(), pct);
         std::fflush(stderr);
     }
 }
 
 void Progress::done() {
     if (enabled_ && shown_ >= 0) {
-        std::fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
+        text::c_fprintf(stderr, "\r%*s\r", static_cast<int>(label_.size()) + 6, "");
         std::fflush(stderr);
         shown_ = -1;
     }

@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <string>
 #include <system_error>
+#include <vector>
 
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/input_error.hpp"
@@ -42,6 +44,13 @@ SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
     : file_(std::move(file_name)), lines_(text), header_(header_line_of(text, file_), file_) {
     std::string_view header_line;
     lines_.next(header_line);
+    if (const auto miss = near_miss_column(header_.names())) {
+        std::size_t column = 1;  // character column of the name in the header line
+        for (std::size_t i = 0; i < miss->column; ++i) {
+            column += header_.raw_names()[i].size() + 1;
+        }
+        throw InputError(file_, 1, column, miss->message);
+    }
     const auto need = [&](const char* name) {
         const int i = header_.index(name);
         if (i < 0) {
@@ -223,6 +232,74 @@ void for_each_solution_row(const std::string& path, const std::function<void(con
 bool is_solutions_column(std::string_view name) noexcept {
     return name == kStatusColumn ||
            std::find(kSolutionsColumns.begin(), kSolutionsColumns.end(), name) != kSolutionsColumns.end();
+}
+
+namespace {
+std::string lower_case(std::string_view s) {
+    std::string out(s);
+    for (char& c : out) {
+        c = c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c;
+    }
+    return out;
+}
+
+// The optimal-string-alignment distance (insertions, deletions, replacements
+// and swaps of neighbours), stopped at limit + 1: header names are short.
+std::size_t edit_distance(std::string_view a, std::string_view b, std::size_t limit) {
+    const std::size_t n = a.size();
+    const std::size_t m = b.size();
+    if ((n > m ? n - m : m - n) > limit) {
+        return limit + 1;
+    }
+    std::vector<std::vector<std::size_t>> d(n + 1, std::vector<std::size_t>(m + 1, 0));
+    for (std::size_t i = 0; i <= n; ++i) {
+        d[i][0] = i;
+    }
+    for (std::size_t j = 0; j <= m; ++j) {
+        d[0][j] = j;
+    }
+    for (std::size_t i = 1; i <= n; ++i) {
+        for (std::size_t j = 1; j <= m; ++j) {
+            const std::size_t cost = a[i - 1] == b[j - 1] ? 0 : 1;
+            d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) {
+                d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+            }
+        }
+    }
+    return std::min(d[n][m], limit + 1);
+}
+
+// Whether name looks like the known column (near_miss_column's rule).
+bool looks_like(const std::string& lower_name, std::string_view known) {
+    constexpr std::size_t kLongName = 5;  // t_chu and longer: one or two edits
+    if (lower_name == known) {
+        return true;
+    }
+    return known.size() >= kLongName && edit_distance(lower_name, known, 2) <= 2;
+}
+}  // namespace
+
+std::optional<NearMiss> near_miss_column(const std::vector<std::string>& names) {
+    std::vector<std::string_view> known(kSolutionsColumns.begin(), kSolutionsColumns.end());
+    known.push_back(kStatusColumn);
+    const auto in_header = [&](std::string_view k) { return std::find(names.begin(), names.end(), k) != names.end(); };
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        if (is_solutions_column(names[i])) {
+            continue;
+        }
+        const std::string lower = lower_case(names[i]);
+        for (const std::string_view k : known) {
+            if (!in_header(k) && looks_like(lower, k)) {
+                return NearMiss{i, k,
+                                "column '" + names[i] + "' is not a column ascorr reads, but looks like '" +
+                                    std::string(k) + "', which the header lacks (column names are case-sensitive, " +
+                                    "docs/contract.md, section 3): rename it '" + std::string(k) +
+                                    "', or give it a name unlike the columns ascorr reads"};
+            }
+        }
+    }
+    return std::nullopt;
 }
 
 namespace {

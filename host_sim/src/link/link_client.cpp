@@ -305,6 +305,9 @@ void LinkClient<T>::restore() {
     if (calibrating_) {
         throw LinkError("the target restarted during self-calibration: its estimator's state is lost");
     }
+    if (combining_) {
+        throw LinkError("the target restarted while combining: its mountings and the epoch's solutions are lost");
+    }
     for (int round = 0; round < max_attempts_; ++round) {
         ++stats_.restarts;
         if (!restore_round()) {
@@ -441,6 +444,33 @@ void LinkClient<T>::send_calib_model(const ModelCoefficients& m, bool load) {
         }
         update({link::MessageType::kCalibModelLoad, encoded(f), "calibration model load"});
     }
+}
+
+template <typename T>
+void LinkClient<T>::load_mountings(const combine::Mountings& m) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const combine::HeadMounting& hm = m.head[h];
+        link::MountingLoad f{};
+        f.head = h;
+        f.present = hm.present ? 1U : 0U;
+        f.build = h + 1U == kMaxHeads ? 1U : 0U;
+        f.q_chu_crf = hm.present ? hm.q_chu_crf : Quaternion<double>{1.0, 0.0, 0.0, 0.0};
+        f.sigma_cross_arcsec = hm.present ? hm.sigma_cross_arcsec : 1.0;
+        f.sigma_about_arcsec = hm.present ? hm.sigma_about_arcsec : 1.0;
+        update({link::MessageType::kMountingLoad, encoded(f), "mountings load"});
+    }
+    combining_ = true;
+}
+
+template <typename T>
+link::Combined<T> LinkClient<T>::combine_epoch() {
+    const std::vector<std::uint8_t> a =
+        request({link::MessageType::kCombineRequest, {}, "combine request"}, link::MessageType::kCombined);
+    link::Combined<T> c{};
+    if (!link::decode(a.data(), a.size(), c)) {
+        throw LinkError("malformed combined attitude from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return c;
 }
 
 // The scalars the targets compute in.

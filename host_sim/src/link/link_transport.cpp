@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -163,7 +164,7 @@ void ProcessTransport::start() {
         ::dup2(in[0], STDIN_FILENO);
         ::dup2(out[1], STDOUT_FILENO);
         ::execvp(args[0], args.data());
-        std::fprintf(stderr, "ascorr: cannot run %s: %s\n", args[0], std::strerror(errno));
+        text::c_fprintf(stderr, "ascorr: cannot run %s: %s\n", args[0], std::strerror(errno));
         ::_exit(127);
     }
     cleanup_slot_ = cleanup_register_child(pid_);

@@ -18,19 +18,25 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/epoch_pipeline.hpp"
+#include "ascorr_host/analysis/combine.hpp"
+#include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/corrected_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
 #include "ascorr_host/formats/states_csv.hpp"
 #include "ascorr_host/link/link_client.hpp"
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_link/server.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -162,20 +168,19 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
         return {};
     }
     char buf[64];
-    std::snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
+    text::c_snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
     return buf;
 }
 
 constexpr std::size_t kMaxCalibMessages = 20;  // per kind, as the diagnostics of `ascorr correct`
 
-// A solution's model version on the target against the host's schedule; a
+// A solution's model version on the target against the host's (`want`); a
 // version the target uses for the first time is fetched (CALIB_MODEL) and
 // compared with the host's model of that version.
 template <typename T>
 void check_model_version(LinkClient<T>& client, const std::string& file, const SolutionRecord& rec, std::uint32_t got,
-                         ReplaySummary& sum, std::vector<ActiveModel>& target_history, std::ostream& log,
-                         const SelfCalibration& host_sc, const ModelSchedule<T>& schedule) {
-    const std::optional<std::uint32_t> want = schedule.version_at(rec.t);
+                         const std::optional<std::uint32_t>& want, ReplaySummary& sum,
+                         std::vector<ActiveModel>& target_history, std::ostream& log, const SelfCalibration& host_sc) {
     const bool same = want ? got == *want : got == link::kNoModelVersion;
     if (!same && ++sum.version_mismatches <= kMaxCalibMessages) {
         log << file << ":" << rec.line << ": the target corrected with model version "
@@ -194,8 +199,8 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     if (!difference.empty()) {
         if (++sum.history_mismatches <= kMaxCalibMessages) {
             char buf[200];
-            std::snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
-                          mine.crc);
+            text::c_snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
+                             mine.crc);
             log << "ascorr replay: the target's " << buf << difference << "\n";
         }
     }
@@ -225,6 +230,100 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     on_target.report = r;
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }
+
+// --mountings/--combined: each epoch (rows whose t agree to the
+// millisecond, iba.hpp's epoch_key; in time order they come together) is
+// combined on the target (COMBINE_REQUEST after its last solution) and on the
+// host by the same pipeline stage in the same scalar, and the two compared
+// bit for bit; the target's is the combined file's row, with the formal σ of
+// the host's tables (the same mountings, the head set only). A row in no
+// epoch is combined alone and dropped on both sides.
+template <typename T>
+class EpochCombination {
+public:
+    EpochCombination(const MountingsFile& m, LinkClient<T>& client, pipeline::EpochPipeline<T>& host, std::string file,
+                     std::ostream& log)
+        : client_(client), host_(host), combiner_(m.mountings), file_(std::move(file)), log_(log) {
+        client_.load_mountings(m.mountings);
+        host_.use_combiner(&combiner_);
+        text_ = std::string(kCombinedHeader) + "\n";
+    }
+
+    // Before a row at t is sent: the open epoch ends when t is of another.
+    void before(double t) {
+        const bool keyed = std::abs(t) < kMaxEpochTimeS;
+        if (open_ && !(keyed && epoch_key(t) == key_)) {
+            close(true);
+        }
+        if (keyed && !open_) {
+            open_ = true;
+            key_ = epoch_key(t);
+            t_ = t;
+        }
+    }
+    // After a row at t is sent: a row in no epoch is combined alone, dropped.
+    void after(double t) {
+        if (!(std::abs(t) < kMaxEpochTimeS)) {
+            close(false);
+        }
+    }
+    void finish(ReplaySummary& sum) {
+        if (open_) {
+            close(true);
+        }
+        sum.combined = true;
+        sum.combined_epochs = epochs_;
+        sum.combined_mismatches = mismatches_;
+        sum.combination_instructions_per_epoch = costed_ == 0 ? 0.0 : instructions_ / static_cast<double>(costed_);
+    }
+    const std::string& text() const noexcept { return text_; }
+
+private:
+    void close(bool write) {
+        open_ = false;
+        const link::Combined<T> got = client_.combine_epoch();
+        const combine::CombinedAttitude<T> want = host_.close();
+        const bool same = got.status == want.status && got.used == want.used && got.left_out == want.left_out &&
+                          got.inconsistent == want.inconsistent &&
+                          std::memcmp(&got.q_crf_icrf, &want.q_crf_icrf, sizeof got.q_crf_icrf) == 0;
+        if (!same && ++mismatches_ <= kMaxCalibMessages) {
+            log_ << file_ << ": epoch t = " << number_text(t_) << ": the target's combined attitude differs from the "
+                 << "host's (status " << unsigned{got.status} << " vs " << unsigned{want.status} << ", heads "
+                 << head_letters(got.used) << " vs " << head_letters(want.used) << ")\n";
+        }
+        if (!write) {
+            return;
+        }
+        ++epochs_;
+        if ((got.status & combine::combined_status::kTwoOrMoreHeads) != 0U) {
+            instructions_ += got.instructions;
+            ++costed_;
+        }
+        AttitudeRow row;
+        row.t = t_;
+        row.has_q = (got.status & combine::combined_status::kNoHead) == 0U;
+        row.q_crf_icrf = widen(got.q_crf_icrf);
+        row.heads = row.has_q ? got.used : 0U;
+        const double* sigma = combiner_.sigma_arcsec(got.used);
+        row.sigma_arcsec = {sigma[0], sigma[1], sigma[2]};
+        row.status = got.status;
+        append_combined_row(text_, row);
+    }
+
+    LinkClient<T>& client_;
+    pipeline::EpochPipeline<T>& host_;
+    combine::Combiner<T> combiner_;
+    std::string file_;
+    std::ostream& log_;
+    bool open_ = false;
+    std::int64_t key_ = 0;
+    double t_ = 0.0;  // the epoch's first (earliest) row's
+    std::size_t epochs_ = 0;
+    std::size_t mismatches_ = 0;
+    double instructions_ = 0.0;
+    std::size_t costed_ = 0;
+    std::string text_;
+};
 
 template <typename T>
 ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
@@ -300,8 +399,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
     // the target's started alike.
     ReplaySummary sum;
     std::optional<SelfCalibration> host_sc;
-    std::optional<ModelSchedule<T>> schedule;
-    std::optional<ModelSchedule<double>> schedule_d;
+    std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
+    std::optional<calib::Estimator<T>> host_estimator;
+    pipeline::EpochPipeline<T> host_pipeline;
     std::vector<ActiveModel> target_history;
     if (opt.self_calibrate) {
         calib::EstimatorConfig ecfg;
@@ -314,17 +414,28 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
                 }
             },
             mf, ecfg, opt.orbit_period_s);
-        schedule.emplace(host_sc->history);
         schedule_d.emplace(host_sc->history);
         std::optional<ModelCoefficients> initial;
         if (mf) {
             initial = coefficients_of(*mf);
         }
-        client.start_calibration(std::llround(host_sc->orbit_period_s * 1e6), opt.time_constant_days,
-                                 initial ? &*initial : nullptr);
+        const std::int64_t period_us = std::llround(host_sc->orbit_period_s * 1e6);
+        client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr);
+        calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
+        host_cfg.orbit_period_us = period_us;
+        host_cfg.time_constant_days = opt.time_constant_days;
+        host_estimator.emplace(host_cfg, initial ? &*initial : nullptr);
+        host_pipeline.use_estimator(&*host_estimator);
         sum.self_calibrate = true;
     } else {
         client.upload_model(model_t);
+        host_pipeline.use_model(&model_t);
+    }
+    std::optional<EpochCombination<T>> combination;
+    if (!opt.combined.empty()) {
+        const MountingsFile m = read_mountings_file(opt.mountings);
+        refuse_unusable_mountings(m, opt.mountings);
+        combination.emplace(m, client, host_pipeline, opt.in, log);
     }
     // Time order is the on-board clock's (TT µs; rows within one microsecond
     // in file order, as the target and the host's self-calibration take
@@ -386,19 +497,40 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
         std::uint8_t calib_use = 0U;
         if (opt.self_calibrate) {
             calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
+        } else if (combination) {
+            calib_use = calibration_clean(rec) ? link::kCalibClean : 0U;  // the combination's selection
+        }
+        if (combination) {
+            combination->before(rec.t);
         }
         const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0}, from_states,
                                                         from_states && in.velocity.valid, calib_use);
         ++sum.returned;
-        const ThermalModel<T>& host_model = schedule ? schedule->at(rec.t) : model_t;
-        CorrectedSolution<T> host = correct_solution(in, CorrectionConfig<T>{true, &host_model});
-        host.status = with_service_status(host.status, service_status, from_states);
-        if (opt.self_calibrate) {
-            check_model_version(client, opt.in, rec, got.model_version, sum, target_history, log, *host_sc, *schedule);
+        // The host's answer: the target's pipeline on the host, fed alike.
+        const pipeline::VelocityAnswer<T> velocity{in.velocity, service_status, from_states};
+        const auto answer = [&velocity] { return velocity; };
+        CorrectedSolution<T> host{};
+        std::optional<std::uint32_t> host_version;
+        if (host_pipeline.calibrating() && !timed) {
+            host = host_pipeline.untimed_solution(in, answer);
+        } else {
+            (void)host_pipeline.begin(timed ? t.us : 0);
+            host = host_pipeline.solution(in, answer, (calib_use & link::kCalibClean) != 0U);
+            if (host_pipeline.calibrating() && host_pipeline.model() != nullptr) {
+                host_version = host_pipeline.version();
+            }
         }
-        CorrectedSolution<double> ref =
-            correct_solution(in_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
-        ref.status = with_service_status(ref.status, service_status_d, from_states);
+        if (opt.self_calibrate) {
+            check_model_version(client, opt.in, rec, got.model_version, host_version, sum, target_history, log,
+                                *host_sc);
+        }
+        // The reference: the same rows and models in double.
+        const pipeline::VelocityAnswer<double> velocity_d{in_d.velocity, service_status_d, from_states};
+        const CorrectedSolution<double> ref = pipeline::correct_stage(
+            in_d, velocity_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
+        if (combination) {
+            combination->after(rec.t);
+        }
         const bool same =
             got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
         if (!same) {
@@ -446,9 +578,18 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, std::ostream& log) {
             history_file->write(format_model_history(target_history));
         }
     }
+    std::optional<AtomicFile> combined_file;
+    if (combination) {
+        combination->finish(sum);
+        combined_file.emplace(opt.combined);
+        combined_file->write(combination->text());
+    }
     out.commit();
     if (history_file) {
         history_file->commit();
+    }
+    if (combined_file) {
+        combined_file->commit();
     }
     const LinkStats& st = client.stats();
     sum.crc_errors = st.naks + st.broken_answers;
@@ -509,8 +650,8 @@ void check_link_image(const std::string& path, const QemuTarget& board) {
     const std::uint32_t entry = u32(24);
     if (entry >= kCodeMemoryBytes) {
         char buf[120];
-        std::snprintf(buf, sizeof buf, "entry point 0x%08x is outside the board's code memory [0, 0x%x)", entry,
-                      kCodeMemoryBytes);
+        text::c_snprintf(buf, sizeof buf, "entry point 0x%08x is outside the board's code memory [0, 0x%x)", entry,
+                         kCodeMemoryBytes);
         throw std::runtime_error(where + buf);
     }
 }
@@ -525,9 +666,24 @@ void check_options(const ReplayOptions& opt) {
     if (!opt.model_history.empty()) {
         outputs.push_back({"--model-history", opt.model_history});
     }
-    refuse_output_over_input(
-        {{"--in", opt.in}, {"--model", opt.model}, {"--firmware", opt.firmware}, {"--states", opt.states}}, outputs,
-        true);
+    if (!opt.combined.empty()) {
+        outputs.push_back({"--combined", opt.combined});
+    }
+    refuse_output_over_input({{"--in", opt.in},
+                              {"--model", opt.model},
+                              {"--firmware", opt.firmware},
+                              {"--states", opt.states},
+                              {"--mountings", opt.mountings}},
+                             outputs, true);
+    if (opt.combined.empty() != opt.mountings.empty()) {
+        throw std::runtime_error("--mountings and --combined go together");
+    }
+    if (!opt.combined.empty()) {
+        refuse_same_output({"--out", opt.out}, {"--combined", opt.combined});
+        if (!opt.model_history.empty()) {
+            refuse_same_output({"--model-history", opt.model_history}, {"--combined", opt.combined});
+        }
+    }
     if (opt.max_propagation_s && !max_propagation_acceptable(*opt.max_propagation_s)) {
         throw std::runtime_error("--max-propagation " + number_text(*opt.max_propagation_s) + ": " +
                                  kMaxPropagationRule);
@@ -664,7 +820,8 @@ std::string default_link_firmware(const std::string& target) {
 
 bool agrees(const ReplaySummary& s) {
     return s.mismatches == 0 &&
-           (!s.self_calibrate || (s.version_mismatches == 0 && s.history_mismatches == 0 && s.report_matches));
+           (!s.self_calibrate || (s.version_mismatches == 0 && s.history_mismatches == 0 && s.report_matches)) &&
+           (!s.combined || s.combined_mismatches == 0);
 }
 
 std::string disagreement(const ReplaySummary& s) {
@@ -674,23 +831,32 @@ std::string disagreement(const ReplaySummary& s) {
                std::to_string(s.history_mismatches) + " model(s), the report " +
                (s.report_matches ? "agrees" : "differs");
     }
+    if (s.combined) {
+        out += ", " + std::to_string(s.combined_mismatches) + " combined attitude(s)";
+    }
     return out + " (the outputs are written; see the messages above)";
 }
 
 std::string to_json(const ReplaySummary& s) {
     char buf[512];
-    std::snprintf(buf, sizeof buf,
-                  "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
-                  "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
-                  "\"injected_faults\": %zu",
-                  s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
-                  s.instructions_per_solution, s.restarts, s.injected);
+    text::c_snprintf(buf, sizeof buf,
+                     "{\"frames\": %zu, \"returned\": %zu, \"mismatches\": %zu, \"max_error_arcsec\": %.6g, "
+                     "\"crc_errors\": %zu, \"retries\": %zu, \"instructions_per_solution\": %.1f, \"restarts\": %zu, "
+                     "\"injected_faults\": %zu",
+                     s.frames, s.returned, s.mismatches, s.max_error_arcsec, s.crc_errors, s.retries,
+                     s.instructions_per_solution, s.restarts, s.injected);
     std::string out = buf;
     if (s.self_calibrate) {
-        std::snprintf(buf, sizeof buf,
-                      ", \"self_calibration\": {\"models\": %zu, \"version_mismatches\": %zu, "
-                      "\"history_mismatches\": %zu, \"report_matches\": %s}",
-                      s.models, s.version_mismatches, s.history_mismatches, s.report_matches ? "true" : "false");
+        text::c_snprintf(buf, sizeof buf,
+                         ", \"self_calibration\": {\"models\": %zu, \"version_mismatches\": %zu, "
+                         "\"history_mismatches\": %zu, \"report_matches\": %s}",
+                         s.models, s.version_mismatches, s.history_mismatches, s.report_matches ? "true" : "false");
+        out += buf;
+    }
+    if (s.combined) {
+        text::c_snprintf(buf, sizeof buf,
+                         ", \"combined\": {\"epochs\": %zu, \"mismatches\": %zu, \"instructions_per_epoch\": %.1f}",
+                         s.combined_epochs, s.combined_mismatches, s.combination_instructions_per_epoch);
         out += buf;
     }
     return out + "}";

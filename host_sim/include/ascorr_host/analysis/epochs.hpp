@@ -31,6 +31,7 @@
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
 
@@ -66,7 +67,7 @@ public:
         Entry& e = pending_[key];
         if (e.epoch.head[head]) {
             char when[32];
-            std::snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
+            text::c_snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
             throw InputError(file_, line, 1,
                              std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
                                  " (the first is on line " + std::to_string(e.epoch.line[head]) + ")");

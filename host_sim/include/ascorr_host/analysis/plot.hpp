@@ -41,6 +41,22 @@ struct PlotOptions {
 // window that is empty or has no clean epoch).
 void plot_iba(const PlotOptions& opt, std::ostream& log);
 
+// The combined attitude's error against the truth in a window (`plot
+// --combined A --truth-attitude T --window-from --window-to`): three panels,
+// the error about CRF x, y and z (arcsec, combined_stats.hpp's θ), each epoch
+// a point coloured by its head set, the epochs without the full set shaded
+// grey (the head set has changed: where a step would show).
+struct CombinedPlotOptions {
+    std::string combined;
+    std::string truth;
+    std::string out;
+    double from = 0.0;
+    double to = 0.0;
+    int width = 1400;
+    std::string gnuplot = "gnuplot";
+};
+void plot_combined(const CombinedPlotOptions& opt, std::ostream& log);
+
 // Writes "t+time_offset T_CHU_A … T_CHU_<last head of heads.hpp> T029 T032"
 // per bin of bin_s seconds with data in [from, to] (means over the rows of
 // each head; NaN where a bin has none of a temperature). Returns the number of bins.

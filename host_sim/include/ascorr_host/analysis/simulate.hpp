@@ -34,6 +34,13 @@
 //    on and off with a half-day time constant. Their windows [start, end] (the
 //    heater on; the temperatures relax for a few days after) are written
 //    beside the data.
+//  - The bench's common reference frame (CRF) is the body frame: the
+//    mountings are q_chu_crf = head_mounting(h), the true CRF attitude
+//    q_crf_icrf = R_body_icrf, so R(q_chu_icrf) = R(q_chu_crf) R(q_crf_icrf)
+//    before deformation and noise. The noise is drawn in head axes: 1σ
+//    kNoiseCrossArcsec about x and y (across the boresight), kNoiseAboutArcsec
+//    about z (flagged rows: more in every axis); OUT.mountings.csv states
+//    both, OUT.attitude.csv the true CRF attitude at every epoch (rows or not).
 //  - The floor: the IBA RMS per pair of q_noise ⊗ q_true over the clean
 //    epochs (docs/contract.md), written beside the data, and per day as
 //    sums from which the floor of any window of whole days follows.
@@ -55,6 +62,7 @@
 #include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
 
 namespace ascorr::host {
 
@@ -138,18 +146,31 @@ struct SimulateSummary {
     std::size_t gap_epochs = 0;        // epochs without rows (--gap)
     std::vector<HeaterEvent> heaters;  // those starting before the last epoch
     std::string heaters_path;
+    std::string mountings_path;
+    std::string attitude_path;
 };
 
 // Writes opt.out, opt.out + ".truth.csv" (the initial truth),
 // opt.out + ".truth-history.csv" (the truth as a model history: version 0 from
 // the first epoch, one version per change), opt.out + ".floor.json",
-// opt.out + ".floor-daily.csv" and opt.out + ".heaters.csv" (start,end,heater:
-// operational or survival).
+// opt.out + ".floor-daily.csv", opt.out + ".heaters.csv" (start,end,heater:
+// operational or survival), opt.out + ".mountings.csv" (simulated_mountings)
+// and opt.out + ".attitude.csv" (t,qw,qx,qy,qz: q_crf_icrf at every epoch k·step,
+// in --gap too; combined_csv.hpp).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
 SimulateSummary simulate(const SimulateOptions& opt);
 
 // Body into head components for head 0 … kMaxHeads − 1 (see the top).
 Eigen::Matrix3d head_mounting(int head);
+
+// The star trackers' noise (1σ per axis, arcsec) of clean rows: across the
+// boresight (about the head's x and y) and about it (z).
+inline constexpr double kSimNoiseCrossArcsec = 1.5;
+inline constexpr double kSimNoiseAboutArcsec = 10.0;
+
+// The mountings of the heads `heads`, q_chu_crf = head_mounting(h), with the
+// true noise above (the file simulate writes beside the data).
+MountingsFile simulated_mountings(HeadSet heads);
 
 std::string describe(const SimulateSummary& s);
 std::string floor_json(const std::array<Rms, kMaxPairs>& floor, const PairList& pairs);

@@ -10,11 +10,15 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
 
@@ -52,8 +56,32 @@ struct CorrectSummary {
     std::string self_calibration;      // --self-calibrate: the estimator's account
 };
 
-// Throws InputError or std::runtime_error; writes nothing then.
-CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log);
+// A corrected row as a later stage takes it (correct --combined): q as the
+// corrected file writes it (15 decimals), the row's status and cleanness.
+struct CorrectedRow {
+    double t = 0.0;
+    std::size_t line = 0;
+    std::uint8_t head = kUnknownHead;
+    Quaternion<double> q_chu_icrf{};
+    long long flags = 0;
+    double confidence = 0.0;  // NaN when not a number
+    bool corrected = false;   // status is the row's (false: a raw row, taken as it is)
+    StatusBits status = 0;
+};
+
+// Takes every corrected row in file order; finish() after the last, then
+// commit() after the corrected file's (the outputs of one run appear together).
+class CorrectedRowSink {
+public:
+    virtual ~CorrectedRowSink() = default;
+    virtual void add(const CorrectedRow& row) = 0;
+    virtual void finish() = 0;
+    virtual void commit() = 0;
+};
+
+// Throws InputError or std::runtime_error; writes nothing then. sink: the
+// corrected rows also go there (correct --combined).
+CorrectSummary correct_file(const CorrectOptions& opt, std::ostream& log, CorrectedRowSink* sink = nullptr);
 
 // A one-paragraph account of a summary, for the terminal.
 std::string describe(const CorrectSummary& s);

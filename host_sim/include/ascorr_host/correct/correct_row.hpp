@@ -5,7 +5,9 @@
 // Python module (python/src/bind_correct.cpp): the row's inputs converted once to
 // the scalar T (solution_input.hpp), with --states the on-board velocity
 // service's velocity for a row without its own (states_velocity.hpp), the
-// core, and the status bits the core cannot know (a velocity with 1 or 2 of
+// epoch pipeline's correction stage (correct_stage(), pipeline/
+// solution_stage.hpp: the core and the service's bits), and the status bits
+// the core cannot know (a velocity with 1 or 2 of
 // its 3 components: the core saw "not available", the row gets 4 + 32; the
 // service's 4, 4|512, 4|32). Compiled once, in ascorr_host, for double,
 // float and Q30, so both callers run the same object code and agree bit for

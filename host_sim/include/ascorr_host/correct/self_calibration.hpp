@@ -4,7 +4,7 @@
 //
 // The rows are read once, in any order; they are taken in time order (TT µs
 // of the on-board clock, then line) one at a time, as the link server takes
-// them (ascorr_link/server.hpp), through the same calib::EpochFeed: each
+// them (ascorr_link/server.hpp), through the same epoch pipeline (pipeline/epoch_pipeline.hpp): each
 // epoch (a distinct time tag) takes the model the estimator holds active at
 // its first row (a model adopted after an earlier epoch becomes active
 // there); the epoch's clean rows of A, B and C (calibration_clean(),

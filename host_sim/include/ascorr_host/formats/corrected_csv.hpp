@@ -32,4 +32,8 @@ private:
     int status_col_ = -1;
 };
 
+// q as the corrected file holds it (15 decimals, read back): what `combine`
+// reads from a corrected file, so that `correct --combined` combines the same numbers.
+Quaternion<double> as_written(const Quaternion<double>& q) noexcept;
+
 }  // namespace ascorr::host

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -127,6 +128,22 @@ inline constexpr std::string_view kSolutionsHeader = "t,chu,qw,qx,qy,qz,t_chu,t_
 // True for a column of kSolutionsColumns or kStatusColumn: one a writer
 // writes from its own values (any other column is an extra one, kept as written).
 bool is_solutions_column(std::string_view name) noexcept;
+
+// A header's column that is not one ascorr reads but looks like one the header
+// lacks: a misspelt `T_CHU` would leave every row without temperatures and
+// nothing would name it. Looks like: the same name in another case, or, for
+// the names of five letters or more (t_chu, t_029, t_032, flags, confidence,
+// status), one or two letters inserted, deleted, replaced or swapped (`tchu`,
+// `t_29`, `confidance`); the short names (t, chu, qw..qz, vx..vz) only by case,
+// as a short extra column (`x`, `id`) is one or two edits from one of them.
+// The solutions reader refuses such a header (InputError at file:1:column), and
+// Python's from_frame() the same columns, with the same words.
+struct NearMiss {
+    std::size_t column = 0;  // index in names
+    std::string_view known;  // the column it looks like
+    std::string message;     // "column 'T_CHU' is not a column ascorr reads ..."
+};
+std::optional<NearMiss> near_miss_column(const std::vector<std::string>& names);
 
 // One row's values, NaN where not available.
 struct SolutionValues {

@@ -100,6 +100,14 @@ public:
     // Head h of the estimator's active model (protocol v4).
     link::CalibModel calib_model(std::uint8_t head);
 
+    // The combination (protocol v5): the mountings, head by head, built into
+    // the target's combiner (a LinkError when the target refuses them); then
+    // each call of combine_epoch() has the target combine the solutions it
+    // corrected since the previous call. A restart while combining is an
+    // error (restore() refuses it): the epoch's solutions are lost with it.
+    void load_mountings(const combine::Mountings& m);
+    link::Combined<T> combine_epoch();
+
     const LinkStats& stats() const { return stats_; }
 
 private:
@@ -166,6 +174,7 @@ private:
     bool from_states_ = false;  // of the solution in flight
     bool velocity_expected_ = false;
     bool calibrating_ = false;  // start_calibration() sent: a restart is an error
+    bool combining_ = false;    // load_mountings() sent: a restart is an error
     std::uint8_t calib_ = 0U;   // of the solution in flight (link::kCalibClean, kCalibNoTime)
     bool had_version_ = false;  // an answer carried a model version
     LinkStats stats_;

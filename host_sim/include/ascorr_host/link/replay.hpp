@@ -19,6 +19,13 @@
 // version used; for each model the target adopts, its coefficients, CRC and
 // time (CALIB_MODEL); and at the end the estimator's report. The target's
 // model history is written to model_history, when given.
+//
+// With mountings and combined the target also combines each epoch (rows whose
+// t agree to the millisecond) into the bench's attitude (MOUNTING_LOAD, then
+// COMBINE_REQUEST after each epoch's last solution: the epoch pipeline's stage
+// 6); the host runs the same pipeline beside it and compares each combined
+// attitude bit for bit; the combined file (docs/contract.md) is the target's,
+// with the formal σ of the host's tables (they depend on the head set only).
 #pragma once
 
 #include <cstdint>
@@ -44,6 +51,8 @@ struct ReplayOptions {
     std::string model_history;             // --model-history: the target's models; empty: not written
     double time_constant_days = 30;        // --time-constant (calib::EstimatorConfig's default)
     std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
+    std::string mountings;                 // --mountings: with --combined, the combiner's (sigmas given)
+    std::string combined;                  // --combined: the target's combined attitude per epoch; empty: none
     double inject_errors = 0.0;            // fraction of frames faulted, each direction
     bool realtime = false;                 // pace by the rows' t instead of as fast as the link allows
     int timeout_ms = 0;                    // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
@@ -68,6 +77,11 @@ struct ReplaySummary {
     std::size_t version_mismatches = 0;  // solutions corrected with another model version than the host's
     std::size_t history_mismatches = 0;  // models differing from the host's (coefficients, CRC, time) or missing
     bool report_matches = false;         // the final report equals the host's, field for field
+    // --combined: the target's combined attitudes against the host's.
+    bool combined = false;
+    std::size_t combined_epochs = 0;                // rows of the combined file
+    std::size_t combined_mismatches = 0;            // epochs whose combination differs from the host's
+    double combination_instructions_per_epoch = 0;  // mean over epochs of two or more heads
 };
 
 ReplaySummary replay(const ReplayOptions& opt, std::ostream& log);

@@ -1,0 +1,315 @@
+// ascorr/pipeline/epoch_pipeline.hpp: one epoch's solutions through every
+// stage, in one order, for every caller.
+//
+// Conventions: an epoch is one time tag on the on-board clock (TT µs; the
+// flight loop: one cycle). Its solutions, of any heads in any order, go
+// through a fixed list of stages:
+//   1. model     (begin(), at the epoch's first solution): the thermal model of
+//                the whole epoch: a fixed one (use_model), or the one the
+//                on-board estimator holds active (use_estimator; a new model
+//                becomes active here, between epochs, never within one);
+//   2. velocity  (the caller's source: given_velocity or from_service,
+//                solution_stage.hpp);
+//   3. correction and 4. status (correct_stage(), solution_stage.hpp, then
+//                the caller's own bits: Calls::status);
+//   5. estimator feed: the first clean, usable solution of each of the
+//                calibrated heads is kept; when all are there and the epoch is
+//                one the schedule feeds (every feed_every-th), they feed the
+//                estimator (calib::feed_estimator) and its per-orbit update
+//                runs steps_after_feed bounded steps; idle() runs one more;
+//   6. combination (use_combiner; close()): the corrected solutions since the
+//                last close() (the caller's epoch of the bench: a flight
+//                cycle, the host's millisecond epoch) combined into the
+//                attitude of the common reference frame (combine/combiner.hpp),
+//                each head usable or not by combine/usable.hpp.
+// The link server, the flight loop, the host's self-calibration run and
+// replay's host side all drive this class, so they take the same decisions
+// in the same order; `ascorr correct` (rows in any order, on many threads)
+// calls the stages 2–4 alone (correct_stage).
+//
+// Calls: the out-of-line entries a flight image measures alone (the flight
+// loop's core_entry.hpp, calib_entry.hpp); InlineCalls is the library's.
+// Meter: sees each stage's work, never changes it (now(), add(Stage, start)).
+// Bounded and allocation-free: no loop but over the calibrated heads and the
+// steps_after_feed steps.
+#pragma once
+
+#include <cstdint>
+
+#include "../calib/estimator.hpp"
+#include "../calib/feed.hpp"
+#include "../combine/combined_status.hpp"
+#include "../combine/combiner.hpp"
+#include "../combine/usable.hpp"
+#include "../core/correct.hpp"
+#include "solution_stage.hpp"
+
+namespace ascorr::pipeline {
+
+enum class Stage : std::uint8_t { kModel, kVelocity, kCorrect, kFeed, kStep, kCombine };
+
+struct NoMeter {
+    std::uint32_t now() noexcept { return 0U; }
+    void add(Stage /*stage*/, std::uint32_t /*start*/) noexcept {}
+};
+
+template <typename T>
+struct InlineCalls {
+    static const ThermalModel<T>* model_for_epoch(calib::Estimator<T>& e, std::int64_t t_us) noexcept {
+        return e.model_for_cycle(t_us);
+    }
+    static CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
+        return correct_solution(in, cfg);
+    }
+    static bool feed(calib::Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
+                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
+        return calib::feed_estimator(e, t_us, model, corrected, temperatures);
+    }
+    static bool step(calib::Estimator<T>& e) noexcept { return e.step(); }
+    static combine::CombinedAttitude<T> combine(const combine::Combiner<T>& c, const combine::HeadAttitude<T>* heads,
+                                                std::uint8_t n) noexcept {
+        return c.combine(heads, n);
+    }
+    // The caller's own status bits for head `head` (none here).
+    static StatusBits status(std::uint8_t /*head*/, StatusBits s) noexcept { return s; }
+};
+
+// Which epochs feed the estimator, and how much of its per-orbit update runs
+// right after a feed (the rest: idle()).
+struct FeedSchedule {
+    std::uint32_t feed_every = 1U;
+    int steps_after_feed = static_cast<int>(calib::Estimator<double>::Phase::kGate);
+};
+
+template <typename T, typename Calls = InlineCalls<T>>
+class EpochPipeline {
+public:
+    explicit EpochPipeline(FeedSchedule schedule = {}) noexcept : schedule_(schedule) {}
+
+    // The model stage's source: a fixed model for every epoch (nullptr: no
+    // thermal stage) ...
+    void use_model(const ThermalModel<T>* model) noexcept {
+        estimator_ = nullptr;
+        fixed_ = model;
+        forget();
+    }
+    // ... or the estimator's active model (none yet: no head has
+    // coefficients, status 256), which then learns from the epochs.
+    void use_estimator(calib::Estimator<T>* e) noexcept {
+        estimator_ = e;
+        forget();
+    }
+    // Forgets the current epoch (a restarted estimator).
+    void forget() noexcept {
+        have_epoch_ = false;
+        kept_ = 0U;
+        epochs_ = 0U;
+        model_ = nullptr;
+    }
+
+    bool calibrating() const noexcept { return estimator_ != nullptr; }
+
+    // Stage 6's combiner (nullptr: no combination); forgets the solutions
+    // not combined yet.
+    void use_combiner(const combine::Combiner<T>* c) noexcept {
+        combiner_ = c;
+        combined_n_ = 0U;
+        overflow_ = false;
+    }
+    const combine::Combiner<T>* combiner() const noexcept { return combiner_; }
+
+    // Stage 6: the solutions since the last close() combined (use_combiner
+    // came first: without a combiner, no head, status 8). More solutions than
+    // kCombineSlots in one epoch: the rest are left out (bit 4).
+    template <typename Meter = NoMeter>
+    combine::CombinedAttitude<T> close(Meter& meter) noexcept {
+        combine::CombinedAttitude<T> r{};
+        if (combiner_ == nullptr) {
+            r.q_crf_icrf = {constant<T>(1.0), constant<T>(0.0), constant<T>(0.0), constant<T>(0.0)};
+            r.status = combine::combined_status::kNoHead;
+            return r;
+        }
+        const std::uint32_t start = meter.now();
+        r = Calls::combine(*combiner_, combined_, combined_n_);
+        meter.add(Stage::kCombine, start);
+        if (overflow_) {
+            r.status = static_cast<combine::CombinedStatus>(r.status | combine::combined_status::kHeadLeftOut);
+        }
+        combined_n_ = 0U;
+        overflow_ = false;
+        return r;
+    }
+    combine::CombinedAttitude<T> close() noexcept {
+        NoMeter m;
+        return close(m);
+    }
+
+    // Stage 1: epoch t_us, unless it is the current one; its model.
+    template <typename Meter = NoMeter>
+    const ThermalModel<T>* begin(std::int64_t t_us, Meter& meter) noexcept {
+        if (have_epoch_ && t_us == t_us_) {
+            return model_;
+        }
+        if (have_epoch_) {
+            ++epochs_;
+        }
+        have_epoch_ = true;
+        t_us_ = t_us;
+        kept_ = 0U;
+        if (estimator_ == nullptr) {
+            model_ = fixed_;
+            return model_;
+        }
+        const std::uint32_t start = meter.now();
+        model_ = Calls::model_for_epoch(*estimator_, t_us);
+        version_ = estimator_->active_version();
+        meter.add(Stage::kModel, start);
+        return model_;
+    }
+    const ThermalModel<T>* begin(std::int64_t t_us) noexcept {
+        NoMeter m;
+        return begin(t_us, m);
+    }
+
+    // The current epoch's model (nullptr: none) and, calibrating, its version.
+    const ThermalModel<T>* model() const noexcept { return model_; }
+    std::uint32_t version() const noexcept { return version_; }
+    // Epochs that fed the estimator so far (wraps at 2^32).
+    std::uint32_t feeds() const noexcept { return feeds_; }
+
+    // Stages 2–5 for one solution of the current epoch (begin() came first).
+    // `velocity` () → VelocityAnswer<T>; `clean`: the source's selection
+    // (flags, confidence) lets it feed the estimator.
+    template <typename Velocity, typename Meter = NoMeter>
+    CorrectedSolution<T> solution(SolutionInput<T> in, Velocity&& velocity, bool clean, bool aberration,
+                                  Meter& meter) noexcept {
+        std::uint32_t start = meter.now();
+        const VelocityAnswer<T> v = velocity();
+        meter.add(Stage::kVelocity, start);
+        take_velocity(in, v);
+        const CorrectionConfig<T> cfg = config(aberration);
+        start = meter.now();
+        CorrectedSolution<T> c = Calls::correct(in, cfg);
+        meter.add(Stage::kCorrect, start);
+        c.status = Calls::status(in.head, status_stage(c.status, v, cfg.aberration));
+        if (estimator_ != nullptr && clean) {
+            keep(in.head, c, in.temperatures, meter);
+        }
+        if (combiner_ != nullptr) {
+            to_combine(in.head, c, clean);
+        }
+        return c;
+    }
+    template <typename Velocity>
+    CorrectedSolution<T> solution(const SolutionInput<T>& in, Velocity&& velocity, bool clean,
+                                  bool aberration = true) noexcept {
+        NoMeter m;
+        return solution(in, velocity, clean, aberration, m);
+    }
+
+    // A solution that belongs to no epoch (no time tag): corrected without a
+    // model when calibrating (status 256), never fed.
+    template <typename Velocity>
+    CorrectedSolution<T> untimed_solution(SolutionInput<T> in, Velocity&& velocity, bool aberration = true) noexcept {
+        const CorrectionConfig<T> cfg{aberration, estimator_ != nullptr ? &kNoModel : fixed_};
+        CorrectedSolution<T> c = correct_stage(in, velocity(), cfg, CallsCorrect{});
+        c.status = Calls::status(in.head, c.status);
+        return c;
+    }
+
+    // One step of the estimator's per-orbit update, in idle time.
+    template <typename Meter = NoMeter>
+    bool idle(Meter& meter) noexcept {
+        const std::uint32_t start = meter.now();
+        if (estimator_ == nullptr || !Calls::step(*estimator_)) {
+            return false;
+        }
+        meter.add(Stage::kStep, start);
+        return true;
+    }
+
+private:
+    struct CallsCorrect {
+        CorrectedSolution<T> operator()(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) const noexcept {
+            return Calls::correct(in, cfg);
+        }
+    };
+
+    // No coefficients for any head: the estimator has no model yet (256).
+    static constexpr ThermalModel<T> kNoModel{};
+
+    CorrectionConfig<T> config(bool aberration) const noexcept {
+        if (estimator_ == nullptr) {
+            return {aberration, fixed_};
+        }
+        return {aberration, model_ != nullptr ? model_ : &kNoModel};
+    }
+
+    // Stage 6's input: every solution, usable or not (the combiner accounts
+    // for each one it is given).
+    void to_combine(std::uint8_t head, const CorrectedSolution<T>& c, bool clean) noexcept {
+        if (combined_n_ == kCombineSlots) {
+            overflow_ = true;
+            return;
+        }
+        combined_[combined_n_] = {c.q_chu_icrf, head, combine::usable_for_combination(c.status, clean)};
+        ++combined_n_;
+    }
+
+    static bool usable(const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp) noexcept {
+        return (c.status & status::kAberrationApplied) != 0U && (c.status & status::kRejected) == 0U &&
+               tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid;
+    }
+
+    // Stage 5: the first clean, usable solution of each calibrated head; the
+    // feed when all are there, on the schedule's epochs.
+    template <typename Meter>
+    void keep(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
+        if (!have_epoch_ || h >= calib::kCalibHeads || kept_ == kFed || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+            return;
+        }
+        solutions_[h] = c;
+        temperatures_[h] = tp;
+        kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
+        if (kept_ != kAll) {
+            return;
+        }
+        kept_ = kFed;
+        if (epochs_ % schedule_.feed_every != 0U) {
+            return;
+        }
+        const std::uint32_t start = meter.now();
+        const HeadTemperatures<T>* t[calib::kCalibHeads] = {&temperatures_[0], &temperatures_[1], &temperatures_[2]};
+        if (Calls::feed(*estimator_, t_us_, model_, solutions_, t)) {
+            ++feeds_;
+        }
+        meter.add(Stage::kFeed, start);
+        for (int i = 0; i < schedule_.steps_after_feed && Calls::step(*estimator_); ++i) {
+        }
+    }
+
+    static constexpr std::uint8_t kAll = (1U << calib::kCalibHeads) - 1U;
+    static constexpr std::uint8_t kFed = 0x80U;
+    // Two solutions of every head: room for a repeated head, whose second
+    // solution the combiner leaves out.
+    static constexpr std::uint8_t kCombineSlots = 2U * kMaxHeads;
+
+    FeedSchedule schedule_;
+    const ThermalModel<T>* fixed_ = nullptr;
+    calib::Estimator<T>* estimator_ = nullptr;
+    bool have_epoch_ = false;
+    std::int64_t t_us_ = 0;
+    std::uint32_t epochs_ = 0U;  // epochs begun before the current one
+    std::uint8_t kept_ = 0U;     // bit h: head h kept; kFed: the epoch is done with the feed
+    const ThermalModel<T>* model_ = nullptr;
+    std::uint32_t version_ = 0U;
+    std::uint32_t feeds_ = 0U;
+    CorrectedSolution<T> solutions_[calib::kCalibHeads]{};
+    HeadTemperatures<T> temperatures_[calib::kCalibHeads]{};
+    const combine::Combiner<T>* combiner_ = nullptr;
+    combine::HeadAttitude<T> combined_[kCombineSlots]{};
+    std::uint8_t combined_n_ = 0U;
+    bool overflow_ = false;
+};
+
+}  // namespace ascorr::pipeline

@@ -1,0 +1,42 @@
+#include <iostream>
+#include <memory>
+
+#include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/combine.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "commands.hpp"
+
+namespace ascorr::cli {
+
+void add_combine_command(CLI::App& app) {
+    auto opt = std::make_shared<host::CombineOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "combine", "one attitude of the bench (CRF) per epoch from the heads' solutions, weighted by their noise");
+    cmd->add_option("--in", opt->in,
+                    "corrected file (CSV; or a solutions file: its attitudes as they are); '-': standard input")
+        ->required()
+        ->check(non_empty_path());
+    cmd->add_option("--mountings", opt->mountings,
+                    "mountings file (CSV chu,qw,qx,qy,qz[,sigma_cross,sigma_about]: q_chu_crf and each head's noise "
+                    "in arcsec; without the sigmas the noise is estimated from --in and reported)")
+        ->required()
+        ->check(non_empty_path());
+    cmd->add_option("--out", opt->out,
+                    "combined file (CSV t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status), written whole or not at "
+                    "all; '-': standard output")
+        ->required()
+        ->check(non_empty_path());
+    cmd->callback([opt]() {
+        read_dash_from_standard_input({{"--in", &opt->in}, {"--mountings", &opt->mountings}});
+        try {
+            const host::CombineSummary s = host::combine_file(*opt, std::cerr);
+            std::cerr << "ascorr combine: " << opt->out << ": " << host::describe(s) << '\n';
+        } catch (const host::InputError& e) {
+            throw RefusedInput(e.what());  // as align: refused input exits 2
+        } catch (const host::AlignRefused& e) {
+            throw RefusedInput(std::string(e.what()) + " (estimating the heads' noise: the mountings have no sigmas)");
+        }
+    });
+}
+
+}  // namespace ascorr::cli

@@ -1,0 +1,163 @@
+// ascorr_host/analysis/combine.hpp: the combined attitude of a file (`ascorr combine`,
+// `ascorr correct ... --combined`; docs/contract.md, "Combined attitude").
+//
+// Rows become epochs (t to the millisecond, any row order) and every epoch
+// one row of the combined file, in time order, by the core's combiner
+// (ascorr/combine/combiner.hpp) in double. Which rows it averages:
+//  - a row is usable when it is clean (flags 0, confidence a number <= 5,
+//    as docs/contract.md's Statistics) and, in a corrected file, its status
+//    has none of 16 (rejected), 4, 8 (a stage skipped for a missing input),
+//    128, 256 (the thermal stage skipped for its model): in a corrected file
+//    these bits appear only for a stage the run asked for, so "a stage the
+//    run asked for and did not apply" is read from the row itself;
+//  - a mix of corrected and uncorrected rows is decided per epoch: the
+//    epoch's stages are those applied (status 1, 2) to any of its usable
+//    rows, and a row without one of them is left out ("stage missing"). A
+//    raw solutions file has no status: its attitudes are taken as they are;
+//  - two rows of one head in one epoch: both left out (which is right
+//    cannot be told), the epoch gets bit 4 and the message names both lines;
+//  - a head not in the mountings, a chu that is no head: left out, bit 4;
+//  - what the combiner's gates find inconsistent, a quaternion that is not
+//    unit: left out, bit 4 (two heads that disagree: neither, bit 4 | 8).
+// Every left-out head of the bad-input kinds is reported on the log
+// (Diagnostics: the first 20 of each kind, then counts); flagged, rejected
+// and skipped-stage rows are counted in the summary.
+//
+// Memory: rows in time order (the usual file) are combined as they are read,
+// one epoch held. At the first row out of time order the pass stops and the
+// rows are read again, kept (56 bytes each with its epoch key) and sorted; a pass that cannot be
+// restarted (an output that is a stream, standard output or a FIFO) keeps
+// the rows from the start.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+
+#include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/status.hpp"
+#include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
+
+namespace ascorr::host {
+
+// Why a head's row of an epoch is not averaged in (for the summary).
+enum class LeftOut : std::uint8_t {
+    kUsed,
+    kFlagged,         // flags != 0
+    kConfidence,      // confidence > 5 or not a number
+    kRejected,        // status 16
+    kStageSkipped,    // status 4, 8, 128 or 256
+    kStageMissing,    // a stage other rows of the epoch have (mix)
+    kNotAHead,        // chu is no head of heads.hpp
+    kNotInMountings,  // a head the mountings do not have
+    kDuplicate,       // two rows of one head in one epoch
+    kInconsistent,    // refused by the combiner's gates
+    kNotUnit,         // a quaternion the combiner refuses (not unit, not finite)
+    kNoEpoch,         // |t| beyond the millisecond key (iba.hpp): in no epoch
+};
+inline constexpr std::size_t kLeftOutKinds = 12;
+const char* left_out_name(LeftOut why) noexcept;
+
+// Why a row is left out on its own (kUsed: usable so far); the epoch decides
+// the rest (stage missing, two rows of one head, the combiner's refusals).
+// Also align's rule (align.hpp).
+LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept;
+
+// Every row of a corrected or solutions file as the combination takes it, in
+// file order (status: the corrected file's column; InputError at
+// file:line:column when it is not an integer in [0, 65535]). label: for the
+// progress on a terminal.
+void for_each_corrected_row(const std::string& path, const std::function<void(const CorrectedRow&)>& fn,
+                            const std::string& label);
+
+// The step at head-set changes, without a truth: at every epoch where the
+// full set (every mounted head) is averaged in, the epoch is combined again
+// with each proper subset S of it, and d_S = θ of q_S ⊗ q_full* (CRF axes,
+// arcsec) is averaged per day (whole days since the first epoch). step is the
+// RMS over days of the daily mean of d_S: the systematic jump of the combined
+// attitude when the head set changes from the full set to S (noise averages
+// out in the daily mean; what the heads' mountings and corrections leave
+// between them does not).
+struct HeadSetStep {
+    std::size_t days = 0;
+    std::array<double, 3> rms_daily_mean{};  // arcsec, CRF x, y, z
+};
+
+struct CombineSummary {
+    std::size_t rows = 0;
+    std::size_t epochs = 0;                                  // rows of the combined file
+    std::array<std::size_t, 4> status_bit{};                 // epochs with bit 1, 2, 4, 8
+    std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // by LeftOut (kUsed: rows averaged in)
+    bool out_of_order = false;                               // the rows were sorted
+    std::uint32_t full = 0;                                  // the mounted heads
+    std::array<HeadSetStep, 1U << kMaxHeads> steps{};        // by subset mask of `full` (days 0: none)
+};
+std::string describe(const CombineSummary& s);
+
+// Thrown by a streaming stage at the first row out of time order; the
+// caller runs again with a stage that keeps the rows.
+struct RowsOutOfOrder {
+    std::size_t line;
+};
+
+// Rows in, one combined row per epoch out (see the top).
+class CombineStage : public CorrectedRowSink {
+public:
+    enum class Mode { kStream, kKeep };
+    // Writes `out` (AtomicFile) when commit() is called; m: usable mountings
+    // with sigmas. file: the input's name, for messages.
+    CombineStage(const MountingsFile& m, const std::string& out, std::string file, std::ostream& log, Mode mode);
+    ~CombineStage() override;
+    CombineStage(const CombineStage&) = delete;
+    CombineStage& operator=(const CombineStage&) = delete;
+
+    // Stream mode: throws RowsOutOfOrder for a row of an epoch before the
+    // latest one, when the output can be written again (not streamed);
+    // a streamed output keeps the rows instead.
+    void add(const CorrectedRow& row) override;
+    // Combines what is held, writes the last rows, prints the summary of
+    // messages cut short; then commit() makes the file appear.
+    void finish() override;
+    void commit() override;
+    const CombineSummary& summary() const noexcept;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+struct CombineOptions {
+    std::string in;         // corrected or solutions file
+    std::string mountings;  // with sigmas
+    std::string out;
+};
+
+// `ascorr combine`. Mountings without sigmas: each head's noise is estimated
+// from the input (align.hpp's estimator, align_rows; its refusals are
+// AlignRefused) and reported on log. Throws InputError (file:line:column) for
+// a malformed input or mountings file, std::runtime_error for unusable
+// mountings; writes nothing then.
+CombineSummary combine_file(const CombineOptions& opt, std::ostream& log);
+
+// Refuses mountings the combiner cannot use (InputError at the head's line,
+// or std::runtime_error for the head set), or without sigmas
+// (correct --combined: the noise cannot be estimated before the rows are corrected).
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path);
+
+// `ascorr correct ... --mountings M --combined A`: corrects (correct_file) and
+// combines the corrected rows in the same pass; the corrected file is
+// committed first, then the combined one. Rows out of time order: the run
+// is made again with the rows kept (the first run's messages are dropped).
+struct CorrectAndCombine {
+    CorrectSummary corrected;
+    CombineSummary combined;
+};
+CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
+                                      const std::string& combined, std::ostream& log);
+
+}  // namespace ascorr::host

@@ -1,0 +1,67 @@
+// ascorr_host/formats/combined_csv.hpp: attitude files of the bench (docs/contract.md, "Combined attitude").
+//
+// Two files of one attitude per epoch, q = q_crf_icrf (v_crf = R(q) v_icrf,
+// qw >= 0):
+//  - the combined file, `t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status`
+//    (`ascorr combine`, `correct --combined`);
+//  - the attitude file, `t,qw,qx,qy,qz` (`simulate`'s true attitude of the
+//    CRF, OUT.attitude.csv), the combined file's first five columns.
+// Numbers as the corrected file writes them: q with 15 decimals (2e-10
+// arcsec); t and the sigmas in the shortest text that reads back exactly
+// (t the earliest of the epoch's rows', to the bit); an epoch without a usable
+// head has empty q, heads and sigmas.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "ascorr/core/quaternion.hpp"
+
+namespace ascorr::host {
+
+inline constexpr std::string_view kAttitudeHeader = "t,qw,qx,qy,qz";
+inline constexpr std::string_view kCombinedHeader = "t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status";
+
+// One row of either file. `heads` is a mask (bit h: head h of heads.hpp);
+// without q (no usable head) heads is 0 and sigma is not written.
+struct AttitudeRow {
+    std::size_t line = 0;  // 1-based, when read
+    double t = 0.0;
+    bool has_q = false;
+    Quaternion<double> q_crf_icrf{};
+    std::uint32_t heads = 0;
+    std::array<double, 3> sigma_arcsec{};  // about CRF x, y, z
+    unsigned status = 0;
+};
+
+// Appends `t,qw,qx,qy,qz\n` (the attitude file's row).
+void append_attitude_row(std::string& out, double t, const Quaternion<double>& q_crf_icrf);
+// Appends the combined file's row (with its line end).
+void append_combined_row(std::string& out, const AttitudeRow& row);
+
+// Reads an attitude or a combined file (told apart by the header:
+// combined()), row by row in file order, in blocks (bounded memory). Throws
+// InputError (file:line:column) for a malformed row: a header that is
+// neither, q neither four numbers nor four empty fields, a non-unit q, heads
+// not letters of heads.hpp in order, a status not an integer in [0, 255]. In
+// an attitude file every row has q.
+class AttitudeReader {
+public:
+    explicit AttitudeReader(const std::string& path);
+    ~AttitudeReader();
+    AttitudeReader(const AttitudeReader&) = delete;
+    AttitudeReader& operator=(const AttitudeReader&) = delete;
+    bool combined() const noexcept;
+    // The next row; false at the end.
+    bool next(AttitudeRow& row);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ascorr::host

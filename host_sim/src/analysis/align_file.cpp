@@ -1,0 +1,343 @@
+// `ascorr align`: the passes over the rows, the refusals, the report
+// (ascorr_host/analysis/align.hpp).
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "ascorr/core/status.hpp"
+#include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+constexpr StatusBits kStages = status::kAberrationApplied | status::kThermalApplied;
+
+// Why a row cannot be averaged in, on its own: combine.hpp's rule, and a
+// quaternion the combiner would refuse (not unit, not finite); the epoch's
+// stage mix is decided afterwards (LeftOut::kStageMissing).
+LeftOut why_left_out(const CorrectedRow& r, const MountingsFile& m) noexcept {
+    const LeftOut why = why_unusable(r, m);
+    if (why == LeftOut::kUsed && !norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)) {
+        return LeftOut::kNotUnit;
+    }
+    return why;
+}
+
+std::string time_text(double t) {
+    char buf[48];
+    text::c_snprintf(buf, sizeof buf, "%.3f", t);
+    return buf;
+}
+
+std::string period_text(const std::optional<double>& from, const std::optional<double>& to) {
+    if (!from && !to) {
+        return "the whole file";
+    }
+    return "[" + (from ? time_text(*from) : std::string("start")) + ", " + (to ? time_text(*to) : std::string("end")) +
+           "]";
+}
+
+bool in_period(double t, const AlignOptions& opt) noexcept {
+    return (!opt.from || t >= *opt.from) && (!opt.to || t <= *opt.to);
+}
+
+// What one pass counts (the first pass's counts go into the report).
+struct PassCounts {
+    std::size_t rows = 0;
+    std::size_t rows_in_period = 0;
+    std::size_t epochs = 0;
+    std::array<std::size_t, kLeftOutKinds> left_out{};
+    std::array<std::array<std::size_t, kLeftOutKinds>, kMaxHeads> head_left_out{};
+};
+
+using CurrentMountings = std::array<Quaternion<double>, kMaxHeads>;
+
+// A row of an epoch and why it is left out on its own.
+struct Judged {
+    CorrectedRow row;
+    LeftOut why;
+};
+
+// One epoch into the sums: the epoch's stages (those applied to any usable
+// row: a usable row without one is left out, combine.hpp), each usable head's
+// CRF attitude.
+void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, AlignSums& sums, PassCounts& c) {
+    StatusBits stages = 0U;
+    for (const std::optional<Judged>& j : e.head) {
+        if (j && j->why == LeftOut::kUsed && j->row.corrected) {
+            stages = static_cast<StatusBits>(stages | (j->row.status & kStages));
+        }
+    }
+    std::array<std::optional<Quaternion<double>>, kMaxHeads> q_crf_icrf{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!e.head[h]) {
+            continue;
+        }
+        const CorrectedRow& r = e.head[h]->row;
+        LeftOut why = e.head[h]->why;
+        if (why == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
+            why = LeftOut::kStageMissing;
+        }
+        ++c.left_out[static_cast<std::size_t>(why)];
+        ++c.head_left_out[h][static_cast<std::size_t>(why)];
+        if (why == LeftOut::kUsed) {
+            q_crf_icrf[h] = conjugate(q_chu_crf[h]) * r.q_chu_icrf;
+        }
+    }
+    ++c.epochs;
+    sums.add(e.t, q_crf_icrf);
+}
+
+// One pass over the rows with the current mountings. Two rows of one head in
+// one epoch: the assembler's InputError (both lines named).
+void run_pass(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
+              const CurrentMountings& q_chu_crf, const AlignOptions& opt, AlignSums& sums, PassCounts& c) {
+    EpochAssembler<Judged> epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, sums, c); });
+    rows([&](const CorrectedRow& r) {
+        ++c.rows;
+        if (!in_period(r.t, opt)) {
+            return;
+        }
+        ++c.rows_in_period;
+        LeftOut why = why_left_out(r, m);
+        if (why != LeftOut::kNotAHead && why != LeftOut::kNotInMountings && !(std::abs(r.t) < kMaxEpochTimeS)) {
+            why = LeftOut::kNoEpoch;
+        }
+        if (why == LeftOut::kNotAHead || why == LeftOut::kNotInMountings || why == LeftOut::kNoEpoch) {
+            ++c.left_out[static_cast<std::size_t>(why)];
+            return;
+        }
+        epochs.add(r.t, r.head, r.line, Judged{r, why});
+    });
+    epochs.finish();
+    sums.finish();
+}
+
+std::string reasons_text(const std::array<std::size_t, kLeftOutKinds>& n) {
+    std::string s;
+    for (std::size_t k = 1; k < kLeftOutKinds; ++k) {
+        if (n[k] != 0U) {
+            s += (s.empty() ? "" : ", ") + std::to_string(n[k]) + " " + left_out_name(static_cast<LeftOut>(k));
+        }
+    }
+    return s.empty() ? std::string("none left out") : s;
+}
+
+// The refusals found after the first pass: no row, a head without clean
+// epochs, too few epochs.
+void refuse_thin_data(const std::string& file, const AlignSums& sums, const PassCounts& c, HeadSet heads,
+                      const AlignOptions& opt) {
+    const std::string where = text::input_name(file) + " in " + period_text(opt.from, opt.to);
+    if (c.rows_in_period == 0U) {
+        throw AlignRefused("the period is empty: no row of " + where);
+    }
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(heads, h) && sums.head_epochs(h) == 0U) {
+            std::size_t n = 0;
+            for (const std::size_t k : c.head_left_out[h]) {
+                n += k;
+            }
+            throw AlignRefused(std::string("CHU ") + kHeadLetters[h] +
+                               " (in the mountings) has no clean epoch with "
+                               "another head of " +
+                               where + ": " + std::to_string(n) + " rows (" + reasons_text(c.head_left_out[h]) + ")");
+        }
+    }
+    if (sums.joint_epochs() < opt.min_epochs) {
+        throw AlignRefused("too few epochs: " + std::to_string(sums.joint_epochs()) +
+                           " with two or more usable heads of " + where + ", align needs " +
+                           std::to_string(opt.min_epochs));
+    }
+}
+
+double largest(const Alignment& a) {
+    double m = 0.0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(a.heads, h)) {
+            m = std::max(m, a.delta_arcsec[h].cwiseAbs().maxCoeff());
+        }
+    }
+    return m;
+}
+
+// The rotation (CRF axes, arcsec) head h's current mounting is turned by from the given one.
+Eigen::Vector3d turned_from(const MountingsFile& m, const CurrentMountings& q, std::uint8_t h) noexcept {
+    return rotation_arcsec(conjugate(m.mountings.head[h].q_chu_crf) * q[h], {1.0, 0.0, 0.0, 0.0});
+}
+
+HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
+    HeadSet s = 0U;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        s |= m.mountings.head[h].present ? head_bit(h) : 0U;
+    }
+    return s;
+}
+
+}  // namespace
+
+AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
+                       const AlignOptions& opt) {
+    try {
+        refuse_bad_time_range(opt.from, opt.to);
+    } catch (const std::invalid_argument& e) {
+        throw AlignRefused(e.what());
+    }
+    AlignReport r;
+    r.in = file;
+    r.from = opt.from;
+    r.to = opt.to;
+    r.noise_window_s = opt.noise_window_s;
+    r.heads = heads_of_mountings(m);
+    if (head_count(r.heads) < 2U) {
+        throw AlignRefused("the mountings have " + std::to_string(head_count(r.heads)) +
+                           " head: align needs two or more (their relative attitudes are its data)");
+    }
+    CurrentMountings q{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        q[h] = m.mountings.head[h].present ? m.mountings.head[h].q_chu_crf : Quaternion<double>{1.0, 0.0, 0.0, 0.0};
+    }
+    Alignment a;
+    std::array<Eigen::Matrix3d, kMaxHeads> w{};
+    r.last_update_arcsec = std::numeric_limits<double>::infinity();
+    for (r.passes = 1; r.passes <= kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec); ++r.passes) {
+        AlignSums sums(opt.noise_window_s);
+        PassCounts c;
+        run_pass(rows, file, m, q, opt, sums, c);
+        if (r.passes == 1) {
+            refuse_thin_data(file, sums, c, r.heads, opt);
+            r.rows = c.rows;
+            r.rows_in_period = c.rows_in_period;
+            r.rows_left_out = c.left_out;
+            r.epochs = c.epochs;
+            r.joint_epochs = sums.joint_epochs();
+            r.single_epochs = sums.single_epochs();
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                r.head[h].epochs = sums.head_epochs(h);
+            }
+        }
+        std::array<Eigen::Vector3d, kMaxHeads> b{};
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            b[h] = boresight_crf(q[h]);
+        }
+        try {
+            r.noise = estimate_noise(sums, r.heads, b);
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                w[h] = information_crf(q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec);
+            }
+            std::array<Eigen::Vector3d, kMaxHeads> turned{};
+            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+                turned[h] = has_head(r.heads, h) ? turned_from(m, q, h) : Eigen::Vector3d::Zero();
+            }
+            a = solve_alignment(sums, r.heads, w, turned);
+        } catch (const std::invalid_argument& e) {
+            throw AlignRefused(e.what());
+        }
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            if (has_head(r.heads, h)) {
+                q[h] = canonical(renormalized(q[h] * rotation_quaternion(a.delta_arcsec[h])));
+            }
+        }
+        r.last_update_arcsec = largest(a);
+    }
+    --r.passes;
+    if (!(r.last_update_arcsec < kAlignToleranceArcsec)) {
+        throw AlignRefused("the mountings did not converge in " + std::to_string(kMaxAlignPasses) +
+                           " passes (the last turned a head by " + number_text(r.last_update_arcsec) +
+                           " arcsec): are the given mountings within a degree of the heads'?");
+    }
+    Eigen::Matrix3d w_sum = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d wr = Eigen::Vector3d::Zero();
+    r.aligned.sigmas = true;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const combine::HeadMounting& given = m.mountings.head[h];
+        combine::HeadMounting& out = r.aligned.mountings.head[h];
+        out = given;
+        r.aligned.line[h] = 0;
+        if (!given.present) {
+            continue;
+        }
+        HeadAlignment& ha = r.head[h];
+        out.q_chu_crf = q[h];
+        out.sigma_cross_arcsec = r.noise.head[h].sigma_cross_arcsec;
+        out.sigma_about_arcsec = r.noise.head[h].sigma_about_arcsec;
+        ha.noise = r.noise.head[h];
+        ha.given_sigma_cross_arcsec = m.sigmas ? given.sigma_cross_arcsec : std::nan("");
+        ha.given_sigma_about_arcsec = m.sigmas ? given.sigma_about_arcsec : std::nan("");
+        ha.rotation_arcsec = turned_from(m, q, h);
+        ha.rotation_sd_arcsec = a.covariance[h].diagonal().cwiseMax(0.0).cwiseSqrt();
+        w_sum += w[h];
+        wr += w[h] * ha.rotation_arcsec;
+    }
+    r.weighted_mean_arcsec = w_sum.inverse() * wr;
+    return r;
+}
+
+CorrectedRowSource rows_of_file(const std::string& path) {
+    return [path](const std::function<void(const CorrectedRow&)>& fn) { for_each_corrected_row(path, fn, "align"); };
+}
+
+AlignReport align_file(const AlignOptions& opt) {
+    refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
+    const MountingsFile m = read_mountings_file(opt.mountings);
+    AlignReport r = align_rows(rows_of_file(opt.in), opt.in, m, opt);
+    r.mountings = opt.mountings;
+    r.out = opt.out;
+    write_mountings_file(opt.out, r.aligned);
+    return r;
+}
+
+namespace {
+
+std::string fixed(double x, int decimals) {
+    char buf[64];
+    text::c_snprintf(buf, sizeof buf, "%.*f", decimals, x);
+    return buf;
+}
+
+}  // namespace
+
+std::string describe(const AlignReport& r) {
+    std::ostringstream s;
+    s << "align: " << text::input_name(r.in) << ", " << period_text(r.from, r.to) << ": " << r.rows_in_period
+      << " rows, " << r.epochs << " epochs of the mountings' heads, " << r.joint_epochs
+      << " with two or more usable heads (used), " << r.single_epochs << " with one\n";
+    s << "rows left out: " << reasons_text(r.rows_left_out) << "\n";
+    s << "noise: REML from the heads' relative attitudes about their mean over " << fixed(r.noise_window_s, 0)
+      << " s windows (" << fixed(r.noise.dof, 0) << " degrees of freedom), " << noise_model_text(r.noise.model) << ", "
+      << r.noise.iterations << " iterations" << (r.noise.converged ? "" : " (not converged)") << "\n";
+    s << "mountings: " << r.passes << " passes, last update " << number_text(r.last_update_arcsec)
+      << " arcsec; CRF kept: information-weighted mean rotation (x, y, z) " << fixed(r.weighted_mean_arcsec.x(), 6)
+      << " " << fixed(r.weighted_mean_arcsec.y(), 6) << " " << fixed(r.weighted_mean_arcsec.z(), 6) << " arcsec\n";
+    s << "head  epochs  rotation from the given mounting, CRF x, y, z (arcsec +- 1 sigma)    "
+         "sigma_cross (arcsec)  sigma_about (arcsec)\n";
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!has_head(r.heads, h)) {
+            continue;
+        }
+        const HeadAlignment& a = r.head[h];
+        char line[400];
+        text::c_snprintf(line, sizeof line,
+                         "%c     %7zu  %+10.3f +- %.3f  %+10.3f +- %.3f  %+10.3f +- %.3f    %7.3f +- %.3f     %7.3f +- "
+                         "%.3f\n",
+                         kHeadLetters[h], a.epochs, a.rotation_arcsec.x(), a.rotation_sd_arcsec.x(),
+                         a.rotation_arcsec.y(), a.rotation_sd_arcsec.y(), a.rotation_arcsec.z(),
+                         a.rotation_sd_arcsec.z(), a.noise.sigma_cross_arcsec, a.noise.sd_cross_arcsec,
+                         a.noise.sigma_about_arcsec, a.noise.sd_about_arcsec);
+        s << line;
+    }
+    return s.str();
+}
+
+}  // namespace ascorr::host

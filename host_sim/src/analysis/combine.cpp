@@ -1,0 +1,582 @@
+#include "ascorr_host/analysis/combine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "ascorr/combine/combined_status.hpp"
+#include "ascorr/combine/combiner.hpp"
+#include "ascorr/core/constants.hpp"
+#include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/combined_stats.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/atomic_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/diagnostics.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_name.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+namespace cs = combine::combined_status;
+
+constexpr StatusBits kStagesApplied = status::kAberrationApplied | status::kThermalApplied;
+constexpr StatusBits kStageSkipped =
+    status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
+constexpr double kMaxCleanConfidence = 5.0;  // arcsec: Statistics' clean rows (docs/contract.md)
+
+constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
+                                                      "flagged",
+                                                      "confidence above 5",
+                                                      "rejected (16)",
+                                                      "stage skipped (4, 8, 128, 256)",
+                                                      "stage missing",
+                                                      "not a head",
+                                                      "not in the mountings",
+                                                      "two rows of one head",
+                                                      "inconsistent",
+                                                      "quaternion not unit",
+                                                      "in no epoch"};
+
+// A row as kept between reading and combining (48 bytes, 56 with its key): whether it is
+// usable is decided when it is read, from what needs no other row.
+struct Kept {
+    double t;
+    Quaternion<double> q;
+    std::uint32_t line;  // (a file of 4e9 lines is beyond any recording)
+    std::uint8_t head;
+    LeftOut why;
+    std::uint8_t stages;  // status & (1|2) of a corrected row; 0 for a raw one
+};
+
+}  // namespace
+
+LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept {
+    if (r.head >= kMaxHeads) {
+        return LeftOut::kNotAHead;
+    }
+    if (!m.mountings.head[r.head].present) {
+        return LeftOut::kNotInMountings;
+    }
+    if (r.corrected && (r.status & status::kRejected) != 0U) {
+        return LeftOut::kRejected;
+    }
+    if (r.flags != 0) {
+        return LeftOut::kFlagged;
+    }
+    if (!(r.confidence <= kMaxCleanConfidence)) {
+        return LeftOut::kConfidence;
+    }
+    if (r.corrected && (r.status & kStageSkipped) != 0U) {
+        return LeftOut::kStageSkipped;
+    }
+    return LeftOut::kUsed;
+}
+
+namespace {
+
+std::string time_text(double t) {
+    char buf[48];
+    text::c_snprintf(buf, sizeof buf, "%.3f", t);
+    return buf;
+}
+
+}  // namespace
+
+const char* left_out_name(LeftOut why) noexcept {
+    return kLeftOutNames[static_cast<std::size_t>(why)];
+}
+
+std::string describe(const CombineSummary& s) {
+    std::ostringstream o;
+    o << s.epochs << " epochs from " << s.rows << " rows";
+    for (std::size_t b = 0; b < s.status_bit.size(); ++b) {
+        o << (b == 0 ? ": " : ", ") << s.status_bit[b] << ' ' << cs::kBitNames[b] << " (" << (1U << b) << ')';
+    }
+    o << "; rows averaged in " << s.rows_left_out[0];
+    bool any = false;
+    for (std::size_t k = 1; k < kLeftOutKinds; ++k) {
+        if (s.rows_left_out[k] != 0) {
+            o << (any ? ", " : "; left out: ") << s.rows_left_out[k] << ' ' << kLeftOutNames[k];
+            any = true;
+        }
+    }
+    if (s.out_of_order) {
+        o << "; rows out of time order: sorted";
+    }
+    // Most heads first (AB, AC, BC, then A, B, C).
+    std::vector<std::uint32_t> sets;
+    for (std::uint32_t set = 1; set < s.steps.size(); ++set) {
+        if (s.steps[set].days != 0) {
+            sets.push_back(set);
+        }
+    }
+    std::stable_sort(sets.begin(), sets.end(),
+                     [](std::uint32_t a, std::uint32_t b) { return head_count(a) > head_count(b); });
+    if (!sets.empty()) {
+        o << "\nsteps from " << head_letters(s.full)
+          << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
+    }
+    for (const std::uint32_t set : sets) {
+        const HeadSetStep& st = s.steps[set];
+        char buf[128];
+        text::c_snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(),
+                         st.rms_daily_mean[0], st.rms_daily_mean[1], st.rms_daily_mean[2], st.days);
+        o << buf;
+    }
+    return o.str();
+}
+
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) {
+    const std::string name = text::input_name(path);
+    if (!m.sigmas) {
+        throw std::runtime_error(name +
+                                 ": the mountings have no sigma_cross,sigma_about: give each head's noise (arcsec "
+                                 "across and about its boresight), or correct first and `ascorr combine` the "
+                                 "corrected file, which estimates it from the data");
+    }
+    std::uint8_t head = 0;
+    const combine::MountingsProblem p = combine::check_mountings(m.mountings, &head);
+    if (p != combine::MountingsProblem::kNone) {
+        const bool one_head = head < kMaxHeads && m.line[head] != 0;
+        if (one_head) {
+            throw InputError(path, m.line[head], 1,
+                             std::string("CHU ") + head_name(head) + ": " + combine::problem_text(p));
+        }
+        throw std::runtime_error(name + ": " + combine::problem_text(p));
+    }
+}
+
+struct CombineStage::Impl {
+    Impl(const MountingsFile& mountings, const std::string& out_path, std::string file_name, std::ostream& log,
+         Mode mode_)
+        : m(mountings),
+          combiner(mountings.mountings),
+          out(out_path),
+          file(std::move(file_name)),
+          diag(log),
+          mode(out.streamed() ? Mode::kKeep : mode_) {
+        buf += kCombinedHeader;
+        buf += '\n';
+    }
+
+    void add(const CorrectedRow& r) {
+        ++sum.rows;
+        if (!(std::abs(r.t) < kMaxEpochTimeS)) {
+            ++sum.rows_left_out[static_cast<std::size_t>(LeftOut::kNoEpoch)];
+            diag.report("in no epoch", where(r.line) + "t = " + number_text(r.t) +
+                                           " s has no millisecond key: the row is in no epoch");
+            return;
+        }
+        Kept k{r.t,    r.q_chu_icrf,       static_cast<std::uint32_t>(r.line),
+               r.head, why_unusable(r, m), static_cast<std::uint8_t>(r.corrected ? (r.status & kStagesApplied) : 0U)};
+        const std::int64_t key = epoch_key(r.t);
+        if (mode == Mode::kKeep) {
+            kept.push_back({key, k});
+            return;
+        }
+        if (!epoch.empty() && key != epoch_key_) {
+            if (key < epoch_key_) {
+                throw RowsOutOfOrder{r.line};
+            }
+            emit(epoch);
+            epoch.clear();
+        }
+        epoch_key_ = key;
+        epoch.push_back(k);
+    }
+
+    void finish() {
+        if (mode == Mode::kKeep) {
+            std::stable_sort(kept.begin(), kept.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            for (std::size_t i = 0; i < kept.size();) {
+                epoch.clear();
+                std::size_t j = i;
+                for (; j < kept.size() && kept[j].first == kept[i].first; ++j) {
+                    epoch.push_back(kept[j].second);
+                }
+                emit(epoch);
+                i = j;
+            }
+            kept.clear();
+        } else if (!epoch.empty()) {
+            emit(epoch);
+        }
+        epoch.clear();
+        out.write(buf);
+        buf.clear();
+        diag.summarize();
+        finish_steps();
+    }
+
+    std::string where(std::size_t line) const { return text::input_name(file) + ":" + std::to_string(line) + ": "; }
+
+    // Two rows of one head: both left out, named with the first's line.
+    void mark_duplicates(std::vector<Kept>& rows) {
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            for (std::size_t j = i + 1; j < rows.size(); ++j) {
+                if (rows[i].head == rows[j].head && rows[i].head < kMaxHeads) {
+                    if (rows[j].why != LeftOut::kDuplicate) {
+                        diag.report("two rows of one head",
+                                    where(rows[j].line) + "a second row of CHU " + head_name(rows[j].head) +
+                                        " at t = " + time_text(rows[j].t) + " (the first on line " +
+                                        std::to_string(rows[i].line) + "): both left out (status 4)");
+                    }
+                    rows[i].why = LeftOut::kDuplicate;
+                    rows[j].why = LeftOut::kDuplicate;
+                }
+            }
+        }
+    }
+
+    // A usable row without a stage applied to another usable row of the epoch.
+    void mark_missing_stages(std::vector<Kept>& rows) {
+        std::uint8_t stages = 0;
+        for (const Kept& k : rows) {
+            stages = static_cast<std::uint8_t>(stages | (k.why == LeftOut::kUsed ? k.stages : 0U));
+        }
+        for (Kept& k : rows) {
+            if (k.why == LeftOut::kUsed && k.stages != stages) {
+                k.why = LeftOut::kStageMissing;
+                diag.report("stage missing", where(k.line) + "CHU " + head_name(k.head) + " at t = " + time_text(k.t) +
+                                                 ": status " + std::to_string(k.stages) +
+                                                 " lacks a stage applied to another head of the epoch (status " +
+                                                 std::to_string(stages) + "): left out (status 4)");
+            }
+        }
+    }
+
+    void report_left_out(const Kept& k) {
+        if (k.why == LeftOut::kNotInMountings) {
+            diag.report("not in the mountings", where(k.line) + "CHU " + head_name(k.head) + " at t = " +
+                                                    time_text(k.t) + " is not in the mountings: left out (status 4)");
+        } else if (k.why == LeftOut::kNotAHead) {
+            diag.report("not a head",
+                        where(k.line) + "chu is not a camera head (" + kHeadChoices.text + "): left out (status 4)");
+        } else if (k.why == LeftOut::kNotUnit) {
+            diag.report("quaternion not unit", where(k.line) + "CHU " + head_name(k.head) +
+                                                   " at t = " + time_text(k.t) +
+                                                   ": the quaternion is not unit: left out (status 4)");
+        } else if (k.why == LeftOut::kInconsistent) {
+            diag.report("inconsistent", where(k.line) + "CHU " + head_name(k.head) + " at t = " + time_text(k.t) +
+                                            " disagrees with the other heads beyond the combiner's gate: left out "
+                                            "(status 4)");
+        }
+    }
+
+    // The full set's epoch combined again with each proper subset (HeadSetStep).
+    void add_steps(const combine::HeadAttitude<double>* heads, std::uint8_t n, const Quaternion<double>& q_full,
+                   double t) {
+        if (!any_epoch) {
+            t_first = t;
+            any_epoch = true;
+        }
+        const auto day = static_cast<long long>(std::floor((t - t_first) / kSecondsPerDay));
+        combine::HeadAttitude<double> subset[kMaxHeads];
+        for (std::uint32_t set = 1; set < mounted; ++set) {
+            if ((set & ~mounted) != 0U) {
+                continue;
+            }
+            for (std::uint8_t i = 0; i < n; ++i) {
+                subset[i] = heads[i];
+                subset[i].usable = has_head(set, heads[i].head);
+            }
+            const combine::CombinedAttitude<double> c = combiner.combine(subset, n);
+            if (c.used != set) {
+                continue;  // the gate left a head of the subset out: no step of this set
+            }
+            DaySum& d = daily[set][day];
+            const std::array<double, 3> v = difference_arcsec(c.q_crf_icrf, q_full);
+            ++d.n;
+            for (std::size_t a = 0; a < 3; ++a) {
+                d.sum[a] += v[a];
+            }
+        }
+    }
+
+    void finish_steps() {
+        sum.full = mounted;
+        for (std::uint32_t set = 1; set < mounted; ++set) {
+            HeadSetStep& st = sum.steps[set];
+            std::array<double, 3> sq{};
+            for (const auto& [day, d] : daily[set]) {
+                for (std::size_t a = 0; a < 3; ++a) {
+                    const double mean = d.sum[a] / static_cast<double>(d.n);
+                    sq[a] += mean * mean;
+                }
+                ++st.days;
+            }
+            for (std::size_t a = 0; a < 3; ++a) {
+                st.rms_daily_mean[a] = st.days == 0 ? 0.0 : std::sqrt(sq[a] / static_cast<double>(st.days));
+            }
+        }
+    }
+
+    void emit(std::vector<Kept>& rows) {
+        // Heads in index order (then lines): the combiner's reference and sums,
+        // hence the bits, are the same in any row order.
+        std::sort(rows.begin(), rows.end(), [](const Kept& a, const Kept& b) {
+            return a.head < b.head || (a.head == b.head && a.line < b.line);
+        });
+        mark_duplicates(rows);
+        mark_missing_stages(rows);
+        combine::HeadAttitude<double> heads[kMaxHeads];
+        std::size_t used_row[kMaxHeads] = {};
+        std::uint8_t n = 0;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            if (rows[i].why == LeftOut::kUsed) {  // heads unique by now: at most kMaxHeads
+                used_row[n] = i;
+                heads[n++] = {rows[i].q, rows[i].head, true};
+            }
+        }
+        const combine::CombinedAttitude<double> c = combiner.combine(heads, n);
+        for (std::uint8_t i = 0; i < n; ++i) {
+            const combine::HeadMask bit = combine::head_bit(heads[i].head);
+            if ((c.used & bit) == 0U) {
+                rows[used_row[i]].why = (c.inconsistent & bit) != 0U ? LeftOut::kInconsistent : LeftOut::kNotUnit;
+            }
+        }
+        bool left_out = false;
+        for (const Kept& k : rows) {
+            left_out = left_out || k.why != LeftOut::kUsed;
+            ++sum.rows_left_out[static_cast<std::size_t>(k.why)];
+            report_left_out(k);
+        }
+        AttitudeRow row;
+        row.t = rows.front().t;  // the epoch's earliest t, as written: the same in any row order
+        for (const Kept& k : rows) {
+            row.t = std::min(row.t, k.t);
+        }
+        row.status = static_cast<unsigned>(c.status | (left_out ? cs::kHeadLeftOut : 0U));
+        row.has_q = (c.status & cs::kNoHead) == 0U;
+        if (row.has_q) {
+            row.q_crf_icrf = c.q_crf_icrf;
+            row.heads = c.used;
+            const double* s = combiner.sigma_arcsec(c.subset);
+            row.sigma_arcsec = {s[0], s[1], s[2]};
+        }
+        if (c.used == mounted && head_count(mounted) >= 2) {
+            add_steps(heads, n, c.q_crf_icrf, row.t);
+        }
+        for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
+            sum.status_bit[b] += (row.status >> b) & 1U;
+        }
+        ++sum.epochs;
+        append_combined_row(buf, row);
+        if (buf.size() > (1U << 20)) {
+            out.write(buf);
+            buf.clear();
+        }
+    }
+
+    const MountingsFile& m;
+    combine::Combiner<double> combiner;
+    AtomicFile out;
+    std::string file;
+    Diagnostics diag;
+    Mode mode;
+    std::string buf;
+    std::vector<Kept> epoch;
+    std::int64_t epoch_key_ = 0;
+    std::vector<std::pair<std::int64_t, Kept>> kept;
+    CombineSummary sum;
+    // The steps (HeadSetStep): per subset, per day, the sum of d_S.
+    struct DaySum {
+        std::size_t n = 0;
+        std::array<double, 3> sum{};
+    };
+    std::uint32_t mounted = combiner.mounted();
+    std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
+    double t_first = 0.0;
+    bool any_epoch = false;
+};
+
+CombineStage::CombineStage(const MountingsFile& m, const std::string& out, std::string file, std::ostream& log,
+                           Mode mode)
+    : impl_(std::make_unique<Impl>(m, out, std::move(file), log, mode)) {}
+
+CombineStage::~CombineStage() = default;
+
+void CombineStage::add(const CorrectedRow& row) {
+    impl_->add(row);
+}
+
+void CombineStage::finish() {
+    impl_->finish();
+}
+
+const CombineSummary& CombineStage::summary() const noexcept {
+    return impl_->sum;
+}
+
+void CombineStage::commit() {
+    impl_->out.commit();
+}
+
+namespace {
+
+// The status field of a corrected row, an integer of the status bits.
+StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, int col) {
+    const std::string_view f = reader.fields()[static_cast<std::size_t>(col)];
+    const auto v = parse_integer(f);
+    if (!v || *v < 0 || *v > 0xFFFF) {
+        std::size_t column = 1;
+        for (int i = 0; i < col; ++i) {
+            column += reader.fields()[static_cast<std::size_t>(i)].size() + 1;
+        }
+        throw InputError(reader.file_name(), rec.line, column, "column 'status': " + why_not_an_integer(f, 0, 0xFFFF));
+    }
+    return static_cast<StatusBits>(*v);
+}
+
+CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, std::ostream& log,
+                            CombineStage::Mode mode) {
+    CombineStage stage(m, opt.out, opt.in, log, mode);
+    for_each_corrected_row(
+        opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
+    stage.finish();
+    CombineSummary s = stage.summary();
+    stage.commit();
+    return s;
+}
+
+}  // namespace
+
+void for_each_corrected_row(const std::string& path, const std::function<void(const CorrectedRow&)>& fn,
+                            const std::string& label) {
+    int status_col = -1;
+    for_each_solution_row(
+        path, [&status_col](const SolutionsReader& h) { status_col = h.header().index(kStatusColumn); },
+        [&](const SolutionsReader& reader, const SolutionRecord& rec) {
+            CorrectedRow r;
+            r.t = rec.t;
+            r.line = rec.line;
+            r.head = rec.head;
+            r.q_chu_icrf = rec.q_chu_icrf;
+            r.flags = rec.flags;
+            r.confidence = rec.confidence;
+            r.corrected = status_col >= 0;
+            r.status = r.corrected ? status_of(reader, rec, status_col) : StatusBits{0};
+            fn(r);
+        },
+        label);
+}
+
+namespace {
+
+// Whether the corrected file goes to a stream (standard output, a device, a
+// FIFO: atomic_file.hpp's rule): it cannot be written twice, so the rows are
+// kept from the start instead of a second run on rows out of order.
+bool streamed_output(const std::string& path) {
+    if (path == "-" || path.rfind("/dev/", 0) == 0 || path.rfind("/proc/", 0) == 0) {
+        return true;
+    }
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    return !ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st);
+}
+
+}  // namespace
+
+CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
+                                      const std::string& combined, std::ostream& log) {
+    refuse_output_over_input(
+        {{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}, {"--mountings", mountings}},
+        {{"--out", opt.out}, {"--model-history", opt.model_history}, {"--combined", combined}});
+    refuse_same_output({"--out", opt.out}, {"--combined", combined});
+    const MountingsFile m = read_mountings_file(mountings);
+    refuse_unusable_mountings(m, mountings);
+    const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
+        CombineStage stage(m, combined, opt.in, to, mode);
+        CorrectAndCombine r;
+        r.corrected = correct_file(opt, to, &stage);
+        r.combined = stage.summary();
+        return r;
+    };
+    if (streamed_output(opt.out)) {
+        return pass(CombineStage::Mode::kKeep, log);
+    }
+    std::ostringstream first;
+    try {
+        CorrectAndCombine r = pass(CombineStage::Mode::kStream, first);
+        log << first.str();
+        return r;
+    } catch (const RowsOutOfOrder&) {
+    } catch (...) {
+        log << first.str();
+        throw;
+    }
+    CorrectAndCombine r = pass(CombineStage::Mode::kKeep, log);
+    r.combined.out_of_order = true;
+    return r;
+}
+
+namespace {
+
+// m with each head's noise estimated from the rows of `in` (align_rows), reported on log.
+MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in, const std::string& path,
+                                   std::ostream& log) {
+    AlignOptions ao;
+    ao.in = in;
+    ao.mountings = path;
+    const AlignReport r = align_rows(rows_of_file(in), in, m, ao);
+    MountingsFile out = m;
+    out.sigmas = true;
+    std::ostringstream o;
+    o << "ascorr combine: " << text::input_name(path)
+      << " has no sigmas: each head's noise estimated from the data (ascorr align's REML estimate, "
+      << noise_model_text(r.noise.model) << "; arcsec, +- 1 sigma):";
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!m.mountings.head[h].present) {
+            continue;
+        }
+        const HeadNoise& n = r.head[h].noise;
+        out.mountings.head[h].sigma_cross_arcsec = n.sigma_cross_arcsec;
+        out.mountings.head[h].sigma_about_arcsec = n.sigma_about_arcsec;
+        char buf[160];
+        text::c_snprintf(buf, sizeof buf, " %c across %.3f +- %.3f, about %.3f +- %.3f;", head_name(h),
+                         n.sigma_cross_arcsec, n.sd_cross_arcsec, n.sigma_about_arcsec, n.sd_about_arcsec);
+        o << buf;
+    }
+    log << o.str() << '\n';
+    return out;
+}
+
+}  // namespace
+
+CombineSummary combine_file(const CombineOptions& opt, std::ostream& log) {
+    refuse_output_over_input({{"--in", opt.in}, {"--mountings", opt.mountings}}, {{"--out", opt.out}});
+    MountingsFile m = read_mountings_file(opt.mountings);
+    if (!m.sigmas) {
+        m = with_estimated_noise(m, opt.in, opt.mountings, log);
+    }
+    refuse_unusable_mountings(m, opt.mountings);
+    // The first pass's messages wait: if it stops at a row out of order, the
+    // second pass says them again.
+    std::ostringstream first;
+    try {
+        CombineSummary s = combine_pass(opt, m, first, CombineStage::Mode::kStream);
+        log << first.str();
+        return s;
+    } catch (const RowsOutOfOrder&) {
+    } catch (...) {
+        log << first.str();
+        throw;
+    }
+    CombineSummary s = combine_pass(opt, m, log, CombineStage::Mode::kKeep);
+    s.out_of_order = true;
+    return s;
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,298 @@
+#include "ascorr_host/analysis/combined_stats.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/heads.hpp"
+#include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/c_format.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+using Vec = std::array<double, 3>;
+
+struct Sums {
+    std::size_t n = 0;
+    Vec sum{};
+    Vec sum_sq{};
+    void add(const Vec& v) {
+        ++n;
+        for (std::size_t a = 0; a < 3; ++a) {
+            sum[a] += v[a];
+            sum_sq[a] += v[a] * v[a];
+        }
+    }
+    Vec mean() const {
+        Vec m{};
+        for (std::size_t a = 0; a < 3; ++a) {
+            m[a] = n == 0 ? std::nan("") : sum[a] / static_cast<double>(n);
+        }
+        return m;
+    }
+    Vec rms() const {
+        Vec r{};
+        for (std::size_t a = 0; a < 3; ++a) {
+            r[a] = n == 0 ? std::nan("") : std::sqrt(sum_sq[a] / static_cast<double>(n));
+        }
+        return r;
+    }
+};
+
+struct SetAccumulator {
+    std::size_t epochs = 0;
+    Sums error;
+    Sums sigma;
+    std::map<long long, Sums> daily;  // day -> errors
+};
+
+// The truth rows, in time order, read along with the combined file's.
+class TruthCursor {
+public:
+    explicit TruthCursor(const std::string& path) : path_(path), reader_(path) {
+        if (reader_.combined()) {
+            throw InputError(path, 1, 1, "the truth is an attitude file (t,qw,qx,qy,qz), not a combined file");
+        }
+        more_ = reader_.next(row_);
+        key_ = more_ ? epoch_key(row_.t) : 0;
+    }
+    // The truth at key, if it has a row there; keys asked in increasing order.
+    const AttitudeRow* at(std::int64_t key) {
+        while (more_ && key_ < key) {
+            advance();
+        }
+        return more_ && key_ == key ? &row_ : nullptr;
+    }
+
+private:
+    void advance() {
+        const std::int64_t previous = key_;
+        const std::size_t previous_line = row_.line;
+        more_ = reader_.next(row_);
+        if (!more_) {
+            return;
+        }
+        key_ = epoch_key(row_.t);
+        if (key_ <= previous) {
+            throw InputError(path_, row_.line, 1,
+                             "the truth's rows must be in time order, one per epoch (line " +
+                                 std::to_string(previous_line) + " is at or after this one)");
+        }
+    }
+    std::string path_;
+    AttitudeReader reader_;
+    AttitudeRow row_;
+    std::int64_t key_ = 0;
+    bool more_ = false;
+};
+
+std::size_t set_size(std::uint32_t heads) {
+    return head_count(heads);
+}
+
+// Most heads first, then heads.hpp's order (the mask's lowest bits first); none last.
+bool set_order(std::uint32_t a, std::uint32_t b) {
+    if ((a == 0) != (b == 0)) {
+        return b == 0;
+    }
+    if (set_size(a) != set_size(b)) {
+        return set_size(a) > set_size(b);
+    }
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const bool ha = has_head(a, h);
+        const bool hb = has_head(b, h);
+        if (ha != hb) {
+            return ha;
+        }
+    }
+    return false;
+}
+
+void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedStats& s) {
+    const auto full = acc.find(s.full);
+    for (HeadSetReport& r : s.sets) {
+        if (full == acc.end() || r.heads == s.full || r.heads == 0) {
+            continue;
+        }
+        Sums diff;
+        for (const auto& [day, sums] : acc[r.heads].daily) {
+            const auto f = full->second.daily.find(day);
+            if (f == full->second.daily.end()) {
+                continue;
+            }
+            const Vec ms = sums.mean();
+            const Vec mf = f->second.mean();
+            diff.add({ms[0] - mf[0], ms[1] - mf[1], ms[2] - mf[2]});
+        }
+        r.step_days = diff.n;
+        r.step = diff.rms();
+    }
+}
+
+}  // namespace
+
+std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
+    const Quaternion<double> d = canonical(a * conjugate(b));
+    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    const double k = s > 0.0 ? 2.0 * std::atan2(s, d.w) / s * kRadToArcsec : 2.0 * kRadToArcsec;
+    return {d.x * k, d.y * k, d.z * k};
+}
+
+std::string head_set_name(std::uint32_t heads) {
+    return heads == 0 ? std::string("-") : head_letters(heads);
+}
+
+CombinedStats combined_stats(const CombinedStatsOptions& opt) {
+    AttitudeReader reader(opt.combined);
+    if (!reader.combined()) {
+        throw InputError(opt.combined, 1, 1,
+                         "expected a combined file (t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status)");
+    }
+    std::optional<TruthCursor> truth;
+    if (!opt.truth.empty()) {
+        truth.emplace(opt.truth);
+    }
+    CombinedStats s;
+    s.truth = truth.has_value();
+    std::map<std::uint32_t, SetAccumulator> acc;
+    AttitudeRow row;
+    double t0 = 0.0;
+    std::int64_t last_key = 0;
+    while (reader.next(row)) {
+        const std::int64_t key = epoch_key(row.t);
+        if (s.epochs != 0 && key <= last_key) {
+            throw InputError(opt.combined, row.line, 1,
+                             "a combined file has one row per epoch, in time order: this row is not after the last");
+        }
+        t0 = s.epochs == 0 ? row.t : t0;
+        last_key = key;
+        ++s.epochs;
+        for (std::size_t b = 0; b < s.status_bit.size(); ++b) {
+            s.status_bit[b] += (row.status >> b) & 1U;
+        }
+        SetAccumulator& a = acc[row.heads];
+        ++a.epochs;
+        if (!truth || !row.has_q) {
+            continue;
+        }
+        const AttitudeRow* tr = truth->at(key);
+        if (tr == nullptr) {
+            ++s.epochs_without_truth;
+            continue;
+        }
+        const Vec e = difference_arcsec(row.q_crf_icrf, tr->q_crf_icrf);
+        a.error.add(e);
+        a.sigma.add(row.sigma_arcsec);
+        a.daily[static_cast<long long>(std::floor((row.t - t0) / kSecondsPerDay))].add(e);
+    }
+    std::size_t full_epochs = 0;
+    for (const auto& [heads, a] : acc) {
+        HeadSetReport r;
+        r.heads = heads;
+        r.epochs = a.epochs;
+        r.with_truth = a.error.n;
+        r.error_rms = a.error.rms();
+        r.error_mean = a.error.mean();
+        r.sigma_rms = a.sigma.rms();
+        r.step = {std::nan(""), std::nan(""), std::nan("")};
+        s.sets.push_back(r);
+        const bool fuller = heads != 0 && (set_size(heads) > set_size(s.full) ||
+                                           (set_size(heads) == set_size(s.full) && a.epochs > full_epochs));
+        if (fuller) {
+            s.full = heads;
+            full_epochs = a.epochs;
+        }
+    }
+    std::sort(s.sets.begin(), s.sets.end(),
+              [](const HeadSetReport& a, const HeadSetReport& b) { return set_order(a.heads, b.heads); });
+    if (truth) {
+        steps_against_full(acc, s);
+    }
+    return s;
+}
+
+namespace {
+
+std::string triple(const Vec& v, const char* format) {
+    std::string out;
+    char buf[48];
+    for (std::size_t a = 0; a < 3; ++a) {
+        if (std::isnan(v[a])) {
+            out += a == 0 ? "       -" : "        -";
+            continue;
+        }
+        text::c_snprintf(buf, sizeof buf, format, a == 0 ? "" : " ", v[a]);
+        out += buf;
+    }
+    return out;
+}
+
+std::string json_triple(const Vec& v) {
+    if (std::isnan(v[0]) || std::isnan(v[1]) || std::isnan(v[2])) {
+        return "null";
+    }
+    char buf[96];
+    text::c_snprintf(buf, sizeof buf, "[%.6f, %.6f, %.6f]", v[0], v[1], v[2]);
+    return buf;
+}
+
+}  // namespace
+
+std::string combined_stats_table(const CombinedStats& s) {
+    std::ostringstream o;
+    o << s.epochs << " epochs: " << s.status_bit[0] << " two or more heads (1), " << s.status_bit[1]
+      << " one head (2), " << s.status_bit[2] << " a head left out (4), " << s.status_bit[3] << " no usable head (8)\n";
+    if (!s.truth) {
+        o << "heads  epochs\n";
+        for (const HeadSetReport& r : s.sets) {
+            char line[64];
+            text::c_snprintf(line, sizeof line, "%-5s %7zu\n", head_set_name(r.heads).c_str(), r.epochs);
+            o << line;
+        }
+        return o.str();
+    }
+    o << "error against the truth per CRF axis (x y z, arcsec); step: RMS over days of the daily mean error "
+         "minus the full set's ("
+      << head_set_name(s.full) << ")\n";
+    o << "heads  epochs |     RMS error (x y z)     |    mean error (x y z)     |     formal sigma (x y z)  |       "
+         "step (x y z)        days\n";
+    for (const HeadSetReport& r : s.sets) {
+        char head[32];
+        text::c_snprintf(head, sizeof head, "%-5s %7zu", head_set_name(r.heads).c_str(), r.epochs);
+        o << head << " | " << triple(r.error_rms, "%s%8.3f") << " | " << triple(r.error_mean, "%s%8.3f") << " | "
+          << triple(r.sigma_rms, "%s%8.3f") << " | " << triple(r.step, "%s%8.3f");
+        char days[24];
+        text::c_snprintf(days, sizeof days, " %5zu\n", r.step_days);
+        o << days;
+    }
+    if (s.epochs_without_truth != 0) {
+        o << s.epochs_without_truth << " epochs without a truth row (not in the errors)\n";
+    }
+    return o.str();
+}
+
+std::string combined_stats_json(const CombinedStats& s) {
+    std::ostringstream o;
+    o << "{\"epochs\": " << s.epochs << ", \"status\": {\"1\": " << s.status_bit[0] << ", \"2\": " << s.status_bit[1]
+      << ", \"4\": " << s.status_bit[2] << ", \"8\": " << s.status_bit[3] << "}, \"full\": \"" << head_set_name(s.full)
+      << "\", \"head_sets\": {";
+    for (std::size_t i = 0; i < s.sets.size(); ++i) {
+        const HeadSetReport& r = s.sets[i];
+        o << (i ? ", " : "") << '"' << head_set_name(r.heads) << "\": {\"epochs\": " << r.epochs
+          << ", \"with_truth\": " << r.with_truth << ", \"error_rms\": " << json_triple(r.error_rms)
+          << ", \"error_mean\": " << json_triple(r.error_mean) << ", \"sigma_rms\": " << json_triple(r.sigma_rms)
+          << ", \"step\": " << json_triple(r.step) << ", \"step_days\": " << r.step_days << '}';
+    }
+    o << "}}\n";
+    return o.str();
+}
+
+}  // namespace ascorr::host

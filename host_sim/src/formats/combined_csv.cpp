@@ -1,0 +1,236 @@
+#include "ascorr_host/formats/combined_csv.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <vector>
+
+#include "ascorr/core/heads.hpp"
+#include "ascorr/core/scalar_traits.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/input_error.hpp"
+
+namespace ascorr::host {
+
+namespace {
+
+void append_shortest(std::string& out, double x) {
+    char buf[40];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);  // the shortest text that reads back exactly
+    out.append(buf, static_cast<std::size_t>(r.ptr - buf));
+}
+
+void append_quaternion(std::string& out, const Quaternion<double>& q) {
+    char num[64];
+    for (const double c : {q.w, q.x, q.y, q.z}) {
+        out += ',';
+        const char* end = format_fixed(num, num + sizeof num, c, 15);
+        out.append(num, static_cast<std::size_t>(end - num));
+    }
+}
+
+// The columns of either file; heads..status -1 in an attitude file.
+struct Columns {
+    int t = -1;
+    int q[4] = {-1, -1, -1, -1};
+    int heads = -1;
+    int sigma[3] = {-1, -1, -1};
+    int status = -1;
+};
+
+Columns columns_of(const Header& h, const std::string& file, bool& combined) {
+    Columns c;
+    c.t = h.index("t");
+    c.q[0] = h.index("qw");
+    c.q[1] = h.index("qx");
+    c.q[2] = h.index("qy");
+    c.q[3] = h.index("qz");
+    c.heads = h.index("heads");
+    c.sigma[0] = h.index("sigma_x");
+    c.sigma[1] = h.index("sigma_y");
+    c.sigma[2] = h.index("sigma_z");
+    c.status = h.index("status");
+    const bool attitude = c.t >= 0 && c.q[0] >= 0 && c.q[1] >= 0 && c.q[2] >= 0 && c.q[3] >= 0;
+    combined = attitude && c.heads >= 0 && c.sigma[0] >= 0 && c.sigma[1] >= 0 && c.sigma[2] >= 0 && c.status >= 0;
+    if (!attitude) {
+        throw InputError(file, 1, 1,
+                         "expected the header of an attitude file (" + std::string(kAttitudeHeader) +
+                             ") or of a combined file (" + std::string(kCombinedHeader) + ")");
+    }
+    return c;
+}
+
+class RowParser {
+public:
+    RowParser(std::string file, const Columns& c, bool combined) : file_(std::move(file)), c_(c), combined_(combined) {}
+
+    AttitudeRow parse(std::string_view line, std::size_t n) {
+        AttitudeRow row;
+        row.line = n;
+        line_ = n;
+        if (const std::size_t bad = split_fields(line, fields_, starts_); bad != kSplitOk) {
+            throw InputError(file_, n, bad + 1, why_split_failed(line, bad));
+        }
+        row.t = number(c_.t, "t");
+        if (!std::isfinite(row.t)) {
+            fail(c_.t, "'t' must be a finite time");
+        }
+        const int empty_q = int(field(c_.q[0]).empty()) + int(field(c_.q[1]).empty()) + int(field(c_.q[2]).empty()) +
+                            int(field(c_.q[3]).empty());
+        row.has_q = empty_q == 0;
+        if (!row.has_q && (empty_q != 4 || !combined_)) {
+            fail(c_.q[0], combined_ ? "qw,qx,qy,qz: four numbers, or four empty fields (no usable head)"
+                                    : "qw,qx,qy,qz: an attitude file has a quaternion on every row");
+        }
+        if (row.has_q) {
+            row.q_crf_icrf = {number(c_.q[0], "qw"), number(c_.q[1], "qx"), number(c_.q[2], "qy"),
+                              number(c_.q[3], "qz")};
+            if (!norm_within(row.q_crf_icrf, ScalarTraits<double>::unit_norm_tolerance)) {
+                fail(c_.q[0], "q_crf_icrf is not a unit quaternion");
+            }
+        }
+        if (combined_) {
+            parse_combined(row);
+        }
+        return row;
+    }
+
+private:
+    void parse_combined(AttitudeRow& row) {
+        const std::string_view heads = field(c_.heads);
+        std::uint8_t last = 0;
+        for (std::size_t i = 0; i < heads.size(); ++i) {
+            const std::uint8_t h = head_index(heads[i]);
+            if (h == kUnknownHead || (i > 0 && h <= last)) {
+                fail(c_.heads, "heads must be letters of " + std::string(kHeadLetters) + ", in that order, got '" +
+                                   std::string(heads) + "'");
+            }
+            row.heads |= 1U << h;
+            last = h;
+        }
+        if (row.has_q != (row.heads != 0U)) {
+            fail(c_.heads, "heads and q: both given, or both empty");
+        }
+        for (std::size_t a = 0; a < 3; ++a) {
+            static constexpr const char* kNames[3] = {"sigma_x", "sigma_y", "sigma_z"};
+            row.sigma_arcsec[a] = row.has_q ? number(c_.sigma[a], kNames[a]) : std::nan("");
+        }
+        const std::string_view st = field(c_.status);
+        const auto v = parse_integer(st);
+        if (!v || *v < 0 || *v > 255) {
+            fail(c_.status, "column 'status': " + why_not_an_integer(st, 0, 255));
+        }
+        row.status = static_cast<unsigned>(*v);
+    }
+
+    std::string_view field(int col) const {
+        const auto i = static_cast<std::size_t>(col);
+        if (i >= fields_.size()) {
+            throw InputError(
+                file_, line_, starts_.back() + 1,
+                "expected at least " + std::to_string(i + 1) + " fields, found " + std::to_string(fields_.size()));
+        }
+        return fields_[i];
+    }
+    double number(int col, const char* name) const {
+        const std::string_view f = field(col);
+        const auto x = parse_double(f);
+        if (!x) {
+            fail(col, std::string("column '") + name + "': " + why_not_a_number(f));
+        }
+        return *x;
+    }
+    [[noreturn]] void fail(int col, const std::string& what) const {
+        const auto i = static_cast<std::size_t>(col);
+        throw InputError(file_, line_, (i < starts_.size() ? starts_[i] : 0) + 1, what);
+    }
+
+    std::string file_;
+    Columns c_;
+    bool combined_;
+    std::size_t line_ = 0;
+    std::vector<std::string_view> fields_;
+    std::vector<std::size_t> starts_;
+};
+
+}  // namespace
+
+void append_attitude_row(std::string& out, double t, const Quaternion<double>& q_crf_icrf) {
+    append_shortest(out, t);
+    append_quaternion(out, canonical(q_crf_icrf));
+    out += '\n';
+}
+
+void append_combined_row(std::string& out, const AttitudeRow& row) {
+    append_shortest(out, row.t);
+    if (row.has_q) {
+        append_quaternion(out, canonical(row.q_crf_icrf));
+    } else {
+        out += ",,,,";
+    }
+    out += ',';
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (((row.heads >> h) & 1U) != 0U) {
+            out += head_letter(h);
+        }
+    }
+    for (const double s : row.sigma_arcsec) {
+        out += ',';
+        if (row.has_q) {
+            append_shortest(out, s);
+        }
+    }
+    out += ',';
+    out += std::to_string(row.status);
+    out += '\n';
+}
+
+struct AttitudeReader::Impl {
+    explicit Impl(const std::string& p) : path(p), blocks(p) {
+        if (!blocks.next(block)) {
+            throw InputError(path, 1, 1, "empty file: expected a header line");
+        }
+        const std::size_t nl = block.find('\n');
+        std::string_view header_line = block.substr(0, nl);
+        if (!header_line.empty() && header_line.back() == '\r') {
+            header_line.remove_suffix(1);
+        }
+        const Header header(header_line, path);
+        columns = columns_of(header, path, combined);
+        parser = std::make_unique<RowParser>(path, columns, combined);
+        block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
+        lines = LineReader(block, 1);
+    }
+    bool next(AttitudeRow& row) {
+        for (;;) {
+            std::string_view line;
+            while (lines.next(line)) {
+                if (!line.empty()) {
+                    row = parser->parse(line, lines.line_number());
+                    return true;
+                }
+            }
+            if (!blocks.next(block)) {
+                return false;
+            }
+            lines = LineReader(block, blocks.lines_before());
+        }
+    }
+    std::string path;
+    BlockReader blocks;
+    std::string_view block;
+    LineReader lines{std::string_view()};
+    Columns columns;
+    bool combined = false;
+    std::unique_ptr<RowParser> parser;
+};
+
+AttitudeReader::AttitudeReader(const std::string& path) : impl_(std::make_unique<Impl>(path)) {}
+AttitudeReader::~AttitudeReader() = default;
+bool AttitudeReader::combined() const noexcept {
+    return impl_->combined;
+}
+bool AttitudeReader::next(AttitudeRow& row) {
+    return impl_->next(row);
+}
+
+}  // namespace ascorr::host

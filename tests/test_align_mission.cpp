@@ -1,0 +1,372 @@
+// Issue 28's acceptance checks of `align` on simulated missions (simulate ->
+// correct -> [fit] -> align), against the simulator's truth: its mountings
+// and noise (OUT.mountings.csv, simulate.hpp) and its thermal model.
+//
+// Runtime bound: missions of 3 days at 20 s (12961 epochs) and 30 days at
+// 300 s (8641 epochs); the whole program takes a few seconds.
+//
+// The combined attitude is computed here independently of the combiner, in
+// the information form: per epoch each head's CRF estimate
+// q_crf_icrf_i = q_chu_crf_i* ⊗ q_chu_icrf_i, its rotation θ_i from a
+// reference, and (Σ W_i)⁻¹ Σ W_i θ_i over the heads of a set.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/fit.hpp"
+#include "ascorr_host/analysis/simulate.hpp"
+#include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
+#include "cli_run.hpp"
+
+namespace ascorr::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+    const fs::path d = fs::path(testing::TempDir()) / ("ascorr_align_" + name);
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+// A simulated mission, raw.
+std::string simulate_mission(const fs::path& dir, double days, double step_s, std::uint64_t seed) {
+    SimulateOptions s;
+    s.out = (dir / "mission.csv").string();
+    s.days = days;
+    s.step_s = step_s;
+    s.seed = seed;
+    (void)simulate(s);
+    return s.out;
+}
+
+// The mission corrected: model empty for the aberration stage alone.
+std::string corrected(const std::string& raw, const std::string& model, const std::string& name) {
+    CorrectOptions c;
+    c.in = raw;
+    c.out = (fs::path(raw).parent_path() / name).string();
+    c.model = model;
+    std::ostringstream log;
+    (void)correct_file(c, log);
+    return c.out;
+}
+
+AlignReport run_align(const std::string& in, const MountingsFile& m) {
+    AlignOptions opt;
+    opt.in = in;
+    return align_rows(rows_of_file(in), in, m, opt);
+}
+
+Eigen::Matrix3d information_of(const combine::HeadMounting& m) {
+    return information_crf(m.q_chu_crf, m.sigma_cross_arcsec, m.sigma_about_arcsec);
+}
+
+// ---- The noise estimated from the data
+
+struct NoiseMission {
+    std::string corrected;
+    MountingsFile truth;
+    AlignReport report;
+};
+
+const NoiseMission& noise_mission() {
+    static const NoiseMission m = [] {
+        NoiseMission n;
+        const fs::path dir = scratch("noise");
+        const std::string raw = simulate_mission(dir, 3.0, 20.0, 11);
+        n.truth = read_mountings_file(raw + ".mountings.csv");
+        n.corrected = corrected(raw, raw + ".truth.csv", "corrected.csv");
+        MountingsFile given = n.truth;  // the true mountings without their sigmas
+        given.sigmas = false;
+        n.report = run_align(n.corrected, given);
+        return n;
+    }();
+    return m;
+}
+
+// The estimated σc and σa of each head within 3 % of the simulator's truth
+// (1.5" across, 10" about), and within 4 of their formal σ.
+TEST(AlignMission, EstimatedNoiseIsTheSimulatorsWithinThreePercent) {
+    const NoiseMission& m = noise_mission();
+    EXPECT_EQ(m.report.noise.model, NoiseModel::kPerHead);
+    EXPECT_TRUE(m.report.noise.converged);
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        SCOPED_TRACE(std::string("CHU ") + kHeadLetters[h]);
+        const HeadNoise& n = m.report.head[h].noise;
+        const combine::HeadMounting& t = m.truth.mountings.head[h];
+        std::printf("CHU %c: sigma_cross %.4f +- %.4f (truth %.2f), sigma_about %.4f +- %.4f (truth %.2f)\n",
+                    kHeadLetters[h], n.sigma_cross_arcsec, n.sd_cross_arcsec, t.sigma_cross_arcsec,
+                    n.sigma_about_arcsec, n.sd_about_arcsec, t.sigma_about_arcsec);
+        EXPECT_NEAR(n.sigma_cross_arcsec, t.sigma_cross_arcsec, 0.03 * t.sigma_cross_arcsec);
+        EXPECT_NEAR(n.sigma_about_arcsec, t.sigma_about_arcsec, 0.03 * t.sigma_about_arcsec);
+        EXPECT_NEAR(n.sigma_cross_arcsec, t.sigma_cross_arcsec, 4.0 * n.sd_cross_arcsec);
+        EXPECT_NEAR(n.sigma_about_arcsec, t.sigma_about_arcsec, 4.0 * n.sd_about_arcsec);
+    }
+}
+
+// The expected error per CRF axis of the combination weighted with `used`
+// (gains K_i = (Σ Ŵ)⁻¹ Ŵ_i) when the heads' true noise is `truth`, over the
+// optimal bound sqrt(diag((Σ W_i)⁻¹)): the largest ratio over the axes.
+double worst_ratio(HeadSet set, const std::array<Eigen::Matrix3d, kMaxHeads>& used, const MountingsFile& truth) {
+    Eigen::Matrix3d w_used = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d w_true = Eigen::Matrix3d::Zero();
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(set, h)) {
+            w_used += used[h];
+            w_true += information_of(truth.mountings.head[h]);
+        }
+    }
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(set, h)) {
+            const Eigen::Matrix3d k = w_used.inverse() * used[h];
+            cov += k * information_of(truth.mountings.head[h]).inverse() * k.transpose();
+        }
+    }
+    const Eigen::Vector3d bound = w_true.inverse().diagonal().cwiseSqrt();
+    return (cov.diagonal().cwiseSqrt().array() / bound.array()).maxCoeff();
+}
+
+// With the noise estimated by align (and its mountings), the combined error
+// per CRF axis is within 5 % of the optimal bound for every head set; equal
+// weights (the mutation) are not.
+TEST(AlignMission, CombinedErrorWithEstimatedNoiseIsWithinFivePercentOfTheBound) {
+    const NoiseMission& m = noise_mission();
+    std::array<Eigen::Matrix3d, kMaxHeads> estimated{};
+    std::array<Eigen::Matrix3d, kMaxHeads> equal{};
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        estimated[h] = information_of(m.report.aligned.mountings.head[h]);
+        equal[h] = information_crf(m.report.aligned.mountings.head[h].q_chu_crf, 1.0, 1.0);
+    }
+    double worst_equal = 0.0;
+    for (HeadSet set = 1; set <= kPaperHeads; ++set) {
+        const double r = worst_ratio(set, estimated, m.truth);
+        std::printf("heads %s: error / bound %.4f (equal weights %.3f)\n", head_letters(set).c_str(), r,
+                    worst_ratio(set, equal, m.truth));
+        EXPECT_LE(r, 1.05) << head_letters(set);
+        worst_equal = std::max(worst_equal, worst_ratio(set, equal, m.truth));
+    }
+    EXPECT_GT(worst_equal, 2.0);  // equal weights: about 3 times the bound
+}
+
+// ---- Mountings: a known perturbation, and the CRF kept
+
+// The true mountings with head A's turned by 20" (CRF axes): align removes the
+// relative error. Every head's M2 is then the truth turned by one common
+// rotation c, the datum's: c = (Σ W)⁻¹ W_A p (the weighted mean of the
+// corrections is zero, and only A's was not). Bound: 4 formal σ of the
+// estimate per axis (each below 0.1").
+TEST(AlignMission, RecoversAKnownPerturbationAndKeepsTheCrf) {
+    const NoiseMission& m = noise_mission();
+    const Eigen::Vector3d p(12.0, -16.0, 0.0);  // 20"
+    MountingsFile given = m.truth;
+    given.mountings.head[0].q_chu_crf = given.mountings.head[0].q_chu_crf * rotation_quaternion(p);
+    const fs::path dir = scratch("perturbed");
+    write_mountings_file((dir / "given.csv").string(), given);
+    AlignOptions opt;
+    opt.in = m.corrected;
+    opt.mountings = (dir / "given.csv").string();
+    opt.out = (dir / "aligned.csv").string();
+    const AlignReport r = align_file(opt);
+    const MountingsFile m2 = read_mountings_file(opt.out);
+    Eigen::Matrix3d w_sum = Eigen::Matrix3d::Zero();
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        w_sum += information_of(m2.mountings.head[h]);
+    }
+    const Eigen::Vector3d c = w_sum.inverse() * information_of(m2.mountings.head[0]) * p;
+    Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        SCOPED_TRACE(std::string("CHU ") + kHeadLetters[h]);
+        const Eigen::Vector3d from_truth = rotation_arcsec(
+            conjugate(m.truth.mountings.head[h].q_chu_crf) * m2.mountings.head[h].q_chu_crf, {1.0, 0.0, 0.0, 0.0});
+        std::printf("CHU %c: M2 from the truth %+.4f %+.4f %+.4f, expected %+.4f %+.4f %+.4f\n", kHeadLetters[h],
+                    from_truth.x(), from_truth.y(), from_truth.z(), c.x(), c.y(), c.z());
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_NEAR(from_truth(axis), c(axis), 4.0 * r.head[h].rotation_sd_arcsec(axis)) << axis;
+            EXPECT_LT(r.head[h].rotation_sd_arcsec(axis), 0.1);
+        }
+        const Eigen::Vector3d from_given = rotation_arcsec(
+            conjugate(given.mountings.head[h].q_chu_crf) * m2.mountings.head[h].q_chu_crf, {1.0, 0.0, 0.0, 0.0});
+        weighted += information_of(m2.mountings.head[h]) * from_given;
+    }
+    // The CRF of M is kept: the information-weighted mean of M -> M2 is zero
+    // (to the file's digits and the composition of small rotations).
+    EXPECT_LT((w_sum.inverse() * weighted).norm(), 1e-6);
+    // Mutation check: the perturbation was seen (A turned back by about 20").
+    const Eigen::Vector3d a_back = rotation_arcsec(
+        conjugate(given.mountings.head[0].q_chu_crf) * m2.mountings.head[0].q_chu_crf, {1.0, 0.0, 0.0, 0.0});
+    EXPECT_GT(a_back.norm(), 15.0);
+}
+
+// ---- Steps at head-set changes, with a fitted model
+
+// The clean epochs of a corrected file with all three heads: each head's CRF
+// estimate under the mountings m.
+struct FullEpoch {
+    double t = 0.0;
+    std::array<Quaternion<double>, 3> q_crf_icrf{};
+};
+
+std::vector<FullEpoch> full_epochs(const std::string& path, const MountingsFile& m) {
+    std::vector<FullEpoch> out;
+    EpochAssembler<CorrectedRow> epochs(path, [&](const Epoch<CorrectedRow>& e) {
+        FullEpoch f;
+        f.t = e.t;
+        for (std::uint8_t h = 0; h < 3; ++h) {
+            const std::optional<CorrectedRow>& r = e.head[h];
+            const StatusBits bad = status::kRejected | status::kNoVelocity | status::kNoTemperature |
+                                   status::kThermalOutOfRange | status::kNoModelForHead;
+            if (!r || r->flags != 0 || !(r->confidence <= 5.0) || (r->status & bad) != 0U) {
+                return;
+            }
+            f.q_crf_icrf[h] = conjugate(m.mountings.head[h].q_chu_crf) * r->q_chu_icrf;
+        }
+        out.push_back(f);
+    });
+    rows_of_file(path)([&](const CorrectedRow& r) {
+        if (r.head < 3) {
+            epochs.add(r.t, r.head, r.line, r);
+        }
+    });
+    epochs.finish();
+    return out;
+}
+
+// The step when one head is dropped: RMS over days of the daily mean of
+// (combined with A, B, C) − (combined without the head), the largest over
+// the dropped heads and the CRF axes, arcsec.
+double largest_step(const std::vector<FullEpoch>& epochs, const MountingsFile& m) {
+    std::array<Eigen::Matrix3d, 3> w{};
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        w[h] = information_of(m.mountings.head[h]);
+    }
+    double worst = 0.0;
+    for (std::uint8_t dropped = 0; dropped < 3; ++dropped) {
+        std::map<long long, std::pair<Eigen::Vector3d, std::size_t>> days;
+        for (const FullEpoch& e : epochs) {
+            Eigen::Matrix3d w_all = Eigen::Matrix3d::Zero();
+            Eigen::Matrix3d w_sub = Eigen::Matrix3d::Zero();
+            Eigen::Vector3d s_all = Eigen::Vector3d::Zero();
+            Eigen::Vector3d s_sub = Eigen::Vector3d::Zero();
+            for (std::uint8_t h = 0; h < 3; ++h) {
+                const Eigen::Vector3d theta = rotation_arcsec(e.q_crf_icrf[h], e.q_crf_icrf[0]);
+                w_all += w[h];
+                s_all += w[h] * theta;
+                if (h != dropped) {
+                    w_sub += w[h];
+                    s_sub += w[h] * theta;
+                }
+            }
+            const Eigen::Vector3d step = w_all.inverse() * s_all - w_sub.inverse() * s_sub;
+            auto& d = days[static_cast<long long>(std::floor((e.t - epochs.front().t) / 86400.0))];
+            if (d.second == 0U) {
+                d.first = Eigen::Vector3d::Zero();
+            }
+            d.first += step;
+            ++d.second;
+        }
+        Eigen::Vector3d sum_sq = Eigen::Vector3d::Zero();
+        std::size_t n = 0;
+        for (const auto& kv : days) {
+            if (kv.second.second >= 50U) {  // whole days only (the last may be short)
+                sum_sq += (kv.second.first / static_cast<double>(kv.second.second)).cwiseAbs2();
+                ++n;
+            }
+        }
+        worst = std::max(worst, (sum_sq / static_cast<double>(n)).cwiseSqrt().maxCoeff());
+    }
+    return worst;
+}
+
+// Fitted model (30 days; --min-days 20) and align: dropping any head moves
+// the combined attitude by at most 0.2" (RMS over days of the daily mean).
+// Without the thermal stage (aberration alone, aligned the same way) the
+// steps are the bench's deformation: larger, and the test says by how much.
+TEST(AlignMission, FittedModelAndAlignLeaveNoStepWhenAHeadDrops) {
+    const fs::path dir = scratch("steps");
+    const std::string raw = simulate_mission(dir, 30.0, 120.0, 5);
+    FitOptions f;
+    f.in = raw;
+    f.out = (dir / "fitted.csv").string();
+    f.min_span_days = 20.0;
+    f.selection_report = false;
+    (void)fit_model(f);
+    const MountingsFile nominal = read_mountings_file(raw + ".mountings.csv");
+    double step[2] = {0.0, 0.0};
+    const char* names[2] = {"thermal", "aberration only"};
+    for (int stage = 0; stage < 2; ++stage) {
+        const std::string in = corrected(raw, stage == 0 ? f.out : std::string(), stage == 0 ? "th.csv" : "ab.csv");
+        AlignReport r = run_align(in, nominal);
+        const std::vector<FullEpoch> epochs = full_epochs(in, r.aligned);
+        ASSERT_GT(epochs.size(), 3000U);
+        step[stage] = largest_step(epochs, r.aligned);
+        std::printf("%s: largest step when a head drops %.3f arcsec (RMS over days of the daily mean, %zu epochs)\n",
+                    names[stage], step[stage], epochs.size());
+    }
+    EXPECT_LE(step[0], 0.2);
+    EXPECT_GT(step[1], 2.0 * step[0]);  // what the thermal stage removes
+}
+
+// ---- Refusals: exit 2, naming what and where
+
+TEST(AlignCli, RefusesBadInputWithExit2NamingFileAndLine) {
+    const NoiseMission& m = noise_mission();
+    const fs::path dir = scratch("cli");
+    const auto write = [&](const char* name, const std::string& text) {
+        std::FILE* fp = std::fopen((dir / name).string().c_str(), "w");
+        std::fputs(text.c_str(), fp);
+        std::fclose(fp);
+    };
+    write("not_unit.csv", "chu,qw,qx,qy,qz\nA,1,0,0,0\nB,0.9,0,0,0\n");
+    write("with_d.csv", format_mountings(m.truth) + "D,1,0,0,0,1.5,10\n");
+    write("short.csv", "t,chu,qw,qx,qy,qz,status\n0.0,A,1,0,0,0,3\n0.0,B,1,0,0,0,3\n");
+    write("dup.csv", "t,chu,qw,qx,qy,qz,status\n0.0,A,1,0,0,0,3\n0.0,A,1,0,0,0,3\n");
+    write("truth.csv", format_mountings(m.truth));
+    MountingsFile ab = m.truth;
+    ab.mountings.head[2].present = false;
+    write("ab.csv", format_mountings(ab));
+    const std::string in = " --in " + m.corrected + " --out " + (dir / "m2.csv").string();
+    struct Case {
+        std::string args;
+        std::string says;
+    } cases[] = {
+        {in + " --mountings " + (dir / "not_unit.csv").string(), "not_unit.csv:3"},
+        {in + " --mountings " + (dir / "with_d.csv").string(), "CHU D (in the mountings) has no clean epoch"},
+        {in + " --mountings " + (dir / "truth.csv").string() + " --from 0 --to 1", "the period is empty"},
+        {in + " --mountings " + (dir / "truth.csv").string() + " --from 2 --to 1", "the period is empty"},
+        {" --in " + (dir / "short.csv").string() + " --out " + (dir / "m2.csv").string() + " --mountings " +
+             (dir / "ab.csv").string(),
+         "too few epochs: 1 with two or more usable heads"},
+        {" --in " + (dir / "dup.csv").string() + " --out " + (dir / "m2.csv").string() + " --mountings " +
+             (dir / "truth.csv").string(),
+         "dup.csv:3:1: second solution of CHU A"},
+    };
+    for (const Case& c : cases) {
+        const test::CliRun r = test::run_here("align" + c.args, dir);
+        EXPECT_EQ(r.exit_code, 2) << c.args << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.says), std::string::npos) << c.args << "\n" << r.err;
+        EXPECT_FALSE(fs::exists(dir / "m2.csv")) << c.args;
+    }
+    // And the good run, for contrast (the same command can succeed).
+    const test::CliRun ok = test::run_here("align" + in + " --mountings " + (dir / "truth.csv").string(), dir);
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_TRUE(fs::exists(dir / "m2.csv"));
+}
+
+}  // namespace
+}  // namespace ascorr::host
