@@ -7,7 +7,10 @@
 // (double, float, fixed core; the baseline of bench/baseline.hpp), and RUNS
 // copies in ascorr_bench_overhead. Run under valgrind --tool=callgrind, the
 // inclusive instruction count of each function minus the overhead's, over
-// RUNS, is the host's instructions per solution. It also prints the
+// RUNS, is the host's instructions per solution. The combined attitude
+// (ascorr/combine/) is measured the same way per epoch of three heads
+// (bench/combination_fixture.hpp) in ascorr_bench_<scalar>_combination,
+// against ascorr_bench_combination_overhead (copies). It also prints the
 // baseline's largest difference from the double core over all 2000+ inputs:
 // "baseline_max_error_arcsec x".
 #include <Eigen/Geometry>
@@ -20,6 +23,7 @@
 
 #include "ascorr/ascorr.hpp"
 #include "baseline.hpp"
+#include "combination_fixture.hpp"
 #include "target/vector_convert.hpp"
 
 namespace {
@@ -91,6 +95,41 @@ Fixture<double> g_double;
 Fixture<float> g_float;
 Fixture<Q30> g_fixed;
 
+// The combination: kInputs epochs of three heads per scalar, the combiner
+// built once from the fixture's mountings.
+template <typename T>
+struct CombinationFixture {
+    combine::HeadAttitude<T> epoch[kInputs][bench::kCombinationHeads];
+};
+
+template <typename T>
+CombinationFixture<T> make_combination_fixture() {
+    using Tr = ScalarTraits<T>;
+    CombinationFixture<T> fx{};
+    const combine::Mountings m = bench::combination_mountings();
+    std::uint32_t state = 1U;
+    for (std::size_t i = 0; i < kInputs; ++i) {
+        const double* q = g_records[i].q;
+        Quaternion<double> heads[bench::kCombinationHeads];
+        bench::combination_epoch(m, {q[0], q[1], q[2], q[3]}, &state, heads);
+        for (std::uint8_t h = 0; h < bench::kCombinationHeads; ++h) {
+            fx.epoch[i][h] = {{Tr::from_double(heads[h].w), Tr::from_double(heads[h].x), Tr::from_double(heads[h].y),
+                               Tr::from_double(heads[h].z)},
+                              h,
+                              true};
+        }
+    }
+    return fx;
+}
+
+template <typename T>
+__attribute__((noinline)) void run_combination(const combine::Combiner<T>& c, const CombinationFixture<T>& fx) {
+    for (std::uint32_t i = 0; i < g_runs; ++i) {
+        const combine::CombinedAttitude<T> r = c.combine(fx.epoch[i % kInputs], bench::kCombinationHeads);
+        keep(r);
+    }
+}
+
 template <typename T>
 void run_stages(const Fixture<T>& fx, int stage) {
     const CorrectionConfig<T> cfg[] = {
@@ -133,6 +172,30 @@ ASCORR_BENCH_STAGES(double, ASCORR_CALL_DOUBLE)
 ASCORR_BENCH_STAGES(float, ASCORR_CALL_FLOAT)
 ASCORR_BENCH_STAGES(fixed, ASCORR_CALL_FIXED)
 ASCORR_BENCH_STAGES(baseline, ASCORR_CALL_BASELINE)
+
+const combine::Combiner<double> g_combiner_double{bench::combination_mountings()};
+const combine::Combiner<float> g_combiner_float{bench::combination_mountings()};
+const combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
+CombinationFixture<double> g_combination_double;
+CombinationFixture<float> g_combination_float;
+CombinationFixture<Q30> g_combination_fixed;
+
+extern "C" __attribute__((noinline)) void ascorr_bench_double_combination() {
+    run_combination(g_combiner_double, g_combination_double);
+}
+extern "C" __attribute__((noinline)) void ascorr_bench_float_combination() {
+    run_combination(g_combiner_float, g_combination_float);
+}
+extern "C" __attribute__((noinline)) void ascorr_bench_fixed_combination() {
+    run_combination(g_combiner_fixed, g_combination_fixed);
+}
+extern "C" __attribute__((noinline)) void ascorr_bench_combination_overhead() {
+    for (std::uint32_t i = 0; i < g_runs; ++i) {
+        const combine::CombinedAttitude<Q30> r{
+            g_combination_fixed.epoch[i % kInputs][0].q_chu_icrf, 0U, 0U, 0U, 0U, 0U};
+        keep(r);
+    }
+}
 
 extern "C" __attribute__((noinline)) void ascorr_bench_overhead() {
     for (std::uint32_t i = 0; i < g_runs; ++i) {
@@ -187,6 +250,13 @@ int main(int argc, char** argv) {
     g_double = make_fixture<double>();
     g_float = make_fixture<float>();
     g_fixed = make_fixture<Q30>();
+    g_combination_double = make_combination_fixture<double>();
+    g_combination_float = make_combination_fixture<float>();
+    g_combination_fixed = make_combination_fixture<Q30>();
+    ascorr_bench_combination_overhead();
+    ascorr_bench_double_combination();
+    ascorr_bench_float_combination();
+    ascorr_bench_fixed_combination();
 
     ascorr_bench_overhead();
     ascorr_bench_double_both();

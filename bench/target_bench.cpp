@@ -14,7 +14,7 @@
 // with the random model with quadratic terms (stages *_quadratic), and with
 // both stages off ("neither": validation and renormalisation alone).
 // The baseline (bench/baseline.hpp, double, Eigen) is measured the same way.
-// The Earth ephemeris series (ascorr/earth_series.hpp, double: software floating
+// The Earth ephemeris series (ascorr/nav/earth_series.hpp, double: software floating
 // point on both targets, the M4F's FPU being single precision) is measured per
 // evaluation at kSeriesRuns epochs spread over its span, against a function
 // that only writes its output; the series is the out-of-line entry of

@@ -3,13 +3,15 @@
 // and noise (OUT.mountings.csv, simulate.hpp) and its thermal model.
 //
 // Runtime bound: missions of 3 days at 20 s (12961 epochs) and 30 days at
-// 300 s (8641 epochs); the whole program takes a few seconds.
+// 120 s (21601 epochs); the whole program takes a few seconds.
 //
 // The combined attitude is computed here independently of the combiner, in
 // the information form: per epoch each head's CRF estimate
 // q_crf_icrf_i = q_chu_crf_i* ⊗ q_chu_icrf_i, its rotation θ_i from a
 // reference, and (Σ W_i)⁻¹ Σ W_i θ_i over the heads of a set.
 #include <gtest/gtest.h>
+
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -37,8 +39,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A folder of this process (CTest runs the tests of this program in parallel
+// processes, each building the missions it needs), removed at exit.
 fs::path scratch(const std::string& name) {
-    const fs::path d = fs::path(testing::TempDir()) / ("ascorr_align_" + name);
+    struct Root {
+        fs::path path = fs::path(testing::TempDir()) / ("ascorr_align_" + std::to_string(getpid()));
+        ~Root() {
+            std::error_code ec;
+            fs::remove_all(path, ec);
+        }
+    };
+    static const Root root;
+    const fs::path d = root.path / name;
     fs::remove_all(d);
     fs::create_directories(d);
     return d;

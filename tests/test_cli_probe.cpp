@@ -3,7 +3,7 @@
 // states file with no usable row fails the run, a one-epoch plot window, bounded
 // lines in every reader, usage errors before any input is read, one spelling of
 // the enumerations, '-' on both sides, and a firmware image checked before the
-// emulator starts. Each case is a row of DEVELOPERS.md's bad-input table.
+// emulator starts. Each case is a row of docs/bad-input.md.
 #include <gtest/gtest.h>
 
 #include <cstdint>

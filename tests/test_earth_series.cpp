@@ -1,4 +1,4 @@
-// The on-board Earth ephemeris series (ascorr/earth_series.hpp) against
+// The on-board Earth ephemeris series (ascorr/nav/earth_series.hpp) against
 // liberfa's eraEpv00: barycentric velocity and Sun distance over the whole
 // span, the refusals, a mutation check, and linear interpolation between
 // evaluations N seconds apart (how the velocity service uses it).

@@ -1,5 +1,5 @@
 // tests/test_facts.cpp: one place for each fact. The heads
-// (ascorr/heads.hpp) are defined once; what can include them derives from them,
+// (ascorr/core/heads.hpp) are defined once; what can include them derives from them,
 // and what cannot (documentation, the HAL's role names) is checked here against
 // them, so a copy that drifts fails this test.
 #include <gtest/gtest.h>
@@ -129,7 +129,7 @@ TEST(Heads, DocumentationStatesTheHeadsOfHeadsHpp) {
             want.replace(p, key.size(), std::string(1, static_cast<char>(std::tolower(last_letter()))));
         }
         EXPECT_NE(source_file(d.file).find(want), std::string::npos)
-            << d.file << " no longer says \"" << want << "\" (ascorr/heads.hpp): bring it in step";
+            << d.file << " no longer says \"" << want << "\" (ascorr/core/heads.hpp): bring it in step";
     }
 }
 
@@ -159,7 +159,7 @@ TEST(Heads, NoLetterRangeInTheDocumentationEndsElsewhere) {
           "firmware/link-protocol.md", "python/ascorr/__init__.py", "python/ascorr/__init__.pyi"}) {
         for (const std::string& r : stray_ranges(source_file(file), seen)) {
             ADD_FAILURE() << file << ": '" << r << "' is a range of heads that does not end at " << last_letter()
-                          << " (ascorr/heads.hpp)";
+                          << " (ascorr/core/heads.hpp)";
         }
     }
     EXPECT_GT(seen, 2);  // the statements above are found, so the scan is not vacuous
@@ -185,7 +185,7 @@ std::vector<double> values(const HeadThermalModel<T>& h) {
     return v;
 }
 
-// ---- Table 2 (ascorr/table2.hpp)
+// ---- Table 2 (ascorr/core/table2.hpp)
 
 std::string contract_table2_path() {
     return std::string(ASCORR_TEST_DATA) + "/model_table2.csv";
@@ -255,7 +255,7 @@ TEST(Table2, TheFlightModelAndTheSimulatorsTruthAreTheContractsFile) {
     EXPECT_NE(values(q30_flight.head[2]), values(ThermalModel<Q30>{}.head[2]));  // not vacuous
 }
 
-// ---- The model → core conversion (ascorr/model_coefficients.hpp)
+// ---- The model → core conversion (ascorr/core/model_coefficients.hpp)
 
 host::ModelFile random_model(std::mt19937_64& rng) {
     std::uniform_real_distribution<double> c0(-200.0, 200.0);

@@ -115,7 +115,7 @@ int read_model(const char* path, ModelRow* rows) {
 }
 
 // The rows in the core's layout (arcsec); the installed core converts them
-// (ascorr/model_coefficients.hpp).
+// (ascorr/core/model_coefficients.hpp).
 ascorr::ModelCoefficients coefficients_of(const ModelRow* rows, int n) {
     ascorr::ModelCoefficients m{};
     for (int i = 0; i < n; ++i) {

@@ -1,5 +1,5 @@
 // firmware/app/earth_series_entry.hpp: the Earth ephemeris series
-// (ascorr/earth_series.hpp) compiled once for the DPU, out of line.
+// (ascorr/nav/earth_series.hpp) compiled once for the DPU, out of line.
 //
 // Conventions: as earth_series() (TT seconds since J2000.0; ICRF axes, km/s;
 // au). In its own translation unit (earth_series_entry.cpp) so that its flash

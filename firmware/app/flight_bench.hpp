@@ -2,7 +2,7 @@
 // deforms with temperature, and the on-board estimator's place in the loop.
 //
 // Conventions: the bench's truth is a thermal model in the contract's form
-// (arcsec, ascorr/thermal.hpp) that is not the one in flash: Table 2 with head
+// (arcsec, ascorr/core/thermal.hpp) that is not the one in flash: Table 2 with head
 // B's slopes 40 % larger and head C's mount 3″ further in α (a bench that has
 // settled since the ground fit). Each head's raw solution at second s of the
 // 16-s temperature profile is the truth's thermal rotation at that second's

@@ -2,7 +2,7 @@
 // static storage.
 //
 // Conventions: the thermal model is Table 2 of Herceg et al. 2017 (heads A–C,
-// linear; ascorr/table2.hpp, the one copy in code, checked against
+// linear; ascorr/core/table2.hpp, the one copy in code, checked against
 // tests/data/model_table2.csv by Table2.*), converted to the core's formats in
 // radians at compile time (thermal_model(), model_coefficients.hpp) and kept
 // in flash. The

@@ -6,9 +6,10 @@ since J2000.0 TT; quaternions Hamilton, scalar first, q_chu_icrf maps ICRF
 components into CHU components; velocities km/s; angles arcsec.
 
 Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
-read_solutions, write_solutions, to_frame, from_frame. Classes: Model. Exceptions:
-InputError and FitRefused (both ValueError). HEADS: the head letters in
-index order (from the core's ascorr/heads.hpp).
+read_solutions, write_solutions, to_frame, from_frame, read_mountings, combine, align.
+Classes: Model. Exceptions: InputError, FitRefused and AlignRefused (all
+ValueError). HEADS: the head letters in index order (from the core's
+ascorr/core/heads.hpp).
 
 Arguments: a wrong value raises ValueError "argument 'NAME': expected ..., got
 ..."; a missing or unknown argument raises TypeError naming it. Paths are str
@@ -21,7 +22,7 @@ import functools as _functools
 import inspect as _inspect
 
 from . import _ascorr
-from ._ascorr import HEADS, FitRefused, InputError, Model  # noqa: F401
+from ._ascorr import HEADS, AlignRefused, FitRefused, InputError, Model  # noqa: F401
 from ._version import __version__  # noqa: F401
 
 
@@ -66,11 +67,14 @@ def _checked(f, name, method=False):
     return call
 
 
+align = _checked(_ascorr.align, "align")
+combine = _checked(_ascorr.combine, "combine")
 correct = _checked(_ascorr.correct, "correct")
 earth_velocity = _checked(_ascorr.earth_velocity, "earth_velocity")
 fit = _checked(_ascorr.fit, "fit")
 iba = _checked(_ascorr.iba, "iba")
 read_model = _checked(_ascorr.read_model, "read_model")
+read_mountings = _checked(_ascorr.read_mountings, "read_mountings")
 read_solutions = _checked(_ascorr.read_solutions, "read_solutions")
 self_calibrate = _checked(_ascorr.self_calibrate, "self_calibrate")
 stats = _checked(_ascorr.stats, "stats")
@@ -79,15 +83,19 @@ Model.__init__ = _checked(Model.__init__, "Model", method=True)
 Model.write = _checked(Model.write, "Model.write", method=True)
 
 __all__ = [
+    "AlignRefused",
     "FitRefused",
     "InputError",
     "Model",
+    "align",
+    "combine",
     "correct",
     "earth_velocity",
     "fit",
     "from_frame",
     "iba",
     "read_model",
+    "read_mountings",
     "read_solutions",
     "self_calibrate",
     "stats",

@@ -12,12 +12,14 @@ _Real = npt.ArrayLike  # any real dtype; float64 C-contiguous is used in place
 _Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pathlib.Path)
 
 __version__: str  # project(VERSION) of the CMake build
-HEADS: str  # the head letters in index order, from the core (ascorr/heads.hpp)
+HEADS: str  # the head letters in index order, from the core (ascorr/core/heads.hpp)
 
 class InputError(ValueError):
     """A malformed input file or rows (a ValueError); the message starts with file:line:column."""
 class FitRefused(ValueError):
     """fit() refused the data: period too short, too few orbits or an ill-conditioned design (a ValueError)."""
+class AlignRefused(ValueError):
+    """align() refused the data: an empty period, too few epochs, a head without clean epochs with another head, noise or mountings the data do not determine (a ValueError)."""
 
 class Model:
     """A thermal model: per head and axis, angles in arcsec linear (and
@@ -275,3 +277,77 @@ def from_frame(frame: Any) -> dict[str, npt.NDArray[Any]]:
     present (a corrected file); every other column goes under "extra" as text,
     as read_solutions() keeps the columns it does not know. Rows are taken in
     the frame's order; its index only names rows in messages."""
+
+
+class _Mountings(TypedDict):
+    heads: str  # the letters of the heads, in order
+    q: npt.NDArray[np.float64]  # (k, 4) q_chu_crf
+    sigma_cross: Optional[npt.NDArray[np.float64]]  # (k,) arcsec, None without sigmas
+    sigma_about: Optional[npt.NDArray[np.float64]]
+
+def read_mountings(path: _Path) -> _Mountings:
+    """Read a mountings file (docs/contract.md, "Combined attitude") into a dict:
+    {"heads": the letters of its heads in order (e.g. 'ABC'), "q": (k, 4) q_chu_crf
+    (w, x, y, z; v_chu = R(q) v_crf), "sigma_cross", "sigma_about": (k,) arcsec, or None
+    when the file has no sigmas}, one row per head of heads. combine() and align() take
+    this dict. A malformed file raises ascorr.InputError (a ValueError) with
+    file:line:column, as the command line reports it."""
+
+def combine(
+    t: _Real,
+    chu: npt.ArrayLike,
+    q: _Real,
+    mountings: _Mountings,
+    status: Optional[npt.ArrayLike] = ...,
+    flags: Optional[npt.ArrayLike] = ...,
+    confidence: Optional[_Real] = ...,
+) -> dict[str, npt.NDArray[Any]]:
+    """The combined attitude of the bench, one row per epoch (rows whose t agree to the
+    millisecond), in time order: the numbers and status bits of `ascorr combine` on the
+    same rows, to the digit (q as the combined file writes it, 15 decimals).
+
+    t, chu, q: as correct()'s (q: the corrected, or raw, q_chu_icrf). mountings: a dict
+    as read_mountings() returns, with sigmas. status: (n,) the status of corrected rows
+    (as correct() returns it), or None for raw rows taken as they are. flags, confidence:
+    (n,) as in a solutions file, or None (0; not given). A row is averaged in when it is
+    clean (flags 0, confidence <= 5) and its status has none of 4, 8, 16, 128, 256.
+    Returns a dict: "t" (m,); "q" (m, 4) q_crf_icrf (w >= 0), NaN without a usable head;
+    "heads" (m,) str, the letters of the heads used ('' for none); "sigma" (m, 3) the
+    formal 1-sigma about the CRF axes, arcsec (NaN without a head); "status" (m,) the
+    combined file's bits (1 two or more heads, 2 one head, 4 a head left out, 8 none).
+    What was left out and why is given as a UserWarning, as the command line's messages."""
+
+def align(
+    t: _Real,
+    chu: npt.ArrayLike,
+    q: _Real,
+    mountings: _Mountings,
+    status: Optional[npt.ArrayLike] = ...,
+    flags: Optional[npt.ArrayLike] = ...,
+    confidence: Optional[_Real] = ...,
+    t_from: Optional[float] = ...,
+    t_to: Optional[float] = ...,
+    noise_window: float = ...,
+    min_epochs: int = ...,
+) -> tuple[_Mountings, dict[str, Any]]:
+    """Estimate each head's mounting and noise from the data, as `ascorr align`, keeping
+    the CRF of the given mountings: the new mountings differ from the given ones by
+    rotations whose information-weighted mean is zero. The same numbers as the mountings
+    file `ascorr align` writes, to the bit.
+
+    t, chu, q, status, flags, confidence: as combine()'s. mountings: a dict as
+    read_mountings() returns (sigmas, if any, are not used). t_from, t_to: the period
+    (s since J2000 TT; None: the whole data). noise_window: the window (s) of the slowly
+    varying mean the noise is measured about (0: one mean over the period). min_epochs:
+    the fewest epochs with two or more usable heads. Returns (mountings, report):
+    mountings the new dict, with the estimated sigmas; report a dict (heads, rotation and
+    rotation_sd (k, 3): each head's rotation from the given mounting in CRF axes and its
+    formal 1-sigma, arcsec; sigma_cross, sd_cross, sigma_about, sd_about (k,): the
+    estimated noise and its formal 1-sigma, arcsec; epochs (k,): each head's epochs used;
+    rows, rows_in_period, left_out (counts by reason), period_epochs, joint_epochs,
+    single_epochs, noise_model ('per_head', or 'equal_cross' with two heads: one
+    sigma_cross shared), noise_window, dof, iterations, passes, last_update,
+    weighted_mean, text: the command line's report). Raises ascorr.AlignRefused (a
+    ValueError) for an empty period, too few epochs, a head of the mountings without
+    clean epochs with another head, or noise the data do not determine;
+    ascorr.InputError for two rows of one head in one epoch."""

@@ -414,6 +414,22 @@ host::RowSource source_of(const Rows& r) {
     };
 }
 
+std::optional<double> time_arg(const py::object& x, const char* name) {
+    if (x.is_none()) {
+        return std::nullopt;
+    }
+    if (py::isinstance(x, py::module_::import("numpy").attr("floating")) &&
+        x.attr("dtype").attr("itemsize").cast<int>() < 8) {
+        bad_argument(name, "expected a float64 (or integer) time, got " + value_text(x) +
+                               ": too few bits for a time since J2000");
+    }
+    const double d = real_arg(x, name);
+    if (std::isnan(d)) {
+        bad_argument(name, "must not be NaN");
+    }
+    return d;
+}
+
 bool model_initialised(const py::handle& obj) {
     return py::isinstance<host::ModelFile>(obj) &&
            reinterpret_cast<py::detail::instance*>(obj.ptr())->get_value_and_holder().holder_constructed();

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,7 @@ void bind_formats(py::module_& mod);
 void bind_correct(py::module_& mod);
 void bind_self_calibration(py::module_& mod);
 void bind_analysis(py::module_& mod);
+void bind_combine(py::module_& mod);  // read_mountings, combine, align
 
 // ---- arguments (arguments.cpp)
 
@@ -76,6 +78,9 @@ std::string path_arg(const py::handle& x, const char* name);
 // (iba.hpp parse_head_letters: heads.hpp's, in its order, none twice), at
 // least min and at most max of them; a str, else refused.
 host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
+// A time (t_from, t_to): None, or a real number that is not NaN; a NumPy
+// float below 64 bits is refused (too few bits for a time since J2000).
+std::optional<double> time_arg(const py::object& x, const char* name);
 // An ascorr.Model or None (nullptr).
 const host::ModelFile* model_arg(const py::object& model);
 // obj, an ascorr.Model, as the host's model; TypeError naming `what` when it

@@ -100,22 +100,6 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     return out;
 }
 
-std::optional<double> time_arg(const py::object& x, const char* name) {
-    if (x.is_none()) {
-        return std::nullopt;
-    }
-    if (py::isinstance(x, py::module_::import("numpy").attr("floating")) &&
-        x.attr("dtype").attr("itemsize").cast<int>() < 8) {
-        bad_argument(name, "expected a float64 (or integer) time, got " + value_text(x) +
-                               ": too few bits for a time since J2000");
-    }
-    const double d = real_arg(x, name);
-    if (std::isnan(d)) {
-        bad_argument(name, "must not be NaN");
-    }
-    return d;
-}
-
 py::dict stats(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
                const py::object& t_from, const py::object& t_to) {

@@ -164,4 +164,57 @@ fields. Nothing is written that read_solutions() would refuse: a status outside
 camera head with a status other than 16, a value that is not one CSV field raise
 ValueError naming the argument (or column) and the row.)doc";
 
+// ---- the combined attitude (bind_combine.cpp)
+
+inline constexpr const char* kAlignRefused =
+    "align() refused the data: an empty period, too few epochs, a head without clean epochs with another head, "
+    "noise or mountings the data do not determine (a ValueError).";
+
+inline constexpr const char* kReadMountings =
+    R"doc(Read a mountings file (docs/contract.md, "Combined attitude") into a dict:
+{"heads": the letters of its heads in order (e.g. 'ABC'), "q": (k, 4) q_chu_crf
+(w, x, y, z; v_chu = R(q) v_crf), "sigma_cross", "sigma_about": (k,) arcsec, or None
+when the file has no sigmas}, one row per head of heads. combine() and align() take
+this dict. A malformed file raises ascorr.InputError (a ValueError) with
+file:line:column, as the command line reports it.)doc";
+
+inline constexpr const char* kCombine =
+    R"doc(The combined attitude of the bench, one row per epoch (rows whose t agree to the
+millisecond), in time order: the numbers and status bits of `ascorr combine` on the
+same rows, to the digit (q as the combined file writes it, 15 decimals).
+
+t, chu, q: as correct()'s (q: the corrected, or raw, q_chu_icrf). mountings: a dict
+as read_mountings() returns, with sigmas. status: (n,) the status of corrected rows
+(as correct() returns it), or None for raw rows taken as they are. flags, confidence:
+(n,) as in a solutions file, or None (0; not given). A row is averaged in when it is
+clean (flags 0, confidence <= 5) and its status has none of 4, 8, 16, 128, 256.
+Returns a dict: "t" (m,); "q" (m, 4) q_crf_icrf (w >= 0), NaN without a usable head;
+"heads" (m,) str, the letters of the heads used ('' for none); "sigma" (m, 3) the
+formal 1-sigma about the CRF axes, arcsec (NaN without a head); "status" (m,) the
+combined file's bits (1 two or more heads, 2 one head, 4 a head left out, 8 none).
+What was left out and why is given as a UserWarning, as the command line's messages.)doc";
+
+inline constexpr const char* kAlign =
+    R"doc(Estimate each head's mounting and noise from the data, as `ascorr align`, keeping
+the CRF of the given mountings: the new mountings differ from the given ones by
+rotations whose information-weighted mean is zero. The same numbers as the mountings
+file `ascorr align` writes, to the bit.
+
+t, chu, q, status, flags, confidence: as combine()'s. mountings: a dict as
+read_mountings() returns (sigmas, if any, are not used). t_from, t_to: the period
+(s since J2000 TT; None: the whole data). noise_window: the window (s) of the slowly
+varying mean the noise is measured about (0: one mean over the period). min_epochs:
+the fewest epochs with two or more usable heads. Returns (mountings, report):
+mountings the new dict, with the estimated sigmas; report a dict (heads, rotation and
+rotation_sd (k, 3): each head's rotation from the given mounting in CRF axes and its
+formal 1-sigma, arcsec; sigma_cross, sd_cross, sigma_about, sd_about (k,): the
+estimated noise and its formal 1-sigma, arcsec; epochs (k,): each head's epochs used;
+rows, rows_in_period, left_out (counts by reason), period_epochs, joint_epochs,
+single_epochs, noise_model ('per_head', or 'equal_cross' with two heads: one
+sigma_cross shared), noise_window, dof, iterations, passes, last_update,
+weighted_mean, text: the command line's report). Raises ascorr.AlignRefused (a
+ValueError) for an empty period, too few epochs, a head of the mountings without
+clean epochs with another head, or noise the data do not determine;
+ascorr.InputError for two rows of one head in one epoch.)doc";
+
 }  // namespace ascorr::python::docs

@@ -3,9 +3,9 @@
 // Glue only: every number comes from the core headers (firmware/include/) and
 // the host library (host_sim/, ascorr_host), the same code as the command
 // line. The bindings are split by topic (bind_model, bind_formats,
-// bind_correct, bind_self_calibration, bind_analysis), their argument checks
-// shared (bind.hpp, arguments.cpp), their docstrings written once
-// (docstrings.hpp).
+// bind_correct, bind_self_calibration, bind_analysis, bind_combine), their
+// argument checks shared (bind.hpp, arguments.cpp), their docstrings written
+// once (docstrings.hpp).
 #include <pybind11/pybind11.h>
 
 #include "ascorr/core/heads.hpp"
@@ -26,7 +26,7 @@ PYBIND11_MODULE(_ascorr, mod) {
     py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") = docs::kInputError;
     py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") = docs::kFitRefused;
 
-    // The heads (ascorr/heads.hpp), for Python and for the docstrings.
+    // The heads (ascorr/core/heads.hpp), for Python and for the docstrings.
     mod.attr("HEADS") = py::str(kHeadLetters);
 
     bind_model(mod);
@@ -34,4 +34,5 @@ PYBIND11_MODULE(_ascorr, mod) {
     bind_correct(mod);
     bind_self_calibration(mod);
     bind_analysis(mod);
+    bind_combine(mod);
 }

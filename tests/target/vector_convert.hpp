@@ -1,7 +1,7 @@
 // tests/target/vector_convert.hpp: records of vector_format.hpp → the core's
 // types in scalar T, rounded the way a DPU would be given them
 // (ScalarTraits<T>::from_double, celsius; the model through the core's
-// thermal_model(), ascorr/model_coefficients.hpp).
+// thermal_model(), ascorr/core/model_coefficients.hpp).
 // Shared by the target accuracy image and the benchmarks.
 #pragma once
 

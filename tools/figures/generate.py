@@ -111,6 +111,7 @@ def core_section(d):
                        ("thermal only", "thermal_only"), ("with a quadratic model", "both_quadratic_model"),
                        ("thermal only, quadratic model", "thermal_only_quadratic_model"),
                        ("validation + renormalisation alone", "validation_and_renormalisation_only"),
+                       ("combined attitude, per epoch of three heads", "combination_three_heads"),
                        ("ratio to the baseline", "baseline_ratio"), ("error vs double (arcsec)", "max_error_arcsec")):
         row = [label]
         for t, s, _ in cols:

@@ -41,8 +41,7 @@
 //   nav/earth_grid.hpp     the Earth series on a 60 s grid, linear between
 //   nav/velocity_node.hpp  the 10 s velocity node and its per-solution query
 //   nav/velocity_service.hpp   states in, ObserverVelocity<T> per solution out
-// The headers at this folder's top level but this one forward to their part's
-// header, so that includes written before the parts existed keep working.
+// Include each part's headers by their part's path (ascorr/core/…, ascorr/nav/…).
 #pragma once
 
 #include "core/aberration.hpp"

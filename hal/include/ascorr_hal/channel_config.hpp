@@ -28,11 +28,11 @@ enum class Role : std::uint8_t { kMonitor = 0, kChuA, kChuB, kChuC, kChuD, kT029
 inline constexpr std::uint8_t kRoleCount = static_cast<std::uint8_t>(static_cast<std::uint8_t>(Role::kT032) + 1U);
 inline constexpr const char* kRoleNames[] = {"monitor", "chu_a", "chu_b", "chu_c", "chu_d", "t029", "t032"};
 static_assert(sizeof(kRoleNames) / sizeof(kRoleNames[0]) == kRoleCount, "one name per role");
-// One CHU role per head of ascorr/heads.hpp, in head order, named chu_<letter>
+// One CHU role per head of ascorr/core/heads.hpp, in head order, named chu_<letter>
 // (Heads.HalRolesAreOnePerHeadNamedByItsLetter in tests/test_facts.cpp checks the
 // names): a head added there needs its role here.
 static_assert(static_cast<std::uint8_t>(Role::kT029) == static_cast<std::uint8_t>(Role::kChuA) + ascorr::kMaxHeads,
-              "one Role::kChu<letter> per head of ascorr/heads.hpp");
+              "one Role::kChu<letter> per head of ascorr/core/heads.hpp");
 
 constexpr Role chu_role(std::uint8_t head) noexcept {
     return static_cast<Role>(static_cast<std::uint8_t>(Role::kChuA) + head);

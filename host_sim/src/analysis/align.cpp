@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/csv.hpp"
+
 namespace ascorr::host {
 
 namespace {
@@ -173,8 +175,30 @@ Components components_of(HeadSet heads, NoiseModel model) {
     return c;
 }
 
-// For head set s: A_k, the covariance of its differences per unit of
-// component k (x's order), for every k.
+// The 3(k−1) square covariance of head set s's differences d per unit of a
+// component `unit` (I − bbᵀ or bbᵀ) of head h: the reference head (the
+// set's first) is in every difference, every other head in its own.
+Eigen::MatrixXd unit_covariance(const HeadList& l, std::uint8_t h, const Eigen::Matrix3d& unit) {
+    const auto dim = static_cast<Eigen::Index>(3U * (l.count - 1U));
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(dim, dim);
+    if (h == l.head[0]) {
+        for (Eigen::Index i = 0; i < dim; i += 3) {
+            for (Eigen::Index j = 0; j < dim; j += 3) {
+                m.block<3, 3>(i, j) = unit;
+            }
+        }
+        return m;
+    }
+    std::size_t pos = 1;
+    while (l.head[pos] != h) {
+        ++pos;
+    }
+    const auto i = static_cast<Eigen::Index>(3U * (pos - 1U));
+    m.block<3, 3>(i, i) = unit;
+    return m;
+}
+
+// For head set s: A_k for every component k (x's order); zero for heads not in s.
 std::vector<Eigen::MatrixXd> unit_covariances(HeadSet s, const Components& c,
                                               const std::array<Eigen::Vector3d, kMaxHeads>& b) {
     const HeadList l = heads_of(s);
@@ -182,29 +206,10 @@ std::vector<Eigen::MatrixXd> unit_covariances(HeadSet s, const Components& c,
     std::vector<Eigen::MatrixXd> a(2U * c.heads.count, Eigen::MatrixXd::Zero(dim, dim));
     for (std::size_t k = 0; k < c.heads.count; ++k) {
         const std::uint8_t h = c.heads.head[k];
-        if (!has_head(s, h)) {
-            continue;
-        }
-        const Eigen::Matrix3d about = b[h] * b[h].transpose();
-        const Eigen::Matrix3d cross = Eigen::Matrix3d::Identity() - about;
-        for (int which = 0; which < 2; ++which) {
-            const Eigen::Matrix3d& unit = which == 0 ? cross : about;
-            Eigen::MatrixXd& m = a[2U * k + static_cast<std::size_t>(which)];
-            if (h == l.head[0]) {
-                // the reference head is in every difference
-                for (Eigen::Index i = 0; i < dim; i += 3) {
-                    for (Eigen::Index j = 0; j < dim; j += 3) {
-                        m.block<3, 3>(i, j) = unit;
-                    }
-                }
-            } else {
-                std::size_t pos = 1;
-                while (l.head[pos] != h) {
-                    ++pos;
-                }
-                const auto i = static_cast<Eigen::Index>(3U * (pos - 1U));
-                m.block<3, 3>(i, i) = unit;
-            }
+        if (has_head(s, h)) {
+            const Eigen::Matrix3d about = b[h] * b[h].transpose();
+            a[2U * k] = unit_covariance(l, h, Eigen::Matrix3d::Identity() - about);
+            a[2U * k + 1U] = unit_covariance(l, h, about);
         }
     }
     return a;
@@ -317,6 +322,11 @@ NoiseEstimate estimate_noise(const AlignSums& sums, HeadSet heads,
     est.heads = heads;
     Components c = components_of(heads, NoiseModel::kPerHead);
     std::vector<SetModel> sets = set_models(sums, c, boresight_crf);
+    if (sets.empty()) {
+        throw std::invalid_argument(
+            "the noise has no degree of freedom: no noise window (" + number_text(sums.noise_window_s()) +
+            " s) holds two epochs of the same heads; give a window longer than the data's step");
+    }
     Eigen::MatrixXd n;
     Eigen::VectorXd r;
     unweighted_equations(sets, n, r);

@@ -185,10 +185,73 @@ HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
     return s;
 }
 
-}  // namespace
+using Information = std::array<Eigen::Matrix3d, kMaxHeads>;
 
-AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
-                       const AlignOptions& opt) {
+// The counts of the first pass, into the report.
+void count_into(AlignReport& r, const AlignSums& sums, const PassCounts& c) {
+    r.rows = c.rows;
+    r.rows_in_period = c.rows_in_period;
+    r.rows_left_out = c.left_out;
+    r.epochs = c.epochs;
+    r.joint_epochs = sums.joint_epochs();
+    r.single_epochs = sums.single_epochs();
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        r.head[h].epochs = sums.head_epochs(h);
+    }
+}
+
+// One pass's estimate: the noise (into r), the weights w it gives under the
+// current mountings q, and the δ under the datum on the total rotation from m.
+Alignment estimate(const AlignSums& sums, const MountingsFile& m, const CurrentMountings& q, AlignReport& r,
+                   Information& w) {
+    std::array<Eigen::Vector3d, kMaxHeads> b{};
+    std::array<Eigen::Vector3d, kMaxHeads> turned{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        b[h] = boresight_crf(q[h]);
+        turned[h] = has_head(r.heads, h) ? turned_from(m, q, h) : Eigen::Vector3d::Zero();
+    }
+    try {
+        r.noise = estimate_noise(sums, r.heads, b);
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            w[h] = information_crf(q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec);
+        }
+        return solve_alignment(sums, r.heads, w, turned);
+    } catch (const std::invalid_argument& e) {
+        throw AlignRefused(e.what());
+    }
+}
+
+// M2 (the final mountings q with the estimated noise), each head's account
+// and the weighted mean of the rotations from m.
+void finish_report(AlignReport& r, const MountingsFile& m, const CurrentMountings& q, const Alignment& a,
+                   const Information& w) {
+    Eigen::Matrix3d w_sum = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d wr = Eigen::Vector3d::Zero();
+    r.aligned = m;
+    r.aligned.sigmas = true;
+    r.aligned.line = {};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!has_head(r.heads, h)) {
+            continue;
+        }
+        const combine::HeadMounting& given = m.mountings.head[h];
+        combine::HeadMounting& out = r.aligned.mountings.head[h];
+        HeadAlignment& ha = r.head[h];
+        out.q_chu_crf = q[h];
+        out.sigma_cross_arcsec = r.noise.head[h].sigma_cross_arcsec;
+        out.sigma_about_arcsec = r.noise.head[h].sigma_about_arcsec;
+        ha.noise = r.noise.head[h];
+        ha.given_sigma_cross_arcsec = m.sigmas ? given.sigma_cross_arcsec : std::nan("");
+        ha.given_sigma_about_arcsec = m.sigmas ? given.sigma_about_arcsec : std::nan("");
+        ha.rotation_arcsec = turned_from(m, q, h);
+        ha.rotation_sd_arcsec = a.covariance[h].diagonal().cwiseMax(0.0).cwiseSqrt();
+        w_sum += w[h];
+        wr += w[h] * ha.rotation_arcsec;
+    }
+    r.weighted_mean_arcsec = w_sum.inverse() * wr;
+}
+
+AlignReport start_report(const std::string& file, const MountingsFile& m, const AlignOptions& opt) {
     try {
         refuse_bad_time_range(opt.from, opt.to);
     } catch (const std::invalid_argument& e) {
@@ -204,46 +267,30 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
         throw AlignRefused("the mountings have " + std::to_string(head_count(r.heads)) +
                            " head: align needs two or more (their relative attitudes are its data)");
     }
+    return r;
+}
+
+}  // namespace
+
+AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
+                       const AlignOptions& opt) {
+    AlignReport r = start_report(file, m, opt);
     CurrentMountings q{};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         q[h] = m.mountings.head[h].present ? m.mountings.head[h].q_chu_crf : Quaternion<double>{1.0, 0.0, 0.0, 0.0};
     }
     Alignment a;
-    std::array<Eigen::Matrix3d, kMaxHeads> w{};
+    Information w{};
     r.last_update_arcsec = std::numeric_limits<double>::infinity();
-    for (r.passes = 1; r.passes <= kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec); ++r.passes) {
+    for (r.passes = 0; r.passes < kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec);) {
         AlignSums sums(opt.noise_window_s);
         PassCounts c;
         run_pass(rows, file, m, q, opt, sums, c);
-        if (r.passes == 1) {
+        if (++r.passes == 1) {
             refuse_thin_data(file, sums, c, r.heads, opt);
-            r.rows = c.rows;
-            r.rows_in_period = c.rows_in_period;
-            r.rows_left_out = c.left_out;
-            r.epochs = c.epochs;
-            r.joint_epochs = sums.joint_epochs();
-            r.single_epochs = sums.single_epochs();
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                r.head[h].epochs = sums.head_epochs(h);
-            }
+            count_into(r, sums, c);
         }
-        std::array<Eigen::Vector3d, kMaxHeads> b{};
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            b[h] = boresight_crf(q[h]);
-        }
-        try {
-            r.noise = estimate_noise(sums, r.heads, b);
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                w[h] = information_crf(q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec);
-            }
-            std::array<Eigen::Vector3d, kMaxHeads> turned{};
-            for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-                turned[h] = has_head(r.heads, h) ? turned_from(m, q, h) : Eigen::Vector3d::Zero();
-            }
-            a = solve_alignment(sums, r.heads, w, turned);
-        } catch (const std::invalid_argument& e) {
-            throw AlignRefused(e.what());
-        }
+        a = estimate(sums, m, q, r, w);
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             if (has_head(r.heads, h)) {
                 q[h] = canonical(renormalized(q[h] * rotation_quaternion(a.delta_arcsec[h])));
@@ -251,36 +298,12 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
         }
         r.last_update_arcsec = largest(a);
     }
-    --r.passes;
     if (!(r.last_update_arcsec < kAlignToleranceArcsec)) {
         throw AlignRefused("the mountings did not converge in " + std::to_string(kMaxAlignPasses) +
                            " passes (the last turned a head by " + number_text(r.last_update_arcsec) +
                            " arcsec): are the given mountings within a degree of the heads'?");
     }
-    Eigen::Matrix3d w_sum = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d wr = Eigen::Vector3d::Zero();
-    r.aligned.sigmas = true;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        const combine::HeadMounting& given = m.mountings.head[h];
-        combine::HeadMounting& out = r.aligned.mountings.head[h];
-        out = given;
-        r.aligned.line[h] = 0;
-        if (!given.present) {
-            continue;
-        }
-        HeadAlignment& ha = r.head[h];
-        out.q_chu_crf = q[h];
-        out.sigma_cross_arcsec = r.noise.head[h].sigma_cross_arcsec;
-        out.sigma_about_arcsec = r.noise.head[h].sigma_about_arcsec;
-        ha.noise = r.noise.head[h];
-        ha.given_sigma_cross_arcsec = m.sigmas ? given.sigma_cross_arcsec : std::nan("");
-        ha.given_sigma_about_arcsec = m.sigmas ? given.sigma_about_arcsec : std::nan("");
-        ha.rotation_arcsec = turned_from(m, q, h);
-        ha.rotation_sd_arcsec = a.covariance[h].diagonal().cwiseMax(0.0).cwiseSqrt();
-        w_sum += w[h];
-        wr += w[h] * ha.rotation_arcsec;
-    }
-    r.weighted_mean_arcsec = w_sum.inverse() * wr;
+    finish_report(r, m, q, a, w);
     return r;
 }
 
@@ -336,6 +359,14 @@ std::string describe(const AlignReport& r) {
                          a.rotation_sd_arcsec.z(), a.noise.sigma_cross_arcsec, a.noise.sd_cross_arcsec,
                          a.noise.sigma_about_arcsec, a.noise.sd_about_arcsec);
         s << line;
+    }
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const HeadAlignment& a = r.head[h];
+        if (has_head(r.heads, h) && !std::isnan(a.given_sigma_cross_arcsec)) {
+            s << "CHU " << kHeadLetters[h] << ": the given mountings said sigma_cross "
+              << number_text(a.given_sigma_cross_arcsec) << ", sigma_about " << number_text(a.given_sigma_about_arcsec)
+              << " (not used)\n";
+        }
     }
     return s.str();
 }

@@ -463,15 +463,18 @@ void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
     const auto write_script = [&](const char* terminal) {
         std::ofstream g(dir.file("plot.gp"));
         g.precision(12);
-        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 6 / 7 << "\n";
+        // Three panels of at least 280 pixels; a narrow figure in a smaller font.
+        const bool narrow = opt.width < 1000;
+        g << "set terminal " << terminal << " size " << opt.width << "," << std::max(opt.width * 6 / 7, 840)
+          << (narrow ? " font ',8'" : "") << "\n";
         g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
-        g << "set multiplot layout 3,1 title 'Combined attitude: error against the truth, each epoch coloured by its "
-             "head set (grey: not the full set "
+        g << "set multiplot layout 3,1 title 'Combined attitude minus truth, coloured by head set (grey: not "
           << head_set_name(full) << ")'\n";
-        g << "set xdata time\nset timefmt '%s'\nset format x \"%m-%d\\n%H:%M\"\nset grid\nset key outside right "
-             "top\n";
+        g << "set xdata time\nset timefmt '%s'\nset format x \"%m-%d\\n%H:%M\"\nset grid\n";
+        g << "set key outside right top vertical maxrows " << sets.size() << " samplen 1\n";
         g << "set xrange ['" << opt.from + kJ2000Unix << "':'" << opt.to + kJ2000Unix << "']\n";
-        g << "set yrange [" << -y_max << ":" << y_max << "]\nset lmargin 10\nset rmargin 24\n";
+        g << "set yrange [" << -y_max << ":" << y_max << "]\nset lmargin 10\nset rmargin " << (narrow ? 16 : 24)
+          << "\n";
         g << "set style fill solid 0.5 noborder\n";
         const char* axes[3] = {"x", "y", "z"};
         for (int a = 0; a < 3; ++a) {

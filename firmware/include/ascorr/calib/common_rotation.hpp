@@ -9,7 +9,7 @@
 //   P = I − G·Gᵀ/3
 // is the orthogonal projector onto what the inter-boresight angles see; the
 // ground fit applies P to each orbit's equations and treats F's own rotation
-// as a nuisance (self-calibration.md).
+// as a nuisance (calib/README.md, "The estimator").
 // The model's regressors are per head [1, T1, T2 − T1, T3 − T1]; only T2 and
 // T3 (THT00029, THT00032) are shared by all heads, so a common rotation
 // w0 + w2·T2 + w3·T3 (3 × 3 = 9 numbers) changes no IBA: 9 of the 36 linear

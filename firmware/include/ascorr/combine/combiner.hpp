@@ -11,11 +11,14 @@
 //    whose noise is σc across and σa about their boresight;
 //  - q_crf_icrf has w ≥ 0; both signs of every input are the same attitude.
 //
-// Per epoch, for n heads: n quaternion products (the mountings), n − 1
-// half-angle differences to the reference, n − 1 gain products (3 × 3), n
-// gate statistics (six products and three squares), one quaternion update and
-// one renormalisation (a Newton step: no division, no square root). Every
-// table is built at construction in double (subset_tables.hpp).
+// Per epoch, for n heads (the usual epoch; the vote and the gate's rounds
+// only when a head is off): n quaternion products (the mountings), n − 1
+// half-angle differences to the reference, n − 1 gain products (3 × 3), per
+// head a quick gate (‖e‖² against a bound of the gate, three squares; the full
+// statistic, six products and three squares, only above it), one quaternion
+// update and one renormalisation (a Newton step: no division, no square
+// root). Every table is built at construction in double (subset_tables.hpp).
+// Instructions per epoch of three heads: docs/figures.md.
 //
 // Which heads are averaged (in this order):
 //  1. Left out, status 4 (not `inconsistent`): an entry whose head index is no
@@ -161,6 +164,7 @@ private:
 
     void build(const Mountings& m, const CombinerConfig& cfg) noexcept;
     bool build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept;
+    bool build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept;
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
@@ -179,9 +183,10 @@ private:
     MountingsProblem problem_ = MountingsProblem::kNoHead;
     std::uint8_t problem_head_ = kUnknownHead;
     HeadMask mounted_ = 0;
-    T near2_{};                              // sin²(kGrossAngleRad/2)
-    T one_minus_near2_{};                    // cos²(kGrossAngleRad/2)
-    Quaternion<T> mount_conj_[kMaxHeads]{};  // q_chu_crf* (unit)
+    T near2_{};                                    // sin²(kGrossAngleRad/2)
+    T one_minus_near2_{};                          // cos²(kGrossAngleRad/2)
+    Quaternion<T> mount_conj_[kMaxHeads]{};        // q_chu_crf* (unit, rounded to T)
+    MountingFactor<T> mount_factor_[kMaxHeads]{};  // the same, as mounting_product() takes it
     GainMatrix<T> gain_[kSubsetCount][kMaxHeads]{};
     GateMatrix<T> gate_[kSubsetCount][kMaxHeads]{};
     QuickBound<T> quick_[kSubsetCount][kMaxHeads]{};  // 1/λ_max bound of UᵀU (kernels.hpp quick_gate)
@@ -230,6 +235,7 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
             const Quaternion<double> q = unit_mounting(m.head[h]);
             mount_conj_[h] = {ScalarTraits<T>::from_double(q.w), ScalarTraits<T>::from_double(-q.x),
                               ScalarTraits<T>::from_double(-q.y), ScalarTraits<T>::from_double(-q.z)};
+            mount_factor_[h] = CombineFormats<T>::mounting_from(mount_conj_[h]);
         }
     }
     for (unsigned sub = 1; sub < kSubsetCount; ++sub) {
@@ -239,6 +245,28 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
             return;
         }
     }
+}
+
+// The gate factor of head h in subset s (|s| ≥ 2), its quick bound, in T;
+// false when a matrix is singular or a factor beyond kMaxGateFactor.
+template <typename T>
+bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept {
+    using F = CombineFormats<T>;
+    Matrix3 u{};
+    if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
+        return false;
+    }
+    for (const auto& row : u.m) {
+        for (double x : row) {
+            if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
+                return false;
+            }
+        }
+    }
+    quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
+    gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]), F::gate_from_double(u.m[0][2]),
+                   F::gate_from_double(u.m[1][1]), F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+    return true;
 }
 
 template <typename T>
@@ -264,22 +292,8 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
             }
             bias[r] += g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
-        Matrix3 u{};
-        if (several) {
-            if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
-                return false;
-            }
-            for (const auto& row : u.m) {
-                for (double x : row) {
-                    if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
-                        return false;
-                    }
-                }
-            }
-            quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
-            gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]),
-                           F::gate_from_double(u.m[0][2]), F::gate_from_double(u.m[1][1]),
-                           F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+        if (several && !build_gate(m, s, h, cfg)) {
+            return false;
         }
     }
     bias_[s] = {ScalarTraits<T>::from_double(bias[0]), ScalarTraits<T>::from_double(bias[1]),
@@ -308,7 +322,7 @@ template <typename T>
 HeadMask Combiner<T>::heads_of(const Epoch& e, std::uint8_t group) const noexcept {
     HeadMask s = 0;
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) != 0U) {
+        if (in_mask(group, i)) {
             s = static_cast<HeadMask>(s | head_bit(e.c[i].head));
         }
     }
@@ -338,7 +352,7 @@ void Combiner<T>::select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e)
             continue;
         }
         Candidate& c = e.c[count];
-        c.q = product(mount_conj_[a.head], a.q_chu_icrf);
+        c.q = mounting_product(mount_factor_[a.head], a.q_chu_icrf);
         c.head = a.head;
         taken = static_cast<HeadMask>(taken | bit);
         ++count;
@@ -356,11 +370,12 @@ std::uint8_t Combiner<T>::linearise(Epoch& e) const noexcept {
     constexpr T zero = constant<T>(0.0);
     auto near = static_cast<std::uint8_t>(1U << e.ref);
     e.c[e.ref].h = {zero, zero, zero};
+    const ReferenceFactor<T> rf = CombineFormats<T>::reference_from(e.c[e.ref].q);
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if (i == e.ref || (e.group >> i & 1U) == 0U) {
+        if (i == e.ref || !in_mask(e.group, i)) {
             continue;
         }
-        const HalfDifference<T> d = half_difference(e.c[i].q, e.c[e.ref].q, near2_);
+        const HalfDifference<T> d = half_difference(e.c[i].q, rf, near2_);
         e.c[i].h = d.h;
         near = static_cast<std::uint8_t>(near | (d.near ? 1U << i : 0U));
     }
@@ -391,7 +406,7 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
     }
     const auto group = static_cast<std::uint8_t>(near[best] | 1U << best);
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) == 0U && count[i] == count[best]) {
+        if (!in_mask(group, i) && count[i] == count[best]) {
             return false;  // a group outside as large: ambiguous
         }
     }
@@ -409,7 +424,7 @@ template <typename T>
 Vector3<T> Combiner<T>::estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept {
     Accumulator<T> acc = zero_accumulator<T>();
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if (i != e.ref && (group >> i & 1U) != 0U) {  // the reference's difference is zero
+        if (i != e.ref && in_mask(group, i)) {  // the reference's difference is zero
             accumulate(acc, gain_[s][e.c[i].head], e.c[i].h);
         }
     }
@@ -423,7 +438,7 @@ typename Combiner<T>::GateResult Combiner<T>::gate_group(const Epoch& e, std::ui
                                                          const Vector3<T>& est) const noexcept {
     GateResult r{0, {}};
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((group >> i & 1U) == 0U) {
+        if (!in_mask(group, i)) {
             continue;
         }
         const GateValue<T> v = gate_value(gate_[s][e.c[i].head], residual(e.c[i].h, est));
@@ -441,7 +456,7 @@ std::uint8_t Combiner<T>::odd_one_out(const Epoch& e, std::uint8_t failing) cons
     std::uint8_t best = 0xFF;
     GateValue<T> best_value{};
     for (std::uint8_t i = 0; i < e.n; ++i) {
-        if ((failing >> i & 1U) == 0U) {
+        if (!in_mask(failing, i)) {
             continue;
         }
         const auto rest = static_cast<std::uint8_t>(e.group & ~(1U << i));
@@ -479,7 +494,7 @@ bool Combiner<T>::gate(Epoch& e, Vector3<T>* est) const noexcept {
         e.inconsistent = static_cast<HeadMask>(e.inconsistent | head_bit(e.c[odd].head));
         if (odd == e.ref) {  // re-form the differences about a head that stays
             for (std::uint8_t i = 0; i < e.n; ++i) {
-                if ((e.group >> i & 1U) != 0U) {
+                if (in_mask(e.group, i)) {
                     e.ref = i;
                     break;
                 }
@@ -500,7 +515,7 @@ bool Combiner<T>::combine_group(Epoch& e, Vector3<T>* est) const noexcept {
     constexpr T zero = constant<T>(0.0);
     e.ref = 0;
     e.group = static_cast<std::uint8_t>((1U << e.n) - 1U);
-    const Quaternion<T> ref = e.c[0].q;
+    const ReferenceFactor<T> ref = CombineFormats<T>::reference_from(e.c[0].q);
     e.c[0].h = {zero, zero, zero};
     bool near = true;
     Accumulator<T> acc = zero_accumulator<T>();
@@ -540,6 +555,10 @@ CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vec
         out.used = e.group == (1U << e.n) - 1U ? e.heads : heads_of(e, e.group);
         const Quaternion<T>& ref = e.c[e.ref].q;
         const Vector3<T> h = residual(est, bias_[out.used]);
+        // d = (0, h) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖h‖²
+        // (+ ref's own ≤ 1e-6): within Q30's range of renormalized_sum for any
+        // h of the accumulator's range (|hᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
+        // unit to 2⁻³⁰ for ‖h‖ ≤ 0.033 rad, which the gates keep it far below.
         out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(h, ref)));
         out.inconsistent = e.inconsistent;
     } else {

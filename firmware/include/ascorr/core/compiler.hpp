@@ -16,7 +16,7 @@
 #include <cstdint>
 
 #if !defined(__GNUC__) && !defined(__clang__)
-#error "ascorr's fixed-point core needs GCC >= 9 or Clang >= 9 (builtins, GNU inline asm); see ascorr/compiler.hpp"
+#error "ascorr's fixed-point core needs GCC >= 9 or Clang >= 9 (builtins, GNU inline asm); see ascorr/core/compiler.hpp"
 #elif defined(__clang__)
 #if __clang_major__ < 9
 #error "ascorr's fixed-point core needs Clang >= 9 (__builtin_is_constant_evaluated)"

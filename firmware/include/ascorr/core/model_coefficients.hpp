@@ -2,7 +2,7 @@
 // conversion of such numbers into the core's ThermalModel<T>.
 //
 // Conventions: coefficient[head][axis][term], head by index (heads.hpp), axis
-// alpha, beta, gamma (kAlphaAxis …), term c0, c1, c2, c3, c1_2, c2_2, c3_2 (the
+// alpha, beta, gamma (0, 1, 2; kModelAxes of them), term c0, c1, c2, c3, c1_2, c2_2, c3_2 (the
 // model file's columns, docs/contract.md "Model file"), in one unit given with
 // the numbers: `unit_to_rad` = kArcsecToRad for a model file's arcsec (arcsec/°C,
 // arcsec/°C²), 1 for radians. Each coefficient is multiplied by unit_to_rad in

@@ -125,7 +125,9 @@ public:
     combine::CombinedAttitude<T> close(Meter& meter) noexcept {
         combine::CombinedAttitude<T> r{};
         if (combiner_ == nullptr) {
-            r.q_crf_icrf = {constant<T>(1.0), constant<T>(0.0), constant<T>(0.0), constant<T>(0.0)};
+            constexpr T one = constant<T>(1.0);
+            constexpr T zero = constant<T>(0.0);
+            r.q_crf_icrf = {one, zero, zero, zero};
             r.status = combine::combined_status::kNoHead;
             return r;
         }

@@ -24,8 +24,9 @@
 //    thermal disagreement does not enter; one degree of freedom per window
 //    and head set is spent on it), summed per head set. The components are
 //    then estimated by restricted maximum likelihood, iterated as Fisher
-//    scoring (the variance-component estimation GROOPS uses; Koch 1999,
-//    "Parameter Estimation and Hypothesis Testing in Linear Models", §3.6),
+//    scoring (the variance-component estimation GROOPS uses per arc; Koch,
+//    "Parameter Estimation and Hypothesis Testing in Linear Models", 1999,
+//    estimation of variance and covariance components),
 //    starting from the unweighted (MINQUE with unit weights) solution; their
 //    covariance is the inverse Fisher information at the solution. With two
 //    heads the four components are not all identifiable (three numbers per

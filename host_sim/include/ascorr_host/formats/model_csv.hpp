@@ -3,7 +3,7 @@
 // Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
 // One row per head and axis; a head that appears must have all three axes.
 // Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
-// the core's radians (ascorr/model_coefficients.hpp).
+// the core's radians (ascorr/core/model_coefficients.hpp).
 #pragma once
 
 #include <array>
@@ -77,7 +77,7 @@ inline ModelFile model_file_of(const ModelCoefficients& c) {
 }
 
 // The model in the core's units (radians), for scalar T: the core's one
-// conversion (ascorr/model_coefficients.hpp).
+// conversion (ascorr/core/model_coefficients.hpp).
 template <typename T>
 ThermalModel<T> to_core(const ModelFile& m) {
     return thermal_model<T>(coefficients_of(m), kArcsecToRad);

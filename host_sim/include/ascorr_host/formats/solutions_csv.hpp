@@ -27,7 +27,7 @@ namespace ascorr::host {
 
 using ascorr::kUnknownHead;  // heads.hpp
 
-// The head index of a `chu` field (one letter of kHeadLetters, ascorr/heads.hpp),
+// The head index of a `chu` field (one letter of kHeadLetters, ascorr/core/heads.hpp),
 // kUnknownHead otherwise.
 std::uint8_t head_from_name(std::string_view chu) noexcept;
 char head_name(std::uint8_t head) noexcept;  // its letter, '?' for an unknown head
