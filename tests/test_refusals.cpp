@@ -298,8 +298,10 @@ TEST(Refusals, RefusedValuesArePrintedExactly) {
         std::string args;
         std::string message;
     } cases[] = {
+        // (self-calibration: the median of the six speeds, the third slow row's, and the set disagrees)
         {"correct --in slow.csv --out o.csv --self-calibrate",
-         "slow.csv:2:1: spacecraft speed 1.0000001e-07 km/s is not that of an Earth orbit"},
+         "slow.csv:4:1: the spacecraft speeds of the first 6 rows the self-calibration learns from disagree: 3 are "
+         "within 1 % of their median 1.0000001e-07 km/s"},
         {"fit --in slow.csv --out o.csv",
          "slow.csv:2:1: spacecraft speed 1.0000001e-07 km/s is not that of an Earth orbit"},
         {"correct --scalar fixed --in " + in + " --model m.csv --out o.csv",

@@ -423,7 +423,7 @@ TEST(SelfCalibrationCli, CorrectSelfCalibrate) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto hist = lines_of(slurp(m.dir / "h.csv"));
     ASSERT_GE(hist.size(), 10U);
-    EXPECT_EQ(hist[0], "t,version,chu,axis,c0,c1,c2,c3,crc32c");
+    EXPECT_EQ(hist[0], "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin");
     EXPECT_EQ(hist[1].substr(hist[1].find(',') + 1, 10), "1,A,alpha,");
     const double t_first = std::stod(hist[1]);
     // Rows before the first model: 256 and no thermal stage; after it, the thermal stage.

@@ -127,6 +127,8 @@ void add_fit_command(CLI::App& app);
 // --time-constant DAYS of `correct` and `replay` --self-calibrate (its range
 // and default from the estimator's; correct_command.cpp).
 CLI::Option* add_time_constant_option(CLI::App& cmd, double& days);
+// --orbit-period SECONDS of correct and replay --self-calibrate (the estimator's range, as fit's).
+CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds);
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 void add_combine_command(CLI::App& app);

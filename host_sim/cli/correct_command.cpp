@@ -78,6 +78,16 @@ CLI::Option* add_time_constant_option(CLI::App& cmd, double& days) {
         ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
 }
 
+CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds) {
+    return cmd
+        .add_option("--orbit-period", seconds,
+                    "with --self-calibrate: the orbit period in s, " + host::orbit_period_range() +
+                        " (default: from the median speed of the first " + std::to_string(host::kOrbitPeriodRows) +
+                        " rows learnt from)")
+        ->check(real_in(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6,
+                        static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6));
+}
+
 void add_correct_command(CLI::App& app) {
     auto opt = std::make_shared<host::CorrectOptions>();
     CLI::App* cmd =
@@ -111,19 +121,23 @@ void add_correct_command(CLI::App& app) {
     cmd->add_flag("--self-calibrate", opt->self_calibrate,
                   "estimate the thermal model from the rows themselves with the on-board estimator, causally in time "
                   "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
-    cmd->add_option(
-           "--model-history", opt->model_history,
-           "with --self-calibrate: write every model that became active (CSV t,version,chu,axis,c0..c3,crc32c)")
+    cmd->add_option("--model-history", opt->model_history,
+                    "with --self-calibrate: write every model that became active (CSV "
+                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
+    CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
-    cmd->callback([opt, time_constant, combine]() {
+    cmd->callback([opt, time_constant, orbit_period, combine]() {
         if (!opt->self_calibrate && !opt->model_history.empty()) {
             throw CLI::ValidationError("--model-history", "needs --self-calibrate");
         }
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
+        }
+        if (!opt->self_calibrate && orbit_period->count() > 0) {
+            throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
         }
         if (!combine->combined.empty()) {
             correct_and_combine(*opt, *combine);

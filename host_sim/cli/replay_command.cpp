@@ -50,6 +50,7 @@ void add_replay_command(CLI::App& app) {
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());
     CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
+    CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
     CLI::Option* mountings =
         cmd->add_option("--mountings", opt->mountings,
                         "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "
@@ -72,7 +73,7 @@ void add_replay_command(CLI::App& app) {
         ->transform(integer_in<int>(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
-    cmd->callback([opt, speed, time_constant]() {
+    cmd->callback([opt, speed, time_constant, orbit_period]() {
         opt->realtime = *speed == "realtime";
         if (!opt->self_calibrate && opt->model.empty()) {
             throw CLI::RequiredError("--model (or --self-calibrate)");
@@ -82,6 +83,9 @@ void add_replay_command(CLI::App& app) {
         }
         if (!opt->self_calibrate && time_constant->count() > 0) {
             throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
+        }
+        if (!opt->self_calibrate && orbit_period->count() > 0) {
+            throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
         }
         std::vector<host::NamedPath> outputs = host::replay_outputs(*opt);
         outputs.push_back(host::kStandardOutput);  // the summary

@@ -191,6 +191,8 @@ class _ActiveModel(TypedDict):
     version: int
     crc32c: int
     model: Model
+    tt_us: int
+    origin: dict[str, str]
 
 def self_calibrate(
     t: _Real,
@@ -203,6 +205,7 @@ def self_calibrate(
     model: Optional[Model] = ...,
     scalar: Literal["double", "float", "fixed"] = ...,
     time_constant: float = ...,
+    orbit_period: Optional[float] = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
@@ -210,9 +213,14 @@ def self_calibrate(
     NaN or None where not given: not clean), after the aberration stage, in `scalar`,
     starting from `model` (version 0) or from none (rows before the first adopted
     model get status 256).
-    time_constant: the estimator's forgetting in days. Returns (q_corrected float64
+    time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
+    or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
+    Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
-    "model"} for every model that became active, in time order."""
+    "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,
+    on the on-board clock: the rows whose t rounded to the microsecond is at least it;
+    origin: per head present, "given" (version 0), "learnt" or "kept" (a head the estimator
+    does not learn keeps the active model's coefficients)."""
 # arrays, and "extra": dict[str, NDArray[str_]]
 def read_solutions(path: _Path) -> dict[str, Any]:
     """Read a solutions file, or a corrected file, into arrays: {"t", "chu" (strings as written),

@@ -125,6 +125,13 @@ py::tuple correct(const py::object& t, const py::object& chu, const py::object& 
             bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
         }
     }
+    if (scalar == host::ScalarKind::kFloat && m != nullptr) {
+        try {
+            host::check_float_range(*m, "model");  // refused, as by the command line
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", std::string(e.what()) + " (scalar='float')");
+        }
+    }
     const Rows r = rows_of(t, chu, q, temps, v);
     py::array_t<double> q_out({r.n, py::ssize_t{4}});
     py::array_t<std::uint16_t> st_out(r.n);

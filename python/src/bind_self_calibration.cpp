@@ -31,12 +31,13 @@ using namespace pybind11::literals;
 namespace {
 
 template <typename T>
-py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days, double* q_out,
-                              std::uint16_t* st_out) {
+py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days,
+                              std::optional<double> orbit_period_s, double* q_out, std::uint16_t* st_out) {
     calib::EstimatorConfig cfg;
     cfg.time_constant_days = time_constant_days;
-    const host::SelfCalibration sc = host::self_calibrate<T>(
-        kArrayRows, source_of(r), m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, std::nullopt);
+    const host::SelfCalibration sc =
+        host::self_calibrate<T>(kArrayRows, source_of(r),
+                                m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s);
     const host::ModelSchedule<T> schedule(sc.history);
     host::EarthVelocity earth;
     SolutionRecord rec;
@@ -49,9 +50,18 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     for (const host::ActiveModel& a : sc.history) {
         py::dict d;
         d["t"] = a.t;
+        d["tt_us"] = a.t_us;
         d["version"] = a.version;
         d["crc32c"] = a.crc;
         d["model"] = py::cast(a.model);
+        py::dict origin;  // per head present: "given", "learnt" or "kept" (head_origin)
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            if (a.model.present[h]) {
+                origin[py::str(std::string(1, host::head_name(static_cast<std::uint8_t>(h))))] =
+                    host::head_origin(a.version, h);
+            }
+        }
+        d["origin"] = origin;
         history.append(d);
     }
     return history;
@@ -59,13 +69,29 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
 
 py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                          const py::object& v, const py::object& flags, const py::object& confidence,
-                         const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj) {
+                         const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj,
+                         const py::object& orbit_period_obj) {
     const host::ModelFile* m = model_arg(model);
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
     const double time_constant = real_arg(time_constant_obj, "time_constant");
     if (!calib::time_constant_acceptable(time_constant)) {
         bad_argument("time_constant",
                      "expected days in " + host::time_constant_range() + ", got " + value_text(time_constant_obj));
+    }
+    std::optional<double> orbit_period;
+    if (!orbit_period_obj.is_none()) {
+        orbit_period = real_arg(orbit_period_obj, "orbit_period");
+        if (!host::orbit_period_acceptable(*orbit_period)) {
+            bad_argument("orbit_period",
+                         "expected seconds in " + host::orbit_period_range() + ", got " + value_text(orbit_period_obj));
+        }
+    }
+    if (m != nullptr) {
+        try {
+            host::refuse_quadratic_initial_model(*m, "the model given");
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", e.what());
+        }
     }
     if (scalar == host::ScalarKind::kFixed && m != nullptr) {
         try {
@@ -74,16 +100,26 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
             bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
         }
     }
+    if (scalar == host::ScalarKind::kFloat && m != nullptr) {
+        try {
+            host::check_float_range(*m, "model");  // refused, as by the command line
+        } catch (const std::runtime_error& e) {
+            bad_argument("model", std::string(e.what()) + " (scalar='float')");
+        }
+    }
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     py::array_t<double> q_out({r.n, py::ssize_t{4}});
     py::array_t<std::uint16_t> st_out(r.n);
     py::list history;
     if (scalar == host::ScalarKind::kDouble) {
-        history = self_calibrated_rows<double>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, q_out.mutable_data(),
+                                               st_out.mutable_data());
     } else if (scalar == host::ScalarKind::kFloat) {
-        history = self_calibrated_rows<float>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+        history =
+            self_calibrated_rows<float>(r, m, time_constant, orbit_period, q_out.mutable_data(), st_out.mutable_data());
     } else {
-        history = self_calibrated_rows<Q30>(r, m, time_constant, q_out.mutable_data(), st_out.mutable_data());
+        history =
+            self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, q_out.mutable_data(), st_out.mutable_data());
     }
     return py::make_tuple(q_out, st_out, history);
 }
@@ -93,7 +129,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
 void bind_self_calibration(py::module_& mod) {
     mod.def("self_calibrate", &self_calibrate, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
             "confidence"_a = py::none(), "model"_a = py::none(), "scalar"_a = "double", "time_constant"_a = 30.0,
-            docstring(docs::kSelfCalibrate));
+            "orbit_period"_a = py::none(), docstring(docs::kSelfCalibrate));
 }
 
 }  // namespace ascorr::python

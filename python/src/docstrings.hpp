@@ -80,9 +80,14 @@ epochs `fit` would select (flags: integers (n,) or None; confidence: (n,) arcsec
 NaN or None where not given: not clean), after the aberration stage, in `scalar`,
 starting from `model` (version 0) or from none (rows before the first adopted
 model get status 256).
-time_constant: the estimator's forgetting in days. Returns (q_corrected float64
+time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
+or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
+Returns (q_corrected float64
 (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
-"model"} for every model that became active, in time order.)doc";
+"model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,
+on the on-board clock: the rows whose t rounded to the microsecond is at least it;
+origin: per head present, "given" (version 0), "learnt" or "kept" (a head the estimator
+does not learn keeps the active model's coefficients).)doc";
 
 inline constexpr const char* kEarthVelocity =
     R"doc(The Earth's barycentric velocity (ICRF axes, km/s) and heliocentric distance (au) at t

@@ -38,7 +38,12 @@ def test_same_as_the_command_line(exe, mission, scalar):
     assert versions == [h["version"] for h in history]
     assert [float(r[0]) for r in h_rows[::9]] == pytest.approx([h["t"] for h in history], abs=5e-4)
     assert (status[s["t"] >= history[0]["t"]] & 256).sum() == 0, "every row from the first model on has one"
-    assert [f"{h['crc32c']:08x}" for h in history] == [r[-1] for r in h_rows[::9]]
+    crc = h_header.index("crc32c")
+    assert [f"{h['crc32c']:08x}" for h in history] == [r[crc] for r in h_rows[::9]]
+    tt_us = h_header.index("tt_us")
+    assert [int(r[tt_us]) for r in h_rows[::9]] == [h["tt_us"] for h in history]
+    origin = h_header.index("origin")
+    assert [r[origin] for r in h_rows[::9]] == [h["origin"]["A"] for h in history]
 
 
 def test_bad_arguments(mission):
@@ -47,3 +52,43 @@ def test_bad_arguments(mission):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], time_constant=0.5)
     with pytest.raises(ValueError, match="scalar"):
         ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], scalar="half")
+    for bad in (599.0, float("nan"), 86401.0):
+        with pytest.raises(ValueError, match=r"argument 'orbit_period': expected seconds in \[600, 86400\]"):
+            ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], orbit_period=bad)
+
+
+def test_the_orbit_period_as_on_the_command_line(exe, mission):
+    hist = mission / "h_period.csv"
+    run_cli(exe, "correct", "--in", mission / "m.csv", "--out", mission / "c_period.csv", "--self-calibrate",
+            "--orbit-period", "6000", "--model-history", hist)
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    _, _, history = ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], flags=s["flags"],
+                                          confidence=s["confidence"], orbit_period=6000.0)
+    h_header, h_rows = read_csv_text(hist)
+    crc = h_header.index("crc32c")
+    assert [f"{h['crc32c']:08x}" for h in history] == [r[crc] for r in h_rows[::9]]
+
+
+def test_a_quadratic_model_is_refused_as_on_the_command_line(mission, tmp_path):
+    # One rule with `correct --self-calibrate` and `replay --self-calibrate`:
+    # the estimator starts from a linear model (refuse_quadratic_initial_model).
+    lines = (tmp_path / "q.csv")
+    lines.write_text("chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n"
+                     "A,alpha,0,0,0,0,0,0,0\nA,beta,0,0,0,0,0,0,0\nA,gamma,0,0,0,0,0,0,0\n"
+                     "B,alpha,0,0,0,0,0,0,0\nB,beta,0,0,0,0,0,0,0\nB,gamma,0,0,0,0,0,1e-3,0\n")
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    with pytest.raises(ValueError, match=r"argument 'model'.*head B gamma has a quadratic term \(c2_2\)"):
+        ascorr.self_calibrate(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=ascorr.read_model(str(lines)))
+
+
+def test_a_model_beyond_the_float_range_is_refused_for_float(mission, tmp_path):
+    # As on the command line (check_float_range): c1 = c2 = 6000"/degC, which
+    # fixed point accepts, cannot be evaluated in float within its bound.
+    p = tmp_path / "big.csv"
+    p.write_text("chu,axis,c0,c1,c2,c3\nA,alpha,0,6000,6000,0\nA,beta,0,0,0,0\nA,gamma,0,0,0,0\n")
+    m = ascorr.read_model(str(p))
+    s = ascorr.read_solutions(str(mission / "m.csv"))
+    for call in (ascorr.correct, ascorr.self_calibrate):
+        with pytest.raises(ValueError, match=r"argument 'model'.*beyond what the float core evaluates"):
+            call(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=m, scalar="float")
+    ascorr.correct(s["t"], s["chu"], s["q"], s["temps"], s["v"], model=m, scalar="fixed")

@@ -306,6 +306,10 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
         throw std::runtime_error("--time-constant must be in " + time_constant_range() + " days, got " +
                                  number_text(opt.time_constant_days));
     }
+    if (opt.orbit_period_s && !orbit_period_acceptable(*opt.orbit_period_s)) {
+        throw std::runtime_error("--orbit-period must be in " + orbit_period_range() + " s, got " +
+                                 number_text(*opt.orbit_period_s));
+    }
     if (!opt.states.empty()) {
         // The estimator's pass reads the rows' own velocities only: rows whose
         // velocity would come from the states would never be learnt from.
@@ -328,6 +332,12 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         if constexpr (std::is_same_v<T, Q30>) {
             check_fixed_point_range(*model_file, opt.model);
         }
+        if constexpr (std::is_same_v<T, float>) {
+            check_float_range(*model_file, opt.model);
+        }
+        if (opt.self_calibrate) {
+            refuse_quadratic_initial_model(*model_file, opt.model);
+        }
         model = to_core<T>(*model_file);
     }
     std::optional<ModelSchedule<T>> schedule;
@@ -340,7 +350,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         const SelfCalibration sc = self_calibrate<T>(
             opt.in,
             [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
-            model_file, ecfg, std::nullopt);
+            model_file, ecfg, opt.orbit_period_s);
         schedule.emplace(sc.history);
         history = format_model_history(sc.history);
         account = describe(sc);

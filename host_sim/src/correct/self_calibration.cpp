@@ -1,10 +1,15 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
@@ -34,10 +39,21 @@ struct CalibRow {
     SolutionInput<T> in;
 };
 
+// The orbit period, when not given, from the speeds of the first
+// kOrbitPeriodRows fed rows in time order (docs/contract.md,
+// Self-calibration): their median's circular orbit (vis-viva), so that no
+// single row decides; a set in which fewer than three quarters lie within
+// kPeriodSpeedTolerance of the median is refused (an eccentric orbit or
+// corrupted velocities: give --orbit-period).
+constexpr double kPeriodSpeedTolerance = 0.01;
+
 // The estimator over rows taken in time order (t_us, then line), one at a
-// time, as the link server takes them. The orbit period comes from the first
-// fed row's speed unless given: epochs before it wait (their times only) and
-// are replayed when the estimator starts.
+// time, as the link server takes them. Until the orbit period is known (given,
+// or kOrbitPeriodRows fed rows seen), rows are held and replayed when the
+// estimator starts: the fed rows whole, and of the epochs between two fed rows
+// only the first and the last (the others change nothing: no model becomes
+// pending without a fed epoch, and the run's pipeline feeds every epoch, so
+// the epochs' count does not matter), so the rows held are bounded.
 template <typename T>
 class Run {
 public:
@@ -53,15 +69,27 @@ public:
     }
 
     void take(const CalibRow<T>& r) {
-        if (!est_) {
-            if (!r.fed) {
-                if (waiting_.empty() || waiting_.back().first != r.t_us) {
-                    waiting_.emplace_back(r.t_us, r.t);
-                }
-                return;
-            }
-            start(period_from_speed(r));
+        if (est_) {
+            process(r);
+        } else {
+            hold(r);
         }
+    }
+
+    SelfCalibration finish(std::size_t untimed) {
+        if (!est_) {
+            // Fewer than kOrbitPeriodRows fed rows: their period; none: nothing is
+            // learnt, the period is not used.
+            start(fed_held_ > 0 ? period_from_speeds()
+                                : static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
+        }
+        out_.report = est_->report();
+        out_.untimed = untimed;
+        return out_;
+    }
+
+private:
+    void process(const CalibRow<T>& r) {
         (void)epoch(r.t_us, r.t);
         if (r.fed) {
             const std::uint32_t feeds = pipeline_.feeds();
@@ -71,47 +99,73 @@ public:
         }
     }
 
-    SelfCalibration finish(std::size_t untimed) {
-        if (!est_) {
-            // No row to learn from: nothing is learnt, the period is not used.
-            start(static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
+    void hold(const CalibRow<T>& r) {
+        const std::size_t n = held_.size();
+        if (!r.fed && n >= 2 && !held_[n - 1].fed && !held_[n - 2].fed) {
+            if (r.t_us != held_[n - 1].t_us) {
+                held_[n - 1] = r;  // the last epoch between two fed rows so far
+            }
+            return;
         }
-        out_.report = est_->report();
-        out_.untimed = untimed;
-        return out_;
+        held_.push_back(r);
+        if (r.fed && ++fed_held_ == kOrbitPeriodRows) {
+            start(period_from_speeds());
+        }
     }
 
-private:
-    // A circular orbit's period at the first fed row's speed (vis-viva); the
-    // estimator's limits (10 min to a day) are speeds of 3.3 to 16 km/s:
-    // beyond 12 km/s nothing is bound to the Earth.
-    double period_from_speed(const CalibRow<T>& r) const {
-        const double v = r.speed_kms;
+    // A circular orbit's period at the median speed of the fed rows held
+    // (vis-viva); the estimator's limits (10 min to a day) are speeds of 3.3
+    // to 16 km/s: beyond 12 km/s nothing is bound to the Earth.
+    double period_from_speeds() const {
+        std::vector<const CalibRow<T>*> fed;
+        for (const CalibRow<T>& r : held_) {
+            if (r.fed) {
+                fed.push_back(&r);
+            }
+        }
+        const auto by_speed = [](const CalibRow<T>* a, const CalibRow<T>* b) {  // ties by line: one median row
+            return a->speed_kms < b->speed_kms || (a->speed_kms == b->speed_kms && a->line < b->line);
+        };
+        const auto mid = fed.begin() + static_cast<std::ptrdiff_t>((fed.size() - 1) / 2);
+        std::nth_element(fed.begin(), mid, fed.end(), by_speed);
+        const CalibRow<T>& median = **mid;
+        const double v = median.speed_kms;
+        const std::size_t near = static_cast<std::size_t>(std::count_if(fed.begin(), fed.end(), [v](const auto* r) {
+            return std::fabs(r->speed_kms - v) <= kPeriodSpeedTolerance * v;
+        }));
+        if (4 * near < 3 * fed.size()) {
+            throw InputError(file_, median.line, 1,
+                             "the spacecraft speeds of the first " + std::to_string(fed.size()) +
+                                 " rows the self-calibration learns from disagree: " + std::to_string(near) +
+                                 " are within " + number_text(kPeriodSpeedTolerance * 100.0) + " % of their median " +
+                                 number_text(v) +
+                                 " km/s (three quarters must be): the orbit period cannot be derived; give "
+                                 "--orbit-period");
+        }
         const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
         if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw InputError(file_, r.line, 1,
+            throw InputError(file_, median.line, 1,
                              "spacecraft speed " + number_text(v) +
                                  " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
-                                 "self-calibration cannot be derived");
+                                 "self-calibration cannot be derived; give --orbit-period");
         }
         return period_s;
     }
 
     void start(double period_s) {
-        if (!(period_s * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
-              period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw std::invalid_argument("orbit period " + number_text(period_s) +
-                                        " s is outside the estimator's 600 s to 1 day");
+        if (!orbit_period_acceptable(period_s)) {
+            throw std::invalid_argument("orbit period " + number_text(period_s) + " s is outside the estimator's " +
+                                        orbit_period_range() + " s");
         }
         out_.orbit_period_s = period_s;
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
         pipeline_.use_estimator(&*est_);
-        for (const auto& [t_us, t] : waiting_) {
-            (void)epoch(t_us, t);
+        for (const CalibRow<T>& r : held_) {
+            process(r);
         }
-        waiting_.clear();
-        waiting_.shrink_to_fit();
+        held_.clear();
+        held_.shrink_to_fit();
     }
 
     // The epoch's model (a new epoch when t_us changes), and the history.
@@ -131,17 +185,251 @@ private:
     std::optional<ModelCoefficients> initial_;
     std::optional<calib::Estimator<T>> est_;
     pipeline::EpochPipeline<T> pipeline_;
-    std::vector<std::pair<std::int64_t, double>> waiting_;  // epochs before the orbit period is known
+    std::vector<CalibRow<T>> held_;  // rows before the orbit period is known (hold)
+    std::size_t fed_held_ = 0;
     bool had_ = false;
     std::uint32_t version_ = 0;
     SelfCalibration out_;
 };
 
+// The clock's order: TT µs, then the line (rows and their keys).
+template <typename A, typename B>
+bool before(const A& a, const B& b) {
+    return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
+}
+
+// Rows sorted into the clock's order within a memory budget. Each row is a
+// 24-byte key, and a fed row also its input (CalibRow); a run is sorted in
+// memory. When a run fills the budget it is written, sorted, to an anonymous
+// temporary file (std::tmpfile: gone when closed, at exit and on a signal),
+// and each() merges the runs, each read through a small buffer: the memory
+// stays within about the budget whatever the number of rows (the disk holds
+// them). One run (the usual case) never touches the disk.
+template <typename T>
+class SortedRuns {
+public:
+    explicit SortedRuns(std::size_t budget_bytes) : budget_(std::max<std::size_t>(budget_bytes, 4096)) {}
+    SortedRuns(const SortedRuns&) = delete;
+    SortedRuns& operator=(const SortedRuns&) = delete;
+    ~SortedRuns() {
+        if (file_ != nullptr) {
+            (void)std::fclose(file_);
+        }
+    }
+
+    void add(const CalibRow<T>& r) {
+        // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
+        keys_.push_back(
+            {r.t_us, r.t, static_cast<std::uint32_t>(r.line), r.fed ? static_cast<std::uint32_t>(fed_.size()) : kNone});
+        if (r.fed) {
+            fed_.push_back(r);
+        }
+        if (bytes() >= budget_) {
+            spill();
+        }
+    }
+
+    // Calls fn for every row in the clock's order.
+    template <typename Fn>
+    void each(Fn&& fn) {
+        if (file_ == nullptr) {
+            sort_run();
+            for (const Key& k : keys_) {
+                fn(row_of(k));
+            }
+            return;
+        }
+        if (!keys_.empty()) {
+            spill();
+        }
+        merge(fn);
+    }
+
+    std::size_t count() const noexcept { return spilled_.empty() ? 1U : spilled_.size(); }
+
+private:
+    struct Key {
+        std::int64_t t_us;
+        double t;
+        std::uint32_t line;
+        std::uint32_t fed;  // index in fed_ (in a run file: 1 when the row's input follows), or kNone
+    };
+    static constexpr std::uint32_t kNone = 0xFFFFFFFFU;
+    static_assert(std::is_trivially_copyable_v<CalibRow<T>>, "rows are written to the run file as bytes");
+
+    // A spilled run: its bytes [begin, end) in the file, read through a buffer.
+    struct RunReader {
+        std::int64_t at;
+        std::int64_t end;
+        std::vector<char> buf;
+        std::size_t pos = 0;
+        std::size_t len = 0;
+        Key key{};
+        CalibRow<T> row{};
+    };
+
+    // What the run holds, as allocated (a vector grows beyond its size).
+    std::size_t bytes() const noexcept {
+        return keys_.capacity() * sizeof(Key) + fed_.capacity() * sizeof(CalibRow<T>);
+    }
+
+    void sort_run() {
+        std::sort(keys_.begin(), keys_.end(), [](const Key& a, const Key& b) { return before(a, b); });
+    }
+
+    CalibRow<T> row_of(const Key& k) const {
+        if (k.fed != kNone) {
+            return fed_[k.fed];
+        }
+        CalibRow<T> r{};
+        r.t_us = k.t_us;
+        r.t = k.t;
+        r.line = k.line;
+        return r;
+    }
+
+    void spill() {
+        sort_run();
+        if (file_ == nullptr) {
+            file_ = std::tmpfile();
+            if (file_ == nullptr) {
+                throw std::runtime_error(std::string("self-calibration: cannot open a temporary file for the rows "
+                                                     "out of time order: ") +
+                                         std::strerror(errno));
+            }
+        }
+        const std::int64_t begin = written_;
+        for (const Key& k : keys_) {
+            Key out = k;
+            out.fed = k.fed == kNone ? kNone : 1U;
+            put(&out, sizeof out);
+            if (k.fed != kNone) {
+                put(&fed_[k.fed], sizeof(CalibRow<T>));
+            }
+        }
+        if (std::fflush(file_) != 0) {
+            fail("write");
+        }
+        spilled_.emplace_back(begin, written_);
+        keys_.clear();
+        keys_.shrink_to_fit();
+        fed_.clear();
+        fed_.shrink_to_fit();
+    }
+
+    void put(const void* p, std::size_t n) {
+        if (std::fwrite(p, 1, n, file_) != n) {
+            fail("write");
+        }
+        written_ += static_cast<std::int64_t>(n);
+    }
+
+    [[noreturn]] static void fail(const char* what) {
+        throw std::runtime_error(std::string("self-calibration: cannot ") + what +
+                                 " the temporary file of the rows out of time order: " + std::strerror(errno));
+    }
+
+    void get(RunReader& r, void* p, std::size_t n) const {
+        char* out = static_cast<char*>(p);
+        while (n > 0) {
+            if (r.pos == r.len) {
+                const auto want = static_cast<std::size_t>(
+                    std::min<std::int64_t>(static_cast<std::int64_t>(r.buf.size()), r.end - r.at));
+                const ssize_t got = ::pread(fileno(file_), r.buf.data(), want, static_cast<off_t>(r.at));
+                if (got <= 0) {
+                    fail("read");
+                }
+                r.at += got;
+                r.len = static_cast<std::size_t>(got);
+                r.pos = 0;
+            }
+            const std::size_t k = std::min(n, r.len - r.pos);
+            std::memcpy(out, r.buf.data() + r.pos, k);
+            r.pos += k;
+            out += k;
+            n -= k;
+        }
+    }
+
+    // The next row of run r; false at its end.
+    bool next(RunReader& r) const {
+        if (r.at == r.end && r.pos == r.len) {
+            return false;
+        }
+        get(r, &r.key, sizeof r.key);
+        if (r.key.fed != kNone) {
+            get(r, &r.row, sizeof r.row);
+        } else {
+            r.row = CalibRow<T>{};
+            r.row.t_us = r.key.t_us;
+            r.row.t = r.key.t;
+            r.row.line = r.key.line;
+        }
+        return true;
+    }
+
+    template <typename Fn>
+    void merge(Fn&& fn) {
+        // The read buffers share the budget (at least 4 KiB each).
+        const std::size_t each_bytes = std::max<std::size_t>(4096, budget_ / spilled_.size());
+        std::vector<RunReader> readers;
+        readers.reserve(spilled_.size());
+        for (const auto& [begin, end] : spilled_) {
+            readers.push_back({begin, end, std::vector<char>(each_bytes)});
+        }
+        const auto later = [&readers](std::size_t a, std::size_t b) { return before(readers[b].key, readers[a].key); };
+        std::vector<std::size_t> heap;
+        for (std::size_t i = 0; i < readers.size(); ++i) {
+            if (next(readers[i])) {
+                heap.push_back(i);
+            }
+        }
+        std::make_heap(heap.begin(), heap.end(), later);
+        while (!heap.empty()) {
+            std::pop_heap(heap.begin(), heap.end(), later);
+            RunReader& r = readers[heap.back()];
+            fn(static_cast<const CalibRow<T>&>(r.row));
+            if (next(r)) {
+                std::push_heap(heap.begin(), heap.end(), later);
+            } else {
+                heap.pop_back();
+            }
+        }
+    }
+
+    std::size_t budget_;
+    std::vector<Key> keys_;
+    std::vector<CalibRow<T>> fed_;
+    std::FILE* file_ = nullptr;
+    std::int64_t written_ = 0;
+    std::vector<std::pair<std::int64_t, std::int64_t>> spilled_;
+};
+
 }  // namespace
+
+void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name) {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
+                if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
+                    throw std::runtime_error(
+                        name + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
+                        kAxisNames[a] + " has a quadratic term (" + kCoefficientNames[i] +
+                        "): self-calibration starts from a linear model (the on-board estimator's models are c0..c3, "
+                        "and the link's CALIB_MODEL_LOAD carries c0..c3); give the model without its quadratic terms");
+                }
+            }
+        }
+    }
+}
 
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s) {
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
+                               std::size_t memory_budget_bytes) {
+    if (initial) {
+        refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
+    }
     EarthVelocity earth;
     // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
     const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {
@@ -161,15 +449,11 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         }
         return true;
     };
-    // The on-board clock's order: TT µs, then the line (rows and their keys).
-    const auto before = [](const auto& a, const auto& b) {
-        return a.t_us < b.t_us || (a.t_us == b.t_us && a.line < b.line);
-    };
-    // (Line numbers fit 32 bits: a file of 4 × 10⁹ lines is beyond any recording.)
 
     // Rows in time order (the usual file) are taken as they are read; at the
-    // first row out of order the run stops, and the rows are read again, kept
-    // (the epoch of each, the input of those fed) and sorted.
+    // first row out of order the run stops, and the rows are read again and
+    // sorted (the epoch of each, the input of those fed) within the memory
+    // budget (SortedRuns).
     {
         Run<T> run(file, initial, cfg, orbit_period_s);
         std::size_t untimed = 0;
@@ -197,15 +481,10 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
             return run.finish(untimed);
         }
     }
-    struct Key {  // 24 bytes a row; the input only for the rows fed
-        std::int64_t t_us;
-        double t;
-        std::uint32_t line;
-        std::uint32_t fed;  // index in `fed`, or kNone
-    };
-    constexpr std::uint32_t kNone = 0xFFFFFFFFU;
-    std::vector<Key> keys;
-    std::vector<CalibRow<T>> fed;
+    // Out of order: the rows are sorted by the clock's order in runs that fit
+    // the memory budget; when there are more, each run is written sorted to an
+    // anonymous temporary file and the runs are merged (SortedRuns).
+    SortedRuns<T> runs(memory_budget_bytes);
     std::size_t untimed = 0;
     rows([&](const SolutionRecord& rec) {
         CalibRow<T> r{};
@@ -213,34 +492,21 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
             ++untimed;
             return;
         }
-        keys.push_back(
-            {r.t_us, r.t, static_cast<std::uint32_t>(r.line), r.fed ? static_cast<std::uint32_t>(fed.size()) : kNone});
-        if (r.fed) {
-            fed.push_back(r);
-        }
+        runs.add(r);
     });
-    std::sort(keys.begin(), keys.end(), before);
     Run<T> run(file, initial, cfg, orbit_period_s);
-    for (const Key& k : keys) {
-        if (k.fed != kNone) {
-            run.take(fed[k.fed]);
-        } else {
-            CalibRow<T> r{};
-            r.t_us = k.t_us;
-            r.t = k.t;
-            r.line = k.line;
-            run.take(r);
-        }
-    }
-    return run.finish(untimed);
+    runs.each([&run](const CalibRow<T>& r) { run.take(r); });
+    SelfCalibration out = run.finish(untimed);
+    out.runs = runs.count();
+    return out;
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                                const calib::EstimatorConfig&, std::optional<double>);
+                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                               const calib::EstimatorConfig&, std::optional<double>);
+                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                             const calib::EstimatorConfig&, std::optional<double>);
+                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {
@@ -275,8 +541,15 @@ template class ModelSchedule<double>;
 template class ModelSchedule<float>;
 template class ModelSchedule<Q30>;
 
+const char* head_origin(std::uint32_t version, std::size_t h) {
+    if (version == 0U) {
+        return "given";
+    }
+    return calib::learns_head(h) ? "learnt" : "kept";
+}
+
 std::string format_model_history(const std::vector<ActiveModel>& history) {
-    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c\n";
+    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin\n";
     char buf[96];
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -291,12 +564,23 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                text::c_snprintf(buf, sizeof buf, ",%08x\n", m.crc);
+                text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
+                                 head_origin(m.version, h));
                 out += buf;
             }
         }
     }
     return out;
+}
+
+bool orbit_period_acceptable(double seconds) {
+    return seconds * 1e6 >= static_cast<double>(calib::kMinOrbitPeriodUs) &&
+           seconds * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs);
+}
+
+std::string orbit_period_range() {
+    return "[" + number_text(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6) + ", " +
+           number_text(static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6) + "]";
 }
 
 std::string time_constant_range() {

@@ -40,6 +40,34 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
     }
 }
 
+void check_float_range(const ModelFile& m, const std::string& path) {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
+            double c[kModelTerms];
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                c[i] = m.coefficients[h][a][i];
+            }
+            const double s = float_term_sum(c, kArcsecToRad);
+            if (!(s <= kFloatMaxTermSumRad)) {
+                char limit[200];
+                text::c_snprintf(
+                    limit, sizeof limit,
+                    " is beyond what the float core evaluates within %g arcsec over +-%g degC (%.0f arcsec): "
+                    "use --scalar double or fixed",
+                    kFloatAngleErrorRad * kRadToArcsec, kMaxAbsTemperatureC, kFloatMaxTermSumRad * kRadToArcsec);
+                const std::string what =
+                    std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " + kAxisNames[a] +
+                    ": |c0| + 200|c1| + 400(|c2| + |c3|) + 200^2|c1_2| + 400^2(|c2_2| + |c3_2|) = " +
+                    number_text(s * kRadToArcsec) + " arcsec" + limit;
+                if (m.line[h][a] != 0) {
+                    throw InputError(path, m.line[h][a], 1, what);
+                }
+                throw std::runtime_error(text::input_name(path) + ": " + what);
+            }
+        }
+    }
+}
+
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
     if (text.empty()) {
         throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");

@@ -231,26 +231,6 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }
 
-// The estimator's models are linear, and CALIB_MODEL_LOAD carries c0..c3:
-// a --model with quadratic terms would start the target from another model
-// than the host's. Refused, naming the file and the term.
-void refuse_quadratic_initial_model(const ModelFile& m, const std::string& path) {
-    static constexpr const char* kQuadratic[] = {"c1_2", "c2_2", "c3_2"};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
-                if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
-                    throw std::runtime_error(
-                        path + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
-                        kAxisNames[a] + " has a quadratic term (" + kQuadratic[i - kLinearModelTerms] +
-                        "): replay --self-calibrate starts the target from a linear model "
-                        "(CALIB_MODEL_LOAD carries c0..c3)");
-                }
-            }
-        }
-    }
-}
-
 // --mountings/--combined: each epoch (rows whose t agree to the
 // millisecond, iba.hpp's epoch_key; in time order they come together) is
 // combined on the target (COMBINE_REQUEST after its last solution) and on the
@@ -358,6 +338,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
         if constexpr (std::is_same_v<T, Q30>) {
             check_fixed_point_range(*mf, opt.model);  // refused before the target sees it, as by `correct`
         }
+        if constexpr (std::is_same_v<T, float>) {
+            check_float_range(*mf, opt.model);
+        }
     }
     if (opt.self_calibrate && mf) {
         refuse_quadratic_initial_model(*mf, opt.model);
@@ -430,7 +413,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
                     fn(r);
                 }
             },
-            mf, ecfg, std::nullopt);
+            mf, ecfg, opt.orbit_period_s);
         schedule_d.emplace(host_sc->history);
         std::optional<ModelCoefficients> initial;
         if (mf) {
@@ -706,6 +689,10 @@ void check_options(const ReplayOptions& opt) {
             throw std::runtime_error("--time-constant " + number_text(opt.time_constant_days) + ": must be in " +
                                      time_constant_range() + " days");
         }
+        if (opt.orbit_period_s && !orbit_period_acceptable(*opt.orbit_period_s)) {
+            throw std::runtime_error("--orbit-period " + number_text(*opt.orbit_period_s) + ": must be in " +
+                                     orbit_period_range() + " s");
+        }
     } else {
         if (opt.model.empty()) {
             throw std::runtime_error(
@@ -714,6 +701,9 @@ void check_options(const ReplayOptions& opt) {
         }
         if (!opt.model_history.empty()) {
             throw std::runtime_error("--model-history needs --self-calibrate");
+        }
+        if (opt.orbit_period_s) {
+            throw std::runtime_error("--orbit-period needs --self-calibrate");
         }
     }
 }

@@ -42,6 +42,8 @@
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
 // arcsec as ModelCoefficients and converted once into the core's
 // ThermalModel<T> (model_coefficients.hpp) when prepared, in the back buffer.
+// An adopted model is learnt for A, B and C; its other heads are the active
+// model's (learns_head, estimator_types.hpp).
 //
 // No allocation, no exception, no recursion, fixed-size state, every loop
 // with a fixed bound. T: double, float or Q30 (the core's scalar).
@@ -379,9 +381,30 @@ private:
             }
         }
         last_refusal_ = Refusal::kNone;
+        keep_heads_not_learnt(cand_);
         prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U);
         active_rms_ = candidate_rms_;
         swap_pending_ = true;
+    }
+
+    // The heads the estimator does not learn (learns_head) keep the active
+    // model's presence and coefficients in candidate m.
+    void keep_heads_not_learnt(ModelCoefficients& m) const noexcept {
+        if (!has_[active_]) {
+            return;
+        }
+        const ModelCoefficients& a = model_[active_];
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            if (learns_head(h)) {
+                continue;
+            }
+            m.present[h] = a.present[h];
+            for (std::size_t x = 0; x < kModelAxes; ++x) {
+                for (std::size_t t = 0; t < kModelTerms; ++t) {
+                    m.coefficient[h][x][t] = a.coefficient[h][x][t];
+                }
+            }
+        }
     }
 
     void refuse(Refusal r) noexcept {

@@ -14,8 +14,14 @@
 namespace ascorr::calib {
 
 inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the IBAs all three
-inline constexpr std::size_t kUnknowns = 4;    // [1, T1, T2 − T1, T3 − T1] per axis
-inline constexpr std::size_t kWindow = 32;     // recent orbits kept (gate and held-back orbits)
+// The heads the estimator learns. A model's other heads (D) are not
+// estimated: an adopted model keeps the active model's coefficients for them
+// (Estimator::gate), so a head with a model never loses it to an adoption.
+constexpr bool learns_head(std::size_t h) noexcept {
+    return h < kCalibHeads;
+}
+inline constexpr std::size_t kUnknowns = 4;  // [1, T1, T2 − T1, T3 − T1] per axis
+inline constexpr std::size_t kWindow = 32;   // recent orbits kept (gate and held-back orbits)
 
 // The orbit periods and time constants the estimator is meant for: an orbit
 // of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins

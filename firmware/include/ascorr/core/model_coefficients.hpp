@@ -19,6 +19,7 @@
 
 #include <cstdint>
 
+#include "constants.hpp"
 #include "heads.hpp"
 #include "scalar_traits.hpp"
 #include "thermal.hpp"
@@ -42,6 +43,34 @@ constexpr AxisPolynomial<T> axis_polynomial(const double (&c)[kModelTerms], doub
             Tr::coefficient(c[2] * unit_to_rad),           Tr::coefficient(c[3] * unit_to_rad),
             Tr::quadratic_coefficient(c[4] * unit_to_rad), Tr::quadratic_coefficient(c[5] * unit_to_rad),
             Tr::quadratic_coefficient(c[6] * unit_to_rad)};
+}
+
+// ---- The float core's thermal angle over the whole temperature domain.
+// thermal_angle<float> (thermal.hpp) of one axis, at temperatures within
+// ±kMaxAbsTemperatureC, differs from the exact polynomial of the axis' double
+// coefficients by at most 12·2⁻²⁴·S (first order), with
+//   S = |c0| + 200·|c1| + 400·(|c2| + |c3|) + 200²·|c1_2| + 400²·(|c2_2| + |c3_2|)  (rad),
+// the largest sum of the terms' magnitudes over the domain (T1 within ±200 °C,
+// T2 − T1 and T3 − T1 within ±400 °C): coefficients and temperatures rounded
+// to float (2⁻²⁴ each), the differences (≤ 2·2⁻²⁴·400 °C), the products and
+// inner sums (≤ 8·2⁻²⁴ of a term), the three outer sums (≤ 3·2⁻²⁴·S). Terms
+// that cancel leave that error in a small angle. With S ≤ kFloatMaxTermSumRad
+// for every head and axis the angle is within kFloatAngleErrorRad (0.01″, a
+// fifth of the float path's 0.05″, tests/target/accuracy-bounds.txt); a
+// loader refuses a model beyond it for the float scalar (the host's
+// check_float_range), as one beyond the Q30 formats for fixed point. (Table
+// 2's largest S is 1152″; the limit is 13981″.)
+inline constexpr double kFloatAngleErrorRad = 0.01 * kArcsecToRad;
+inline constexpr double kFloatMaxTermSumRad = kFloatAngleErrorRad / (12.0 * 0x1p-24);
+
+// S above for one axis' coefficients c in the unit of unit_to_rad, in rad.
+constexpr double float_term_sum(const double (&c)[kModelTerms], double unit_to_rad) noexcept {
+    constexpr double t = kMaxAbsTemperatureC;
+    constexpr double d = 2.0 * kMaxAbsTemperatureC;
+    const auto mag = [](double x) { return x < 0.0 ? -x : x; };
+    return (mag(c[0]) + t * mag(c[1]) + d * (mag(c[2]) + mag(c[3])) + t * t * mag(c[4]) +
+            d * d * (mag(c[5]) + mag(c[6]))) *
+           unit_to_rad;
 }
 
 // The whole model; a head not present keeps zero coefficients.

@@ -42,7 +42,8 @@ struct CorrectOptions {
     // (version 0) or from none; model_history: where its models go (empty: not written).
     bool self_calibrate = false;
     std::string model_history;
-    double time_constant_days = 30.0;  // --time-constant
+    double time_constant_days = 30.0;      // --time-constant
+    std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
 };
 
 struct CorrectSummary {

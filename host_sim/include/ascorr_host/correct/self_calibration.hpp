@@ -43,14 +43,42 @@ struct SelfCalibration {
     double orbit_period_s = 0.0;
     std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
+    std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
 };
 
-// kind: "double", "float" or "fixed" is chosen by T. initial: --model.
-// orbit_period_s: when not given, from the earliest selected row's speed
-// (as `ascorr fit`). Throws InputError for a file whose rows cannot be read.
+// The fed rows (in time order) whose median speed gives the orbit period
+// when it is not given: 33 epochs of A, B and C.
+inline constexpr std::size_t kOrbitPeriodRows = 99;
+
+// The memory self_calibrate() keeps rows out of time order in (the rest goes
+// to a temporary file in sorted runs): 64 MiB.
+inline constexpr std::size_t kSelfCalibrationMemoryBytes = std::size_t{64} << 20;
+
+// Self-calibration starts from a linear model, on the host as on the target:
+// the estimator's models are linear (c0..c3) and the link's CALIB_MODEL_LOAD
+// carries c0..c3, so a model with a quadratic term would start the target
+// from another model than the host, and the history would list a model other
+// than the one that corrected. Throws std::runtime_error naming `name` (the
+// model's file or argument), the head, axis and term. One rule for `correct
+// --self-calibrate`, `replay --self-calibrate` and Python's self_calibrate()
+// (self_calibrate() below checks it too).
+void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name);
+
+// kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
+// (refuse_quadratic_initial_model).
+// orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
+// the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
+// that feed the estimator; refused (InputError naming a row and
+// --orbit-period) when fewer than three quarters of them are within 1 % of
+// that median, or it is no Earth orbit of 10 min to a day (docs/contract.md).
+// Rows in time order are taken as read; once one is out of order, the rows
+// are read again and sorted within memory_budget_bytes (beyond it, in sorted
+// runs on a temporary file, merged). Throws InputError for a file whose rows
+// cannot be read.
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s);
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
+                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes);
 
 // The models of a history in turn, for correcting rows: at(t) is the model
 // active at t's epoch (TT µs of the on-board clock), or one with no head
@@ -70,9 +98,24 @@ private:
     std::vector<ThermalModel<T>> model_;  // [0]: no head present
 };
 
+// How head h of a history's model `version` came to be: "given" (version 0,
+// the model given at start), "learnt" (estimated: calib::learns_head) or
+// "kept" (a head the estimator does not learn: the active model's
+// coefficients, carried into the adopted model, Estimator::gate).
+const char* head_origin(std::uint32_t version, std::size_t h);
+
 // The model history file (docs/contract.md): header
-// t,version,chu,axis,c0,c1,c2,c3,crc32c and one row per head and axis of each model.
+// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
+// axis of each model (origin: head_origin). t (3 decimals) says when; tt_us (t_us: TT µs of the
+// on-board clock, an integer) says exactly which rows: those whose t rounds
+// (tt_from_seconds) to at least it, up to the next version's.
 std::string format_model_history(const std::vector<ActiveModel>& history);
+
+// The orbit periods the estimator takes (calib::kMinOrbitPeriodUs ..
+// kMaxOrbitPeriodUs), in s; false for NaN. And as messages write them:
+// "[600, 86400]".
+bool orbit_period_acceptable(double seconds);
+std::string orbit_period_range();
 
 // The forgetting time constants the estimator takes
 // (calib::time_constant_acceptable) as messages write them: "[1, 10000]".

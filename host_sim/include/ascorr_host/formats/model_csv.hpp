@@ -41,6 +41,11 @@ std::string format_model(const ModelFile& model);
 // beyond what the fixed-point core's formats hold (fixed_point.hpp): such a
 // model is refused, never saturated.
 void check_fixed_point_range(const ModelFile& m, const std::string& path);
+// Throws (as above, naming head and axis, the sum and the limit in arcsec) if
+// a head's axis is beyond what the float core evaluates within its bound over
+// the whole temperature domain (float_term_sum > kFloatMaxTermSumRad,
+// model_coefficients.hpp): such a model is refused for the float scalar.
+void check_float_range(const ModelFile& m, const std::string& path);
 
 // The model's numbers in the core's layout (arcsec, as in the file).
 inline ModelCoefficients coefficients_of(const ModelFile& m) {

@@ -49,14 +49,15 @@ struct ReplayOptions {
     // --max-propagation: the target's velocity service's horizon (SERVICE_CONFIG);
     // nullopt: its firmware's (21600 s).
     std::optional<double> max_propagation_s;
-    bool self_calibrate = false;     // --self-calibrate
-    std::string model_history;       // --model-history: the target's models; empty: not written
-    double time_constant_days = 30;  // --time-constant (calib::EstimatorConfig's default)
-    std::string mountings;           // --mountings: with --combined, the combiner's (sigmas given)
-    std::string combined;            // --combined: the target's combined attitude per epoch; empty: none
-    double inject_errors = 0.0;      // fraction of frames faulted, each direction
-    bool realtime = false;           // pace by the rows' t instead of as fast as the link allows
-    int timeout_ms = 0;              // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
+    bool self_calibrate = false;           // --self-calibrate
+    std::string model_history;             // --model-history: the target's models; empty: not written
+    double time_constant_days = 30;        // --time-constant (calib::EstimatorConfig's default)
+    std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
+    std::string mountings;                 // --mountings: with --combined, the combiner's (sigmas given)
+    std::string combined;                  // --combined: the target's combined attitude per epoch; empty: none
+    double inject_errors = 0.0;            // fraction of frames faulted, each direction
+    bool realtime = false;                 // pace by the rows' t instead of as fast as the link allows
+    int timeout_ms = 0;                    // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
     int max_attempts = 20;
     std::uint64_t seed = 1;
     unsigned baud = 115200;
