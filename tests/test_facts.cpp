@@ -116,8 +116,8 @@ TEST(Heads, DocumentationStatesTheHeadsOfHeadsHpp) {
     const std::vector<DocStatement> statements = {
         {"docs/contract.md", "`{first}`, `B` or `C` (`{last}` accepted too)"},
         {"docs/contract.md", "`chu` (n,) of `\"{first}\"`…`\"{last}\"` strings or head indices 0…{last_index}"},
-        {"DEVELOPERS.md", "`chu` not {first}–{last}, head index ≥ {count}"},
-        {"DEVELOPERS.md", "head `\"{next}\"` or index ≥ {count}"},
+        {"docs/bad-input.md", "`chu` not {first}–{last}, head index ≥ {count}"},
+        {"docs/bad-input.md", "head `\"{next}\"` or index ≥ {count}"},
         {"firmware/link-protocol.md", "head u8 (0–{last_index})"},
         {"hal/linux/include/ascorr_hal_linux/config_file.hpp", "chu_a … chu_{last_lower}"},
         {"hal/linux/include/ascorr_hal_linux/simulated_source.hpp", "({first}–{last})"},
@@ -155,8 +155,8 @@ std::vector<std::string> stray_ranges(const std::string& text, int& seen) {
 TEST(Heads, NoLetterRangeInTheDocumentationEndsElsewhere) {
     int seen = 0;
     for (const char* file :
-         {"README.md", "DEVELOPERS.md", "docs/contract.md", "docs/ground.md", "docs/firmware.md", "docs/testing.md",
-          "firmware/link-protocol.md", "python/ascorr/__init__.py", "python/ascorr/__init__.pyi"}) {
+         {"README.md", "DEVELOPERS.md", "docs/bad-input.md", "docs/contract.md", "docs/ground.md", "docs/firmware.md",
+          "docs/testing.md", "firmware/link-protocol.md", "python/ascorr/__init__.py", "python/ascorr/__init__.pyi"}) {
         for (const std::string& r : stray_ranges(source_file(file), seen)) {
             ADD_FAILURE() << file << ": '" << r << "' is a range of heads that does not end at " << last_letter()
                           << " (ascorr/core/heads.hpp)";
