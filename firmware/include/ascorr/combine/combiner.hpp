@@ -165,6 +165,8 @@ private:
     void build(const Mountings& m, const CombinerConfig& cfg) noexcept;
     bool build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept;
     bool build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept;
+    bool combine_usual(const HeadAttitude<T>* heads, std::uint8_t n, CombinedAttitude<T>* out) const noexcept;
+    CombinedAttitude<T> combine_general(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept;
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
@@ -215,6 +217,20 @@ Vector3<double> rounding_rotation(const HeadMounting& h, const Quaternion<T>& co
     return {sign * e.x, sign * e.y, sign * e.z};
 }
 
+// The quick gate's bound on ‖e‖² (kernels.hpp quick_gate): 1/λ_max(UᵀU),
+// capped at a fifth of sin²(kGrossAngleRad/2), so that heads that all pass
+// it are within the gross gate of each other (‖h_i‖ ≤ ‖e_i‖ + ‖e_ref‖ ≤
+// 2/√5·sin(φ_max/2), with margin for rounding): combine_usual() needs no
+// separate gross test. The cap only sends a head to the full statistic
+// sooner; it decides nothing (the default gate's bounds are ~1e-8 rad²,
+// the cap 7.6e-7).
+inline double quick_bound(const Matrix3& u) noexcept {
+    const double s = 0.5 * kGrossAngleRad;
+    const double cap = 0.2 * s * s * (1.0 - s * s / 3.0);
+    const double b = 1.0 / gate_norm_bound(u);
+    return b < cap ? b : cap;
+}
+
 template <typename T>
 void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept {
     problem_ = check_mountings(m, &problem_head_);
@@ -263,7 +279,7 @@ bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, con
             }
         }
     }
-    quick_[s][h] = F::quick_from_double(1.0 / gate_norm_bound(u));
+    quick_[s][h] = F::quick_from_double(quick_bound(u));
     gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]), F::gate_from_double(u.m[0][2]),
                    F::gate_from_double(u.m[1][1]), F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
     return true;
@@ -327,6 +343,57 @@ HeadMask Combiner<T>::heads_of(const Epoch& e, std::uint8_t group) const noexcep
         }
     }
     return s;
+}
+
+// The usual epoch in one pass: n ≥ 2 entries, each a distinct, usable,
+// mounted head with a unit quaternion, every head within the quick gate
+// (which implies the gross gate: quick_bound). The same operations in the
+// same order as the general path (select, combine_group, finish), so the
+// answer is that path's bit for bit; false, and *out untouched, for any
+// other epoch.
+template <typename T>
+bool Combiner<T>::combine_usual(const HeadAttitude<T>* heads, std::uint8_t n, CombinedAttitude<T>* out) const noexcept {
+    constexpr T tol = ScalarTraits<T>::unit_norm_tolerance;
+    if (n < 2 || n > kMaxHeads) {
+        return false;
+    }
+    constexpr T zero = constant<T>(0.0);
+    HeadMask s = 0;
+    Quaternion<T> ref{};
+    Vector3<T> h[kMaxHeads];  // half-angle differences to the reference (h[0] = 0)
+    for (std::uint8_t i = 0; i < n; ++i) {
+        const HeadAttitude<T>& a = heads[i];
+        const HeadMask bit = a.head < kMaxHeads ? head_bit(a.head) : HeadMask{0};
+        if ((bit & mounted_ & ~s) == 0U || !a.usable || !norm_within(a.q_chu_icrf, tol)) {
+            return false;
+        }
+        s = static_cast<HeadMask>(s | bit);
+        const Quaternion<T> q = mounting_product(mount_factor_[a.head], a.q_chu_icrf);
+        if (i == 0) {
+            ref = q;
+            h[0] = {zero, zero, zero};
+        } else {
+            h[i] = half_difference(q, CombineFormats<T>::reference_from(ref), near2_).h;
+        }
+    }
+    Accumulator<T> acc = zero_accumulator<T>();
+    for (std::uint8_t i = 1; i < n; ++i) {
+        accumulate(acc, gain_[s][heads[i].head], h[i]);
+    }
+    const Vector3<T> est = result(acc);
+    for (std::uint8_t i = 0; i < n; ++i) {
+        if (!quick_gate(residual(h[i], est), quick_[s][heads[i].head])) {
+            return false;
+        }
+    }
+    const Vector3<T> d = residual(est, bias_[s]);
+    out->q_crf_icrf = canonical(renormalized_sum(ref, left_increment(d, ref)));
+    out->used = s;
+    out->left_out = 0;
+    out->inconsistent = 0;
+    out->subset = s;
+    out->status = combined_status::kTwoOrMoreHeads;
+    return true;
 }
 
 // Step 1: the candidates, each as its CRF estimate q_crf_icrf_i.
@@ -577,6 +644,15 @@ CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vec
 
 template <typename T>
 CombinedAttitude<T> Combiner<T>::combine(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept {
+    CombinedAttitude<T> out;  // one object, returned in place
+    if (!valid() || !combine_usual(heads, n, &out)) {
+        out = combine_general(heads, n);
+    }
+    return out;
+}
+
+template <typename T>
+CombinedAttitude<T> Combiner<T>::combine_general(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept {
     constexpr T zero = constant<T>(0.0);
     Epoch e;  // the candidates are written as they are found
     e.n = 0;

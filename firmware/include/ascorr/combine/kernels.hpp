@@ -302,9 +302,11 @@ constexpr void accumulate(Accumulator<Q30>& a, const GainMatrix<Q30>& g, const V
     const std::int32_t hx = unshared(h.x.raw);
     const std::int32_t hy = unshared(h.y.raw);
     const std::int32_t hz = unshared(h.z.raw);
-    for (int r = 0; r < 3; ++r) {
-        a.sum[r] = fx::accumulate_products(a.sum[r], g.k[r][0].raw, hx, g.k[r][1].raw, hy, g.k[r][2].raw, hz);
-    }
+    // Unrolled: the three sums stay in registers across the heads (the
+    // Cortex-M3 spilled them through memory in a loop).
+    a.sum[0] = fx::accumulate_products(a.sum[0], g.k[0][0].raw, hx, g.k[0][1].raw, hy, g.k[0][2].raw, hz);
+    a.sum[1] = fx::accumulate_products(a.sum[1], g.k[1][0].raw, hx, g.k[1][1].raw, hy, g.k[1][2].raw, hz);
+    a.sum[2] = fx::accumulate_products(a.sum[2], g.k[2][0].raw, hx, g.k[2][1].raw, hy, g.k[2][2].raw, hz);
 }
 template <>
 void accumulate<Q30>(Accumulator<Q30>&, const GainMatrix<Q30>&, const Vector3<Q30>&) noexcept = delete;
