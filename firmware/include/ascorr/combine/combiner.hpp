@@ -75,6 +75,14 @@
 
 namespace ascorr::combine {
 
+// combine_usual_n's loops run N ≤ kMaxHeads times: unrolled, so that the
+// candidates stay in registers (GCC's -O2 keeps them as loops otherwise).
+#if defined(__clang__)
+#define ASCORR_UNROLL_HEADS _Pragma("unroll")
+#else
+#define ASCORR_UNROLL_HEADS _Pragma("GCC unroll 4")
+#endif
+
 // The gross gate's angle (rad): beyond it the small-angle differences lose
 // their bound (kernels.hpp) and a head is judged by vote (step 2 above).
 inline constexpr double kGrossAngleRad = 0x1p-8;
@@ -166,7 +174,10 @@ private:
     bool build_subset(const Mountings& m, HeadMask s, const CombinerConfig& cfg) noexcept;
     bool build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept;
     bool combine_usual(const HeadAttitude<T>* heads, std::uint8_t n, CombinedAttitude<T>* out) const noexcept;
-    CombinedAttitude<T> combine_general(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept;
+    template <std::uint8_t N>
+    bool combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude<T>* out) const noexcept;
+    // Out of line: the usual epoch's call stays small (no frame for the general path).
+    [[gnu::noinline]] CombinedAttitude<T> combine_general(const HeadAttitude<T>* heads, std::uint8_t n) const noexcept;
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
@@ -189,10 +200,14 @@ private:
     T one_minus_near2_{};                          // cos²(kGrossAngleRad/2)
     Quaternion<T> mount_conj_[kMaxHeads]{};        // q_chu_crf* (unit, rounded to T)
     MountingFactor<T> mount_factor_[kMaxHeads]{};  // the same, as mounting_product() takes it
-    GainMatrix<T> gain_[kSubsetCount][kMaxHeads]{};
-    GateMatrix<T> gate_[kSubsetCount][kMaxHeads]{};
-    QuickBound<T> quick_[kSubsetCount][kMaxHeads]{};  // 1/λ_max bound of UᵀU (kernels.hpp quick_gate)
-    Vector3<T> bias_[kSubsetCount]{};                 // Σ K_{S,i} vec(E_i): the mountings' rounding to T, subtracted
+    // What an epoch of one head subset reads, together (one base address).
+    struct SubsetTable {
+        Accumulator<T> start;            // −Σ K_{S,i} vec(E_i): the mountings' rounding to T, the sums' start
+        GainMatrix<T> gain[kMaxHeads];   // K_{S,i}
+        QuickBound<T> quick[kMaxHeads];  // 1/λ_max bound of UᵀU, capped (quick_bound; kernels.hpp quick_gate)
+        GateMatrix<T> gate[kMaxHeads];   // U_{S,i}
+    };
+    SubsetTable table_[kSubsetCount]{};
     double sigma_[kSubsetCount][3]{};
 };
 
@@ -203,7 +218,7 @@ private:
 // E = rounded ⊗ q_chu_crf (exact, double), so every estimate of that head
 // carries E on the left, and the combination Σ_i K_{S,i} vec(E_i) (Σ K = I
 // makes the reference's own part cancel to that too). Taken out per subset
-// (bias_): in float the rounding of a mounting (≤ 2⁻²⁵ per component) would
+// (start_, the sums' start): in float the rounding of a mounting (≤ 2⁻²⁵ per component) would
 // otherwise put up to 0.02″ of constant error per head set into the
 // attitude, a step at every head-set change; in Q30 (2⁻³¹) 3e-4″; zero in double.
 template <typename T>
@@ -279,9 +294,10 @@ bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, con
             }
         }
     }
-    quick_[s][h] = F::quick_from_double(quick_bound(u));
-    gate_[s][h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]), F::gate_from_double(u.m[0][2]),
-                   F::gate_from_double(u.m[1][1]), F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
+    table_[s].quick[h] = F::quick_from_double(quick_bound(u));
+    table_[s].gate[h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]),
+                         F::gate_from_double(u.m[0][2]), F::gate_from_double(u.m[1][1]),
+                         F::gate_from_double(u.m[1][2]), F::gate_from_double(u.m[2][2])};
     return true;
 }
 
@@ -304,7 +320,7 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
         const Vector3<double> e = rounding_rotation(m.head[h], mount_conj_[h]);
         for (int r = 0; r < 3; ++r) {
             for (int c = 0; c < 3; ++c) {
-                gain_[s][h].k[r][c] = F::gain_from_double(g.gain[h].m[r][c]);
+                table_[s].gain[h].k[r][c] = F::gain_from_double(g.gain[h].m[r][c]);
             }
             bias[r] += g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
@@ -312,8 +328,9 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
             return false;
         }
     }
-    bias_[s] = {ScalarTraits<T>::from_double(bias[0]), ScalarTraits<T>::from_double(bias[1]),
-                ScalarTraits<T>::from_double(bias[2])};
+    table_[s].start =
+        accumulator_from(Vector3<T>{ScalarTraits<T>::from_double(-bias[0]), ScalarTraits<T>::from_double(-bias[1]),
+                                    ScalarTraits<T>::from_double(-bias[2])});
     return true;
 }
 
@@ -353,18 +370,35 @@ HeadMask Combiner<T>::heads_of(const Epoch& e, std::uint8_t group) const noexcep
 // other epoch.
 template <typename T>
 bool Combiner<T>::combine_usual(const HeadAttitude<T>* heads, std::uint8_t n, CombinedAttitude<T>* out) const noexcept {
-    constexpr T tol = ScalarTraits<T>::unit_norm_tolerance;
-    if (n < 2 || n > kMaxHeads) {
-        return false;
+    static_assert(kMaxHeads == 4, "one instance per head count from 2 to kMaxHeads");
+    switch (n) {
+        case 2:
+            return combine_usual_n<2>(heads, out);
+        case 3:
+            return combine_usual_n<3>(heads, out);
+        case 4:
+            return combine_usual_n<4>(heads, out);
+        default:
+            return false;
     }
+}
+
+// combine_usual for N entries: the loops unrolled, the candidates in registers.
+template <typename T>
+template <std::uint8_t N>
+bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude<T>* out) const noexcept {
+    constexpr T tol = ScalarTraits<T>::unit_norm_tolerance;
+    constexpr std::uint8_t n = N;
     constexpr T zero = constant<T>(0.0);
     HeadMask s = 0;
+    UnitNorms<T> unit;
     Quaternion<T> ref{};
     Vector3<T> h[kMaxHeads];  // half-angle differences to the reference (h[0] = 0)
+    ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 0; i < n; ++i) {
         const HeadAttitude<T>& a = heads[i];
         const HeadMask bit = a.head < kMaxHeads ? head_bit(a.head) : HeadMask{0};
-        if ((bit & mounted_ & ~s) == 0U || !a.usable || !norm_within(a.q_chu_icrf, tol)) {
+        if ((bit & mounted_ & ~s) == 0U || !a.usable || !unit.add(a.q_chu_icrf)) {
             return false;
         }
         s = static_cast<HeadMask>(s | bit);
@@ -376,18 +410,22 @@ bool Combiner<T>::combine_usual(const HeadAttitude<T>* heads, std::uint8_t n, Co
             h[i] = half_difference(q, CombineFormats<T>::reference_from(ref), near2_).h;
         }
     }
-    Accumulator<T> acc = zero_accumulator<T>();
+    if (!unit.within(tol)) {
+        return false;
+    }
+    Accumulator<T> acc = table_[s].start;
+    ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 1; i < n; ++i) {
-        accumulate(acc, gain_[s][heads[i].head], h[i]);
+        accumulate(acc, table_[s].gain[heads[i].head], h[i]);
     }
     const Vector3<T> est = result(acc);
+    ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 0; i < n; ++i) {
-        if (!quick_gate(residual(h[i], est), quick_[s][heads[i].head])) {
+        if (!quick_gate(residual(h[i], est), table_[s].quick[heads[i].head])) {
             return false;
         }
     }
-    const Vector3<T> d = residual(est, bias_[s]);
-    out->q_crf_icrf = canonical(renormalized_sum(ref, left_increment(d, ref)));
+    out->q_crf_icrf = canonical(apply_left(est, ref));
     out->used = s;
     out->left_out = 0;
     out->inconsistent = 0;
@@ -489,10 +527,10 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
 // Σ K_{S,i} h_i over the group (s: its heads).
 template <typename T>
 Vector3<T> Combiner<T>::estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept {
-    Accumulator<T> acc = zero_accumulator<T>();
+    Accumulator<T> acc = table_[s].start;
     for (std::uint8_t i = 0; i < e.n; ++i) {
         if (i != e.ref && in_mask(group, i)) {  // the reference's difference is zero
-            accumulate(acc, gain_[s][e.c[i].head], e.c[i].h);
+            accumulate(acc, table_[s].gain[e.c[i].head], e.c[i].h);
         }
     }
     return result(acc);
@@ -508,7 +546,7 @@ typename Combiner<T>::GateResult Combiner<T>::gate_group(const Epoch& e, std::ui
         if (!in_mask(group, i)) {
             continue;
         }
-        const GateValue<T> v = gate_value(gate_[s][e.c[i].head], residual(e.c[i].h, est));
+        const GateValue<T> v = gate_value(table_[s].gate[e.c[i].head], residual(e.c[i].h, est));
         r.largest = r.largest < v ? v : r.largest;
         r.failing = static_cast<std::uint8_t>(r.failing | (gate_exceeds(v) ? 1U << i : 0U));
     }
@@ -585,12 +623,12 @@ bool Combiner<T>::combine_group(Epoch& e, Vector3<T>* est) const noexcept {
     const ReferenceFactor<T> ref = CombineFormats<T>::reference_from(e.c[0].q);
     e.c[0].h = {zero, zero, zero};
     bool near = true;
-    Accumulator<T> acc = zero_accumulator<T>();
+    Accumulator<T> acc = table_[e.heads].start;
     for (std::uint8_t i = 1; i < e.n; ++i) {
         const HalfDifference<T> d = half_difference(e.c[i].q, ref, near2_);
         e.c[i].h = d.h;
         near = near && d.near;
-        accumulate(acc, gain_[e.heads][e.c[i].head], d.h);
+        accumulate(acc, table_[e.heads].gain[e.c[i].head], d.h);
     }
     if (near) {
         *est = result(acc);
@@ -598,7 +636,8 @@ bool Combiner<T>::combine_group(Epoch& e, Vector3<T>* est) const noexcept {
         for (std::uint8_t i = 0; i < e.n && e.n >= 2; ++i) {
             const Vector3<T> r = residual(e.c[i].h, *est);
             const std::uint8_t h = e.c[i].head;
-            failing = failing || (!quick_gate(r, quick_[e.heads][h]) && gate_exceeds(gate_value(gate_[e.heads][h], r)));
+            failing = failing || (!quick_gate(r, table_[e.heads].quick[h]) &&
+                                  gate_exceeds(gate_value(table_[e.heads].gate[h], r)));
         }
         if (!failing) {
             return true;
@@ -621,12 +660,11 @@ CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vec
     if (combined) {
         out.used = e.group == (1U << e.n) - 1U ? e.heads : heads_of(e, e.group);
         const Quaternion<T>& ref = e.c[e.ref].q;
-        const Vector3<T> h = residual(est, bias_[out.used]);
-        // d = (0, h) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖h‖²
+        // d = (0, est) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖est‖²
         // (+ ref's own ≤ 1e-6): within Q30's range of renormalized_sum for any
-        // h of the accumulator's range (|hᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
-        // unit to 2⁻³⁰ for ‖h‖ ≤ 0.033 rad, which the gates keep it far below.
-        out.q_crf_icrf = canonical(renormalized_sum(ref, left_increment(h, ref)));
+        // est of the accumulator's range (|estᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
+        // unit to 2⁻³⁰ for ‖est‖ ≤ 0.033 rad, which the gates keep it far below.
+        out.q_crf_icrf = canonical(apply_left(est, ref));
         out.inconsistent = e.inconsistent;
     } else {
         out.inconsistent = static_cast<HeadMask>(e.inconsistent | e.heads);  // no combination: all refused

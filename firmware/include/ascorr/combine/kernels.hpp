@@ -177,7 +177,8 @@ constexpr Quaternion<T> mounting_product(const MountingFactor<T>& conj, const Qu
 // mounting_product (above) in Q30 from the signed matrix: each component one
 // chain of four exact products rounded once (≤ 2⁻³¹), without saturation.
 // Range: as product() (unit operands, each component ≤ 1 + 2e-6).
-constexpr Quaternion<Q30> mounting_product(const QMounting& a, const Quaternion<Q30>& p) noexcept {
+[[gnu::always_inline]] constexpr Quaternion<Q30> mounting_product(const QMounting& a,
+                                                                  const Quaternion<Q30>& p) noexcept {
     using fx::unshared;
     const std::int32_t pw = unshared(p.w.raw);
     const std::int32_t px = unshared(p.x.raw);
@@ -216,16 +217,20 @@ constexpr bool near_each_other(const Quaternion<T>& a, const Quaternion<T>& b, c
     return c * c >= one_minus_near2;
 }
 
-// Σ K h over the heads of a subset.
+// Σ K h over the heads of a subset, started at a constant (the subset's
+// rounding correction, combiner.hpp bias_). Each row is one chain
+// sum + k₀hx + k₁hy + k₂hz, left to right (fused multiply-adds where the
+// compiler contracts them).
 template <typename T>
 struct Accumulator {
     Vector3<T> sum;
 };
 
+// The sums' start from a vector (at construction; combiner.hpp keeps the
+// accumulators themselves, so an epoch starts with plain loads).
 template <typename T>
-constexpr Accumulator<T> zero_accumulator() noexcept {
-    constexpr T zero = constant<T>(0.0);
-    return {{zero, zero, zero}};
+constexpr Accumulator<T> accumulator_from(const Vector3<T>& start) noexcept {
+    return {start};
 }
 
 template <typename T>
@@ -280,21 +285,60 @@ constexpr Quaternion<T> left_increment(const Vector3<T>& h, const Quaternion<T>&
     return {-dot(h, qv), v.x, v.y, v.z};
 }
 
+// The usual pass's test that every input is unit (combiner.hpp
+// combine_usual_n), one comparison per epoch: Σ (‖p_i‖² − 1)² ≤ tol²
+// implies |‖p_i‖² − 1| ≤ tol for each (norm_within); NaN and infinity fail
+// it. When it fails, the general path tests head by head. add() returns
+// false when the epoch already fails (Q30's exact test, below); here the
+// verdict waits for within().
+template <typename T>
+class UnitNorms {
+public:
+    constexpr bool add(const Quaternion<T>& q) noexcept {
+        constexpr T minus_one = constant<T>(-1.0);
+        const T e = minus_one + q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z;  // ‖q‖² − 1, one chain
+        sum_ = sum_ + e * e;
+        return true;
+    }
+    constexpr bool within(const T& tol) const noexcept { return sum_ <= tol * tol; }
+
+private:
+    T sum_ = constant<T>(0.0);
+};
+
+// (1, h) ⊗ q renormalised: the combined attitude from the reference q and
+// the weighted mean h (combiner.hpp finish): q + d with d = (0, h) ⊗ q,
+// renormalised by the core's second-order step (quaternion.hpp
+// renormalized_sum: the small terms summed first, q rounded once, in the
+// last addition; in float two roundings of the O(1) components would double
+// the error). Range: q unit within the core's tolerance, |h| ≤ 2⁻⁸ (the
+// gross gate).
+template <typename T>
+constexpr Quaternion<T> apply_left(const Vector3<T>& h, const Quaternion<T>& q) noexcept {
+    return renormalized_sum(q, left_increment(h, q));
+}
+
 // ---- The remaining kernels in Q30, each with its guard.
 
 // Σ K h in Q30: three int64 sums of exact products of a QGain and a Q30
-// (units 2⁻⁵⁵). Range: |K| ≤ 60 (raw < 2³¹), |h| ≤ 2⁻⁸ (the gross gate:
-// half-angles within 2⁻⁸ of the reference after a re-formation) so each
-// product is below 2⁵³ and a sum over kMaxHeads heads below 2⁵⁷; the result
-// (result()) is at most kMaxGainRowSum·2⁻⁸ < 0.24 in magnitude.
+// (units 2⁻⁵⁵), started at the start's exact value. Range: |K| ≤ 60
+// (raw < 2³¹), |h| ≤ 2⁻⁸ (the gross gate: half-angles within 2⁻⁸ of the
+// reference after a re-formation) so each product is below 2⁵³ and a sum
+// over kMaxHeads heads below 2⁵⁷; the start (the mountings' rounding,
+// ≤ 1e-8) adds nothing to that; the result (result()) is at most
+// kMaxGainRowSum·2⁻⁸ < 0.24 in magnitude.
 template <>
 struct Accumulator<Q30> {
     std::int64_t sum[3];
 };
 
+// The start in units 2⁻⁵⁵, exact (|start| < 2: below 2⁵⁶).
 template <>
-constexpr Accumulator<Q30> zero_accumulator<Q30>() noexcept {
-    return {{0, 0, 0}};
+constexpr Accumulator<Q30> accumulator_from<Q30>(const Vector3<Q30>& start) noexcept {
+    constexpr int kShift = QGain::kFracBits;
+    return {{std::int64_t{start.x.raw} * (std::int64_t{1} << kShift),
+             std::int64_t{start.y.raw} * (std::int64_t{1} << kShift),
+             std::int64_t{start.z.raw} * (std::int64_t{1} << kShift)}};
 }
 
 constexpr void accumulate(Accumulator<Q30>& a, const GainMatrix<Q30>& g, const Vector3<Q30>& h) noexcept {
@@ -414,5 +458,26 @@ constexpr Vector3<Q30> residual(const Vector3<Q30>& h, const Vector3<Q30>& est) 
 }
 template <>
 Vector3<Q30> residual<Q30>(const Vector3<Q30>&, const Vector3<Q30>&) noexcept = delete;
+
+// apply_left (above) in Q30: the same calls, each the Q30 kernel
+// (left_increment here, renormalized_sum in quaternion.hpp, with its range:
+// |dᵢ| ≤ 2⁻⁴, here ≤ 2⁻⁸·(1 + 1e-6)), inlined so that the M3 keeps the
+// reference in registers.
+[[gnu::always_inline]] constexpr Quaternion<Q30> apply_left(const Vector3<Q30>& h, const Quaternion<Q30>& q) noexcept {
+    return renormalized_sum(q, left_increment(h, q));
+}
+template <>
+Quaternion<Q30> apply_left<Q30>(const Vector3<Q30>&, const Quaternion<Q30>&) noexcept = delete;
+
+// UnitNorms (above) in Q30: each input's own exact test (norm_within), as
+// (‖p‖² − 1)² would leave int64 in units 2⁻¹²⁰.
+template <>
+class UnitNorms<Q30> {
+public:
+    static constexpr bool add(const Quaternion<Q30>& q) noexcept {
+        return norm_within(q, ScalarTraits<Q30>::unit_norm_tolerance);
+    }
+    static constexpr bool within(const Q30& /*tol*/) noexcept { return true; }  // each add() decided
+};
 
 }  // namespace ascorr::combine
