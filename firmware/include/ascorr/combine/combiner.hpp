@@ -349,6 +349,19 @@ constexpr HeadCounts make_head_counts() noexcept {
 }
 // The number of heads of each mask: a table, as Armv7-M has no population count.
 inline constexpr HeadCounts kHeadCounts = make_head_counts();
+// head_bit() of every uint8_t head index, 0 for those that are no head: one load
+// instead of a range test and a shift (the usual pass, per entry).
+struct HeadBits {
+    std::uint8_t bit[256];
+};
+constexpr HeadBits make_head_bits() noexcept {
+    HeadBits t{};
+    for (unsigned h = 0; h < kMaxHeads; ++h) {
+        t.bit[h] = head_bit(static_cast<std::uint8_t>(h));
+    }
+    return t;
+}
+inline constexpr HeadBits kHeadBits = make_head_bits();
 }  // namespace detail
 
 template <typename T>
@@ -389,23 +402,21 @@ template <std::uint8_t N>
 bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude<T>* out) const noexcept {
     constexpr T tol = ScalarTraits<T>::unit_norm_tolerance;
     constexpr std::uint8_t n = N;
-    constexpr T zero = constant<T>(0.0);
     HeadMask s = 0;
     UnitNorms<T> unit;
     Quaternion<T> ref{};
-    Vector3<T> h[kMaxHeads];  // half-angle differences to the reference (h[0] = 0)
+    Vector3<T> h[kMaxHeads];  // half-angle differences to the reference (h[0], zero, unused)
     ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 0; i < n; ++i) {
         const HeadAttitude<T>& a = heads[i];
-        const HeadMask bit = a.head < kMaxHeads ? head_bit(a.head) : HeadMask{0};
-        if ((bit & mounted_ & ~s) == 0U || !a.usable || !unit.add(a.q_chu_icrf)) {
+        const unsigned bit = detail::kHeadBits.bit[a.head];  // 0 for an index that is no head
+        if ((bit & mounted_ & ~unsigned{s}) == 0U || !a.usable || !unit.add(a.q_chu_icrf)) {
             return false;
         }
         s = static_cast<HeadMask>(s | bit);
         const Quaternion<T> q = mounting_product(mount_factor_[a.head], a.q_chu_icrf);
         if (i == 0) {
             ref = q;
-            h[0] = {zero, zero, zero};
         } else {
             h[i] = half_difference(q, CombineFormats<T>::reference_from(ref), near2_).h;
         }
@@ -419,8 +430,12 @@ bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude
         accumulate(acc, table_[s].gain[heads[i].head], h[i]);
     }
     const Vector3<T> est = result(acc);
+    // The reference's residual is 0 − est: its square is est's, bit for bit.
+    if (!quick_gate(est, table_[s].quick[heads[0].head])) {
+        return false;
+    }
     ASCORR_UNROLL_HEADS
-    for (std::uint8_t i = 0; i < n; ++i) {
+    for (std::uint8_t i = 1; i < n; ++i) {
         if (!quick_gate(residual(h[i], est), table_[s].quick[heads[i].head])) {
             return false;
         }
