@@ -106,6 +106,82 @@ void warn_faults_outside(const ThermistorOptions& opt, const std::vector<hal::In
     }
 }
 
+// The frames' source: --replay's file, --simulate's history (with
+// --inject's faults) or, with neither, the GPIO backend (its clock in
+// live_clock).
+std::unique_ptr<hal::SampleSetSource<double>> open_source(const ThermistorOptions& opt, const hal::HalConfig& cfg,
+                                                          std::unique_ptr<hal::Clock>& live_clock) {
+    const hal::AcquisitionConfig<double>& acfg = cfg.acquisition;
+    if (!opt.replay.empty() && !opt.simulate.empty()) {
+        throw std::runtime_error("--replay and --simulate exclude each other");
+    }
+    if (!opt.inject.empty() && opt.simulate.empty()) {
+        throw std::runtime_error("--inject needs --simulate");
+    }
+    if (!opt.replay.empty()) {
+        return hal::ReplaySource::from_file(opt.replay, acfg);
+    }
+    if (!opt.simulate.empty()) {
+        std::vector<hal::InjectedFault> faults;
+        for (const std::string& s : opt.inject) {
+            faults.push_back(hal::parse_fault(s, acfg));
+        }
+        std::vector<hal::HistoryEpoch> history = hal::read_history(opt.simulate);
+        warn_faults_outside(opt, faults, history);
+        return std::make_unique<hal::SimulatedSource>(acfg, std::move(history), std::move(faults));
+    }
+#ifdef ASCORR_HAVE_GPIOD
+    live_clock = std::make_unique<hal::SteadyClock>();
+    return std::make_unique<hal::GpiodSampleSetSource>(cfg, *live_clock);
+#else
+    (void)live_clock;
+    throw std::runtime_error("this build has no libgpiod backend: use --replay or --simulate");
+#endif
+}
+
+// One row per channel, with kOutvoted from the vote of its role.
+void print_channels(std::FILE* out, hal::TemperatureAcquisition<double>& acq,
+                    const hal::AcquisitionConfig<double>& acfg, std::uint64_t now) {
+    hal::ChannelReading<double> readings[hal::kMaxChannels];
+    for (std::uint8_t i = 0; i < acfg.channels; ++i) {
+        readings[i] = acq.channel(i, now);
+    }
+    for (std::uint8_t r = 0; r < hal::kRoleCount; ++r) {
+        hal::ChannelReading<double> members[hal::kMaxVoters];
+        std::uint8_t index[hal::kMaxVoters] = {};
+        const hal::VotedTemperature<double> v = acq.role(static_cast<hal::Role>(r), now, members, index);
+        for (std::uint8_t k = 0; r != 0U && k < v.members; ++k) {
+            readings[index[k]] = members[k];
+        }
+    }
+    for (std::uint8_t i = 0; i < acfg.channels; ++i) {
+        const hal::ChannelReading<double>& r = readings[i];
+        const hal::ChannelConfig<double>& c = acfg.channel[i];
+        const bool has_counts = !std::isnan(r.ohm);
+        print_row(out, r.t_us, c.name, hal::kRoleNames[static_cast<int>(c.role)], has_counts ? r.counts : -1, r.ohm,
+                  r.celsius, r.faults);
+    }
+}
+
+// The head's three voted values, counting the withheld ones and their faults.
+void print_voted(std::FILE* out, hal::TemperatureAcquisition<double>& acq, std::uint8_t head, std::uint64_t now,
+                 std::size_t& invalid, std::size_t* per_fault) {
+    const hal::HeadAcquisition<double> h = acq.head(head, now);
+    const hal::VotedTemperature<double> v[3] = {acq.role(hal::chu_role(head), now), acq.role(hal::Role::kT029, now),
+                                                acq.role(hal::Role::kT032, now)};
+    const hal::FaultBits f[3] = {h.faults_chu, h.faults_029, h.faults_032};
+    const char* names[3] = {"t_chu", "t_029", "t_032"};
+    for (int k = 0; k < 3; ++k) {
+        print_row(out, now, names[k], "voted", -1, kNaN, f[k] == 0U ? v[k].celsius : kNaN, f[k]);
+        if (f[k] != 0U) {
+            ++invalid;
+            for (int b = 0; b < hal::fault::kCount; ++b) {
+                per_fault[b] += (f[k] >> b) & 1U;
+            }
+        }
+    }
+}
+
 void run(const ThermistorOptions& opt) {
     host::refuse_output_over_input({{"--config", opt.config}, {"--replay", opt.replay}, {"--simulate", opt.simulate}},
                                    {}, true);
@@ -115,33 +191,9 @@ void run(const ThermistorOptions& opt) {
         cfg.gpio.chip = opt.chip;
     }
     const hal::AcquisitionConfig<double>& acfg = cfg.acquisition;
-    std::unique_ptr<hal::SampleSetSource<double>> source;
     std::unique_ptr<hal::Clock> live_clock;
     const bool live = opt.replay.empty() && opt.simulate.empty();
-    if (!opt.replay.empty() && !opt.simulate.empty()) {
-        throw std::runtime_error("--replay and --simulate exclude each other");
-    }
-    if (!opt.inject.empty() && opt.simulate.empty()) {
-        throw std::runtime_error("--inject needs --simulate");
-    }
-    if (!opt.replay.empty()) {
-        source = hal::ReplaySource::from_file(opt.replay, acfg);
-    } else if (!opt.simulate.empty()) {
-        std::vector<hal::InjectedFault> faults;
-        for (const std::string& s : opt.inject) {
-            faults.push_back(hal::parse_fault(s, acfg));
-        }
-        std::vector<hal::HistoryEpoch> history = hal::read_history(opt.simulate);
-        warn_faults_outside(opt, faults, history);
-        source = std::make_unique<hal::SimulatedSource>(acfg, std::move(history), std::move(faults));
-    } else {
-#ifdef ASCORR_HAVE_GPIOD
-        live_clock = std::make_unique<hal::SteadyClock>();
-        source = std::make_unique<hal::GpiodSampleSetSource>(cfg, *live_clock);
-#else
-        throw std::runtime_error("this build has no libgpiod backend: use --replay or --simulate");
-#endif
-    }
+    const std::unique_ptr<hal::SampleSetSource<double>> source = open_source(opt, cfg, live_clock);
     const std::uint8_t head = head_index(opt.head);
     hal::TemperatureAcquisition<double> acq(acfg);
     std::FILE* out = stdout;
@@ -160,40 +212,8 @@ void run(const ThermistorOptions& opt) {
         acq.update(samples);
         ++frames;
         const std::uint64_t now = samples.t_us;
-        // Channel readings, with kOutvoted from the vote of their role.
-        hal::ChannelReading<double> readings[hal::kMaxChannels];
-        for (std::uint8_t i = 0; i < acfg.channels; ++i) {
-            readings[i] = acq.channel(i, now);
-        }
-        for (std::uint8_t r = 0; r < hal::kRoleCount; ++r) {
-            hal::ChannelReading<double> members[hal::kMaxVoters];
-            std::uint8_t index[hal::kMaxVoters] = {};
-            const hal::VotedTemperature<double> v = acq.role(static_cast<hal::Role>(r), now, members, index);
-            for (std::uint8_t k = 0; r != 0U && k < v.members; ++k) {
-                readings[index[k]] = members[k];
-            }
-        }
-        for (std::uint8_t i = 0; i < acfg.channels; ++i) {
-            const hal::ChannelReading<double>& r = readings[i];
-            const hal::ChannelConfig<double>& c = acfg.channel[i];
-            const bool has_counts = !std::isnan(r.ohm);
-            print_row(out, r.t_us, c.name, hal::kRoleNames[static_cast<int>(c.role)], has_counts ? r.counts : -1, r.ohm,
-                      r.celsius, r.faults);
-        }
-        const hal::HeadAcquisition<double> h = acq.head(head, now);
-        const hal::VotedTemperature<double> v[3] = {acq.role(hal::chu_role(head), now), acq.role(hal::Role::kT029, now),
-                                                    acq.role(hal::Role::kT032, now)};
-        const hal::FaultBits f[3] = {h.faults_chu, h.faults_029, h.faults_032};
-        const char* names[3] = {"t_chu", "t_029", "t_032"};
-        for (int k = 0; k < 3; ++k) {
-            print_row(out, now, names[k], "voted", -1, kNaN, f[k] == 0U ? v[k].celsius : kNaN, f[k]);
-            if (f[k] != 0U) {
-                ++invalid;
-                for (int b = 0; b < hal::fault::kCount; ++b) {
-                    per_fault[b] += (f[k] >> b) & 1U;
-                }
-            }
-        }
+        print_channels(out, acq, acfg, now);
+        print_voted(out, acq, head, now, invalid, per_fault);
     }
     std::fflush(out);
     std::cerr << "ascorr thermistors: " << frames << " frames, " << invalid << " voted values withheld";

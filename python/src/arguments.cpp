@@ -267,6 +267,66 @@ Doubles optional_real_array(const py::handle& obj, const std::string& name, py::
     return real_array(obj, name, n, cols);
 }
 
+// The head of an integer index (below kMaxHeads), kUnknownHead otherwise.
+std::uint8_t head_of_index(long long h) {
+    return h >= 0 && h < static_cast<long long>(kMaxHeads) ? static_cast<std::uint8_t>(h) : host::kUnknownHead;
+}
+
+// chu as numbers: integer head indices.
+void heads_of_indices(const py::array& a, py::ssize_t n, std::vector<std::uint8_t>& heads) {
+    const Integers idx = integers_of(a, std::numeric_limits<long long>::min(), std::numeric_limits<long long>::max());
+    if (idx.bad_row >= 0) {
+        bad_argument("chu", "row " + std::to_string(idx.bad_row) + ": " + idx.why + " (a head index)");
+    }
+    for (py::ssize_t i = 0; i < n; ++i) {
+        heads[static_cast<std::size_t>(i)] = head_of_index(idx.values[static_cast<std::size_t>(i)]);
+    }
+}
+
+// The code point of a fixed-width string's character k (UCS-4 when unit is
+// 4, a byte when 1), 0 past the width; assembled byte by byte: the elements
+// need not be aligned.
+std::uint32_t code_point(const unsigned char* e, std::size_t width, std::size_t unit, std::size_t k) {
+    std::uint32_t c = 0;
+    if (width >= (k + 1) * unit) {
+        for (std::size_t b = 0; b < unit; ++b) {
+            c |= static_cast<std::uint32_t>(e[k * unit + b]) << (8 * (unit == 4 ? b : 0));
+        }
+    }
+    return c;
+}
+
+// chu as fixed-width strings, read in place: UCS-4 code points or bytes, NUL-padded.
+void heads_of_strings(const py::array& a, py::ssize_t n, std::vector<std::uint8_t>& heads) {
+    const py::array c = py::array::ensure(a, py::array::c_style);
+    const auto width = static_cast<std::size_t>(c.itemsize());
+    const std::size_t unit = a.dtype().kind() == 'U' ? 4 : 1;
+    const auto* base = static_cast<const unsigned char*>(c.data());
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const unsigned char* e = base + static_cast<std::size_t>(i) * width;
+        const std::uint32_t first = code_point(e, width, unit, 0);
+        const std::uint32_t second = code_point(e, width, unit, 1);
+        if (second == 0 && first < 0x80U) {
+            heads[static_cast<std::size_t>(i)] = head_index(static_cast<char>(first));
+        }
+    }
+}
+
+// chu as Python objects: str head names or int indices.
+void heads_of_objects(const py::array& a, py::ssize_t n, std::vector<std::uint8_t>& heads) {
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const py::object x = a[py::int_(i)];
+        if (py::isinstance<py::str>(x)) {
+            heads[static_cast<std::size_t>(i)] = host::head_from_name(x.cast<std::string>());
+        } else if (py::isinstance<py::int_>(x)) {
+            heads[static_cast<std::size_t>(i)] = head_of_index(x.cast<long long>());
+        } else {
+            bad_argument("chu", "row " + std::to_string(i) + ": expected a string or an integer, got " +
+                                    std::string(py::str(x.get_type())));
+        }
+    }
+}
+
 // chu: head letters (kHeadLetters; anything else is an unknown head, status 16)
 // or integer head indices (below kMaxHeads; anything else: status 16), as the
 // reader maps them.
@@ -285,56 +345,11 @@ std::vector<std::uint8_t> heads_of(const py::handle& obj, py::ssize_t n) {
     std::vector<std::uint8_t> heads(static_cast<std::size_t>(n), host::kUnknownHead);
     const char kind = a.dtype().kind();
     if (kind == 'i' || kind == 'u' || kind == 'f') {
-        const Integers idx =
-            integers_of(a, std::numeric_limits<long long>::min(), std::numeric_limits<long long>::max());
-        if (idx.bad_row >= 0) {
-            bad_argument("chu", "row " + std::to_string(idx.bad_row) + ": " + idx.why + " (a head index)");
-        }
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const long long h = idx.values[static_cast<std::size_t>(i)];
-            if (h >= 0 && h < static_cast<long long>(kMaxHeads)) {
-                heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(h);
-            }
-        }
+        heads_of_indices(a, n, heads);
     } else if (kind == 'U' || kind == 'S') {
-        // Fixed-width strings, read in place: UCS-4 code points or bytes, NUL-padded.
-        const py::array c = py::array::ensure(a, py::array::c_style);
-        const auto width = static_cast<std::size_t>(c.itemsize());
-        const std::size_t unit = kind == 'U' ? 4 : 1;
-        const auto* base = static_cast<const unsigned char*>(c.data());
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const unsigned char* e = base + static_cast<std::size_t>(i) * width;
-            std::uint32_t first = 0;  // assembled byte by byte: the elements need not be aligned
-            std::uint32_t second = 0;
-            if (width >= unit) {
-                for (std::size_t b = 0; b < unit; ++b) {
-                    first |= static_cast<std::uint32_t>(e[b]) << (8 * (kind == 'U' ? b : 0));
-                }
-            }
-            if (width >= 2 * unit) {
-                for (std::size_t b = 0; b < unit; ++b) {
-                    second |= static_cast<std::uint32_t>(e[unit + b]) << (8 * (kind == 'U' ? b : 0));
-                }
-            }
-            if (second == 0 && first < 0x80U) {
-                heads[static_cast<std::size_t>(i)] = head_index(static_cast<char>(first));
-            }
-        }
+        heads_of_strings(a, n, heads);
     } else if (kind == 'O') {
-        for (py::ssize_t i = 0; i < n; ++i) {
-            const py::object x = a[py::int_(i)];
-            if (py::isinstance<py::str>(x)) {
-                heads[static_cast<std::size_t>(i)] = host::head_from_name(x.cast<std::string>());
-            } else if (py::isinstance<py::int_>(x)) {
-                const long long h = x.cast<long long>();
-                if (h >= 0 && h < static_cast<long long>(kMaxHeads)) {
-                    heads[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(h);
-                }
-            } else {
-                bad_argument("chu", "row " + std::to_string(i) + ": expected a string or an integer, got " +
-                                        std::string(py::str(x.get_type())));
-            }
-        }
+        heads_of_objects(a, n, heads);
     } else {
         bad_argument("chu", "expected strings " + head_letter_range() + " or integers " + head_index_range() +
                                 ", got dtype " + std::string(py::str(a.dtype())));

@@ -31,6 +31,28 @@ using namespace pybind11::literals;
 
 namespace {
 
+// The row's vx,vy,vz, NaN where absent (a field that is not there or empty).
+void append_velocity(const host::SolutionsReader& reader, const SolutionRecord& rec, std::vector<double>& v) {
+    const int cols[3] = {reader.columns().vx, reader.columns().vy, reader.columns().vz};
+    const double vs[3] = {rec.v_sc_kms.x, rec.v_sc_kms.y, rec.v_sc_kms.z};
+    for (std::size_t j = 0; j < 3; ++j) {  // present: a field that is there and not empty or nan
+        const bool there = cols[j] >= 0 && !reader.fields()[static_cast<std::size_t>(cols[j])].empty();
+        v.push_back(there ? vs[j] : kNaN);
+    }
+}
+
+// The row's status column (0 … 65535; InputError otherwise).
+long long status_of(const std::string& path, const host::SolutionsReader& reader, const SolutionRecord& rec,
+                    int status_col) {
+    const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
+    const auto s = host::parse_integer(f);
+    if (!s || *s < 0 || *s > 0xFFFF) {
+        throw host::InputError(path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
+                               "column 'status': " + host::why_not_an_integer(f, 0, 0xFFFF));
+    }
+    return *s;
+}
+
 py::dict read_solutions(const py::object& path_obj) {
     const std::string path = path_arg(path_obj, "path");
     std::vector<double> t, q, temps, v, conf;
@@ -63,23 +85,11 @@ py::dict read_solutions(const py::object& path_obj) {
             for (std::size_t j = 0; j < 3; ++j) {
                 temps.push_back(rec.temperature_present[j] ? rec.temperature[j] : kNaN);
             }
-            const int cols[3] = {reader.columns().vx, reader.columns().vy, reader.columns().vz};
-            const double vs[3] = {rec.v_sc_kms.x, rec.v_sc_kms.y, rec.v_sc_kms.z};
-            for (std::size_t j = 0; j < 3; ++j) {  // present: a field that is there and not empty or nan
-                const bool there = cols[j] >= 0 && !reader.fields()[static_cast<std::size_t>(cols[j])].empty();
-                v.push_back(there ? vs[j] : kNaN);
-            }
+            append_velocity(reader, rec, v);
             flags.push_back(rec.flags);
             conf.push_back(rec.confidence_present ? rec.confidence : kNaN);
             if (has_status) {
-                const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
-                const auto s = host::parse_integer(f);
-                if (!s || *s < 0 || *s > 0xFFFF) {
-                    throw host::InputError(path, rec.line,
-                                           static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
-                                           "column 'status': " + host::why_not_an_integer(f, 0, 0xFFFF));
-                }
-                st.push_back(*s);
+                st.push_back(status_of(path, reader, rec, status_col));
             }
             for (std::size_t j = 0; j < extra_cols.size(); ++j) {
                 extra[j].emplace_back(reader.fields()[extra_cols[j]]);

@@ -139,66 +139,28 @@ private:
                     f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
                 return;
             case MessageType::kCalibStart:
-                update<CalibStart>(f, sink, [this](const CalibStart& m) {
-                    calib::EstimatorConfig cfg{};
-                    cfg.orbit_period_us = m.orbit_period_us;
-                    cfg.time_constant_days = m.time_constant_days;
-                    // In place: no 10-KiB temporary on the stack (trivially destructible).
-                    new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
-                    pipeline_.use_estimator(&estimator_);
-                });
+                update<CalibStart>(f, sink, [this](const CalibStart& m) { start_estimator(m); });
                 return;
             case MessageType::kServiceConfig:
                 update<ServiceConfig>(f, sink, [this](const ServiceConfig& m) {
                     new (&service_) VelocityService<T>(velocity_service_config(m.horizon_us));
                 });
                 return;
-            case MessageType::kCalibModelRequest: {
-                if (f.length != 1U || f.payload[0] >= kMaxHeads) {
-                    ack(f.seq, AckResult::kBadPayload, sink);
-                    return;
-                }
-                std::uint8_t p[kMaxPayload];
-                emit(MessageType::kCalibModel, f.seq, p, encode(active_model(f.payload[0]), p), sink, true);
+            case MessageType::kCalibModelRequest:
+                reply(
+                    f, f.length == 1U && f.payload[0] < kMaxHeads, MessageType::kCalibModel,
+                    [this, &f] { return active_model(f.payload[0]); }, sink);
                 return;
-            }
             case MessageType::kCalibCommand:
-                update<CalibCommand>(f, sink, [this](CalibCommand c) {
-                    switch (c) {
-                        case CalibCommand::kFreeze:
-                            estimator_.freeze();
-                            return;
-                        case CalibCommand::kResume:
-                            estimator_.resume();
-                            return;
-                        case CalibCommand::kReset:
-                            estimator_.reset();
-                            return;
-                    }
-                });
+                update<CalibCommand>(f, sink, [this](CalibCommand c) { command_estimator(c); });
                 return;
             case MessageType::kCalibModelLoad:
-                update<CalibModelLoad>(f, sink, [this](const CalibModelLoad& m) {
-                    staged_.present[m.head] = m.present == 1U;
-                    for (std::size_t a = 0; a < kModelAxes; ++a) {
-                        for (std::size_t t = 0; t < kModelTerms; ++t) {
-                            staged_.coefficient[m.head][a][t] = t < kLinearModelTerms ? m.c[a][t] : 0.0;
-                        }
-                    }
-                    if (m.load == 1U) {
-                        estimator_.load_model(staged_);
-                    }
-                });
+                update<CalibModelLoad>(f, sink, [this](const CalibModelLoad& m) { stage_model(m); });
                 return;
-            case MessageType::kCalibReportRequest: {
-                if (f.length != 0U) {
-                    ack(f.seq, AckResult::kBadPayload, sink);
-                    return;
-                }
-                std::uint8_t p[kMaxPayload];
-                emit(MessageType::kCalibReport, f.seq, p, encode(estimator_.report(), p), sink, true);
+            case MessageType::kCalibReportRequest:
+                reply(
+                    f, f.length == 0U, MessageType::kCalibReport, [this] { return estimator_.report(); }, sink);
                 return;
-            }
             case MessageType::kSolutionIn: {
                 SolutionIn<T> s{};
                 if (!decode(f.payload, f.length, s)) {
@@ -215,15 +177,10 @@ private:
                     f, sink, [this](const MountingLoad& m) { load_mounting(m); },
                     [this](const MountingLoad& m) { return m.build == 0U || buildable(m); });
                 return;
-            case MessageType::kCombineRequest: {
-                if (f.length != 0U) {
-                    ack(f.seq, AckResult::kBadPayload, sink);
-                    return;
-                }
-                std::uint8_t p[kMaxPayload];
-                emit(MessageType::kCombined, f.seq, p, encode(close_epoch(), p), sink, true);
+            case MessageType::kCombineRequest:
+                reply(
+                    f, f.length == 0U, MessageType::kCombined, [this] { return close_epoch(); }, sink);
                 return;
-            }
             case MessageType::kHello:
             case MessageType::kCombined:
             case MessageType::kCalibReport:
@@ -234,6 +191,53 @@ private:
                 break;
         }
         ack(f.seq, AckResult::kUnknownType, sink);
+    }
+
+    // A request's reply: `type` with make()'s message when the payload is
+    // well formed, kBadPayload otherwise.
+    template <typename Make, typename Sink>
+    void reply(const Frame& f, bool well_formed, MessageType type, Make make, Sink& sink) noexcept {
+        if (!well_formed) {
+            ack(f.seq, AckResult::kBadPayload, sink);
+            return;
+        }
+        std::uint8_t p[kMaxPayload];
+        emit(type, f.seq, p, encode(make(), p), sink, true);
+    }
+
+    void start_estimator(const CalibStart& m) noexcept {
+        calib::EstimatorConfig cfg{};
+        cfg.orbit_period_us = m.orbit_period_us;
+        cfg.time_constant_days = m.time_constant_days;
+        // In place: no 10-KiB temporary on the stack (trivially destructible).
+        new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
+        pipeline_.use_estimator(&estimator_);
+    }
+
+    void command_estimator(CalibCommand c) noexcept {
+        switch (c) {
+            case CalibCommand::kFreeze:
+                estimator_.freeze();
+                return;
+            case CalibCommand::kResume:
+                estimator_.resume();
+                return;
+            case CalibCommand::kReset:
+                estimator_.reset();
+                return;
+        }
+    }
+
+    void stage_model(const CalibModelLoad& m) noexcept {
+        staged_.present[m.head] = m.present == 1U;
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t t = 0; t < kModelTerms; ++t) {
+                staged_.coefficient[m.head][a][t] = t < kLinearModelTerms ? m.c[a][t] : 0.0;
+            }
+        }
+        if (m.load == 1U) {
+            estimator_.load_model(staged_);
+        }
     }
 
     // The meter of a solution's cost: one window, from the first stage's

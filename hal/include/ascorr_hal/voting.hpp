@@ -37,6 +37,58 @@ struct VotedTemperature {
     bool valid() const noexcept { return faults == 0U; }
 };
 
+namespace detail {
+
+// Three valid members (indices v[0..2]): the median is the value; each outer
+// member within tolerance of it agrees, the others are outvoted.
+template <typename T>
+void vote_three(ChannelReading<T>* m, const std::uint8_t* v, T tolerance, VotedTemperature<T>& out) noexcept {
+    using Math = TemperatureMath<T>;
+    // Sort the three indices by value.
+    std::uint8_t a = v[0], b = v[1], c = v[2], t = 0;
+    if (Math::less(m[b].celsius, m[a].celsius)) {
+        t = a;
+        a = b;
+        b = t;
+    }
+    if (Math::less(m[c].celsius, m[b].celsius)) {
+        t = b;
+        b = c;
+        c = t;
+    }
+    if (Math::less(m[b].celsius, m[a].celsius)) {
+        t = a;
+        a = b;
+        b = t;
+    }
+    const T med = m[b].celsius;
+    out.celsius = med;
+    out.agreeing = 1U;
+    out.t_us = m[b].t_us;
+    const std::uint8_t outer[2] = {a, c};
+    for (const std::uint8_t k : outer) {
+        if (Math::within(m[k].celsius, med, tolerance)) {
+            ++out.agreeing;
+            out.t_us = m[k].t_us < out.t_us ? m[k].t_us : out.t_us;
+        } else {
+            m[k].faults |= fault::kOutvoted;
+        }
+    }
+}
+
+// Two valid members: their mean when they agree, no value otherwise.
+template <typename T>
+void vote_two(const ChannelReading<T>& x, const ChannelReading<T>& y, T tolerance, VotedTemperature<T>& out) noexcept {
+    using Math = TemperatureMath<T>;
+    if (Math::within(x.celsius, y.celsius, tolerance)) {
+        out.celsius = Math::mean(x.celsius, y.celsius);
+        out.agreeing = 2U;
+        out.t_us = x.t_us < y.t_us ? x.t_us : y.t_us;
+    }
+}
+
+}  // namespace detail
+
 // Votes `n` (≤ kMaxVoters) readings; sets kOutvoted on disagreeing members.
 template <typename T>
 VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std::uint8_t quorum) noexcept {
@@ -54,44 +106,9 @@ VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std:
     }
     const std::uint8_t need = n <= 1U ? 1U : (quorum == 0U ? 1U : quorum);
     if (nv == 3U) {
-        // Sort the three indices by value.
-        std::uint8_t a = valid[0], b = valid[1], c = valid[2], t = 0;
-        if (Math::less(m[b].celsius, m[a].celsius)) {
-            t = a;
-            a = b;
-            b = t;
-        }
-        if (Math::less(m[c].celsius, m[b].celsius)) {
-            t = b;
-            b = c;
-            c = t;
-        }
-        if (Math::less(m[b].celsius, m[a].celsius)) {
-            t = a;
-            a = b;
-            b = t;
-        }
-        const T med = m[b].celsius;
-        out.celsius = med;
-        out.agreeing = 1U;
-        out.t_us = m[b].t_us;
-        const std::uint8_t outer[2] = {a, c};
-        for (const std::uint8_t k : outer) {
-            if (Math::within(m[k].celsius, med, tolerance)) {
-                ++out.agreeing;
-                out.t_us = m[k].t_us < out.t_us ? m[k].t_us : out.t_us;
-            } else {
-                m[k].faults |= fault::kOutvoted;
-            }
-        }
+        detail::vote_three(m, valid, tolerance, out);
     } else if (nv == 2U) {
-        const ChannelReading<T>& x = m[valid[0]];
-        const ChannelReading<T>& y = m[valid[1]];
-        if (Math::within(x.celsius, y.celsius, tolerance)) {
-            out.celsius = Math::mean(x.celsius, y.celsius);
-            out.agreeing = 2U;
-            out.t_us = x.t_us < y.t_us ? x.t_us : y.t_us;
-        }
+        detail::vote_two(m[valid[0]], m[valid[1]], tolerance, out);
     } else if (nv == 1U) {
         out.celsius = m[valid[0]].celsius;
         out.agreeing = 1U;

@@ -15,6 +15,78 @@ struct Column {
     std::string name;  // as the header names it, unquoted
 };
 
+// The header's columns: "t" once, then configured channels ("<name>" in
+// degC or "<name>.counts"), each once.
+std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
+                                   const std::vector<linux_detail::Field>& fields,
+                                   const AcquisitionConfig<double>& config) {
+    std::vector<Column> columns;
+    bool have_t = false;
+    bool used[kMaxChannels] = {};
+    for (const auto& [raw, col] : fields) {
+        const std::string name = text::csv::unquoted(raw);  // "t" names the column t
+        if (name == "t") {
+            if (have_t) {
+                throw ConfigError(file, line_no, col, "column 't' appears twice");
+            }
+            have_t = true;
+            columns.push_back({-1, false, name});
+            continue;
+        }
+        const bool counts = name.size() > 7 && name.substr(name.size() - 7) == ".counts";
+        const std::string_view ch = std::string_view(name).substr(0, counts ? name.size() - 7 : name.size());
+        const int idx = find_channel(config, ch);
+        if (idx < 0) {
+            throw ConfigError(file, line_no, col, "column '" + name + "' names no configured channel");
+        }
+        if (used[idx]) {
+            throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
+        }
+        used[idx] = true;
+        columns.push_back({idx, counts, name});
+    }
+    if (!have_t) {
+        throw ConfigError(file, line_no, 1, "no column 't'");
+    }
+    return columns;
+}
+
+// The t field in µs (seconds in [0, 1e12]).
+std::uint64_t read_time_us(const std::string& file, std::size_t line_no, std::string_view v, std::size_t col) {
+    const char* b = v.data();
+    const char* e = b + v.size();
+    double t = 0.0;
+    const auto r = std::from_chars(b, e, t);
+    if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
+        throw ConfigError(file, line_no, col,
+                          linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
+    }
+    return static_cast<std::uint64_t>(std::llround(t * 1e6));
+}
+
+// A channel's field (not empty, not "nan") as counts or degC.
+ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, std::string_view v, std::size_t col,
+                                  const Column& c, const AcquisitionConfig<double>& config) {
+    const char* b = v.data();
+    const char* e = b + v.size();
+    if (c.counts) {
+        unsigned long n = 0;
+        const auto r = std::from_chars(b, e, n);
+        const unsigned long top = config.channel[c.channel].divider.levels - 1UL;
+        if (r.ec != std::errc() || r.ptr != e || n > top) {
+            throw ConfigError(file, line_no, col, "counts must be an integer in [0, " + std::to_string(top) + "]");
+        }
+        return {SampleKind::kCounts, static_cast<std::uint16_t>(n), 0U, 0.0, 0U};
+    }
+    double x = 0.0;
+    const auto r = std::from_chars(b, e, x);
+    if (r.ec != std::errc() || r.ptr != e) {
+        throw ConfigError(file, line_no, col,
+                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
+    }
+    return {SampleKind::kCelsius, 0U, 0U, x, 0U};
+}
+
 }  // namespace
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
@@ -28,33 +100,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         const std::vector<linux_detail::Field>& fields = splitter.split(file, line_no, line);
         if (header) {
             header = false;
-            bool have_t = false;
-            bool used[kMaxChannels] = {};
-            for (const auto& [raw, col] : fields) {
-                const std::string name = text::csv::unquoted(raw);  // "t" names the column t
-                if (name == "t") {
-                    if (have_t) {
-                        throw ConfigError(file, line_no, col, "column 't' appears twice");
-                    }
-                    have_t = true;
-                    columns.push_back({-1, false, name});
-                    continue;
-                }
-                const bool counts = name.size() > 7 && name.substr(name.size() - 7) == ".counts";
-                const std::string_view ch = std::string_view(name).substr(0, counts ? name.size() - 7 : name.size());
-                const int idx = find_channel(config, ch);
-                if (idx < 0) {
-                    throw ConfigError(file, line_no, col, "column '" + name + "' names no configured channel");
-                }
-                if (used[idx]) {
-                    throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
-                }
-                used[idx] = true;
-                columns.push_back({idx, counts, name});
-            }
-            if (!have_t) {
-                throw ConfigError(file, line_no, 1, "no column 't'");
-            }
+            columns = header_columns(file, line_no, fields, config);
             continue;
         }
         if (line.empty() && lines.at_end()) {  // a blank last line
@@ -70,40 +116,10 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
             linux_detail::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
-            const char* b = v.data();
-            const char* e = b + v.size();
             if (c.channel < 0) {
-                double t = 0.0;
-                const auto r = std::from_chars(b, e, t);
-                if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
-                    throw ConfigError(
-                        file, line_no, col,
-                        linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
-                }
-                f.t_us = static_cast<std::uint64_t>(std::llround(t * 1e6));
-                continue;
-            }
-            ChannelSample<double>& s = f.channel[c.channel];
-            if (v.empty() || v == "nan") {
-                continue;  // kNone
-            }
-            if (c.counts) {
-                unsigned long n = 0;
-                const auto r = std::from_chars(b, e, n);
-                const unsigned long top = config.channel[c.channel].divider.levels - 1UL;
-                if (r.ec != std::errc() || r.ptr != e || n > top) {
-                    throw ConfigError(file, line_no, col,
-                                      "counts must be an integer in [0, " + std::to_string(top) + "]");
-                }
-                s = {SampleKind::kCounts, static_cast<std::uint16_t>(n), 0U, 0.0, 0U};
-            } else {
-                double x = 0.0;
-                const auto r = std::from_chars(b, e, x);
-                if (r.ec != std::errc() || r.ptr != e) {
-                    throw ConfigError(file, line_no, col,
-                                      linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
-                }
-                s = {SampleKind::kCelsius, 0U, 0U, x, 0U};
+                f.t_us = read_time_us(file, line_no, v, col);
+            } else if (!v.empty() && v != "nan") {  // else kNone
+                f.channel[c.channel] = read_sample(file, line_no, v, col, c, config);
             }
         }
         sample_sets_.push_back(f);

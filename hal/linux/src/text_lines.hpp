@@ -50,6 +50,24 @@ inline std::string number_refusal(std::string_view v, const std::string& what, c
     return why.empty() ? what : prefix + why;
 }
 
+// Whether c1 may follow the lead byte c (0xE0 … 0xF4) of a three- or
+// four-byte sequence: a continuation byte, narrowed after E0 (no overlong),
+// ED (no surrogate), F0 (no overlong) and F4 (nothing beyond U+10FFFF).
+constexpr bool utf8_second_ok(unsigned c, unsigned c1) noexcept {
+    switch (c) {
+        case 0xE0U:
+            return c1 >= 0xA0U && c1 <= 0xBFU;
+        case 0xEDU:
+            return c1 >= 0x80U && c1 <= 0x9FU;
+        case 0xF0U:
+            return c1 >= 0x90U && c1 <= 0xBFU;
+        case 0xF4U:
+            return c1 >= 0x80U && c1 <= 0x8FU;
+        default:
+            return (c1 & 0xC0U) == 0x80U;
+    }
+}
+
 // The length of the valid UTF-8 sequence at s[i] (1 … 4), or 0 when it is
 // not one (a stray continuation byte, a truncated or overlong sequence, a
 // surrogate, beyond U+10FFFF). RFC 3629, section 4.
@@ -64,18 +82,10 @@ inline std::size_t utf8_length(std::string_view s, std::size_t i) noexcept {
         return tail(i + 1) ? 2 : 0;
     }
     if (c >= 0xE0U && c <= 0xEFU) {
-        const unsigned c1 = at(i + 1);
-        const bool ok1 = c == 0xE0U   ? (c1 >= 0xA0U && c1 <= 0xBFU)
-                         : c == 0xEDU ? (c1 >= 0x80U && c1 <= 0x9FU)
-                                      : tail(i + 1);
-        return ok1 && tail(i + 2) ? 3 : 0;
+        return utf8_second_ok(c, at(i + 1)) && tail(i + 2) ? 3 : 0;
     }
     if (c >= 0xF0U && c <= 0xF4U) {
-        const unsigned c1 = at(i + 1);
-        const bool ok1 = c == 0xF0U   ? (c1 >= 0x90U && c1 <= 0xBFU)
-                         : c == 0xF4U ? (c1 >= 0x80U && c1 <= 0x8FU)
-                                      : tail(i + 1);
-        return ok1 && tail(i + 2) && tail(i + 3) ? 4 : 0;
+        return utf8_second_ok(c, at(i + 1)) && tail(i + 2) && tail(i + 3) ? 4 : 0;
     }
     return 0;
 }

@@ -50,74 +50,62 @@ double predicted(const std::array<double, 7>& c, const OrbitAverage& o, std::siz
            c[6] * o.x2[h](2);
 }
 
-}  // namespace
-
-const char* terms_name(Terms t) noexcept {
-    return t == Terms::kLinear ? "linear" : "quadratic";
+// Regressor j of head h: its mean, its scale (the standard deviation; 1
+// for a constant one, a zero column refused by the condition) and range.
+void centre_regressor(const std::vector<OrbitAverage>& orbits, std::size_t h, std::size_t j, Eigen::Index n,
+                      Centring& centring) {
+    const auto ji = static_cast<Eigen::Index>(j);
+    double sum = 0.0;
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (const OrbitAverage& o : orbits) {
+        sum += o.x[h](ji);
+        lo = std::min(lo, o.x[h](ji));
+        hi = std::max(hi, o.x[h](ji));
+    }
+    const double mean = sum / static_cast<double>(n);
+    double ss = 0.0;
+    for (const OrbitAverage& o : orbits) {
+        ss += (o.x[h](ji) - mean) * (o.x[h](ji) - mean);
+    }
+    const double sd = std::sqrt(ss / static_cast<double>(n));
+    centring.mean[h][j] = mean;
+    centring.scale[h][j] = sd > 0.0 ? sd : 1.0;  // a constant regressor: a zero column, refused below
+    centring.range[h][j] = hi - lo;
 }
 
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
-                     double max_condition, double min_range_c) {
-    TermsFit f;
-    f.terms = terms;
-    f.heads = heads;
-    const HeadList list = heads_of(heads);
-    const auto nh = static_cast<Eigen::Index>(list.count);
-    const Eigen::Index rows = 3 * nh;  // an orbit's equations: 3 per head
-    const int per_axis = terms_per_axis(terms);
-    const int unknowns = static_cast<int>(rows) * per_axis;
-    f.unknowns = unknowns;
-    f.rank = unknowns - kGauge;
+// Centring and scaling of each head's regressors over the orbit averages.
+void centre_regressors(const std::vector<OrbitAverage>& orbits, const HeadList& list, Centring& centring) {
     const auto n = static_cast<Eigen::Index>(orbits.size());
-    if (n == 0) {
-        f.refused = "no orbit to fit";
-        return f;
-    }
-
-    // Centring and scaling of each head's regressors over the orbit averages.
     for (std::size_t i = 0; i < list.count; ++i) {
         const std::size_t h = list.head[i];
         for (std::size_t j = 0; j < 3; ++j) {
-            const auto ji = static_cast<Eigen::Index>(j);
-            double sum = 0.0;
-            double lo = std::numeric_limits<double>::infinity();
-            double hi = -lo;
-            for (const OrbitAverage& o : orbits) {
-                sum += o.x[h](ji);
-                lo = std::min(lo, o.x[h](ji));
-                hi = std::max(hi, o.x[h](ji));
-            }
-            const double mean = sum / static_cast<double>(n);
-            double ss = 0.0;
-            for (const OrbitAverage& o : orbits) {
-                ss += (o.x[h](ji) - mean) * (o.x[h](ji) - mean);
-            }
-            const double sd = std::sqrt(ss / static_cast<double>(n));
-            f.centring.mean[h][j] = mean;
-            f.centring.scale[h][j] = sd > 0.0 ? sd : 1.0;  // a constant regressor: a zero column, refused below
-            f.centring.range[h][j] = hi - lo;
+            centre_regressor(orbits, h, j, n, centring);
         }
     }
-    if (terms == Terms::kQuadratic) {
-        for (std::size_t i = 0; i < list.count; ++i) {
-            const std::size_t h = list.head[i];
-            for (std::size_t j = 0; j < 3; ++j) {
-                if (!(f.centring.range[h][j] >= min_range_c)) {
-                    f.refused = format(
-                        "temperature range too small for quadratic terms: CHU %c's %s spans %.3f degC over the orbit "
-                        "averages of the period; at least %.3f degC are needed to fit its square "
-                        "(--min-temperature-range)",
-                        head_name(static_cast<std::uint8_t>(h)), kRegressorNames[j], f.centring.range[h][j],
-                        min_range_c);
-                    return f;
-                }
-            }
-        }
-    }
+}
 
-    // The joint design (fit.hpp): each orbit's 3·heads equations projected
-    // orthogonally to F's own rotation, P = I − G·Gᵀ/heads
-    // (calib/common_rotation.hpp).
+// Whether every regressor spans min_range_c (quadratic terms); f.refused
+// says which does not.
+bool range_enough(TermsFit& f, const HeadList& list, double min_range_c) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
+        for (std::size_t j = 0; j < 3; ++j) {
+            if (!(f.centring.range[h][j] >= min_range_c)) {
+                f.refused = format(
+                    "temperature range too small for quadratic terms: CHU %c's %s spans %.3f degC over the orbit "
+                    "averages of the period; at least %.3f degC are needed to fit its square "
+                    "(--min-temperature-range)",
+                    head_name(static_cast<std::uint8_t>(h)), kRegressorNames[j], f.centring.range[h][j], min_range_c);
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// P = I − G·Gᵀ/heads over the heads' equations (calib/common_rotation.hpp).
+Eigen::MatrixXd projector(const HeadOrientations& n_ref, const HeadList& list, Eigen::Index rows) {
     std::array<calib::Matrix3, kMaxHeads> n_core{};
     for (std::size_t i = 0; i < list.count; ++i) {
         for (Eigen::Index r = 0; r < 3; ++r) {
@@ -134,6 +122,13 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
             proj(r, c) = p_core[static_cast<std::size_t>(r * rows + c)];
         }
     }
+    return proj;
+}
+
+// The orbits' e by head, centred on their mean, so that c0 refers to the
+// mean orientation.
+Eigen::MatrixXd centred_errors(const std::vector<OrbitAverage>& orbits, const HeadList& list, Eigen::Index rows) {
+    const auto n = static_cast<Eigen::Index>(orbits.size());
     Eigen::MatrixXd y(n, rows);
     for (Eigen::Index k = 0; k < n; ++k) {
         for (std::size_t i = 0; i < list.count; ++i) {
@@ -141,25 +136,37 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
                 orbits[static_cast<std::size_t>(k)].e[list.head[i]].transpose();
         }
     }
-    // Centre e on its mean, so that c0 refers to the mean orientation.
     const Eigen::RowVectorXd mean = y.colwise().mean();
     y.rowwise() -= mean;
-    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(rows * n, unknowns);
-    Eigen::VectorXd target(rows * n);
+    return y;
+}
+
+// Orbit k's unprojected equations: each head's regressors on its axes' rows.
+void orbit_equations(const OrbitAverage& o, const HeadList& list, const Centring& centring, int per_axis,
+                     Eigen::MatrixXd& a) {
+    a.setZero();
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const Eigen::VectorXd r = regressors(o, list.head[i], centring, per_axis);
+        for (Eigen::Index ax = 0; ax < 3; ++ax) {
+            const Eigen::Index row = 3 * static_cast<Eigen::Index>(i) + ax;
+            a.block(row, row * per_axis, 1, per_axis) = r.transpose();
+        }
+    }
+}
+
+// The projected design and target, orbit by orbit.
+void fill_design(const std::vector<OrbitAverage>& orbits, const HeadList& list, const Centring& centring, int per_axis,
+                 const Eigen::MatrixXd& proj, const Eigen::MatrixXd& y, Eigen::MatrixXd& design,
+                 Eigen::VectorXd& target) {
+    const auto n = static_cast<Eigen::Index>(orbits.size());
+    const Eigen::Index rows = proj.rows();
+    const auto unknowns = design.cols();
     Eigen::MatrixXd a(rows, unknowns);
     // Three heads: P fixed-size, the products as they always were, bit for bit.
     const Eigen::Matrix<double, 9, 9> proj3 =
         rows == 9 ? Eigen::Matrix<double, 9, 9>(proj) : Eigen::Matrix<double, 9, 9>::Zero();
     for (Eigen::Index k = 0; k < n; ++k) {
-        a.setZero();
-        for (std::size_t i = 0; i < list.count; ++i) {
-            const Eigen::VectorXd r =
-                regressors(orbits[static_cast<std::size_t>(k)], list.head[i], f.centring, per_axis);
-            for (Eigen::Index ax = 0; ax < 3; ++ax) {
-                const Eigen::Index row = 3 * static_cast<Eigen::Index>(i) + ax;
-                a.block(row, row * per_axis, 1, per_axis) = r.transpose();
-            }
-        }
+        orbit_equations(orbits[static_cast<std::size_t>(k)], list, centring, per_axis, a);
         if (rows == 9) {
             design.block(9 * k, 0, 9, unknowns) = proj3 * a;
             target.segment<9>(9 * k) = proj3 * y.row(k).transpose();
@@ -168,46 +175,37 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
             target.segment(rows * k, rows) = proj * y.row(k).transpose();
         }
     }
-    Eigen::VectorXd scale = design.colwise().norm().transpose();
-    for (Eigen::Index i = 0; i < scale.size(); ++i) {
-        scale(i) = scale(i) > 0.0 ? scale(i) : 1.0;  // a zero column stays zero: its singular value is 0
-    }
-    design = design * scale.cwiseInverse().asDiagonal();
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
-    const Eigen::VectorXd sv = svd.singularValues();
-    f.singular_values.assign(sv.data(), sv.data() + sv.size());
-    const Eigen::Index rank = f.rank;
-    f.condition = sv(rank - 1) > 0.0 ? sv(0) / sv(rank - 1) : std::numeric_limits<double>::infinity();
-    if (!(f.condition <= max_condition)) {
-        // Name the head, and the term, whose coefficients dominate the weakest direction.
-        const Eigen::VectorXd weakest = svd.matrixV().col(rank - 1);
-        std::array<double, kMaxHeads> head_share{};  // by position in list
-        std::array<std::array<double, 7>, kMaxHeads> term_share{};
-        for (Eigen::Index i = 0; i < unknowns; ++i) {
-            const auto h = static_cast<std::size_t>(i / (3 * per_axis));
-            const auto t = static_cast<std::size_t>(i % per_axis);
-            head_share[h] += weakest(i) * weakest(i);
-            term_share[h][t] += weakest(i) * weakest(i);
-        }
-        const auto head = static_cast<std::size_t>(
-            std::max_element(head_share.begin(), head_share.begin() + static_cast<long>(list.count)) -
-            head_share.begin());
-        const auto term = static_cast<std::size_t>(
-            std::max_element(term_share[head].begin(), term_share[head].begin() + per_axis) - term_share[head].begin());
-        f.refused = format(
-            "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, the largest "
-            "%.3g; the weakest direction is mostly CHU %c's coefficients, most of all %s)",
-            f.condition, max_condition, static_cast<int>(rank), unknowns, sv(rank - 1), sv(0),
-            head_name(list.head[head]), kCoefficientNames[term]);
-        return f;
-    }
-    // Least squares on the observable directions only (truncated SVD).
-    const Eigen::VectorXd c_scaled =
-        svd.matrixV().leftCols(rank) * (svd.matrixU().leftCols(rank).transpose() * target).cwiseQuotient(sv.head(rank));
-    const Eigen::VectorXd b = scale.cwiseInverse().asDiagonal() * c_scaled;  // centred coefficients
+}
 
-    // Residuals, with each orbit's common rotation removed (as in the fit).
-    const Eigen::VectorXd res = target - design * c_scaled;
+// Names the head, and the term, whose coefficients dominate the weakest direction.
+std::string why_ill_conditioned(const TermsFit& f, const Eigen::BDCSVD<Eigen::MatrixXd>& svd, const HeadList& list,
+                                int per_axis, double max_condition) {
+    const Eigen::Index rank = f.rank;
+    const int unknowns = f.unknowns;
+    const Eigen::VectorXd sv = svd.singularValues();
+    const Eigen::VectorXd weakest = svd.matrixV().col(rank - 1);
+    std::array<double, kMaxHeads> head_share{};  // by position in list
+    std::array<std::array<double, 7>, kMaxHeads> term_share{};
+    for (Eigen::Index i = 0; i < unknowns; ++i) {
+        const auto h = static_cast<std::size_t>(i / (3 * per_axis));
+        const auto t = static_cast<std::size_t>(i % per_axis);
+        head_share[h] += weakest(i) * weakest(i);
+        term_share[h][t] += weakest(i) * weakest(i);
+    }
+    const auto head = static_cast<std::size_t>(
+        std::max_element(head_share.begin(), head_share.begin() + static_cast<long>(list.count)) - head_share.begin());
+    const auto term = static_cast<std::size_t>(
+        std::max_element(term_share[head].begin(), term_share[head].begin() + per_axis) - term_share[head].begin());
+    return format(
+        "rank-deficient design: condition number %.3g exceeds %.3g (singular value %d of %d is %.3g, the largest "
+        "%.3g; the weakest direction is mostly CHU %c's coefficients, most of all %s)",
+        f.condition, max_condition, static_cast<int>(rank), unknowns, sv(rank - 1), sv(0), head_name(list.head[head]),
+        kCoefficientNames[term]);
+}
+
+// Each head's and axis' residual and signal RMS over the orbits.
+void residual_rms(const Eigen::VectorXd& res, const Eigen::VectorXd& target, const HeadList& list, Eigen::Index rows,
+                  Eigen::Index n, TermsFit& f) {
     for (std::size_t i = 0; i < list.count; ++i) {
         const std::size_t h = list.head[i];
         for (std::size_t ax = 0; ax < 3; ++ax) {
@@ -222,8 +220,10 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
             f.head[h].signal_rms[ax] = std::sqrt(sy / static_cast<double>(n));
         }
     }
+}
 
-    // Back into the contract's form (see the header).
+// The centred coefficients b back into the contract's form (see the header).
+void uncentre(const Eigen::VectorXd& b, const HeadList& list, int per_axis, Terms terms, TermsFit& f) {
     ModelFile& m = f.model;
     m.present = {};
     m.quadratic = terms == Terms::kQuadratic;
@@ -247,10 +247,15 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
             }
         }
     }
+}
 
-    // The gauge: of all models the star trackers cannot tell apart (c plus a
-    // common rotation w0 + w2·T029 + w3·T032), write the one whose corrections
-    // are smallest (RMS over the orbits of the period).
+// The gauge: of all models the star trackers cannot tell apart (c plus a
+// common rotation w0 + w2·T029 + w3·T032), the one whose corrections are
+// smallest (RMS over the orbits of the period).
+void apply_gauge(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, const HeadList& list,
+                 Eigen::Index rows, ModelFile& m) {
+    const auto n = static_cast<Eigen::Index>(orbits.size());
+    const auto nh = static_cast<Eigen::Index>(list.count);
     Eigen::MatrixXd gd(rows * n, kGauge);
     Eigen::VectorXd gt(rows * n);
     for (Eigen::Index k = 0; k < n; ++k) {
@@ -283,6 +288,68 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
             c[3] += w3(ai);
         }
     }
+}
+
+}  // namespace
+
+const char* terms_name(Terms t) noexcept {
+    return t == Terms::kLinear ? "linear" : "quadratic";
+}
+
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
+                     double max_condition, double min_range_c) {
+    TermsFit f;
+    f.terms = terms;
+    f.heads = heads;
+    const HeadList list = heads_of(heads);
+    const auto nh = static_cast<Eigen::Index>(list.count);
+    const Eigen::Index rows = 3 * nh;  // an orbit's equations: 3 per head
+    const int per_axis = terms_per_axis(terms);
+    const int unknowns = static_cast<int>(rows) * per_axis;
+    f.unknowns = unknowns;
+    f.rank = unknowns - kGauge;
+    const auto n = static_cast<Eigen::Index>(orbits.size());
+    if (n == 0) {
+        f.refused = "no orbit to fit";
+        return f;
+    }
+    centre_regressors(orbits, list, f.centring);
+    if (terms == Terms::kQuadratic && !range_enough(f, list, min_range_c)) {
+        return f;
+    }
+
+    // The joint design (fit.hpp): each orbit's 3·heads equations projected
+    // orthogonally to F's own rotation, P = I − G·Gᵀ/heads
+    // (calib/common_rotation.hpp).
+    const Eigen::MatrixXd proj = projector(n_ref, list, rows);
+    const Eigen::MatrixXd y = centred_errors(orbits, list, rows);
+    Eigen::MatrixXd design = Eigen::MatrixXd::Zero(rows * n, unknowns);
+    Eigen::VectorXd target(rows * n);
+    fill_design(orbits, list, f.centring, per_axis, proj, y, design, target);
+    Eigen::VectorXd scale = design.colwise().norm().transpose();
+    for (Eigen::Index i = 0; i < scale.size(); ++i) {
+        scale(i) = scale(i) > 0.0 ? scale(i) : 1.0;  // a zero column stays zero: its singular value is 0
+    }
+    design = design * scale.cwiseInverse().asDiagonal();
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(design, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    f.singular_values.assign(sv.data(), sv.data() + sv.size());
+    const Eigen::Index rank = f.rank;
+    f.condition = sv(rank - 1) > 0.0 ? sv(0) / sv(rank - 1) : std::numeric_limits<double>::infinity();
+    if (!(f.condition <= max_condition)) {
+        f.refused = why_ill_conditioned(f, svd, list, per_axis, max_condition);
+        return f;
+    }
+    // Least squares on the observable directions only (truncated SVD).
+    const Eigen::VectorXd c_scaled =
+        svd.matrixV().leftCols(rank) * (svd.matrixU().leftCols(rank).transpose() * target).cwiseQuotient(sv.head(rank));
+    const Eigen::VectorXd b = scale.cwiseInverse().asDiagonal() * c_scaled;  // centred coefficients
+
+    // Residuals, with each orbit's common rotation removed (as in the fit).
+    const Eigen::VectorXd res = target - design * c_scaled;
+    residual_rms(res, target, list, rows, n, f);
+    uncentre(b, list, per_axis, terms, f);
+    apply_gauge(orbits, n_ref, list, rows, f.model);
     return f;
 }
 
@@ -331,6 +398,23 @@ std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs
     return out;
 }
 
+namespace {
+
+// A model's held-out IBA RMS, mean over the pairs; NaN when a pair has no
+// held-out epoch.
+double mean_held_out_rms(const ModelScore& m, const PairList& pairs) {
+    double sum = 0.0;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        if (m.out[p].n == 0) {
+            return std::numeric_limits<double>::quiet_NaN();
+        }
+        sum += m.out[p].rms;
+    }
+    return sum / static_cast<double>(pairs.count);
+}
+
+}  // namespace
+
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
                        const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
                        double max_condition, double min_range_c) {
@@ -359,16 +443,6 @@ Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vecto
     }
     const ModelScore& lin = s.models[0];
     const ModelScore& quad = s.models[1];
-    const auto mean_out = [&s](const ModelScore& m) {
-        double sum = 0.0;
-        for (std::size_t p = 0; p < s.pairs.count; ++p) {
-            if (m.out[p].n == 0) {
-                return std::numeric_limits<double>::quiet_NaN();
-            }
-            sum += m.out[p].rms;
-        }
-        return sum / static_cast<double>(s.pairs.count);
-    };
     if (!lin.fit.refused.empty()) {
         s.verdict = "no selection: the linear model is not supported either (" + lin.fit.refused + ")";
     } else if (holdout <= 0.0) {
@@ -378,8 +452,8 @@ Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vecto
         s.preferred = Terms::kLinear;
         s.verdict = "linear: the data do not support quadratic terms (" + quad.fit.refused + ")";
     } else {
-        const double l = mean_out(lin);
-        const double q = mean_out(quad);
+        const double l = mean_held_out_rms(lin, s.pairs);
+        const double q = mean_held_out_rms(quad, s.pairs);
         if (!(l > 0.0 && q > 0.0)) {
             s.verdict = "no selection: a pair has no held-out epoch";
         } else {

@@ -197,6 +197,157 @@ void check_window(const PlotOptions& opt) {
     }
 }
 
+// A pair without clean epochs gets an empty panel that says why
+// (compute_stats has logged it); with none at all there is nothing to plot.
+void refuse_nothing_to_plot(const PlotOptions& opt, const StatsResult& st, bool window, std::ostream& log) {
+    const PairList& pairs = st.pairs;  // a panel per pair of the file's heads
+    std::string why_nothing;
+    bool any_epoch = false;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + pairs.pair[p].name +
+                       (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
+        any_epoch = any_epoch || st.n[p] != 0;
+    }
+    if (!any_epoch) {
+        throw std::runtime_error(text::input_name(opt.in) + ": nothing to plot:\n" + why_nothing);
+    }
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        if (st.n[p] == 0) {
+            log << text::input_name(opt.in) << ": pair " << pairs.pair[p].name
+                << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
+        }
+    }
+}
+
+// Each pair's series about its means into pair<p>.dat (smoothed in a window,
+// binned otherwise); t_lo and t_hi widened to the series' times.
+void write_pair_data(const StatsResult& st, TempDir& dir, bool window, double& t_lo, double& t_hi) {
+    for (std::size_t p = 0; p < st.pairs.count; ++p) {
+        const PairSeries& s = st.series[p];
+        if (s.t.empty()) {
+            continue;
+        }
+        t_lo = std::min(t_lo, s.t.front());
+        t_hi = std::max(t_hi, s.t.back());
+        double mean[kStages] = {};
+        for (std::size_t k = 0; k < kStages; ++k) {
+            for (double v : s.iba[k]) {
+                mean[k] += v;
+            }
+            mean[k] /= static_cast<double>(s.t.size());
+        }
+        std::ofstream f(dir.file(("pair" + std::to_string(p) + ".dat")));
+        if (window) {
+            write_smoothed(f, s, mean);
+        } else {
+            write_binned(f, s, mean);
+        }
+        if (!f) {
+            throw std::runtime_error("cannot write plot data in " + dir.path().string());
+        }
+    }
+}
+
+// What the IBA plot's gnuplot script draws.
+struct IbaScript {
+    const PlotOptions& opt;
+    const StatsResult& st;
+    TempDir& dir;
+    const std::filesystem::path& png;
+    const std::filesystem::path& temps;
+    bool window;
+    std::size_t rows;
+    double t_lo;
+    double t_hi;
+};
+
+void write_script_head(std::ostream& g, const IbaScript& s, const char* terminal) {
+    const PlotOptions& opt = s.opt;
+    g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(s.rows)
+      << (opt.width < 1000 ? " font ',8'" : "") << "\n";
+    g << "set output '" << s.png.string() << "'\nset termoption noenhanced\n";
+    if (s.window) {
+        g << "set multiplot layout " << s.rows << ",1 title 'Inter-boresight angles, " << kSmoothingWindowS
+          << " s running means (RMS of the IBA and of its running mean in the legend)'\n";
+    } else {
+        g << "set multiplot layout " << s.rows << ",1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
+          << "-minute means (RMS of the unbinned IBA in the legend)'\n";
+    }
+    g << "set xdata time\nset timefmt '%s'\nset format x \"" << (s.window ? "%m-%d\\n%H:%M" : "%Y-%m")
+      << "\"\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
+    g << "set xrange ['" << s.t_lo + kJ2000Unix << "':'" << s.t_hi + kJ2000Unix << "']\n";
+    g << "set lmargin 10\nset rmargin 42\n";  // the panels' time axes aligned
+    g << "set ylabel 'IBA - mean (arcsec)'\n";
+    if (opt.period_from && opt.period_to) {
+        g.precision(12);
+        g << "set object 1 rect from " << *opt.period_from + kJ2000Unix << ", graph 0 to "
+          << *opt.period_to + kJ2000Unix << ", graph 1 fc rgb '#e6e6e6' fs solid 1.0 noborder behind\n";
+        g << "set label 1 'modelling period' at " << *opt.period_from + kJ2000Unix << ", graph 0.95 offset 1,0 front\n";
+    }
+}
+
+// Pair p's panel: its stages' series, or an empty panel with the reason.
+void write_pair_panel(std::ostream& g, const IbaScript& s, std::size_t p) {
+    const StatsResult& st = s.st;
+    const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
+    if (st.n[p] == 0) {  // an empty panel with the reason in it
+        g << "set title 'pair " << st.pairs.pair[p].name << ": no clean epochs'\n";
+        g << "set label 99 '" << gnuplot_quoted(st.no_epochs_reason[p])
+          << "' at graph 0.5, graph 0.5 center\nset yrange [-1:1]\nplot 2 notitle\n";
+        g << "unset label 99\nset autoscale y\n";
+        return;
+    }
+    g << "set title 'pair " << st.pairs.pair[p].name << " (" << st.n[p] << " clean epochs)'\n";
+    g << "plot ";
+    for (std::size_t k = 0; k < kStages; ++k) {
+        if (k == 2 && !st.thermal) {
+            break;
+        }
+        char t[96];
+        if (s.window) {
+            text::c_snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
+                             st.rms[p][k].rms_smoothed);
+        } else {
+            text::c_snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
+        }
+        g << (k ? ", " : "") << "'" << (s.dir.file(("pair" + std::to_string(p) + ".dat"))).string()
+          << "' using 1:" << k + 2
+          << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
+          << " lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
+    }
+    g << '\n';
+}
+
+// The two temperature panels: T_CHU of each head, the boom thermistors.
+void write_temperature_panels(std::ostream& g, const IbaScript& s) {
+    const std::string f = "'" + s.temps.string() + "'";
+    g << "set ylabel 'temperature (degC)'\n";
+    g << "set title 'T_CHU (T1) of each head'\n";
+    const HeadList heads = heads_of(s.st.heads);  // columns: t, T_CHU by head index, T029, T032
+    g << "plot ";
+    for (std::size_t i = 0; i < heads.count; ++i) {
+        g << (i ? ", " : "") << f << " using 1:" << 2 + heads.head[i] << " with lines lw 1.5 title 'T_CHU "
+          << head_name(heads.head[i]) << "'";
+    }
+    g << "\nset title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
+    g << "plot " << f << " using 1:" << 2 + kMaxHeads << " with lines lw 1.5 title 'T029', " << f
+      << " using 1:" << 3 + kMaxHeads << " with lines lw 1.5 title 'T032'\n";
+}
+
+// The gnuplot script plot.gp for `terminal`.
+void write_iba_script(const IbaScript& s, const char* terminal) {
+    std::ofstream g(s.dir.file("plot.gp"));
+    g.precision(12);
+    write_script_head(g, s, terminal);
+    for (std::size_t p = 0; p < s.st.pairs.count; ++p) {
+        write_pair_panel(g, s, p);
+    }
+    if (s.opt.temperatures) {
+        write_temperature_panels(g, s);
+    }
+    g << "unset multiplot\n";
+}
+
 }  // namespace
 
 void plot_iba(const PlotOptions& opt, std::ostream& log) {
@@ -224,54 +375,12 @@ void plot_iba(const PlotOptions& opt, OutputSet& outputs, std::ostream& log) {
         so.period_options = "--window-from/--window-to";
     }
     const StatsResult st = compute_stats(so, log);
-
-    // A pair without clean epochs gets an empty panel that says why
-    // (compute_stats has logged it); with none at all there is nothing to plot.
-    const PairList& pairs = st.pairs;  // a panel per pair of the file's heads
-    std::string why_nothing;
-    bool any_epoch = false;
-    for (std::size_t p = 0; p < pairs.count; ++p) {
-        why_nothing += std::string(p ? "\n" : "") + "no clean epoch for pair " + pairs.pair[p].name +
-                       (window ? " in the window" : "") + ": " + st.no_epochs_reason[p];
-        any_epoch = any_epoch || st.n[p] != 0;
-    }
-    if (!any_epoch) {
-        throw std::runtime_error(text::input_name(opt.in) + ": nothing to plot:\n" + why_nothing);
-    }
-    for (std::size_t p = 0; p < pairs.count; ++p) {
-        if (st.n[p] == 0) {
-            log << text::input_name(opt.in) << ": pair " << pairs.pair[p].name
-                << ": no clean epochs: " << st.no_epochs_reason[p] << '\n';
-        }
-    }
+    refuse_nothing_to_plot(opt, st, window, log);
 
     TempDir dir;
     double t_lo = std::numeric_limits<double>::infinity();
     double t_hi = -std::numeric_limits<double>::infinity();
-    for (std::size_t p = 0; p < pairs.count; ++p) {
-        const PairSeries& s = st.series[p];
-        if (s.t.empty()) {
-            continue;
-        }
-        t_lo = std::min(t_lo, s.t.front());
-        t_hi = std::max(t_hi, s.t.back());
-        double mean[kStages] = {};
-        for (std::size_t k = 0; k < kStages; ++k) {
-            for (double v : s.iba[k]) {
-                mean[k] += v;
-            }
-            mean[k] /= static_cast<double>(s.t.size());
-        }
-        std::ofstream f(dir.file(("pair" + std::to_string(p) + ".dat")));
-        if (window) {
-            write_smoothed(f, s, mean);
-        } else {
-            write_binned(f, s, mean);
-        }
-        if (!f) {
-            throw std::runtime_error("cannot write plot data in " + dir.path().string());
-        }
-    }
+    write_pair_data(st, dir, window, t_lo, t_hi);
 
     // A single epoch (or several at one time) is drawn as a point on a time
     // axis one smoothing window wide: gnuplot cannot scale an empty x range.
@@ -286,87 +395,18 @@ void plot_iba(const PlotOptions& opt, OutputSet& outputs, std::ostream& log) {
         write_temperature_series(opt.in, temps.string(), window ? kSmoothingWindowS : kPlotBinS, so.from, so.to,
                                  kJ2000Unix);
     }
-    const std::size_t rows = pairs.count + (opt.temperatures ? 2 : 0);
+    const std::size_t rows = st.pairs.count + (opt.temperatures ? 2 : 0);
 
     const std::filesystem::path png = dir.file("plot.png");
-    const auto write_script = [&](const char* terminal) {
-        std::ofstream g(dir.file("plot.gp"));
-        g.precision(12);
-        g << "set terminal " << terminal << " size " << opt.width << "," << opt.width * 2 / 7 * static_cast<int>(rows)
-          << (opt.width < 1000 ? " font ',8'" : "") << "\n";
-        g << "set output '" << png.string() << "'\nset termoption noenhanced\n";
-        if (window) {
-            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kSmoothingWindowS
-              << " s running means (RMS of the IBA and of its running mean in the legend)'\n";
-        } else {
-            g << "set multiplot layout " << rows << ",1 title 'Inter-boresight angles, " << kPlotBinS / 60.0
-              << "-minute means (RMS of the unbinned IBA in the legend)'\n";
-        }
-        g << "set xdata time\nset timefmt '%s'\nset format x \"" << (window ? "%m-%d\\n%H:%M" : "%Y-%m")
-          << "\"\nset grid\nset key outside right top\nset datafile missing 'NaN'\n";
-        g << "set xrange ['" << t_lo + kJ2000Unix << "':'" << t_hi + kJ2000Unix << "']\n";
-        g << "set lmargin 10\nset rmargin 42\n";  // the panels' time axes aligned
-        g << "set ylabel 'IBA - mean (arcsec)'\n";
-        if (opt.period_from && opt.period_to) {
-            g.precision(12);
-            g << "set object 1 rect from " << *opt.period_from + kJ2000Unix << ", graph 0 to "
-              << *opt.period_to + kJ2000Unix << ", graph 1 fc rgb '#e6e6e6' fs solid 1.0 noborder behind\n";
-            g << "set label 1 'modelling period' at " << *opt.period_from + kJ2000Unix
-              << ", graph 0.95 offset 1,0 front\n";
-        }
-        const char* colours[kStages] = {"#1f77b4", "#d62728", "#2ca02c"};
-        for (std::size_t p = 0; p < pairs.count; ++p) {
-            if (st.n[p] == 0) {  // an empty panel with the reason in it
-                g << "set title 'pair " << pairs.pair[p].name << ": no clean epochs'\n";
-                g << "set label 99 '" << gnuplot_quoted(st.no_epochs_reason[p])
-                  << "' at graph 0.5, graph 0.5 center\nset yrange [-1:1]\nplot 2 notitle\n";
-                g << "unset label 99\nset autoscale y\n";
-                continue;
-            }
-            g << "set title 'pair " << pairs.pair[p].name << " (" << st.n[p] << " clean epochs)'\n";
-            g << "plot ";
-            for (std::size_t k = 0; k < kStages; ++k) {
-                if (k == 2 && !st.thermal) {
-                    break;
-                }
-                char t[96];
-                if (window) {
-                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\" (200 s: %.2f\")", kStageNames[k], st.rms[p][k].rms,
-                                     st.rms[p][k].rms_smoothed);
-                } else {
-                    text::c_snprintf(t, sizeof t, "%s, RMS %.2f\"", kStageNames[k], st.rms[p][k].rms);
-                }
-                g << (k ? ", " : "") << "'" << (dir.file(("pair" + std::to_string(p) + ".dat"))).string()
-                  << "' using 1:" << k + 2
-                  << (st.series[p].t.front() < st.series[p].t.back() ? " with lines" : " with points pt 7")
-                  << " lw 1.5 lc rgb '" << colours[k] << "' title '" << t << "'";
-            }
-            g << '\n';
-        }
-        if (opt.temperatures) {
-            const std::string f = "'" + temps.string() + "'";
-            g << "set ylabel 'temperature (degC)'\n";
-            g << "set title 'T_CHU (T1) of each head'\n";
-            const HeadList heads = heads_of(st.heads);  // columns: t, T_CHU by head index, T029, T032
-            g << "plot ";
-            for (std::size_t i = 0; i < heads.count; ++i) {
-                g << (i ? ", " : "") << f << " using 1:" << 2 + heads.head[i] << " with lines lw 1.5 title 'T_CHU "
-                  << head_name(heads.head[i]) << "'";
-            }
-            g << "\nset title 'boom thermistors: THT00029 (T2, OB-boom interface) and THT00032 (T3, on the OB)'\n";
-            g << "plot " << f << " using 1:" << 2 + kMaxHeads << " with lines lw 1.5 title 'T029', " << f
-              << " using 1:" << 3 + kMaxHeads << " with lines lw 1.5 title 'T032'\n";
-        }
-        g << "unset multiplot\n";
-    };
+    const IbaScript script{opt, st, dir, png, temps, window, rows, t_lo, t_hi};
     const std::string gp_log = (dir.file("gnuplot.log")).string();
-    write_script("pngcairo");
+    write_iba_script(script, "pngcairo");
     int rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
     if (rc == -1) {
         throw std::runtime_error("cannot run '" + opt.gnuplot + "' (Debian package gnuplot-nox)");
     }
     if (rc != 0 || !std::filesystem::exists(png)) {
-        write_script("png");  // a gnuplot built without cairo
+        write_iba_script(script, "png");  // a gnuplot built without cairo
         rc = run_gnuplot(opt.gnuplot, (dir.file("plot.gp")).string(), gp_log);
     }
     if (rc != 0 || !std::filesystem::exists(png)) {
@@ -399,6 +439,42 @@ void draw(TempDir& dir, const std::string& gnuplot, const std::filesystem::path&
     out.write(read_all(png));
 }
 
+void refuse_bad_window(const CombinedPlotOptions& opt) {
+    if (!(opt.from < opt.to)) {
+        throw std::runtime_error("the plot window is empty: --window-from " + number_text(opt.from) +
+                                 " is not before --window-to " + number_text(opt.to));
+    }
+    if (!(opt.width >= 400 && opt.width <= 4000)) {
+        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
+    }
+}
+
+// Whether a combined row is drawn: in the window, with an attitude.
+bool drawn(const CombinedPlotOptions& opt, const AttitudeRow& row) {
+    return row.t >= opt.from && row.t <= opt.to && row.has_q;
+}
+
+double max_abs(const std::array<double, 3>& e) {
+    double m = 0.0;
+    for (const double v : e) {
+        m = std::max(m, std::fabs(v));
+    }
+    return m;
+}
+
+// The truth of the window, by epoch key (a few days: a few thousand rows).
+std::map<std::int64_t, Quaternion<double>> truth_in_window(const CombinedPlotOptions& opt) {
+    std::map<std::int64_t, Quaternion<double>> truth;
+    AttitudeReader r(opt.truth);
+    AttitudeRow row;
+    while (r.next(row)) {
+        if (row.t >= opt.from && row.t <= opt.to) {
+            truth[epoch_key(row.t)] = row.q_crf_icrf;
+        }
+    }
+    return truth;
+}
+
 }  // namespace
 
 void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
@@ -409,24 +485,8 @@ void plot_combined(const CombinedPlotOptions& opt, std::ostream& log) {
 
 void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostream& log) {
     refuse_output_over_input({{"--combined", opt.combined}, {"--truth-attitude", opt.truth}}, {{"--out", opt.out}});
-    if (!(opt.from < opt.to)) {
-        throw std::runtime_error("the plot window is empty: --window-from " + number_text(opt.from) +
-                                 " is not before --window-to " + number_text(opt.to));
-    }
-    if (!(opt.width >= 400 && opt.width <= 4000)) {
-        throw std::runtime_error("--width must be in [400, 4000] pixels, got " + std::to_string(opt.width));
-    }
-    // The truth of the window, by epoch key (a few days: a few thousand rows).
-    std::map<std::int64_t, Quaternion<double>> truth;
-    {
-        AttitudeReader r(opt.truth);
-        AttitudeRow row;
-        while (r.next(row)) {
-            if (row.t >= opt.from && row.t <= opt.to) {
-                truth[epoch_key(row.t)] = row.q_crf_icrf;
-            }
-        }
-    }
+    refuse_bad_window(opt);
+    const std::map<std::int64_t, Quaternion<double>> truth = truth_in_window(opt);
     TempDir dir;
     const std::filesystem::path data = dir.file("combined.dat");
     std::ofstream f(data);
@@ -443,7 +503,7 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
     }
     AttitudeRow row;
     while (r.next(row)) {
-        if (!(row.t >= opt.from && row.t <= opt.to) || !row.has_q) {
+        if (!drawn(opt, row)) {
             continue;
         }
         const auto it = truth.find(epoch_key(row.t));
@@ -457,9 +517,7 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
         f << row.t + kJ2000Unix << ' ' << e[0] << ' ' << e[1] << ' ' << e[2] << ' ' << row.heads << '\n';
         ++sets[row.heads];
         full = head_count(row.heads) > head_count(full) ? row.heads : full;
-        for (const double v : e) {
-            y_max = std::max(y_max, std::fabs(v));
-        }
+        y_max = std::max(y_max, max_abs(e));
     }
     f.close();
     if (sets.empty()) {

@@ -101,6 +101,80 @@ std::string why_no_epochs(const HeadPair& pair, const StatsOptions& opt, std::si
            ", one of the two is never clean";
 }
 
+// The epoch's IBA of every pair of kAllPairs with both heads clean.
+template <typename Row>
+void add_epoch(const Epoch<Row>& e, const PairList& all_pairs, std::array<std::size_t, kMaxPairs>& both_present,
+               std::array<PairSeries, kMaxPairs>& series) {
+    for (std::size_t p = 0; p < all_pairs.count; ++p) {
+        const auto& a = e.head[all_pairs.pair[p].first];
+        const auto& b = e.head[all_pairs.pair[p].second];
+        both_present[p] += a && b ? 1U : 0U;
+        if (a && b && a->clean && b->clean) {
+            series[p].t.push_back(e.t);
+            for (std::size_t s = 0; s < kStages; ++s) {
+                series[p].iba[s].push_back(angle_arcsec(a->z[s], b->z[s]));
+            }
+        }
+    }
+}
+
+// The row in its head's tally (before the correction's verdict).
+void tally_row(const SolutionRecord& rec, HeadTally& tally) {
+    ++tally.rows;
+    tally.flagged += rec.flags != 0 ? 1U : 0U;
+    tally.low_confidence += !confidence_clean(rec) ? 1U : 0U;  // as is_clean
+    tally.no_temperatures +=
+        !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
+    tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
+}
+
+// The index of `pair` in `list` (which holds it).
+template <typename Pair>
+std::size_t index_of_pair(const PairList& list, const Pair& pair) {
+    std::size_t all = 0;
+    while (list.pair[all].first != pair.first || list.pair[all].second != pair.second) {
+        ++all;
+    }
+    return all;
+}
+
+// Incomplete epochs arrive last and unordered: sort by time for smoothing.
+void sort_by_time(PairSeries& s) {
+    std::vector<std::size_t> idx(s.t.size());
+    std::iota(idx.begin(), idx.end(), std::size_t{0});
+    std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return s.t[i] < s.t[j]; });
+    const auto permute = [&](std::vector<double>& v) {
+        std::vector<double> o(v.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+            o[i] = v[idx[i]];
+        }
+        v.swap(o);
+    };
+    permute(s.t);
+    for (auto& v : s.iba) {
+        permute(v);
+    }
+}
+
+// Whether the core applied the stages asked for: aberration (c1) and, with
+// a model, the thermal one (c2).
+bool corrected(StatusBits c1, StatusBits c2, bool with_model) {
+    const bool thermal_ok = !with_model || (c2 & status::kThermalApplied) != 0U;
+    return (c1 & status::kAberrationApplied) != 0U && thermal_ok;
+}
+
+// Whether t is within --from/--to.
+bool within_time_range(const StatsOptions& opt, double t) {
+    return !((opt.from && t < *opt.from) || (opt.to && t > *opt.to));
+}
+
+template <typename Name>
+void log_empty_pair(const StatsOptions& opt, const Name& name, const std::string& reason, std::ostream& log) {
+    if (opt.log_empty_pairs) {
+        log << opt.in << ": pair " << name << ": no clean epochs: " << reason << '\n';
+    }
+}
+
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
@@ -142,23 +216,11 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     std::array<HeadTally, kMaxHeads> heads{};
     std::array<std::size_t, kMaxPairs> both_present{};
     std::array<PairSeries, kMaxPairs> series;
-    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) {
-        for (std::size_t p = 0; p < kAllPairs.count; ++p) {
-            const auto& a = e.head[kAllPairs.pair[p].first];
-            const auto& b = e.head[kAllPairs.pair[p].second];
-            both_present[p] += a && b ? 1U : 0U;
-            if (a && b && a->clean && b->clean) {
-                series[p].t.push_back(e.t);
-                for (std::size_t s = 0; s < kStages; ++s) {
-                    series[p].iba[s].push_back(angle_arcsec(a->z[s], b->z[s]));
-                }
-            }
-        }
-    });
+    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, both_present, series); });
     rows([&](const SolutionRecord& rec) {
         ++rows_seen;
         with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : 0U;
-        if ((opt.from && rec.t < *opt.from) || (opt.to && rec.t > *opt.to)) {
+        if (!within_time_range(opt, rec.t)) {
             return;
         }
         ++r.rows;
@@ -166,19 +228,13 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
             return;  // not in any pair (an unknown head: left to `correct` to report)
         }
         HeadTally& tally = heads[rec.head];
-        ++tally.rows;
-        tally.flagged += rec.flags != 0 ? 1U : 0U;
-        tally.low_confidence += !confidence_clean(rec) ? 1U : 0U;  // as is_clean
-        tally.no_temperatures +=
-            !(rec.temperature_present[0] && rec.temperature_present[1] && rec.temperature_present[2]) ? 1U : 0U;
-        tally.no_velocity += rec.velocity_components != 3 ? 1U : 0U;
+        tally_row(rec, tally);
         Row row;
         row.clean = is_clean(rec);
         const SolutionInput<double> in = to_core_input<double>(rec, &earth);
         const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
         const CorrectedSolution<double> c2 = correct_solution(in, both);
-        const bool thermal_ok = !model || (c2.status & status::kThermalApplied) != 0U;
-        if (row.clean && ((c1.status & status::kAberrationApplied) == 0U || !thermal_ok)) {
+        if (row.clean && !corrected(c1.status, c2.status, model != nullptr)) {
             diag.report("not corrected", text::input_name(opt.in) + ":" + std::to_string(rec.line) +
                                              ": clean row the core did not correct (status " +
                                              std::to_string(c2.status) + "): left out of the statistics");
@@ -198,35 +254,14 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     r.heads = analysis_heads(with_rows);
     r.pairs = pairs_of(r.heads);
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
-        std::size_t all = 0;  // the pair's index in kAllPairs
-        while (kAllPairs.pair[all].first != r.pairs.pair[p].first ||
-               kAllPairs.pair[all].second != r.pairs.pair[p].second) {
-            ++all;
-        }
+        const std::size_t all = index_of_pair(kAllPairs, r.pairs.pair[p]);
         PairSeries& s = r.series[p];
         s = std::move(series[all]);
-        // Incomplete epochs arrive last and unordered: sort by time for smoothing.
-        std::vector<std::size_t> idx(s.t.size());
-        std::iota(idx.begin(), idx.end(), std::size_t{0});
-        std::sort(idx.begin(), idx.end(), [&](std::size_t i, std::size_t j) { return s.t[i] < s.t[j]; });
-        const auto permute = [&](std::vector<double>& v) {
-            std::vector<double> o(v.size());
-            for (std::size_t i = 0; i < idx.size(); ++i) {
-                o[i] = v[idx[i]];
-            }
-            v.swap(o);
-        };
-        permute(s.t);
-        for (auto& v : s.iba) {
-            permute(v);
-        }
+        sort_by_time(s);
         r.n[p] = s.t.size();
         if (r.n[p] == 0) {
             r.no_epochs_reason[p] = why_no_epochs(r.pairs.pair[p], opt, rows_seen, r.rows, heads, both_present[all]);
-            if (opt.log_empty_pairs) {
-                log << opt.in << ": pair " << r.pairs.pair[p].name << ": no clean epochs: " << r.no_epochs_reason[p]
-                    << '\n';
-            }
+            log_empty_pair(opt, r.pairs.pair[p].name, r.no_epochs_reason[p], log);
         }
         for (std::size_t st = 0; st < kStages; ++st) {
             r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);

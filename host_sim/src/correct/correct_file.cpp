@@ -176,6 +176,31 @@ void explain_service(StatusBits service, const SolutionRecord& rec, const std::s
     }
 }
 
+enum class RowRead { kRow, kSkipped, kEnd };
+
+// The next row into rec: kEnd at the end or at a malformed row (res.error
+// set), kSkipped for a malformed row under --skip-bad (counted, reported).
+RowRead read_row(SolutionsReader& reader, SolutionRecord& rec, const CorrectOptions& opt, ChunkResult& res) {
+    try {
+        return reader.next(rec) ? RowRead::kRow : RowRead::kEnd;
+    } catch (const InputError& e) {
+        if (!opt.skip_bad) {
+            res.error = e;
+            return RowRead::kEnd;
+        }
+        ++res.summary.malformed;
+        res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
+        return RowRead::kSkipped;
+    }
+}
+
+template <typename Summary>
+void count_status_bits(StatusBits st, Summary& summary) {
+    for (std::size_t b = 0; b < summary.status_bit.size(); ++b) {
+        summary.status_bit[b] += (static_cast<unsigned>(st) >> b) & 1U;
+    }
+}
+
 template <typename T>
 void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
     const CorrectOptions& opt = job.opt;
@@ -187,18 +212,8 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
     }
     SolutionRecord rec;
     res.out.reserve(body.size() + body.size() / 8);
-    for (;;) {
-        try {
-            if (!reader.next(rec)) {
-                break;
-            }
-        } catch (const InputError& e) {
-            if (!opt.skip_bad) {
-                res.error = e;
-                break;
-            }
-            ++res.summary.malformed;
-            res.diag.report("malformed", std::string(e.what()) + " (row skipped: --skip-bad)");
+    for (RowRead got = read_row(reader, rec, opt, res); got != RowRead::kEnd; got = read_row(reader, rec, opt, res)) {
+        if (got == RowRead::kSkipped) {
             continue;
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
@@ -223,9 +238,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
                                 rec.confidence, true, st});
         }
         ++res.summary.rows;
-        for (std::size_t b = 0; b < res.summary.status_bit.size(); ++b) {
-            res.summary.status_bit[b] += (static_cast<unsigned>(st) >> b) & 1U;
-        }
+        count_status_bits(st, res.summary);
     }
     res.empty_lines = reader.empty_lines();
     if (states) {
@@ -321,25 +334,103 @@ void refuse_self_calibration_options(const CorrectOptions& opt) {
     }
 }
 
+// --model read and checked for the scalar (none without --model or with
+// --no-thermal); the file kept in model_file for the self-calibration.
+template <typename T>
+std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::optional<ModelFile>& model_file) {
+    if (!opt.thermal || opt.model.empty()) {
+        return std::nullopt;
+    }
+    model_file = read_model_file(opt.model);
+    if constexpr (std::is_same_v<T, Q30>) {
+        check_fixed_point_range(*model_file, opt.model);
+    }
+    if constexpr (std::is_same_v<T, float>) {
+        check_float_range(*model_file, opt.model);
+    }
+    if (opt.self_calibrate) {
+        refuse_quadratic_initial_model(*model_file, opt.model);
+    }
+    return to_core<T>(*model_file);
+}
+
+// --states read (none without it), after --max-propagation's check.
+std::optional<StatesFile> read_states(const CorrectOptions& opt, Diagnostics& diag) {
+    if (opt.states.empty()) {
+        return std::nullopt;
+    }
+    if (!max_propagation_acceptable(opt.max_propagation_s)) {
+        throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
+    }
+    return read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag, opt.skip_bad);
+}
+
+// One chunk's results into the run's, in file order: its messages, its
+// error (thrown), its counts and its rows for the sink.
+void merge_chunk(const ChunkResult& r, Diagnostics& diag, CorrectSummary& sum, std::size_t& empty_lines,
+                 CorrectedRowSink* sink) {
+    r.diag.replay(diag);
+    if (r.error) {
+        throw *r.error;
+    }
+    sum.rows += r.summary.rows;
+    sum.malformed += r.summary.malformed;
+    sum.service_cost += r.summary.service_cost;
+    for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
+        sum.status_bit[b] += r.summary.status_bit[b];
+    }
+    empty_lines += r.empty_lines;
+    for (const CorrectedRow& row : r.rows) {
+        sink->add(row);
+    }
+}
+
+// The lines before each of a block's parts, the first's being lines_before.
+std::vector<std::size_t> lines_before_parts(const std::vector<std::string_view>& parts, std::size_t lines_before) {
+    std::vector<std::size_t> first_line(parts.size(), lines_before);
+    for (std::size_t i = 1; i < parts.size(); ++i) {
+        first_line[i] = first_line[i - 1] + count_line_ends(parts[i - 1]);
+    }
+    return first_line;
+}
+
+void count_states(const std::optional<StatesFile>& states, CorrectSummary& sum) {
+    if (states) {
+        sum.states_given = true;
+        sum.states_accepted = states->accepted.size();
+        sum.states_refused = states->refused();
+        sum.states_malformed = states->malformed;
+    }
+}
+
+// The end of the rows: the empty lines and the messages' summary; a file
+// whose every row --skip-bad dropped is refused.
+void report_rows(const CorrectOptions& opt, const CorrectSummary& sum, std::size_t empty_lines, Diagnostics& diag,
+                 std::ostream& log) {
+    if (empty_lines != 0) {
+        log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
+    }
+    diag.summarize();
+    if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
+        throw InputError(opt.in, 1, 1,
+                         "every one of the " + std::to_string(sum.malformed) +
+                             " data rows is malformed (--skip-bad dropped them all): nothing written");
+    }
+}
+
+// The write in flight, if any, finished (its error thrown here).
+void wait_for(std::future<void>& writing) {
+    if (writing.valid()) {
+        writing.get();
+    }
+}
+
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
-    std::optional<ThermalModel<T>> model;
     std::optional<ModelFile> model_file;
-    if (opt.thermal && !opt.model.empty()) {
-        model_file = read_model_file(opt.model);
-        if constexpr (std::is_same_v<T, Q30>) {
-            check_fixed_point_range(*model_file, opt.model);
-        }
-        if constexpr (std::is_same_v<T, float>) {
-            check_float_range(*model_file, opt.model);
-        }
-        if (opt.self_calibrate) {
-            refuse_quadratic_initial_model(*model_file, opt.model);
-        }
-        model = to_core<T>(*model_file);
-    }
+    std::optional<ThermalModel<T>> model = read_model<T>(opt, model_file);
     std::optional<ModelSchedule<T>> schedule;
     std::string history;
     std::string account;
@@ -367,14 +458,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     refuse_corrected_input(header);
     const RowWriter writer(header);
     Diagnostics diag(log);
-    std::optional<StatesFile> states;
-    if (!opt.states.empty()) {
-        if (!max_propagation_acceptable(opt.max_propagation_s)) {
-            throw std::runtime_error(std::string("--max-propagation ") + kMaxPropagationRule);
-        }
-        states =
-            read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag, opt.skip_bad);
-    }
+    const std::optional<StatesFile> states = read_states(opt, diag);
     const std::size_t workers = worker_count();
     std::optional<StatesVelocityTable<T>> table;
     if (states && opt.aberration) {
@@ -396,12 +480,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     if (table) {
         sum.service_cost = table->cost();
     }
-    if (states) {
-        sum.states_given = true;
-        sum.states_accepted = states->accepted.size();
-        sum.states_refused = states->refused();
-        sum.states_malformed = states->malformed;
-    }
+    count_states(states, sum);
     std::size_t empty_lines = 0;
     std::future<void> writing;  // declared after `out`: destroyed (joined) before it
     bool first = true;
@@ -414,51 +493,23 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
             first = false;
         }
         const std::vector<std::string_view> parts = split_at_lines(block, workers);
-        std::vector<std::size_t> first_line(parts.size(), lines_before);
-        for (std::size_t i = 1; i < parts.size(); ++i) {
-            first_line[i] = first_line[i - 1] + count_line_ends(parts[i - 1]);
-        }
+        const std::vector<std::size_t> first_line = lines_before_parts(parts, lines_before);
         std::vector<ChunkResult> results(parts.size());
         run_workers(parts.size(), [&](std::size_t i) { correct_chunk(job, parts[i], first_line[i], results[i]); });
         for (const ChunkResult& r : results) {  // in file order
-            r.diag.replay(diag);
-            if (r.error) {
-                throw *r.error;
-            }
-            sum.rows += r.summary.rows;
-            sum.malformed += r.summary.malformed;
-            sum.service_cost += r.summary.service_cost;
-            for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
-                sum.status_bit[b] += r.summary.status_bit[b];
-            }
-            empty_lines += r.empty_lines;
-            for (const CorrectedRow& row : r.rows) {
-                sink->add(row);
-            }
+            merge_chunk(r, diag, sum, empty_lines, sink);
         }
         // Write this block while the workers correct the next one; one block
         // in flight, its errors surface at the next block or at the end.
-        if (writing.valid()) {
-            writing.get();
-        }
+        wait_for(writing);
         writing = std::async(std::launch::async, [&out, done = std::move(results)] {
             for (const ChunkResult& r : done) {
                 out.write(r.out);
             }
         });
     } while (blocks.next(block));
-    if (writing.valid()) {
-        writing.get();
-    }
-    if (empty_lines != 0) {
-        log << opt.in << ": " << empty_lines << " empty line(s) ignored\n";
-    }
-    diag.summarize();
-    if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
-        throw InputError(opt.in, 1, 1,
-                         "every one of the " + std::to_string(sum.malformed) +
-                             " data rows is malformed (--skip-bad dropped them all): nothing written");
-    }
+    wait_for(writing);
+    report_rows(opt, sum, empty_lines, diag, log);
     if (outputs.has("--model-history")) {
         outputs["--model-history"].write(history);
     }

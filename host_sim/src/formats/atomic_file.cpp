@@ -444,56 +444,71 @@ void refuse_same_output(const NamedPath& first, const NamedPath& second) {
     }
 }
 
-void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs,
-                              bool check_stdout) {
-    struct Id {
-        const NamedPath* named;
-        dev_t dev;
-        ino_t ino;
-    };
-    std::vector<Id> in_ids;
+namespace {
+
+struct FileId {
+    const NamedPath* named;
+    dev_t dev;
+    ino_t ino;
+};
+
+// The inputs that exist as files or streams ("-": standard input) other
+// than character devices: a terminal or /dev/null holds nothing an output
+// could destroy.
+std::vector<FileId> input_ids(const std::vector<NamedPath>& inputs) {
+    std::vector<FileId> in_ids;
     for (const NamedPath& p : inputs) {
         struct stat st {};
         const bool is_stdin = p.path == "-";
         if (!p.path.empty() && (is_stdin ? ::fstat(STDIN_FILENO, &st) : ::stat(p.path.c_str(), &st)) == 0 &&
-            !S_ISCHR(st.st_mode)) {  // a terminal or /dev/null holds nothing an output could destroy
+            !S_ISCHR(st.st_mode)) {
             in_ids.push_back({&p, st.st_dev, st.st_ino});
         }
     }
-    std::vector<Id> out_ids;
+    return in_ids;
+}
+
+// Refuses the output `out` (its stat st) when it is one of the inputs or an
+// output already seen.
+void refuse_clash(const NamedPath& out, const struct stat& st, const std::vector<FileId>& in_ids,
+                  const std::vector<FileId>& out_ids) {
+    for (const FileId& in : in_ids) {
+        if (in.dev == st.st_dev && in.ino == st.st_ino) {
+            throw std::runtime_error((out.path == "-" ? std::string("standard output") : out.option + " " + out.path) +
+                                     " is the same file as the input " + in.named->option + " " + in.named->path +
+                                     ": refusing to overwrite an input (nothing was read or written)");
+        }
+    }
+    for (const FileId& o : out_ids) {
+        if (o.dev == st.st_dev && o.ino == st.st_ino) {
+            throw std::runtime_error((out.path == "-" ? std::string("standard output") : out.option + " " + out.path) +
+                                     " is also " + o.named->option + " " + o.named->path +
+                                     ": the same file or stream; two outputs need two files (nothing was written)");
+        }
+    }
+}
+
+}  // namespace
+
+void refuse_output_over_input(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs,
+                              bool check_stdout) {
+    const std::vector<FileId> in_ids = input_ids(inputs);
+    std::vector<FileId> out_ids;
     const NamedPath stdout_name{"standard output", "-"};
-    const auto check = [&](const NamedPath& out, const struct stat& st) {
-        for (const Id& in : in_ids) {
-            if (in.dev == st.st_dev && in.ino == st.st_ino) {
-                throw std::runtime_error(
-                    (out.path == "-" ? std::string("standard output") : out.option + " " + out.path) +
-                    " is the same file as the input " + in.named->option + " " + in.named->path +
-                    ": refusing to overwrite an input (nothing was read or written)");
-            }
-        }
-        for (const Id& o : out_ids) {
-            if (o.dev == st.st_dev && o.ino == st.st_ino) {
-                throw std::runtime_error(
-                    (out.path == "-" ? std::string("standard output") : out.option + " " + out.path) + " is also " +
-                    o.named->option + " " + o.named->path +
-                    ": the same file or stream; two outputs need two files (nothing was written)");
-            }
-        }
-    };
     for (const NamedPath& p : outputs) {
         struct stat st {};
         const bool is_stdout = p.path == "-";
         if (is_stdout ? ::fstat(STDOUT_FILENO, &st) != 0 : ::stat(p.path.c_str(), &st) != 0) {
             continue;  // does not exist yet: cannot be an input
         }
-        check(p, st);
+        refuse_clash(p, st, in_ids, out_ids);
         if (S_ISREG(st.st_mode)) {
             out_ids.push_back({&p, st.st_dev, st.st_ino});
         }
     }
     struct stat st {};
     if (check_stdout && ::fstat(STDOUT_FILENO, &st) == 0 && S_ISREG(st.st_mode)) {
-        check(stdout_name, st);
+        refuse_clash(stdout_name, st, in_ids, out_ids);
     }
 }
 

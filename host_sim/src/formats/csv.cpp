@@ -167,6 +167,22 @@ bool eight_digits(const char* p, std::uint64_t& value) noexcept {
     return true;
 }
 
+// The decimal digits at p appended to m; p left after them.
+inline void append_digits(const char*& p, const char* last, std::uint64_t& m) noexcept {
+    while (p != last && static_cast<unsigned>(*p - '0') < 10U) {
+        m = m * 10U + static_cast<unsigned>(*p - '0');
+        ++p;
+    }
+}
+
+// The first character at or after q that is not '0' (there is one).
+inline const char* past_zeros(const char* q) noexcept {
+    while (*q == '0') {
+        ++q;
+    }
+    return q;
+}
+
 bool parse_plain_decimal(const char* first, const char* last, double& out) noexcept {
     static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                                         1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
@@ -177,10 +193,7 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
     }
     const char* int_begin = p;
     std::uint64_t m = 0;
-    while (p != last && static_cast<unsigned>(*p - '0') < 10U) {
-        m = m * 10U + static_cast<unsigned>(*p - '0');
-        ++p;
-    }
+    append_digits(p, last, m);
     auto significant = static_cast<std::ptrdiff_t>(p - int_begin);
     const bool had_int = significant > 0 || int_begin != (negative ? first + 1 : first);
     std::ptrdiff_t decimals = 0;
@@ -192,18 +205,11 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
             m = m * 100000000U + eight;
             p += 8;
         }
-        while (p != last && static_cast<unsigned>(*p - '0') < 10U) {
-            m = m * 10U + static_cast<unsigned>(*p - '0');
-            ++p;
-        }
+        append_digits(p, last, m);
         decimals = p - frac_begin;
         if (m != 0 && significant == 0) {
             // 0.000123: the zeros after the point are not significant either.
-            const char* q = frac_begin;
-            while (*q == '0') {
-                ++q;
-            }
-            significant = p - q;
+            significant = p - past_zeros(frac_begin);
         } else {
             significant += decimals;
         }

@@ -68,24 +68,16 @@ void check_float_range(const ModelFile& m, const std::string& path) {
     }
 }
 
-ModelFile parse_model(const std::string& file_name, std::string_view text) {
-    if (text.empty()) {
-        throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");
-    }
-    LineReader lines(text);
-    std::string_view line;
-    lines.next(line);
-    const Header header(line, file_name);
-    const int col_chu = header.index("chu");
-    const int col_axis = header.index("axis");
-    int col_c[7];
-    for (std::size_t i = 0; i < 7; ++i) {
-        col_c[i] = header.index(kCoefficientNames[i]);
-    }
+namespace {
+
+void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[7], const std::string& file_name) {
     if (col_chu < 0 || col_axis < 0 || col_c[0] < 0 || col_c[1] < 0 || col_c[2] < 0 || col_c[3] < 0) {
         throw InputError(file_name, 1, 1, "the model header must have chu,axis,c0,c1,c2,c3");
     }
-    // An unknown column is a misspelt coefficient (e.g. c1_2x): never dropped silently.
+}
+
+// An unknown column is a misspelt coefficient (e.g. c1_2x): never dropped silently.
+void refuse_unknown_columns(const Header& header, const std::string& file_name) {
     std::size_t column = 1;
     for (const std::string& name : header.names()) {
         bool known = name == "chu" || name == "axis";
@@ -100,6 +92,67 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         }
         column += name.size() + 1;
     }
+}
+
+// The index of an axis name in kAxisNames, -1 when it is none.
+int axis_index(std::string_view axis_name) {
+    int axis = -1;
+    for (int a = 0; a < 3; ++a) {
+        if (axis_name == kAxisNames[a]) {
+            axis = a;
+        }
+    }
+    return axis;
+}
+
+// Coefficient i of line n (column col) into value, its 1-based column into
+// column; a field that is not a finite number is refused.
+void read_coefficient(const std::string& file_name, std::size_t n, std::size_t i, std::size_t col,
+                      const std::vector<std::string_view>& fields, const std::vector<std::size_t>& starts,
+                      double& value, std::size_t& column) {
+    const auto f = fields[col];
+    const auto x = parse_double(f);
+    if (!x || !std::isfinite(*x)) {
+        throw InputError(file_name, n, starts[col] + 1,
+                         std::string("column '") + kCoefficientNames[i] + "': " +
+                             (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
+    }
+    value = *x;
+    column = starts[col] + 1;
+}
+
+// Whether head h has its three axes' rows; some but not all is refused.
+bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_head, const std::string& file_name) {
+    const int count = int(seen[0]) + int(seen[1]) + int(seen[2]);
+    if (count != 0 && count != 3) {
+        for (int a = 0; a < 3; ++a) {
+            if (!seen[a]) {
+                throw InputError(file_name, line_of_head, 1,
+                                 std::string("head ") + head_name(h) + " has no " + kAxisNames[a] + " row");
+            }
+        }
+    }
+    return count == 3;
+}
+
+}  // namespace
+
+ModelFile parse_model(const std::string& file_name, std::string_view text) {
+    if (text.empty()) {
+        throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");
+    }
+    LineReader lines(text);
+    std::string_view line;
+    lines.next(line);
+    const Header header(line, file_name);
+    const int col_chu = header.index("chu");
+    const int col_axis = header.index("axis");
+    int col_c[7];
+    for (std::size_t i = 0; i < 7; ++i) {
+        col_c[i] = header.index(kCoefficientNames[i]);
+    }
+    refuse_missing_columns(col_chu, col_axis, col_c, file_name);
+    refuse_unknown_columns(header, file_name);
 
     ModelFile m;
     m.quadratic = col_c[4] >= 0 || col_c[5] >= 0 || col_c[6] >= 0;
@@ -127,12 +180,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
                              "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
         }
         const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
-        int axis = -1;
-        for (int a = 0; a < 3; ++a) {
-            if (axis_name == kAxisNames[a]) {
-                axis = a;
-            }
-        }
+        const int axis = axis_index(axis_name);
         if (axis < 0) {
             throw InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
                              "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
@@ -145,33 +193,15 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         line_of_head[head] = n;
         m.line[head][static_cast<std::size_t>(axis)] = n;
         for (std::size_t i = 0; i < 7; ++i) {
-            if (col_c[i] < 0) {
-                continue;
+            if (col_c[i] >= 0) {
+                read_coefficient(file_name, n, i, static_cast<std::size_t>(col_c[i]), fields, starts,
+                                 m.coefficients[head][static_cast<std::size_t>(axis)][i],
+                                 m.column[head][static_cast<std::size_t>(axis)][i]);
             }
-            const auto f = fields[static_cast<std::size_t>(col_c[i])];
-            const auto x = parse_double(f);
-            if (!x || !std::isfinite(*x)) {
-                throw InputError(
-                    file_name, n, starts[static_cast<std::size_t>(col_c[i])] + 1,
-                    std::string("column '") + kCoefficientNames[i] +
-                        "': " + (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
-            }
-            m.coefficients[head][static_cast<std::size_t>(axis)][i] = *x;
-            m.column[head][static_cast<std::size_t>(axis)][i] = starts[static_cast<std::size_t>(col_c[i])] + 1;
         }
     }
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        const int count = int(seen[h][0]) + int(seen[h][1]) + int(seen[h][2]);
-        if (count != 0 && count != 3) {
-            for (int a = 0; a < 3; ++a) {
-                if (!seen[h][a]) {
-                    throw InputError(file_name, line_of_head[h], 1,
-                                     std::string("head ") + head_name(static_cast<std::uint8_t>(h)) + " has no " +
-                                         kAxisNames[a] + " row");
-                }
-            }
-        }
-        m.present[h] = count == 3;
+        m.present[h] = head_complete(seen[h], static_cast<std::uint8_t>(h), line_of_head[h], file_name);
     }
     if (!(m.present[0] || m.present[1] || m.present[2] || m.present[3])) {
         throw InputError(file_name, lines.line_number(), 1, "the model has no rows");

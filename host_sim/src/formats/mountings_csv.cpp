@@ -141,6 +141,23 @@ void append_number(std::string& out, double x) {
     out.append(buf, static_cast<std::size_t>(r.ptr - buf));
 }
 
+// The row's head: named, known and not given by an earlier row.
+std::uint8_t head_of_row(const Row& r, const Columns& c, const MountingsFile& m) {
+    const std::string_view chu = r.field(c.chu);
+    if (chu.empty()) {
+        r.fail(c.chu, "the head is missing: chu must be " + std::string(kHeadChoices.text));
+    }
+    const std::uint8_t head = head_from_name(chu);
+    if (head == kUnknownHead) {
+        r.fail(c.chu, "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
+    }
+    if (m.line[head] != 0) {
+        r.fail(c.chu, std::string("second row for CHU ") + head_name(head) + " (the first is on line " +
+                          std::to_string(m.line[head]) + ")");
+    }
+    return head;
+}
+
 }  // namespace
 
 MountingsFile parse_mountings(const std::string& file_name, std::string_view text) {
@@ -175,18 +192,7 @@ MountingsFile parse_mountings(const std::string& file_name, std::string_view tex
                 "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
         }
         const Row r{file_name, n, fields, starts};
-        const std::string_view chu = r.field(c.chu);
-        if (chu.empty()) {
-            r.fail(c.chu, "the head is missing: chu must be " + std::string(kHeadChoices.text));
-        }
-        const std::uint8_t head = head_from_name(chu);
-        if (head == kUnknownHead) {
-            r.fail(c.chu, "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
-        }
-        if (m.line[head] != 0) {
-            r.fail(c.chu, std::string("second row for CHU ") + head_name(head) + " (the first is on line " +
-                              std::to_string(m.line[head]) + ")");
-        }
+        const std::uint8_t head = head_of_row(r, c, m);
         combine::HeadMounting& h = m.mountings.head[head];
         h.q_chu_crf = quaternion_of(r, c, head_name(head));
         const bool sigmas = row_has_sigmas(r, c);

@@ -325,6 +325,299 @@ private:
     std::string text_;
 };
 
+// --model read and checked for the target's scalar (refused before the
+// target sees it, as by `correct`); none without --model.
+template <typename T>
+std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
+    if (opt.model.empty()) {
+        return std::nullopt;
+    }
+    ModelFile mf = read_model_file(opt.model);
+    if constexpr (std::is_same_v<T, Q30>) {
+        check_fixed_point_range(mf, opt.model);
+    }
+    if constexpr (std::is_same_v<T, float>) {
+        check_float_range(mf, opt.model);
+    }
+    if (opt.self_calibrate) {
+        refuse_quadratic_initial_model(mf, opt.model);
+    }
+    return mf;
+}
+
+std::optional<StatesFile> read_replay_states(const ReplayOptions& opt, std::ostream& log) {
+    if (opt.states.empty()) {
+        return std::nullopt;
+    }
+    Diagnostics diag(log);
+    std::optional<StatesFile> states =
+        read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    diag.summarize();
+    return states;
+}
+
+// The host's side of a replay: the target's pipeline on the host, with
+// --self-calibrate the host's run of the estimator over the file.
+template <typename T>
+struct HostSide {
+    std::optional<SelfCalibration> sc;
+    std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
+    std::optional<calib::Estimator<T>> estimator;
+    pipeline::EpochPipeline<T> pipeline;
+    std::vector<ActiveModel> target_history;
+};
+
+// --self-calibrate: the host's run of the estimator over the file, and the
+// target's started alike; otherwise the model uploaded and used on both.
+template <typename T>
+void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& rows, const std::optional<ModelFile>& mf,
+                const ThermalModel<T>& model_t, LinkClient<T>& client, HostSide<T>& host, ReplaySummary& sum) {
+    if (!opt.self_calibrate) {
+        client.upload_model(model_t);
+        host.pipeline.use_model(&model_t);
+        return;
+    }
+    calib::EstimatorConfig ecfg;
+    ecfg.time_constant_days = opt.time_constant_days;
+    host.sc = self_calibrate<T>(
+        opt.in,
+        [&](const std::function<void(const SolutionRecord&)>& fn) {
+            for (const SolutionRecord& r : rows) {
+                fn(r);
+            }
+        },
+        mf, ecfg, opt.orbit_period_s);
+    host.schedule_d.emplace(host.sc->history);
+    std::optional<ModelCoefficients> initial;
+    if (mf) {
+        initial = coefficients_of(*mf);
+    }
+    const std::int64_t period_us = std::llround(host.sc->orbit_period_s * 1e6);
+    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr);
+    calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
+    host_cfg.orbit_period_us = period_us;
+    host_cfg.time_constant_days = opt.time_constant_days;
+    host.estimator.emplace(host_cfg, initial ? &*initial : nullptr);
+    host.pipeline.use_estimator(&*host.estimator);
+    sum.self_calibrate = true;
+}
+
+// Time order is the on-board clock's (TT µs; rows within one microsecond
+// in file order, as the target and the host's self-calibration take
+// them); rows whose t the clock cannot hold come last.
+std::vector<std::size_t> time_order(const std::vector<SolutionRecord>& rows) {
+    const auto key = [&](std::size_t i) {
+        TtTime tt{};
+        return tt_from_seconds(rows[i].t, tt) ? tt.us : std::numeric_limits<std::int64_t>::max();
+    };
+    std::vector<std::size_t> order(rows.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+    return order;
+}
+
+struct WrittenRow {
+    std::optional<Quaternion<double>> q;  // none: rejected, the input text unchanged
+    StatusBits status;
+};
+
+// One row through the target and the host: the target's velocity service
+// fed the states up to the row's time (mirrored in its scalar and in
+// double), the row corrected by the target, by the host's pipeline and, in
+// double, by the reference, and the three compared.
+template <typename T>
+class RowReplay {
+public:
+    RowReplay(const ReplayOptions& opt, LinkClient<T>& client, const std::optional<StatesFile>& states,
+              const VelocityServiceConfig& service, HostSide<T>& host, const ThermalModel<double>& model_d,
+              EpochCombination<T>* combination, ReplaySummary& sum, std::chrono::steady_clock::time_point start,
+              std::ostream& log)
+        : opt_(opt),
+          client_(client),
+          states_(states),
+          mirror_(service),
+          mirror_d_(service),
+          host_(host),
+          model_d_(model_d),
+          combination_(combination),
+          sum_(sum),
+          start_(start),
+          log_(log) {}
+
+    WrittenRow operator()(const SolutionRecord& rec) {
+        pace(rec.t);
+        SolutionInput<T> in = to_core_input<T>(rec, &earth_);
+        SolutionInput<double> in_d = to_core_input<double>(rec, &earth_);
+        TtTime t{};
+        const bool timed = tt_from_seconds(rec.t, t);
+        const bool wants_states = states_ && rec.velocity_components == 0;
+        const bool from_states = wants_states && timed;
+        // A time the on-board clock cannot hold (|t| > 1e11 s): the states
+        // cannot give a velocity, 4|32 as in `ascorr correct --states`.
+        const bool time_unusable = wants_states && !from_states;
+        StatusBits service_status = 0U;
+        StatusBits service_status_d = 0U;
+        if (from_states) {
+            velocity_from_states(t, in, in_d, service_status, service_status_d);
+        } else {
+            client_.set_velocity(in.velocity);
+        }
+        client_.set_temperatures(in.head, in.temperatures);
+        ++sum_.frames;
+        const std::uint8_t calib_use = calib_use_of(rec, timed);
+        if (combination_ != nullptr) {
+            combination_->before(rec.t);
+        }
+        const link::SolutionOut<T> got = client_.correct(id_, in.head, in.q_chu_icrf, timed ? t : TtTime{0},
+                                                         from_states, from_states && in.velocity.valid, calib_use);
+        ++sum_.returned;
+        // The host's answer: the target's pipeline on the host, fed alike.
+        const pipeline::VelocityAnswer<T> velocity{in.velocity, service_status, from_states};
+        const CorrectedSolution<T> host = host_solution(rec, in, velocity, timed ? t.us : 0, timed, calib_use, got);
+        // The reference: the same rows and models in double.
+        const pipeline::VelocityAnswer<double> velocity_d{in_d.velocity, service_status_d, from_states};
+        const CorrectedSolution<double> ref = pipeline::correct_stage(
+            in_d, velocity_d,
+            CorrectionConfig<double>{true, host_.schedule_d ? &host_.schedule_d->at(rec.t) : &model_d_});
+        if (combination_ != nullptr) {
+            combination_->after(rec.t);
+        }
+        compare(rec, got, host, ref);
+        const StatusBits written = written_status(rec, got.status, time_unusable);
+        ++id_;
+        return {(got.status & status::kRejected) != 0U ? std::nullopt : std::optional(widen(got.q_chu_icrf)), written};
+    }
+
+    double instructions() const noexcept { return instructions_; }
+    std::size_t costed() const noexcept { return costed_; }
+
+private:
+    static constexpr int kMaxVelocityMessages = 20;  // as the diagnostics of `ascorr correct`
+
+    // --realtime: the rows at the pace of their times.
+    void pace(double t) {
+        if (!opt_.realtime) {
+            return;
+        }
+        if (id_ == 0) {
+            t0_ = t;
+        }
+        std::this_thread::sleep_until(start_ + std::chrono::duration<double>(t - t0_));
+    }
+
+    void velocity_from_states(const TtTime& t, SolutionInput<T>& in, SolutionInput<double>& in_d, StatusBits& status,
+                              StatusBits& status_d) {
+        const auto& a = states_->accepted;
+        for (; next_state_ < a.size() && a[next_state_].t <= t; ++next_state_) {  // the bus's time order
+            const StateRecord& s = a[next_state_];
+            const StateFrame frame = states_->frame;
+            client_.send_state({s.t, static_cast<std::uint8_t>(frame == StateFrame::kGcrs ? 1U : 0U), s.r_km, s.v_kms},
+                               true);
+            mirror_.push_state(s.t, s.r_km, s.v_kms, frame);
+            mirror_d_.push_state(s.t, s.r_km, s.v_kms, frame);
+        }
+        mirror_.advance(t, OnBoardEarth{});
+        mirror_d_.advance(t, OnBoardEarth{});
+        const ServiceVelocity<T> v = mirror_.velocity_at(t);
+        const ServiceVelocity<double> vd = mirror_d_.velocity_at(t);
+        in.velocity = v.velocity;
+        in_d.velocity = vd.velocity;
+        status = v.status;
+        status_d = vd.status;
+    }
+
+    std::uint8_t calib_use_of(const SolutionRecord& rec, bool timed) const {
+        std::uint8_t calib_use = 0U;
+        if (opt_.self_calibrate) {
+            calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
+        } else if (combination_ != nullptr) {
+            calib_use = calibration_clean(rec) ? link::kCalibClean : 0U;  // the combination's selection
+        }
+        return calib_use;
+    }
+
+    CorrectedSolution<T> host_solution(const SolutionRecord& rec, const SolutionInput<T>& in,
+                                       const pipeline::VelocityAnswer<T>& velocity, std::int64_t t_us, bool timed,
+                                       std::uint8_t calib_use, const link::SolutionOut<T>& got) {
+        const auto answer = [&velocity] { return velocity; };
+        pipeline::EpochPipeline<T>& p = host_.pipeline;
+        CorrectedSolution<T> host{};
+        std::optional<std::uint32_t> host_version;
+        if (p.calibrating() && !timed) {
+            host = p.untimed_solution(in, answer);
+        } else {
+            (void)p.begin(t_us);
+            host = p.solution(in, answer, (calib_use & link::kCalibClean) != 0U);
+            if (p.calibrating() && p.model() != nullptr) {
+                host_version = p.version();
+            }
+        }
+        if (opt_.self_calibrate) {
+            check_model_version(client_, opt_.in, rec, got.model_version, host_version, sum_, host_.target_history,
+                                log_, *host_.sc);
+        }
+        return host;
+    }
+
+    void compare(const SolutionRecord& rec, const link::SolutionOut<T>& got, const CorrectedSolution<T>& host,
+                 const CorrectedSolution<double>& ref) {
+        const bool same =
+            got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
+        if (!same) {
+            ++sum_.mismatches;
+            if (sum_.mismatches <= 20) {
+                log_ << opt_.in << ":" << rec.line << ": the target's answer differs from the host core (status "
+                     << got.status << " vs " << host.status << ")\n";
+            }
+        }
+        if ((got.status & status::kRejected) == 0U && (ref.status & status::kRejected) == 0U) {
+            sum_.max_error_arcsec =
+                std::max(sum_.max_error_arcsec, angle_arcsec(widen(got.q_chu_icrf), ref.q_chu_icrf));
+        }
+        if ((got.status & (status::kAberrationApplied | status::kThermalApplied)) ==
+            (status::kAberrationApplied | status::kThermalApplied)) {
+            instructions_ += got.instructions;
+            ++costed_;
+        }
+    }
+
+    // The bits the host adds (velocity given but unusable before the core
+    // sees it), as `ascorr correct` does.
+    StatusBits written_status(const SolutionRecord& rec, StatusBits got, bool time_unusable) {
+        StatusBits written = host_status(rec, true, got);
+        if (time_unusable && (written & status::kNoVelocity) != 0U) {
+            written = static_cast<StatusBits>(written | status::kVelocityInvalid);
+        }
+        if (written != got && velocity_messages_ < kMaxVelocityMessages) {
+            ++velocity_messages_;
+            log_ << opt_.in << ":" << rec.line << ": "
+                 << (time_unusable ? "t is outside the on-board clock's range: no velocity from the states"
+                                   : velocity_problem(rec))
+                 << ": aberration skipped\n";
+        }
+        return written;
+    }
+
+    const ReplayOptions& opt_;
+    LinkClient<T>& client_;
+    const std::optional<StatesFile>& states_;
+    VelocityService<T> mirror_;  // the target's velocity service, in its scalar
+    VelocityService<double> mirror_d_;
+    std::size_t next_state_ = 0;
+    HostSide<T>& host_;
+    const ThermalModel<double>& model_d_;
+    EpochCombination<T>* combination_;
+    ReplaySummary& sum_;
+    std::chrono::steady_clock::time_point start_;
+    std::ostream& log_;
+    EarthVelocity earth_;
+    double t0_ = 0.0;
+    std::uint32_t id_ = 0;
+    double instructions_ = 0.0;
+    std::size_t costed_ = 0;
+    int velocity_messages_ = 0;
+};
+
 template <typename T>
 ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, std::ostream& log) {
     const std::string text = read_text_file(opt.in);
@@ -332,19 +625,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     refuse_corrected_input(reader);
     // The thermal model: --model's, or with --self-calibrate the estimator's
     // (--model, if given, is its version 0).
-    std::optional<ModelFile> mf;
-    if (!opt.model.empty()) {
-        mf = read_model_file(opt.model);
-        if constexpr (std::is_same_v<T, Q30>) {
-            check_fixed_point_range(*mf, opt.model);  // refused before the target sees it, as by `correct`
-        }
-        if constexpr (std::is_same_v<T, float>) {
-            check_float_range(*mf, opt.model);
-        }
-    }
-    if (opt.self_calibrate && mf) {
-        refuse_quadratic_initial_model(*mf, opt.model);
-    }
+    const std::optional<ModelFile> mf = read_replay_model<T>(opt);
     const ThermalModel<T> model_t = mf ? to_core<T>(*mf) : ThermalModel<T>{};
     const ThermalModel<double> model_d = mf ? to_core<double>(*mf) : ThermalModel<double>{};
 
@@ -358,35 +639,20 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     const link::Hello hello = client.connect();
     log << "ascorr replay: target " << opt.target << " (boot id " << hello.boot_id << ", scalar kind "
         << static_cast<int>(hello.scalar_kind) << ")\n";
-    std::optional<StatesFile> states;
-    if (!opt.states.empty()) {
-        Diagnostics diag(log);
-        states = read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
-        diag.summarize();
-    }
+    const std::optional<StatesFile> states = read_replay_states(opt, log);
     // The target's velocity service, mirrored in its scalar and in double.
     const VelocityServiceConfig service =
         opt.max_propagation_s ? service_config(*opt.max_propagation_s) : default_velocity_service_config();
     if (opt.max_propagation_s) {
         client.set_service_horizon(service.horizon_us);
     }
-    VelocityService<T> mirror(service);
-    VelocityService<double> mirror_d(service);
-    std::size_t next_state = 0;
 
     const RowWriter writer(reader);
     AtomicFile& out = outputs["--out"];
     out.write(writer.header_line());
     std::string buf;
-    EarthVelocity earth;
     SolutionRecord record;
-    double instructions = 0.0;
-    std::size_t costed = 0;
     const auto start = std::chrono::steady_clock::now();
-    double t0 = 0.0;
-    std::uint32_t id = 0;
-    constexpr int kMaxVelocityMessages = 20;  // as the diagnostics of `ascorr correct`
-    int velocity_messages = 0;
     // The rows go to the target in time order, as a DPU takes them (its
     // velocity service is causal: a row earlier than a state it already has
     // would get none), so that any row order gives `ascorr correct`'s answers;
@@ -395,175 +661,20 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     while (reader.next(record)) {
         rows.push_back(record);
     }
-    // --self-calibrate: the host's run of the estimator over the file, and
-    // the target's started alike.
     ReplaySummary sum;
-    std::optional<SelfCalibration> host_sc;
-    std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
-    std::optional<calib::Estimator<T>> host_estimator;
-    pipeline::EpochPipeline<T> host_pipeline;
-    std::vector<ActiveModel> target_history;
-    if (opt.self_calibrate) {
-        calib::EstimatorConfig ecfg;
-        ecfg.time_constant_days = opt.time_constant_days;
-        host_sc = self_calibrate<T>(
-            opt.in,
-            [&](const std::function<void(const SolutionRecord&)>& fn) {
-                for (const SolutionRecord& r : rows) {
-                    fn(r);
-                }
-            },
-            mf, ecfg, opt.orbit_period_s);
-        schedule_d.emplace(host_sc->history);
-        std::optional<ModelCoefficients> initial;
-        if (mf) {
-            initial = coefficients_of(*mf);
-        }
-        const std::int64_t period_us = std::llround(host_sc->orbit_period_s * 1e6);
-        client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr);
-        calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
-        host_cfg.orbit_period_us = period_us;
-        host_cfg.time_constant_days = opt.time_constant_days;
-        host_estimator.emplace(host_cfg, initial ? &*initial : nullptr);
-        host_pipeline.use_estimator(&*host_estimator);
-        sum.self_calibrate = true;
-    } else {
-        client.upload_model(model_t);
-        host_pipeline.use_model(&model_t);
-    }
+    HostSide<T> host;
+    start_host(opt, rows, mf, model_t, client, host, sum);
     std::optional<EpochCombination<T>> combination;
     if (!opt.combined.empty()) {
         const MountingsFile m = read_mountings_file(opt.mountings);
         refuse_unusable_mountings(m, opt.mountings);
-        combination.emplace(m, client, host_pipeline, opt.in, log);
+        combination.emplace(m, client, host.pipeline, opt.in, log);
     }
-    // Time order is the on-board clock's (TT µs; rows within one microsecond
-    // in file order, as the target and the host's self-calibration take
-    // them); rows whose t the clock cannot hold come last.
-    const auto key = [&](std::size_t i) {
-        TtTime tt{};
-        return tt_from_seconds(rows[i].t, tt) ? tt.us : std::numeric_limits<std::int64_t>::max();
-    };
-    std::vector<std::size_t> order(rows.size());
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
-    struct Written {
-        std::optional<Quaternion<double>> q;  // none: rejected, the input text unchanged
-        StatusBits status;
-    };
-    std::vector<Written> written_rows(rows.size());
-    for (const std::size_t k : order) {
-        const SolutionRecord& rec = rows[k];
-        if (opt.realtime) {
-            if (id == 0) {
-                t0 = rec.t;
-            }
-            std::this_thread::sleep_until(start + std::chrono::duration<double>(rec.t - t0));
-        }
-        SolutionInput<T> in = to_core_input<T>(rec, &earth);
-        SolutionInput<double> in_d = to_core_input<double>(rec, &earth);
-        TtTime t{};
-        const bool timed = tt_from_seconds(rec.t, t);
-        const bool wants_states = states && rec.velocity_components == 0;
-        const bool from_states = wants_states && timed;
-        // A time the on-board clock cannot hold (|t| > 1e11 s): the states
-        // cannot give a velocity, 4|32 as in `ascorr correct --states`.
-        const bool time_unusable = wants_states && !from_states;
-        StatusBits service_status = 0U;
-        StatusBits service_status_d = 0U;
-        if (from_states) {
-            const auto& a = states->accepted;
-            for (; next_state < a.size() && a[next_state].t <= t; ++next_state) {  // the bus's time order
-                const StateRecord& s = a[next_state];
-                const StateFrame frame = states->frame;
-                client.send_state(
-                    {s.t, static_cast<std::uint8_t>(frame == StateFrame::kGcrs ? 1U : 0U), s.r_km, s.v_kms}, true);
-                mirror.push_state(s.t, s.r_km, s.v_kms, frame);
-                mirror_d.push_state(s.t, s.r_km, s.v_kms, frame);
-            }
-            mirror.advance(t, OnBoardEarth{});
-            mirror_d.advance(t, OnBoardEarth{});
-            const ServiceVelocity<T> v = mirror.velocity_at(t);
-            const ServiceVelocity<double> vd = mirror_d.velocity_at(t);
-            in.velocity = v.velocity;
-            in_d.velocity = vd.velocity;
-            service_status = v.status;
-            service_status_d = vd.status;
-        } else {
-            client.set_velocity(in.velocity);
-        }
-        client.set_temperatures(in.head, in.temperatures);
-        ++sum.frames;
-        std::uint8_t calib_use = 0U;
-        if (opt.self_calibrate) {
-            calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
-        } else if (combination) {
-            calib_use = calibration_clean(rec) ? link::kCalibClean : 0U;  // the combination's selection
-        }
-        if (combination) {
-            combination->before(rec.t);
-        }
-        const link::SolutionOut<T> got = client.correct(id, in.head, in.q_chu_icrf, timed ? t : TtTime{0}, from_states,
-                                                        from_states && in.velocity.valid, calib_use);
-        ++sum.returned;
-        // The host's answer: the target's pipeline on the host, fed alike.
-        const pipeline::VelocityAnswer<T> velocity{in.velocity, service_status, from_states};
-        const auto answer = [&velocity] { return velocity; };
-        CorrectedSolution<T> host{};
-        std::optional<std::uint32_t> host_version;
-        if (host_pipeline.calibrating() && !timed) {
-            host = host_pipeline.untimed_solution(in, answer);
-        } else {
-            (void)host_pipeline.begin(timed ? t.us : 0);
-            host = host_pipeline.solution(in, answer, (calib_use & link::kCalibClean) != 0U);
-            if (host_pipeline.calibrating() && host_pipeline.model() != nullptr) {
-                host_version = host_pipeline.version();
-            }
-        }
-        if (opt.self_calibrate) {
-            check_model_version(client, opt.in, rec, got.model_version, host_version, sum, target_history, log,
-                                *host_sc);
-        }
-        // The reference: the same rows and models in double.
-        const pipeline::VelocityAnswer<double> velocity_d{in_d.velocity, service_status_d, from_states};
-        const CorrectedSolution<double> ref = pipeline::correct_stage(
-            in_d, velocity_d, CorrectionConfig<double>{true, schedule_d ? &schedule_d->at(rec.t) : &model_d});
-        if (combination) {
-            combination->after(rec.t);
-        }
-        const bool same =
-            got.status == host.status && std::memcmp(&got.q_chu_icrf, &host.q_chu_icrf, sizeof host.q_chu_icrf) == 0;
-        if (!same) {
-            ++sum.mismatches;
-            if (sum.mismatches <= 20) {
-                log << opt.in << ":" << rec.line << ": the target's answer differs from the host core (status "
-                    << got.status << " vs " << host.status << ")\n";
-            }
-        }
-        if ((got.status & status::kRejected) == 0U && (ref.status & status::kRejected) == 0U) {
-            sum.max_error_arcsec = std::max(sum.max_error_arcsec, angle_arcsec(widen(got.q_chu_icrf), ref.q_chu_icrf));
-        }
-        if ((got.status & (status::kAberrationApplied | status::kThermalApplied)) ==
-            (status::kAberrationApplied | status::kThermalApplied)) {
-            instructions += got.instructions;
-            ++costed;
-        }
-        // The bits the host adds (velocity given but unusable before the core
-        // sees it), as `ascorr correct` does.
-        StatusBits written = host_status(rec, true, got.status);
-        if (time_unusable && (written & status::kNoVelocity) != 0U) {
-            written = static_cast<StatusBits>(written | status::kVelocityInvalid);
-        }
-        if (written != got.status && velocity_messages < kMaxVelocityMessages) {
-            ++velocity_messages;
-            log << opt.in << ":" << rec.line << ": "
-                << (time_unusable ? "t is outside the on-board clock's range: no velocity from the states"
-                                  : velocity_problem(rec))
-                << ": aberration skipped\n";
-        }
-        written_rows[k] = {(got.status & status::kRejected) != 0U ? std::nullopt : std::optional(widen(got.q_chu_icrf)),
-                           written};
-        ++id;
+    RowReplay<T> replay_row(opt, client, states, service, host, model_d, combination ? &*combination : nullptr, sum,
+                            start, log);
+    std::vector<WrittenRow> written_rows(rows.size());
+    for (const std::size_t k : time_order(rows)) {
+        written_rows[k] = replay_row(rows[k]);
     }
     SolutionsReader again(opt.in, text);
     for (std::size_t k = 0; again.next(record); ++k) {
@@ -571,9 +682,9 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     }
     out.write(buf);
     if (opt.self_calibrate) {
-        finish_self_calibration(client, sum, target_history, log, *host_sc);
+        finish_self_calibration(client, sum, host.target_history, log, *host.sc);
         if (outputs.has("--model-history")) {
-            outputs["--model-history"].write(format_model_history(target_history));
+            outputs["--model-history"].write(format_model_history(host.target_history));
         }
     }
     if (combination) {
@@ -584,7 +695,8 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     sum.crc_errors = st.naks + st.broken_answers;
     sum.retries = st.retries;
     sum.restarts = st.restarts;
-    sum.instructions_per_solution = costed == 0 ? 0.0 : instructions / static_cast<double>(costed);
+    sum.instructions_per_solution =
+        replay_row.costed() == 0 ? 0.0 : replay_row.instructions() / static_cast<double>(replay_row.costed());
     if (injector) {
         sum.injected = injector->to_target().total() + injector->to_host().total();
     }

@@ -28,6 +28,23 @@ namespace ascorr::text::csv {
 inline constexpr std::size_t kSplitOk = static_cast<std::size_t>(-1);
 
 namespace detail {
+// The end of the quoted field opening at line[start] (one past its closing
+// quote; a doubled quote is text), or npos when unterminated.
+inline std::size_t quoted_field_end(std::string_view line, std::size_t start) {
+    std::size_t i = start + 1;
+    for (;;) {
+        const std::size_t q = line.find('"', i);
+        if (q == std::string_view::npos) {
+            return q;  // unterminated (a line break inside quotes is not supported)
+        }
+        if (q + 1 < line.size() && line[q + 1] == '"') {
+            i = q + 2;  // a doubled quote
+            continue;
+        }
+        return q + 1;
+    }
+}
+
 // The quote-aware split (the line has a quote). Appends to fields (and to
 // starts, if given); returns kSplitOk or the offset of malformed quoting.
 inline std::size_t split_quoted(std::string_view line, std::vector<std::string_view>& fields,
@@ -39,18 +56,9 @@ inline std::size_t split_quoted(std::string_view line, std::vector<std::string_v
         }
         std::size_t end = start;
         if (start < line.size() && line[start] == '"') {
-            std::size_t i = start + 1;
-            for (;;) {
-                const std::size_t q = line.find('"', i);
-                if (q == std::string_view::npos) {
-                    return start;  // unterminated (a line break inside quotes is not supported)
-                }
-                if (q + 1 < line.size() && line[q + 1] == '"') {
-                    i = q + 2;  // a doubled quote
-                    continue;
-                }
-                end = q + 1;
-                break;
+            end = quoted_field_end(line, start);
+            if (end == std::string_view::npos) {
+                return start;  // unterminated
             }
             if (end < line.size() && line[end] != ',') {
                 return end;  // text after the closing quote

@@ -28,23 +28,34 @@ namespace detail {
 // nonzero digit, and it is too large exactly when k > 0 (double's range,
 // 4.9e-324 to 1.8e308, holds every magnitude with k from −322 to 308).
 // Digits only, no strtod: the C locale's decimal point plays no part.
-constexpr bool magnitude_above_one(std::string_view s) noexcept {
-    std::size_t i = s.empty() || s[0] != '-' ? 0 : 1;
-    long long k = 0;  // the decimal exponent of the first nonzero digit, before the exponent part
+constexpr bool is_digit(char c) noexcept {
+    return c >= '0' && c <= '9';
+}
+
+// The decimal exponent k of the first nonzero digit of [-]digits[.digits]
+// read from s[i]; i left at the first character after them.
+constexpr long long mantissa_exponent(std::string_view s, std::size_t& i) noexcept {
+    long long k = 0;  // saturated far beyond any digit count
     bool seen_nonzero = false;
-    for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+    for (; i < s.size() && is_digit(s[i]); ++i) {
         seen_nonzero = seen_nonzero || s[i] != '0';
         k += seen_nonzero && k < (1LL << 40) ? 1 : 0;
     }
     if (i < s.size() && s[i] == '.') {
-        for (++i; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+        for (++i; i < s.size() && is_digit(s[i]); ++i) {
             if (!seen_nonzero && s[i] == '0') {
                 k -= k > -(1LL << 40) ? 1 : 0;
             }
             seen_nonzero = seen_nonzero || s[i] != '0';
         }
     }
-    long long e = 0;  // the exponent part, saturated far beyond any digit count above
+    return k;
+}
+
+// The exponent part [(e|E)[+|-]digits] read from s[i] (0 without one),
+// saturated far beyond any digit count.
+constexpr long long exponent_part(std::string_view s, std::size_t i) noexcept {
+    long long e = 0;
     if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
         ++i;
         bool negative = false;
@@ -52,12 +63,18 @@ constexpr bool magnitude_above_one(std::string_view s) noexcept {
             negative = s[i] == '-';
             ++i;
         }
-        for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i) {
+        for (; i < s.size() && is_digit(s[i]); ++i) {
             e = e < (1LL << 50) ? e * 10 + (s[i] - '0') : e;
         }
         e = negative ? -e : e;
     }
-    return k + e > 0;
+    return e;
+}
+
+constexpr bool magnitude_above_one(std::string_view s) noexcept {
+    std::size_t i = s.empty() || s[0] != '-' ? 0 : 1;
+    const long long k = mantissa_exponent(s, i);
+    return k + exponent_part(s, i) > 0;
 }
 
 }  // namespace detail
