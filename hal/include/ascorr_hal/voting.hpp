@@ -90,8 +90,11 @@ void vote_two(const ChannelReading<T>& x, const ChannelReading<T>& y, T toleranc
 }  // namespace detail
 
 // Votes `n` (≤ kMaxVoters) readings; sets kOutvoted on disagreeing members.
+// Out of line: split into the helpers above, GCC would inline it into the
+// flight loop's temperature update (+960 B of flash on each target).
 template <typename T>
-VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance, std::uint8_t quorum) noexcept {
+[[gnu::noinline]] VotedTemperature<T> vote(ChannelReading<T>* m, std::uint8_t n, T tolerance,
+                                           std::uint8_t quorum) noexcept {
     using Math = TemperatureMath<T>;
     const T nan = Math::none();
     VotedTemperature<T> out{nan, 0U, 0U, n, 0U};
