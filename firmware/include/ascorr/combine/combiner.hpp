@@ -218,7 +218,7 @@ private:
 // E = rounded ⊗ q_chu_crf (exact, double), so every estimate of that head
 // carries E on the left, and the combination Σ_i K_{S,i} vec(E_i) (Σ K = I
 // makes the reference's own part cancel to that too). Taken out per subset
-// (start_, the sums' start): in float the rounding of a mounting (≤ 2⁻²⁵ per component) would
+// (SubsetTable::start, the sums' start): in float the rounding of a mounting (≤ 2⁻²⁵ per component) would
 // otherwise put up to 0.02″ of constant error per head set into the
 // attitude, a step at every head-set change; in Q30 (2⁻³¹) 3e-4″; zero in double.
 template <typename T>
@@ -729,3 +729,5 @@ CombinedAttitude<T> Combiner<T>::combine_general(const HeadAttitude<T>* heads, s
 }
 
 }  // namespace ascorr::combine
+
+#undef ASCORR_UNROLL_HEADS

@@ -218,9 +218,7 @@ constexpr bool near_each_other(const Quaternion<T>& a, const Quaternion<T>& b, c
 }
 
 // Σ K h over the heads of a subset, started at a constant (the subset's
-// rounding correction, combiner.hpp bias_). Each row is one chain
-// sum + k₀hx + k₁hy + k₂hz, left to right (fused multiply-adds where the
-// compiler contracts them).
+// rounding correction, combiner.hpp SubsetTable::start).
 template <typename T>
 struct Accumulator {
     Vector3<T> sum;
