@@ -20,8 +20,11 @@ inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the 
 constexpr bool learns_head(std::size_t h) noexcept {
     return h < kCalibHeads;
 }
-inline constexpr std::size_t kUnknowns = 4;  // [1, T1, T2 − T1, T3 − T1] per axis
-inline constexpr std::size_t kWindow = 32;   // recent orbits kept (gate and held-back orbits)
+// The estimator learns the linear terms of core/model_terms.hpp per axis,
+// [1, T1, T2 − T1, T3 − T1] (its design row, Estimator::feed).
+inline constexpr std::size_t kUnknowns = kLinearModelTerms;
+static_assert(kUnknowns == 4, "Estimator::feed's design row lists the linear terms of kModelTermTable");
+inline constexpr std::size_t kWindow = 32;  // recent orbits kept (gate and held-back orbits)
 
 // The orbit periods and time constants the estimator is meant for: an orbit
 // of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins
