@@ -7,7 +7,7 @@
 //           changes between solutions, never within one; nullptr: no model
 //           (status 256, no thermal stage)
 //           ... correct the cycle's solutions with m ...
-//           est.accumulate(cycle);   // only when A, B and C passed the selection
+//           est.accumulate(cycle);   // only when heads 0 … N − 1 passed the selection
 //   idle:   while (time left && est.step()) {}   // bounded work per call
 //   ground: freeze(), resume(), reset(), load_model(m), report().
 //
@@ -15,7 +15,10 @@
 // when flags 1, 2 and 4 are clear, confidence ≤ 5, its three temperatures are
 // valid, and the aberration stage was applied; its quaternion without the
 // thermal stage is what is given (feed.hpp forms it, for the flight loop, the
-// link server and the host alike). A cycle counts when A, B and C all do.
+// link server and the host alike). A cycle counts when heads 0 … N − 1 all do.
+//
+// N: the heads learnt, 3 (A, B, C: the flight loop's) to the core's kMaxHeads
+// (heads.hpp); F needs A and C, the IBAs are all N·(N − 1)/2 pairs.
 //
 // The estimate, its numerics and the per-cycle and per-orbit work: README.md
 // in this folder ("The estimator").
@@ -30,7 +33,7 @@
 //     temperatures ± angle_check_margin_c;
 //   - kNoGain: over the last window_orbits orbits, the RMS of the model's IBA
 //     residuals (orbit means; iba_residuals(): what the residual rotations do
-//     to the three IBAs, so a common rotation or a roll about a boresight
+//     to the N heads' IBAs, so a common rotation or a roll about a boresight
 //     counts for nothing) is not below (1 − adoption_margin) × the active
 //     model's. Not about their mean: within a window the orbit means'
 //     temperatures hardly move, so a wrong slope shows as an offset there.
@@ -42,8 +45,8 @@
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
 // arcsec as ModelCoefficients and converted once into the core's
 // ThermalModel<T> (model_coefficients.hpp) when prepared, in the back buffer.
-// An adopted model is learnt for A, B and C; its other heads are the active
-// model's (learns_head, estimator_types.hpp).
+// An adopted model is learnt for heads 0 … N − 1; its other heads are the
+// active model's (learns_head, estimator_types.hpp).
 //
 // No allocation, no exception, no recursion, fixed-size state, every loop
 // with a fixed bound. T: double, float or Q30 (the core's scalar).
@@ -68,9 +71,13 @@
 
 namespace ascorr::calib {
 
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 class Estimator {
+    static_assert(kCalibHeadCountOk<N>, "the estimator learns 3 to kMaxHeads heads");
+
 public:
+    static constexpr std::size_t kHeads = N;
+
     enum class Phase : std::uint8_t { kIdle, kAverages, kUpdate, kCandidate, kGate };
 
     explicit Estimator(const EstimatorConfig& cfg = EstimatorConfig{},
@@ -109,8 +116,8 @@ public:
         return has_[active_] ? &core_[active_] : nullptr;
     }
 
-    // One selected cycle (A, B and C) into the current orbit's sums.
-    void accumulate(const CalibCycle<T>& c) noexcept {
+    // One selected cycle (heads 0 … N − 1) into the current orbit's sums.
+    void accumulate(const CalibCycle<T, N>& c) noexcept {
         if (frozen_) {
             return;
         }
@@ -234,20 +241,23 @@ private:
             ++orbits_short_;
             return false;
         }
-        const OrbitMeans means = orbit_means(closed_);
-        const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);
-        const Quaternion<double> q_head_in_f[kCalibHeads] = {conjugate(q_f_in_a), q_head_f(means.d[0], q_f_in_a),
-                                                             q_head_f(means.d[1], q_f_in_a)};
+        const OrbitMeans<N> means = orbit_means(closed_);
+        const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);  // d[1]: C relative to A
+        Quaternion<double> q_head_in_f[N];
+        q_head_in_f[0] = conjugate(q_f_in_a);
+        for (std::size_t h = 1; h < N; ++h) {
+            q_head_in_f[h] = q_head_f(means.d[h - 1], q_f_in_a);
+        }
         if (!n_valid_) {
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            for (std::size_t h = 0; h < N; ++h) {
                 n_ref_[h] = q_head_in_f[h];
                 n_mat_[h] = rotation_matrix(q_head_in_f[h]);
             }
         }
-        OrbitRecord& o = record_;
+        OrbitRecord<N>& o = record_;
         o.bin = closed_.bin;
         o.held = false;
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < N; ++h) {
             const Vector3<double> e = small_angle(relative_to(q_head_in_f[h], n_ref_[h]));
             o.e[h][0] = e.x * kRadToArcsec;
             o.e[h][1] = e.y * kRadToArcsec;
@@ -257,7 +267,7 @@ private:
             o.x[h][2] = means.t[h][2] - means.t[h][0];
         }
         if (!n_valid_) {
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            for (std::size_t h = 0; h < N; ++h) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
                 }
@@ -270,13 +280,16 @@ private:
 
     // Phase 2: the innovation test, forgetting, the filter update.
     void update() noexcept {
-        OrbitRecord& o = record_;
+        OrbitRecord<N>& o = record_;
         if (has_solution_) {
-            double nu[9];
-            residual(b_, centre_, o, nu);
-            double d[3];
-            iba_residuals(n_mat_, nu, d);
-            const double ss = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            double nu[3 * N];
+            residual<N>(b_, centre_, o, nu);
+            double d[iba_pairs(N)];
+            iba_residuals<N>(n_mat_, nu, d);
+            double ss = 0.0;
+            for (const double dk : d) {
+                ss += dk * dk;
+            }
             if (ms_count_ >= 15U && ss > cfg_.outlier_gate * cfg_.outlier_gate * ms_) {
                 o.held = true;
                 ++orbits_held_;
@@ -300,7 +313,7 @@ private:
             }
             ++changes_;
             for (std::size_t i = 0; i < window_.size(); ++i) {
-                OrbitRecord& r = window_.at(i);
+                OrbitRecord<N>& r = window_.at(i);
                 if (r.held) {
                     r.held = false;
                     feed(r);
@@ -313,7 +326,7 @@ private:
         feed(window_.at(window_.size() - 1U));
     }
 
-    void feed(const OrbitRecord& o) noexcept {
+    void feed(const OrbitRecord<N>& o) noexcept {
         if (last_fed_valid_ && o.bin > last_fed_bin_) {
             const double dt_days = static_cast<double>(o.bin - last_fed_bin_) *
                                    (static_cast<double>(cfg_.orbit_period_us) * 1e-6 / 86400.0);
@@ -326,7 +339,7 @@ private:
             last_fed_bin_ = o.bin;
         }
         last_fed_valid_ = true;
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < N; ++h) {
             const double a[kUnknowns] = {1.0, o.x[h][0] - centre_[h][0], o.x[h][1] - centre_[h][1],
                                          o.x[h][2] - centre_[h][2]};
             const double y[3] = {o.e[h][0], o.e[h][1], o.e[h][2]};
@@ -342,8 +355,8 @@ private:
             return false;
         }
         condition_ = 0.0;
-        double b[kCalibHeads][kUnknowns][3];
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        double b[N][kUnknowns][3];
+        for (std::size_t h = 0; h < N; ++h) {
             const double c = srif_[h].condition();
             condition_ = c > condition_ || std::isnan(c) ? c : condition_;
             if (!srif_[h].solve(b[h])) {
@@ -354,7 +367,7 @@ private:
             refuse(Refusal::kCondition);
             return false;
         }
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < N; ++h) {
             for (std::size_t j = 0; j < kUnknowns; ++j) {
                 for (std::size_t a = 0; a < 3; ++a) {
                     b_[h][j][a] = b[h][j][a];
@@ -362,7 +375,7 @@ private:
             }
         }
         has_solution_ = true;
-        centred_to_model(b_, centre_, cand_);
+        centred_to_model<N>(b_, centre_, cand_);
         if (!within_limits(cand_, window_, cfg_.angle_check_margin_c)) {
             refuse(Refusal::kAngleLimit);
             return false;
@@ -395,7 +408,7 @@ private:
         }
         const ModelCoefficients& a = model_[active_];
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            if (learns_head(h)) {
+            if (learns_head(h, N)) {
                 continue;
             }
             m.present[h] = a.present[h];
@@ -425,26 +438,26 @@ private:
     EstimatorConfig cfg_;
     // The cycle's side.
     bool frozen_ = false;
-    OrbitCollector<T> orbit_;
+    OrbitCollector<T, N> orbit_;
     // The closed orbit being processed.
     Phase phase_ = Phase::kIdle;
-    ClosedOrbit<T> closed_{};
+    ClosedOrbit<T, N> closed_{};
     std::uint32_t typical_count_ = 0;
-    OrbitRecord record_{};
+    OrbitRecord<N> record_{};
     // The filter.
     bool n_valid_ = false;
-    Quaternion<double> n_ref_[kCalibHeads]{};
-    Matrix3 n_mat_[kCalibHeads]{};
-    double centre_[kCalibHeads][3]{};
-    SquareRootInformation<kUnknowns, 3> srif_[kCalibHeads]{};
+    Quaternion<double> n_ref_[N]{};
+    Matrix3 n_mat_[N]{};
+    double centre_[N][3]{};
+    SquareRootInformation<kUnknowns, 3> srif_[N]{};
     bool last_fed_valid_ = false;
     std::int64_t last_fed_bin_ = 0;
     bool has_solution_ = false;
-    double b_[kCalibHeads][kUnknowns][3]{};
+    double b_[N][kUnknowns][3]{};
     double ms_ = 0.0;
     std::uint32_t ms_count_ = 0;
     std::uint32_t held_run_ = 0;
-    OrbitWindow window_{};
+    OrbitWindow<N> window_{};
     // Counters and the report.
     std::uint32_t orbits_used_ = 0;
     std::uint32_t orbits_short_ = 0;

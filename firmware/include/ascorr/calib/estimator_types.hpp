@@ -8,17 +8,29 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "../core/heads.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/thermal.hpp"
 
 namespace ascorr::calib {
 
-inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the IBAs all three
-// The heads the estimator learns. A model's other heads (D) are not
+// The estimator learns heads 0 … N − 1, N from kMinCalibHeads to the core's
+// kMaxHeads (heads.hpp): F needs A and C, the IBAs all N. kCalibHeads is the
+// flight loop's N (A, B and C) and the templates' default.
+inline constexpr std::size_t kMinCalibHeads = 3;
+inline constexpr std::size_t kCalibHeads = 3;
+template <std::size_t N>
+inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads;
+// The heads an estimator of N heads learns. A model's other heads are not
 // estimated: an adopted model keeps the active model's coefficients for them
 // (Estimator::gate), so a head with a model never loses it to an adoption.
-constexpr bool learns_head(std::size_t h) noexcept {
-    return h < kCalibHeads;
+constexpr bool learns_head(std::size_t h, std::size_t n_heads) noexcept {
+    return h < n_heads;
+}
+// The inter-boresight angles of N heads: pairs (i, j), i < j, in the order
+// (0,1), (0,2), …, (0,N−1), (1,2), …
+constexpr std::size_t iba_pairs(std::size_t n_heads) noexcept {
+    return n_heads * (n_heads - 1U) / 2U;
 }
 inline constexpr std::size_t kUnknowns = 4;  // [1, T1, T2 − T1, T3 − T1] per axis
 inline constexpr std::size_t kWindow = 32;   // recent orbits kept (gate and held-back orbits)
@@ -96,12 +108,13 @@ struct EstimatorReport {
     bool frozen;
 };
 
-// One cycle's selected solutions of A, B and C at the same instant.
-template <typename T>
+// One cycle's selected solutions of heads 0 … N − 1 at the same instant.
+template <typename T, std::size_t N = kCalibHeads>
 struct CalibCycle {
-    std::int64_t t_us;                              // time of the epoch, µs
-    Quaternion<T> q_chu_icrf[kCalibHeads];          // aberration-corrected, unit
-    HeadTemperatures<T> temperatures[kCalibHeads];  // all valid
+    static_assert(kCalibHeadCountOk<N>, "the estimator learns 3 to kMaxHeads heads");
+    std::int64_t t_us;                    // time of the epoch, µs
+    Quaternion<T> q_chu_icrf[N];          // aberration-corrected, unit
+    HeadTemperatures<T> temperatures[N];  // all valid
 };
 
 }  // namespace ascorr::calib

@@ -12,7 +12,7 @@
 
 namespace ascorr::calib {
 
-// The cycle's feed to the estimator. A cycle counts when heads A, B and C all
+// The cycle's feed to the estimator. A cycle counts when heads 0 … N − 1 all
 // have the aberration stage applied and three valid temperatures (the ground
 // fit's selection; the loop's solutions carry no flags or confidence). Each
 // head's solution without its thermal stage is q_ab = q_th⁻¹ ⊗ q_corr, with
@@ -20,12 +20,12 @@ namespace ascorr::calib {
 // model and temperatures), formed as the core forms it: the increment
 // (q_th⁻¹ − 1) ⊗ q_corr from small terms, one renormalised sum
 // (quaternion.hpp). False: the cycle did not count.
-template <typename T>
-bool feed_estimator(Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
+template <typename T, std::size_t N>
+bool feed_estimator(Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
-    CalibCycle<T> c{};
+    CalibCycle<T, N> c{};
     c.t_us = t_us;
-    for (std::uint8_t h = 0; h < kCalibHeads; ++h) {
+    for (std::uint8_t h = 0; h < N; ++h) {
         const CorrectedSolution<T>& s = corrected[h];
         const HeadTemperatures<T>& tp = *temperatures[h];
         if ((s.status & status::kAberrationApplied) == 0U || (s.status & status::kRejected) != 0U ||

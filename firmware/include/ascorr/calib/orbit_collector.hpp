@@ -30,14 +30,14 @@
 namespace ascorr::calib {
 
 // An orbit handed from the cycle to the per-orbit work.
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 struct ClosedOrbit {
-    OrbitSums<T> sums{};
-    OrbitReference<T> ref{};
+    OrbitSums<T, N> sums{};
+    OrbitReference<T, N> ref{};
     std::int64_t bin = 0;  // floor(t / P)
 };
 
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 class OrbitCollector {
 public:
     // period_us > 0 (EstimatorConfig's bounds, estimator_types.hpp).
@@ -51,20 +51,21 @@ public:
 
     // Opens the orbit of cycle c (the current one must have been closed or
     // dropped) with empty sums and the references (see the top).
-    void open(const CalibCycle<T>& c) noexcept {
+    void open(const CalibCycle<T, N>& c) noexcept {
         bin_ = floor_div(c.t_us, period_us_);
         start_us_ = bin_ * period_us_;
         end_us_ = start_us_ + period_us_;
         open_ = true;
-        sums_ = OrbitSums<T>{};
+        sums_ = OrbitSums<T, N>{};
         if (next_ref_ready_) {
             ref_ = next_ref_;
             next_ref_ready_ = false;
         } else if (!ref_valid_) {
             const Quaternion<T> q_icrf_a = conjugate(c.q_chu_icrf[0]);
-            ref_.r[0] = c.q_chu_icrf[1] * q_icrf_a;
-            ref_.r[1] = c.q_chu_icrf[2] * q_icrf_a;
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            for (std::size_t k = 0; k + 1 < N; ++k) {
+                ref_.r[k] = c.q_chu_icrf[k + 1] * q_icrf_a;
+            }
+            for (std::size_t h = 0; h < N; ++h) {
                 ref_.t_ref[h][0] = c.temperatures[h].t_chu.value;
                 ref_.t_ref[h][1] = c.temperatures[h].t_029.value;
                 ref_.t_ref[h][2] = c.temperatures[h].t_032.value;
@@ -74,10 +75,10 @@ public:
     }
 
     // One cycle of the open orbit (starts_orbit(c.t_us) false).
-    void add(const CalibCycle<T>& c) noexcept { sums_.add(c.q_chu_icrf, c.temperatures, ref_); }
+    void add(const CalibCycle<T, N>& c) noexcept { sums_.add(c.q_chu_icrf, c.temperatures, ref_); }
 
     // Ends the open orbit, handing it over.
-    void close(ClosedOrbit<T>& out) noexcept {
+    void close(ClosedOrbit<T, N>& out) noexcept {
         open_ = false;
         out.sums = sums_;
         out.ref = ref_;
@@ -89,7 +90,7 @@ public:
     void drop() noexcept { open_ = false; }
 
     // The references of the next orbit opened.
-    void set_next_reference(const OrbitReference<T>& r) noexcept {
+    void set_next_reference(const OrbitReference<T, N>& r) noexcept {
         next_ref_ = r;
         next_ref_ready_ = true;
     }
@@ -105,28 +106,30 @@ private:
     std::int64_t bin_ = 0;
     std::int64_t start_us_ = 0;  // [start, end) of the open orbit
     std::int64_t end_us_ = 0;
-    OrbitSums<T> sums_{};
-    OrbitReference<T> ref_{};
+    OrbitSums<T, N> sums_{};
+    OrbitReference<T, N> ref_{};
     bool ref_valid_ = false;
-    OrbitReference<T> next_ref_{};
+    OrbitReference<T, N> next_ref_{};
     bool next_ref_ready_ = false;
 };
 
-// A closed orbit's means, in double: d_B and d_C (unit; the mean of δ_h,
-// normalised, times r_h, normalised again) and the nine mean temperatures (°C).
+// A closed orbit's means of N heads, in double: d_B, d_C, … (unit; the mean
+// of δ_h, normalised, times r_h, normalised again) and the 3·N mean
+// temperatures (°C).
+template <std::size_t N = kCalibHeads>
 struct OrbitMeans {
-    Quaternion<double> d[2];
-    double t[kCalibHeads][3];
+    Quaternion<double> d[N - 1];
+    double t[N][3];
 };
 
 // The means of o's sums over n = o.sums.count > 0 cycles (o.sums flushed);
 // why means of d_h suffice: orbit_sums.hpp, at the top.
-template <typename T>
-OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
+template <typename T, std::size_t N>
+OrbitMeans<N> orbit_means(const ClosedOrbit<T, N>& o) noexcept {
     using Tr = ScalarTraits<T>;
     const double inv = 1.0 / static_cast<double>(o.sums.count);
-    OrbitMeans m{};
-    for (std::size_t k = 0; k < 2; ++k) {
+    OrbitMeans<N> m{};
+    for (std::size_t k = 0; k + 1 < N; ++k) {
         const auto& s = o.sums.dq[k];
         const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv, s[3].value() * inv};
         const double sm = 1.0 / std::sqrt(squared_norm(mean));
@@ -137,7 +140,7 @@ OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
         const double sn = 1.0 / std::sqrt(squared_norm(dk));
         m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
     }
-    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+    for (std::size_t h = 0; h < N; ++h) {
         for (std::size_t j = 0; j < 3; ++j) {
             m.t[h][j] = Tr::to_double(o.ref.t_ref[h][j]) + o.sums.dt[h][j].value() * inv;
         }
@@ -146,15 +149,15 @@ OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
 }
 
 // The references an orbit's means give the next orbit (rounded to T).
-template <typename T>
-OrbitReference<T> reference_from(const OrbitMeans& m) noexcept {
+template <typename T, std::size_t N>
+OrbitReference<T, N> reference_from(const OrbitMeans<N>& m) noexcept {
     using Tr = ScalarTraits<T>;
-    OrbitReference<T> r{};
-    for (std::size_t k = 0; k < 2; ++k) {
+    OrbitReference<T, N> r{};
+    for (std::size_t k = 0; k + 1 < N; ++k) {
         r.r[k] = {Tr::from_double(m.d[k].w), Tr::from_double(m.d[k].x), Tr::from_double(m.d[k].y),
                   Tr::from_double(m.d[k].z)};
     }
-    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+    for (std::size_t h = 0; h < N; ++h) {
         for (std::size_t j = 0; j < 3; ++j) {
             r.t_ref[h][j] = Tr::celsius(m.t[h][j]);
         }

@@ -55,17 +55,22 @@ struct NoMeter {
 
 template <typename T>
 struct InlineCalls {
-    static const ThermalModel<T>* model_for_epoch(calib::Estimator<T>& e, std::int64_t t_us) noexcept {
+    template <std::size_t N>
+    static const ThermalModel<T>* model_for_epoch(calib::Estimator<T, N>& e, std::int64_t t_us) noexcept {
         return e.model_for_cycle(t_us);
     }
     static CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
         return correct_solution(in, cfg);
     }
-    static bool feed(calib::Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
+    template <std::size_t N>
+    static bool feed(calib::Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
                      const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
         return calib::feed_estimator(e, t_us, model, corrected, temperatures);
     }
-    static bool step(calib::Estimator<T>& e) noexcept { return e.step(); }
+    template <std::size_t N>
+    static bool step(calib::Estimator<T, N>& e) noexcept {
+        return e.step();
+    }
     static combine::CombinedAttitude<T> combine(const combine::Combiner<T>& c, const combine::HeadAttitude<T>* heads,
                                                 std::uint8_t n) noexcept {
         return c.combine(heads, n);
@@ -81,7 +86,8 @@ struct FeedSchedule {
     int steps_after_feed = static_cast<int>(calib::Estimator<double>::Phase::kGate);
 };
 
-template <typename T, typename Calls = InlineCalls<T>>
+// N: the heads the estimator learns (estimator.hpp).
+template <typename T, typename Calls = InlineCalls<T>, std::size_t N = calib::kCalibHeads>
 class EpochPipeline {
 public:
     explicit EpochPipeline(FeedSchedule schedule = {}) noexcept : schedule_(schedule) {}
@@ -95,7 +101,7 @@ public:
     }
     // ... or the estimator's active model (none yet: no head has
     // coefficients, status 256), which then learns from the epochs.
-    void use_estimator(calib::Estimator<T>* e) noexcept {
+    void use_estimator(calib::Estimator<T, N>* e) noexcept {
         estimator_ = e;
         forget();
     }
@@ -267,7 +273,7 @@ private:
     // feed when all are there, on the schedule's epochs.
     template <typename Meter>
     void keep(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
-        if (!have_epoch_ || h >= calib::kCalibHeads || kept_ == kFed || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+        if (!have_epoch_ || h >= N || kept_ == kFed || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
             return;
         }
         solutions_[h] = c;
@@ -281,7 +287,10 @@ private:
             return;
         }
         const std::uint32_t start = meter.now();
-        const HeadTemperatures<T>* t[calib::kCalibHeads] = {&temperatures_[0], &temperatures_[1], &temperatures_[2]};
+        const HeadTemperatures<T>* t[N];
+        for (std::size_t k = 0; k < N; ++k) {
+            t[k] = &temperatures_[k];
+        }
         if (Calls::feed(*estimator_, t_us_, model_, solutions_, t)) {
             ++feeds_;
         }
@@ -290,7 +299,7 @@ private:
         }
     }
 
-    static constexpr std::uint8_t kAll = (1U << calib::kCalibHeads) - 1U;
+    static constexpr std::uint8_t kAll = (1U << N) - 1U;
     static constexpr std::uint8_t kFed = 0x80U;
     // Two solutions of every head: room for a repeated head, whose second
     // solution the combiner leaves out.
@@ -298,7 +307,7 @@ private:
 
     FeedSchedule schedule_;
     const ThermalModel<T>* fixed_ = nullptr;
-    calib::Estimator<T>* estimator_ = nullptr;
+    calib::Estimator<T, N>* estimator_ = nullptr;
     bool have_epoch_ = false;
     std::int64_t t_us_ = 0;
     std::uint32_t epochs_ = 0U;  // epochs begun before the current one
@@ -306,8 +315,8 @@ private:
     const ThermalModel<T>* model_ = nullptr;
     std::uint32_t version_ = 0U;
     std::uint32_t feeds_ = 0U;
-    CorrectedSolution<T> solutions_[calib::kCalibHeads]{};
-    HeadTemperatures<T> temperatures_[calib::kCalibHeads]{};
+    CorrectedSolution<T> solutions_[N]{};
+    HeadTemperatures<T> temperatures_[N]{};
     const combine::Combiner<T>* combiner_ = nullptr;
     combine::HeadAttitude<T> combined_[kCombineSlots]{};
     std::uint8_t combined_n_ = 0U;

@@ -35,6 +35,7 @@ struct ActiveModel {
     std::uint32_t version;  // 0: the model given at start
     std::uint32_t crc;      // calib::model_crc
     ModelFile model;
+    std::size_t heads_learnt = calib::kCalibHeads;  // the estimator learns heads 0 … heads_learnt − 1
 };
 
 struct SelfCalibration {
@@ -64,7 +65,9 @@ inline constexpr std::size_t kSelfCalibrationMemoryBytes = std::size_t{64} << 20
 // (self_calibrate() below checks it too).
 void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name);
 
-// kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
+// kind: "double", "float" or "fixed" is chosen by T. The estimator learns
+// the file's heads: A, B, C, and D when a row of D passes the selection (a
+// first reading of the rows). initial: --model, linear
 // (refuse_quadratic_initial_model).
 // orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
 // the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
@@ -99,10 +102,10 @@ private:
 };
 
 // How head h of a history's model `version` came to be: "given" (version 0,
-// the model given at start), "learnt" (estimated: calib::learns_head) or
-// "kept" (a head the estimator does not learn: the active model's
-// coefficients, carried into the adopted model, Estimator::gate).
-const char* head_origin(std::uint32_t version, std::size_t h);
+// the model given at start), "learnt" (estimated: calib::learns_head, heads
+// 0 … heads_learnt − 1) or "kept" (a head the estimator does not learn: the
+// active model's coefficients, carried into the adopted model, Estimator::gate).
+const char* head_origin(std::uint32_t version, std::size_t h, std::size_t heads_learnt = calib::kCalibHeads);
 
 // The model history file (docs/contract.md): header
 // t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
