@@ -85,6 +85,7 @@ public:
         }
         out_.report = est_->report();
         out_.untimed = untimed;
+        out_.heads_learnt = N;
         return out_;
     }
 
@@ -626,15 +627,29 @@ std::string time_constant_range() {
     return "[" + number_text(calib::kMinTimeConstantDays) + ", " + number_text(calib::kMaxTimeConstantDays) + "]";
 }
 
+namespace {
+
+// "A, B and C", "A, B, C and D": the first n heads' letters.
+std::string head_letters(std::size_t n) {
+    std::string out;
+    for (std::size_t h = 0; h < n && h < kMaxHeads; ++h) {
+        out += h == 0 ? "" : (h + 1 == n ? " and " : ", ");
+        out += kHeadLetters[h];
+    }
+    return out;
+}
+
+}  // namespace
+
 std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
     const calib::EstimatorReport& r = s.report;
-    text::c_snprintf(
-        buf, sizeof buf,
-        "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
-        "%u, held back %u); %zu model(s) active in turn",
-        s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
+    text::c_snprintf(buf, sizeof buf,
+                     "self-calibration: orbit period %.1f s, %zu epochs with %s selected; orbits used %u (short "
+                     "%u, held back %u); %zu model(s) active in turn",
+                     s.orbit_period_s, s.cycles, head_letters(s.heads_learnt).c_str(), r.orbits_used, r.orbits_short,
+                     r.orbits_held, s.history.size());
     o << buf;
     if (r.has_active) {
         text::c_snprintf(

@@ -42,9 +42,10 @@ struct SelfCalibration {
     std::vector<ActiveModel> history;  // in time order
     calib::EstimatorReport report;     // at the end of the file
     double orbit_period_s = 0.0;
-    std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
-    std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
-    std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
+    std::size_t cycles = 0;                         // epochs that fed the estimator (its heads all usable)
+    std::size_t heads_learnt = calib::kCalibHeads;  // heads 0 … heads_learnt − 1 (A, B, C; D on a four-head file)
+    std::size_t untimed = 0;                        // rows whose t the on-board clock cannot hold
+    std::size_t runs = 0;  // rows out of time order: sorted runs (more than 1: merged from a temporary file)
 };
 
 // The fed rows (in time order) whose median speed gives the orbit period
