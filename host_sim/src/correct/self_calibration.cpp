@@ -503,11 +503,11 @@ SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& r
 }
 
 // The heads the estimator learns: A, B, C (kMinCalibHeads), and up to the
-// last head that has a row passing the selection (at most kMaxHeads).
-std::size_t heads_to_learn(const RowSource& rows) {
+// last head that has a row passing the selection (at most kMaxHeads and max_heads).
+std::size_t heads_to_learn(const RowSource& rows, std::size_t max_heads) {
     std::size_t n = calib::kMinCalibHeads;
-    rows([&n](const SolutionRecord& rec) {
-        if (rec.head < kMaxHeads && rec.head >= n && calibration_clean(rec)) {
+    rows([&n, max_heads](const SolutionRecord& rec) {
+        if (rec.head < kMaxHeads && rec.head < max_heads && rec.head >= n && calibration_clean(rec)) {
             n = rec.head + 1U;
         }
     });
@@ -533,20 +533,23 @@ SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& fi
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes) {
+                               std::size_t memory_budget_bytes, std::size_t max_heads) {
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
     }
-    return self_calibrate_dispatch<T>(heads_to_learn(rows), file, rows, initial, cfg, orbit_period_s,
+    return self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg, orbit_period_s,
                                       memory_budget_bytes);
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                                std::size_t);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                               std::size_t);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                             std::size_t);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {

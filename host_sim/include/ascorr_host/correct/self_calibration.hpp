@@ -68,7 +68,8 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 
 // kind: "double", "float" or "fixed" is chosen by T. The estimator learns
 // the file's heads: A, B, C, and D when a row of D passes the selection (a
-// first reading of the rows). initial: --model, linear
+// first reading of the rows), at most max_heads (replay: the link's
+// estimator, calib::kCalibHeads). initial: --model, linear
 // (refuse_quadratic_initial_model).
 // orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
 // the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
@@ -82,7 +83,8 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes);
+                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
+                               std::size_t max_heads = kMaxHeads);
 
 // The models of a history in turn, for correcting rows: at(t) is the model
 // active at t's epoch (TT µs of the on-board clock), or one with no head
