@@ -85,7 +85,6 @@ public:
         }
         out_.report = est_->report();
         out_.untimed = untimed;
-        out_.heads_learnt = N;
         return out_;
     }
 
@@ -174,7 +173,8 @@ private:
         const ThermalModel<T>* model = pipeline_.begin(t_us);
         if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
             out_.history.push_back(
-                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients()), N});
+                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients()),
+                 est_->active_learnt()});
             had_ = true;
             version_ = pipeline_.version();
         }
@@ -584,11 +584,11 @@ template class ModelSchedule<double>;
 template class ModelSchedule<float>;
 template class ModelSchedule<Q30>;
 
-const char* head_origin(std::uint32_t version, std::size_t h, std::size_t heads_learnt) {
+const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learnt) {
     if (version == 0U) {
         return "given";
     }
-    return calib::learns_head(h, heads_learnt) ? "learnt" : "kept";
+    return calib::learns_head(h, learnt) ? "learnt" : "kept";
 }
 
 std::string format_model_history(const std::vector<ActiveModel>& history) {
@@ -608,7 +608,7 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     out += buf;
                 }
                 text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
-                                 head_origin(m.version, h, m.heads_learnt));
+                                 head_origin(m.version, h, m.learnt));
                 out += buf;
             }
         }
@@ -630,29 +630,15 @@ std::string time_constant_range() {
     return "[" + number_text(calib::kMinTimeConstantDays) + ", " + number_text(calib::kMaxTimeConstantDays) + "]";
 }
 
-namespace {
-
-// "A, B and C", "A, B, C and D": the first n heads' letters.
-std::string head_letters(std::size_t n) {
-    std::string out;
-    for (std::size_t h = 0; h < n && h < kMaxHeads; ++h) {
-        out += h == 0 ? "" : (h + 1 == n ? " and " : ", ");
-        out += kHeadLetters[h];
-    }
-    return out;
-}
-
-}  // namespace
-
 std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
     const calib::EstimatorReport& r = s.report;
-    text::c_snprintf(buf, sizeof buf,
-                     "self-calibration: orbit period %.1f s, %zu epochs with %s selected; orbits used %u (short "
-                     "%u, held back %u); %zu model(s) active in turn",
-                     s.orbit_period_s, s.cycles, head_letters(s.heads_learnt).c_str(), r.orbits_used, r.orbits_short,
-                     r.orbits_held, s.history.size());
+    text::c_snprintf(
+        buf, sizeof buf,
+        "self-calibration: orbit period %.1f s, %zu epochs with A, B and C selected; orbits used %u (short "
+        "%u, held back %u); %zu model(s) active in turn",
+        s.orbit_period_s, s.cycles, r.orbits_used, r.orbits_short, r.orbits_held, s.history.size());
     o << buf;
     if (r.has_active) {
         text::c_snprintf(

@@ -116,7 +116,8 @@ public:
         return has_[active_] ? &core_[active_] : nullptr;
     }
 
-    // One selected cycle (heads 0 … N − 1) into the current orbit's sums.
+    // One counted cycle (A, B and C selected; the further heads in c.heads)
+    // into the current orbit's sums.
     void accumulate(const CalibCycle<T, N>& c) noexcept {
         if (frozen_) {
             return;
@@ -126,6 +127,14 @@ public:
             orbit_.open(c);
         }
         orbit_.add(c);
+    }
+
+    // Further head h (≥ kFrameHeads) selected at t_us after that cycle was
+    // accumulated (solutions that come one by one); false: not taken (no
+    // such cycle in the open orbit, frozen).
+    bool accumulate_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_chu_icrf,
+                         const HeadTemperatures<T>& temperatures) noexcept {
+        return !frozen_ && orbit_.add_head(h, t_us, q_chu_icrf, temperatures);
     }
 
     // Ends the current orbit now (the end of a recording; a command).
@@ -169,6 +178,11 @@ public:
             s.clear();
         }
         n_valid_ = false;
+        n_heads_ = 0;
+        for (auto& k : head_orbits_) {
+            k = 0;
+        }
+        solved_ = 0;
         orbits_used_ = 0;
         window_.clear();
         held_run_ = 0;
@@ -211,11 +225,15 @@ public:
     // The active model's version and CRC-32C (model_crc); 0 when there is none.
     std::uint32_t active_version() const noexcept { return has_[active_] ? version_[active_] : 0U; }
     std::uint32_t active_crc() const noexcept { return has_[active_] ? crc_[active_] : 0U; }
+    // The heads the active model learnt (bit h; 0: given or loaded).
+    std::uint8_t active_learnt() const noexcept { return has_[active_] ? learnt_[active_] : 0U; }
     // When the active model became active (the t of the first cycle using it).
     std::int64_t adopted_at_us() const noexcept { return adopted_at_us_; }
     const EstimatorConfig& config() const noexcept { return cfg_; }
 
 private:
+    static constexpr std::size_t kFramePairs = iba_pairs(kFrameHeads);
+
     std::size_t back() const noexcept { return active_ ^ 1U; }
 
     void close_orbit() noexcept {
@@ -241,23 +259,25 @@ private:
             ++orbits_short_;
             return false;
         }
-        const OrbitMeans<N> means = orbit_means(closed_);
+        const OrbitMeans<N> means = orbit_means(closed_, further_min_count(n));
         const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);  // d[1]: C relative to A
         Quaternion<double> q_head_in_f[N];
         q_head_in_f[0] = conjugate(q_f_in_a);
         for (std::size_t h = 1; h < N; ++h) {
-            q_head_in_f[h] = q_head_f(means.d[h - 1], q_f_in_a);
-        }
-        if (!n_valid_) {
-            for (std::size_t h = 0; h < N; ++h) {
-                n_ref_[h] = q_head_in_f[h];
-                n_mat_[h] = rotation_matrix(q_head_in_f[h]);
-            }
+            q_head_in_f[h] = means.has[h] ? q_head_f(means.d[h - 1], q_f_in_a) : Quaternion<double>{};
         }
         OrbitRecord<N>& o = record_;
         o.bin = closed_.bin;
         o.held = false;
         for (std::size_t h = 0; h < N; ++h) {
+            o.has[h] = means.has[h];
+            if (!means.has[h]) {
+                continue;
+            }
+            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
+                n_ref_[h] = q_head_in_f[h];
+                n_mat_[h] = rotation_matrix(q_head_in_f[h]);
+            }
             const Vector3<double> e = small_angle(relative_to(q_head_in_f[h], n_ref_[h]));
             o.e[h][0] = e.x * kRadToArcsec;
             o.e[h][1] = e.y * kRadToArcsec;
@@ -265,17 +285,25 @@ private:
             o.x[h][0] = means.t[h][0];
             o.x[h][1] = means.t[h][1] - means.t[h][0];
             o.x[h][2] = means.t[h][2] - means.t[h][0];
-        }
-        if (!n_valid_) {
-            for (std::size_t h = 0; h < N; ++h) {
+            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
                 }
             }
-            n_valid_ = true;
         }
-        orbit_.set_next_reference(reference_from<T>(means));  // the references of the next orbit opened
+        n_heads_ = static_cast<std::uint8_t>(n_heads_ | o.heads());
+        n_valid_ = true;
+        // the references of the next orbit opened (a head without means keeps its own)
+        orbit_.set_next_reference(reference_from<T>(means, orbit_.latest_reference()));
         return true;
+    }
+
+    // A further head's cycles for its orbit means: min_epochs_per_orbit, and
+    // min_coverage of the orbit's n counted cycles.
+    std::uint32_t further_min_count(std::uint32_t n) const noexcept {
+        const double cover = std::ceil(cfg_.min_coverage * static_cast<double>(n));
+        const std::uint32_t c = cover > 0.0 ? static_cast<std::uint32_t>(cover) : 0U;
+        return c > cfg_.min_epochs_per_orbit ? c : cfg_.min_epochs_per_orbit;
     }
 
     // Phase 2: the innovation test, forgetting, the filter update.
@@ -285,10 +313,13 @@ private:
             double nu[3 * N];
             residual<N>(b_, centre_, o, nu);
             double d[iba_pairs(N)];
-            iba_residuals<N>(n_mat_, nu, d);
+            const std::size_t pairs = iba_residuals<N>(n_mat_, nu, d, static_cast<std::uint8_t>(solved_ & o.heads()));
             double ss = 0.0;
             for (const double dk : d) {
                 ss += dk * dk;
+            }
+            if (pairs != kFramePairs) {
+                ss *= static_cast<double>(kFramePairs) / static_cast<double>(pairs);  // per the frame heads' 3 pairs
             }
             if (ms_count_ >= 15U && ss > cfg_.outlier_gate * cfg_.outlier_gate * ms_) {
                 o.held = true;
@@ -340,10 +371,14 @@ private:
         }
         last_fed_valid_ = true;
         for (std::size_t h = 0; h < N; ++h) {
+            if (!o.has[h]) {
+                continue;
+            }
             const double a[kUnknowns] = {1.0, o.x[h][0] - centre_[h][0], o.x[h][1] - centre_[h][1],
                                          o.x[h][2] - centre_[h][2]};
             const double y[3] = {o.e[h][0], o.e[h][1], o.e[h][2]};
             srif_[h].add(a, y, 1.0);
+            ++head_orbits_[h];
         }
         ++orbits_used_;
     }
@@ -356,7 +391,7 @@ private:
         }
         condition_ = 0.0;
         double b[N][kUnknowns][3];
-        for (std::size_t h = 0; h < N; ++h) {
+        for (std::size_t h = 0; h < kFrameHeads; ++h) {
             const double c = srif_[h].condition();
             condition_ = c > condition_ || std::isnan(c) ? c : condition_;
             if (!srif_[h].solve(b[h])) {
@@ -367,48 +402,70 @@ private:
             refuse(Refusal::kCondition);
             return false;
         }
+        std::uint8_t heads = kFrameMask;
+        for (std::size_t h = kFrameHeads; h < N; ++h) {
+            if (further_solved(h, b[h])) {
+                heads = static_cast<std::uint8_t>(heads | (1U << h));
+            }
+        }
         for (std::size_t h = 0; h < N; ++h) {
-            for (std::size_t j = 0; j < kUnknowns; ++j) {
+            for (std::size_t j = 0; j < kUnknowns && ((heads >> h) & 1U) != 0U; ++j) {
                 for (std::size_t a = 0; a < 3; ++a) {
                     b_[h][j][a] = b[h][j][a];
                 }
             }
         }
         has_solution_ = true;
-        centred_to_model<N>(b_, centre_, cand_);
-        if (!within_limits(cand_, window_, cfg_.angle_check_margin_c)) {
+        solved_ = heads;
+        centred_to_model<N>(b_, centre_, cand_, heads);
+        if (!within_limits(cand_, window_, cfg_.angle_check_margin_c, heads)) {
             refuse(Refusal::kAngleLimit);
             return false;
         }
         return true;
     }
 
+    // A further head joins the candidate when its filter holds min_orbits
+    // orbits, its condition is within max_condition and it solves (its
+    // condition then counts in the report's); otherwise the model keeps it.
+    bool further_solved(std::size_t h, double (&b)[kUnknowns][3]) noexcept {
+        if (head_orbits_[h] < cfg_.min_orbits) {
+            return false;
+        }
+        const double c = srif_[h].condition();
+        if (!(c <= cfg_.max_condition) || !srif_[h].solve(b)) {
+            return false;
+        }
+        condition_ = c > condition_ ? c : condition_;
+        return true;
+    }
+
     // Phase 4: the comparison with the active model; the back buffer and swap.
     void gate() noexcept {
-        candidate_rms_ = window_rms(cand_, window_, n_mat_, cfg_.window_orbits);
+        candidate_rms_ = window_rms(cand_, window_, n_mat_, cfg_.window_orbits, solved_);
         if (has_[active_]) {
-            active_rms_ = window_rms(model_[active_], window_, n_mat_, cfg_.window_orbits);
+            active_rms_ = window_rms(model_[active_], window_, n_mat_, cfg_.window_orbits, solved_);
             if (!(candidate_rms_ <= (1.0 - cfg_.adoption_margin) * active_rms_)) {
                 refuse(Refusal::kNoGain);
                 return;
             }
         }
         last_refusal_ = Refusal::kNone;
-        keep_heads_not_learnt(cand_);
-        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U);
+        keep_heads_not_learnt(cand_, solved_);
+        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_);
         active_rms_ = candidate_rms_;
         swap_pending_ = true;
     }
 
-    // The heads the estimator does not learn (learns_head) keep the active
-    // model's presence and coefficients in candidate m.
-    void keep_heads_not_learnt(ModelCoefficients& m) const noexcept {
+    // The heads candidate m did not learn (not in `learnt`) keep the active
+    // model's presence and coefficients.
+    void keep_heads_not_learnt(ModelCoefficients& m, std::uint8_t learnt) const noexcept {
         if (!has_[active_]) {
             return;
         }
         const ModelCoefficients& a = model_[active_];
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            if (learns_head(h, N)) {
+            if (learns_head(h, learnt)) {
                 continue;
             }
             m.present[h] = a.present[h];
@@ -426,8 +483,9 @@ private:
     }
 
     // The back buffer: coefficients, the core's form, version and CRC.
-    void prepare(const ModelCoefficients& m, std::uint32_t version) noexcept {
+    void prepare(const ModelCoefficients& m, std::uint32_t version, std::uint8_t learnt = 0U) noexcept {
         const std::size_t k = back();
+        learnt_[k] = learnt;
         model_[k] = m;
         core_[k] = thermal_model<T>(m, kArcsecToRad);
         version_[k] = version;
@@ -446,13 +504,16 @@ private:
     OrbitRecord<N> record_{};
     // The filter.
     bool n_valid_ = false;
+    std::uint8_t n_heads_ = 0;  // heads with n_ref_, n_mat_, centre_ (bit h)
     Quaternion<double> n_ref_[N]{};
     Matrix3 n_mat_[N]{};
     double centre_[N][3]{};
     SquareRootInformation<kUnknowns, 3> srif_[N]{};
     bool last_fed_valid_ = false;
     std::int64_t last_fed_bin_ = 0;
+    std::uint32_t head_orbits_[N]{};  // orbits fed per head
     bool has_solution_ = false;
+    std::uint8_t solved_ = 0;  // heads of the last solution b_ (bit h)
     double b_[N][kUnknowns][3]{};
     double ms_ = 0.0;
     std::uint32_t ms_count_ = 0;
@@ -475,6 +536,7 @@ private:
     ThermalModel<T> core_[2]{};
     std::uint32_t version_[2]{};
     std::uint32_t crc_[2]{};
+    std::uint8_t learnt_[2]{};
     bool has_[2]{};
     std::size_t active_ = 0;
     bool swap_pending_ = false;

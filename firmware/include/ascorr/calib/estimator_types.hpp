@@ -16,16 +16,27 @@ namespace ascorr::calib {
 
 // The estimator learns heads 0 … N − 1, N from kMinCalibHeads to the core's
 // kMaxHeads (heads.hpp): F needs A and C, the IBAs all N. kCalibHeads is the
-// flight loop's N (A, B and C) and the templates' default.
+// templates' default (A, B and C); the link and the flight loop learn kMaxHeads.
+//
+// Per-head selection: the frame heads 0 … kFrameHeads − 1 (A, B, C) learn
+// from the epochs in which all three pass the selection (a cycle counts then,
+// docs/contract.md), whatever the further heads do. A further head h (D, …)
+// learns from the counted epochs in which it passes the selection too: its
+// rotation is taken relative to A, in F (A and C), and its IBAs pair it with
+// A, B and C. It joins a model once its own orbits reach min_orbits and its
+// condition is within max_condition; until then, or in a file without it, an
+// adopted model keeps the active model's coefficients for it (Estimator::gate),
+// so a head with a model never loses it to an adoption.
 inline constexpr std::size_t kMinCalibHeads = 3;
+inline constexpr std::size_t kFrameHeads = 3;
 inline constexpr std::size_t kCalibHeads = 3;
 template <std::size_t N>
-inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads;
-// The heads an estimator of N heads learns. A model's other heads are not
-// estimated: an adopted model keeps the active model's coefficients for them
-// (Estimator::gate), so a head with a model never loses it to an adoption.
-constexpr bool learns_head(std::size_t h, std::size_t n_heads) noexcept {
-    return h < n_heads;
+inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads && N <= 8U;
+// The frame heads' bits of a head mask (bit h: head h).
+inline constexpr std::uint8_t kFrameMask = (1U << kFrameHeads) - 1U;
+// Whether a mask of learnt heads (Estimator::active_learnt) has head h.
+constexpr bool learns_head(std::size_t h, std::uint32_t learnt_mask) noexcept {
+    return h < 32U && ((learnt_mask >> h) & 1U) != 0U;
 }
 // The inter-boresight angles of N heads: pairs (i, j), i < j, in the order
 // (0,1), (0,2), …, (0,N−1), (1,2), …
@@ -108,13 +119,15 @@ struct EstimatorReport {
     bool frozen;
 };
 
-// One cycle's selected solutions of heads 0 … N − 1 at the same instant.
+// One counted cycle's selected solutions at the same instant: the frame
+// heads always, a further head h when bit h of `heads` is set.
 template <typename T, std::size_t N = kCalibHeads>
 struct CalibCycle {
     static_assert(kCalibHeadCountOk<N>, "the estimator learns 3 to kMaxHeads heads");
     std::int64_t t_us;                    // time of the epoch, µs
     Quaternion<T> q_chu_icrf[N];          // aberration-corrected, unit
     HeadTemperatures<T> temperatures[N];  // all valid
+    std::uint8_t heads = kFrameMask;      // bit h: head h selected (the frame heads' bits always)
 };
 
 }  // namespace ascorr::calib

@@ -25,12 +25,16 @@ inline double model_angle(const ModelCoefficients& m, std::size_t h, std::size_t
            c[6] * x[2] * x[2];
 }
 
-// Whether every linear coefficient of heads 0 … N − 1 is within the Q30 coefficient
-// format's range, 2⁻⁵ rad (ScalarTraits<Q30>::max_coefficient); false for NaN.
+// Whether every linear coefficient of the heads in `heads` (bit h: head h,
+// h < N) is within the Q30 coefficient format's range, 2⁻⁵ rad
+// (ScalarTraits<Q30>::max_coefficient); false for NaN.
 template <std::size_t N>
-bool coefficients_within_q30(const ModelCoefficients& m) noexcept {
+bool coefficients_within_q30(const ModelCoefficients& m, std::uint8_t heads) noexcept {
     const double max_coef = 0x1p-5 * kRadToArcsec;
     for (std::size_t h = 0; h < N; ++h) {
+        if (((heads >> h) & 1U) == 0U) {
+            continue;
+        }
         for (std::size_t a = 0; a < 3; ++a) {
             for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
                 if (!(std::fabs(m.coefficient[h][a][t]) < max_coef)) {
@@ -53,12 +57,15 @@ inline double iba_change(const double (&zi)[3], const double (&zj)[3], const dou
     return -num / sin_t;
 }
 
-// What residual rotations r_h (head frames, arcsec) do to the N heads' IBAs
-// (arcsec; the pairs of iba_pairs(), estimator_types.hpp), to first order: head h's boresight in F is N_hᵀ·e_z, turned
+// What residual rotations r_h (head frames, arcsec) do to the IBAs of the
+// heads in `heads` (arcsec; the pairs of iba_pairs(), estimator_types.hpp; a
+// pair with a head not in `heads` gets 0), to first order: head h's boresight in F is N_hᵀ·e_z, turned
 // by r_h into N_hᵀ·(e_z + e_z × r_h); an IBA θ_ij = acos(z_i·z_j) changes by −(dz_i·z_j + z_i·dz_j)/sin θ_ij. A
 // rotation common to all heads changes none (common_rotation.hpp), a roll about a head's boresight neither.
+// Returns the number of pairs formed.
 template <std::size_t N>
-void iba_residuals(const Matrix3 (&n_mat)[N], const double (&r)[3 * N], double (&d)[iba_pairs(N)]) noexcept {
+std::size_t iba_residuals(const Matrix3 (&n_mat)[N], const double (&r)[3 * N], double (&d)[iba_pairs(N)],
+                          std::uint8_t heads = (1U << N) - 1U) noexcept {
     double z[N][3];
     double dz[N][3];
     for (std::size_t h = 0; h < N; ++h) {
@@ -69,20 +76,29 @@ void iba_residuals(const Matrix3 (&n_mat)[N], const double (&r)[3 * N], double (
         }
     }
     std::size_t p = 0;
+    std::size_t formed = 0;
     for (std::size_t i = 0; i < N; ++i) {
         for (std::size_t j = i + 1; j < N; ++j, ++p) {
-            d[p] = iba_change(z[i], z[j], dz[i], dz[j]);
+            const bool both = ((heads >> i) & 1U) != 0U && ((heads >> j) & 1U) != 0U;
+            d[p] = both ? iba_change(z[i], z[j], dz[i], dz[j]) : 0.0;
+            formed += both ? 1U : 0U;
         }
     }
+    return formed;
 }
 
 // The centred solution b (per head, unknown and axis: the intercept at the
 // centre and the slopes, square_root_information.hpp) as a model in the
 // contract's form (arcsec, arcsec/°C): c0 = b0 − Σ b_j·centre_j.
+// Only the heads in `heads` (bit h) are present.
 template <std::size_t N>
-void centred_to_model(const double (&b)[N][kUnknowns][3], const double (&centre)[N][3], ModelCoefficients& m) noexcept {
+void centred_to_model(const double (&b)[N][kUnknowns][3], const double (&centre)[N][3], ModelCoefficients& m,
+                      std::uint8_t heads) noexcept {
     m = ModelCoefficients{};
     for (std::size_t h = 0; h < N; ++h) {
+        if (((heads >> h) & 1U) == 0U) {
+            continue;
+        }
         m.present[h] = true;
         for (std::size_t a = 0; a < 3; ++a) {
             double* c = m.coefficient[h][a];
@@ -111,26 +127,42 @@ void residual(const double (&b)[N][kUnknowns][3], const double (&centre)[N][3], 
     }
 }
 
+// The newest orbit of window that has head h, nullptr: none.
+template <std::size_t N>
+const OrbitRecord<N>* newest_with(const OrbitWindow<N>& window, std::size_t h) noexcept {
+    for (std::size_t i = window.size(); i-- > 0;) {
+        if (window.at(i).has[h]) {
+            return &window.at(i);
+        }
+    }
+    return nullptr;
+}
+
 // Whether model m may be adopted as to its size: its coefficients fit the Q30
 // formats (coefficients_within_q30) and, at the newest orbit's temperatures
 // in window ± margin_c (the 8 corners of the box per head), every angle is
 // within the core's 1° (kMaxThermalAngleRad). An empty window checks the
 // coefficients only.
+// Only the heads in `heads` (bit h) are checked.
 template <std::size_t N>
-bool within_limits(const ModelCoefficients& m, const OrbitWindow<N>& window, double margin_c) noexcept {
+bool within_limits(const ModelCoefficients& m, const OrbitWindow<N>& window, double margin_c,
+                   std::uint8_t heads) noexcept {
     constexpr double max_arcsec = kMaxThermalAngleRad * kRadToArcsec;
-    if (!coefficients_within_q30<N>(m)) {
+    if (!coefficients_within_q30<N>(m, heads)) {
         return false;
     }
     if (window.size() == 0U) {
         return true;
     }
-    const OrbitRecord<N>& o = window.at(window.size() - 1U);
     for (std::size_t h = 0; h < N; ++h) {
+        const OrbitRecord<N>* o = newest_with(window, h);
+        if (((heads >> h) & 1U) == 0U || o == nullptr) {
+            continue;
+        }
         for (std::size_t corner = 0; corner < 8U; ++corner) {
             double x[3];
             for (std::size_t j = 0; j < 3; ++j) {
-                x[j] = o.x[h][j] + (((corner >> j) & 1U) != 0U ? margin_c : -margin_c);
+                x[j] = o->x[h][j] + (((corner >> j) & 1U) != 0U ? margin_c : -margin_c);
             }
             for (std::size_t a = 0; a < 3; ++a) {
                 if (!(std::fabs(model_angle(m, h, a, x)) < max_arcsec)) {
@@ -146,26 +178,29 @@ bool within_limits(const ModelCoefficients& m, const OrbitWindow<N>& window, dou
 // newest orbits (at most max_orbits) of window that are not held back; NaN
 // with fewer than two. Not about their mean: within a day the orbit means'
 // temperatures hardly move, so a wrong slope shows as an offset there, and so
-// does a shifted mount.
+// does a shifted mount. The pairs of the heads in `heads` (bit h) that each
+// orbit has (OrbitRecord::has).
 template <std::size_t N>
 double window_rms(const ModelCoefficients& m, const OrbitWindow<N>& window, const Matrix3 (&n_mat)[N],
-                  std::uint32_t max_orbits) noexcept {
+                  std::uint32_t max_orbits, std::uint8_t heads) noexcept {
     constexpr std::size_t kPairs = iba_pairs(N);
     double sq[kPairs] = {};
     std::uint32_t n = 0;
+    std::uint32_t terms = 0;
     for (std::size_t i = window.size(); i-- > 0 && n < max_orbits;) {
         const OrbitRecord<N>& o = window.at(i);
         if (o.held) {
             continue;
         }
-        double r[3 * N];
+        const std::uint8_t in = heads & o.heads();
+        double r[3 * N] = {};
         for (std::size_t h = 0; h < N; ++h) {
-            for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t a = 0; a < 3 && ((in >> h) & 1U) != 0U; ++a) {
                 r[3 * h + a] = o.e[h][a] - model_angle(m, h, a, o.x[h]);
             }
         }
         double d[kPairs];
-        iba_residuals<N>(n_mat, r, d);
+        terms += static_cast<std::uint32_t>(iba_residuals<N>(n_mat, r, d, in));
         for (std::size_t k = 0; k < kPairs; ++k) {
             sq[k] += d[k] * d[k];
         }
@@ -178,7 +213,7 @@ double window_rms(const ModelCoefficients& m, const OrbitWindow<N>& window, cons
     for (std::size_t k = 0; k < kPairs; ++k) {
         s += sq[k];
     }
-    return std::sqrt(s / (static_cast<double>(kPairs) * n));
+    return std::sqrt(s / static_cast<double>(terms));
 }
 
 }  // namespace ascorr::calib

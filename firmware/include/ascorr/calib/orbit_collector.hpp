@@ -62,20 +62,46 @@ public:
             next_ref_ready_ = false;
         } else if (!ref_valid_) {
             const Quaternion<T> q_icrf_a = conjugate(c.q_chu_icrf[0]);
-            for (std::size_t k = 0; k + 1 < N; ++k) {
+            for (std::size_t k = 0; k + 1 < kFrameHeads; ++k) {
                 ref_.r[k] = c.q_chu_icrf[k + 1] * q_icrf_a;
             }
-            for (std::size_t h = 0; h < N; ++h) {
-                ref_.t_ref[h][0] = c.temperatures[h].t_chu.value;
-                ref_.t_ref[h][1] = c.temperatures[h].t_029.value;
-                ref_.t_ref[h][2] = c.temperatures[h].t_032.value;
+            for (std::size_t h = 0; h < kFrameHeads; ++h) {
+                take_temperatures(h, c.temperatures[h]);
             }
         }
         ref_valid_ = true;
     }
 
-    // One cycle of the open orbit (starts_orbit(c.t_us) false).
-    void add(const CalibCycle<T, N>& c) noexcept { sums_.add(c.q_chu_icrf, c.temperatures, ref_); }
+    // One cycle of the open orbit (starts_orbit(c.t_us) false). A further
+    // head's first selected cycle ever gives its references.
+    void add(const CalibCycle<T, N>& c) noexcept {
+        if constexpr (N > kFrameHeads) {
+            last_t_us_ = c.t_us;
+            last_q_icrf_a_ = conjugate(c.q_chu_icrf[0]);
+            for (std::size_t h = kFrameHeads; h < N; ++h) {
+                if (((c.heads >> h) & 1U) != 0U) {
+                    first_reference(h, c.q_chu_icrf[h], c.temperatures[h]);
+                }
+            }
+        }
+        sums_.add(c.q_chu_icrf, c.temperatures, ref_, c.heads);
+    }
+
+    // Further head h (≥ kFrameHeads) of the last cycle added, selected after
+    // it (the link's solutions come one by one); false: no such cycle is
+    // open at t_us, or h was not sent with it.
+    bool add_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_h, const HeadTemperatures<T>& temps) noexcept {
+        if (!open_ || t_us != last_t_us_ || h < kFrameHeads || h >= N) {
+            return false;
+        }
+        first_reference(h, q_h, temps);
+        sums_.add_head(h, last_q_icrf_a_, q_h, temps, ref_);
+        return true;
+    }
+
+    // The references of the orbit opened last (those of the heads a closed
+    // orbit does not have carry over).
+    const OrbitReference<T, N>& latest_reference() const noexcept { return next_ref_ready_ ? next_ref_ : ref_; }
 
     // Ends the open orbit, handing it over.
     void close(ClosedOrbit<T, N>& out) noexcept {
@@ -96,6 +122,28 @@ public:
     }
 
 private:
+    void take_temperatures(std::size_t h, const HeadTemperatures<T>& tp) noexcept {
+        ref_.t_ref[h][0] = tp.t_chu.value;
+        ref_.t_ref[h][1] = tp.t_029.value;
+        ref_.t_ref[h][2] = tp.t_032.value;
+    }
+
+    // A further head's references from its first selected cycle ever.
+    void first_reference(std::size_t h, const Quaternion<T>& q_h, const HeadTemperatures<T>& tp) noexcept {
+        if (((ref_heads_ >> h) & 1U) != 0U) {
+            return;
+        }
+        ref_heads_ = static_cast<std::uint8_t>(ref_heads_ | (1U << h));
+        ref_.r[h - 1U] = q_h * last_q_icrf_a_;
+        take_temperatures(h, tp);
+        if (next_ref_ready_) {
+            next_ref_.r[h - 1U] = ref_.r[h - 1U];
+            for (std::size_t j = 0; j < 3; ++j) {
+                next_ref_.t_ref[h][j] = ref_.t_ref[h][j];
+            }
+        }
+    }
+
     static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
         const std::int64_t q = a / b;
         return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
@@ -111,36 +159,49 @@ private:
     bool ref_valid_ = false;
     OrbitReference<T, N> next_ref_{};
     bool next_ref_ready_ = false;
+    std::uint8_t ref_heads_ = kFrameMask;  // heads with references (a further head: from its first cycle)
+    std::int64_t last_t_us_ = 0;           // the last cycle added (further heads only)
+    Quaternion<T> last_q_icrf_a_{};
 };
 
 // A closed orbit's means of N heads, in double: d_B, d_C, … (unit; the mean
 // of δ_h, normalised, times r_h, normalised again) and the 3·N mean
-// temperatures (°C).
+// temperatures (°C), of the heads with at least min_count cycles in the orbit
+// (has; the frame heads': the orbit's).
 template <std::size_t N = kCalibHeads>
 struct OrbitMeans {
     Quaternion<double> d[N - 1];
     double t[N][3];
+    bool has[N];
 };
 
-// The means of o's sums over n = o.sums.count > 0 cycles (o.sums flushed);
-// why means of d_h suffice: orbit_sums.hpp, at the top.
+// The means of o's sums (o.sums flushed, o.sums.count > 0); a further head
+// has means when it has min_count cycles; why means of d_h suffice:
+// orbit_sums.hpp, at the top.
 template <typename T, std::size_t N>
-OrbitMeans<N> orbit_means(const ClosedOrbit<T, N>& o) noexcept {
+OrbitMeans<N> orbit_means(const ClosedOrbit<T, N>& o, std::uint32_t min_count = 1U) noexcept {
     using Tr = ScalarTraits<T>;
-    const double inv = 1.0 / static_cast<double>(o.sums.count);
     OrbitMeans<N> m{};
-    for (std::size_t k = 0; k + 1 < N; ++k) {
-        const auto& s = o.sums.dq[k];
-        const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv, s[3].value() * inv};
-        const double sm = 1.0 / std::sqrt(squared_norm(mean));
-        const Quaternion<T>& r = o.ref.r[k];
-        const Quaternion<double> rd{Tr::to_double(r.w), Tr::to_double(r.x), Tr::to_double(r.y), Tr::to_double(r.z)};
-        const Quaternion<double> unit{mean.w * sm, mean.x * sm, mean.y * sm, mean.z * sm};
-        const Quaternion<double> dk = unit * rd;
-        const double sn = 1.0 / std::sqrt(squared_norm(dk));
-        m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
-    }
     for (std::size_t h = 0; h < N; ++h) {
+        const std::uint32_t n = o.sums.count_of(h);
+        m.has[h] = h < kFrameHeads || (n >= min_count && n > 0U);
+        if (!m.has[h]) {
+            continue;
+        }
+        const double inv = 1.0 / static_cast<double>(n);
+        if (h > 0U) {
+            const std::size_t k = h - 1U;
+            const auto& s = o.sums.dq[k];
+            const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv,
+                                          s[3].value() * inv};
+            const double sm = 1.0 / std::sqrt(squared_norm(mean));
+            const Quaternion<T>& r = o.ref.r[k];
+            const Quaternion<double> rd{Tr::to_double(r.w), Tr::to_double(r.x), Tr::to_double(r.y), Tr::to_double(r.z)};
+            const Quaternion<double> unit{mean.w * sm, mean.x * sm, mean.y * sm, mean.z * sm};
+            const Quaternion<double> dk = unit * rd;
+            const double sn = 1.0 / std::sqrt(squared_norm(dk));
+            m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
+        }
         for (std::size_t j = 0; j < 3; ++j) {
             m.t[h][j] = Tr::to_double(o.ref.t_ref[h][j]) + o.sums.dt[h][j].value() * inv;
         }
@@ -148,16 +209,19 @@ OrbitMeans<N> orbit_means(const ClosedOrbit<T, N>& o) noexcept {
     return m;
 }
 
-// The references an orbit's means give the next orbit (rounded to T).
+// The references an orbit's means give the next orbit (rounded to T); the
+// heads without means keep those of `r`.
 template <typename T, std::size_t N>
-OrbitReference<T, N> reference_from(const OrbitMeans<N>& m) noexcept {
+OrbitReference<T, N> reference_from(const OrbitMeans<N>& m, OrbitReference<T, N> r = {}) noexcept {
     using Tr = ScalarTraits<T>;
-    OrbitReference<T, N> r{};
-    for (std::size_t k = 0; k + 1 < N; ++k) {
-        r.r[k] = {Tr::from_double(m.d[k].w), Tr::from_double(m.d[k].x), Tr::from_double(m.d[k].y),
-                  Tr::from_double(m.d[k].z)};
-    }
     for (std::size_t h = 0; h < N; ++h) {
+        if (!m.has[h]) {
+            continue;
+        }
+        if (h > 0U) {
+            const Quaternion<double>& d = m.d[h - 1U];
+            r.r[h - 1U] = {Tr::from_double(d.w), Tr::from_double(d.x), Tr::from_double(d.y), Tr::from_double(d.z)};
+        }
         for (std::size_t j = 0; j < 3; ++j) {
             r.t_ref[h][j] = Tr::celsius(m.t[h][j]);
         }

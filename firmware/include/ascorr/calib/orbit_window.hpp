@@ -18,6 +18,15 @@ struct OrbitRecord {
     double e[N][3];  // arcsec, relative to N_h
     double x[N][3];  // T1, T2 − T1, T3 − T1 (°C), orbit means
     bool held;       // held back as an outlier, not (yet) in the filter
+    bool has[N];     // head h's means are in the orbit (the frame heads always)
+
+    std::uint8_t heads() const noexcept {
+        std::uint8_t m = 0;
+        for (std::size_t h = 0; h < N; ++h) {
+            m = static_cast<std::uint8_t>(m | (has[h] ? 1U << h : 0U));
+        }
+        return m;
+    }
 };
 
 template <std::size_t N = kCalibHeads>

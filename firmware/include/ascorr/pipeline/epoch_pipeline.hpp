@@ -64,8 +64,14 @@ struct InlineCalls {
     }
     template <std::size_t N>
     static bool feed(calib::Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
-                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
-        return calib::feed_estimator(e, t_us, model, corrected, temperatures);
+                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures,
+                     std::uint8_t further) noexcept {
+        return calib::feed_estimator(e, t_us, model, corrected, temperatures, further);
+    }
+    template <std::size_t N>
+    static bool feed_head(calib::Estimator<T, N>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<T>* model,
+                          const CorrectedSolution<T>& corrected, const HeadTemperatures<T>& temperatures) noexcept {
+        return calib::feed_estimator_head(e, h, t_us, model, corrected, temperatures);
     }
     template <std::size_t N>
     static bool step(calib::Estimator<T, N>& e) noexcept {
@@ -270,19 +276,27 @@ private:
     }
 
     // Stage 5: the first clean, usable solution of each calibrated head; the
-    // feed when all are there, on the schedule's epochs.
+    // feed when A, B and C are there (with the further heads kept so far), on
+    // the schedule's epochs; a further head that comes after it, alone.
     template <typename Meter>
     void keep(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
-        if (!have_epoch_ || h >= N || kept_ == kFed || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+        if (!have_epoch_ || h >= N || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+            return;
+        }
+        if ((kept_ & kFed) != 0U) {
+            if constexpr (N > calib::kFrameHeads) {
+                keep_late(h, c, tp, meter);
+            }
             return;
         }
         solutions_[h] = c;
         temperatures_[h] = tp;
         kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
-        if (kept_ != kAll) {
+        if ((kept_ & calib::kFrameMask) != calib::kFrameMask) {
             return;
         }
-        kept_ = kFed;
+        kept_ = static_cast<std::uint8_t>(kept_ | kFed);
+        fed_ = false;
         if (epochs_ % schedule_.feed_every != 0U) {
             return;
         }
@@ -291,15 +305,25 @@ private:
         for (std::size_t k = 0; k < N; ++k) {
             t[k] = &temperatures_[k];
         }
-        if (Calls::feed(*estimator_, t_us_, model_, solutions_, t)) {
-            ++feeds_;
-        }
+        fed_ = Calls::feed(*estimator_, t_us_, model_, solutions_, t, static_cast<std::uint8_t>(kept_ & ~kFed));
+        feeds_ += fed_ ? 1U : 0U;
         meter.add(Stage::kFeed, start);
         for (int i = 0; i < schedule_.steps_after_feed && Calls::step(*estimator_); ++i) {
         }
     }
 
-    static constexpr std::uint8_t kAll = (1U << N) - 1U;
+    // A further head after the epoch's feed: into the same cycle's sums.
+    template <typename Meter>
+    void keep_late(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
+        kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
+        if (!fed_) {
+            return;
+        }
+        const std::uint32_t start = meter.now();
+        (void)Calls::feed_head(*estimator_, h, t_us_, model_, c, tp);
+        meter.add(Stage::kFeed, start);
+    }
+
     static constexpr std::uint8_t kFed = 0x80U;
     // Two solutions of every head: room for a repeated head, whose second
     // solution the combiner leaves out.
@@ -312,6 +336,7 @@ private:
     std::int64_t t_us_ = 0;
     std::uint32_t epochs_ = 0U;  // epochs begun before the current one
     std::uint8_t kept_ = 0U;     // bit h: head h kept; kFed: the epoch is done with the feed
+    bool fed_ = false;           // the epoch's cycle fed the estimator (kFed set)
     const ThermalModel<T>* model_ = nullptr;
     std::uint32_t version_ = 0U;
     std::uint32_t feeds_ = 0U;

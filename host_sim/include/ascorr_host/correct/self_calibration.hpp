@@ -35,17 +35,16 @@ struct ActiveModel {
     std::uint32_t version;  // 0: the model given at start
     std::uint32_t crc;      // calib::model_crc
     ModelFile model;
-    std::size_t heads_learnt = calib::kCalibHeads;  // the estimator learns heads 0 … heads_learnt − 1
+    std::uint8_t learnt = calib::kFrameMask;  // the heads this model learnt (bit h; Estimator::active_learnt)
 };
 
 struct SelfCalibration {
     std::vector<ActiveModel> history;  // in time order
     calib::EstimatorReport report;     // at the end of the file
     double orbit_period_s = 0.0;
-    std::size_t cycles = 0;                         // epochs that fed the estimator (its heads all usable)
-    std::size_t heads_learnt = calib::kCalibHeads;  // heads 0 … heads_learnt − 1 (A, B, C; D on a four-head file)
-    std::size_t untimed = 0;                        // rows whose t the on-board clock cannot hold
-    std::size_t runs = 0;  // rows out of time order: sorted runs (more than 1: merged from a temporary file)
+    std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
+    std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
+    std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
 };
 
 // The fed rows (in time order) whose median speed gives the orbit period
@@ -68,8 +67,10 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 
 // kind: "double", "float" or "fixed" is chosen by T. The estimator learns
 // the file's heads: A, B, C, and D when a row of D passes the selection (a
-// first reading of the rows), at most max_heads (replay: the link's
-// estimator, calib::kCalibHeads). initial: --model, linear
+// first reading of the rows), at most max_heads; A, B and C learn from the
+// epochs they all pass, D from those of them it passes too
+// (calib/estimator_types.hpp), so an estimator of more heads than the file
+// has (the link's, kMaxHeads) takes the same decisions. initial: --model, linear
 // (refuse_quadratic_initial_model).
 // orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
 // the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
@@ -105,10 +106,10 @@ private:
 };
 
 // How head h of a history's model `version` came to be: "given" (version 0,
-// the model given at start), "learnt" (estimated: calib::learns_head, heads
-// 0 … heads_learnt − 1) or "kept" (a head the estimator does not learn: the
+// the model given at start), "learnt" (estimated: in the model's `learnt`
+// mask, calib::learns_head) or "kept" (a head the model did not learn: the
 // active model's coefficients, carried into the adopted model, Estimator::gate).
-const char* head_origin(std::uint32_t version, std::size_t h, std::size_t heads_learnt = calib::kCalibHeads);
+const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learnt = calib::kFrameMask);
 
 // The model history file (docs/contract.md): header
 // t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
