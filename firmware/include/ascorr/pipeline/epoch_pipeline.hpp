@@ -305,7 +305,8 @@ private:
         for (std::size_t k = 0; k < N; ++k) {
             t[k] = &temperatures_[k];
         }
-        fed_ = Calls::feed(*estimator_, t_us_, model_, solutions_, t, static_cast<std::uint8_t>(kept_ & ~kFed));
+        fed_ = Calls::feed(*estimator_, t_us_, model_, solutions_, t,
+                           static_cast<std::uint8_t>(kept_ & ~(kFed | calib::kFrameMask)));
         feeds_ += fed_ ? 1U : 0U;
         meter.add(Stage::kFeed, start);
         for (int i = 0; i < schedule_.steps_after_feed && Calls::step(*estimator_); ++i) {
@@ -314,7 +315,8 @@ private:
 
     // A further head after the epoch's feed: into the same cycle's sums.
     template <typename Meter>
-    void keep_late(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
+    void keep_late(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp,
+                   Meter& meter) noexcept {
         kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
         if (!fed_) {
             return;
