@@ -446,10 +446,10 @@ TEST(SelfCalibration, AFourthHeadIsLearntAndItsPairsReachTheFloor) {
     const host::SelfCalibration learnt = learn(true);
     const host::SelfCalibration kept = learn(false);
     ASSERT_GE(learnt.history.size(), 2U);
-    EXPECT_EQ(learnt.history.back().heads_learnt, 4U);
-    EXPECT_STREQ(host::head_origin(learnt.history.back().version, 3, learnt.history.back().heads_learnt), "learnt");
-    EXPECT_EQ(kept.history.back().heads_learnt, 3U);
-    EXPECT_STREQ(host::head_origin(1U, 3, kept.history.back().heads_learnt), "kept");
+    EXPECT_EQ(learnt.history.back().learnt, 15U);  // A, B, C and D
+    EXPECT_STREQ(host::head_origin(learnt.history.back().version, 3, learnt.history.back().learnt), "learnt");
+    EXPECT_EQ(kept.history.back().learnt, 7U);
+    EXPECT_STREQ(host::head_origin(1U, 3, kept.history.back().learnt), "kept");
     const auto r = ratios(learnt);
     const auto r_kept = ratios(kept);
     double worst_d = 0.0;
