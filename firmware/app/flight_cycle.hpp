@@ -14,7 +14,8 @@
 // solution's own time (velocity_entry.hpp), the core in the build's scalar
 // (app_scalar.hpp, core_entry.hpp), the temperatures of
 // temperature_source.hpp and their status bits; every kCalibFeedEvery-th
-// cycle heads A, B and C feed the estimator; then the cycle's heads are
+// cycle heads A, B and C (and D when it passes the selection) feed the
+// estimator (FlightEstimator, calib_entry.hpp); then the cycle's heads are
 // combined into the bench's attitude (combine_entry.hpp, the mountings
 // kBenchMountings of flight_bench.hpp); after the solutions one bounded step
 // of the estimator's per-orbit update runs (idle()). Times are TT µs

@@ -7,7 +7,8 @@
 //           changes between solutions, never within one; nullptr: no model
 //           (status 256, no thermal stage)
 //           ... correct the cycle's solutions with m ...
-//           est.accumulate(cycle);   // only when heads 0 … N − 1 passed the selection
+//           est.accumulate(cycle);   // only when A, B and C passed the selection
+//           est.accumulate_head(h, ...);  // a further head selected after them
 //   idle:   while (time left && est.step()) {}   // bounded work per call
 //   ground: freeze(), resume(), reset(), load_model(m), report().
 //
@@ -15,10 +16,12 @@
 // when flags 1, 2 and 4 are clear, confidence ≤ 5, its three temperatures are
 // valid, and the aberration stage was applied; its quaternion without the
 // thermal stage is what is given (feed.hpp forms it, for the flight loop, the
-// link server and the host alike). A cycle counts when heads 0 … N − 1 all do.
+// link server and the host alike). A cycle counts when A, B and C all do; a
+// further head is learnt from the counted cycles it passes too (per-head
+// selection: estimator_types.hpp, README.md).
 //
-// N: the heads learnt, 3 (A, B, C: the flight loop's) to the core's kMaxHeads
-// (heads.hpp); F needs A and C, the IBAs are all N·(N − 1)/2 pairs.
+// N: the heads learnt, 3 to the core's kMaxHeads (heads.hpp; the flight loop
+// and the link: kMaxHeads); F needs A and C, the IBAs are all N·(N − 1)/2 pairs.
 //
 // The estimate, its numerics and the per-cycle and per-orbit work: README.md
 // in this folder ("The estimator").
@@ -45,8 +48,8 @@
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
 // arcsec as ModelCoefficients and converted once into the core's
 // ThermalModel<T> (model_coefficients.hpp) when prepared, in the back buffer.
-// An adopted model is learnt for heads 0 … N − 1; its other heads are the
-// active model's (learns_head, estimator_types.hpp).
+// An adopted model is learnt for A, B, C and the further heads that joined
+// it (active_learnt()); its other heads are the active model's.
 //
 // No allocation, no exception, no recursion, fixed-size state, every loop
 // with a fixed bound. T: double, float or Q30 (the core's scalar).

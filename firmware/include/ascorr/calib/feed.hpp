@@ -42,21 +42,34 @@ template <typename T, std::size_t N>
 bool feed_estimator(Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures,
                     std::uint8_t further = 0U) noexcept {
-    CalibCycle<T, N> c{};
+    CalibCycle<T, N> c;  // not zeroed: the estimator reads the frame heads and those in c.heads, set below
     c.t_us = t_us;
-    for (std::uint8_t h = 0; h < N; ++h) {
-        const bool wanted = h < kFrameHeads || ((further >> h) & 1U) != 0U;
-        if (!wanted) {
-            continue;
+    // The frame heads: selected_solution's body, written out (the M3's and
+    // M4F's per-cycle cost; the loop is the one the three-head estimator had).
+    for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
+        const CorrectedSolution<T>& s = corrected[h];
+        const HeadTemperatures<T>& tp = *temperatures[h];
+        if ((s.status & status::kAberrationApplied) == 0U || (s.status & status::kRejected) != 0U ||
+            !(tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid)) {
+            return false;
         }
-        if (!selected_solution(h, model, corrected[h], *temperatures[h], c.q_chu_icrf[h])) {
-            if (h < kFrameHeads) {
-                return false;
+        c.q_chu_icrf[h] = s.q_chu_icrf;
+        if ((s.status & status::kThermalApplied) != 0U && model != nullptr) {
+            const ThermalStage<T> th = thermal_stage(*model, h, tp);
+            c.q_chu_icrf[h] = renormalized_sum(s.q_chu_icrf, increment(conjugate(th.q_th)) * s.q_chu_icrf);
+        }
+        c.temperatures[h] = tp;
+    }
+    if constexpr (N > kFrameHeads) {
+        for (std::uint8_t h = kFrameHeads; h < N; ++h) {
+            if (((further >> h) & 1U) != 0U &&
+                selected_solution(h, model, corrected[h], *temperatures[h], c.q_chu_icrf[h])) {
+                c.temperatures[h] = *temperatures[h];
+                c.heads = static_cast<std::uint8_t>(c.heads | (1U << h));
             }
-            continue;
         }
-        c.temperatures[h] = *temperatures[h];
-        c.heads = static_cast<std::uint8_t>(c.heads | (1U << h));
+    } else {
+        (void)further;
     }
     e.accumulate(c);
     return true;

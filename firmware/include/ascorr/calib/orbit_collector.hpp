@@ -77,8 +77,8 @@ public:
     void add(const CalibCycle<T, N>& c) noexcept {
         if constexpr (N > kFrameHeads) {
             last_t_us_ = c.t_us;
-            last_q_icrf_a_ = conjugate(c.q_chu_icrf[0]);
-            for (std::size_t h = kFrameHeads; h < N; ++h) {
+            last_q_a_ = c.q_chu_icrf[0];
+            for (std::size_t h = kFrameHeads; h < N && c.heads != kFrameMask; ++h) {
                 if (((c.heads >> h) & 1U) != 0U) {
                     first_reference(h, c.q_chu_icrf[h], c.temperatures[h]);
                 }
@@ -90,12 +90,13 @@ public:
     // Further head h (≥ kFrameHeads) of the last cycle added, selected after
     // it (the link's solutions come one by one); false: no such cycle is
     // open at t_us, or h was not sent with it.
-    bool add_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_h, const HeadTemperatures<T>& temps) noexcept {
+    bool add_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_h,
+                  const HeadTemperatures<T>& temps) noexcept {
         if (!open_ || t_us != last_t_us_ || h < kFrameHeads || h >= N) {
             return false;
         }
         first_reference(h, q_h, temps);
-        sums_.add_head(h, last_q_icrf_a_, q_h, temps, ref_);
+        sums_.add_head(h, conjugate(last_q_a_), q_h, temps, ref_);
         return true;
     }
 
@@ -134,7 +135,7 @@ private:
             return;
         }
         ref_heads_ = static_cast<std::uint8_t>(ref_heads_ | (1U << h));
-        ref_.r[h - 1U] = q_h * last_q_icrf_a_;
+        ref_.r[h - 1U] = q_h * conjugate(last_q_a_);
         take_temperatures(h, tp);
         if (next_ref_ready_) {
             next_ref_.r[h - 1U] = ref_.r[h - 1U];
@@ -161,7 +162,7 @@ private:
     bool next_ref_ready_ = false;
     std::uint8_t ref_heads_ = kFrameMask;  // heads with references (a further head: from its first cycle)
     std::int64_t last_t_us_ = 0;           // the last cycle added (further heads only)
-    Quaternion<T> last_q_icrf_a_{};
+    Quaternion<T> last_q_a_{};             // its head A (q_a_icrf)
 };
 
 // A closed orbit's means of N heads, in double: d_B, d_C, … (unit; the mean

@@ -101,9 +101,9 @@ template <typename T, std::size_t N = kCalibHeads>
 struct OrbitSums {
     std::uint32_t count = 0;
     std::uint32_t block = 0;
-    Sum<T> dq[N - 1][4];                  // Σ δ_B, Σ δ_C, …: w, x, y, z
-    Sum<Celsius<T>> dt[N][3];             // Σ (T − T_ref), per head and sensor
-    std::uint32_t head_count[N]{};        // further heads' cycles (the frame heads': count)
+    Sum<T> dq[N - 1][4];            // Σ δ_B, Σ δ_C, …: w, x, y, z
+    Sum<Celsius<T>> dt[N][3];       // Σ (T − T_ref), per head and sensor
+    std::uint32_t head_count[N]{};  // further heads' cycles (the frame heads': count)
 
     // One counted cycle: q[h] = q_h_icrf (aberration-corrected, unit) of the
     // frame heads and of the further heads in `heads` (bit h); temps[h] their
@@ -118,7 +118,7 @@ struct OrbitSums {
             add_temperatures(h, temps[h], ref);
         }
         if constexpr (N > kFrameHeads) {
-            for (std::size_t h = kFrameHeads; h < N; ++h) {
+            for (std::size_t h = kFrameHeads; h < N && heads != kFrameMask; ++h) {
                 if (((heads >> h) & 1U) != 0U) {
                     add_head(h, q_icrf_a, q[h], temps[h], ref);
                 }

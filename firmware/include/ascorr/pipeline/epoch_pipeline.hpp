@@ -13,10 +13,13 @@
 //   3. correction and 4. status (correct_stage(), solution_stage.hpp, then
 //                the caller's own bits: Calls::status);
 //   5. estimator feed: the first clean, usable solution of each of the
-//                calibrated heads is kept; when all are there and the epoch is
-//                one the schedule feeds (every feed_every-th), they feed the
-//                estimator (calib::feed_estimator) and its per-orbit update
-//                runs steps_after_feed bounded steps; idle() runs one more;
+//                calibrated heads is kept; when A, B and C are there and the
+//                epoch is one the schedule feeds (every feed_every-th), they
+//                feed the estimator with the further heads kept so far
+//                (calib::feed_estimator) and its per-orbit update runs
+//                steps_after_feed bounded steps; a further head that comes
+//                after them is fed alone into the same cycle
+//                (calib::feed_estimator_head); idle() runs one more step;
 //   6. combination (use_combiner; close()): the corrected solutions since the
 //                last close() (the caller's epoch of the bench: a flight
 //                cycle, the host's millisecond epoch) combined into the
