@@ -32,8 +32,8 @@ using FlightEstimator = calib::Estimator<T, kMaxHeads>;
 const ThermalModel<Q30>* calib_model_fixed(FlightEstimator<Q30>& e, std::int64_t t_us) noexcept;
 const ThermalModel<float>* calib_model_float(FlightEstimator<float>& e, std::int64_t t_us) noexcept;
 bool calib_feed_fixed(FlightEstimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                      const CorrectedSolution<Q30>* corrected,
-                      const HeadTemperatures<Q30>* const* temperatures, std::uint8_t further) noexcept;
+                      const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures,
+                      std::uint8_t further) noexcept;
 bool calib_feed_float(FlightEstimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
                       const CorrectedSolution<float>* corrected, const HeadTemperatures<float>* const* temperatures,
                       std::uint8_t further) noexcept;
@@ -55,17 +55,18 @@ inline const ThermalModel<float>* calib_model(FlightEstimator<float>& e, std::in
     return calib_model_float(e, t_us);
 }
 inline bool calib_feed(FlightEstimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                       const CorrectedSolution<Q30>* corrected,
-                       const HeadTemperatures<Q30>* const* temperatures, std::uint8_t further) noexcept {
+                       const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures,
+                       std::uint8_t further) noexcept {
     return calib_feed_fixed(e, t_us, model, corrected, temperatures, further);
 }
 inline bool calib_feed(FlightEstimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
-                       const CorrectedSolution<float>* corrected,
-                       const HeadTemperatures<float>* const* temperatures, std::uint8_t further) noexcept {
+                       const CorrectedSolution<float>* corrected, const HeadTemperatures<float>* const* temperatures,
+                       std::uint8_t further) noexcept {
     return calib_feed_float(e, t_us, model, corrected, temperatures, further);
 }
 inline bool calib_feed_head(FlightEstimator<Q30>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<Q30>* model,
-                            const CorrectedSolution<Q30>& corrected, const HeadTemperatures<Q30>& temperatures) noexcept {
+                            const CorrectedSolution<Q30>& corrected,
+                            const HeadTemperatures<Q30>& temperatures) noexcept {
     return calib_feed_head_fixed(e, h, t_us, model, corrected, temperatures);
 }
 inline bool calib_feed_head(FlightEstimator<float>& e, std::uint8_t h, std::int64_t t_us,

@@ -8,13 +8,14 @@ const ThermalModel<Q30>* calib_model_fixed(FlightEstimator<Q30>& e, std::int64_t
 }
 
 bool calib_feed_fixed(FlightEstimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                      const CorrectedSolution<Q30>* corrected,
-                      const HeadTemperatures<Q30>* const* temperatures, std::uint8_t further) noexcept {
+                      const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures,
+                      std::uint8_t further) noexcept {
     return feed_estimator(e, t_us, model, corrected, temperatures, further);
 }
 
 bool calib_feed_head_fixed(FlightEstimator<Q30>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<Q30>* model,
-                      const CorrectedSolution<Q30>& corrected, const HeadTemperatures<Q30>& temperatures) noexcept {
+                           const CorrectedSolution<Q30>& corrected,
+                           const HeadTemperatures<Q30>& temperatures) noexcept {
     return feed_estimator_head(e, h, t_us, model, corrected, temperatures);
 }
 

@@ -172,9 +172,8 @@ private:
     const ThermalModel<T>* epoch(std::int64_t t_us, double t) {
         const ThermalModel<T>* model = pipeline_.begin(t_us);
         if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
-            out_.history.push_back(
-                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients()),
-                 est_->active_learnt()});
+            out_.history.push_back({t, t_us, pipeline_.version(), est_->active_crc(),
+                                    model_file_of(*est_->active_coefficients()), est_->active_learnt()});
             had_ = true;
             version_ = pipeline_.version();
         }

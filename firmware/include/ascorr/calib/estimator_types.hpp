@@ -31,7 +31,7 @@ inline constexpr std::size_t kMinCalibHeads = 3;
 inline constexpr std::size_t kFrameHeads = 3;
 inline constexpr std::size_t kCalibHeads = 3;
 template <std::size_t N>
-inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads && N <= 8U;
+inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads&& N <= 8U;
 // The frame heads' bits of a head mask (bit h: head h).
 inline constexpr std::uint8_t kFrameMask = (1U << kFrameHeads) - 1U;
 // Whether a mask of learnt heads (Estimator::active_learnt) has head h.
