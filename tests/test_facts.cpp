@@ -312,5 +312,53 @@ TEST(ModelConversion, EveryPathGivesTheCoresBitsWithinHalfAUnitOfTheFormat) {
     EXPECT_NE(values(wrong.head[0]), values(host::to_core<double>(m).head[0]));
 }
 
+// ---- Model terms (ascorr/core/model_terms.hpp)
+
+TEST(ModelTerms, EachTermIsFoundByItsRegressorAndPower) {
+    for (std::uint8_t k = 0; k < kModelTerms; ++k) {
+        const ModelTerm& t = kModelTermTable[k];
+        EXPECT_EQ(term_index(t.regressor, t.power), k) << t.name;
+        EXPECT_EQ(host::kCoefficientNames[k], std::string(t.name));
+        EXPECT_EQ(quadratic_term(k), k >= kLinearModelTerms) << t.name;
+    }
+    EXPECT_EQ(term_index(Regressor::kOne, 1), kModelTerms);  // none: the end
+}
+
+// The contract's "Model file" names the columns in the table's order.
+TEST(ModelTerms, TheContractsModelFileHasTheTablesColumns) {
+    const std::string contract = source_file("docs/contract.md");
+    const std::string linear = "Header `chu,axis," + host::coefficient_columns(0, kLinearModelTerms, ",") + "`";
+    const std::string quadratic = "`" + host::coefficient_columns(kLinearModelTerms, kModelTerms, ",") + "`";
+    EXPECT_NE(contract.find(linear), std::string::npos) << linear;
+    EXPECT_NE(contract.find("optionally followed by " + quadratic), std::string::npos) << quadratic;
+    EXPECT_EQ(host::model_header(kModelTerms), "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n");
+}
+
+// model_polynomial (the estimator's checks, the fit's gauge) is the contract's
+// polynomial summed left to right, bit for bit; thermal_angle<double> (the
+// core, grouped by regressor) agrees to rounding.
+TEST(ModelTerms, ThePolynomialIsTheContractsSumBitForBit) {
+    std::mt19937_64 rng(29);
+    std::uniform_real_distribution<double> coef(-50.0, 50.0);
+    std::uniform_real_distribution<double> temp(-60.0, 60.0);
+    for (int i = 0; i < 1000; ++i) {
+        double c[kModelTerms];
+        for (std::uint8_t k = 0; k < kModelTerms; ++k) {
+            c[k] = coef(rng) * (quadratic_term(k) ? 1e-3 : 1.0);
+        }
+        const double x[kRegressors] = {temp(rng), temp(rng), temp(rng)};
+        const double want = c[0] + c[1] * x[0] + c[2] * x[1] + c[3] * x[2] + c[4] * x[0] * x[0] + c[5] * x[1] * x[1] +
+                            c[6] * x[2] * x[2];
+        EXPECT_EQ(model_polynomial(c, x), want);
+        AxisPolynomial<double> p{};
+        for_each_term(p, [&c](auto k, double& field) { field = c[k]; });
+        const double core = thermal_angle<double>(p, x[0], x[0] + x[1], x[0] + x[2]);
+        EXPECT_NEAR(core, want, 1e-9 * (1.0 + std::fabs(want)));
+        // Mutation: two regressors swapped are caught.
+        std::swap(c[2], c[3]);
+        EXPECT_TRUE(model_polynomial(c, x) != want || c[2] == c[3] || x[1] == x[2]);
+    }
+}
+
 }  // namespace
 }  // namespace ascorr

@@ -210,7 +210,7 @@ TEST(SelfCalibration, SettlingMissionReachesTheFloor) {
                 text(later).c_str(), r.sc.history.size());
     std::printf("%s\n", host::describe(r.sc).c_str());
     EXPECT_LE(worst(before), 1.03);
-    EXPECT_LE(worst(after30), 1.15);
+    EXPECT_LE(worst(after30), 1.10);
     EXPECT_LE(worst(later), 1.03);
     // The simulator's heater events (a heat flow the seasons do not show): the
     // IBA RMS from each heater on to a day after it is off, each window after
@@ -239,6 +239,99 @@ TEST(SelfCalibration, SettlingMissionReachesTheFloor) {
     EXPECT_LE(worst(worst_heater), 1.03);
 }
 
+// ---- Settlings on many missions (the worst case, not one mission's).
+
+struct Settling {
+    std::uint64_t seed;
+    double day;           // of the settling
+    int heads[2];         // shifted heads (-1: none)
+    double shift_arcsec;  // c0 of alpha; beta gets twice it
+    bool gains;           // cross-boresight gains change by 30-40 % too
+};
+
+// Eight missions: seeds, days, sizes 0.5" to 5" on one or two heads, with
+// and without gain changes.
+constexpr Settling kSettlings[] = {
+    {11, 250.0, {1, -1}, 1.5, true},  {12, 300.0, {0, -1}, 0.5, false}, {13, 350.0, {2, -1}, 5.0, true},
+    {14, 220.0, {0, 2}, 2.0, false},  {15, 280.0, {1, 2}, 3.0, true},   {16, 330.0, {0, 1}, 1.0, true},
+    {17, 260.0, {2, -1}, 2.5, false}, {18, 310.0, {1, -1}, 4.0, true},
+};
+
+std::string settled_truth_of(const Settling& s, const fs::path& dir) {
+    host::ModelFile m = host::table2_model();
+    for (const int h : s.heads) {
+        if (h < 0) {
+            continue;
+        }
+        const auto i = static_cast<std::size_t>(h);
+        m.coefficients[i][0][0] += s.shift_arcsec;
+        m.coefficients[i][1][0] += 2.0 * s.shift_arcsec;
+        if (s.gains) {
+            m.coefficients[i][0][1] *= 1.35;
+            m.coefficients[i][1][1] *= 1.4;
+            m.coefficients[i][0][3] *= 0.7;
+        }
+    }
+    const std::string path = (dir / "settled.csv").string();
+    host::write_model_file(path, m);
+    return path;
+}
+
+struct SettlingScore {
+    double before = 0.0;   // day 30 to the settling
+    double after30 = 0.0;  // the 30 days after it
+    double later = 0.0;    // from 30 days after it to the end
+};
+
+// The worst over the eight missions of each configuration in cfgs (each
+// mission simulated once).
+std::vector<SettlingScore> score_settlings(const std::vector<calib::EstimatorConfig>& cfgs) {
+    std::vector<SettlingScore> w(cfgs.size());
+    int k = 0;
+    for (const Settling& s : kSettlings) {
+        const double end = s.day + 120.0;
+        const Mission m = simulate("settlings-" + std::to_string(k++), end, [&s](host::SimulateOptions& o) {
+            o.seed = s.seed;
+            o.truth_changes.push_back({s.day, settled_truth_of(s, fs::path(o.out).parent_path())});
+            o.gaps.push_back({s.day - 90.0, s.day - 88.0});
+        });
+        const auto d = static_cast<long long>(s.day);
+        for (std::size_t c = 0; c < cfgs.size(); ++c) {
+            const Learnt r = run(m, cfgs[c]);
+            const double b = worst(ratio(m, r.ibas, 30, d));
+            const double a = worst(ratio(m, r.ibas, d, d + 30));
+            const double l = worst(ratio(m, r.ibas, d + 30, static_cast<long long>(end)));
+            std::printf(
+                "config %zu, seed %llu day %.0f %.1f\" heads %d,%d%s: before %.3f, 30 days after %.3f, "
+                "later %.3f\n",
+                c, static_cast<unsigned long long>(s.seed), s.day, s.shift_arcsec, s.heads[0], s.heads[1],
+                s.gains ? " +gains" : "", b, a, l);
+            w[c].before = std::max(w[c].before, b);
+            w[c].after30 = std::max(w[c].after30, a);
+            w[c].later = std::max(w[c].later, l);
+        }
+    }
+    return w;
+}
+
+// Issue 31's done-when, worst over eight settling missions. Mutation: the
+// estimator as it was (a change taken after 24 held orbits, orbits below half
+// a typical one's count unused) fails the 30 days after (1.50).
+TEST(SelfCalibration, SettlingsOnEightMissionsWorstCase) {
+    calib::EstimatorConfig before_issue_31;
+    before_issue_31.persistence_orbits = 24;
+    before_issue_31.min_coverage = 0.5;
+    const std::vector<SettlingScore> w = score_settlings({calib::EstimatorConfig{}, before_issue_31});
+    for (std::size_t c = 0; c < w.size(); ++c) {
+        std::printf("config %zu, worst of %zu missions: before %.3f, 30 days after %.3f, later %.3f\n", c,
+                    std::size(kSettlings), w[c].before, w[c].after30, w[c].later);
+    }
+    EXPECT_LE(w[0].before, 1.03);
+    EXPECT_LE(w[0].after30, 1.10);
+    EXPECT_LE(w[0].later, 1.03);
+    EXPECT_GT(w[1].after30, 1.10);
+}
+
 // A quadratic truth (B's alpha and beta 0.04 arcsec/degC^2 in T_CHU): the
 // linear model with forgetting follows the curvature over the seasons.
 TEST(SelfCalibration, AQuadraticTruthIsFollowed) {
@@ -264,7 +357,8 @@ TEST(SelfCalibration, WithoutForgettingTheSettlingFails) {
     c.time_constant_days = 1e9;
     const Learnt r = run(m, c);
     const auto later = ratio(m, r.ibas, 430, 600);
-    std::printf("no forgetting: days 430-600 %s\n", text(later).c_str());
+    std::printf("no forgetting: days 30-400 %s; 400-430 %s; 430-600 %s\n", text(ratio(m, r.ibas, 30, 400)).c_str(),
+                text(ratio(m, r.ibas, 400, 430)).c_str(), text(later).c_str());
     EXPECT_GT(worst(later), 1.03);
 }
 
@@ -361,17 +455,33 @@ TEST(SelfCalibration, ADriftingThermistorNeverMakesTheModelWorse) {
     EXPECT_LE(w.worst_ratio, 1.05);
 }
 
-// A head biased by 4" for one day: most of its orbits are held back (fewer
-// than the persistence), no change is taken as real, and the IBAs after it
-// stay at the floor.
-TEST(SelfCalibration, AHeadBiasedForADayIsHeldBack) {
+// A head biased by 4" for one day: longer than the persistence, so it is
+// followed while it lasts (taken as a change after 3 held orbits) and undone
+// at its end (3 more held orbits, the second change); the IBAs of the 50 days
+// after it are at the floor. Mutation: were the running RMS restarted at a
+// change, the end would be fed as ordinary orbits (1 change, 1.020 after).
+TEST(SelfCalibration, AHeadBiasedForADayIsFollowedAndUndone) {
     const Mission m = simulate("bias-day", 200.0, [](host::SimulateOptions& o) {
         o.head_biases.push_back({1, {150.0, 151.0}, 4.0});
     });
     const Learnt r = run(m, calib::EstimatorConfig{});
     std::printf("biased day: %u orbits held back, %u changes; days 151-200 %s\n", r.sc.report.orbits_held,
                 r.sc.report.changes, text(ratio(m, r.ibas, 151, 200)).c_str());
-    EXPECT_GE(r.sc.report.orbits_held, 5U);
+    EXPECT_GE(r.sc.report.orbits_held, 2U * calib::EstimatorConfig{}.persistence_orbits);
+    EXPECT_EQ(r.sc.report.changes, 2U);
+    EXPECT_LE(worst(ratio(m, r.ibas, 151, 200)), 1.03);
+}
+
+// A head biased by 4" for 1.5 h (one orbit, within at most two orbit bins):
+// shorter than the persistence, held back, no change taken as real.
+TEST(SelfCalibration, AHeadBiasedForAnOrbitIsHeldBack) {
+    const Mission m = simulate("bias-orbit", 200.0, [](host::SimulateOptions& o) {
+        o.head_biases.push_back({1, {150.0, 150.0 + 5400.0 / kDay}, 4.0});
+    });
+    const Learnt r = run(m, calib::EstimatorConfig{});
+    std::printf("biased orbit: %u orbits held back, %u changes; days 150-200 %s\n", r.sc.report.orbits_held,
+                r.sc.report.changes, text(ratio(m, r.ibas, 150, 200)).c_str());
+    EXPECT_GE(r.sc.report.orbits_held, 1U);
     EXPECT_EQ(r.sc.report.changes, 0U);
     EXPECT_LE(worst(ratio(m, r.ibas, 151, 200)), 1.03);
 }

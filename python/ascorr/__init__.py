@@ -9,7 +9,8 @@ Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame, from_frame, read_mountings, combine, align.
 Classes: Model. Exceptions: InputError, FitRefused and AlignRefused (all
 ValueError). HEADS: the head letters in index order (from the core's
-ascorr/core/heads.hpp).
+ascorr/core/heads.hpp); MODEL_TERMS: the model's terms, the model file's
+columns after chu and axis, in order (from ascorr/core/model_terms.hpp).
 
 Arguments: a wrong value raises ValueError "argument 'NAME': expected ..., got
 ..."; a missing or unknown argument raises TypeError naming it. Paths are str
@@ -22,7 +23,7 @@ import functools as _functools
 import inspect as _inspect
 
 from . import _ascorr
-from ._ascorr import HEADS, AlignRefused, FitRefused, InputError, Model  # noqa: F401
+from ._ascorr import HEADS, MODEL_TERMS, AlignRefused, FitRefused, InputError, Model  # noqa: F401
 from ._version import __version__  # noqa: F401
 
 

@@ -13,6 +13,7 @@ _Path = Union[str, PathLike[str]]  # every path argument: str or os.PathLike (pa
 
 __version__: str  # project(VERSION) of the CMake build
 HEADS: str  # the head letters in index order, from the core (ascorr/core/heads.hpp)
+MODEL_TERMS: tuple[str, ...]  # the model's terms, the model file's columns, from the core (ascorr/core/model_terms.hpp)
 
 class InputError(ValueError):
     """A malformed input file or rows (a ValueError); the message starts with file:line:column."""
@@ -30,7 +31,7 @@ class Model:
     in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
     coefficients (a head not listed gets status 256 in correct())."""
     def __init__(self, coefficients: npt.ArrayLike, heads: Optional[str] = ...) -> None: ...
-    # (len(HEADS), 3, 7) arcsec
+    # (len(HEADS), 3, len(MODEL_TERMS)) arcsec
     @property
     def coefficients(self) -> npt.NDArray[np.float64]:
         """Coefficients, float64 (4, 3, 7): [head 'A'..'D'][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], arcsec (a copy)."""

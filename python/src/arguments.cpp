@@ -10,6 +10,7 @@
 
 #include "ascorr/core/heads.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "bind.hpp"
 
 namespace ascorr::python {
@@ -28,6 +29,10 @@ const char* docstring(const char* text) {
     fill("@N_HEADS@", std::to_string(kMaxHeads));
     fill("@HEAD_LETTERS@", head_letter_range());
     fill("@HEAD_INDICES@", head_index_range());
+    fill("@N_TERMS@", std::to_string(kModelTerms));
+    fill("@N_LINEAR_TERMS@", std::to_string(kLinearModelTerms));
+    fill("@TERMS@", host::coefficient_columns(0, kModelTerms, ", "));
+    fill("@QUADRATIC_TERMS@", host::coefficient_columns(kLinearModelTerms, kModelTerms, ", "));
     return kept.emplace_back(std::move(s)).c_str();
 }
 

@@ -21,11 +21,11 @@ using namespace pybind11::literals;
 namespace {
 
 py::array_t<double> model_coefficients(const host::ModelFile& m) {
-    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{3}, py::ssize_t{7}});
+    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{kModelAxes}, py::ssize_t{kModelTerms}});
     double* p = a.mutable_data();
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t ax = 0; ax < 3; ++ax) {
-            for (std::size_t c = 0; c < 7; ++c) {
+        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
+            for (std::size_t c = 0; c < kModelTerms; ++c) {
                 *p++ = m.coefficients[h][ax][c];
             }
         }
@@ -39,27 +39,30 @@ host::ModelFile model_from(const py::object& coefficients, const py::object& hea
     if (kind != 'f' && kind != 'i' && kind != 'u') {
         bad_argument("coefficients", "expected real numbers, got dtype " + std::string(py::str(a.dtype())));
     }
-    if (a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} || a.shape(1) != 3 ||
-        (a.shape(2) != 4 && a.shape(2) != 7)) {
-        bad_argument("coefficients", "expected shape (" + std::to_string(kMaxHeads) + ", 3, 4) or (" +
-                                         std::to_string(kMaxHeads) + ", 3, 7) (head " + head_letter_range() +
-                                         ", axis alpha/beta/gamma, c0 c1 c2 c3 [c1_2 c2_2 c3_2]), got " +
-                                         shape_text(a));
+    if (a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} || a.shape(1) != py::ssize_t{kModelAxes} ||
+        (a.shape(2) != py::ssize_t{kLinearModelTerms} && a.shape(2) != py::ssize_t{kModelTerms})) {
+        const std::string axes = ", " + std::to_string(kModelAxes) + ", ";
+        bad_argument("coefficients",
+                     "expected shape (" + std::to_string(kMaxHeads) + axes + std::to_string(kLinearModelTerms) +
+                         ") or (" + std::to_string(kMaxHeads) + axes + std::to_string(kModelTerms) + ") (head " +
+                         head_letter_range() + ", axis alpha/beta/gamma, " +
+                         host::coefficient_columns(0, kLinearModelTerms, " ") + " [" +
+                         host::coefficient_columns(kLinearModelTerms, kModelTerms, " ") + "]), got " + shape_text(a));
     }
     const Doubles c = Doubles::ensure(a);
     const auto k = static_cast<std::size_t>(a.shape(2));
     host::ModelFile m;
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t ax = 0; ax < 3; ++ax) {
+        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
             for (std::size_t j = 0; j < k; ++j) {
-                const double x = c.data()[(h * 3 + ax) * k + j];
+                const double x = c.data()[(h * kModelAxes + ax) * k + j];
                 if (!std::isfinite(x)) {
                     bad_argument("coefficients", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) +
                                                      " " + host::kAxisNames[ax] + " " + host::kCoefficientNames[j] +
                                                      " is not finite");
                 }
                 m.coefficients[h][ax][j] = x;
-                m.quadratic = m.quadratic || (j >= 4 && x != 0.0);
+                m.quadratic = m.quadratic || (j >= kLinearModelTerms && x != 0.0);
             }
         }
     }

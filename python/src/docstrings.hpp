@@ -2,9 +2,11 @@
 // place they are written. The type stub (python/ascorr/__init__.pyi) carries
 // the same text, and python/tests/test_docs.py fails when the two differ.
 //
-// Placeholders, filled from the core's ascorr/core/heads.hpp by docstring()
-// (bind.hpp): @HEADS@ the head letters ("ABCD"), @N_HEADS@ their number,
-// @HEAD_LETTERS@ "'A'..'D'", @HEAD_INDICES@ "0..3".
+// Placeholders, filled from the core's ascorr/core/heads.hpp and
+// model_terms.hpp by docstring() (bind.hpp): @HEADS@ the head letters
+// ("ABCD"), @N_HEADS@ their number, @HEAD_LETTERS@ "'A'..'D'", @HEAD_INDICES@
+// "0..3"; @N_TERMS@ the model's terms (7), @N_LINEAR_TERMS@ its linear ones
+// (4), @TERMS@ their names "c0, c1, ...", @QUADRATIC_TERMS@ "c1_2, c2_2, c3_2".
 #pragma once
 
 namespace ascorr::python::docs {
@@ -21,14 +23,14 @@ inline constexpr const char* kFitRefused =
 inline constexpr const char* kModel = R"doc(A thermal model: per head and axis, angles in arcsec linear (and
 optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md, "Model file").
 
-Model(coefficients, heads="@HEADS@"): coefficients of shape (@N_HEADS@, 3, 4) or (@N_HEADS@, 3, 7),
-indexed [head @HEAD_LETTERS@][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
+Model(coefficients, heads="@HEADS@"): coefficients of shape (@N_HEADS@, 3, @N_LINEAR_TERMS@) or (@N_HEADS@, 3, @N_TERMS@),
+indexed [head @HEAD_LETTERS@][axis alpha, beta, gamma][@TERMS@],
 in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
 coefficients (a head not listed gets status 256 in correct()).)doc";
 
 inline constexpr const char* kModelCoefficients =
-    "Coefficients, float64 (@N_HEADS@, 3, 7): [head @HEAD_LETTERS@][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, "
-    "c3_2], arcsec (a copy).";
+    "Coefficients, float64 (@N_HEADS@, 3, @N_TERMS@): [head @HEAD_LETTERS@][alpha, beta, gamma][@TERMS@], arcsec (a "
+    "copy).";
 inline constexpr const char* kModelHeads = "The heads with coefficients, e.g. 'ABC'.";
 inline constexpr const char* kModelQuadratic =
     "True when the model has (and its file will carry) the quadratic columns.";
@@ -122,7 +124,7 @@ null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the comman
 
 inline constexpr const char* kFit =
     R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),
-with its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2;
+with its defaults and checks. terms: 'linear' or 'quadratic' (also @QUADRATIC_TERMS@;
 any case, as --terms); holdout: the fraction of the period (its end) held out for the
 model-selection report, 0..0.5; min_temperature_range: the smallest range (degC) of
 each regressor for quadratic terms; frame_heads: frame F's two heads, e.g. 'AD' (as

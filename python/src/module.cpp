@@ -28,6 +28,12 @@ PYBIND11_MODULE(_ascorr, mod) {
 
     // The heads (ascorr/core/heads.hpp), for Python and for the docstrings.
     mod.attr("HEADS") = py::str(kHeadLetters);
+    // The model's terms, the model file's columns (ascorr/core/model_terms.hpp).
+    py::tuple terms(kModelTerms);
+    for (std::size_t k = 0; k < kModelTerms; ++k) {
+        terms[k] = py::str(kModelTermTable[k].name);
+    }
+    mod.attr("MODEL_TERMS") = terms;
 
     bind_model(mod);
     bind_formats(mod);

@@ -152,3 +152,17 @@ def test_a_mission_without_c_is_fitted_on_its_heads_as_the_command_line(exe, tmp
                            ("heads", "ABE"), ("heads", b"AB")]:
         with pytest.raises(ValueError, match=f"argument '{keyword}': expected .* of the heads ABCD"):
             ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, **{keyword: value})
+
+
+def test_model_terms_are_the_model_files_columns():
+    # ascorr.MODEL_TERMS comes from the core's table (ascorr/core/model_terms.hpp):
+    # the coefficients' last axis and the model file's columns after chu, axis.
+    terms = ascorr.MODEL_TERMS
+    assert terms[0] == "c0" and len(terms) == len(set(terms)) and all(isinstance(t, str) for t in terms)
+    c = np.zeros((len(ascorr.HEADS), 3, len(terms)))
+    c[1, 2, -1] = 1.5  # the last term: a quadratic one, so the file carries every column
+    model = ascorr.Model(c)
+    assert model.coefficients.shape == (len(ascorr.HEADS), 3, len(terms)) and model.quadratic
+    assert model.to_csv().splitlines()[0] == ",".join(("chu", "axis") + terms)
+    linear = ascorr.Model(np.zeros((len(ascorr.HEADS), 3, 4)))
+    assert linear.to_csv().splitlines()[0] == ",".join(("chu", "axis") + terms[:4])

@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "ascorr/core/heads.hpp"
+#include "ascorr/core/model_terms.hpp"
 
 namespace ascorr::target {
 
@@ -23,7 +24,7 @@ inline constexpr std::uint32_t kModels = 2;                 // 0: Table 2, 1: ra
 
 struct ModelRecord {
     std::uint32_t present[kMaxHeads];
-    double coefficient[kMaxHeads][3][7];  // [head][alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2], rad
+    double coefficient[kMaxHeads][kModelAxes][kModelTerms];  // [head][alpha, beta, gamma][term], rad
 };
 
 struct VectorHeader {

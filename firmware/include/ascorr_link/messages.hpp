@@ -57,7 +57,10 @@ enum class AckResult : std::uint8_t {
     kBadPayload = 2,   // wrong length or an out-of-range field
 };
 
-inline constexpr std::size_t kCoefficientsPerHead = 21;  // alpha, beta, gamma × c0 c1 c2 c3 c1_2 c2_2 c3_2
+// A head's coefficients on the link: alpha, beta, gamma × the terms of
+// kModelTermTable (core/model_terms.hpp), in its order, each a word of its
+// term's format.
+inline constexpr std::size_t kCoefficientsPerHead = std::size_t{kModelAxes} * kModelTerms;
 
 struct Hello {
     std::uint32_t boot_id;  // changes at every target start: the host re-uploads state when it does
@@ -143,12 +146,7 @@ std::size_t encode(const ModelUpload<T>& m, std::uint8_t* out) noexcept {
     w.u8(m.head);
     w.u8(m.model.present ? 1U : 0U);
     for (const AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
-        for (const Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3}) {
-            w.word(*c);
-        }
-        for (const QuadraticCoefficient<T>* c : {&a->c1_2, &a->c2_2, &a->c3_2}) {
-            w.word(*c);
-        }
+        for_each_term(*a, [&w](auto, const auto& c) { w.word(c); });
     }
     return w.size();
 }
@@ -160,19 +158,11 @@ bool decode(const std::uint8_t* p, std::size_t n, ModelUpload<T>& m) noexcept {
         return false;
     }
     m.model.present = present == 1U;
+    bool ok = true;
     for (AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
-        for (Coefficient<T>* c : {&a->c0, &a->c1, &a->c2, &a->c3}) {
-            if (!r.word(*c)) {
-                return false;
-            }
-        }
-        for (QuadraticCoefficient<T>* c : {&a->c1_2, &a->c2_2, &a->c3_2}) {
-            if (!r.word(*c)) {
-                return false;
-            }
-        }
+        for_each_term(*a, [&](auto, auto& c) { ok = ok && r.word(c); });
     }
-    return r.done();
+    return ok && r.done();
 }
 
 template <typename T>

@@ -19,6 +19,18 @@ namespace {
 
 constexpr int kGauge = 9;  // a rotation common to all heads, linear in T029 and T032 (fit.hpp)
 
+// uncentre() and apply_gauge() expand each regressor's linear and quadratic
+// term: the table must have both for each.
+constexpr bool terms_expandable() noexcept {
+    bool ok = term_index(Regressor::kOne, 0) == 0;
+    for (std::uint8_t j = 1; j <= kRegressors; ++j) {
+        ok = ok && term_index(static_cast<Regressor>(j), 1) < kLinearModelTerms &&
+             term_index(static_cast<Regressor>(j), 2) < kModelTerms;
+    }
+    return ok;
+}
+static_assert(terms_expandable(), "fit_terms.cpp: every regressor has a linear and a quadratic term");
+
 __attribute__((format(printf, 1, 2))) std::string format(const char* fmt, ...) {
     char buf[600];
     va_list ap;
@@ -28,26 +40,34 @@ __attribute__((format(printf, 1, 2))) std::string format(const char* fmt, ...) {
     return buf;
 }
 
-// The orbit's design row of head h: [1, u1, u2, u3 (, avg u1², avg u2², avg u3²)].
+// The orbit's design row of head h, a column per term (core/model_terms.hpp):
+// [1, u1, u2, u3 (, avg u1², avg u2², avg u3²)], u_j = (x_j − m_j)/s_j.
 Eigen::VectorXd regressors(const OrbitAverage& o, std::size_t h, const Centring& c, int per_axis) {
     Eigen::VectorXd r(per_axis);
-    r(0) = 1.0;
-    for (std::size_t j = 0; j < 3; ++j) {
+    for (std::uint8_t k = 0; k < per_axis; ++k) {
+        const ModelTerm& term = kModelTermTable[k];
+        if (term.power == 0) {
+            r(k) = 1.0;
+            continue;
+        }
+        const std::size_t j = regressor_index(k);
         const double m = c.mean[h][j];
         const double s = c.scale[h][j];
         const auto ji = static_cast<Eigen::Index>(j);
-        r(1 + ji) = (o.x[h](ji) - m) / s;
-        if (per_axis == 7) {
-            r(4 + ji) = (o.x2[h](ji) - 2.0 * m * o.x[h](ji) + m * m) / (s * s);
-        }
+        r(k) = term.power == 1 ? (o.x[h](ji) - m) / s : (o.x2[h](ji) - 2.0 * m * o.x[h](ji) + m * m) / (s * s);
     }
     return r;
 }
 
-// The model's angle (arcsec) for an orbit's averages, contract form.
-double predicted(const std::array<double, 7>& c, const OrbitAverage& o, std::size_t h) {
-    return c[0] + c[1] * o.x[h](0) + c[2] * o.x[h](1) + c[3] * o.x[h](2) + c[4] * o.x2[h](0) + c[5] * o.x2[h](1) +
-           c[6] * o.x2[h](2);
+// The model's angle (arcsec) for an orbit's averages, contract form: a
+// quadratic term takes the orbit's average of the square.
+double predicted(const std::array<double, kModelTerms>& c, const OrbitAverage& o, std::size_t h) {
+    double sum = c[0];
+    for (std::uint8_t k = 1; k < kModelTerms; ++k) {
+        const auto ji = static_cast<Eigen::Index>(regressor_index(k));
+        sum += c[k] * (kModelTermTable[k].power == 1 ? o.x[h](ji) : o.x2[h](ji));
+    }
+    return sum;
 }
 
 // Regressor j of head h: its mean, its scale (the standard deviation; 1
@@ -185,7 +205,7 @@ std::string why_ill_conditioned(const TermsFit& f, const Eigen::BDCSVD<Eigen::Ma
     const Eigen::VectorXd sv = svd.singularValues();
     const Eigen::VectorXd weakest = svd.matrixV().col(rank - 1);
     std::array<double, kMaxHeads> head_share{};  // by position in list
-    std::array<std::array<double, 7>, kMaxHeads> term_share{};
+    std::array<std::array<double, kModelTerms>, kMaxHeads> term_share{};
     for (Eigen::Index i = 0; i < unknowns; ++i) {
         const auto h = static_cast<std::size_t>(i / (3 * per_axis));
         const auto t = static_cast<std::size_t>(i % per_axis);
@@ -235,15 +255,18 @@ void uncentre(const Eigen::VectorXd& b, const HeadList& list, int per_axis, Term
             auto& c = m.coefficients[h][ax];
             c = {};
             c[0] = b(base);
-            for (std::size_t j = 0; j < 3; ++j) {
+            for (std::uint8_t j = 0; j < kRegressors; ++j) {
+                const auto x = static_cast<Regressor>(j + 1);
+                const std::size_t k_lin = term_index(x, 1);
+                const std::size_t k_quad = term_index(x, 2);
                 const double mj = f.centring.mean[h][j];
                 const double sj = f.centring.scale[h][j];
-                const auto ji = static_cast<Eigen::Index>(j);
-                const double lin = b(base + 1 + ji);
-                const double quad = per_axis == 7 ? b(base + 4 + ji) : 0.0;
+                const double lin = b(base + static_cast<Eigen::Index>(k_lin));
+                const double quad =
+                    static_cast<int>(k_quad) < per_axis ? b(base + static_cast<Eigen::Index>(k_quad)) : 0.0;
                 c[0] += -lin * mj / sj + quad * mj * mj / (sj * sj);
-                c[1 + j] = lin / sj - 2.0 * quad * mj / (sj * sj);
-                c[4 + j] = quad / (sj * sj);
+                c[k_lin] = lin / sj - 2.0 * quad * mj / (sj * sj);
+                c[k_quad] = quad / (sj * sj);
             }
         }
     }
@@ -282,10 +305,10 @@ void apply_gauge(const std::vector<OrbitAverage>& orbits, const HeadOrientations
         for (std::size_t ax = 0; ax < 3; ++ax) {
             const auto ai = static_cast<Eigen::Index>(ax);
             auto& c = m.coefficients[h][ax];
-            c[0] += w0(ai);
-            c[1] += w2(ai) + w3(ai);  // T2 = T1 + (T2 − T1), likewise T3
-            c[2] += w2(ai);
-            c[3] += w3(ai);
+            c[term_index(Regressor::kOne, 0)] += w0(ai);
+            c[term_index(Regressor::kT1, 1)] += w2(ai) + w3(ai);  // T2 = T1 + (T2 − T1), likewise T3
+            c[term_index(Regressor::kT2MinusT1, 1)] += w2(ai);
+            c[term_index(Regressor::kT3MinusT1, 1)] += w3(ai);
         }
     }
 }

@@ -316,7 +316,7 @@ std::string truth_history_csv(const std::vector<Truth>& truths) {
     for (const Truth& t : truths) {
         quadratic = quadratic || t.file.quadratic;
     }
-    std::string s = quadratic ? "t,version,chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "t,version,chu,axis,c0,c1,c2,c3\n";
+    std::string s = "t,version," + model_header(quadratic ? kModelTerms : kLinearModelTerms);
     for (std::size_t v = 0; v < truths.size(); ++v) {
         ModelFile m = truths[v].file;
         m.quadratic = quadratic;

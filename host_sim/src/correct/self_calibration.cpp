@@ -412,11 +412,14 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
         for (std::size_t a = 0; a < kModelAxes; ++a) {
             for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
                 if (m.present[h] && m.coefficients[h][a][i] != 0.0) {
+                    const std::string linear =
+                        std::string(kCoefficientNames[0]) + ".." + kCoefficientNames[kLinearModelTerms - 1];
                     throw std::runtime_error(
                         name + ": head " + std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
                         kAxisNames[a] + " has a quadratic term (" + kCoefficientNames[i] +
-                        "): self-calibration starts from a linear model (the on-board estimator's models are c0..c3, "
-                        "and the link's CALIB_MODEL_LOAD carries c0..c3); give the model without its quadratic terms");
+                        "): self-calibration starts from a linear model (the on-board estimator's models are " +
+                        linear + ", and the link's CALIB_MODEL_LOAD carries " + linear +
+                        "); give the model without its quadratic terms");
                 }
             }
         }
@@ -591,7 +594,7 @@ const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learn
 }
 
 std::string format_model_history(const std::vector<ActiveModel>& history) {
-    std::string out = "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin\n";
+    std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin\n";
     char buf[96];
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {

@@ -14,22 +14,43 @@
 
 namespace ascorr::host {
 
+std::string coefficient_columns(std::size_t first, std::size_t last, const char* separator) {
+    std::string out;
+    for (std::size_t k = first; k < last; ++k) {
+        out += (k == first ? "" : separator);
+        out += kCoefficientNames[k];
+    }
+    return out;
+}
+
+std::string model_header(std::size_t terms) {
+    return "chu,axis," + coefficient_columns(0, terms, ",") + "\n";
+}
+
+namespace {
+
+// A coefficient's unit in the model file, by its term's power.
+const char* unit_of(std::size_t k) {
+    static constexpr const char* kUnitOfPower[3] = {"arcsec", "arcsec/degC", "arcsec/degC^2"};
+    return kUnitOfPower[kModelTermTable[k].power];
+}
+
+}  // namespace
+
 void check_fixed_point_range(const ModelFile& m, const std::string& path) {
-    static constexpr const char* kUnits[7] = {"arcsec",        "arcsec/degC",   "arcsec/degC",  "arcsec/degC",
-                                              "arcsec/degC^2", "arcsec/degC^2", "arcsec/degC^2"};
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; a < 3; ++a) {
-            for (std::size_t i = 0; i < 7; ++i) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::uint8_t i = 0; i < kModelTerms; ++i) {
                 const double c = m.coefficients[h][a][i];
-                const double lim =
-                    i < 4 ? ScalarTraits<Q30>::max_coefficient : ScalarTraits<Q30>::max_quadratic_coefficient;
+                const double lim = quadratic_term(i) ? ScalarTraits<Q30>::max_quadratic_coefficient
+                                                     : ScalarTraits<Q30>::max_coefficient;
                 if (!(std::abs(c * kArcsecToRad) < lim)) {
                     char limit[160];
                     text::c_snprintf(limit, sizeof limit, " is beyond the fixed-point coefficient range (|%s| < %g %s)",
-                                     kCoefficientNames[i], lim * kRadToArcsec, kUnits[i]);
+                                     kCoefficientNames[i], lim * kRadToArcsec, unit_of(i));
                     const std::string what = std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " +
                                              kAxisNames[a] + " " + kCoefficientNames[i] + " = " + number_text(c) + " " +
-                                             kUnits[i] + limit;
+                                             unit_of(i) + limit;
                     if (m.line[h][a] != 0) {
                         throw InputError(path, m.line[h][a], m.column[h][a][i], what);
                     }
@@ -70,9 +91,14 @@ void check_float_range(const ModelFile& m, const std::string& path) {
 
 namespace {
 
-void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[7], const std::string& file_name) {
-    if (col_chu < 0 || col_axis < 0 || col_c[0] < 0 || col_c[1] < 0 || col_c[2] < 0 || col_c[3] < 0) {
-        throw InputError(file_name, 1, 1, "the model header must have chu,axis,c0,c1,c2,c3");
+void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[kModelTerms], const std::string& file_name) {
+    bool missing = col_chu < 0 || col_axis < 0;
+    for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
+        missing = missing || col_c[i] < 0;
+    }
+    if (missing) {
+        throw InputError(file_name, 1, 1,
+                         "the model header must have chu,axis," + coefficient_columns(0, kLinearModelTerms, ","));
     }
 }
 
@@ -85,10 +111,10 @@ void refuse_unknown_columns(const Header& header, const std::string& file_name) 
             known = known || name == c;
         }
         if (!known) {
-            throw InputError(
-                file_name, 1, column,
-                "unknown column '" + name +
-                    "' (a model has chu, axis, c0, c1, c2, c3 and, for a quadratic one, c1_2, c2_2, c3_2)");
+            throw InputError(file_name, 1, column,
+                             "unknown column '" + name + "' (a model has chu, axis, " +
+                                 coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
+                                 coefficient_columns(kLinearModelTerms, kModelTerms, ", ") + ")");
         }
         column += name.size() + 1;
     }
@@ -139,7 +165,9 @@ bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_he
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
     if (text.empty()) {
-        throw InputError(file_name, 1, 1, "empty model file: expected the header chu,axis,c0,c1,c2,c3");
+        throw InputError(
+            file_name, 1, 1,
+            "empty model file: expected the header chu,axis," + coefficient_columns(0, kLinearModelTerms, ","));
     }
     LineReader lines(text);
     std::string_view line;
@@ -147,15 +175,17 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
     const Header header(line, file_name);
     const int col_chu = header.index("chu");
     const int col_axis = header.index("axis");
-    int col_c[7];
-    for (std::size_t i = 0; i < 7; ++i) {
+    int col_c[kModelTerms];
+    for (std::size_t i = 0; i < kModelTerms; ++i) {
         col_c[i] = header.index(kCoefficientNames[i]);
     }
     refuse_missing_columns(col_chu, col_axis, col_c, file_name);
     refuse_unknown_columns(header, file_name);
 
     ModelFile m;
-    m.quadratic = col_c[4] >= 0 || col_c[5] >= 0 || col_c[6] >= 0;
+    for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
+        m.quadratic = m.quadratic || col_c[i] >= 0;
+    }
     bool seen[kMaxHeads][3] = {};
     std::vector<std::string_view> fields;
     std::vector<std::size_t> starts;
@@ -192,7 +222,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         seen[head][axis] = true;
         line_of_head[head] = n;
         m.line[head][static_cast<std::size_t>(axis)] = n;
-        for (std::size_t i = 0; i < 7; ++i) {
+        for (std::size_t i = 0; i < kModelTerms; ++i) {
             if (col_c[i] >= 0) {
                 read_coefficient(file_name, n, i, static_cast<std::size_t>(col_c[i]), fields, starts,
                                  m.coefficients[head][static_cast<std::size_t>(axis)][i],
@@ -214,14 +244,14 @@ ModelFile read_model_file(const std::string& path) {
 }
 
 std::string format_model(const ModelFile& m) {
-    std::string out = m.quadratic ? "chu,axis,c0,c1,c2,c3,c1_2,c2_2,c3_2\n" : "chu,axis,c0,c1,c2,c3\n";
-    const std::size_t ncoef = m.quadratic ? 7 : 4;
+    const std::size_t ncoef = m.quadratic ? kModelTerms : kLinearModelTerms;
+    std::string out = model_header(ncoef);
     char buf[64];
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         if (!m.present[h]) {
             continue;
         }
-        for (std::size_t a = 0; a < 3; ++a) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
             out += head_name(static_cast<std::uint8_t>(h));
             out += ',';
             out += kAxisNames[a];

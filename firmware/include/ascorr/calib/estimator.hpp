@@ -189,6 +189,7 @@ public:
         orbits_used_ = 0;
         window_.clear();
         held_run_ = 0;
+        since_change_ = kWindow;
         ms_count_ = 0;
         ms_ = 0.0;
         has_solution_ = false;
@@ -335,13 +336,15 @@ private:
             }
         }
         window_.push(o);
+        since_change_ = since_change_ < kWindow ? since_change_ + 1U : since_change_;
         if (o.held && held_run_ < cfg_.persistence_orbits) {
             return;
         }
         if (o.held) {
             // A real change (a mount that shifted): the intercepts' information
             // is released, the slopes' kept; then the held orbits still in the
-            // window are fed, oldest first.
+            // window are fed, oldest first. The running RMS is kept, so that the
+            // end of a transient step is the next change, and undoes this one.
             for (auto& f : srif_) {
                 f.release_first();
             }
@@ -353,8 +356,8 @@ private:
                     feed(r);
                 }
             }
+            since_change_ = held_run_;  // the change began with the first held orbit
             held_run_ = 0;
-            ms_count_ = 0;
             return;
         }
         feed(window_.at(window_.size() - 1U));
@@ -444,10 +447,13 @@ private:
     }
 
     // Phase 4: the comparison with the active model; the back buffer and swap.
+    // After a change, only the orbits since it are compared: the older ones
+    // favour the active model, made for the bench before the change.
     void gate() noexcept {
-        candidate_rms_ = window_rms(cand_, window_, n_mat_, cfg_.window_orbits, solved_);
+        const std::uint32_t n = since_change_ < cfg_.window_orbits ? since_change_ : cfg_.window_orbits;
+        candidate_rms_ = window_rms(cand_, window_, n_mat_, n, solved_);
         if (has_[active_]) {
-            active_rms_ = window_rms(model_[active_], window_, n_mat_, cfg_.window_orbits, solved_);
+            active_rms_ = window_rms(model_[active_], window_, n_mat_, n, solved_);
             if (!(candidate_rms_ <= (1.0 - cfg_.adoption_margin) * active_rms_)) {
                 refuse(Refusal::kNoGain);
                 return;
@@ -521,6 +527,7 @@ private:
     double ms_ = 0.0;
     std::uint32_t ms_count_ = 0;
     std::uint32_t held_run_ = 0;
+    std::uint32_t since_change_ = kWindow;  // orbits since the last change taken as real (saturating)
     OrbitWindow<N> window_{};
     // Counters and the report.
     std::uint32_t orbits_used_ = 0;

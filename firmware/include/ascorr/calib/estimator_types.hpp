@@ -43,8 +43,11 @@ constexpr bool learns_head(std::size_t h, std::uint32_t learnt_mask) noexcept {
 constexpr std::size_t iba_pairs(std::size_t n_heads) noexcept {
     return n_heads * (n_heads - 1U) / 2U;
 }
-inline constexpr std::size_t kUnknowns = 4;  // [1, T1, T2 − T1, T3 − T1] per axis
-inline constexpr std::size_t kWindow = 32;   // recent orbits kept (gate and held-back orbits)
+// The estimator learns the linear terms of core/model_terms.hpp per axis,
+// [1, T1, T2 − T1, T3 − T1] (its design row, Estimator::feed).
+inline constexpr std::size_t kUnknowns = kLinearModelTerms;
+static_assert(kUnknowns == 4, "Estimator::feed's design row lists the linear terms of kModelTermTable");
+inline constexpr std::size_t kWindow = 32;  // recent orbits kept (gate and held-back orbits)
 
 // The orbit periods and time constants the estimator is meant for: an orbit
 // of 10 min to a day (an Earth orbit's period is 88 min to 24 h; shorter bins
@@ -68,13 +71,21 @@ struct EstimatorConfig {
     double time_constant_days = 30.0;              // τ of the forgetting (chosen: docs/ground.md, Self-calibration)
     std::uint32_t min_orbits = 30;                 // orbits in the filter before a first model
     std::uint32_t min_epochs_per_orbit = 4;        // fewer: the orbit is not used
-    double min_coverage = 0.5;                     // ... nor below this fraction of a typical orbit's count
-    double max_condition = 1e4;                    // per head, equilibrated information matrix
-    double adoption_margin = 0.03;                 // a candidate must beat the active model by 3 %
-    std::uint32_t window_orbits = 30;              // orbits of the residual comparison (≤ kWindow)
-    double angle_check_margin_c = 30.0;            // °C around the recent temperatures
-    double outlier_gate = 3.0;                     // innovation RMS over the running RMS
-    std::uint32_t persistence_orbits = 24;         // held back in a row: a real change (≤ kWindow)
+    // ... nor below this fraction of a typical orbit's count. The model is linear in the
+    // temperatures, so a partial orbit's means obey it as a whole orbit's do; 0.3, not
+    // 0.5: a head blinded for most of each orbit for days (the Moon) must not blind the
+    // estimator to a settling then (issue 31: 1.216 → 1.091 on such a mission).
+    double min_coverage = 0.3;
+    double max_condition = 1e4;          // per head, equilibrated information matrix
+    double adoption_margin = 0.03;       // a candidate must beat the active model by 3 %
+    std::uint32_t window_orbits = 30;    // orbits of the residual comparison (≤ kWindow)
+    double angle_check_margin_c = 30.0;  // °C around the recent temperatures
+    double outlier_gate = 3.0;           // innovation RMS over the running RMS
+    // Held back in a row: a real change (≤ kWindow). Each orbit of a step not followed
+    // costs its whole size: 3 orbits of a 5" step are 1.08 of the floor over 30 days.
+    // Shorter outlier runs are refused; longer ones are followed and, at their end,
+    // undone the same way (README.md, "Outliers and changes").
+    std::uint32_t persistence_orbits = 3;
 };
 
 enum class Refusal : std::uint8_t {

@@ -18,11 +18,11 @@
 namespace ascorr::calib {
 
 // Model m's angle (arcsec) for head h and axis a at regressors x = (T1,
-// T2 − T1, T3 − T1) in °C (the contract's model, quadratic terms included).
-inline double model_angle(const ModelCoefficients& m, std::size_t h, std::size_t a, const double (&x)[3]) noexcept {
-    const double* c = m.coefficient[h][a];
-    return c[0] + c[1] * x[0] + c[2] * x[1] + c[3] * x[2] + c[4] * x[0] * x[0] + c[5] * x[1] * x[1] +
-           c[6] * x[2] * x[2];
+// T2 − T1, T3 − T1) in °C (the contract's model, every term of
+// core/model_terms.hpp).
+inline double model_angle(const ModelCoefficients& m, std::size_t h, std::size_t a,
+                          const double (&x)[kRegressors]) noexcept {
+    return model_polynomial(m.coefficient[h][a], x);
 }
 
 // Whether every linear coefficient of the heads in `heads` (bit h: head h,

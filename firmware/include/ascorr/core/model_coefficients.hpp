@@ -2,47 +2,51 @@
 // conversion of such numbers into the core's ThermalModel<T>.
 //
 // Conventions: coefficient[head][axis][term], head by index (heads.hpp), axis
-// alpha, beta, gamma (0, 1, 2; kModelAxes of them), term c0, c1, c2, c3, c1_2, c2_2, c3_2 (the
-// model file's columns, docs/contract.md "Model file"), in one unit given with
+// alpha, beta, gamma (0, 1, 2; kModelAxes of them), term by kModelTermTable
+// (model_terms.hpp: c0, c1, c2, c3, c1_2, c2_2, c3_2, the model file's
+// columns, docs/contract.md "Model file"), in one unit given with
 // the numbers: `unit_to_rad` = kArcsecToRad for a model file's arcsec (arcsec/°C,
 // arcsec/°C²), 1 for radians. Each coefficient is multiplied by unit_to_rad in
 // double (× 1 is exact) and then rounded once into T's formats by
-// ScalarTraits<T>::coefficient (c0 … c3) or quadratic_coefficient (c1_2 …):
+// ScalarTraits<T>::coefficient (powers 0, 1) or quadratic_coefficient (2):
 // round to nearest; the fixed-point formats saturate, so a loader must refuse
 // a model beyond ScalarTraits<Q30>::max_coefficient / max_quadratic_coefficient
 // first (the host's check_fixed_point_range). Every producer of a core model
 // (the host's model files and Python's ascorr.Model, the flight application's
 // built-in Table 2, the example consumer, the target test vectors) converts
 // through thermal_model() below; constexpr, so the flight model is converted
-// at compile time. No allocation, fixed trip counts (kMaxHeads × 3).
+// at compile time. No allocation, fixed trip counts (kMaxHeads × kModelAxes).
 #pragma once
 
 #include <cstdint>
 
 #include "constants.hpp"
 #include "heads.hpp"
+#include "model_terms.hpp"
 #include "scalar_traits.hpp"
 #include "thermal.hpp"
 
 namespace ascorr {
-
-inline constexpr std::uint8_t kModelAxes = 3;         // alpha, beta, gamma
-inline constexpr std::uint8_t kModelTerms = 7;        // c0, c1, c2, c3, c1_2, c2_2, c3_2
-inline constexpr std::uint8_t kLinearModelTerms = 4;  // c0 … c3; the rest are quadratic
 
 struct ModelCoefficients {
     bool present[kMaxHeads];  // false: no coefficients for this head (status 256)
     double coefficient[kMaxHeads][kModelAxes][kModelTerms];
 };
 
-// One axis: seven numbers in the unit of unit_to_rad → the core's formats.
+// One axis: kModelTerms numbers in the unit of unit_to_rad → the core's
+// formats, each by its term's format.
 template <typename T>
 constexpr AxisPolynomial<T> axis_polynomial(const double (&c)[kModelTerms], double unit_to_rad) noexcept {
     using Tr = ScalarTraits<T>;
-    return {Tr::coefficient(c[0] * unit_to_rad),           Tr::coefficient(c[1] * unit_to_rad),
-            Tr::coefficient(c[2] * unit_to_rad),           Tr::coefficient(c[3] * unit_to_rad),
-            Tr::quadratic_coefficient(c[4] * unit_to_rad), Tr::quadratic_coefficient(c[5] * unit_to_rad),
-            Tr::quadratic_coefficient(c[6] * unit_to_rad)};
+    AxisPolynomial<T> p{};
+    for_each_term(p, [&](auto k, auto& field) {
+        if constexpr (quadratic_term(decltype(k)::value)) {
+            field = Tr::quadratic_coefficient(c[k] * unit_to_rad);
+        } else {
+            field = Tr::coefficient(c[k] * unit_to_rad);
+        }
+    });
+    return p;
 }
 
 // ---- The float core's thermal angle over the whole temperature domain.
@@ -64,7 +68,10 @@ inline constexpr double kFloatAngleErrorRad = 0.01 * kArcsecToRad;
 inline constexpr double kFloatMaxTermSumRad = kFloatAngleErrorRad / (12.0 * 0x1p-24);
 
 // S above for one axis' coefficients c in the unit of unit_to_rad, in rad.
+// Written out by term (not a loop over the table: the sums by regressor
+// round as they always did).
 constexpr double float_term_sum(const double (&c)[kModelTerms], double unit_to_rad) noexcept {
+    static_assert(kModelTerms == 7, "float_term_sum bounds every term of kModelTermTable");
     constexpr double t = kMaxAbsTemperatureC;
     constexpr double d = 2.0 * kMaxAbsTemperatureC;
     const auto mag = [](double x) { return x < 0.0 ? -x : x; };

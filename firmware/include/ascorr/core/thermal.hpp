@@ -32,6 +32,7 @@
 
 #include "constants.hpp"
 #include "heads.hpp"
+#include "model_terms.hpp"
 #include "q_formats.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
@@ -49,6 +50,21 @@ struct AxisPolynomial {
     QuadraticCoefficient<T> c2_2;
     QuadraticCoefficient<T> c3_2;
 };
+
+// Calls f(TermIndex<k>{}, coefficient k) for p's coefficients in the order
+// of kModelTermTable (model_terms.hpp): the one place that lists the fields
+// by term. P is AxisPolynomial<T>, const or not.
+template <typename P, typename F>
+constexpr void for_each_term(P& p, F&& f) noexcept {
+    static_assert(kModelTerms == 7, "AxisPolynomial has a field per term of kModelTermTable, in its order");
+    f(TermIndex<0>{}, p.c0);
+    f(TermIndex<1>{}, p.c1);
+    f(TermIndex<2>{}, p.c2);
+    f(TermIndex<3>{}, p.c3);
+    f(TermIndex<4>{}, p.c1_2);
+    f(TermIndex<5>{}, p.c2_2);
+    f(TermIndex<6>{}, p.c3_2);
+}
 
 template <typename T>
 struct HeadThermalModel {
@@ -85,10 +101,13 @@ constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
 }
 
 // The model angle of one axis, in radians. A fixed-point scalar overloads this
-// (the coefficient and temperature formats differ from T's).
+// (the coefficient and temperature formats differ from T's). Written out by
+// term, grouped by regressor (Horner: x·(c + c_2·x)), not a loop over the
+// table: a loop would sum in another order and change float's results.
 template <typename T>
 constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
                           const Celsius<T>& t3) noexcept {
+    static_assert(kModelTerms == 7, "thermal_angle evaluates every term of kModelTermTable");
     const Celsius<T> d2 = t2 - t1;
     const Celsius<T> d3 = t3 - t1;
     return p.c0 + t1 * (p.c1 + p.c1_2 * t1) + d2 * (p.c2 + p.c2_2 * d2) + d3 * (p.c3 + p.c3_2 * d3);
@@ -191,9 +210,13 @@ constexpr std::int32_t clamp_celsius(std::int32_t t) noexcept {
 // The three quadratic products are skipped for an axis whose quadratic
 // coefficients are all zero (the usual linear model): same result, fewer
 // instructions. A branch, not a loop: the instruction count stays bounded.
+// Written out by term, not a loop over kModelTermTable: the bound on the sum
+// above is argued term by term, and the linear terms share one
+// multiply-accumulate chain (sum_products) that a loop would not keep.
 template <>
 [[gnu::always_inline]] constexpr Q30 thermal_angle<Q30>(const AxisPolynomial<Q30>& p, const QCelsius& t1,
                                                         const QCelsius& t2, const QCelsius& t3) noexcept {
+    static_assert(kModelTerms == 7 && kLinearModelTerms == 4, "the Q30 kernel evaluates c0 … c3, c1_2 … c3_2");
     using fx::mul;
     constexpr int kSumFrac = QCoefficient::kFracBits + QCelsius::kFracBits;       // 56
     constexpr int kQuadShift = QQuadraticCoefficient::kFracBits + 12 - kSumFrac;  // 4

@@ -96,7 +96,8 @@ struct FitOptions {
     std::optional<HeadSet> heads;
 };
 
-inline constexpr int kUnknowns = 36;  // three heads, linear: 3 heads × 3 axes × (c0, c1, c2, c3); quadratic: 63
+// Three heads, linear: 3 heads × 3 axes × (c0, c1, c2, c3), 36; quadratic: 63.
+inline constexpr int kUnknowns = 3 * kModelAxes * kLinearModelTerms;
 inline constexpr int kGaugeDims = 9;  // a common rotation linear in T029, T032
 
 struct FitReport {

@@ -2,8 +2,9 @@
 // linear or the quadratic model, and the model-selection report.
 //
 // Regressors, per head h (the data contract, docs/contract.md): x1 = T1 = T_CHU of h, x2 = T2 − T1,
-// x3 = T3 − T1 (T2 = T029, T3 = T032), in °C. The linear model has the terms
-// [1, x1, x2, x3] per axis, the quadratic one also [x1², x2², x3²].
+// x3 = T3 − T1 (T2 = T029, T3 = T032), in °C. The terms per axis are those of
+// ascorr/core/model_terms.hpp: the linear model's [1, x1, x2, x3], the
+// quadratic one's also [x1², x2², x3²].
 //
 // Centring and scaling. The design is built from u_j = (x_j − m_j)/s_j, m_j and
 // s_j the mean and standard deviation of x_j over the orbit averages the fit
@@ -37,7 +38,7 @@ namespace ascorr::host {
 enum class Terms { kLinear, kQuadratic };
 const char* terms_name(Terms t) noexcept;
 inline constexpr int terms_per_axis(Terms t) noexcept {
-    return t == Terms::kLinear ? 4 : 7;
+    return t == Terms::kLinear ? kLinearModelTerms : kModelTerms;
 }
 
 inline constexpr double kDefaultHoldout = 0.25;             // last quarter of the period held out
@@ -47,7 +48,7 @@ inline constexpr double kDefaultMinTemperatureRange = 2.0;  // °C, of each regr
 // it, the quadratic terms fit noise.
 inline constexpr double kSelectionMargin = 0.01;
 
-inline constexpr const char* kRegressorNames[3] = {"T_CHU", "T029 - T_CHU", "T032 - T_CHU"};
+inline constexpr const char* kRegressorNames[kRegressors] = {"T_CHU", "T029 - T_CHU", "T032 - T_CHU"};
 
 struct HeadFit {
     std::array<double, 3> residual_rms{};  // orbit averages, arcsec, alpha/beta/gamma

@@ -1,6 +1,8 @@
 // ascorr_host/formats/model_csv.hpp: the thermal-model file (docs/contract.md, "Model file").
 //
-// Header chu,axis,c0,c1,c2,c3 and optionally c1_2,c2_2,c3_2 (absent = 0).
+// Header chu,axis and the linear terms' columns (c0,c1,c2,c3), optionally the
+// quadratic ones (c1_2,c2_2,c3_2; absent = 0): the names of
+// ascorr/core/model_terms.hpp, in its order.
 // One row per head and axis; a head that appears must have all three axes.
 // Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
 // the core's radians (ascorr/core/model_coefficients.hpp).
@@ -17,17 +19,29 @@ namespace ascorr::host {
 
 enum Axis : int { kAlpha = 0, kBeta = 1, kGamma = 2 };
 inline constexpr const char* kAxisNames[kModelAxes] = {"alpha", "beta", "gamma"};
-inline constexpr const char* kCoefficientNames[kModelTerms] = {"c0", "c1", "c2", "c3", "c1_2", "c2_2", "c3_2"};
+// The terms' columns, by term index (core/model_terms.hpp).
+inline constexpr std::array<const char*, kModelTerms> kCoefficientNames = [] {
+    std::array<const char*, kModelTerms> names{};
+    for (std::size_t k = 0; k < kModelTerms; ++k) {
+        names[k] = kModelTermTable[k].name;
+    }
+    return names;
+}();
+
+// The names of terms [first, last) joined by separator: "c0,c1,c2,c3".
+std::string coefficient_columns(std::size_t first, std::size_t last, const char* separator);
+// The model file's header: chu,axis and the first `terms` columns, with '\n'.
+std::string model_header(std::size_t terms);
 
 struct ModelFile {
     std::array<bool, kMaxHeads> present{};
-    // coefficients[head][axis] = {c0, c1, c2, c3, c1_2, c2_2, c3_2} in arcsec.
+    // coefficients[head][axis][term] (c0, c1, … c3_2: kModelTermTable's order) in arcsec.
     std::array<std::array<std::array<double, kModelTerms>, kModelAxes>, kMaxHeads> coefficients{};
     bool quadratic = false;  // write the quadratic columns
     // Where each head and axis was read (1-based line) and each coefficient
     // (1-based character column); 0 for a model not read from a file.
-    std::array<std::array<std::size_t, 3>, kMaxHeads> line{};
-    std::array<std::array<std::array<std::size_t, 7>, 3>, kMaxHeads> column{};
+    std::array<std::array<std::size_t, kModelAxes>, kMaxHeads> line{};
+    std::array<std::array<std::array<std::size_t, kModelTerms>, kModelAxes>, kMaxHeads> column{};
 };
 
 ModelFile read_model_file(const std::string& path);
