@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "ascorr/calib/common_rotation.hpp"
@@ -359,6 +360,96 @@ TEST(CalibOrbitCollector, BinsReferencesAndMeans) {
     EXPECT_EQ(o.ref.r[0].x, next.r[0].x);  // kept, not taken from the cycle
     EXPECT_EQ(o.ref.t_ref[0][0], next.t_ref[0][0]);
     EXPECT_NE(next.t_ref[0][0], c3.temperatures[0].t_chu.value);  // (the check can fail)
+}
+
+// Cycle k with a fourth head D (bent 0.2"/degC of T_CHU about its x axis)
+// when with_d; otherwise D is not selected (its bit clear, its data garbage).
+calib::CalibCycle<double, 4> synthetic_cycle4(long k, bool with_d) {
+    const calib::CalibCycle<double> c3 = synthetic_cycle(k);
+    calib::CalibCycle<double, 4> c{};
+    c.t_us = c3.t_us;
+    for (std::size_t h = 0; h < 3; ++h) {
+        c.q_chu_icrf[h] = c3.q_chu_icrf[h];
+        c.temperatures[h] = c3.temperatures[h];
+    }
+    c.temperatures[3] = c3.temperatures[0];
+    if (!with_d) {
+        c.q_chu_icrf[3] = {0.0, 1.0, 0.0, 0.0};  // not to be read
+        c.temperatures[3].t_chu.value = 1e6;
+        return c;
+    }
+    const Eigen::Quaterniond d_a(Eigen::AngleAxisd(2.1, Eigen::Vector3d(0.5, -0.4, 0.7).normalized()));
+    const double bend = 0.2 * (c.temperatures[3].t_chu.value - 10.0) * kArcsecToRad;
+    const Eigen::Quaterniond qa = to_eigen(c.q_chu_icrf[0]);
+    const Eigen::Quaterniond qd = Eigen::Quaterniond(Eigen::AngleAxisd(bend, Eigen::Vector3d::UnitX())) * d_a * qa;
+    c.q_chu_icrf[3] = from_eigen(qd.normalized());
+    c.heads = static_cast<std::uint8_t>(c.heads | 8U);
+    return c;
+}
+
+// Per-head selection (estimator_types.hpp). An estimator of four heads whose
+// fourth never passes the selection takes the three-head estimator's
+// decisions bit for bit (report, versions, CRCs, coefficients), and keeps D
+// out of its models. With D selected in two cycles of three (and, in one of
+// them, fed after the cycle: accumulate_head), it learns D's slope and says
+// so (active_learnt), from the same orbits as A, B and C.
+TEST(CalibEstimator, AFourthHeadLearnsFromItsOwnEpochsAndLeavesTheThreeAlone) {
+    calib::Estimator<double> e3;
+    calib::Estimator<double, 4> e4_absent;
+    calib::Estimator<double, 4> e4;
+    for (long k = 0; k < 288 * 15; ++k) {
+        const calib::CalibCycle<double> c = synthetic_cycle(k);
+        const calib::CalibCycle<double, 4> absent = synthetic_cycle4(k, false);
+        (void)e3.model_for_cycle(c.t_us);
+        (void)e4_absent.model_for_cycle(c.t_us);
+        (void)e4.model_for_cycle(c.t_us);
+        e3.accumulate(c);
+        e4_absent.accumulate(absent);
+        if (k % 3 == 1) {  // D after the cycle
+            e4.accumulate(absent);
+            const calib::CalibCycle<double, 4> d = synthetic_cycle4(k, true);
+            EXPECT_TRUE(e4.accumulate_head(3, d.t_us, d.q_chu_icrf[3], d.temperatures[3]));
+            EXPECT_FALSE(e4.accumulate_head(3, d.t_us + 1, d.q_chu_icrf[3], d.temperatures[3]));  // no such cycle
+        } else {
+            e4.accumulate(synthetic_cycle4(k, k % 3 == 0));
+        }
+        while (e3.step()) {
+        }
+        while (e4_absent.step()) {
+        }
+        while (e4.step()) {
+        }
+        ASSERT_EQ(e3.active_version(), e4_absent.active_version()) << k;
+        ASSERT_EQ(e3.active_crc(), e4_absent.active_crc()) << k;
+    }
+    const calib::EstimatorReport r3 = e3.report();
+    const calib::EstimatorReport r4 = e4_absent.report();
+    ASSERT_TRUE(r3.has_active);
+    EXPECT_GE(r3.active_version, 2U);
+    const auto bits = [](double x) {
+        std::uint64_t b = 0;
+        std::memcpy(&b, &x, sizeof b);
+        return b;
+    };
+    EXPECT_EQ(r3.orbits_used, r4.orbits_used);
+    EXPECT_EQ(r3.orbits_short, r4.orbits_short);
+    EXPECT_EQ(r3.orbits_held, r4.orbits_held);
+    EXPECT_EQ(bits(r3.condition), bits(r4.condition));
+    EXPECT_EQ(bits(r3.residual_rms_arcsec), bits(r4.residual_rms_arcsec));
+    EXPECT_EQ(bits(r3.candidate_rms_arcsec), bits(r4.candidate_rms_arcsec));
+    for (std::size_t i = 0; i < calib::kRefusalKinds; ++i) {
+        EXPECT_EQ(r3.refusals[i], r4.refusals[i]) << i;
+    }
+    EXPECT_EQ(std::memcmp(e3.active_coefficients(), e4_absent.active_coefficients(), sizeof(ModelCoefficients)), 0);
+    EXPECT_FALSE(e4_absent.active_coefficients()->present[3]);
+    EXPECT_EQ(e4_absent.active_learnt(), 7U);
+    // D learnt, from every orbit A, B and C were learnt from.
+    const calib::EstimatorReport rd = e4.report();
+    EXPECT_EQ(rd.orbits_used, r3.orbits_used);
+    EXPECT_EQ(e4.active_learnt(), 15U);
+    ASSERT_TRUE(e4.active_coefficients()->present[3]);
+    EXPECT_NEAR(e4.active_coefficients()->coefficient[3][0][1], 0.2, 0.01);
+    EXPECT_NEAR(e4.active_coefficients()->coefficient[1][0][1], 0.3, 0.01);
 }
 
 // The commands and the double buffer: a model becomes active only at the

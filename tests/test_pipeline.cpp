@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "ascorr/core/constants.hpp"
@@ -18,25 +19,38 @@ namespace {
 
 // Records the pipeline's calls (F Prime's test doubles), and answers as the library does.
 struct Recorded {
-    std::vector<std::int64_t> model_epochs;  // model_for_epoch's t_us
-    std::vector<std::int64_t> feeds;         // feed's t_us
+    std::vector<std::int64_t> model_epochs;               // model_for_epoch's t_us
+    std::vector<std::int64_t> feeds;                      // feed's t_us
+    std::vector<unsigned> further;                        // feed's further heads (mask)
+    std::vector<std::pair<std::int64_t, unsigned>> late;  // feed_head's t_us and head
     int steps = 0;
     std::vector<int> combined_n;  // combine's n
 };
 Recorded g_calls;
 
 struct RecordingCalls : pipeline::InlineCalls<double> {
-    static const ThermalModel<double>* model_for_epoch(calib::Estimator<double>& e, std::int64_t t_us) noexcept {
+    template <std::size_t N>
+    static const ThermalModel<double>* model_for_epoch(calib::Estimator<double, N>& e, std::int64_t t_us) noexcept {
         g_calls.model_epochs.push_back(t_us);
         return e.model_for_cycle(t_us);
     }
-    static bool feed(calib::Estimator<double>& e, std::int64_t t_us, const ThermalModel<double>* model,
-                     const CorrectedSolution<double>* corrected,
-                     const HeadTemperatures<double>* const* temperatures) noexcept {
+    template <std::size_t N>
+    static bool feed(calib::Estimator<double, N>& e, std::int64_t t_us, const ThermalModel<double>* model,
+                     const CorrectedSolution<double>* corrected, const HeadTemperatures<double>* const* temperatures,
+                     std::uint8_t further) noexcept {
         g_calls.feeds.push_back(t_us);
-        return calib::feed_estimator(e, t_us, model, corrected, temperatures);
+        g_calls.further.push_back(further);
+        return calib::feed_estimator(e, t_us, model, corrected, temperatures, further);
     }
-    static bool step(calib::Estimator<double>& e) noexcept {
+    template <std::size_t N>
+    static bool feed_head(calib::Estimator<double, N>& e, std::uint8_t h, std::int64_t t_us,
+                          const ThermalModel<double>* model, const CorrectedSolution<double>& corrected,
+                          const HeadTemperatures<double>& temperatures) noexcept {
+        g_calls.late.emplace_back(t_us, h);
+        return calib::feed_estimator_head(e, h, t_us, model, corrected, temperatures);
+    }
+    template <std::size_t N>
+    static bool step(calib::Estimator<double, N>& e) noexcept {
         ++g_calls.steps;
         return e.step();
     }
@@ -98,6 +112,43 @@ TEST(Pipeline, TheScheduleFeedsEveryNthEpochAndIdleSteps) {
     }
     EXPECT_EQ(g_calls.feeds, (std::vector<std::int64_t>{0, 2, 4}));  // epochs 0, 2, 4
     EXPECT_EQ(g_calls.steps, 5);                                     // one per idle(), none after a feed
+}
+
+// Per-head selection with four heads: the cycle feeds as soon as A, B and C
+// are in, whatever D does (D not clean: the epoch still counts for A, B, C);
+// D kept before them goes with the cycle, D after them is fed alone into the
+// same cycle (feed_head), and only once.
+TEST(Pipeline, AFourthHeadNeverHoldsBackTheFrameHeadsAndIsFedWhenItIsClean) {
+    g_calls = {};
+    calib::Estimator<double, 4> estimator(calib::EstimatorConfig{}, &kTable2);
+    pipeline::EpochPipeline<double, RecordingCalls, 4> pipe;
+    pipe.use_estimator(&estimator);
+    const auto in = [&](std::uint8_t h, bool clean) { (void)pipe.solution(solution(h), given(solution(h)), clean); };
+    (void)pipe.begin(0);  // D not clean: A, B, C feed alone
+    in(3, false);
+    in(0, true);
+    in(1, true);
+    in(2, true);
+    (void)pipe.begin(1);  // D first: in the cycle
+    in(3, true);
+    in(0, true);
+    in(1, true);
+    in(2, true);
+    (void)pipe.begin(2);  // D last: alone, once
+    in(0, true);
+    in(1, true);
+    in(2, true);
+    in(3, true);
+    in(3, true);
+    (void)pipe.begin(3);  // B not clean: no cycle, D not fed
+    in(0, true);
+    in(1, false);
+    in(2, true);
+    in(3, true);
+    EXPECT_EQ(g_calls.feeds, (std::vector<std::int64_t>{0, 1, 2}));
+    EXPECT_EQ(g_calls.further, (std::vector<unsigned>{0U, 8U, 0U}));
+    EXPECT_EQ(g_calls.late, (std::vector<std::pair<std::int64_t, unsigned>>{{2, 3U}}));
+    EXPECT_EQ(pipe.feeds(), 3U);
 }
 
 TEST(Pipeline, ASolutionThatIsNotCleanOrRepeatedDoesNotFeed) {

@@ -76,19 +76,20 @@ host::RowSource rows_of(const Mission& m) {
 // The thermal-stage IBAs of the clean epochs, each row corrected with the
 // model active at its t (double path).
 struct Ibas {
-    std::array<std::vector<double>, kPairs> t;
-    std::array<std::vector<double>, kPairs> v;
+    std::array<std::vector<double>, host::kMaxPairs> t;
+    std::array<std::vector<double>, host::kMaxPairs> v;
 };
 
-Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& history) {
+Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& history,
+                  const host::PairList& pairs = host::kPaperPairs) {
     std::vector<std::pair<double, ThermalModel<double>>> schedule;
     for (const auto& a : history) {
         schedule.emplace_back(a.t, host::to_core<double>(a.model));
     }
     host::EarthVelocity earth;
-    std::map<double, std::array<std::optional<Vector3<double>>, 3>> epochs;
+    std::map<double, std::array<std::optional<Vector3<double>>, kMaxHeads>> epochs;
     for (const auto& rec : m.records) {
-        if (rec.head > 2 || host::fit_selection(rec) != host::Drop::kNone) {
+        if (rec.head >= kMaxHeads || host::fit_selection(rec) != host::Drop::kNone) {
             continue;
         }
         auto it = std::upper_bound(schedule.begin(), schedule.end(), rec.t,
@@ -104,9 +105,9 @@ Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& histor
     }
     Ibas out;
     for (const auto& [t, z] : epochs) {
-        for (std::size_t p = 0; p < kPairs; ++p) {
-            const auto& a = z[host::kPaperPairs.pair[p].first];
-            const auto& b = z[host::kPaperPairs.pair[p].second];
+        for (std::size_t p = 0; p < pairs.count; ++p) {
+            const auto& a = z[pairs.pair[p].first];
+            const auto& b = z[pairs.pair[p].second];
             if (a && b) {
                 out.t[p].push_back(t);
                 out.v[p].push_back(host::angle_arcsec(*a, *b));
@@ -116,28 +117,31 @@ Ibas thermal_ibas(const Mission& m, const std::vector<host::ActiveModel>& histor
     return out;
 }
 
+// One pair's IBA RMS about its mean over days [a, b) (NaN: fewer than two epochs).
+double day_rms(const Mission& m, const std::vector<double>& t, const std::vector<double>& v, long long a, long long b) {
+    double s = 0.0;
+    double s2 = 0.0;
+    std::size_t n = 0;
+    const double ref = v.empty() ? 0.0 : v.front();
+    for (std::size_t i = 0; i < t.size(); ++i) {
+        const double d = (t[i] - m.t0) / kDay;
+        if (d >= static_cast<double>(a) && d < static_cast<double>(b)) {
+            s += v[i] - ref;
+            s2 += (v[i] - ref) * (v[i] - ref);
+            ++n;
+        }
+    }
+    return n > 1 ? std::sqrt(std::max(
+                       0.0, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n))))
+                 : std::nan("");
+}
+
 // Per pair: IBA RMS about its mean over days [a, b) / the floor's.
 std::array<double, kPairs> ratio(const Mission& m, const Ibas& ibas, long long a, long long b) {
     const auto floor = host::floor_of_days(m.data + ".floor-daily.csv", a, b);
     std::array<double, kPairs> r{};
     for (std::size_t p = 0; p < kPairs; ++p) {
-        double s = 0.0;
-        double s2 = 0.0;
-        std::size_t n = 0;
-        const double ref = ibas.v[p].empty() ? 0.0 : ibas.v[p].front();
-        for (std::size_t i = 0; i < ibas.t[p].size(); ++i) {
-            const double d = (ibas.t[p][i] - m.t0) / kDay;
-            if (d >= static_cast<double>(a) && d < static_cast<double>(b)) {
-                s += ibas.v[p][i] - ref;
-                s2 += (ibas.v[p][i] - ref) * (ibas.v[p][i] - ref);
-                ++n;
-            }
-        }
-        const double rms =
-            n > 1 ? std::sqrt(std::max(
-                        0.0, s2 / static_cast<double>(n) - (s / static_cast<double>(n)) * (s / static_cast<double>(n))))
-                  : std::nan("");
-        r[p] = rms / floor[p].rms;
+        r[p] = day_rms(m, ibas.t[p], ibas.v[p], a, b) / floor[p].rms;
     }
     return r;
 }
@@ -510,6 +514,65 @@ TEST(SelfCalibration, FlightScalarsReachTheFloor) {
     EXPECT_LE(worst(ratio(m, q.ibas, 30, 150)), 1.03);
     EXPECT_GE(f.sc.history.size(), 2U);
     EXPECT_GE(q.sc.history.size(), 2U);
+}
+
+// A four-head mission (A, B, C, D): the estimator learns D as it learns A, B
+// and C, so every pair with D reaches the floor from day 30. Both runs start
+// from the simulator's truth with D's cross-boresight slopes 0.5"/°C off;
+// the mutation runs the estimator on A, B and C only (D's rows withheld): D
+// keeps the wrong slopes and its pairs stay above the floor.
+TEST(SelfCalibration, AFourthHeadIsLearntAndItsPairsReachTheFloor) {
+    constexpr host::PairList kPairs4 = host::pairs_of(host::kAllHeads);
+    const Mission m = simulate("four-heads", 120.0, [](host::SimulateOptions& o) { o.heads = host::kAllHeads; });
+    host::ModelFile start = host::read_model_file(m.data + ".truth.csv");
+    ASSERT_TRUE(start.present[3]);
+    for (std::size_t a = 0; a < 2; ++a) {
+        for (std::size_t t = 1; t < 4; ++t) {
+            start.coefficients[3][a][t] += 0.5;
+        }
+    }
+    const auto learn = [&m, &start](bool with_d) {
+        const host::RowSource rows = [&m, with_d](const std::function<void(const host::SolutionRecord&)>& fn) {
+            for (const auto& r : m.records) {
+                if (with_d || r.head != 3) {
+                    fn(r);
+                }
+            }
+        };
+        return host::self_calibrate<double>(m.data, rows, start, calib::EstimatorConfig{}, std::nullopt);
+    };
+    // Per pair of the four heads: the thermal-stage IBA RMS over days 30-120 / the floor's.
+    const auto ratios = [&m, &kPairs4](const host::SelfCalibration& sc) {
+        const Ibas all = thermal_ibas(m, sc.history, kPairs4);
+        const auto floor = host::floor_of_days(m.data + ".floor-daily.csv", 30, 120, kPairs4);
+        std::array<double, host::kMaxPairs> r{};
+        for (std::size_t p = 0; p < kPairs4.count; ++p) {
+            r[p] = day_rms(m, all.t[p], all.v[p], 30, 120) / floor[p].rms;
+            std::printf("%s %.3f  ", kPairs4.pair[p].name, r[p]);
+        }
+        std::printf("\n");
+        return r;
+    };
+    const host::SelfCalibration learnt = learn(true);
+    const host::SelfCalibration kept = learn(false);
+    ASSERT_GE(learnt.history.size(), 2U);
+    EXPECT_EQ(learnt.history.back().learnt, 15U);  // A, B, C and D
+    EXPECT_STREQ(host::head_origin(learnt.history.back().version, 3, learnt.history.back().learnt), "learnt");
+    EXPECT_EQ(kept.history.back().learnt, 7U);
+    EXPECT_STREQ(host::head_origin(1U, 3, kept.history.back().learnt), "kept");
+    const auto r = ratios(learnt);
+    const auto r_kept = ratios(kept);
+    double worst_d = 0.0;
+    double worst_d_kept = 0.0;
+    for (std::size_t p = 0; p < kPairs4.count; ++p) {
+        EXPECT_LE(r[p], 1.03) << kPairs4.pair[p].name;
+        if (kPairs4.pair[p].second == 3U) {
+            worst_d = std::max(worst_d, r[p]);
+            worst_d_kept = std::max(worst_d_kept, r_kept[p]);
+        }
+    }
+    EXPECT_LE(worst_d, 1.03);
+    EXPECT_GT(worst_d_kept, 1.03) << "the mutation (D not learnt) must fail the bound";
 }
 
 // Lines of a text, the first (header) apart.

@@ -193,11 +193,12 @@ std::vector<std::string> column(const std::vector<std::string>& lines, const std
     return out;
 }
 
-// Class 13: a head the estimator does not learn (D) keeps the given model's
-// coefficients in every adopted model, and the history says so (origin
-// "kept"; A, B, C "learnt"; version 0 "given"). Was: D's rows got 256 from
-// the first adopted model on.
-TEST(SelfCalibrationInputs, AHeadTheEstimatorDoesNotLearnKeepsTheGivenModel) {
+// Class 13: on a four-head file the estimator learns D as well: D's rows keep
+// a thermal stage in every adopted model, and the history says so (origin
+// "learnt" for A to C; for D once its own orbits reach min_orbits, "kept"
+// before; version 0 "given"). Was: D's rows got 256 from the first adopted
+// model on; then D kept the given model.
+TEST(SelfCalibrationInputs, AFourthHeadIsLearntAndKeepsItsThermalStage) {
     const fs::path dir = simulated("sc_in_head_d", " --heads ABCD");
     const CliRun r = run_in(
         "correct --in sim.csv --out c.csv --self-calibrate --model sim.csv.truth.csv --model-history h.csv", dir);
@@ -223,20 +224,90 @@ TEST(SelfCalibrationInputs, AHeadTheEstimatorDoesNotLearnKeepsTheGivenModel) {
     const std::vector<std::string> origin = column(h, "origin");
     const std::vector<std::string> c1 = column(h, "c1");
     std::vector<std::string> given_d;
-    std::size_t kept = 0;
+    std::size_t learnt = 0;
+    std::size_t changed = 0;
     for (std::size_t i = 0; i < version.size(); ++i) {
         const bool v0 = version[i] == "0";
-        EXPECT_EQ(origin[i], v0 ? "given" : (head[i] == "D" ? "kept" : "learnt")) << h[i + 1];
+        if (head[i] != "D" || v0) {
+            EXPECT_EQ(origin[i], v0 ? "given" : "learnt") << h[i + 1];
+        }
         if (head[i] == "D") {
             if (v0) {
                 given_d.push_back(c1[i]);
+            } else if (origin[i] == "learnt") {
+                changed += c1[i] != given_d.at(learnt % 3) ? 1U : 0U;
+                ++learnt;
             } else {
-                EXPECT_EQ(c1[i], given_d.at(kept % 3)) << h[i + 1];
-                ++kept;
+                EXPECT_EQ(origin[i], "kept") << h[i + 1];
+                EXPECT_EQ(learnt, 0U) << "D kept after it was learnt: " << h[i + 1];
+                EXPECT_EQ(c1[i], given_d.at(i % 3)) << h[i + 1];
             }
         }
     }
-    EXPECT_GE(kept, 3U) << "no adopted model: the check above would be vacuous";
+    EXPECT_GE(learnt, 3U) << "no adopted model: the checks above would be vacuous";
+    EXPECT_GT(changed, 0U) << "D's coefficients were never learnt";
+}
+
+// The count in "N epochs with A, B and C selected" of a run's terminal line.
+std::size_t epochs_selected(const std::string& err) {
+    const std::size_t at = err.find(" epochs with A, B and C selected");
+    EXPECT_NE(at, std::string::npos) << err;
+    if (at == std::string::npos) {
+        return 0;
+    }
+    const std::size_t from = err.rfind(' ', at - 1) + 1;
+    return static_cast<std::size_t>(std::stoul(err.substr(from, at - from)));
+}
+
+// Per-head selection (docs/contract.md): A, B and C learn from the epochs in
+// which the three are clean, whatever D is. D's rows flagged (not clean) in
+// one epoch of three, or removed: the same epochs and orbits for A, B and C
+// as in the file as simulated, and D is still learnt from its clean epochs
+// (two of three: above the orbit's min_coverage). (An estimator that took an
+// epoch only with all four heads clean, the mutation, counts about two
+// thirds of the epochs with D flagged and fails.)
+TEST(SelfCalibrationInputs, HeadDNotCleanLeavesTheEpochsOfABAndC) {
+    const fs::path dir = simulated("sc_in_head_d_dirty", " --heads ABCD");
+    std::vector<std::string> lines = lines_of(slurp(dir / "sim.csv"));
+    const std::vector<std::string> chu = column(lines, "chu");
+    std::vector<std::string> flagged{lines[0]};
+    std::vector<std::string> without{lines[0]};
+    std::size_t d_seen = 0;
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+        std::string l = lines[i];
+        if (chu[i - 1] == "D") {
+            if (d_seen++ % 3 == 0) {
+                const std::size_t flags = l.rfind(',', l.rfind(',') - 1);  // flags,confidence at the end
+                l = l.substr(0, flags) + ",1" + l.substr(l.rfind(','));
+            }
+            flagged.push_back(l);
+            continue;
+        }
+        flagged.push_back(l);
+        without.push_back(l);
+    }
+    write_lines(dir / "flagged.csv", flagged);
+    write_lines(dir / "without.csv", without);
+    const auto run = [&](const std::string& in) {
+        const CliRun r = run_in("correct --in " + in + " --out c_" + in +
+                                    " --self-calibrate --model sim.csv.truth.csv --model-history h_" + in,
+                                dir);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return r.err;
+    };
+    const std::string all = run("sim.csv");
+    const std::string dirty = run("flagged.csv");
+    const std::string none = run("without.csv");
+    EXPECT_GT(epochs_selected(all), 300U);
+    EXPECT_EQ(epochs_selected(dirty), epochs_selected(all)) << dirty;
+    EXPECT_EQ(epochs_selected(none), epochs_selected(all)) << none;
+    const auto orbits = [](const std::string& err) { return err.substr(err.find("orbits used"), 20); };
+    EXPECT_EQ(orbits(dirty), orbits(all));
+    EXPECT_NE(slurp(dir / "h_flagged.csv").find(",D,alpha,"), std::string::npos);
+    EXPECT_NE(slurp(dir / "h_flagged.csv").find(",learnt\n"), std::string::npos);
+    for (const std::string& l : lines_of(slurp(dir / "h_without.csv"))) {
+        EXPECT_FALSE(l.find(",D,") != std::string::npos && l.find(",learnt") != std::string::npos) << l;
+    }
 }
 
 // The velocity columns (vx, vy, vz) of data lines `which` scaled by f.

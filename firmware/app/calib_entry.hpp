@@ -22,40 +22,62 @@
 
 namespace ascorr::app {
 
+// The flight loop's estimator: every head of the loop (kMaxHeads), A, B and C
+// from the cycles they all pass the selection, a further head from those of
+// them it passes too (estimator_types.hpp).
+template <typename T>
+using FlightEstimator = calib::Estimator<T, kMaxHeads>;
+
 // Per cycle (calib_entry_<scalar>.cpp).
-const ThermalModel<Q30>* calib_model_fixed(calib::Estimator<Q30>& e, std::int64_t t_us) noexcept;
-const ThermalModel<float>* calib_model_float(calib::Estimator<float>& e, std::int64_t t_us) noexcept;
-bool calib_feed_fixed(calib::Estimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                      const CorrectedSolution<Q30>* corrected,
-                      const HeadTemperatures<Q30>* const* temperatures) noexcept;
-bool calib_feed_float(calib::Estimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
-                      const CorrectedSolution<float>* corrected,
-                      const HeadTemperatures<float>* const* temperatures) noexcept;
+const ThermalModel<Q30>* calib_model_fixed(FlightEstimator<Q30>& e, std::int64_t t_us) noexcept;
+const ThermalModel<float>* calib_model_float(FlightEstimator<float>& e, std::int64_t t_us) noexcept;
+bool calib_feed_fixed(FlightEstimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
+                      const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures,
+                      std::uint8_t further) noexcept;
+bool calib_feed_float(FlightEstimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
+                      const CorrectedSolution<float>* corrected, const HeadTemperatures<float>* const* temperatures,
+                      std::uint8_t further) noexcept;
+// A further head that comes after the cycle's feed (feed_estimator_head).
+bool calib_feed_head_fixed(FlightEstimator<Q30>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<Q30>* model,
+                           const CorrectedSolution<Q30>& corrected, const HeadTemperatures<Q30>& temperatures) noexcept;
+bool calib_feed_head_float(FlightEstimator<float>& e, std::uint8_t h, std::int64_t t_us,
+                           const ThermalModel<float>* model, const CorrectedSolution<float>& corrected,
+                           const HeadTemperatures<float>& temperatures) noexcept;
 // Idle time (calib_idle_<scalar>.cpp): one phase of the per-orbit update; false: nothing left.
-bool calib_step_fixed(calib::Estimator<Q30>& e) noexcept;
-bool calib_step_float(calib::Estimator<float>& e) noexcept;
+bool calib_step_fixed(FlightEstimator<Q30>& e) noexcept;
+bool calib_step_float(FlightEstimator<float>& e) noexcept;
 
 // The entries for scalar T, for code templated on it.
-inline const ThermalModel<Q30>* calib_model(calib::Estimator<Q30>& e, std::int64_t t_us) noexcept {
+inline const ThermalModel<Q30>* calib_model(FlightEstimator<Q30>& e, std::int64_t t_us) noexcept {
     return calib_model_fixed(e, t_us);
 }
-inline const ThermalModel<float>* calib_model(calib::Estimator<float>& e, std::int64_t t_us) noexcept {
+inline const ThermalModel<float>* calib_model(FlightEstimator<float>& e, std::int64_t t_us) noexcept {
     return calib_model_float(e, t_us);
 }
-inline bool calib_feed(calib::Estimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
-                       const CorrectedSolution<Q30>* corrected,
-                       const HeadTemperatures<Q30>* const* temperatures) noexcept {
-    return calib_feed_fixed(e, t_us, model, corrected, temperatures);
+inline bool calib_feed(FlightEstimator<Q30>& e, std::int64_t t_us, const ThermalModel<Q30>* model,
+                       const CorrectedSolution<Q30>* corrected, const HeadTemperatures<Q30>* const* temperatures,
+                       std::uint8_t further) noexcept {
+    return calib_feed_fixed(e, t_us, model, corrected, temperatures, further);
 }
-inline bool calib_feed(calib::Estimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
-                       const CorrectedSolution<float>* corrected,
-                       const HeadTemperatures<float>* const* temperatures) noexcept {
-    return calib_feed_float(e, t_us, model, corrected, temperatures);
+inline bool calib_feed(FlightEstimator<float>& e, std::int64_t t_us, const ThermalModel<float>* model,
+                       const CorrectedSolution<float>* corrected, const HeadTemperatures<float>* const* temperatures,
+                       std::uint8_t further) noexcept {
+    return calib_feed_float(e, t_us, model, corrected, temperatures, further);
 }
-inline bool calib_step(calib::Estimator<Q30>& e) noexcept {
+inline bool calib_feed_head(FlightEstimator<Q30>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<Q30>* model,
+                            const CorrectedSolution<Q30>& corrected,
+                            const HeadTemperatures<Q30>& temperatures) noexcept {
+    return calib_feed_head_fixed(e, h, t_us, model, corrected, temperatures);
+}
+inline bool calib_feed_head(FlightEstimator<float>& e, std::uint8_t h, std::int64_t t_us,
+                            const ThermalModel<float>* model, const CorrectedSolution<float>& corrected,
+                            const HeadTemperatures<float>& temperatures) noexcept {
+    return calib_feed_head_float(e, h, t_us, model, corrected, temperatures);
+}
+inline bool calib_step(FlightEstimator<Q30>& e) noexcept {
     return calib_step_fixed(e);
 }
-inline bool calib_step(calib::Estimator<float>& e) noexcept {
+inline bool calib_step(FlightEstimator<float>& e) noexcept {
     return calib_step_float(e);
 }
 

@@ -3,7 +3,7 @@
 
 namespace ascorr::app {
 
-bool calib_step_fixed(calib::Estimator<Q30>& e) noexcept {
+bool calib_step_fixed(FlightEstimator<Q30>& e) noexcept {
     return e.step();
 }
 

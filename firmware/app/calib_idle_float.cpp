@@ -3,7 +3,7 @@
 
 namespace ascorr::app {
 
-bool calib_step_float(calib::Estimator<float>& e) noexcept {
+bool calib_step_float(FlightEstimator<float>& e) noexcept {
     return e.step();
 }
 

@@ -14,7 +14,8 @@
 // solution's own time (velocity_entry.hpp), the core in the build's scalar
 // (app_scalar.hpp, core_entry.hpp), the temperatures of
 // temperature_source.hpp and their status bits; every kCalibFeedEvery-th
-// cycle heads A, B and C feed the estimator; then the cycle's heads are
+// cycle heads A, B and C (and D when it passes the selection) feed the
+// estimator (FlightEstimator, calib_entry.hpp); then the cycle's heads are
 // combined into the bench's attitude (combine_entry.hpp, the mountings
 // kBenchMountings of flight_bench.hpp); after the solutions one bounded step
 // of the estimator's per-orbit update runs (idle()). Times are TT µs
@@ -262,7 +263,7 @@ public:
             text(" crc32c ");
             hex32(e.crc);
             text("\n");
-            for (std::uint32_t h = 0; h < calib::kCalibHeads; ++h) {
+            for (std::uint32_t h = 0; h < kMaxHeads; ++h) {
                 for (std::uint32_t a = 0; a < kModelAxes; ++a) {
                     text("model version ");
                     u32(e.version);
@@ -292,19 +293,24 @@ private:
 // The pipeline's calls: the image's out-of-line entries (core_entry.hpp,
 // calib_entry.hpp, each measured alone) and the temperatures' status bits.
 struct EntryCalls {
-    static const ThermalModel<Scalar>* model_for_epoch(calib::Estimator<Scalar>& e, std::int64_t t_us) noexcept {
+    static const ThermalModel<Scalar>* model_for_epoch(FlightEstimator<Scalar>& e, std::int64_t t_us) noexcept {
         return calib_model(e, t_us);
     }
     static CorrectedSolution<Scalar> correct(const SolutionInput<Scalar>& in,
                                              const CorrectionConfig<Scalar>& cfg) noexcept {
         return app::correct(in, cfg);
     }
-    static bool feed(calib::Estimator<Scalar>& e, std::int64_t t_us, const ThermalModel<Scalar>* model,
-                     const CorrectedSolution<Scalar>* corrected,
-                     const HeadTemperatures<Scalar>* const* temperatures) noexcept {
-        return calib_feed(e, t_us, model, corrected, temperatures);
+    static bool feed(FlightEstimator<Scalar>& e, std::int64_t t_us, const ThermalModel<Scalar>* model,
+                     const CorrectedSolution<Scalar>* corrected, const HeadTemperatures<Scalar>* const* temperatures,
+                     std::uint8_t further) noexcept {
+        return calib_feed(e, t_us, model, corrected, temperatures, further);
     }
-    static bool step(calib::Estimator<Scalar>& e) noexcept { return calib_step(e); }
+    static bool feed_head(FlightEstimator<Scalar>& e, std::uint8_t h, std::int64_t t_us,
+                          const ThermalModel<Scalar>* model, const CorrectedSolution<Scalar>& corrected,
+                          const HeadTemperatures<Scalar>& temperatures) noexcept {
+        return calib_feed_head(e, h, t_us, model, corrected, temperatures);
+    }
+    static bool step(FlightEstimator<Scalar>& e) noexcept { return calib_step(e); }
     static StatusBits status(std::uint8_t head, StatusBits s) noexcept { return temperatures_merge_status(head, s); }
     static combine::CombinedAttitude<Scalar> combine(const combine::Combiner<Scalar>& c,
                                                      const combine::HeadAttitude<Scalar>* heads,
@@ -420,7 +426,7 @@ public:
     std::uint32_t states_skipped() const noexcept { return states_skipped_; }
     std::uint32_t states_refused() const noexcept { return states_refused_; }
     const CorrectionLog& record() const noexcept { return record_; }
-    const calib::Estimator<Scalar>& estimator() const noexcept { return estimator_; }
+    const FlightEstimator<Scalar>& estimator() const noexcept { return estimator_; }
     const ModelHistory& history() const noexcept { return history_; }
 
 private:
@@ -432,8 +438,8 @@ private:
     CorrectionLog record_;
     // The estimator, starting from the model in flash (version 0), fed every
     // kCalibFeedEvery-th cycle; its per-orbit update steps in idle time.
-    calib::Estimator<Scalar> estimator_{kCalibConfig, &kTable2};
-    pipeline::EpochPipeline<Scalar, EntryCalls> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
+    FlightEstimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    pipeline::EpochPipeline<Scalar, EntryCalls, kMaxHeads> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
     // The combination's tables, built once from the mountings in flash.
     combine::Combiner<Scalar> combiner_{kBenchMountings};
     combine::CombinedAttitude<Scalar> combined_{};

@@ -206,7 +206,7 @@ void print_estimator(std::uint32_t correction3) noexcept {
     text(" idle steps (worst step ");
     u32(g_costs.calib_step.worst * 40U);
     text("), RAM ");
-    u32(static_cast<std::uint32_t>(sizeof(calib::Estimator<Scalar>)));
+    u32(static_cast<std::uint32_t>(sizeof(FlightEstimator<Scalar>)));
     const std::uint32_t correction =
         g_stats.cycles == 0U ? 0U : (g_costs.correct.total * 40U + g_stats.cycles / 2U) / g_stats.cycles;
     text(" bytes; correction per cycle ");

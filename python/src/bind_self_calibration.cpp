@@ -58,7 +58,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
             if (a.model.present[h]) {
                 origin[py::str(std::string(1, host::head_name(static_cast<std::uint8_t>(h))))] =
-                    host::head_origin(a.version, h);
+                    host::head_origin(a.version, h, a.learnt);
             }
         }
         d["origin"] = origin;

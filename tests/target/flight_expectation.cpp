@@ -121,8 +121,8 @@ struct Report {
         unsigned version = 0U;
         unsigned cycle = 0U;
         std::uint32_t crc = 0U;
-        std::uint64_t bits[ascorr::calib::kCalibHeads][ascorr::kModelAxes][ascorr::kLinearModelTerms] = {};
-        bool row_seen[ascorr::calib::kCalibHeads][ascorr::kModelAxes] = {};
+        std::uint64_t bits[ascorr::kMaxHeads][ascorr::kModelAxes][ascorr::kLinearModelTerms] = {};
+        bool row_seen[ascorr::kMaxHeads][ascorr::kModelAxes] = {};
     };
     std::vector<Model> models;
 };
@@ -161,7 +161,7 @@ void add_history(const ascorr::app::ModelHistory& hist, Report& out) {
         m.version = e.version;
         m.cycle = e.cycle;
         m.crc = e.crc;
-        for (std::size_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < ascorr::kMaxHeads; ++h) {
             for (std::size_t a = 0; a < ascorr::kModelAxes; ++a) {
                 m.row_seen[h][a] = true;
                 for (std::size_t t = 0; t < ascorr::kLinearModelTerms; ++t) {
@@ -237,7 +237,7 @@ bool parse_report(const std::string& path, Report& out) {
         } else if (unsigned long long w[4] = {};
                    std::sscanf(line.c_str(), "model version %u head %u axis %u c %16llx %16llx %16llx %16llx%c", &a, &h,
                                &c, &w[0], &w[1], &w[2], &w[3], &rest) == 7 &&
-                   h < ascorr::calib::kCalibHeads && c < ascorr::kModelAxes && !out.models.empty() &&
+                   h < ascorr::kMaxHeads && c < ascorr::kModelAxes && !out.models.empty() &&
                    out.models.back().version == a) {
             for (std::size_t t = 0; t < ascorr::kLinearModelTerms; ++t) {
                 out.models.back().bits[h][c][t] = w[t];
@@ -328,7 +328,7 @@ double model_difference(const Report::Model& a, const Report::Model& b) {
     using ascorr::app::boom::profile_celsius;
     double worst = 0.0;
     for (std::uint32_t sec = 0; sec < ascorr::app::boom::kProfileSeconds; ++sec) {
-        for (std::uint8_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+        for (std::uint8_t h = 0; h < ascorr::kMaxHeads; ++h) {
             const double t1 = chu_celsius(h, sec);
             const double x[4] = {1.0, t1, profile_celsius(0U, sec) - t1, profile_celsius(3U, sec) - t1};
             for (std::size_t ax = 0; ax < ascorr::kModelAxes; ++ax) {
@@ -367,7 +367,7 @@ void compare_models(const Report& host, const Report& image, double bound, Diffe
             continue;
         }
         bool rows = true;
-        for (std::size_t h = 0; h < ascorr::calib::kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < ascorr::kMaxHeads; ++h) {
             for (std::size_t a = 0; a < ascorr::kModelAxes; ++a) {
                 rows = rows && g.row_seen[h][a];
             }

@@ -61,6 +61,15 @@
 
 namespace ascorr::link {
 
+// The link's estimator and pipeline: every head of the core (kMaxHeads); A,
+// B and C learn from the epochs they all pass the selection, a further head
+// from those of them it passes too (calib/estimator_types.hpp), so a file of
+// three heads takes the decisions of a three-head estimator.
+template <typename T>
+using LinkEstimator = calib::Estimator<T, kMaxHeads>;
+template <typename T>
+using LinkPipeline = pipeline::EpochPipeline<T, pipeline::InlineCalls<T>, kMaxHeads>;
+
 // CycleCounter: a callable returning a free-running std::uint32_t counter
 // (SysTick or DWT on target), read around correct_solution().
 template <typename T, typename CycleCounter>
@@ -210,7 +219,7 @@ private:
         cfg.orbit_period_us = m.orbit_period_us;
         cfg.time_constant_days = m.time_constant_days;
         // In place: no 10-KiB temporary on the stack (trivially destructible).
-        new (&estimator_) calib::Estimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
+        new (&estimator_) LinkEstimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
         pipeline_.use_estimator(&estimator_);
     }
 
@@ -416,12 +425,12 @@ private:
     std::uint32_t duplicates_ = 0;
     std::uint32_t solutions_ = 0;
     // Self-calibration (kCalibStart).
-    static_assert(std::is_trivially_destructible_v<calib::Estimator<T>>, "restarted in place");
+    static_assert(std::is_trivially_destructible_v<LinkEstimator<T>>, "restarted in place");
     static_assert(std::is_trivially_destructible_v<VelocityService<T>>, "restarted in place");
-    calib::Estimator<T> estimator_{};
+    LinkEstimator<T> estimator_{};
     ModelCoefficients staged_{};
     // Before kCalibStart: the uploaded model (use_model, in the constructor).
-    pipeline::EpochPipeline<T> pipeline_{};
+    LinkPipeline<T> pipeline_{};
     // The combination (kMountingLoad with build): none until then.
     static_assert(std::is_trivially_destructible_v<combine::Combiner<T>>, "rebuilt in place");
     combine::Mountings staged_mountings_{};

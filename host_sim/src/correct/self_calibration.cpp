@@ -54,7 +54,7 @@ constexpr double kPeriodSpeedTolerance = 0.01;
 // only the first and the last (the others change nothing: no model becomes
 // pending without a fed epoch, and the run's pipeline feeds every epoch, so
 // the epochs' count does not matter), so the rows held are bounded.
-template <typename T>
+template <typename T, std::size_t N>
 class Run {
 public:
     Run(const std::string& file, const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
@@ -172,8 +172,8 @@ private:
     const ThermalModel<T>* epoch(std::int64_t t_us, double t) {
         const ThermalModel<T>* model = pipeline_.begin(t_us);
         if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
-            out_.history.push_back(
-                {t, t_us, pipeline_.version(), est_->active_crc(), model_file_of(*est_->active_coefficients())});
+            out_.history.push_back({t, t_us, pipeline_.version(), est_->active_crc(),
+                                    model_file_of(*est_->active_coefficients()), est_->active_learnt()});
             had_ = true;
             version_ = pipeline_.version();
         }
@@ -183,8 +183,8 @@ private:
     const std::string& file_;
     calib::EstimatorConfig cfg_;
     std::optional<ModelCoefficients> initial_;
-    std::optional<calib::Estimator<T>> est_;
-    pipeline::EpochPipeline<T> pipeline_;
+    std::optional<calib::Estimator<T, N>> est_;
+    pipeline::EpochPipeline<T, pipeline::InlineCalls<T>, N> pipeline_;
     std::vector<CalibRow<T>> held_;  // rows before the orbit period is known (hold)
     std::size_t fed_held_ = 0;
     bool had_ = false;
@@ -426,13 +426,13 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
     }
 }
 
-template <typename T>
-SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
-                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes) {
-    if (initial) {
-        refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
-    }
+namespace {
+
+// self_calibrate() with an estimator of N heads.
+template <typename T, std::size_t N>
+SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& rows,
+                                     const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
+                                     std::optional<double> orbit_period_s, std::size_t memory_budget_bytes) {
     EarthVelocity earth;
     // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
     const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {
@@ -444,7 +444,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         r.t = rec.t;
         r.line = rec.line;
         r.fed = false;
-        if (rec.head < calib::kCalibHeads && calibration_clean(rec)) {
+        if (rec.head < N && calibration_clean(rec)) {
             r.in = to_core_input<T>(rec, &earth);
             r.fed =
                 (correct_solution(r.in, CorrectionConfig<T>{true, nullptr}).status & status::kAberrationApplied) != 0U;
@@ -458,7 +458,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
     // sorted (the epoch of each, the input of those fed) within the memory
     // budget (SortedRuns).
     {
-        Run<T> run(file, initial, cfg, orbit_period_s);
+        Run<T, N> run(file, initial, cfg, orbit_period_s);
         std::size_t untimed = 0;
         bool ordered = true;
         CalibRow<T> r{};
@@ -497,19 +497,61 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         }
         runs.add(r);
     });
-    Run<T> run(file, initial, cfg, orbit_period_s);
+    Run<T, N> run(file, initial, cfg, orbit_period_s);
     runs.each([&run](const CalibRow<T>& r) { run.take(r); });
     SelfCalibration out = run.finish(untimed);
     out.runs = runs.count();
     return out;
 }
 
+// The heads the estimator learns: A, B, C (kMinCalibHeads), and up to the
+// last head that has a row passing the selection (at most kMaxHeads and max_heads).
+std::size_t heads_to_learn(const RowSource& rows, std::size_t max_heads) {
+    std::size_t n = calib::kMinCalibHeads;
+    rows([&n, max_heads](const SolutionRecord& rec) {
+        if (rec.head < kMaxHeads && rec.head < max_heads && rec.head >= n && calibration_clean(rec)) {
+            n = rec.head + 1U;
+        }
+    });
+    return n;
+}
+
+// self_calibrate_heads() with N the smallest from N0 up that is at least heads.
+template <typename T, std::size_t N0 = calib::kMinCalibHeads>
+SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& file, const RowSource& rows,
+                                        const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
+                                        std::optional<double> orbit_period_s, std::size_t memory_budget_bytes) {
+    if constexpr (N0 < kMaxHeads) {
+        if (heads > N0) {
+            return self_calibrate_dispatch<T, N0 + 1U>(heads, file, rows, initial, cfg, orbit_period_s,
+                                                       memory_budget_bytes);
+        }
+    }
+    return self_calibrate_heads<T, N0>(file, rows, initial, cfg, orbit_period_s, memory_budget_bytes);
+}
+
+}  // namespace
+
+template <typename T>
+SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
+                               const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
+                               std::size_t memory_budget_bytes, std::size_t max_heads) {
+    if (initial) {
+        refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
+    }
+    return self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg, orbit_period_s,
+                                      memory_budget_bytes);
+}
+
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                                std::size_t);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                               const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                               std::size_t);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
-                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t);
+                                             const calib::EstimatorConfig&, std::optional<double>, std::size_t,
+                                             std::size_t);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {
@@ -544,11 +586,11 @@ template class ModelSchedule<double>;
 template class ModelSchedule<float>;
 template class ModelSchedule<Q30>;
 
-const char* head_origin(std::uint32_t version, std::size_t h) {
+const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learnt) {
     if (version == 0U) {
         return "given";
     }
-    return calib::learns_head(h) ? "learnt" : "kept";
+    return calib::learns_head(h, learnt) ? "learnt" : "kept";
 }
 
 std::string format_model_history(const std::vector<ActiveModel>& history) {
@@ -568,7 +610,7 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     out += buf;
                 }
                 text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
-                                 head_origin(m.version, h));
+                                 head_origin(m.version, h, m.learnt));
                 out += buf;
             }
         }

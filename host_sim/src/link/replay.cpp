@@ -191,9 +191,12 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
         return;
     }
     target_history.push_back(target_model(client, rec.t));
-    const ActiveModel& mine = target_history.back();
+    ActiveModel& mine = target_history.back();
     const auto host = std::find_if(host_sc.history.begin(), host_sc.history.end(),
                                    [&](const ActiveModel& a) { return a.version == mine.version; });
+    if (host != host_sc.history.end()) {
+        mine.learnt = host->learnt;  // the link does not say; the comparison below checks the coefficients
+    }
     const std::string difference =
         host == host_sc.history.end() ? "the host has no such version" : first_model_difference(mine, *host);
     if (!difference.empty()) {
@@ -241,7 +244,7 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
 template <typename T>
 class EpochCombination {
 public:
-    EpochCombination(const MountingsFile& m, LinkClient<T>& client, pipeline::EpochPipeline<T>& host, std::string file,
+    EpochCombination(const MountingsFile& m, LinkClient<T>& client, link::LinkPipeline<T>& host, std::string file,
                      std::ostream& log)
         : client_(client), host_(host), combiner_(m.mountings), file_(std::move(file)), log_(log) {
         client_.load_mountings(m.mountings);
@@ -311,7 +314,7 @@ private:
     }
 
     LinkClient<T>& client_;
-    pipeline::EpochPipeline<T>& host_;
+    link::LinkPipeline<T>& host_;
     combine::Combiner<T> combiner_;
     std::string file_;
     std::ostream& log_;
@@ -362,8 +365,8 @@ template <typename T>
 struct HostSide {
     std::optional<SelfCalibration> sc;
     std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
-    std::optional<calib::Estimator<T>> estimator;
-    pipeline::EpochPipeline<T> pipeline;
+    std::optional<link::LinkEstimator<T>> estimator;  // the link's
+    link::LinkPipeline<T> pipeline;
     std::vector<ActiveModel> target_history;
 };
 
@@ -540,7 +543,7 @@ private:
                                        const pipeline::VelocityAnswer<T>& velocity, std::int64_t t_us, bool timed,
                                        std::uint8_t calib_use, const link::SolutionOut<T>& got) {
         const auto answer = [&velocity] { return velocity; };
-        pipeline::EpochPipeline<T>& p = host_.pipeline;
+        link::LinkPipeline<T>& p = host_.pipeline;
         CorrectedSolution<T> host{};
         std::optional<std::uint32_t> host_version;
         if (p.calibrating() && !timed) {

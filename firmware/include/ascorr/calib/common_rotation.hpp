@@ -22,23 +22,24 @@
 
 namespace ascorr::calib {
 
-// y ← P·y, P = I − G·Gᵀ/3 (see the top).
-inline void remove_common_rotation(const Matrix3 (&n)[3], double (&y)[9]) noexcept {
+// y ← P·y, P = I − G·Gᵀ/H, for H heads (see the top; H = 3 there).
+template <std::size_t H>
+void remove_common_rotation(const Matrix3 (&n)[H], double (&y)[3 * H]) noexcept {
     double g[3] = {0.0, 0.0, 0.0};  // Gᵀ·y
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t h = 0; h < H; ++h) {
         for (std::size_t r = 0; r < 3; ++r) {
             for (std::size_t c = 0; c < 3; ++c) {
                 g[c] += n[h].m[r][c] * y[3 * h + r];
             }
         }
     }
-    for (std::size_t h = 0; h < 3; ++h) {
+    for (std::size_t h = 0; h < H; ++h) {
         for (std::size_t r = 0; r < 3; ++r) {
             double s = 0.0;
             for (std::size_t c = 0; c < 3; ++c) {
                 s += n[h].m[r][c] * g[c];
             }
-            y[3 * h + r] -= s / 3.0;
+            y[3 * h + r] -= s / static_cast<double>(H);
         }
     }
 }
@@ -59,9 +60,10 @@ inline void common_rotation_projector(const Matrix3* n, std::size_t heads, doubl
     }
 }
 
-// The projector P itself (9 × 9) of three heads, for a design built column by column.
-inline void common_rotation_projector(const Matrix3 (&n)[3], double (&p)[9][9]) noexcept {
-    common_rotation_projector(n, 3, &p[0][0]);
+// The projector P itself (3H × 3H) of H heads, for a design built column by column.
+template <std::size_t H>
+void common_rotation_projector(const Matrix3 (&n)[H], double (&p)[3 * H][3 * H]) noexcept {
+    common_rotation_projector(n, H, &p[0][0]);
 }
 
 }  // namespace ascorr::calib

@@ -8,6 +8,7 @@
 //           (status 256, no thermal stage)
 //           ... correct the cycle's solutions with m ...
 //           est.accumulate(cycle);   // only when A, B and C passed the selection
+//           est.accumulate_head(h, ...);  // a further head selected after them
 //   idle:   while (time left && est.step()) {}   // bounded work per call
 //   ground: freeze(), resume(), reset(), load_model(m), report().
 //
@@ -15,7 +16,12 @@
 // when flags 1, 2 and 4 are clear, confidence ≤ 5, its three temperatures are
 // valid, and the aberration stage was applied; its quaternion without the
 // thermal stage is what is given (feed.hpp forms it, for the flight loop, the
-// link server and the host alike). A cycle counts when A, B and C all do.
+// link server and the host alike). A cycle counts when A, B and C all do; a
+// further head is learnt from the counted cycles it passes too (per-head
+// selection: estimator_types.hpp, README.md).
+//
+// N: the heads learnt, 3 to the core's kMaxHeads (heads.hpp; the flight loop
+// and the link: kMaxHeads); F needs A and C, the IBAs are all N·(N − 1)/2 pairs.
 //
 // The estimate, its numerics and the per-cycle and per-orbit work: README.md
 // in this folder ("The estimator").
@@ -30,7 +36,7 @@
 //     temperatures ± angle_check_margin_c;
 //   - kNoGain: over the last window_orbits orbits, the RMS of the model's IBA
 //     residuals (orbit means; iba_residuals(): what the residual rotations do
-//     to the three IBAs, so a common rotation or a roll about a boresight
+//     to the N heads' IBAs, so a common rotation or a roll about a boresight
 //     counts for nothing) is not below (1 − adoption_margin) × the active
 //     model's. Not about their mean: within a window the orbit means'
 //     temperatures hardly move, so a wrong slope shows as an offset there.
@@ -42,8 +48,8 @@
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
 // arcsec as ModelCoefficients and converted once into the core's
 // ThermalModel<T> (model_coefficients.hpp) when prepared, in the back buffer.
-// An adopted model is learnt for A, B and C; its other heads are the active
-// model's (learns_head, estimator_types.hpp).
+// An adopted model is learnt for A, B, C and the further heads that joined
+// it (active_learnt()); its other heads are the active model's.
 //
 // No allocation, no exception, no recursion, fixed-size state, every loop
 // with a fixed bound. T: double, float or Q30 (the core's scalar).
@@ -68,9 +74,13 @@
 
 namespace ascorr::calib {
 
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 class Estimator {
+    static_assert(kCalibHeadCountOk<N>, "the estimator learns 3 to kMaxHeads heads");
+
 public:
+    static constexpr std::size_t kHeads = N;
+
     enum class Phase : std::uint8_t { kIdle, kAverages, kUpdate, kCandidate, kGate };
 
     explicit Estimator(const EstimatorConfig& cfg = EstimatorConfig{},
@@ -109,8 +119,9 @@ public:
         return has_[active_] ? &core_[active_] : nullptr;
     }
 
-    // One selected cycle (A, B and C) into the current orbit's sums.
-    void accumulate(const CalibCycle<T>& c) noexcept {
+    // One counted cycle (A, B and C selected; the further heads in c.heads)
+    // into the current orbit's sums.
+    void accumulate(const CalibCycle<T, N>& c) noexcept {
         if (frozen_) {
             return;
         }
@@ -119,6 +130,14 @@ public:
             orbit_.open(c);
         }
         orbit_.add(c);
+    }
+
+    // Further head h (≥ kFrameHeads) selected at t_us after that cycle was
+    // accumulated (solutions that come one by one); false: not taken (no
+    // such cycle in the open orbit, frozen).
+    bool accumulate_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_chu_icrf,
+                         const HeadTemperatures<T>& temperatures) noexcept {
+        return !frozen_ && orbit_.add_head(h, t_us, q_chu_icrf, temperatures);
     }
 
     // Ends the current orbit now (the end of a recording; a command).
@@ -162,6 +181,11 @@ public:
             s.clear();
         }
         n_valid_ = false;
+        n_heads_ = 0;
+        for (auto& k : head_orbits_) {
+            k = 0;
+        }
+        solved_ = 0;
         orbits_used_ = 0;
         window_.clear();
         held_run_ = 0;
@@ -205,11 +229,15 @@ public:
     // The active model's version and CRC-32C (model_crc); 0 when there is none.
     std::uint32_t active_version() const noexcept { return has_[active_] ? version_[active_] : 0U; }
     std::uint32_t active_crc() const noexcept { return has_[active_] ? crc_[active_] : 0U; }
+    // The heads the active model learnt (bit h; 0: given or loaded).
+    std::uint8_t active_learnt() const noexcept { return has_[active_] ? learnt_[active_] : 0U; }
     // When the active model became active (the t of the first cycle using it).
     std::int64_t adopted_at_us() const noexcept { return adopted_at_us_; }
     const EstimatorConfig& config() const noexcept { return cfg_; }
 
 private:
+    static constexpr std::size_t kFramePairs = iba_pairs(kFrameHeads);
+
     std::size_t back() const noexcept { return active_ ^ 1U; }
 
     void close_orbit() noexcept {
@@ -235,20 +263,25 @@ private:
             ++orbits_short_;
             return false;
         }
-        const OrbitMeans means = orbit_means(closed_);
-        const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);
-        const Quaternion<double> q_head_in_f[kCalibHeads] = {conjugate(q_f_in_a), q_head_f(means.d[0], q_f_in_a),
-                                                             q_head_f(means.d[1], q_f_in_a)};
-        if (!n_valid_) {
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        const OrbitMeans<N> means = orbit_means(closed_, further_min_count(n));
+        const Quaternion<double> q_f_in_a = q_f_a(means.d[1]);  // d[1]: C relative to A
+        Quaternion<double> q_head_in_f[N];
+        q_head_in_f[0] = conjugate(q_f_in_a);
+        for (std::size_t h = 1; h < N; ++h) {
+            q_head_in_f[h] = means.has[h] ? q_head_f(means.d[h - 1], q_f_in_a) : Quaternion<double>{};
+        }
+        OrbitRecord<N>& o = record_;
+        o.bin = closed_.bin;
+        o.held = false;
+        for (std::size_t h = 0; h < N; ++h) {
+            o.has[h] = means.has[h];
+            if (!means.has[h]) {
+                continue;
+            }
+            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
                 n_ref_[h] = q_head_in_f[h];
                 n_mat_[h] = rotation_matrix(q_head_in_f[h]);
             }
-        }
-        OrbitRecord& o = record_;
-        o.bin = closed_.bin;
-        o.held = false;
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
             const Vector3<double> e = small_angle(relative_to(q_head_in_f[h], n_ref_[h]));
             o.e[h][0] = e.x * kRadToArcsec;
             o.e[h][1] = e.y * kRadToArcsec;
@@ -256,28 +289,42 @@ private:
             o.x[h][0] = means.t[h][0];
             o.x[h][1] = means.t[h][1] - means.t[h][0];
             o.x[h][2] = means.t[h][2] - means.t[h][0];
-        }
-        if (!n_valid_) {
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
+            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
                 }
             }
-            n_valid_ = true;
         }
-        orbit_.set_next_reference(reference_from<T>(means));  // the references of the next orbit opened
+        n_heads_ = static_cast<std::uint8_t>(n_heads_ | o.heads());
+        n_valid_ = true;
+        // the references of the next orbit opened (a head without means keeps its own)
+        orbit_.set_next_reference(reference_from<T>(means, orbit_.latest_reference()));
         return true;
+    }
+
+    // A further head's cycles for its orbit means: min_epochs_per_orbit, and
+    // min_coverage of the orbit's n counted cycles.
+    std::uint32_t further_min_count(std::uint32_t n) const noexcept {
+        const double cover = std::ceil(cfg_.min_coverage * static_cast<double>(n));
+        const std::uint32_t c = cover > 0.0 ? static_cast<std::uint32_t>(cover) : 0U;
+        return c > cfg_.min_epochs_per_orbit ? c : cfg_.min_epochs_per_orbit;
     }
 
     // Phase 2: the innovation test, forgetting, the filter update.
     void update() noexcept {
-        OrbitRecord& o = record_;
+        OrbitRecord<N>& o = record_;
         if (has_solution_) {
-            double nu[9];
-            residual(b_, centre_, o, nu);
-            double d[3];
-            iba_residuals(n_mat_, nu, d);
-            const double ss = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            double nu[3 * N];
+            residual<N>(b_, centre_, o, nu);
+            double d[iba_pairs(N)];
+            const std::size_t pairs = iba_residuals<N>(n_mat_, nu, d, static_cast<std::uint8_t>(solved_ & o.heads()));
+            double ss = 0.0;
+            for (const double dk : d) {
+                ss += dk * dk;
+            }
+            if (pairs != kFramePairs) {
+                ss *= static_cast<double>(kFramePairs) / static_cast<double>(pairs);  // per the frame heads' 3 pairs
+            }
             if (ms_count_ >= 15U && ss > cfg_.outlier_gate * cfg_.outlier_gate * ms_) {
                 o.held = true;
                 ++orbits_held_;
@@ -303,7 +350,7 @@ private:
             }
             ++changes_;
             for (std::size_t i = 0; i < window_.size(); ++i) {
-                OrbitRecord& r = window_.at(i);
+                OrbitRecord<N>& r = window_.at(i);
                 if (r.held) {
                     r.held = false;
                     feed(r);
@@ -316,7 +363,7 @@ private:
         feed(window_.at(window_.size() - 1U));
     }
 
-    void feed(const OrbitRecord& o) noexcept {
+    void feed(const OrbitRecord<N>& o) noexcept {
         if (last_fed_valid_ && o.bin > last_fed_bin_) {
             const double dt_days = static_cast<double>(o.bin - last_fed_bin_) *
                                    (static_cast<double>(cfg_.orbit_period_us) * 1e-6 / 86400.0);
@@ -329,11 +376,15 @@ private:
             last_fed_bin_ = o.bin;
         }
         last_fed_valid_ = true;
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        for (std::size_t h = 0; h < N; ++h) {
+            if (!o.has[h]) {
+                continue;
+            }
             const double a[kUnknowns] = {1.0, o.x[h][0] - centre_[h][0], o.x[h][1] - centre_[h][1],
                                          o.x[h][2] - centre_[h][2]};
             const double y[3] = {o.e[h][0], o.e[h][1], o.e[h][2]};
             srif_[h].add(a, y, 1.0);
+            ++head_orbits_[h];
         }
         ++orbits_used_;
     }
@@ -345,8 +396,8 @@ private:
             return false;
         }
         condition_ = 0.0;
-        double b[kCalibHeads][kUnknowns][3];
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
+        double b[N][kUnknowns][3];
+        for (std::size_t h = 0; h < kFrameHeads; ++h) {
             const double c = srif_[h].condition();
             condition_ = c > condition_ || std::isnan(c) ? c : condition_;
             if (!srif_[h].solve(b[h])) {
@@ -357,19 +408,41 @@ private:
             refuse(Refusal::kCondition);
             return false;
         }
-        for (std::size_t h = 0; h < kCalibHeads; ++h) {
-            for (std::size_t j = 0; j < kUnknowns; ++j) {
+        std::uint8_t heads = kFrameMask;
+        for (std::size_t h = kFrameHeads; h < N; ++h) {
+            if (further_solved(h, b[h])) {
+                heads = static_cast<std::uint8_t>(heads | (1U << h));
+            }
+        }
+        for (std::size_t h = 0; h < N; ++h) {
+            for (std::size_t j = 0; j < kUnknowns && ((heads >> h) & 1U) != 0U; ++j) {
                 for (std::size_t a = 0; a < 3; ++a) {
                     b_[h][j][a] = b[h][j][a];
                 }
             }
         }
         has_solution_ = true;
-        centred_to_model(b_, centre_, cand_);
-        if (!within_limits(cand_, window_, cfg_.angle_check_margin_c)) {
+        solved_ = heads;
+        centred_to_model<N>(b_, centre_, cand_, heads);
+        if (!within_limits(cand_, window_, cfg_.angle_check_margin_c, heads)) {
             refuse(Refusal::kAngleLimit);
             return false;
         }
+        return true;
+    }
+
+    // A further head joins the candidate when its filter holds min_orbits
+    // orbits, its condition is within max_condition and it solves (its
+    // condition then counts in the report's); otherwise the model keeps it.
+    bool further_solved(std::size_t h, double (&b)[kUnknowns][3]) noexcept {
+        if (head_orbits_[h] < cfg_.min_orbits) {
+            return false;
+        }
+        const double c = srif_[h].condition();
+        if (!(c <= cfg_.max_condition) || !srif_[h].solve(b)) {
+            return false;
+        }
+        condition_ = c > condition_ ? c : condition_;
         return true;
     }
 
@@ -378,30 +451,30 @@ private:
     // favour the active model, made for the bench before the change.
     void gate() noexcept {
         const std::uint32_t n = since_change_ < cfg_.window_orbits ? since_change_ : cfg_.window_orbits;
-        candidate_rms_ = window_rms(cand_, window_, n_mat_, n);
+        candidate_rms_ = window_rms(cand_, window_, n_mat_, n, solved_);
         if (has_[active_]) {
-            active_rms_ = window_rms(model_[active_], window_, n_mat_, n);
+            active_rms_ = window_rms(model_[active_], window_, n_mat_, n, solved_);
             if (!(candidate_rms_ <= (1.0 - cfg_.adoption_margin) * active_rms_)) {
                 refuse(Refusal::kNoGain);
                 return;
             }
         }
         last_refusal_ = Refusal::kNone;
-        keep_heads_not_learnt(cand_);
-        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U);
+        keep_heads_not_learnt(cand_, solved_);
+        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_);
         active_rms_ = candidate_rms_;
         swap_pending_ = true;
     }
 
-    // The heads the estimator does not learn (learns_head) keep the active
-    // model's presence and coefficients in candidate m.
-    void keep_heads_not_learnt(ModelCoefficients& m) const noexcept {
+    // The heads candidate m did not learn (not in `learnt`) keep the active
+    // model's presence and coefficients.
+    void keep_heads_not_learnt(ModelCoefficients& m, std::uint8_t learnt) const noexcept {
         if (!has_[active_]) {
             return;
         }
         const ModelCoefficients& a = model_[active_];
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            if (learns_head(h)) {
+            if (learns_head(h, learnt)) {
                 continue;
             }
             m.present[h] = a.present[h];
@@ -419,8 +492,9 @@ private:
     }
 
     // The back buffer: coefficients, the core's form, version and CRC.
-    void prepare(const ModelCoefficients& m, std::uint32_t version) noexcept {
+    void prepare(const ModelCoefficients& m, std::uint32_t version, std::uint8_t learnt = 0U) noexcept {
         const std::size_t k = back();
+        learnt_[k] = learnt;
         model_[k] = m;
         core_[k] = thermal_model<T>(m, kArcsecToRad);
         version_[k] = version;
@@ -431,27 +505,30 @@ private:
     EstimatorConfig cfg_;
     // The cycle's side.
     bool frozen_ = false;
-    OrbitCollector<T> orbit_;
+    OrbitCollector<T, N> orbit_;
     // The closed orbit being processed.
     Phase phase_ = Phase::kIdle;
-    ClosedOrbit<T> closed_{};
+    ClosedOrbit<T, N> closed_{};
     std::uint32_t typical_count_ = 0;
-    OrbitRecord record_{};
+    OrbitRecord<N> record_{};
     // The filter.
     bool n_valid_ = false;
-    Quaternion<double> n_ref_[kCalibHeads]{};
-    Matrix3 n_mat_[kCalibHeads]{};
-    double centre_[kCalibHeads][3]{};
-    SquareRootInformation<kUnknowns, 3> srif_[kCalibHeads]{};
+    std::uint8_t n_heads_ = 0;  // heads with n_ref_, n_mat_, centre_ (bit h)
+    Quaternion<double> n_ref_[N]{};
+    Matrix3 n_mat_[N]{};
+    double centre_[N][3]{};
+    SquareRootInformation<kUnknowns, 3> srif_[N]{};
     bool last_fed_valid_ = false;
     std::int64_t last_fed_bin_ = 0;
+    std::uint32_t head_orbits_[N]{};  // orbits fed per head
     bool has_solution_ = false;
-    double b_[kCalibHeads][kUnknowns][3]{};
+    std::uint8_t solved_ = 0;  // heads of the last solution b_ (bit h)
+    double b_[N][kUnknowns][3]{};
     double ms_ = 0.0;
     std::uint32_t ms_count_ = 0;
     std::uint32_t held_run_ = 0;
     std::uint32_t since_change_ = kWindow;  // orbits since the last change taken as real (saturating)
-    OrbitWindow window_{};
+    OrbitWindow<N> window_{};
     // Counters and the report.
     std::uint32_t orbits_used_ = 0;
     std::uint32_t orbits_short_ = 0;
@@ -469,6 +546,7 @@ private:
     ThermalModel<T> core_[2]{};
     std::uint32_t version_[2]{};
     std::uint32_t crc_[2]{};
+    std::uint8_t learnt_[2]{};
     bool has_[2]{};
     std::size_t active_ = 0;
     bool swap_pending_ = false;

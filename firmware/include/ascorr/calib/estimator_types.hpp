@@ -8,17 +8,40 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "../core/heads.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/thermal.hpp"
 
 namespace ascorr::calib {
 
-inline constexpr std::size_t kCalibHeads = 3;  // A, B, C: F needs A and C, the IBAs all three
-// The heads the estimator learns. A model's other heads (D) are not
-// estimated: an adopted model keeps the active model's coefficients for them
-// (Estimator::gate), so a head with a model never loses it to an adoption.
-constexpr bool learns_head(std::size_t h) noexcept {
-    return h < kCalibHeads;
+// The estimator learns heads 0 … N − 1, N from kMinCalibHeads to the core's
+// kMaxHeads (heads.hpp): F needs A and C, the IBAs all N. kCalibHeads is the
+// templates' default (A, B and C); the link and the flight loop learn kMaxHeads.
+//
+// Per-head selection: the frame heads 0 … kFrameHeads − 1 (A, B, C) learn
+// from the epochs in which all three pass the selection (a cycle counts then,
+// docs/contract.md), whatever the further heads do. A further head h (D, …)
+// learns from the counted epochs in which it passes the selection too: its
+// rotation is taken relative to A, in F (A and C), and its IBAs pair it with
+// A, B and C. It joins a model once its own orbits reach min_orbits and its
+// condition is within max_condition; until then, or in a file without it, an
+// adopted model keeps the active model's coefficients for it (Estimator::gate),
+// so a head with a model never loses it to an adoption.
+inline constexpr std::size_t kMinCalibHeads = 3;
+inline constexpr std::size_t kFrameHeads = 3;
+inline constexpr std::size_t kCalibHeads = 3;
+template <std::size_t N>
+inline constexpr bool kCalibHeadCountOk = N >= kMinCalibHeads&& N <= kMaxHeads&& N <= 8U;
+// The frame heads' bits of a head mask (bit h: head h).
+inline constexpr std::uint8_t kFrameMask = (1U << kFrameHeads) - 1U;
+// Whether a mask of learnt heads (Estimator::active_learnt) has head h.
+constexpr bool learns_head(std::size_t h, std::uint32_t learnt_mask) noexcept {
+    return h < 32U && ((learnt_mask >> h) & 1U) != 0U;
+}
+// The inter-boresight angles of N heads: pairs (i, j), i < j, in the order
+// (0,1), (0,2), …, (0,N−1), (1,2), …
+constexpr std::size_t iba_pairs(std::size_t n_heads) noexcept {
+    return n_heads * (n_heads - 1U) / 2U;
 }
 // The estimator learns the linear terms of core/model_terms.hpp per axis,
 // [1, T1, T2 − T1, T3 − T1] (its design row, Estimator::feed).
@@ -107,12 +130,15 @@ struct EstimatorReport {
     bool frozen;
 };
 
-// One cycle's selected solutions of A, B and C at the same instant.
-template <typename T>
+// One counted cycle's selected solutions at the same instant: the frame
+// heads always, a further head h when bit h of `heads` is set.
+template <typename T, std::size_t N = kCalibHeads>
 struct CalibCycle {
-    std::int64_t t_us;                              // time of the epoch, µs
-    Quaternion<T> q_chu_icrf[kCalibHeads];          // aberration-corrected, unit
-    HeadTemperatures<T> temperatures[kCalibHeads];  // all valid
+    static_assert(kCalibHeadCountOk<N>, "the estimator learns 3 to kMaxHeads heads");
+    std::int64_t t_us;                    // time of the epoch, µs
+    Quaternion<T> q_chu_icrf[N];          // aberration-corrected, unit
+    HeadTemperatures<T> temperatures[N];  // all valid
+    std::uint8_t heads = kFrameMask;      // bit h: head h selected (the frame heads' bits always)
 };
 
 }  // namespace ascorr::calib

@@ -30,14 +30,14 @@
 namespace ascorr::calib {
 
 // An orbit handed from the cycle to the per-orbit work.
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 struct ClosedOrbit {
-    OrbitSums<T> sums{};
-    OrbitReference<T> ref{};
+    OrbitSums<T, N> sums{};
+    OrbitReference<T, N> ref{};
     std::int64_t bin = 0;  // floor(t / P)
 };
 
-template <typename T>
+template <typename T, std::size_t N = kCalibHeads>
 class OrbitCollector {
 public:
     // period_us > 0 (EstimatorConfig's bounds, estimator_types.hpp).
@@ -51,33 +51,61 @@ public:
 
     // Opens the orbit of cycle c (the current one must have been closed or
     // dropped) with empty sums and the references (see the top).
-    void open(const CalibCycle<T>& c) noexcept {
+    void open(const CalibCycle<T, N>& c) noexcept {
         bin_ = floor_div(c.t_us, period_us_);
         start_us_ = bin_ * period_us_;
         end_us_ = start_us_ + period_us_;
         open_ = true;
-        sums_ = OrbitSums<T>{};
+        sums_ = OrbitSums<T, N>{};
         if (next_ref_ready_) {
             ref_ = next_ref_;
             next_ref_ready_ = false;
         } else if (!ref_valid_) {
             const Quaternion<T> q_icrf_a = conjugate(c.q_chu_icrf[0]);
-            ref_.r[0] = c.q_chu_icrf[1] * q_icrf_a;
-            ref_.r[1] = c.q_chu_icrf[2] * q_icrf_a;
-            for (std::size_t h = 0; h < kCalibHeads; ++h) {
-                ref_.t_ref[h][0] = c.temperatures[h].t_chu.value;
-                ref_.t_ref[h][1] = c.temperatures[h].t_029.value;
-                ref_.t_ref[h][2] = c.temperatures[h].t_032.value;
+            for (std::size_t k = 0; k + 1 < kFrameHeads; ++k) {
+                ref_.r[k] = c.q_chu_icrf[k + 1] * q_icrf_a;
+            }
+            for (std::size_t h = 0; h < kFrameHeads; ++h) {
+                take_temperatures(h, c.temperatures[h]);
             }
         }
         ref_valid_ = true;
     }
 
-    // One cycle of the open orbit (starts_orbit(c.t_us) false).
-    void add(const CalibCycle<T>& c) noexcept { sums_.add(c.q_chu_icrf, c.temperatures, ref_); }
+    // One cycle of the open orbit (starts_orbit(c.t_us) false). A further
+    // head's first selected cycle ever gives its references.
+    void add(const CalibCycle<T, N>& c) noexcept {
+        if constexpr (N > kFrameHeads) {
+            last_t_us_ = c.t_us;
+            last_q_a_ = c.q_chu_icrf[0];
+            for (std::size_t h = kFrameHeads; h < N && c.heads != kFrameMask; ++h) {
+                if (((c.heads >> h) & 1U) != 0U) {
+                    first_reference(h, c.q_chu_icrf[h], c.temperatures[h]);
+                }
+            }
+        }
+        sums_.add(c.q_chu_icrf, c.temperatures, ref_, c.heads);
+    }
+
+    // Further head h (≥ kFrameHeads) of the last cycle added, selected after
+    // it (the link's solutions come one by one); false: no such cycle is
+    // open at t_us, or h was not sent with it.
+    bool add_head(std::size_t h, std::int64_t t_us, const Quaternion<T>& q_h,
+                  const HeadTemperatures<T>& temps) noexcept {
+        if (!open_ || t_us != last_t_us_ || h < kFrameHeads || h >= N) {
+            return false;
+        }
+        first_reference(h, q_h, temps);
+        sums_.add_head(h, conjugate(last_q_a_), q_h, temps, ref_);
+        return true;
+    }
+
+    // The references of the orbit opened last (those of the heads a closed
+    // orbit does not have carry over).
+    const OrbitReference<T, N>& latest_reference() const noexcept { return next_ref_ready_ ? next_ref_ : ref_; }
 
     // Ends the open orbit, handing it over.
-    void close(ClosedOrbit<T>& out) noexcept {
+    void close(ClosedOrbit<T, N>& out) noexcept {
         open_ = false;
         out.sums = sums_;
         out.ref = ref_;
@@ -89,12 +117,34 @@ public:
     void drop() noexcept { open_ = false; }
 
     // The references of the next orbit opened.
-    void set_next_reference(const OrbitReference<T>& r) noexcept {
+    void set_next_reference(const OrbitReference<T, N>& r) noexcept {
         next_ref_ = r;
         next_ref_ready_ = true;
     }
 
 private:
+    void take_temperatures(std::size_t h, const HeadTemperatures<T>& tp) noexcept {
+        ref_.t_ref[h][0] = tp.t_chu.value;
+        ref_.t_ref[h][1] = tp.t_029.value;
+        ref_.t_ref[h][2] = tp.t_032.value;
+    }
+
+    // A further head's references from its first selected cycle ever.
+    void first_reference(std::size_t h, const Quaternion<T>& q_h, const HeadTemperatures<T>& tp) noexcept {
+        if (((ref_heads_ >> h) & 1U) != 0U) {
+            return;
+        }
+        ref_heads_ = static_cast<std::uint8_t>(ref_heads_ | (1U << h));
+        ref_.r[h - 1U] = q_h * conjugate(last_q_a_);
+        take_temperatures(h, tp);
+        if (next_ref_ready_) {
+            next_ref_.r[h - 1U] = ref_.r[h - 1U];
+            for (std::size_t j = 0; j < 3; ++j) {
+                next_ref_.t_ref[h][j] = ref_.t_ref[h][j];
+            }
+        }
+    }
+
     static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
         const std::int64_t q = a / b;
         return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
@@ -105,39 +155,54 @@ private:
     std::int64_t bin_ = 0;
     std::int64_t start_us_ = 0;  // [start, end) of the open orbit
     std::int64_t end_us_ = 0;
-    OrbitSums<T> sums_{};
-    OrbitReference<T> ref_{};
+    OrbitSums<T, N> sums_{};
+    OrbitReference<T, N> ref_{};
     bool ref_valid_ = false;
-    OrbitReference<T> next_ref_{};
+    OrbitReference<T, N> next_ref_{};
     bool next_ref_ready_ = false;
+    std::uint8_t ref_heads_ = kFrameMask;  // heads with references (a further head: from its first cycle)
+    std::int64_t last_t_us_ = 0;           // the last cycle added (further heads only)
+    Quaternion<T> last_q_a_{};             // its head A (q_a_icrf)
 };
 
-// A closed orbit's means, in double: d_B and d_C (unit; the mean of δ_h,
-// normalised, times r_h, normalised again) and the nine mean temperatures (°C).
+// A closed orbit's means of N heads, in double: d_B, d_C, … (unit; the mean
+// of δ_h, normalised, times r_h, normalised again) and the 3·N mean
+// temperatures (°C), of the heads with at least min_count cycles in the orbit
+// (has; the frame heads': the orbit's).
+template <std::size_t N = kCalibHeads>
 struct OrbitMeans {
-    Quaternion<double> d[2];
-    double t[kCalibHeads][3];
+    Quaternion<double> d[N - 1];
+    double t[N][3];
+    bool has[N];
 };
 
-// The means of o's sums over n = o.sums.count > 0 cycles (o.sums flushed);
-// why means of d_h suffice: orbit_sums.hpp, at the top.
-template <typename T>
-OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
+// The means of o's sums (o.sums flushed, o.sums.count > 0); a further head
+// has means when it has min_count cycles; why means of d_h suffice:
+// orbit_sums.hpp, at the top.
+template <typename T, std::size_t N>
+OrbitMeans<N> orbit_means(const ClosedOrbit<T, N>& o, std::uint32_t min_count = 1U) noexcept {
     using Tr = ScalarTraits<T>;
-    const double inv = 1.0 / static_cast<double>(o.sums.count);
-    OrbitMeans m{};
-    for (std::size_t k = 0; k < 2; ++k) {
-        const auto& s = o.sums.dq[k];
-        const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv, s[3].value() * inv};
-        const double sm = 1.0 / std::sqrt(squared_norm(mean));
-        const Quaternion<T>& r = o.ref.r[k];
-        const Quaternion<double> rd{Tr::to_double(r.w), Tr::to_double(r.x), Tr::to_double(r.y), Tr::to_double(r.z)};
-        const Quaternion<double> unit{mean.w * sm, mean.x * sm, mean.y * sm, mean.z * sm};
-        const Quaternion<double> dk = unit * rd;
-        const double sn = 1.0 / std::sqrt(squared_norm(dk));
-        m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
-    }
-    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+    OrbitMeans<N> m{};
+    for (std::size_t h = 0; h < N; ++h) {
+        const std::uint32_t n = o.sums.count_of(h);
+        m.has[h] = h < kFrameHeads || (n >= min_count && n > 0U);
+        if (!m.has[h]) {
+            continue;
+        }
+        const double inv = 1.0 / static_cast<double>(n);
+        if (h > 0U) {
+            const std::size_t k = h - 1U;
+            const auto& s = o.sums.dq[k];
+            const Quaternion<double> mean{s[0].value() * inv, s[1].value() * inv, s[2].value() * inv,
+                                          s[3].value() * inv};
+            const double sm = 1.0 / std::sqrt(squared_norm(mean));
+            const Quaternion<T>& r = o.ref.r[k];
+            const Quaternion<double> rd{Tr::to_double(r.w), Tr::to_double(r.x), Tr::to_double(r.y), Tr::to_double(r.z)};
+            const Quaternion<double> unit{mean.w * sm, mean.x * sm, mean.y * sm, mean.z * sm};
+            const Quaternion<double> dk = unit * rd;
+            const double sn = 1.0 / std::sqrt(squared_norm(dk));
+            m.d[k] = {dk.w * sn, dk.x * sn, dk.y * sn, dk.z * sn};
+        }
         for (std::size_t j = 0; j < 3; ++j) {
             m.t[h][j] = Tr::to_double(o.ref.t_ref[h][j]) + o.sums.dt[h][j].value() * inv;
         }
@@ -145,16 +210,19 @@ OrbitMeans orbit_means(const ClosedOrbit<T>& o) noexcept {
     return m;
 }
 
-// The references an orbit's means give the next orbit (rounded to T).
-template <typename T>
-OrbitReference<T> reference_from(const OrbitMeans& m) noexcept {
+// The references an orbit's means give the next orbit (rounded to T); the
+// heads without means keep those of `r`.
+template <typename T, std::size_t N>
+OrbitReference<T, N> reference_from(const OrbitMeans<N>& m, OrbitReference<T, N> r = {}) noexcept {
     using Tr = ScalarTraits<T>;
-    OrbitReference<T> r{};
-    for (std::size_t k = 0; k < 2; ++k) {
-        r.r[k] = {Tr::from_double(m.d[k].w), Tr::from_double(m.d[k].x), Tr::from_double(m.d[k].y),
-                  Tr::from_double(m.d[k].z)};
-    }
-    for (std::size_t h = 0; h < kCalibHeads; ++h) {
+    for (std::size_t h = 0; h < N; ++h) {
+        if (!m.has[h]) {
+            continue;
+        }
+        if (h > 0U) {
+            const Quaternion<double>& d = m.d[h - 1U];
+            r.r[h - 1U] = {Tr::from_double(d.w), Tr::from_double(d.x), Tr::from_double(d.y), Tr::from_double(d.z)};
+        }
         for (std::size_t j = 0; j < 3; ++j) {
             r.t_ref[h][j] = Tr::celsius(m.t[h][j]);
         }

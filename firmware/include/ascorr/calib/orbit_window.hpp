@@ -11,23 +11,34 @@
 
 namespace ascorr::calib {
 
-// One orbit as the filter sees it.
+// One orbit as the filter sees it (N heads).
+template <std::size_t N = kCalibHeads>
 struct OrbitRecord {
     std::int64_t bin;
-    double e[kCalibHeads][3];  // arcsec, relative to N_h
-    double x[kCalibHeads][3];  // T1, T2 − T1, T3 − T1 (°C), orbit means
-    bool held;                 // held back as an outlier, not (yet) in the filter
+    double e[N][3];  // arcsec, relative to N_h
+    double x[N][3];  // T1, T2 − T1, T3 − T1 (°C), orbit means
+    bool held;       // held back as an outlier, not (yet) in the filter
+    bool has[N];     // head h's means are in the orbit (the frame heads always)
+
+    std::uint8_t heads() const noexcept {
+        std::uint8_t m = 0;
+        for (std::size_t h = 0; h < N; ++h) {
+            m = static_cast<std::uint8_t>(m | (has[h] ? 1U << h : 0U));
+        }
+        return m;
+    }
 };
 
+template <std::size_t N = kCalibHeads>
 class OrbitWindow {
 public:
     void clear() noexcept { size_ = 0; }
     std::size_t size() const noexcept { return size_; }
     // The i-th oldest record, i < size().
-    OrbitRecord& at(std::size_t i) noexcept { return ring_[(first_ + i) % kWindow]; }
-    const OrbitRecord& at(std::size_t i) const noexcept { return ring_[(first_ + i) % kWindow]; }
+    OrbitRecord<N>& at(std::size_t i) noexcept { return ring_[(first_ + i) % kWindow]; }
+    const OrbitRecord<N>& at(std::size_t i) const noexcept { return ring_[(first_ + i) % kWindow]; }
     // Appends o; when full, o replaces the oldest.
-    void push(const OrbitRecord& o) noexcept {
+    void push(const OrbitRecord<N>& o) noexcept {
         if (size_ < kWindow) {
             ring_[(first_ + size_) % kWindow] = o;
             ++size_;
@@ -38,7 +49,7 @@ public:
     }
 
 private:
-    OrbitRecord ring_[kWindow]{};
+    OrbitRecord<N> ring_[kWindow]{};
     std::size_t first_ = 0;
     std::size_t size_ = 0;
 };

@@ -13,10 +13,13 @@
 //   3. correction and 4. status (correct_stage(), solution_stage.hpp, then
 //                the caller's own bits: Calls::status);
 //   5. estimator feed: the first clean, usable solution of each of the
-//                calibrated heads is kept; when all are there and the epoch is
-//                one the schedule feeds (every feed_every-th), they feed the
-//                estimator (calib::feed_estimator) and its per-orbit update
-//                runs steps_after_feed bounded steps; idle() runs one more;
+//                calibrated heads is kept; when A, B and C are there and the
+//                epoch is one the schedule feeds (every feed_every-th), they
+//                feed the estimator with the further heads kept so far
+//                (calib::feed_estimator) and its per-orbit update runs
+//                steps_after_feed bounded steps; a further head that comes
+//                after them is fed alone into the same cycle
+//                (calib::feed_estimator_head); idle() runs one more step;
 //   6. combination (use_combiner; close()): the corrected solutions since the
 //                last close() (the caller's epoch of the bench: a flight
 //                cycle, the host's millisecond epoch) combined into the
@@ -55,17 +58,28 @@ struct NoMeter {
 
 template <typename T>
 struct InlineCalls {
-    static const ThermalModel<T>* model_for_epoch(calib::Estimator<T>& e, std::int64_t t_us) noexcept {
+    template <std::size_t N>
+    static const ThermalModel<T>* model_for_epoch(calib::Estimator<T, N>& e, std::int64_t t_us) noexcept {
         return e.model_for_cycle(t_us);
     }
     static CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
         return correct_solution(in, cfg);
     }
-    static bool feed(calib::Estimator<T>& e, std::int64_t t_us, const ThermalModel<T>* model,
-                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures) noexcept {
-        return calib::feed_estimator(e, t_us, model, corrected, temperatures);
+    template <std::size_t N>
+    static bool feed(calib::Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
+                     const CorrectedSolution<T>* corrected, const HeadTemperatures<T>* const* temperatures,
+                     std::uint8_t further) noexcept {
+        return calib::feed_estimator(e, t_us, model, corrected, temperatures, further);
     }
-    static bool step(calib::Estimator<T>& e) noexcept { return e.step(); }
+    template <std::size_t N>
+    static bool feed_head(calib::Estimator<T, N>& e, std::uint8_t h, std::int64_t t_us, const ThermalModel<T>* model,
+                          const CorrectedSolution<T>& corrected, const HeadTemperatures<T>& temperatures) noexcept {
+        return calib::feed_estimator_head(e, h, t_us, model, corrected, temperatures);
+    }
+    template <std::size_t N>
+    static bool step(calib::Estimator<T, N>& e) noexcept {
+        return e.step();
+    }
     static combine::CombinedAttitude<T> combine(const combine::Combiner<T>& c, const combine::HeadAttitude<T>* heads,
                                                 std::uint8_t n) noexcept {
         return c.combine(heads, n);
@@ -81,7 +95,8 @@ struct FeedSchedule {
     int steps_after_feed = static_cast<int>(calib::Estimator<double>::Phase::kGate);
 };
 
-template <typename T, typename Calls = InlineCalls<T>>
+// N: the heads the estimator learns (estimator.hpp).
+template <typename T, typename Calls = InlineCalls<T>, std::size_t N = calib::kCalibHeads>
 class EpochPipeline {
 public:
     explicit EpochPipeline(FeedSchedule schedule = {}) noexcept : schedule_(schedule) {}
@@ -95,7 +110,7 @@ public:
     }
     // ... or the estimator's active model (none yet: no head has
     // coefficients, status 256), which then learns from the epochs.
-    void use_estimator(calib::Estimator<T>* e) noexcept {
+    void use_estimator(calib::Estimator<T, N>* e) noexcept {
         estimator_ = e;
         forget();
     }
@@ -264,33 +279,56 @@ private:
     }
 
     // Stage 5: the first clean, usable solution of each calibrated head; the
-    // feed when all are there, on the schedule's epochs.
+    // feed when A, B and C are there (with the further heads kept so far), on
+    // the schedule's epochs; a further head that comes after it, alone.
     template <typename Meter>
     void keep(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
-        if (!have_epoch_ || h >= calib::kCalibHeads || kept_ == kFed || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+        if (!have_epoch_ || h >= N || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+            return;
+        }
+        if ((kept_ & kFed) != 0U) {
+            if constexpr (N > calib::kFrameHeads) {
+                keep_late(h, c, tp, meter);
+            }
             return;
         }
         solutions_[h] = c;
         temperatures_[h] = tp;
         kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
-        if (kept_ != kAll) {
+        if ((kept_ & calib::kFrameMask) != calib::kFrameMask) {
             return;
         }
-        kept_ = kFed;
+        kept_ = static_cast<std::uint8_t>(kept_ | kFed);
+        fed_ = false;
         if (epochs_ % schedule_.feed_every != 0U) {
             return;
         }
         const std::uint32_t start = meter.now();
-        const HeadTemperatures<T>* t[calib::kCalibHeads] = {&temperatures_[0], &temperatures_[1], &temperatures_[2]};
-        if (Calls::feed(*estimator_, t_us_, model_, solutions_, t)) {
-            ++feeds_;
+        const HeadTemperatures<T>* t[N];
+        for (std::size_t k = 0; k < N; ++k) {
+            t[k] = &temperatures_[k];
         }
+        fed_ = Calls::feed(*estimator_, t_us_, model_, solutions_, t,
+                           static_cast<std::uint8_t>(kept_ & ~(kFed | calib::kFrameMask)));
+        feeds_ += fed_ ? 1U : 0U;
         meter.add(Stage::kFeed, start);
         for (int i = 0; i < schedule_.steps_after_feed && Calls::step(*estimator_); ++i) {
         }
     }
 
-    static constexpr std::uint8_t kAll = (1U << calib::kCalibHeads) - 1U;
+    // A further head after the epoch's feed: into the same cycle's sums.
+    template <typename Meter>
+    void keep_late(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp,
+                   Meter& meter) noexcept {
+        kept_ = static_cast<std::uint8_t>(kept_ | (1U << h));
+        if (!fed_) {
+            return;
+        }
+        const std::uint32_t start = meter.now();
+        (void)Calls::feed_head(*estimator_, h, t_us_, model_, c, tp);
+        meter.add(Stage::kFeed, start);
+    }
+
     static constexpr std::uint8_t kFed = 0x80U;
     // Two solutions of every head: room for a repeated head, whose second
     // solution the combiner leaves out.
@@ -298,16 +336,17 @@ private:
 
     FeedSchedule schedule_;
     const ThermalModel<T>* fixed_ = nullptr;
-    calib::Estimator<T>* estimator_ = nullptr;
+    calib::Estimator<T, N>* estimator_ = nullptr;
     bool have_epoch_ = false;
     std::int64_t t_us_ = 0;
     std::uint32_t epochs_ = 0U;  // epochs begun before the current one
     std::uint8_t kept_ = 0U;     // bit h: head h kept; kFed: the epoch is done with the feed
+    bool fed_ = false;           // the epoch's cycle fed the estimator (kFed set)
     const ThermalModel<T>* model_ = nullptr;
     std::uint32_t version_ = 0U;
     std::uint32_t feeds_ = 0U;
-    CorrectedSolution<T> solutions_[calib::kCalibHeads]{};
-    HeadTemperatures<T> temperatures_[calib::kCalibHeads]{};
+    CorrectedSolution<T> solutions_[N]{};
+    HeadTemperatures<T> temperatures_[N]{};
     const combine::Combiner<T>* combiner_ = nullptr;
     combine::HeadAttitude<T> combined_[kCombineSlots]{};
     std::uint8_t combined_n_ = 0U;

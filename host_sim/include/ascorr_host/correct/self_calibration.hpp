@@ -35,6 +35,7 @@ struct ActiveModel {
     std::uint32_t version;  // 0: the model given at start
     std::uint32_t crc;      // calib::model_crc
     ModelFile model;
+    std::uint8_t learnt = calib::kFrameMask;  // the heads this model learnt (bit h; Estimator::active_learnt)
 };
 
 struct SelfCalibration {
@@ -64,7 +65,12 @@ inline constexpr std::size_t kSelfCalibrationMemoryBytes = std::size_t{64} << 20
 // (self_calibrate() below checks it too).
 void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name);
 
-// kind: "double", "float" or "fixed" is chosen by T. initial: --model, linear
+// kind: "double", "float" or "fixed" is chosen by T. The estimator learns
+// the file's heads: A, B, C, and D when a row of D passes the selection (a
+// first reading of the rows), at most max_heads; A, B and C learn from the
+// epochs they all pass, D from those of them it passes too
+// (calib/estimator_types.hpp), so an estimator of more heads than the file
+// has (the link's, kMaxHeads) takes the same decisions. initial: --model, linear
 // (refuse_quadratic_initial_model).
 // orbit_period_s (--orbit-period, orbit_period_acceptable): when not given,
 // the circular orbit's at the median speed of the first kOrbitPeriodRows rows in time order
@@ -78,7 +84,8 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes);
+                               std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
+                               std::size_t max_heads = kMaxHeads);
 
 // The models of a history in turn, for correcting rows: at(t) is the model
 // active at t's epoch (TT µs of the on-board clock), or one with no head
@@ -99,10 +106,10 @@ private:
 };
 
 // How head h of a history's model `version` came to be: "given" (version 0,
-// the model given at start), "learnt" (estimated: calib::learns_head) or
-// "kept" (a head the estimator does not learn: the active model's
-// coefficients, carried into the adopted model, Estimator::gate).
-const char* head_origin(std::uint32_t version, std::size_t h);
+// the model given at start), "learnt" (estimated: in the model's `learnt`
+// mask, calib::learns_head) or "kept" (a head the model did not learn: the
+// active model's coefficients, carried into the adopted model, Estimator::gate).
+const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learnt = calib::kFrameMask);
 
 // The model history file (docs/contract.md): header
 // t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
