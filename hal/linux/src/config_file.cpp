@@ -29,7 +29,7 @@ public:
     LineParser(const std::string& file, std::size_t line) : file_(file), line_(line) {}
 
     [[noreturn]] void fail(std::size_t col, const std::string& what) const {
-        throw ConfigError(file_, line_, col, what);
+        throw text::InputError(file_, line_, col, what);
     }
 
     double number(const Token& t) const {
@@ -399,7 +399,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
         }
     }
     if (a.channels == 0U) {
-        throw ConfigError(file_name, lines.end_line(), 1, "no 'channel' line");
+        throw text::InputError(file_name, lines.end_line(), 1, "no 'channel' line");
     }
     return cfg;
 }

@@ -27,7 +27,7 @@ std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
         const std::string name = text::csv::unquoted(raw);  // "t" names the column t
         if (name == "t") {
             if (have_t) {
-                throw ConfigError(file, line_no, col, "column 't' appears twice");
+                throw text::InputError(file, line_no, col, "column 't' appears twice");
             }
             have_t = true;
             columns.push_back({-1, false, name});
@@ -37,16 +37,16 @@ std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
         const std::string_view ch = std::string_view(name).substr(0, counts ? name.size() - 7 : name.size());
         const int idx = find_channel(config, ch);
         if (idx < 0) {
-            throw ConfigError(file, line_no, col, "column '" + name + "' names no configured channel");
+            throw text::InputError(file, line_no, col, "column '" + name + "' names no configured channel");
         }
         if (used[idx]) {
-            throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
+            throw text::InputError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
         }
         used[idx] = true;
         columns.push_back({idx, counts, name});
     }
     if (!have_t) {
-        throw ConfigError(file, line_no, 1, "no column 't'");
+        throw text::InputError(file, line_no, 1, "no column 't'");
     }
     return columns;
 }
@@ -58,8 +58,9 @@ std::uint64_t read_time_us(const std::string& file, std::size_t line_no, std::st
     double t = 0.0;
     const auto r = std::from_chars(b, e, t);
     if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
-        throw ConfigError(file, line_no, col,
-                          linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
+        throw text::InputError(
+            file, line_no, col,
+            linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
     return static_cast<std::uint64_t>(std::llround(t * 1e6));
 }
@@ -74,15 +75,15 @@ ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, 
         const auto r = std::from_chars(b, e, n);
         const unsigned long top = config.channel[c.channel].divider.levels - 1UL;
         if (r.ec != std::errc() || r.ptr != e || n > top) {
-            throw ConfigError(file, line_no, col, "counts must be an integer in [0, " + std::to_string(top) + "]");
+            throw text::InputError(file, line_no, col, "counts must be an integer in [0, " + std::to_string(top) + "]");
         }
         return {SampleKind::kCounts, static_cast<std::uint16_t>(n), 0U, 0.0, 0U};
     }
     double x = 0.0;
     const auto r = std::from_chars(b, e, x);
     if (r.ec != std::errc() || r.ptr != e) {
-        throw ConfigError(file, line_no, col,
-                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
+        throw text::InputError(file, line_no, col,
+                               linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
     }
     return {SampleKind::kCelsius, 0U, 0U, x, 0U};
 }
@@ -107,7 +108,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             break;
         }
         if (fields.size() != columns.size()) {
-            throw ConfigError(
+            throw text::InputError(
                 file, line_no, line.size() + 1,
                 "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
         }
@@ -125,7 +126,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         sample_sets_.push_back(f);
     }
     if (header) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        throw text::InputError(file, 1, 1, "empty file (no header)");
     }
 }
 

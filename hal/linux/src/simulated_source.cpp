@@ -138,7 +138,7 @@ HistoryColumns history_columns(const std::string& file, const std::vector<linux_
         }
     }
     if (cols.t < 0 || cols.temperature[0] < 0 || cols.temperature[1] < 0 || cols.temperature[2] < 0) {
-        throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
+        throw text::InputError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
     }
     return cols;
 }
@@ -156,7 +156,7 @@ int history_head(const std::string& file, std::size_t line_no, const std::vector
     linux_detail::refuse_quoted(file, line_no, field(f, cols.chu), "chu");
     const auto& [v, c] = field(f, cols.chu);
     if (v.size() != 1 || head_index(v[0]) == kUnknownHead) {
-        throw ConfigError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
+        throw text::InputError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
     }
     return head_index(v[0]);
 }
@@ -169,9 +169,9 @@ double history_temperature(const std::string& file, std::size_t line_no, const l
         return x;
     }
     if (!parse_number(v, x) || !std::isfinite(x)) {
-        throw ConfigError(file, line_no, c,
-                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) +
-                                                              "' (a finite number, or empty or nan for none)"));
+        throw text::InputError(file, line_no, c,
+                               linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) +
+                                                                   "' (a finite number, or empty or nan for none)"));
     }
     return x;
 }
@@ -180,15 +180,15 @@ double history_temperature(const std::string& file, std::size_t line_no, const l
 HistoryRow history_row(const std::string& file, std::size_t line_no, std::string_view line,
                        const std::vector<linux_detail::Field>& f, const HistoryColumns& cols) {
     if (f.size() != cols.count) {
-        throw ConfigError(file, line_no, line.size() + 1,
-                          "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
+        throw text::InputError(file, line_no, line.size() + 1,
+                               "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
     }
     HistoryRow r{0.0, -1, 0.0, 0.0, 0.0};
     r.line = line_no;
     linux_detail::refuse_quoted(file, line_no, field(f, cols.t), "t");
     const auto& [t_text, t_col] = field(f, cols.t);
     if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
-        throw ConfigError(
+        throw text::InputError(
             file, line_no, t_col,
             linux_detail::number_refusal(t_text, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
@@ -210,7 +210,7 @@ std::vector<HistoryRow> parse_history(const std::string& file, std::string_view 
     std::string_view line;
     linux_detail::FieldSplitter splitter;
     if (!lines.next(line)) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        throw text::InputError(file, 1, 1, "empty file (no header)");
     }
     const HistoryColumns cols = history_columns(file, splitter.split(file, lines.number(), line));
     std::vector<HistoryRow> rows;
@@ -251,7 +251,7 @@ void merge_value(const std::string& file, const HistoryRow& row, int k, const ch
     char buf[160];
     text::c_snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)",
                      name, v, row.t, slot.value, slot.line);
-    throw ConfigError(file, row.line, row.column[k], buf);
+    throw text::InputError(file, row.line, row.column[k], buf);
 }
 
 }  // namespace
