@@ -1,10 +1,11 @@
 // Replay of recorded temperatures or counts (replay_source.hpp).
 #include "ascorr_hal_linux/replay_source.hpp"
-#include "text_lines.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <memory>
+
+#include "ascorr_text/text_file.hpp"
 
 namespace ascorr::hal {
 namespace {
@@ -17,8 +18,7 @@ struct Column {
 
 // The header's columns: "t" once, then configured channels ("<name>" in
 // degC or "<name>.counts"), each once.
-std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
-                                   const std::vector<linux_detail::Field>& fields,
+std::vector<Column> header_columns(const std::string& file, std::size_t line_no, const std::vector<text::Field>& fields,
                                    const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
     bool have_t = false;
@@ -58,9 +58,8 @@ std::uint64_t read_time_us(const std::string& file, std::size_t line_no, std::st
     double t = 0.0;
     const auto r = std::from_chars(b, e, t);
     if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
-        throw text::InputError(
-            file, line_no, col,
-            linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
+        throw text::InputError(file, line_no, col,
+                               text::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
     return static_cast<std::uint64_t>(std::llround(t * 1e6));
 }
@@ -83,7 +82,7 @@ ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, 
     const auto r = std::from_chars(b, e, x);
     if (r.ec != std::errc() || r.ptr != e) {
         throw text::InputError(file, line_no, col,
-                               linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
+                               text::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
     }
     return {SampleKind::kCelsius, 0U, 0U, x, 0U};
 }
@@ -92,13 +91,13 @@ ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, 
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
-    linux_detail::TextLines lines(file, text);
+    text::TextLines lines(file, text);
     std::string_view line;
-    linux_detail::FieldSplitter splitter;
+    text::FieldSplitter splitter;
     bool header = true;
     while (lines.next(line)) {
         const std::size_t line_no = lines.number();
-        const std::vector<linux_detail::Field>& fields = splitter.split(file, line_no, line);
+        const std::vector<text::Field>& fields = splitter.split(file, line_no, line);
         if (header) {
             header = false;
             columns = header_columns(file, line_no, fields, config);
@@ -116,7 +115,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         for (std::size_t i = 0; i < columns.size(); ++i) {
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
-            linux_detail::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
+            text::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
             if (c.channel < 0) {
                 f.t_us = read_time_us(file, line_no, v, col);
             } else if (!v.empty() && v != "nan") {  // else kNone
@@ -132,7 +131,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
 
 std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
                                                       const AcquisitionConfig<double>& config) {
-    return std::make_unique<ReplaySource>(path, linux_detail::read_text_file(path), config);
+    return std::make_unique<ReplaySource>(path, text::read_text_file(path), config);
 }
 
 bool ReplaySource::acquire(SampleSet<double>& samples) noexcept {

@@ -1,10 +1,16 @@
-// hal/linux/src/text_lines.hpp: the line and field reader shared by the HAL's
-// text files (board configuration, temperature replay, simulation history).
+// ascorr_text/text_file.hpp: a text file's lines and fields, checked: the
+// reader of the HAL's text files (board configuration, temperature replay,
+// simulation history), on the one line reader (line_reader.hpp) and field
+// splitter (csv_fields.hpp) that the host's readers use too, every refusal an
+// InputError (input_error.hpp).
 //
 // Conventions: lines end at '\n'; a '\r' before it is dropped; line numbers
 // start at 1 and columns at 1, as the file:line:column messages give them. A
-// final '\n' does not start another line. Private to hal/linux (hal/ cannot
-// use host_sim's reader: nothing in hal/ depends on host_sim/).
+// final '\n' does not start another line. The whole file is checked as UTF-8
+// text (refuse_binary) and read with the HAL's words ("cannot open FILE:
+// reason"); the host's solutions, model and states readers read in bounded
+// blocks and refuse only a NUL byte, in their own words ("FILE: cannot open:
+// reason", ascorr_host/formats/csv.hpp): both wordings are the contract's.
 #pragma once
 
 #include <cerrno>
@@ -23,15 +29,15 @@
 #include <utility>
 #include <vector>
 
-#include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/csv_fields.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/line_reader.hpp"
 #include "ascorr_text/numbers.hpp"
 
-namespace ascorr::hal::linux_detail {
+namespace ascorr::text {
 
 // Why a field is not a usable number when it is a well-formed decimal beyond
 // double's range ("1e999", "1e-999"): "'1e999' is out of range: ..." in the
@@ -274,4 +280,4 @@ inline void refuse_quoted(const std::string& file, std::size_t line_no, const Fi
     }
 }
 
-}  // namespace ascorr::hal::linux_detail
+}  // namespace ascorr::text
