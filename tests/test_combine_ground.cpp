@@ -20,9 +20,9 @@
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -61,7 +61,7 @@ constexpr const char* kGood =
 std::string refusal(const std::string& text) {
     try {
         host::parse_mountings("m.csv", text);
-    } catch (const host::InputError& e) {
+    } catch (const text::InputError& e) {
         return e.what();
     }
     return "";

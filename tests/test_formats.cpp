@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/numbers.hpp"
 #include "test_support.hpp"
 
@@ -41,7 +41,7 @@ std::vector<SolutionRecord> parse_all(const std::string& text) {
 std::string error_of(const std::string& text) {
     try {
         parse_all(text);
-    } catch (const InputError& e) {
+    } catch (const text::InputError& e) {
         EXPECT_EQ(e.file(), "f.csv");
         return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.what();
     }
@@ -158,7 +158,7 @@ TEST(SolutionsReader, ReaderMovesPastABadRow) {
     SolutionsReader r("f.csv", text);
     SolutionRecord rec;
     ASSERT_TRUE(r.next(rec));
-    EXPECT_THROW(r.next(rec), InputError);
+    EXPECT_THROW(r.next(rec), text::InputError);
     ASSERT_TRUE(r.next(rec));
     EXPECT_EQ(rec.line, 4U);
     EXPECT_FALSE(r.next(rec));
@@ -195,7 +195,7 @@ TEST(BlockReader, WholeLinesAtAnyBlockSize) {
     try {
         r.next(block);
         ADD_FAILURE() << "NUL byte not detected";
-    } catch (const InputError& e) {
+    } catch (const text::InputError& e) {
         EXPECT_EQ(e.line(), 2U);
     }
 }
@@ -370,7 +370,7 @@ TEST(ModelFile, MalformedModels) {
     const auto err = [](const std::string& text) -> std::string {
         try {
             parse_model("m.csv", text);
-        } catch (const InputError& e) {
+        } catch (const text::InputError& e) {
             return e.what();
         }
         return "";
@@ -471,7 +471,7 @@ TEST(SolutionsReader, RowsWithTheirFields) {
         for_each_solution_row(
             path, [](const SolutionsReader&) {}, [](const SolutionsReader&, const SolutionRecord&) {}, "");
         ADD_FAILURE() << "a malformed row passed";
-    } catch (const InputError& e) {
+    } catch (const text::InputError& e) {
         EXPECT_EQ(e.line(), 3U);
         EXPECT_EQ(e.column(), 9U);
     }

@@ -3,7 +3,7 @@
 #include <memory>
 
 #include "ascorr_host/analysis/align.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -43,7 +43,7 @@ void add_align_command(CLI::App& app) {
             outputs[host::kStandardOutput.option].write(host::describe(r));
             outputs.commit();
             std::cerr << "ascorr align: mountings written to " << opt->out << '\n';
-        } catch (const host::InputError& e) {
+        } catch (const text::InputError& e) {
             throw RefusedInput(e.what());
         } catch (const host::AlignRefused& e) {
             throw RefusedInput(e.what());

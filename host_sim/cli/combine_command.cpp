@@ -3,7 +3,7 @@
 
 #include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/combine.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
 
 namespace ascorr::cli {
@@ -33,7 +33,7 @@ void add_combine_command(CLI::App& app) {
             const host::CombineSummary s = host::combine_file(*opt, outputs, std::cerr);
             outputs.commit();
             std::cerr << "ascorr combine: " << opt->out << ": " << host::describe(s) << '\n';
-        } catch (const host::InputError& e) {
+        } catch (const text::InputError& e) {
             throw RefusedInput(e.what());  // as align: refused input exits 2
         } catch (const host::AlignRefused& e) {
             throw RefusedInput(std::string(e.what()) + " (estimating the heads' noise: the mountings have no sigmas)");

@@ -11,7 +11,7 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
 
@@ -53,7 +53,7 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
         host::correct_and_combine_outputs(opt, t.combined));
     try {  // the mountings first: refused input exits 2 (as combine and align)
         host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings);
-    } catch (const host::InputError& e) {
+    } catch (const text::InputError& e) {
         throw RefusedInput(e.what());
     } catch (const std::runtime_error& e) {
         throw RefusedInput(e.what());

@@ -21,8 +21,8 @@
 #include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "bind.hpp"
 #include "docstrings.hpp"
 
@@ -112,7 +112,7 @@ host::MountingsFile mountings_arg(const py::handle& obj) {
     // The file's text reads back to exactly these values (shortest round trip).
     try {
         return host::parse_mountings("argument 'mountings' (as a mountings file)", host::format_mountings(m));
-    } catch (const host::InputError& e) {
+    } catch (const text::InputError& e) {
         throw py::value_error(e.what());
     }
 }

@@ -20,7 +20,7 @@
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "bind.hpp"
 #include "docstrings.hpp"
 
@@ -47,7 +47,7 @@ long long status_of(const std::string& path, const host::SolutionsReader& reader
     const auto f = reader.fields()[static_cast<std::size_t>(status_col)];
     const auto s = host::parse_integer(f);
     if (!s || *s < 0 || *s > 0xFFFF) {
-        throw host::InputError(path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
+        throw text::InputError(path, rec.line, static_cast<std::size_t>(f.data() - reader.fields()[0].data()) + 1,
                                "column 'status': " + host::why_not_an_integer(f, 0, 0xFFFF));
     }
     return *s;
@@ -183,7 +183,7 @@ void check_reads_back(const std::string& text) {
         SolutionRecord rec;
         while (reader.next(rec)) {
         }
-    } catch (const host::InputError& e) {
+    } catch (const text::InputError& e) {
         const std::string what = e.what();
         const std::string why = what.substr(std::min(what.size(), what.find(": ") + 2));
         throw py::value_error(

@@ -10,7 +10,7 @@
 
 #include "ascorr/core/heads.hpp"
 #include "ascorr_host/analysis/fit.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "bind.hpp"
 #include "docstrings.hpp"
 
@@ -23,7 +23,7 @@ PYBIND11_MODULE(_ascorr, mod) {
     // Malformed input and refused fits are ValueErrors; other failures of the
     // host library (a file that cannot be written, a model beyond the fixed-point
     // formats) are std::runtime_error, hence RuntimeError.
-    py::register_exception<host::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") = docs::kInputError;
+    py::register_exception<text::InputError>(mod, "InputError", PyExc_ValueError).attr("__doc__") = docs::kInputError;
     py::register_exception<host::FitRefused>(mod, "FitRefused", PyExc_ValueError).attr("__doc__") = docs::kFitRefused;
 
     // The heads (ascorr/core/heads.hpp), for Python and for the docstrings.

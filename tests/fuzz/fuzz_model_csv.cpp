@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_text/input_error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
@@ -26,7 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (ascorr::host::parse_model("again", ascorr::host::format_model(m)).coefficients != m.coefficients) {
             std::abort();
         }
-    } catch (const ascorr::host::InputError&) {
+    } catch (const ascorr::text::InputError&) {
     }
     return 0;
 }

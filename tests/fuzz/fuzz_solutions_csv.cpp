@@ -7,8 +7,8 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "ascorr_text/input_error.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
@@ -30,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                 if (!reader.next(rec)) {
                     break;
                 }
-            } catch (const ascorr::host::InputError&) {
+            } catch (const ascorr::text::InputError&) {
                 continue;  // --skip-bad behaviour: the reader has moved on
             }
             (void)ascorr::correct_solution(ascorr::host::to_core_input<double>(rec, nullptr),
@@ -38,7 +38,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             (void)ascorr::correct_solution(ascorr::host::to_core_input<float>(rec, nullptr),
                                            ascorr::CorrectionConfig<float>{true, &model_f});
         }
-    } catch (const ascorr::host::InputError&) {
+    } catch (const ascorr::text::InputError&) {
         // a bad header: reported, not a crash
     }
     return 0;

@@ -30,7 +30,7 @@ const std::string kExamples = ASCORR_HAL_EXAMPLES;
 std::string config_error(const std::string& text) {
     try {
         hal::parse_config("board.cfg", text);
-    } catch (const hal::ConfigError& e) {
+    } catch (const text::InputError& e) {
         return e.what();
     }
     return "no error";
@@ -134,7 +134,7 @@ TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
     try {
         hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,inf,3,4\n");
         FAIL();
-    } catch (const hal::ConfigError& e) {
+    } catch (const text::InputError& e) {
         EXPECT_STREQ(e.what(), "h.csv:3:3: not a temperature: 'inf' (a finite number, or empty or nan for none)");
     }
     EXPECT_EQ(hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,nan,,4\n").size(), 2U);
@@ -145,7 +145,7 @@ TEST(HalReplay, ErrorsNameLineAndColumn) {
     const auto err = [&](const std::string& text) {
         try {
             hal::ReplaySource("r.csv", text, c);
-        } catch (const hal::ConfigError& e) {
+        } catch (const text::InputError& e) {
             return std::string(e.what());
         }
         return std::string("no error");
@@ -174,10 +174,10 @@ TEST(HalSimulated, FaultSpecsAndHistoryErrors) {
     try {
         hal::parse_history("h.csv", "t,t_chu,t_029,t_032,chu\n1,2,3,4,E\n");
         FAIL();
-    } catch (const hal::ConfigError& e) {
+    } catch (const text::InputError& e) {
         EXPECT_STREQ(e.what(), "h.csv:2:9: 'chu' must be A, B, C or D");
     }
-    EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), hal::ConfigError);
+    EXPECT_THROW(hal::parse_history("h.csv", "t,t_chu,t_029\n"), text::InputError);
 }
 
 // A well-formed number beyond double's range says "out of range"
@@ -194,7 +194,7 @@ TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
     const auto replay_error = [&](const std::string& text) {
         try {
             hal::ReplaySource("r.csv", text, c);
-        } catch (const hal::ConfigError& e) {
+        } catch (const text::InputError& e) {
             return std::string(e.what());
         }
         return std::string("no error");
@@ -205,7 +205,7 @@ TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
     const auto history_error = [](const std::string& text) {
         try {
             hal::parse_history("h.csv", text);
-        } catch (const hal::ConfigError& e) {
+        } catch (const text::InputError& e) {
             return std::string(e.what());
         }
         return std::string("no error");
@@ -245,7 +245,7 @@ TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {
     const auto err = [](const std::string& text) {
         try {
             hal::parse_history("h.csv", text);
-        } catch (const hal::ConfigError& e) {
+        } catch (const text::InputError& e) {
             return std::string(e.what());
         }
         return std::string("no error");
@@ -461,9 +461,9 @@ TEST(HalCli, AnUnopenableFileIsNamedWithoutLineOrColumnZero) {
         EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
     }
     // The error itself: no line or column when there is none.
-    EXPECT_STREQ(hal::ConfigError("f.cfg", 0, 0, "x").what(), "f.cfg: x");
-    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 0, "x").what(), "f.cfg:3: x");
-    EXPECT_STREQ(hal::ConfigError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
+    EXPECT_STREQ(text::InputError("f.cfg", 0, 0, "x").what(), "f.cfg: x");
+    EXPECT_STREQ(text::InputError("f.cfg", 3, 0, "x").what(), "f.cfg:3: x");
+    EXPECT_STREQ(text::InputError("f.cfg", 3, 7, "x").what(), "f.cfg:3:7: x");
 }
 
 // Binary data in a configuration, replay or history file is refused

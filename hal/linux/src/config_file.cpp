@@ -1,9 +1,9 @@
 // The thermistor configuration file (config_file.hpp).
 #include "ascorr_hal_linux/config_file.hpp"
-#include "text_lines.hpp"
 
 #include "ascorr_hal/channel_defaults.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/text_file.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -29,7 +29,7 @@ public:
     LineParser(const std::string& file, std::size_t line) : file_(file), line_(line) {}
 
     [[noreturn]] void fail(std::size_t col, const std::string& what) const {
-        throw ConfigError(file_, line_, col, what);
+        throw text::InputError(file_, line_, col, what);
     }
 
     double number(const Token& t) const {
@@ -38,9 +38,8 @@ public:
         const char* e = b + t.value.size();
         const auto r = std::from_chars(b, e, v);
         if (t.value.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(v)) {
-            fail(t.value_col,
-                 "'" + std::string(t.key) + "': " +
-                     linux_detail::number_refusal(t.value, "not a finite number: '" + std::string(t.value) + "'"));
+            fail(t.value_col, "'" + std::string(t.key) + "': " +
+                                  text::number_refusal(t.value, "not a finite number: '" + std::string(t.value) + "'"));
         }
         return v;
     }
@@ -372,7 +371,7 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
     AcquisitionConfig<double>& a = cfg.acquisition;
     bool seen_acq = false;
     bool seen_gpio = false;
-    linux_detail::TextLines lines(file_name, text);
+    text::TextLines lines(file_name, text);
     std::string_view line;
     DirectiveLine d;
     while (lines.next(line)) {
@@ -399,13 +398,13 @@ HalConfig parse_config(const std::string& file_name, std::string_view text) {
         }
     }
     if (a.channels == 0U) {
-        throw ConfigError(file_name, lines.end_line(), 1, "no 'channel' line");
+        throw text::InputError(file_name, lines.end_line(), 1, "no 'channel' line");
     }
     return cfg;
 }
 
 HalConfig read_config(const std::string& path) {
-    return parse_config(path, linux_detail::read_text_file(path));
+    return parse_config(path, text::read_text_file(path));
 }
 
 }  // namespace ascorr::hal

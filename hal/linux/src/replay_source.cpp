@@ -1,10 +1,11 @@
 // Replay of recorded temperatures or counts (replay_source.hpp).
 #include "ascorr_hal_linux/replay_source.hpp"
-#include "text_lines.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <memory>
+
+#include "ascorr_text/text_file.hpp"
 
 namespace ascorr::hal {
 namespace {
@@ -17,8 +18,7 @@ struct Column {
 
 // The header's columns: "t" once, then configured channels ("<name>" in
 // degC or "<name>.counts"), each once.
-std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
-                                   const std::vector<linux_detail::Field>& fields,
+std::vector<Column> header_columns(const std::string& file, std::size_t line_no, const std::vector<text::Field>& fields,
                                    const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
     bool have_t = false;
@@ -27,7 +27,7 @@ std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
         const std::string name = text::csv::unquoted(raw);  // "t" names the column t
         if (name == "t") {
             if (have_t) {
-                throw ConfigError(file, line_no, col, "column 't' appears twice");
+                throw text::InputError(file, line_no, col, "column 't' appears twice");
             }
             have_t = true;
             columns.push_back({-1, false, name});
@@ -37,16 +37,16 @@ std::vector<Column> header_columns(const std::string& file, std::size_t line_no,
         const std::string_view ch = std::string_view(name).substr(0, counts ? name.size() - 7 : name.size());
         const int idx = find_channel(config, ch);
         if (idx < 0) {
-            throw ConfigError(file, line_no, col, "column '" + name + "' names no configured channel");
+            throw text::InputError(file, line_no, col, "column '" + name + "' names no configured channel");
         }
         if (used[idx]) {
-            throw ConfigError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
+            throw text::InputError(file, line_no, col, "channel '" + std::string(ch) + "' recorded twice");
         }
         used[idx] = true;
         columns.push_back({idx, counts, name});
     }
     if (!have_t) {
-        throw ConfigError(file, line_no, 1, "no column 't'");
+        throw text::InputError(file, line_no, 1, "no column 't'");
     }
     return columns;
 }
@@ -58,8 +58,8 @@ std::uint64_t read_time_us(const std::string& file, std::size_t line_no, std::st
     double t = 0.0;
     const auto r = std::from_chars(b, e, t);
     if (v.empty() || r.ec != std::errc() || r.ptr != e || !std::isfinite(t) || t < 0.0 || t > 1.0e12) {
-        throw ConfigError(file, line_no, col,
-                          linux_detail::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
+        throw text::InputError(file, line_no, col,
+                               text::number_refusal(v, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
     return static_cast<std::uint64_t>(std::llround(t * 1e6));
 }
@@ -74,15 +74,15 @@ ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, 
         const auto r = std::from_chars(b, e, n);
         const unsigned long top = config.channel[c.channel].divider.levels - 1UL;
         if (r.ec != std::errc() || r.ptr != e || n > top) {
-            throw ConfigError(file, line_no, col, "counts must be an integer in [0, " + std::to_string(top) + "]");
+            throw text::InputError(file, line_no, col, "counts must be an integer in [0, " + std::to_string(top) + "]");
         }
         return {SampleKind::kCounts, static_cast<std::uint16_t>(n), 0U, 0.0, 0U};
     }
     double x = 0.0;
     const auto r = std::from_chars(b, e, x);
     if (r.ec != std::errc() || r.ptr != e) {
-        throw ConfigError(file, line_no, col,
-                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
+        throw text::InputError(file, line_no, col,
+                               text::number_refusal(v, "not a temperature: '" + std::string(v) + "'"));
     }
     return {SampleKind::kCelsius, 0U, 0U, x, 0U};
 }
@@ -91,13 +91,13 @@ ChannelSample<double> read_sample(const std::string& file, std::size_t line_no, 
 
 ReplaySource::ReplaySource(const std::string& file, std::string_view text, const AcquisitionConfig<double>& config) {
     std::vector<Column> columns;
-    linux_detail::TextLines lines(file, text);
+    text::TextLines lines(file, text);
     std::string_view line;
-    linux_detail::FieldSplitter splitter;
+    text::FieldSplitter splitter;
     bool header = true;
     while (lines.next(line)) {
         const std::size_t line_no = lines.number();
-        const std::vector<linux_detail::Field>& fields = splitter.split(file, line_no, line);
+        const std::vector<text::Field>& fields = splitter.split(file, line_no, line);
         if (header) {
             header = false;
             columns = header_columns(file, line_no, fields, config);
@@ -107,7 +107,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
             break;
         }
         if (fields.size() != columns.size()) {
-            throw ConfigError(
+            throw text::InputError(
                 file, line_no, line.size() + 1,
                 "expected " + std::to_string(columns.size()) + " fields, found " + std::to_string(fields.size()));
         }
@@ -115,7 +115,7 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         for (std::size_t i = 0; i < columns.size(); ++i) {
             const auto& [v, col] = fields[i];
             const Column& c = columns[i];
-            linux_detail::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
+            text::refuse_quoted(file, line_no, fields[i], c.name);  // every column is read
             if (c.channel < 0) {
                 f.t_us = read_time_us(file, line_no, v, col);
             } else if (!v.empty() && v != "nan") {  // else kNone
@@ -125,13 +125,13 @@ ReplaySource::ReplaySource(const std::string& file, std::string_view text, const
         sample_sets_.push_back(f);
     }
     if (header) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        throw text::InputError(file, 1, 1, "empty file (no header)");
     }
 }
 
 std::unique_ptr<ReplaySource> ReplaySource::from_file(const std::string& path,
                                                       const AcquisitionConfig<double>& config) {
-    return std::make_unique<ReplaySource>(path, linux_detail::read_text_file(path), config);
+    return std::make_unique<ReplaySource>(path, text::read_text_file(path), config);
 }
 
 bool ReplaySource::acquire(SampleSet<double>& samples) noexcept {

@@ -1,7 +1,7 @@
 // Simulated acquisition from temperature histories (simulated_source.hpp).
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "ascorr_text/c_format.hpp"
-#include "text_lines.hpp"
+#include "ascorr_text/text_file.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -55,7 +55,7 @@ FaultKind fault_kind(const std::string& s, std::string_view text) {
 void fault_times(const std::string& s, std::string_view from, std::string_view to, InjectedFault& f) {
     if (!parse_number(from, f.from_s) || !parse_number(to, f.to_s) || !std::isfinite(f.from_s) ||
         !std::isfinite(f.to_s) || !(f.from_s < f.to_s)) {
-        const std::string why = linux_detail::out_of_range_reason(from) + linux_detail::out_of_range_reason(to);
+        const std::string why = text::out_of_range_reason(from) + text::out_of_range_reason(to);
         throw std::invalid_argument("fault '" + s +
                                     "': " + (why.empty() ? "FROM and TO must be finite numbers with FROM < TO" : why));
     }
@@ -75,7 +75,7 @@ void fault_value(const std::string& s, const std::vector<std::string_view>& part
     }
     const std::string text(part[4]);
     if (!parse_number(part[4], f.value)) {
-        const std::string why = linux_detail::out_of_range_reason(part[4]);
+        const std::string why = text::out_of_range_reason(part[4]);
         throw std::invalid_argument("fault '" + s + "': " + (why.empty() ? "needs VALUE" : why));
     }
     if (f.kind == FaultKind::kOffset && !(std::fabs(f.value) <= 200.0)) {
@@ -120,7 +120,7 @@ struct HistoryColumns {
 constexpr const char* kHistoryTemperatureNames[3] = {"t_chu", "t_029", "t_032"};
 
 // The header line: which field is which; t, t_chu, t_029, t_032 required.
-HistoryColumns history_columns(const std::string& file, const std::vector<linux_detail::Field>& header) {
+HistoryColumns history_columns(const std::string& file, const std::vector<text::Field>& header) {
     HistoryColumns cols;
     cols.count = header.size();
     for (std::size_t i = 0; i < header.size(); ++i) {
@@ -138,65 +138,64 @@ HistoryColumns history_columns(const std::string& file, const std::vector<linux_
         }
     }
     if (cols.t < 0 || cols.temperature[0] < 0 || cols.temperature[1] < 0 || cols.temperature[2] < 0) {
-        throw ConfigError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
+        throw text::InputError(file, 1, 1, "a temperature history needs columns t, t_chu, t_029, t_032");
     }
     return cols;
 }
 
-const linux_detail::Field& field(const std::vector<linux_detail::Field>& f, int column) {
+const text::Field& field(const std::vector<text::Field>& f, int column) {
     return f[static_cast<std::size_t>(column)];
 }
 
 // The head of a row: -1 without a chu column, else its index (heads.hpp).
-int history_head(const std::string& file, std::size_t line_no, const std::vector<linux_detail::Field>& f,
+int history_head(const std::string& file, std::size_t line_no, const std::vector<text::Field>& f,
                  const HistoryColumns& cols) {
     if (cols.chu < 0) {
         return -1;
     }
-    linux_detail::refuse_quoted(file, line_no, field(f, cols.chu), "chu");
+    text::refuse_quoted(file, line_no, field(f, cols.chu), "chu");
     const auto& [v, c] = field(f, cols.chu);
     if (v.size() != 1 || head_index(v[0]) == kUnknownHead) {
-        throw ConfigError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
+        throw text::InputError(file, line_no, c, "'chu' must be " + std::string(kHeadChoices.text));
     }
     return head_index(v[0]);
 }
 
 // A temperature field: NaN when empty or nan (none), else a finite number.
-double history_temperature(const std::string& file, std::size_t line_no, const linux_detail::Field& field) {
+double history_temperature(const std::string& file, std::size_t line_no, const text::Field& field) {
     const auto& [v, c] = field;
     double x = std::numeric_limits<double>::quiet_NaN();
     if (v.empty() || v == "nan") {
         return x;
     }
     if (!parse_number(v, x) || !std::isfinite(x)) {
-        throw ConfigError(file, line_no, c,
-                          linux_detail::number_refusal(v, "not a temperature: '" + std::string(v) +
-                                                              "' (a finite number, or empty or nan for none)"));
+        throw text::InputError(file, line_no, c,
+                               text::number_refusal(v, "not a temperature: '" + std::string(v) +
+                                                           "' (a finite number, or empty or nan for none)"));
     }
     return x;
 }
 
 // One data line of a history.
 HistoryRow history_row(const std::string& file, std::size_t line_no, std::string_view line,
-                       const std::vector<linux_detail::Field>& f, const HistoryColumns& cols) {
+                       const std::vector<text::Field>& f, const HistoryColumns& cols) {
     if (f.size() != cols.count) {
-        throw ConfigError(file, line_no, line.size() + 1,
-                          "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
+        throw text::InputError(file, line_no, line.size() + 1,
+                               "expected " + std::to_string(cols.count) + " fields, found " + std::to_string(f.size()));
     }
     HistoryRow r{0.0, -1, 0.0, 0.0, 0.0};
     r.line = line_no;
-    linux_detail::refuse_quoted(file, line_no, field(f, cols.t), "t");
+    text::refuse_quoted(file, line_no, field(f, cols.t), "t");
     const auto& [t_text, t_col] = field(f, cols.t);
     if (!parse_number(t_text, r.t) || !(r.t >= 0.0 && r.t <= 1.0e12)) {
-        throw ConfigError(
-            file, line_no, t_col,
-            linux_detail::number_refusal(t_text, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
+        throw text::InputError(file, line_no, t_col,
+                               text::number_refusal(t_text, "'t' must be a number of seconds in [0, 1e12]", "'t': "));
     }
     r.head = history_head(file, line_no, f, cols);
     double* dst[3] = {&r.t_chu, &r.t_029, &r.t_032};
     for (int k = 0; k < 3; ++k) {
-        const linux_detail::Field& tf = field(f, cols.temperature[k]);
-        linux_detail::refuse_quoted(file, line_no, tf, kHistoryTemperatureNames[k]);
+        const text::Field& tf = field(f, cols.temperature[k]);
+        text::refuse_quoted(file, line_no, tf, kHistoryTemperatureNames[k]);
         r.column[k] = tf.second;
         *dst[k] = history_temperature(file, line_no, tf);
     }
@@ -206,11 +205,11 @@ HistoryRow history_row(const std::string& file, std::size_t line_no, std::string
 }  // namespace
 
 std::vector<HistoryRow> parse_history(const std::string& file, std::string_view text) {
-    linux_detail::TextLines lines(file, text);
+    text::TextLines lines(file, text);
     std::string_view line;
-    linux_detail::FieldSplitter splitter;
+    text::FieldSplitter splitter;
     if (!lines.next(line)) {
-        throw ConfigError(file, 1, 1, "empty file (no header)");
+        throw text::InputError(file, 1, 1, "empty file (no header)");
     }
     const HistoryColumns cols = history_columns(file, splitter.split(file, lines.number(), line));
     std::vector<HistoryRow> rows;
@@ -251,7 +250,7 @@ void merge_value(const std::string& file, const HistoryRow& row, int k, const ch
     char buf[160];
     text::c_snprintf(buf, sizeof buf, "%s = %.17g at t = %.3f s disagrees with %.17g on line %zu (the same epoch)",
                      name, v, row.t, slot.value, slot.line);
-    throw ConfigError(file, row.line, row.column[k], buf);
+    throw text::InputError(file, row.line, row.column[k], buf);
 }
 
 }  // namespace
@@ -286,7 +285,7 @@ std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vect
 }
 
 std::vector<HistoryEpoch> read_history(const std::string& path) {
-    return history_epochs(path, parse_history(path, linux_detail::read_text_file(path)));
+    return history_epochs(path, parse_history(path, text::read_text_file(path)));
 }
 
 bool SimulatedAdc::active(const InjectedFault& f) const noexcept {

@@ -19,9 +19,9 @@
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -150,8 +150,8 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) 
     if (p != combine::MountingsProblem::kNone) {
         const bool one_head = head < kMaxHeads && m.line[head] != 0;
         if (one_head) {
-            throw InputError(path, m.line[head], 1,
-                             std::string("CHU ") + head_name(head) + ": " + combine::problem_text(p));
+            throw text::InputError(path, m.line[head], 1,
+                                   std::string("CHU ") + head_name(head) + ": " + combine::problem_text(p));
         }
         throw std::runtime_error(name + ": " + combine::problem_text(p));
     }
@@ -428,7 +428,8 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
         for (int i = 0; i < col; ++i) {
             column += reader.fields()[static_cast<std::size_t>(i)].size() + 1;
         }
-        throw InputError(reader.file_name(), rec.line, column, "column 'status': " + why_not_an_integer(f, 0, 0xFFFF));
+        throw text::InputError(reader.file_name(), rec.line, column,
+                               "column 'status': " + why_not_an_integer(f, 0, 0xFFFF));
     }
     return static_cast<StatusBits>(*v);
 }

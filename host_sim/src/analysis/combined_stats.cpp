@@ -11,8 +11,8 @@
 #include "ascorr/core/heads.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -59,7 +59,7 @@ class TruthCursor {
 public:
     explicit TruthCursor(const std::string& path) : path_(path), reader_(path) {
         if (reader_.combined()) {
-            throw InputError(path, 1, 1, "the truth is an attitude file (t,qw,qx,qy,qz), not a combined file");
+            throw text::InputError(path, 1, 1, "the truth is an attitude file (t,qw,qx,qy,qz), not a combined file");
         }
         more_ = reader_.next(row_);
         key_ = more_ ? epoch_key(row_.t) : 0;
@@ -82,9 +82,9 @@ private:
         }
         key_ = epoch_key(row_.t);
         if (key_ <= previous) {
-            throw InputError(path_, row_.line, 1,
-                             "the truth's rows must be in time order, one per epoch (line " +
-                                 std::to_string(previous_line) + " is at or after this one)");
+            throw text::InputError(path_, row_.line, 1,
+                                   "the truth's rows must be in time order, one per epoch (line " +
+                                       std::to_string(previous_line) + " is at or after this one)");
         }
     }
     std::string path_;
@@ -153,8 +153,8 @@ std::string head_set_name(std::uint32_t heads) {
 CombinedStats combined_stats(const CombinedStatsOptions& opt) {
     AttitudeReader reader(opt.combined);
     if (!reader.combined()) {
-        throw InputError(opt.combined, 1, 1,
-                         "expected a combined file (t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status)");
+        throw text::InputError(opt.combined, 1, 1,
+                               "expected a combined file (t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status)");
     }
     std::optional<TruthCursor> truth;
     if (!opt.truth.empty()) {
@@ -169,8 +169,9 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
     while (reader.next(row)) {
         const std::int64_t key = epoch_key(row.t);
         if (s.epochs != 0 && key <= last_key) {
-            throw InputError(opt.combined, row.line, 1,
-                             "a combined file has one row per epoch, in time order: this row is not after the last");
+            throw text::InputError(
+                opt.combined, row.line, 1,
+                "a combined file has one row per epoch, in time order: this row is not after the last");
         }
         t0 = s.epochs == 0 ? row.t : t0;
         last_key = key;

@@ -479,9 +479,9 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
         return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows));
     }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
-        throw InputError(opt.in, p.earliest_row_line, 1,
-                         "spacecraft speed " + number_text(p.earliest_row_speed) +
-                             " km/s is not that of an Earth orbit: give --orbit-period");
+        throw text::InputError(opt.in, p.earliest_row_line, 1,
+                               "spacecraft speed " + number_text(p.earliest_row_speed) +
+                                   " km/s is not that of an Earth orbit: give --orbit-period");
     }
     if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
         // Rows out of time order: again, with the earliest row's period.

@@ -10,8 +10,8 @@
 #include <system_error>
 
 #include "ascorr_host/analysis/simulate.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -49,7 +49,7 @@ long double number(const std::string& path, std::size_t line, const Fields& f, s
     long double x = 0.0L;
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), x);
     if (s.empty() || ptr != s.data() + s.size() || ec != std::errc() || !std::isfinite(x)) {
-        throw InputError(path, line, f.column[i], "'" + s + "' is not a finite number");
+        throw text::InputError(path, line, f.column[i], "'" + s + "' is not a finite number");
     }
     return x;
 }
@@ -63,8 +63,8 @@ std::size_t pair_position(const std::string& path, std::size_t line, const Field
         known = known || f.text[2] == kAllPairs.pair[p].name;
     }
     if (!known) {
-        throw InputError(path, line, f.column[2],
-                         "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
+        throw text::InputError(path, line, f.column[2],
+                               "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
     }
     std::size_t position = pairs.count;
     for (std::size_t p = 0; p < pairs.count; ++p) {
@@ -93,26 +93,27 @@ std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long l
                                                  const PairList& pairs) {
     std::ifstream in(path);
     if (!in) {
-        throw InputError(path, 0, 0, "cannot open the daily floor file");
+        throw text::InputError(path, 0, 0, "cannot open the daily floor file");
     }
     std::string line;
     std::size_t number_of_line = 1;
     if (!std::getline(in, line) || line != kFloorDailyHeader) {
-        throw InputError(path, 1, 1, std::string("expected the header ") + kFloorDailyHeader);
+        throw text::InputError(path, 1, 1, std::string("expected the header ") + kFloorDailyHeader);
     }
     std::array<FloorSums, kMaxPairs> total{};
     while (std::getline(in, line)) {
         ++number_of_line;
         const Fields f = split(line);
         if (f.count != 6) {
-            throw InputError(path, number_of_line, 1, "expected 6 fields (" + std::string(kFloorDailyHeader) + ")");
+            throw text::InputError(path, number_of_line, 1,
+                                   "expected 6 fields (" + std::string(kFloorDailyHeader) + ")");
         }
         const std::size_t pair = pair_position(path, number_of_line, f, pairs);
         const long double day = number(path, number_of_line, f, 0);
         const long double n = number(path, number_of_line, f, 3);
         if (day < 0 || day != std::floor(day) || n < 0 || n != std::floor(n)) {
-            throw InputError(path, number_of_line, f.column[day < 0 || day != std::floor(day) ? 0 : 3],
-                             "day and n must be non-negative integers");
+            throw text::InputError(path, number_of_line, f.column[day < 0 || day != std::floor(day) ? 0 : 3],
+                                   "day and n must be non-negative integers");
         }
         if (pair < pairs.count && day >= static_cast<long double>(from_day) && day < static_cast<long double>(to_day)) {
             total[pair].n += static_cast<std::size_t>(n);

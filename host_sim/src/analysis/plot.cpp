@@ -499,7 +499,7 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
     double t_previous = std::nan("");
     AttitudeReader r(opt.combined);
     if (!r.combined()) {
-        throw InputError(opt.combined, 1, 1, "expected a combined file (t,qw,qx,qy,qz,heads,...)");
+        throw text::InputError(opt.combined, 1, 1, "expected a combined file (t,qw,qx,qy,qz,heads,...)");
     }
     AttitudeRow row;
     while (r.next(row)) {

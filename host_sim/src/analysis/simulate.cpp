@@ -22,11 +22,11 @@
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/embedded_model.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/progress.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -640,7 +640,7 @@ struct HeadSolution {
                      "T029 %g, T032 %g degC)",
                      head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
                      e.temp[3], e.temp[4]);
-    throw InputError(truth.name, truth.file.line[h][axis], 0, what);
+    throw text::InputError(truth.name, truth.file.line[h][axis], 0, what);
 }
 
 // Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), rotated

@@ -28,11 +28,11 @@
 #include "ascorr_host/formats/corrected_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_host/formats/states_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -128,7 +128,7 @@ struct ChunkResult {
     std::string out;
     CorrectSummary summary;
     DeferredDiagnostics diag;
-    std::optional<InputError> error;  // the first malformed row, when not skipping
+    std::optional<text::InputError> error;  // the first malformed row, when not skipping
     std::size_t empty_lines = 0;
     std::vector<CorrectedRow> rows;  // for the sink (correct --combined), in file order
 };
@@ -183,7 +183,7 @@ enum class RowRead { kRow, kSkipped, kEnd };
 RowRead read_row(SolutionsReader& reader, SolutionRecord& rec, const CorrectOptions& opt, ChunkResult& res) {
     try {
         return reader.next(rec) ? RowRead::kRow : RowRead::kEnd;
-    } catch (const InputError& e) {
+    } catch (const text::InputError& e) {
         if (!opt.skip_bad) {
             res.error = e;
             return RowRead::kEnd;
@@ -285,7 +285,7 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
                     if (!reader.next(rec)) {
                         break;
                     }
-                } catch (const InputError&) {
+                } catch (const text::InputError&) {
                     continue;
                 }
                 TtTime t{};
@@ -412,9 +412,9 @@ void report_rows(const CorrectOptions& opt, const CorrectSummary& sum, std::size
     }
     diag.summarize();
     if (sum.rows == 0 && sum.malformed != 0) {  // --skip-bad dropped everything: not a success
-        throw InputError(opt.in, 1, 1,
-                         "every one of the " + std::to_string(sum.malformed) +
-                             " data rows is malformed (--skip-bad dropped them all): nothing written");
+        throw text::InputError(opt.in, 1, 1,
+                               "every one of the " + std::to_string(sum.malformed) +
+                                   " data rows is malformed (--skip-bad dropped them all): nothing written");
     }
 }
 
@@ -452,7 +452,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     BlockReader blocks(opt.in);
     std::string_view block;
     if (!blocks.next(block)) {
-        throw InputError(opt.in, 1, 1, "empty file: expected a header line");
+        throw text::InputError(opt.in, 1, 1, "empty file: expected a header line");
     }
     const SolutionsReader header(opt.in, block.substr(0, block.find('\n')));
     refuse_corrected_input(header);

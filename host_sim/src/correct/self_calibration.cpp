@@ -20,8 +20,8 @@
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -134,20 +134,21 @@ private:
             return std::fabs(r->speed_kms - v) <= kPeriodSpeedTolerance * v;
         }));
         if (4 * near < 3 * fed.size()) {
-            throw InputError(file_, median.line, 1,
-                             "the spacecraft speeds of the first " + std::to_string(fed.size()) +
-                                 " rows the self-calibration learns from disagree: " + std::to_string(near) +
-                                 " are within " + number_text(kPeriodSpeedTolerance * 100.0) + " % of their median " +
-                                 number_text(v) +
-                                 " km/s (three quarters must be): the orbit period cannot be derived; give "
-                                 "--orbit-period");
+            throw text::InputError(file_, median.line, 1,
+                                   "the spacecraft speeds of the first " + std::to_string(fed.size()) +
+                                       " rows the self-calibration learns from disagree: " + std::to_string(near) +
+                                       " are within " + number_text(kPeriodSpeedTolerance * 100.0) +
+                                       " % of their median " + number_text(v) +
+                                       " km/s (three quarters must be): the orbit period cannot be derived; give "
+                                       "--orbit-period");
         }
         const double period_s = 2.0 * kPi * kEarthGmKm3S2 / (v * v * v);
         if (!(v < 12.0 && period_s * 1e6 <= static_cast<double>(calib::kMaxOrbitPeriodUs))) {
-            throw InputError(file_, median.line, 1,
-                             "spacecraft speed " + number_text(v) +
-                                 " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
-                                 "self-calibration cannot be derived; give --orbit-period");
+            throw text::InputError(
+                file_, median.line, 1,
+                "spacecraft speed " + number_text(v) +
+                    " km/s is not that of an Earth orbit of 10 min to a day: the orbit period for the "
+                    "self-calibration cannot be derived; give --orbit-period");
         }
         return period_s;
     }

@@ -7,7 +7,7 @@
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/scalar_traits.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -52,9 +52,9 @@ Columns columns_of(const Header& h, const std::string& file, bool& combined) {
     const bool attitude = c.t >= 0 && c.q[0] >= 0 && c.q[1] >= 0 && c.q[2] >= 0 && c.q[3] >= 0;
     combined = attitude && c.heads >= 0 && c.sigma[0] >= 0 && c.sigma[1] >= 0 && c.sigma[2] >= 0 && c.status >= 0;
     if (!attitude) {
-        throw InputError(file, 1, 1,
-                         "expected the header of an attitude file (" + std::string(kAttitudeHeader) +
-                             ") or of a combined file (" + std::string(kCombinedHeader) + ")");
+        throw text::InputError(file, 1, 1,
+                               "expected the header of an attitude file (" + std::string(kAttitudeHeader) +
+                                   ") or of a combined file (" + std::string(kCombinedHeader) + ")");
     }
     return c;
 }
@@ -68,7 +68,7 @@ public:
         row.line = n;
         line_ = n;
         if (const std::size_t bad = split_fields(line, fields_, starts_); bad != kSplitOk) {
-            throw InputError(file_, n, bad + 1, why_split_failed(line, bad));
+            throw text::InputError(file_, n, bad + 1, why_split_failed(line, bad));
         }
         row.t = number(c_.t, "t");
         if (!std::isfinite(row.t)) {
@@ -125,7 +125,7 @@ private:
     std::string_view field(int col) const {
         const auto i = static_cast<std::size_t>(col);
         if (i >= fields_.size()) {
-            throw InputError(
+            throw text::InputError(
                 file_, line_, starts_.back() + 1,
                 "expected at least " + std::to_string(i + 1) + " fields, found " + std::to_string(fields_.size()));
         }
@@ -141,7 +141,7 @@ private:
     }
     [[noreturn]] void fail(int col, const std::string& what) const {
         const auto i = static_cast<std::size_t>(col);
-        throw InputError(file_, line_, (i < starts_.size() ? starts_[i] : 0) + 1, what);
+        throw text::InputError(file_, line_, (i < starts_.size() ? starts_[i] : 0) + 1, what);
     }
 
     std::string file_;
@@ -187,7 +187,7 @@ void append_combined_row(std::string& out, const AttitudeRow& row) {
 struct AttitudeReader::Impl {
     explicit Impl(const std::string& p) : path(p), blocks(p) {
         if (!blocks.next(block)) {
-            throw InputError(path, 1, 1, "empty file: expected a header line");
+            throw text::InputError(path, 1, 1, "empty file: expected a header line");
         }
         const std::size_t nl = block.find('\n');
         std::string_view header_line = block.substr(0, nl);

@@ -12,7 +12,7 @@
 #include <memory>
 #include <system_error>
 
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/numbers.hpp"
 
@@ -22,7 +22,7 @@ namespace {
 void refuse_directory(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
-        throw InputError(path, 0, 0, "is a directory, not a file");
+        throw text::InputError(path, 0, 0, "is a directory, not a file");
     }
 }
 }  // namespace
@@ -31,7 +31,7 @@ std::string read_text_file(const std::string& path) {
     refuse_directory(path);
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) {
-        throw InputError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+        throw text::InputError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
     }
     std::string data;
     char buf[1 << 16];
@@ -39,7 +39,7 @@ std::string read_text_file(const std::string& path) {
     text::LineLengthScan scan;
     while ((n = std::fread(buf, 1, sizeof buf, f.get())) > 0) {
         if (!scan.feed(std::string_view(buf, n))) {
-            throw InputError(path, scan.too_long_line(), 0, text::line_too_long());
+            throw text::InputError(path, scan.too_long_line(), 0, text::line_too_long());
         }
         data.append(buf, n);
         if (std::memchr(buf, '\0', n) != nullptr) {
@@ -47,13 +47,13 @@ std::string read_text_file(const std::string& path) {
         }
     }
     if (std::ferror(f.get()) != 0) {
-        throw InputError(path, 0, 0, "read error");
+        throw text::InputError(path, 0, 0, "read error");
     }
     if (data.find('\0') != std::string::npos) {
         const std::size_t at = data.find('\0');
         const std::size_t line = 1 + static_cast<std::size_t>(std::count(
                                          data.begin(), data.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
-        throw InputError(path, line, 0, "binary data (NUL byte) in a text file");
+        throw text::InputError(path, line, 0, "binary data (NUL byte) in a text file");
     }
     return data;
 }
@@ -63,7 +63,7 @@ BlockReader::BlockReader(std::string path, std::size_t block_bytes)
     refuse_directory(path_);
     f_ = std::fopen(path_.c_str(), "rb");
     if (f_ == nullptr) {
-        throw InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+        throw text::InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
     }
 }
 
@@ -112,12 +112,12 @@ bool BlockReader::next(std::string_view& block) {
         }
         const std::size_t n = std::fread(buf_.get() + size_, 1, block_bytes_, f_);
         if (!scan_.feed(std::string_view(buf_.get() + size_, n))) {
-            throw InputError(path_, scan_.too_long_line(), 0, text::line_too_long());
+            throw text::InputError(path_, scan_.too_long_line(), 0, text::line_too_long());
         }
         size_ += n;
         if (n == 0) {
             if (std::ferror(f_) != 0) {
-                throw InputError(path_, lines_before_ + 1, 0, "read error");
+                throw text::InputError(path_, lines_before_ + 1, 0, "read error");
             }
             eof_ = true;
         }
@@ -131,8 +131,8 @@ bool BlockReader::next(std::string_view& block) {
     block = all.substr(0, consumed_);
     if (const void* nul = std::memchr(block.data(), '\0', block.size()); nul != nullptr) {
         const auto at = static_cast<std::size_t>(static_cast<const char*>(nul) - block.data());
-        throw InputError(path_, lines_before_ + 1 + count_line_ends(block.substr(0, at)), 0,
-                         "binary data (NUL byte) in a text file");
+        throw text::InputError(path_, lines_before_ + 1 + count_line_ends(block.substr(0, at)), 0,
+                               "binary data (NUL byte) in a text file");
     }
     lines_in_last_ = count_line_ends(block) + (block.back() != '\n' ? 1 : 0);
     return true;
@@ -352,24 +352,25 @@ Header::Header(std::string_view line, const std::string& file) {
         line.remove_prefix(3);
     }
     if (line.find('\r') != std::string_view::npos) {
-        throw InputError(file, 1, line.find('\r') + 1,
-                         "carriage return inside the header: the file has CR-only line ends (classic Mac); convert "
-                         "them to LF or CRLF");
+        throw text::InputError(
+            file, 1, line.find('\r') + 1,
+            "carriage return inside the header: the file has CR-only line ends (classic Mac); convert "
+            "them to LF or CRLF");
     }
     std::vector<std::string_view> fields;
     std::vector<std::size_t> starts;
     if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-        throw InputError(file, 1, bad + 1, why_split_failed(line, bad));
+        throw text::InputError(file, 1, bad + 1, why_split_failed(line, bad));
     }
     for (std::size_t i = 0; i < fields.size(); ++i) {
         const std::string name = unquoted(fields[i]);  // "note" names the column note
         raw_names_.emplace_back(fields[i]);
         if (name.empty()) {
-            throw InputError(file, 1, starts[i] + 1, "empty column name in the header");
+            throw text::InputError(file, 1, starts[i] + 1, "empty column name in the header");
         }
         for (const auto& n : names_) {
             if (n == name) {
-                throw InputError(file, 1, starts[i] + 1, "column '" + name + "' appears twice in the header");
+                throw text::InputError(file, 1, starts[i] + 1, "column '" + name + "' appears twice in the header");
             }
         }
         names_.push_back(name);

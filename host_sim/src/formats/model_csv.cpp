@@ -7,9 +7,9 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -52,7 +52,7 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
                                              kAxisNames[a] + " " + kCoefficientNames[i] + " = " + number_text(c) + " " +
                                              unit_of(i) + limit;
                     if (m.line[h][a] != 0) {
-                        throw InputError(path, m.line[h][a], m.column[h][a][i], what);
+                        throw text::InputError(path, m.line[h][a], m.column[h][a][i], what);
                     }
                     throw std::runtime_error(text::input_name(path) + ": " + what);
                 }
@@ -81,7 +81,7 @@ void check_float_range(const ModelFile& m, const std::string& path) {
                     ": |c0| + 200|c1| + 400(|c2| + |c3|) + 200^2|c1_2| + 400^2(|c2_2| + |c3_2|) = " +
                     number_text(s * kRadToArcsec) + " arcsec" + limit;
                 if (m.line[h][a] != 0) {
-                    throw InputError(path, m.line[h][a], 1, what);
+                    throw text::InputError(path, m.line[h][a], 1, what);
                 }
                 throw std::runtime_error(text::input_name(path) + ": " + what);
             }
@@ -97,8 +97,8 @@ void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[kModel
         missing = missing || col_c[i] < 0;
     }
     if (missing) {
-        throw InputError(file_name, 1, 1,
-                         "the model header must have chu,axis," + coefficient_columns(0, kLinearModelTerms, ","));
+        throw text::InputError(file_name, 1, 1,
+                               "the model header must have chu,axis," + coefficient_columns(0, kLinearModelTerms, ","));
     }
 }
 
@@ -111,10 +111,10 @@ void refuse_unknown_columns(const Header& header, const std::string& file_name) 
             known = known || name == c;
         }
         if (!known) {
-            throw InputError(file_name, 1, column,
-                             "unknown column '" + name + "' (a model has chu, axis, " +
-                                 coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
-                                 coefficient_columns(kLinearModelTerms, kModelTerms, ", ") + ")");
+            throw text::InputError(file_name, 1, column,
+                                   "unknown column '" + name + "' (a model has chu, axis, " +
+                                       coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
+                                       coefficient_columns(kLinearModelTerms, kModelTerms, ", ") + ")");
         }
         column += name.size() + 1;
     }
@@ -139,9 +139,10 @@ void read_coefficient(const std::string& file_name, std::size_t n, std::size_t i
     const auto f = fields[col];
     const auto x = parse_double(f);
     if (!x || !std::isfinite(*x)) {
-        throw InputError(file_name, n, starts[col] + 1,
-                         std::string("column '") + kCoefficientNames[i] + "': " +
-                             (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
+        throw text::InputError(
+            file_name, n, starts[col] + 1,
+            std::string("column '") + kCoefficientNames[i] +
+                "': " + (x ? "expected a finite number, got '" + std::string(f) + "'" : why_not_a_number(f)));
     }
     value = *x;
     column = starts[col] + 1;
@@ -153,8 +154,8 @@ bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_he
     if (count != 0 && count != 3) {
         for (int a = 0; a < 3; ++a) {
             if (!seen[a]) {
-                throw InputError(file_name, line_of_head, 1,
-                                 std::string("head ") + head_name(h) + " has no " + kAxisNames[a] + " row");
+                throw text::InputError(file_name, line_of_head, 1,
+                                       std::string("head ") + head_name(h) + " has no " + kAxisNames[a] + " row");
             }
         }
     }
@@ -165,7 +166,7 @@ bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_he
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
     if (text.empty()) {
-        throw InputError(
+        throw text::InputError(
             file_name, 1, 1,
             "empty model file: expected the header chu,axis," + coefficient_columns(0, kLinearModelTerms, ","));
     }
@@ -196,28 +197,29 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         }
         const std::size_t n = lines.line_number();
         if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw InputError(file_name, n, bad + 1, why_split_failed(line, bad));
+            throw text::InputError(file_name, n, bad + 1, why_split_failed(line, bad));
         }
         if (fields.size() != header.size()) {
-            throw InputError(
+            throw text::InputError(
                 file_name, n, starts.back() + 1,
                 "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
         }
         const auto chu = fields[static_cast<std::size_t>(col_chu)];
         const std::uint8_t head = head_from_name(chu);
         if (head == kUnknownHead) {
-            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
-                             "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
+            throw text::InputError(
+                file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
+                "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
         }
         const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
         const int axis = axis_index(axis_name);
         if (axis < 0) {
-            throw InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
-                             "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
+            throw text::InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
+                                   "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
         }
         if (seen[head][axis]) {
-            throw InputError(file_name, n, 1,
-                             std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
+            throw text::InputError(file_name, n, 1,
+                                   std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
         }
         seen[head][axis] = true;
         line_of_head[head] = n;
@@ -234,7 +236,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         m.present[h] = head_complete(seen[h], static_cast<std::uint8_t>(h), line_of_head[h], file_name);
     }
     if (!(m.present[0] || m.present[1] || m.present[2] || m.present[3])) {
-        throw InputError(file_name, lines.line_number(), 1, "the model has no rows");
+        throw text::InputError(file_name, lines.line_number(), 1, "the model has no rows");
     }
     return m;
 }

@@ -9,9 +9,9 @@
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -37,7 +37,7 @@ Columns columns_of(const Header& header, const std::string& file) {
         c.sigma[i] = header.index(kSigmaNames[i]);
     }
     if (c.chu < 0 || c.q[0] < 0 || c.q[1] < 0 || c.q[2] < 0 || c.q[3] < 0) {
-        throw InputError(file, 1, 1, std::string("the mountings header must have ") + kHeaderText);
+        throw text::InputError(file, 1, 1, std::string("the mountings header must have ") + kHeaderText);
     }
     // A misspelt column (sigma_acros) is never dropped silently.
     std::size_t column = 1;
@@ -50,16 +50,16 @@ Columns columns_of(const Header& header, const std::string& file) {
             known = known || name == s;
         }
         if (!known) {
-            throw InputError(file, 1, column,
-                             "unknown column '" + name + "' (a mountings file has " + kHeaderText + ")");
+            throw text::InputError(file, 1, column,
+                                   "unknown column '" + name + "' (a mountings file has " + kHeaderText + ")");
         }
         column += name.size() + 1;
     }
     if ((c.sigma[0] < 0) != (c.sigma[1] < 0)) {
-        throw InputError(file, 1, 1,
-                         std::string("the header has ") + (c.sigma[0] < 0 ? kSigmaNames[1] : kSigmaNames[0]) +
-                             " without " + (c.sigma[0] < 0 ? kSigmaNames[0] : kSigmaNames[1]) +
-                             ": a head's noise is both or neither");
+        throw text::InputError(file, 1, 1,
+                               std::string("the header has ") + (c.sigma[0] < 0 ? kSigmaNames[1] : kSigmaNames[0]) +
+                                   " without " + (c.sigma[0] < 0 ? kSigmaNames[0] : kSigmaNames[1]) +
+                                   ": a head's noise is both or neither");
     }
     return c;
 }
@@ -71,7 +71,7 @@ struct Row {
     const std::vector<std::string_view>& fields;
     const std::vector<std::size_t>& starts;
     [[noreturn]] void fail(int col, const std::string& what) const {
-        throw InputError(file, line, starts[static_cast<std::size_t>(col)] + 1, what);
+        throw text::InputError(file, line, starts[static_cast<std::size_t>(col)] + 1, what);
     }
     std::string_view field(int col) const { return fields[static_cast<std::size_t>(col)]; }
 };
@@ -162,7 +162,8 @@ std::uint8_t head_of_row(const Row& r, const Columns& c, const MountingsFile& m)
 
 MountingsFile parse_mountings(const std::string& file_name, std::string_view text) {
     if (text.empty()) {
-        throw InputError(file_name, 1, 1, std::string("empty mountings file: expected the header ") + kHeaderText);
+        throw text::InputError(file_name, 1, 1,
+                               std::string("empty mountings file: expected the header ") + kHeaderText);
     }
     LineReader lines(text);
     std::string_view line;
@@ -184,10 +185,10 @@ MountingsFile parse_mountings(const std::string& file_name, std::string_view tex
         }
         const std::size_t n = lines.line_number();
         if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw InputError(file_name, n, bad + 1, why_split_failed(line, bad));
+            throw text::InputError(file_name, n, bad + 1, why_split_failed(line, bad));
         }
         if (fields.size() != header.size()) {
-            throw InputError(
+            throw text::InputError(
                 file_name, n, starts.back() + 1,
                 "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
         }
@@ -214,7 +215,7 @@ MountingsFile parse_mountings(const std::string& file_name, std::string_view tex
         m.line[head] = n;
     }
     if (first_line == 0) {
-        throw InputError(file_name, lines.line_number(), 1, "the mountings file has no head rows");
+        throw text::InputError(file_name, lines.line_number(), 1, "the mountings file has no head rows");
     }
     return m;
 }

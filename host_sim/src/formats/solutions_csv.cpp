@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/progress.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -21,7 +21,7 @@ namespace ascorr::host {
 namespace {
 std::string_view header_line_of(std::string_view text, const std::string& file) {
     if (text.empty()) {
-        throw InputError(file, 1, 1, "empty file: expected a header line");
+        throw text::InputError(file, 1, 1, "empty file: expected a header line");
     }
     const std::size_t end = text.find('\n');
     std::string_view line = text.substr(0, end);
@@ -49,12 +49,13 @@ SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
         for (std::size_t i = 0; i < miss->column; ++i) {
             column += header_.raw_names()[i].size() + 1;
         }
-        throw InputError(file_, 1, column, miss->message);
+        throw text::InputError(file_, 1, column, miss->message);
     }
     const auto need = [&](const char* name) {
         const int i = header_.index(name);
         if (i < 0) {
-            throw InputError(file_, 1, 1, std::string("required column '") + name + "' is missing from the header");
+            throw text::InputError(file_, 1, 1,
+                                   std::string("required column '") + name + "' is missing from the header");
         }
         return i;
     };
@@ -80,7 +81,7 @@ SolutionsReader::SolutionsReader(const SolutionsReader& header_from, std::string
 void SolutionsReader::fail(std::size_t field, const std::string& what) const {
     const std::size_t column =
         field < fields_.size() ? static_cast<std::size_t>(fields_[field].data() - line_.data()) + 1 : 1;
-    throw InputError(file_, lines_.line_number(), column, what);
+    throw text::InputError(file_, lines_.line_number(), column, what);
 }
 
 double SolutionsReader::number(int col, const char* name) const {
@@ -117,7 +118,7 @@ bool SolutionsReader::next(SolutionRecord& rec) {
     }
     line_ = line;
     if (const std::size_t bad = split_fields(line, fields_); bad != kSplitOk) {
-        throw InputError(file_, lines_.line_number(), bad + 1, why_split_failed(line, bad));
+        throw text::InputError(file_, lines_.line_number(), bad + 1, why_split_failed(line, bad));
     }
     if (fields_.size() != header_.size()) {
         fail(fields_.size() - 1, "expected " + std::to_string(header_.size()) + " fields as in the header, found " +
@@ -165,9 +166,10 @@ void refuse_corrected_input(const SolutionsReader& header) {
         for (int i = 0; i < col; ++i) {
             column += header.header().names()[static_cast<std::size_t>(i)].size() + 1;
         }
-        throw InputError(header.file_name(), 1, column,
-                         "column 'status': this file is already corrected (it has the status column of a corrected "
-                         "file); give the raw solutions file, so that no correction is applied twice");
+        throw text::InputError(
+            header.file_name(), 1, column,
+            "column 'status': this file is already corrected (it has the status column of a corrected "
+            "file); give the raw solutions file, so that no correction is applied twice");
     }
 }
 
@@ -200,7 +202,7 @@ void for_each_solution_row(const std::string& path, const std::function<void(con
     BlockReader blocks(path);
     std::string_view block;
     if (!blocks.next(block)) {
-        throw InputError(path, 1, 1, "empty file: expected a header line");
+        throw text::InputError(path, 1, 1, "empty file: expected a header line");
     }
     const std::size_t nl = block.find('\n');
     const SolutionsReader header(path, block.substr(0, nl));

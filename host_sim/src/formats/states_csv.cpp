@@ -5,7 +5,7 @@
 #include <string_view>
 
 #include "ascorr_host/formats/csv.hpp"
-#include "ascorr_host/formats/input_error.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 
 namespace ascorr::host {
@@ -36,7 +36,8 @@ std::array<std::size_t, 7> state_columns(const Header& header, const std::string
     for (std::size_t i = 0; i < kNames.size(); ++i) {
         const int c = header.index(kNames[i]);
         if (c < 0) {
-            throw InputError(path, 1, 1, std::string("required column '") + kNames[i] + "' is missing from the header");
+            throw text::InputError(path, 1, 1,
+                                   std::string("required column '") + kNames[i] + "' is missing from the header");
         }
         col[i] = static_cast<std::size_t>(c);
     }
@@ -60,26 +61,26 @@ StateRecord parse_state_row(const StateLine& l, std::vector<std::string_view>& f
     const Header& header = l.header;
     const std::array<std::size_t, 7>& col = l.col;
     if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-        throw InputError(path, n, bad + 1, why_split_failed(line, bad));
+        throw text::InputError(path, n, bad + 1, why_split_failed(line, bad));
     }
     if (fields.size() != header.size()) {
-        throw InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
-                         "expected " + std::to_string(header.size()) + " fields as in the header, found " +
-                             std::to_string(fields.size()) +
-                             (fields.size() < header.size() ? " (truncated row?)" : ""));
+        throw text::InputError(path, n, fields.size() < header.size() ? line.size() + 1 : starts[header.size()] + 1,
+                               "expected " + std::to_string(header.size()) + " fields as in the header, found " +
+                                   std::to_string(fields.size()) +
+                                   (fields.size() < header.size() ? " (truncated row?)" : ""));
     }
     double x[7] = {};
     for (std::size_t i = 0; i < kNames.size(); ++i) {
         const auto v = parse_double(fields[col[i]]);
         if (!v) {
-            throw InputError(path, n, starts[col[i]] + 1,
-                             std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
+            throw text::InputError(path, n, starts[col[i]] + 1,
+                                   std::string("column '") + kNames[i] + "': " + why_not_a_number(fields[col[i]]));
         }
         x[i] = *v;
     }
     TtTime t{};
     if (!tt_from_seconds(x[0], t)) {
-        throw InputError(
+        throw text::InputError(
             path, n, starts[col[0]] + 1,
             "column 't': time must be finite and within 1e11 s of J2000, got '" + std::string(fields[col[0]]) + "'");
     }
@@ -93,7 +94,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
     LineReader lines(text);
     std::string_view line;
     if (!lines.next(line) || line.empty()) {
-        throw InputError(path, 1, 1, "empty states file: expected the header t,x,y,z,vx,vy,vz");
+        throw text::InputError(path, 1, 1, "empty states file: expected the header t,x,y,z,vx,vy,vz");
     }
     const Header header(line, path);
     const std::array<std::size_t, 7> col = state_columns(header, path);
@@ -118,7 +119,7 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
                 diag.report("state refused", text::input_name(path) + ":" + std::to_string(n) +
                                                  ": state refused: " + describe(v) + " (kept the previous one)");
             }
-        } catch (const InputError& e) {
+        } catch (const text::InputError& e) {
             if (!skip_bad) {
                 throw;
             }
@@ -129,15 +130,15 @@ StatesFile read_states_file(const std::string& path, StateFrame frame, Diagnosti
     out.counts = board.counts();
     const StateCounts& c = out.counts;
     if (c.accepted + out.refused() + out.malformed == 0U) {
-        throw InputError(path, lines.line_number() + 1, 1, "the states file has no rows");
+        throw text::InputError(path, lines.line_number() + 1, 1, "the states file has no rows");
     }
     if (c.accepted == 0U) {
-        throw InputError(path, 0, 0,
-                         "no state of the file is usable: " + std::to_string(out.refused()) +
-                             " refused by the velocity service" +
-                             (out.malformed != 0 ? ", " + std::to_string(out.malformed) + " malformed (--skip-bad)"
-                                                 : std::string()) +
-                             "; no row would get a velocity from it (km and km/s in increasing time?)");
+        throw text::InputError(
+            path, 0, 0,
+            "no state of the file is usable: " + std::to_string(out.refused()) + " refused by the velocity service" +
+                (out.malformed != 0 ? ", " + std::to_string(out.malformed) + " malformed (--skip-bad)"
+                                    : std::string()) +
+                "; no row would get a velocity from it (km and km/s in increasing time?)");
     }
     return out;
 }

@@ -20,41 +20,17 @@
 #pragma once
 
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 
 #include "ascorr_hal/channel_config.hpp"
 #include "ascorr_hal/voting.hpp"
-#include "ascorr_text/input_name.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::hal {
 
-// A refused input file: "file:line:column: what". Lines and columns count
-// from 1; 0 means none, and is never printed: "file:line: what" without a
-// column, "file: what" for the whole file (e.g. "cannot open FILE: reason",
-// whole_file()).
-class ConfigError : public std::runtime_error {
-public:
-    ConfigError(const std::string& file, std::size_t line, std::size_t column, const std::string& what)
-        : std::runtime_error(where(file, line, column) + what), line_(line), column_(column) {}
-    // An error about the whole file, whose message names it itself.
-    static ConfigError whole_file(const std::string& message) { return ConfigError(message); }
-    std::size_t line() const noexcept { return line_; }
-    std::size_t column() const noexcept { return column_; }
-
-private:
-    explicit ConfigError(const std::string& message) : std::runtime_error(message), line_(0), column_(0) {}
-    static std::string where(const std::string& file, std::size_t line, std::size_t column) {
-        if (line == 0U) {
-            return text::input_name(file) + ": ";
-        }
-        return text::input_name(file) + ":" + std::to_string(line) +
-               (column == 0U ? "" : ":" + std::to_string(column)) + ": ";
-    }
-    std::size_t line_;
-    std::size_t column_;
-};
+// Every refusal of the HAL's readers is a text::InputError
+// (ascorr_text/input_error.hpp): "file:line:column: what".
 
 // The wiring of the bit-banged MCP3208 (GPIO line offsets on one chip).
 struct GpioWiring {

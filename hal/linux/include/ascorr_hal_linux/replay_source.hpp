@@ -9,7 +9,7 @@
 // until it turns stale). Channels without a column are never sampled.
 // Rows need not be evenly spaced; a time that does not advance is not a
 // format error, the checks flag it (kStale). Malformed input, an unknown
-// channel, or a channel recorded twice → ConfigError at file:line:column.
+// channel, or a channel recorded twice → InputError at file:line:column.
 #pragma once
 
 #include <cstddef>

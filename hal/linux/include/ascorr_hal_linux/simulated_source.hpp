@@ -10,7 +10,7 @@
 // Epochs: the rows whose t agree to the millisecond (as docs/contract.md §5
 // matches the rows of the heads) are one epoch, in any row order (the rows
 // are sorted by t, stably); rows of one epoch must not disagree (two values of
-// one head's t_chu, of t_029 or of t_032: ConfigError at the later row).
+// one head's t_chu, of t_029 or of t_032: InputError at the later row).
 // Each epoch becomes one sample set at its t (µs = the millisecond key · 1000),
 // with every head's truth of that epoch: the truth goes through the inverse
 // Steinhart–Hart and the divider into counts (SimulatedAdc), and the sample set
@@ -78,7 +78,7 @@ struct HistoryEpoch {
     double t_029;
     double t_032;
 };
-// Rows → epochs in time order (see the top); ConfigError at the first row
+// Rows → epochs in time order (see the top); InputError at the first row
 // that disagrees with an earlier row of its epoch.
 std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows);
 // parse_history + history_epochs of a file.

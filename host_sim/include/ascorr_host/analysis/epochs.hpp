@@ -29,9 +29,9 @@
 #include <utility>
 
 #include "ascorr_host/analysis/iba.hpp"
-#include "ascorr_host/formats/input_error.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/input_error.hpp"
 
 namespace ascorr::host {
 
@@ -68,9 +68,9 @@ public:
         if (e.epoch.head[head]) {
             char when[32];
             text::c_snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
-            throw InputError(file_, line, 1,
-                             std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
-                                 " (the first is on line " + std::to_string(e.epoch.line[head]) + ")");
+            throw text::InputError(file_, line, 1,
+                                   std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
+                                       " (the first is on line " + std::to_string(e.epoch.line[head]) + ")");
         }
         if (e.heads == 0U) {
             e.epoch.t = t;

@@ -64,12 +64,12 @@ private:
 std::size_t count_line_ends(std::string_view text) noexcept;
 
 // Iterates the lines of a buffer, keeping 1-based line numbers.
-// The line splitting: one copy, in the HAL's text library
-// (ascorr_text/line_reader.hpp), which the HAL's readers use too.
+// The line splitting: one copy, in ascorr_text (text/: line_reader.hpp),
+// which the HAL's readers use too.
 using text::LineReader;
 
-// The field splitter and unquoting of the dialect: one copy, in the HAL
-// (ascorr_text/csv_fields.hpp), which the HAL's readers use too. A quoted
+// The field splitter and unquoting of the dialect: one copy, in ascorr_text
+// (text/: csv_fields.hpp), which the HAL's readers use too. A quoted
 // field (RFC 4180) is one field, handed on as written, quotes included;
 // split_fields returns kSplitOk or the 0-based offset where the quoting is
 // malformed, why_split_failed() says which; unquoted() gives a field's text.

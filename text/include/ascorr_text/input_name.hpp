@@ -4,8 +4,8 @@
 // through a stand-in: standard input ("-") is copied to a private temporary
 // file first (host_sim/cli/standard_input.cpp), and every message about that
 // file says "standard input", with its line and column, never the copy's
-// path. Shared by the host's readers (InputError, the correction's
-// diagnostics) and the HAL's (ConfigError), so that all of them say it alike.
+// path. Used by every reader's InputError (input_error.hpp) and the
+// correction's diagnostics, so that all of them say it alike.
 //
 // Stand-ins are named once, before any input is read; reading the names
 // concurrently (the correction's worker threads) is then safe.

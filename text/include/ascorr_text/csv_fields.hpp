@@ -1,7 +1,7 @@
 // ascorr_text/csv_fields.hpp: the one field splitter of ascorr's CSV
 // dialect (docs/contract.md, section 3), shared by the HAL's text readers
-// (hal/linux/src/text_lines.hpp) and the host's (host_sim/src/formats/csv.cpp). It
-// is its own small library, ascorr_text (hal/CMakeLists.txt), below both:
+// (text_file.hpp) and the host's (host_sim/src/formats/csv.cpp). It
+// is its own small library, ascorr_text (text/CMakeLists.txt), below both:
 // host_sim/ may use hal/, hal/ may not use host_sim/, and neither the
 // freestanding HAL nor the firmware needs it.
 //

@@ -1,10 +1,16 @@
-// hal/linux/src/text_lines.hpp: the line and field reader shared by the HAL's
-// text files (board configuration, temperature replay, simulation history).
+// ascorr_text/text_file.hpp: a text file's lines and fields, checked: the
+// reader of the HAL's text files (board configuration, temperature replay,
+// simulation history), on the one line reader (line_reader.hpp) and field
+// splitter (csv_fields.hpp) that the host's readers use too, every refusal an
+// InputError (input_error.hpp).
 //
 // Conventions: lines end at '\n'; a '\r' before it is dropped; line numbers
 // start at 1 and columns at 1, as the file:line:column messages give them. A
-// final '\n' does not start another line. Private to hal/linux (hal/ cannot
-// use host_sim's reader: nothing in hal/ depends on host_sim/).
+// final '\n' does not start another line. The whole file is checked as UTF-8
+// text (refuse_binary) and read with the HAL's words ("cannot open FILE:
+// reason"); the host's solutions, model and states readers read in bounded
+// blocks and refuse only a NUL byte, in their own words ("FILE: cannot open:
+// reason", ascorr_host/formats/csv.hpp): both wordings are the contract's.
 #pragma once
 
 #include <cerrno>
@@ -23,15 +29,15 @@
 #include <utility>
 #include <vector>
 
-#include "ascorr_hal_linux/config_file.hpp"
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/csv_fields.hpp"
+#include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/line_reader.hpp"
 #include "ascorr_text/numbers.hpp"
 
-namespace ascorr::hal::linux_detail {
+namespace ascorr::text {
 
 // Why a field is not a usable number when it is a well-formed decimal beyond
 // double's range ("1e999", "1e-999"): "'1e999' is out of range: ..." in the
@@ -128,7 +134,7 @@ inline bool printable_line(std::string_view line) noexcept {
 }
 
 // Refuses a text that is not UTF-8 text: a NUL or another control character
-// (but tab, and CR before LF), DEL, or invalid UTF-8. ConfigError at the
+// (but tab, and CR before LF), DEL, or invalid UTF-8. InputError at the
 // first such byte, with an escaped excerpt of its line, never the bytes:
 // invalid UTF-8 in an otherwise printable line (a Latin-1 '°', 0xb0) is
 // "file:line:column: not UTF-8 text (byte 0xb0; the file may be Latin-1:
@@ -164,7 +170,7 @@ inline void refuse_binary(const std::string& file, std::string_view text) {
             } else {
                 what = std::string("binary data (byte ") + byte + "): not a text file, " + starts;
             }
-            throw ConfigError(file, line, i - line_start + 1, what);
+            throw text::InputError(file, line, i - line_start + 1, what);
         }
         i += n;
     }
@@ -207,17 +213,18 @@ private:
 };
 
 // The whole text of a file. A file that cannot be opened or read, or a
-// directory: ConfigError "cannot open FILE: reason" (no line, no column). A
-// line beyond text::kMaxLineBytes: ConfigError at file:line, as soon as it is
+// directory: InputError "cannot open FILE: reason" (no line, no column). A
+// line beyond text::kMaxLineBytes: InputError at file:line, as soon as it is
 // read (/dev/zero fails at once, not when memory runs out).
 inline std::string read_text_file(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
-        throw ConfigError::whole_file("cannot open " + text::input_name(path) + ": is a directory, not a file");
+        throw text::InputError::whole_file(path,
+                                           "cannot open " + text::input_name(path) + ": is a directory, not a file");
     }
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        throw ConfigError::whole_file("cannot open " + text::input_name(path) + ": " + std::strerror(errno));
+        throw text::InputError::whole_file(path, "cannot open " + text::input_name(path) + ": " + std::strerror(errno));
     }
     std::string text;
     text::LineLengthScan scan;
@@ -225,12 +232,12 @@ inline std::string read_text_file(const std::string& path) {
     while (in.read(buf, sizeof buf) || in.gcount() > 0) {
         const std::string_view piece(buf, static_cast<std::size_t>(in.gcount()));
         if (!scan.feed(piece)) {
-            throw ConfigError(path, scan.too_long_line(), 0, text::line_too_long());
+            throw text::InputError(path, scan.too_long_line(), 0, text::line_too_long());
         }
         text.append(piece);
     }
     if (in.bad()) {
-        throw ConfigError::whole_file("cannot read " + text::input_name(path) + ": " + std::strerror(errno));
+        throw text::InputError::whole_file(path, "cannot read " + text::input_name(path) + ": " + std::strerror(errno));
     }
     return text;
 }
@@ -245,12 +252,12 @@ using Field = std::pair<std::string_view, std::size_t>;
 class FieldSplitter {
 public:
     // The fields of line `line_no` of `file`. Malformed quoting (an
-    // unterminated quoted field, text after a closing quote): ConfigError at
+    // unterminated quoted field, text after a closing quote): InputError at
     // file:line:column, in the host readers' words.
     const std::vector<Field>& split(const std::string& file, std::size_t line_no, std::string_view line) {
         const std::size_t bad = text::csv::split_fields(line, text_);
         if (bad != text::csv::kSplitOk) {
-            throw ConfigError(file, line_no, bad + 1, text::csv::why_split_failed(line, bad));
+            throw text::InputError(file, line_no, bad + 1, text::csv::why_split_failed(line, bad));
         }
         fields_.clear();
         for (const std::string_view f : text_) {
@@ -268,9 +275,9 @@ private:
 // column ("column 't_chu': \"5\" is a quoted field in a column ascorr reads").
 inline void refuse_quoted(const std::string& file, std::size_t line_no, const Field& field, std::string_view column) {
     if (text::csv::is_quoted(field.first)) {
-        throw ConfigError(file, line_no, field.second,
-                          "column '" + std::string(column) + "': " + text::csv::quoted_field_refusal(field.first));
+        throw text::InputError(file, line_no, field.second,
+                               "column '" + std::string(column) + "': " + text::csv::quoted_field_refusal(field.first));
     }
 }
 
-}  // namespace ascorr::hal::linux_detail
+}  // namespace ascorr::text
