@@ -1,5 +1,6 @@
 // Simulated acquisition from temperature histories (simulated_source.hpp).
 #include "ascorr_hal_linux/simulated_source.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/text_file.hpp"
 
@@ -227,11 +228,6 @@ namespace {
 static_assert(static_cast<int>(Role::kT029) - static_cast<int>(Role::kChuA) == kHistoryHeads,
               "one history head per chu role");
 
-// The epoch key of a time: t to the millisecond (t is within [0, 1e12] s).
-std::int64_t epoch_key(double t) noexcept {
-    return std::llround(t * 1000.0);
-}
-
 // One truth of an epoch and the row that gave it.
 struct EpochValue {
     double value = std::numeric_limits<double>::quiet_NaN();
@@ -253,33 +249,53 @@ void merge_value(const std::string& file, const HistoryRow& row, int k, const ch
     throw text::InputError(file, row.line, row.column[k], buf);
 }
 
-}  // namespace
+// The truths of one epoch, merged from its rows.
+struct EpochTruths {
+    EpochValue chu[kHistoryHeads];
+    EpochValue t029;
+    EpochValue t032;
 
-std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows) {
-    std::stable_sort(rows.begin(), rows.end(),
-                     [](const HistoryRow& a, const HistoryRow& b) { return epoch_key(a.t) < epoch_key(b.t); });
-    std::vector<HistoryEpoch> epochs;
-    std::size_t i = 0;
-    while (i < rows.size()) {
-        const std::int64_t key = epoch_key(rows[i].t);
-        EpochValue chu[kHistoryHeads];
-        EpochValue t029;
-        EpochValue t032;
-        for (; i < rows.size() && epoch_key(rows[i].t) == key; ++i) {
-            const HistoryRow& r = rows[i];
-            for (int h = 0; h < kHistoryHeads; ++h) {
-                if (r.head < 0 || r.head == h) {
-                    merge_value(file_name, r, 0, "t_chu", r.t_chu, chu[h]);
-                }
+    void merge(const std::string& file, const HistoryRow& r) {
+        for (int h = 0; h < kHistoryHeads; ++h) {
+            if (r.head < 0 || r.head == h) {
+                merge_value(file, r, 0, "t_chu", r.t_chu, chu[h]);
             }
-            merge_value(file_name, r, 1, "t_029", r.t_029, t029);
-            merge_value(file_name, r, 2, "t_032", r.t_032, t032);
         }
+        merge_value(file, r, 1, "t_029", r.t_029, t029);
+        merge_value(file, r, 2, "t_032", r.t_032, t032);
+    }
+
+    HistoryEpoch epoch(std::int64_t key) const {
         HistoryEpoch e{static_cast<std::uint64_t>(key) * 1000U, {}, t029.value, t032.value};
         for (int h = 0; h < kHistoryHeads; ++h) {
             e.t_chu[h] = chu[h].value;
         }
-        epochs.push_back(e);
+        return e;
+    }
+};
+
+}  // namespace
+
+std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vector<HistoryRow> rows) {
+    // t is within [0, 1e12] s (history_row): every row has a key.
+    using pipeline::epoch_key;
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const HistoryRow& a, const HistoryRow& b) { return epoch_key(a.t) < epoch_key(b.t); });
+    std::vector<HistoryEpoch> epochs;
+    pipeline::ConsecutiveEpochs runs;
+    EpochTruths truths;
+    for (const HistoryRow& r : rows) {
+        const std::int64_t key = epoch_key(r.t);
+        if (runs.ends_before(key)) {
+            epochs.push_back(truths.epoch(runs.key()));
+            truths = {};
+            runs.close();
+        }
+        runs.add(key);
+        truths.merge(file_name, r);
+    }
+    if (runs.is_open()) {
+        epochs.push_back(truths.epoch(runs.key()));
     }
     return epochs;
 }

@@ -12,6 +12,7 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/iba.hpp"
@@ -184,32 +185,23 @@ struct CombineStage::Impl {
             kept.push_back({key, k});
             return;
         }
-        if (!epoch.empty() && key != epoch_key_) {
-            if (key < epoch_key_) {
-                throw RowsOutOfOrder{r.line};
-            }
-            emit(epoch);
-            epoch.clear();
+        if (epochs.ends_before(key) && key < epochs.key()) {
+            throw RowsOutOfOrder{r.line};
         }
-        epoch_key_ = key;
-        epoch.push_back(k);
+        take(key, k);
     }
 
     void finish() {
         if (mode == Mode::kKeep) {
             std::stable_sort(kept.begin(), kept.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-            for (std::size_t i = 0; i < kept.size();) {
-                epoch.clear();
-                std::size_t j = i;
-                for (; j < kept.size() && kept[j].first == kept[i].first; ++j) {
-                    epoch.push_back(kept[j].second);
-                }
-                emit(epoch);
-                i = j;
+            for (const auto& [key, k] : kept) {
+                take(key, k);
             }
             kept.clear();
-        } else if (!epoch.empty()) {
+        }
+        if (epochs.is_open()) {
             emit(epoch);
+            epochs.close();
         }
         epoch.clear();
         out.write(buf);
@@ -321,6 +313,17 @@ struct CombineStage::Impl {
         }
     }
 
+    // A row of `key`, in time order: the open epoch is emitted first when the row is of another.
+    void take(std::int64_t key, const Kept& k) {
+        if (epochs.ends_before(key)) {
+            emit(epoch);
+            epoch.clear();
+            epochs.close();
+        }
+        epochs.add(key);
+        epoch.push_back(k);
+    }
+
     void emit(std::vector<Kept>& rows) {
         // Heads in index order (then lines): the combiner's reference and sums,
         // hence the bits, are the same in any row order.
@@ -386,7 +389,7 @@ struct CombineStage::Impl {
     Mode mode;
     std::string buf;
     std::vector<Kept> epoch;
-    std::int64_t epoch_key_ = 0;
+    pipeline::ConsecutiveEpochs epochs;  // the open epoch: consecutive rows with one key
     std::vector<std::pair<std::int64_t, Kept>> kept;
     CombineSummary sum;
     // The steps (HeadSetStep): per subset, per day, the sum of d_S.

@@ -52,10 +52,6 @@ std::optional<HeadSet> parse_head_letters(const std::string& letters) {
     return s;
 }
 
-std::int64_t epoch_key(double t) noexcept {
-    return static_cast<std::int64_t>(std::llround(t * 1000.0));
-}
-
 namespace {
 
 // Mean and RMS about it, in two passes (the values sit on a large offset, the

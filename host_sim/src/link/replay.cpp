@@ -18,6 +18,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_host/analysis/iba.hpp"
@@ -235,7 +236,7 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
 }
 
 // --mountings/--combined: each epoch (rows whose t agree to the
-// millisecond, iba.hpp's epoch_key; in time order they come together) is
+// millisecond, pipeline/epoch_key.hpp; in time order they come together) is
 // combined on the target (COMBINE_REQUEST after its last solution) and on the
 // host by the same pipeline stage in the same scalar, and the two compared
 // bit for bit; the target's is the combined file's row, with the formal σ of
@@ -254,24 +255,22 @@ public:
 
     // Before a row at t is sent: the open epoch ends when t is of another.
     void before(double t) {
-        const bool keyed = std::abs(t) < kMaxEpochTimeS;
-        if (open_ && !(keyed && epoch_key(t) == key_)) {
+        const std::optional<std::int64_t> key = pipeline::epoch_key_of(t);
+        if (grouper_.ends_before(key)) {
             close(true);
         }
-        if (keyed && !open_) {
-            open_ = true;
-            key_ = epoch_key(t);
+        if (key && grouper_.add(*key)) {
             t_ = t;
         }
     }
     // After a row at t is sent: a row in no epoch is combined alone, dropped.
     void after(double t) {
-        if (!(std::abs(t) < kMaxEpochTimeS)) {
+        if (!pipeline::has_epoch_key(t)) {
             close(false);
         }
     }
     void finish(ReplaySummary& sum) {
-        if (open_) {
+        if (grouper_.is_open()) {
             close(true);
         }
         sum.combined = true;
@@ -283,7 +282,7 @@ public:
 
 private:
     void close(bool write) {
-        open_ = false;
+        grouper_.close();
         const link::Combined<T> got = client_.combine_epoch();
         const combine::CombinedAttitude<T> want = host_.close();
         const bool same = got.status == want.status && got.used == want.used && got.left_out == want.left_out &&
@@ -318,9 +317,8 @@ private:
     combine::Combiner<T> combiner_;
     std::string file_;
     std::ostream& log_;
-    bool open_ = false;
-    std::int64_t key_ = 0;
-    double t_ = 0.0;  // the epoch's first (earliest) row's
+    pipeline::ConsecutiveEpochs grouper_;  // consecutive rows with one key
+    double t_ = 0.0;                       // the epoch's first (earliest) row's
     std::size_t epochs_ = 0;
     std::size_t mismatches_ = 0;
     double instructions_ = 0.0;

@@ -24,6 +24,7 @@
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/vector3.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 
 namespace ascorr::host {
 
@@ -122,9 +123,10 @@ double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept
 
 // Epoch key: t rounded to the millisecond, as rows are matched. Only for
 // |t| < kMaxEpochTimeS (the key is a 64-bit count of milliseconds); a row
-// beyond it (1e300 s: far outside any ephemeris) belongs to no epoch.
-inline constexpr double kMaxEpochTimeS = 9.0e15;
-std::int64_t epoch_key(double t) noexcept;
+// beyond it (1e300 s: far outside any ephemeris) belongs to no epoch. The
+// firmware's, the one rule of every grouper (ascorr/pipeline/epoch_key.hpp).
+using pipeline::epoch_key;
+using pipeline::kMaxEpochTimeS;
 
 struct Rms {
     double rms = 0.0;           // about the mean, arcsec
