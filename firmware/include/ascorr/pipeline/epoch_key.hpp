@@ -1,7 +1,7 @@
 // ascorr/pipeline/epoch_key.hpp: which rows form one epoch.
 //
 // Conventions: a row's time t is in seconds (a double, as in the files of
-// docs/formats.md); its epoch key is t rounded to the nearest millisecond,
+// docs/contract.md); its epoch key is t rounded to the nearest millisecond,
 // halves away from zero (std::llround of t * 1000), a signed 64-bit count of
 // milliseconds. The key exists only for |t| < kMaxEpochTimeS (NaN and
 // ±infinity included in "not"): beyond it the count would not fit, and such a
