@@ -278,7 +278,7 @@ private:
             if (!means.has[h]) {
                 continue;
             }
-            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
+            if (!n_valid_ || ((static_cast<unsigned>(n_heads_) >> h) & 1U) == 0U) {
                 n_ref_[h] = q_head_in_f[h];
                 n_mat_[h] = rotation_matrix(q_head_in_f[h]);
             }
@@ -289,7 +289,7 @@ private:
             o.x[h][0] = means.t[h][0];
             o.x[h][1] = means.t[h][1] - means.t[h][0];
             o.x[h][2] = means.t[h][2] - means.t[h][0];
-            if (!n_valid_ || ((n_heads_ >> h) & 1U) == 0U) {
+            if (!n_valid_ || ((static_cast<unsigned>(n_heads_) >> h) & 1U) == 0U) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
                 }
@@ -415,7 +415,7 @@ private:
             }
         }
         for (std::size_t h = 0; h < N; ++h) {
-            for (std::size_t j = 0; j < kUnknowns && ((heads >> h) & 1U) != 0U; ++j) {
+            for (std::size_t j = 0; j < kUnknowns && ((static_cast<unsigned>(heads) >> h) & 1U) != 0U; ++j) {
                 for (std::size_t a = 0; a < 3; ++a) {
                     b_[h][j][a] = b[h][j][a];
                 }

@@ -62,7 +62,7 @@ bool feed_estimator(Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>
     }
     if constexpr (N > kFrameHeads) {
         for (std::uint8_t h = kFrameHeads; h < N; ++h) {
-            if (((further >> h) & 1U) != 0U &&
+            if (((static_cast<unsigned>(further) >> h) & 1U) != 0U &&
                 selected_solution(h, model, corrected[h], *temperatures[h], c.q_chu_icrf[h])) {
                 c.temperatures[h] = *temperatures[h];
                 c.heads = static_cast<std::uint8_t>(c.heads | (1U << h));

@@ -32,7 +32,7 @@ template <std::size_t N>
 bool coefficients_within_q30(const ModelCoefficients& m, std::uint8_t heads) noexcept {
     const double max_coef = 0x1p-5 * kRadToArcsec;
     for (std::size_t h = 0; h < N; ++h) {
-        if (((heads >> h) & 1U) == 0U) {
+        if (((static_cast<unsigned>(heads) >> h) & 1U) == 0U) {
             continue;
         }
         for (std::size_t a = 0; a < 3; ++a) {
@@ -79,7 +79,8 @@ std::size_t iba_residuals(const Matrix3 (&n_mat)[N], const double (&r)[3 * N], d
     std::size_t formed = 0;
     for (std::size_t i = 0; i < N; ++i) {
         for (std::size_t j = i + 1; j < N; ++j, ++p) {
-            const bool both = ((heads >> i) & 1U) != 0U && ((heads >> j) & 1U) != 0U;
+            const bool both =
+                ((static_cast<unsigned>(heads) >> i) & 1U) != 0U && ((static_cast<unsigned>(heads) >> j) & 1U) != 0U;
             d[p] = both ? iba_change(z[i], z[j], dz[i], dz[j]) : 0.0;
             formed += both ? 1U : 0U;
         }
@@ -96,7 +97,7 @@ void centred_to_model(const double (&b)[N][kUnknowns][3], const double (&centre)
                       std::uint8_t heads) noexcept {
     m = ModelCoefficients{};
     for (std::size_t h = 0; h < N; ++h) {
-        if (((heads >> h) & 1U) == 0U) {
+        if (((static_cast<unsigned>(heads) >> h) & 1U) == 0U) {
             continue;
         }
         m.present[h] = true;
@@ -156,13 +157,13 @@ bool within_limits(const ModelCoefficients& m, const OrbitWindow<N>& window, dou
     }
     for (std::size_t h = 0; h < N; ++h) {
         const OrbitRecord<N>* o = newest_with(window, h);
-        if (((heads >> h) & 1U) == 0U || o == nullptr) {
+        if (((static_cast<unsigned>(heads) >> h) & 1U) == 0U || o == nullptr) {
             continue;
         }
         for (std::size_t corner = 0; corner < 8U; ++corner) {
             double x[3];
             for (std::size_t j = 0; j < 3; ++j) {
-                x[j] = o->x[h][j] + (((corner >> j) & 1U) != 0U ? margin_c : -margin_c);
+                x[j] = o->x[h][j] + (((static_cast<unsigned>(corner) >> j) & 1U) != 0U ? margin_c : -margin_c);
             }
             for (std::size_t a = 0; a < 3; ++a) {
                 if (!(std::fabs(model_angle(m, h, a, x)) < max_arcsec)) {
@@ -195,7 +196,7 @@ double window_rms(const ModelCoefficients& m, const OrbitWindow<N>& window, cons
         const std::uint8_t in = heads & o.heads();
         double r[3 * N] = {};
         for (std::size_t h = 0; h < N; ++h) {
-            for (std::size_t a = 0; a < 3 && ((in >> h) & 1U) != 0U; ++a) {
+            for (std::size_t a = 0; a < 3 && ((static_cast<unsigned>(in) >> h) & 1U) != 0U; ++a) {
                 r[3 * h + a] = o.e[h][a] - model_angle(m, h, a, o.x[h]);
             }
         }

@@ -79,7 +79,7 @@ public:
             last_t_us_ = c.t_us;
             last_q_a_ = c.q_chu_icrf[0];
             for (std::size_t h = kFrameHeads; h < N && c.heads != kFrameMask; ++h) {
-                if (((c.heads >> h) & 1U) != 0U) {
+                if (((static_cast<unsigned>(c.heads) >> h) & 1U) != 0U) {
                     first_reference(h, c.q_chu_icrf[h], c.temperatures[h]);
                 }
             }
@@ -131,7 +131,7 @@ private:
 
     // A further head's references from its first selected cycle ever.
     void first_reference(std::size_t h, const Quaternion<T>& q_h, const HeadTemperatures<T>& tp) noexcept {
-        if (((ref_heads_ >> h) & 1U) != 0U) {
+        if (((static_cast<unsigned>(ref_heads_) >> h) & 1U) != 0U) {
             return;
         }
         ref_heads_ = static_cast<std::uint8_t>(ref_heads_ | (1U << h));

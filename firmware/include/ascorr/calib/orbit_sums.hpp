@@ -119,7 +119,7 @@ struct OrbitSums {
         }
         if constexpr (N > kFrameHeads) {
             for (std::size_t h = kFrameHeads; h < N && heads != kFrameMask; ++h) {
-                if (((heads >> h) & 1U) != 0U) {
+                if (((static_cast<unsigned>(heads) >> h) & 1U) != 0U) {
                     add_head(h, q_icrf_a, q[h], temps[h], ref);
                 }
             }
