@@ -180,7 +180,6 @@ public:
         for (auto& s : srif_) {
             s.clear();
         }
-        n_valid_ = false;
         n_heads_ = 0;
         for (auto& k : head_orbits_) {
             k = 0;
@@ -278,7 +277,8 @@ private:
             if (!means.has[h]) {
                 continue;
             }
-            if (!n_valid_ || ((static_cast<unsigned>(n_heads_) >> h) & 1U) == 0U) {
+            const bool first = ((static_cast<unsigned>(n_heads_) >> h) & 1U) == 0U;  // its first orbit
+            if (first) {
                 n_ref_[h] = q_head_in_f[h];
                 n_mat_[h] = rotation_matrix(q_head_in_f[h]);
             }
@@ -289,14 +289,13 @@ private:
             o.x[h][0] = means.t[h][0];
             o.x[h][1] = means.t[h][1] - means.t[h][0];
             o.x[h][2] = means.t[h][2] - means.t[h][0];
-            if (!n_valid_ || ((static_cast<unsigned>(n_heads_) >> h) & 1U) == 0U) {
+            if (first) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
                 }
             }
         }
         n_heads_ = static_cast<std::uint8_t>(n_heads_ | o.heads());
-        n_valid_ = true;
         // the references of the next orbit opened (a head without means keeps its own)
         orbit_.set_next_reference(reference_from<T>(means, orbit_.latest_reference()));
         return true;
@@ -512,7 +511,6 @@ private:
     std::uint32_t typical_count_ = 0;
     OrbitRecord<N> record_{};
     // The filter.
-    bool n_valid_ = false;
     std::uint8_t n_heads_ = 0;  // heads with n_ref_, n_mat_, centre_ (bit h)
     Quaternion<double> n_ref_[N]{};
     Matrix3 n_mat_[N]{};
