@@ -40,6 +40,7 @@ const fs::path& simulated_day() {
         const fs::path d = fs::temp_directory_path() / ("ascorr-test-" + std::to_string(::getpid()) + "-io-sim");
         fs::remove_all(d);
         fs::create_directories(d);
+        scratch_cleaner().add(d);  // shared by the tests: removed when the program passes
         const CliRun r = run_in("simulate --days 1 --out sim.csv", d);
         EXPECT_EQ(r.exit_code, 0) << r.err;
         return d;

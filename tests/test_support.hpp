@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 
 #include <filesystem>
 #include <random>
@@ -71,13 +72,49 @@ inline std::vector<host::SolutionRecord> read_records(const std::string& path, s
     return out;
 }
 
-// A fresh, empty directory for one test.
+// Removes the process' scratch directories when the whole test program
+// passed (a failure keeps them all for the diagnosis; so does
+// ASCORR_KEEP_SCRATCH=1). At the program's end, not the test's: some missions
+// are simulated once into a directory and shared by the tests that follow.
+// Without it every run left its directories in the temporary folder (their
+// names carry the process id), tens of GB over many runs.
+class ScratchCleaner : public ::testing::EmptyTestEventListener {
+public:
+    void add(const std::filesystem::path& dir) { dirs_.push_back(dir); }
+    void OnTestProgramEnd(const ::testing::UnitTest& unit) override {
+        const char* keep = std::getenv("ASCORR_KEEP_SCRATCH");
+        if (!unit.Passed() || (keep != nullptr && std::string(keep) == "1")) {
+            return;
+        }
+        for (const auto& d : dirs_) {
+            std::error_code ec;
+            std::filesystem::remove_all(d, ec);
+        }
+    }
+
+private:
+    std::vector<std::filesystem::path> dirs_;
+};
+
+// The one cleaner of the process, appended to gtest's listeners (which own
+// it) at the first scratch directory.
+inline ScratchCleaner& scratch_cleaner() {
+    static ScratchCleaner* cleaner = [] {
+        auto* c = new ScratchCleaner();
+        ::testing::UnitTest::GetInstance()->listeners().Append(c);
+        return c;
+    }();
+    return *cleaner;
+}
+
+// A fresh, empty directory for one test; removed when the program passes.
 inline std::filesystem::path scratch_dir(const std::string& name) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     auto dir = std::filesystem::temp_directory_path() /
                ("ascorr-test-" + std::to_string(::getpid()) + "-" + name + "-" + info->name());
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
+    scratch_cleaner().add(dir);
     return dir;
 }
 
