@@ -47,7 +47,21 @@ void add_fit_command(CLI::App& app) {
                     "the heads to fit, two or more in heads' order, frame F's among them; rows of others are left "
                     "out (default: A, B, C, F's two and every head with rows)")
         ->check(head_letters_in(2, kMaxHeads));
-    cmd->callback([opt, frame, heads]() {
+    auto mountings = std::make_shared<std::string>();
+    cmd->add_option("--mountings", *mountings,
+                    "mountings file (CSV, with sigma_cross,sigma_about): the common rotation, which no IBA sees, is "
+                    "then fixed so that the heads' combined attitude moves least (--common-rotation combined)")
+        ->check(non_empty_path());
+    auto rule = std::make_shared<std::string>();
+    cmd->add_option("--common-rotation", *rule,
+                    "the rule for the rotation common to all heads: combined (default with --mountings: the "
+                    "combined attitude moves least), smallest (default without: the smallest corrections), rigid-X "
+                    "(head X taken as rigid to the bench)")
+        ->type_name("RULE")
+        ->check([](const std::string& v) {
+            return host::common_rotation_named(v) ? std::string() : "expected " + host::common_rotation_choices();
+        });
+    cmd->callback([opt, frame, heads, mountings, rule]() {
         opt->frame_heads = {head_index((*frame)[0]), head_index((*frame)[1])};  // checked already
         if (!heads->empty()) {
             opt->heads = host::parse_head_letters(*heads);  // checked already
@@ -56,8 +70,22 @@ void add_fit_command(CLI::App& app) {
                                            "frame F's heads " + *frame + " (--frame-heads) are not among them");
             }
         }
-        host::OutputSet outputs = open_run_files({{"--in", &opt->in}}, {{"--out", opt->out}, host::kStandardOutput});
+        if (!rule->empty()) {
+            opt->common_rotation.emplace();
+            static_cast<host::CommonRotationId&>(*opt->common_rotation) = *host::common_rotation_named(*rule);
+        }
+        host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--mountings", mountings.get()}},
+                                                 {{"--out", opt->out}, host::kStandardOutput});
+        if (!mountings->empty()) {
+            opt->mountings = host::read_mountings_file(*mountings);
+            opt->mountings_name = *mountings;
+        }
         const host::FitReport r = host::fit_model(*opt, outputs);
+        if (r.common_rotation.rule == host::CommonRotationRule::kSmallest && !opt->common_rotation) {
+            std::cerr << "ascorr fit: warning: no --mountings: the rotation common to all heads, which no IBA sees, "
+                         "is fixed as the smallest correction; the heads' combined attitude is not protected from "
+                         "it (give --mountings M)\n";
+        }
         outputs[host::kStandardOutput.option].write(host::describe(r));
         outputs.commit();
         std::cerr << "ascorr fit: model written to " << opt->out << '\n';

@@ -41,6 +41,9 @@ class Model:
     @property
     def quadratic(self) -> bool:
         """True when the model has (and its file will carry) the quadratic columns."""
+    @property
+    def common_rotation(self) -> str:
+        """The rule that fixed the rotation common to all heads: 'smallest', 'combined' or 'rigid-X' (the model file's common_rotation column; docs/contract.md)."""
     def write(self, path: _Path) -> None:
         """Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike."""
     def to_csv(self) -> str:
@@ -170,6 +173,8 @@ def fit(
     min_temperature_range: float = ...,
     frame_heads: str = ...,
     heads: Optional[str] = ...,
+    mountings: Optional[dict[str, Any]] = ...,
+    common_rotation: Optional[str] = ...,
 ) -> tuple[Model, dict[str, Any]]:
     """Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),
     with its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2;
@@ -177,12 +182,16 @@ def fit(
     model-selection report, 0..0.5; min_temperature_range: the smallest range (degC) of
     each regressor for quadratic terms; frame_heads: frame F's two heads, e.g. 'AD' (as
     --frame-heads); heads: the heads to fit, F's among them, e.g. 'ABD' for a mission
-    without C (as --heads; None: A, B, C, F's two and every other head with rows). Returns
+    without C (as --heads; None: A, B, C, F's two and every other head with rows);
+    mountings: read_mountings()'s dict, with sigmas (as --mountings): the rotation common
+    to all heads, which no IBA sees, is then fixed so that the heads' combined attitude
+    moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
+    (as --common-rotation; None: 'combined' with mountings, 'smallest' without). Returns
     (model, report): model an ascorr.Model (model.write(path) writes the model file),
     report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
-    dropped, epochs, orbits_used, condition, singular_values, terms, heads (the letters of
-    the heads fitted), residual_rms and signal_rms (len(heads), 3) arcsec [head][alpha,
-    beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+    dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
+    rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
+    (len(heads), 3) arcsec [head][alpha, beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
     determine the model (period shorter than min_days, fewer than min_orbits orbits,
     condition number above max_condition, too small a temperature range for quadratic
     terms) or a setting is out of its range; its text, and the report's, name the settings

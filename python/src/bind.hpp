@@ -28,6 +28,7 @@
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::python {
@@ -52,6 +53,10 @@ void bind_correct(py::module_& mod);
 void bind_self_calibration(py::module_& mod);
 void bind_analysis(py::module_& mod);
 void bind_combine(py::module_& mod);  // read_mountings, combine, align
+
+// A mountings dict (read_mountings()'s) as the mountings file's reader takes
+// it, with its rules and messages (ValueError naming argument 'mountings').
+host::MountingsFile mountings_arg(const py::handle& obj);
 
 // ---- arguments (arguments.cpp)
 

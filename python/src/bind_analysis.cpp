@@ -207,7 +207,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
               const py::object& t_to, const py::object& min_days, const py::object& min_orbits,
               const py::object& max_condition, const py::object& orbit_period, const py::object& terms,
               const py::object& holdout, const py::object& min_temperature_range, const py::object& frame_heads,
-              const py::object& heads) {
+              const py::object& heads, const py::object& mountings, const py::object& common_rotation) {
     host::FitOptions opt;
     opt.in = kArrayRows;
     opt.from = time_arg(t_from, "t_from");
@@ -226,6 +226,20 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     opt.frame_heads = {frame.head[0], frame.head[1]};
     if (!heads.is_none()) {
         opt.heads = heads_arg(heads, "heads", 2U, kMaxHeads);
+    }
+    if (!mountings.is_none()) {
+        opt.mountings = mountings_arg(mountings);
+        opt.mountings_name = "argument 'mountings'";
+    }
+    if (!common_rotation.is_none()) {
+        const std::string name = py::isinstance<py::str>(common_rotation) ? common_rotation.cast<std::string>() : "";
+        const std::optional<host::CommonRotationId> id = host::common_rotation_named(name);
+        if (!id) {
+            bad_argument("common_rotation",
+                         "expected " + host::common_rotation_choices() + ", got " + value_text(common_rotation));
+        }
+        opt.common_rotation.emplace();
+        static_cast<host::CommonRotationId&>(*opt.common_rotation) = *id;
     }
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
@@ -266,6 +280,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["residual_rms"] = res;
     d["signal_rms"] = sig;
     d["terms"] = host::terms_name(rep.terms);
+    d["common_rotation"] = host::common_rotation_name(rep.common_rotation);
     d["text"] = as_keywords(host::describe(rep));
     return py::make_tuple(py::cast(rep.model), d);
 }
@@ -283,7 +298,7 @@ void bind_analysis(py::module_& mod) {
             "orbit_period"_a = py::none(), "terms"_a = "linear", "holdout"_a = host::kDefaultHoldout,
             "min_temperature_range"_a = host::kDefaultMinTemperatureRange,
             "frame_heads"_a = host::frame_heads_text(host::kDefaultFrameHeads), "heads"_a = py::none(),
-            docstring(docs::kFit));
+            "mountings"_a = py::none(), "common_rotation"_a = py::none(), docstring(docs::kFit));
 }
 
 }  // namespace ascorr::python

@@ -69,54 +69,6 @@ py::dict mountings_dict(const host::MountingsFile& m) {
     return d;
 }
 
-// The dict back, checked by the mountings file's own reader (the same rules
-// and messages, with the argument's name for the file's).
-host::MountingsFile mountings_arg(const py::handle& obj) {
-    if (!py::isinstance<py::dict>(obj)) {
-        bad_argument("mountings",
-                     "expected a dict {'heads', 'q', 'sigma_cross', 'sigma_about'} (read_mountings()), "
-                     "got " +
-                         value_text(obj));
-    }
-    const py::dict d = py::reinterpret_borrow<py::dict>(obj);
-    for (const char* key : {"heads", "q", "sigma_cross", "sigma_about"}) {
-        if (!d.contains(key)) {
-            bad_argument("mountings", std::string("the dict has no '") + key + "' (as read_mountings() returns it)");
-        }
-    }
-    const host::HeadSet heads = heads_arg(d["heads"], "mountings['heads']", 1, kMaxHeads);
-    const auto k = static_cast<py::ssize_t>(host::head_count(heads));
-    const Doubles q = real_array(d["q"], "mountings['q']", k, 4);
-    const bool sigmas = !d["sigma_cross"].is_none() || !d["sigma_about"].is_none();
-    Doubles cross;
-    Doubles about;
-    if (sigmas) {
-        cross = real_array(d["sigma_cross"], "mountings['sigma_cross']", k, 0);
-        about = real_array(d["sigma_about"], "mountings['sigma_about']", k, 0);
-    }
-    host::MountingsFile m;
-    m.sigmas = sigmas;
-    py::ssize_t i = 0;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (!host::has_head(heads, h)) {
-            continue;
-        }
-        combine::HeadMounting& hm = m.mountings.head[h];
-        hm.present = true;
-        const double* row = q.data() + 4 * i;
-        hm.q_chu_crf = {row[0], row[1], row[2], row[3]};
-        hm.sigma_cross_arcsec = sigmas ? cross.data()[i] : kNaN;
-        hm.sigma_about_arcsec = sigmas ? about.data()[i] : kNaN;
-        ++i;
-    }
-    // The file's text reads back to exactly these values (shortest round trip).
-    try {
-        return host::parse_mountings("argument 'mountings' (as a mountings file)", host::format_mountings(m));
-    } catch (const text::InputError& e) {
-        throw py::value_error(e.what());
-    }
-}
-
 // The rows of arrays as the combination takes a file's: status None is a raw
 // solutions file (taken as it is), else each row's status bits.
 struct CombineRows {
@@ -334,6 +286,54 @@ py::tuple align_arrays(const py::object& t, const py::object& chu, const py::obj
 }
 
 }  // namespace
+
+// The dict back, checked by the mountings file's own reader (the same rules
+// and messages, with the argument's name for the file's).
+host::MountingsFile mountings_arg(const py::handle& obj) {
+    if (!py::isinstance<py::dict>(obj)) {
+        bad_argument("mountings",
+                     "expected a dict {'heads', 'q', 'sigma_cross', 'sigma_about'} (read_mountings()), "
+                     "got " +
+                         value_text(obj));
+    }
+    const py::dict d = py::reinterpret_borrow<py::dict>(obj);
+    for (const char* key : {"heads", "q", "sigma_cross", "sigma_about"}) {
+        if (!d.contains(key)) {
+            bad_argument("mountings", std::string("the dict has no '") + key + "' (as read_mountings() returns it)");
+        }
+    }
+    const host::HeadSet heads = heads_arg(d["heads"], "mountings['heads']", 1, kMaxHeads);
+    const auto k = static_cast<py::ssize_t>(host::head_count(heads));
+    const Doubles q = real_array(d["q"], "mountings['q']", k, 4);
+    const bool sigmas = !d["sigma_cross"].is_none() || !d["sigma_about"].is_none();
+    Doubles cross;
+    Doubles about;
+    if (sigmas) {
+        cross = real_array(d["sigma_cross"], "mountings['sigma_cross']", k, 0);
+        about = real_array(d["sigma_about"], "mountings['sigma_about']", k, 0);
+    }
+    host::MountingsFile m;
+    m.sigmas = sigmas;
+    py::ssize_t i = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!host::has_head(heads, h)) {
+            continue;
+        }
+        combine::HeadMounting& hm = m.mountings.head[h];
+        hm.present = true;
+        const double* row = q.data() + 4 * i;
+        hm.q_chu_crf = {row[0], row[1], row[2], row[3]};
+        hm.sigma_cross_arcsec = sigmas ? cross.data()[i] : kNaN;
+        hm.sigma_about_arcsec = sigmas ? about.data()[i] : kNaN;
+        ++i;
+    }
+    // The file's text reads back to exactly these values (shortest round trip).
+    try {
+        return host::parse_mountings("argument 'mountings' (as a mountings file)", host::format_mountings(m));
+    } catch (const text::InputError& e) {
+        throw py::value_error(e.what());
+    }
+}
 
 void bind_combine(py::module_& mod) {
     py::register_exception<host::AlignRefused>(mod, "AlignRefused", PyExc_ValueError).attr("__doc__") =

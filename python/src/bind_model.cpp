@@ -94,20 +94,33 @@ std::string model_heads(const host::ModelFile& m) {
 // Two models are equal when they would write the same model file: the same
 // heads, coefficients and columns (where they were read from is no part of it).
 bool models_equal(const host::ModelFile& a, const host::ModelFile& b) {
-    return a.present == b.present && a.coefficients == b.coefficients && a.quadratic == b.quadratic;
+    return a.present == b.present && a.coefficients == b.coefficients && a.quadratic == b.quadratic &&
+           host::common_rotation_name(a.common_rotation) == host::common_rotation_name(b.common_rotation);
 }
 
-// Pickling: (coefficients (heads, 3, 7), heads, quadratic), rebuilt by Model().
+// Pickling: (coefficients (heads, 3, 7), heads, quadratic, common_rotation),
+// rebuilt by Model(); a state of three (pickled before the rule had a name) is
+// the rule 'smallest'.
 py::tuple model_state(const host::ModelFile& m) {
-    return py::make_tuple(model_coefficients(m), model_heads(m), m.quadratic);
+    return py::make_tuple(model_coefficients(m), model_heads(m), m.quadratic,
+                          host::common_rotation_name(m.common_rotation));
 }
 
 host::ModelFile model_from_state(const py::tuple& state) {
-    if (state.size() != 3) {
-        throw py::value_error("ascorr.Model: a pickled state is (coefficients, heads, quadratic)");
+    if (state.size() != 3 && state.size() != 4) {
+        throw py::value_error("ascorr.Model: a pickled state is (coefficients, heads, quadratic, common_rotation)");
     }
     host::ModelFile m = model_from(state[0], state[1]);
     m.quadratic = state[2].cast<bool>();
+    if (state.size() == 4) {
+        const std::optional<host::CommonRotationId> rule =
+            host::common_rotation_named(py::str(state[3]).cast<std::string>());
+        if (!rule) {
+            throw py::value_error("ascorr.Model: a pickled state's common_rotation must be " +
+                                  host::common_rotation_choices());
+        }
+        m.common_rotation = *rule;
+    }
     return m;
 }
 
@@ -128,6 +141,10 @@ void bind_model(py::module_& mod) {
         .def_property_readonly(
             "quadratic", [](const py::object& self) { return model_of(self, kSelf).quadratic; },
             docstring(docs::kModelQuadratic))
+        .def_property_readonly(
+            "common_rotation",
+            [](const py::object& self) { return host::common_rotation_name(model_of(self, kSelf).common_rotation); },
+            docstring(docs::kModelCommonRotation))
         .def(
             "write",
             [](const py::object& self, const py::object& path) {

@@ -34,6 +34,9 @@ inline constexpr const char* kModelCoefficients =
 inline constexpr const char* kModelHeads = "The heads with coefficients, e.g. 'ABC'.";
 inline constexpr const char* kModelQuadratic =
     "True when the model has (and its file will carry) the quadratic columns.";
+inline constexpr const char* kModelCommonRotation =
+    "The rule that fixed the rotation common to all heads: 'smallest', 'combined' or 'rigid-X' (the model "
+    "file's common_rotation column; docs/contract.md).";
 inline constexpr const char* kModelWrite =
     "Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike.";
 inline constexpr const char* kModelToCsv = "The model file's text.";
@@ -129,12 +132,16 @@ any case, as --terms); holdout: the fraction of the period (its end) held out fo
 model-selection report, 0..0.5; min_temperature_range: the smallest range (degC) of
 each regressor for quadratic terms; frame_heads: frame F's two heads, e.g. 'AD' (as
 --frame-heads); heads: the heads to fit, F's among them, e.g. 'ABD' for a mission
-without C (as --heads; None: A, B, C, F's two and every other head with rows). Returns
+without C (as --heads; None: A, B, C, F's two and every other head with rows);
+mountings: read_mountings()'s dict, with sigmas (as --mountings): the rotation common
+to all heads, which no IBA sees, is then fixed so that the heads' combined attitude
+moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
+(as --common-rotation; None: 'combined' with mountings, 'smallest' without). Returns
 (model, report): model an ascorr.Model (model.write(path) writes the model file),
 report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
-dropped, epochs, orbits_used, condition, singular_values, terms, heads (the letters of
-the heads fitted), residual_rms and signal_rms (len(heads), 3) arcsec [head][alpha,
-beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
+rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
+(len(heads), 3) arcsec [head][alpha, beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
 determine the model (period shorter than min_days, fewer than min_orbits orbits,
 condition number above max_condition, too small a temperature range for quadratic
 terms) or a setting is out of its range; its text, and the report's, name the settings

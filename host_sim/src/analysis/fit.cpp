@@ -15,6 +15,7 @@
 
 #include "ascorr/calib/frame.hpp"
 #include "ascorr/calib/head_rotation.hpp"
+#include "ascorr/combine/mountings.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
@@ -424,6 +425,34 @@ std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& o
     return averages;
 }
 
+// The rule `combined`'s weights A_h (combine/mountings.hpp, motion_weight)
+// for the heads fitted, from the mountings, which must have them all, with
+// their sigmas.
+void fill_motion(const FitOptions& opt, HeadSet heads, CommonRotation& rule) {
+    const MountingsFile& m = *opt.mountings;
+    const std::string name = text::input_name(opt.mountings_name);
+    if (!m.sigmas) {
+        throw FitRefused(name +
+                         ": the mountings give no sigma_cross,sigma_about; the common rotation's rule 'combined' "
+                         "weights the heads as the combination does, by their noise (ascorr align estimates it)");
+    }
+    const HeadList list = heads_of(heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::uint8_t h = list.head[i];
+        if (!m.mountings.head[h].present) {
+            throw FitRefused(name + ": head " + head_name(h) +
+                             ", fitted, is not in the mountings; the common rotation's rule 'combined' needs every "
+                             "head fitted (or --common-rotation smallest, or --heads without it)");
+        }
+        const combine::Matrix3 a = combine::motion_weight(m.mountings.head[h]);
+        for (Eigen::Index r = 0; r < 3; ++r) {
+            for (Eigen::Index c = 0; c < 3; ++c) {
+                rule.motion[h](r, c) = a.m[r][c];
+            }
+        }
+    }
+}
+
 // The fit of the orbit averages against the heads' orientations N_i in F,
 // refused as solve_terms says; then the model-selection report.
 void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& averages, const std::string& period_text) {
@@ -435,7 +464,18 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
         n_ref[list.head[i]] = p.reference[list.head[i]]->toRotationMatrix();
     }
     r.terms = opt.terms;
-    r.fit = solve_terms(averages, n_ref, r.heads, opt.terms, opt.max_condition, opt.min_temperature_range_c);
+    r.common_rotation = common_rotation_rule(opt);
+    if (r.common_rotation.rule == CommonRotationRule::kCombined) {
+        fill_motion(opt, r.heads, r.common_rotation);
+    }
+    if (r.common_rotation.rule == CommonRotationRule::kRigid &&
+        (r.heads & head_bit(r.common_rotation.rigid_head)) == 0U) {
+        throw FitRefused("--common-rotation " + common_rotation_name(r.common_rotation) + ": head " +
+                         head_name(r.common_rotation.rigid_head) + " is not among the heads fitted (" +
+                         head_letters(r.heads) + ")");
+    }
+    r.fit = solve_terms(averages, n_ref, r.heads, opt.terms, opt.max_condition, opt.min_temperature_range_c,
+                        r.common_rotation);
     if (!r.fit.refused.empty()) {
         if (opt.terms == Terms::kQuadratic) {
             throw FitRefused(text::input_name(opt.in) +
@@ -449,12 +489,15 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     std::sort(p.fit_epochs.begin(), p.fit_epochs.end(), [](const FitEpoch& a, const FitEpoch& b) { return a.t < b.t; });
     if (opt.selection_report) {
         r.selection = select_terms(averages, p.fit_epochs, n_ref, r.heads, r.t_first, r.t_last, opt.holdout,
-                                   opt.max_condition, opt.min_temperature_range_c);
+                                   opt.max_condition, opt.min_temperature_range_c, r.common_rotation);
     }
     r.singular_values = r.fit.singular_values;
     r.condition = r.fit.condition;
     r.head = r.fit.head;
     r.model = r.fit.model;
+    if (r.common_rotation.rule != CommonRotationRule::kSmallest) {
+        r.model.common_rotation = r.common_rotation;  // a file without the column: smallest
+    }
 }
 
 // Row order must not matter. The reference N_i is the earliest
@@ -505,7 +548,38 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     return p.r;
 }
 
+// The rule's sentence of the report; the smallest correction's is the
+// report's as it always was.
+std::string describe_rule(const CommonRotation& c) {
+    switch (c.rule) {
+        case CommonRotationRule::kCombined:
+            return "(9 directions), the one that moves the combined attitude of the heads fitted least over the "
+                   "period\n(--common-rotation combined, weights of the mountings) is written.\n";
+        case CommonRotationRule::kRigid:
+            return std::string("(9 directions), the one whose correction of head ") + head_name(c.rigid_head) +
+                   " is smallest (taken as rigid to the bench:\n--common-rotation " + common_rotation_name(c) +
+                   ") is written.\n";
+        case CommonRotationRule::kSmallest:
+            break;
+    }
+    return "(9 directions), the one with the smallest corrections over the period is written.\n";
+}
+
 }  // namespace
+
+CommonRotation common_rotation_rule(const FitOptions& opt) {
+    if (!opt.common_rotation) {
+        CommonRotation c;
+        c.rule = opt.mountings ? CommonRotationRule::kCombined : CommonRotationRule::kSmallest;
+        return c;
+    }
+    if (opt.common_rotation->rule == CommonRotationRule::kCombined && !opt.mountings) {
+        throw FitRefused(
+            "--common-rotation combined needs the mountings (--mountings): the combination's weights say how each "
+            "head's correction moves the bench");
+    }
+    return *opt.common_rotation;
+}
 
 std::string describe(const FitReport& r) {
     std::ostringstream o;
@@ -529,8 +603,8 @@ std::string describe(const FitReport& r) {
          "squares),\n"
          "with F's own rotation in each orbit as a nuisance. Rotations common to all heads are not observable by "
          "the\n"
-         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n"
-         "(9 directions), the one with the smallest corrections over the period is written.\n";
+         "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n";
+    o << describe_rule(r.common_rotation);
     const auto rank = static_cast<std::size_t>(r.fit.rank);
     text::c_snprintf(buf, sizeof buf,
                      "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "

@@ -272,9 +272,31 @@ void uncentre(const Eigen::VectorXd& b, const HeadList& list, int per_axis, Term
     }
 }
 
-// The gauge: of all models the star trackers cannot tell apart (c plus a
-// common rotation w0 + w2·T029 + w3·T032), the one whose corrections are
-// smallest (RMS over the orbits of the period).
+// Adds the common rotation ω = w0 + w2·T029 + w3·T032 (F axes, arcsec) to
+// every head's model: N_h·ω in head axes.
+void add_common_rotation(const HeadList& list, const HeadOrientations& n_ref, const Eigen::Vector3d& w0_f,
+                         const Eigen::Vector3d& w2_f, const Eigen::Vector3d& w3_f, ModelFile& m) {
+    for (std::size_t i = 0; i < list.count; ++i) {
+        const std::size_t h = list.head[i];
+        const Eigen::Vector3d w0 = n_ref[h] * w0_f;
+        const Eigen::Vector3d w2 = n_ref[h] * w2_f;
+        const Eigen::Vector3d w3 = n_ref[h] * w3_f;
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            const auto ai = static_cast<Eigen::Index>(ax);
+            auto& c = m.coefficients[h][ax];
+            c[term_index(Regressor::kOne, 0)] += w0(ai);
+            c[term_index(Regressor::kT1, 1)] += w2(ai) + w3(ai);  // T2 = T1 + (T2 − T1), likewise T3
+            c[term_index(Regressor::kT2MinusT1, 1)] += w2(ai);
+            c[term_index(Regressor::kT3MinusT1, 1)] += w3(ai);
+        }
+    }
+}
+
+// The rule kSmallest: of all models the star trackers cannot tell apart (c
+// plus a common rotation w0 + w2·T029 + w3·T032), the one whose corrections
+// are smallest (RMS over the orbits of the period), solved as it always was
+// (its models are byte-identical to those written before the rules had names;
+// apply_rule with A_h = N_hᵀ gives the same to rounding).
 void apply_gauge(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, const HeadList& list,
                  Eigen::Index rows, ModelFile& m) {
     const auto n = static_cast<Eigen::Index>(orbits.size());
@@ -297,20 +319,74 @@ void apply_gauge(const std::vector<OrbitAverage>& orbits, const HeadOrientations
         }
     }
     const Eigen::VectorXd wv = gd.bdcSvd(Eigen::ComputeThinU | Eigen::ComputeThinV).solve(gt);
+    add_common_rotation(list, n_ref, wv.segment<3>(0), wv.segment<3>(3), wv.segment<3>(6), m);
+}
+
+// The rule's weights B_h by position in list (calib/common_rotation.hpp);
+// false when no head carries weight.
+bool rule_weights(const CommonRotation& rule, const HeadOrientations& n_ref, const HeadList& list,
+                  std::array<calib::Matrix3, kMaxHeads>& b) {
+    std::array<calib::Matrix3, kMaxHeads> a{};
+    std::array<calib::Matrix3, kMaxHeads> n{};
     for (std::size_t i = 0; i < list.count; ++i) {
         const std::size_t h = list.head[i];
-        const Eigen::Vector3d w0 = n_ref[h] * wv.segment<3>(0);
-        const Eigen::Vector3d w2 = n_ref[h] * wv.segment<3>(3);
-        const Eigen::Vector3d w3 = n_ref[h] * wv.segment<3>(6);
-        for (std::size_t ax = 0; ax < 3; ++ax) {
-            const auto ai = static_cast<Eigen::Index>(ax);
-            auto& c = m.coefficients[h][ax];
-            c[term_index(Regressor::kOne, 0)] += w0(ai);
-            c[term_index(Regressor::kT1, 1)] += w2(ai) + w3(ai);  // T2 = T1 + (T2 − T1), likewise T3
-            c[term_index(Regressor::kT2MinusT1, 1)] += w2(ai);
-            c[term_index(Regressor::kT3MinusT1, 1)] += w3(ai);
+        Eigen::Matrix3d a_h = Eigen::Matrix3d::Zero();
+        if (rule.rule == CommonRotationRule::kCombined) {
+            a_h = rule.motion[h];
+        } else if (rule.rule == CommonRotationRule::kRigid && h == rule.rigid_head) {
+            a_h = Eigen::Matrix3d::Identity();
+        }
+        for (Eigen::Index r = 0; r < 3; ++r) {
+            for (Eigen::Index c = 0; c < 3; ++c) {
+                a[i].m[r][c] = a_h(r, c);
+                n[i].m[r][c] = n_ref[h](r, c);
+            }
         }
     }
+    return calib::bench_weights(a.data(), n.data(), list.count, b.data());
+}
+
+// The rule (calib/common_rotation.hpp) over the orbits: of the models c + N_h·ω,
+// the one whose weighted motion of the bench is least. False when the
+// orbits do not fix it (no weight, or T029 and T032 never vary apart).
+bool apply_rule(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, const HeadList& list,
+                const CommonRotation& rule, ModelFile& m) {
+    std::array<calib::Matrix3, kMaxHeads> b{};
+    if (!rule_weights(rule, n_ref, list, b)) {
+        return false;
+    }
+    const std::size_t h0 = list.head[0];
+    calib::CommonRotationSums sums;
+    for (const OrbitAverage& o : orbits) {
+        sums.t2_centre += (o.x[h0](0) + o.x[h0](1)) / static_cast<double>(orbits.size());
+        sums.t3_centre += (o.x[h0](0) + o.x[h0](2)) / static_cast<double>(orbits.size());
+    }
+    for (const OrbitAverage& o : orbits) {
+        double y[3] = {0.0, 0.0, 0.0};
+        for (std::size_t i = 0; i < list.count; ++i) {
+            const std::size_t h = list.head[i];
+            double c[3];
+            for (std::size_t ax = 0; ax < 3; ++ax) {
+                c[ax] = predicted(m.coefficients[h][ax], o, h);
+            }
+            for (int r = 0; r < 3; ++r) {
+                y[r] += b[i].m[r][0] * c[0] + b[i].m[r][1] * c[1] + b[i].m[r][2] * c[2];
+            }
+        }
+        calib::add_to_common_rotation(sums, y, o.x[h0](0) + o.x[h0](1), o.x[h0](0) + o.x[h0](2));
+    }
+    double w[3][3];
+    if (!calib::common_rotation_of(sums, w)) {
+        return false;
+    }
+    Eigen::Matrix3d wm;  // columns w0, w2, w3 (F axes)
+    for (Eigen::Index r = 0; r < 3; ++r) {
+        for (Eigen::Index c = 0; c < 3; ++c) {
+            wm(r, c) = w[r][c];
+        }
+    }
+    add_common_rotation(list, n_ref, wm.col(0), wm.col(1), wm.col(2), m);
+    return true;
 }
 
 }  // namespace
@@ -320,7 +396,7 @@ const char* terms_name(Terms t) noexcept {
 }
 
 TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
-                     double max_condition, double min_range_c) {
+                     double max_condition, double min_range_c, const CommonRotation& rule) {
     TermsFit f;
     f.terms = terms;
     f.heads = heads;
@@ -372,7 +448,12 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
     const Eigen::VectorXd res = target - design * c_scaled;
     residual_rms(res, target, list, rows, n, f);
     uncentre(b, list, per_axis, terms, f);
-    apply_gauge(orbits, n_ref, list, rows, f.model);
+    if (rule.rule == CommonRotationRule::kSmallest) {
+        apply_gauge(orbits, n_ref, list, rows, f.model);
+    } else if (!apply_rule(orbits, n_ref, list, rule, f.model)) {
+        f.refused = "the common rotation (rule " + common_rotation_name(rule) +
+                    ") is not fixed by the data: T029 and T032 do not vary independently, or no head carries weight";
+    }
     return f;
 }
 
@@ -440,7 +521,7 @@ double mean_held_out_rms(const ModelScore& m, const PairList& pairs) {
 
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
                        const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
-                       double max_condition, double min_range_c) {
+                       double max_condition, double min_range_c, const CommonRotation& rule) {
     Selection s;
     s.pairs = pairs_of(heads);
     s.holdout = holdout;
@@ -455,7 +536,7 @@ Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vecto
     s.orbits_fitted = fitted.size();
     for (Terms terms : {Terms::kLinear, Terms::kQuadratic}) {
         ModelScore ms;
-        ms.fit = solve_terms(fitted, n_ref, heads, terms, max_condition, min_range_c);
+        ms.fit = solve_terms(fitted, n_ref, heads, terms, max_condition, min_range_c, rule);
         if (ms.fit.refused.empty()) {
             ms.in = corrected_iba_rms(epochs, heads, -inf, s.t_split, ms.fit.model);
             if (holdout > 0.0) {

@@ -28,6 +28,45 @@ std::string model_header(std::size_t terms) {
 }
 
 namespace {
+constexpr std::string_view kRigidPrefix = "rigid-";
+constexpr const char* kCommonRotationColumn = "common_rotation";
+}  // namespace
+
+std::string common_rotation_name(const CommonRotationId& c) {
+    switch (c.rule) {
+        case CommonRotationRule::kCombined:
+            return "combined";
+        case CommonRotationRule::kRigid:
+            return std::string(kRigidPrefix) + head_name(c.rigid_head);
+        case CommonRotationRule::kSmallest:
+            break;
+    }
+    return "smallest";
+}
+
+std::optional<CommonRotationId> common_rotation_named(std::string_view name) {
+    CommonRotationId c;
+    if (name == "smallest") {
+        return c;
+    }
+    if (name == "combined") {
+        c.rule = CommonRotationRule::kCombined;
+        return c;
+    }
+    if (name.size() == kRigidPrefix.size() + 1 && name.substr(0, kRigidPrefix.size()) == kRigidPrefix &&
+        head_index(name.back()) < kMaxHeads) {
+        c.rule = CommonRotationRule::kRigid;
+        c.rigid_head = head_index(name.back());
+        return c;
+    }
+    return std::nullopt;
+}
+
+std::string common_rotation_choices() {
+    return std::string("smallest, combined or rigid-X (X a head: ") + kHeadChoices.text + ")";
+}
+
+namespace {
 
 // A coefficient's unit in the model file, by its term's power.
 const char* unit_of(std::size_t k) {
@@ -106,7 +145,7 @@ void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[kModel
 void refuse_unknown_columns(const Header& header, const std::string& file_name) {
     std::size_t column = 1;
     for (const std::string& name : header.names()) {
-        bool known = name == "chu" || name == "axis";
+        bool known = name == "chu" || name == "axis" || name == kCommonRotationColumn;
         for (const char* c : kCoefficientNames) {
             known = known || name == c;
         }
@@ -114,7 +153,8 @@ void refuse_unknown_columns(const Header& header, const std::string& file_name) 
             throw text::InputError(file_name, 1, column,
                                    "unknown column '" + name + "' (a model has chu, axis, " +
                                        coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
-                                       coefficient_columns(kLinearModelTerms, kModelTerms, ", ") + ")");
+                                       coefficient_columns(kLinearModelTerms, kModelTerms, ", ") +
+                                       "; optionally common_rotation)");
         }
         column += name.size() + 1;
     }
@@ -162,6 +202,23 @@ bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_he
     return count == 3;
 }
 
+// The common_rotation field of line n: a rule's name, the same on every row.
+void read_common_rotation(const std::string& file_name, std::size_t n, std::string_view field, std::size_t column,
+                          bool first_row, ModelFile& m) {
+    const std::optional<CommonRotationId> c = common_rotation_named(field);
+    if (!c) {
+        throw text::InputError(
+            file_name, n, column,
+            "column 'common_rotation': expected " + common_rotation_choices() + ", got '" + std::string(field) + "'");
+    }
+    if (!first_row && common_rotation_name(*c) != common_rotation_name(m.common_rotation)) {
+        throw text::InputError(file_name, n, column,
+                               "column 'common_rotation': '" + std::string(field) + "' differs from the rows above ('" +
+                                   common_rotation_name(m.common_rotation) + "'): one model has one rule");
+    }
+    m.common_rotation = *c;
+}
+
 }  // namespace
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
@@ -187,6 +244,8 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
     for (std::size_t i = kLinearModelTerms; i < kModelTerms; ++i) {
         m.quadratic = m.quadratic || col_c[i] >= 0;
     }
+    const int col_rule = header.index(kCommonRotationColumn);
+    bool first_row = true;
     bool seen[kMaxHeads][3] = {};
     std::vector<std::string_view> fields;
     std::vector<std::size_t> starts;
@@ -221,6 +280,11 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             throw text::InputError(file_name, n, 1,
                                    std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
         }
+        if (col_rule >= 0) {
+            const auto c = static_cast<std::size_t>(col_rule);
+            read_common_rotation(file_name, n, fields[c], starts[c] + 1, first_row, m);
+        }
+        first_row = false;
         seen[head][axis] = true;
         line_of_head[head] = n;
         m.line[head][static_cast<std::size_t>(axis)] = n;
@@ -247,7 +311,11 @@ ModelFile read_model_file(const std::string& path) {
 
 std::string format_model(const ModelFile& m) {
     const std::size_t ncoef = m.quadratic ? kModelTerms : kLinearModelTerms;
+    const bool rule_column = m.common_rotation.rule != CommonRotationRule::kSmallest;
     std::string out = model_header(ncoef);
+    if (rule_column) {
+        out.insert(out.size() - 1, std::string(",") + kCommonRotationColumn);
+    }
     char buf[64];
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         if (!m.present[h]) {
@@ -261,6 +329,9 @@ std::string format_model(const ModelFile& m) {
                 // 17 significant digits: a model survives a write/read round trip exactly.
                 text::c_snprintf(buf, sizeof buf, ",%.16e", m.coefficients[h][a][i]);
                 out += buf;
+            }
+            if (rule_column) {
+                out += ',' + common_rotation_name(m.common_rotation);
             }
             out += '\n';
         }

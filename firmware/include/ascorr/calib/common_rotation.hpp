@@ -13,8 +13,8 @@
 // The model's regressors are per head [1, T1, T2 − T1, T3 − T1]; only T2 and
 // T3 (THT00029, THT00032) are shared by all heads, so a common rotation
 // w0 + w2·T2 + w3·T3 (3 × 3 = 9 numbers) changes no IBA: 9 of the 36 linear
-// coefficients are unobservable and 27 observable. Of the equivalent models,
-// the ground fit writes the one with the smallest corrections.
+// coefficients are unobservable and 27 observable. Which of the equivalent
+// models is written is a rule (below, "The rule"), not something the data say.
 // Double only (per orbit); fixed trip counts, no allocation.
 #pragma once
 
@@ -64,6 +64,136 @@ inline void common_rotation_projector(const Matrix3* n, std::size_t heads, doubl
 template <std::size_t H>
 void common_rotation_projector(const Matrix3 (&n)[H], double (&p)[3 * H][3 * H]) noexcept {
     common_rotation_projector(n, H, &p[0][0]);
+}
+
+// ---- The rule (docs/contract.md, "The common rotation")
+//
+// Adding a common rotation ω (F axes) to a model adds N_h·ω to every head's
+// correction c_h (head axes) and changes no IBA. What it does change is the
+// attitude of the bench that the heads give together. With per-head weights
+// B_h (3 × 3, head axes → F axes) normalised so that Σ_h B_h·N_h = I, the
+// bench's motion from the correction at an orbit is y = Σ_h B_h·c_h, and the
+// common rotation moves it by exactly ω. The rule takes, of the models
+// c_h + N_h·ω with ω = w·r, r = [1, T2 − T̄2, T3 − T̄3] (the 9 numbers w), the
+// one minimising Σ_orbits ‖y + ω‖²: w = −(Σ y·rᵀ)(Σ r·rᵀ)⁻¹, least squares
+// over the data used. The weights say whose motion counts:
+//   - the combined attitude (do no harm, the default with mountings):
+//     A_h = M_hᵀ·diag(1/σc², 1/σc², 1/σa²), M_h = R(q_chu_crf): head h's
+//     share of the combined attitude up to the full set's common factor
+//     P⁻¹ (combine/mountings.hpp, motion_weight), which cancels in B_h;
+//   - the smallest correction (without mountings): A_h = N_hᵀ;
+//   - head X rigid to the bench: A_X = I, the others 0 (X's correction
+//     keeps no part that a common rotation could take);
+// and B_h = (Σ_j A_j·N_j)⁻¹·A_h, so that Σ_h B_h·N_h = I.
+
+// a·b.
+inline Matrix3 product(const Matrix3& a, const Matrix3& b) noexcept {
+    Matrix3 r{};
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            r.m[i][j] = a.m[i][0] * b.m[0][j] + a.m[i][1] * b.m[1][j] + a.m[i][2] * b.m[2][j];
+        }
+    }
+    return r;
+}
+
+// The inverse by cofactors, after scaling rows and columns by the diagonal's
+// roots (an SPD matrix's columns may differ by orders of magnitude: °C² sums
+// beside counts); false when the scaled determinant is below 1e-12 (the rows
+// are dependent to double's precision: T029 and T032 that never vary apart)
+// or a diagonal entry is not positive.
+inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv) noexcept {
+    double s[3] = {1.0, 1.0, 1.0};
+    for (int i = 0; spd && i < 3; ++i) {
+        if (!(a.m[i][i] > 0.0)) {
+            return false;
+        }
+        s[i] = 1.0 / std::sqrt(a.m[i][i]);
+    }
+    Matrix3 b{};
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            b.m[i][j] = s[i] * a.m[i][j] * s[j];
+        }
+    }
+    const double c00 = b.m[1][1] * b.m[2][2] - b.m[1][2] * b.m[2][1];
+    const double c01 = b.m[1][2] * b.m[2][0] - b.m[1][0] * b.m[2][2];
+    const double c02 = b.m[1][0] * b.m[2][1] - b.m[1][1] * b.m[2][0];
+    const double det = b.m[0][0] * c00 + b.m[0][1] * c01 + b.m[0][2] * c02;
+    if (!(std::fabs(det) > 1e-12) || !std::isfinite(det)) {
+        return false;
+    }
+    const double c[3][3] = {
+        {c00, b.m[0][2] * b.m[2][1] - b.m[0][1] * b.m[2][2], b.m[0][1] * b.m[1][2] - b.m[0][2] * b.m[1][1]},
+        {c01, b.m[0][0] * b.m[2][2] - b.m[0][2] * b.m[2][0], b.m[0][2] * b.m[1][0] - b.m[0][0] * b.m[1][2]},
+        {c02, b.m[0][1] * b.m[2][0] - b.m[0][0] * b.m[2][1], b.m[0][0] * b.m[1][1] - b.m[0][1] * b.m[1][0]}};
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            inv->m[i][j] = s[i] * (c[i][j] / det) * s[j];
+        }
+    }
+    return true;
+}
+
+// B_h = (Σ_j A_j·N_j)⁻¹·A_h for `heads` heads (a[], n[], b[] by position);
+// false when Σ_j A_j·N_j is singular (no head carries weight).
+inline bool bench_weights(const Matrix3* a, const Matrix3* n, std::size_t heads, Matrix3* b) noexcept {
+    Matrix3 g{};
+    for (std::size_t h = 0; h < heads; ++h) {
+        const Matrix3 an = product(a[h], n[h]);
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) {
+                g.m[i][j] += an.m[i][j];
+            }
+        }
+    }
+    Matrix3 g_inv{};
+    if (!inverse_scaled(g, false, &g_inv)) {
+        return false;
+    }
+    for (std::size_t h = 0; h < heads; ++h) {
+        b[h] = product(g_inv, a[h]);
+    }
+    return true;
+}
+
+// The sums of the rule's least squares over orbits (or epochs), about a
+// centre of T2 and T3 fixed before the first is added (the regressors are
+// then nearly orthogonal to the constant).
+struct CommonRotationSums {
+    double t2_centre = 0.0;  // °C
+    double t3_centre = 0.0;
+    Matrix3 rr{};  // Σ r·rᵀ
+    Matrix3 yr{};  // Σ y·rᵀ, a row per F axis (arcsec)
+};
+
+// Adds one orbit: y the bench's motion (arcsec, F axes), t2, t3 its T029 and T032 (°C).
+inline void add_to_common_rotation(CommonRotationSums& s, const double (&y)[3], double t2, double t3) noexcept {
+    const double r[3] = {1.0, t2 - s.t2_centre, t3 - s.t3_centre};
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            s.rr.m[i][j] += r[i] * r[j];
+            s.yr.m[i][j] += y[i] * r[j];
+        }
+    }
+}
+
+// The common rotation the rule adds, ω(T2, T3) = w0 + w2·T2 + w3·T3 (arcsec,
+// F axes; w[axis] = {w0, w2, w3}, about 0 °C, not the centre): w = −(Σ y·rᵀ)(Σ r·rᵀ)⁻¹.
+// false when T029 and T032 do not vary independently over the sums (the rule
+// is then not unique).
+inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3]) noexcept {
+    Matrix3 rr_inv{};
+    if (!inverse_scaled(s.rr, true, &rr_inv)) {
+        return false;
+    }
+    const Matrix3 wc = product(s.yr, rr_inv);
+    for (int i = 0; i < 3; ++i) {
+        w[i][1] = -wc.m[i][1];
+        w[i][2] = -wc.m[i][2];
+        w[i][0] = -wc.m[i][0] - w[i][1] * s.t2_centre - w[i][2] * s.t3_centre;
+    }
+    return true;
 }
 
 }  // namespace ascorr::calib

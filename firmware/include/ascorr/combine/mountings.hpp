@@ -172,6 +172,19 @@ inline Matrix3 information(const HeadMounting& h) noexcept {
     return transpose(m) * diagonal(ic, ic, ia) * m;
 }
 
+// How a small rotation δ of the head (CHU axes) moves the combined attitude
+// of a head set S, up to the set's common factor P_S⁻¹ (subset_tables.hpp):
+// P_S⁻¹·W·Mᵀ·δ = P_S⁻¹·Mᵀ diag(1/σc², 1/σc², 1/σa²)·δ, so the weight is
+// Mᵀ diag(1/σc², 1/σc², 1/σa²) (1/arcsec², CHU axes → CRF axes). The rule for
+// the rotation common to all heads (calib/common_rotation.hpp) weighs each
+// head's correction by it; the common factor cancels there.
+inline Matrix3 motion_weight(const HeadMounting& h) noexcept {
+    const Matrix3 m = rotation_matrix(unit_mounting(h));
+    const double ic = 1.0 / (h.sigma_cross_arcsec * h.sigma_cross_arcsec);
+    const double ia = 1.0 / (h.sigma_about_arcsec * h.sigma_about_arcsec);
+    return transpose(m) * diagonal(ic, ic, ia);
+}
+
 // C = W⁻¹ = Mᵀ diag(σc², σc², σa²) M (arcsec², CRF axes).
 inline Matrix3 covariance(const HeadMounting& h) noexcept {
     const Matrix3 m = rotation_matrix(unit_mounting(h));

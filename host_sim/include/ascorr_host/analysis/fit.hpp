@@ -38,10 +38,12 @@
 // equations orthogonally to it. The data then fix the 36 coefficients up to a
 // rotation common to all heads that is linear in T029 and T032 (the only
 // regressors all heads share): 9 directions that star trackers cannot see and
-// that change no IBA. Of those equivalent models, the one whose corrections
-// are smallest (RMS over the orbits of the period) is written. c0 refers to
-// the mean orientations over the period: the absolute mounting is not
-// observable either.
+// that change no IBA. Which of those equivalent models is written is a rule
+// (FitOptions::common_rotation, calib/common_rotation.hpp): with the
+// mountings, the one that moves the full head set's combined attitude least
+// over the orbits of the period (do no harm); without them, the one whose
+// corrections are smallest. c0 refers to the mean orientations over the
+// period: the absolute mounting is not observable either.
 #pragma once
 
 #include <array>
@@ -57,6 +59,7 @@
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/mountings_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
@@ -94,7 +97,19 @@ struct FitOptions {
     // heads are left out. Default: A, B, C, F's two and every head with rows
     // in the modelling period (analysis_heads).
     std::optional<HeadSet> heads;
+    // The mountings (--mountings): the combination's weights for the rule
+    // `combined`; every head fitted must be in them, with its sigmas.
+    std::optional<MountingsFile> mountings;
+    std::string mountings_name;  // where they were read, for messages
+    // The rule for the common rotation (--common-rotation): default
+    // `combined` with mountings, `smallest` without. Its `motion` is filled
+    // from the mountings by the fit.
+    std::optional<CommonRotation> common_rotation;
 };
+
+// The rule a fit with these options uses (the default above); the rule
+// `combined` without mountings is refused (FitRefused).
+CommonRotation common_rotation_rule(const FitOptions& opt);
 
 // Three heads, linear: 3 heads × 3 axes × (c0, c1, c2, c3), 36; quadratic: 63.
 inline constexpr int kUnknowns = 3 * kModelAxes * kLinearModelTerms;
@@ -117,8 +132,9 @@ struct FitReport {
     double condition = 0.0;                 // largest / smallest observable singular value
     std::array<HeadFit, kMaxHeads> head{};  // by head index
     ModelFile model;
-    TermsFit fit;         // the written model's fit: centring, rank
-    Selection selection;  // the model-selection report
+    CommonRotation common_rotation;  // the rule that fixed the 9 unobservable directions
+    TermsFit fit;                    // the written model's fit: centring, rank
+    Selection selection;             // the model-selection report
 };
 
 // Refusal of the data given (too short, too few orbits, rank-deficient, for

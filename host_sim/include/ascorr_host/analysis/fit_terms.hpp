@@ -50,6 +50,16 @@ inline constexpr double kSelectionMargin = 0.01;
 
 inline constexpr const char* kRegressorNames[kRegressors] = {"T_CHU", "T029 - T_CHU", "T032 - T_CHU"};
 
+// The rule that fixes the 9 unobservable directions, a rotation common to all
+// heads and linear in T029 and T032 (calib/common_rotation.hpp, "The rule";
+// its names: model_csv.hpp's CommonRotationId), with what `combined` needs.
+struct CommonRotation : CommonRotationId {
+    // kCombined: A_h by head index, how head h's correction (head axes) moves
+    // the combined attitude (CRF axes), up to a factor common to all heads
+    // (combine/mountings.hpp, motion_weight; fit.cpp, from the mountings).
+    std::array<Eigen::Matrix3d, kMaxHeads> motion{};
+};
+
 struct HeadFit {
     std::array<double, 3> residual_rms{};  // orbit averages, arcsec, alpha/beta/gamma
     std::array<double, 3> signal_rms{};    // orbit-averaged angle about its mean
@@ -90,8 +100,11 @@ struct TermsFit {
 // over the orbit averages, and any model whose condition number exceeds
 // max_condition, naming the head and term of the weakest direction.
 using HeadOrientations = std::array<Eigen::Matrix3d, kMaxHeads>;  // N_i by head index
+// The 9 unobservable directions are fixed by `rule` over the same orbits; a
+// rule that the orbits do not fix uniquely (T029 and T032 never vary apart) is
+// refused.
 TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
-                     double max_condition, double min_range_c);
+                     double max_condition, double min_range_c, const CommonRotation& rule = {});
 
 // One epoch with all the fit's heads selected: the aberration-corrected
 // attitudes and each head's (T1, T2, T3), by head index.
@@ -134,7 +147,7 @@ std::string selection_verdict(double linear_rms, double quadratic_rms);
 // no verdict.
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
                        const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
-                       double max_condition, double min_range_c);
+                       double max_condition, double min_range_c, const CommonRotation& rule = {});
 
 std::string describe_centring(const TermsFit& f);
 std::string describe_selection(const Selection& s);

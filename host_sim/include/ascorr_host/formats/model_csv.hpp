@@ -9,7 +9,10 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/model_coefficients.hpp"
@@ -33,11 +36,32 @@ std::string coefficient_columns(std::size_t first, std::size_t last, const char*
 // The model file's header: chu,axis and the first `terms` columns, with '\n'.
 std::string model_header(std::size_t terms);
 
+// The rule that fixed the rotation common to all heads, which no IBA sees
+// (docs/contract.md, "The common rotation"; calib/common_rotation.hpp):
+// kSmallest, the smallest corrections (a model file without the
+// common_rotation column); kCombined, the full head set's combined attitude
+// moves least (do no harm); kRigid, head rigid_head taken as rigid to the bench.
+enum class CommonRotationRule : std::uint8_t { kSmallest, kCombined, kRigid };
+struct CommonRotationId {
+    CommonRotationRule rule = CommonRotationRule::kSmallest;
+    std::uint8_t rigid_head = 0;  // kRigid
+};
+// Its name in the model file, the history and the options: "smallest",
+// "combined", "rigid-A" (rigid-B, …).
+std::string common_rotation_name(const CommonRotationId& c);
+// The rule of a name (common_rotation_name's), or nullopt.
+std::optional<CommonRotationId> common_rotation_named(std::string_view name);
+// "smallest, combined or rigid-X (X a head: A, B, C or D)", for messages.
+std::string common_rotation_choices();
+
 struct ModelFile {
     std::array<bool, kMaxHeads> present{};
     // coefficients[head][axis][term] (c0, c1, … c3_2: kModelTermTable's order) in arcsec.
     std::array<std::array<std::array<double, kModelTerms>, kModelAxes>, kMaxHeads> coefficients{};
     bool quadratic = false;  // write the quadratic columns
+    // The rule that fixed its common rotation: a column common_rotation after
+    // the coefficients when it is not kSmallest (every row the same name).
+    CommonRotationId common_rotation{};
     // Where each head and axis was read (1-based line) and each coefficient
     // (1-based character column); 0 for a model not read from a file.
     std::array<std::array<std::size_t, kModelAxes>, kMaxHeads> line{};
