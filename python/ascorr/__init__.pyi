@@ -216,6 +216,7 @@ def self_calibrate(
     scalar: Literal["double", "float", "fixed"] = ...,
     time_constant: float = ...,
     orbit_period: Optional[float] = ...,
+    mountings: Optional[dict[str, Any]] = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
@@ -225,6 +226,8 @@ def self_calibrate(
     model get status 256).
     time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
     or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
+    mountings: read_mountings()'s dict (as correct --mountings): the rotation common to all
+    heads is then fixed by the rule 'combined', with the weights of the heads with sigmas.
     Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

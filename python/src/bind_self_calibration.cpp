@@ -17,6 +17,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
@@ -32,9 +33,11 @@ namespace {
 
 template <typename T>
 py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days,
-                              std::optional<double> orbit_period_s, double* q_out, std::uint16_t* st_out) {
+                              std::optional<double> orbit_period_s, const calib::CommonRotationWeights& rule,
+                              double* q_out, std::uint16_t* st_out) {
     calib::EstimatorConfig cfg;
     cfg.time_constant_days = time_constant_days;
+    cfg.common_rotation = rule;
     const host::SelfCalibration sc =
         host::self_calibrate<T>(kArrayRows, source_of(r),
                                 m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s);
@@ -70,8 +73,12 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
 py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                          const py::object& v, const py::object& flags, const py::object& confidence,
                          const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj,
-                         const py::object& orbit_period_obj) {
+                         const py::object& orbit_period_obj, const py::object& mountings) {
     const host::ModelFile* m = model_arg(model);
+    // The rule for the rotation common to all heads, as correct --mountings M: combined.
+    const calib::CommonRotationWeights rule =
+        mountings.is_none() ? calib::CommonRotationWeights{}
+                            : pipeline::common_rotation_weights(mountings_arg(mountings).mountings);
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
     const double time_constant = real_arg(time_constant_obj, "time_constant");
     if (!calib::time_constant_acceptable(time_constant)) {
@@ -112,14 +119,14 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     py::array_t<std::uint16_t> st_out(r.n);
     py::list history;
     if (scalar == host::ScalarKind::kDouble) {
-        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, q_out.mutable_data(),
+        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
                                                st_out.mutable_data());
     } else if (scalar == host::ScalarKind::kFloat) {
-        history =
-            self_calibrated_rows<float>(r, m, time_constant, orbit_period, q_out.mutable_data(), st_out.mutable_data());
+        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
+                                              st_out.mutable_data());
     } else {
-        history =
-            self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, q_out.mutable_data(), st_out.mutable_data());
+        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
+                                            st_out.mutable_data());
     }
     return py::make_tuple(q_out, st_out, history);
 }
@@ -129,7 +136,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
 void bind_self_calibration(py::module_& mod) {
     mod.def("self_calibrate", &self_calibrate, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
             "confidence"_a = py::none(), "model"_a = py::none(), "scalar"_a = "double", "time_constant"_a = 30.0,
-            "orbit_period"_a = py::none(), docstring(docs::kSelfCalibrate));
+            "orbit_period"_a = py::none(), "mountings"_a = py::none(), docstring(docs::kSelfCalibrate));
 }
 
 }  // namespace ascorr::python

@@ -41,6 +41,41 @@ def test_fit_on_arrays_is_ascorr_fit(exe, mission, tmp_path):
     assert ascorr.read_model(str(written)).to_csv() == model.to_csv()
 
 
+def test_fit_with_mountings_is_ascorr_fit_and_names_its_rule(exe, mission, tmp_path):
+    """The rule for the rotation common to all heads: mountings= as --mountings
+    (rule 'combined'), common_rotation= as --common-rotation; the model says
+    which, and survives pickling and its file."""
+    import pickle
+
+    mountings_path = str(mission) + ".mountings.csv"
+    out = tmp_path / "model.csv"
+    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30, "--mountings", mountings_path)
+    d = ascorr.read_solutions(str(mission))
+    m = ascorr.read_mountings(mountings_path)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, mountings=m)
+    assert model.to_csv() == out.read_text()
+    assert model.common_rotation == "combined" and report["common_rotation"] == "combined"
+    assert ascorr.read_model(str(out)).common_rotation == "combined"
+    assert pickle.loads(pickle.dumps(model)) == model
+    plain, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    assert plain.common_rotation == "smallest" and plain != model
+    rigid, _ = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, common_rotation="rigid-B")
+    assert rigid.common_rotation == "rigid-B"
+    # The rule changes no IBA: the thermal-corrected stats are the same.
+    a = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
+    b = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=plain)
+    for pair in ("A-B", "A-C", "B-C"):
+        assert a["pairs"][pair]["thermal"] == pytest.approx(b["pairs"][pair]["thermal"], abs=1e-6)
+    with pytest.raises(ValueError, match="common_rotation"):
+        ascorr.fit(*as_args(d), min_days=30, common_rotation="largest")
+    with pytest.raises(ascorr.FitRefused, match="needs the mountings"):
+        ascorr.fit(*as_args(d), min_days=30, common_rotation="combined")
+    # Self-calibration with the same mountings: the rule on board, the IBAs its own.
+    q1, s1, h1 = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], mountings=m)
+    q0, s0, h0 = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"])
+    assert (s1 == s0).all() and len(h1) == len(h0) and not np.array_equal(q1, q0)
+
+
 def test_fit_refuses_too_short_a_period(mission):
     d = ascorr.read_solutions(str(mission))
     with pytest.raises(ascorr.FitRefused, match="modelling period too short"):

@@ -12,6 +12,7 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/combined_stats.hpp"
@@ -493,10 +494,21 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
     refuse_output_over_input(correct_and_combine_inputs(opt, mountings), correct_and_combine_outputs(opt, combined));
     const MountingsFile m = read_mountings_file(mountings);
     refuse_unusable_mountings(m, mountings);
+    // Self-calibration protects the combined attitude of these mountings (the
+    // rule `combined`, docs/contract.md, "The common rotation").
+    CorrectOptions run = opt;
+    if (opt.self_calibrate) {
+        run.common_rotation = pipeline::common_rotation_weights(m.mountings);
+        if (run.common_rotation.heads == 0U) {
+            log << "ascorr correct: warning: " << text::input_name(mountings)
+                << " has no sigmas: the self-calibration's rotation common to all heads stays the estimator's own "
+                   "frame; the combined attitude is not protected from it\n";
+        }
+    }
     const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
         CombineStage stage(m, outputs["--combined"], opt.in, to, mode);
         CorrectAndCombine r;
-        r.corrected = correct_file(opt, outputs, to, &stage);
+        r.corrected = correct_file(run, outputs, to, &stage);
         r.combined = stage.summary();
         return r;
     };

@@ -438,12 +438,13 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         refuse_self_calibration_options(opt);
         calib::EstimatorConfig ecfg;
         ecfg.time_constant_days = opt.time_constant_days;
+        ecfg.common_rotation = opt.common_rotation;
         const SelfCalibration sc = self_calibrate<T>(
             opt.in,
             [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
             model_file, ecfg, opt.orbit_period_s);
         schedule.emplace(sc.history);
-        history = format_model_history(sc.history);
+        history = format_model_history(sc.history, opt.common_rotation.heads != 0U);
         account = describe(sc);
         model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
     }

@@ -594,8 +594,9 @@ const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learn
     return calib::learns_head(h, learnt) ? "learnt" : "kept";
 }
 
-std::string format_model_history(const std::vector<ActiveModel>& history) {
-    std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin\n";
+std::string format_model_history(const std::vector<ActiveModel>& history, bool combined) {
+    std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin" +
+                      (combined ? ",common_rotation\n" : "\n");
     char buf[96];
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -610,9 +611,11 @@ std::string format_model_history(const std::vector<ActiveModel>& history) {
                     text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
                     out += buf;
                 }
-                text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s\n", m.crc, static_cast<long long>(m.t_us),
+                text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s", m.crc, static_cast<long long>(m.t_us),
                                  head_origin(m.version, h, m.learnt));
                 out += buf;
+                // A given model (version 0) is in the rule it was made by, which the history does not know.
+                out += combined ? (m.version == 0U ? ",given\n" : ",combined\n") : "\n";
             }
         }
     }

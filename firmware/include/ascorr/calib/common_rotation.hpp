@@ -101,8 +101,8 @@ inline Matrix3 product(const Matrix3& a, const Matrix3& b) noexcept {
 // roots (an SPD matrix's columns may differ by orders of magnitude: °C² sums
 // beside counts); false when the scaled determinant is below 1e-12 (the rows
 // are dependent to double's precision: T029 and T032 that never vary apart)
-// or a diagonal entry is not positive.
-inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv) noexcept {
+// or a diagonal entry is not positive (min_det: a stricter bound).
+inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv, double min_det = 1e-12) noexcept {
     double s[3] = {1.0, 1.0, 1.0};
     for (int i = 0; spd && i < 3; ++i) {
         if (!(a.m[i][i] > 0.0)) {
@@ -120,7 +120,7 @@ inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv) noexcept {
     const double c01 = b.m[1][2] * b.m[2][0] - b.m[1][0] * b.m[2][2];
     const double c02 = b.m[1][0] * b.m[2][1] - b.m[1][1] * b.m[2][0];
     const double det = b.m[0][0] * c00 + b.m[0][1] * c01 + b.m[0][2] * c02;
-    if (!(std::fabs(det) > 1e-12) || !std::isfinite(det)) {
+    if (!(std::fabs(det) > min_det) || !std::isfinite(det)) {
         return false;
     }
     const double c[3][3] = {
@@ -181,10 +181,10 @@ inline void add_to_common_rotation(CommonRotationSums& s, const double (&y)[3], 
 // The common rotation the rule adds, ω(T2, T3) = w0 + w2·T2 + w3·T3 (arcsec,
 // F axes; w[axis] = {w0, w2, w3}, about 0 °C, not the centre): w = −(Σ y·rᵀ)(Σ r·rᵀ)⁻¹.
 // false when T029 and T032 do not vary independently over the sums (the rule
-// is then not unique).
-inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3]) noexcept {
+// is then not unique; min_det as inverse_scaled's).
+inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3], double min_det = 1e-12) noexcept {
     Matrix3 rr_inv{};
-    if (!inverse_scaled(s.rr, true, &rr_inv)) {
+    if (!inverse_scaled(s.rr, true, &rr_inv, min_det)) {
         return false;
     }
     const Matrix3 wc = product(s.yr, rr_inv);

@@ -63,6 +63,7 @@
 #include "../core/model_coefficients.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/thermal.hpp"
+#include "common_rotation_memory.hpp"
 #include "estimator_types.hpp"
 #include "frame.hpp"
 #include "head_rotation.hpp"
@@ -175,8 +176,15 @@ public:
         orbit_.drop();
     }
     void resume() noexcept { frozen_ = false; }
+    // The rule for the rotation common to all heads (common_rotation_memory.hpp):
+    // from the next candidate on, of the models the IBAs cannot tell apart the
+    // one that moves the bench, as the weights say, least over the memory.
+    // heads 0 (the default): the estimator's own frame (F as in the first orbit).
+    void set_common_rotation(const CommonRotationWeights& w) noexcept { cfg_.common_rotation = w; }
+
     // Forget everything learnt; the active model stays.
     void reset() noexcept {
+        rule_memory_.clear();
         for (auto& s : srif_) {
             s.clear();
         }
@@ -235,6 +243,10 @@ public:
     const EstimatorConfig& config() const noexcept { return cfg_; }
 
 private:
+    struct Omega {
+        double w[3][3];  // the rule's common rotation, w[axis] = {w0, w2, w3} (F axes, arcsec)
+    };
+
     static constexpr std::size_t kFramePairs = iba_pairs(kFrameHeads);
 
     std::size_t back() const noexcept { return active_ ^ 1U; }
@@ -292,6 +304,9 @@ private:
             if (first) {
                 for (std::size_t j = 0; j < 3; ++j) {
                     centre_[h][j] = o.x[h][j];
+                }
+                if (h == 0U) {  // T2 and T3 are head A's T1 + D2, T1 + D3
+                    rule_memory_.set_centre(o.x[0][0] + o.x[0][1], o.x[0][0] + o.x[0][2]);
                 }
             }
         }
@@ -385,6 +400,9 @@ private:
             srif_[h].add(a, y, 1.0);
             ++head_orbits_[h];
         }
+        if (cfg_.common_rotation.heads != 0U) {
+            rule_memory_.add(o, centre_);
+        }
         ++orbits_used_;
     }
 
@@ -423,6 +441,7 @@ private:
         has_solution_ = true;
         solved_ = heads;
         centred_to_model<N>(b_, centre_, cand_, heads);
+        apply_rule();
         if (!within_limits(cand_, window_, cfg_.angle_check_margin_c, heads)) {
             refuse(Refusal::kAngleLimit);
             return false;
@@ -460,7 +479,8 @@ private:
         }
         last_refusal_ = Refusal::kNone;
         keep_heads_not_learnt(cand_, solved_);
-        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_);
+        rule_on_kept_heads();
+        prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_, cand_omega_);
         active_rms_ = candidate_rms_;
         swap_pending_ = true;
     }
@@ -485,15 +505,53 @@ private:
         }
     }
 
+    // The rule's common rotation ω (common_rotation_memory.hpp) added to every
+    // head the candidate solved; cand_omega_ keeps it (zero without the rule).
+    void apply_rule() noexcept {
+        cand_omega_ = {};
+        if (cfg_.common_rotation.heads == 0U ||
+            !rule_memory_.solve(b_, n_mat_, solved_, cfg_.common_rotation, cand_omega_.w)) {
+            cand_omega_ = {};
+            return;
+        }
+        for (std::size_t h = 0; h < N; ++h) {
+            if (learns_head(h, solved_)) {
+                add_common_rotation(n_mat_[h], cand_omega_.w, cand_.coefficient[h]);
+            }
+        }
+    }
+
+    // A head kept from the active model gets the candidate's ω less the active
+    // model's, so that its IBAs with the heads learnt stay as they were (a
+    // head never seen has no N_h: it is kept as it was).
+    void rule_on_kept_heads() noexcept {
+        if (cfg_.common_rotation.heads == 0U || !has_[active_]) {
+            return;
+        }
+        Omega d{};
+        for (int r = 0; r < 3; ++r) {
+            for (int c = 0; c < 3; ++c) {
+                d.w[r][c] = cand_omega_.w[r][c] - omega_[active_].w[r][c];
+            }
+        }
+        for (std::size_t h = 0; h < N; ++h) {
+            if (!learns_head(h, solved_) && cand_.present[h] && learns_head(h, n_heads_)) {
+                add_common_rotation(n_mat_[h], d.w, cand_.coefficient[h]);
+            }
+        }
+    }
+
     void refuse(Refusal r) noexcept {
         last_refusal_ = r;
         ++refusals_[static_cast<std::size_t>(r)];
     }
 
     // The back buffer: coefficients, the core's form, version and CRC.
-    void prepare(const ModelCoefficients& m, std::uint32_t version, std::uint8_t learnt = 0U) noexcept {
+    void prepare(const ModelCoefficients& m, std::uint32_t version, std::uint8_t learnt = 0U,
+                 const Omega& omega = Omega{}) noexcept {
         const std::size_t k = back();
         learnt_[k] = learnt;
+        omega_[k] = omega;
         model_[k] = m;
         core_[k] = thermal_model<T>(m, kArcsecToRad);
         version_[k] = version;
@@ -502,6 +560,10 @@ private:
     }
 
     EstimatorConfig cfg_;
+    // The memory of the rule for the common rotation (cfg_.common_rotation).
+    CommonRotationMemory<N> rule_memory_{};
+    Omega cand_omega_{};
+    Omega omega_[2]{};  // per buffer: the ω its learnt heads carry (0: given, loaded)
     // The cycle's side.
     bool frozen_ = false;
     OrbitCollector<T, N> orbit_;

@@ -11,6 +11,7 @@
 #include "../core/heads.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/thermal.hpp"
+#include "frame.hpp"
 
 namespace ascorr::calib {
 
@@ -66,6 +67,17 @@ constexpr bool configuration_acceptable(std::int64_t orbit_period_us, double tim
            time_constant_acceptable(time_constant_days);
 }
 
+// The rule for the rotation common to all heads on board
+// (common_rotation_memory.hpp; common_rotation.hpp, "The rule"), by head
+// index: A_h (head axes → bench, 1/arcsec²; combine/mountings.hpp's
+// motion_weight, from the mountings the DPU combines with) for the heads of
+// `heads`. heads 0, the default: no rule; the models keep the estimator's own
+// frame (F of A and C as in the first orbit learnt).
+struct CommonRotationWeights {
+    std::uint8_t heads = 0;  // bit h: head h weighs a[h]
+    Matrix3 a[kMaxHeads]{};
+};
+
 struct EstimatorConfig {
     std::int64_t orbit_period_us = 5'640'000'000;  // orbits are bins floor(t / period)
     double time_constant_days = 30.0;              // τ of the forgetting (chosen: docs/ground.md, Self-calibration)
@@ -86,6 +98,7 @@ struct EstimatorConfig {
     // Shorter outlier runs are refused; longer ones are followed and, at their end,
     // undone the same way (README.md, "Outliers and changes").
     std::uint32_t persistence_orbits = 3;
+    CommonRotationWeights common_rotation{};  // the rule's weights (none: the estimator's frame)
 };
 
 enum class Refusal : std::uint8_t {

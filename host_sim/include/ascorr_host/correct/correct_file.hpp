@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/calib/estimator_types.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
@@ -44,6 +45,9 @@ struct CorrectOptions {
     std::string model_history;
     double time_constant_days = 30.0;      // --time-constant
     std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
+    // The estimator's rule for the rotation common to all heads (with
+    // --mountings: pipeline/common_rotation_weights.hpp; none: its own frame).
+    calib::CommonRotationWeights common_rotation{};
 };
 
 struct CorrectSummary {

@@ -116,7 +116,9 @@ const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learn
 // axis of each model (origin: head_origin). t (3 decimals) says when; tt_us (t_us: TT µs of the
 // on-board clock, an integer) says exactly which rows: those whose t rounds
 // (tt_from_seconds) to at least it, up to the next version's.
-std::string format_model_history(const std::vector<ActiveModel>& history);
+// combined: the estimator applied the rule `combined` (its config's
+// common_rotation weights); the column common_rotation is then added.
+std::string format_model_history(const std::vector<ActiveModel>& history, bool combined = false);
 
 // The orbit periods the estimator takes (calib::kMinOrbitPeriodUs ..
 // kMaxOrbitPeriodUs), in s; false for NaN. And as messages write them:

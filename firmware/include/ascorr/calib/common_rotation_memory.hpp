@@ -1,0 +1,189 @@
+// ascorr/calib/common_rotation_memory.hpp: the rule for the rotation common to
+// all heads (common_rotation.hpp, "The rule") on board, over the estimator's
+// memory of orbits.
+//
+// The rule's least squares needs, over the orbits, Σ y·rᵀ and Σ r·rᵀ with
+// y = Σ_h B_h·c_h(orbit) the bench's motion from the candidate's corrections
+// and r = [1, T2 − T̄2, T3 − T̄3]. The candidate changes every orbit, so the
+// model-free moments are kept instead and contracted with it when a candidate
+// is formed: per head h, S_h = Σ a_h·rᵀ (4 × 3), a_h the head's design row
+// [1, T1 − T̄1, D2 − D̄2, D3 − D̄3] (the filter's, Estimator::feed), so that
+// Σ c_h·rᵀ = b_hᵀ·S_h with b_h the centred solution (4 unknowns × 3 axes).
+// They hold temperatures only, so they are not forgotten with the filter: a
+// candidate is re-gauged over every orbit since the last reset, whose wider
+// range of T029 and T032 fixes the slopes w2, w3 better than the filter's
+// memory of τ (measured: the combined attitude's error 1.263 → 1.257″ on x
+// from day 30, test_common_rotation). Bounded: an orbit adds at most
+// (ΔT)² ≤ 1.6e5 °C² (temperatures within ±200 °C) per sum, so 10 years of
+// 100-minute orbits stay below 1e10, far from double's range or precision.
+// A change taken as real (release of the intercepts) leaves them; reset()
+// clears them. A further head (D) has orbits without means, and the full set
+// then differs: the moments are kept per set of heads in the orbit (the frame
+// heads always; 2^(N − 3) sets), and each set's bench weights B_h are those of
+// its heads that the candidate solved and the rule weighs.
+//
+// Double (per orbit, in Estimator::step's phases); fixed trip counts, no
+// allocation. Cost per fed orbit: 9 + 12·|heads| multiply-adds; per
+// candidate about 1 000 flops (N = 4).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "../core/model_coefficients.hpp"
+#include "../core/model_terms.hpp"
+#include "common_rotation.hpp"
+#include "estimator_types.hpp"
+#include "orbit_window.hpp"
+
+namespace ascorr::calib {
+
+// Adds the common rotation ω = w0 + w2·T2 + w3·T3 (F axes, arcsec; w[axis] =
+// {w0, w2, w3}) to head h's coefficients (arcsec, head axes): N_h·ω, with
+// T2 = T1 + (T2 − T1) and likewise T3 (the model's regressors).
+inline void add_common_rotation(const Matrix3& n_h, const double (&w)[3][3],
+                                double (&c)[kModelAxes][kModelTerms]) noexcept {
+    for (int ax = 0; ax < 3; ++ax) {
+        double nw[3] = {0.0, 0.0, 0.0};  // N_h·w0, N_h·w2, N_h·w3, axis ax
+        for (int j = 0; j < 3; ++j) {
+            nw[j] = n_h.m[ax][0] * w[0][j] + n_h.m[ax][1] * w[1][j] + n_h.m[ax][2] * w[2][j];
+        }
+        c[ax][term_index(Regressor::kOne, 0)] += nw[0];
+        c[ax][term_index(Regressor::kT1, 1)] += nw[1] + nw[2];
+        c[ax][term_index(Regressor::kT2MinusT1, 1)] += nw[1];
+        c[ax][term_index(Regressor::kT3MinusT1, 1)] += nw[2];
+    }
+}
+
+template <std::size_t N = kCalibHeads>
+class CommonRotationMemory {
+public:
+    static constexpr std::size_t kSets = std::size_t{1} << (N - kFrameHeads);
+
+    void clear() noexcept { *this = CommonRotationMemory{}; }
+
+    // The centre of T2 and T3 (°C), fixed before the first orbit (head A's
+    // first orbit: the estimator's centre, T1 + D2 and T1 + D3).
+    void set_centre(double t2, double t3) noexcept {
+        t2_ = t2;
+        t3_ = t3;
+    }
+
+    // One fed orbit: its heads' design rows (centred as the filter's, centre[h]).
+    void add(const OrbitRecord<N>& o, const double (&centre)[N][3]) noexcept {
+        Set& s = set_[o.heads() >> kFrameHeads];
+        const double t2 = o.x[0][0] + o.x[0][1];
+        const double t3 = o.x[0][0] + o.x[0][2];
+        const double r[3] = {1.0, t2 - t2_, t3 - t3_};
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) {
+                s.rr.m[i][j] += r[i] * r[j];
+            }
+        }
+        for (std::size_t h = 0; h < N; ++h) {
+            if (!o.has[h]) {
+                continue;
+            }
+            const double a[kUnknowns] = {1.0, o.x[h][0] - centre[h][0], o.x[h][1] - centre[h][1],
+                                         o.x[h][2] - centre[h][2]};
+            for (std::size_t k = 0; k < kUnknowns; ++k) {
+                for (int j = 0; j < 3; ++j) {
+                    s.s[h][k][j] += a[k] * r[j];
+                }
+            }
+        }
+        ++s.count;
+    }
+
+    // The rule's ω for the centred solution b of the heads `solved`, with the
+    // weights wt and the heads' orientations n (F → head axes): w[axis] =
+    // {w0, w2, w3} about 0 °C. Where T029 and T032 have not varied apart
+    // within the memory (the first days), the constant alone (w2 = w3 = 0).
+    // false: no set has weighted heads.
+    bool solve(const double (&b)[N][kUnknowns][3], const Matrix3 (&n)[N], std::uint8_t solved,
+               const CommonRotationWeights& wt, double (&w)[3][3]) const noexcept {
+        CommonRotationSums sums;
+        sums.t2_centre = t2_;
+        sums.t3_centre = t3_;
+        bool any = false;
+        for (std::size_t m = 0; m < kSets; ++m) {
+            const auto heads = static_cast<std::uint8_t>((kFrameMask | (m << kFrameHeads)) & solved & wt.heads);
+            if (set_[m].count == 0U || heads == 0U) {
+                continue;
+            }
+            any = add_set(set_[m], b, n, heads, wt, sums) || any;
+        }
+        if (!any) {
+            return false;
+        }
+        if (common_rotation_of(sums, w, kMinDeterminant)) {
+            return true;
+        }
+        for (int ax = 0; ax < 3; ++ax) {  // the constant alone: w0 = −Σy / n
+            w[ax][0] = -sums.yr.m[ax][0] / sums.rr.m[0][0];
+            w[ax][1] = 0.0;
+            w[ax][2] = 0.0;
+        }
+        return true;
+    }
+
+private:
+    // Below it (the scaled Σ r·rᵀ's determinant) T029 and T032 have not varied
+    // apart enough to fix their slopes: a model would extrapolate them.
+    static constexpr double kMinDeterminant = 1e-6;
+
+    struct Set {
+        Matrix3 rr{};                 // Σ r·rᵀ
+        double s[N][kUnknowns][3]{};  // Σ a_h·rᵀ
+        std::uint32_t count = 0;      // orbits added (not forgotten)
+    };
+
+    // Σ y·rᵀ of one set into sums: Σ_h B_h·(b_hᵀ·S_h).
+    static bool add_set(const Set& s, const double (&b)[N][kUnknowns][3], const Matrix3 (&n)[N], std::uint8_t heads,
+                        const CommonRotationWeights& wt, CommonRotationSums& sums) noexcept {
+        Matrix3 a[N]{};
+        Matrix3 nn[N]{};
+        std::size_t idx[N]{};
+        std::size_t k = 0;
+        for (std::size_t h = 0; h < N; ++h) {
+            if (((static_cast<unsigned>(heads) >> h) & 1U) != 0U) {
+                a[k] = wt.a[h];
+                nn[k] = n[h];
+                idx[k++] = h;
+            }
+        }
+        Matrix3 bw[N]{};
+        if (!bench_weights(a, nn, k, bw)) {
+            return false;
+        }
+        for (std::size_t i = 0; i < k; ++i) {
+            const std::size_t h = idx[i];
+            Matrix3 cr{};  // Σ c_h·rᵀ = b_hᵀ·S_h (head axes × r)
+            for (int ax = 0; ax < 3; ++ax) {
+                for (int j = 0; j < 3; ++j) {
+                    for (std::size_t u = 0; u < kUnknowns; ++u) {
+                        cr.m[ax][j] += b[h][u][ax] * s.s[h][u][j];
+                    }
+                }
+            }
+            const Matrix3 y = product(bw[i], cr);
+            for (int r = 0; r < 3; ++r) {
+                for (int j = 0; j < 3; ++j) {
+                    sums.yr.m[r][j] += y.m[r][j];
+                }
+            }
+        }
+        for (int r = 0; r < 3; ++r) {
+            for (int j = 0; j < 3; ++j) {
+                sums.rr.m[r][j] += s.rr.m[r][j];
+            }
+        }
+        return true;
+    }
+
+    double t2_ = 0.0;
+    double t3_ = 0.0;
+    Set set_[kSets]{};
+};
+
+}  // namespace ascorr::calib
