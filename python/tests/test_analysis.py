@@ -65,7 +65,7 @@ def test_fit_with_mountings_is_ascorr_fit_and_names_its_rule(exe, mission, tmp_p
     a = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
     b = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=plain)
     for pair in ("A-B", "A-C", "B-C"):
-        assert a["pairs"][pair]["thermal"] == pytest.approx(b["pairs"][pair]["thermal"], abs=1e-6)
+        assert a["pairs"][pair]["thermal"] == pytest.approx(b["pairs"][pair]["thermal"], abs=1e-4)  # 2nd order
     with pytest.raises(ValueError, match="common_rotation"):
         ascorr.fit(*as_args(d), min_days=30, common_rotation="largest")
     with pytest.raises(ascorr.FitRefused, match="needs the mountings"):

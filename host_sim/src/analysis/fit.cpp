@@ -89,6 +89,7 @@ void refuse_bad_fit_options(const FitOptions& opt) {
         throw FitRefused(std::string("--frame-heads ") + head_name(opt.frame_heads[0]) + head_name(opt.frame_heads[1]) +
                          ": two different heads of " + kHeadChoices.text + " are needed");
     }
+    (void)common_rotation_rule(opt);  // a rule without what it weighs with, before any row is read
     if (opt.heads) {
         const std::string given = "--heads " + head_letters(*opt.heads);
         if (head_count(*opt.heads) < 2U || (*opt.heads & ~kAllHeads) != 0U) {

@@ -202,6 +202,30 @@ bool head_complete(const bool (&seen)[3], std::uint8_t h, std::size_t line_of_he
     return count == 3;
 }
 
+// The head of line n (its chu field), refused when it is none.
+std::uint8_t row_head(const std::string& file_name, std::size_t n, const std::vector<std::string_view>& fields,
+                      const std::vector<std::size_t>& starts, int col_chu) {
+    const auto chu = fields[static_cast<std::size_t>(col_chu)];
+    const std::uint8_t head = head_from_name(chu);
+    if (head == kUnknownHead) {
+        throw text::InputError(file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
+                               "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
+    }
+    return head;
+}
+
+// The axis of line n (its axis field), refused when it is none.
+int row_axis(const std::string& file_name, std::size_t n, const std::vector<std::string_view>& fields,
+             const std::vector<std::size_t>& starts, int col_axis) {
+    const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
+    const int axis = axis_index(axis_name);
+    if (axis < 0) {
+        throw text::InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
+                               "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
+    }
+    return axis;
+}
+
 // The common_rotation field of line n: a rule's name, the same on every row.
 void read_common_rotation(const std::string& file_name, std::size_t n, std::string_view field, std::size_t column,
                           bool first_row, ModelFile& m) {
@@ -263,19 +287,8 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
                 file_name, n, starts.back() + 1,
                 "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
         }
-        const auto chu = fields[static_cast<std::size_t>(col_chu)];
-        const std::uint8_t head = head_from_name(chu);
-        if (head == kUnknownHead) {
-            throw text::InputError(
-                file_name, n, starts[static_cast<std::size_t>(col_chu)] + 1,
-                "chu must be " + std::string(kHeadChoices.text) + ", got '" + std::string(chu) + "'");
-        }
-        const auto axis_name = fields[static_cast<std::size_t>(col_axis)];
-        const int axis = axis_index(axis_name);
-        if (axis < 0) {
-            throw text::InputError(file_name, n, starts[static_cast<std::size_t>(col_axis)] + 1,
-                                   "axis must be alpha, beta or gamma, got '" + std::string(axis_name) + "'");
-        }
+        const std::uint8_t head = row_head(file_name, n, fields, starts, col_chu);
+        const int axis = row_axis(file_name, n, fields, starts, col_axis);
         if (seen[head][axis]) {
             throw text::InputError(file_name, n, 1,
                                    std::string("second row for ") + head_name(head) + " " + kAxisNames[axis]);
