@@ -354,6 +354,17 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     };
 
     const CalibStart start{5'640'000'000, 30.0, 0};
+    {
+        // CALIB_START of a host before common_rotation (17 bytes) reads as 0;
+        // one byte more than 18 is refused.
+        std::uint8_t p[kMaxPayload] = {};
+        const std::size_t n = encode(CalibStart{5'640'000'000, 30.0, 1, 1}, p);
+        EXPECT_EQ(n, 18U);
+        CalibStart m{};
+        EXPECT_TRUE(decode(p, n, m) && m.common_rotation == 1U && m.initial == 1U);
+        EXPECT_TRUE(decode(p, n - 1U, m) && m.common_rotation == 0U);
+        EXPECT_FALSE(decode(p, n + 1U, m));
+    }
     EXPECT_EQ(ack_of(loop.request(MessageType::kCalibStart, seq++, start)), AckResult::kOk);
     EXPECT_NE(solution(0, 1'000'000).status & status::kNoModelForHead, 0U);  // no model yet: 256
     const Bytes before = report_bytes();
@@ -369,7 +380,8 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     for (const CalibStart& s :
          {CalibStart{0, 30.0, 0}, CalibStart{-5, 30.0, 0}, CalibStart{calib::kMinOrbitPeriodUs - 1, 30.0, 0},
           CalibStart{calib::kMaxOrbitPeriodUs + 1, 30.0, 0}, CalibStart{kOrbit, 0.0, 0}, CalibStart{kOrbit, 0.999, 0},
-          CalibStart{kOrbit, 10000.001, 0}, CalibStart{kOrbit, std::nan(""), 0}, CalibStart{kOrbit, 30.0, 2}}) {
+          CalibStart{kOrbit, 10000.001, 0}, CalibStart{kOrbit, std::nan(""), 0}, CalibStart{kOrbit, 30.0, 2},
+          CalibStart{kOrbit, 30.0, 0, 2}}) {
         std::uint8_t p[kMaxPayload];
         bad.emplace_back(MessageType::kCalibStart, Bytes(p, p + encode(s, p)));
     }

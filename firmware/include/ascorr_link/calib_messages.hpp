@@ -25,6 +25,11 @@ struct CalibStart {
     std::int64_t orbit_period_us;  // within the estimator's limits (calib::kMinOrbitPeriodUs ...)
     double time_constant_days;     // within calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays
     std::uint8_t initial;          // 0 or 1
+    // 1: the rule 'combined' for the rotation common to all heads, with the
+    // weights of the mountings staged by MOUNTING_LOAD (their heads with
+    // sigmas; pipeline/common_rotation_weights.hpp); 0: the estimator's own
+    // frame. Absent from the payload (a host before it): 0.
+    std::uint8_t common_rotation = 0;
 };
 
 enum class CalibCommand : std::uint8_t {
@@ -68,12 +73,16 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
     w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
     w.f64(m.time_constant_days);
     w.u8(m.initial);
+    w.u8(m.common_rotation);
     return w.size();
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
     Reader r(p, n);
-    return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) && r.done() &&
-           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U;
+    m.common_rotation = 0U;
+    return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) &&
+           (r.done() || (r.u8(m.common_rotation) && r.done())) &&
+           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U &&
+           m.common_rotation <= 1U;
 }
 
 inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {

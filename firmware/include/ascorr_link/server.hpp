@@ -25,7 +25,10 @@
 //                        feeds it, and its per-orbit update runs to its end
 //                        (four bounded steps). A solution flagged
 //                        kCalibNoTime is corrected without a model. Before
-//                        kCalibStart: the uploaded model.
+//                        kCalibStart: the uploaded model. With
+//                        common_rotation 1, the estimator's rule for the
+//                        rotation common to all heads takes the weights of
+//                        the mountings staged so far (kMountingLoad first).
 //   kCalibCommand      → kAck (freeze, resume, reset)
 //   kCalibModelLoad    → kAck (a head staged; with `load`, the staged model
 //                        becomes the estimator's, active from the next epoch)
@@ -55,6 +58,7 @@
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "frame.hpp"
 #include "messages.hpp"
@@ -218,6 +222,9 @@ private:
         calib::EstimatorConfig cfg{};
         cfg.orbit_period_us = m.orbit_period_us;
         cfg.time_constant_days = m.time_constant_days;
+        if (m.common_rotation == 1U) {
+            cfg.common_rotation = pipeline::common_rotation_weights(staged_mountings_);
+        }
         // In place: no 10-KiB temporary on the stack (trivially destructible).
         new (&estimator_) LinkEstimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
         pipeline_.use_estimator(&estimator_);

@@ -389,11 +389,12 @@ typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t
 
 template <typename T>
 void LinkClient<T>::start_calibration(std::int64_t orbit_period_us, double time_constant_days,
-                                      const ModelCoefficients* initial) {
+                                      const ModelCoefficients* initial, bool common_rotation) {
     if (initial != nullptr) {
         send_calib_model(*initial, false);
     }
-    const link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U)};
+    const link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U),
+                                 static_cast<std::uint8_t>(common_rotation ? 1U : 0U)};
     update({link::MessageType::kCalibStart, encoded(start), "calibration start"});
     calibrating_ = true;
 }

@@ -18,6 +18,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_host/analysis/combine.hpp"
@@ -370,9 +371,12 @@ struct HostSide {
 
 // --self-calibrate: the host's run of the estimator over the file, and the
 // target's started alike; otherwise the model uploaded and used on both.
+// rule: the estimator's rule for the rotation common to all heads (the
+// mountings of --combined, already loaded on the target; none: its frame).
 template <typename T>
 void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& rows, const std::optional<ModelFile>& mf,
-                const ThermalModel<T>& model_t, LinkClient<T>& client, HostSide<T>& host, ReplaySummary& sum) {
+                const ThermalModel<T>& model_t, LinkClient<T>& client, HostSide<T>& host, ReplaySummary& sum,
+                const calib::CommonRotationWeights& rule) {
     if (!opt.self_calibrate) {
         client.upload_model(model_t);
         host.pipeline.use_model(&model_t);
@@ -380,6 +384,7 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
     }
     calib::EstimatorConfig ecfg;
     ecfg.time_constant_days = opt.time_constant_days;
+    ecfg.common_rotation = rule;
     host.sc = self_calibrate<T>(
         opt.in,
         [&](const std::function<void(const SolutionRecord&)>& fn) {
@@ -394,10 +399,11 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
         initial = coefficients_of(*mf);
     }
     const std::int64_t period_us = std::llround(host.sc->orbit_period_s * 1e6);
-    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr);
+    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U);
     calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
     host_cfg.orbit_period_us = period_us;
     host_cfg.time_constant_days = opt.time_constant_days;
+    host_cfg.common_rotation = rule;
     host.estimator.emplace(host_cfg, initial ? &*initial : nullptr);
     host.pipeline.use_estimator(&*host.estimator);
     sum.self_calibrate = true;
@@ -664,13 +670,18 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     }
     ReplaySummary sum;
     HostSide<T> host;
-    start_host(opt, rows, mf, model_t, client, host, sum);
+    // The mountings first: the target's estimator takes its rule's weights
+    // from those staged when CALIB_START comes (correct --self-calibrate
+    // --combined's rule).
     std::optional<EpochCombination<T>> combination;
+    calib::CommonRotationWeights rule{};
     if (!opt.combined.empty()) {
         const MountingsFile m = read_mountings_file(opt.mountings);
         refuse_unusable_mountings(m, opt.mountings);
         combination.emplace(m, client, host.pipeline, opt.in, log);
+        rule = pipeline::common_rotation_weights(m.mountings);
     }
+    start_host(opt, rows, mf, model_t, client, host, sum, rule);
     RowReplay<T> replay_row(opt, client, states, service, host, model_d, combination ? &*combination : nullptr, sum,
                             start, log);
     std::vector<WrittenRow> written_rows(rows.size());
@@ -685,7 +696,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     if (opt.self_calibrate) {
         finish_self_calibration(client, sum, host.target_history, log, *host.sc);
         if (outputs.has("--model-history")) {
-            outputs["--model-history"].write(format_model_history(host.target_history));
+            outputs["--model-history"].write(format_model_history(host.target_history, rule.heads != 0U));
         }
     }
     if (combination) {

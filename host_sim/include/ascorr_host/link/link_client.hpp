@@ -92,7 +92,10 @@ public:
     // (staged head by head, then started with it); none: no model. A restart
     // while the target's estimator runs is an error (restore() refuses it):
     // what it had learnt is lost with it.
-    void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial);
+    // common_rotation: the rule 'combined' with the mountings loaded before
+    // (load_mountings), CALIB_START's common_rotation 1.
+    void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial,
+                           bool common_rotation = false);
     void calib_command(link::CalibCommand c);
     // A model for the estimator, active from the next epoch (version + 1).
     void load_calib_model(const ModelCoefficients& m);
