@@ -42,6 +42,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
 #include "ascorr_link/crc32c.hpp"
 #include "calib_entry.hpp"
@@ -347,6 +348,9 @@ struct StageMeter {
 class FlightCycle {
 public:
     FlightCycle() noexcept {
+        // The rule for the rotation common to all heads: the combined attitude
+        // of the mountings in flash moves least (docs/contract.md, "The common rotation").
+        estimator_.set_common_rotation(pipeline::common_rotation_weights(kBenchMountings));
         pipeline_.use_estimator(&estimator_);
         pipeline_.use_combiner(&combiner_);
     }
