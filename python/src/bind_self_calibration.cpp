@@ -76,9 +76,16 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
                          const py::object& orbit_period_obj, const py::object& mountings) {
     const host::ModelFile* m = model_arg(model);
     // The rule for the rotation common to all heads, as correct --mountings M: combined.
-    const calib::CommonRotationWeights rule =
-        mountings.is_none() ? calib::CommonRotationWeights{}
-                            : pipeline::common_rotation_weights(mountings_arg(mountings).mountings);
+    calib::CommonRotationWeights rule{};
+    if (!mountings.is_none()) {
+        const host::MountingsFile mf = mountings_arg(mountings);
+        if (!mf.sigmas) {
+            bad_argument("mountings",
+                         "no sigma_cross, sigma_about: the rule for the rotation common to all heads weighs the heads "
+                         "by their noise");
+        }
+        rule = pipeline::common_rotation_weights(mf.mountings);
+    }
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
     const double time_constant = real_arg(time_constant_obj, "time_constant");
     if (!calib::time_constant_acceptable(time_constant)) {

@@ -74,6 +74,8 @@ def test_fit_with_mountings_is_ascorr_fit_and_names_its_rule(exe, mission, tmp_p
     q1, s1, h1 = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], mountings=m)
     q0, s0, h0 = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"])
     assert (s1 == s0).all() and len(h1) == len(h0) and not np.array_equal(q1, q0)
+    with pytest.raises(ValueError, match="mountings.*no sigma_cross"):
+        ascorr.self_calibrate(*as_args(d), mountings=dict(m, sigma_cross=None, sigma_about=None))
 
 
 def test_fit_refuses_too_short_a_period(mission):

@@ -498,12 +498,7 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
     // rule `combined`, docs/contract.md, "The common rotation").
     CorrectOptions run = opt;
     if (opt.self_calibrate) {
-        run.common_rotation = pipeline::common_rotation_weights(m.mountings);
-        if (run.common_rotation.heads == 0U) {
-            log << "ascorr correct: warning: " << text::input_name(mountings)
-                << " has no sigmas: the self-calibration's rotation common to all heads stays the estimator's own "
-                   "frame; the combined attitude is not protected from it\n";
-        }
+        run.common_rotation = pipeline::common_rotation_weights(m.mountings);  // sigmas: refused above without
     }
     const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
         CombineStage stage(m, outputs["--combined"], opt.in, to, mode);
