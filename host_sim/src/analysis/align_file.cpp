@@ -4,12 +4,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "ascorr/core/status.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -100,11 +104,59 @@ void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, AlignS
     sums.add(e.t, q_crf_icrf);
 }
 
-// One pass over the rows with the current mountings. Two rows of one head in
-// one epoch: the assembler's InputError (both lines named).
+// A row earlier than the epoch before it: the pass cannot stream (align_rows
+// sorts the rows and starts again).
+struct OutOfOrder {};
+
+// The epochs of rows in time order, each handed on when the next begins
+// (consecutive rows with one millisecond key, pipeline/epoch_key.hpp), so the
+// noise windows see them in time order and the memory is one epoch's. A
+// second row of one head in an epoch: InputError (both lines named).
+class OrderedEpochs {
+public:
+    OrderedEpochs(const std::string& file, std::function<void(const Epoch<Judged>&)> sink)
+        : file_(file), sink_(std::move(sink)) {}
+
+    void add(std::uint8_t head, std::size_t line, const Judged& j) {
+        const std::int64_t key = epoch_key(j.row.t);
+        if (keys_.ends_before(key)) {
+            if (key < keys_.key()) {
+                throw OutOfOrder{};
+            }
+            flush();
+        }
+        if (keys_.add(key)) {
+            epoch_.t = static_cast<double>(key) / 1000.0;  // the key's time: the same whichever row comes first
+        }
+        if (epoch_.head[head]) {
+            throw second_solution(file_, line, head, j.row.t, epoch_.line[head]);
+        }
+        epoch_.head[head] = j;
+        epoch_.line[head] = line;
+    }
+    void finish() {
+        if (keys_.is_open()) {
+            flush();
+        }
+    }
+
+private:
+    void flush() {
+        sink_(epoch_);
+        epoch_ = Epoch<Judged>{};
+        keys_.close();
+    }
+
+    const std::string& file_;
+    std::function<void(const Epoch<Judged>&)> sink_;
+    pipeline::ConsecutiveEpochs keys_;
+    Epoch<Judged> epoch_;
+};
+
+// One pass over the rows (in time order) with the current mountings.
 void run_pass(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
               const CurrentMountings& q_chu_crf, const AlignOptions& opt, AlignSums& sums, PassCounts& c) {
-    EpochAssembler<Judged> epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, sums, c); });
+    OrderedEpochs epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, sums, c); });
     rows([&](const CorrectedRow& r) {
         ++c.rows;
         if (!in_period(r.t, opt)) {
@@ -119,10 +171,27 @@ void run_pass(const CorrectedRowSource& rows, const std::string& file, const Mou
             ++c.left_out[static_cast<std::size_t>(why)];
             return;
         }
-        epochs.add(r.t, r.head, r.line, Judged{r, why});
+        epochs.add(r.head, r.line, Judged{r, why});
     });
     epochs.finish();
     sums.finish();
+}
+
+// The rows in time order: kept in memory and sorted by their epoch key
+// (stable: file order within an epoch), for a file that is not in time order.
+CorrectedRowSource sorted_rows(const CorrectedRowSource& rows) {
+    auto kept = std::make_shared<std::vector<CorrectedRow>>();
+    rows([&](const CorrectedRow& r) { kept->push_back(r); });
+    const auto key = [](const CorrectedRow& r) {
+        return std::abs(r.t) < kMaxEpochTimeS ? epoch_key(r.t) : std::numeric_limits<std::int64_t>::max();
+    };
+    std::stable_sort(kept->begin(), kept->end(),
+                     [&](const CorrectedRow& a, const CorrectedRow& b) { return key(a) < key(b); });
+    return [kept](const std::function<void(const CorrectedRow&)>& fn) {
+        for (const CorrectedRow& r : *kept) {
+            fn(r);
+        }
+    };
 }
 
 std::string reasons_text(const std::array<std::size_t, kLeftOutKinds>& n) {
@@ -282,10 +351,17 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
     Alignment a;
     Information w{};
     r.last_update_arcsec = std::numeric_limits<double>::infinity();
+    CorrectedRowSource in_order = rows;
     for (r.passes = 0; r.passes < kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec);) {
         AlignSums sums(opt.noise_window_s);
         PassCounts c;
-        run_pass(rows, file, m, q, opt, sums, c);
+        try {
+            run_pass(in_order, file, m, q, opt, sums, c);
+        } catch (const OutOfOrder&) {  // the first pass only: the sorted rows are in order
+            in_order = sorted_rows(rows);
+            r.rows_sorted = true;
+            continue;
+        }
         if (++r.passes == 1) {
             refuse_thin_data(file, sums, c, r.heads, opt);
             count_into(r, sums, c);
@@ -344,6 +420,9 @@ std::string describe(const AlignReport& r) {
       << " rows, " << r.epochs << " epochs of the mountings' heads, " << r.joint_epochs
       << " with two or more usable heads (used), " << r.single_epochs << " with one\n";
     s << "rows left out: " << reasons_text(r.rows_left_out) << "\n";
+    if (r.rows_sorted) {
+        s << "rows out of time order: sorted in memory (a file in time order streams)\n";
+    }
     s << "noise: REML from the heads' relative attitudes about their mean over " << fixed(r.noise_window_s, 0)
       << " s windows (" << fixed(r.noise.dof, 0) << " degrees of freedom), " << noise_model_text(r.noise.model) << ", "
       << r.noise.iterations << " iterations" << (r.noise.converged ? "" : " (not converged)") << "\n";

@@ -220,8 +220,11 @@ struct AlignReport {
     std::size_t rows_in_period = 0;                          // with t in [from, to]
     std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // in the period, by LeftOut (kUsed: used)
     std::size_t epochs = 0;                                  // in the period
-    std::size_t joint_epochs = 0;                            // with two or more usable heads
-    std::size_t single_epochs = 0;                           // with one
+    // The rows were not in time order: kept in memory and sorted (a file in
+    // time order streams, one epoch at a time).
+    bool rows_sorted = false;
+    std::size_t joint_epochs = 0;   // with two or more usable heads
+    std::size_t single_epochs = 0;  // with one
     std::size_t passes = 0;
     double last_update_arcsec = 0.0;                                 // the largest δ of the last pass
     Eigen::Vector3d weighted_mean_arcsec = Eigen::Vector3d::Zero();  // (ΣW)⁻¹ Σ W_i rotation_i, W of M2

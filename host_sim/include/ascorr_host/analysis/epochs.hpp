@@ -16,6 +16,7 @@
 // at the same epoch is an input error.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -27,6 +28,7 @@
 #include <string>
 #include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -48,6 +50,16 @@ struct Epoch {
     std::array<std::size_t, kMaxHeads> line{};           // where each head's row is
 };
 
+// The refusal of a second row of one head in one epoch (every grouper's).
+inline text::InputError second_solution(const std::string& file, std::size_t line, std::uint8_t head, double t,
+                                        std::size_t first_line) {
+    char when[32];
+    text::c_snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
+    return text::InputError(file, line, 1,
+                            std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
+                                " (the first is on line " + std::to_string(first_line) + ")");
+}
+
 template <typename Payload>
 class EpochAssembler {
 public:
@@ -66,11 +78,7 @@ public:
         const std::int64_t key = epoch_key(t);
         Entry& e = pending_[key];
         if (e.epoch.head[head]) {
-            char when[32];
-            text::c_snprintf(when, sizeof when, "%.3f", t);  // |t| < 9e15: at most 16 digits before the point
-            throw text::InputError(file_, line, 1,
-                                   std::string("second solution of CHU ") + head_name(head) + " at t = " + when +
-                                       " (the first is on line " + std::to_string(e.epoch.line[head]) + ")");
+            throw second_solution(file_, line, head, t, e.epoch.line[head]);
         }
         if (e.heads == 0U) {
             e.epoch.t = t;
@@ -102,13 +110,19 @@ public:
     }
 
     // Hands on the epochs still pending: the complete ones in time order, then
-    // those missing a head (in no particular order).
+    // those missing a head, in time order too (whatever the row order).
     void finish() {
         while (!held_.empty()) {
             hand_on(*held_.begin());
         }
+        std::vector<std::int64_t> keys;
+        keys.reserve(pending_.size());
         for (const auto& kv : pending_) {
-            sink_(kv.second.epoch);
+            keys.push_back(kv.first);
+        }
+        std::sort(keys.begin(), keys.end());
+        for (const std::int64_t k : keys) {
+            sink_(pending_.at(k).epoch);
         }
         pending_.clear();
     }
