@@ -4,6 +4,8 @@
 // mission against the simulator's true CRF attitude.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -558,6 +560,27 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     r = run_in("stats --combined c2.csv --truth-attitude truth_swapped.csv", ms.dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
+    // A truth in reverse time order is refused too (was: exit 0, every epoch
+    // but one "without a truth row"), and plot takes a truth by stats' rules:
+    // no combined file, no epoch twice (was: accepted).
+    rows = lines_of(ms.dir / "sim.csv.attitude.csv");
+    std::reverse(rows.begin() + 1, rows.end());
+    text.clear();
+    for (const std::string& l : rows) {
+        text += l + "\n";
+    }
+    write(ms.dir / "truth_reversed.csv", text);
+    r = run_in("stats --combined c2.csv --truth-attitude truth_reversed.csv", ms.dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "truth_reversed.csv:3:1: the truth's rows must be in time order")) << r.err;
+    const std::string window = " --window-from 456148800 --window-to 456408000 --out refused.png";
+    r = run_in("plot --combined c2.csv --truth-attitude c2.csv" + window, ms.dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "c2.csv:1:1: the truth is an attitude file (t,qw,qx,qy,qz), not a combined file")) << r.err;
+    r = run_in("plot --combined c2.csv --truth-attitude truth_swapped.csv" + window, ms.dir);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(ms.dir / "refused.png"));
     // The figure: three days, a PNG (when gnuplot is installed).
     r = run_in(
         "plot --combined c2.csv --truth-attitude sim.csv.attitude.csv --window-from 456148800 --window-to "

@@ -57,13 +57,7 @@ struct SetAccumulator {
 // The truth rows, in time order, read along with the combined file's.
 class TruthCursor {
 public:
-    explicit TruthCursor(const std::string& path) : path_(path), reader_(path) {
-        if (reader_.combined()) {
-            throw text::InputError(path, 1, 1, "the truth is an attitude file (t,qw,qx,qy,qz), not a combined file");
-        }
-        more_ = reader_.next(row_);
-        key_ = more_ ? epoch_key(row_.t) : 0;
-    }
+    explicit TruthCursor(const std::string& path) : reader_(path) { advance(); }
     // The truth at key, if it has a row there; keys asked in increasing order.
     const AttitudeRow* at(std::int64_t key) {
         while (more_ && key_ < key) {
@@ -71,24 +65,20 @@ public:
         }
         return more_ && key_ == key ? &row_ : nullptr;
     }
+    // The rows after the last asked for are checked too (a truth in reverse
+    // order is refused, not taken as one without rows).
+    void finish() {
+        while (more_) {
+            advance();
+        }
+    }
 
 private:
     void advance() {
-        const std::int64_t previous = key_;
-        const std::size_t previous_line = row_.line;
         more_ = reader_.next(row_);
-        if (!more_) {
-            return;
-        }
-        key_ = epoch_key(row_.t);
-        if (key_ <= previous) {
-            throw text::InputError(path_, row_.line, 1,
-                                   "the truth's rows must be in time order, one per epoch (line " +
-                                       std::to_string(previous_line) + " is at or after this one)");
-        }
+        key_ = more_ ? epoch_key(row_.t) : key_;
     }
-    std::string path_;
-    AttitudeReader reader_;
+    TruthReader reader_;
     AttitudeRow row_;
     std::int64_t key_ = 0;
     bool more_ = false;
@@ -215,6 +205,7 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
     std::sort(s.sets.begin(), s.sets.end(),
               [](const HeadSetReport& a, const HeadSetReport& b) { return set_order(a.heads, b.heads); });
     if (truth) {
+        truth->finish();
         steps_against_full(acc, s);
     }
     return s;

@@ -465,7 +465,7 @@ double max_abs(const std::array<double, 3>& e) {
 // The truth of the window, by epoch key (a few days: a few thousand rows).
 std::map<std::int64_t, Quaternion<double>> truth_in_window(const CombinedPlotOptions& opt) {
     std::map<std::int64_t, Quaternion<double>> truth;
-    AttitudeReader r(opt.truth);
+    TruthReader r(opt.truth);  // stats --combined's rules for a truth
     AttitudeRow row;
     while (r.next(row)) {
         if (row.t >= opt.from && row.t <= opt.to) {

@@ -6,6 +6,7 @@
 
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/scalar_traits.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_text/input_error.hpp"
 
@@ -231,6 +232,28 @@ bool AttitudeReader::combined() const noexcept {
 }
 bool AttitudeReader::next(AttitudeRow& row) {
     return impl_->next(row);
+}
+
+TruthReader::TruthReader(const std::string& path) : path_(path), reader_(path) {
+    if (reader_.combined()) {
+        throw text::InputError(path, 1, 1, "the truth is an attitude file (t,qw,qx,qy,qz), not a combined file");
+    }
+}
+
+bool TruthReader::next(AttitudeRow& row) {
+    if (!reader_.next(row)) {
+        return false;
+    }
+    const std::int64_t key = pipeline::epoch_key(row.t);
+    if (any_ && key <= last_key_) {
+        throw text::InputError(path_, row.line, 1,
+                               "the truth's rows must be in time order, one per epoch (line " +
+                                   std::to_string(last_line_) + " is at or after this one)");
+    }
+    any_ = true;
+    last_key_ = key;
+    last_line_ = row.line;
+    return true;
 }
 
 }  // namespace ascorr::host

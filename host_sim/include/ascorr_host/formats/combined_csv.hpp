@@ -64,4 +64,22 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+// An attitude file read as the truth (stats --combined, plot --combined,
+// --truth-attitude): a combined file is refused (file:1:1), and so is a row
+// not after the one before it by epoch (file:line:1, naming both lines): one
+// rule for every reader of a truth.
+class TruthReader {
+public:
+    explicit TruthReader(const std::string& path);
+    // The next row, checked; false at the end.
+    bool next(AttitudeRow& row);
+
+private:
+    std::string path_;
+    AttitudeReader reader_;
+    bool any_ = false;
+    std::int64_t last_key_ = 0;
+    std::size_t last_line_ = 0;
+};
+
 }  // namespace ascorr::host
