@@ -210,7 +210,7 @@ const char* set_name(std::uint8_t s) {
 std::vector<Eigen::Vector3d> combined_error(const Stage& s, std::uint8_t set) {
     Eigen::Matrix3d w = Eigen::Matrix3d::Zero();
     for (std::uint8_t h = 0; h < 3; ++h) {
-        if ((set >> h) & 1U) {
+        if ((static_cast<unsigned>(set) >> h) & 1U) {
             w += s.w[h];
         }
     }
@@ -220,7 +220,7 @@ std::vector<Eigen::Vector3d> combined_error(const Stage& s, std::uint8_t set) {
     for (const auto& theta : s.theta) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (std::uint8_t h = 0; h < 3; ++h) {
-            if ((set >> h) & 1U) {
+            if ((static_cast<unsigned>(set) >> h) & 1U) {
                 sum += s.w[h] * theta[h];
             }
         }
