@@ -355,9 +355,10 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
 
     const CalibStart start{5'640'000'000, 30.0, 0};
     {
-        // CALIB_START of a host before common_rotation (17 bytes) reads as 0;
-        // one byte more than 18 is refused.
+        // common_rotation 0 is the 17 bytes of a host before it (a target
+        // before it takes them); 1 adds the byte; one byte more is refused.
         std::uint8_t p[kMaxPayload] = {};
+        EXPECT_EQ(encode(CalibStart{5'640'000'000, 30.0, 1, 0}, p), 17U);
         const std::size_t n = encode(CalibStart{5'640'000'000, 30.0, 1, 1}, p);
         EXPECT_EQ(n, 18U);
         CalibStart m{};

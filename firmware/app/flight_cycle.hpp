@@ -345,12 +345,18 @@ struct StageMeter {
     void add(pipeline::Stage stage, std::uint32_t start) noexcept { meter.add(part_of(stage), start); }
 };
 
+// The estimator's configuration: kCalibConfig with the rule for the rotation
+// common to all heads, the combined attitude of the mountings in flash moving
+// least (docs/contract.md, "The common rotation"), fixed at construction.
+inline calib::EstimatorConfig calib_config() noexcept {
+    calib::EstimatorConfig c = kCalibConfig;
+    c.common_rotation = pipeline::common_rotation_weights(kBenchMountings);
+    return c;
+}
+
 class FlightCycle {
 public:
     FlightCycle() noexcept {
-        // The rule for the rotation common to all heads: the combined attitude
-        // of the mountings in flash moves least (docs/contract.md, "The common rotation").
-        estimator_.set_common_rotation(pipeline::common_rotation_weights(kBenchMountings));
         pipeline_.use_estimator(&estimator_);
         pipeline_.use_combiner(&combiner_);
     }
@@ -442,7 +448,7 @@ private:
     CorrectionLog record_;
     // The estimator, starting from the model in flash (version 0), fed every
     // kCalibFeedEvery-th cycle; its per-orbit update steps in idle time.
-    FlightEstimator<Scalar> estimator_{kCalibConfig, &kTable2};
+    FlightEstimator<Scalar> estimator_{calib_config(), &kTable2};
     pipeline::EpochPipeline<Scalar, EntryCalls, kMaxHeads> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
     // The combination's tables, built once from the mountings in flash.
     combine::Combiner<Scalar> combiner_{kBenchMountings};

@@ -227,7 +227,7 @@ def self_calibrate(
     time_constant: the estimator's forgetting in days. orbit_period: seconds in [600, 86400],
     or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
     mountings: read_mountings()'s dict (as correct --mountings): the rotation common to all
-    heads is then fixed by the rule 'combined', with the weights of the heads with sigmas.
+    heads is then fixed by the rule 'combined' (mountings without sigmas are refused).
     Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

@@ -28,7 +28,7 @@ struct CalibStart {
     // 1: the rule 'combined' for the rotation common to all heads, with the
     // weights of the mountings staged by MOUNTING_LOAD (their heads with
     // sigmas; pipeline/common_rotation_weights.hpp); 0: the estimator's own
-    // frame. Absent from the payload (a host before it): 0.
+    // frame. Absent from the payload when 0 (as a host before it sent it).
     std::uint8_t common_rotation = 0;
 };
 
@@ -73,7 +73,9 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
     w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
     w.f64(m.time_constant_days);
     w.u8(m.initial);
-    w.u8(m.common_rotation);
+    if (m.common_rotation != 0U) {  // absent when 0: a target before it takes the message as it was
+        w.u8(m.common_rotation);
+    }
     return w.size();
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {

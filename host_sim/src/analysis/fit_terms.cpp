@@ -273,7 +273,9 @@ void uncentre(const Eigen::VectorXd& b, const HeadList& list, int per_axis, Term
 }
 
 // Adds the common rotation ω = w0 + w2·T029 + w3·T032 (F axes, arcsec) to
-// every head's model: N_h·ω in head axes.
+// every head's model: N_h·ω in head axes. The rule kSmallest's, in Eigen's
+// operations as it always was (its models byte-identical); the other rules
+// use calib::add_common_rotation, the estimator's.
 void add_common_rotation(const HeadList& list, const HeadOrientations& n_ref, const Eigen::Vector3d& w0_f,
                          const Eigen::Vector3d& w2_f, const Eigen::Vector3d& w3_f, ModelFile& m) {
     for (std::size_t i = 0; i < list.count; ++i) {
@@ -379,13 +381,15 @@ bool apply_rule(const std::vector<OrbitAverage>& orbits, const HeadOrientations&
     if (!calib::common_rotation_of(sums, w)) {
         return false;
     }
-    Eigen::Matrix3d wm;  // columns w0, w2, w3 (F axes)
-    for (Eigen::Index r = 0; r < 3; ++r) {
-        for (Eigen::Index c = 0; c < 3; ++c) {
-            wm(r, c) = w[r][c];
+    for (std::size_t i = 0; i < list.count; ++i) {
+        calib::Matrix3 n{};
+        for (Eigen::Index r = 0; r < 3; ++r) {
+            for (Eigen::Index c = 0; c < 3; ++c) {
+                n.m[r][c] = n_ref[list.head[i]](r, c);
+            }
         }
+        calib::add_common_rotation(n, w, m.coefficients[list.head[i]]);  // the estimator's
     }
-    add_common_rotation(list, n_ref, wm.col(0), wm.col(1), wm.col(2), m);
     return true;
 }
 

@@ -244,6 +244,10 @@ bool TruthReader::next(AttitudeRow& row) {
     if (!reader_.next(row)) {
         return false;
     }
+    if (!(std::abs(row.t) < pipeline::kMaxEpochTimeS)) {
+        throw text::InputError(path_, row.line, 1,
+                               "t = " + std::to_string(row.t) + " s has no millisecond key: no epoch to compare");
+    }
     const std::int64_t key = pipeline::epoch_key(row.t);
     if (any_ && key <= last_key_) {
         throw text::InputError(path_, row.line, 1,

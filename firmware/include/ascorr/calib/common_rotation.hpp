@@ -18,6 +18,7 @@
 // Double only (per orbit); fixed trip counts, no allocation.
 #pragma once
 
+#include "../core/model_terms.hpp"
 #include "frame.hpp"
 
 namespace ascorr::calib {
@@ -101,8 +102,8 @@ inline Matrix3 product(const Matrix3& a, const Matrix3& b) noexcept {
 // roots (an SPD matrix's columns may differ by orders of magnitude: °C² sums
 // beside counts); false when the scaled determinant is below 1e-12 (the rows
 // are dependent to double's precision: T029 and T032 that never vary apart)
-// or a diagonal entry is not positive (min_det: a stricter bound).
-inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv, double min_det = 1e-12) noexcept {
+// or a diagonal entry is not positive.
+inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv) noexcept {
     double s[3] = {1.0, 1.0, 1.0};
     for (int i = 0; spd && i < 3; ++i) {
         if (!(a.m[i][i] > 0.0)) {
@@ -120,7 +121,7 @@ inline bool inverse_scaled(const Matrix3& a, bool spd, Matrix3* inv, double min_
     const double c01 = b.m[1][2] * b.m[2][0] - b.m[1][0] * b.m[2][2];
     const double c02 = b.m[1][0] * b.m[2][1] - b.m[1][1] * b.m[2][0];
     const double det = b.m[0][0] * c00 + b.m[0][1] * c01 + b.m[0][2] * c02;
-    if (!(std::fabs(det) > min_det) || !std::isfinite(det)) {
+    if (!(std::fabs(det) > 1e-12) || !std::isfinite(det)) {
         return false;
     }
     const double c[3][3] = {
@@ -147,12 +148,28 @@ inline bool bench_weights(const Matrix3* a, const Matrix3* n, std::size_t heads,
             }
         }
     }
+    // B_h does not depend on the weights' scale (1/σ² spans 1e-6 to 1e6):
+    // g is inverted at unit mean diagonal.
+    const double scale = (std::fabs(g.m[0][0]) + std::fabs(g.m[1][1]) + std::fabs(g.m[2][2])) / 3.0;
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+        return false;
+    }
+    for (auto& row : g.m) {
+        for (double& v : row) {
+            v /= scale;
+        }
+    }
     Matrix3 g_inv{};
     if (!inverse_scaled(g, false, &g_inv)) {
         return false;
     }
     for (std::size_t h = 0; h < heads; ++h) {
         b[h] = product(g_inv, a[h]);
+        for (auto& row : b[h].m) {
+            for (double& v : row) {
+                v /= scale;
+            }
+        }
     }
     return true;
 }
@@ -178,13 +195,38 @@ inline void add_to_common_rotation(CommonRotationSums& s, const double (&y)[3], 
     }
 }
 
+// How far T029 and T032 have varied apart over the sums: 1 − ρ², ρ their
+// correlation about their own mean (so where the centre lies does not
+// matter); 0 when either has not varied.
+inline double common_rotation_independence(const CommonRotationSums& s) noexcept {
+    const double n = s.rr.m[0][0];
+    if (!(n > 0.0)) {
+        return 0.0;
+    }
+    const double m2 = s.rr.m[0][1] / n;
+    const double m3 = s.rr.m[0][2] / n;
+    const double c22 = s.rr.m[1][1] - n * m2 * m2;
+    const double c33 = s.rr.m[2][2] - n * m3 * m3;
+    const double c23 = s.rr.m[1][2] - n * m2 * m3;
+    if (!(c22 > 0.0 && c33 > 0.0)) {
+        return 0.0;
+    }
+    return 1.0 - c23 * c23 / (c22 * c33);
+}
+
+// Below it (1 − ρ², |ρ| > 0.99995) the slopes on T029 and T032 are not fixed
+// apart by the data: the rule then fixes the constant alone (on board) or is
+// refused (the ground fit). One threshold for both.
+inline constexpr double kMinTemperatureIndependence = 1e-4;
+
 // The common rotation the rule adds, ω(T2, T3) = w0 + w2·T2 + w3·T3 (arcsec,
 // F axes; w[axis] = {w0, w2, w3}, about 0 °C, not the centre): w = −(Σ y·rᵀ)(Σ r·rᵀ)⁻¹.
-// false when T029 and T032 do not vary independently over the sums (the rule
-// is then not unique; min_det as inverse_scaled's).
-inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3], double min_det = 1e-12) noexcept {
+// false when T029 and T032 do not vary independently over the sums
+// (common_rotation_independence below kMinTemperatureIndependence: the rule
+// is then not unique).
+inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3]) noexcept {
     Matrix3 rr_inv{};
-    if (!inverse_scaled(s.rr, true, &rr_inv, min_det)) {
+    if (!(common_rotation_independence(s) >= kMinTemperatureIndependence) || !inverse_scaled(s.rr, true, &rr_inv)) {
         return false;
     }
     const Matrix3 wc = product(s.yr, rr_inv);
@@ -194,6 +236,24 @@ inline bool common_rotation_of(const CommonRotationSums& s, double (&w)[3][3], d
         w[i][0] = -wc.m[i][0] - w[i][1] * s.t2_centre - w[i][2] * s.t3_centre;
     }
     return true;
+}
+
+// Adds the common rotation ω = w0 + w2·T2 + w3·T3 (F axes, arcsec; w[axis] =
+// {w0, w2, w3}) to one head's coefficients c[axis][term] (arcsec, head axes,
+// the terms of core/model_terms.hpp): N_h·ω, with T2 = T1 + (T2 − T1) and
+// likewise T3 (the model's regressors). C: any array of axes of terms.
+template <typename C>
+void add_common_rotation(const Matrix3& n_h, const double (&w)[3][3], C& c) noexcept {
+    for (std::size_t ax = 0; ax < 3; ++ax) {
+        double nw[3] = {0.0, 0.0, 0.0};  // N_h·w0, N_h·w2, N_h·w3, axis ax
+        for (std::size_t j = 0; j < 3; ++j) {
+            nw[j] = n_h.m[ax][0] * w[0][j] + n_h.m[ax][1] * w[1][j] + n_h.m[ax][2] * w[2][j];
+        }
+        c[ax][term_index(Regressor::kOne, 0)] += nw[0];
+        c[ax][term_index(Regressor::kT1, 1)] += nw[1] + nw[2];
+        c[ax][term_index(Regressor::kT2MinusT1, 1)] += nw[1];
+        c[ax][term_index(Regressor::kT3MinusT1, 1)] += nw[2];
+    }
 }
 
 }  // namespace ascorr::calib

@@ -38,23 +38,6 @@
 
 namespace ascorr::calib {
 
-// Adds the common rotation ω = w0 + w2·T2 + w3·T3 (F axes, arcsec; w[axis] =
-// {w0, w2, w3}) to head h's coefficients (arcsec, head axes): N_h·ω, with
-// T2 = T1 + (T2 − T1) and likewise T3 (the model's regressors).
-inline void add_common_rotation(const Matrix3& n_h, const double (&w)[3][3],
-                                double (&c)[kModelAxes][kModelTerms]) noexcept {
-    for (int ax = 0; ax < 3; ++ax) {
-        double nw[3] = {0.0, 0.0, 0.0};  // N_h·w0, N_h·w2, N_h·w3, axis ax
-        for (int j = 0; j < 3; ++j) {
-            nw[j] = n_h.m[ax][0] * w[0][j] + n_h.m[ax][1] * w[1][j] + n_h.m[ax][2] * w[2][j];
-        }
-        c[ax][term_index(Regressor::kOne, 0)] += nw[0];
-        c[ax][term_index(Regressor::kT1, 1)] += nw[1] + nw[2];
-        c[ax][term_index(Regressor::kT2MinusT1, 1)] += nw[1];
-        c[ax][term_index(Regressor::kT3MinusT1, 1)] += nw[2];
-    }
-}
-
 template <std::size_t N = kCalibHeads>
 class CommonRotationMemory {
 public:
@@ -116,7 +99,7 @@ public:
         if (!any) {
             return false;
         }
-        if (common_rotation_of(sums, w, kMinDeterminant)) {
+        if (common_rotation_of(sums, w)) {
             return true;
         }
         for (int ax = 0; ax < 3; ++ax) {  // the constant alone: w0 = −Σy / n
@@ -128,10 +111,6 @@ public:
     }
 
 private:
-    // Below it (the scaled Σ r·rᵀ's determinant) T029 and T032 have not varied
-    // apart enough to fix their slopes: a model would extrapolate them.
-    static constexpr double kMinDeterminant = 1e-6;
-
     struct Set {
         Matrix3 rr{};                 // Σ r·rᵀ
         double s[N][kUnknowns][3]{};  // Σ a_h·rᵀ

@@ -176,15 +176,12 @@ public:
         orbit_.drop();
     }
     void resume() noexcept { frozen_ = false; }
-    // The rule for the rotation common to all heads (common_rotation_memory.hpp):
-    // from the next candidate on, of the models the IBAs cannot tell apart the
-    // one that moves the bench, as the weights say, least over the memory.
-    // heads 0 (the default): the estimator's own frame (F as in the first orbit).
-    void set_common_rotation(const CommonRotationWeights& w) noexcept { cfg_.common_rotation = w; }
-
     // Forget everything learnt; the active model stays.
     void reset() noexcept {
         rule_memory_.clear();
+        for (std::size_t k = 0; k < 2; ++k) {  // an adopted model's ω is in the frame F being forgotten
+            omega_valid_[k] = learnt_[k] == 0U;
+        }
         for (auto& s : srif_) {
             s.clear();
         }
@@ -479,7 +476,11 @@ private:
         }
         last_refusal_ = Refusal::kNone;
         keep_heads_not_learnt(cand_, solved_);
-        rule_on_kept_heads();
+        const std::uint8_t moved = rule_on_kept_heads();
+        if (moved != 0U && !within_limits(cand_, window_, cfg_.angle_check_margin_c, moved)) {
+            refuse(Refusal::kAngleLimit);  // a kept head the rule moved beyond the limits
+            return;
+        }
         prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_, cand_omega_);
         active_rms_ = candidate_rms_;
         swap_pending_ = true;
@@ -523,10 +524,12 @@ private:
 
     // A head kept from the active model gets the candidate's ω less the active
     // model's, so that its IBAs with the heads learnt stay as they were (a
-    // head never seen has no N_h: it is kept as it was).
-    void rule_on_kept_heads() noexcept {
-        if (cfg_.common_rotation.heads == 0U || !has_[active_]) {
-            return;
+    // head never seen has no N_h, and after a reset the active ω is in the
+    // frame forgotten: kept as it was). The heads it moved (their limits are
+    // checked before adoption).
+    std::uint8_t rule_on_kept_heads() noexcept {
+        if (cfg_.common_rotation.heads == 0U || !has_[active_] || !omega_valid_[active_]) {
+            return 0U;
         }
         Omega d{};
         for (int r = 0; r < 3; ++r) {
@@ -534,11 +537,14 @@ private:
                 d.w[r][c] = cand_omega_.w[r][c] - omega_[active_].w[r][c];
             }
         }
+        std::uint8_t moved = 0U;
         for (std::size_t h = 0; h < N; ++h) {
             if (!learns_head(h, solved_) && cand_.present[h] && learns_head(h, n_heads_)) {
                 add_common_rotation(n_mat_[h], d.w, cand_.coefficient[h]);
+                moved = static_cast<std::uint8_t>(moved | (1U << h));
             }
         }
+        return moved;
     }
 
     void refuse(Refusal r) noexcept {
@@ -552,6 +558,7 @@ private:
         const std::size_t k = back();
         learnt_[k] = learnt;
         omega_[k] = omega;
+        omega_valid_[k] = true;
         model_[k] = m;
         core_[k] = thermal_model<T>(m, kArcsecToRad);
         version_[k] = version;
@@ -563,7 +570,8 @@ private:
     // The memory of the rule for the common rotation (cfg_.common_rotation).
     CommonRotationMemory<N> rule_memory_{};
     Omega cand_omega_{};
-    Omega omega_[2]{};  // per buffer: the ω its learnt heads carry (0: given, loaded)
+    Omega omega_[2]{};       // per buffer: the ω its learnt heads carry (0: given, loaded)
+    bool omega_valid_[2]{};  // false: adopted before a reset (its ω is in the frame forgotten)
     // The cycle's side.
     bool frozen_ = false;
     OrbitCollector<T, N> orbit_;
