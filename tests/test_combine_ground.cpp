@@ -581,6 +581,36 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
     EXPECT_FALSE(std::filesystem::exists(ms.dir / "refused.png"));
+    // Rows the combination cannot have written are refused at their column
+    // (was: accepted): a status against the rule, heads that contradict it, a
+    // sigma not positive and finite.
+    const std::vector<std::string> c2 = lines_of(ms.dir / "c2.csv");
+    std::string abc;  // a row of three heads: t,qw,qx,qy,qz,ABC,sx,sy,sz,1
+    for (const std::string& l : c2) {
+        if (l.find(",ABC,") != std::string::npos && l.substr(l.rfind(',') + 1) == "1") {
+            abc = l;
+            break;
+        }
+    }
+    ASSERT_FALSE(abc.empty());
+    const std::string head = abc.substr(0, abc.rfind(','));  // without the status
+    const std::string before_sigmas = abc.substr(0, abc.find(",ABC,") + 5);
+    struct Bad {
+        std::string row;
+        std::string message;
+    };
+    for (const Bad& b : std::vector<Bad>{
+             {head + ",3", "bad.csv:2:"},
+             {head + ",0", "is no combined status"},
+             {head + ",8", "column 'status': 8 contradicts the row's 3 heads"},
+             {head + ",2", "column 'status': 2 contradicts the row's 3 heads"},
+             {before_sigmas + "-1,1,1,1", "column 'sigma_x': a formal sigma is a positive finite number"},
+             {before_sigmas + "1,nan,1,1", "column 'sigma_y': a formal sigma is a positive finite number"}}) {
+        write(ms.dir / "bad.csv", c2[0] + "\n" + b.row + "\n");
+        r = run_in("stats --combined bad.csv", ms.dir);
+        EXPECT_EQ(r.exit_code, 1) << b.row;
+        EXPECT_TRUE(has(r.err, b.message)) << b.row << ": " << r.err;
+    }
     // The figure: three days, a PNG (when gnuplot is installed).
     r = run_in(
         "plot --combined c2.csv --truth-attitude sim.csv.attitude.csv --window-from 456148800 --window-to "

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "ascorr/combine/combined_status.hpp"
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/scalar_traits.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
@@ -121,6 +122,36 @@ private:
             fail(c_.status, "column 'status': " + why_not_an_integer(st, 0, 255));
         }
         row.status = static_cast<unsigned>(*v);
+        refuse_impossible(row);
+    }
+
+    // A row the combination cannot have written: a status against the rule
+    // (combine/combined_status.hpp), heads that contradict it, a sigma that is
+    // not a positive finite number.
+    void refuse_impossible(const AttitudeRow& row) const {
+        namespace cs = combine::combined_status;
+        const auto st = static_cast<combine::CombinedStatus>(row.status);
+        if (!cs::status_consistent(st)) {
+            fail(c_.status, "column 'status': " + std::to_string(row.status) +
+                                " is no combined status (exactly one of 1, 2 and 8, with or without 4)");
+        }
+        unsigned n = 0U;
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            n += (row.heads >> h) & 1U;
+        }
+        const unsigned kind = st & (cs::kTwoOrMoreHeads | cs::kOneHead | cs::kNoHead);
+        const unsigned expected = n == 0U ? cs::kNoHead : n == 1U ? cs::kOneHead : cs::kTwoOrMoreHeads;
+        if (kind != expected) {
+            fail(c_.status, "column 'status': " + std::to_string(row.status) + " contradicts the row's " +
+                                std::to_string(n) + (n == 1U ? " head" : " heads"));
+        }
+        for (std::size_t a = 0; row.has_q && a < 3; ++a) {
+            static constexpr const char* kNames[3] = {"sigma_x", "sigma_y", "sigma_z"};
+            if (!(row.sigma_arcsec[a] > 0.0) || !std::isfinite(row.sigma_arcsec[a])) {
+                fail(c_.sigma[a], std::string("column '") + kNames[a] + "': a formal sigma is a positive finite " +
+                                      "number of arcsec, got " + number_text(row.sigma_arcsec[a]));
+            }
+        }
     }
 
     std::string_view field(int col) const {
@@ -246,7 +277,7 @@ bool TruthReader::next(AttitudeRow& row) {
     }
     if (!(std::abs(row.t) < pipeline::kMaxEpochTimeS)) {
         throw text::InputError(path_, row.line, 1,
-                               "t = " + std::to_string(row.t) + " s has no millisecond key: no epoch to compare");
+                               "t = " + number_text(row.t) + " s has no millisecond key: no epoch to compare");
     }
     const std::int64_t key = pipeline::epoch_key(row.t);
     if (any_ && key <= last_key_) {
