@@ -139,8 +139,10 @@ private:
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             n += (row.heads >> h) & 1U;
         }
-        const unsigned kind = st & (cs::kTwoOrMoreHeads | cs::kOneHead | cs::kNoHead);
-        const unsigned expected = n == 0U ? cs::kNoHead : n == 1U ? cs::kOneHead : cs::kTwoOrMoreHeads;
+        const unsigned kind = static_cast<unsigned>(st) & (cs::kTwoOrMoreHeads | cs::kOneHead | cs::kNoHead);
+        const unsigned expected = static_cast<unsigned>(n == 0U   ? cs::kNoHead
+                                                        : n == 1U ? cs::kOneHead
+                                                                  : cs::kTwoOrMoreHeads);
         if (kind != expected) {
             fail(c_.status, "column 'status': " + std::to_string(row.status) + " contradicts the row's " +
                                 std::to_string(n) + (n == 1U ? " head" : " heads"));
