@@ -5,8 +5,27 @@
 #include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
+#include "number_options.hpp"
 
 namespace ascorr::cli {
+
+void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined) {
+    CLI::Option* k =
+        cmd.add_option_function<double>(
+               "--gate-sigmas", [&gate](const double& v) { gate.sigmas = v; },
+               "the consistency gate: a head is left out beyond this many sigmas of its disagreement with the others, "
+               "[3, 100] (default 6)")
+            ->check(real_in(combine::kMinGateSigmas, combine::kMaxGateSigmas));
+    CLI::Option* f = cmd.add_option_function<double>(
+                            "--gate-floor", [&gate](const double& v) { gate.floor_arcsec = v; },
+                            "the consistency gate's floor in arcsec, [1, 3600], added to the heads' noise (default: "
+                            "2 for rows with the aberration and the thermal stage applied, 10 otherwise)")
+                         ->check(real_in(combine::kMinGateFloorArcsec, combine::kMaxGateFloorArcsec));
+    if (combined != nullptr) {
+        k->needs(combined);
+        f->needs(combined);
+    }
+}
 
 void add_combine_command(CLI::App& app) {
     auto opt = std::make_shared<host::CombineOptions>();
@@ -26,6 +45,7 @@ void add_combine_command(CLI::App& app) {
                     "all; '-': standard output")
         ->required()
         ->check(non_empty_path());
+    add_gate_options(*cmd, opt->gate, nullptr);
     cmd->callback([opt]() {
         host::OutputSet outputs =
             open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}}, host::combine_outputs(*opt));

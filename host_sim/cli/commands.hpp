@@ -18,6 +18,10 @@
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 
+namespace ascorr::host {
+struct GateOptions;
+}
+
 namespace ascorr::cli {
 
 // A command that ran to its end and wrote every output, whose result is a
@@ -132,6 +136,9 @@ CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& secon
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 void add_combine_command(CLI::App& app);
+// --gate-sigmas K and --gate-floor ARCSEC of combine, correct and replay
+// (--combined: each needs `combined`); combine_command.cpp.
+void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined);
 void add_align_command(CLI::App& app);
 
 }  // namespace ascorr::cli

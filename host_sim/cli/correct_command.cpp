@@ -32,6 +32,7 @@ std::vector<std::pair<std::string, host::ScalarKind>> scalar_names() {
 struct CombineTexts {
     std::string mountings;
     std::string combined;
+    host::GateOptions gate;
 };
 
 void add_combine_options(CLI::App& cmd, CombineTexts& t) {
@@ -45,6 +46,7 @@ void add_combine_options(CLI::App& cmd, CombineTexts& t) {
                                 ->check(non_empty_path());
     mountings->needs(combined);
     combined->needs(mountings);
+    add_gate_options(cmd, t.gate, combined);
 }
 
 void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
@@ -52,13 +54,14 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
         {{"--in", &opt.in}, {"--model", &opt.model}, {"--states", &opt.states}, {"--mountings", &t.mountings}},
         host::correct_and_combine_outputs(opt, t.combined));
     try {  // the mountings first: refused input exits 2 (as combine and align)
-        host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings);
+        host::refuse_unusable_mountings(host::read_mountings_file(t.mountings), t.mountings, t.gate);
     } catch (const text::InputError& e) {
         throw RefusedInput(e.what());
     } catch (const std::runtime_error& e) {
         throw RefusedInput(e.what());
     }
-    const host::CorrectAndCombine r = host::correct_and_combine(opt, t.mountings, t.combined, outputs, std::cerr);
+    const host::CorrectAndCombine r =
+        host::correct_and_combine(opt, t.mountings, t.combined, outputs, std::cerr, t.gate);
     outputs.commit();
     if (!r.corrected.self_calibration.empty()) {
         std::cerr << "ascorr correct: " << r.corrected.self_calibration << '\n';

@@ -314,6 +314,8 @@ def combine(
     status: Optional[npt.ArrayLike] = ...,
     flags: Optional[npt.ArrayLike] = ...,
     confidence: Optional[_Real] = ...,
+    gate_sigmas: Optional[float] = ...,
+    gate_floor: Optional[float] = ...,
 ) -> dict[str, npt.NDArray[Any]]:
     """The combined attitude of the bench, one row per epoch (rows whose t agree to the
     millisecond), in time order: the numbers and status bits of `ascorr combine` on the
@@ -324,6 +326,10 @@ def combine(
     (as correct() returns it), or None for raw rows taken as they are. flags, confidence:
     (n,) as in a solutions file, or None (0; not given). A row is averaged in when it is
     clean (flags 0, confidence <= 5) and its status has none of 4, 8, 16, 128, 256.
+    gate_sigmas, gate_floor: the consistency gate, as --gate-sigmas ([3, 100], default 6)
+    and --gate-floor (arcsec, [1, 3600]; default 2 for rows with the aberration and the
+    thermal stage applied, 10 otherwise). Mountings a target would refuse with this gate
+    raise ValueError saying why. Needs no file: no temporary folder is used.
     Returns a dict: "t" (m,); "q" (m, 4) q_crf_icrf (w >= 0), NaN without a usable head;
     "heads" (m,) str, the letters of the heads used ('' for none); "sigma" (m, 3) the
     formal 1-sigma about the CRF axes, arcsec (NaN without a head); "status" (m,) the

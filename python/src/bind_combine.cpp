@@ -5,12 +5,9 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-#include <unistd.h>
-
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <filesystem>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -119,62 +116,54 @@ host::CorrectedRowSource rows_source(const CombineRows& c) {
     };
 }
 
-// A file in a folder of its own, removed with it.
-class ScratchFile {
-public:
-    ScratchFile() {
-        std::string tmpl = (std::filesystem::temp_directory_path() / "ascorr-combine-XXXXXX").string();
-        if (mkdtemp(tmpl.data()) == nullptr) {
-            throw std::runtime_error("cannot create a temporary folder in " +
-                                     std::filesystem::temp_directory_path().string());
-        }
-        dir_ = tmpl;
-    }
-    ~ScratchFile() {
-        std::error_code ec;
-        std::filesystem::remove_all(dir_, ec);
-    }
-    ScratchFile(const ScratchFile&) = delete;
-    ScratchFile& operator=(const ScratchFile&) = delete;
-    std::string path() const { return (std::filesystem::path(dir_) / "combined.csv").string(); }
-
-private:
-    std::string dir_;
-};
-
 void warn(const std::string& log) {
     if (!log.empty() && PyErr_WarnEx(PyExc_UserWarning, log.c_str(), 1) != 0) {
         throw py::error_already_set();
     }
 }
 
-// The combination writes the command line's combined file and the arrays
-// are read back from it: the same numbers, to the digit (q with 15
-// decimals), as `ascorr combine`.
+// The gate's arguments (None: the default by the rows' stages), checked as
+// the command line's --gate-sigmas and --gate-floor.
+host::GateOptions gate_arg(const py::object& sigmas, const py::object& floor) {
+    host::GateOptions g;
+    if (!sigmas.is_none()) {
+        g.sigmas = real_arg(sigmas, "gate_sigmas");
+        if (!(*g.sigmas >= combine::kMinGateSigmas && *g.sigmas <= combine::kMaxGateSigmas)) {
+            bad_argument("gate_sigmas", "expected a number in [3, 100], got " + value_text(sigmas));
+        }
+    }
+    if (!floor.is_none()) {
+        g.floor_arcsec = real_arg(floor, "gate_floor");
+        if (!(*g.floor_arcsec >= combine::kMinGateFloorArcsec && *g.floor_arcsec <= combine::kMaxGateFloorArcsec)) {
+            bad_argument("gate_floor", "expected arcsec in [1, 3600], got " + value_text(floor));
+        }
+    }
+    return g;
+}
+
+// The combination of `ascorr combine`, kept in memory: its rows as the
+// combined file reads back (q to 15 decimals), so the numbers are the
+// command line's to the digit, with no file (and no TMPDIR) at all.
 py::dict combine_arrays(const py::object& t, const py::object& chu, const py::object& q, const py::object& mountings,
-                        const py::object& status, const py::object& flags, const py::object& confidence) {
+                        const py::object& status, const py::object& flags, const py::object& confidence,
+                        const py::object& gate_sigmas, const py::object& gate_floor) {
     const host::MountingsFile m = mountings_arg(mountings);
+    const host::GateOptions gate = gate_arg(gate_sigmas, gate_floor);
     try {
-        host::refuse_unusable_mountings(m, "argument 'mountings'");
+        host::refuse_unusable_mountings(m, "argument 'mountings'", gate);
     } catch (const std::runtime_error& e) {
         throw py::value_error(e.what());
     }
     const CombineRows rows = combine_rows(t, chu, q, status, flags, confidence);
-    const ScratchFile file;
     std::ostringstream log;
+    std::vector<host::AttitudeRow> out;
     {
-        host::OutputSet outputs({{"combined rows", file.path()}});
-        host::CombineStage stage(m, outputs["combined rows"], kArrayRows, log, host::CombineStage::Mode::kKeep);
+        py::gil_scoped_release unlocked;  // the rows are C++ data by now
+        host::CombineStage stage(m, gate, out, kArrayRows, log);
         rows_source(rows)([&stage](const host::CorrectedRow& r) { stage.add(r); });
         stage.finish();
-        outputs.commit();
     }
     warn(log.str());
-    std::vector<host::AttitudeRow> out;
-    host::AttitudeReader reader(file.path());
-    for (host::AttitudeRow row; reader.next(row);) {
-        out.push_back(row);
-    }
     const auto n = static_cast<py::ssize_t>(out.size());
     py::array_t<double> ta(n);
     py::array_t<double> qa({n, py::ssize_t{4}});
@@ -281,8 +270,12 @@ py::tuple align_arrays(const py::object& t, const py::object& chu, const py::obj
         bad_argument("min_epochs", "expected 2 or more, got " + value_text(min_epochs));
     }
     const CombineRows rows = combine_rows(t, chu, q, status, flags, confidence);
-    const host::AlignReport r = host::align_rows(rows_source(rows), kArrayRows, m, opt);
-    return py::make_tuple(mountings_dict(r.aligned), report_dict(r));
+    std::optional<host::AlignReport> r;
+    {
+        py::gil_scoped_release unlocked;  // the rows are C++ data by now
+        r = host::align_rows(rows_source(rows), kArrayRows, m, opt);
+    }
+    return py::make_tuple(mountings_dict(r->aligned), report_dict(*r));
 }
 
 }  // namespace
@@ -343,7 +336,8 @@ void bind_combine(py::module_& mod) {
         [](const py::object& path) { return mountings_dict(host::read_mountings_file(path_arg(path, "path"))); },
         "path"_a, docstring(docs::kReadMountings));
     mod.def("combine", &combine_arrays, "t"_a, "chu"_a, "q"_a, "mountings"_a, "status"_a = py::none(),
-            "flags"_a = py::none(), "confidence"_a = py::none(), docstring(docs::kCombine));
+            "flags"_a = py::none(), "confidence"_a = py::none(), "gate_sigmas"_a = py::none(),
+            "gate_floor"_a = py::none(), docstring(docs::kCombine));
     mod.def("align", &align_arrays, "t"_a, "chu"_a, "q"_a, "mountings"_a, "status"_a = py::none(),
             "flags"_a = py::none(), "confidence"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
             "noise_window"_a = host::kDefaultNoiseWindowS, "min_epochs"_a = host::kMinAlignEpochs,

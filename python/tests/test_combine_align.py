@@ -82,3 +82,41 @@ def test_bad_arguments_name_the_argument(corrected):
         ascorr.align(**a, mountings=m, noise_window=-1.0)
     with pytest.raises(TypeError, match="mountings"):
         ascorr.align(a["t"], a["chu"], a["q"])
+
+
+def test_combine_needs_no_file_and_no_temporary_folder(exe, corrected, monkeypatch):
+    # Issue 37, class 11: combine() failed with "temp_directory_path" when
+    # TMPDIR did not exist; it keeps the combination in memory now.
+    d, data, mountings = corrected
+    c0 = ascorr.combine(**arrays(data), mountings=ascorr.read_mountings(mountings))
+    monkeypatch.setenv("TMPDIR", str(d / "no-such-folder"))
+    c1 = ascorr.combine(**arrays(data), mountings=ascorr.read_mountings(mountings))
+    for key in ("t", "q", "sigma", "status"):
+        assert np.array_equal(c0[key], c1[key], equal_nan=True), key
+    assert not (d / "no-such-folder").exists()
+
+
+def test_combine_gate_as_the_command_line(exe, corrected):
+    d, data, mountings = corrected
+    run_cli(exe, "combine", "--in", data, "--mountings", mountings, "--out", d / "g10.csv", "--gate-floor", 10,
+            "--gate-sigmas", 8)
+    _, rows = read_csv_text(d / "g10.csv")
+    c = ascorr.combine(**arrays(data), mountings=ascorr.read_mountings(mountings), gate_floor=10.0, gate_sigmas=8)
+    assert np.array_equal(c["status"], [int(r[9]) for r in rows])
+    a = arrays(data)
+    m = ascorr.read_mountings(mountings)
+    for kw, match in ((dict(gate_floor=0.5), "gate_floor"), (dict(gate_sigmas=200.0), "gate_sigmas"),
+                      (dict(gate_floor=float("nan")), "gate_floor")):
+        with pytest.raises(ValueError, match=match):
+            ascorr.combine(**a, mountings=m, **kw)
+
+
+def test_sigmas_a_target_refuses_raise_saying_why(corrected):
+    # Issue 37, class 6: sigma_cross 0.01" for A against 1.5" gave every
+    # epoch status 12 and every row "quaternion not unit".
+    _, data, mountings = corrected
+    m = ascorr.read_mountings(mountings)
+    cross = m["sigma_cross"].copy()
+    cross[0] = 0.01
+    with pytest.raises(ValueError, match="CHU A: its consistency gate in head set .* a target refuses"):
+        ascorr.combine(**arrays(data), mountings=dict(m, sigma_cross=cross))

@@ -22,8 +22,11 @@ namespace ascorr::link {
 // One head's mounting and noise (the mountings file's row, IEEE binary64),
 // staged on the target. build = 1: the staged mountings, with this head,
 // become the combiner's (its tables built in double on the target, as on the
-// host), refused with kBadPayload and nothing changed when they are not
-// usable (combine::check_mountings).
+// host), with the consistency gate `gate`, refused with kBadPayload and
+// nothing changed when they are not usable (combine::check_mountings). The
+// gate (two more binary64, k and the floor) is sent only in a build frame and
+// only when it is not CombinerConfig{}'s: a target before it takes the
+// 51-byte message as it was.
 struct MountingLoad {
     std::uint8_t head;
     std::uint8_t present;  // 0 or 1
@@ -31,6 +34,7 @@ struct MountingLoad {
     Quaternion<double> q_chu_crf;
     double sigma_cross_arcsec;
     double sigma_about_arcsec;
+    combine::CombinerConfig gate;  // with build 1
 };
 
 // Answer to kCombineRequest (empty payload): the solutions the target
@@ -56,10 +60,17 @@ inline std::size_t encode(const MountingLoad& m, std::uint8_t* out) noexcept {
          {m.q_chu_crf.w, m.q_chu_crf.x, m.q_chu_crf.y, m.q_chu_crf.z, m.sigma_cross_arcsec, m.sigma_about_arcsec}) {
         w.f64(x);
     }
+    const combine::CombinerConfig usual{};
+    if (m.build == 1U &&
+        (m.gate.gate_sigmas != usual.gate_sigmas || m.gate.gate_floor_arcsec != usual.gate_floor_arcsec)) {
+        w.f64(m.gate.gate_sigmas);
+        w.f64(m.gate.gate_floor_arcsec);
+    }
     return w.size();
 }
 // Refused: a head beyond the last, a flag other than 0 or 1, a value that is
-// not finite (what the combiner checks of the set, at build).
+// not finite (what the combiner checks of the set, at build), a gate outside
+// its range or in a frame that builds nothing.
 inline bool decode(const std::uint8_t* p, std::size_t n, MountingLoad& m) noexcept {
     Reader r(p, n);
     if (!(r.u8(m.head) && r.u8(m.present) && r.u8(m.build)) || m.head >= kMaxHeads || m.present > 1U || m.build > 1U) {
@@ -72,7 +83,12 @@ inline bool decode(const std::uint8_t* p, std::size_t n, MountingLoad& m) noexce
             return false;
         }
     }
-    return r.done();
+    m.gate = combine::CombinerConfig{};
+    if (r.done()) {
+        return true;
+    }
+    return m.build == 1U && r.f64(m.gate.gate_sigmas) && r.f64(m.gate.gate_floor_arcsec) && r.done() &&
+           combine::gate_config_valid(m.gate);
 }
 
 template <typename T>

@@ -331,7 +331,7 @@ private:
     void load_mounting(const MountingLoad& m) noexcept {
         staged_mountings_.head[m.head] = mounting_of(m);
         if (m.build == 1U) {
-            new (&combiner_) combine::Combiner<T>(staged_mountings_);
+            new (&combiner_) combine::Combiner<T>(staged_mountings_, m.gate);
             pipeline_.use_combiner(&combiner_);
         }
     }

@@ -139,7 +139,54 @@ std::string describe(const CombineSummary& s) {
     return o.str();
 }
 
-void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) {
+combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noexcept {
+    combine::CombinerConfig c = combine::default_gate(both_stages);
+    c.gate_sigmas = g.sigmas.value_or(c.gate_sigmas);
+    c.gate_floor_arcsec = g.floor_arcsec.value_or(c.gate_floor_arcsec);
+    return c;
+}
+
+std::string describe(const GateOptions& g) {
+    const std::string k = number_text(gate_config(g, true).gate_sigmas) + " sigmas";
+    if (g.floor_arcsec) {
+        return k + ", a floor of " + number_text(*g.floor_arcsec) + " arcsec";
+    }
+    return k + ", a floor of " + number_text(combine::kGateFloorCorrectedArcsec) +
+           " arcsec with both stages applied, " + number_text(combine::kGateFloorUncorrectedArcsec) + " otherwise";
+}
+
+namespace {
+
+std::string sigmas_text(const combine::HeadMounting& h) {
+    return number_text(h.sigma_cross_arcsec) + " across, " + number_text(h.sigma_about_arcsec) + " about";
+}
+
+// Why the tables of a target refuse the gate of a head in a head set (the
+// mountings passed check_mountings): its noise against the other heads'.
+std::string gate_refusal(const MountingsFile& m, const combine::Combiner<double>& c,
+                         const combine::CombinerConfig& cfg) {
+    const std::uint8_t h = c.problem_head();
+    std::string others;
+    for (std::uint8_t o = 0; o < kMaxHeads; ++o) {
+        if (o != h && has_head(c.problem_subset(), o)) {
+            others +=
+                (others.empty() ? "" : "; ") + std::string(1, head_name(o)) + " " + sigmas_text(m.mountings.head[o]);
+        }
+    }
+    return std::string("CHU ") + head_name(h) + ": its consistency gate in head set " +
+           head_letters(c.problem_subset()) +
+           " is beyond the fixed-point format a target builds it in (a factor above 2^28 per radian), so a target "
+           "refuses these mountings: its noise (" +
+           sigmas_text(m.mountings.head[h]) + " arcsec) is too small against the other heads' (" + others +
+           ") for a gate of " + number_text(cfg.gate_sigmas) + " sigmas and a floor of " +
+           number_text(cfg.gate_floor_arcsec) +
+           " arcsec; a target needs the heads' noise within a factor of about 100 of each other's (its gate "
+           "weighs one head's residual by the others' covariance)";
+}
+
+}  // namespace
+
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path, const GateOptions& gate) {
     const std::string name = text::input_name(path);
     if (!m.sigmas) {
         throw std::runtime_error(name +
@@ -157,18 +204,44 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path) 
         }
         throw std::runtime_error(name + ": " + combine::problem_text(p));
     }
+    for (const bool both_stages : {true, false}) {
+        const combine::CombinerConfig cfg = gate_config(gate, both_stages);
+        if (!combine::gate_config_valid(cfg)) {
+            throw std::runtime_error(std::string("the consistency gate: ") +
+                                     combine::problem_text(combine::MountingsProblem::kGateConfig) + ", given " +
+                                     number_text(cfg.gate_sigmas) + " sigmas and a floor of " +
+                                     number_text(cfg.gate_floor_arcsec) + " arcsec");
+        }
+        const combine::Combiner<double> c(m.mountings, cfg);
+        if (c.problem() == combine::MountingsProblem::kNone) {
+            continue;
+        }
+        const std::uint8_t h = c.problem_head();
+        const std::string why = c.problem() == combine::MountingsProblem::kGateOutOfRange && h < kMaxHeads
+                                    ? gate_refusal(m, c, cfg)
+                                    : std::string(combine::problem_text(c.problem()));
+        if (h < kMaxHeads && m.line[h] != 0) {
+            throw text::InputError(path, m.line[h], 1, why);
+        }
+        throw std::runtime_error(name + ": " + why);
+    }
 }
 
 struct CombineStage::Impl {
-    Impl(const MountingsFile& mountings, AtomicFile& out_file, std::string file_name, std::ostream& log, Mode mode_)
+    Impl(const MountingsFile& mountings, const GateOptions& gate, AtomicFile* out_file,
+         std::vector<AttitudeRow>* out_rows, std::string file_name, std::ostream& log, Mode mode_)
         : m(mountings),
-          combiner(mountings.mountings),
+          corrected(mountings.mountings, gate_config(gate, true)),
+          uncorrected(mountings.mountings, gate_config(gate, false)),
           out(out_file),
+          rows_out(out_rows),
           file(std::move(file_name)),
           diag(log),
-          mode(out.streamed() ? Mode::kKeep : mode_) {
-        buf += kCombinedHeader;
-        buf += '\n';
+          mode(out == nullptr || out->streamed() ? Mode::kKeep : mode_) {
+        if (out != nullptr) {
+            buf += kCombinedHeader;
+            buf += '\n';
+        }
     }
 
     void add(const CorrectedRow& r) {
@@ -205,8 +278,7 @@ struct CombineStage::Impl {
             epochs.close();
         }
         epoch.clear();
-        out.write(buf);
-        buf.clear();
+        flush();
         diag.summarize();
         finish_steps();
     }
@@ -231,8 +303,9 @@ struct CombineStage::Impl {
         }
     }
 
-    // A usable row without a stage applied to another usable row of the epoch.
-    void mark_missing_stages(std::vector<Kept>& rows) {
+    // A usable row without a stage applied to another usable row of the
+    // epoch; returns the epoch's stages.
+    std::uint8_t mark_missing_stages(std::vector<Kept>& rows) {
         std::uint8_t stages = 0;
         for (const Kept& k : rows) {
             stages = static_cast<std::uint8_t>(stages | (k.why == LeftOut::kUsed ? k.stages : 0U));
@@ -246,6 +319,7 @@ struct CombineStage::Impl {
                                                  std::to_string(stages) + "): left out (status 4)");
             }
         }
+        return stages;
     }
 
     void report_left_out(const Kept& k) {
@@ -267,8 +341,8 @@ struct CombineStage::Impl {
     }
 
     // The full set's epoch combined again with each proper subset (HeadSetStep).
-    void add_steps(const combine::HeadAttitude<double>* heads, std::uint8_t n, const Quaternion<double>& q_full,
-                   double t) {
+    void add_steps(const combine::Combiner<double>& combiner, const combine::HeadAttitude<double>* heads,
+                   std::uint8_t n, const Quaternion<double>& q_full, double t) {
         if (!any_epoch) {
             t_first = t;
             any_epoch = true;
@@ -332,7 +406,9 @@ struct CombineStage::Impl {
             return a.head < b.head || (a.head == b.head && a.line < b.line);
         });
         mark_duplicates(rows);
-        mark_missing_stages(rows);
+        // The epoch's gate by its stages (GateOptions): a raw file's rows have none.
+        const combine::Combiner<double>& combiner =
+            mark_missing_stages(rows) == kStagesApplied ? corrected : uncorrected;
         combine::HeadAttitude<double> heads[kMaxHeads];
         std::size_t used_row[kMaxHeads] = {};
         std::uint8_t n = 0;
@@ -369,7 +445,7 @@ struct CombineStage::Impl {
             row.sigma_arcsec = {s[0], s[1], s[2]};
         }
         if (c.used == mounted && head_count(mounted) >= 2) {
-            add_steps(heads, n, c.q_crf_icrf, row.t);
+            add_steps(combiner, heads, n, c.q_crf_icrf, row.t);
         }
         for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
             sum.status_bit[b] += (row.status >> b) & 1U;
@@ -377,14 +453,25 @@ struct CombineStage::Impl {
         ++sum.epochs;
         append_combined_row(buf, row);
         if (buf.size() > (1U << 20)) {
-            out.write(buf);
-            buf.clear();
+            flush();
         }
     }
 
+    // The rows written so far into the file, or read back into rows_out.
+    void flush() {
+        if (out != nullptr) {
+            out->write(buf);
+        } else {
+            read_combined_rows(buf, *rows_out);
+        }
+        buf.clear();
+    }
+
     const MountingsFile& m;
-    combine::Combiner<double> combiner;
-    AtomicFile& out;
+    combine::Combiner<double> corrected;    // the gate of epochs with both stages applied
+    combine::Combiner<double> uncorrected;  // of the others (the same tables but the gate's)
+    AtomicFile* out;                        // the file, or
+    std::vector<AttitudeRow>* rows_out;     // the rows
     std::string file;
     Diagnostics diag;
     Mode mode;
@@ -398,14 +485,19 @@ struct CombineStage::Impl {
         std::size_t n = 0;
         std::array<double, 3> sum{};
     };
-    std::uint32_t mounted = combiner.mounted();
+    std::uint32_t mounted = corrected.mounted();
     std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
     double t_first = 0.0;
     bool any_epoch = false;
 };
 
-CombineStage::CombineStage(const MountingsFile& m, AtomicFile& out, std::string file, std::ostream& log, Mode mode)
-    : impl_(std::make_unique<Impl>(m, out, std::move(file), log, mode)) {}
+CombineStage::CombineStage(const MountingsFile& m, const GateOptions& gate, AtomicFile& out, std::string file,
+                           std::ostream& log, Mode mode)
+    : impl_(std::make_unique<Impl>(m, gate, &out, nullptr, std::move(file), log, mode)) {}
+
+CombineStage::CombineStage(const MountingsFile& m, const GateOptions& gate, std::vector<AttitudeRow>& rows,
+                           std::string file, std::ostream& log)
+    : impl_(std::make_unique<Impl>(m, gate, nullptr, &rows, std::move(file), log, Mode::kKeep)) {}
 
 CombineStage::~CombineStage() = default;
 
@@ -440,7 +532,7 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
 
 CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, OutputSet& outputs, std::ostream& log,
                             CombineStage::Mode mode) {
-    CombineStage stage(m, outputs["--out"], opt.in, log, mode);
+    CombineStage stage(m, opt.gate, outputs["--out"], opt.in, log, mode);
     for_each_corrected_row(
         opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
     stage.finish();
@@ -482,18 +574,19 @@ std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, co
 }
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, std::ostream& log) {
+                                      const std::string& combined, std::ostream& log, const GateOptions& gate) {
     OutputSet outputs(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
-    CorrectAndCombine r = correct_and_combine(opt, mountings, combined, outputs, log);
+    CorrectAndCombine r = correct_and_combine(opt, mountings, combined, outputs, log, gate);
     outputs.commit();
     return r;
 }
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, OutputSet& outputs, std::ostream& log) {
+                                      const std::string& combined, OutputSet& outputs, std::ostream& log,
+                                      const GateOptions& gate) {
     refuse_output_over_input(correct_and_combine_inputs(opt, mountings), correct_and_combine_outputs(opt, combined));
     const MountingsFile m = read_mountings_file(mountings);
-    refuse_unusable_mountings(m, mountings);
+    refuse_unusable_mountings(m, mountings, gate);
     // Self-calibration protects the combined attitude of these mountings (the
     // rule `combined`, docs/contract.md, "The common rotation").
     CorrectOptions run = opt;
@@ -501,7 +594,7 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
         run.common_rotation = pipeline::common_rotation_weights(m.mountings);  // sigmas: refused above without
     }
     const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
-        CombineStage stage(m, outputs["--combined"], opt.in, to, mode);
+        CombineStage stage(m, gate, outputs["--combined"], opt.in, to, mode);
         CorrectAndCombine r;
         r.corrected = correct_file(run, outputs, to, &stage);
         r.combined = stage.summary();
@@ -583,7 +676,7 @@ CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::
     if (!m.sigmas) {
         m = with_estimated_noise(m, opt.in, opt.mountings, log);
     }
-    refuse_unusable_mountings(m, opt.mountings);
+    refuse_unusable_mountings(m, opt.mountings, opt.gate);
     // The first pass's messages wait: if it stops at a row out of order, the
     // second pass says them again (into the outputs opened anew).
     std::ostringstream first;

@@ -293,4 +293,17 @@ bool TruthReader::next(AttitudeRow& row) {
     return true;
 }
 
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows) {
+    static const std::string kName = "combined rows";
+    bool combined = false;
+    const Columns c = columns_of(Header(kCombinedHeader, kName), kName, combined);
+    RowParser parser(kName, c, combined);
+    while (!text.empty()) {
+        const std::size_t end = text.find('\n');
+        const std::string_view line = text.substr(0, end);
+        rows.push_back(parser.parse(line, rows.size() + 2U));  // line 1: the header the file would have
+        text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1U);
+    }
+}
+
 }  // namespace ascorr::host

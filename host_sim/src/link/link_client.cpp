@@ -448,7 +448,7 @@ void LinkClient<T>::send_calib_model(const ModelCoefficients& m, bool load) {
 }
 
 template <typename T>
-void LinkClient<T>::load_mountings(const combine::Mountings& m) {
+void LinkClient<T>::load_mountings(const combine::Mountings& m, const combine::CombinerConfig& gate) {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         const combine::HeadMounting& hm = m.head[h];
         link::MountingLoad f{};
@@ -458,6 +458,7 @@ void LinkClient<T>::load_mountings(const combine::Mountings& m) {
         f.q_chu_crf = hm.present ? hm.q_chu_crf : Quaternion<double>{1.0, 0.0, 0.0, 0.0};
         f.sigma_cross_arcsec = hm.present ? hm.sigma_cross_arcsec : 1.0;
         f.sigma_about_arcsec = hm.present ? hm.sigma_about_arcsec : 1.0;
+        f.gate = gate;
         update({link::MessageType::kMountingLoad, encoded(f), "mountings load"});
     }
     combining_ = true;

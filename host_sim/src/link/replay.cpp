@@ -246,10 +246,10 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
 template <typename T>
 class EpochCombination {
 public:
-    EpochCombination(const MountingsFile& m, LinkClient<T>& client, link::LinkPipeline<T>& host, std::string file,
-                     std::ostream& log)
-        : client_(client), host_(host), combiner_(m.mountings), file_(std::move(file)), log_(log) {
-        client_.load_mountings(m.mountings);
+    EpochCombination(const MountingsFile& m, const combine::CombinerConfig& gate, LinkClient<T>& client,
+                     link::LinkPipeline<T>& host, std::string file, std::ostream& log)
+        : client_(client), host_(host), combiner_(m.mountings, gate), file_(std::move(file)), log_(log) {
+        client_.load_mountings(m.mountings, gate);
         host_.use_combiner(&combiner_);
         text_ = std::string(kCombinedHeader) + "\n";
     }
@@ -677,8 +677,10 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     calib::CommonRotationWeights rule{};
     if (!opt.combined.empty()) {
         const MountingsFile m = read_mountings_file(opt.mountings);
-        refuse_unusable_mountings(m, opt.mountings);
-        combination.emplace(m, client, host.pipeline, opt.in, log);
+        refuse_unusable_mountings(m, opt.mountings, opt.gate);
+        // Every row the target averages has both stages (a row without one
+        // it was asked for is not usable): one gate for the run.
+        combination.emplace(m, gate_config(opt.gate, true), client, host.pipeline, opt.in, log);
         rule = pipeline::common_rotation_weights(m.mountings);
     }
     start_host(opt, rows, mf, model_t, client, host, sum, rule);

@@ -37,14 +37,16 @@
 //     residual r_i = θ_i − θ̂_{S∖i} (its estimate against the others'
 //     combination) is normalised by its covariance plus a floor:
 //        d_i² = r_iᵀ (C_i + P_{S∖i}⁻¹ + f² I)⁻¹ r_i,
-//     and the head is inconsistent when d_i > k (CombinerConfig: k = 6,
-//     f = 10″). The floor makes the gate trip only on gross errors: never
-//     below k·f = 60″ whatever the heads' σ, so not on the 2–3″ by which
-//     heads disagree without the thermal correction, nor on misaligned
-//     mountings of a few tens of arcsec; with the covariance, not on noise
-//     (5σ of one head gives d² ≤ 25 < 36). With σc = 1.3″, σa = 9″ it
-//     surely trips beyond k·sqrt(σa² + σa² + f²) ≈ 97″ (two heads) and ~82″
-//     (three): a head 200″ off is always caught. With three or more heads,
+//     and the head is inconsistent when d_i > k (CombinerConfig: k = 6;
+//     the floor f by what the rows have been through, default_gate below).
+//     The floor keeps what the heads' noise does not describe inside the
+//     gate: with f = 10″ (rows without both stages) it never trips below
+//     k·f = 60″, so not on the differential aberration (up to ~29″) nor on
+//     the 2–3″ of uncorrected deformation; with f = 2″ (both stages) a head
+//     40″ off across its boresight is caught (tests: CombineGate). With the
+//     covariance, not on noise (5σ of one head gives d² ≤ 25 < 36). With
+//     σc = 1.3″, σa = 9″ and f = 10″ it surely trips beyond
+//     k·sqrt(σa² + σa² + f²) ≈ 97″ (two heads) and ~82″ (three). With three or more heads,
 //     of the heads beyond the gate the one whose removal leaves the others
 //     most consistent (the smallest largest d² of the rest, each found by the
 //     same tables) is left out, and the gate is run again on the rest: at
@@ -95,6 +97,21 @@ struct CombinerConfig {
     double gate_floor_arcsec = 10.0;
 };
 
+// The gate's default follows what the rows have been through (the
+// contract's "The consistency gate"). With the aberration and the thermal
+// stage applied, the heads disagree by their noise and what the thermal model
+// leaves (about 0.5″, method.md §3.3): a floor of 2″ keeps that far inside
+// the gate (k·f = 12″, and the covariance adds to it) and catches a head 40″
+// off across its boresight (20″ where the other heads' weak axes allow). Without both stages they disagree also by the
+// differential aberration (up to 2·20.5″·sin(angle/2) between two
+// boresights, ~29″ at 90°) and the bench's uncorrected deformation: 10″.
+inline constexpr double kGateFloorCorrectedArcsec = 2.0;
+inline constexpr double kGateFloorUncorrectedArcsec = 10.0;
+
+constexpr CombinerConfig default_gate(bool both_stages_applied) noexcept {
+    return {6.0, both_stages_applied ? kGateFloorCorrectedArcsec : kGateFloorUncorrectedArcsec};
+}
+
 inline constexpr double kMinGateSigmas = 3.0;
 inline constexpr double kMaxGateSigmas = 100.0;
 inline constexpr double kMinGateFloorArcsec = 1.0;
@@ -140,6 +157,8 @@ public:
     bool valid() const noexcept { return problem_ == MountingsProblem::kNone; }
     MountingsProblem problem() const noexcept { return problem_; }
     std::uint8_t problem_head() const noexcept { return problem_head_; }
+    // kGateOutOfRange: the head set whose gate of problem_head() is beyond the format.
+    HeadMask problem_subset() const noexcept { return problem_subset_; }
     HeadMask mounted() const noexcept { return mounted_; }
 
     // Formal 1σ about CRF x, y, z (arcsec) of the combination of `subset`
@@ -187,6 +206,7 @@ private:
     };
     Vector3<T> estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept;
     GateResult gate_group(const Epoch& e, std::uint8_t group, HeadMask s, const Vector3<T>& est) const noexcept;
+    bool within_gate(HeadMask s, std::uint8_t head, const Vector3<T>& r, const Vector3<T>* h) const noexcept;
     std::uint8_t odd_one_out(const Epoch& e, std::uint8_t failing) const noexcept;
     bool gate(Epoch& e, Vector3<T>* est) const noexcept;
     bool combine_group(Epoch& e, Vector3<T>* est) const noexcept;
@@ -195,6 +215,7 @@ private:
 
     MountingsProblem problem_ = MountingsProblem::kNoHead;
     std::uint8_t problem_head_ = kUnknownHead;
+    HeadMask problem_subset_ = 0;
     HeadMask mounted_ = 0;
     T near2_{};                                    // sin²(kGrossAngleRad/2)
     T one_minus_near2_{};                          // cos²(kGrossAngleRad/2)
@@ -271,8 +292,8 @@ void Combiner<T>::build(const Mountings& m, const CombinerConfig& cfg) noexcept 
     }
     for (unsigned sub = 1; sub < kSubsetCount; ++sub) {
         if ((sub & ~unsigned{mounted_}) == 0U && !build_subset(m, static_cast<HeadMask>(sub), cfg)) {
-            problem_ = MountingsProblem::kGateOutOfRange;
-            problem_head_ = kUnknownHead;
+            problem_ = MountingsProblem::kGateOutOfRange;  // problem_head_ set by build_subset
+            problem_subset_ = static_cast<HeadMask>(sub);
             return;
         }
     }
@@ -325,6 +346,7 @@ bool Combiner<T>::build_subset(const Mountings& m, HeadMask s, const CombinerCon
             bias[r] += g.gain[h].m[r][0] * e.x + g.gain[h].m[r][1] * e.y + g.gain[h].m[r][2] * e.z;
         }
         if (several && !build_gate(m, s, h, cfg)) {
+            problem_head_ = h;
             return false;
         }
     }
@@ -430,13 +452,15 @@ bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude
         accumulate(acc, table_[s].gain[heads[i].head], h[i]);
     }
     const Vector3<T> est = result(acc);
+    // The reference's residual is 0 − est (gate_group's, its h being zero).
     // The reference's residual is 0 − est: its square is est's, bit for bit.
-    if (!quick_gate(est, table_[s].quick[heads[0].head])) {
+    if (!quick_gate(est, table_[s].quick[heads[0].head]) && !within_gate(s, heads[0].head, est, nullptr)) {
         return false;
     }
     ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 1; i < n; ++i) {
-        if (!quick_gate(residual(h[i], est), table_[s].quick[heads[i].head])) {
+        const Vector3<T> r = residual(h[i], est);
+        if (!quick_gate(r, table_[s].quick[heads[i].head]) && !within_gate(s, heads[i].head, r, &h[i])) {
             return false;
         }
     }
@@ -447,6 +471,23 @@ bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude
     out->subset = s;
     out->status = combined_status::kTwoOrMoreHeads;
     return true;
+}
+
+// A head of the usual epoch beyond the quick test (which implies the gross
+// gate, quick_bound): within the gross gate of the reference (h, its
+// half-angle difference, linearise's test; none for the reference, whose
+// residual is then 0 − r) and within the statistic, gate_group's to the bit.
+// A gate anisotropic enough that the quick test fails on noise (a small
+// floor, combine::default_gate) then costs the statistic, not the general
+// path; out of line, as the usual epoch with the usual gate never gets here.
+template <typename T>
+__attribute__((noinline)) bool Combiner<T>::within_gate(HeadMask s, std::uint8_t head, const Vector3<T>& r,
+                                                        const Vector3<T>* h) const noexcept {
+    constexpr T zero = constant<T>(0.0);
+    if (h == nullptr) {
+        return !gate_exceeds(gate_value(table_[s].gate[head], residual(Vector3<T>{zero, zero, zero}, r)));
+    }
+    return within_near(*h, near2_) && !gate_exceeds(gate_value(table_[s].gate[head], r));
 }
 
 // Step 1: the candidates, each as its CRF estimate q_crf_icrf_i.

@@ -36,12 +36,15 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "ascorr/combine/combiner.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
 
 namespace ascorr::host {
@@ -106,14 +109,32 @@ struct RowsOutOfOrder {
     std::size_t line;
 };
 
+// The consistency gate (combine/combiner.hpp; the contract's "The consistency
+// gate"). Unset: each epoch's gate follows its stages (combine::default_gate:
+// a floor of 2″ with the aberration and the thermal stage applied, 10″
+// otherwise); set: the same for every epoch.
+struct GateOptions {
+    std::optional<double> sigmas;        // k, [3, 100]
+    std::optional<double> floor_arcsec;  // f, [1, 3600] arcsec
+};
+// The gate of an epoch whose usable rows have (both_stages) or lack both stages.
+combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noexcept;
+// What --gate-floor and --gate-sigmas say in a message ("a floor of 2 arcsec ...").
+std::string describe(const GateOptions& g);
+
 // Rows in, one combined row per epoch out (see the top).
 class CombineStage : public CorrectedRowSink {
 public:
     enum class Mode { kStream, kKeep };
     // Writes into out (an output of the run's OutputSet, committed by the
-    // caller); m: usable mountings with sigmas. file: the input's name, for
-    // messages.
-    CombineStage(const MountingsFile& m, AtomicFile& out, std::string file, std::ostream& log, Mode mode);
+    // caller); m: usable mountings with sigmas (refuse_unusable_mountings
+    // with the same gate). file: the input's name, for messages.
+    CombineStage(const MountingsFile& m, const GateOptions& gate, AtomicFile& out, std::string file, std::ostream& log,
+                 Mode mode);
+    // The same into rows (Mode::kKeep), each as a reader of the combined file
+    // reads it (as_written): no file at all.
+    CombineStage(const MountingsFile& m, const GateOptions& gate, std::vector<AttitudeRow>& rows, std::string file,
+                 std::ostream& log);
     ~CombineStage() override;
     CombineStage(const CombineStage&) = delete;
     CombineStage& operator=(const CombineStage&) = delete;
@@ -136,6 +157,7 @@ struct CombineOptions {
     std::string in;         // corrected or solutions file
     std::string mountings;  // with sigmas
     std::string out;
+    GateOptions gate;
 };
 
 // `ascorr combine`. Mountings without sigmas: each head's noise is estimated
@@ -151,10 +173,13 @@ std::vector<NamedPath> combine_outputs(const CombineOptions& opt);
 // caller; a run made again on rows out of order opens them anew).
 CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::ostream& log);
 
-// Refuses mountings the combiner cannot use (InputError at the head's line,
-// or std::runtime_error for the head set), or without sigmas
-// (correct --combined: the noise cannot be estimated before the rows are corrected).
-void refuse_unusable_mountings(const MountingsFile& m, const std::string& path);
+// Refuses mountings the combiner cannot use with the gate (InputError at the
+// head's line, or std::runtime_error for the head set), or without sigmas
+// (correct --combined: the noise cannot be estimated before the rows are
+// corrected). The tables are those a target builds (Combiner<double> refuses
+// what the fixed-point formats cannot hold), for both defaults of the gate
+// when it is unset: what a target would refuse is refused here, and why.
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path, const GateOptions& gate = {});
 
 // `ascorr correct ... --mountings M --combined A`: corrects (correct_file) and
 // combines the corrected rows in the same pass; the corrected file, the model
@@ -166,12 +191,13 @@ struct CorrectAndCombine {
     CombineSummary combined;
 };
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, std::ostream& log);
+                                      const std::string& combined, std::ostream& log, const GateOptions& gate = {});
 // The run's files: correct_inputs and "--mountings"; correct_outputs and "--combined".
 std::vector<NamedPath> correct_and_combine_inputs(const CorrectOptions& opt, const std::string& mountings);
 std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, const std::string& combined);
 // The same into outputs (opened from correct_and_combine_outputs, committed by the caller).
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, OutputSet& outputs, std::ostream& log);
+                                      const std::string& combined, OutputSet& outputs, std::ostream& log,
+                                      const GateOptions& gate = {});
 
 }  // namespace ascorr::host

@@ -18,6 +18,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "ascorr/core/quaternion.hpp"
 
@@ -42,6 +43,10 @@ struct AttitudeRow {
 void append_attitude_row(std::string& out, double t, const Quaternion<double>& q_crf_icrf);
 // Appends the combined file's row (with its line end).
 void append_combined_row(std::string& out, const AttitudeRow& row);
+// The rows of `text` (append_combined_row's, no header) as a reader of the
+// combined file reads them (q to 15 decimals), appended to rows: a
+// combination kept in memory gives the file's numbers to the digit.
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows);
 
 // Reads an attitude or a combined file (told apart by the header:
 // combined()), row by row in file order, in blocks (bounded memory). Throws

@@ -108,7 +108,9 @@ public:
     // each call of combine_epoch() has the target combine the solutions it
     // corrected since the previous call. A restart while combining is an
     // error (restore() refuses it): the epoch's solutions are lost with it.
-    void load_mountings(const combine::Mountings& m);
+    // gate: the consistency gate of the target's combiner (sent only when it
+    // is not CombinerConfig{}'s, combine_messages.hpp).
+    void load_mountings(const combine::Mountings& m, const combine::CombinerConfig& gate = {});
     link::Combined<T> combine_epoch();
 
     const LinkStats& stats() const { return stats_; }

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 
 namespace ascorr::host {
@@ -55,6 +56,7 @@ struct ReplayOptions {
     std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
     std::string mountings;                 // --mountings: with --combined, the combiner's (sigmas given)
     std::string combined;                  // --combined: the target's combined attitude per epoch; empty: none
+    GateOptions gate;                      // --gate-sigmas, --gate-floor: the target combiner's gate
     double inject_errors = 0.0;            // fraction of frames faulted, each direction
     bool realtime = false;                 // pace by the rows' t instead of as fast as the link allows
     int timeout_ms = 0;                    // before a resend; 0: the target's default (serial 500, qemu 20, loopback 1)
