@@ -28,11 +28,14 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/constants.hpp"
+#include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
 #include "cli_run.hpp"
 
@@ -380,6 +383,126 @@ TEST(AlignMission, FittedModelAndAlignLeaveNoStepWhenAHeadDrops) {
 
 // ---- Refusals: exit 2, naming what and where
 
+// ---- What align refuses or leaves out (issue 37, classes 2, 3 and 7)
+
+// The noise mission's rows, changed by `change` (which may drop a row by
+// returning false), as a row source.
+CorrectedRowSource changed_rows(const std::function<bool(CorrectedRow&)>& change) {
+    auto kept = std::make_shared<std::vector<CorrectedRow>>();
+    rows_of_file(noise_mission().corrected)([&](const CorrectedRow& r) {
+        CorrectedRow c = r;
+        if (change(c)) {
+            kept->push_back(c);
+        }
+    });
+    return [kept](const std::function<void(const CorrectedRow&)>& fn) {
+        for (const CorrectedRow& r : *kept) {
+            fn(r);
+        }
+    };
+}
+
+// q turned by `arcsec` about the head's own x axis (CHU axes, on the left).
+Quaternion<double> turned_about_x(const Quaternion<double>& q, double arcsec) {
+    const double half = 0.5 * arcsec * kArcsecToRad;
+    return Quaternion<double>{std::cos(half), std::sin(half), 0.0, 0.0} * q;
+}
+
+AlignReport align_changed(const CorrectedRowSource& rows, const GateOptions& gate = {}) {
+    MountingsFile given = noise_mission().truth;
+    given.sigmas = false;
+    AlignOptions opt;
+    opt.in = "changed.csv";
+    opt.gate = gate;
+    return align_rows(rows, opt.in, given, opt);
+}
+
+TEST(AlignMission, OutliersOfOneHeadAreLeftOutByTheCombinationsGate) {
+    // 2 % of A's rows 300 arcsec off: rows combine leaves out as inconsistent.
+    // Before: A's sigma_cross 28.8 arcsec (truth 1.5), its mounting 6.7 off.
+    std::mt19937 rng(2);
+    std::size_t bad = 0;
+    const auto outliers = [&](CorrectedRow& r) {
+        if (r.head == 0 && std::uniform_real_distribution<double>(0.0, 1.0)(rng) < 0.02) {
+            r.q_chu_icrf = turned_about_x(r.q_chu_icrf, 300.0);
+            ++bad;
+        }
+        return true;
+    };
+    const CorrectedRowSource rows = changed_rows(outliers);
+    const AlignReport r = align_changed(rows);
+    const AlignReport clean = noise_mission().report;
+    ASSERT_GT(bad, 100U);
+    EXPECT_GE(r.rows_left_out[static_cast<std::size_t>(LeftOut::kInconsistent)], bad);
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        SCOPED_TRACE(std::string("CHU ") + kHeadLetters[h]);
+        EXPECT_NEAR(r.head[h].noise.sigma_cross_arcsec, clean.head[h].noise.sigma_cross_arcsec,
+                    2.0 * r.head[h].noise.sd_cross_arcsec);
+        EXPECT_NEAR(r.head[h].noise.sigma_about_arcsec, clean.head[h].noise.sigma_about_arcsec,
+                    2.0 * r.head[h].noise.sd_about_arcsec);
+        for (Eigen::Index a = 0; a < 3; ++a) {
+            EXPECT_NEAR(r.head[h].rotation_arcsec(a), clean.head[h].rotation_arcsec(a),
+                        2.0 * r.head[h].rotation_sd_arcsec(a));
+        }
+    }
+    // Mutation: a gate that never trips (100 sigmas, a floor of 3600") gives
+    // the outliers' noise.
+    const AlignReport open = align_changed(rows, GateOptions{100.0, 3600.0});
+    EXPECT_GT(open.head[0].noise.sigma_cross_arcsec, 10.0);
+    std::printf("%zu outliers of 300 arcsec in A: sigma_cross %.3f (gated), %.3f (not), clean %.3f\n", bad,
+                r.head[0].noise.sigma_cross_arcsec, open.head[0].noise.sigma_cross_arcsec,
+                clean.head[0].noise.sigma_cross_arcsec);
+}
+
+TEST(AlignMission, NoiseTheDataDoNotDetermineIsRefused) {
+    // C in 4 epochs only: before, sigma_cross 0.011 +- 328 arcsec and exit 0.
+    std::size_t c_rows = 0;
+    const CorrectedRowSource rows = changed_rows([&](CorrectedRow& r) { return r.head != 2 || ++c_rows <= 4; });
+    try {
+        (void)align_changed(rows);
+        ADD_FAILURE() << "accepted";
+    } catch (const AlignRefused& e) {
+        // Which head's noise comes out undetermined depends on what the rest
+        // can separate (here B's, as A and B are then mostly alone).
+        EXPECT_NE(std::string(e.what()).find(": its noise is not determined by the data"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(AlignMission, NoiseOutsideTheMountingsFilesRangeIsRefused) {
+    // Every head sees the truth exactly (noise-free), or with 1500" of noise:
+    // before, sigmas of 1e-9 and 1527 arcsec that combine then refused.
+    const fs::path dir = fs::path(noise_mission().corrected).parent_path();
+    std::map<std::int64_t, Quaternion<double>> truth;
+    {
+        AttitudeReader a((dir / "mission.csv.attitude.csv").string());
+        for (AttitudeRow row; a.next(row);) {
+            truth[epoch_key(row.t)] = row.q_crf_icrf;
+        }
+    }
+    const MountingsFile& m = noise_mission().truth;
+    const CorrectedRowSource exact = changed_rows([&](CorrectedRow& r) {
+        r.q_chu_icrf = m.mountings.head[r.head].q_chu_crf * truth.at(epoch_key(r.t));
+        return true;
+    });
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, 1500.0);
+    const CorrectedRowSource loud = changed_rows([&](CorrectedRow& r) {
+        r.q_chu_icrf = turned_about_x(r.q_chu_icrf, noise(rng));
+        return true;
+    });
+    const std::pair<const CorrectedRowSource*, const char*> cases[] = {{&exact, "carry no noise"},
+                                                                       {&loud, "is not determined by the data"}};
+    for (const auto& [rows, says] : cases) {
+        try {
+            (void)align_changed(*rows);
+            ADD_FAILURE() << "accepted: " << says;
+        } catch (const AlignRefused& e) {
+            EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(AlignCli, RefusesBadInputWithExit2NamingFileAndLine) {
     const NoiseMission& m = noise_mission();
     const fs::path dir = scratch("cli");
@@ -411,6 +534,11 @@ TEST(AlignCli, RefusesBadInputWithExit2NamingFileAndLine) {
         {" --in " + (dir / "dup.csv").string() + " --out " + (dir / "m2.csv").string() + " --mountings " +
              (dir / "truth.csv").string(),
          "dup.csv:3:1: second solution of CHU A"},
+        // A window whose index of an epoch would not fit an integer (was: an
+        // out-of-range cast before the refusal), and one beyond the range.
+        {in + " --mountings " + (dir / "truth.csv").string() + " --noise-window 1e-300",
+         "--noise-window 1e-300: expected 0 (one mean over the period) or a window in [0.01, 1e+10] s"},
+        {in + " --mountings " + (dir / "truth.csv").string() + " --noise-window 1e300", "--noise-window"},
     };
     for (const Case& c : cases) {
         const test::CliRun r = test::run_here("align" + c.args, dir);

@@ -1,8 +1,8 @@
-#include <cmath>
 #include <iostream>
 #include <memory>
 
 #include "ascorr_host/analysis/align.hpp"
+#include "ascorr_host/analysis/combine.hpp"
 #include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
@@ -30,11 +30,12 @@ void add_align_command(CLI::App& app) {
                     "window (s) of the slowly varying mean the noise is measured about, 0: one mean over the period "
                     "(default " +
                         std::to_string(static_cast<int>(host::kDefaultNoiseWindowS)) + ")")
-        ->check(real_in(0.0, HUGE_VAL, End::kClosed, End::kOpen));
+        ->check(real_in(0.0, host::kMaxNoiseWindowS));
     cmd->add_option(
            "--min-epochs", opt->min_epochs,
            "fewest epochs with two or more usable heads (default " + std::to_string(host::kMinAlignEpochs) + ")")
         ->transform(integer_in<std::size_t>(2));
+    add_gate_options(*cmd, opt->gate, nullptr);
     cmd->callback([opt]() {
         host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}},
                                                  {{"--out", opt->out}, host::kStandardOutput});

@@ -348,6 +348,8 @@ def align(
     t_to: Optional[float] = ...,
     noise_window: float = ...,
     min_epochs: int = ...,
+    gate_sigmas: Optional[float] = ...,
+    gate_floor: Optional[float] = ...,
 ) -> tuple[_Mountings, dict[str, Any]]:
     """Estimate each head's mounting and noise from the data, as `ascorr align`, keeping
     the CRF of the given mountings: the new mountings differ from the given ones by
@@ -358,7 +360,9 @@ def align(
     read_mountings() returns (sigmas, if any, are not used). t_from, t_to: the period
     (s since J2000 TT; None: the whole data). noise_window: the window (s) of the slowly
     varying mean the noise is measured about (0: one mean over the period). min_epochs:
-    the fewest epochs with two or more usable heads. Returns (mountings, report):
+    the fewest epochs with two or more usable heads. gate_sigmas, gate_floor: the
+    combination's consistency gate, as combine()'s, applied from the second pass on (a
+    head it finds inconsistent is left out of the sums). Returns (mountings, report):
     mountings the new dict, with the estimated sigmas; report a dict (heads, rotation and
     rotation_sd (k, 3): each head's rotation from the given mounting in CRF axes and its
     formal 1-sigma, arcsec; sigma_cross, sd_cross, sigma_about, sd_about (k,): the

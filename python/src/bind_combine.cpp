@@ -254,7 +254,7 @@ py::dict report_dict(const host::AlignReport& r) {
 py::tuple align_arrays(const py::object& t, const py::object& chu, const py::object& q, const py::object& mountings,
                        const py::object& status, const py::object& flags, const py::object& confidence,
                        const py::object& t_from, const py::object& t_to, const py::object& noise_window,
-                       const py::object& min_epochs) {
+                       const py::object& min_epochs, const py::object& gate_sigmas, const py::object& gate_floor) {
     const host::MountingsFile m = mountings_arg(mountings);
     host::AlignOptions opt;
     opt.in = kArrayRows;
@@ -262,9 +262,13 @@ py::tuple align_arrays(const py::object& t, const py::object& chu, const py::obj
     opt.to = time_arg(t_to, "t_to");
     host::refuse_bad_time_range(opt.from, opt.to, "t_from", "t_to");  // as `ascorr align`: an empty period is refused
     opt.noise_window_s = real_arg(noise_window, "noise_window");
-    if (!(opt.noise_window_s >= 0.0 && std::isfinite(opt.noise_window_s))) {
-        bad_argument("noise_window", "expected a window in s, 0 or more and finite, got " + value_text(noise_window));
+    const double w = opt.noise_window_s;
+    if (!(w == 0.0 || (w >= host::kMinNoiseWindowS && w <= host::kMaxNoiseWindowS))) {
+        bad_argument("noise_window", "expected 0 or a window in [" + host::number_text(host::kMinNoiseWindowS) + ", " +
+                                         host::number_text(host::kMaxNoiseWindowS) + "] s, got " +
+                                         value_text(noise_window));
     }
+    opt.gate = gate_arg(gate_sigmas, gate_floor);
     opt.min_epochs = count_arg(min_epochs, "min_epochs");
     if (opt.min_epochs < 2) {
         bad_argument("min_epochs", "expected 2 or more, got " + value_text(min_epochs));
@@ -341,7 +345,7 @@ void bind_combine(py::module_& mod) {
     mod.def("align", &align_arrays, "t"_a, "chu"_a, "q"_a, "mountings"_a, "status"_a = py::none(),
             "flags"_a = py::none(), "confidence"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
             "noise_window"_a = host::kDefaultNoiseWindowS, "min_epochs"_a = host::kMinAlignEpochs,
-            docstring(docs::kAlign));
+            "gate_sigmas"_a = py::none(), "gate_floor"_a = py::none(), docstring(docs::kAlign));
 }
 
 }  // namespace ascorr::python

@@ -219,7 +219,9 @@ t, chu, q, status, flags, confidence: as combine()'s. mountings: a dict as
 read_mountings() returns (sigmas, if any, are not used). t_from, t_to: the period
 (s since J2000 TT; None: the whole data). noise_window: the window (s) of the slowly
 varying mean the noise is measured about (0: one mean over the period). min_epochs:
-the fewest epochs with two or more usable heads. Returns (mountings, report):
+the fewest epochs with two or more usable heads. gate_sigmas, gate_floor: the
+combination's consistency gate, as combine()'s, applied from the second pass on (a
+head it finds inconsistent is left out of the sums). Returns (mountings, report):
 mountings the new dict, with the estimated sigmas; report a dict (heads, rotation and
 rotation_sd (k, 3): each head's rotation from the given mounting in CRF axes and its
 formal 1-sigma, arcsec; sigma_cross, sd_cross, sigma_about, sd_about (k,): the

@@ -74,30 +74,76 @@ struct Judged {
     LeftOut why;
 };
 
-// One epoch into the sums: the epoch's stages (those applied to any usable
-// row: a usable row without one is left out, combine.hpp), each usable head's
-// CRF attitude.
-void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, AlignSums& sums, PassCounts& c) {
+// The epoch's stages: those applied to any usable row (a usable row without
+// one is left out, combine.hpp).
+StatusBits epoch_stages(const Epoch<Judged>& e) noexcept {
     StatusBits stages = 0U;
     for (const std::optional<Judged>& j : e.head) {
         if (j && j->why == LeftOut::kUsed && j->row.corrected) {
             stages = static_cast<StatusBits>(stages | (j->row.status & kStages));
         }
     }
+    return stages;
+}
+
+// The combination's consistency gate for a pass after the first: its tables
+// from the current mountings and the noise of the pass before, one for each
+// kind of epoch (the gate follows the epoch's stages, combine.hpp).
+class PassGate {
+public:
+    PassGate(const combine::Mountings& m, const GateOptions& g)
+        : corrected_(m, gate_config(g, true)), uncorrected_(m, gate_config(g, false)) {}
+    bool valid() const noexcept { return corrected_.valid() && uncorrected_.valid(); }
+
+    // The heads of the epoch still kLeftOut::kUsed that the gate finds
+    // inconsistent get LeftOut::kInconsistent.
+    void apply(const Epoch<Judged>& e, StatusBits stages, std::array<LeftOut, kMaxHeads>& why) const noexcept {
+        combine::HeadAttitude<double> heads[kMaxHeads];
+        std::uint8_t n = 0;
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            if (e.head[h] && why[h] == LeftOut::kUsed) {
+                heads[n++] = {e.head[h]->row.q_chu_icrf, h, true};
+            }
+        }
+        const combine::Combiner<double>& c = stages == kStages ? corrected_ : uncorrected_;
+        const combine::HeadMask out = n >= 2 ? c.combine(heads, n).inconsistent : combine::HeadMask{0};
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            why[h] = (out & combine::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
+        }
+    }
+
+private:
+    combine::Combiner<double> corrected_;
+    combine::Combiner<double> uncorrected_;
+};
+
+// One epoch into the sums: each usable head's CRF attitude (the rows the
+// gate, if any, leaves in).
+void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const PassGate* gate, AlignSums& sums,
+               PassCounts& c) {
+    const StatusBits stages = epoch_stages(e);
+    std::array<LeftOut, kMaxHeads> why{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (e.head[h]) {
+            const CorrectedRow& r = e.head[h]->row;
+            why[h] = e.head[h]->why;
+            if (why[h] == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
+                why[h] = LeftOut::kStageMissing;
+            }
+        }
+    }
+    if (gate != nullptr) {
+        gate->apply(e, stages, why);
+    }
     std::array<std::optional<Quaternion<double>>, kMaxHeads> q_crf_icrf{};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if (!e.head[h]) {
             continue;
         }
-        const CorrectedRow& r = e.head[h]->row;
-        LeftOut why = e.head[h]->why;
-        if (why == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
-            why = LeftOut::kStageMissing;
-        }
-        ++c.left_out[static_cast<std::size_t>(why)];
-        ++c.head_left_out[h][static_cast<std::size_t>(why)];
-        if (why == LeftOut::kUsed) {
-            q_crf_icrf[h] = conjugate(q_chu_crf[h]) * r.q_chu_icrf;
+        ++c.left_out[static_cast<std::size_t>(why[h])];
+        ++c.head_left_out[h][static_cast<std::size_t>(why[h])];
+        if (why[h] == LeftOut::kUsed) {
+            q_crf_icrf[h] = conjugate(q_chu_crf[h]) * e.head[h]->row.q_chu_icrf;
         }
     }
     ++c.epochs;
@@ -155,8 +201,9 @@ private:
 
 // One pass over the rows (in time order) with the current mountings.
 void run_pass(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
-              const CurrentMountings& q_chu_crf, const AlignOptions& opt, AlignSums& sums, PassCounts& c) {
-    OrderedEpochs epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, sums, c); });
+              const CurrentMountings& q_chu_crf, const PassGate* gate, const AlignOptions& opt, AlignSums& sums,
+              PassCounts& c) {
+    OrderedEpochs epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, gate, sums, c); });
     rows([&](const CorrectedRow& r) {
         ++c.rows;
         if (!in_period(r.t, opt)) {
@@ -326,6 +373,12 @@ AlignReport start_report(const std::string& file, const MountingsFile& m, const 
     } catch (const std::invalid_argument& e) {
         throw AlignRefused(e.what());
     }
+    const double window = opt.noise_window_s;
+    if (!(window == 0.0 || (window >= kMinNoiseWindowS && window <= kMaxNoiseWindowS))) {
+        throw AlignRefused("--noise-window " + number_text(window) + ": expected 0 (one mean over the period) or " +
+                           "a window in [" + number_text(kMinNoiseWindowS) + ", " + number_text(kMaxNoiseWindowS) +
+                           "] s");
+    }
     AlignReport r;
     r.in = file;
     r.from = opt.from;
@@ -337,6 +390,73 @@ AlignReport start_report(const std::string& file, const MountingsFile& m, const 
                            " head: align needs two or more (their relative attitudes are its data)");
     }
     return r;
+}
+
+// x with four significant digits, for messages.
+std::string digits4(double x) {
+    char buf[32];
+    text::c_snprintf(buf, sizeof buf, "%.4g", x);
+    return buf;
+}
+
+// The gate left out the same rows in two passes: equal counts, or within a
+// thousandth of them (a row at the gate's edge may go either way as the
+// noise settles in its last digits).
+bool same_rows_gated(std::size_t now, std::size_t before) noexcept {
+    const std::size_t diff = now > before ? now - before : before - now;
+    return diff * 1000U <= std::max(now, before);
+}
+
+// The gate of the next pass: the current mountings with the noise just
+// estimated; none when the combination cannot use them (refused at the end).
+std::unique_ptr<PassGate> next_gate(const AlignReport& r, const CurrentMountings& q, const GateOptions& g) {
+    combine::Mountings m{};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (has_head(r.heads, h)) {
+            m.head[h] = {true, q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec};
+        }
+    }
+    auto gate = std::make_unique<PassGate>(m, g);
+    return gate->valid() ? std::move(gate) : nullptr;
+}
+
+// Noise the data do not determine (a formal 1σ above kMaxNoiseRelativeSd of
+// the σ), and mountings the combination could not use: refused, naming the
+// head and the numbers.
+void refuse_undetermined_noise(const AlignReport& r, const std::string& file, const AlignOptions& opt) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (!has_head(r.heads, h)) {
+            continue;
+        }
+        const HeadNoise& n = r.head[h].noise;
+        const std::string head = std::string("CHU ") + kHeadLetters[h];
+        if (n.sd_cross_arcsec > kMaxNoiseRelativeSd * n.sigma_cross_arcsec ||
+            n.sd_about_arcsec > kMaxNoiseRelativeSd * n.sigma_about_arcsec || !std::isfinite(n.sd_cross_arcsec) ||
+            !std::isfinite(n.sd_about_arcsec)) {
+            throw AlignRefused(head + ": its noise is not determined by the data (sigma_cross " +
+                               digits4(n.sigma_cross_arcsec) + " +- " + digits4(n.sd_cross_arcsec) + ", sigma_about " +
+                               digits4(n.sigma_about_arcsec) + " +- " + digits4(n.sd_about_arcsec) + " arcsec from " +
+                               std::to_string(r.head[h].epochs) + " epochs with another head of " +
+                               text::input_name(file) + "): align needs each within " +
+                               number_text(100.0 * kMaxNoiseRelativeSd) + " % (more epochs of that head)");
+        }
+        for (const double sigma : {n.sigma_cross_arcsec, n.sigma_about_arcsec}) {
+            if (!(sigma >= combine::kMinSigmaArcsec && sigma <= combine::kMaxSigmaArcsec)) {
+                throw AlignRefused(head + ": its noise estimate " + digits4(sigma) +
+                                   " arcsec is outside the [0.001, 1000] arcsec a mountings file (and the "
+                                   "combination) takes: " +
+                                   (sigma < combine::kMinSigmaArcsec
+                                        ? "the heads' relative attitudes carry no noise (data simulated without it?)"
+                                        : "the heads do not see the same attitude") +
+                                   "; nothing written");
+            }
+        }
+    }
+    try {
+        refuse_unusable_mountings(r.aligned, text::input_name(file) + " (the mountings align estimated)", opt.gate);
+    } catch (const std::runtime_error& e) {
+        throw AlignRefused(e.what());
+    }
 }
 
 }  // namespace
@@ -352,20 +472,27 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
     Information w{};
     r.last_update_arcsec = std::numeric_limits<double>::infinity();
     CorrectedRowSource in_order = rows;
-    for (r.passes = 0; r.passes < kMaxAlignPasses && !(r.last_update_arcsec < kAlignToleranceArcsec);) {
+    std::unique_ptr<PassGate> gate;  // none in the first pass: no noise to gate with
+    std::size_t gated = 0;           // rows the pass before left out as inconsistent
+    for (bool settled = false; !settled;) {
+        if (r.passes == kMaxAlignPasses) {
+            throw AlignRefused("the mountings did not converge in " + std::to_string(kMaxAlignPasses) +
+                               " passes (the last turned a head by " + number_text(r.last_update_arcsec) +
+                               " arcsec, its gate left out " + std::to_string(gated) +
+                               " rows as inconsistent): are the given mountings within a degree of the heads'?");
+        }
         AlignSums sums(opt.noise_window_s);
         PassCounts c;
         try {
-            run_pass(in_order, file, m, q, opt, sums, c);
+            run_pass(in_order, file, m, q, gate.get(), opt, sums, c);
         } catch (const OutOfOrder&) {  // the first pass only: the sorted rows are in order
             in_order = sorted_rows(rows);
             r.rows_sorted = true;
             continue;
         }
-        if (++r.passes == 1) {
-            refuse_thin_data(file, sums, c, r.heads, opt);
-            count_into(r, sums, c);
-        }
+        ++r.passes;
+        refuse_thin_data(file, sums, c, r.heads, opt);
+        count_into(r, sums, c);
         a = estimate(sums, m, q, r, w);
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             if (has_head(r.heads, h)) {
@@ -373,13 +500,15 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
             }
         }
         r.last_update_arcsec = largest(a);
-    }
-    if (!(r.last_update_arcsec < kAlignToleranceArcsec)) {
-        throw AlignRefused("the mountings did not converge in " + std::to_string(kMaxAlignPasses) +
-                           " passes (the last turned a head by " + number_text(r.last_update_arcsec) +
-                           " arcsec): are the given mountings within a degree of the heads'?");
+        const std::size_t now = c.left_out[static_cast<std::size_t>(LeftOut::kInconsistent)];
+        // The first pass is never the last: the second has the gate (or none,
+        // when the combination cannot use the noise; refused below).
+        settled = r.passes > 1 && r.last_update_arcsec < kAlignToleranceArcsec && same_rows_gated(now, gated);
+        gated = now;
+        gate = next_gate(r, q, opt.gate);
     }
     finish_report(r, m, q, a, w);
+    refuse_undetermined_noise(r, file, opt);
     return r;
 }
 
@@ -423,7 +552,7 @@ std::string describe(const AlignReport& r) {
     if (r.rows_sorted) {
         s << "rows out of time order: sorted in memory (a file in time order streams)\n";
     }
-    s << "noise: REML from the heads' relative attitudes about their mean over " << fixed(r.noise_window_s, 0)
+    s << "noise: REML from the heads' relative attitudes about their mean over " << number_text(r.noise_window_s)
       << " s windows (" << fixed(r.noise.dof, 0) << " degrees of freedom), " << noise_model_text(r.noise.model) << ", "
       << r.noise.iterations << " iterations" << (r.noise.converged ? "" : " (not converged)") << "\n";
     s << "mountings: " << r.passes << " passes, last update " << number_text(r.last_update_arcsec)

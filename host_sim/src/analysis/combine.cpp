@@ -626,10 +626,11 @@ namespace {
 
 // m with each head's noise estimated from the rows of `in` (align_rows), reported on log.
 MountingsFile with_estimated_noise(const MountingsFile& m, const std::string& in, const std::string& path,
-                                   std::ostream& log) {
+                                   const GateOptions& gate, std::ostream& log) {
     AlignOptions ao;
     ao.in = in;
     ao.mountings = path;
+    ao.gate = gate;
     const AlignReport r = align_rows(rows_of_file(in), in, m, ao);
     MountingsFile out = m;
     out.sigmas = true;
@@ -674,7 +675,7 @@ CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::
     refuse_output_over_input(combine_inputs(opt), combine_outputs(opt));
     MountingsFile m = read_mountings_file(opt.mountings);
     if (!m.sigmas) {
-        m = with_estimated_noise(m, opt.in, opt.mountings, log);
+        m = with_estimated_noise(m, opt.in, opt.mountings, opt.gate, log);
     }
     refuse_unusable_mountings(m, opt.mountings, opt.gate);
     // The first pass's messages wait: if it stops at a row out of order, the

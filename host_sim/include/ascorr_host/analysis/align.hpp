@@ -64,8 +64,12 @@
 
 namespace ascorr::host {
 
-// The window of the noise's slowly varying mean (s); 0: one mean over the period.
+// The window of the noise's slowly varying mean (s); 0: one mean over the
+// period, else within [kMinNoiseWindowS, kMaxNoiseWindowS] (a window's index
+// of any epoch time, |t| < 9e15 s, then fits an int64).
 inline constexpr double kDefaultNoiseWindowS = 600.0;
+inline constexpr double kMinNoiseWindowS = 0.01;
+inline constexpr double kMaxNoiseWindowS = 1e10;
 // Fewest epochs with two or more usable heads that align accepts.
 inline constexpr std::size_t kMinAlignEpochs = 100;
 
@@ -181,12 +185,27 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
 // mountings; an epoch counts when two or more heads have such a row. Every
 // head of the mountings must have clean epochs with another head. The
 // estimate is iterated: each pass sums the data with the current mountings,
-// estimates the noise and the δ_i, and turns the mountings by them, until the
-// largest δ is below kAlignToleranceArcsec (the first pass removes all but
-// the second-order terms, about δ² ≈ 0.005" for 30"), at most kMaxAlignPasses.
+// estimates the noise and the δ_i, and turns the mountings by them.
+//
+// The gate: from the second pass on, each epoch goes through the
+// combination's own consistency gate (combine/combiner.hpp, the gate of the
+// epoch's stages, GateOptions) built from the current mountings and the
+// noise of the pass before; a head it finds inconsistent is left out of the
+// sums (LeftOut::kInconsistent). The first pass has no noise to gate with:
+// outliers inflate its noise, and the gate of the next passes tightens as
+// they go. The passes end when the largest δ is below kAlignToleranceArcsec
+// (the first pass removes all but the second-order terms, about δ² ≈
+// 0.005" for 30") and the gate left out the same rows as the pass before, at
+// most kMaxAlignPasses.
+//
+// Refused (AlignRefused): noise the data do not determine (a head whose σ has
+// a formal 1σ above kMaxNoiseRelativeSd of itself), and mountings the
+// combination could not use: a σ outside the mountings file's range (noise-
+// free or absurd data), tables a target cannot build (refuse_unusable_mountings).
 
 inline constexpr double kAlignToleranceArcsec = 1e-3;
-inline constexpr std::size_t kMaxAlignPasses = 5;
+inline constexpr std::size_t kMaxAlignPasses = 10;
+inline constexpr double kMaxNoiseRelativeSd = 0.5;
 
 struct AlignOptions {
     std::string in;         // corrected file (or solutions file: raw attitudes as they are)
@@ -196,6 +215,7 @@ struct AlignOptions {
     std::optional<double> to;
     double noise_window_s = kDefaultNoiseWindowS;
     std::size_t min_epochs = kMinAlignEpochs;
+    GateOptions gate;  // the consistency gate of the passes after the first (combine.hpp)
 };
 
 struct HeadAlignment {
@@ -218,7 +238,7 @@ struct AlignReport {
     NoiseEstimate noise;
     std::size_t rows = 0;                                    // all rows of the input
     std::size_t rows_in_period = 0;                          // with t in [from, to]
-    std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // in the period, by LeftOut (kUsed: used)
+    std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // in the period, by LeftOut (kUsed: used), last pass
     std::size_t epochs = 0;                                  // in the period
     // The rows were not in time order: kept in memory and sorted (a file in
     // time order streams, one epoch at a time).
