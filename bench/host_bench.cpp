@@ -173,9 +173,9 @@ ASCORR_BENCH_STAGES(float, ASCORR_CALL_FLOAT)
 ASCORR_BENCH_STAGES(fixed, ASCORR_CALL_FIXED)
 ASCORR_BENCH_STAGES(baseline, ASCORR_CALL_BASELINE)
 
-const combine::Combiner<double> g_combiner_double{bench::combination_mountings(), combine::default_gate(true)};
-const combine::Combiner<float> g_combiner_float{bench::combination_mountings(), combine::default_gate(true)};
-const combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings(), combine::default_gate(true)};
+const combine::Combiner<double> g_combiner_double{bench::combination_mountings()};
+const combine::Combiner<float> g_combiner_float{bench::combination_mountings()};
+const combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
 CombinationFixture<double> g_combination_double;
 CombinationFixture<float> g_combination_float;
 CombinationFixture<Q30> g_combination_fixed;

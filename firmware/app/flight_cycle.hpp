@@ -451,10 +451,8 @@ private:
     FlightEstimator<Scalar> estimator_{calib_config(), &kTable2};
     pipeline::EpochPipeline<Scalar, EntryCalls, kMaxHeads> pipeline_{pipeline::FeedSchedule{kCalibFeedEvery, 0}};
     // The combination's tables, built once from the mountings in flash, with
-    // the gate of corrected rows: a row the loop could not correct with both
-    // stages (no velocity, no temperatures) is not usable, so every averaged
-    // row has both.
-    combine::Combiner<Scalar> combiner_{kBenchMountings, combine::default_gate(true)};
+    // the gate of pre-flight mountings (combine::flight_gate).
+    combine::Combiner<Scalar> combiner_{kBenchMountings, combine::flight_gate()};
     combine::CombinedAttitude<Scalar> combined_{};
     const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
     ModelHistory history_;

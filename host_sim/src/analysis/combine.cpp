@@ -139,11 +139,12 @@ std::string describe(const CombineSummary& s) {
     return o.str();
 }
 
+combine::CombinerConfig gate_config(const GateOptions& g, const combine::CombinerConfig& base) noexcept {
+    return {g.sigmas.value_or(base.gate_sigmas), g.floor_arcsec.value_or(base.gate_floor_arcsec)};
+}
+
 combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noexcept {
-    combine::CombinerConfig c = combine::default_gate(both_stages);
-    c.gate_sigmas = g.sigmas.value_or(c.gate_sigmas);
-    c.gate_floor_arcsec = g.floor_arcsec.value_or(c.gate_floor_arcsec);
-    return c;
+    return gate_config(g, combine::default_gate(both_stages));
 }
 
 std::string describe(const GateOptions& g) {
@@ -187,6 +188,11 @@ std::string gate_refusal(const MountingsFile& m, const combine::Combiner<double>
 }  // namespace
 
 void refuse_unusable_mountings(const MountingsFile& m, const std::string& path, const GateOptions& gate) {
+    refuse_unusable_mountings(m, path, {gate_config(gate, true), gate_config(gate, false)});
+}
+
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path,
+                               const std::vector<combine::CombinerConfig>& gates) {
     const std::string name = text::input_name(path);
     if (!m.sigmas) {
         throw std::runtime_error(name +
@@ -204,8 +210,7 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path, 
         }
         throw std::runtime_error(name + ": " + combine::problem_text(p));
     }
-    for (const bool both_stages : {true, false}) {
-        const combine::CombinerConfig cfg = gate_config(gate, both_stages);
+    for (const combine::CombinerConfig& cfg : gates) {
         if (!combine::gate_config_valid(cfg)) {
             throw std::runtime_error(std::string("the consistency gate: ") +
                                      combine::problem_text(combine::MountingsProblem::kGateConfig) + ", given " +

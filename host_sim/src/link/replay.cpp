@@ -677,10 +677,11 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
     calib::CommonRotationWeights rule{};
     if (!opt.combined.empty()) {
         const MountingsFile m = read_mountings_file(opt.mountings);
-        refuse_unusable_mountings(m, opt.mountings, opt.gate);
-        // Every row the target averages has both stages (a row without one
-        // it was asked for is not usable): one gate for the run.
-        combination.emplace(m, gate_config(opt.gate, true), client, host.pipeline, opt.in, log);
+        // The target combines as the flight loop does (its gate, pre-flight
+        // mountings), unless --gate-sigmas/--gate-floor say otherwise.
+        const combine::CombinerConfig gate = gate_config(opt.gate, combine::flight_gate());
+        refuse_unusable_mountings(m, opt.mountings, std::vector<combine::CombinerConfig>{gate});
+        combination.emplace(m, gate, client, host.pipeline, opt.in, log);
         rule = pipeline::common_rotation_weights(m.mountings);
     }
     start_host(opt, rows, mf, model_t, client, host, sum, rule);

@@ -38,15 +38,17 @@
 //     combination) is normalised by its covariance plus a floor:
 //        d_i² = r_iᵀ (C_i + P_{S∖i}⁻¹ + f² I)⁻¹ r_i,
 //     and the head is inconsistent when d_i > k (CombinerConfig: k = 6;
-//     the floor f by what the rows have been through, default_gate below).
-//     The floor keeps what the heads' noise does not describe inside the
-//     gate: with f = 10″ (rows without both stages) it never trips below
-//     k·f = 60″, so not on the differential aberration (up to ~29″) nor on
-//     the 2–3″ of uncorrected deformation; with f = 2″ (both stages) a head
+//     the floor f by what is known of the rows and the mountings,
+//     default_gate below). The floor keeps what the heads' noise does not
+//     describe inside the gate: with f = 10″ it never trips below k·f = 60″,
+//     so not on the differential aberration of raw rows (up to ~29″), the
+//     2–3″ of uncorrected deformation, nor pre-flight mountings a few tens of
+//     arcsec off; with f = 2″ (both stages, mountings of the ground) a head
 //     40″ off across its boresight is caught (tests: CombineGate). With the
 //     covariance, not on noise (5σ of one head gives d² ≤ 25 < 36). With
 //     σc = 1.3″, σa = 9″ and f = 10″ it surely trips beyond
-//     k·sqrt(σa² + σa² + f²) ≈ 97″ (two heads) and ~82″ (three). With three or more heads,
+//     k·sqrt(σa² + σa² + f²) ≈ 97″ (two heads) and ~82″ (three). With three
+//     or more heads,
 //     of the heads beyond the gate the one whose removal leaves the others
 //     most consistent (the smallest largest d² of the rest, each found by the
 //     same tables) is left out, and the gate is run again on the rest: at
@@ -97,19 +99,26 @@ struct CombinerConfig {
     double gate_floor_arcsec = 10.0;
 };
 
-// The gate's default follows what the rows have been through (the
-// contract's "The consistency gate"). With the aberration and the thermal
-// stage applied, the heads disagree by their noise and what the thermal model
-// leaves (about 0.5″, method.md §3.3): a floor of 2″ keeps that far inside
-// the gate (k·f = 12″, and the covariance adds to it) and catches a head 40″
-// off across its boresight (20″ where the other heads' weak axes allow). Without both stages they disagree also by the
-// differential aberration (up to 2·20.5″·sin(angle/2) between two
-// boresights, ~29″ at 90°) and the bench's uncorrected deformation: 10″.
+// The gate's default follows what is known of the rows and the mountings
+// (the contract's "The consistency gate"). On the ground, with the
+// aberration and the thermal stage applied, the heads disagree by their noise
+// and what the thermal model leaves (about 0.5″, method.md §3.3), and the
+// mountings are the ground's (estimated by align, or stated with their
+// noise): a floor of 2″ keeps that far inside the gate (k·f = 12″, and the
+// covariance adds to it) and catches a head 40″ off across its boresight
+// (20″ where the other heads' weak axes allow). Rows without both stages
+// disagree also by the differential aberration (up to 2·20.5″·sin(angle/2)
+// between two boresights, ~29″ at 90°) and the bench's uncorrected
+// deformation: 10″. On board (flight_gate) the mountings are the pre-flight
+// ones in flash, which nothing aligns in flight: 10″ too.
 inline constexpr double kGateFloorCorrectedArcsec = 2.0;
 inline constexpr double kGateFloorUncorrectedArcsec = 10.0;
 
 constexpr CombinerConfig default_gate(bool both_stages_applied) noexcept {
     return {6.0, both_stages_applied ? kGateFloorCorrectedArcsec : kGateFloorUncorrectedArcsec};
+}
+constexpr CombinerConfig flight_gate() noexcept {
+    return default_gate(false);
 }
 
 inline constexpr double kMinGateSigmas = 3.0;
@@ -206,7 +215,6 @@ private:
     };
     Vector3<T> estimate(const Epoch& e, std::uint8_t group, HeadMask s) const noexcept;
     GateResult gate_group(const Epoch& e, std::uint8_t group, HeadMask s, const Vector3<T>& est) const noexcept;
-    bool within_gate(HeadMask s, std::uint8_t head, const Vector3<T>& r, const Vector3<T>* h) const noexcept;
     std::uint8_t odd_one_out(const Epoch& e, std::uint8_t failing) const noexcept;
     bool gate(Epoch& e, Vector3<T>* est) const noexcept;
     bool combine_group(Epoch& e, Vector3<T>* est) const noexcept;
@@ -452,15 +460,13 @@ bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude
         accumulate(acc, table_[s].gain[heads[i].head], h[i]);
     }
     const Vector3<T> est = result(acc);
-    // The reference's residual is 0 − est (gate_group's, its h being zero).
     // The reference's residual is 0 − est: its square is est's, bit for bit.
-    if (!quick_gate(est, table_[s].quick[heads[0].head]) && !within_gate(s, heads[0].head, est, nullptr)) {
+    if (!quick_gate(est, table_[s].quick[heads[0].head])) {
         return false;
     }
     ASCORR_UNROLL_HEADS
     for (std::uint8_t i = 1; i < n; ++i) {
-        const Vector3<T> r = residual(h[i], est);
-        if (!quick_gate(r, table_[s].quick[heads[i].head]) && !within_gate(s, heads[i].head, r, &h[i])) {
+        if (!quick_gate(residual(h[i], est), table_[s].quick[heads[i].head])) {
             return false;
         }
     }
@@ -471,23 +477,6 @@ bool Combiner<T>::combine_usual_n(const HeadAttitude<T>* heads, CombinedAttitude
     out->subset = s;
     out->status = combined_status::kTwoOrMoreHeads;
     return true;
-}
-
-// A head of the usual epoch beyond the quick test (which implies the gross
-// gate, quick_bound): within the gross gate of the reference (h, its
-// half-angle difference, linearise's test; none for the reference, whose
-// residual is then 0 − r) and within the statistic, gate_group's to the bit.
-// A gate anisotropic enough that the quick test fails on noise (a small
-// floor, combine::default_gate) then costs the statistic, not the general
-// path; out of line, as the usual epoch with the usual gate never gets here.
-template <typename T>
-__attribute__((noinline)) bool Combiner<T>::within_gate(HeadMask s, std::uint8_t head, const Vector3<T>& r,
-                                                        const Vector3<T>* h) const noexcept {
-    constexpr T zero = constant<T>(0.0);
-    if (h == nullptr) {
-        return !gate_exceeds(gate_value(table_[s].gate[head], residual(Vector3<T>{zero, zero, zero}, r)));
-    }
-    return within_near(*h, near2_) && !gate_exceeds(gate_value(table_[s].gate[head], r));
 }
 
 // Step 1: the candidates, each as its CRF estimate q_crf_icrf_i.

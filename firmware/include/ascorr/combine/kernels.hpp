@@ -200,19 +200,13 @@ struct HalfDifference {
     bool near;
 };
 
-// ‖h‖² ≤ near2: a half-angle difference within the gross gate.
-template <typename T>
-constexpr bool within_near(const Vector3<T>& h, const T& near2) noexcept {
-    return squared_norm(h) <= near2;
-}
-
 template <typename T>
 constexpr HalfDifference<T> half_difference(const Quaternion<T>& q, const ReferenceFactor<T>& ref,
                                             const T& near2) noexcept {
     constexpr T zero = constant<T>(0.0);
     const Quaternion<T> d = product(q, conjugate(ref));
     const Vector3<T> h = d.w < zero ? Vector3<T>{-d.x, -d.y, -d.z} : Vector3<T>{d.x, d.y, d.z};
-    return {h, within_near(h, near2)};
+    return {h, squared_norm(h) <= near2};
 }
 
 // q_a and q_b within the gross gate of each other, either sign:
@@ -420,15 +414,6 @@ constexpr Quaternion<Q30> left_increment(const Vector3<Q30>& h, const Quaternion
 template <>
 Quaternion<Q30> left_increment<Q30>(const Vector3<Q30>&, const Quaternion<Q30>&) noexcept = delete;
 
-// within_near (above) in Q30: ‖h‖² exact in int64 (units 2⁻⁶⁰; |hᵢ| ≤ 1,
-// each square ≤ 2⁶⁰), against near2 scaled exactly to the same units.
-constexpr bool within_near(const Vector3<Q30>& h, const Q30& near2) noexcept {
-    const auto sq = [](Q30 c) { return static_cast<std::uint64_t>(fx::mul(c.raw, c.raw)); };
-    return sq(h.x) + sq(h.y) + sq(h.z) <= static_cast<std::uint64_t>(fx::mul(near2.raw, std::int32_t{1} << 30));
-}
-template <>
-bool within_near<Q30>(const Vector3<Q30>&, const Q30&) noexcept = delete;
-
 // half_difference (above) in Q30: q ⊗ ref* as product() forms it (each
 // component one chain of four exact products rounded once, ≤ 2⁻³¹; the
 // conjugate's signs folded into the operands), the sign aligned by negating
@@ -457,8 +442,9 @@ constexpr HalfDifference<Q30> half_difference(const Quaternion<Q30>& q, const Qu
         y = -y;
         z = -z;
     }
-    const Vector3<Q30> h{{x}, {y}, {z}};
-    return {h, within_near(h, near2)};
+    const auto sq = [](std::int32_t c) { return static_cast<std::uint64_t>(fx::mul(c, c)); };
+    const std::uint64_t n2 = sq(x) + sq(y) + sq(z);
+    return {{{x}, {y}, {z}}, n2 <= static_cast<std::uint64_t>(fx::mul(near2.raw, std::int32_t{1} << 30))};
 }
 template <>
 HalfDifference<Q30> half_difference<Q30>(const Quaternion<Q30>&, const Quaternion<Q30>&, const Q30&) noexcept = delete;

@@ -110,15 +110,18 @@ struct RowsOutOfOrder {
 };
 
 // The consistency gate (combine/combiner.hpp; the contract's "The consistency
-// gate"). Unset: each epoch's gate follows its stages (combine::default_gate:
-// a floor of 2″ with the aberration and the thermal stage applied, 10″
-// otherwise); set: the same for every epoch.
+// gate"). Unset: on the ground each epoch's gate follows its stages
+// (combine::default_gate: a floor of 2″ with the aberration and the thermal
+// stage applied, 10″ otherwise), on a target the flight's (10″, pre-flight
+// mountings); set: the same for every epoch.
 struct GateOptions {
     std::optional<double> sigmas;        // k, [3, 100]
     std::optional<double> floor_arcsec;  // f, [1, 3600] arcsec
 };
 // The gate of an epoch whose usable rows have (both_stages) or lack both stages.
 combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noexcept;
+// The options over `base` (replay: the flight's gate, combine::flight_gate).
+combine::CombinerConfig gate_config(const GateOptions& g, const combine::CombinerConfig& base) noexcept;
 // What --gate-floor and --gate-sigmas say in a message ("a floor of 2 arcsec ...").
 std::string describe(const GateOptions& g);
 
@@ -180,6 +183,9 @@ CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::
 // what the fixed-point formats cannot hold), for both defaults of the gate
 // when it is unset: what a target would refuse is refused here, and why.
 void refuse_unusable_mountings(const MountingsFile& m, const std::string& path, const GateOptions& gate = {});
+// The same for the gates given (replay: the target's).
+void refuse_unusable_mountings(const MountingsFile& m, const std::string& path,
+                               const std::vector<combine::CombinerConfig>& gates);
 
 // `ascorr correct ... --mountings M --combined A`: corrects (correct_file) and
 // combines the corrected rows in the same pass; the corrected file, the model
