@@ -188,6 +188,43 @@ TEST(ReplayCombined, OptionsAreChecked) {
     EXPECT_EQ(r.exit_code, 2) << r.err;  // --combined needs --mountings
 }
 
+// The gate travels in MOUNTING_LOAD's build frame, only when it is not the
+// flight's (a target before it takes the 51 bytes), and a target refuses a
+// gate out of its range or in a frame that builds nothing.
+TEST(ReplayCombined, TheGateTravelsInTheBuildFrameOnlyWhenNotTheFlights) {
+    link::MountingLoad m{};
+    m.head = 0;
+    m.present = 1;
+    m.build = 1;
+    m.q_chu_crf = {1.0, 0.0, 0.0, 0.0};
+    m.sigma_cross_arcsec = 1.5;
+    m.sigma_about_arcsec = 10.0;
+    std::uint8_t p[link::kMaxPayload];
+    EXPECT_EQ(link::encode(m, p), 51U);  // combine::flight_gate()
+    m.gate = combine::default_gate(true);
+    const std::size_t n = link::encode(m, p);
+    EXPECT_EQ(n, 67U);
+    link::MountingLoad back{};
+    ASSERT_TRUE(link::decode(p, n, back));
+    EXPECT_EQ(back.gate.gate_floor_arcsec, 2.0);
+    EXPECT_EQ(back.gate.gate_sigmas, 6.0);
+    p[2] = 0;  // build 0 with a gate
+    EXPECT_FALSE(link::decode(p, n, back));
+    m.gate = {2.0, 10.0};  // k below 3
+    EXPECT_FALSE(link::decode(p, link::encode(m, p), back));
+    m.gate = {6.0, std::nan("")};
+    EXPECT_FALSE(link::decode(p, link::encode(m, p), back));
+}
+
+TEST(ReplayCombined, AGateSetByTheGroundIsTheTargetsToo) {
+    const auto dir = simulated("replay_combined_gate");
+    std::ostringstream log;
+    host::ReplayOptions o = options(dir, "loopback-float");
+    o.gate.floor_arcsec = 2.0;
+    o.gate.sigmas = 5.0;
+    expect_agreement(host::replay(o, log));
+}
+
 #ifdef ASCORR_REPLAY_QEMU
 class ReplayCombinedQemu : public ::testing::TestWithParam<host::QemuTarget> {};
 
