@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/quaternion.hpp"
@@ -73,7 +74,8 @@ void expect_agreement(const host::ReplaySummary& s) {
 // and 0.03″ by test_combine.
 void expect_near_double(const std::filesystem::path& dir, double bound) {
     const CliRun r = run_in("correct --in sim.csv --model " + data_path("model_table2.csv") +
-                                " --out corrected.csv --mountings sim.csv.mountings.csv --combined double.csv",
+                                " --out corrected.csv --mountings sim.csv.mountings.csv --combined double.csv "
+                                "--gate-floor 10",  // the target's gate (combine::flight_gate)
                             dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     host::AttitudeReader target((dir / "replayed.combined.csv").string());
@@ -216,13 +218,48 @@ TEST(ReplayCombined, TheGateTravelsInTheBuildFrameOnlyWhenNotTheFlights) {
     EXPECT_FALSE(link::decode(p, link::encode(m, p), back));
 }
 
+// A loopback target that records the length of each MOUNTING_LOAD build frame.
+class BuildFrameSpy {
+public:
+    BuildFrameSpy()
+        : server_(0x53505931U, [] { return std::uint32_t{0}; }),
+          transport_([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
+              for (std::size_t i = 0; i < n; ++i) {
+                  if (decoder_.push(p[i]) == link::FrameDecoder::Event::kFrame) {
+                      const link::Frame& f = decoder_.frame();
+                      if (f.type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && f.length > 2U &&
+                          f.payload[2] == 1U) {
+                          build_lengths_.push_back(f.length);
+                      }
+                  }
+                  server_.on_byte(p[i], reply);
+              }
+          }) {}
+    host::Transport& transport() { return transport_; }
+    const std::vector<std::size_t>& build_lengths() const { return build_lengths_; }
+
+private:
+    using Counter = std::uint32_t (*)();
+    link::FrameDecoder decoder_;
+    link::LinkServer<float, Counter> server_;
+    host::LoopbackTransport transport_;
+    std::vector<std::size_t> build_lengths_;
+};
+
 TEST(ReplayCombined, AGateSetByTheGroundIsTheTargetsToo) {
     const auto dir = simulated("replay_combined_gate");
-    std::ostringstream log;
-    host::ReplayOptions o = options(dir, "loopback-float");
-    o.gate.floor_arcsec = 2.0;
-    o.gate.sigmas = 5.0;
-    expect_agreement(host::replay(o, log));
+    for (const bool set : {false, true}) {
+        host::ReplayOptions o = options(dir, "link float");
+        if (set) {
+            o.gate.floor_arcsec = 2.0;
+            o.gate.sigmas = 5.0;
+        }
+        BuildFrameSpy target;
+        std::ostringstream log;
+        expect_agreement(host::replay_over(o, target.transport(), log));
+        // The flight's gate: the 51 bytes a target before the gate takes; another: 67.
+        EXPECT_EQ(target.build_lengths(), std::vector<std::size_t>{set ? 67U : 51U});
+    }
 }
 
 #ifdef ASCORR_REPLAY_QEMU

@@ -35,7 +35,7 @@ void add_align_command(CLI::App& app) {
            "--min-epochs", opt->min_epochs,
            "fewest epochs with two or more usable heads (default " + std::to_string(host::kMinAlignEpochs) + ")")
         ->transform(integer_in<std::size_t>(2));
-    add_gate_options(*cmd, opt->gate, nullptr);
+    add_gate_options(*cmd, opt->gate, nullptr, GateDefault::kGround);
     cmd->callback([opt]() {
         host::OutputSet outputs = open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}},
                                                  {{"--out", opt->out}, host::kStandardOutput});

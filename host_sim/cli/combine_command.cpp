@@ -9,7 +9,7 @@
 
 namespace ascorr::cli {
 
-void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined) {
+void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined, GateDefault floor) {
     CLI::Option* k =
         cmd.add_option_function<double>(
                "--gate-sigmas", [&gate](const double& v) { gate.sigmas = v; },
@@ -18,8 +18,11 @@ void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combi
             ->check(real_in(combine::kMinGateSigmas, combine::kMaxGateSigmas));
     CLI::Option* f = cmd.add_option_function<double>(
                             "--gate-floor", [&gate](const double& v) { gate.floor_arcsec = v; },
-                            "the consistency gate's floor in arcsec, [1, 3600], added to the heads' noise (default: "
-                            "2 for rows with the aberration and the thermal stage applied, 10 otherwise)")
+                            std::string("the consistency gate's floor in arcsec, [1, 3600], added to the heads' "
+                                        "noise (default: ") +
+                                (floor == GateDefault::kFlight
+                                     ? "10, the flight's: the mountings in flash are pre-flight)"
+                                     : "2 for rows with the aberration and the thermal stage applied, 10 otherwise)"))
                          ->check(real_in(combine::kMinGateFloorArcsec, combine::kMaxGateFloorArcsec));
     if (combined != nullptr) {
         k->needs(combined);
@@ -45,7 +48,7 @@ void add_combine_command(CLI::App& app) {
                     "all; '-': standard output")
         ->required()
         ->check(non_empty_path());
-    add_gate_options(*cmd, opt->gate, nullptr);
+    add_gate_options(*cmd, opt->gate, nullptr, GateDefault::kGround);
     cmd->callback([opt]() {
         host::OutputSet outputs =
             open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}}, host::combine_outputs(*opt));

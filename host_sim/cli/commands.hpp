@@ -138,7 +138,8 @@ void add_plot_command(CLI::App& app);
 void add_combine_command(CLI::App& app);
 // --gate-sigmas K and --gate-floor ARCSEC of combine, correct and replay
 // (--combined: each needs `combined`); combine_command.cpp.
-void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined);
+enum class GateDefault { kGround, kFlight };  // which default --gate-floor's help names
+void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined, GateDefault floor);
 void add_align_command(CLI::App& app);
 
 }  // namespace ascorr::cli

@@ -46,7 +46,7 @@ void add_combine_options(CLI::App& cmd, CombineTexts& t) {
                                 ->check(non_empty_path());
     mountings->needs(combined);
     combined->needs(mountings);
-    add_gate_options(cmd, t.gate, combined);
+    add_gate_options(cmd, t.gate, combined, GateDefault::kGround);
 }
 
 void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {

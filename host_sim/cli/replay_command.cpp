@@ -63,7 +63,7 @@ void add_replay_command(CLI::App& app) {
             ->check(non_empty_path());
     mountings->needs(combined);
     combined->needs(mountings);
-    add_gate_options(*cmd, opt->gate, combined);
+    add_gate_options(*cmd, opt->gate, combined, GateDefault::kFlight);
     cmd->add_option("--inject-errors", opt->inject_errors, "fraction of frames to fault in each direction")
 
         ->check(real_in(0.0, 0.5));

@@ -128,15 +128,16 @@ host::GateOptions gate_arg(const py::object& sigmas, const py::object& floor) {
     host::GateOptions g;
     if (!sigmas.is_none()) {
         g.sigmas = real_arg(sigmas, "gate_sigmas");
-        if (!(*g.sigmas >= combine::kMinGateSigmas && *g.sigmas <= combine::kMaxGateSigmas)) {
-            bad_argument("gate_sigmas", "expected a number in [3, 100], got " + value_text(sigmas));
-        }
     }
     if (!floor.is_none()) {
         g.floor_arcsec = real_arg(floor, "gate_floor");
-        if (!(*g.floor_arcsec >= combine::kMinGateFloorArcsec && *g.floor_arcsec <= combine::kMaxGateFloorArcsec)) {
-            bad_argument("gate_floor", "expected arcsec in [1, 3600], got " + value_text(floor));
-        }
+    }
+    const combine::CombinerConfig c = host::gate_config(g, true);  // the options' own values
+    if (!(c.gate_sigmas >= combine::kMinGateSigmas && c.gate_sigmas <= combine::kMaxGateSigmas)) {
+        bad_argument("gate_sigmas", "expected a number in [3, 100], got " + value_text(sigmas));
+    }
+    if (!combine::gate_config_valid(c)) {
+        bad_argument("gate_floor", "expected arcsec in [1, 3600], got " + value_text(floor));
     }
     return g;
 }
@@ -262,8 +263,7 @@ py::tuple align_arrays(const py::object& t, const py::object& chu, const py::obj
     opt.to = time_arg(t_to, "t_to");
     host::refuse_bad_time_range(opt.from, opt.to, "t_from", "t_to");  // as `ascorr align`: an empty period is refused
     opt.noise_window_s = real_arg(noise_window, "noise_window");
-    const double w = opt.noise_window_s;
-    if (!(w == 0.0 || (w >= host::kMinNoiseWindowS && w <= host::kMaxNoiseWindowS))) {
+    if (!host::noise_window_valid(opt.noise_window_s)) {
         bad_argument("noise_window", "expected 0 or a window in [" + host::number_text(host::kMinNoiseWindowS) + ", " +
                                          host::number_text(host::kMaxNoiseWindowS) + "] s, got " +
                                          value_text(noise_window));

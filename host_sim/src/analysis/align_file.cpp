@@ -26,8 +26,6 @@ namespace ascorr::host {
 
 namespace {
 
-constexpr StatusBits kStages = status::kAberrationApplied | status::kThermalApplied;
-
 // Why a row cannot be averaged in, on its own: combine.hpp's rule, and a
 // quaternion the combiner would refuse (not unit, not finite); the epoch's
 // stage mix is decided afterwards (LeftOut::kStageMissing).
@@ -57,7 +55,7 @@ bool in_period(double t, const AlignOptions& opt) noexcept {
     return (!opt.from || t >= *opt.from) && (!opt.to || t <= *opt.to);
 }
 
-// What one pass counts (the first pass's counts go into the report).
+// What one pass counts (the last pass's counts go into the report).
 struct PassCounts {
     std::size_t rows = 0;
     std::size_t rows_in_period = 0;
@@ -80,46 +78,34 @@ StatusBits epoch_stages(const Epoch<Judged>& e) noexcept {
     StatusBits stages = 0U;
     for (const std::optional<Judged>& j : e.head) {
         if (j && j->why == LeftOut::kUsed && j->row.corrected) {
-            stages = static_cast<StatusBits>(stages | (j->row.status & kStages));
+            stages = static_cast<StatusBits>(stages | (j->row.status & kBothStages));
         }
     }
     return stages;
 }
 
 // The combination's consistency gate for a pass after the first: its tables
-// from the current mountings and the noise of the pass before, one for each
-// kind of epoch (the gate follows the epoch's stages, combine.hpp).
-class PassGate {
-public:
-    PassGate(const combine::Mountings& m, const GateOptions& g)
-        : corrected_(m, gate_config(g, true)), uncorrected_(m, gate_config(g, false)) {}
-    bool valid() const noexcept { return corrected_.valid() && uncorrected_.valid(); }
-
-    // The heads of the epoch still kLeftOut::kUsed that the gate finds
-    // inconsistent get LeftOut::kInconsistent.
-    void apply(const Epoch<Judged>& e, StatusBits stages, std::array<LeftOut, kMaxHeads>& why) const noexcept {
-        combine::HeadAttitude<double> heads[kMaxHeads];
-        std::uint8_t n = 0;
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            if (e.head[h] && why[h] == LeftOut::kUsed) {
-                heads[n++] = {e.head[h]->row.q_chu_icrf, h, true};
-            }
-        }
-        const combine::Combiner<double>& c = stages == kStages ? corrected_ : uncorrected_;
-        const combine::HeadMask out = n >= 2 ? c.combine(heads, n).inconsistent : combine::HeadMask{0};
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            why[h] = (out & combine::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
+// from the current mountings and the noise of the pass before (StageGates:
+// the gate follows the epoch's stages). The heads of the epoch still usable
+// that it finds inconsistent get LeftOut::kInconsistent.
+void apply_gate(const StageGates& gates, const Epoch<Judged>& e, StatusBits stages,
+                std::array<LeftOut, kMaxHeads>& why) noexcept {
+    combine::HeadAttitude<double> heads[kMaxHeads];
+    std::uint8_t n = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (e.head[h] && why[h] == LeftOut::kUsed) {
+            heads[n++] = {e.head[h]->row.q_chu_icrf, h, true};
         }
     }
-
-private:
-    combine::Combiner<double> corrected_;
-    combine::Combiner<double> uncorrected_;
-};
+    const combine::HeadMask out = n >= 2 ? gates.of(stages).combine(heads, n).inconsistent : combine::HeadMask{0};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        why[h] = (out & combine::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
+    }
+}
 
 // One epoch into the sums: each usable head's CRF attitude (the rows the
 // gate, if any, leaves in).
-void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const PassGate* gate, AlignSums& sums,
+void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const StageGates* gate, AlignSums& sums,
                PassCounts& c) {
     const StatusBits stages = epoch_stages(e);
     std::array<LeftOut, kMaxHeads> why{};
@@ -133,7 +119,7 @@ void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const 
         }
     }
     if (gate != nullptr) {
-        gate->apply(e, stages, why);
+        apply_gate(*gate, e, stages, why);
     }
     std::array<std::optional<Quaternion<double>>, kMaxHeads> q_crf_icrf{};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
@@ -201,7 +187,7 @@ private:
 
 // One pass over the rows (in time order) with the current mountings.
 void run_pass(const CorrectedRowSource& rows, const std::string& file, const MountingsFile& m,
-              const CurrentMountings& q_chu_crf, const PassGate* gate, const AlignOptions& opt, AlignSums& sums,
+              const CurrentMountings& q_chu_crf, const StageGates* gate, const AlignOptions& opt, AlignSums& sums,
               PassCounts& c) {
     OrderedEpochs epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, gate, sums, c); });
     rows([&](const CorrectedRow& r) {
@@ -251,8 +237,8 @@ std::string reasons_text(const std::array<std::size_t, kLeftOutKinds>& n) {
     return s.empty() ? std::string("none left out") : s;
 }
 
-// The refusals found after the first pass: no row, a head without clean
-// epochs, too few epochs.
+// The refusals found after each pass: no row, a head without clean epochs
+// (the gate may leave a head none), too few epochs.
 void refuse_thin_data(const std::string& file, const AlignSums& sums, const PassCounts& c, HeadSet heads,
                       const AlignOptions& opt) {
     const std::string where = text::input_name(file) + " in " + period_text(opt.from, opt.to);
@@ -303,7 +289,7 @@ HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
 
 using Information = std::array<Eigen::Matrix3d, kMaxHeads>;
 
-// The counts of the first pass, into the report.
+// The counts of a pass, into the report (the last one's stay).
 void count_into(AlignReport& r, const AlignSums& sums, const PassCounts& c) {
     r.rows = c.rows;
     r.rows_in_period = c.rows_in_period;
@@ -373,11 +359,10 @@ AlignReport start_report(const std::string& file, const MountingsFile& m, const 
     } catch (const std::invalid_argument& e) {
         throw AlignRefused(e.what());
     }
-    const double window = opt.noise_window_s;
-    if (!(window == 0.0 || (window >= kMinNoiseWindowS && window <= kMaxNoiseWindowS))) {
-        throw AlignRefused("--noise-window " + number_text(window) + ": expected 0 (one mean over the period) or " +
-                           "a window in [" + number_text(kMinNoiseWindowS) + ", " + number_text(kMaxNoiseWindowS) +
-                           "] s");
+    if (!noise_window_valid(opt.noise_window_s)) {
+        throw AlignRefused("--noise-window " + number_text(opt.noise_window_s) +
+                           ": expected 0 (one mean over the period) or " + "a window in [" +
+                           number_text(kMinNoiseWindowS) + ", " + number_text(kMaxNoiseWindowS) + "] s");
     }
     AlignReport r;
     r.in = file;
@@ -399,36 +384,36 @@ std::string digits4(double x) {
     return buf;
 }
 
-// The gate left out the same rows in two passes: equal counts, or within a
+// The gate left out the same rows in two passes: within one row or a
 // thousandth of them (a row at the gate's edge may go either way as the
 // noise settles in its last digits).
 bool same_rows_gated(std::size_t now, std::size_t before) noexcept {
     const std::size_t diff = now > before ? now - before : before - now;
-    return diff * 1000U <= std::max(now, before);
+    return diff <= std::max<std::size_t>(1U, std::max(now, before) / 1000U);
 }
 
 // The gate of the next pass: the current mountings with the noise just
 // estimated; none when the combination cannot use them (refused at the end).
-std::unique_ptr<PassGate> next_gate(const AlignReport& r, const CurrentMountings& q, const GateOptions& g) {
+std::unique_ptr<StageGates> next_gate(const AlignReport& r, const CurrentMountings& q, const GateOptions& g) {
     combine::Mountings m{};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if (has_head(r.heads, h)) {
             m.head[h] = {true, q[h], r.noise.head[h].sigma_cross_arcsec, r.noise.head[h].sigma_about_arcsec};
         }
     }
-    auto gate = std::make_unique<PassGate>(m, g);
+    auto gate = std::make_unique<StageGates>(m, g);
     return gate->valid() ? std::move(gate) : nullptr;
 }
 
 // Noise the data do not determine (a formal 1σ above kMaxNoiseRelativeSd of
-// the σ), and mountings the combination could not use: refused, naming the
-// head and the numbers.
-void refuse_undetermined_noise(const AlignReport& r, const std::string& file, const AlignOptions& opt) {
+// the σ) or outside the mountings file's range: refused after each pass
+// (before it builds the next pass's gate), naming the head and the numbers.
+void refuse_undetermined_noise(const AlignReport& r, const std::string& file) {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if (!has_head(r.heads, h)) {
             continue;
         }
-        const HeadNoise& n = r.head[h].noise;
+        const HeadNoise& n = r.noise.head[h];
         const std::string head = std::string("CHU ") + kHeadLetters[h];
         if (n.sd_cross_arcsec > kMaxNoiseRelativeSd * n.sigma_cross_arcsec ||
             n.sd_about_arcsec > kMaxNoiseRelativeSd * n.sigma_about_arcsec || !std::isfinite(n.sd_cross_arcsec) ||
@@ -452,6 +437,10 @@ void refuse_undetermined_noise(const AlignReport& r, const std::string& file, co
             }
         }
     }
+}
+
+// Mountings the combination could not use (a target's tables): refused.
+void refuse_unusable_result(const AlignReport& r, const std::string& file, const AlignOptions& opt) {
     try {
         refuse_unusable_mountings(r.aligned, text::input_name(file) + " (the mountings align estimated)", opt.gate);
     } catch (const std::runtime_error& e) {
@@ -472,14 +461,17 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
     Information w{};
     r.last_update_arcsec = std::numeric_limits<double>::infinity();
     CorrectedRowSource in_order = rows;
-    std::unique_ptr<PassGate> gate;  // none in the first pass: no noise to gate with
-    std::size_t gated = 0;           // rows the pass before left out as inconsistent
+    std::unique_ptr<StageGates> gate;  // none in the first pass: no noise to gate with
+    std::size_t gated = 0;             // rows this pass left out as inconsistent
+    std::size_t before = 0;            // and the pass before
+    bool gated_pass = false;           // this pass had the gate (or could not have it)
     for (bool settled = false; !settled;) {
         if (r.passes == kMaxAlignPasses) {
             throw AlignRefused("the mountings did not converge in " + std::to_string(kMaxAlignPasses) +
                                " passes (the last turned a head by " + number_text(r.last_update_arcsec) +
-                               " arcsec, its gate left out " + std::to_string(gated) +
-                               " rows as inconsistent): are the given mountings within a degree of the heads'?");
+                               " arcsec, and its gate left out " + std::to_string(gated) +
+                               " rows as inconsistent where the pass before left out " + std::to_string(before) +
+                               "): are the given mountings within a degree of the heads'?");
         }
         AlignSums sums(opt.noise_window_s);
         PassCounts c;
@@ -494,21 +486,26 @@ AlignReport align_rows(const CorrectedRowSource& rows, const std::string& file, 
         refuse_thin_data(file, sums, c, r.heads, opt);
         count_into(r, sums, c);
         a = estimate(sums, m, q, r, w);
+        refuse_undetermined_noise(r, file);
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             if (has_head(r.heads, h)) {
                 q[h] = canonical(renormalized(q[h] * rotation_quaternion(a.delta_arcsec[h])));
             }
         }
         r.last_update_arcsec = largest(a);
-        const std::size_t now = c.left_out[static_cast<std::size_t>(LeftOut::kInconsistent)];
-        // The first pass is never the last: the second has the gate (or none,
-        // when the combination cannot use the noise; refused below).
-        settled = r.passes > 1 && r.last_update_arcsec < kAlignToleranceArcsec && same_rows_gated(now, gated);
-        gated = now;
-        gate = next_gate(r, q, opt.gate);
+        before = gated;
+        gated = c.left_out[static_cast<std::size_t>(LeftOut::kInconsistent)];
+        // Not settled before a pass with the gate (or without one, when the
+        // combination cannot use the noise: refused below).
+        settled = gated_pass && r.last_update_arcsec < kAlignToleranceArcsec && same_rows_gated(gated, before);
+        // The gate once the mountings are near (a head given half a degree
+        // off is still tens of arcsec off after the first pass), and from
+        // then on: what it leaves out may move the mountings again.
+        gated_pass = gated_pass || r.last_update_arcsec < kGateAfterUpdateArcsec;
+        gate = gated_pass ? next_gate(r, q, opt.gate) : nullptr;
     }
     finish_report(r, m, q, a, w);
-    refuse_undetermined_noise(r, file, opt);
+    refuse_unusable_result(r, file, opt);
     return r;
 }
 

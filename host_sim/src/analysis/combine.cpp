@@ -32,7 +32,6 @@ namespace {
 
 namespace cs = combine::combined_status;
 
-constexpr StatusBits kStagesApplied = status::kAberrationApplied | status::kThermalApplied;
 constexpr StatusBits kStageSkipped =
     status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
 constexpr double kMaxCleanConfidence = 5.0;  // arcsec: Statistics' clean rows (docs/contract.md)
@@ -147,15 +146,6 @@ combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noex
     return gate_config(g, combine::default_gate(both_stages));
 }
 
-std::string describe(const GateOptions& g) {
-    const std::string k = number_text(gate_config(g, true).gate_sigmas) + " sigmas";
-    if (g.floor_arcsec) {
-        return k + ", a floor of " + number_text(*g.floor_arcsec) + " arcsec";
-    }
-    return k + ", a floor of " + number_text(combine::kGateFloorCorrectedArcsec) +
-           " arcsec with both stages applied, " + number_text(combine::kGateFloorUncorrectedArcsec) + " otherwise";
-}
-
 namespace {
 
 std::string sigmas_text(const combine::HeadMounting& h) {
@@ -174,6 +164,8 @@ std::string gate_refusal(const MountingsFile& m, const combine::Combiner<double>
                 (others.empty() ? "" : "; ") + std::string(1, head_name(o)) + " " + sigmas_text(m.mountings.head[o]);
         }
     }
+    // subset_gate also fails on a singular matrix, which check_mountings'
+    // conditioning test has excluded: what is left is the format's range.
     return std::string("CHU ") + head_name(h) + ": its consistency gate in head set " +
            head_letters(c.problem_subset()) +
            " is beyond the fixed-point format a target builds it in (a factor above 2^28 per radian), so a target "
@@ -236,8 +228,7 @@ struct CombineStage::Impl {
     Impl(const MountingsFile& mountings, const GateOptions& gate, AtomicFile* out_file,
          std::vector<AttitudeRow>* out_rows, std::string file_name, std::ostream& log, Mode mode_)
         : m(mountings),
-          corrected(mountings.mountings, gate_config(gate, true)),
-          uncorrected(mountings.mountings, gate_config(gate, false)),
+          gates(mountings.mountings, gate),
           out(out_file),
           rows_out(out_rows),
           file(std::move(file_name)),
@@ -258,7 +249,7 @@ struct CombineStage::Impl {
             return;
         }
         Kept k{r.t,    r.q_chu_icrf,       static_cast<std::uint32_t>(r.line),
-               r.head, why_unusable(r, m), static_cast<std::uint8_t>(r.corrected ? (r.status & kStagesApplied) : 0U)};
+               r.head, why_unusable(r, m), static_cast<std::uint8_t>(r.corrected ? (r.status & kBothStages) : 0U)};
         const std::int64_t key = epoch_key(r.t);
         if (mode == Mode::kKeep) {
             kept.push_back({key, k});
@@ -412,8 +403,7 @@ struct CombineStage::Impl {
         });
         mark_duplicates(rows);
         // The epoch's gate by its stages (GateOptions): a raw file's rows have none.
-        const combine::Combiner<double>& combiner =
-            mark_missing_stages(rows) == kStagesApplied ? corrected : uncorrected;
+        const combine::Combiner<double>& combiner = gates.of(mark_missing_stages(rows));
         combine::HeadAttitude<double> heads[kMaxHeads];
         std::size_t used_row[kMaxHeads] = {};
         std::uint8_t n = 0;
@@ -473,10 +463,9 @@ struct CombineStage::Impl {
     }
 
     const MountingsFile& m;
-    combine::Combiner<double> corrected;    // the gate of epochs with both stages applied
-    combine::Combiner<double> uncorrected;  // of the others (the same tables but the gate's)
-    AtomicFile* out;                        // the file, or
-    std::vector<AttitudeRow>* rows_out;     // the rows
+    StageGates gates;                    // the combiner of each kind of epoch (the same tables but the gate's)
+    AtomicFile* out;                     // the file, or
+    std::vector<AttitudeRow>* rows_out;  // the rows
     std::string file;
     Diagnostics diag;
     Mode mode;
@@ -490,7 +479,7 @@ struct CombineStage::Impl {
         std::size_t n = 0;
         std::array<double, 3> sum{};
     };
-    std::uint32_t mounted = corrected.mounted();
+    std::uint32_t mounted = gates.of(kBothStages).mounted();
     std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
     double t_first = 0.0;
     bool any_epoch = false;

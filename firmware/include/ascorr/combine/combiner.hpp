@@ -138,6 +138,44 @@ constexpr bool gate_config_valid(const CombinerConfig& c) noexcept {
 // amplification (≤ 50 for near-orthogonal heads).
 inline constexpr double kMaxGateFactor = 0x1p28;
 
+// U of subset_gate within kMaxGateFactor in every entry (build_gate's test).
+inline bool gate_factors_fit(const Matrix3& u) noexcept {
+    for (const auto& row : u.m) {
+        for (double x : row) {
+            if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// Every gate of every head set of two or more mounted heads within the
+// fixed-point format, without building the tables (the link server's test
+// before it builds: a few hundred bytes of stack, not the combiner's tables).
+// kNone, or kGateOutOfRange with *head and *subset; for mountings that
+// check_mountings() accepts and a gate_config_valid() cfg.
+inline MountingsProblem check_gates(const Mountings& m, const CombinerConfig& cfg, std::uint8_t* head,
+                                    HeadMask* subset) noexcept {
+    const HeadMask mounted = mounted_heads(m);
+    for (unsigned sub = 1; sub < kSubsetCount; ++sub) {
+        const auto s = static_cast<HeadMask>(sub);
+        if ((sub & ~unsigned{mounted}) != 0U || head_count(s) < 2) {
+            continue;
+        }
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            Matrix3 u{};
+            if ((s & head_bit(h)) != 0U &&
+                !(subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u) && gate_factors_fit(u))) {
+                *head = h;
+                *subset = s;
+                return MountingsProblem::kGateOutOfRange;
+            }
+        }
+    }
+    return MountingsProblem::kNone;
+}
+
 // One head's corrected solution at the epoch.
 template <typename T>
 struct HeadAttitude {
@@ -313,15 +351,8 @@ template <typename T>
 bool Combiner<T>::build_gate(const Mountings& m, HeadMask s, std::uint8_t h, const CombinerConfig& cfg) noexcept {
     using F = CombineFormats<T>;
     Matrix3 u{};
-    if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u)) {
+    if (!subset_gate(m, s, h, cfg.gate_sigmas, cfg.gate_floor_arcsec, &u) || !gate_factors_fit(u)) {
         return false;
-    }
-    for (const auto& row : u.m) {
-        for (double x : row) {
-            if (!(x <= kMaxGateFactor && x >= -kMaxGateFactor)) {
-                return false;
-            }
-        }
     }
     table_[s].quick[h] = F::quick_from_double(quick_bound(u));
     table_[s].gate[h] = {F::gate_from_double(u.m[0][0]), F::gate_from_double(u.m[0][1]),

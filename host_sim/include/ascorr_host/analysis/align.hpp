@@ -70,6 +70,9 @@ namespace ascorr::host {
 inline constexpr double kDefaultNoiseWindowS = 600.0;
 inline constexpr double kMinNoiseWindowS = 0.01;
 inline constexpr double kMaxNoiseWindowS = 1e10;
+constexpr bool noise_window_valid(double s) noexcept {
+    return s == 0.0 || (s >= kMinNoiseWindowS && s <= kMaxNoiseWindowS);
+}
 // Fewest epochs with two or more usable heads that align accepts.
 inline constexpr std::size_t kMinAlignEpochs = 100;
 
@@ -187,16 +190,17 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
 // estimate is iterated: each pass sums the data with the current mountings,
 // estimates the noise and the δ_i, and turns the mountings by them.
 //
-// The gate: from the second pass on, each epoch goes through the
-// combination's own consistency gate (combine/combiner.hpp, the gate of the
-// epoch's stages, GateOptions) built from the current mountings and the
-// noise of the pass before; a head it finds inconsistent is left out of the
-// sums (LeftOut::kInconsistent). The first pass has no noise to gate with:
+// The gate: once a pass turned no head by more than kGateAfterUpdateArcsec,
+// each epoch of every later pass goes through the combination's own
+// consistency gate (combine/combiner.hpp, the gate of the epoch's stages,
+// GateOptions) built from the current mountings and the noise of the pass
+// before; a head it finds inconsistent is left out of the sums
+// (LeftOut::kInconsistent). The first pass has no noise to gate with:
 // outliers inflate its noise, and the gate of the next passes tightens as
-// they go. The passes end when the largest δ is below kAlignToleranceArcsec
-// (the first pass removes all but the second-order terms, about δ² ≈
-// 0.005" for 30") and the gate left out the same rows as the pass before, at
-// most kMaxAlignPasses.
+// they go. The passes end after a gated pass whose largest δ is below
+// kAlignToleranceArcsec (the first pass removes all but the second-order
+// terms, about δ² ≈ 0.005" for 30") and whose gate left out the same rows as
+// the pass before, at most kMaxAlignPasses.
 //
 // Refused (AlignRefused): noise the data do not determine (a head whose σ has
 // a formal 1σ above kMaxNoiseRelativeSd of itself), and mountings the
@@ -205,6 +209,8 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
 
 inline constexpr double kAlignToleranceArcsec = 1e-3;
 inline constexpr std::size_t kMaxAlignPasses = 10;
+// The gate from the pass after one that turned no head by more than this.
+inline constexpr double kGateAfterUpdateArcsec = 1.0;
 inline constexpr double kMaxNoiseRelativeSd = 0.5;
 
 struct AlignOptions {

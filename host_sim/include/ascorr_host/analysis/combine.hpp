@@ -62,7 +62,7 @@ enum class LeftOut : std::uint8_t {
     kDuplicate,       // two rows of one head in one epoch
     kInconsistent,    // refused by the combiner's gates
     kNotUnit,         // a quaternion the combiner refuses (not unit, not finite)
-    kNoEpoch,         // |t| beyond the millisecond key (iba.hpp): in no epoch
+    kNoEpoch,         // |t| beyond the millisecond key (pipeline/epoch_key.hpp): in no epoch
 };
 inline constexpr std::size_t kLeftOutKinds = 12;
 const char* left_out_name(LeftOut why) noexcept;
@@ -122,8 +122,26 @@ struct GateOptions {
 combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noexcept;
 // The options over `base` (replay: the flight's gate, combine::flight_gate).
 combine::CombinerConfig gate_config(const GateOptions& g, const combine::CombinerConfig& base) noexcept;
-// What --gate-floor and --gate-sigmas say in a message ("a floor of 2 arcsec ...").
-std::string describe(const GateOptions& g);
+
+// Both stages: the status bits of a row corrected by aberration and thermal.
+inline constexpr StatusBits kBothStages = status::kAberrationApplied | status::kThermalApplied;
+
+// The ground's gates of GateOptions, one combiner's tables for each kind of
+// epoch (combine's and align's): the epoch's stages pick one.
+class StageGates {
+public:
+    StageGates(const combine::Mountings& m, const GateOptions& g)
+        : both_(m, gate_config(g, true)), other_(m, gate_config(g, false)) {}
+    bool valid() const noexcept { return both_.valid() && other_.valid(); }
+    // The combiner of an epoch whose usable rows have `stages` (status & kBothStages).
+    const combine::Combiner<double>& of(StatusBits stages) const noexcept {
+        return stages == kBothStages ? both_ : other_;
+    }
+
+private:
+    combine::Combiner<double> both_;
+    combine::Combiner<double> other_;
+};
 
 // Rows in, one combined row per epoch out (see the top).
 class CombineStage : public CorrectedRowSink {
