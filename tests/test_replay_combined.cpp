@@ -25,6 +25,7 @@
 #include "ascorr_link/messages.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "rewriting_loopback.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::host {
@@ -115,56 +116,23 @@ TEST(ReplayCombined, LoopbackAgreesAndIsNearTheDoubleCombination) {
 
 // A target whose mountings differ from the host's (head A's turned by 4″ in
 // MOUNTING_LOAD): its combined attitudes must be caught.
-class MountingTwister {
-public:
-    MountingTwister()
-        : server_(0x54455354U, [] { return std::uint32_t{0}; }),
-          transport_([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
-              for (std::size_t i = 0; i < n; ++i) {
-                  pass(p[i], reply);
-              }
-          }) {}
-    host::Transport& transport() { return transport_; }
-    std::size_t twisted() const { return twisted_; }
-
-private:
-    void pass(std::uint8_t b, const host::LoopbackTransport::Reply& reply) {
-        if (decoder_.push(b) != link::FrameDecoder::Event::kFrame) {
-            return;
-        }
-        const link::Frame& f = decoder_.frame();
-        std::uint8_t payload[link::kMaxPayload];
-        std::size_t n = f.length;
-        std::copy(f.payload, f.payload + n, payload);
+TEST(ReplayCombined, ATargetWithOtherMountingsIsCaught) {
+    const auto dir = simulated("replay_combined_mutant");
+    std::size_t twisted = 0;
+    RewritingLoopback target([&](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
         link::MountingLoad m{};
-        if (f.type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && link::decode(payload, n, m) &&
+        if (type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && link::decode(payload, n, m) &&
             m.head == 0U) {
             // q ⊗ (1, 1e-5, 0, 0): 4″ about the head's x axis, unit within 1e-10.
             const Quaternion<double> q = m.q_chu_crf;
             m.q_chu_crf = {q.w - 1e-5 * q.x, q.x + 1e-5 * q.w, q.y + 1e-5 * q.z, q.z - 1e-5 * q.y};
             n = link::encode(m, payload);
-            ++twisted_;
+            ++twisted;
         }
-        std::uint8_t wire[link::kMaxWire];
-        const std::size_t w = link::encode_frame(f.type, f.seq, payload, n, wire, sizeof wire);
-        for (std::size_t i = 0; i < w; ++i) {
-            server_.on_byte(wire[i], reply);
-        }
-    }
-
-    using Counter = std::uint32_t (*)();
-    link::FrameDecoder decoder_;
-    link::LinkServer<float, Counter> server_;
-    host::LoopbackTransport transport_;
-    std::size_t twisted_ = 0;
-};
-
-TEST(ReplayCombined, ATargetWithOtherMountingsIsCaught) {
-    const auto dir = simulated("replay_combined_mutant");
-    MountingTwister target;
+    });
     std::ostringstream log;
     const host::ReplaySummary s = host::replay_over(options(dir, "link double"), target.transport(), log);
-    EXPECT_EQ(target.twisted(), 1U);
+    EXPECT_EQ(twisted, 1U);
     EXPECT_EQ(s.mismatches, 0U);  // the heads' corrections are untouched
     EXPECT_GT(s.combined_mismatches, kEpochs / 2);
     EXPECT_FALSE(host::agrees(s));
@@ -218,34 +186,6 @@ TEST(ReplayCombined, TheGateTravelsInTheBuildFrameOnlyWhenNotTheFlights) {
     EXPECT_FALSE(link::decode(p, link::encode(m, p), back));
 }
 
-// A loopback target that records the length of each MOUNTING_LOAD build frame.
-class BuildFrameSpy {
-public:
-    BuildFrameSpy()
-        : server_(0x53505931U, [] { return std::uint32_t{0}; }),
-          transport_([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
-              for (std::size_t i = 0; i < n; ++i) {
-                  if (decoder_.push(p[i]) == link::FrameDecoder::Event::kFrame) {
-                      const link::Frame& f = decoder_.frame();
-                      if (f.type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && f.length > 2U &&
-                          f.payload[2] == 1U) {
-                          build_lengths_.push_back(f.length);
-                      }
-                  }
-                  server_.on_byte(p[i], reply);
-              }
-          }) {}
-    host::Transport& transport() { return transport_; }
-    const std::vector<std::size_t>& build_lengths() const { return build_lengths_; }
-
-private:
-    using Counter = std::uint32_t (*)();
-    link::FrameDecoder decoder_;
-    link::LinkServer<float, Counter> server_;
-    host::LoopbackTransport transport_;
-    std::vector<std::size_t> build_lengths_;
-};
-
 TEST(ReplayCombined, AGateSetByTheGroundIsTheTargetsToo) {
     const auto dir = simulated("replay_combined_gate");
     for (const bool set : {false, true}) {
@@ -254,11 +194,17 @@ TEST(ReplayCombined, AGateSetByTheGroundIsTheTargetsToo) {
             o.gate.floor_arcsec = 2.0;
             o.gate.sigmas = 5.0;
         }
-        BuildFrameSpy target;
+        // The length of each MOUNTING_LOAD build frame.
+        std::vector<std::size_t> build_lengths;
+        RewritingLoopback target([&](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
+            if (type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && n > 2U && payload[2] == 1U) {
+                build_lengths.push_back(n);
+            }
+        });
         std::ostringstream log;
         expect_agreement(host::replay_over(o, target.transport(), log));
         // The flight's gate: the 51 bytes a target before the gate takes; another: 67.
-        EXPECT_EQ(target.build_lengths(), std::vector<std::size_t>{set ? 67U : 51U});
+        EXPECT_EQ(build_lengths, std::vector<std::size_t>{set ? 67U : 51U});
     }
 }
 

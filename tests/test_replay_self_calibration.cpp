@@ -27,6 +27,7 @@
 #include "ascorr_link/messages.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "rewriting_loopback.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::host {
@@ -249,48 +250,21 @@ TEST(ReplaySelfCalibration, AQuadraticInitialModelIsRefused) {
 // bit of some SOLUTION_INs (every head-B solution from `from_id` on): the
 // target learns from other epochs than the host, which the comparison must
 // see.
-class CleanBitEraser {
-public:
+struct CleanBitEraser {
     explicit CleanBitEraser(std::uint32_t from_id)
-        : from_id_(from_id),
-          server_(0x54455354U, [] { return std::uint32_t{0}; }),
-          transport_([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
-              for (std::size_t i = 0; i < n; ++i) {
-                  pass(p[i], reply);
+        : target([this, from_id](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
+              link::SolutionIn<float> s{};
+              if (type == static_cast<std::uint8_t>(link::MessageType::kSolutionIn) && link::decode(payload, n, s) &&
+                  s.head == 1U && s.id >= from_id && (s.calib & link::kCalibClean) != 0U) {
+                  s.calib = static_cast<std::uint8_t>(s.calib & ~link::kCalibClean);
+                  n = link::encode(s, payload);
+                  ++erased;
               }
           }) {}
-    host::Transport& transport() { return transport_; }
-    std::size_t erased() const { return erased_; }
+    host::Transport& transport() { return target.transport(); }
 
-private:
-    void pass(std::uint8_t b, const host::LoopbackTransport::Reply& reply) {
-        if (decoder_.push(b) != link::FrameDecoder::Event::kFrame) {
-            return;
-        }
-        const link::Frame& f = decoder_.frame();
-        std::uint8_t payload[link::kMaxPayload];
-        std::size_t n = f.length;
-        std::copy(f.payload, f.payload + n, payload);
-        link::SolutionIn<float> s{};
-        if (f.type == static_cast<std::uint8_t>(link::MessageType::kSolutionIn) && link::decode(payload, n, s) &&
-            s.head == 1U && s.id >= from_id_ && (s.calib & link::kCalibClean) != 0U) {
-            s.calib = static_cast<std::uint8_t>(s.calib & ~link::kCalibClean);
-            n = link::encode(s, payload);
-            ++erased_;
-        }
-        std::uint8_t wire[link::kMaxWire];
-        const std::size_t w = link::encode_frame(f.type, f.seq, payload, n, wire, sizeof wire);
-        for (std::size_t i = 0; i < w; ++i) {
-            server_.on_byte(wire[i], reply);
-        }
-    }
-
-    using Counter = std::uint32_t (*)();
-    std::uint32_t from_id_;
-    link::FrameDecoder decoder_;
-    link::LinkServer<float, Counter> server_;
-    host::LoopbackTransport transport_;
-    std::size_t erased_ = 0;
+    std::size_t erased = 0;
+    RewritingLoopback target;
 };
 
 TEST(ReplaySelfCalibration, UntouchedLinkDoubleAgrees) {
@@ -299,7 +273,7 @@ TEST(ReplaySelfCalibration, UntouchedLinkDoubleAgrees) {
     CleanBitEraser target(0xFFFFFFFFU);
     std::ostringstream log;
     const host::ReplaySummary s = host::replay_over(options(dir, "link double"), target.transport(), log);
-    EXPECT_EQ(target.erased(), 0U);
+    EXPECT_EQ(target.erased, 0U);
     expect_agreement(s);
 }
 
@@ -309,7 +283,7 @@ TEST(ReplaySelfCalibration, ATargetThatLearnsOtherwiseIsCaught) {
     std::ostringstream log;
     const host::ReplaySummary s = host::replay_over(options(dir, "link double"), target.transport(), log);
     std::cout << host::to_json(s) << "\n" << log.str();
-    EXPECT_GT(target.erased(), 100U);
+    EXPECT_GT(target.erased, 100U);
     EXPECT_EQ(s.returned, 2751U);
     EXPECT_FALSE(s.report_matches);
     EXPECT_GT(s.version_mismatches + s.history_mismatches, 0U);

@@ -1,7 +1,6 @@
-"""The third hostile probe's classes on the Python side: an uninitialised Model
-(15), integer columns by one rule with the file reader (flags, head indices,
-status: 9 and 19), datetime64 times (9), near-miss column names (17), the
-locale (8) and the selection of clean rows (12)."""
+"""The Python side's columns and times: an uninitialised Model, integer columns
+by one rule with the file reader (flags, head indices, status), datetime64
+times, near-miss column names, the locale and the selection of clean rows."""
 
 import pickle
 import re

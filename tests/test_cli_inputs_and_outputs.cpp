@@ -1,4 +1,4 @@
-// The command line against a second hostile probe: every output checked
+// The command line's inputs and outputs: every output checked
 // against every input, never a second correction, empty paths refused, a
 // states file with no usable row fails the run, a one-epoch plot window, bounded
 // lines in every reader, usage errors before any input is read, one spelling of
@@ -36,7 +36,7 @@ bool has(const std::string& text, const std::string& part) {
 
 // A model kept beside simulate's outputs under the name of one of them is an
 // input: simulate refuses before reading it, and the file stays as it was.
-TEST(CliProbe, SimulateRefusesATruthModelThatIsOneOfItsOwnOutputs) {
+TEST(CliInputsAndOutputs, SimulateRefusesATruthModelThatIsOneOfItsOwnOutputs) {
     const fs::path dir = scratch_dir("probe-sim-truth");
     for (const std::string suffix : {".heaters.csv", ".truth.csv", ".floor.json", ""}) {
         SCOPED_TRACE(suffix);
@@ -59,7 +59,7 @@ TEST(CliProbe, SimulateRefusesATruthModelThatIsOneOfItsOwnOutputs) {
 // stats and plot apply the stages themselves: with a model, a corrected file
 // is refused (the thermal stage would be applied twice); stats without a model
 // shows it as it is, its one stage under "original", the others null.
-TEST(CliProbe, StatsAndPlotNeverCorrectACorrectedFileAgain) {
+TEST(CliInputsAndOutputs, StatsAndPlotNeverCorrectACorrectedFileAgain) {
     const fs::path dir = scratch_dir("probe-twice");
     ASSERT_EQ(run_in("simulate --days 0.2 --out s.csv", dir).exit_code, 0);
     ASSERT_EQ(run_in("correct --in s.csv --model " + kModel + " --out c.csv", dir).exit_code, 0);
@@ -93,7 +93,7 @@ TEST(CliProbe, StatsAndPlotNeverCorrectACorrectedFileAgain) {
 
 // ---- empty paths ------------------------------------------------------------
 
-TEST(CliProbe, AnEmptyPathIsAUsageErrorNotNone) {
+TEST(CliInputsAndOutputs, AnEmptyPathIsAUsageErrorNotNone) {
     const fs::path dir = scratch_dir("probe-empty-path");
     const std::string cmds[] = {
         "correct --in " + kSolutions + " --out o.csv --states ''",
@@ -123,7 +123,7 @@ TEST(CliProbe, AnEmptyPathIsAUsageErrorNotNone) {
 
 // ---- a states file with no usable state -------------------------------------
 
-TEST(CliProbe, AStatesFileWithNoAcceptedStateFailsTheRun) {
+TEST(CliInputsAndOutputs, AStatesFileWithNoAcceptedStateFailsTheRun) {
     const fs::path dir = scratch_dir("probe-states-none");
     const std::string head = "t,x,y,z,vx,vy,vz\n";
     const std::string metres = head + "447534180.184,6838000,0,0,0,300,7600\n447534190.184,6838000,0,0,0,300,7600\n";
@@ -164,7 +164,7 @@ TEST(CliProbe, AStatesFileWithNoAcceptedStateFailsTheRun) {
 
 // ---- usage errors: exit 2, before any input is read, the value as given -------
 
-TEST(CliProbe, RangeErrorsAreUsageErrorsWithTheValueAsGiven) {
+TEST(CliInputsAndOutputs, RangeErrorsAreUsageErrorsWithTheValueAsGiven) {
     const fs::path dir = scratch_dir("probe-ranges");
     struct Case {
         std::string args;
@@ -203,7 +203,7 @@ TEST(CliProbe, RangeErrorsAreUsageErrorsWithTheValueAsGiven) {
 
 // ---- one spelling of the enumerations ----------------------------------------
 
-TEST(CliProbe, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
+TEST(CliInputsAndOutputs, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
     const fs::path dir = scratch_dir("probe-choices");
     std::ofstream(dir / "st.csv") << "t,x,y,z,vx,vy,vz\n447534180.184,6838,0,0,0,0.3,7.6\n";
     for (const std::string bad : {"--states-frame 1", "--states-frame 0", "--scalar 2", "--scalar 0", "--scalar dbl"}) {
@@ -245,7 +245,7 @@ TEST(CliProbe, ChoiceOptionsTakeNamesInAnyCaseAndNeverNumbers) {
 // A line beyond 1 MiB is refused with file:line as soon as it is read, in every
 // reader; /dev/zero is refused at once (before this, --states /dev/zero read
 // until memory ran out). The line just within the limit is read as usual.
-TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
+TEST(CliInputsAndOutputs, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
     const fs::path dir = scratch_dir("probe-long-lines");
     const std::size_t limit = std::size_t{1} << 20;
     const std::string cfg = std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg";
@@ -292,7 +292,7 @@ TEST(CliProbe, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
 
 // ---- plot: one epoch; reasons said once -------------------------------------------
 
-TEST(CliProbe, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
+TEST(CliInputsAndOutputs, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
     const fs::path dir = scratch_dir("probe-plot-one");
     ASSERT_EQ(run_in("simulate --days 0.05 --out s.csv", dir).exit_code, 0);
     // The second epoch of the file (A and B at 60 s), alone in its window: one clean A-B epoch.
@@ -323,7 +323,7 @@ TEST(CliProbe, PlotDrawsAOneEpochWindowAndSaysEachReasonOnce) {
 
 // ---- the fit report: no number where there is none --------------------------------
 
-TEST(CliProbe, TheFitReportSaysNaForAPairWithoutEpochsAndNeverLowerByANegativePercentage) {
+TEST(CliInputsAndOutputs, TheFitReportSaysNaForAPairWithoutEpochsAndNeverLowerByANegativePercentage) {
     host::Selection s;
     s.holdout = 0.25;
     host::ModelScore m;
@@ -372,7 +372,7 @@ std::string elf_header(std::uint8_t elf_class, std::uint16_t type, std::uint16_t
     return h;
 }
 
-TEST(CliProbe, ReplayChecksTheFirmwareImageBeforeStartingTheEmulator) {
+TEST(CliInputsAndOutputs, ReplayChecksTheFirmwareImageBeforeStartingTheEmulator) {
     const fs::path dir = scratch_dir("probe-firmware");
     const std::uint32_t soft = 0x5000200U;
     const std::uint32_t hard = 0x5000400U;
@@ -419,7 +419,7 @@ TEST(CliProbe, ReplayChecksTheFirmwareImageBeforeStartingTheEmulator) {
 // replay's --max-propagation goes to the target (SERVICE_CONFIG): it is
 // accepted, and what it does to the answers is tested in test_replay_states
 // (ReplayStates.LoopbackMaxPropagationEqualsCorrect).
-TEST(CliProbe, ReplayMaxPropagationIsTheTargetsHorizon) {
+TEST(CliInputsAndOutputs, ReplayMaxPropagationIsTheTargetsHorizon) {
     const fs::path dir = scratch_dir("probe-replay-horizon");
     const std::string run = "replay --target loopback-float --in " + kSolutions + " --model " + kModel + " --out o.csv";
     const CliRun other = run_in(run + " --max-propagation 120 > summary.json", dir);
@@ -431,7 +431,7 @@ TEST(CliProbe, ReplayMaxPropagationIsTheTargetsHorizon) {
 
 // ---- '-' is a stream on both sides ------------------------------------------------
 
-TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt) {
+TEST(CliInputsAndOutputs, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt) {
     const fs::path dir = scratch_dir("probe-dash");
     // simulate writes eight files: '-' is refused naming why, and nothing is created.
     const CliRun sim = run_in("simulate --days 0.01 --out -", dir);
@@ -466,7 +466,7 @@ TEST(CliProbe, DashIsStandardInputAndOutputAndRefusedWhereOneStreamCannotCarryIt
 // Every message about standard input names it "standard input", with the
 // line and column, never the private copy the readers open (which it named
 // before: /tmp/ascorr-stdin-XXXXXX/standard-input:3:15: ...).
-TEST(CliProbe, MessagesNameStandardInputNotItsCopy) {
+TEST(CliInputsAndOutputs, MessagesNameStandardInputNotItsCopy) {
     const fs::path dir = scratch_dir("probe-stdin-names");
     const std::string header = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
     std::ofstream(dir / "bad.csv") << header << "750000000.0,A,0.5,0.5,0.5,0.5,10.0,-8.0,-19.0,1,2,3,0,1.00\n"
@@ -498,7 +498,7 @@ TEST(CliProbe, MessagesNameStandardInputNotItsCopy) {
 
 // ---- thermistors: live options, fault windows -------------------------------------
 
-TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheHistory) {
+TEST(CliInputsAndOutputs, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheHistory) {
     const fs::path dir = scratch_dir("probe-thermistors");
     const std::string cfg = std::string(ASCORR_HAL_EXAMPLES) + "/board.cfg";
     std::ofstream(dir / "history.csv") << "t,t_chu,t_029,t_032\n100,3.2,-9.5,-19.8\n101,3.2,-9.5,-19.8\n";
@@ -526,7 +526,7 @@ TEST(CliProbe, ThermistorsRefusesLiveOptionsWithAFileAndWarnsOfAFaultOutsideTheH
 
 // The library's own refusals (the Python module reaches them) repeat the value
 // unrounded too.
-TEST(CliProbe, LibraryRefusalsRepeatTheValueUnrounded) {
+TEST(CliInputsAndOutputs, LibraryRefusalsRepeatTheValueUnrounded) {
     host::FitOptions o;
     o.holdout = 0.50000001;
     const host::RowSource none = [](const std::function<void(const host::SolutionRecord&)>&) {};

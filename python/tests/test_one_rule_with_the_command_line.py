@@ -1,4 +1,4 @@
-"""The second hostile probe's classes on the Python side: nothing lost (unknown
+"""The Python side by the command line's rules: nothing lost (unknown
 columns, atomic writes), nothing silently wrong (Earth velocity outside the
 ephemeris, rejected quaternions in iba, float32 times, aberration=None, the RMS
 of one epoch), one rule with the command line (times beyond the ephemeris,

@@ -1,8 +1,7 @@
-// The command line against the third hostile probe's I/O items (issue 30):
-// the outputs of one run committed together or not at all (1, 4), results on
-// standard output checked to the last flush (2), two outputs onto one stream
-// refused (10), a pipe or FIFO given by path read once (14), and every output
-// path checked before the work (18). Each case is a row of DEVELOPERS.md's
+// The outputs of one run: committed together or not at all, results on
+// standard output checked to the last flush, two outputs onto one stream
+// refused, a pipe or FIFO given by path read once, and every output path
+// checked before the work. Each case is a row of DEVELOPERS.md's
 // bad-input table. Nothing here waits on a clock: `timeout` only guards
 // against a hang, it measures nothing.
 #include <gtest/gtest.h>
@@ -79,7 +78,7 @@ std::vector<std::string> temporaries_in(const fs::path& dir) {
 // The history to /dev/full: its write fails at the flush, after the corrected
 // rows are complete. The corrected file was renamed first and the run said
 // nothing of it; now nothing is renamed. And the other way round.
-TEST(IoProbe, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound) {
+TEST(RunOutputs, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound) {
     const fs::path dir = scratch_dir("io-history");
     const std::vector<std::string> commands = {
         "correct --in " + sim() + " --self-calibrate",
@@ -109,7 +108,7 @@ TEST(IoProbe, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound) {
 // simulate's eight files: the heater list cannot be written (a link to
 // /dev/full, a stream); the seven others keep the previous run's contents.
 // Simulate renamed them one by one, the solutions first.
-TEST(IoProbe, SimulateCommitsItsEightFilesTogether) {
+TEST(RunOutputs, SimulateCommitsItsEightFilesTogether) {
     const fs::path dir = scratch_dir("io-simulate");
     ASSERT_EQ(run_in("simulate --days 0.1 --seed 1 --out s.csv", dir).exit_code, 0);
     const std::vector<std::string> kept = {"s.csv",
@@ -145,7 +144,7 @@ TEST(IoProbe, SimulateCommitsItsEightFilesTogether) {
 // the corrected file and the history as they were; the corrected file to
 // /dev/full leaves the combined file as it was. The combined file was written
 // and committed on its own, after the corrected file.
-TEST(IoProbe, TheCombinedFileIsCommittedWithTheCorrectedFile) {
+TEST(RunOutputs, TheCombinedFileIsCommittedWithTheCorrectedFile) {
     const fs::path dir = scratch_dir("io-combined");
     const std::string m = sim() + ".mountings.csv";
     const std::vector<std::string> commands = {
@@ -178,7 +177,7 @@ TEST(IoProbe, TheCombinedFileIsCommittedWithTheCorrectedFile) {
 
 // ---- item 2: results on standard output are written or the run fails --------
 
-TEST(IoProbe, AResultThatCannotReachStandardOutputFailsTheRun) {
+TEST(RunOutputs, AResultThatCannotReachStandardOutputFailsTheRun) {
     const fs::path dir = scratch_dir("io-stdout");
     const std::vector<std::string> commands = {
         "stats --in " + sim() + " --json",
@@ -216,7 +215,7 @@ TEST(IoProbe, AResultThatCannotReachStandardOutputFailsTheRun) {
 
 // ---- item 10: two outputs onto one stream -------------------------------------
 
-TEST(IoProbe, TwoOutputsOntoOneStreamAreRefused) {
+TEST(RunOutputs, TwoOutputsOntoOneStreamAreRefused) {
     const fs::path dir = scratch_dir("io-one-stream");
     const std::string self = "correct --in " + sim() + " --self-calibrate ";
     const std::vector<std::string> refused = {
@@ -242,7 +241,7 @@ TEST(IoProbe, TwoOutputsOntoOneStreamAreRefused) {
 
 // ---- item 14: a stream given by path is read once --------------------------------
 
-TEST(IoProbe, APipeOrFifoGivenByPathIsReadOnceLikeStandardInput) {
+TEST(RunOutputs, APipeOrFifoGivenByPathIsReadOnceLikeStandardInput) {
     const fs::path dir = scratch_dir("io-streams");
     const std::string fit_options = " --min-days 0.5 --min-orbits 10";
     struct Case {
@@ -295,7 +294,7 @@ TEST(IoProbe, APipeOrFifoGivenByPathIsReadOnceLikeStandardInput) {
 // The input is malformed at its last row: a run that checked its outputs only
 // at the end stopped at that row and never said the output could not be
 // written; now the output is named first, before any input is read.
-TEST(IoProbe, AnOutputThatCannotBeWrittenFailsBeforeAnyInputIsRead) {
+TEST(RunOutputs, AnOutputThatCannotBeWrittenFailsBeforeAnyInputIsRead) {
     const fs::path dir = scratch_dir("io-early");
     std::string text = slurp(sim());
     text += "1.0,A,not-a-number\n";
