@@ -15,6 +15,7 @@
 //   core/constants.hpp      physical constants and the core's validity domain
 //   core/vector3.hpp        3-vectors
 //   core/quaternion.hpp     Hamilton, scalar-first attitude quaternions
+//   core/rotation_vector.hpp  the rotation between two attitudes, arcsec (ground analysis)
 //   core/aberration.hpp     ERFA eraAb stellar aberration as an attitude rotation
 //   core/heads.hpp          the camera heads: how many, their letters
 //   core/thermal.hpp        the thermal model (Herceg et al. 2017, eqs. 4–10)
@@ -52,6 +53,7 @@
 #include "core/heads.hpp"
 #include "core/model_coefficients.hpp"
 #include "core/quaternion.hpp"
+#include "core/rotation_vector.hpp"
 #include "core/scalar_traits.hpp"
 #include "core/status.hpp"
 #include "core/thermal.hpp"

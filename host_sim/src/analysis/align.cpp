@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/constants.hpp"
+#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr_host/formats/csv.hpp"
 
 namespace ascorr::host {
 
 namespace {
-
-constexpr double kRadToArcsec = 180.0 / 3.14159265358979323846 * 3600.0;
 
 Eigen::Matrix3d rotation_matrix_of(const Quaternion<double>& q) noexcept {
     return Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
@@ -30,17 +30,8 @@ HeadList members(HeadSet s) noexcept {
 }  // namespace
 
 Eigen::Vector3d rotation_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
-    Quaternion<double> d = a * conjugate(b);
-    if (d.w < 0.0) {
-        d = {-d.w, -d.x, -d.y, -d.z};
-    }
-    const Eigen::Vector3d v(d.x, d.y, d.z);
-    const double s = v.norm();
-    if (s == 0.0) {
-        return Eigen::Vector3d::Zero();
-    }
-    // 2·atan2(|v|, w) is exact at every angle (2·asin(|v|) loses digits near π).
-    return v * (2.0 * std::atan2(s, d.w) / s * kRadToArcsec);
+    const Vector3<double> v = rotation_vector_arcsec(a, b);
+    return {v.x, v.y, v.z};
 }
 
 Quaternion<double> rotation_quaternion(const Eigen::Vector3d& theta_arcsec) noexcept {

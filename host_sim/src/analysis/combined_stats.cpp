@@ -9,6 +9,7 @@
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
+#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_text/c_format.hpp"
@@ -130,10 +131,8 @@ void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedSt
 }  // namespace
 
 std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
-    const Quaternion<double> d = canonical(a * conjugate(b));
-    const double s = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    const double k = s > 0.0 ? 2.0 * std::atan2(s, d.w) / s * kRadToArcsec : 2.0 * kRadToArcsec;
-    return {d.x * k, d.y * k, d.z * k};
+    const Vector3<double> v = rotation_vector_arcsec(a, b);
+    return {v.x, v.y, v.z};
 }
 
 std::string head_set_name(std::uint32_t heads) {
