@@ -118,18 +118,11 @@ py::tuple correct(const py::object& t, const py::object& chu, const py::object& 
     const double max_propagation = real_arg(max_propagation_obj, "max_propagation");
     const std::optional<host::StatesFile> sf = states_arg(states, states_frame, max_propagation);
     const host::StatesFile* s = sf ? &*sf : nullptr;
-    if (scalar == host::ScalarKind::kFixed && m != nullptr) {
+    if (m != nullptr) {
         try {
-            host::check_fixed_point_range(*m, "model");  // refused, never saturated, as by the command line
+            host::check_model_for_scalar(*m, scalar, "model");  // refused, never saturated, as by the command line
         } catch (const std::runtime_error& e) {
-            bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
-        }
-    }
-    if (scalar == host::ScalarKind::kFloat && m != nullptr) {
-        try {
-            host::check_float_range(*m, "model");  // refused, as by the command line
-        } catch (const std::runtime_error& e) {
-            bad_argument("model", std::string(e.what()) + " (scalar='float')");
+            bad_argument("model", std::string(e.what()) + " (scalar='" + std::string(host::scalar_name(scalar)) + "')");
         }
     }
     const Rows r = rows_of(t, chu, q, temps, v);

@@ -18,6 +18,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
+#include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
@@ -107,18 +108,11 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
             bad_argument("model", e.what());
         }
     }
-    if (scalar == host::ScalarKind::kFixed && m != nullptr) {
+    if (m != nullptr) {
         try {
-            host::check_fixed_point_range(*m, "model");
+            host::check_model_for_scalar(*m, scalar, "model");  // refused, never saturated, as by the command line
         } catch (const std::runtime_error& e) {
-            bad_argument("model", std::string(e.what()) + " (scalar='fixed')");
-        }
-    }
-    if (scalar == host::ScalarKind::kFloat && m != nullptr) {
-        try {
-            host::check_float_range(*m, "model");  // refused, as by the command line
-        } catch (const std::runtime_error& e) {
-            bad_argument("model", std::string(e.what()) + " (scalar='float')");
+            bad_argument("model", std::string(e.what()) + " (scalar='" + std::string(host::scalar_name(scalar)) + "')");
         }
     }
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);

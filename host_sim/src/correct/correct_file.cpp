@@ -342,12 +342,7 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
         return std::nullopt;
     }
     model_file = read_model_file(opt.model);
-    if constexpr (std::is_same_v<T, Q30>) {
-        check_fixed_point_range(*model_file, opt.model);
-    }
-    if constexpr (std::is_same_v<T, float>) {
-        check_float_range(*model_file, opt.model);
-    }
+    check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
     }
@@ -522,6 +517,14 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
 }
 
 }  // namespace
+
+void check_model_for_scalar(const ModelFile& m, ScalarKind scalar, const std::string& path) {
+    if (scalar == ScalarKind::kFixed) {
+        check_fixed_point_range(m, path);
+    } else if (scalar == ScalarKind::kFloat) {
+        check_float_range(m, path);
+    }
+}
 
 std::vector<NamedPath> correct_inputs(const CorrectOptions& opt) {
     return {{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}};

@@ -335,12 +335,7 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
         return std::nullopt;
     }
     ModelFile mf = read_model_file(opt.model);
-    if constexpr (std::is_same_v<T, Q30>) {
-        check_fixed_point_range(mf, opt.model);
-    }
-    if constexpr (std::is_same_v<T, float>) {
-        check_float_range(mf, opt.model);
-    }
+    check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(mf, opt.model);
     }

@@ -87,6 +87,14 @@ public:
 
 // The command's files (atomic_file.hpp's OutputSet): its inputs, and its
 // outputs by option: "--out", and "--model-history" with self_calibrate.
+struct ModelFile;  // formats/model_csv.hpp
+
+// A model refused for a scalar as by `correct --scalar`: beyond the
+// fixed-point formats (check_fixed_point_range, fixed) or beyond the float
+// core's bound (check_float_range, float); nothing for double. One rule for
+// correct, replay and Python.
+void check_model_for_scalar(const ModelFile& m, ScalarKind scalar, const std::string& path);
+
 std::vector<NamedPath> correct_inputs(const CorrectOptions& opt);
 std::vector<NamedPath> correct_outputs(const CorrectOptions& opt);
 

@@ -9,6 +9,9 @@
 #include <array>
 #include <optional>
 #include <string_view>
+#include <type_traits>
+
+#include "ascorr/core/q_formats.hpp"
 
 namespace ascorr::host {
 
@@ -41,6 +44,14 @@ constexpr std::optional<ScalarKind> scalar_from_name(std::string_view name) noex
         }
     }
     return std::nullopt;
+}
+
+// The kind of a core scalar type (double, float, Q30).
+template <typename T>
+constexpr ScalarKind scalar_kind_of() noexcept {
+    static_assert(std::is_same_v<T, double> || std::is_same_v<T, float> || std::is_same_v<T, Q30>, "a core scalar");
+    return std::is_same_v<T, double> ? ScalarKind::kDouble
+                                     : (std::is_same_v<T, float> ? ScalarKind::kFloat : ScalarKind::kFixed);
 }
 
 }  // namespace ascorr::host
