@@ -11,6 +11,7 @@
 
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
+#include "ascorr/combine/usable.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
@@ -31,10 +32,6 @@ namespace ascorr::host {
 namespace {
 
 namespace cs = combine::combined_status;
-
-constexpr StatusBits kStageSkipped =
-    status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
-constexpr double kMaxCleanConfidence = 5.0;  // arcsec: Statistics' clean rows (docs/contract.md)
 
 constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
                                                       "flagged",
@@ -75,10 +72,10 @@ LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept {
     if (r.flags != 0) {
         return LeftOut::kFlagged;
     }
-    if (!(r.confidence <= kMaxCleanConfidence)) {
+    if (!(r.confidence <= combine::kMaxCleanConfidenceArcsec)) {
         return LeftOut::kConfidence;
     }
-    if (r.corrected && (r.status & kStageSkipped) != 0U) {
+    if (r.corrected && (r.status & combine::kStageSkipped) != 0U) {
         return LeftOut::kStageSkipped;
     }
     return LeftOut::kUsed;

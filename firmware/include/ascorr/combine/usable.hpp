@@ -16,9 +16,15 @@
 
 namespace ascorr::combine {
 
+// A stage the run asked for and could not apply (4, 8, 128, 256).
+inline constexpr StatusBits kStageSkipped =
+    status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
 // The corrected solution's status bits that leave it out.
-inline constexpr StatusBits kNotUsable = status::kRejected | status::kNoVelocity | status::kNoTemperature |
-                                         status::kThermalOutOfRange | status::kNoModelForHead;
+inline constexpr StatusBits kNotUsable = status::kRejected | kStageSkipped;
+// A clean row's largest confidence (arcsec): the contract's Statistics,
+// which the ground's readers of files apply (on board the camera head says
+// whether its solution is clean).
+inline constexpr double kMaxCleanConfidenceArcsec = 5.0;
 
 constexpr bool usable_for_combination(StatusBits corrected, bool clean) noexcept {
     return clean && (corrected & kNotUsable) == 0U;

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 
+#include "ascorr/combine/usable.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
@@ -20,7 +21,7 @@ namespace ascorr::host {
 // column, an empty field, `nan`; NaN or None in Python, where NaN is "not
 // available" as in read_solutions()) is not one: such a row is not clean.
 inline bool confidence_clean(const SolutionRecord& rec) noexcept {
-    return rec.confidence_present && rec.confidence <= 5.0;
+    return rec.confidence_present && rec.confidence <= combine::kMaxCleanConfidenceArcsec;
 }
 
 // Why a row is left out of the fit (the first reason that applies).
