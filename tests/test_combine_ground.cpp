@@ -118,6 +118,53 @@ TEST(MountingsFile, EveryRefusalNamesFileLineAndColumn) {
     }
 }
 
+// The covariance columns (issue 39): read back as written, refused naming
+// file, line and column when they cannot be the combination's.
+TEST(CombinedFile, CovarianceColumnsReadBackAndBadOnesAreRefused) {
+    const fs::path dir = fs::temp_directory_path() / "ascorr_cov_columns";
+    fs::create_directories(dir);
+    const std::string h = std::string(host::kCombinedHeader) + ",cov_xy,cov_xz,cov_yz\n";
+    const std::string good = "10,1,0,0,0,AB,2,2,3,1,0.5,-1.25,0\n20,,,,,,,,,8,,,\n";
+    const auto read = [&dir](const std::string& text) {
+        const fs::path p = dir / "a.csv";
+        std::ofstream(p) << text;
+        std::vector<host::AttitudeRow> rows;
+        host::AttitudeReader r(p.string());
+        host::AttitudeRow row;
+        while (r.next(row)) {
+            rows.push_back(row);
+        }
+        return rows;
+    };
+    const std::vector<host::AttitudeRow> rows = read(h + good);
+    ASSERT_EQ(rows.size(), 2U);
+    EXPECT_TRUE(rows[0].has_cov && !rows[1].has_cov);
+    EXPECT_EQ(rows[0].cov_arcsec2, (std::array<double, 3>{0.5, -1.25, 0.0}));
+    std::string again = host::combined_header({true}) + "\n";
+    for (const host::AttitudeRow& r : rows) {
+        host::append_combined_row(again, r, {true});
+    }
+    EXPECT_EQ(again, h + "10,1.000000000000000,0.000000000000000,0.000000000000000,0.000000000000000,AB,2,2,3,1,0.5,-1.25,0\n" +
+                         "20,,,,,,,,,8,,,\n");
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {h + "10,1,0,0,0,AB,2,2,3,1,4.5,0,0\n", "a.csv:2:23: column 'cov_xy': 4.5 arcsec^2 is no covariance"},
+        {h + "10,1,0,0,0,AB,2,2,3,1,0,nan,0\n", "a.csv:2:25: column 'cov_xz'"},
+        {h + "10,1,0,0,0,AB,2,2,3,1,0,0,\n", "a.csv:2:27: column 'cov_yz'"},
+        {h + "20,,,,,,,,,8,0,,\n", "a.csv:2:14: column 'cov_xy': empty on a row without q"},
+        {std::string(host::kCombinedHeader) + ",cov_xy,cov_xz\n", "a.csv:1:1: the covariance columns"},
+        {"t,qw,qx,qy,qz,cov_xy,cov_xz,cov_yz\n", "a.csv:1:1: the covariance columns"},
+    };
+    for (const auto& [text, want] : bad) {
+        try {
+            read(text);
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const text::InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what() << "\nwanted: " << want;
+        }
+    }
+    fs::remove_all(dir);
+}
+
 // ---- Bad input through the command line
 
 // Mountings of A, B, C (the simulator's, with its true noise) and rows
@@ -511,6 +558,7 @@ TEST(CombineAccuracy, StepsWithoutTheThermalStageAreLargerThanWithIt) {
     host::CombineOptions opt{(ms.dir / "cor.csv").string(),
                              (ms.dir / "sim.csv.mountings.csv").string(),
                              (ms.dir / "steps_th.csv").string(),
+                             {},
                              {}};
     std::ostringstream log;
     const host::CombineSummary with = host::combine_file(opt, log);

@@ -30,6 +30,12 @@ void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combi
     }
 }
 
+CLI::Option* add_covariance_option(CLI::App& cmd, host::CombinedColumns& columns) {
+    return cmd.add_flag("--covariance", columns.covariance,
+                        "also write the formal covariance's off-diagonal, columns cov_xy,cov_xz,cov_yz (arcsec^2; "
+                        "the diagonal's roots are sigma_x,sigma_y,sigma_z)");
+}
+
 void add_combine_command(CLI::App& app) {
     auto opt = std::make_shared<host::CombineOptions>();
     CLI::App* cmd = app.add_subcommand(
@@ -49,6 +55,7 @@ void add_combine_command(CLI::App& app) {
         ->required()
         ->check(non_empty_path());
     add_gate_options(*cmd, opt->gate, nullptr, GateDefault::kGround);
+    add_covariance_option(*cmd, opt->columns);
     cmd->callback([opt]() {
         host::OutputSet outputs =
             open_run_files({{"--in", &opt->in}, {"--mountings", &opt->mountings}}, host::combine_outputs(*opt));

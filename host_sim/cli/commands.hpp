@@ -20,6 +20,7 @@
 
 namespace ascorr::host {
 struct GateOptions;
+struct CombinedColumns;
 }
 
 namespace ascorr::cli {
@@ -140,6 +141,8 @@ void add_combine_command(CLI::App& app);
 // (--combined: each needs `combined`); combine_command.cpp.
 enum class GateDefault { kGround, kFlight };  // which default --gate-floor's help names
 void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combined, GateDefault floor);
+// --covariance of combine and correct --combined (combine_command.cpp).
+CLI::Option* add_covariance_option(CLI::App& cmd, host::CombinedColumns& columns);
 void add_align_command(CLI::App& app);
 
 }  // namespace ascorr::cli

@@ -33,6 +33,7 @@ struct CombineTexts {
     std::string mountings;
     std::string combined;
     host::GateOptions gate;
+    host::CombinedColumns columns;
 };
 
 void add_combine_options(CLI::App& cmd, CombineTexts& t) {
@@ -47,6 +48,7 @@ void add_combine_options(CLI::App& cmd, CombineTexts& t) {
     mountings->needs(combined);
     combined->needs(mountings);
     add_gate_options(cmd, t.gate, combined, GateDefault::kGround);
+    add_covariance_option(cmd, t.columns)->needs(combined);
 }
 
 void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
@@ -61,7 +63,7 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
         throw RefusedInput(e.what());
     }
     const host::CorrectAndCombine r =
-        host::correct_and_combine(opt, t.mountings, t.combined, outputs, std::cerr, t.gate);
+        host::correct_and_combine(opt, t.mountings, t.combined, outputs, std::cerr, t.gate, t.columns);
     outputs.commit();
     if (!r.corrected.self_calibration.empty()) {
         std::cerr << "ascorr correct: " << r.corrected.self_calibration << '\n';

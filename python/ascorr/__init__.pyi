@@ -316,6 +316,7 @@ def combine(
     confidence: Optional[_Real] = ...,
     gate_sigmas: Optional[float] = ...,
     gate_floor: Optional[float] = ...,
+    covariance: bool = ...,
 ) -> dict[str, npt.NDArray[Any]]:
     """The combined attitude of the bench, one row per epoch (rows whose t agree to the
     millisecond), in time order: the numbers and status bits of `ascorr combine` on the
@@ -329,7 +330,9 @@ def combine(
     gate_sigmas, gate_floor: the consistency gate, as --gate-sigmas ([3, 100], default 6)
     and --gate-floor (arcsec, [1, 3600]; default 2 for rows with the aberration and the
     thermal stage applied, 10 otherwise). Mountings a target would refuse with this gate
-    raise ValueError saying why. Needs no file: no temporary folder is used.
+    raise ValueError saying why. covariance: also return "cov" (m, 3), the formal
+    covariance's off-diagonal xy, xz, yz in arcsec^2 (--covariance's columns; NaN without
+    a head). Needs no file: no temporary folder is used.
     Returns a dict: "t" (m,); "q" (m, 4) q_crf_icrf (w >= 0), NaN without a usable head;
     "heads" (m,) str, the letters of the heads used ('' for none); "sigma" (m, 3) the
     formal 1-sigma about the CRF axes, arcsec (NaN without a head); "status" (m,) the

@@ -147,8 +147,9 @@ host::GateOptions gate_arg(const py::object& sigmas, const py::object& floor) {
 // command line's to the digit, with no file (and no TMPDIR) at all.
 py::dict combine_arrays(const py::object& t, const py::object& chu, const py::object& q, const py::object& mountings,
                         const py::object& status, const py::object& flags, const py::object& confidence,
-                        const py::object& gate_sigmas, const py::object& gate_floor) {
+                        const py::object& gate_sigmas, const py::object& gate_floor, bool covariance) {
     const host::MountingsFile m = mountings_arg(mountings);
+    const host::CombinedColumns columns{covariance};
     const host::GateOptions gate = gate_arg(gate_sigmas, gate_floor);
     try {
         host::refuse_unusable_mountings(m, "argument 'mountings'", gate);
@@ -160,7 +161,7 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
     std::vector<host::AttitudeRow> out;
     {
         py::gil_scoped_release unlocked;  // the rows are C++ data by now
-        host::CombineStage stage(m, gate, out, kArrayRows, log);
+        host::CombineStage stage(m, gate, out, kArrayRows, log, columns);
         rows_source(rows)([&stage](const host::CorrectedRow& r) { stage.add(r); });
         stage.finish();
     }
@@ -170,6 +171,7 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
     py::array_t<double> qa({n, py::ssize_t{4}});
     py::array_t<double> sa({n, py::ssize_t{3}});
     py::array_t<std::uint8_t> st(n);
+    py::array_t<double> ca({n, py::ssize_t{3}});
     py::list heads;
     for (py::ssize_t i = 0; i < n; ++i) {
         const host::AttitudeRow& r = out[static_cast<std::size_t>(i)];
@@ -180,8 +182,10 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
         qq[1] = r.has_q ? r.q_crf_icrf.x : kNaN;
         qq[2] = r.has_q ? r.q_crf_icrf.y : kNaN;
         qq[3] = r.has_q ? r.q_crf_icrf.z : kNaN;
+        double* cc = ca.mutable_data() + 3 * i;
         for (std::size_t a = 0; a < 3; ++a) {
             ss[a] = r.has_q ? r.sigma_arcsec[a] : kNaN;
+            cc[a] = r.has_cov ? r.cov_arcsec2[a] : kNaN;
         }
         heads.append(host::head_letters(r.heads));
         st.mutable_data()[i] = static_cast<std::uint8_t>(r.status);
@@ -192,6 +196,9 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
     d["heads"] = py::module_::import("numpy").attr("array")(heads, "dtype"_a = "U" + std::to_string(kMaxHeads));
     d["sigma"] = sa;
     d["status"] = st;
+    if (covariance) {
+        d["cov"] = ca;
+    }
     return d;
 }
 
@@ -341,7 +348,7 @@ void bind_combine(py::module_& mod) {
         "path"_a, docstring(docs::kReadMountings));
     mod.def("combine", &combine_arrays, "t"_a, "chu"_a, "q"_a, "mountings"_a, "status"_a = py::none(),
             "flags"_a = py::none(), "confidence"_a = py::none(), "gate_sigmas"_a = py::none(),
-            "gate_floor"_a = py::none(), docstring(docs::kCombine));
+            "gate_floor"_a = py::none(), "covariance"_a = false, docstring(docs::kCombine));
     mod.def("align", &align_arrays, "t"_a, "chu"_a, "q"_a, "mountings"_a, "status"_a = py::none(),
             "flags"_a = py::none(), "confidence"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
             "noise_window"_a = host::kDefaultNoiseWindowS, "min_epochs"_a = host::kMinAlignEpochs,

@@ -202,7 +202,9 @@ clean (flags 0, confidence <= 5) and its status has none of 4, 8, 16, 128, 256.
 gate_sigmas, gate_floor: the consistency gate, as --gate-sigmas ([3, 100], default 6)
 and --gate-floor (arcsec, [1, 3600]; default 2 for rows with the aberration and the
 thermal stage applied, 10 otherwise). Mountings a target would refuse with this gate
-raise ValueError saying why. Needs no file: no temporary folder is used.
+raise ValueError saying why. covariance: also return "cov" (m, 3), the formal
+covariance's off-diagonal xy, xz, yz in arcsec^2 (--covariance's columns; NaN without
+a head). Needs no file: no temporary folder is used.
 Returns a dict: "t" (m,); "q" (m, 4) q_crf_icrf (w >= 0), NaN without a usable head;
 "heads" (m,) str, the letters of the heads used ('' for none); "sigma" (m, 3) the
 formal 1-sigma about the CRF axes, arcsec (NaN without a head); "status" (m,) the

@@ -1,6 +1,8 @@
 """read_mountings(), combine() and align() against the command line's files
 (`ascorr combine`, `ascorr align`) on a small simulated mission: bit for bit."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -120,3 +122,74 @@ def test_sigmas_a_target_refuses_raise_saying_why(corrected):
     cross[0] = 0.01
     with pytest.raises(ValueError, match="CHU A: its consistency gate in head set .* a target refuses"):
         ascorr.combine(**arrays(data), mountings=dict(m, sigma_cross=cross))
+
+
+def information_crf(q_chu_crf, sigma_cross, sigma_about):
+    """A head's information in CRF axes, (1/arcsec^2): M^T diag(1/sc^2, 1/sc^2, 1/sa^2) M,
+    M = R(q_chu_crf) from the Hamilton product written out (not ascorr's code)."""
+    w, x, y, z = q_chu_crf / np.linalg.norm(q_chu_crf)
+    m = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                  [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                  [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    return m.T @ np.diag([sigma_cross**-2, sigma_cross**-2, sigma_about**-2]) @ m
+
+
+def check_covariance(cov, sigma, heads, m):
+    """cov (k, 3) and sigma (k, 3) of rows with heads (k,) against numpy's (sum W_i)^-1
+    (to 1e-9 of sigma_a sigma_b); returns the largest |cov_ab| / (sigma_a sigma_b)."""
+    info = {h: information_crf(m["q"][i], m["sigma_cross"][i], m["sigma_about"][i]) for i, h in enumerate(m["heads"])}
+    largest = 0.0
+    for c, s, h in zip(cov, sigma, heads):
+        if not h:
+            assert np.all(np.isnan(c))
+            continue
+        p = np.linalg.inv(sum(info[x] for x in h))
+        scale = np.sqrt(np.diag(p))
+        pairs = np.array([scale[0] * scale[1], scale[0] * scale[2], scale[1] * scale[2]])
+        want = np.array([p[0, 1], p[0, 2], p[1, 2]])
+        assert np.all(np.abs(c - want) <= 1e-9 * pairs), (h, c, want)
+        assert np.allclose(s, scale, rtol=1e-9)
+        largest = max(largest, float(np.max(np.abs(want) / pairs)))
+    return largest
+
+
+def test_covariance_is_the_inverse_of_the_summed_information(exe, corrected):
+    # Issue 39, item 3: the columns cov_xy,cov_xz,cov_yz equal (sum W_i)^-1's
+    # off-diagonal to 1e-9 (relative to sigma_a sigma_b); the sigmas are its
+    # diagonal's roots; Python's are the file's to the bit.
+    d, data, mountings = corrected
+    run_cli(exe, "combine", "--in", data, "--mountings", mountings, "--out", d / "cov.csv", "--covariance")
+    header, rows = read_csv_text(d / "cov.csv")
+    assert header[10:] == ["cov_xy", "cov_xz", "cov_yz"]
+    number = lambda x: float(x) if x else np.nan  # noqa: E731
+    cov = np.array([[number(x) for x in r[10:13]] for r in rows])
+    sigma = np.array([[number(x) for x in r[6:9]] for r in rows])
+    m = ascorr.read_mountings(mountings)
+    c = ascorr.combine(**arrays(data), mountings=m, covariance=True)
+    assert np.array_equal(c["cov"], cov, equal_nan=True)
+    assert {"ABC", "AB"} <= {r[5] for r in rows}
+    assert check_covariance(cov, sigma, [r[5] for r in rows], m) > 0.05  # not vacuous: AB's is sizeable
+    # Heads of unequal noise: the three-head set's off-diagonal is sizeable too.
+    m2 = dict(m, sigma_cross=np.array([1.0, 2.0, 4.0]), sigma_about=np.array([7.0, 12.0, 30.0]))
+    c2 = ascorr.combine(**arrays(data), mountings=m2, covariance=True)
+    full = c2["heads"] == "ABC"
+    assert check_covariance(c2["cov"][full], c2["sigma"][full], c2["heads"][full], m2) > 0.05
+    # Mutation check: another head set's covariance fails the bound.
+    with pytest.raises(AssertionError):
+        check_covariance(c2["cov"][full][:1], c2["sigma"][full][:1], ["AB"], m2)
+    without = ascorr.combine(**arrays(data), mountings=m)
+    assert "cov" not in without
+    assert np.array_equal(without["sigma"], c["sigma"], equal_nan=True)
+
+
+def test_correct_combined_writes_the_same_covariance(exe, corrected):
+    d, data, mountings = corrected
+    raw = d / "mission.csv"
+    run_cli(exe, "correct", "--in", raw, "--out", d / "c2.csv", "--model", f"{raw}.truth.csv", "--mountings",
+            mountings, "--combined", d / "c2-combined.csv", "--covariance")
+    run_cli(exe, "combine", "--in", d / "c2.csv", "--mountings", mountings, "--out", d / "c2-again.csv",
+            "--covariance")
+    assert (d / "c2-combined.csv").read_text() == (d / "c2-again.csv").read_text()
+    p = subprocess.run([exe, "correct", "--in", raw, "--out", d / "c3.csv", "--covariance"], capture_output=True,
+                       text=True)
+    assert p.returncode == 2 and "--covariance requires --combined" in p.stderr, p.stderr

@@ -11,6 +11,7 @@
 
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/combine/combiner.hpp"
+#include "ascorr/combine/subset_tables.hpp"
 #include "ascorr/combine/usable.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
@@ -221,19 +222,34 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path,
     }
 }
 
+SubsetCovariances subset_covariances(const combine::Mountings& m, std::uint32_t mounted) noexcept {
+    SubsetCovariances out{};
+    for (unsigned s = 1; s < combine::kSubsetCount; ++s) {
+        combine::Matrix3 cov{};
+        if ((s & ~mounted) == 0U && combine::subset_covariance(m, static_cast<combine::HeadMask>(s), &cov)) {
+            out[s] = {cov.m[0][1], cov.m[0][2], cov.m[1][2]};
+        }
+    }
+    return out;
+}
+
 struct CombineStage::Impl {
-    Impl(const MountingsFile& mountings, const GateOptions& gate, AtomicFile* out_file,
+    Impl(const MountingsFile& mountings, const GateOptions& gate, CombinedColumns columns, AtomicFile* out_file,
          std::vector<AttitudeRow>* out_rows, std::string file_name, std::ostream& log, Mode mode_)
         : m(mountings),
           gates(mountings.mountings, gate),
+          cols(columns),
           out(out_file),
           rows_out(out_rows),
           file(std::move(file_name)),
           diag(log),
           mode(out == nullptr || out->streamed() ? Mode::kKeep : mode_) {
         if (out != nullptr) {
-            buf += kCombinedHeader;
+            buf += combined_header(cols);
             buf += '\n';
+        }
+        if (cols.covariance) {
+            covariance = subset_covariances(mountings.mountings, mounted);
         }
     }
 
@@ -435,6 +451,8 @@ struct CombineStage::Impl {
             row.heads = c.used;
             const double* s = combiner.sigma_arcsec(c.subset);
             row.sigma_arcsec = {s[0], s[1], s[2]};
+            row.has_cov = cols.covariance;
+            row.cov_arcsec2 = covariance[c.subset];
         }
         if (c.used == mounted && head_count(mounted) >= 2) {
             add_steps(combiner, heads, n, c.q_crf_icrf, row.t);
@@ -443,7 +461,7 @@ struct CombineStage::Impl {
             sum.status_bit[b] += (row.status >> b) & 1U;
         }
         ++sum.epochs;
-        append_combined_row(buf, row);
+        append_combined_row(buf, row, cols);
         if (buf.size() > (1U << 20)) {
             flush();
         }
@@ -454,13 +472,14 @@ struct CombineStage::Impl {
         if (out != nullptr) {
             out->write(buf);
         } else {
-            read_combined_rows(buf, *rows_out);
+            read_combined_rows(buf, *rows_out, cols);
         }
         buf.clear();
     }
 
     const MountingsFile& m;
-    StageGates gates;                    // the combiner of each kind of epoch (the same tables but the gate's)
+    StageGates gates;  // the combiner of each kind of epoch (the same tables but the gate's)
+    CombinedColumns cols;
     AtomicFile* out;                     // the file, or
     std::vector<AttitudeRow>* rows_out;  // the rows
     std::string file;
@@ -477,18 +496,19 @@ struct CombineStage::Impl {
         std::array<double, 3> sum{};
     };
     std::uint32_t mounted = gates.of(kBothStages).mounted();
+    SubsetCovariances covariance{};  // with cols.covariance
     std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
     double t_first = 0.0;
     bool any_epoch = false;
 };
 
 CombineStage::CombineStage(const MountingsFile& m, const GateOptions& gate, AtomicFile& out, std::string file,
-                           std::ostream& log, Mode mode)
-    : impl_(std::make_unique<Impl>(m, gate, &out, nullptr, std::move(file), log, mode)) {}
+                           std::ostream& log, Mode mode, CombinedColumns columns)
+    : impl_(std::make_unique<Impl>(m, gate, columns, &out, nullptr, std::move(file), log, mode)) {}
 
 CombineStage::CombineStage(const MountingsFile& m, const GateOptions& gate, std::vector<AttitudeRow>& rows,
-                           std::string file, std::ostream& log)
-    : impl_(std::make_unique<Impl>(m, gate, nullptr, &rows, std::move(file), log, Mode::kKeep)) {}
+                           std::string file, std::ostream& log, CombinedColumns columns)
+    : impl_(std::make_unique<Impl>(m, gate, columns, nullptr, &rows, std::move(file), log, Mode::kKeep)) {}
 
 CombineStage::~CombineStage() = default;
 
@@ -523,7 +543,7 @@ StatusBits status_of(const SolutionsReader& reader, const SolutionRecord& rec, i
 
 CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, OutputSet& outputs, std::ostream& log,
                             CombineStage::Mode mode) {
-    CombineStage stage(m, opt.gate, outputs["--out"], opt.in, log, mode);
+    CombineStage stage(m, opt.gate, outputs["--out"], opt.in, log, mode, opt.columns);
     for_each_corrected_row(
         opt.in, [&stage](const CorrectedRow& r) { stage.add(r); }, "combine");
     stage.finish();
@@ -565,16 +585,17 @@ std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, co
 }
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, std::ostream& log, const GateOptions& gate) {
+                                      const std::string& combined, std::ostream& log, const GateOptions& gate,
+                                      CombinedColumns columns) {
     OutputSet outputs(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
-    CorrectAndCombine r = correct_and_combine(opt, mountings, combined, outputs, log, gate);
+    CorrectAndCombine r = correct_and_combine(opt, mountings, combined, outputs, log, gate, columns);
     outputs.commit();
     return r;
 }
 
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, OutputSet& outputs, std::ostream& log,
-                                      const GateOptions& gate) {
+                                      const GateOptions& gate, CombinedColumns columns) {
     refuse_output_over_input(correct_and_combine_inputs(opt, mountings), correct_and_combine_outputs(opt, combined));
     const MountingsFile m = read_mountings_file(mountings);
     refuse_unusable_mountings(m, mountings, gate);
@@ -585,7 +606,7 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
         run.common_rotation = pipeline::common_rotation_weights(m.mountings);  // sigmas: refused above without
     }
     const auto pass = [&](CombineStage::Mode mode, std::ostream& to) {
-        CombineStage stage(m, gate, outputs["--combined"], opt.in, to, mode);
+        CombineStage stage(m, gate, outputs["--combined"], opt.in, to, mode, columns);
         CorrectAndCombine r;
         r.corrected = correct_file(run, outputs, to, &stage);
         r.combined = stage.summary();

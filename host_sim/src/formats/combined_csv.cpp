@@ -37,6 +37,7 @@ struct Columns {
     int heads = -1;
     int sigma[3] = {-1, -1, -1};
     int status = -1;
+    int cov[3] = {-1, -1, -1};  // all or none (columns_of)
 };
 
 Columns columns_of(const Header& h, const std::string& file, bool& combined) {
@@ -51,12 +52,21 @@ Columns columns_of(const Header& h, const std::string& file, bool& combined) {
     c.sigma[1] = h.index("sigma_y");
     c.sigma[2] = h.index("sigma_z");
     c.status = h.index("status");
+    c.cov[0] = h.index("cov_xy");
+    c.cov[1] = h.index("cov_xz");
+    c.cov[2] = h.index("cov_yz");
     const bool attitude = c.t >= 0 && c.q[0] >= 0 && c.q[1] >= 0 && c.q[2] >= 0 && c.q[3] >= 0;
     combined = attitude && c.heads >= 0 && c.sigma[0] >= 0 && c.sigma[1] >= 0 && c.sigma[2] >= 0 && c.status >= 0;
     if (!attitude) {
         throw text::InputError(file, 1, 1,
                                "expected the header of an attitude file (" + std::string(kAttitudeHeader) +
                                    ") or of a combined file (" + std::string(kCombinedHeader) + ")");
+    }
+    const int covs = int(c.cov[0] >= 0) + int(c.cov[1] >= 0) + int(c.cov[2] >= 0);
+    if (covs != 0 && (covs != 3 || !combined)) {
+        throw text::InputError(file, 1, 1,
+                               "the covariance columns (" + std::string(kCovarianceColumns) +
+                                   ") are all three or none, and only in a combined file");
     }
     return c;
 }
@@ -123,6 +133,34 @@ private:
         }
         row.status = static_cast<unsigned>(*v);
         refuse_impossible(row);
+        if (c_.cov[0] >= 0) {
+            parse_covariance(row);
+        }
+    }
+
+    // cov_xy, cov_xz, cov_yz: empty without q, else numbers that with the
+    // sigmas can be a covariance (|cov_ab| <= sigma_a sigma_b, to rounding).
+    void parse_covariance(AttitudeRow& row) const {
+        static constexpr const char* kNames[3] = {"cov_xy", "cov_xz", "cov_yz"};
+        static constexpr int kAxes[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (!row.has_q) {
+                if (!field(c_.cov[k]).empty()) {
+                    fail(c_.cov[k], std::string("column '") + kNames[k] + "': empty on a row without q");
+                }
+                continue;
+            }
+            const double c = number(c_.cov[k], kNames[k]);
+            const double product = row.sigma_arcsec[static_cast<std::size_t>(kAxes[k][0])] *
+                                   row.sigma_arcsec[static_cast<std::size_t>(kAxes[k][1])];
+            if (!(std::fabs(c) <= product * (1.0 + 1e-12))) {  // the written sigmas' rounding
+                fail(c_.cov[k], std::string("column '") + kNames[k] + "': " + number_text(c) +
+                                    " arcsec^2 is no covariance with the row's sigmas (|cov| <= " +
+                                    number_text(product) + ")");
+            }
+            row.cov_arcsec2[k] = c;
+        }
+        row.has_cov = row.has_q;
     }
 
     // A row the combination cannot have written: a status against the rule
@@ -194,7 +232,16 @@ void append_attitude_row(std::string& out, double t, const Quaternion<double>& q
     out += '\n';
 }
 
-void append_combined_row(std::string& out, const AttitudeRow& row) {
+std::string combined_header(CombinedColumns c) {
+    std::string h(kCombinedHeader);
+    if (c.covariance) {
+        h += ',';
+        h += kCovarianceColumns;
+    }
+    return h;
+}
+
+void append_combined_row(std::string& out, const AttitudeRow& row, CombinedColumns c) {
     append_shortest(out, row.t);
     if (row.has_q) {
         append_quaternion(out, canonical(row.q_crf_icrf));
@@ -215,6 +262,12 @@ void append_combined_row(std::string& out, const AttitudeRow& row) {
     }
     out += ',';
     out += std::to_string(row.status);
+    for (std::size_t k = 0; c.covariance && k < 3; ++k) {
+        out += ',';
+        if (row.has_q) {
+            append_shortest(out, row.cov_arcsec2[k]);
+        }
+    }
     out += '\n';
 }
 
@@ -293,10 +346,11 @@ bool TruthReader::next(AttitudeRow& row) {
     return true;
 }
 
-void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows) {
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns cols) {
     static const std::string kName = "combined rows";
     bool combined = false;
-    const Columns c = columns_of(Header(kCombinedHeader, kName), kName, combined);
+    const std::string header = combined_header(cols);
+    const Columns c = columns_of(Header(header, kName), kName, combined);
     RowParser parser(kName, c, combined);
     while (!text.empty()) {
         const std::size_t end = text.find('\n');

@@ -7,7 +7,8 @@
 //                the combined small rotation is Σ_i K_{S,i} θ_i, the
 //                information-weighted mean (weighted least squares, the
 //                heads' errors independent, Gaussian, with covariances C_i);
-//  - formal σ    sqrt(diag(P_S⁻¹)) (arcsec), the 1σ about the CRF axes;
+//  - formal σ    sqrt(diag(P_S⁻¹)) (arcsec), the 1σ about the CRF axes; the
+//                whole P_S⁻¹ (arcsec²) is subset_covariance's;
 //  - gate factor U_{S,i}, upper triangular, for |S| ≥ 2 (combiner.hpp's gate).
 //    Head i's leave-one-out residual r_i = θ_i − θ̂_{S∖i} has covariance
 //    C_i + P_{S∖i}⁻¹; the gate adds the floor f² I (arcsec²) and divides by k²:
@@ -64,11 +65,17 @@ struct SubsetGains {
     double max_row_sum;       // max over rows of Σ_{i∈S} Σ_c |K_{S,i}[row][c]|
 };
 
+// The formal covariance P_S⁻¹ of subset s's combination (arcsec², CRF axes);
+// false when P_S is singular to matrix3.hpp's inverse_spd.
+inline bool subset_covariance(const Mountings& m, HeadMask s, Matrix3* cov) noexcept {
+    return inverse_spd(subset_information(m, s), cov);
+}
+
 // The gains and formal σ of subset s (non-empty, of usable mounted heads);
 // false when P_S is singular to matrix3.hpp's inverse_spd.
 inline bool subset_gains(const Mountings& m, HeadMask s, SubsetGains* out) noexcept {
     Matrix3 cov{};
-    if (!inverse_spd(subset_information(m, s), &cov)) {
+    if (!subset_covariance(m, s, &cov)) {
         return false;
     }
     SubsetGains g{};

@@ -143,6 +143,12 @@ private:
     combine::Combiner<double> other_;
 };
 
+// The formal covariance's off-diagonal (xy, xz, yz; arcsec²) of each head
+// set's combination (combine/subset_tables.hpp's P_S⁻¹), by HeadMask; zeros
+// for a set with a head not in `mounted`.
+using SubsetCovariances = std::array<std::array<double, 3>, combine::kSubsetCount>;
+SubsetCovariances subset_covariances(const combine::Mountings& m, std::uint32_t mounted) noexcept;
+
 // Rows in, one combined row per epoch out (see the top).
 class CombineStage : public CorrectedRowSink {
 public:
@@ -151,11 +157,11 @@ public:
     // caller); m: usable mountings with sigmas (refuse_unusable_mountings
     // with the same gate). file: the input's name, for messages.
     CombineStage(const MountingsFile& m, const GateOptions& gate, AtomicFile& out, std::string file, std::ostream& log,
-                 Mode mode);
+                 Mode mode, CombinedColumns columns = {});
     // The same into rows (Mode::kKeep), each as a reader of the combined file
     // reads it (as_written): no file at all.
     CombineStage(const MountingsFile& m, const GateOptions& gate, std::vector<AttitudeRow>& rows, std::string file,
-                 std::ostream& log);
+                 std::ostream& log, CombinedColumns columns = {});
     ~CombineStage() override;
     CombineStage(const CombineStage&) = delete;
     CombineStage& operator=(const CombineStage&) = delete;
@@ -179,6 +185,7 @@ struct CombineOptions {
     std::string mountings;  // with sigmas
     std::string out;
     GateOptions gate;
+    CombinedColumns columns;  // --covariance
 };
 
 // `ascorr combine`. Mountings without sigmas: each head's noise is estimated
@@ -215,13 +222,14 @@ struct CorrectAndCombine {
     CombineSummary combined;
 };
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
-                                      const std::string& combined, std::ostream& log, const GateOptions& gate = {});
+                                      const std::string& combined, std::ostream& log, const GateOptions& gate = {},
+                                      CombinedColumns columns = {});
 // The run's files: correct_inputs and "--mountings"; correct_outputs and "--combined".
 std::vector<NamedPath> correct_and_combine_inputs(const CorrectOptions& opt, const std::string& mountings);
 std::vector<NamedPath> correct_and_combine_outputs(const CorrectOptions& opt, const std::string& combined);
 // The same into outputs (opened from correct_and_combine_outputs, committed by the caller).
 CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::string& mountings,
                                       const std::string& combined, OutputSet& outputs, std::ostream& log,
-                                      const GateOptions& gate = {});
+                                      const GateOptions& gate = {}, CombinedColumns columns = {});
 
 }  // namespace ascorr::host

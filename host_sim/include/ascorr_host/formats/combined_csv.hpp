@@ -4,6 +4,9 @@
 // qw >= 0):
 //  - the combined file, `t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status`
 //    (`ascorr combine`, `correct --combined`);
+//    and with `--covariance` the columns `cov_xy,cov_xz,cov_yz` after them
+//    (arcsec²: the off-diagonal of the formal covariance whose diagonal's
+//    roots are the sigmas);
 //  - the attitude file, `t,qw,qx,qy,qz` (`simulate`'s true attitude of the
 //    CRF, OUT.attitude.csv), the combined file's first five columns.
 // Numbers as the corrected file writes them: q with 15 decimals (2e-10
@@ -26,6 +29,14 @@ namespace ascorr::host {
 
 inline constexpr std::string_view kAttitudeHeader = "t,qw,qx,qy,qz";
 inline constexpr std::string_view kCombinedHeader = "t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status";
+inline constexpr std::string_view kCovarianceColumns = "cov_xy,cov_xz,cov_yz";
+
+// The optional columns of a combined file.
+struct CombinedColumns {
+    bool covariance = false;  // cov_xy,cov_xz,cov_yz
+};
+// The header line (no line end) of a combined file with these columns.
+std::string combined_header(CombinedColumns c);
 
 // One row of either file. `heads` is a mask (bit h: head h of heads.hpp);
 // without q (no usable head) heads is 0 and sigma is not written.
@@ -37,23 +48,27 @@ struct AttitudeRow {
     std::uint32_t heads = 0;
     std::array<double, 3> sigma_arcsec{};  // about CRF x, y, z
     unsigned status = 0;
+    bool has_cov = false;                 // read: the file has the columns and the row a q
+    std::array<double, 3> cov_arcsec2{};  // xy, xz, yz (arcsec²)
 };
 
 // Appends `t,qw,qx,qy,qz\n` (the attitude file's row).
 void append_attitude_row(std::string& out, double t, const Quaternion<double>& q_crf_icrf);
-// Appends the combined file's row (with its line end).
-void append_combined_row(std::string& out, const AttitudeRow& row);
-// The rows of `text` (append_combined_row's, no header) as a reader of the
-// combined file reads them (q to 15 decimals), appended to rows: a
+// Appends the combined file's row (with its line end); the covariance
+// columns when c has them (empty without q, as the sigmas).
+void append_combined_row(std::string& out, const AttitudeRow& row, CombinedColumns c = {});
+// The rows of `text` (append_combined_row's with c, no header) as a reader of
+// the combined file reads them (q to 15 decimals), appended to rows: a
 // combination kept in memory gives the file's numbers to the digit.
-void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows);
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns c = {});
 
 // Reads an attitude or a combined file (told apart by the header:
 // combined()), row by row in file order, in blocks (bounded memory). Throws
 // InputError (file:line:column) for a malformed row: a header that is
 // neither, q neither four numbers nor four empty fields, a non-unit q, heads
-// not letters of heads.hpp in order, a status not an integer in [0, 255]. In
-// an attitude file every row has q.
+// not letters of heads.hpp in order, a status not an integer in [0, 255],
+// covariance columns not all three, not finite, or not a covariance with the
+// row's sigmas (|cov_ab| > sigma_a sigma_b). In an attitude file every row has q.
 class AttitudeReader {
 public:
     explicit AttitudeReader(const std::string& path);
