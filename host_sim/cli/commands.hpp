@@ -144,5 +144,6 @@ void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combi
 // --covariance of combine and correct --combined (combine_command.cpp).
 CLI::Option* add_covariance_option(CLI::App& cmd, host::CombinedColumns& columns);
 void add_align_command(CLI::App& app);
+void add_interpolate_command(CLI::App& app);
 
 }  // namespace ascorr::cli

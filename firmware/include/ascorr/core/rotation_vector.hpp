@@ -7,7 +7,8 @@
 // left frame's axes: a = Exp(θ) ⊗ b, R_a = R(θ) R_b. Either sign of a and b
 // gives the same θ (w ≥ 0 taken), so |θ| ≤ 180°. The angle is
 // 2·atan2(|v|, w), exact at every angle (2·asin(|v|) loses digits near π);
-// θ = 0 for identical attitudes (no 0/0).
+// θ = 0 for identical attitudes (no 0/0). exp_arcsec is the inverse: the
+// unit quaternion Exp(θ) of a rotation vector, with no 0/0 at θ = 0 either.
 #pragma once
 
 #include <cmath>
@@ -26,6 +27,16 @@ inline Vector3<double> rotation_vector_arcsec(const Quaternion<double>& a, const
     }
     const double k = 2.0 * std::atan2(s, d.w) / s * kRadToArcsec;
     return {d.x * k, d.y * k, d.z * k};
+}
+
+// Exp(θ) = [cos(|θ|/2), θ̂ sin(|θ|/2)] for θ in arcsec. sin(x/2)/x is taken
+// from its series below 1e-4 rad (truncation < x⁴/3840 < 3e-20, of 0.5).
+inline Quaternion<double> exp_arcsec(const Vector3<double>& theta_arcsec) noexcept {
+    const double x = std::sqrt(theta_arcsec.x * theta_arcsec.x + theta_arcsec.y * theta_arcsec.y +
+                               theta_arcsec.z * theta_arcsec.z) /
+                     kRadToArcsec;
+    const double k = (x < 1e-4 ? 0.5 - x * x / 48.0 : std::sin(0.5 * x) / x) / kRadToArcsec;
+    return {std::cos(0.5 * x), theta_arcsec.x * k, theta_arcsec.y * k, theta_arcsec.z * k};
 }
 
 }  // namespace ascorr
