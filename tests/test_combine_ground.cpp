@@ -144,8 +144,10 @@ TEST(CombinedFile, CovarianceColumnsReadBackAndBadOnesAreRefused) {
     for (const host::AttitudeRow& r : rows) {
         host::append_combined_row(again, r, {true});
     }
-    EXPECT_EQ(again, h + "10,1.000000000000000,0.000000000000000,0.000000000000000,0.000000000000000,AB,2,2,3,1,0.5,-1.25,0\n" +
-                         "20,,,,,,,,,8,,,\n");
+    EXPECT_EQ(
+        again,
+        h + "10,1.000000000000000,0.000000000000000,0.000000000000000,0.000000000000000,AB,2,2,3,1,0.5,-1.25,0\n" +
+            "20,,,,,,,,,8,,,\n");
     const std::vector<std::pair<std::string, std::string>> bad = {
         {h + "10,1,0,0,0,AB,2,2,3,1,4.5,0,0\n", "a.csv:2:23: column 'cov_xy': 4.5 arcsec^2 is no covariance"},
         {h + "10,1,0,0,0,AB,2,2,3,1,0,nan,0\n", "a.csv:2:25: column 'cov_xz'"},

@@ -121,8 +121,8 @@ TEST(Interpolate, ThinnedToTenSecondsAndBackIsNoWorseThanAtTheEpochs) {
     }
     ASSERT_GT(interpolated.n, 3000U);
     for (int a = 0; a < 3; ++a) {
-        EXPECT_LE(interpolated.rms()(a), epochs.rms()(a)) << "axis " << a << ": " << interpolated.rms().transpose()
-                                                          << " against " << epochs.rms().transpose();
+        EXPECT_LE(interpolated.rms()(a), epochs.rms()(a))
+            << "axis " << a << ": " << interpolated.rms().transpose() << " against " << epochs.rms().transpose();
     }
     // Mutation check: the epoch before, held, fails the bound (by the turn about the orbit normal).
     EXPECT_GT(held.rms().maxCoeff(), 10.0 * epochs.rms().maxCoeff());
@@ -158,11 +158,11 @@ TEST(Interpolate, EqualAttitudesAndOppositeSignsGiveTheAttitudeItself) {
         EXPECT_TRUE(std::isfinite(r[i].sigma_arcsec[0]));
     }
     EXPECT_EQ(r[0].t, 0.5);
-    EXPECT_EQ(r[0].heads, 7U);      // ABC ∪ AB
-    EXPECT_EQ(r[0].status, 5U);     // two or more heads; a head left out at 1
-    EXPECT_EQ(r[1].heads, 3U);      // AB ∪ A
+    EXPECT_EQ(r[0].heads, 7U);   // ABC ∪ AB
+    EXPECT_EQ(r[0].status, 5U);  // two or more heads; a head left out at 1
+    EXPECT_EQ(r[1].heads, 3U);   // AB ∪ A
     EXPECT_EQ(r[1].status, 5U);
-    EXPECT_EQ(r[2].status, 1U);     // at the epoch: its own row
+    EXPECT_EQ(r[2].status, 1U);  // at the epoch: its own row
     EXPECT_EQ(r[2].sigma_arcsec[0], 1.0);
     // the epochs' own errors averaged: 0.5² · (1 + 4) at mid-interval; the
     // rate did not change (no bound)

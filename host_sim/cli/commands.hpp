@@ -21,7 +21,7 @@
 namespace ascorr::host {
 struct GateOptions;
 struct CombinedColumns;
-}
+}  // namespace ascorr::host
 
 namespace ascorr::cli {
 

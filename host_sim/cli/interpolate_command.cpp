@@ -10,8 +10,9 @@ namespace ascorr::cli {
 void add_interpolate_command(CLI::App& app) {
     auto opt = std::make_shared<host::InterpolateOptions>();
     CLI::App* cmd = app.add_subcommand(
-        "interpolate", "the combined attitude at given times, on the rotation group, its formal sigma grown between "
-                       "epochs");
+        "interpolate",
+        "the combined attitude at given times, on the rotation group, its formal sigma grown between "
+        "epochs");
     cmd->add_option("--in", opt->in, "combined file (CSV, as ascorr combine writes it); '-': standard input")
         ->required()
         ->check(non_empty_path());

@@ -6,7 +6,8 @@ since J2000.0 TT; quaternions Hamilton, scalar first, q_chu_icrf maps ICRF
 components into CHU components; velocities km/s; angles arcsec.
 
 Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
-read_solutions, write_solutions, to_frame, from_frame, read_mountings, combine, align.
+read_solutions, write_solutions, to_frame, from_frame, read_mountings, combine, align,
+interpolate.
 Classes: Model. Exceptions: InputError, FitRefused and AlignRefused (all
 ValueError). HEADS: the head letters in index order (from the core's
 ascorr/core/heads.hpp); MODEL_TERMS: the model's terms, the model file's
@@ -74,6 +75,7 @@ correct = _checked(_ascorr.correct, "correct")
 earth_velocity = _checked(_ascorr.earth_velocity, "earth_velocity")
 fit = _checked(_ascorr.fit, "fit")
 iba = _checked(_ascorr.iba, "iba")
+interpolate = _checked(_ascorr.interpolate, "interpolate")
 read_model = _checked(_ascorr.read_model, "read_model")
 read_mountings = _checked(_ascorr.read_mountings, "read_mountings")
 read_solutions = _checked(_ascorr.read_solutions, "read_solutions")
@@ -95,6 +97,7 @@ __all__ = [
     "fit",
     "from_frame",
     "iba",
+    "interpolate",
     "read_model",
     "read_mountings",
     "read_solutions",

@@ -377,3 +377,24 @@ def align(
     ValueError) for an empty period, too few epochs, a head of the mountings without
     clean epochs with another head, or noise the data do not determine;
     ascorr.InputError for two rows of one head in one epoch."""
+
+def interpolate(
+    combined: dict[str, npt.NDArray[Any]],
+    at: _Real,
+    max_gap: float = ...,
+) -> dict[str, npt.NDArray[Any]]:
+    """The combined attitude at given times, as `ascorr interpolate` writes it: for each
+    time of `at` (in its order) a row of combine()'s form, interpolated on the rotation
+    group between the usable epochs on either side (signs made continuous; equal
+    attitudes give the attitude itself), the same numbers to the digit.
+
+    combined: a dict as combine() returns (with "cov" when it was called with
+    covariance=True; the covariance is then interpolated too), rows in time order. at:
+    (k,) times, s since J2000 TT, float64. max_gap: seconds to the usable epoch on either
+    side beyond which a time gets status 8 ([0.001, 1e6]). Returns a dict of k rows:
+    "sigma" the epochs' own errors weighted by the distance to them, plus a bound of the
+    interpolation's error from the rate's change in the data; "heads" the union of the two
+    epochs' heads; "status" 1 or 2 by that union, with 4 when either epoch has it; 8 (q
+    and sigma NaN) beyond max_gap or outside the rows. A row the combined file's reader
+    would refuse raises ValueError with its words, at its 1-based row."""
+

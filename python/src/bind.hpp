@@ -27,6 +27,7 @@
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/mountings_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -53,6 +54,7 @@ void bind_correct(py::module_& mod);
 void bind_self_calibration(py::module_& mod);
 void bind_analysis(py::module_& mod);
 void bind_combine(py::module_& mod);  // read_mountings, combine, align
+void bind_interpolate(py::module_& mod);
 
 // A mountings dict (read_mountings()'s) as the mountings file's reader takes
 // it, with its rules and messages (ValueError naming argument 'mountings').
@@ -97,6 +99,9 @@ bool model_initialised(const py::handle& obj);
 const host::ModelFile& model_of(const py::handle& obj, const std::string& what);
 
 std::string shape_text(const py::array& a);
+// Rows of a combined file as combine() and interpolate() return them: "t",
+// "q" (m, 4), "heads", "sigma" (m, 3), "status", with covariance "cov" (m, 3).
+py::dict combined_dict(const std::vector<host::AttitudeRow>& rows, bool covariance);
 py::array as_numpy(const py::handle& obj);
 // A real-valued array of shape (n,) (cols == 0) or (n, cols) as float64,
 // C-contiguous: the same buffer when it already is, else one converted copy.

@@ -142,30 +142,9 @@ host::GateOptions gate_arg(const py::object& sigmas, const py::object& floor) {
     return g;
 }
 
-// The combination of `ascorr combine`, kept in memory: its rows as the
-// combined file reads back (q to 15 decimals), so the numbers are the
-// command line's to the digit, with no file (and no TMPDIR) at all.
-py::dict combine_arrays(const py::object& t, const py::object& chu, const py::object& q, const py::object& mountings,
-                        const py::object& status, const py::object& flags, const py::object& confidence,
-                        const py::object& gate_sigmas, const py::object& gate_floor, bool covariance) {
-    const host::MountingsFile m = mountings_arg(mountings);
-    const host::CombinedColumns columns{covariance};
-    const host::GateOptions gate = gate_arg(gate_sigmas, gate_floor);
-    try {
-        host::refuse_unusable_mountings(m, "argument 'mountings'", gate);
-    } catch (const std::runtime_error& e) {
-        throw py::value_error(e.what());
-    }
-    const CombineRows rows = combine_rows(t, chu, q, status, flags, confidence);
-    std::ostringstream log;
-    std::vector<host::AttitudeRow> out;
-    {
-        py::gil_scoped_release unlocked;  // the rows are C++ data by now
-        host::CombineStage stage(m, gate, out, kArrayRows, log, columns);
-        rows_source(rows)([&stage](const host::CorrectedRow& r) { stage.add(r); });
-        stage.finish();
-    }
-    warn(log.str());
+}  // namespace
+
+py::dict combined_dict(const std::vector<host::AttitudeRow>& out, bool covariance) {
     const auto n = static_cast<py::ssize_t>(out.size());
     py::array_t<double> ta(n);
     py::array_t<double> qa({n, py::ssize_t{4}});
@@ -200,6 +179,35 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
         d["cov"] = ca;
     }
     return d;
+}
+
+namespace {
+
+// The combination of `ascorr combine`, kept in memory: its rows as the
+// combined file reads back (q to 15 decimals), so the numbers are the
+// command line's to the digit, with no file (and no TMPDIR) at all.
+py::dict combine_arrays(const py::object& t, const py::object& chu, const py::object& q, const py::object& mountings,
+                        const py::object& status, const py::object& flags, const py::object& confidence,
+                        const py::object& gate_sigmas, const py::object& gate_floor, bool covariance) {
+    const host::MountingsFile m = mountings_arg(mountings);
+    const host::CombinedColumns columns{covariance};
+    const host::GateOptions gate = gate_arg(gate_sigmas, gate_floor);
+    try {
+        host::refuse_unusable_mountings(m, "argument 'mountings'", gate);
+    } catch (const std::runtime_error& e) {
+        throw py::value_error(e.what());
+    }
+    const CombineRows rows = combine_rows(t, chu, q, status, flags, confidence);
+    std::ostringstream log;
+    std::vector<host::AttitudeRow> out;
+    {
+        py::gil_scoped_release unlocked;  // the rows are C++ data by now
+        host::CombineStage stage(m, gate, out, kArrayRows, log, columns);
+        rows_source(rows)([&stage](const host::CorrectedRow& r) { stage.add(r); });
+        stage.finish();
+    }
+    warn(log.str());
+    return combined_dict(out, covariance);
 }
 
 py::dict report_dict(const host::AlignReport& r) {

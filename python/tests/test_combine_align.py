@@ -193,3 +193,42 @@ def test_correct_combined_writes_the_same_covariance(exe, corrected):
     p = subprocess.run([exe, "correct", "--in", raw, "--out", d / "c3.csv", "--covariance"], capture_output=True,
                        text=True)
     assert p.returncode == 2 and "--covariance requires --combined" in p.stderr, p.stderr
+
+
+def test_interpolate_on_arrays_is_ascorr_interpolate(exe, corrected):
+    # Issue 39, item 5: interpolate() gives the command line's rows to the digit,
+    # in the order of the times asked for, covariance included.
+    d, data, mountings = corrected
+    run_cli(exe, "combine", "--in", data, "--mountings", mountings, "--out", d / "ci.csv", "--covariance")
+    c = ascorr.combine(**arrays(data), mountings=ascorr.read_mountings(mountings), covariance=True)
+    at = np.concatenate([c["t"][:50] + 37.5, [c["t"][0] - 1.0, c["t"][10]], c["t"][100:40:-7] + 60.0])
+    (d / "at.csv").write_text("t\n" + "".join(f"{x!r}\n" for x in at))
+    run_cli(exe, "interpolate", "--in", d / "ci.csv", "--at", d / "at.csv", "--out", d / "ii.csv", "--max-gap", 130)
+    header, rows = read_csv_text(d / "ii.csv")
+    assert header[10:] == ["cov_xy", "cov_xz", "cov_yz"]
+    i = ascorr.interpolate(c, at, max_gap=130.0)
+    number = lambda x: float(x) if x else np.nan  # noqa: E731
+    assert np.array_equal(i["t"], at)
+    assert np.array_equal(i["q"], [[number(x) for x in r[1:5]] for r in rows], equal_nan=True)
+    assert list(i["heads"]) == [r[5] for r in rows]
+    assert np.array_equal(i["sigma"], [[number(x) for x in r[6:9]] for r in rows], equal_nan=True)
+    assert np.array_equal(i["cov"], [[number(x) for x in r[10:13]] for r in rows], equal_nan=True)
+    assert np.array_equal(i["status"], [int(r[9]) for r in rows])
+    assert i["status"][50] == 8 and i["status"][51] == c["status"][10]  # before the first epoch; at an epoch
+    assert np.sum(i["status"] & 1) > 50
+
+
+def test_interpolate_refuses_what_the_file_reader_refuses(corrected):
+    _, data, mountings = corrected
+    c = ascorr.combine(**arrays(data), mountings=ascorr.read_mountings(mountings))
+    bad = dict(c, q=c["q"] * 1.1)
+    with pytest.raises(ValueError, match=r"argument 'combined': <arrays, 1-based row>:1:\d+: .*not a unit"):
+        ascorr.interpolate(bad, c["t"][:3])
+    with pytest.raises(ValueError, match="row 2 is not after row 1"):
+        ascorr.interpolate(dict(c, t=c["t"][::-1].copy()), c["t"][:3])
+    with pytest.raises(ValueError, match="max_gap"):
+        ascorr.interpolate(c, c["t"][:3], max_gap=0.0)
+    with pytest.raises(ValueError, match="without key 'sigma'"):
+        ascorr.interpolate({k: v for k, v in c.items() if k != "sigma"}, c["t"][:3])
+    with pytest.raises(ValueError, match="argument 'at'"):
+        ascorr.interpolate(c, np.array([np.nan]))

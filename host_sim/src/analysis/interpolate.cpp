@@ -54,8 +54,7 @@ std::string describe(const InterpolateSummary& s) {
                      "%zu rows: %zu interpolated, %zu at an epoch, %zu outside the file and %zu across a gap "
                      "(status 8); from %zu epochs, %zu with an attitude; largest interpolation error bound %.3g "
                      "arcsec",
-                     s.rows, s.interpolated, s.exact, s.outside, s.gap, s.epochs, s.usable,
-                     s.max_error_bound_arcsec);
+                     s.rows, s.interpolated, s.exact, s.outside, s.gap, s.epochs, s.usable, s.max_error_bound_arcsec);
     std::string out = buf;
     if (s.without_rate_change > 0) {
         out += "; " + std::to_string(s.without_rate_change) +
@@ -176,9 +175,8 @@ struct Interpolator::Impl {
         const double wa = (1.0 - u) * (1.0 - u);
         const double wb = u * u;
         for (std::size_t k = 0; k < 3; ++k) {
-            r.sigma_arcsec[k] =
-                std::sqrt(wa * a.sigma_arcsec[k] * a.sigma_arcsec[k] + wb * b.sigma_arcsec[k] * b.sigma_arcsec[k] +
-                          e * e);
+            r.sigma_arcsec[k] = std::sqrt(wa * a.sigma_arcsec[k] * a.sigma_arcsec[k] +
+                                          wb * b.sigma_arcsec[k] * b.sigma_arcsec[k] + e * e);
             r.cov_arcsec2[k] = wa * a.cov_arcsec2[k] + wb * b.cov_arcsec2[k];
         }
         r.has_cov = covariance;
@@ -252,9 +250,9 @@ std::vector<double> read_times(const std::string& path) {
             }
             const auto c = static_cast<std::size_t>(col);
             if (c >= fields.size()) {
-                throw text::InputError(path, n, line.size() + 1,
-                                       "expected at least " + std::to_string(c + 1) + " fields, found " +
-                                           std::to_string(fields.size()));
+                throw text::InputError(
+                    path, n, line.size() + 1,
+                    "expected at least " + std::to_string(c + 1) + " fields, found " + std::to_string(fields.size()));
             }
             const auto t = parse_double(fields[c]);
             if (!t || !(std::abs(*t) < pipeline::kMaxEpochTimeS)) {
@@ -305,8 +303,8 @@ InterpolateSummary interpolate_file(const InterpolateOptions& opt, OutputSet& ou
     while (reader.next(row)) {
         if (last_line != 0 && !(row.t > last_t)) {
             throw text::InputError(opt.in, row.line, 1,
-                                   "the combined file's rows must be in time order (line " +
-                                       std::to_string(last_line) + " is at or after this one)");
+                                   "the combined file's rows must be in time order (line " + std::to_string(last_line) +
+                                       " is at or after this one)");
         }
         last_t = row.t;
         last_line = row.line;

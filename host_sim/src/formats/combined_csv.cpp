@@ -154,9 +154,9 @@ private:
             const double product = row.sigma_arcsec[static_cast<std::size_t>(kAxes[k][0])] *
                                    row.sigma_arcsec[static_cast<std::size_t>(kAxes[k][1])];
             if (!(std::fabs(c) <= product * (1.0 + 1e-12))) {  // the written sigmas' rounding
-                fail(c_.cov[k], std::string("column '") + kNames[k] + "': " + number_text(c) +
-                                    " arcsec^2 is no covariance with the row's sigmas (|cov| <= " +
-                                    number_text(product) + ")");
+                fail(c_.cov[k],
+                     std::string("column '") + kNames[k] + "': " + number_text(c) +
+                         " arcsec^2 is no covariance with the row's sigmas (|cov| <= " + number_text(product) + ")");
             }
             row.cov_arcsec2[k] = c;
         }
@@ -346,16 +346,17 @@ bool TruthReader::next(AttitudeRow& row) {
     return true;
 }
 
-void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns cols) {
-    static const std::string kName = "combined rows";
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns cols,
+                        const std::string& name, std::size_t first_line) {
     bool combined = false;
     const std::string header = combined_header(cols);
-    const Columns c = columns_of(Header(header, kName), kName, combined);
-    RowParser parser(kName, c, combined);
+    const Columns c = columns_of(Header(header, name), name, combined);
+    RowParser parser(name, c, combined);
+    std::size_t n = first_line + rows.size();  // rows appended: the lines go on
     while (!text.empty()) {
         const std::size_t end = text.find('\n');
         const std::string_view line = text.substr(0, end);
-        rows.push_back(parser.parse(line, rows.size() + 2U));  // line 1: the header the file would have
+        rows.push_back(parser.parse(line, n++));
         text.remove_prefix(end == std::string_view::npos ? text.size() : end + 1U);
     }
 }

@@ -32,9 +32,9 @@ inline Vector3<double> rotation_vector_arcsec(const Quaternion<double>& a, const
 // Exp(θ) = [cos(|θ|/2), θ̂ sin(|θ|/2)] for θ in arcsec. sin(x/2)/x is taken
 // from its series below 1e-4 rad (truncation < x⁴/3840 < 3e-20, of 0.5).
 inline Quaternion<double> exp_arcsec(const Vector3<double>& theta_arcsec) noexcept {
-    const double x = std::sqrt(theta_arcsec.x * theta_arcsec.x + theta_arcsec.y * theta_arcsec.y +
-                               theta_arcsec.z * theta_arcsec.z) /
-                     kRadToArcsec;
+    const double x =
+        std::sqrt(theta_arcsec.x * theta_arcsec.x + theta_arcsec.y * theta_arcsec.y + theta_arcsec.z * theta_arcsec.z) /
+        kRadToArcsec;
     const double k = (x < 1e-4 ? 0.5 - x * x / 48.0 : std::sin(0.5 * x) / x) / kRadToArcsec;
     return {std::cos(0.5 * x), theta_arcsec.x * k, theta_arcsec.y * k, theta_arcsec.z * k};
 }

@@ -45,13 +45,13 @@ inline constexpr double kMinMaxGapS = 1e-3;
 inline constexpr double kMaxMaxGapS = 1e6;
 
 struct InterpolateSummary {
-    std::size_t rows = 0;           // rows written (the times asked for)
-    std::size_t exact = 0;          // at an epoch's own t
-    std::size_t interpolated = 0;   // between two usable epochs
-    std::size_t outside = 0;        // status 8: before the first or after the last usable epoch
-    std::size_t gap = 0;            // status 8: an epoch on a side further than max_gap
-    std::size_t epochs = 0;         // rows of the combined file read
-    std::size_t usable = 0;         // of them with q
+    std::size_t rows = 0;                 // rows written (the times asked for)
+    std::size_t exact = 0;                // at an epoch's own t
+    std::size_t interpolated = 0;         // between two usable epochs
+    std::size_t outside = 0;              // status 8: before the first or after the last usable epoch
+    std::size_t gap = 0;                  // status 8: an epoch on a side further than max_gap
+    std::size_t epochs = 0;               // rows of the combined file read
+    std::size_t usable = 0;               // of them with q
     std::size_t without_rate_change = 0;  // interpolated with α = 0 (no neighbour to measure it)
     double max_error_bound_arcsec = 0.0;  // the largest e(t) of the rows
 };

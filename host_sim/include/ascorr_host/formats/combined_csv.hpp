@@ -59,8 +59,11 @@ void append_attitude_row(std::string& out, double t, const Quaternion<double>& q
 void append_combined_row(std::string& out, const AttitudeRow& row, CombinedColumns c = {});
 // The rows of `text` (append_combined_row's with c, no header) as a reader of
 // the combined file reads them (q to 15 decimals), appended to rows: a
-// combination kept in memory gives the file's numbers to the digit.
-void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns c = {});
+// combination kept in memory gives the file's numbers to the digit. name and
+// first_line: for messages, the line of rows' first element (the rows of
+// arrays: 1-based rows).
+void read_combined_rows(std::string_view text, std::vector<AttitudeRow>& rows, CombinedColumns c = {},
+                        const std::string& name = "combined rows", std::size_t first_line = 2);
 
 // Reads an attitude or a combined file (told apart by the header:
 // combined()), row by row in file order, in blocks (bounded memory). Throws
