@@ -145,5 +145,6 @@ void add_gate_options(CLI::App& cmd, host::GateOptions& gate, CLI::Option* combi
 CLI::Option* add_covariance_option(CLI::App& cmd, host::CombinedColumns& columns);
 void add_align_command(CLI::App& app);
 void add_interpolate_command(CLI::App& app);
+void add_import_command(CLI::App& app);  // import gracefo
 
 }  // namespace ascorr::cli

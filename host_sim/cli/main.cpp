@@ -79,5 +79,6 @@ int main(int argc, char** argv) {
     ascorr::cli::add_combine_command(app);
     ascorr::cli::add_align_command(app);
     ascorr::cli::add_interpolate_command(app);
+    ascorr::cli::add_import_command(app);
     return checked_exit(run(app, argc, argv));
 }
