@@ -196,7 +196,6 @@ TEST(GracefoImport, AlignAndCombineAgreeWithJplWithinThreeArcsec) {
     }
 }
 
-
 // The SCA1A file of GRACE C split: its header (through the end marker) and records.
 struct Sca1aText {
     std::string header;
@@ -226,7 +225,8 @@ struct Sca1aText {
 TEST(GracefoImport, OldHeadersAndSeveralFilesGiveTheSameSolutions) {
     const fs::path dir = test::scratch_dir("gracefo_headers");
     const Sca1aText sca;
-    std::ofstream(dir / "old.txt") << "PRODUCER AGENCY               : NASA\nEND OF HEADER\n" << sca.with(99, sca.lines[99]).substr(sca.header.size());
+    std::ofstream(dir / "old.txt") << "PRODUCER AGENCY               : NASA\nEND OF HEADER\n"
+                                   << sca.with(99, sca.lines[99]).substr(sca.header.size());
     std::string first;
     std::string second;
     for (std::size_t k = 0; k < sca.lines.size(); ++k) {
@@ -246,7 +246,8 @@ TEST(GracefoImport, OldHeadersAndSeveralFilesGiveTheSameSolutions) {
 TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
     const fs::path dir = test::scratch_dir("gracefo_bad");
     const Sca1aText sca;
-    const auto first_line = static_cast<std::size_t>(std::count(sca.header.begin(), sca.header.end(), '\n')) + 1;  // of record 0
+    const auto first_line =
+        static_cast<std::size_t>(std::count(sca.header.begin(), sca.header.end(), '\n')) + 1;  // of record 0
     const std::string rec = sca.lines[3];  // 738849600 529976 C 1 P qw qx qy qz 0 46 1 0 0 11000001 11000000
     const auto replace = [&rec](const std::string& from, const std::string& to) {
         std::string r = rec;
@@ -259,7 +260,8 @@ TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
     };
     const std::string at = std::to_string(first_line + 3) + ":";
     const std::vector<Case> cases = {
-        {sca.with(3, rec + " 7"), at + std::to_string(rec.size() + 2) + ": expected 16 fields of a SCA1A record, found 17"},
+        {sca.with(3, rec + " 7"),
+         at + std::to_string(rec.size() + 2) + ": expected 16 fields of a SCA1A record, found 17"},
         {sca.with(3, replace(" C 1 P ", " C 4 P ")), at + "20: sca_id (1, 2 or 3): "},
         {sca.with(3, replace("-0.2798879596590735", "-0.3798879596590735")), at + "24: the quaternion is not unit"},
         {sca.with(3, replace("529976", "1000000")), at + "11: rcvtime_frac: "},
@@ -267,7 +269,8 @@ TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
         {sca.with(3, replace(" C 1 P ", " D 1 P ")), at + "18: a record of GRACE D among those of GRACE C"},
         {sca.with(3, replace("11000001 11000000", "11000001 1100000x")),
          at + std::to_string(rec.rfind(' ') + 2) + ": qualflg: expected eight binary digits"},
-        {sca.with(3, replace("738849600 529976", "738860000 529976")), at + "1: the time 738860000.529976 s is not covered by"},
+        {sca.with(3, replace("738849600 529976", "738860000 529976")),
+         at + "1: the time 738860000.529976 s is not covered by"},
         {sca.lines[0] + "\n", " no end of a GRACE-FO Level-1 header"},
     };
     for (const Case& c : cases) {
@@ -280,16 +283,18 @@ TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
         EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "m.csv")) << c.want;
     }
     // QSA1B with a head twice; SCA1B whose time goes back.
-    std::ofstream(dir / "qsa.txt") << "END OF HEADER\n580219200 C 1 1 0 0 0 0 00000000\n580219200 C 1 1 0 0 0 0 00000000\n";
-    const test::CliRun twice =
-        run_in("import gracefo --sca1a " + product("SCA1A", 'C') + " --qsa1b qsa.txt --out sol.csv --mountings m.csv", dir);
+    std::ofstream(dir / "qsa.txt")
+        << "END OF HEADER\n580219200 C 1 1 0 0 0 0 00000000\n580219200 C 1 1 0 0 0 0 00000000\n";
+    const test::CliRun twice = run_in(
+        "import gracefo --sca1a " + product("SCA1A", 'C') + " --qsa1b qsa.txt --out sol.csv --mountings m.csv", dir);
     EXPECT_NE(twice.err.find("qsa.txt:3:13: a second mounting of head A (the first on line 2)"), std::string::npos)
         << twice.err;
-    std::ofstream(dir / "sca1b.txt") << "# End of YAML header\n738849601 C 23 1 0 0 0 0 00000000\n738849600 C 23 1 0 0 0 0 00000000\n";
-    const test::CliRun back = run_in("import gracefo --sca1a " + product("SCA1A", 'C') + " --qsa1b " +
-                                         product("QSA1B", 'C') +
-                                         " --sca1b sca1b.txt --reference ref.csv --out sol.csv --mountings m.csv",
-                                     dir);
+    std::ofstream(dir / "sca1b.txt")
+        << "# End of YAML header\n738849601 C 23 1 0 0 0 0 00000000\n738849600 C 23 1 0 0 0 0 00000000\n";
+    const test::CliRun back =
+        run_in("import gracefo --sca1a " + product("SCA1A", 'C') + " --qsa1b " + product("QSA1B", 'C') +
+                   " --sca1b sca1b.txt --reference ref.csv --out sol.csv --mountings m.csv",
+               dir);
     EXPECT_NE(back.err.find("sca1b.txt:3:1: the time goes back"), std::string::npos) << back.err;
     EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "ref.csv"));
 }

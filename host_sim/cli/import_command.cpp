@@ -12,8 +12,9 @@ namespace {
 void add_gracefo_command(CLI::App& import) {
     auto opt = std::make_shared<host::GracefoOptions>();
     CLI::App* cmd = import.add_subcommand(
-        "gracefo", "GRACE Follow-On Level-1 star-camera data (SCA1A, QSA1B; TIM1B, CLK1B, SCA1B) in this contract's "
-                   "files");
+        "gracefo",
+        "GRACE Follow-On Level-1 star-camera data (SCA1A, QSA1B; TIM1B, CLK1B, SCA1B) in this contract's "
+        "files");
     cmd->add_option("--sca1a", opt->sca1a,
                     "SCA1A file(s) of one satellite (repeatable; taken in the order of their first records)")
         ->required()

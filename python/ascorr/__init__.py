@@ -7,7 +7,7 @@ components into CHU components; velocities km/s; angles arcsec.
 
 Functions: read_model, correct, self_calibrate, earth_velocity, iba, stats, fit,
 read_solutions, write_solutions, to_frame, from_frame, read_mountings, combine, align,
-interpolate.
+interpolate, import_gracefo.
 Classes: Model. Exceptions: InputError, FitRefused and AlignRefused (all
 ValueError). HEADS: the head letters in index order (from the core's
 ascorr/core/heads.hpp); MODEL_TERMS: the model's terms, the model file's
@@ -75,6 +75,7 @@ correct = _checked(_ascorr.correct, "correct")
 earth_velocity = _checked(_ascorr.earth_velocity, "earth_velocity")
 fit = _checked(_ascorr.fit, "fit")
 iba = _checked(_ascorr.iba, "iba")
+import_gracefo = _checked(_ascorr.import_gracefo, "import_gracefo")
 interpolate = _checked(_ascorr.interpolate, "interpolate")
 read_model = _checked(_ascorr.read_model, "read_model")
 read_mountings = _checked(_ascorr.read_mountings, "read_mountings")
@@ -97,6 +98,7 @@ __all__ = [
     "fit",
     "from_frame",
     "iba",
+    "import_gracefo",
     "interpolate",
     "read_model",
     "read_mountings",

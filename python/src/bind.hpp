@@ -55,6 +55,7 @@ void bind_self_calibration(py::module_& mod);
 void bind_analysis(py::module_& mod);
 void bind_combine(py::module_& mod);  // read_mountings, combine, align
 void bind_interpolate(py::module_& mod);
+void bind_gracefo(py::module_& mod);  // import_gracefo
 
 // A mountings dict (read_mountings()'s) as the mountings file's reader takes
 // it, with its rules and messages (ValueError naming argument 'mountings').
@@ -102,6 +103,9 @@ std::string shape_text(const py::array& a);
 // Rows of a combined file as combine() and interpolate() return them: "t",
 // "q" (m, 4), "heads", "sigma" (m, 3), "status", with covariance "cov" (m, 3).
 py::dict combined_dict(const std::vector<host::AttitudeRow>& rows, bool covariance);
+// Mountings as read_mountings() returns them: {"heads": "ABC", "q": (k, 4),
+// "sigma_cross": (k,) or None, "sigma_about": (k,) or None}.
+py::dict mountings_dict(const host::MountingsFile& m);
 py::array as_numpy(const py::handle& obj);
 // A real-valued array of shape (n,) (cols == 0) or (n, cols) as float64,
 // C-contiguous: the same buffer when it already is, else one converted copy.

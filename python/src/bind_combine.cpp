@@ -29,43 +29,6 @@ using namespace pybind11::literals;
 
 namespace {
 
-// The mountings as Python holds them: {"heads": "ABC", "q": (k, 4),
-// "sigma_cross": (k,) or None, "sigma_about": (k,) or None}, rows in the
-// order of heads.
-py::dict mountings_dict(const host::MountingsFile& m) {
-    std::string heads;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (m.mountings.head[h].present) {
-            heads += kHeadLetters[h];
-        }
-    }
-    const auto k = static_cast<py::ssize_t>(heads.size());
-    py::array_t<double> q({k, py::ssize_t{4}});
-    py::array_t<double> cross(k);
-    py::array_t<double> about(k);
-    py::ssize_t i = 0;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        const combine::HeadMounting& hm = m.mountings.head[h];
-        if (!hm.present) {
-            continue;
-        }
-        double* row = q.mutable_data() + 4 * i;
-        row[0] = hm.q_chu_crf.w;
-        row[1] = hm.q_chu_crf.x;
-        row[2] = hm.q_chu_crf.y;
-        row[3] = hm.q_chu_crf.z;
-        cross.mutable_data()[i] = hm.sigma_cross_arcsec;
-        about.mutable_data()[i] = hm.sigma_about_arcsec;
-        ++i;
-    }
-    py::dict d;
-    d["heads"] = heads;
-    d["q"] = q;
-    d["sigma_cross"] = m.sigmas ? py::object(cross) : py::object(py::none());
-    d["sigma_about"] = m.sigmas ? py::object(about) : py::object(py::none());
-    return d;
-}
-
 // The rows of arrays as the combination takes a file's: status None is a raw
 // solutions file (taken as it is), else each row's status bits.
 struct CombineRows {
@@ -143,6 +106,43 @@ host::GateOptions gate_arg(const py::object& sigmas, const py::object& floor) {
 }
 
 }  // namespace
+
+// The mountings as Python holds them: {"heads": "ABC", "q": (k, 4),
+// "sigma_cross": (k,) or None, "sigma_about": (k,) or None}, rows in the
+// order of heads.
+py::dict mountings_dict(const host::MountingsFile& m) {
+    std::string heads;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (m.mountings.head[h].present) {
+            heads += kHeadLetters[h];
+        }
+    }
+    const auto k = static_cast<py::ssize_t>(heads.size());
+    py::array_t<double> q({k, py::ssize_t{4}});
+    py::array_t<double> cross(k);
+    py::array_t<double> about(k);
+    py::ssize_t i = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const combine::HeadMounting& hm = m.mountings.head[h];
+        if (!hm.present) {
+            continue;
+        }
+        double* row = q.mutable_data() + 4 * i;
+        row[0] = hm.q_chu_crf.w;
+        row[1] = hm.q_chu_crf.x;
+        row[2] = hm.q_chu_crf.y;
+        row[3] = hm.q_chu_crf.z;
+        cross.mutable_data()[i] = hm.sigma_cross_arcsec;
+        about.mutable_data()[i] = hm.sigma_about_arcsec;
+        ++i;
+    }
+    py::dict d;
+    d["heads"] = heads;
+    d["q"] = q;
+    d["sigma_cross"] = m.sigmas ? py::object(cross) : py::object(py::none());
+    d["sigma_about"] = m.sigmas ? py::object(about) : py::object(py::none());
+    return d;
+}
 
 py::dict combined_dict(const std::vector<host::AttitudeRow>& out, bool covariance) {
     const auto n = static_cast<py::ssize_t>(out.size());

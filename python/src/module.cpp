@@ -3,9 +3,9 @@
 // Glue only: every number comes from the core headers (firmware/include/) and
 // the host library (host_sim/, ascorr_host), the same code as the command
 // line. The bindings are split by topic (bind_model, bind_formats,
-// bind_correct, bind_self_calibration, bind_analysis, bind_combine, bind_interpolate), their
-// argument checks shared (bind.hpp, arguments.cpp), their docstrings written
-// once (docstrings.hpp).
+// bind_correct, bind_self_calibration, bind_analysis, bind_combine,
+// bind_interpolate, bind_gracefo), their argument checks shared (bind.hpp,
+// arguments.cpp), their docstrings written once (docstrings.hpp).
 #include <pybind11/pybind11.h>
 
 #include "ascorr/core/heads.hpp"
@@ -42,4 +42,5 @@ PYBIND11_MODULE(_ascorr, mod) {
     bind_analysis(mod);
     bind_combine(mod);
     bind_interpolate(mod);
+    bind_gracefo(mod);
 }

@@ -39,7 +39,8 @@ struct Record {
     double number(std::size_t i, const char* name) const {
         const auto v = parse_double(field[i]);
         if (!v || !std::isfinite(*v)) {
-            fail(i, std::string(name) + ": " + (v ? "a finite number, got " + number_text(*v) : why_not_a_number(field[i])));
+            fail(i, std::string(name) + ": " +
+                        (v ? "a finite number, got " + number_text(*v) : why_not_a_number(field[i])));
         }
         return *v;
     }
@@ -53,7 +54,8 @@ struct Record {
             v = (v << 1U) | (c == '1' ? 1U : 0U);
         }
         if (!ok) {
-            fail(i, std::string(name) + ": expected eight binary digits (bit 0 rightmost), got '" + std::string(f) + "'");
+            fail(i,
+                 std::string(name) + ": expected eight binary digits (bit 0 rightmost), got '" + std::string(f) + "'");
         }
         return static_cast<std::uint8_t>(v);
     }
@@ -317,8 +319,9 @@ MountingsFile import_gracefo(const GracefoOptions& opt, const GracefoSink& sink,
             same_satellite(satellite, s.satellite, r, 2);
             const std::int64_t us = s.obc_s * 1000000 + s.obc_us;
             if (us < last_us) {
-                r.fail(0, "the time goes back from the record before (files are taken in the order of their first "
-                          "records)");
+                r.fail(0,
+                       "the time goes back from the record before (files are taken in the order of their first "
+                       "records)");
             }
             last_us = us;
             SolutionValues v;
@@ -392,9 +395,7 @@ GracefoSummary import_gracefo_files(const GracefoOptions& opt, OutputSet& output
             solutions.clear();
         }
     };
-    sink.reference = [&](double t, const Quaternion<double>& q) {
-        append_attitude_row(reference, t, q);
-    };
+    sink.reference = [&](double t, const Quaternion<double>& q) { append_attitude_row(reference, t, q); };
     GracefoSummary sum;
     const MountingsFile m = import_gracefo(opt, sink, sum);
     out.write(solutions);

@@ -52,16 +52,16 @@ inline constexpr double kGracefoTimeOffsetS = 0.0;
 inline constexpr double kMaxTimeOffsetS = 10.0;  // --time-offset in [-10, 10]
 
 // The solutions file's flags of an imported record (the contract's bits):
-inline constexpr long long kGracefoInvalid = 4;         // sca_mode bit 0 clear, or qualflg bit 0 set
-inline constexpr long long kGracefoFalseStars = 2;      // sca_mode or qualflg bit 3: non-stellar object
-inline constexpr long long kGracefoNotCorrected = 8;    // sca_mode bit 6 clear: aberration not corrected on board
+inline constexpr long long kGracefoInvalid = 4;       // sca_mode bit 0 clear, or qualflg bit 0 set
+inline constexpr long long kGracefoFalseStars = 2;    // sca_mode or qualflg bit 3: non-stellar object
+inline constexpr long long kGracefoNotCorrected = 8;  // sca_mode bit 6 clear: aberration not corrected on board
 
 struct Sca1aRecord {
     std::size_t line = 0;
-    std::int64_t obc_s = 0;  // rcvtime_intg
-    std::int64_t obc_us = 0;  // rcvtime_frac
-    char satellite = 0;       // 'C' or 'D'
-    std::uint8_t head = 0;    // sca_id − 1
+    std::int64_t obc_s = 0;           // rcvtime_intg
+    std::int64_t obc_us = 0;          // rcvtime_frac
+    char satellite = 0;               // 'C' or 'D'
+    std::uint8_t head = 0;            // sca_id − 1
     Quaternion<double> q_icrf_chu{};  // as written: SCF into inertial
     int confidence = 0;               // sca_confid
     std::uint8_t mode = 0;            // sca_mode
@@ -96,21 +96,21 @@ private:
 struct GracefoOptions {
     std::vector<std::string> sca1a;
     std::string qsa1b;
-    std::string tim1b;  // empty: OBC time taken as GPS time
-    std::string clk1b;  // empty: receiver time taken as GPS time (an extension)
-    std::string sca1b;  // empty: no reference
-    std::string out;          // solutions file
-    std::string mountings;    // mountings file
-    std::string reference;    // attitude file of SCA1B, with sca1b
+    std::string tim1b;      // empty: OBC time taken as GPS time
+    std::string clk1b;      // empty: receiver time taken as GPS time (an extension)
+    std::string sca1b;      // empty: no reference
+    std::string out;        // solutions file
+    std::string mountings;  // mountings file
+    std::string reference;  // attitude file of SCA1B, with sca1b
     double time_offset_s = kGracefoTimeOffsetS;
 };
 
 struct GracefoSummary {
     char satellite = 0;
-    std::size_t records = 0;        // SCA1A records written
-    std::size_t not_clean = 0;      // of them with flags != 0 or confidence > 5
-    std::size_t reference = 0;      // SCA1B records
-    double first_t = 0.0;           // TT of the first and last record
+    std::size_t records = 0;    // SCA1A records written
+    std::size_t not_clean = 0;  // of them with flags != 0 or confidence > 5
+    std::size_t reference = 0;  // SCA1B records
+    double first_t = 0.0;       // TT of the first and last record
     double last_t = 0.0;
 };
 std::string describe(const GracefoSummary& s);
