@@ -178,6 +178,10 @@ TEST(GracefoImport, AlignAndCombineAgreeWithJplWithinThreeArcsec) {
         const Eigen::Vector3d rms = rms_against_jpl(dir, "comb.csv", n);
         EXPECT_GE(n, 15U) << sat;  // SCA1B's times within the 16.5 s of SCA1A records
         EXPECT_LT(rms.maxCoeff(), 3.0) << sat << ": " << rms.transpose();
+        // The worked example's last step reports the same comparison.
+        const test::CliRun stats = run_in("stats --combined at.csv --truth-attitude ref.csv > stats.txt", dir);
+        EXPECT_EQ(stats.exit_code, 0) << stats.err;
+        EXPECT_NE(test::slurp(dir / "stats.txt").find("ABC "), std::string::npos);
         // Mutation check: the boresight weighted as the cross axes (each
         // head's sigma_about set to its sigma_cross) fails the bound.
         std::ifstream in(dir / "m2.csv");
@@ -297,6 +301,17 @@ TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
                dir);
     EXPECT_NE(back.err.find("sca1b.txt:3:1: the time goes back"), std::string::npos) << back.err;
     EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "ref.csv"));
+    // TIM1B with a record short of a field; CLK1B whose time goes back.
+    std::ofstream(dir / "tim.txt") << "# End of YAML header\n738849605 C 0 738849605 0 -1 -1\n";
+    std::ofstream(dir / "clk.txt") << "# End of YAML header\n738849610 C -1 -0.0167 0 0 0 00000000\n"
+                                   << "738849600 C -1 -0.0167 0 0 0 00000000\n";
+    const std::string sol = " --sca1a " + product("SCA1A", 'C') + " --qsa1b " + product("QSA1B", 'C');
+    const test::CliRun tim = run_in("import gracefo" + sol + " --tim1b tim.txt --out sol.csv --mountings m.csv", dir);
+    EXPECT_NE(tim.err.find("tim.txt:2:32: expected 8 fields of a TIM1B record, found 7"), std::string::npos)
+        << tim.err;
+    const test::CliRun clk = run_in("import gracefo" + sol + " --clk1b clk.txt --out sol.csv --mountings m.csv", dir);
+    EXPECT_NE(clk.err.find("clk.txt:3:1: the time goes back"), std::string::npos) << clk.err;
+    EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "m.csv"));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "ascorr/core/constants.hpp"
+#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr_host/formats/combined_csv.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
@@ -129,8 +131,8 @@ TEST(Interpolate, ThinnedToTenSecondsAndBackIsNoWorseThanAtTheEpochs) {
     EXPECT_GT(static_cast<double>(within_sigma), 0.99 * static_cast<double>(interpolated.n));
 }
 
-// Hand-written epochs: t 0 and 1 with equal attitudes of opposite signs, then
-// 2 with a turn of 1e-9 rad, then nothing until 100, 101.
+// Hand-written epochs: t 0, 1 and 2 with equal attitudes (1 of the opposite
+// sign), 3 without one, then 100 and 101 half a turn apart.
 const char* const kEpochs =
     "t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status\n"
     "0,0.5,0.5,0.5,0.5,ABC,1,1,1,1\n"
@@ -164,9 +166,10 @@ TEST(Interpolate, EqualAttitudesAndOppositeSignsGiveTheAttitudeItself) {
     EXPECT_EQ(r[1].status, 5U);
     EXPECT_EQ(r[2].status, 1U);  // at the epoch: its own row
     EXPECT_EQ(r[2].sigma_arcsec[0], 1.0);
-    // the epochs' own errors averaged: 0.5² · (1 + 4) at mid-interval; the
-    // rate did not change (no bound)
-    EXPECT_NEAR(r[0].sigma_arcsec[0], std::sqrt(0.25 * 1.0 + 0.25 * 4.0), 1e-12);
+    // the epochs' own variances linear in u, 0.5 · (1 + 4) at mid-interval;
+    // the rate did not change (no bound)
+    EXPECT_NEAR(r[0].sigma_arcsec[0], std::sqrt(0.5 * 1.0 + 0.5 * 4.0), 1e-12);
+    EXPECT_GE(r[1].sigma_arcsec[0], 2.0);  // never below the smaller epoch's (2 and 3 at t 1 and 2)
 }
 
 TEST(Interpolate, BeyondTheGapOrTheFileStatusEightAndTheLastEpochItself) {
@@ -212,6 +215,25 @@ TEST(Interpolate, BadInputNamesFileLineAndColumnAndWritesNothing) {
     const test::CliRun same = run_in("interpolate --in a.csv --at t.csv --out a.csv", dir);
     EXPECT_NE(same.exit_code, 0);
     EXPECT_EQ(test::slurp(dir / "a.csv"), kEpochs);
+}
+
+// exp_arcsec (core/rotation_vector.hpp) against Eigen's angle-axis, through
+// its series (below 1e-4 rad) and sin(x/2)/x, and rotation_vector_arcsec back.
+TEST(Interpolate, ExpAndLogOfSmallAndLargeTurnsAgreeWithEigen) {
+    const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
+    for (const double x : {1e-15, 1e-9, 1e-6, 0.99e-4, 1e-4, 1.01e-4, 1e-2, 1.0, 3.0}) {
+        const Eigen::Vector3d v = axis * x * kRadToArcsec;
+        const Quaternion<double> q = exp_arcsec({v.x(), v.y(), v.z()});
+        const Eigen::Quaterniond want(Eigen::AngleAxisd(x, axis));
+        EXPECT_NEAR(q.w, want.w(), 1e-15) << x;  // x through arcsec: an ulp or two
+        EXPECT_NEAR(q.x, want.x(), 1e-16 + 1e-15 * std::abs(want.x())) << x;
+        EXPECT_NEAR(q.z, want.z(), 1e-16 + 1e-15 * std::abs(want.z())) << x;
+        const Vector3<double> back = rotation_vector_arcsec(q, {1.0, 0.0, 0.0, 0.0});
+        EXPECT_NEAR(back.x, v.x(), 1e-12 * kRadToArcsec * std::max(x, 1e-3)) << x;
+    }
+    const Quaternion<double> identity = exp_arcsec({0.0, 0.0, 0.0});
+    EXPECT_EQ(identity.w, 1.0);
+    EXPECT_EQ(identity.x, 0.0);
 }
 
 }  // namespace

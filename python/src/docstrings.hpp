@@ -246,8 +246,8 @@ combined: a dict as combine() returns (with "cov" when it was called with
 covariance=True; the covariance is then interpolated too), rows in time order. at:
 (k,) times, s since J2000 TT, float64. max_gap: seconds to the usable epoch on either
 side beyond which a time gets status 8 ([0.001, 1e6]). Returns a dict of k rows:
-"sigma" the epochs' own errors weighted by the distance to them, plus a bound of the
-interpolation's error from the rate's change in the data; "heads" the union of the two
+"sigma" from the epochs' own variances, linear in the distance to them, plus a bound
+of the interpolation's error from the rate's change in the data; "heads" the union of the two
 epochs' heads; "status" 1 or 2 by that union, with 4 when either epoch has it; 8 (q
 and sigma NaN) beyond max_gap or outside the rows. A row the combined file's reader
 would refuse raises ValueError with its words, at its 1-based row.)doc";

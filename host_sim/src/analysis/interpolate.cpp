@@ -172,8 +172,8 @@ struct Interpolator::Impl {
                    ((a.status | b.status) & static_cast<unsigned>(cs::kHeadLeftOut));
         const double e = std::max(alpha, 0.0) * (t - a.t) * (b.t - t) / 2.0;
         sum.max_error_bound_arcsec = std::max(sum.max_error_bound_arcsec, e);
-        const double wa = (1.0 - u) * (1.0 - u);
-        const double wb = u * u;
+        const double wa = 1.0 - u;  // linear in the covariances (see the header)
+        const double wb = u;
         for (std::size_t k = 0; k < 3; ++k) {
             r.sigma_arcsec[k] = std::sqrt(wa * a.sigma_arcsec[k] * a.sigma_arcsec[k] +
                                           wb * b.sigma_arcsec[k] * b.sigma_arcsec[k] + e * e);
@@ -220,6 +220,30 @@ std::vector<NamedPath> interpolate_outputs(const InterpolateOptions& opt) {
     return {{"--out", opt.out}};
 }
 
+namespace {
+
+// The time in field `col` of a data line of `path` (read_times).
+double time_of_line(std::string_view line, std::size_t n, std::size_t col, const std::string& path,
+                    std::vector<std::string_view>& fields, std::vector<std::size_t>& starts) {
+    if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+        throw text::InputError(path, n, bad + 1, why_split_failed(line, bad));
+    }
+    if (col >= fields.size()) {
+        throw text::InputError(path, n, line.size() + 1,
+                               "expected at least " + std::to_string(col + 1) + " fields, found " +
+                                   std::to_string(fields.size()));
+    }
+    const auto t = parse_double(fields[col]);
+    if (!t || !(std::abs(*t) < pipeline::kMaxEpochTimeS)) {
+        throw text::InputError(path, n, starts[col] + 1,
+                               "column 't': " + (t ? "t = " + number_text(*t) + " s is no time of an epoch"
+                                                   : why_not_a_number(fields[col])));
+    }
+    return *t;
+}
+
+}  // namespace
+
 std::vector<double> read_times(const std::string& path) {
     BlockReader blocks(path);
     std::string_view block;
@@ -229,38 +253,19 @@ std::vector<double> read_times(const std::string& path) {
     int col = -1;
     while (blocks.next(block)) {
         LineReader lines(block, blocks.lines_before());
-        std::string_view line;
-        while (lines.next(line)) {
+        for (std::string_view line; lines.next(line);) {
             if (!line.empty() && line.back() == '\r') {
                 line.remove_suffix(1);
             }
-            if (col < 0) {
+            if (col < 0) {  // the header
                 col = Header(line, path).index("t");
                 if (col < 0) {
                     throw text::InputError(path, lines.line_number(), 1, "expected a header with a column 't'");
                 }
-                continue;
+            } else if (!line.empty()) {
+                times.push_back(
+                    time_of_line(line, lines.line_number(), static_cast<std::size_t>(col), path, fields, starts));
             }
-            if (line.empty()) {
-                continue;
-            }
-            const std::size_t n = lines.line_number();
-            if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-                throw text::InputError(path, n, bad + 1, why_split_failed(line, bad));
-            }
-            const auto c = static_cast<std::size_t>(col);
-            if (c >= fields.size()) {
-                throw text::InputError(
-                    path, n, line.size() + 1,
-                    "expected at least " + std::to_string(c + 1) + " fields, found " + std::to_string(fields.size()));
-            }
-            const auto t = parse_double(fields[c]);
-            if (!t || !(std::abs(*t) < pipeline::kMaxEpochTimeS)) {
-                throw text::InputError(path, n, starts[c] + 1,
-                                       "column 't': " + (t ? "t = " + number_text(*t) + " s is no time of an epoch"
-                                                           : why_not_a_number(fields[c])));
-            }
-            times.push_back(*t);
         }
     }
     if (col < 0) {
@@ -268,24 +273,6 @@ std::vector<double> read_times(const std::string& path) {
     }
     return times;
 }
-
-namespace {
-
-// Reads the header line of `path` to tell whether it has the covariance columns.
-bool has_covariance_columns(const std::string& path) {
-    BlockReader blocks(path, 1U << 16);
-    std::string_view block;
-    if (!blocks.next(block)) {
-        return false;
-    }
-    std::string_view line = block.substr(0, block.find('\n'));
-    if (!line.empty() && line.back() == '\r') {
-        line.remove_suffix(1);
-    }
-    return Header(line, path).index("cov_xy") >= 0;
-}
-
-}  // namespace
 
 InterpolateSummary interpolate_file(const InterpolateOptions& opt, OutputSet& outputs) {
     refuse_output_over_input(interpolate_inputs(opt), interpolate_outputs(opt));
@@ -295,7 +282,7 @@ InterpolateSummary interpolate_file(const InterpolateOptions& opt, OutputSet& ou
         throw text::InputError(opt.in, 1, 1,
                                "expected a combined file (" + std::string(kCombinedHeader) + "), not an attitude file");
     }
-    const CombinedColumns cols{has_covariance_columns(opt.in)};
+    const CombinedColumns cols = reader.columns();
     Interpolator interp(times, opt.max_gap_s, cols.covariance);
     AttitudeRow row;
     double last_t = 0.0;

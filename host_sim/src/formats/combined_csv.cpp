@@ -316,6 +316,9 @@ AttitudeReader::~AttitudeReader() = default;
 bool AttitudeReader::combined() const noexcept {
     return impl_->combined;
 }
+CombinedColumns AttitudeReader::columns() const noexcept {
+    return {impl_->columns.cov[0] >= 0};
+}
 bool AttitudeReader::next(AttitudeRow& row) {
     return impl_->next(row);
 }

@@ -9,9 +9,12 @@
 // Log takes q_b ⊗ q_a* with w ≥ 0, so the signs are made continuous first and
 // the shorter way is taken; equal attitudes give θ = 0 exactly (no 0/0).
 // The formal covariance per CRF axis pair:
-//   C(t) = (1 − u)² C_a + u² C_b + e(t)² I,
-// the first two terms the epochs' own errors (independent: each epoch's heads
-// were measured apart), e(t) the interpolation error bound: for an attitude
+//   C(t) = (1 − u) C_a + u C_b + e(t)² I,
+// the epochs' own covariances linear in u (exact when their errors are the
+// same, as a star tracker's slow errors are over seconds; with independent
+// errors it would be (1 − u)² C_a + u² C_b, smaller: C(t) never falls below
+// the smaller of C_a and C_b, and grows by e), e(t) the interpolation error
+// bound: for an attitude
 // whose angular acceleration is at most α, a constant-rate path departs from
 // it by at most α (t − t_a)(t_b − t)/2 (the bound of linear interpolation,
 // a function with |f''| ≤ α). α is taken from the data: the largest change of
@@ -21,7 +24,8 @@
 // The epochs' own noise enters α too (about 2σ/Δt² for spacing Δt, so e is
 // about σ/4 at mid-interval): a bound rather than an estimate.
 // heads: the union of a's and b's; status 1 or 2 by that union, with 4 when
-// a's or b's has it. At t equal to an epoch's t: that epoch's row, unchanged.
+// a's or b's has it. At t equal to a usable epoch's t: that epoch's row,
+// unchanged.
 // Status 8 (q, heads, sigmas empty) where t is before the first or after the
 // last usable epoch, or an epoch on either side is further than max_gap.
 //

@@ -79,6 +79,8 @@ public:
     AttitudeReader(const AttitudeReader&) = delete;
     AttitudeReader& operator=(const AttitudeReader&) = delete;
     bool combined() const noexcept;
+    // The optional columns the file has (cov_xy, cov_xz, cov_yz).
+    CombinedColumns columns() const noexcept;
     // The next row; false at the end.
     bool next(AttitudeRow& row);
 
