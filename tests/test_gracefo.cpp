@@ -104,9 +104,20 @@ TEST(GracefoImport, SolutionsEqualAnIndependentReadingOfTheFiles) {
             EXPECT_NEAR(got[i].q_chu_icrf.x, -std::stod(r[6]), 1e-15);
             EXPECT_NEAR(got[i].q_chu_icrf.y, -std::stod(r[7]), 1e-15);
             EXPECT_NEAR(got[i].q_chu_icrf.z, -std::stod(r[8]), 1e-15);
-            EXPECT_EQ(got[i].flags, 0);  // valid, aberration corrected on board, no false stars
-            EXPECT_EQ(got[i].confidence, std::stod(r[11]));
+            EXPECT_EQ(got[i].flags, 0);               // valid, aberration corrected on board, no false stars
+            EXPECT_FALSE(got[i].confidence_present);  // sca_confid is no misfit in arcsec
             EXPECT_FALSE(got[i].temperature_present[0] || got[i].velocity_components > 0);
+        }
+        // The quality fields as they are, after the contract's columns.
+        std::ifstream text(dir / "sol.csv");
+        std::string line;
+        std::getline(text, line);
+        EXPECT_EQ(line, "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,sca_mode,qualflg,sca_confid");
+        for (const auto& r : sca) {
+            std::getline(text, line);
+            const std::string want = "," + std::to_string(std::stoi(r[14], nullptr, 2)) + "," +
+                                     std::to_string(std::stoi(r[15], nullptr, 2)) + "," + r[11];
+            EXPECT_EQ(line.substr(line.size() - want.size()), want);
         }
         // the clock products matter: 16.7 ms of receiver clock offset on this day
         EXPECT_LT(got[0].t - (std::stod(sca[0][0]) + 1e-6 * std::stod(sca[0][1]) + 51.184), -0.016);
@@ -247,6 +258,44 @@ TEST(GracefoImport, OldHeadersAndSeveralFilesGiveTheSameSolutions) {
     EXPECT_EQ(test::slurp(dir / "split.csv"), whole);
 }
 
+TEST(GracefoImport, TheQualityBitsMakeTheFlags) {
+    const fs::path dir = test::scratch_dir("gracefo_flags");
+    const Sca1aText sca;
+    const std::string rec = sca.lines[3];  // sca_mode 11000001 qualflg 11000000: flags 0
+    const std::string head = rec.substr(0, rec.size() - 17);
+    struct Case {
+        std::string mode_quality;
+        long long flags;
+    };
+    const std::vector<Case> cases = {
+        {"11000001 11000000", 0},  // valid, orbit (aberration) correction used
+        {"11000000 11000000", 4},  // sca_mode: invalid
+        {"11000001 11000001", 4},  // qualflg bit 0 set: invalid (read inverted, as JPL's format and GROOPS)
+        {"11001001 11000000", 2},  // a non-stellar object
+        {"11000001 11001000", 2},  {"10000001 11000000", 8},  // the tracker did not correct aberration
+        {"11000101 11000000", 16},                            // "add 1/4 of the integration period": unknown, not clean
+        {"11000001 11000100", 16}, {"10001100 11000001", 4 + 2 + 8 + 16},
+        {"01000011 10010000", 0},  // sequence, precision, 1-Hz mode: no quality
+    };
+    std::string text = sca.header;
+    for (const Case& c : cases) {
+        text += head + c.mode_quality + "\n";
+    }
+    std::ofstream(dir / "flags.txt") << text;
+    ASSERT_EQ(
+        run_in("import gracefo --sca1a flags.txt --qsa1b " + product("QSA1B", 'C') + " --out sol.csv --mountings m.csv",
+               dir)
+            .exit_code,
+        0)
+        << test::slurp(dir / "stderr.txt");
+    std::string storage;
+    const std::vector<host::SolutionRecord> got = test::read_records((dir / "sol.csv").string(), storage);
+    ASSERT_EQ(got.size(), cases.size());
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+        EXPECT_EQ(got[i].flags, cases[i].flags) << cases[i].mode_quality;
+    }
+}
+
 TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
     const fs::path dir = test::scratch_dir("gracefo_bad");
     const Sca1aText sca;
@@ -307,11 +356,36 @@ TEST(GracefoImport, EveryBadRecordIsNamedByFileAndLineAndNothingIsWritten) {
                                    << "738849600 C -1 -0.0167 0 0 0 00000000\n";
     const std::string sol = " --sca1a " + product("SCA1A", 'C') + " --qsa1b " + product("QSA1B", 'C');
     const test::CliRun tim = run_in("import gracefo" + sol + " --tim1b tim.txt --out sol.csv --mountings m.csv", dir);
-    EXPECT_NE(tim.err.find("tim.txt:2:32: expected 8 fields of a TIM1B record, found 7"), std::string::npos)
-        << tim.err;
+    EXPECT_NE(tim.err.find("tim.txt:2:32: expected 8 fields of a TIM1B record, found 7"), std::string::npos) << tim.err;
     const test::CliRun clk = run_in("import gracefo" + sol + " --clk1b clk.txt --out sol.csv --mountings m.csv", dir);
     EXPECT_NE(clk.err.find("clk.txt:3:1: the time goes back"), std::string::npos) << clk.err;
-    EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "m.csv"));
+    // More bad products: each refused naming the file (and line), nothing written.
+    std::ofstream(dir / "empty_tim.txt") << "# End of YAML header\n";
+    std::ofstream(dir / "gap_tim.txt") << "# End of YAML header\n738849590 C 0 738849590 0 -1 -1 00000100\n"
+                                       << "738849598 C 0 738849598 0 -1 -1 00000100\n"
+                                       << "738849606 C 0 738849606 0 -1 -1 00000100\n"
+                                       << "738849700 C 0 738849700 0 -1 -1 00000100\n";
+    std::ofstream(dir / "qsa_short.txt") << "END OF HEADER\n580219200 C 1 1 0 0 0 00000000\n";
+    std::ofstream(dir / "qsa_norm.txt") << "END OF HEADER\n580219200 C 1 1 0.1 0 0 0 00000000\n";
+    std::ofstream(dir / "sca1b_norm.txt") << "# End of YAML header\n738849601 C 23 0.9 0 0 0 0 00000000\n";
+    const std::string sca1a = " --sca1a " + product("SCA1A", 'C');
+    const std::string qsa = " --qsa1b " + product("QSA1B", 'C');
+    const std::vector<std::pair<std::string, std::string>> more = {
+        {sca1a + qsa + " --tim1b empty_tim.txt", "TIM1B: 0 usable records in empty_tim.txt"},
+        // the 37th record (line 184 + 36), the first after 738849606: in the gap up to 738849700
+        {sca1a + qsa + " --tim1b gap_tim.txt",
+         "SCA1A_2023-06-01_C_04.txt:220:1: the time 738849606.029988 s is not covered by gap_tim.txt"},
+        {sca1a + " --qsa1b qsa_short.txt", "qsa_short.txt:2:31: expected 9 fields of a QSA1B record, found 8"},
+        {sca1a + " --qsa1b qsa_norm.txt", "qsa_norm.txt:2:15: the quaternion is not unit"},
+        {sca1a + qsa + " --sca1b sca1b_norm.txt --reference ref.csv",
+         "sca1b_norm.txt:2:16: the quaternion is not unit"},
+    };
+    for (const auto& [args, want] : more) {
+        const test::CliRun r = run_in("import gracefo" + args + " --out sol.csv --mountings m.csv", dir);
+        EXPECT_NE(r.exit_code, 0) << args;
+        EXPECT_NE(r.err.find(want), std::string::npos) << "wanted " << want << "\n" << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "sol.csv") || fs::exists(dir / "m.csv") || fs::exists(dir / "ref.csv"));
 }
 
 }  // namespace

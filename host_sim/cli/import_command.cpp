@@ -20,10 +20,12 @@ void add_gracefo_command(CLI::App& import) {
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_option("--qsa1b", opt->qsa1b, "QSA1B file: the heads' mountings")->required()->check(CLI::ExistingFile);
-    cmd->add_option("--tim1b", opt->tim1b, "TIM1B file: OBC time to receiver time (without: OBC time taken as GPS)")
+    cmd->add_option("--tim1b", opt->tim1b,
+                    "TIM1B file(s): OBC time to receiver time (repeatable: several days; without: OBC time taken as "
+                    "receiver time)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--clk1b", opt->clk1b,
-                    "CLK1B file: receiver time to GPS time (without: receiver time taken as GPS)")
+                    "CLK1B file(s): receiver time to GPS time (repeatable; without: receiver time taken as GPS)")
         ->check(CLI::ExistingFile);
     CLI::Option* sca1b =
         cmd->add_option("--sca1b", opt->sca1b, "SCA1B file: JPL's combined attitude, written to --reference")

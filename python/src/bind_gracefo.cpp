@@ -48,6 +48,10 @@ std::string optional_path(const py::object& x, const char* name) {
     return x.is_none() ? std::string() : path_arg(x, name);
 }
 
+std::vector<std::string> optional_paths(const py::object& x, const char* name) {
+    return x.is_none() ? std::vector<std::string>() : paths_arg(x, name);
+}
+
 template <typename T>
 py::array_t<T> array_of(const std::vector<T>& v, py::ssize_t cols) {
     const auto rows = static_cast<py::ssize_t>(cols == 0 ? v.size() : v.size() / static_cast<std::size_t>(cols));
@@ -61,8 +65,8 @@ py::dict import_gracefo_arrays(const py::object& sca1a, const py::object& qsa1b,
     host::GracefoOptions opt;
     opt.sca1a = paths_arg(sca1a, "sca1a");
     opt.qsa1b = path_arg(qsa1b, "qsa1b");
-    opt.tim1b = optional_path(tim1b, "tim1b");
-    opt.clk1b = optional_path(clk1b, "clk1b");
+    opt.tim1b = optional_paths(tim1b, "tim1b");
+    opt.clk1b = optional_paths(clk1b, "clk1b");
     opt.sca1b = optional_path(sca1b, "sca1b");
     opt.time_offset_s = real_arg(time_offset, "time_offset");
     if (!(std::abs(opt.time_offset_s) <= host::kMaxTimeOffsetS)) {
@@ -71,13 +75,17 @@ py::dict import_gracefo_arrays(const py::object& sca1a, const py::object& qsa1b,
     std::vector<double> t, q, conf, ref_t, ref_q;
     std::vector<std::string> chu;
     std::vector<std::int64_t> flags;
+    std::vector<std::string> extra[3];  // kGracefoColumns, as the file writes them
     host::GracefoSink sink;
-    sink.solution = [&](const host::SolutionValues& v) {
+    sink.solution = [&](const host::SolutionValues& v, const host::Sca1aRecord& r) {
         t.push_back(v.t);
         chu.emplace_back(v.chu);
         q.insert(q.end(), {v.q_chu_icrf.w, v.q_chu_icrf.x, v.q_chu_icrf.y, v.q_chu_icrf.z});
         flags.push_back(v.flags);
         conf.push_back(v.confidence);
+        extra[0].push_back(std::to_string(r.mode));
+        extra[1].push_back(std::to_string(r.quality));
+        extra[2].push_back(std::to_string(r.confidence));
     };
     sink.reference = [&](double at, const Quaternion<double>& r) {
         const Quaternion<double> c = canonical(r);
@@ -99,6 +107,16 @@ py::dict import_gracefo_arrays(const py::object& sca1a, const py::object& qsa1b,
     s["v"] = array_of(std::vector<double>(static_cast<std::size_t>(3 * n), kNaN), 3);
     s["flags"] = array_of(flags, 0);
     s["confidence"] = array_of(conf, 0);
+    py::dict ex;  // as read_solutions() gives a file's other columns: {name: (n,) str}
+    const std::string names(host::kGracefoColumns);
+    std::size_t from = 0;
+    for (const auto& column : extra) {
+        const std::size_t to = std::min(names.find(',', from), names.size());
+        ex[py::str(names.substr(from, to - from))] =
+            py::module_::import("numpy").attr("array")(py::cast(column), "dtype"_a = "U");
+        from = to + 1;
+    }
+    s["extra"] = ex;
     py::dict d;
     d["satellite"] = std::string(1, sum.satellite);
     d["solutions"] = s;

@@ -42,6 +42,29 @@ void append_number(std::string& out, double x) {
     }
 }
 
+// combined['heads']: n strings of head letters (the reader checks their order).
+std::vector<std::string> head_sets(const py::object& x, py::ssize_t n) {
+    const std::string what = "expected " + std::to_string(n) + " strings of the letters " + kHeadLetters;
+    if (py::isinstance<py::str>(x) || !py::isinstance<py::sequence>(py::object(as_numpy(x).attr("tolist")()))) {
+        bad_argument("combined['heads']", what + ", got " + value_text(x));
+    }
+    const py::list items = as_numpy(x).attr("tolist")();
+    if (static_cast<py::ssize_t>(items.size()) != n) {
+        bad_argument("combined['heads']", what + ", got " + std::to_string(items.size()));
+    }
+    std::vector<std::string> out;
+    for (const py::handle item : items) {
+        const bool text = py::isinstance<py::str>(item);
+        const std::string h = text ? item.cast<std::string>() : std::string();
+        if (!text || h.find_first_not_of(kHeadLetters) != std::string::npos) {
+            bad_argument("combined['heads']", what + ": row " + std::to_string(out.size() + 1) + " is " +
+                                                  value_text(py::reinterpret_borrow<py::object>(item)));
+        }
+        out.push_back(h);
+    }
+    return out;
+}
+
 // The rows of combine()'s dict as the combined file's text (no header).
 std::string combined_text(const py::dict& d, bool covariance) {
     const Doubles t = time_array(key_of(d, "t"), "combined['t']");
@@ -55,10 +78,7 @@ std::string combined_text(const py::dict& d, bool covariance) {
                                                (st.bad_row >= 0 ? ": row " + std::to_string(st.bad_row) + ": " + st.why
                                                                 : ", got " + shape_text(status)));
     }
-    const py::list heads(key_of(d, "heads"));
-    if (static_cast<py::ssize_t>(heads.size()) != n) {
-        bad_argument("combined['heads']", "expected " + std::to_string(n) + " strings of head letters");
-    }
+    const std::vector<std::string> heads = head_sets(key_of(d, "heads"), n);
     const Doubles cov = covariance ? real_array(key_of(d, "cov"), "combined['cov']", n, 3) : Doubles();
     std::string text;
     for (py::ssize_t i = 0; i < n; ++i) {
@@ -68,7 +88,7 @@ std::string combined_text(const py::dict& d, bool covariance) {
             append_number(text, q.data()[4 * i + k]);
         }
         text += ',';
-        text += py::str(heads[static_cast<std::size_t>(i)]).cast<std::string>();
+        text += heads[static_cast<std::size_t>(i)];
         for (int k = 0; k < 3; ++k) {
             text += ',';
             append_number(text, sigma.data()[3 * i + k]);

@@ -258,13 +258,14 @@ inline constexpr const char* kImportGracefo =
 
 sca1a: a path or a list of paths of SCA1A files of one satellite (taken in the order
 of their first records). qsa1b: the QSA1B file (the heads' mountings). tim1b, clk1b:
-the clock products (OBC to receiver time, receiver to GPS time), or None (the time
-taken as it is). sca1b: JPL's combined attitude, or None. time_offset: seconds added
+the clock products (OBC to receiver time, receiver to GPS time; a path or a list of
+paths, merged), or None (the time taken as it is). sca1b: JPL's combined attitude, or None. time_offset: seconds added
 to every SCA1A time ([-10, 10]; default 0). Returns a dict: "satellite" ('C' or 'D');
 "solutions", as read_solutions() returns a solutions file (t in TT, s since J2000;
 chu 'A'..'C' for sca_id 1..3; q = q_chu_icrf, the conjugate of SCA1A's; temps and v
-NaN; flags 4 invalid, 2 non-stellar object, 8 aberration not corrected on board;
-confidence the product's sca_confid); "mountings", as read_mountings() returns, from
+NaN; flags 4 invalid, 2 non-stellar object, 8 aberration not corrected on board, 16
+time tag to be corrected by an unknown amount; confidence NaN; extra: sca_mode,
+qualflg, sca_confid as written); "mountings", as read_mountings() returns, from
 QSA1B, without sigmas (align() estimates them); "reference", {"t": (m,), "q": (m, 4)
 q_crf_icrf, qw >= 0} from SCA1B, or None. Raises ascorr.InputError naming file, line
 and column for a bad record.)doc";

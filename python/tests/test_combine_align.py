@@ -232,3 +232,8 @@ def test_interpolate_refuses_what_the_file_reader_refuses(corrected):
         ascorr.interpolate({k: v for k, v in c.items() if k != "sigma"}, c["t"][:3])
     with pytest.raises(ValueError, match="argument 'at'"):
         ascorr.interpolate(c, np.array([np.nan]))
+    n = len(c["t"])
+    with pytest.raises(ValueError, match=r"argument 'combined\['heads'\]'"):
+        ascorr.interpolate(dict(c, heads="ABC" * n), c["t"][:3])
+    with pytest.raises(ValueError, match="row 2 is 'A,B'"):
+        ascorr.interpolate(dict(c, heads=np.array(["AB", "A,B"] + ["AB"] * (n - 2))), c["t"][:3])

@@ -35,6 +35,10 @@ def test_import_gracefo_is_the_command_lines_files(exe, tmp_path, sat):
     for key in ("t", "q", "flags", "confidence", "temps", "v"):
         assert np.array_equal(g["solutions"][key], s[key], equal_nan=True), key
     assert list(g["solutions"]["chu"]) == list(s["chu"])
+    assert set(s["extra"]) == {"sca_mode", "qualflg", "sca_confid"}
+    for key, column in s["extra"].items():
+        assert list(g["solutions"]["extra"][key]) == list(column), key
+    assert np.all(np.isnan(s["confidence"]))  # sca_confid is a code, not a misfit in arcsec
     m = ascorr.read_mountings(tmp_path / "m.csv")
     assert g["mountings"]["heads"] == m["heads"] == "ABC"
     assert np.array_equal(g["mountings"]["q"], m["q"]) and g["mountings"]["sigma_cross"] is None
@@ -84,3 +88,6 @@ def test_bad_arguments_and_records(tmp_path):
         ascorr.import_gracefo(**dict(f, sca1a=bad))
     with pytest.raises(ascorr.InputError, match="a record of GRACE D among those of GRACE C"):
         ascorr.import_gracefo(**dict(f, sca1a=[product("SCA1A", "C"), product("SCA1A", "D")]))
+    # several clock files are merged (here the same day twice)
+    twice = ascorr.import_gracefo(**dict(f, tim1b=[f["tim1b"], f["tim1b"]], clk1b=[f["clk1b"]]))
+    assert np.array_equal(twice["solutions"]["t"], ascorr.import_gracefo(**f)["solutions"]["t"])

@@ -157,10 +157,18 @@ Sca1aRecord sca1a_record(const Record& r) {
     return s;
 }
 
+// qualflg bit 0 is read inverted from sca_mode's: JPL's GRACE Level-1 format
+// (GRACEiolib.h: qualflg bit 0, "valid flag", set when invalid) and GROOPS
+// (graceL1a2StarCamera drops records with it set) read it so, and every
+// record of the public sample has it clear while sca_mode calls it valid; the
+// files' YAML header repeats sca_mode's description for qualflg.
 long long flags_of(const Sca1aRecord& s) {
     long long f = 0;
     if ((s.mode & 1U) == 0U || (s.quality & 1U) != 0U) {
         f |= kGracefoInvalid;
+    }
+    if (((s.mode | s.quality) & 4U) != 0U) {
+        f |= kGracefoTimeTagShift;
     }
     if (((s.mode | s.quality) & 8U) != 0U) {
         f |= kGracefoFalseStars;
@@ -215,38 +223,80 @@ double first_obc(const std::string& path) {
 
 }  // namespace
 
-GracefoClock::GracefoClock(const std::string& tim1b, const std::string& clk1b, char satellite) {
-    const auto load = [satellite](const std::string& path, const char* product, bool tim) {
+namespace {
+
+// One clock record: at the product's own time, the offset to add.
+struct ClockPoint {
+    double at;
+    double offset;
+    std::uint8_t flags;
+};
+
+// A TIM1B record's mapping, or none: bit 3 "Receiver Time mapping not
+// defined", bit 6 "Unable to compute Receiver Time mapping" (the file's header).
+constexpr std::uint8_t kTimNoMapping = 8U | 64U;
+
+std::vector<ClockPoint> clock_points(const std::string& path, const char* product, bool tim, char satellite) {
+    std::vector<ClockPoint> points;
+    double last = -1e300;
+    for_each_record(path, 8, product, [&](const Record& r) {
+        same_satellite(satellite, r.satellite(1), r, 1);
+        ClockPoint p{};
+        if (tim) {
+            const long long obc = r.integer(0, "obctime", 0, 4000000000LL);
+            const long long rcv = r.integer(3, "rcvtime_intg", 0, 4000000000LL);
+            const long long ns = r.integer(4, "rcvtime_frac", 0, 999999999);
+            p = {static_cast<double>(obc), static_cast<double>(rcv - obc) + 1e-9 * static_cast<double>(ns),
+                 r.flag_byte(7, "qualflg")};
+        } else {
+            p = {r.number(0, "rcv_time"), r.number(3, "eps_time"), r.flag_byte(7, "qualflg")};
+        }
+        if (p.at < last) {  // a repeat is an arc's end and the next one's start
+            r.fail(0, "the time goes back from the record before");
+        }
+        last = p.at;
+        if (!tim || (p.flags & kTimNoMapping) == 0U) {
+            points.push_back(p);
+        }
+        return true;
+    });
+    return points;
+}
+
+}  // namespace
+
+GracefoClock::GracefoClock(const std::vector<std::string>& tim1b, const std::vector<std::string>& clk1b,
+                           char satellite) {
+    const auto load = [satellite](const std::vector<std::string>& paths, const char* product, bool tim) {
+        std::vector<ClockPoint> all;
+        for (const std::string& path : paths) {
+            const std::vector<ClockPoint> p = clock_points(path, product, tim, satellite);
+            all.insert(all.end(), p.begin(), p.end());
+        }
+        std::stable_sort(all.begin(), all.end(), [](const ClockPoint& a, const ClockPoint& b) { return a.at < b.at; });
+        if (all.size() < 2 || all.front().at == all.back().at) {
+            throw text::InputError::whole_file(
+                paths.front(), std::string(product) + ": " + std::to_string(all.size()) + " usable records in " +
+                                   text::input_name(paths.front()) + (paths.size() > 1 ? " and the others" : "") +
+                                   ": a clock product needs two or more at different times (with a defined "
+                                   "mapping)");
+        }
         Table t;
-        t.path = path;
-        for_each_record(path, 8, product, [&](const Record& r) {
-            same_satellite(satellite, r.satellite(1), r, 1);
-            double at = 0.0;
-            double offset = 0.0;
-            if (tim) {
-                at = static_cast<double>(r.integer(0, "obctime", 0, 4000000000LL));
-                const long long rcv = r.integer(3, "rcvtime_intg", 0, 4000000000LL);
-                const long long ns = r.integer(4, "rcvtime_frac", 0, 999999999);
-                offset = static_cast<double>(rcv - static_cast<long long>(at)) + 1e-9 * static_cast<double>(ns);
-            } else {
-                at = r.number(0, "rcv_time");
-                offset = r.number(3, "eps_time");
-            }
-            if (!t.at.empty() && at < t.at.back()) {  // a repeat is an arc's end and the next one's start
-                r.fail(0, "the time goes back from the record before");
-            }
-            t.at.push_back(at);
-            t.offset.push_back(offset);
-            return true;
-        });
+        t.name = text::input_name(paths.front()) +
+                 (paths.size() > 1 ? " and the other " + std::string(product) + " files" : "");
         std::vector<double> steps;
-        for (std::size_t i = 1; i < t.at.size(); ++i) {
-            steps.push_back(t.at[i] - t.at[i - 1]);
+        for (std::size_t i = 0; i < all.size(); ++i) {
+            t.at.push_back(all[i].at);
+            t.offset.push_back(all[i].offset);
+            if (i > 0 && all[i].at > all[i - 1].at) {  // repeats (arcs' ends, a file twice) are no spacing
+                steps.push_back(all[i].at - all[i - 1].at);
+            }
         }
-        if (!steps.empty()) {
-            std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2), steps.end());
-            t.max_step = 2.0 * steps[steps.size() / 2];
-        }
+        std::nth_element(steps.begin(), steps.begin() + static_cast<long>(steps.size() / 2), steps.end());
+        t.max_step = 2.0 * steps[steps.size() / 2];
+        // CLK1B: bit 1 "extrapolation not valid BEFORE", bit 0 "not valid AFTER" the record.
+        t.before_first = tim || (all.front().flags & 2U) == 0U;
+        t.after_last = tim || (all.back().flags & 1U) == 0U;
         return t;
     };
     if (!tim1b.empty()) {
@@ -264,18 +314,19 @@ double GracefoClock::offset_at(const Table& t, double x, const std::string& file
         return t.offset[i];
     }
     // Within two records' spacing of the first or the last: its offset (a
-    // day's product starts seconds after midnight; the offsets vary by ns).
-    if (i == 0 && t.at.front() - x <= t.max_step) {
+    // day's product starts seconds after midnight; the offsets vary by ns),
+    // unless the record says its value is not valid beyond it.
+    if (i == 0 && t.before_first && t.at.front() - x <= t.max_step) {
         return t.offset.front();
     }
-    if (i == t.at.size() && i > 0 && x - t.at.back() <= t.max_step) {
+    if (i == t.at.size() && t.after_last && x - t.at.back() <= t.max_step) {
         return t.offset.back();
     }
     if (i == 0 || i == t.at.size() || t.at[i] - t.at[i - 1] > t.max_step) {
         char buf[200];
         text::c_snprintf(buf, sizeof buf, "%.6f", x);
         throw text::InputError(file, line, 1,
-                               "the time " + std::string(buf) + " s is not covered by " + text::input_name(t.path) +
+                               "the time " + std::string(buf) + " s is not covered by " + t.name +
                                    " (outside its records, or in a gap between them)");
     }
     const double u = (x - t.at[i - 1]) / (t.at[i] - t.at[i - 1]);
@@ -299,13 +350,20 @@ std::string describe(const GracefoSummary& s) {
     text::c_snprintf(buf, sizeof buf,
                      "GRACE %c: %zu star-camera records (%zu not clean), t %.3f to %.3f s TT; %zu reference records",
                      s.satellite, s.records, s.not_clean, s.first_t, s.last_t, s.reference);
-    return buf;
+    std::string out = buf;
+    if (!s.tim1b || !s.clk1b) {  // the OBC and receiver clocks are off GPS by up to tens of ms
+        out += std::string("; without ") + (s.tim1b ? "" : "TIM1B (OBC time taken as receiver time)") +
+               (!s.tim1b && !s.clk1b ? " and " : "") + (s.clk1b ? "" : "CLK1B (receiver time taken as GPS time)");
+    }
+    return out;
 }
 
 MountingsFile import_gracefo(const GracefoOptions& opt, const GracefoSink& sink, GracefoSummary& sum) {
     char satellite = 0;
     MountingsFile m = read_qsa1b(opt.qsa1b, satellite);
     sum.satellite = satellite;
+    sum.tim1b = !opt.tim1b.empty();
+    sum.clk1b = !opt.clk1b.empty();
     const GracefoClock clock(opt.tim1b, opt.clk1b, satellite);
     std::vector<std::pair<double, std::string>> files;
     for (const std::string& f : opt.sca1a) {
@@ -331,12 +389,12 @@ MountingsFile import_gracefo(const GracefoOptions& opt, const GracefoSink& sink,
             v.temperature = {std::nan(""), std::nan(""), std::nan("")};
             v.v_sc_kms = {std::nan(""), std::nan(""), std::nan("")};
             v.flags = flags_of(s);
-            v.confidence = static_cast<double>(s.confidence);
-            sum.not_clean += (v.flags != 0 || s.confidence > 5) ? 1U : 0U;
+            v.confidence = std::nan("");  // no misfit in arcsec: sca_confid is a code (kGracefoColumns)
+            sum.not_clean += v.flags != 0 ? 1U : 0U;
             sum.first_t = sum.records == 0 ? v.t : sum.first_t;
             sum.last_t = v.t;
             ++sum.records;
-            sink.solution(v);
+            sink.solution(v, s);
             return true;
         });
     }
@@ -363,12 +421,14 @@ std::vector<NamedPath> gracefo_inputs(const GracefoOptions& opt) {
         in.push_back({"--sca1a", f});
     }
     in.push_back({"--qsa1b", opt.qsa1b});
-    for (const auto& [option, path] : {std::pair<const char*, const std::string*>{"--tim1b", &opt.tim1b},
-                                       {"--clk1b", &opt.clk1b},
-                                       {"--sca1b", &opt.sca1b}}) {
-        if (!path->empty()) {
-            in.push_back({option, *path});
-        }
+    for (const std::string& f : opt.tim1b) {
+        in.push_back({"--tim1b", f});
+    }
+    for (const std::string& f : opt.clk1b) {
+        in.push_back({"--clk1b", f});
+    }
+    if (!opt.sca1b.empty()) {
+        in.push_back({"--sca1b", opt.sca1b});
     }
     return in;
 }
@@ -383,12 +443,15 @@ std::vector<NamedPath> gracefo_outputs(const GracefoOptions& opt) {
 
 GracefoSummary import_gracefo_files(const GracefoOptions& opt, OutputSet& outputs) {
     refuse_output_over_input(gracefo_inputs(opt), gracefo_outputs(opt));
-    std::string solutions = std::string(kSolutionsHeader) + "\n";
+    std::string solutions = std::string(kSolutionsHeader) + "," + std::string(kGracefoColumns) + "\n";
     std::string reference = std::string(kAttitudeHeader) + "\n";
     AtomicFile& out = outputs["--out"];
     GracefoSink sink;
-    sink.solution = [&](const SolutionValues& v) {
+    sink.solution = [&](const SolutionValues& v, const Sca1aRecord& r) {
         append_solution_fields(solutions, v);
+        for (const int x : {int{r.mode}, int{r.quality}, r.confidence}) {
+            solutions += ',' + std::to_string(x);
+        }
         solutions += '\n';
         if (solutions.size() > (1U << 20)) {
             out.write(solutions);

@@ -32,6 +32,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ascorr/core/quaternion.hpp"
@@ -45,9 +46,10 @@ namespace ascorr::host {
 inline constexpr double kTtMinusGpsS = 51.184;
 // The default --time-offset for GRACE-FO SCA1A (s): none. On the public
 // sample a latency is not observable (the combined attitude against SCA1B at
-// its own epochs is flat to 0.004″ RMS over ±1 s; the −0.28 s an earlier
-// comparison found was interpolation averaging two epochs' noise):
-// tools/gracefo/calibrate_time_offset.py, docs/ground.md "Real flight data".
+// its own epochs is flat over ±1 s: docs/figures/gracefo-jpl.json; the
+// −0.28 s an earlier comparison found was interpolation averaging two epochs'
+// noise): tools/gracefo/calibrate_time_offset.py, docs/ground.md "Real
+// flight data".
 inline constexpr double kGracefoTimeOffsetS = 0.0;
 inline constexpr double kMaxTimeOffsetS = 10.0;  // --time-offset in [-10, 10]
 
@@ -55,6 +57,15 @@ inline constexpr double kMaxTimeOffsetS = 10.0;  // --time-offset in [-10, 10]
 inline constexpr long long kGracefoInvalid = 4;       // sca_mode bit 0 clear, or qualflg bit 0 set
 inline constexpr long long kGracefoFalseStars = 2;    // sca_mode or qualflg bit 3: non-stellar object
 inline constexpr long long kGracefoNotCorrected = 8;  // sca_mode bit 6 clear: aberration not corrected on board
+// sca_mode or qualflg bit 2, "add 1/4 of star camera integration period to
+// rcv_time": the integration period is in no product, so the record's time
+// cannot be made right; it is kept, not clean.
+inline constexpr long long kGracefoTimeTagShift = 16;
+// The solutions file's columns after the contract's: the record's quality
+// fields as they are (sca_mode and qualflg as integers 0-255, sca_confid,
+// the tracker's own 0-255 code, not a misfit in arcsec: `confidence` is
+// empty, so that a record the product calls valid is clean).
+inline constexpr std::string_view kGracefoColumns = "sca_mode,qualflg,sca_confid";
 
 struct Sca1aRecord {
     std::size_t line = 0;
@@ -72,8 +83,11 @@ struct Sca1aRecord {
 // GPS), each linear between its records; without a product, no change.
 class GracefoClock {
 public:
-    // tim1b, clk1b: paths or empty; satellite: the SCA1A files'.
-    GracefoClock(const std::string& tim1b, const std::string& clk1b, char satellite);
+    // tim1b, clk1b: the products' files (several days: merged in time
+    // order), or none; satellite: the SCA1A files'. TIM1B records without a
+    // mapping (qualflg bit 3 or 6) are not used. InputError for a bad record,
+    // or fewer than two usable records.
+    GracefoClock(const std::vector<std::string>& tim1b, const std::vector<std::string>& clk1b, char satellite);
     // GPS time of OBC time obc_s + obc_us µs; within two records' usual
     // spacing before the first or after the last record, that record's
     // offset. Throws InputError naming the SCA1A record (file, line) when a
@@ -83,10 +97,12 @@ public:
 
 private:
     struct Table {
-        std::string path;
+        std::string name;            // for messages
         std::vector<double> at;      // the product's own time (OBC, receiver)
         std::vector<double> offset;  // to add (s)
         double max_step = 0.0;       // the records' usual spacing × 2
+        bool before_first = true;    // the first record's offset holds before it (CLK1B: qualflg bit 1 clear)
+        bool after_last = true;      // the last record's offset holds after it (CLK1B: qualflg bit 0 clear)
     };
     static double offset_at(const Table& t, double x, const std::string& file, std::size_t line);
     std::optional<Table> tim_;
@@ -96,19 +112,21 @@ private:
 struct GracefoOptions {
     std::vector<std::string> sca1a;
     std::string qsa1b;
-    std::string tim1b;      // empty: OBC time taken as GPS time
-    std::string clk1b;      // empty: receiver time taken as GPS time (an extension)
-    std::string sca1b;      // empty: no reference
-    std::string out;        // solutions file
-    std::string mountings;  // mountings file
-    std::string reference;  // attitude file of SCA1B, with sca1b
+    std::vector<std::string> tim1b;  // none: OBC time taken as receiver time
+    std::vector<std::string> clk1b;  // none: receiver time taken as GPS time (an extension)
+    std::string sca1b;               // empty: no reference
+    std::string out;                 // solutions file
+    std::string mountings;           // mountings file
+    std::string reference;           // attitude file of SCA1B, with sca1b
     double time_offset_s = kGracefoTimeOffsetS;
 };
 
 struct GracefoSummary {
     char satellite = 0;
     std::size_t records = 0;    // SCA1A records written
-    std::size_t not_clean = 0;  // of them with flags != 0 or confidence > 5
+    std::size_t not_clean = 0;  // of them with flags != 0
+    bool tim1b = false;         // the clock products used
+    bool clk1b = false;
     std::size_t reference = 0;  // SCA1B records
     double first_t = 0.0;       // TT of the first and last record
     double last_t = 0.0;
@@ -117,7 +135,7 @@ std::string describe(const GracefoSummary& s);
 
 // What an import produces, row by row (the CLI writes files, Python arrays).
 struct GracefoSink {
-    std::function<void(const SolutionValues&)> solution;
+    std::function<void(const SolutionValues&, const Sca1aRecord&)> solution;
     std::function<void(double t, const Quaternion<double>& q_crf_icrf)> reference;  // with sca1b
 };
 
