@@ -229,9 +229,9 @@ double time_of_line(std::string_view line, std::size_t n, std::size_t col, const
         throw text::InputError(path, n, bad + 1, why_split_failed(line, bad));
     }
     if (col >= fields.size()) {
-        throw text::InputError(path, n, line.size() + 1,
-                               "expected at least " + std::to_string(col + 1) + " fields, found " +
-                                   std::to_string(fields.size()));
+        throw text::InputError(
+            path, n, line.size() + 1,
+            "expected at least " + std::to_string(col + 1) + " fields, found " + std::to_string(fields.size()));
     }
     const auto t = parse_double(fields[col]);
     if (!t || !(std::abs(*t) < pipeline::kMaxEpochTimeS)) {
