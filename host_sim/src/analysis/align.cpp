@@ -35,13 +35,7 @@ Eigen::Vector3d rotation_arcsec(const Quaternion<double>& a, const Quaternion<do
 }
 
 Quaternion<double> rotation_quaternion(const Eigen::Vector3d& theta_arcsec) noexcept {
-    const Eigen::Vector3d r = theta_arcsec / kRadToArcsec;
-    const double angle = r.norm();
-    if (angle == 0.0) {
-        return {1.0, 0.0, 0.0, 0.0};
-    }
-    const Eigen::Vector3d v = r * (std::sin(0.5 * angle) / angle);
-    return {std::cos(0.5 * angle), v.x(), v.y(), v.z()};
+    return exp_arcsec({theta_arcsec.x(), theta_arcsec.y(), theta_arcsec.z()});
 }
 
 Eigen::Vector3d boresight_crf(const Quaternion<double>& q_chu_crf) noexcept {

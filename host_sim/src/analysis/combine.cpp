@@ -14,6 +14,7 @@
 #include "ascorr/combine/subset_tables.hpp"
 #include "ascorr/combine/usable.hpp"
 #include "ascorr/core/constants.hpp"
+#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
@@ -371,11 +372,11 @@ struct CombineStage::Impl {
                 continue;  // the gate left a head of the subset out: no step of this set
             }
             DaySum& d = daily[set][day];
-            const std::array<double, 3> v = difference_arcsec(c.q_crf_icrf, q_full);
+            const Vector3<double> v = rotation_vector_arcsec(c.q_crf_icrf, q_full);
             ++d.n;
-            for (std::size_t a = 0; a < 3; ++a) {
-                d.sum[a] += v[a];
-            }
+            d.sum[0] += v.x;
+            d.sum[1] += v.y;
+            d.sum[2] += v.z;
         }
     }
 

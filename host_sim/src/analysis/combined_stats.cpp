@@ -130,11 +130,6 @@ void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedSt
 
 }  // namespace
 
-std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
-    const Vector3<double> v = rotation_vector_arcsec(a, b);
-    return {v.x, v.y, v.z};
-}
-
 std::string head_set_name(std::uint32_t heads) {
     return heads == 0 ? std::string("-") : head_letters(heads);
 }
@@ -178,7 +173,8 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
             ++s.epochs_without_truth;
             continue;
         }
-        const Vec e = difference_arcsec(row.q_crf_icrf, tr->q_crf_icrf);
+        const Vector3<double> v = rotation_vector_arcsec(row.q_crf_icrf, tr->q_crf_icrf);
+        const Vec e{v.x, v.y, v.z};
         a.error.add(e);
         a.sigma.add(row.sigma_arcsec);
         a.daily[static_cast<long long>(std::floor((row.t - t0) / kSecondsPerDay))].add(e);

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr_host/analysis/combined_stats.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/stats.hpp"
@@ -511,7 +512,8 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
             ++without_truth;
             continue;
         }
-        const std::array<double, 3> e = difference_arcsec(row.q_crf_icrf, it->second);
+        const Vector3<double> v = rotation_vector_arcsec(row.q_crf_icrf, it->second);
+        const std::array<double, 3> e{v.x, v.y, v.z};
         step = row.t > t_previous ? std::min(step, row.t - t_previous) : step;
         t_previous = row.t;
         f << row.t + kJ2000Unix << ' ' << e[0] << ' ' << e[1] << ' ' << e[2] << ' ' << row.heads << '\n';

@@ -9,6 +9,8 @@
 // 2·atan2(|v|, w), exact at every angle (2·asin(|v|) loses digits near π);
 // θ = 0 for identical attitudes (no 0/0). exp_arcsec is the inverse: the
 // unit quaternion Exp(θ) of a rotation vector, with no 0/0 at θ = 0 either.
+// One implementation of each for the ground (align, combine, interpolate,
+// the statistics and plots of a combined file).
 #pragma once
 
 #include <cmath>
@@ -29,14 +31,18 @@ inline Vector3<double> rotation_vector_arcsec(const Quaternion<double>& a, const
     return {d.x * k, d.y * k, d.z * k};
 }
 
-// Exp(θ) = [cos(|θ|/2), θ̂ sin(|θ|/2)] for θ in arcsec. sin(x/2)/x is taken
-// from its series below 1e-4 rad (truncation < x⁴/3840 < 3e-20, of 0.5).
+// Exp(θ) = [cos(x/2), r sin(x/2)/x] with r = θ in rad, x = |r|: sin(x/2)/x
+// has no cancellation at any x > 0 (sin is accurate to the last bit for
+// small arguments), so only x = 0 needs its own case.
 inline Quaternion<double> exp_arcsec(const Vector3<double>& theta_arcsec) noexcept {
-    const double x =
-        std::sqrt(theta_arcsec.x * theta_arcsec.x + theta_arcsec.y * theta_arcsec.y + theta_arcsec.z * theta_arcsec.z) /
-        kRadToArcsec;
-    const double k = (x < 1e-4 ? 0.5 - x * x / 48.0 : std::sin(0.5 * x) / x) / kRadToArcsec;
-    return {std::cos(0.5 * x), theta_arcsec.x * k, theta_arcsec.y * k, theta_arcsec.z * k};
+    const Vector3<double> r{theta_arcsec.x / kRadToArcsec, theta_arcsec.y / kRadToArcsec,
+                            theta_arcsec.z / kRadToArcsec};
+    const double x = std::sqrt(r.x * r.x + r.y * r.y + r.z * r.z);
+    if (x == 0.0) {
+        return {1.0, 0.0, 0.0, 0.0};
+    }
+    const double k = std::sin(0.5 * x) / x;
+    return {std::cos(0.5 * x), r.x * k, r.y * k, r.z * k};
 }
 
 }  // namespace ascorr

@@ -76,9 +76,10 @@ constexpr bool noise_window_valid(double s) noexcept {
 // Fewest epochs with two or more usable heads that align accepts.
 inline constexpr std::size_t kMinAlignEpochs = 100;
 
-// θ (arcsec, the left frame's axes) with a = exp(θ) ⊗ b; either sign of a and b.
+// core/rotation_vector.hpp's rotation_vector_arcsec and exp_arcsec in Eigen's
+// vectors: θ (arcsec, the left frame's axes) with a = exp(θ) ⊗ b (either sign
+// of a and b), and exp(θ), the unit quaternion of the rotation vector θ.
 Eigen::Vector3d rotation_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept;
-// exp(θ): the unit quaternion of the rotation vector θ (arcsec).
 Quaternion<double> rotation_quaternion(const Eigen::Vector3d& theta_arcsec) noexcept;
 
 // A head's boresight in CRF (third row of R(q_chu_crf)) and its information

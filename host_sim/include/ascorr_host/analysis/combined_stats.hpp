@@ -60,11 +60,6 @@ std::string combined_stats_table(const CombinedStats& s);
 // arrays null where not measured.
 std::string combined_stats_json(const CombinedStats& s);
 
-// θ of a ⊗ b* (R_a = R(θ) R_b): the rotation from attitude b to a in the
-// left frame's axes (CRF for q_crf_icrf), arcsec; w ≥ 0 taken, so both signs
-// of a quaternion give the same θ (|θ| ≤ 180°).
-std::array<double, 3> difference_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept;
-
 // The letters of a head mask, "-" for none.
 std::string head_set_name(std::uint32_t heads);
 
