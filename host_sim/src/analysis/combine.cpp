@@ -551,6 +551,30 @@ CombineSummary combine_pass(const CombineOptions& opt, const MountingsFile& m, O
     return stage.summary();
 }
 
+// A run over rows that streams them (CombineStage::Mode::kStream) and, at
+// the first row out of time order, runs again keeping them (kKeep) into the
+// outputs opened anew by reopen() (the first run's temporary files removed);
+// sorted tells which. The first run's messages wait: a second run says them
+// again, so they are said once either way.
+template <typename Result>
+Result stream_then_keep(const std::function<Result(CombineStage::Mode, std::ostream&)>& pass,
+                        const std::function<void()>& reopen, std::ostream& log, bool& sorted) {
+    std::ostringstream first;
+    try {
+        Result r = pass(CombineStage::Mode::kStream, first);
+        log << first.str();
+        sorted = false;
+        return r;
+    } catch (const RowsOutOfOrder&) {
+    } catch (...) {
+        log << first.str();
+        throw;
+    }
+    reopen();
+    sorted = true;
+    return pass(CombineStage::Mode::kKeep, log);
+}
+
 }  // namespace
 
 void for_each_corrected_row(const std::string& path, const std::function<void(const CorrectedRow&)>& fn,
@@ -618,20 +642,14 @@ CorrectAndCombine correct_and_combine(const CorrectOptions& opt, const std::stri
     if (outputs["--out"].streamed()) {
         return pass(CombineStage::Mode::kKeep, log);
     }
-    std::ostringstream first;
-    try {
-        CorrectAndCombine r = pass(CombineStage::Mode::kStream, first);
-        log << first.str();
-        return r;
-    } catch (const RowsOutOfOrder&) {
-    } catch (...) {
-        log << first.str();
-        throw;
-    }
-    // The first run's temporary files removed, the outputs opened anew.
-    outputs = OutputSet(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
-    CorrectAndCombine r = pass(CombineStage::Mode::kKeep, log);
-    r.combined.out_of_order = true;
+    bool sorted = false;
+    CorrectAndCombine r = stream_then_keep<CorrectAndCombine>(
+        pass,
+        [&] {
+            outputs = OutputSet(correct_and_combine_outputs(opt, combined), correct_and_combine_inputs(opt, mountings));
+        },
+        log, sorted);
+    r.combined.out_of_order = sorted;
     return r;
 }
 
@@ -691,21 +709,11 @@ CombineSummary combine_file(const CombineOptions& opt, OutputSet& outputs, std::
         m = with_estimated_noise(m, opt.in, opt.mountings, opt.gate, log);
     }
     refuse_unusable_mountings(m, opt.mountings, opt.gate);
-    // The first pass's messages wait: if it stops at a row out of order, the
-    // second pass says them again (into the outputs opened anew).
-    std::ostringstream first;
-    try {
-        CombineSummary s = combine_pass(opt, m, outputs, first, CombineStage::Mode::kStream);
-        log << first.str();
-        return s;
-    } catch (const RowsOutOfOrder&) {
-    } catch (...) {
-        log << first.str();
-        throw;
-    }
-    outputs = OutputSet(combine_outputs(opt), combine_inputs(opt));
-    CombineSummary s = combine_pass(opt, m, outputs, log, CombineStage::Mode::kKeep);
-    s.out_of_order = true;
+    bool sorted = false;
+    CombineSummary s = stream_then_keep<CombineSummary>(
+        [&](CombineStage::Mode mode, std::ostream& to) { return combine_pass(opt, m, outputs, to, mode); },
+        [&] { outputs = OutputSet(combine_outputs(opt), combine_inputs(opt)); }, log, sorted);
+    s.out_of_order = sorted;
     return s;
 }
 
