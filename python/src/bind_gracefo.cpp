@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr_host/formats/combined_csv.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/gracefo.hpp"
 #include "ascorr_text/input_error.hpp"
@@ -21,13 +22,6 @@ namespace ascorr::python {
 using namespace pybind11::literals;
 
 namespace {
-
-// x as the attitude file writes and reads it (15 decimals).
-double as_written(double x) {
-    char buf[64];
-    const char* end = host::format_fixed(buf, buf + sizeof buf, x, 15);
-    return *host::parse_double(std::string_view(buf, static_cast<std::size_t>(end - buf)));
-}
 
 std::vector<std::string> paths_arg(const py::object& x, const char* name) {
     std::vector<std::string> out;
@@ -88,9 +82,9 @@ py::dict import_gracefo_arrays(const py::object& sca1a, const py::object& qsa1b,
         extra[2].push_back(std::to_string(r.confidence));
     };
     sink.reference = [&](double at, const Quaternion<double>& r) {
-        const Quaternion<double> c = canonical(r);
+        const Quaternion<double> c = host::attitude_as_written(r);
         ref_t.push_back(at);
-        ref_q.insert(ref_q.end(), {as_written(c.w), as_written(c.x), as_written(c.y), as_written(c.z)});
+        ref_q.insert(ref_q.end(), {c.w, c.x, c.y, c.z});
     };
     host::GracefoSummary sum;
     host::MountingsFile m;

@@ -9,7 +9,9 @@
 #include "ascorr/combine/combined_status.hpp"
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/rotation_vector.hpp"
+#include "ascorr/core/vector3.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
+#include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_error.hpp"
@@ -19,18 +21,6 @@ namespace ascorr::host {
 namespace {
 
 namespace cs = combine::combined_status;
-
-double norm(const Vector3<double>& v) noexcept {
-    return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-}
-
-unsigned heads_in(std::uint32_t mask) noexcept {
-    unsigned n = 0;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        n += (mask >> h) & 1U;
-    }
-    return n;
-}
 
 AttitudeRow no_attitude(double t) {
     AttitudeRow r;
@@ -107,10 +97,7 @@ struct Interpolator::Impl {
 
     // The times in [a.t, b.t) (b.t itself belongs to the next interval, or to exact_last).
     void interval(const AttitudeRow* before, const AttitudeRow& a, const AttitudeRow& b, const AttitudeRow* after) {
-        for (; next < order.size() && at[order[next]] < a.t; ++next) {
-            set(order[next], no_attitude(at[order[next]]));
-            ++sum.outside;  // only before the first usable epoch: later ones are taken by an interval
-        }
+        outside_before(a.t);  // only before the first usable epoch: later ones are taken by an interval
         if (next == order.size() || at[order[next]] >= b.t) {
             return;
         }
@@ -120,11 +107,16 @@ struct Interpolator::Impl {
         }
     }
 
-    void exact_last(const AttitudeRow& last) {
-        for (; next < order.size() && at[order[next]] < last.t; ++next) {  // one usable epoch: none before it
+    // The times before t, not yet taken, have no attitude (status 8).
+    void outside_before(double t) {
+        for (; next < order.size() && at[order[next]] < t; ++next) {
             set(order[next], no_attitude(at[order[next]]));
             ++sum.outside;
         }
+    }
+
+    void exact_last(const AttitudeRow& last) {
+        outside_before(last.t);  // one usable epoch: none before it
         for (; next < order.size() && at[order[next]] == last.t; ++next) {
             set(order[next], last);
             ++sum.exact;
@@ -139,7 +131,7 @@ struct Interpolator::Impl {
         double alpha = -1.0;
         const auto change = [&](const Vector3<double>& w2, double span) {
             const Vector3<double> d{w2.x - w.x, w2.y - w.y, w2.z - w.z};
-            alpha = std::max(alpha, norm(d) / span);
+            alpha = std::max(alpha, std::sqrt(squared_norm(d)) / span);
         };
         if (before != nullptr && a.t - before->t <= 2.0 * max_gap) {
             change(mean_rate(*before, a), 0.5 * (b.t - before->t));
@@ -168,7 +160,7 @@ struct Interpolator::Impl {
         r.has_q = true;
         r.q_crf_icrf = canonical(exp_arcsec({u * th.x, u * th.y, u * th.z}) * a.q_crf_icrf);
         r.heads = a.heads | b.heads;
-        r.status = static_cast<unsigned>(heads_in(r.heads) >= 2 ? cs::kTwoOrMoreHeads : cs::kOneHead) |
+        r.status = static_cast<unsigned>(head_count(r.heads) >= 2 ? cs::kTwoOrMoreHeads : cs::kOneHead) |
                    ((a.status | b.status) & static_cast<unsigned>(cs::kHeadLeftOut));
         const double e = std::max(alpha, 0.0) * (t - a.t) * (b.t - t) / 2.0;
         sum.max_error_bound_arcsec = std::max(sum.max_error_bound_arcsec, e);

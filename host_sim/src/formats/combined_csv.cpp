@@ -1,7 +1,10 @@
 #include "ascorr_host/formats/combined_csv.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <string_view>
 #include <vector>
 
 #include "ascorr/combine/combined_status.hpp"
@@ -230,6 +233,19 @@ void append_attitude_row(std::string& out, double t, const Quaternion<double>& q
     append_shortest(out, t);
     append_quaternion(out, canonical(q_crf_icrf));
     out += '\n';
+}
+
+Quaternion<double> attitude_as_written(const Quaternion<double>& q_crf_icrf) {
+    std::string text;
+    append_quaternion(text, canonical(q_crf_icrf));
+    std::array<double, 4> c{};
+    std::size_t from = 1;  // past the leading ','
+    for (double& x : c) {
+        const std::size_t to = std::min(text.find(',', from), text.size());
+        x = *parse_double(std::string_view(text).substr(from, to - from));
+        from = to + 1;
+    }
+    return {c[0], c[1], c[2], c[3]};
 }
 
 std::string combined_header(CombinedColumns c) {

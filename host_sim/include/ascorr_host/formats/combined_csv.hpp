@@ -54,6 +54,10 @@ struct AttitudeRow {
 
 // Appends `t,qw,qx,qy,qz\n` (the attitude file's row).
 void append_attitude_row(std::string& out, double t, const Quaternion<double>& q_crf_icrf);
+// q_crf_icrf as append_attitude_row writes it and a reader reads it back
+// (canonical, each component rounded to the file's decimals), for a caller
+// that hands the attitude over without the file.
+Quaternion<double> attitude_as_written(const Quaternion<double>& q_crf_icrf);
 // Appends the combined file's row (with its line end); the covariance
 // columns when c has them (empty without q, as the sigmas).
 void append_combined_row(std::string& out, const AttitudeRow& row, CombinedColumns c = {});
