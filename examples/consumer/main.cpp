@@ -57,8 +57,10 @@ bool fields(const char* line, int skip, double* out, int n) {
     return true;
 }
 
-// solutions / expected: t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,...
-int read_rows(const char* path, Row* rows) {
+// Calls take(line, row) for each line after the header, at most kMaxRows;
+// the number of rows, or -1 when the file cannot be read or take() refuses a line.
+template <typename R, typename F>
+int read_lines(const char* path, R* rows, F take) {
     std::FILE* f = std::fopen(path, "r");
     if (f == nullptr) {
         return -1;
@@ -71,47 +73,43 @@ int read_rows(const char* path, Row* rows) {
             header = false;
             continue;
         }
-        const char* chu = std::strchr(line, ',');
-        double v[7];
-        if (chu == nullptr || !fields(line, 2, v, 7)) {
+        if (!take(line, rows[n])) {
             std::fclose(f);
             return -1;
         }
-        rows[n] = {chu[1], {v[0], v[1], v[2], v[3]}, {v[4], v[5], v[6]}};
         ++n;
     }
     std::fclose(f);
     return n;
 }
 
+// solutions / expected: t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,...
+int read_rows(const char* path, Row* rows) {
+    return read_lines(path, rows, [](const char* line, Row& row) {
+        const char* chu = std::strchr(line, ',');
+        double v[7];
+        if (chu == nullptr || !fields(line, 2, v, 7)) {
+            return false;
+        }
+        row = {chu[1], {v[0], v[1], v[2], v[3]}, {v[4], v[5], v[6]}};
+        return true;
+    });
+}
+
 // model: chu,axis,c0,c1,c2,c3 (linear, as Table 2)
 int read_model(const char* path, ModelRow* rows) {
-    std::FILE* f = std::fopen(path, "r");
-    if (f == nullptr) {
-        return -1;
-    }
-    char line[256];
-    int n = 0;
-    bool header = true;
-    while (std::fgets(line, sizeof line, f) != nullptr && n < kMaxRows) {
-        if (header) {
-            header = false;
-            continue;
-        }
+    return read_lines(path, rows, [](const char* line, ModelRow& row) {
         double c[4];
         if (!fields(line, 2, c, 4)) {
-            std::fclose(f);
-            return -1;
+            return false;
         }
-        rows[n] = {line[0],
-                   std::strncmp(line + 2, "alpha", 5) == 0  ? 'a'
-                   : std::strncmp(line + 2, "beta", 4) == 0 ? 'b'
-                                                            : 'g',
-                   {c[0], c[1], c[2], c[3]}};
-        ++n;
-    }
-    std::fclose(f);
-    return n;
+        row = {line[0],
+               std::strncmp(line + 2, "alpha", 5) == 0  ? 'a'
+               : std::strncmp(line + 2, "beta", 4) == 0 ? 'b'
+                                                        : 'g',
+               {c[0], c[1], c[2], c[3]}};
+        return true;
+    });
 }
 
 // The rows in the core's layout (arcsec); the installed core converts them

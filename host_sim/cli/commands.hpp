@@ -129,11 +129,17 @@ void add_replay_command(CLI::App& app);
 void add_thermistors_command(CLI::App& app);
 void add_simulate_command(CLI::App& app);
 void add_fit_command(CLI::App& app);
-// --time-constant DAYS of `correct` and `replay` --self-calibrate (its range
-// and default from the estimator's; correct_command.cpp).
-CLI::Option* add_time_constant_option(CLI::App& cmd, double& days);
-// --orbit-period SECONDS of correct and replay --self-calibrate (the estimator's range, as fit's).
-CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds);
+// --time-constant DAYS and --orbit-period SECONDS of `correct` and `replay`
+// --self-calibrate (their ranges and defaults the estimator's, the period's
+// as fit's; correct_command.cpp).
+struct SelfCalibrationOptions {
+    CLI::Option* time_constant;
+    CLI::Option* orbit_period;
+};
+SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds);
+// Refuses --model-history, --time-constant and --orbit-period without --self-calibrate.
+void check_needs_self_calibrate(bool self_calibrate, const std::string& model_history,
+                                const SelfCalibrationOptions& given);
 void add_stats_command(CLI::App& app);
 void add_plot_command(CLI::App& app);
 void add_combine_command(CLI::App& app);

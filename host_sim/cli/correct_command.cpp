@@ -74,23 +74,33 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
 
 }  // namespace
 
-CLI::Option* add_time_constant_option(CLI::App& cmd, double& days) {
-    return cmd
-        .add_option("--time-constant", days,
-                    "with --self-calibrate: the estimator's forgetting time constant in days, " +
-                        host::time_constant_range() + " (default " +
-                        host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
-        ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
+SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds) {
+    SelfCalibrationOptions o{};
+    o.time_constant = cmd.add_option("--time-constant", days,
+                                     "with --self-calibrate: the estimator's forgetting time constant in days, " +
+                                         host::time_constant_range() + " (default " +
+                                         host::number_text(calib::EstimatorConfig{}.time_constant_days) + ")")
+                          ->check(real_in(calib::kMinTimeConstantDays, calib::kMaxTimeConstantDays));
+    o.orbit_period = cmd.add_option("--orbit-period", seconds,
+                                    "with --self-calibrate: the orbit period in s, " + host::orbit_period_range() +
+                                        " (default: from the median speed of the first " +
+                                        std::to_string(host::kOrbitPeriodRows) + " rows learnt from)")
+                         ->check(real_in(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6,
+                                         static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6));
+    return o;
 }
 
-CLI::Option* add_orbit_period_option(CLI::App& cmd, std::optional<double>& seconds) {
-    return cmd
-        .add_option("--orbit-period", seconds,
-                    "with --self-calibrate: the orbit period in s, " + host::orbit_period_range() +
-                        " (default: from the median speed of the first " + std::to_string(host::kOrbitPeriodRows) +
-                        " rows learnt from)")
-        ->check(real_in(static_cast<double>(calib::kMinOrbitPeriodUs) / 1e6,
-                        static_cast<double>(calib::kMaxOrbitPeriodUs) / 1e6));
+void check_needs_self_calibrate(bool self_calibrate, const std::string& model_history,
+                                const SelfCalibrationOptions& given) {
+    if (!self_calibrate && !model_history.empty()) {
+        throw CLI::ValidationError("--model-history", "needs --self-calibrate");
+    }
+    if (!self_calibrate && given.time_constant->count() > 0) {
+        throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
+    }
+    if (!self_calibrate && given.orbit_period->count() > 0) {
+        throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
+    }
 }
 
 void add_correct_command(CLI::App& app) {
@@ -130,20 +140,12 @@ void add_correct_command(CLI::App& app) {
                     "with --self-calibrate: write every model that became active (CSV "
                     "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
         ->check(non_empty_path());
-    CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
-    CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
+    const SelfCalibrationOptions self_cal =
+        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s);
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
-    cmd->callback([opt, time_constant, orbit_period, combine]() {
-        if (!opt->self_calibrate && !opt->model_history.empty()) {
-            throw CLI::ValidationError("--model-history", "needs --self-calibrate");
-        }
-        if (!opt->self_calibrate && time_constant->count() > 0) {
-            throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
-        }
-        if (!opt->self_calibrate && orbit_period->count() > 0) {
-            throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
-        }
+    cmd->callback([opt, self_cal, combine]() {
+        check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
         if (!combine->combined.empty()) {
             correct_and_combine(*opt, *combine);
             return;

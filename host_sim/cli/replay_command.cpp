@@ -49,8 +49,8 @@ void add_replay_command(CLI::App& app) {
     cmd->add_option("--model-history", opt->model_history,
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());
-    CLI::Option* time_constant = add_time_constant_option(*cmd, opt->time_constant_days);
-    CLI::Option* orbit_period = add_orbit_period_option(*cmd, opt->orbit_period_s);
+    const SelfCalibrationOptions self_cal =
+        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s);
     CLI::Option* mountings =
         cmd->add_option("--mountings", opt->mountings,
                         "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "
@@ -74,20 +74,12 @@ void add_replay_command(CLI::App& app) {
         ->transform(integer_in<int>(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
-    cmd->callback([opt, speed, time_constant, orbit_period]() {
+    cmd->callback([opt, speed, self_cal]() {
         opt->realtime = *speed == "realtime";
         if (!opt->self_calibrate && opt->model.empty()) {
             throw CLI::RequiredError("--model (or --self-calibrate)");
         }
-        if (!opt->self_calibrate && !opt->model_history.empty()) {
-            throw CLI::ValidationError("--model-history", "needs --self-calibrate");
-        }
-        if (!opt->self_calibrate && time_constant->count() > 0) {
-            throw CLI::ValidationError("--time-constant", "needs --self-calibrate");
-        }
-        if (!opt->self_calibrate && orbit_period->count() > 0) {
-            throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
-        }
+        check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
         std::vector<host::NamedPath> outputs = host::replay_outputs(*opt);
         outputs.push_back(host::kStandardOutput);  // the summary
         host::OutputSet files = open_run_files({{"--in", &opt->in},

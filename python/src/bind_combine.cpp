@@ -65,16 +65,9 @@ host::CorrectedRowSource rows_source(const CombineRows& c) {
         host::SolutionRecord rec;
         for (py::ssize_t i = 0; i < c.rows.n; ++i) {
             record_of(c.rows, i, rec);
-            host::CorrectedRow r;
-            r.t = rec.t;
-            r.line = rec.line;
-            r.head = rec.head;
-            r.q_chu_icrf = rec.q_chu_icrf;
-            r.flags = rec.flags;
-            r.confidence = rec.confidence;
-            r.corrected = !c.status.empty();
-            r.status = r.corrected ? c.status[static_cast<std::size_t>(i)] : StatusBits{0};
-            fn(r);
+            const bool corrected = !c.status.empty();
+            fn(host::CorrectedRow::of(rec, corrected,
+                                      corrected ? c.status[static_cast<std::size_t>(i)] : StatusBits{0}));
         }
     };
 }

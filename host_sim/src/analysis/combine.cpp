@@ -583,16 +583,8 @@ void for_each_corrected_row(const std::string& path, const std::function<void(co
     for_each_solution_row(
         path, [&status_col](const SolutionsReader& h) { status_col = h.header().index(kStatusColumn); },
         [&](const SolutionsReader& reader, const SolutionRecord& rec) {
-            CorrectedRow r;
-            r.t = rec.t;
-            r.line = rec.line;
-            r.head = rec.head;
-            r.q_chu_icrf = rec.q_chu_icrf;
-            r.flags = rec.flags;
-            r.confidence = rec.confidence;
-            r.corrected = status_col >= 0;
-            r.status = r.corrected ? status_of(reader, rec, status_col) : StatusBits{0};
-            fn(r);
+            const bool corrected = status_col >= 0;
+            fn(CorrectedRow::of(rec, corrected, corrected ? status_of(reader, rec, status_col) : StatusBits{0}));
         },
         label);
 }

@@ -228,6 +228,17 @@ bool parse_plain_decimal(const char* first, const char* last, double& out) noexc
 }
 }  // namespace
 
+void split_row(std::string_view line, std::size_t count, const std::string& file, std::size_t n,
+               std::vector<std::string_view>& fields, std::vector<std::size_t>& starts) {
+    if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
+        throw text::InputError(file, n, bad + 1, why_split_failed(line, bad));
+    }
+    if (fields.size() != count) {
+        throw text::InputError(file, n, starts.back() + 1,
+                               "expected " + std::to_string(count) + " fields, found " + std::to_string(fields.size()));
+    }
+}
+
 std::optional<double> parse_double(std::string_view field) noexcept {
     if (field.empty()) {
         return std::nullopt;

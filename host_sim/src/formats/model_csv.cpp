@@ -279,14 +279,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
             continue;
         }
         const std::size_t n = lines.line_number();
-        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw text::InputError(file_name, n, bad + 1, why_split_failed(line, bad));
-        }
-        if (fields.size() != header.size()) {
-            throw text::InputError(
-                file_name, n, starts.back() + 1,
-                "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
-        }
+        split_row(line, header.size(), file_name, n, fields, starts);
         const std::uint8_t head = row_head(file_name, n, fields, starts, col_chu);
         const int axis = row_axis(file_name, n, fields, starts, col_axis);
         if (seen[head][axis]) {

@@ -184,14 +184,7 @@ MountingsFile parse_mountings(const std::string& file_name, std::string_view tex
             continue;
         }
         const std::size_t n = lines.line_number();
-        if (const std::size_t bad = split_fields(line, fields, starts); bad != kSplitOk) {
-            throw text::InputError(file_name, n, bad + 1, why_split_failed(line, bad));
-        }
-        if (fields.size() != header.size()) {
-            throw text::InputError(
-                file_name, n, starts.back() + 1,
-                "expected " + std::to_string(header.size()) + " fields, found " + std::to_string(fields.size()));
-        }
+        split_row(line, header.size(), file_name, n, fields, starts);
         const Row r{file_name, n, fields, starts};
         const std::uint8_t head = head_of_row(r, c, m);
         combine::HeadMounting& h = m.mountings.head[head];

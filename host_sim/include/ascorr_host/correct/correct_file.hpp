@@ -73,6 +73,11 @@ struct CorrectedRow {
     double confidence = 0.0;  // NaN when not a number
     bool corrected = false;   // status is the row's (false: a raw row, taken as it is)
     StatusBits status = 0;
+
+    // A solution's row, corrected with `status` or raw (status 0).
+    static CorrectedRow of(const SolutionRecord& rec, bool corrected, StatusBits status) noexcept {
+        return {rec.t, rec.line, rec.head, rec.q_chu_icrf, rec.flags, rec.confidence, corrected, status};
+    }
 };
 
 // Takes every corrected row in file order; finish() after the last, which

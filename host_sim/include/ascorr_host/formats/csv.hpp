@@ -78,6 +78,12 @@ using text::csv::split_fields;
 using text::csv::unquoted;
 using text::csv::why_split_failed;
 
+// Splits line n of `file` into `fields` (and their 0-based `starts`), which
+// must be `count` (the header's): InputError at the malformed quote, or at
+// the last field, otherwise. For the model and mountings files.
+void split_row(std::string_view line, std::size_t count, const std::string& file, std::size_t n,
+               std::vector<std::string_view>& fields, std::vector<std::size_t>& starts);
+
 // A field as a double: a decimal or scientific number, "nan", "inf".
 // Leading/trailing spaces are not accepted (they are not in the format).
 std::optional<double> parse_double(std::string_view field) noexcept;
