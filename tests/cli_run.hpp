@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace ascorr::test {
 
@@ -17,6 +18,26 @@ struct CliRun {
     int exit_code;    // -1 when it did not exit normally
     std::string err;  // its standard error
 };
+
+// Writes TEXT to the file P, replacing it.
+inline void write(const std::filesystem::path& p, const std::string& text) {
+    std::ofstream(p, std::ios::binary) << text;
+}
+
+// The lines of the file P, without their line ends.
+inline std::vector<std::string> lines_of_file(const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::vector<std::string> out;
+    for (std::string l; std::getline(f, l);) {
+        out.push_back(l);
+    }
+    return out;
+}
+
+// Whether TEXT holds PART.
+inline bool has(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+}
 
 inline std::string slurp(const std::filesystem::path& p) {
     std::ifstream f(p, std::ios::binary);

@@ -28,10 +28,6 @@ namespace fs = std::filesystem;
 const std::string kSolutions = data_path("solutions.csv");
 const std::string kModel = data_path("model_table2.csv");
 
-bool has(const std::string& text, const std::string& part) {
-    return text.find(part) != std::string::npos;
-}
-
 // ---- every output against every input ---------------------------------------
 
 // A model kept beside simulate's outputs under the name of one of them is an

@@ -34,23 +34,6 @@ namespace {
 namespace fs = std::filesystem;
 using host::MountingsFile;
 
-void write(const fs::path& p, const std::string& text) {
-    std::ofstream(p) << text;
-}
-
-std::vector<std::string> lines_of(const fs::path& p) {
-    std::ifstream f(p);
-    std::vector<std::string> out;
-    for (std::string l; std::getline(f, l);) {
-        out.push_back(l);
-    }
-    return out;
-}
-
-bool has(const std::string& text, const std::string& what) {
-    return text.find(what) != std::string::npos;
-}
-
 // ---- The mountings file
 
 constexpr const char* kGood =
@@ -246,10 +229,10 @@ TEST(CombineCli, EveryBadInputHasItsOutcomeAndEveryEpochItsRow) {
     EXPECT_TRUE(has(r.err, "3 flagged")) << r.err;
     EXPECT_TRUE(has(r.err, "1 rejected")) << r.err;
     // The epoch without a usable head: empty q, heads and sigmas.
-    EXPECT_EQ(lines_of(dir / "out.csv")[4], "400,,,,,,,,,12");
+    EXPECT_EQ(lines_of_file(dir / "out.csv")[4], "400,,,,,,,,,12");
 
     // Rows in any order: the same file (the second pass sorts them).
-    std::vector<std::string> rows = lines_of(dir / "in.csv");
+    std::vector<std::string> rows = lines_of_file(dir / "in.csv");
     std::string shuffled = rows[0] + "\n";
     for (std::size_t i = rows.size() - 1; i >= 1; --i) {
         shuffled += rows[i] + "\n";
@@ -314,7 +297,7 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
     EXPECT_EQ(slurp(dir / "comb.csv"), slurp(dir / "comb2.csv"));
     // Rows out of time order: the run is made again with the rows kept; the
     // combined file is the same bits, the corrected one keeps the input order.
-    std::vector<std::string> rows = lines_of(dir / "sim.csv");
+    std::vector<std::string> rows = lines_of_file(dir / "sim.csv");
     std::string reversed = rows[0] + "\n";
     for (std::size_t i = rows.size() - 1; i >= 1; --i) {
         reversed += rows[i] + "\n";
@@ -326,7 +309,7 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
         dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "rcomb.csv"), slurp(dir / "comb.csv"));
-    EXPECT_EQ(lines_of(dir / "rcor.csv").size(), lines_of(dir / "cor.csv").size());
+    EXPECT_EQ(lines_of_file(dir / "rcor.csv").size(), lines_of_file(dir / "cor.csv").size());
     EXPECT_TRUE(has(r.err, "rows out of time order: sorted")) << r.err;
     // The corrected rows to standard output: written once (the rows kept from the start).
     r = run_in(
@@ -592,7 +575,7 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     EXPECT_EQ(run_in("stats --in sim.csv --truth-attitude sim.csv.attitude.csv", ms.dir).exit_code, 2);
     EXPECT_EQ(run_in("stats --in sim.csv --combined c2.csv", ms.dir).exit_code, 2);
     // A combined file out of time order, a truth out of time order: refused at their lines.
-    std::vector<std::string> rows = lines_of(ms.dir / "c2.csv");
+    std::vector<std::string> rows = lines_of_file(ms.dir / "c2.csv");
     std::swap(rows[5], rows[6]);
     std::string text;
     for (const std::string& l : rows) {
@@ -602,7 +585,7 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     r = run_in("stats --combined c2_swapped.csv", ms.dir);
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_TRUE(has(r.err, "c2_swapped.csv:7:1: a combined file has one row per epoch, in time order")) << r.err;
-    rows = lines_of(ms.dir / "sim.csv.attitude.csv");
+    rows = lines_of_file(ms.dir / "sim.csv.attitude.csv");
     std::swap(rows[5], rows[6]);
     text.clear();
     for (const std::string& l : rows) {
@@ -615,7 +598,7 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     // A truth in reverse time order is refused too (was: exit 0, every epoch
     // but one "without a truth row"), and plot takes a truth by stats' rules:
     // no combined file, no epoch twice (was: accepted).
-    rows = lines_of(ms.dir / "sim.csv.attitude.csv");
+    rows = lines_of_file(ms.dir / "sim.csv.attitude.csv");
     std::reverse(rows.begin() + 1, rows.end());
     text.clear();
     for (const std::string& l : rows) {
@@ -636,7 +619,7 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     // Rows the combination cannot have written are refused at their column
     // (was: accepted): a status against the rule, heads that contradict it, a
     // sigma not positive and finite.
-    const std::vector<std::string> c2 = lines_of(ms.dir / "c2.csv");
+    const std::vector<std::string> c2 = lines_of_file(ms.dir / "c2.csv");
     std::string abc;  // a row of three heads: t,qw,qx,qy,qz,ABC,sx,sy,sz,1
     for (const std::string& l : c2) {
         if (l.find(",ABC,") != std::string::npos && l.substr(l.rfind(',') + 1) == "1") {
@@ -746,7 +729,7 @@ TEST(CombineGate, RowsWithoutBothStagesKeepTheFloorOfTenArcsec) {
     ASSERT_EQ(
         run_in("combine --in ab.csv --mountings sim.csv.mountings.csv --out g2.csv --gate-floor 10", ms.dir).exit_code,
         0);
-    EXPECT_EQ(lines_of(ms.dir / "g1.csv"), lines_of(ms.dir / "g2.csv"));
+    EXPECT_EQ(lines_of_file(ms.dir / "g1.csv"), lines_of_file(ms.dir / "g2.csv"));
 }
 
 TEST(CombineGate, OptionsOutsideTheirRangeAreUsageErrors) {
@@ -770,7 +753,7 @@ TEST(CombineGate, SigmasATargetRefusesAreRefusedNamingTheHeadAndWhy) {
     // file's range, but A's gate factors are beyond the fixed-point format.
     // Before: exit 0 and every row "quaternion not unit".
     const Mission& ms = mission();
-    std::vector<std::string> rows = lines_of(ms.dir / "sim.csv.mountings.csv");
+    std::vector<std::string> rows = lines_of_file(ms.dir / "sim.csv.mountings.csv");
     ASSERT_EQ(rows.size(), 4U);
     std::string text = rows[0] + "\n";
     for (std::size_t i = 1; i < rows.size(); ++i) {

@@ -15,19 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write(const fs::path& p, const std::string& text) {
-    std::ofstream(p) << text;
-}
-
-std::vector<std::string> lines_of(const fs::path& p) {
-    std::ifstream f(p);
-    std::vector<std::string> out;
-    for (std::string l; std::getline(f, l);) {
-        out.push_back(l);
-    }
-    return out;
-}
-
 double max_error(const fs::path& got, const std::string& expected_name) {
     std::string a;
     std::string b;
@@ -64,12 +51,12 @@ TEST(CorrectCli, WorkedExamplesAllStages) {
     // Without --model: aberration only, status 1.
     ASSERT_EQ(run_here("correct --in " + in + " --out " + (dir / "nomodel.csv").string(), dir).exit_code, 0);
     EXPECT_LE(max_error(dir / "nomodel.csv", "expected_aberration_only.csv"), 1e-6);
-    const auto l = lines_of(dir / "both.csv");
+    const auto l = lines_of_file(dir / "both.csv");
     ASSERT_EQ(l.size(), 13U);
     EXPECT_EQ(l[0], "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,status");
     EXPECT_EQ(l[1].substr(l[1].rfind(',')), ",3");
-    EXPECT_EQ(lines_of(dir / "ab.csv")[1].substr(l[1].rfind(',')), ",1");
-    EXPECT_EQ(lines_of(dir / "th.csv")[1].substr(l[1].rfind(',')), ",2");
+    EXPECT_EQ(lines_of_file(dir / "ab.csv")[1].substr(l[1].rfind(',')), ",1");
+    EXPECT_EQ(lines_of_file(dir / "th.csv")[1].substr(l[1].rfind(',')), ",2");
     // All other fields verbatim.
     const std::string tail = ",19.673,-7.351,-17.769,2.366838,7.186540,0.715348,0,1.00,3";
     EXPECT_EQ(l[5].substr(0, 16), "494599640.318,B,");
@@ -105,7 +92,7 @@ TEST(CorrectCli, EveryRowKeptWithItsStatus) {
                                   " --model " + data_path("model_table2.csv"),
                               dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const auto l = lines_of(dir / "out.csv");
+    const auto l = lines_of_file(dir / "out.csv");
     ASSERT_EQ(l.size(), 12U);
     EXPECT_EQ(l[0], "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence,note,status");
     const auto status_of = [&](std::size_t i) { return l[i].substr(l[i].rfind(',') + 1); };
@@ -131,8 +118,8 @@ TEST(CorrectCli, EveryRowKeptWithItsStatus) {
 
 TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
     const fs::path dir = scratch_dir("cli");
-    std::string text = lines_of(data_path("solutions.csv"))[0] + "\n";
-    const auto src = lines_of(data_path("solutions.csv"));
+    std::string text = lines_of_file(data_path("solutions.csv"))[0] + "\n";
+    const auto src = lines_of_file(data_path("solutions.csv"));
     for (std::size_t i = 1; i < src.size(); ++i) {
         text += (i == 7 ? src[i].substr(0, 40) : src[i]) + "\n";  // line 8 truncated
     }
@@ -142,7 +129,7 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
         run_here("correct --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.err.find((dir / "in.csv").string() + ":8:"), std::string::npos) << r.err;
-    EXPECT_EQ(lines_of(dir / "out.csv"), std::vector<std::string>{"previous content"});  // untouched
+    EXPECT_EQ(lines_of_file(dir / "out.csv"), std::vector<std::string>{"previous content"});  // untouched
     for (const auto& e : fs::directory_iterator(dir)) {
         EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << "temporary file left behind";
     }
@@ -150,7 +137,7 @@ TEST(CorrectCli, MalformedRowStopsAndWritesNothing) {
     const CliRun s =
         run_here("correct --skip-bad --in " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string(), dir);
     EXPECT_EQ(s.exit_code, 0) << s.err;
-    EXPECT_EQ(lines_of(dir / "out.csv").size(), 12U);
+    EXPECT_EQ(lines_of_file(dir / "out.csv").size(), 12U);
     EXPECT_NE(s.err.find(":8:"), std::string::npos);
     EXPECT_NE(s.err.find("1 malformed rows skipped"), std::string::npos) << s.err;
 }

@@ -35,10 +35,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write(const fs::path& p, const std::string& text) {
-    std::ofstream(p, std::ios::binary) << text;
-}
-
 // Starts ascorr with argv, PATH prefixed by path_prefix (stand-in programs),
 // TMPDIR set when tmpdir is not empty; stdout and stderr to files in dir.
 pid_t spawn(const std::vector<std::string>& args, const fs::path& dir, const std::string& path_prefix = "",

@@ -35,6 +35,12 @@ std::vector<int> statuses(const fs::path& p) {
 const std::string kHeader = "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
 const std::string kRow = "0.5,0.5,0.5,0.5,10.0,-8.0,-19.0";  // after t,chu
 
+// A command line and a message its standard error must hold.
+struct ArgsCase {
+    std::string args;
+    std::string message;
+};
+
 TEST(Refusals, ATimeOutsideTheEphemerisIsFlaggedNotCorrected) {
     const fs::path dir = scratch_dir("ephemeris");
     std::ofstream(dir / "in.csv") << kHeader << "750000000.000,A," << kRow << ",1.0,2.0,3.0,0,1.00\n"
@@ -102,21 +108,11 @@ TEST(Refusals, AnEmptyModelPathIsRefused) {
     }
 }
 
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
-
 TEST(Refusals, BadTimeRangesAndThresholdsAreRefused) {
     const fs::path dir = scratch_dir("options");
     const std::string in = data_path("solutions.csv");
     const std::string model = data_path("model_table2.csv");
-    struct Case {
-        std::string args;
-        std::string message;
-    };
-    const std::vector<Case> cases = {
+    const std::vector<ArgsCase> cases = {
         {"stats --in " + in + " --from 5e8 --to 4e8", "is not before --to"},
         {"stats --in " + in + " --from nan", "--from nan: not a finite time"},
         {"plot --in " + in + " --model " + model + " --out p.png --from 5e8 --to 4e8", "is not before --to"},
@@ -125,21 +121,21 @@ TEST(Refusals, BadTimeRangesAndThresholdsAreRefused) {
         {"simulate --days 1 --out s.csv --start nan", "--start nan: the mission must lie within the Earth ephemeris"},
         {"simulate --days 1 --out s.csv --start 1e13", "the mission must lie within the Earth ephemeris"},
     };
-    for (const Case& c : cases) {
+    for (const ArgsCase& c : cases) {
         SCOPED_TRACE(c.args);
         const CliRun r = run_in(c.args, dir);
         EXPECT_EQ(r.exit_code, 1);
         EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
     }
     // Thresholds out of their range are usage errors (exit 2), the value as given.
-    const std::vector<Case> usage = {
+    const std::vector<ArgsCase> usage = {
         {"fit --in " + in + " --out m.csv --min-days nan", "--min-days: nan is out of range: the range is (0, inf)"},
         {"fit --in " + in + " --out m.csv --min-days 0", "--min-days: 0 is out of range"},
         {"fit --in " + in + " --out m.csv --min-days -3", "--min-days: -3 is out of range"},
         {"fit --in " + in + " --out m.csv --max-condition nan", "--max-condition: nan is out of range"},
         {"fit --in " + in + " --out m.csv --max-condition -1", "--max-condition: -1 is out of range"},
     };
-    for (const Case& c : usage) {
+    for (const ArgsCase& c : usage) {
         SCOPED_TRACE(c.args);
         const CliRun r = run_in(c.args, dir);
         EXPECT_EQ(r.exit_code, 2);
@@ -173,12 +169,6 @@ TEST(Refusals, TheFloorFileIsValidJsonWithNullForEmptyPairs) {
     EXPECT_NE(json.find("\"A-B\": {\"rms\": 1."), std::string::npos) << json;
     EXPECT_EQ(json.find("nan"), std::string::npos) << json;
 }
-
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
 
 TEST(Refusals, AUtf8ByteOrderMarkIsAcceptedByEveryReader) {
     const fs::path dir = scratch_dir("bom");
@@ -224,12 +214,6 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
     EXPECT_NE(c.err.find("CR-only line ends"), std::string::npos) << c.err;
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
 }
-
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
 
 // A seed is an unsigned 64-bit integer, in decimal. On
 // ed4f56e `--seed -1` ran with seed 2^64 − 1, `--seed 99999999999999999999`
@@ -415,12 +399,6 @@ TEST(Refusals, OutOfRangeNumbersSayOutOfRangeWithTheRange) {
     }
 }
 
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
-
 // A model beyond a range names file:line:column and its
 // numbers in %g (on ed4f56e: "m.csv: A beta c1 = 1000000000.000000 is beyond
 // the fixed-point coefficient range (+-...)" without a line, and a truth model
@@ -460,12 +438,6 @@ TEST(Refusals, ModelRangeErrorsNameFileLineAndColumnWithNumbersInG) {
     EXPECT_FALSE(fs::exists(dir / "o.csv"));
     EXPECT_FALSE(fs::exists(dir / "s.csv"));
 }
-
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
 
 // RFC 4180 quoting in columns ascorr ignores is accepted
 // and copied verbatim (on ed4f56e a comma inside quotes split the field: "expected
@@ -528,12 +500,6 @@ TEST(Refusals, QuotedFieldsInIgnoredColumnsAreAcceptedAndCopiedVerbatim) {
     EXPECT_NE(m.err.find("m.csv:2:9: column 'c0': \"1\" is a quoted field"), std::string::npos) << m.err;
     EXPECT_FALSE(fs::exists(dir / "bad.csv"));
 }
-
-}  // namespace
-}  // namespace ascorr::test
-
-namespace ascorr::test {
-namespace {
 
 // Rows of heads A, B and C at n epochs 10 s apart; C's rows get c_flags and
 // c_dt seconds added to their time.

@@ -25,14 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool has(const std::string& text, const std::string& part) {
-    return text.find(part) != std::string::npos;
-}
-
-void write(const fs::path& p, const std::string& text) {
-    std::ofstream(p, std::ios::binary) << text;
-}
-
 // One simulated day (sim.csv, its truth model sim.csv.truth.csv), made once.
 const fs::path& simulated_day() {
     static const fs::path dir = [] {

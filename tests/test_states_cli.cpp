@@ -23,10 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 using V3 = Vector3<double>;
 
-void write(const fs::path& p, const std::string& text) {
-    std::ofstream(p) << text;
-}
-
 constexpr double kT0 = 801964800.184;  // 2025-06-01, on .184 like GNSS
 constexpr double kMaxPropagation = 120.0;
 
