@@ -25,14 +25,9 @@
 #include "ascorr_link/messages.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "replay_boards.hpp"
 #include "rewriting_loopback.hpp"
 #include "test_support.hpp"
-
-namespace ascorr::host {
-inline void PrintTo(const QemuTarget& board, std::ostream* os) {
-    *os << board.replay;
-}
-}  // namespace ascorr::host
 
 namespace ascorr::test {
 namespace {
@@ -215,27 +210,16 @@ class ReplayCombinedQemu : public ::testing::TestWithParam<host::QemuTarget> {};
 // Q30 within 0.01″, in float within 0.05″ of the chain in double.
 TEST_P(ReplayCombinedQemu, SameCombinedAttitudesAsTheHost) {
     const host::QemuTarget& board = GetParam();
-    std::string name = "replay_combined_" + std::string(board.replay);
-    for (char& c : name) {
-        c = c == '-' ? '_' : c;
-    }
-    const auto dir = simulated(name);
+    const auto dir = simulated("replay_combined_" + board_name(board));
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(options(dir, std::string(board.replay)), log);
-    std::cout << board.replay << ": " << host::to_json(s) << "\n" << log.str();
+    const host::ReplaySummary s =
+        replay_printed(options(dir, std::string(board.replay)), log, std::string(board.replay) + ": ");
     expect_agreement(s);
     EXPECT_GT(s.combination_instructions_per_epoch, 0.0);
     expect_near_double(dir, board.scalar == host::ScalarKind::kFixed ? 0.01 : 0.05);
 }
 
-INSTANTIATE_TEST_SUITE_P(Boards, ReplayCombinedQemu, ::testing::ValuesIn(host::kQemuTargets),
-                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) {
-                             std::string n(i.param.replay);
-                             for (char& c : n) {
-                                 c = c == '-' ? '_' : c;
-                             }
-                             return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Boards, ReplayCombinedQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);
 #endif
 
 }  // namespace

@@ -19,15 +19,9 @@
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
+#include "replay_boards.hpp"
 #include "replay_recording.hpp"
 #include "test_support.hpp"
-
-namespace ascorr::host {
-// GoogleTest shows a board by its replay name (not its bytes) in test names.
-inline void PrintTo(const QemuTarget& board, std::ostream* os) {
-    *os << board.replay;
-}
-}  // namespace ascorr::host
 
 namespace ascorr::test {
 namespace {
@@ -41,11 +35,7 @@ double bound_arcsec(const host::QemuTarget& board) {
 }
 
 std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
-    std::string s(board.replay);
-    for (char& c : s) {
-        c = c == '-' ? '_' : c;
-    }
-    return s + what;
+    return board_name(board) + what;
 }
 
 host::ReplaySummary replay_through(const host::QemuTarget& board, double inject, const std::string& name) {
@@ -133,16 +123,13 @@ void survive_restart(const host::QemuTarget* board, const std::string& name) {
 }
 
 TEST_P(ReplayQemu, RestartMidRunIsRecovered) {
-    if (GetParam().scalar == host::ScalarKind::kFixed) {
-        survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
-    } else {
-        survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));
-    }
+    with_board_scalar(GetParam(), [this](auto scalar) {
+        survive_restart<decltype(scalar)>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    });
 }
 
 // Each test once per board: Boards/ReplayQemu.CleanLink/qemu_m3, ...
-INSTANTIATE_TEST_SUITE_P(Boards, ReplayQemu, ::testing::ValuesIn(host::kQemuTargets),
-                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) { return scratch_name(i.param, ""); });
+INSTANTIATE_TEST_SUITE_P(Boards, ReplayQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);
 
 }  // namespace
 }  // namespace ascorr::test

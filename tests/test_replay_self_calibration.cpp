@@ -27,15 +27,9 @@
 #include "ascorr_link/messages.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "replay_boards.hpp"
 #include "rewriting_loopback.hpp"
 #include "test_support.hpp"
-
-namespace ascorr::host {
-// GoogleTest shows a board by its replay name (not its bytes) in test names.
-inline void PrintTo(const QemuTarget& board, std::ostream* os) {
-    *os << board.replay;
-}
-}  // namespace ascorr::host
 
 namespace ascorr::test {
 namespace {
@@ -84,21 +78,34 @@ bool learnt(const std::string& history, const std::string& head) {
     return false;
 }
 
-void expect_agreement(const host::ReplaySummary& s) {
-    EXPECT_TRUE(s.self_calibrate);
-    EXPECT_EQ(s.returned, 2751U);
-    EXPECT_EQ(s.mismatches, 0U);
-    EXPECT_GE(s.models, 1U);
+// Every answer, model version, adopted model and the final report as the host's.
+void expect_models_agree(const host::ReplaySummary& s, const std::string& log) {
+    EXPECT_EQ(s.mismatches, 0U) << log;
     EXPECT_EQ(s.version_mismatches, 0U);
     EXPECT_EQ(s.history_mismatches, 0U);
     EXPECT_TRUE(s.report_matches);
 }
 
+void expect_agreement(const host::ReplaySummary& s) {
+    EXPECT_TRUE(s.self_calibrate);
+    EXPECT_EQ(s.returned, 2751U);
+    EXPECT_GE(s.models, 1U);
+    expect_models_agree(s, "");
+}
+
+// Replays the simulated file of `dir` through `target` from the model dir/model, printed after `label`.
+host::ReplaySummary replay_from_model(const std::filesystem::path& dir, const std::string& target,
+                                      const std::string& model, std::ostringstream& log,
+                                      const std::string& label = "") {
+    host::ReplayOptions o = options(dir, target);
+    o.model = (dir / model).string();
+    return replay_printed(o, log, label);
+}
+
 TEST(ReplaySelfCalibration, LoopbackEqualsCorrectSelfCalibrate) {
     const auto dir = simulated("replay_sc_loop");
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(options(dir, "loopback-float"), log);
-    std::cout << host::to_json(s) << "\n" << log.str();
+    const host::ReplaySummary s = replay_printed(options(dir, "loopback-float"), log);
     expect_agreement(s);
     expect_same_as_correct(dir, "float");
 }
@@ -113,8 +120,7 @@ void expect_rule_as_correct(const std::string& target, const std::string& scalar
     o.mountings = (dir / "sim.csv.mountings.csv").string();
     o.combined = (dir / "replayed.combined.csv").string();
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(o, log);
-    std::cout << target << ": " << host::to_json(s) << "\n" << log.str();
+    const host::ReplaySummary s = replay_printed(o, log, target + ": ");
     expect_agreement(s);
     expect_same_as_correct(dir, scalar, " --mountings sim.csv.mountings.csv --combined corrected.combined.csv");
     const std::string history = slurp(dir / "replayed.history.csv");
@@ -173,15 +179,8 @@ TEST(ReplaySelfCalibration, FromAModelWithRowsOutOfOrderAndWithinAMicrosecond) {
         }
     }
     host::write_model_file((dir / "initial.csv").string(), host::read_model_file(data_path("model_table2.csv")));
-    host::ReplayOptions o = options(dir, "loopback-float");
-    o.model = (dir / "initial.csv").string();
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(o, log);
-    std::cout << host::to_json(s) << "\n" << log.str();
-    EXPECT_EQ(s.mismatches, 0U) << log.str();
-    EXPECT_EQ(s.version_mismatches, 0U);
-    EXPECT_EQ(s.history_mismatches, 0U);
-    EXPECT_TRUE(s.report_matches);
+    expect_models_agree(replay_from_model(dir, "loopback-float", "initial.csv", log), log.str());
     const CliRun r = run_in(
         "correct --in sim.csv --out corrected.csv --self-calibrate --scalar float --model "
         "initial.csv --model-history corrected.history.csv",
@@ -202,15 +201,9 @@ TEST(ReplaySelfCalibration, FourHeadsFromAModelLearnHeadDOnTheTargetAsOnTheHost)
     const auto dir = scratch_dir("replay_sc_four");
     const CliRun sim = run_in("simulate --out sim.csv --days 4 --step 300 --seed 3 --heads ABCD", dir);
     ASSERT_EQ(sim.exit_code, 0) << sim.err;
-    host::ReplayOptions o = options(dir, "loopback-float");
-    o.model = (dir / "sim.csv.truth.csv").string();
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(o, log);
-    std::cout << host::to_json(s) << "\n" << log.str();
-    EXPECT_EQ(s.mismatches, 0U) << log.str();
-    EXPECT_EQ(s.version_mismatches, 0U);
-    EXPECT_EQ(s.history_mismatches, 0U);
-    EXPECT_TRUE(s.report_matches);
+    const host::ReplaySummary s = replay_from_model(dir, "loopback-float", "sim.csv.truth.csv", log);
+    expect_models_agree(s, log.str());
     EXPECT_GE(s.models, 2U);
     const CliRun r = run_in(
         "correct --in sim.csv --out corrected.csv --self-calibrate --scalar float --model sim.csv.truth.csv "
@@ -316,62 +309,36 @@ class ReplaySelfCalibrationQemu : public ::testing::TestWithParam<host::QemuTarg
 // M4F, whose link image does not fuse multiply-adds), bit for bit.
 TEST_P(ReplaySelfCalibrationQemu, SameModelsAndAnswersAsTheHost) {
     const host::QemuTarget& board = GetParam();
-    std::string name = "replay_sc_" + std::string(board.replay);
-    for (char& c : name) {
-        c = c == '-' ? '_' : c;
-    }
-    const auto dir = simulated(name);
+    const auto dir = simulated("replay_sc_" + board_name(board));
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(options(dir, std::string(board.replay)), log);
-    std::cout << board.replay << ": " << host::to_json(s) << "\n" << log.str();
+    const host::ReplaySummary s =
+        replay_printed(options(dir, std::string(board.replay)), log, std::string(board.replay) + ": ");
     expect_agreement(s);
     EXPECT_EQ(s.restarts, 0U);
-    expect_same_as_correct(dir, board.scalar == host::ScalarKind::kFixed ? "fixed" : "float");
+    expect_same_as_correct(dir, board_scalar(board));
 }
 
 // The rule for the common rotation on each board, bit for bit.
 TEST_P(ReplaySelfCalibrationQemu, TheCommonRotationRuleAsTheHost) {
     const host::QemuTarget& board = GetParam();
-    std::string name = "replay_sc_rule_" + std::string(board.replay);
-    for (char& c : name) {
-        c = c == '-' ? '_' : c;
-    }
-    expect_rule_as_correct(std::string(board.replay), board.scalar == host::ScalarKind::kFixed ? "fixed" : "float",
-                           name);
+    expect_rule_as_correct(std::string(board.replay), board_scalar(board), "replay_sc_rule_" + board_name(board));
 }
 
 // Four heads from a model, on each board: D learnt on board as on the host,
 // bit for bit (the link's estimator has every head of the core).
 TEST_P(ReplaySelfCalibrationQemu, FourHeadsLearnHeadDAsTheHost) {
     const host::QemuTarget& board = GetParam();
-    std::string name = "replay_sc4_" + std::string(board.replay);
-    for (char& c : name) {
-        c = c == '-' ? '_' : c;
-    }
-    const auto dir = simulated(name, " --heads ABCD");
-    host::ReplayOptions o = options(dir, std::string(board.replay));
-    o.model = (dir / "sim.csv.truth.csv").string();
+    const auto dir = simulated("replay_sc4_" + board_name(board), " --heads ABCD");
     std::ostringstream log;
-    const host::ReplaySummary s = host::replay(o, log);
-    std::cout << board.replay << ": " << host::to_json(s) << "\n" << log.str();
-    EXPECT_EQ(s.mismatches, 0U) << log.str();
-    EXPECT_EQ(s.version_mismatches, 0U);
-    EXPECT_EQ(s.history_mismatches, 0U);
-    EXPECT_TRUE(s.report_matches);
+    const host::ReplaySummary s =
+        replay_from_model(dir, std::string(board.replay), "sim.csv.truth.csv", log, std::string(board.replay) + ": ");
+    expect_models_agree(s, log.str());
     EXPECT_EQ(s.restarts, 0U);
-    expect_same_as_correct(dir, board.scalar == host::ScalarKind::kFixed ? "fixed" : "float",
-                           " --model sim.csv.truth.csv");
+    expect_same_as_correct(dir, board_scalar(board), " --model sim.csv.truth.csv");
     EXPECT_TRUE(learnt(slurp(dir / "replayed.history.csv"), "D")) << "D never learnt on the board";
 }
 
-INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets),
-                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) {
-                             std::string n(i.param.replay);
-                             for (char& c : n) {
-                                 c = c == '-' ? '_' : c;
-                             }
-                             return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);
 #endif
 
 }  // namespace

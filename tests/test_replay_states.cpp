@@ -27,15 +27,9 @@
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "cli_run.hpp"
+#include "replay_boards.hpp"
 #include "states_recording.hpp"
 #include "test_support.hpp"
-
-namespace ascorr::host {
-// GoogleTest shows a board by its replay name (not its bytes) in test names.
-inline void PrintTo(const QemuTarget& board, std::ostream* os) {
-    *os << board.replay;
-}
-}  // namespace ascorr::host
 
 namespace ascorr::test {
 namespace {
@@ -61,6 +55,18 @@ host::ReplaySummary replay_states(const std::string& target, double inject, int 
     return s;
 }
 
+// `ascorr correct --scalar float --states` (and `extra`) of the recording into
+// dir/correct.csv: the replayed dir/out.csv, set in `replayed`, equals it.
+void expect_replayed_as_correct(const StatesRecording& rec, const std::filesystem::path& dir, const std::string& extra,
+                                std::string& replayed) {
+    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + rec.solutions + " --out " +
+                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
+                            " --states " + rec.states + extra + " 2>/dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    replayed = slurp((dir / "out.csv").string());
+    EXPECT_EQ(replayed, slurp((dir / "correct.csv").string()));
+}
+
 TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
     StatesRecording rec;
     const host::ReplaySummary s = replay_states("loopback-float", 0.0, 900, "replay_states_loop", &rec);
@@ -68,12 +74,8 @@ TEST(ReplayStates, LoopbackEqualsCorrectWithStates) {
     EXPECT_EQ(s.mismatches, 0U);
     EXPECT_LE(s.max_error_arcsec, 0.05);
     const std::filesystem::path dir = std::filesystem::path(rec.solutions).parent_path();
-    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + rec.solutions + " --out " +
-                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
-                            " --states " + rec.states + " 2>/dev/null";
-    ASSERT_EQ(std::system(cmd.c_str()), 0);
-    const std::string replayed = slurp((dir / "out.csv").string());
-    EXPECT_EQ(replayed, slurp((dir / "correct.csv").string()));
+    std::string replayed;
+    ASSERT_NO_FATAL_FAILURE(expect_replayed_as_correct(rec, dir, "", replayed));
     // Before the first state: status 4 (+ thermal); in and after the 40 s gap: applied.
     EXPECT_NE(replayed.find(",6\n"), std::string::npos);  // 4 | 2
     EXPECT_NE(replayed.find(",3\n"), std::string::npos);  // 1 | 2
@@ -101,12 +103,8 @@ TEST(ReplayStates, LoopbackMaxPropagationEqualsCorrect) {
     const host::ReplaySummary s = host::replay(o, log);
     EXPECT_EQ(s.returned, 1000U);
     EXPECT_EQ(s.mismatches, 0U) << log.str();
-    const std::string cmd = std::string(ASCORR_EXE) + " correct --scalar float --in " + rec.solutions + " --out " +
-                            (dir / "correct.csv").string() + " --model " + data_path("model_table2.csv") +
-                            " --states " + rec.states + " --max-propagation 10 2>/dev/null";
-    ASSERT_EQ(std::system(cmd.c_str()), 0);
-    const std::string replayed = slurp((dir / "out.csv").string());
-    EXPECT_EQ(replayed, slurp((dir / "correct.csv").string()));
+    std::string replayed;
+    ASSERT_NO_FATAL_FAILURE(expect_replayed_as_correct(rec, dir, " --max-propagation 10", replayed));
     EXPECT_NE(replayed.find(",518\n"), std::string::npos);
 }
 
@@ -173,11 +171,7 @@ double bound_arcsec(const host::QemuTarget& board) {
 }
 
 std::string scratch_name(const host::QemuTarget& board, const std::string& what) {
-    std::string s(board.replay);
-    for (char& c : s) {
-        c = c == '-' ? '_' : c;
-    }
-    return "rs_" + s + what;
+    return "rs_" + board_name(board) + what;
 }
 
 class ReplayStatesQemu : public ::testing::TestWithParam<host::QemuTarget> {};
@@ -255,22 +249,13 @@ void survive_restart(const host::QemuTarget* board, const std::string& name) {
 }
 
 TEST_P(ReplayStatesQemu, RestartRestoresTheState) {
-    if (GetParam().scalar == host::ScalarKind::kFixed) {
-        survive_restart<Q30>(&GetParam(), scratch_name(GetParam(), "_restart"));
-    } else {
-        survive_restart<float>(&GetParam(), scratch_name(GetParam(), "_restart"));
-    }
+    with_board_scalar(GetParam(), [this](auto scalar) {
+        survive_restart<decltype(scalar)>(&GetParam(), scratch_name(GetParam(), "_restart"));
+    });
 }
 
 // Each test once per board: Boards/ReplayStatesQemu.Clean/qemu_m3, ...
-INSTANTIATE_TEST_SUITE_P(Boards, ReplayStatesQemu, ::testing::ValuesIn(host::kQemuTargets),
-                         [](const ::testing::TestParamInfo<host::QemuTarget>& i) {
-                             std::string s(i.param.replay);
-                             for (char& c : s) {
-                                 c = c == '-' ? '_' : c;
-                             }
-                             return s;
-                         });
+INSTANTIATE_TEST_SUITE_P(Boards, ReplayStatesQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);
 #endif
 
 }  // namespace
