@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <random>
@@ -279,6 +280,29 @@ inline double floor_rms(const std::vector<std::pair<double, double>>& s, double 
         }
     }
     return std::sqrt(ss / static_cast<double>(n));
+}
+
+// A generated data set: its folder, its file, what the generator made, and
+// its span with the end of the modelling period (280 days after the start).
+struct GeneratedSet {
+    std::filesystem::path dir;
+    std::filesystem::path data;
+    Generated gen;
+    double t_from = 0.0;
+    double t_split = 0.0;  // end of the modelling period
+    double t_end = 0.0;
+};
+
+// Generates dir/file with options o.
+inline GeneratedSet generate_set(const std::filesystem::path& dir, const std::string& file, const GeneratorOptions& o) {
+    GeneratedSet d;
+    d.dir = dir;
+    d.data = dir / file;
+    d.gen = generate(d.data.string(), o);
+    d.t_from = d.gen.t.front();
+    d.t_split = d.t_from + 280.0 * kSecondsPerDay;
+    d.t_end = d.gen.t.back();
+    return d;
 }
 
 }  // namespace ascorr::test

@@ -29,6 +29,7 @@
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "solutions_records.hpp"
 #include "target/model_record.hpp"
 #include "target/vector_convert.hpp"
 #include "target/vector_format.hpp"
@@ -40,17 +41,6 @@ using namespace ascorr::target;
 
 std::string data(const std::string& name) {
     return std::string(ASCORR_TEST_DATA) + "/" + name;
-}
-
-std::vector<host::SolutionRecord> records(const std::string& path, std::string& storage) {
-    storage = host::read_text_file(path);
-    host::SolutionsReader r(path, storage);
-    std::vector<host::SolutionRecord> out;
-    host::SolutionRecord rec;
-    while (r.next(rec)) {
-        out.push_back(rec);
-    }
-    return out;
 }
 
 SolutionInput<double> to_input(const VectorRecord& r) {
@@ -73,7 +63,7 @@ double angle_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) {
 
 int write(const std::string& dir, std::uint32_t n, std::uint64_t seed) {
     std::string text;
-    const auto rows = records(data("solutions.csv"), text);
+    const auto rows = ascorr::test::read_records(data("solutions.csv"), text);
     host::EarthVelocity earth;
     std::mt19937_64 rng(seed);
     VectorHeader header{};
@@ -197,7 +187,7 @@ int check(const std::string& dir, double bound) {
     std::string storage[kConfigs];
     std::vector<host::SolutionRecord> expected[kConfigs];
     for (int c = 0; c < kConfigs; ++c) {
-        expected[c] = records(data(expected_files[c]), storage[c]);
+        expected[c] = ascorr::test::read_records(data(expected_files[c]), storage[c]);
     }
     double worst_examples = 0.0;
     double worst_expected = 0.0;

@@ -30,26 +30,13 @@ namespace fs = std::filesystem;
 constexpr double kDay = kSecondsPerDay;
 
 // One data set shared by the tests of this file (generating it takes a second).
-struct Shared {
-    fs::path dir;
-    fs::path data;
-    Generated gen;
-    double t_from = 0.0;
-    double t_split = 0.0;  // end of the modelling period
-    double t_end = 0.0;
-};
+using Shared = GeneratedSet;
 
 const Shared& shared() {
     static const Shared s = [] {
-        Shared x;
-        x.dir = fs::temp_directory_path() / ("ascorr-test-analysis-" + std::to_string(::getpid()));
-        fs::create_directories(x.dir);
-        x.data = x.dir / "independent.csv";
-        x.gen = generate(x.data.string(), GeneratorOptions{});
-        x.t_from = x.gen.t.front();
-        x.t_split = x.t_from + 280.0 * kDay;
-        x.t_end = x.gen.t.back();
-        return x;
+        const fs::path dir = fs::temp_directory_path() / ("ascorr-test-analysis-" + std::to_string(::getpid()));
+        fs::create_directories(dir);
+        return generate_set(dir, "independent.csv", GeneratorOptions{});
     }();
     return s;
 }

@@ -24,27 +24,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kDay = kSecondsPerDay;
 constexpr double kQuadraticTruth = 0.04;  // arcsec/°C²: ±2.6" over the ±8 °C seasons
 
-struct DataSet {
-    fs::path dir;
-    fs::path data;
-    Generated gen;
-    double t_from = 0.0;
-    double t_split = 0.0;  // end of the modelling period
-    double t_end = 0.0;
-};
+using DataSet = GeneratedSet;
 
 DataSet make(const std::string& name, const GeneratorOptions& o) {
-    DataSet d;
-    d.dir = scratch_dir(name);
-    d.data = d.dir / "data.csv";
-    d.gen = generate(d.data.string(), o);
-    d.t_from = d.gen.t.front();
-    d.t_split = d.t_from + 280.0 * kDay;
-    d.t_end = d.gen.t.back();
-    return d;
+    return generate_set(scratch_dir(name), "data.csv", o);
 }
 
 const DataSet& quadratic_truth() {

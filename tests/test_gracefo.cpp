@@ -195,17 +195,11 @@ TEST(GracefoImport, AlignAndCombineAgreeWithJplWithinThreeArcsec) {
         EXPECT_NE(test::slurp(dir / "stats.txt").find("ABC "), std::string::npos);
         // Mutation check: the boresight weighted as the cross axes (each
         // head's sigma_about set to its sigma_cross) fails the bound.
-        std::ifstream in(dir / "m2.csv");
-        std::ofstream out(dir / "equal.csv");
-        std::string line;
-        std::getline(in, line);
-        out << line << '\n';
-        while (std::getline(in, line)) {
+        test::rewrite_csv_rows(dir / "m2.csv", dir / "equal.csv", [](const std::string& line, std::ostream& out) {
             const std::size_t last = line.rfind(',');
             const std::size_t cross = line.rfind(',', last - 1);
             out << line.substr(0, last) << ',' << line.substr(cross + 1, last - cross - 1) << '\n';
-        }
-        out.close();
+        });
         ASSERT_EQ(run_in("combine --in sol.csv --mountings equal.csv --out equal-comb.csv", dir).exit_code, 0);
         EXPECT_GT(rms_against_jpl(dir, "equal-comb.csv", n).maxCoeff(), 3.0) << sat;
     }

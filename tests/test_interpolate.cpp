@@ -66,16 +66,11 @@ struct Thinned {
                          dir)
                       .exit_code,
                   0);
-        std::ifstream in(dir / "every.csv");
-        std::ofstream out(dir / "tenth.csv");
-        std::string line;
-        std::getline(in, line);
-        out << line << '\n';
-        while (std::getline(in, line)) {
+        test::rewrite_csv_rows(dir / "every.csv", dir / "tenth.csv", [](const std::string& line, std::ostream& out) {
             if (std::fmod(std::stod(line.substr(0, line.find(','))), 10.0) == 0.0) {
                 out << line << '\n';
             }
-        }
+        });
         for (const host::AttitudeRow& r : read_rows(dir / "sim.csv.attitude.csv")) {
             truth[r.t] = r.q_crf_icrf;
         }

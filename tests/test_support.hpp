@@ -10,6 +10,8 @@
 #include <cstdlib>
 
 #include <filesystem>
+#include <fstream>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "ascorr/ascorr.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
+#include "solutions_records.hpp"
 
 namespace ascorr::test {
 
@@ -60,16 +63,18 @@ inline Eigen::Quaterniond random_attitude(std::mt19937_64& rng) {
     return q;
 }
 
-// All records of a solutions file (the host reader is itself tested in test_formats).
-inline std::vector<host::SolutionRecord> read_records(const std::string& path, std::string& storage) {
-    storage = host::read_text_file(path);
-    host::SolutionsReader r(path, storage);
-    std::vector<host::SolutionRecord> out;
-    host::SolutionRecord rec;
-    while (r.next(rec)) {
-        out.push_back(rec);
+// Copies the CSV file `from` to `to`: its header line as it is, then what
+// row(line, out) writes for each other line (a line it writes nothing for is dropped).
+template <typename Row>
+void rewrite_csv_rows(const std::filesystem::path& from, const std::filesystem::path& to, Row row) {
+    std::ifstream in(from);
+    std::ofstream out(to);
+    std::string line;
+    std::getline(in, line);
+    out << line << '\n';
+    while (std::getline(in, line)) {
+        row(line, out);
     }
-    return out;
 }
 
 // Removes the process' scratch directories when the whole test program
