@@ -3,6 +3,7 @@
 // correction core makes of each fault.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -214,7 +215,7 @@ struct Rig {
 
     // Every channel at its temperature as counts: one sample set at t
     // (commit() hands it to the acquisition).
-    void fill(const double (&temps)[8], std::uint64_t dt_us = 1000000U) {
+    void fill(const std::array<double, 8>& temps, std::uint64_t dt_us = 1000000U) {
         t += dt_us;
         f.t_us = t;
         for (std::uint8_t i = 0; i < 8; ++i) {
@@ -225,7 +226,7 @@ struct Rig {
     ChannelReading<double> ch(std::uint8_t i) const { return acq.channel(i, t); }
 };
 
-constexpr double kNominal[8] = {-9.5, -9.45, -9.55, -19.8, -19.75, -19.85, 3.2, 15.8};
+constexpr std::array<double, 8> kNominal = {-9.5, -9.45, -9.55, -19.8, -19.75, -19.85, 3.2, 15.8};
 
 // The core never applies a thermal correction with the acquisition's result,
 // and reports why.
@@ -309,8 +310,7 @@ TEST(HalFaults, OpenAndShortOnAHighSideDivider) {
 
 TEST(HalFaults, OutOfRange) {
     Rig r;
-    double t[8];
-    std::copy(kNominal, kNominal + 8, t);
+    std::array<double, 8> t = kNominal;
     t[6] = 95.0;  // above t_max = 80, still a plausible resistance
     r.fill(t);
     r.commit();
@@ -330,8 +330,7 @@ TEST(HalFaults, ConversionWithBadCoefficients) {
 
 TEST(HalFaults, RateSpikeCostsOneReadingAndAStepIsAcceptedAfterOne) {
     Rig r;
-    double t[8];
-    std::copy(kNominal, kNominal + 8, t);
+    std::array<double, 8> t = kNominal;
     r.fill(t);
     r.commit();
     t[6] = 13.2;  // +10 °C in 1 s, max_rate 0.5 °C/s
@@ -463,8 +462,7 @@ TEST(HalVoting, ASingleChannelIsItsOwnValue) {
 
 TEST(HalVoting, AcquisitionFlagsTheOutvotedMemberAndKeepsTheMedian) {
     Rig r;
-    double t[8];
-    std::copy(kNominal, kNominal + 8, t);
+    std::array<double, 8> t = kNominal;
     t[2] = -4.0;  // THT00087 reads 5.5 °C warm (first sample set: no rate anchor yet)
     r.fill(t);
     r.commit();

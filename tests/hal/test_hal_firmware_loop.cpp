@@ -40,27 +40,14 @@ private:
 };
 
 hal::AcquisitionConfig<float> float_config() {
-    const hal::AcquisitionConfig<double> d = swarm_config();
-    hal::AcquisitionConfig<float> f{};
-    for (std::uint8_t i = 0; i < d.channels; ++i) {
-        const hal::ChannelConfig<double>& a = d.channel[i];
-        hal::ChannelConfig<float>& b = f.channel[i];
-        std::copy(a.name, a.name + hal::kNameLength, b.name);
-        b.role = a.role;
-        b.adc_channel = a.adc_channel;
-        b.divider = {a.divider.thermistor_low, static_cast<float>(a.divider.r_fixed), a.divider.levels};
-        b.sh = {static_cast<float>(a.sh.a), static_cast<float>(a.sh.b), static_cast<float>(a.sh.c)};
-        b.r_open = static_cast<float>(a.r_open);
-        b.r_short = static_cast<float>(a.r_short);
-        b.t_min = static_cast<float>(a.t_min);
-        b.t_max = static_cast<float>(a.t_max);
-        b.max_rate = static_cast<float>(a.max_rate);
-        b.stuck_frames = 30U;
-        b.max_spread = a.max_spread;
+    hal::AcquisitionConfig<float> f = to_float(swarm_config());
+    for (std::uint8_t i = 0; i < hal::kMaxChannels; ++i) {
+        if (i < f.channels) {
+            f.channel[i].stuck_frames = 30U;
+        } else {
+            f.channel[i] = {};  // only the configured channels
+        }
     }
-    f.channels = d.channels;
-    f.sampler = d.sampler;
-    f.stale_us = d.stale_us;
     f.vote_tolerance = 1.0F;
     f.quorum = 2U;
     return f;

@@ -34,33 +34,6 @@ double to_c(QCelsius x) {
     return static_cast<double>(x.raw) / 1048576.0;
 }
 
-// The floating configuration in float, as on the DPU.
-hal::AcquisitionConfig<float> to_float(const hal::AcquisitionConfig<double>& d) {
-    hal::AcquisitionConfig<float> f{};
-    for (std::uint8_t i = 0; i < hal::kMaxChannels; ++i) {
-        const hal::ChannelConfig<double>& c = d.channel[i];
-        hal::ChannelConfig<float>& o = f.channel[i];
-        std::copy(std::begin(c.name), std::end(c.name), std::begin(o.name));
-        o.role = c.role;
-        o.adc_channel = c.adc_channel;
-        o.divider = {c.divider.thermistor_low, static_cast<float>(c.divider.r_fixed), c.divider.levels};
-        o.sh = {static_cast<float>(c.sh.a), static_cast<float>(c.sh.b), static_cast<float>(c.sh.c)};
-        o.r_open = static_cast<float>(c.r_open);
-        o.r_short = static_cast<float>(c.r_short);
-        o.t_min = static_cast<float>(c.t_min);
-        o.t_max = static_cast<float>(c.t_max);
-        o.max_rate = static_cast<float>(c.max_rate);
-        o.stuck_frames = c.stuck_frames;
-        o.max_spread = c.max_spread;
-    }
-    f.channels = d.channels;
-    f.sampler = d.sampler;
-    f.stale_us = d.stale_us;
-    f.vote_tolerance = static_cast<float>(d.vote_tolerance);
-    f.quorum = d.quorum;
-    return f;
-}
-
 // Both paths of one floating configuration: its float acquisition and the
 // fixed-point one derived from it (one table per channel).
 struct Paths {
