@@ -63,6 +63,19 @@ inline Eigen::Quaterniond random_attitude(std::mt19937_64& rng) {
     return q;
 }
 
+// The message of the E that f() throws; when it throws nothing, a failure
+// `accepted` and "".
+template <typename E, typename F>
+std::string thrown_by(F&& f, const std::string& accepted) {
+    try {
+        f();
+    } catch (const E& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << accepted;
+    return "";
+}
+
 // Copies the CSV file `from` to `to`: its header line as it is, then what
 // row(line, out) writes for each other line (a line it writes nothing for is dropped).
 template <typename Row>
