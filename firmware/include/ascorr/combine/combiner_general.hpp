@@ -244,10 +244,7 @@ CombinedAttitude<T> Combiner<T>::finish(const Epoch& e, bool combined, const Vec
     if (combined) {
         out.used = e.group == (1U << e.n) - 1U ? e.heads : heads_of(e, e.group);
         const Quaternion<T>& ref = e.c[e.ref].q;
-        // d = (0, est) ⊗ ref is orthogonal to ref, so ‖ref + d‖² − 1 = ‖est‖²
-        // (+ ref's own ≤ 1e-6): within Q30's range of renormalized_sum for any
-        // est of the accumulator's range (|estᵢ| < 0.24: ε < 0.18, |sᵢ| < 1.5),
-        // unit to 2⁻³⁰ for ‖est‖ ≤ 0.033 rad, which the gates keep it far below.
+        // Any est of the accumulator's range is within apply_left's (kernels_q30.hpp).
         out.q_crf_icrf = canonical(apply_left(est, ref));
         out.inconsistent = e.inconsistent;
     } else {

@@ -291,8 +291,8 @@ private:
 // renormalised by the core's second-order step (quaternion.hpp
 // renormalized_sum: the small terms summed first, q rounded once, in the
 // last addition; in float two roundings of the O(1) components would double
-// the error). Range: q unit within the core's tolerance, |h| ≤ 2⁻⁸ (the
-// gross gate).
+// the error). Range: q unit within the core's tolerance; h any result() of
+// the accumulator (the bound that matters, Q30's: kernels_q30.hpp).
 template <typename T>
 constexpr Quaternion<T> apply_left(const Vector3<T>& h, const Quaternion<T>& q) noexcept {
     return renormalized_sum(q, left_increment(h, q));

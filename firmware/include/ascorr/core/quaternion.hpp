@@ -291,11 +291,14 @@ Quaternion<Q30> add_left_increment<Q30>(const Quaternion<Q30>&, const SmallRotat
 // second order, g = −ε/2 + 3ε²/8 (1/√(1 + ε) = 1 − ε/2 + 3ε²/8 − …): then
 // ‖result‖² − 1 = 5ε³/8 + O(ε⁴), which stays below 2⁻³⁰ for |ε| ≤ 1.1e-3,
 // four times what the thermal rotation's scale (≤ 2.3e-4) and the input's
-// tolerance (1e-6) add. g and each sᵢ·g are rounded once. Range: q passed
-// norm_within(), |dᵢ| ≤ 2⁻⁴ (the corrections' increments are ≤ 0.017,
-// correct.hpp); then |sᵢ| < 1.07, ‖s‖² < 4.6 (< 2⁶³ in units 2⁻⁶⁰); with
-// |dᵢ| ≤ 2⁻⁴, |ε| ≤ 0.27, |g| < 0.17 and every result < 1.3 in magnitude
-// (the actual increments give |ε| ≤ 0.07).
+// tolerance (1e-6) add. g and each sᵢ·g are rounded once.
+// Range (the one statement; callers show they meet it): |sᵢ| < 1.5 and
+// |ε| ≤ 0.27. Then ‖s‖² < 1.27 (< 2⁶³ in units 2⁻⁶⁰), |g| < 0.17 and every
+// result below 1.8 in magnitude: no sum overflows, no result leaves Q30.
+// The correction's increments (correct.hpp): q passed norm_within() and
+// |dᵢ| ≤ 2⁻⁴ (they are ≤ 0.017), so ‖s‖ ≤ 1 + ‖d‖ ≤ 1.125: |sᵢ| < 1.07,
+// |ε| ≤ 0.27 (0.07 for the actual increments). The combination's: see
+// apply_left (combine/kernels_q30.hpp).
 constexpr Quaternion<Q30> renormalized_sum(const Quaternion<Q30>& q, const Quaternion<Q30>& d) noexcept {
     using fx::unshared;
     const std::int32_t sw = unshared(q.w.raw + d.w.raw);
