@@ -28,7 +28,6 @@ using combine::CombinedAttitude;
 using combine::Combiner;
 using combine::CombinerConfig;
 using combine::HeadAttitude;
-using combine::HeadMask;
 using combine::Mountings;
 using combine::MountingsProblem;
 namespace cs = combine::combined_status;

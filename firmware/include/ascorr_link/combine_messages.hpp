@@ -43,9 +43,9 @@ struct MountingLoad {
 template <typename T>
 struct Combined {
     combine::CombinedStatus status;
-    combine::HeadMask used;
-    combine::HeadMask left_out;
-    combine::HeadMask inconsistent;
+    HeadMask used;
+    HeadMask left_out;
+    HeadMask inconsistent;
     Quaternion<T> q_crf_icrf;
     std::uint32_t instructions;  // cost of the combination on the target
 };

@@ -323,7 +323,7 @@ private:
         combine::Mountings trial = staged_mountings_;
         trial.head[m.head] = mounting_of(m);
         std::uint8_t head = kUnknownHead;
-        combine::HeadMask subset = 0;
+        HeadMask subset = 0;
         // The gates too: tables a combiner could not hold would make every
         // epoch status 8 after an ACK.
         return combine::check_mountings(trial, &head) == combine::MountingsProblem::kNone &&

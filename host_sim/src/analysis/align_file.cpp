@@ -97,9 +97,9 @@ void apply_gate(const StageGates& gates, const Epoch<Judged>& e, StatusBits stag
             heads[n++] = {e.head[h]->row.q_chu_icrf, h, true};
         }
     }
-    const combine::HeadMask out = n >= 2 ? gates.of(stages).combine(heads, n).inconsistent : combine::HeadMask{0};
+    const HeadMask out = n >= 2 ? gates.of(stages).combine(heads, n).inconsistent : HeadMask{0};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        why[h] = (out & combine::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
+        why[h] = (out & ascorr::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
     }
 }
 

@@ -227,7 +227,7 @@ SubsetCovariances subset_covariances(const combine::Mountings& m, std::uint32_t 
     SubsetCovariances out{};
     for (unsigned s = 1; s < combine::kSubsetCount; ++s) {
         combine::Matrix3 cov{};
-        if ((s & ~mounted) == 0U && combine::subset_covariance(m, static_cast<combine::HeadMask>(s), &cov)) {
+        if ((s & ~mounted) == 0U && combine::subset_covariance(m, static_cast<HeadMask>(s), &cov)) {
             out[s] = {cov.m[0][1], cov.m[0][2], cov.m[1][2]};
         }
     }
@@ -429,7 +429,7 @@ struct CombineStage::Impl {
         }
         const combine::CombinedAttitude<double> c = combiner.combine(heads, n);
         for (std::uint8_t i = 0; i < n; ++i) {
-            const combine::HeadMask bit = combine::head_bit(heads[i].head);
+            const HeadMask bit = ascorr::head_bit(heads[i].head);
             if ((c.used & bit) == 0U) {
                 rows[used_row[i]].why = (c.inconsistent & bit) != 0U ? LeftOut::kInconsistent : LeftOut::kNotUnit;
             }

@@ -24,13 +24,8 @@
 
 namespace ascorr::combine {
 
-using HeadMask = std::uint8_t;  // bit h: head h (heads.hpp)
-static_assert(kMaxHeads <= 8, "a HeadMask holds one bit per head");
+// Head sets are core/heads.hpp's HeadMask.
 inline constexpr unsigned kSubsetCount = 1U << kMaxHeads;  // masks 0 … 2^kMaxHeads − 1 (0: no head)
-
-constexpr HeadMask head_bit(std::uint8_t head) noexcept {
-    return static_cast<HeadMask>(1U << head);
-}
 
 struct HeadMounting {
     bool present;                  // the head is in the mountings

@@ -34,20 +34,6 @@
 
 namespace ascorr::combine {
 
-// Bit i of a mask (a HeadMask, or a mask of an epoch's candidates).
-constexpr bool in_mask(std::uint8_t mask, std::uint8_t i) noexcept {
-    return ((static_cast<unsigned>(mask) >> i) & 1U) != 0U;
-}
-
-// Number of heads in a mask (bounded: kMaxHeads bits).
-constexpr std::uint8_t head_count(HeadMask s) noexcept {
-    std::uint8_t n = 0;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        n = static_cast<std::uint8_t>(n + (in_mask(s, h) ? 1U : 0U));
-    }
-    return n;
-}
-
 // P_S = Σ_{j∈S} W_j (1/arcsec²).
 inline Matrix3 subset_information(const Mountings& m, HeadMask s) noexcept {
     Matrix3 p = zero_matrix();

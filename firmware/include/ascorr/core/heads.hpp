@@ -22,6 +22,33 @@ inline constexpr std::uint8_t kMaxHeads = sizeof(kHeadLetters) - 1;
 inline constexpr std::uint8_t kUnknownHead = 0xFF;
 static_assert(kMaxHeads > 0 && kMaxHeads < kUnknownHead, "head indices fit in a byte, below kUnknownHead");
 
+// A set of heads: bit h is head h. The one head-set type of the flight code
+// and the ground's (combine/, calib/, the host's analyses).
+using HeadMask = std::uint8_t;
+static_assert(kMaxHeads <= 8, "a HeadMask holds one bit per head");
+
+constexpr HeadMask head_bit(std::uint8_t head) noexcept {
+    return static_cast<HeadMask>(1U << head);
+}
+
+// Bit i of a mask (a HeadMask, or a mask of an epoch's candidates).
+constexpr bool in_mask(std::uint8_t mask, std::uint8_t i) noexcept {
+    return ((static_cast<unsigned>(mask) >> i) & 1U) != 0U;
+}
+
+constexpr bool has_head(HeadMask s, std::uint8_t head) noexcept {
+    return in_mask(s, head);
+}
+
+// Number of heads in a mask (bounded: kMaxHeads bits).
+constexpr std::uint8_t head_count(HeadMask s) noexcept {
+    std::uint8_t n = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        n = static_cast<std::uint8_t>(n + (in_mask(s, h) ? 1U : 0U));
+    }
+    return n;
+}
+
 // The letter of head `head`, '?' for an index ≥ kMaxHeads.
 constexpr char head_letter(std::uint8_t head) noexcept {
     return head < kMaxHeads ? kHeadLetters[head] : '?';
