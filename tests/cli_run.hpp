@@ -3,13 +3,16 @@
 // for the tests of its command-line behaviour.
 #pragma once
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ascorr::test {
@@ -77,6 +80,46 @@ inline int run_cli(const std::string& args, const std::filesystem::path& out, co
 // The same with dir/out.txt and dir/err.txt.
 inline int run_cli(const std::string& args, const std::filesystem::path& dir) {
     return run_cli(args, dir / "out.txt", dir / "err.txt");
+}
+
+// For expect_refused: any exit code but 0.
+constexpr int kAnyFailure = -2;
+
+// Expects R to have exited with CODE (kAnyFailure: with any code but 0) and
+// its standard error to hold each of PARTS.
+inline void expect_refused(const CliRun& r, int code, std::initializer_list<std::string> parts) {
+    if (code == kAnyFailure) {
+        EXPECT_NE(r.exit_code, 0) << r.err;
+    } else {
+        EXPECT_EQ(r.exit_code, code) << r.err;
+    }
+    for (const std::string& part : parts) {
+        EXPECT_TRUE(has(r.err, part)) << "no '" << part << "' in: " << r.err;
+    }
+}
+
+// Writes ROWS to the file P, each with a line end.
+inline void write_lines(const std::filesystem::path& p, const std::vector<std::string>& rows) {
+    std::string text;
+    for (const std::string& l : rows) {
+        text += l + "\n";
+    }
+    write(p, text);
+}
+
+// Expects each pair of files in DIR to hold the same bytes.
+inline void expect_same_files(const std::filesystem::path& dir,
+                              std::initializer_list<std::pair<std::string, std::string>> pairs) {
+    for (const auto& [a, b] : pairs) {
+        EXPECT_EQ(slurp(dir / a), slurp(dir / b)) << a << " vs " << b;
+    }
+}
+
+// Expects none of FILES to exist in DIR.
+inline void expect_absent(const std::filesystem::path& dir, std::initializer_list<std::string> files) {
+    for (const std::string& f : files) {
+        EXPECT_FALSE(std::filesystem::exists(dir / f)) << f;
+    }
 }
 
 }  // namespace ascorr::test

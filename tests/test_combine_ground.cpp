@@ -44,12 +44,7 @@ constexpr const char* kGood =
 
 // The message of parse_mountings' refusal, "" when it accepts.
 std::string refusal(const std::string& text) {
-    try {
-        host::parse_mountings("m.csv", text);
-    } catch (const text::InputError& e) {
-        return e.what();
-    }
-    return "";
+    return message_of<text::InputError>([&] { static_cast<void>(host::parse_mountings("m.csv", text)); }, "");
 }
 
 TEST(MountingsFile, ReadsWritesAndReadsBackTheSame) {
@@ -252,33 +247,27 @@ TEST(CombineCli, BadMountingsOrInputStopWithFileLineColumnAndWriteNothing) {
     const Bench b;
     write(dir / "in.csv", bad_input_file(b));
     write(dir / "bad.csv", "chu,qw,qx,qy,qz,sigma_cross,sigma_about\nA,1,0,0,0,1.5,10\nB,2,0,0,0,1.5,10\n");
-    CliRun r = run_in("combine --in in.csv --mountings bad.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_TRUE(has(r.err, "bad.csv:3:3: the mounting of CHU B is not unit")) << r.err;
-    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    expect_refused(run_in("combine --in in.csv --mountings bad.csv --out out.csv", dir), 2,
+                   {"bad.csv:3:3: the mounting of CHU B is not unit"});
+    expect_absent(dir, {"out.csv"});
     // Without sigmas, on data too thin to estimate the noise: align's refusal, exit 2.
     write(dir / "nosigma.csv", "chu,qw,qx,qy,qz\nA,1,0,0,0\nB,0,1,0,0\n");
     write(dir / "thin.csv", std::string(kCorrectedHeader) + b.row(100, 'A', 0, 3) + b.row(100, 'B', 0, 3));
-    r = run_in("combine --in thin.csv --mountings nosigma.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_TRUE(has(r.err, "estimating the heads' noise")) << r.err;
-    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    expect_refused(run_in("combine --in thin.csv --mountings nosigma.csv --out out.csv", dir), 2,
+                   {"estimating the heads' noise"});
+    expect_absent(dir, {"out.csv"});
     // correct --combined cannot estimate it (the rows are not corrected yet): refused, saying what to do.
-    r = run_in("correct --in in.csv --out cor.csv --mountings nosigma.csv --combined comb.csv", dir);
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_TRUE(has(r.err, "nosigma.csv: the mountings have no sigma_cross,sigma_about")) << r.err;
-    EXPECT_FALSE(fs::exists(dir / "cor.csv"));
-    EXPECT_FALSE(fs::exists(dir / "comb.csv"));
+    expect_refused(run_in("correct --in in.csv --out cor.csv --mountings nosigma.csv --combined comb.csv", dir), 2,
+                   {"nosigma.csv: the mountings have no sigma_cross,sigma_about"});
+    expect_absent(dir, {"cor.csv", "comb.csv"});
     // A status that is not an integer.
     host::write_mountings_file((dir / "m.csv").string(), b.m);
     write(dir / "badstatus.csv", std::string(kCorrectedHeader) + "100,A,1,0,0,0,0,1,x\n");
-    r = run_in("combine --in badstatus.csv --mountings m.csv --out out.csv", dir);
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_TRUE(has(r.err, "badstatus.csv:2:19: column 'status'")) << r.err;
-    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+    expect_refused(run_in("combine --in badstatus.csv --mountings m.csv --out out.csv", dir), 2,
+                   {"badstatus.csv:2:19: column 'status'"});
+    expect_absent(dir, {"out.csv"});
     // --out over an input.
-    r = run_in("combine --in in.csv --mountings m.csv --out m.csv", dir);
-    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(run_in("combine --in in.csv --mountings m.csv --out m.csv", dir).exit_code, 0);
 }
 
 TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine) {
@@ -293,8 +282,7 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
     ASSERT_EQ(r.exit_code, 0) << r.err;
     r = run_in("combine --in cor2.csv --mountings sim.csv.mountings.csv --out comb2.csv", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(slurp(dir / "cor.csv"), slurp(dir / "cor2.csv"));
-    EXPECT_EQ(slurp(dir / "comb.csv"), slurp(dir / "comb2.csv"));
+    expect_same_files(dir, {{"cor.csv", "cor2.csv"}, {"comb.csv", "comb2.csv"}});
     // Rows out of time order: the run is made again with the rows kept; the
     // combined file is the same bits, the corrected one keeps the input order.
     std::vector<std::string> rows = lines_of_file(dir / "sim.csv");
@@ -308,7 +296,7 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
         "--combined rcomb.csv",
         dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(slurp(dir / "rcomb.csv"), slurp(dir / "comb.csv"));
+    expect_same_files(dir, {{"rcomb.csv", "comb.csv"}});
     EXPECT_EQ(lines_of_file(dir / "rcor.csv").size(), lines_of_file(dir / "cor.csv").size());
     EXPECT_TRUE(has(r.err, "rows out of time order: sorted")) << r.err;
     // The corrected rows to standard output: written once (the rows kept from the start).
@@ -317,8 +305,7 @@ TEST(CombineCli, CorrectCombinedCommitsBothOrNeitherAndEqualsCorrectThenCombine)
         "--combined scomb.csv > scor.csv",
         dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(slurp(dir / "scor.csv"), slurp(dir / "rcor.csv"));
-    EXPECT_EQ(slurp(dir / "scomb.csv"), slurp(dir / "comb.csv"));
+    expect_same_files(dir, {{"scor.csv", "rcor.csv"}, {"scomb.csv", "comb.csv"}});
     // A malformed row: neither output.
     std::string text = slurp(dir / "sim.csv");
     text.insert(text.find('\n', text.size() / 2) + 1, "1e9,A,x,0,0,0,,,,,,,0,1\n");
@@ -577,44 +564,27 @@ TEST(CombineCli, StatsAndPlotOfACombinedFile) {
     // A combined file out of time order, a truth out of time order: refused at their lines.
     std::vector<std::string> rows = lines_of_file(ms.dir / "c2.csv");
     std::swap(rows[5], rows[6]);
-    std::string text;
-    for (const std::string& l : rows) {
-        text += l + "\n";
-    }
-    write(ms.dir / "c2_swapped.csv", text);
-    r = run_in("stats --combined c2_swapped.csv", ms.dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "c2_swapped.csv:7:1: a combined file has one row per epoch, in time order")) << r.err;
+    write_lines(ms.dir / "c2_swapped.csv", rows);
+    expect_refused(run_in("stats --combined c2_swapped.csv", ms.dir), 1,
+                   {"c2_swapped.csv:7:1: a combined file has one row per epoch, in time order"});
     rows = lines_of_file(ms.dir / "sim.csv.attitude.csv");
     std::swap(rows[5], rows[6]);
-    text.clear();
-    for (const std::string& l : rows) {
-        text += l + "\n";
-    }
-    write(ms.dir / "truth_swapped.csv", text);
-    r = run_in("stats --combined c2.csv --truth-attitude truth_swapped.csv", ms.dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
+    write_lines(ms.dir / "truth_swapped.csv", rows);
+    expect_refused(run_in("stats --combined c2.csv --truth-attitude truth_swapped.csv", ms.dir), 1,
+                   {"truth_swapped.csv:7:1: the truth's rows must be in time order"});
     // A truth in reverse time order is refused too (was: exit 0, every epoch
     // but one "without a truth row"), and plot takes a truth by stats' rules:
     // no combined file, no epoch twice (was: accepted).
     rows = lines_of_file(ms.dir / "sim.csv.attitude.csv");
     std::reverse(rows.begin() + 1, rows.end());
-    text.clear();
-    for (const std::string& l : rows) {
-        text += l + "\n";
-    }
-    write(ms.dir / "truth_reversed.csv", text);
-    r = run_in("stats --combined c2.csv --truth-attitude truth_reversed.csv", ms.dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "truth_reversed.csv:3:1: the truth's rows must be in time order")) << r.err;
+    write_lines(ms.dir / "truth_reversed.csv", rows);
+    expect_refused(run_in("stats --combined c2.csv --truth-attitude truth_reversed.csv", ms.dir), 1,
+                   {"truth_reversed.csv:3:1: the truth's rows must be in time order"});
     const std::string window = " --window-from 456148800 --window-to 456408000 --out refused.png";
-    r = run_in("plot --combined c2.csv --truth-attitude c2.csv" + window, ms.dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "c2.csv:1:1: the truth is an attitude file (t,qw,qx,qy,qz), not a combined file")) << r.err;
-    r = run_in("plot --combined c2.csv --truth-attitude truth_swapped.csv" + window, ms.dir);
-    EXPECT_EQ(r.exit_code, 1);
-    EXPECT_TRUE(has(r.err, "truth_swapped.csv:7:1: the truth's rows must be in time order")) << r.err;
+    expect_refused(run_in("plot --combined c2.csv --truth-attitude c2.csv" + window, ms.dir), 1,
+                   {"c2.csv:1:1: the truth is an attitude file (t,qw,qx,qy,qz), not a combined file"});
+    expect_refused(run_in("plot --combined c2.csv --truth-attitude truth_swapped.csv" + window, ms.dir), 1,
+                   {"truth_swapped.csv:7:1: the truth's rows must be in time order"});
     EXPECT_FALSE(std::filesystem::exists(ms.dir / "refused.png"));
     // Rows the combination cannot have written are refused at their column
     // (was: accepted): a status against the rule, heads that contradict it, a

@@ -186,8 +186,7 @@ TEST(ReplaySelfCalibration, FromAModelWithRowsOutOfOrderAndWithinAMicrosecond) {
         "initial.csv --model-history corrected.history.csv",
         dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(slurp(dir / "replayed.history.csv"), slurp(dir / "corrected.history.csv"));
-    EXPECT_EQ(slurp(dir / "replayed.csv"), slurp(dir / "corrected.csv"));
+    expect_same_files(dir, {{"replayed.history.csv", "corrected.history.csv"}, {"replayed.csv", "corrected.csv"}});
     EXPECT_NE(slurp(dir / "corrected.history.csv").find(",0,A,alpha,"), std::string::npos);  // version 0
 }
 

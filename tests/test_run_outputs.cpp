@@ -65,6 +65,63 @@ std::vector<std::string> temporaries_in(const fs::path& dir) {
     return names;
 }
 
+// Files by name with their text (or a part of it).
+using Files = std::vector<std::pair<std::string, std::string>>;
+
+// The outputs of a previous run: the corrected file, the history, the combined file.
+const Files kPrevious = {{"out.csv", "the previous corrected file\n"},
+                         {"history.csv", "the previous history\n"},
+                         {"combined.csv", "the previous combined file\n"}};
+
+// Writes each of FILES in DIR.
+void write_files(const fs::path& dir, const Files& files) {
+    for (const auto& [name, text] : files) {
+        write(dir / name, text);
+    }
+}
+
+// Runs COMMAND (its summary to summary.json) in DIR: refused with exit 1 and
+// MESSAGE, each of KEPT holding the text it had.
+void expect_nothing_committed(const fs::path& dir, const std::string& command, const std::string& message,
+                              const Files& kept) {
+    expect_refused(run_in(command + " > summary.json", dir), 1, {message});
+    for (const auto& [name, text] : kept) {
+        EXPECT_EQ(slurp(dir / name), text) << name;
+    }
+}
+
+// Runs COMMAND (its summary to summary.json) in DIR: exit 0, each of PARTS in its file.
+void expect_committed(const fs::path& dir, const std::string& command, const Files& parts) {
+    const CliRun ok = run_in(command + " > summary.json", dir);
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+    for (const auto& [name, part] : parts) {
+        EXPECT_TRUE(has(slurp(dir / name), part)) << name;
+    }
+}
+
+// The corrected file and another output of a run, which are committed together.
+struct CommitSet {
+    std::string option;        // the other output's option
+    std::string file;          // and its file
+    Files previous;            // written before the runs
+    Files kept_without_other;  // as they were when the other output cannot be written
+    Files kept_without_out;    // as they were when --out cannot be written
+    Files replaced;            // parts of the files a run that can write both writes
+};
+
+// COMMAND in DIR with --out and S's output: neither committed when one of them
+// is /dev/full, no temporary left; both replaced when both are writable.
+void expect_committed_together(const fs::path& dir, const std::string& command, const CommitSet& s) {
+    write_files(dir, s.previous);
+    expect_nothing_committed(dir, command + " --out out.csv " + s.option + " /dev/full",
+                             s.option + " /dev/full: write failed: No space left on device", s.kept_without_other);
+    expect_nothing_committed(dir, command + " --out /dev/full " + s.option + " " + s.file,
+                             "--out /dev/full: write failed: No space left on device", s.kept_without_out);
+    EXPECT_TRUE(temporaries_in(dir).empty());
+    // Control: with all writable, all are replaced.
+    expect_committed(dir, command + " --out out.csv " + s.option + " " + s.file, s.replaced);
+}
+
 // ---- items 1 and 4: the outputs of one run, together or not at all ----------
 
 // The history to /dev/full: its write fails at the flush, after the corrected
@@ -78,22 +135,13 @@ TEST(RunOutputs, AFailedHistoryLeavesTheCorrectedFileAsItWasAndTheOtherWayRound)
     };
     for (const std::string& c : commands) {
         SCOPED_TRACE(c);
-        write(dir / "out.csv", "the previous corrected file\n");
-        write(dir / "history.csv", "the previous history\n");
-        const CliRun a = run_in(c + " --out out.csv --model-history /dev/full > summary.json", dir);
-        EXPECT_EQ(a.exit_code, 1);
-        EXPECT_TRUE(has(a.err, "--model-history /dev/full: write failed: No space left on device")) << a.err;
-        EXPECT_EQ(slurp(dir / "out.csv"), "the previous corrected file\n");
-        const CliRun b = run_in(c + " --out /dev/full --model-history history.csv > summary.json", dir);
-        EXPECT_EQ(b.exit_code, 1);
-        EXPECT_TRUE(has(b.err, "--out /dev/full: write failed: No space left on device")) << b.err;
-        EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
-        EXPECT_TRUE(temporaries_in(dir).empty());
-        // Control: with both writable, both are replaced.
-        const CliRun ok = run_in(c + " --out out.csv --model-history history.csv > summary.json", dir);
-        EXPECT_EQ(ok.exit_code, 0) << ok.err;
-        EXPECT_TRUE(has(slurp(dir / "out.csv"), ",status\n"));
-        EXPECT_TRUE(has(slurp(dir / "history.csv"), "t,version,chu,axis"));
+        expect_committed_together(dir, c,
+                                  {"--model-history",
+                                   "history.csv",
+                                   {kPrevious[0], kPrevious[1]},
+                                   {kPrevious[0]},
+                                   {kPrevious[1]},
+                                   {{"out.csv", ",status\n"}, {"history.csv", "t,version,chu,axis"}}});
     }
 }
 
@@ -146,24 +194,13 @@ TEST(RunOutputs, TheCombinedFileIsCommittedWithTheCorrectedFile) {
     };
     for (const std::string& c : commands) {
         SCOPED_TRACE(c);
-        write(dir / "out.csv", "the previous corrected file\n");
-        write(dir / "history.csv", "the previous history\n");
-        write(dir / "combined.csv", "the previous combined file\n");
-        const CliRun a = run_in(c + " --out out.csv --combined /dev/full > summary.json", dir);
-        EXPECT_EQ(a.exit_code, 1);
-        EXPECT_TRUE(has(a.err, "--combined /dev/full: write failed: No space left on device")) << a.err;
-        EXPECT_EQ(slurp(dir / "out.csv"), "the previous corrected file\n");
-        EXPECT_EQ(slurp(dir / "history.csv"), "the previous history\n");
-        const CliRun b = run_in(c + " --out /dev/full --combined combined.csv > summary.json", dir);
-        EXPECT_EQ(b.exit_code, 1);
-        EXPECT_TRUE(has(b.err, "--out /dev/full: write failed: No space left on device")) << b.err;
-        EXPECT_EQ(slurp(dir / "combined.csv"), "the previous combined file\n");
-        EXPECT_TRUE(temporaries_in(dir).empty());
-        // Control: with all writable, all are replaced.
-        const CliRun ok = run_in(c + " --out out.csv --combined combined.csv > summary.json", dir);
-        EXPECT_EQ(ok.exit_code, 0) << ok.err;
-        EXPECT_TRUE(has(slurp(dir / "out.csv"), ",status\n"));
-        EXPECT_TRUE(has(slurp(dir / "combined.csv"), "t,qw,qx,qy,qz,heads"));
+        expect_committed_together(dir, c,
+                                  {"--combined",
+                                   "combined.csv",
+                                   kPrevious,
+                                   {kPrevious[0], kPrevious[1]},
+                                   {kPrevious[2]},
+                                   {{"out.csv", ",status\n"}, {"combined.csv", "t,qw,qx,qy,qz,heads"}}});
     }
 }
 
