@@ -11,9 +11,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <ostream>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ascorr/ascorr.hpp"
@@ -63,17 +65,32 @@ inline Eigen::Quaterniond random_attitude(std::mt19937_64& rng) {
     return q;
 }
 
+// The message of the E that f() throws; nothing when it throws nothing.
+template <typename E, typename F>
+std::optional<std::string> message_thrown(F&& f) {
+    try {
+        f();
+    } catch (const E& e) {
+        return std::string(e.what());
+    }
+    return std::nullopt;
+}
+
 // The message of the E that f() throws; when it throws nothing, a failure
 // `accepted` and "".
 template <typename E, typename F>
 std::string thrown_by(F&& f, const std::string& accepted) {
-    try {
-        f();
-    } catch (const E& e) {
-        return e.what();
+    const std::optional<std::string> m = message_thrown<E>(std::forward<F>(f));
+    if (!m) {
+        ADD_FAILURE() << accepted;
     }
-    ADD_FAILURE() << accepted;
-    return "";
+    return m.value_or("");
+}
+
+// The message of the E that f() throws; `none` when it throws nothing.
+template <typename E, typename F>
+std::string message_of(F&& f, const std::string& none) {
+    return message_thrown<E>(std::forward<F>(f)).value_or(none);
 }
 
 // Copies the CSV file `from` to `to`: its header line as it is, then what

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,12 +29,22 @@ namespace fault = hal::fault;
 const std::string kExamples = ASCORR_HAL_EXAMPLES;
 
 std::string config_error(const std::string& text) {
-    try {
-        hal::parse_config("board.cfg", text);
-    } catch (const text::InputError& e) {
-        return e.what();
-    }
-    return "no error";
+    return message_of<text::InputError>([&] { static_cast<void>(hal::parse_config("board.cfg", text)); }, "no error");
+}
+
+// The message of ReplaySource's refusal of TEXT, "no error" when it accepts.
+std::string replay_error(const std::string& text, const hal::AcquisitionConfig<double>& c) {
+    return message_of<text::InputError>([&] { hal::ReplaySource("r.csv", text, c); }, "no error");
+}
+
+// The message of parse_history's refusal of TEXT, "no error" when it accepts.
+std::string history_error(const std::string& text) {
+    return message_of<text::InputError>([&] { static_cast<void>(hal::parse_history("h.csv", text)); }, "no error");
+}
+
+// The message of parse_fault's refusal of SPEC, "no error" when it accepts.
+std::string fault_error(const std::string& spec, const hal::AcquisitionConfig<double>& c) {
+    return message_of<std::invalid_argument>([&] { static_cast<void>(hal::parse_fault(spec, c)); }, "no error");
 }
 
 const char* kChannel = "channel name=T1 adc=0 role=t029 a=1.129241e-3 b=2.341077e-4 c=8.775468e-8\n";
@@ -109,28 +120,21 @@ TEST(HalConfigFile, NonMonotonicSteinhartHartIsRefusedWithItsRange) {
 // positive, are refused naming the fault; so are non-finite history values.
 TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
-    const auto err = [&](const char* spec) {
-        try {
-            hal::parse_fault(spec, c);
-        } catch (const std::invalid_argument& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
     EXPECT_EQ(
-        err("THT00057:offset:10:20:nan"),
+        fault_error("THT00057:offset:10:20:nan", c),
         "fault 'THT00057:offset:10:20:nan': offset VALUE must be a finite number of degC within +-200, got 'nan'");
-    EXPECT_NE(err("THT00057:offset:10:20:inf").find("offset VALUE must be a finite number"), std::string::npos);
-    EXPECT_EQ(err("THT00057:noise:10:20:-5"),
+    EXPECT_NE(fault_error("THT00057:offset:10:20:inf", c).find("offset VALUE must be a finite number"),
+              std::string::npos);
+    EXPECT_EQ(fault_error("THT00057:noise:10:20:-5", c),
               "fault 'THT00057:noise:10:20:-5': noise VALUE must be a number of counts in (0, 65535], got '-5'");
-    EXPECT_NE(err("THT00057:noise:10:20:0").find("noise VALUE must be"), std::string::npos);
-    EXPECT_NE(err("THT00057:noise:10:20:nan").find("noise VALUE must be"), std::string::npos);
-    EXPECT_NE(err("THT00057:noise:10:20:1e300").find("noise VALUE must be"), std::string::npos);
-    EXPECT_EQ(err("THT00057:open:nan:20"),
+    EXPECT_NE(fault_error("THT00057:noise:10:20:0", c).find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(fault_error("THT00057:noise:10:20:nan", c).find("noise VALUE must be"), std::string::npos);
+    EXPECT_NE(fault_error("THT00057:noise:10:20:1e300", c).find("noise VALUE must be"), std::string::npos);
+    EXPECT_EQ(fault_error("THT00057:open:nan:20", c),
               "fault 'THT00057:open:nan:20': FROM and TO must be finite numbers with FROM < TO");
-    EXPECT_NE(err("THT00057:open:0:inf").find("FROM and TO must be finite"), std::string::npos);
-    EXPECT_EQ(err("THT00057:noise:10:20:4"), "no error");
-    EXPECT_EQ(err("THT00057:offset:10:20:-3.5"), "no error");
+    EXPECT_NE(fault_error("THT00057:open:0:inf", c).find("FROM and TO must be finite"), std::string::npos);
+    EXPECT_EQ(fault_error("THT00057:noise:10:20:4", c), "no error");
+    EXPECT_EQ(fault_error("THT00057:offset:10:20:-3.5", c), "no error");
     try {
         hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,inf,3,4\n");
         FAIL();
@@ -142,21 +146,13 @@ TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
 
 TEST(HalReplay, ErrorsNameLineAndColumn) {
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
-    const auto err = [&](const std::string& text) {
-        try {
-            hal::ReplaySource("r.csv", text, c);
-        } catch (const text::InputError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
-    EXPECT_EQ(err("t,THT00029,NOPE\n"), "r.csv:1:12: column 'NOPE' names no configured channel");
-    EXPECT_EQ(err("t,THT00029,THT00029.counts\n"), "r.csv:1:12: channel 'THT00029' recorded twice");
-    EXPECT_EQ(err("THT00029\n1\n"), "r.csv:1:1: no column 't'");
-    EXPECT_EQ(err("t,THT00029.counts\n1,4096\n"), "r.csv:2:3: counts must be an integer in [0, 4095]");
-    EXPECT_EQ(err("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
-    EXPECT_EQ(err("t,THT00029\n-1,3\n"), "r.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
-    EXPECT_EQ(err("t,THT00029\n1,3,4\n"), "r.csv:2:6: expected 2 fields, found 3");
+    EXPECT_EQ(replay_error("t,THT00029,NOPE\n", c), "r.csv:1:12: column 'NOPE' names no configured channel");
+    EXPECT_EQ(replay_error("t,THT00029,THT00029.counts\n", c), "r.csv:1:12: channel 'THT00029' recorded twice");
+    EXPECT_EQ(replay_error("THT00029\n1\n", c), "r.csv:1:1: no column 't'");
+    EXPECT_EQ(replay_error("t,THT00029.counts\n1,4096\n", c), "r.csv:2:3: counts must be an integer in [0, 4095]");
+    EXPECT_EQ(replay_error("t,THT00029\n1,warm\n", c), "r.csv:2:3: not a temperature: 'warm'");
+    EXPECT_EQ(replay_error("t,THT00029\n-1,3\n", c), "r.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
+    EXPECT_EQ(replay_error("t,THT00029\n1,3,4\n", c), "r.csv:2:6: expected 2 fields, found 3");
     EXPECT_EQ(hal::ReplaySource("r.csv", "t,THT00029\n1,3\n2,\n", c).sample_sets(), 2U);
 }
 
@@ -191,38 +187,14 @@ TEST(HalFiles, NumbersBeyondDoubleSayOutOfRange) {
     EXPECT_EQ(config_error("channel name=T1 adc=0 role=t029 a=x b=2 c=3\n"),
               "board.cfg:1:35: 'a': not a finite number: 'x'");
     const hal::AcquisitionConfig<double> c = hal::read_config(kExamples + "/board.cfg").acquisition;
-    const auto replay_error = [&](const std::string& text) {
-        try {
-            hal::ReplaySource("r.csv", text, c);
-        } catch (const text::InputError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
-    EXPECT_EQ(replay_error("t,THT00029\n1,1e999\n"), "r.csv:2:3: " + huge);
-    EXPECT_EQ(replay_error("t,THT00029\n1e999,3\n"), "r.csv:2:1: 't': " + huge);
-    EXPECT_EQ(replay_error("t,THT00029\n1,warm\n"), "r.csv:2:3: not a temperature: 'warm'");
-    const auto history_error = [](const std::string& text) {
-        try {
-            hal::parse_history("h.csv", text);
-        } catch (const text::InputError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
+    EXPECT_EQ(replay_error("t,THT00029\n1,1e999\n", c), "r.csv:2:3: " + huge);
+    EXPECT_EQ(replay_error("t,THT00029\n1e999,3\n", c), "r.csv:2:1: 't': " + huge);
+    EXPECT_EQ(replay_error("t,THT00029\n1,warm\n", c), "r.csv:2:3: not a temperature: 'warm'");
     EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1,1e-999,3,4\n"), "h.csv:2:3: " + tiny);
     EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1e999,2,3,4\n"), "h.csv:2:1: 't': " + huge);
-    const auto fault_error = [&](const std::string& spec) {
-        try {
-            hal::parse_fault(spec, c);
-        } catch (const std::invalid_argument& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
-    EXPECT_EQ(fault_error("THT00057:offset:10:20:1e999"), "fault 'THT00057:offset:10:20:1e999': " + huge);
-    EXPECT_EQ(fault_error("THT00057:open:1e999:20"), "fault 'THT00057:open:1e999:20': " + huge);
-    EXPECT_EQ(fault_error("THT00057:open:x:20"),
+    EXPECT_EQ(fault_error("THT00057:offset:10:20:1e999", c), "fault 'THT00057:offset:10:20:1e999': " + huge);
+    EXPECT_EQ(fault_error("THT00057:open:1e999:20", c), "fault 'THT00057:open:1e999:20': " + huge);
+    EXPECT_EQ(fault_error("THT00057:open:x:20", c),
               "fault 'THT00057:open:x:20': FROM and TO must be finite numbers with FROM < TO");
 }
 
@@ -242,22 +214,16 @@ TEST(HalSimulated, ParseHistoryReadsEveryRowAsBefore) {
     const std::vector<hal::HistoryRow> b = hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n0,1,2,3");
     ASSERT_EQ(b.size(), 1U);
     EXPECT_EQ(b[0].head, -1);
-    const auto err = [](const std::string& text) {
-        try {
-            hal::parse_history("h.csv", text);
-        } catch (const text::InputError& e) {
-            return std::string(e.what());
-        }
-        return std::string("no error");
-    };
-    EXPECT_EQ(err(""), "h.csv:1:1: empty file (no header)");
-    EXPECT_EQ(err("t,t_chu,t_029\n"), "h.csv:1:1: a temperature history needs columns t, t_chu, t_029, t_032");
-    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3\n"), "h.csv:2:6: expected 4 fields, found 3");
-    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,3,4\n\n2,2,3,4\n"), "h.csv:3:1: expected 4 fields, found 1");
-    EXPECT_EQ(err("t,t_chu,t_029,t_032\n1,2,x,4\n"),
+    EXPECT_EQ(history_error(""), "h.csv:1:1: empty file (no header)");
+    EXPECT_EQ(history_error("t,t_chu,t_029\n"),
+              "h.csv:1:1: a temperature history needs columns t, t_chu, t_029, t_032");
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1,2,3\n"), "h.csv:2:6: expected 4 fields, found 3");
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1,2,3,4\n\n2,2,3,4\n"), "h.csv:3:1: expected 4 fields, found 1");
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\n1,2,x,4\n"),
               "h.csv:2:5: not a temperature: 'x' (a finite number, or empty or nan for none)");
-    EXPECT_EQ(err("t,t_chu,t_029,t_032\nsoon,2,3,4\n"), "h.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
-    EXPECT_EQ(err("t,chu,t_chu,t_029,t_032\n1,AB,2,3,4\n"), "h.csv:2:3: 'chu' must be A, B, C or D");
+    EXPECT_EQ(history_error("t,t_chu,t_029,t_032\nsoon,2,3,4\n"),
+              "h.csv:2:1: 't' must be a number of seconds in [0, 1e12]");
+    EXPECT_EQ(history_error("t,chu,t_chu,t_029,t_032\n1,AB,2,3,4\n"), "h.csv:2:3: 'chu' must be A, B, C or D");
 }
 
 // Each injected fault class reaches the acquisition as its flag.

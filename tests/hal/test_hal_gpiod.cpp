@@ -74,21 +74,14 @@ TEST(HalGpiod, MissingChipOrLineIsAnErrorNamingIt) {
     gpiod_double::reset({});
     hal::GpioWiring w = board().gpio;
     w.chip = "gpiochip7";
-    try {
-        hal::GpiodPins pins(w);
-        FAIL() << "no exception";
-    } catch (const std::system_error& e) {
-        EXPECT_NE(std::string(e.what()).find("gpiochip7"), std::string::npos) << e.what();
-    }
+    const auto refusal = [&w] { hal::GpiodPins pins(w); };
+    const std::string no_chip = thrown_by<std::system_error>(refusal, "no exception");
+    EXPECT_NE(no_chip.find("gpiochip7"), std::string::npos) << no_chip;
     gpiod_double::reset({});
     w = board().gpio;
     w.miso = 40;  // the scripted chip has 32 lines
-    try {
-        hal::GpiodPins pins(w);
-        FAIL() << "no exception";
-    } catch (const std::exception& e) {
-        EXPECT_NE(std::string(e.what()).find("gpiochip0: line 40 (MISO)"), std::string::npos) << e.what();
-    }
+    const std::string no_line = thrown_by<std::exception>(refusal, "no exception");
+    EXPECT_NE(no_line.find("gpiochip0: line 40 (MISO)"), std::string::npos) << no_line;
     gpiod_double::reset({});
     {
         hal::GpiodPins first(board().gpio);  // a second user of the same lines
