@@ -236,15 +236,20 @@ TEST(Properties, RenormalisationIsNewtonStep) {
 }
 
 // ---- Bad input: every case gets its status and never a wrong correction.
+
+// A bad-input case: what it is, the input that is bad, the head, and what it gives.
+template <typename Input, typename Want>
+struct HeadCase {
+    const char* what;
+    Input input;
+    std::uint8_t head;
+    Want want;
+};
+
 TEST(BadInput, RejectedSolutionsComeBackUnchanged) {
     const ThermalModel<double> model = host::to_core<double>(table2());
     const CorrectionConfig<double> cfg{true, &model};
-    struct Case {
-        const char* what;
-        Quaternion<double> q;
-        std::uint8_t head;
-        Rejection why;
-    };
+    using Case = HeadCase<Quaternion<double>, Rejection>;
     const double inf = std::numeric_limits<double>::infinity();
     const Case cases[] = {
         {"NaN component", {kNaN, 0, 0, 1}, 0, Rejection::kQuaternionNotFinite},
@@ -257,11 +262,12 @@ TEST(BadInput, RejectedSolutionsComeBackUnchanged) {
         {"head 255", {1, 0, 0, 0}, 255, Rejection::kHeadOutOfRange},
     };
     for (const Case& c : cases) {
-        SolutionInput<double> in = input(c.q, c.head);
-        EXPECT_EQ(check_solution(in), c.why) << c.what;
+        SolutionInput<double> in = input(c.input, c.head);
+        EXPECT_EQ(check_solution(in), c.want) << c.what;
         const auto out = correct_solution(in, cfg);
         EXPECT_EQ(out.status, status::kRejected) << c.what;
-        EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &c.q, sizeof c.q), 0) << c.what << ": must be returned bit for bit";
+        EXPECT_EQ(std::memcmp(&out.q_chu_icrf, &c.input, sizeof c.input), 0)
+            << c.what << ": must be returned bit for bit";
     }
 }
 
@@ -409,12 +415,7 @@ TEST(StatusBits, EveryStatusTheCoreEmitsFollowsTheRule) {
 TEST(BadInput, TemperatureCases) {
     const ThermalModel<double> model = host::to_core<double>(table2());
     const Quaternion<double> q{0.5, 0.5, 0.5, 0.5};
-    struct Case {
-        const char* what;
-        HeadTemperatures<double> t;
-        std::uint8_t head;
-        StatusBits want;
-    };
+    using Case = HeadCase<HeadTemperatures<double>, StatusBits>;
     const double inf = std::numeric_limits<double>::infinity();
     const Case cases[] = {
         {"t_chu missing", {{0, false}, {-5, true}, {-20, true}}, 0, status::kNoTemperature},
@@ -438,7 +439,7 @@ TEST(BadInput, TemperatureCases) {
     };
     for (const Case& c : cases) {
         SolutionInput<double> in = input(q, c.head);
-        in.temperatures = c.t;
+        in.temperatures = c.input;
         const auto out = correct_solution(in, CorrectionConfig<double>{false, &model});
         EXPECT_EQ(out.status, c.want) << c.what;
         if ((c.want & status::kThermalApplied) == 0) {
