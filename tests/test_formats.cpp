@@ -13,6 +13,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "ascorr_host/formats/csv.hpp"
@@ -46,6 +47,15 @@ std::string error_of(const std::string& text) {
         return std::to_string(e.line()) + ":" + std::to_string(e.column()) + ": " + e.what();
     }
     return "";
+}
+
+// Expects the message of REFUSAL(text) to hold part, for each {text, part}.
+template <typename F>
+void expect_refusals(F refusal, const std::vector<std::pair<std::string, std::string>>& cases) {
+    for (const auto& [text, part] : cases) {
+        const std::string e = refusal(text);
+        EXPECT_NE(e.find(part), std::string::npos) << text << ": " << e;
+    }
 }
 
 TEST(SolutionsReader, ReadsExampleFile) {
@@ -130,26 +140,26 @@ TEST(SolutionsReader, UnknownHeadIsDataNotSyntax) {
 TEST(SolutionsReader, MalformedInputNamesLineAndColumn) {
     const std::string h = kHeader;
     EXPECT_EQ(error_of(""), "1:1: f.csv:1:1: empty file: expected a header line");
-    EXPECT_NE(error_of("t,chu,qw,qx,qy\n").find("required column 'qz' is missing"), std::string::npos);
-    EXPECT_NE(error_of("t,chu,qw,qw,qx,qy,qz\n").find("appears twice"), std::string::npos);
+    expect_refusals(error_of, {{"t,chu,qw,qx,qy\n", "required column 'qz' is missing"},
+                               {"t,chu,qw,qw,qx,qy,qz\n", "appears twice"}});
     // A number that is not one: line 3, column of the qx field.
     const std::string bad_qx = h + "1,A,1,0,0,0,1,2,3,1,2,3,0,1\n" + "2,A,1,abc,0,0,1,2,3,1,2,3,0,1\n";
     EXPECT_EQ(error_of(bad_qx).substr(0, 5), "3:7: ");
-    EXPECT_NE(error_of(bad_qx).find("column 'qx': expected a number, got 'abc'"), std::string::npos);
-    // Truncated row.
-    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2\n").find("truncated row"), std::string::npos);
-    // Too many fields.
-    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,0,1,9\n").find("found 15"), std::string::npos);
-    // Temperature garbage is an error, not "missing".
-    EXPECT_NE(error_of(h + "1,A,1,0,0,0,hot,2,3,1,2,3,0,1\n").find("column 't_chu'"), std::string::npos);
-    // Non-finite time.
-    EXPECT_NE(error_of(h + "inf,A,1,0,0,0,1,2,3,1,2,3,0,1\n").find("time must be finite"), std::string::npos);
-    // Flags must be a non-negative integer.
-    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,1.5,1\n").find("column 'flags'"), std::string::npos);
-    EXPECT_NE(error_of(h + "1,A,1,0,0,0,1,2,3,1,2,3,-1,1\n").find("column 'flags'"), std::string::npos);
-    // Spaces and quotes are not numbers in this format.
-    EXPECT_NE(error_of(h + "1,A, 1,0,0,0,1,2,3,1,2,3,0,1\n").find("column 'qw'"), std::string::npos);
-    EXPECT_NE(error_of(h + "1,A,\"1\",0,0,0,1,2,3,1,2,3,0,1\n").find("column 'qw'"), std::string::npos);
+    expect_refusals(error_of, {{bad_qx, "column 'qx': expected a number, got 'abc'"},
+                               // Truncated row.
+                               {h + "1,A,1,0,0,0,1,2\n", "truncated row"},
+                               // Too many fields.
+                               {h + "1,A,1,0,0,0,1,2,3,1,2,3,0,1,9\n", "found 15"},
+                               // Temperature garbage is an error, not "missing".
+                               {h + "1,A,1,0,0,0,hot,2,3,1,2,3,0,1\n", "column 't_chu'"},
+                               // Non-finite time.
+                               {h + "inf,A,1,0,0,0,1,2,3,1,2,3,0,1\n", "time must be finite"},
+                               // Flags must be a non-negative integer.
+                               {h + "1,A,1,0,0,0,1,2,3,1,2,3,1.5,1\n", "column 'flags'"},
+                               {h + "1,A,1,0,0,0,1,2,3,1,2,3,-1,1\n", "column 'flags'"},
+                               // Spaces and quotes are not numbers in this format.
+                               {h + "1,A, 1,0,0,0,1,2,3,1,2,3,0,1\n", "column 'qw'"},
+                               {h + "1,A,\"1\",0,0,0,1,2,3,1,2,3,0,1\n", "column 'qw'"}});
 }
 
 TEST(SolutionsReader, ReaderMovesPastABadRow) {
@@ -376,16 +386,16 @@ TEST(ModelFile, MalformedModels) {
         return "";
     };
     const std::string h = "chu,axis,c0,c1,c2,c3\n";
-    EXPECT_NE(err("").find("empty model"), std::string::npos);
-    EXPECT_NE(err("chu,axis,c0,c1\n").find("must have chu,axis,c0,c1,c2,c3"), std::string::npos);
-    EXPECT_NE(err(h).find("no rows"), std::string::npos);
-    EXPECT_NE(err(h + "E,alpha,1,2,3,4\n").find("m.csv:2:1: chu must be"), std::string::npos);
-    EXPECT_NE(err(h + "A,delta,1,2,3,4\n").find("m.csv:2:3: axis must be"), std::string::npos);
-    EXPECT_NE(err(h + "A,alpha,1,2,x,4\n").find("m.csv:2:13: column 'c2'"), std::string::npos);
-    EXPECT_NE(err(h + "A,alpha,1,2,nan,4\n").find("finite"), std::string::npos);
-    EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,alpha,1,2,3,4\n").find("second row for A alpha"), std::string::npos);
-    EXPECT_NE(err(h + "A,alpha,1,2,3,4\nA,beta,1,2,3,4\n").find("head A has no gamma row"), std::string::npos);
-    EXPECT_NE(err(h + "A,alpha,1,2,3\n").find("expected 6 fields"), std::string::npos);
+    expect_refusals(err, {{"", "empty model"}, {"chu,axis,c0,c1\n", "must have chu,axis,c0,c1,c2,c3"}, {h, "no rows"}});
+    // Rows below the header.
+    const auto rows_err = [&](const std::string& rows) { return err(h + rows); };
+    expect_refusals(rows_err, {{"E,alpha,1,2,3,4\n", "m.csv:2:1: chu must be"},
+                               {"A,delta,1,2,3,4\n", "m.csv:2:3: axis must be"},
+                               {"A,alpha,1,2,x,4\n", "m.csv:2:13: column 'c2'"},
+                               {"A,alpha,1,2,nan,4\n", "finite"},
+                               {"A,alpha,1,2,3,4\nA,alpha,1,2,3,4\n", "second row for A alpha"},
+                               {"A,alpha,1,2,3,4\nA,beta,1,2,3,4\n", "head A has no gamma row"},
+                               {"A,alpha,1,2,3\n", "expected 6 fields"}});
 }
 
 // The writer's header is its column list, and a row it writes reads back
