@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <iostream>
 #include <ostream>
 #include <sstream>
@@ -13,6 +14,8 @@
 #include "ascorr/core/q_formats.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
+#include "cli_run.hpp"
+#include "test_support.hpp"
 
 namespace ascorr::host {
 // GoogleTest shows a board by its replay name (not its bytes) in test names.
@@ -58,6 +61,29 @@ inline host::ReplaySummary replay_printed(const host::ReplayOptions& o, std::ost
     const host::ReplaySummary s = host::replay(o, log);
     std::cout << label << host::to_json(s) << "\n" << log.str();
     return s;
+}
+
+// A scratch folder NAME in which `simulate --out sim.csv ARGS` has run.
+inline std::filesystem::path simulated_in(const std::string& name, const std::string& args) {
+    const auto dir = scratch_dir(name);
+    const CliRun r = run_in("simulate --out sim.csv " + args, dir);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return dir;
+}
+
+// A replay through TARGET of dir/sim.csv into dir/replayed.csv.
+inline host::ReplayOptions replay_options(const std::filesystem::path& dir, const std::string& target) {
+    host::ReplayOptions o;
+    o.target = target;
+    o.in = (dir / "sim.csv").string();
+    o.out = (dir / "replayed.csv").string();
+    return o;
+}
+
+// replay_printed of O on BOARD, with a log of its own, after the board's replay name.
+inline host::ReplaySummary replay_on_board(const host::QemuTarget& board, const host::ReplayOptions& o) {
+    std::ostringstream log;
+    return replay_printed(o, log, std::string(board.replay) + ": ");
 }
 
 }  // namespace ascorr::test

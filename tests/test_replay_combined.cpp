@@ -36,18 +36,12 @@ constexpr std::size_t kEpochs = 289;  // two days at 600 s, and the first
 
 // Two simulated days at 600 s; the simulator also writes its mountings.
 std::filesystem::path simulated(const std::string& name) {
-    const auto dir = scratch_dir(name);
-    const CliRun r = run_in("simulate --out sim.csv --days 2 --step 600 --seed 7", dir);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return dir;
+    return simulated_in(name, "--days 2 --step 600 --seed 7");
 }
 
 host::ReplayOptions options(const std::filesystem::path& dir, const std::string& target) {
-    host::ReplayOptions o;
-    o.target = target;
-    o.in = (dir / "sim.csv").string();
+    host::ReplayOptions o = replay_options(dir, target);
     o.model = data_path("model_table2.csv");
-    o.out = (dir / "replayed.csv").string();
     o.mountings = (dir / "sim.csv.mountings.csv").string();
     o.combined = (dir / "replayed.combined.csv").string();
     return o;
@@ -211,9 +205,7 @@ class ReplayCombinedQemu : public ::testing::TestWithParam<host::QemuTarget> {};
 TEST_P(ReplayCombinedQemu, SameCombinedAttitudesAsTheHost) {
     const host::QemuTarget& board = GetParam();
     const auto dir = simulated("replay_combined_" + board_name(board));
-    std::ostringstream log;
-    const host::ReplaySummary s =
-        replay_printed(options(dir, std::string(board.replay)), log, std::string(board.replay) + ": ");
+    const host::ReplaySummary s = replay_on_board(board, options(dir, std::string(board.replay)));
     expect_agreement(s);
     EXPECT_GT(s.combination_instructions_per_epoch, 0.0);
     expect_near_double(dir, board.scalar == host::ScalarKind::kFixed ? 0.01 : 0.05);

@@ -37,17 +37,11 @@ namespace {
 // Four simulated days at 300 s (2751 rows): enough orbits (≥ 30 with ≥ 4
 // epochs each) for the estimator to adopt a model on day 3.
 std::filesystem::path simulated(const std::string& name, const std::string& extra = "") {
-    const auto dir = scratch_dir(name);
-    const CliRun r = run_in("simulate --out sim.csv --days 4 --step 300 --seed 3" + extra, dir);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return dir;
+    return simulated_in(name, "--days 4 --step 300 --seed 3" + extra);
 }
 
 host::ReplayOptions options(const std::filesystem::path& dir, const std::string& target) {
-    host::ReplayOptions o;
-    o.target = target;
-    o.in = (dir / "sim.csv").string();
-    o.out = (dir / "replayed.csv").string();
+    host::ReplayOptions o = replay_options(dir, target);
     o.model_history = (dir / "replayed.history.csv").string();
     o.self_calibrate = true;
     return o;
@@ -304,23 +298,21 @@ TEST(ReplaySelfCalibration, OptionsAreChecked) {
 #ifdef ASCORR_REPLAY_QEMU
 class ReplaySelfCalibrationQemu : public ::testing::TestWithParam<host::QemuTarget> {};
 
+// The rule for the common rotation on each board, bit for bit.
+TEST_P(ReplaySelfCalibrationQemu, TheCommonRotationRuleAsTheHost) {
+    const host::QemuTarget& board = GetParam();
+    expect_rule_as_correct(std::string(board.replay), board_scalar(board), "replay_sc_rule_" + board_name(board));
+}
+
 // Each board against the host in its own scalar (Q30 on the M3, float on the
 // M4F, whose link image does not fuse multiply-adds), bit for bit.
 TEST_P(ReplaySelfCalibrationQemu, SameModelsAndAnswersAsTheHost) {
     const host::QemuTarget& board = GetParam();
     const auto dir = simulated("replay_sc_" + board_name(board));
-    std::ostringstream log;
-    const host::ReplaySummary s =
-        replay_printed(options(dir, std::string(board.replay)), log, std::string(board.replay) + ": ");
+    const host::ReplaySummary s = replay_on_board(board, options(dir, std::string(board.replay)));
     expect_agreement(s);
-    EXPECT_EQ(s.restarts, 0U);
     expect_same_as_correct(dir, board_scalar(board));
-}
-
-// The rule for the common rotation on each board, bit for bit.
-TEST_P(ReplaySelfCalibrationQemu, TheCommonRotationRuleAsTheHost) {
-    const host::QemuTarget& board = GetParam();
-    expect_rule_as_correct(std::string(board.replay), board_scalar(board), "replay_sc_rule_" + board_name(board));
+    EXPECT_EQ(s.restarts, 0U);
 }
 
 // Four heads from a model, on each board: D learnt on board as on the host,
