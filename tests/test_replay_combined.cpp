@@ -103,6 +103,29 @@ TEST(ReplayCombined, LoopbackAgreesAndIsNearTheDoubleCombination) {
     expect_near_double(dir, 0.05);
 }
 
+// SOLUTION_IN's clean bit is the combination's selection (flags 0,
+// confidence <= 5; combine/usable.hpp), not self-calibration's, which also
+// needs a confidence given: rows without one are combined on the target as by
+// `correct --combined` (before, the target left every head out: status 8).
+TEST(ReplayCombined, TheCleanBitIsTheCombinationsSelection) {
+    const auto dir = simulated("replay_combined_clean");
+    std::filesystem::rename(dir / "sim.csv", dir / "with_confidence.csv");
+    rewrite_csv_rows(dir / "with_confidence.csv", dir / "sim.csv", [](const std::string& line, std::ostream& out) {
+        out << line.substr(0, line.rfind(',') + 1) << '\n';  // confidence: empty
+    });
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(options(dir, "loopback-float"), log);
+    expect_agreement(s);
+    expect_near_double(dir, 0.05);
+    host::AttitudeReader target((dir / "replayed.combined.csv").string());
+    host::AttitudeRow a;
+    std::size_t combined = 0;
+    while (target.next(a)) {
+        combined += a.has_q ? 1U : 0U;
+    }
+    EXPECT_GT(combined, kEpochs / 2);
+}
+
 // A target whose mountings differ from the host's (head A's turned by 4″ in
 // MOUNTING_LOAD): its combined attitudes must be caught.
 TEST(ReplayCombined, ATargetWithOtherMountingsIsCaught) {

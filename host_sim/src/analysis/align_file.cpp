@@ -26,17 +26,6 @@ namespace ascorr::host {
 
 namespace {
 
-// Why a row cannot be averaged in, on its own: combine.hpp's rule, and a
-// quaternion the combiner would refuse (not unit, not finite); the epoch's
-// stage mix is decided afterwards (LeftOut::kStageMissing).
-LeftOut why_left_out(const CorrectedRow& r, const MountingsFile& m) noexcept {
-    const LeftOut why = why_unusable(r, m);
-    if (why == LeftOut::kUsed && !norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)) {
-        return LeftOut::kNotUnit;
-    }
-    return why;
-}
-
 std::string time_text(double t) {
     char buf[48];
     text::c_snprintf(buf, sizeof buf, "%.3f", t);
@@ -72,14 +61,24 @@ struct Judged {
     LeftOut why;
 };
 
-// The epoch's stages: those applied to any usable row (a usable row without
-// one is left out, combine.hpp).
-StatusBits epoch_stages(const Epoch<Judged>& e) noexcept {
-    StatusBits stages = 0U;
-    for (const std::optional<Judged>& j : e.head) {
-        if (j && j->why == LeftOut::kUsed && j->row.corrected) {
-            stages = static_cast<StatusBits>(stages | (j->row.status & kBothStages));
+// The core's step 2 over the epoch's rows (combine/usable.hpp; a second row
+// of a head was refused when read): `why` from each row's own, and a usable
+// row without a stage another has gets kStageMissing. Returns the stages.
+StatusBits select_epoch(const Epoch<Judged>& e, std::array<LeftOut, kMaxHeads>& why) noexcept {
+    combine::RowFacts facts[kMaxHeads];
+    LeftOut whys[kMaxHeads];
+    std::uint8_t heads[kMaxHeads];
+    std::size_t n = 0;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (e.head[h]) {
+            facts[n] = row_facts(e.head[h]->row);
+            whys[n] = e.head[h]->why;
+            heads[n++] = h;
         }
+    }
+    const StatusBits stages = combine::select_epoch(facts, whys, n, combine::Repeated::kLeaveAllOut);
+    for (std::size_t i = 0; i < n; ++i) {
+        why[heads[i]] = whys[i];
     }
     return stages;
 }
@@ -107,17 +106,8 @@ void apply_gate(const StageGates& gates, const Epoch<Judged>& e, StatusBits stag
 // gate, if any, leaves in).
 void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const StageGates* gate, AlignSums& sums,
                PassCounts& c) {
-    const StatusBits stages = epoch_stages(e);
     std::array<LeftOut, kMaxHeads> why{};
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (e.head[h]) {
-            const CorrectedRow& r = e.head[h]->row;
-            why[h] = e.head[h]->why;
-            if (why[h] == LeftOut::kUsed && r.corrected && (r.status & stages) != stages) {
-                why[h] = LeftOut::kStageMissing;
-            }
-        }
-    }
+    const StatusBits stages = select_epoch(e, why);
     if (gate != nullptr) {
         apply_gate(*gate, e, stages, why);
     }
@@ -196,7 +186,7 @@ void run_pass(const CorrectedRowSource& rows, const std::string& file, const Mou
             return;
         }
         ++c.rows_in_period;
-        LeftOut why = why_left_out(r, m);
+        LeftOut why = why_unusable(r, m);
         if (why != LeftOut::kNotAHead && why != LeftOut::kNotInMountings && !(std::abs(r.t) < kMaxEpochTimeS)) {
             why = LeftOut::kNoEpoch;
         }

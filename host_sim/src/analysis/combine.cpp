@@ -35,19 +35,6 @@ namespace {
 
 namespace cs = combine::combined_status;
 
-constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
-                                                      "flagged",
-                                                      "confidence above 5",
-                                                      "rejected (16)",
-                                                      "stage skipped (4, 8, 128, 256)",
-                                                      "stage missing",
-                                                      "not a head",
-                                                      "not in the mountings",
-                                                      "two rows of one head",
-                                                      "inconsistent",
-                                                      "quaternion not unit",
-                                                      "in no epoch"};
-
 // A row as kept between reading and combining (48 bytes, 56 with its key): whether it is
 // usable is decided when it is read, from what needs no other row.
 struct Kept {
@@ -61,26 +48,14 @@ struct Kept {
 
 }  // namespace
 
+combine::RowFacts row_facts(const CorrectedRow& r) noexcept {
+    return {r.head, r.corrected ? r.status : StatusBits{0}, r.flags != 0,
+            r.confidence <= combine::kMaxCleanConfidenceArcsec,
+            norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)};
+}
+
 LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept {
-    if (r.head >= kMaxHeads) {
-        return LeftOut::kNotAHead;
-    }
-    if (!m.mountings.head[r.head].present) {
-        return LeftOut::kNotInMountings;
-    }
-    if (r.corrected && (r.status & status::kRejected) != 0U) {
-        return LeftOut::kRejected;
-    }
-    if (r.flags != 0) {
-        return LeftOut::kFlagged;
-    }
-    if (!(r.confidence <= combine::kMaxCleanConfidenceArcsec)) {
-        return LeftOut::kConfidence;
-    }
-    if (r.corrected && (r.status & combine::kStageSkipped) != 0U) {
-        return LeftOut::kStageSkipped;
-    }
-    return LeftOut::kUsed;
+    return combine::left_out_alone(row_facts(r), combine::mounted_heads(m.mountings));
 }
 
 namespace {
@@ -93,10 +68,6 @@ std::string time_text(double t) {
 
 }  // namespace
 
-const char* left_out_name(LeftOut why) noexcept {
-    return kLeftOutNames[static_cast<std::size_t>(why)];
-}
-
 std::string describe(const CombineSummary& s) {
     std::ostringstream o;
     o << s.epochs << " epochs from " << s.rows << " rows";
@@ -107,7 +78,7 @@ std::string describe(const CombineSummary& s) {
     bool any = false;
     for (std::size_t k = 1; k < kLeftOutKinds; ++k) {
         if (s.rows_left_out[k] != 0) {
-            o << (any ? ", " : "; left out: ") << s.rows_left_out[k] << ' ' << kLeftOutNames[k];
+            o << (any ? ", " : "; left out: ") << s.rows_left_out[k] << ' ' << left_out_name(static_cast<LeftOut>(k));
             any = true;
         }
     }
@@ -295,39 +266,38 @@ struct CombineStage::Impl {
 
     std::string where(std::size_t line) const { return text::input_name(file) + ":" + std::to_string(line) + ": "; }
 
-    // Two rows of one head: both left out, named with the first's line.
-    void mark_duplicates(std::vector<Kept>& rows) {
+    // Step 2 of the core's selection (combine/usable.hpp) over the epoch's
+    // rows, sorted by head and line: two rows of one head (both left out,
+    // named with the first's line), a usable row without a stage another
+    // usable row has. Returns the epoch's stages.
+    StatusBits select(std::vector<Kept>& rows) {
+        facts.clear();
+        whys.clear();
+        for (const Kept& k : rows) {
+            facts.push_back({k.head, k.stages, false, true, true});
+            whys.push_back(k.why);
+        }
+        const StatusBits stages =
+            combine::select_epoch(facts.data(), whys.data(), rows.size(), combine::Repeated::kLeaveAllOut);
+        std::size_t first = 0;  // the first row of rows[i]'s head
         for (std::size_t i = 0; i < rows.size(); ++i) {
-            for (std::size_t j = i + 1; j < rows.size(); ++j) {
-                if (rows[i].head == rows[j].head && rows[i].head < kMaxHeads) {
-                    if (rows[j].why != LeftOut::kDuplicate) {
-                        diag.report("two rows of one head",
-                                    where(rows[j].line) + "a second row of CHU " + head_name(rows[j].head) +
-                                        " at t = " + time_text(rows[j].t) + " (the first on line " +
-                                        std::to_string(rows[i].line) + "): both left out (status 4)");
-                    }
-                    rows[i].why = LeftOut::kDuplicate;
-                    rows[j].why = LeftOut::kDuplicate;
-                }
+            first = rows[i].head == rows[first].head ? first : i;
+            if (whys[i] == LeftOut::kDuplicate && i != first) {
+                diag.report("two rows of one head", where(rows[i].line) + "a second row of CHU " +
+                                                        head_name(rows[i].head) + " at t = " + time_text(rows[i].t) +
+                                                        " (the first on line " + std::to_string(rows[first].line) +
+                                                        "): both left out (status 4)");
             }
         }
-    }
-
-    // A usable row without a stage applied to another usable row of the
-    // epoch; returns the epoch's stages.
-    std::uint8_t mark_missing_stages(std::vector<Kept>& rows) {
-        std::uint8_t stages = 0;
-        for (const Kept& k : rows) {
-            stages = static_cast<std::uint8_t>(stages | (k.why == LeftOut::kUsed ? k.stages : 0U));
-        }
-        for (Kept& k : rows) {
-            if (k.why == LeftOut::kUsed && k.stages != stages) {
-                k.why = LeftOut::kStageMissing;
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+            if (whys[i] == LeftOut::kStageMissing) {
+                const Kept& k = rows[i];
                 diag.report("stage missing", where(k.line) + "CHU " + head_name(k.head) + " at t = " + time_text(k.t) +
                                                  ": status " + std::to_string(k.stages) +
                                                  " lacks a stage applied to another head of the epoch (status " +
                                                  std::to_string(stages) + "): left out (status 4)");
             }
+            rows[i].why = whys[i];
         }
         return stages;
     }
@@ -415,9 +385,8 @@ struct CombineStage::Impl {
         std::sort(rows.begin(), rows.end(), [](const Kept& a, const Kept& b) {
             return a.head < b.head || (a.head == b.head && a.line < b.line);
         });
-        mark_duplicates(rows);
         // The epoch's gate by its stages (GateOptions): a raw file's rows have none.
-        const combine::Combiner<double>& combiner = gates.of(mark_missing_stages(rows));
+        const combine::Combiner<double>& combiner = gates.of(select(rows));
         combine::HeadAttitude<double> heads[kMaxHeads];
         std::size_t used_row[kMaxHeads] = {};
         std::uint8_t n = 0;
@@ -430,8 +399,8 @@ struct CombineStage::Impl {
         const combine::CombinedAttitude<double> c = combiner.combine(heads, n);
         for (std::uint8_t i = 0; i < n; ++i) {
             const HeadMask bit = ascorr::head_bit(heads[i].head);
-            if ((c.used & bit) == 0U) {
-                rows[used_row[i]].why = (c.inconsistent & bit) != 0U ? LeftOut::kInconsistent : LeftOut::kNotUnit;
+            if ((c.used & bit) == 0U) {  // the selection took head, mounting and norm: only the gate is left
+                rows[used_row[i]].why = LeftOut::kInconsistent;
             }
         }
         bool left_out = false;
@@ -488,6 +457,8 @@ struct CombineStage::Impl {
     Mode mode;
     std::string buf;
     std::vector<Kept> epoch;
+    std::vector<combine::RowFacts> facts;  // select()'s, kept between epochs
+    std::vector<LeftOut> whys;
     pipeline::ConsecutiveEpochs epochs;  // the open epoch: consecutive rows with one key
     std::vector<std::pair<std::int64_t, Kept>> kept;
     CombineSummary sum;

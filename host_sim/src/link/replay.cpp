@@ -528,12 +528,17 @@ private:
         status_d = vd.status;
     }
 
+    // SOLUTION_IN's clean bit: the selection of what the target learns from,
+    // as the host's self-calibration over the file (calibration_clean, which
+    // also needs the row's own velocity and temperatures); otherwise the
+    // combination's, as `correct --combined` (the camera head's own: flags 0,
+    // confidence <= 5; the target's pipeline adds the status, usable.hpp).
     std::uint8_t calib_use_of(const SolutionRecord& rec, bool timed) const {
         std::uint8_t calib_use = 0U;
         if (opt_.self_calibrate) {
             calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
         } else if (combination_ != nullptr) {
-            calib_use = calibration_clean(rec) ? link::kCalibClean : 0U;  // the combination's selection
+            calib_use = clean_for_combination(CorrectedRow::of(rec, false, 0U)) ? link::kCalibClean : 0U;
         }
         return calib_use;
     }

@@ -1,33 +1,178 @@
-// ascorr/combine/usable.hpp: which corrected solution the combination may
-// average in (the contract's "Combined attitude": a usable head).
+// ascorr/combine/usable.hpp: which corrected solutions of an epoch the
+// combination may average in, and why each other one is left out (the
+// contract's "Combined attitude": a usable head; bit 4 of the combined status).
 //
-// A solution is usable when it is clean (the camera head's own selection:
-// flags 0 and confidence ≤ 5″, as in Statistics) and its correction
-// neither rejected it (16) nor skipped a stage: no velocity (4), no
-// temperatures (8), a model angle out of range (128), no model for the head
-// (256). A head corrected otherwise would disagree with the others by the
-// stage it lacks (up to 25″ of aberration, the bench's thermal deformation),
-// so it is left out (bit 4 of the combined status), never averaged in. One
-// rule for the flight loop, the link server (epoch pipeline) and the ground
-// (`ascorr combine`, `correct --combined`).
+// One rule, in two steps, for every caller:
+//   1. a row alone (left_out_alone): it is a head of the mountings; it is
+//      clean (the camera head's own selection: flags 0 and confidence ≤ 5″,
+//      as in Statistics); its correction neither rejected it (16) nor skipped
+//      a stage: no velocity (4), no temperatures (8), a model angle out of
+//      range (128), no model for the head (256); its quaternion is unit (the
+//      combiner's own test). A head corrected otherwise would disagree with
+//      the others by the stage it lacks (up to 25″ of aberration, the bench's
+//      thermal deformation), so it is left out, never averaged in;
+//   2. the epoch (select_epoch): a second row of one head (Repeated says
+//      which stand), and a usable row without a stage (1, 2) that another
+//      usable row of the epoch has.
+// The combiner's consistency gate then decides kInconsistent (combiner.hpp).
+//
+// Callers: the ground (`ascorr combine`, `correct --combined`, `align`) run
+// both steps with Repeated::kLeaveAllOut (align refuses a file with a second
+// row instead: a mounting estimate must not depend on which row came first).
+// The flight loop and the link server (epoch pipeline) know with each
+// solution only its status and whether it is clean: they apply step 1's
+// status part (usable_for_combination); the combiner tests head, mounting and
+// norm itself and keeps the first row of a head (Repeated::kKeepFirst: a
+// repeated head is the camera head's retransmission), and the flight loop
+// applies one correction configuration to every head, so step 2's stage mix
+// cannot arise on board.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+
+#include "../core/heads.hpp"
 #include "../core/status.hpp"
 
 namespace ascorr::combine {
 
 // A stage the run asked for and could not apply (4, 8, 128, 256).
-inline constexpr StatusBits kStageSkipped =
+inline constexpr StatusBits kSkippedStages =
     status::kNoVelocity | status::kNoTemperature | status::kThermalOutOfRange | status::kNoModelForHead;
-// The corrected solution's status bits that leave it out.
-inline constexpr StatusBits kNotUsable = status::kRejected | kStageSkipped;
+// The stages a correction applied (1, 2).
+inline constexpr StatusBits kStagesApplied = status::kAberrationApplied | status::kThermalApplied;
 // A clean row's largest confidence (arcsec): the contract's Statistics,
 // which the ground's readers of files apply (on board the camera head says
 // whether its solution is clean).
 inline constexpr double kMaxCleanConfidenceArcsec = 5.0;
 
+// Why a head's row of an epoch is not averaged in: the first reason that
+// applies, in left_out_alone's order, then select_epoch's, then the
+// combiner's (kInconsistent) and the ground's reader's (kNoEpoch).
+enum class LeftOut : std::uint8_t {
+    kUsed,
+    kFlagged,         // flags != 0
+    kConfidence,      // confidence > 5 or not a number
+    kRejected,        // status 16
+    kStageSkipped,    // status 4, 8, 128 or 256
+    kStageMissing,    // a stage other rows of the epoch have (mix)
+    kNotAHead,        // chu is no head of heads.hpp
+    kNotInMountings,  // a head the mountings do not have
+    kDuplicate,       // two rows of one head in one epoch
+    kInconsistent,    // refused by the combiner's gates
+    kNotUnit,         // a quaternion the combiner refuses (not unit, not finite)
+    kNoEpoch,         // |t| beyond the millisecond key (pipeline/epoch_key.hpp): in no epoch
+};
+inline constexpr std::size_t kLeftOutKinds = 12;
+
+// The reasons as the summaries name them (index: LeftOut).
+inline constexpr const char* kLeftOutNames[kLeftOutKinds] = {"used",
+                                                             "flagged",
+                                                             "confidence above 5",
+                                                             "rejected (16)",
+                                                             "stage skipped (4, 8, 128, 256)",
+                                                             "stage missing",
+                                                             "not a head",
+                                                             "not in the mountings",
+                                                             "two rows of one head",
+                                                             "inconsistent",
+                                                             "quaternion not unit",
+                                                             "in no epoch"};
+
+constexpr const char* left_out_name(LeftOut why) noexcept {
+    return kLeftOutNames[static_cast<std::size_t>(why)];
+}
+
+// A row as step 1 sees it: what needs no other row.
+struct RowFacts {
+    std::uint8_t head;  // any byte: an index ≥ kMaxHeads is no head
+    StatusBits status;  // the correction's status; 0 for a row no stage was asked of
+    bool flagged;       // flags != 0
+    bool confident;     // confidence ≤ kMaxCleanConfidenceArcsec (false for NaN)
+    bool unit;          // norm_within(q, ScalarTraits<T>::unit_norm_tolerance), as the combiner tests
+};
+
+// Step 1: why the row is left out on its own (kUsed: usable so far).
+constexpr LeftOut left_out_alone(const RowFacts& r, HeadMask mounted) noexcept {
+    if (r.head >= kMaxHeads) {
+        return LeftOut::kNotAHead;
+    }
+    if (!has_head(mounted, r.head)) {
+        return LeftOut::kNotInMountings;
+    }
+    if ((r.status & status::kRejected) != 0U) {
+        return LeftOut::kRejected;
+    }
+    if (r.flagged) {
+        return LeftOut::kFlagged;
+    }
+    if (!r.confident) {
+        return LeftOut::kConfidence;
+    }
+    if ((r.status & kSkippedStages) != 0U) {
+        return LeftOut::kStageSkipped;
+    }
+    return r.unit ? LeftOut::kUsed : LeftOut::kNotUnit;
+}
+
+// Step 1's status part (the on-board pipeline's): a solution of a mounted
+// head with a unit quaternion (the combiner tests both), clean or not. The
+// same answer as left_out_alone (checked below), written as one mask test:
+// through left_out_alone GCC 12 inlines differently in the targets' link
+// server (the M3's serve() +589 instructions, the corrections +6).
 constexpr bool usable_for_combination(StatusBits corrected, bool clean) noexcept {
-    return clean && (corrected & kNotUsable) == 0U;
+    return clean && (corrected & (status::kRejected | kSkippedStages)) == 0U;
+}
+
+// Both are "no bit of a mask set, and clean": equal on every single status
+// bit and on none, clean or not, they are equal on every status.
+constexpr bool usable_agrees_with_left_out_alone() noexcept {
+    for (unsigned b = 0; b <= 8U * sizeof(StatusBits); ++b) {
+        const auto s = static_cast<StatusBits>(b == 0U ? 0U : 1U << (b - 1U));
+        for (unsigned c = 0; c < 2U; ++c) {
+            const bool clean = c != 0U;
+            const bool by_reason = left_out_alone({0U, s, !clean, true, true}, head_bit(0U)) == LeftOut::kUsed;
+            if (usable_for_combination(s, clean) != by_reason) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+static_assert(usable_agrees_with_left_out_alone(), "one rule: usable_for_combination is left_out_alone's status part");
+
+// Which rows of a head repeated in an epoch stand.
+enum class Repeated : std::uint8_t {
+    kLeaveAllOut,  // the ground: none can be told right, every one is kDuplicate
+    kKeepFirst,    // on board: the first stands, the later ones are kDuplicate
+};
+
+// Step 2 over an epoch's rows (any order; `why` holds step 1's answers and
+// receives the epoch's): the rows of a repeated head by `rule`, whatever
+// step 1 said of them; then each usable row whose stages (status & 3) are
+// not all of the epoch's, the stages of its usable rows. Returns the
+// epoch's stages (they choose the consistency gate, gate_config.hpp).
+// O(n²) in the rows, n ≤ 2 · kMaxHeads on board.
+constexpr StatusBits select_epoch(const RowFacts* rows, LeftOut* why, std::size_t n, Repeated rule) noexcept {
+    for (std::size_t j = 1; j < n; ++j) {
+        for (std::size_t i = 0; i < j; ++i) {
+            if (rows[i].head == rows[j].head && rows[j].head < kMaxHeads) {
+                why[j] = LeftOut::kDuplicate;
+                why[i] = rule == Repeated::kLeaveAllOut ? LeftOut::kDuplicate : why[i];
+                break;
+            }
+        }
+    }
+    StatusBits stages = 0U;
+    for (std::size_t i = 0; i < n; ++i) {
+        stages = static_cast<StatusBits>(stages | (why[i] == LeftOut::kUsed ? (rows[i].status & kStagesApplied) : 0U));
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (why[i] == LeftOut::kUsed && (rows[i].status & kStagesApplied) != stages) {
+            why[i] = LeftOut::kStageMissing;
+        }
+    }
+    return stages;
 }
 
 }  // namespace ascorr::combine

@@ -330,6 +330,7 @@ private:
     }
 
     static constexpr std::uint8_t kFed = 0x80U;
+    static_assert(N < 8U, "kept_ holds a bit per head below kFed");
     // Two solutions of every head: room for a repeated head, whose second
     // solution the combiner leaves out.
     static constexpr std::uint8_t kCombineSlots = 2U * kMaxHeads;

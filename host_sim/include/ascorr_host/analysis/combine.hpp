@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "ascorr/combine/combiner.hpp"
+#include "ascorr/combine/usable.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
@@ -49,27 +50,25 @@
 
 namespace ascorr::host {
 
-// Why a head's row of an epoch is not averaged in (for the summary).
-enum class LeftOut : std::uint8_t {
-    kUsed,
-    kFlagged,         // flags != 0
-    kConfidence,      // confidence > 5 or not a number
-    kRejected,        // status 16
-    kStageSkipped,    // status 4, 8, 128 or 256
-    kStageMissing,    // a stage other rows of the epoch have (mix)
-    kNotAHead,        // chu is no head of heads.hpp
-    kNotInMountings,  // a head the mountings do not have
-    kDuplicate,       // two rows of one head in one epoch
-    kInconsistent,    // refused by the combiner's gates
-    kNotUnit,         // a quaternion the combiner refuses (not unit, not finite)
-    kNoEpoch,         // |t| beyond the millisecond key (pipeline/epoch_key.hpp): in no epoch
-};
-inline constexpr std::size_t kLeftOutKinds = 12;
-const char* left_out_name(LeftOut why) noexcept;
+// Why a head's row of an epoch is not averaged in: the core's one rule
+// (combine/usable.hpp), for the summaries.
+using combine::kLeftOutKinds;
+using combine::left_out_name;
+using combine::LeftOut;
 
-// Why a row is left out on its own (kUsed: usable so far); the epoch decides
-// the rest (stage missing, two rows of one head, the combiner's refusals).
-// Also align's rule (align.hpp).
+// The row as the core's selection sees it (a raw row: status 0).
+combine::RowFacts row_facts(const CorrectedRow& r) noexcept;
+
+// The camera head's own selection of the row (flags 0, confidence <= 5):
+// what a target's pipeline takes with a solution (SOLUTION_IN's clean bit).
+inline bool clean_for_combination(const CorrectedRow& r) noexcept {
+    const combine::RowFacts f = row_facts(r);
+    return !f.flagged && f.confident;
+}
+
+// Why a row is left out on its own (kUsed: usable so far; the core's
+// left_out_alone against the mountings); the epoch decides the rest
+// (combine::select_epoch, then the combiner's gate). Also align's rule.
 LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept;
 
 // Every row of a corrected or solutions file as the combination takes it, in
@@ -124,7 +123,7 @@ combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noex
 combine::CombinerConfig gate_config(const GateOptions& g, const combine::CombinerConfig& base) noexcept;
 
 // Both stages: the status bits of a row corrected by aberration and thermal.
-inline constexpr StatusBits kBothStages = status::kAberrationApplied | status::kThermalApplied;
+inline constexpr StatusBits kBothStages = combine::kStagesApplied;
 
 // The ground's gates of GateOptions, one combiner's tables for each kind of
 // epoch (combine's and align's): the epoch's stages pick one.
