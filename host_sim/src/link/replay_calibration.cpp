@@ -1,0 +1,184 @@
+// `ascorr replay --self-calibrate`: the target's model versions, models and estimator report against the host's.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <ostream>
+#include <string>
+
+#include "ascorr_text/c_format.hpp"
+#include "replay_parts.hpp"
+
+namespace ascorr::host::detail {
+
+namespace {
+
+// Whether two doubles are the same value: bit for bit, or both NaN (the
+// targets' and the host's default NaNs differ in sign).
+bool same_double(double a, double b) {
+    return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// The first field in which a (the target's) and b (the host's) differ, with
+// both values; empty when they are the same (doubles: same_double).
+std::string first_report_difference(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
+    const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
+        return x == y ? std::string()
+                      : std::string(name) + ": target " + std::to_string(x) + ", host " + std::to_string(y);
+    };
+    const auto d = [](const char* name, double x, double y) {
+        return same_double(x, y) ? std::string()
+                                 : std::string(name) + ": target " + number_text(x) + ", host " + number_text(y);
+    };
+    const std::string fields[] = {
+        u("orbits used", a.orbits_used, b.orbits_used),
+        u("orbits short", a.orbits_short, b.orbits_short),
+        u("orbits held back", a.orbits_held, b.orbits_held),
+        u("orbits late", a.orbits_late, b.orbits_late),
+        u("changes", a.changes, b.changes),
+        d("condition", a.condition, b.condition),
+        d("residual RMS", a.residual_rms_arcsec, b.residual_rms_arcsec),
+        d("candidate RMS", a.candidate_rms_arcsec, b.candidate_rms_arcsec),
+        u("has a model", a.has_active, b.has_active),
+        u("active version", a.active_version, b.active_version),
+        u("active CRC-32C", a.active_crc, b.active_crc),
+        u("last refusal", static_cast<unsigned>(a.last_refusal), static_cast<unsigned>(b.last_refusal)),
+        u("frozen", a.frozen, b.frozen)};
+    for (const std::string& f : fields) {
+        if (!f.empty()) {
+            return f;
+        }
+    }
+    for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
+        if (a.refusals[i] != b.refusals[i]) {
+            return std::string("refusals '") + calib::refusal_name(static_cast<calib::Refusal>(i)) + "': target " +
+                   std::to_string(a.refusals[i]) + ", host " + std::to_string(b.refusals[i]);
+        }
+    }
+    return {};
+}
+
+// The target's model `version`, head by head (CALIB_MODEL), as a history entry
+// active from t (the first solution corrected with it).
+template <typename T>
+ActiveModel target_model(LinkClient<T>& client, double t) {
+    ActiveModel a{t, 0, 0, 0, ModelFile{}};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const link::CalibModel m = client.calib_model(h);
+        a.t_us = m.active_from_us;
+        a.version = m.version;
+        a.crc = m.crc;
+        a.model.present[h] = m.present == 1U;
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
+                a.model.coefficients[h][x][i] = m.c[x][i];
+            }
+        }
+    }
+    return a;
+}
+
+// What differs first between a (the target's) and b (the host's) model of
+// one version: the epoch, a head's presence, a coefficient or the CRC; empty
+// when they are the same model, active from the same epoch.
+std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
+    if (a.t_us != b.t_us) {
+        return "active from TT " + std::to_string(a.t_us) + " us on the target, " + std::to_string(b.t_us) +
+               " us on the host";
+    }
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        const std::string head(1, head_name(static_cast<std::uint8_t>(h)));
+        if (a.model.present[h] != b.model.present[h]) {
+            return "head " + head + (a.model.present[h] ? " present" : " absent") + " on the target only";
+        }
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t i = 0; i < kModelTerms; ++i) {
+                if (!same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i])) {
+                    return "head " + head + " " + kAxisNames[x] + " c" + std::to_string(i) + ": target " +
+                           number_text(a.model.coefficients[h][x][i]) + ", host " +
+                           number_text(b.model.coefficients[h][x][i]);
+                }
+            }
+        }
+    }
+    if (a.crc == b.crc) {
+        return {};
+    }
+    char buf[64];
+    text::c_snprintf(buf, sizeof buf, "CRC-32C %08x on the target, %08x on the host", a.crc, b.crc);
+    return buf;
+}
+
+}  // namespace
+
+// A solution's model version on the target against the host's (`want`); a
+// version the target uses for the first time is fetched (CALIB_MODEL) and
+// compared with the host's model of that version.
+template <typename T>
+void check_model_version(LinkClient<T>& client, const std::string& file, const SolutionRecord& rec, std::uint32_t got,
+                         const std::optional<std::uint32_t>& want, ReplaySummary& sum,
+                         std::vector<ActiveModel>& target_history, std::ostream& log, const SelfCalibration& host_sc) {
+    const bool same = want ? got == *want : got == link::kNoModelVersion;
+    if (!same && ++sum.version_mismatches <= kMaxCalibMessages) {
+        log << file << ":" << rec.line << ": the target corrected with model version "
+            << (got == link::kNoModelVersion ? std::string("none") : std::to_string(got)) << ", the host with "
+            << (want ? std::to_string(*want) : std::string("none")) << "\n";
+    }
+    if (got == link::kNoModelVersion || (!target_history.empty() && target_history.back().version == got)) {
+        return;
+    }
+    target_history.push_back(target_model(client, rec.t));
+    ActiveModel& mine = target_history.back();
+    const auto host = std::find_if(host_sc.history.begin(), host_sc.history.end(),
+                                   [&](const ActiveModel& a) { return a.version == mine.version; });
+    if (host != host_sc.history.end()) {
+        mine.learnt = host->learnt;  // the link does not say; the comparison below checks the coefficients
+    }
+    const std::string difference =
+        host == host_sc.history.end() ? "the host has no such version" : first_model_difference(mine, *host);
+    if (!difference.empty()) {
+        if (++sum.history_mismatches <= kMaxCalibMessages) {
+            char buf[200];
+            text::c_snprintf(buf, sizeof buf, "model version %u (crc32c %08x) differs from the host's: ", mine.version,
+                             mine.crc);
+            log << "ascorr replay: the target's " << buf << difference << "\n";
+        }
+    }
+}
+
+// The end of a self-calibrating replay: the host's models the target never
+// used, and the final report.
+template <typename T>
+void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const std::vector<ActiveModel>& target_history,
+                             std::ostream& log, const SelfCalibration& host_sc) {
+    sum.models = target_history.size();
+    for (const ActiveModel& a : host_sc.history) {
+        const bool seen = std::any_of(target_history.begin(), target_history.end(),
+                                      [&](const ActiveModel& b) { return b.version == a.version; });
+        if (!seen && ++sum.history_mismatches <= kMaxCalibMessages) {
+            log << "ascorr replay: the host's model version " << a.version << " was never used by the target\n";
+        }
+    }
+    const calib::EstimatorReport r = client.calib_report();
+    const std::string difference = first_report_difference(r, host_sc.report);
+    sum.report_matches = difference.empty();
+    if (!sum.report_matches) {
+        log << "ascorr replay: the target's estimator report differs from the host's: " << difference << "\n";
+    }
+    SelfCalibration on_target = host_sc;
+    on_target.history = target_history;
+    on_target.report = r;
+    log << "ascorr replay: on the target, " << describe(on_target) << "\n";
+}
+
+template void check_model_version(LinkClient<float>&, const std::string&, const SolutionRecord&, std::uint32_t,
+                                  const std::optional<std::uint32_t>&, ReplaySummary&, std::vector<ActiveModel>&,
+                                  std::ostream&, const SelfCalibration&);
+template void check_model_version(LinkClient<Q30>&, const std::string&, const SolutionRecord&, std::uint32_t,
+                                  const std::optional<std::uint32_t>&, ReplaySummary&, std::vector<ActiveModel>&,
+                                  std::ostream&, const SelfCalibration&);
+template void finish_self_calibration(LinkClient<float>&, ReplaySummary&, const std::vector<ActiveModel>&,
+                                      std::ostream&, const SelfCalibration&);
+template void finish_self_calibration(LinkClient<Q30>&, ReplaySummary&, const std::vector<ActiveModel>&, std::ostream&,
+                                      const SelfCalibration&);
+
+}  // namespace ascorr::host::detail

@@ -1,0 +1,210 @@
+// One `ascorr replay` session over an open transport: the inputs read, the host's side started, the outputs written.
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "ascorr/pipeline/common_rotation_weights.hpp"
+#include "ascorr_host/correct/solution_input.hpp"
+#include "ascorr_host/formats/corrected_csv.hpp"
+#include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "replay_parts.hpp"
+
+namespace ascorr::host::detail {
+
+namespace {
+
+// --model read and checked for the target's scalar (refused before the
+// target sees it, as by `correct`); none without --model.
+template <typename T>
+std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
+    if (opt.model.empty()) {
+        return std::nullopt;
+    }
+    ModelFile mf = read_model_file(opt.model);
+    check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
+    if (opt.self_calibrate) {
+        refuse_quadratic_initial_model(mf, opt.model);
+    }
+    return mf;
+}
+
+std::optional<StatesFile> read_replay_states(const ReplayOptions& opt, std::ostream& log) {
+    if (opt.states.empty()) {
+        return std::nullopt;
+    }
+    Diagnostics diag(log);
+    std::optional<StatesFile> states =
+        read_states_file(opt.states, opt.states_gcrs ? StateFrame::kGcrs : StateFrame::kItrf, diag);
+    diag.summarize();
+    return states;
+}
+
+// --self-calibrate: the host's run of the estimator over the file, and the
+// target's started alike; otherwise the model uploaded and used on both.
+// rule: the estimator's rule for the rotation common to all heads (the
+// mountings of --combined, already loaded on the target; none: its frame).
+template <typename T>
+void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& rows, const std::optional<ModelFile>& mf,
+                const ThermalModel<T>& model_t, LinkClient<T>& client, HostSide<T>& host, ReplaySummary& sum,
+                const calib::CommonRotationWeights& rule) {
+    if (!opt.self_calibrate) {
+        client.upload_model(model_t);
+        host.pipeline.use_model(&model_t);
+        return;
+    }
+    calib::EstimatorConfig ecfg;
+    ecfg.time_constant_days = opt.time_constant_days;
+    ecfg.common_rotation = rule;
+    host.sc = self_calibrate<T>(
+        opt.in,
+        [&](const std::function<void(const SolutionRecord&)>& fn) {
+            for (const SolutionRecord& r : rows) {
+                fn(r);
+            }
+        },
+        mf, ecfg, opt.orbit_period_s);
+    host.schedule_d.emplace(host.sc->history);
+    std::optional<ModelCoefficients> initial;
+    if (mf) {
+        initial = coefficients_of(*mf);
+    }
+    const std::int64_t period_us = std::llround(host.sc->orbit_period_s * 1e6);
+    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U);
+    calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
+    host_cfg.orbit_period_us = period_us;
+    host_cfg.time_constant_days = opt.time_constant_days;
+    host_cfg.common_rotation = rule;
+    host.estimator.emplace(host_cfg, initial ? &*initial : nullptr);
+    host.pipeline.use_estimator(&*host.estimator);
+    sum.self_calibrate = true;
+}
+
+// The rows, in file order.
+std::vector<SolutionRecord> read_rows(SolutionsReader& reader) {
+    SolutionRecord record;
+    std::vector<SolutionRecord> rows;
+    while (reader.next(record)) {
+        rows.push_back(record);
+    }
+    return rows;
+}
+
+// --mountings/--combined: the mountings read and checked, loaded on the
+// target and the combination started on both sides; the estimator's rule
+// for the rotation common to all heads (none without --combined).
+template <typename T>
+calib::CommonRotationWeights start_combination(const ReplayOptions& opt, LinkClient<T>& client, HostSide<T>& host,
+                                               std::optional<EpochCombination<T>>& combination, std::ostream& log) {
+    calib::CommonRotationWeights rule{};
+    if (!opt.combined.empty()) {
+        const MountingsFile m = read_mountings_file(opt.mountings);
+        // The target combines as the flight loop does (its gate, pre-flight
+        // mountings), unless --gate-sigmas/--gate-floor say otherwise.
+        const combine::CombinerConfig gate = gate_config(opt.gate, combine::flight_gate());
+        refuse_unusable_mountings(m, opt.mountings, std::vector<combine::CombinerConfig>{gate});
+        combination.emplace(m, gate, client, host.pipeline, opt.in, log);
+        rule = pipeline::common_rotation_weights(m.mountings);
+    }
+    return rule;
+}
+
+// The corrected file's rows, in file order (text: the input's).
+std::string corrected_rows(const ReplayOptions& opt, const std::string& text, const RowWriter& writer,
+                           const std::vector<WrittenRow>& written_rows) {
+    std::string buf;
+    SolutionRecord record;
+    SolutionsReader again(opt.in, text);
+    for (std::size_t k = 0; again.next(record); ++k) {
+        writer.row(again, written_rows[k].q, written_rows[k].status, buf);
+    }
+    return buf;
+}
+
+// The link's figures: corrupted frames, retries, restarts, the target's
+// instructions per solution and the faults injected (none: injector null).
+void count_link(ReplaySummary& sum, const LinkStats& st, const ReplayedRows& replayed, const FaultInjector* injector) {
+    sum.crc_errors = st.naks + st.broken_answers;
+    sum.retries = st.retries;
+    sum.restarts = st.restarts;
+    sum.instructions_per_solution =
+        replayed.costed == 0 ? 0.0 : replayed.instructions / static_cast<double>(replayed.costed);
+    if (injector != nullptr) {
+        sum.injected = injector->to_target().total() + injector->to_host().total();
+    }
+}
+
+}  // namespace
+
+template <typename T>
+ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, std::ostream& log) {
+    const std::string text = read_text_file(opt.in);
+    SolutionsReader reader(opt.in, text);
+    refuse_corrected_input(reader);
+    // The thermal model: --model's, or with --self-calibrate the estimator's
+    // (--model, if given, is its version 0).
+    const std::optional<ModelFile> mf = read_replay_model<T>(opt);
+    const ThermalModel<T> model_t = mf ? to_core<T>(*mf) : ThermalModel<T>{};
+    const ThermalModel<double> model_d = mf ? to_core<double>(*mf) : ThermalModel<double>{};
+
+    std::unique_ptr<FaultInjector> injector;
+    Transport* transport = &raw;
+    if (opt.inject_errors > 0.0) {
+        injector = std::make_unique<FaultInjector>(raw, opt.inject_errors, opt.seed);
+        transport = injector.get();
+    }
+    LinkClient<T> client(*transport, opt.timeout_ms, opt.max_attempts);
+    const link::Hello hello = client.connect();
+    log << "ascorr replay: target " << opt.target << " (boot id " << hello.boot_id << ", scalar kind "
+        << static_cast<int>(hello.scalar_kind) << ")\n";
+    const std::optional<StatesFile> states = read_replay_states(opt, log);
+    // The target's velocity service, mirrored in its scalar and in double.
+    const VelocityServiceConfig service =
+        opt.max_propagation_s ? service_config(*opt.max_propagation_s) : default_velocity_service_config();
+    if (opt.max_propagation_s) {
+        client.set_service_horizon(service.horizon_us);
+    }
+
+    const RowWriter writer(reader);
+    AtomicFile& out = outputs["--out"];
+    out.write(writer.header_line());
+    const auto start = std::chrono::steady_clock::now();
+    // The rows go to the target in time order, as a DPU takes them (its
+    // velocity service is causal: a row earlier than a state it already has
+    // would get none), so that any row order gives `ascorr correct`'s answers;
+    // they are written in file order.
+    const std::vector<SolutionRecord> rows = read_rows(reader);
+    ReplaySummary sum;
+    HostSide<T> host;
+    // The mountings first: the target's estimator takes its rule's weights
+    // from those staged when CALIB_START comes (correct --self-calibrate
+    // --combined's rule).
+    std::optional<EpochCombination<T>> combination;
+    const calib::CommonRotationWeights rule = start_combination(opt, client, host, combination, log);
+    start_host(opt, rows, mf, model_t, client, host, sum, rule);
+    const ReplayedRows replayed = replay_rows(opt, rows, client, states, service, host, model_d,
+                                              combination ? &*combination : nullptr, sum, start, log);
+    out.write(corrected_rows(opt, text, writer, replayed.rows));
+    if (opt.self_calibrate) {
+        finish_self_calibration(client, sum, host.target_history, log, *host.sc);
+        if (outputs.has("--model-history")) {
+            outputs["--model-history"].write(format_model_history(host.target_history, rule.heads != 0U));
+        }
+    }
+    if (combination) {
+        combination->finish(sum);
+        outputs["--combined"].write(combination->text());
+    }
+    count_link(sum, client.stats(), replayed, injector.get());
+    return sum;
+}
+
+template ReplaySummary run<float>(const ReplayOptions&, Transport&, OutputSet&, std::ostream&);
+template ReplaySummary run<Q30>(const ReplayOptions&, Transport&, OutputSet&, std::ostream&);
+
+}  // namespace ascorr::host::detail
