@@ -18,6 +18,7 @@
 
 #include "alloc_counter.hpp"
 #include "ascorr/combine/combiner.hpp"
+#include "ascorr/combine/usable.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/fixed_point.hpp"
 
@@ -28,8 +29,14 @@ using combine::CombinedAttitude;
 using combine::Combiner;
 using combine::CombinerConfig;
 using combine::HeadAttitude;
+using combine::left_out_alone;
+using combine::left_out_name;
+using combine::LeftOut;
 using combine::Mountings;
 using combine::MountingsProblem;
+using combine::Repeated;
+using combine::RowFacts;
+using combine::select_epoch;
 namespace cs = combine::combined_status;
 
 using Mat3 = Eigen::Matrix3d;
@@ -478,6 +485,109 @@ TEST(Combine, DuplicatesUnknownAndUnmountedHeadsAreLeftOut) {
     const auto nonunit = comb.combine(bad, 3);
     EXPECT_EQ(nonunit.status, cs::kOneHead | cs::kHeadLeftOut);
     EXPECT_EQ(nonunit.left_out, 6);
+}
+
+// ---- The selection (usable.hpp).
+
+// Step 1's order: the first reason that applies; step 2: every row of a head
+// repeated (kLeaveAllOut) or all but the first (kKeepFirst), over any step-1
+// reason; a usable row without a stage another usable row has; then not unit.
+TEST(Combine, TheSelectionGivesTheFirstReasonAndDecidesTheEpoch) {
+    constexpr HeadMask abc = 0x7U;
+    const RowFacts ok{true, 0U, 3U, false, true, true};
+    EXPECT_EQ(left_out_alone(ok, abc), LeftOut::kUsed);
+    RowFacts r = ok;
+    r.flagged = true;
+    r.status = status::kRejected;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kRejected);  // rejected before flagged
+    r.status = status::kNoVelocity;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kFlagged);  // flagged before a skipped stage
+    r.head = 3U;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kNotInMountings);
+    r.head = kUnknownHead;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kNotAHead);
+    r.in_epoch = false;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kNoEpoch);
+    r = ok;
+    r.confident = false;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kConfidence);
+    r.unit = false;  // a step-2 fact
+    r.confident = true;
+    EXPECT_EQ(left_out_alone(r, abc), LeftOut::kUsed);
+
+    // A twice (the first flagged), B without the thermal stage, C not unit with
+    // both stages, two rows that are no head.
+    RowFacts rows[6] = {ok, ok, ok, ok, ok, ok};
+    rows[0].flagged = true;
+    rows[2].head = 1U;
+    rows[2].status = status::kAberrationApplied;
+    rows[3].head = 2U;
+    rows[3].unit = false;
+    rows[4].head = kUnknownHead;
+    rows[5].head = kUnknownHead;
+    for (const Repeated rule : {Repeated::kLeaveAllOut, Repeated::kKeepFirst}) {
+        LeftOut why[6];
+        for (std::size_t i = 0; i < 6; ++i) {
+            why[i] = left_out_alone(rows[i], abc);
+        }
+        const StatusBits stages = select_epoch(rows, why, 6, rule);
+        EXPECT_EQ(why[0], rule == Repeated::kKeepFirst ? LeftOut::kFlagged : LeftOut::kDuplicate);
+        EXPECT_EQ(why[1], LeftOut::kDuplicate);
+        // The stages of the usable rows, C's included: B lacks the thermal stage.
+        EXPECT_EQ(stages, 3U);
+        EXPECT_EQ(why[2], LeftOut::kStageMissing);
+        EXPECT_EQ(why[3], LeftOut::kNotUnit);
+        EXPECT_EQ(why[4], LeftOut::kNotAHead);  // two rows that are no head are no repeated head
+        EXPECT_EQ(why[5], LeftOut::kNotAHead);
+    }
+    for (std::size_t k = 0; k < combine::kLeftOutKinds; ++k) {
+        EXPECT_NE(left_out_name(static_cast<LeftOut>(k)), nullptr);
+    }
+}
+
+// The on-board combiner applies step 1's head and mounting tests, step 2's
+// norm test and Repeated::kKeepFirst itself (its caller gives the status part
+// as `usable`): on random epochs of consistent heads, repeated, unusable,
+// unmounted, unknown and not unit, it averages in exactly the heads the
+// selection keeps.
+TEST(Combine, TheCombinerKeepsTheHeadsTheSelectionKeeps) {
+    std::mt19937 rng(11);
+    const List<Head> heads = near_orthogonal_heads(rng, 3, 10.0);
+    const Combiner<double> comb(mountings_of(heads));  // A, B, C; D not mounted
+    std::uniform_int_distribution<int> pick(0, 9);
+    int epochs_with_a_left_out_row = 0;
+    for (int t = 0; t < 2000; ++t) {
+        const Quat truth = random_rotation(rng);
+        const auto n = static_cast<std::uint8_t>(1 + t % 8);
+        HeadAttitude<double> in[8];
+        RowFacts facts[8];
+        LeftOut why[8];
+        for (std::uint8_t i = 0; i < n; ++i) {
+            const int kind = pick(rng);
+            const auto head = static_cast<std::uint8_t>(kind == 9 ? kUnknownHead : kind % 4);
+            const Head& h = heads[head < 3U ? head : 0U];
+            in[i] = attitude<double>(measure(h, truth, rng), head, kind != 8);
+            if (kind == 7) {
+                in[i].q_chu_icrf.w *= 1.01;
+            }
+            facts[i] = {true,          head, 0U,
+                        !in[i].usable, true, norm_within(in[i].q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)};
+            why[i] = left_out_alone(facts[i], comb.mounted());
+        }
+        (void)select_epoch(facts, why, n, Repeated::kKeepFirst);
+        HeadMask kept = 0U;
+        bool any_left_out = false;
+        for (std::uint8_t i = 0; i < n; ++i) {
+            kept = static_cast<HeadMask>(kept | (why[i] == LeftOut::kUsed ? head_bit(in[i].head) : 0U));
+            any_left_out = any_left_out || why[i] != LeftOut::kUsed;
+        }
+        const auto out = comb.combine(in, n);
+        ASSERT_EQ(out.inconsistent, 0) << "epoch " << t;  // consistent heads: the gate keeps all
+        EXPECT_EQ(out.used, kept) << "epoch " << t;
+        EXPECT_EQ((out.status & cs::kHeadLeftOut) != 0U, any_left_out) << "epoch " << t;
+        epochs_with_a_left_out_row += any_left_out ? 1 : 0;
+    }
+    EXPECT_GT(epochs_with_a_left_out_row, 1000);
 }
 
 // ---- The gate.

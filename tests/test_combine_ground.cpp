@@ -242,27 +242,6 @@ TEST(CombineCli, EveryBadInputHasItsOutcomeAndEveryEpochItsRow) {
     EXPECT_EQ(slurp(dir / "piped.csv"), slurp(dir / "out.csv"));
 }
 
-// One selection for combine and align (combine/usable.hpp): a quaternion
-// that is not unit leaves its row out before the epoch's stages are taken,
-// so it does not leave out a usable row for lacking its stage. Before, combine
-// took A's stages first: C "stage missing", no usable head (status 12).
-TEST(CombineCli, ARowLeftOutAloneDoesNotDecideTheEpochsStages) {
-    const fs::path dir = scratch_dir("combine_not_unit_stages");
-    const Bench b;
-    host::write_mountings_file((dir / "m.csv").string(), b.m);
-    Bench stretched = b;
-    stretched.q_crf_icrf = {1.01 * b.q_crf_icrf.w, 1.01 * b.q_crf_icrf.x, 1.01 * b.q_crf_icrf.y, 1.01 * b.q_crf_icrf.z};
-    write(dir / "in.csv", std::string(kCorrectedHeader) + stretched.row(900, 'A', 0, 3) + b.row(900, 'C', 0, 1));
-    const CliRun r = run_in("combine --in in.csv --mountings m.csv --out out.csv", dir);
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::vector<Combined> c = read_combined(dir / "out.csv", b.q_crf_icrf);
-    ASSERT_EQ(c.size(), 1U);
-    EXPECT_EQ(c[0].heads, "C");
-    EXPECT_EQ(c[0].status, 6U);  // one head, a head left out
-    EXPECT_TRUE(has(r.err, "in.csv:2: CHU A at t = 900.000: the quaternion is not unit")) << r.err;
-    EXPECT_FALSE(has(r.err, "lacks a stage")) << r.err;
-}
-
 TEST(CombineCli, BadMountingsOrInputStopWithFileLineColumnAndWriteNothing) {
     const fs::path dir = scratch_dir("combine_refused");
     const Bench b;

@@ -62,9 +62,9 @@ struct Judged {
 };
 
 // The core's step 2 over the epoch's rows (combine/usable.hpp; a second row
-// of a head was refused when read): `why` from each row's own, and a usable
-// row without a stage another has gets kStageMissing. Returns the stages.
-StatusBits select_epoch(const Epoch<Judged>& e, std::array<LeftOut, kMaxHeads>& why) noexcept {
+// of a head was refused when read): `why` from each row's own; a usable row
+// without a stage another has, or not unit, is left out. Returns the stages.
+StatusBits select_rows(const Epoch<Judged>& e, std::array<LeftOut, kMaxHeads>& why) noexcept {
     combine::RowFacts facts[kMaxHeads];
     LeftOut whys[kMaxHeads];
     std::uint8_t heads[kMaxHeads];
@@ -107,7 +107,7 @@ void apply_gate(const StageGates& gates, const Epoch<Judged>& e, StatusBits stag
 void add_epoch(const Epoch<Judged>& e, const CurrentMountings& q_chu_crf, const StageGates* gate, AlignSums& sums,
                PassCounts& c) {
     std::array<LeftOut, kMaxHeads> why{};
-    const StatusBits stages = select_epoch(e, why);
+    const StatusBits stages = select_rows(e, why);
     if (gate != nullptr) {
         apply_gate(*gate, e, stages, why);
     }
@@ -186,10 +186,7 @@ void run_pass(const CorrectedRowSource& rows, const std::string& file, const Mou
             return;
         }
         ++c.rows_in_period;
-        LeftOut why = why_unusable(r, m);
-        if (why != LeftOut::kNotAHead && why != LeftOut::kNotInMountings && !(std::abs(r.t) < kMaxEpochTimeS)) {
-            why = LeftOut::kNoEpoch;
-        }
+        const LeftOut why = why_unusable(r, m);
         if (why == LeftOut::kNotAHead || why == LeftOut::kNotInMountings || why == LeftOut::kNoEpoch) {
             ++c.left_out[static_cast<std::size_t>(why)];
             return;

@@ -49,7 +49,10 @@ struct Kept {
 }  // namespace
 
 combine::RowFacts row_facts(const CorrectedRow& r) noexcept {
-    return {r.head, r.corrected ? r.status : StatusBits{0}, r.flags != 0,
+    return {pipeline::has_epoch_key(r.t),
+            r.head,
+            r.corrected ? r.status : StatusBits{0},
+            r.flags != 0,
             r.confidence <= combine::kMaxCleanConfidenceArcsec,
             norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)};
 }
@@ -227,14 +230,15 @@ struct CombineStage::Impl {
 
     void add(const CorrectedRow& r) {
         ++sum.rows;
-        if (!(std::abs(r.t) < kMaxEpochTimeS)) {
+        const LeftOut why = why_unusable(r, m);
+        if (why == LeftOut::kNoEpoch) {
             ++sum.rows_left_out[static_cast<std::size_t>(LeftOut::kNoEpoch)];
             diag.report("in no epoch", where(r.line) + "t = " + number_text(r.t) +
                                            " s has no millisecond key: the row is in no epoch");
             return;
         }
-        Kept k{r.t,    r.q_chu_icrf,       static_cast<std::uint32_t>(r.line),
-               r.head, why_unusable(r, m), static_cast<std::uint8_t>(r.corrected ? (r.status & kBothStages) : 0U)};
+        Kept k{r.t,    r.q_chu_icrf, static_cast<std::uint32_t>(r.line),
+               r.head, why,          static_cast<std::uint8_t>(r.corrected ? (r.status & kBothStages) : 0U)};
         const std::int64_t key = epoch_key(r.t);
         if (mode == Mode::kKeep) {
             kept.push_back({key, k});
@@ -269,12 +273,13 @@ struct CombineStage::Impl {
     // Step 2 of the core's selection (combine/usable.hpp) over the epoch's
     // rows, sorted by head and line: two rows of one head (both left out,
     // named with the first's line), a usable row without a stage another
-    // usable row has. Returns the epoch's stages.
+    // usable row has, a quaternion not unit. Returns the epoch's stages.
     StatusBits select(std::vector<Kept>& rows) {
         facts.clear();
         whys.clear();
         for (const Kept& k : rows) {
-            facts.push_back({k.head, k.stages, false, true, true});
+            facts.push_back(
+                {true, k.head, k.stages, false, true, norm_within(k.q, ScalarTraits<double>::unit_norm_tolerance)});
             whys.push_back(k.why);
         }
         const StatusBits stages =
@@ -399,8 +404,8 @@ struct CombineStage::Impl {
         const combine::CombinedAttitude<double> c = combiner.combine(heads, n);
         for (std::uint8_t i = 0; i < n; ++i) {
             const HeadMask bit = ascorr::head_bit(heads[i].head);
-            if ((c.used & bit) == 0U) {  // the selection took head, mounting and norm: only the gate is left
-                rows[used_row[i]].why = LeftOut::kInconsistent;
+            if ((c.used & bit) == 0U) {  // the selection took head, mounting and norm: the gate, unless it differs
+                rows[used_row[i]].why = (c.inconsistent & bit) != 0U ? LeftOut::kInconsistent : LeftOut::kNotUnit;
             }
         }
         bool left_out = false;
