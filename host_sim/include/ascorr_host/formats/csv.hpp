@@ -20,6 +20,7 @@
 #include "ascorr_text/csv_fields.hpp"
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/line_reader.hpp"
+#include "ascorr_text/number_fields.hpp"
 
 namespace ascorr::host {
 
@@ -84,25 +85,13 @@ using text::csv::why_split_failed;
 void split_row(std::string_view line, std::size_t count, const std::string& file, std::size_t n,
                std::vector<std::string_view>& fields, std::vector<std::size_t>& starts);
 
-// A field as a double: a decimal or scientific number, "nan", "inf".
-// Leading/trailing spaces are not accepted (they are not in the format).
-std::optional<double> parse_double(std::string_view field) noexcept;
-// A field as a decimal integer with an optional sign ('+' as in parse_double);
-// nullopt for other text and beyond long long (why_not_an_integer says which).
-std::optional<long long> parse_integer(std::string_view field) noexcept;
-
-// Why parse_double refused a field, for the message: "out of range ..." (with
-// a double's range) for a number beyond it (1e999, 1e-999), otherwise
-// "expected a number, got 'FIELD'".
-std::string why_not_a_number(std::string_view field);
-// Why an integer field is refused: "out of range ..." (with [lo, hi]) for
-// decimal digits beyond it (-1 for flags, 99999999999999999999), otherwise
-// "expected an integer in [lo, hi], got 'FIELD'".
-std::string why_not_an_integer(std::string_view field, long long lo, long long hi);
-
-// The shortest decimal text that reads back as x ("0.50000001", "1e-05",
-// "nan", "inf"), for messages that repeat a refused value: never rounded.
-std::string number_text(double x);
+// A field as a number, and the words for one refused: one syntax for every
+// host reader and the Python module (ascorr_text/number_fields.hpp).
+using text::number_text;
+using text::parse_double;
+using text::parse_integer;
+using text::why_not_a_number;
+using text::why_not_an_integer;
 
 // Formats x with `decimals` digits after the point into out, returns the end.
 char* format_fixed(char* out, char* end, double x, int decimals) noexcept;
