@@ -1,6 +1,6 @@
 // ascorr_text/numbers.hpp: what a piece of text is as a real number, and the
 // words for a number beyond double's range ("1e999", "1e-999"), shared by the
-// host's readers (host_sim/src/formats/csv.cpp), the HAL's text readers
+// host's readers (number_fields.hpp), the HAL's text readers
 // (text_file.hpp) and the command line's options
 // (host_sim/cli/number_options.hpp), so that all three say it alike.
 //
