@@ -19,7 +19,7 @@ namespace ascorr::host {
 namespace {
 
 struct Truth {
-    HeadSet heads = kPaperHeads;
+    HeadMask heads = kPaperHeads;
     std::array<Quaternion<double>, kMaxHeads> q_chu_crf{};
     std::array<double, kMaxHeads> cross{1.5, 1.2, 2.0, 1.5};
     std::array<double, kMaxHeads> about{10.0, 8.0, 12.0, 10.0};
@@ -164,7 +164,7 @@ std::array<Eigen::Matrix3d, kMaxHeads> information_of(const Truth& t) {
 // its information-weighted mean, within 4 formal σ per axis, and its own
 // weighted mean is zero.
 TEST(AlignMountings, RecoverRelativeErrorsUnderTheDatum) {
-    for (const HeadSet heads : {HeadSet{0x7U}, HeadSet{0xFU}, HeadSet{0x5U}}) {
+    for (const HeadMask heads : {HeadMask{0x7U}, HeadMask{0xFU}, HeadMask{0x5U}}) {
         Truth truth = swarm_like();
         truth.heads = heads;
         truth.blind_fraction = 0.4;

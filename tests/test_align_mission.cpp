@@ -181,7 +181,7 @@ TEST(AlignMission, EstimatedNoiseIsTheSimulatorsWithinThreePercent) {
 // The expected error per CRF axis of the combination weighted with `used`
 // (gains K_i = (Σ Ŵ)⁻¹ Ŵ_i) when the heads' true noise is `truth`, over the
 // optimal bound sqrt(diag((Σ W_i)⁻¹)): the largest ratio over the axes.
-double worst_ratio(HeadSet set, const std::array<Eigen::Matrix3d, kMaxHeads>& used, const MountingsFile& truth) {
+double worst_ratio(HeadMask set, const std::array<Eigen::Matrix3d, kMaxHeads>& used, const MountingsFile& truth) {
     Eigen::Matrix3d w_used = Eigen::Matrix3d::Zero();
     Eigen::Matrix3d w_true = Eigen::Matrix3d::Zero();
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
@@ -213,7 +213,7 @@ TEST(AlignMission, CombinedErrorWithEstimatedNoiseIsWithinFivePercentOfTheBound)
         equal[h] = information_crf(m.report.aligned.mountings.head[h].q_chu_crf, 1.0, 1.0);
     }
     double worst_equal = 0.0;
-    for (HeadSet set = 1; set <= kPaperHeads; ++set) {
+    for (HeadMask set = 1; set <= kPaperHeads; ++set) {
         const double r = worst_ratio(set, estimated, m.truth);
         std::printf("heads %s: error / bound %.4f (equal weights %.3f)\n", head_letters(set).c_str(), r,
                     worst_ratio(set, equal, m.truth));

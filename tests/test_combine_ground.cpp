@@ -367,7 +367,7 @@ const Mission& mission() {
 // Every subset of A, B, C on the epochs where the three are clean: each
 // combined by the core's combiner with mountings m, its error against the
 // truth per CRF axis, beside the formal σ of `formal` (the true noise).
-std::map<unsigned, AxisStats> subsets_against_truth(const MountingsFile& m, const MountingsFile& formal) {
+std::map<HeadMask, AxisStats> subsets_against_truth(const MountingsFile& m, const MountingsFile& formal) {
     const Mission& ms = mission();
     const combine::Combiner<double> combiner(m.mountings);
     const combine::Combiner<double> optimal(formal.mountings);
@@ -384,15 +384,16 @@ std::map<unsigned, AxisStats> subsets_against_truth(const MountingsFile& m, cons
                                     }
                                 },
                                 "");
-    std::map<unsigned, AxisStats> out;
+    std::map<HeadMask, AxisStats> out;
     for (const auto& [key, heads] : epochs) {
         if (heads.size() != 3) {
             continue;
         }
-        for (unsigned set = 1; set < 8; ++set) {
+        for (unsigned bits = 1; bits < 8; ++bits) {
+            const auto set = static_cast<HeadMask>(bits);
             std::vector<combine::HeadAttitude<double>> sub = heads;
             for (auto& h : sub) {
-                h.usable = ((set >> h.head) & 1U) != 0U;
+                h.usable = has_head(set, h.head);
             }
             const auto c = combiner.combine(sub.data(), 3);
             if (c.used != set) {
@@ -402,7 +403,7 @@ std::map<unsigned, AxisStats> subsets_against_truth(const MountingsFile& m, cons
             AxisStats& s = out[set];
             for (std::size_t a = 0; a < 3; ++a) {
                 s.sum_sq[a] += e[a] * e[a];
-                s.sigma[a] = optimal.sigma_arcsec(static_cast<std::uint8_t>(set))[a];
+                s.sigma[a] = optimal.sigma_arcsec(set)[a];
             }
             ++s.n;
         }
@@ -412,7 +413,7 @@ std::map<unsigned, AxisStats> subsets_against_truth(const MountingsFile& m, cons
 
 TEST(CombineAccuracy, EveryHeadSetWithinFivePercentOfTheOptimalBound) {
     const MountingsFile truth = host::simulated_mountings(0x7U);
-    const std::map<unsigned, AxisStats> s = subsets_against_truth(truth, truth);
+    const std::map<HeadMask, AxisStats> s = subsets_against_truth(truth, truth);
     ASSERT_EQ(s.size(), 7U);
     for (const auto& [set, st] : s) {
         ASSERT_GT(st.n, 4000U);  // about 1.1 % statistical error on an RMS
@@ -435,14 +436,14 @@ TEST(CombineAccuracy, EqualSigmasFailTheBound) {
     for (auto& h : equal.mountings.head) {
         h.sigma_about_arcsec = h.sigma_cross_arcsec;
     }
-    const std::map<unsigned, AxisStats> s = subsets_against_truth(equal, truth);
+    const std::map<HeadMask, AxisStats> s = subsets_against_truth(equal, truth);
     double worst_abc = 0.0;
     for (const auto& [set, st] : s) {
         double worst = 0.0;
         for (std::size_t a = 0; a < 3; ++a) {
             worst = std::max(worst, rms(st, a) / st.sigma[a]);
         }
-        if (host::head_count(set) >= 2) {
+        if (head_count(set) >= 2) {
             EXPECT_GT(worst, 1.05) << host::head_set_name(set);
         } else {
             EXPECT_NEAR(worst, 1.0, 0.05) << host::head_set_name(set);
@@ -475,7 +476,7 @@ TEST(CombineAccuracy, TheCommandLineReportsTheErrorPerHeadSetAndSmallSteps) {
     EXPECT_GE(checked, 3U);  // ABC, AB, AC
     // Steps against the truth: two-head sets within 0.2" of the full set.
     for (const host::HeadSetReport& r : st.sets) {
-        if (host::head_count(r.heads) == 2 && r.with_truth >= 3000) {  // BC: a few dozen epochs, noise
+        if (head_count(r.heads) == 2 && r.with_truth >= 3000) {  // BC: a few dozen epochs, noise
             for (std::size_t a = 0; a < 3; ++a) {
                 EXPECT_LT(r.step[a], 0.2) << host::head_set_name(r.heads);
             }
@@ -537,7 +538,7 @@ TEST(CombineAccuracy, StepsWithoutTheThermalStageAreLargerThanWithIt) {
     opt.in = (ms.dir / "raw_ab.csv").string();
     opt.out = (ms.dir / "steps_ab.csv").string();
     const host::CombineSummary without = host::combine_file(opt, log);
-    for (const unsigned set : {3U, 5U, 6U}) {  // AB, AC, BC
+    for (const HeadMask set : {HeadMask{3}, HeadMask{5}, HeadMask{6}}) {  // AB, AC, BC
         double with_max = 0.0;
         double without_max = 0.0;
         for (std::size_t a = 0; a < 3; ++a) {
@@ -652,7 +653,7 @@ host::CombinedStats biased_mission(double arcsec, const std::string& gate) {
 double worst_error_over_sigma(const host::CombinedStats& s) {
     double worst = 0.0;
     for (const host::HeadSetReport& r : s.sets) {
-        if (host::head_count(r.heads) < 2 || r.with_truth < 100) {
+        if (head_count(r.heads) < 2 || r.with_truth < 100) {
             continue;
         }
         for (std::size_t a = 0; a < 3; ++a) {

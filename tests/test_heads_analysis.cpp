@@ -75,12 +75,12 @@ TEST(HeadsAnalysis, PairsAreEveryTwoHeadsInHeadsOrder) {
     EXPECT_STREQ(paper.pair[2].name, "B-C");
     // The paper's heads are always analysed; others when they have rows.
     EXPECT_EQ(host::analysis_heads(0U), host::kPaperHeads);
-    EXPECT_EQ(host::head_letters(host::analysis_heads(host::head_bit(3))), "ABCD");
+    EXPECT_EQ(host::head_letters(host::analysis_heads(head_bit(3))), "ABCD");
     EXPECT_EQ(host::head_words(host::kAllHeads), "A, B, C and D");
     EXPECT_FALSE(host::parse_head_letters("BA").has_value());
     EXPECT_FALSE(host::parse_head_letters("AA").has_value());
     EXPECT_FALSE(host::parse_head_letters("AE").has_value());
-    EXPECT_EQ(host::parse_head_letters("ACD"), host::head_bit(0) | host::head_bit(2) | host::head_bit(3));
+    EXPECT_EQ(host::parse_head_letters("ACD"), head_bit(0) | head_bit(2) | head_bit(3));
 }
 
 TEST(HeadsAnalysis, FourHeadMissionIsFittedAndCorrectedToTheFloor) {

@@ -47,8 +47,8 @@ public:
 inline CLI::Validator head_letters_in(std::size_t min, std::size_t max) {
     return CLI::Validator(
         [min, max](std::string& s) {
-            const std::optional<host::HeadSet> set = host::parse_head_letters(s);
-            const std::size_t n = set ? host::head_count(*set) : 0;
+            const std::optional<HeadMask> set = host::parse_head_letters(s);
+            const std::size_t n = set ? head_count(*set) : 0;
             if (set && n >= min && n <= max) {
                 return std::string();
             }

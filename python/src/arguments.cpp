@@ -89,10 +89,10 @@ host::ScalarKind scalar_arg(const py::handle& x) {
     return *host::scalar_from_name(choice(x, "scalar", names));
 }
 
-host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max) {
-    const std::optional<host::HeadSet> set =
+HeadMask heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max) {
+    const std::optional<HeadMask> set =
         py::isinstance<py::str>(x) ? host::parse_head_letters(x.cast<std::string>()) : std::nullopt;
-    const std::size_t n = set ? host::head_count(*set) : 0U;
+    const std::size_t n = set ? head_count(*set) : 0U;
     if (!set || n < min || n > max) {
         const std::string count = min == max ? std::to_string(min) : std::to_string(min) + " or more";
         bad_argument(name, "expected " + count + " of the heads " + kHeadLetters +

@@ -85,7 +85,7 @@ std::string path_arg(const py::handle& x, const char* name);
 // Heads by their letters, as the command line's --heads and --frame-heads
 // (iba.hpp parse_head_letters: heads.hpp's, in its order, none twice), at
 // least min and at most max of them; a str, else refused.
-host::HeadSet heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
+HeadMask heads_arg(const py::handle& x, const char* name, std::size_t min, std::size_t max);
 // A time (t_from, t_to): None, or a real number that is not NaN; a NumPy
 // float below 64 bits is refused (too few bits for a time since J2000).
 std::optional<double> time_arg(const py::object& x, const char* name);

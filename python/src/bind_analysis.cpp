@@ -35,7 +35,7 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     const Rows r = rows_of(t, chu, q, py::none(), py::none());
     // Every pair of kMaxHeads while reading; those of the rows' heads at the end (as stats()).
     constexpr host::PairList kAllPairs = host::pairs_of(host::kAllHeads);
-    host::HeadSet with_rows = 0U;
+    HeadMask with_rows = 0U;
     std::array<std::vector<double>, host::kMaxPairs> pt;
     std::array<std::vector<double>, host::kMaxPairs> pv;
     // A row whose quaternion the core rejects (not finite, not unit: status 16
@@ -61,7 +61,7 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
         if (rec.head < kMaxHeads) {
-            with_rows |= host::head_bit(rec.head);
+            with_rows |= head_bit(rec.head);
             SolutionInput<double> in{};
             in.q_chu_icrf = rec.q_chu_icrf;
             in.head = rec.head;
@@ -82,8 +82,8 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     py::dict out;
     for (std::size_t p = 0; p < kAllPairs.count; ++p) {
         const host::HeadPair& pair = kAllPairs.pair[p];
-        const host::HeadSet heads = host::analysis_heads(with_rows);
-        if (!host::has_head(heads, pair.first) || !host::has_head(heads, pair.second)) {
+        const HeadMask heads = host::analysis_heads(with_rows);
+        if (!has_head(heads, pair.first) || !has_head(heads, pair.second)) {
             continue;
         }
         std::vector<std::size_t> idx(pt[p].size());

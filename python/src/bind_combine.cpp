@@ -204,7 +204,7 @@ py::dict combine_arrays(const py::object& t, const py::object& chu, const py::ob
 }
 
 py::dict report_dict(const host::AlignReport& r) {
-    const auto k = static_cast<py::ssize_t>(host::head_count(r.heads));
+    const auto k = static_cast<py::ssize_t>(head_count(r.heads));
     py::array_t<double> rot({k, py::ssize_t{3}});
     py::array_t<double> rot_sd({k, py::ssize_t{3}});
     py::array_t<double> sc(k);
@@ -214,7 +214,7 @@ py::dict report_dict(const host::AlignReport& r) {
     py::array_t<std::int64_t> epochs(k);
     py::ssize_t i = 0;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (!host::has_head(r.heads, h)) {
+        if (!has_head(r.heads, h)) {
             continue;
         }
         const host::HeadAlignment& a = r.head[h];
@@ -307,8 +307,8 @@ host::MountingsFile mountings_arg(const py::handle& obj) {
             bad_argument("mountings", std::string("the dict has no '") + key + "' (as read_mountings() returns it)");
         }
     }
-    const host::HeadSet heads = heads_arg(d["heads"], "mountings['heads']", 1, kMaxHeads);
-    const auto k = static_cast<py::ssize_t>(host::head_count(heads));
+    const HeadMask heads = heads_arg(d["heads"], "mountings['heads']", 1, kMaxHeads);
+    const auto k = static_cast<py::ssize_t>(head_count(heads));
     const Doubles q = real_array(d["q"], "mountings['q']", k, 4);
     const bool sigmas = !d["sigma_cross"].is_none() || !d["sigma_about"].is_none();
     Doubles cross;
@@ -321,7 +321,7 @@ host::MountingsFile mountings_arg(const py::handle& obj) {
     m.sigmas = sigmas;
     py::ssize_t i = 0;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (!host::has_head(heads, h)) {
+        if (!has_head(heads, h)) {
             continue;
         }
         combine::HeadMounting& hm = m.mountings.head[h];

@@ -23,7 +23,7 @@ Eigen::Matrix3d rotation_matrix_of(const Quaternion<double>& q) noexcept {
 }
 
 // The heads of s in heads.hpp's order; the first is the reference of the set's differences.
-HeadList members(HeadSet s) noexcept {
+HeadList members(HeadMask s) noexcept {
     return heads_of(s);
 }
 
@@ -55,16 +55,16 @@ Eigen::Matrix3d information_crf(const Quaternion<double>& q_chu_crf, double sigm
 AlignSums::AlignSums(double noise_window_s) : window_s_(noise_window_s) {
     for (std::size_t s = 0; s < kHeadSets; ++s) {
         const std::size_t dim =
-            3U * (head_count(static_cast<HeadSet>(s)) > 0 ? head_count(static_cast<HeadSet>(s)) - 1U : 0U);
+            3U * (head_count(static_cast<HeadMask>(s)) > 0 ? head_count(static_cast<HeadMask>(s)) - 1U : 0U);
         total_[s].sum = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dim));
         total_[s].scatter = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dim), static_cast<Eigen::Index>(dim));
     }
 }
 
 void AlignSums::add(double t, const std::array<std::optional<Quaternion<double>>, kMaxHeads>& q_crf_icrf) {
-    HeadSet s = 0U;
+    HeadMask s = 0U;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        s |= q_crf_icrf[h] ? head_bit(h) : 0U;
+        s |= q_crf_icrf[h] ? head_bit(h) : HeadMask{0};
     }
     if (head_count(s) < 2U) {
         single_ += head_count(s) == 1U ? 1U : 0U;
@@ -144,7 +144,7 @@ struct Components {
     Eigen::MatrixXd p;  // 2·heads × parameters
 };
 
-Components components_of(HeadSet heads, NoiseModel model) {
+Components components_of(HeadMask heads, NoiseModel model) {
     Components c;
     c.heads = heads_of(heads);
     const auto n = static_cast<Eigen::Index>(c.heads.count);
@@ -184,7 +184,7 @@ Eigen::MatrixXd unit_covariance(const HeadList& l, std::uint8_t h, const Eigen::
 }
 
 // For head set s: A_k for every component k (x's order); zero for heads not in s.
-std::vector<Eigen::MatrixXd> unit_covariances(HeadSet s, const Components& c,
+std::vector<Eigen::MatrixXd> unit_covariances(HeadMask s, const Components& c,
                                               const std::array<Eigen::Vector3d, kMaxHeads>& b) {
     const HeadList l = heads_of(s);
     const auto dim = static_cast<Eigen::Index>(3U * (l.count - 1U));
@@ -209,12 +209,12 @@ struct SetModel {
 std::vector<SetModel> set_models(const AlignSums& sums, const Components& c,
                                  const std::array<Eigen::Vector3d, kMaxHeads>& b) {
     std::vector<SetModel> out;
-    HeadSet all = 0U;
+    HeadMask all = 0U;
     for (std::size_t k = 0; k < c.heads.count; ++k) {
         all |= head_bit(c.heads.head[k]);
     }
     for (std::size_t s = 0; s < kHeadSets; ++s) {
-        const auto set = static_cast<HeadSet>(s);
+        const auto set = static_cast<HeadMask>(s);
         const AlignSums::SetSums& ss = sums.set(set);
         if (head_count(set) < 2U || ss.dof <= 0.0 || (set & ~all) != 0U) {
             continue;
@@ -301,7 +301,7 @@ constexpr double kRemlTolerance = 1e-10;  // relative change of every component
 
 }  // namespace
 
-NoiseEstimate estimate_noise(const AlignSums& sums, HeadSet heads,
+NoiseEstimate estimate_noise(const AlignSums& sums, HeadMask heads,
                              const std::array<Eigen::Vector3d, kMaxHeads>& boresight_crf) {
     NoiseEstimate est;
     est.heads = heads;
@@ -365,14 +365,14 @@ namespace {
 
 // Heads joined by a common epoch to the first head of `heads`; a head outside
 // is named in the refusal.
-void refuse_unconnected(const AlignSums& sums, HeadSet heads) {
+void refuse_unconnected(const AlignSums& sums, HeadMask heads) {
     const HeadList l = heads_of(heads);
-    HeadSet reached = l.count > 0 ? head_bit(l.head[0]) : 0U;
+    HeadMask reached = l.count > 0 ? head_bit(l.head[0]) : HeadMask{0};
     for (bool grew = true; grew;) {
         grew = false;
         for (std::size_t s = 0; s < kHeadSets; ++s) {
-            const auto set = static_cast<HeadSet>(s) & heads;
-            if (sums.set(static_cast<HeadSet>(s)).n > 0 && (set & reached) != 0U && (set & ~reached) != 0U) {
+            const auto set = static_cast<HeadMask>(s & heads);
+            if (sums.set(static_cast<HeadMask>(s)).n > 0 && (set & reached) != 0U && (set & ~reached) != 0U) {
                 reached |= set;
                 grew = true;
             }
@@ -390,7 +390,7 @@ void refuse_unconnected(const AlignSums& sums, HeadSet heads) {
 
 }  // namespace
 
-Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+Alignment solve_alignment(const AlignSums& sums, HeadMask heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information,
                           const std::array<Eigen::Vector3d, kMaxHeads>& turned_arcsec) {
     refuse_unconnected(sums, heads);
@@ -403,7 +403,7 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
     Eigen::MatrixXd n = Eigen::MatrixXd::Zero(n3, n3);
     Eigen::VectorXd r = Eigen::VectorXd::Zero(n3);
     for (std::size_t s = 0; s < kHeadSets; ++s) {
-        const auto set = static_cast<HeadSet>(s);
+        const auto set = static_cast<HeadMask>(s);
         const AlignSums::SetSums& ss = sums.set(set);
         if (ss.n == 0U || (set & ~heads) != 0U) {
             continue;
@@ -467,7 +467,7 @@ Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
     return a;
 }
 
-Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+Alignment solve_alignment(const AlignSums& sums, HeadMask heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information) {
     std::array<Eigen::Vector3d, kMaxHeads> zero{};
     for (Eigen::Vector3d& z : zero) {

@@ -98,7 +98,7 @@ void apply_gate(const StageGates& gates, const Epoch<Judged>& e, StatusBits stag
     }
     const HeadMask out = n >= 2 ? gates.of(stages).combine(heads, n).inconsistent : HeadMask{0};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        why[h] = (out & ascorr::head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
+        why[h] = (out & head_bit(h)) != 0U ? LeftOut::kInconsistent : why[h];
     }
 }
 
@@ -226,7 +226,7 @@ std::string reasons_text(const std::array<std::size_t, kLeftOutKinds>& n) {
 
 // The refusals found after each pass: no row, a head without clean epochs
 // (the gate may leave a head none), too few epochs.
-void refuse_thin_data(const std::string& file, const AlignSums& sums, const PassCounts& c, HeadSet heads,
+void refuse_thin_data(const std::string& file, const AlignSums& sums, const PassCounts& c, HeadMask heads,
                       const AlignOptions& opt) {
     const std::string where = text::input_name(file) + " in " + period_text(opt.from, opt.to);
     if (c.rows_in_period == 0U) {
@@ -266,10 +266,10 @@ Eigen::Vector3d turned_from(const MountingsFile& m, const CurrentMountings& q, s
     return rotation_arcsec(conjugate(m.mountings.head[h].q_chu_crf) * q[h], {1.0, 0.0, 0.0, 0.0});
 }
 
-HeadSet heads_of_mountings(const MountingsFile& m) noexcept {
-    HeadSet s = 0U;
+HeadMask heads_of_mountings(const MountingsFile& m) noexcept {
+    HeadMask s = 0U;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        s |= m.mountings.head[h].present ? head_bit(h) : 0U;
+        s |= m.mountings.head[h].present ? head_bit(h) : HeadMask{0};
     }
     return s;
 }

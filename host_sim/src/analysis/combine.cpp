@@ -89,19 +89,18 @@ std::string describe(const CombineSummary& s) {
         o << "; rows out of time order: sorted";
     }
     // Most heads first (AB, AC, BC, then A, B, C).
-    std::vector<std::uint32_t> sets;
-    for (std::uint32_t set = 1; set < s.steps.size(); ++set) {
+    std::vector<HeadMask> sets;
+    for (std::size_t set = 1; set < s.steps.size(); ++set) {
         if (s.steps[set].days != 0) {
-            sets.push_back(set);
+            sets.push_back(static_cast<HeadMask>(set));
         }
     }
-    std::stable_sort(sets.begin(), sets.end(),
-                     [](std::uint32_t a, std::uint32_t b) { return head_count(a) > head_count(b); });
+    std::stable_sort(sets.begin(), sets.end(), [](HeadMask a, HeadMask b) { return head_count(a) > head_count(b); });
     if (!sets.empty()) {
         o << "\nsteps from " << head_letters(s.full)
           << " (RMS over days of the daily mean of q_S - q_full, CRF x y z, arcsec):";
     }
-    for (const std::uint32_t set : sets) {
+    for (const HeadMask set : sets) {
         const HeadSetStep& st = s.steps[set];
         char buf[128];
         text::c_snprintf(buf, sizeof buf, " %s %.3f %.3f %.3f (%zu d);", head_letters(set).c_str(),
@@ -197,7 +196,7 @@ void refuse_unusable_mountings(const MountingsFile& m, const std::string& path,
     }
 }
 
-SubsetCovariances subset_covariances(const combine::Mountings& m, std::uint32_t mounted) noexcept {
+SubsetCovariances subset_covariances(const combine::Mountings& m, HeadMask mounted) noexcept {
     SubsetCovariances out{};
     for (unsigned s = 1; s < combine::kSubsetCount; ++s) {
         combine::Matrix3 cov{};
@@ -334,8 +333,9 @@ struct CombineStage::Impl {
         }
         const auto day = static_cast<long long>(std::floor((t - t_first) / kSecondsPerDay));
         combine::HeadAttitude<double> subset[kMaxHeads];
-        for (std::uint32_t set = 1; set < mounted; ++set) {
-            if ((set & ~mounted) != 0U) {
+        for (unsigned sub = 1; sub < mounted; ++sub) {
+            const auto set = static_cast<HeadMask>(sub);
+            if ((set & ~mounted) != 0) {
                 continue;
             }
             for (std::uint8_t i = 0; i < n; ++i) {
@@ -357,7 +357,7 @@ struct CombineStage::Impl {
 
     void finish_steps() {
         sum.full = mounted;
-        for (std::uint32_t set = 1; set < mounted; ++set) {
+        for (unsigned set = 1; set < mounted; ++set) {
             HeadSetStep& st = sum.steps[set];
             std::array<double, 3> sq{};
             for (const auto& [day, d] : daily[set]) {
@@ -403,7 +403,7 @@ struct CombineStage::Impl {
         }
         const combine::CombinedAttitude<double> c = combiner.combine(heads, n);
         for (std::uint8_t i = 0; i < n; ++i) {
-            const HeadMask bit = ascorr::head_bit(heads[i].head);
+            const HeadMask bit = head_bit(heads[i].head);
             if ((c.used & bit) == 0U) {  // the selection took head, mounting and norm: the gate, unless it differs
                 rows[used_row[i]].why = (c.inconsistent & bit) != 0U ? LeftOut::kInconsistent : LeftOut::kNotUnit;
             }
@@ -472,7 +472,7 @@ struct CombineStage::Impl {
         std::size_t n = 0;
         std::array<double, 3> sum{};
     };
-    std::uint32_t mounted = gates.of(kBothStages).mounted();
+    HeadMask mounted = gates.of(kBothStages).mounted();
     SubsetCovariances covariance{};  // with cols.covariance
     std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
     double t_first = 0.0;

@@ -85,12 +85,12 @@ private:
     bool more_ = false;
 };
 
-std::size_t set_size(std::uint32_t heads) {
+std::size_t set_size(HeadMask heads) {
     return head_count(heads);
 }
 
 // Most heads first, then heads.hpp's order (the mask's lowest bits first); none last.
-bool set_order(std::uint32_t a, std::uint32_t b) {
+bool set_order(HeadMask a, HeadMask b) {
     if ((a == 0) != (b == 0)) {
         return b == 0;
     }
@@ -107,7 +107,7 @@ bool set_order(std::uint32_t a, std::uint32_t b) {
     return false;
 }
 
-void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedStats& s) {
+void steps_against_full(std::map<HeadMask, SetAccumulator>& acc, CombinedStats& s) {
     const auto full = acc.find(s.full);
     for (HeadSetReport& r : s.sets) {
         if (full == acc.end() || r.heads == s.full || r.heads == 0) {
@@ -130,7 +130,7 @@ void steps_against_full(std::map<std::uint32_t, SetAccumulator>& acc, CombinedSt
 
 }  // namespace
 
-std::string head_set_name(std::uint32_t heads) {
+std::string head_set_name(HeadMask heads) {
     return heads == 0 ? std::string("-") : head_letters(heads);
 }
 
@@ -146,7 +146,7 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
     }
     CombinedStats s;
     s.truth = truth.has_value();
-    std::map<std::uint32_t, SetAccumulator> acc;
+    std::map<HeadMask, SetAccumulator> acc;
     AttitudeRow row;
     double t0 = 0.0;
     std::int64_t last_key = 0;

@@ -62,11 +62,11 @@ std::string time_text(double t) {
 }  // namespace
 
 namespace {
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads);
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads);
 
 // The heads a reading assumes: the given ones, else the analysis's with the
 // heads seen with rows so far.
-HeadSet fit_heads(const FitOptions& opt, HeadSet with_rows) {
+HeadMask fit_heads(const FitOptions& opt, HeadMask with_rows) {
     return opt.heads ? *opt.heads : analysis_heads(with_rows, frame_set(opt.frame_heads));
 }
 
@@ -147,7 +147,7 @@ constexpr double kPlaceholderPeriodS = 5400.0;
 // when the rows are out of time order).
 struct Pass {
     FitReport r;
-    HeadSet with_rows = 0U;                                              // heads with rows in the modelling period
+    HeadMask with_rows = 0U;                                             // heads with rows in the modelling period
     std::array<double, kMaxHeads> first_row{};                           // per head in with_rows: its rows' first t
     std::array<double, kMaxHeads> last_row{};                            //   and last t in the period
     std::optional<double> period;                                        // bins the epochs into orbits
@@ -195,7 +195,7 @@ void add_head(Pass& p, OrbitSums& o, const Epoch<Row>& e, const Quaternion<doubl
     o.x2[h] += Eigen::Vector3d(t[0] * t[0], (t[1] - t[0]) * (t[1] - t[0]), (t[2] - t[0]) * (t[2] - t[0]));
 }
 
-FitEpoch fit_epoch_of(const Epoch<Row>& e, HeadSet heads) {
+FitEpoch fit_epoch_of(const Epoch<Row>& e, HeadMask heads) {
     FitEpoch fe{};
     fe.t = e.t;
     const HeadList list = heads_of(heads);
@@ -339,13 +339,13 @@ void rebase_on_earliest_epoch(Pass& p) {
 // --heads and --frame-heads that fit those; empty when no head is to blame.
 std::string heads_hint(const FitOptions& opt, const Pass& p) {
     const FitReport& r = p.r;
-    const HeadSet present = r.heads & p.with_rows;
+    const HeadMask present = r.heads & p.with_rows;
     const HeadList listed = heads_of(present);
     double longest = 0.0;
     for (std::size_t i = 0; i < listed.count; ++i) {
         longest = std::max(longest, p.last_row[listed.head[i]] - p.first_row[listed.head[i]]);
     }
-    HeadSet brief = 0U;
+    HeadMask brief = 0U;
     std::string why;
     for (std::size_t i = 0; i < listed.count; ++i) {
         const std::uint8_t h = listed.head[i];
@@ -355,7 +355,7 @@ std::string heads_hint(const FitOptions& opt, const Pass& p) {
                    "'s rows span only t = " + time_text(p.first_row[h]) + " .. " + time_text(p.last_row[h]);
         }
     }
-    const HeadSet without_rows = r.heads & ~p.with_rows;
+    const HeadMask without_rows = r.heads & ~p.with_rows;
     if (without_rows != 0U) {
         why = head_words(without_rows) + (head_count(without_rows) == 1U ? " has" : " have") + " no rows there" +
               (why.empty() ? "" : ", ") + why;
@@ -363,7 +363,7 @@ std::string heads_hint(const FitOptions& opt, const Pass& p) {
     if (present == 0U || why.empty()) {
         return {};
     }
-    const HeadSet keep = present & ~brief;
+    const HeadMask keep = present & ~brief;
     const HeadList kept = heads_of(keep);
     if (kept.count < 2U) {
         return "; " + why + ": a fit needs two heads with rows";
@@ -406,7 +406,7 @@ std::size_t min_epochs_per_orbit(const std::map<long long, OrbitSums>& orbits) {
 
 // The averages of the orbits with at least min_count epochs.
 std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& orbits, std::size_t min_count,
-                                         double period, HeadSet heads) {
+                                         double period, HeadMask heads) {
     const HeadList list = heads_of(heads);
     std::vector<OrbitAverage> averages;
     for (const auto& kv : orbits) {
@@ -429,7 +429,7 @@ std::vector<OrbitAverage> orbit_averages(const std::map<long long, OrbitSums>& o
 // The rule `combined`'s weights A_h (combine/mountings.hpp, motion_weight)
 // for the heads fitted, from the mountings, which must have them all, with
 // their sigmas.
-void fill_motion(const FitOptions& opt, HeadSet heads, CommonRotation& rule) {
+void fill_motion(const FitOptions& opt, HeadMask heads, CommonRotation& rule) {
     const MountingsFile& m = *opt.mountings;
     const std::string name = text::input_name(opt.mountings_name);
     if (!m.sigmas) {
@@ -508,7 +508,8 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // (earliest_period: that second reading.) Likewise the heads, unless
 // --heads names them: a reading assumes them (A, B, C and F's first); when
 // the period holds rows of others, the rows are read again with those too.
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadSet heads) {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period,
+                   HeadMask heads) {
     EarthVelocity earth;
     Pass p;
     p.r.heads = heads;

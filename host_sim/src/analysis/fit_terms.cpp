@@ -399,8 +399,8 @@ const char* terms_name(Terms t) noexcept {
     return t == Terms::kLinear ? "linear" : "quadratic";
 }
 
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
-                     double max_condition, double min_range_c, const CommonRotation& rule) {
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadMask heads,
+                     Terms terms, double max_condition, double min_range_c, const CommonRotation& rule) {
     TermsFit f;
     f.terms = terms;
     f.heads = heads;
@@ -461,8 +461,8 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
     return f;
 }
 
-std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
-                                             const ModelFile& m) {
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
+                                             double to, const ModelFile& m) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
     const HeadList list = heads_of(heads);
@@ -524,7 +524,7 @@ double mean_held_out_rms(const ModelScore& m, const PairList& pairs) {
 }  // namespace
 
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
-                       const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
+                       const HeadOrientations& n_ref, HeadMask heads, double t_first, double t_last, double holdout,
                        double max_condition, double min_range_c, const CommonRotation& rule) {
     Selection s;
     s.pairs = pairs_of(heads);

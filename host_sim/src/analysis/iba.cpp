@@ -16,7 +16,7 @@ std::string pair_name(const HeadPair& p) {
     return std::string(1, kHeadLetters[p.first]) + '-' + kHeadLetters[p.second];
 }
 
-std::string head_letters(HeadSet s) {
+std::string head_letters(HeadMask s) {
     std::string out;
     const HeadList l = heads_of(s);
     for (std::size_t i = 0; i < l.count; ++i) {
@@ -25,7 +25,7 @@ std::string head_letters(HeadSet s) {
     return out;
 }
 
-std::string head_words(HeadSet s, const char* last) {
+std::string head_words(HeadMask s, const char* last) {
     const std::string letters = head_letters(s);
     std::string out;
     for (std::size_t i = 0; i < letters.size(); ++i) {
@@ -35,8 +35,8 @@ std::string head_words(HeadSet s, const char* last) {
     return out;
 }
 
-std::optional<HeadSet> parse_head_letters(const std::string& letters) {
-    HeadSet s = 0;
+std::optional<HeadMask> parse_head_letters(const std::string& letters) {
+    HeadMask s = 0;
     int last = -1;
     for (const char c : letters) {
         const std::uint8_t h = head_index(c);

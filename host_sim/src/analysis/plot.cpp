@@ -492,8 +492,8 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
     const std::filesystem::path data = dir.file("combined.dat");
     std::ofstream f(data);
     f.precision(12);
-    std::map<std::uint32_t, std::size_t> sets;  // head set -> epochs in the window
-    std::uint32_t full = 0;
+    std::map<HeadMask, std::size_t> sets;  // head set -> epochs in the window
+    HeadMask full = 0;
     double y_max = 0.0;
     std::size_t without_truth = 0;
     double step = std::numeric_limits<double>::infinity();  // the shading's box width
@@ -516,7 +516,7 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
         const std::array<double, 3> e{v.x, v.y, v.z};
         step = row.t > t_previous ? std::min(step, row.t - t_previous) : step;
         t_previous = row.t;
-        f << row.t + kJ2000Unix << ' ' << e[0] << ' ' << e[1] << ' ' << e[2] << ' ' << row.heads << '\n';
+        f << row.t + kJ2000Unix << ' ' << e[0] << ' ' << e[1] << ' ' << e[2] << ' ' << unsigned{row.heads} << '\n';
         ++sets[row.heads];
         full = head_count(row.heads) > head_count(full) ? row.heads : full;
         y_max = std::max(y_max, max_abs(e));
@@ -552,11 +552,11 @@ void plot_combined(const CombinedPlotOptions& opt, OutputSet& outputs, std::ostr
         for (int a = 0; a < 3; ++a) {
             g << "set title 'about CRF " << axes[a] << "'\nset ylabel 'error (arcsec)'\n";
             // The shading: a box per epoch without the full set, the epoch's step wide.
-            g << "plot '" << data.string() << "' using 1:(0):($1-" << half << "):($1+" << half << "):($5 != " << full
-              << " ? " << -y_max << " : 1/0):($5 != " << full << " ? " << y_max
-              << " : 1/0) with boxxyerror lc rgb '#d0d0d0' notitle";
+            g << "plot '" << data.string() << "' using 1:(0):($1-" << half << "):($1+" << half
+              << "):($5 != " << unsigned{full} << " ? " << -y_max << " : 1/0):($5 != " << unsigned{full} << " ? "
+              << y_max << " : 1/0) with boxxyerror lc rgb '#d0d0d0' notitle";
             for (const auto& [set, n] : sets) {
-                g << ", '" << data.string() << "' using 1:($5 == " << set << " ? $" << 2 + a
+                g << ", '" << data.string() << "' using 1:($5 == " << unsigned{set} << " ? $" << 2 + a
                   << " : 1/0) with points pt 7 ps 0.3 title '" << head_set_name(set) << " (" << n << ")'";
             }
             g << "\n";

@@ -237,7 +237,7 @@ private:
     std::array<std::vector<double>, kMaxPairs> floor_v_;
     DailyFloor daily_;
     std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
-    HeadSet solved_;                            // A, B, C and the heads simulated
+    HeadMask solved_;                           // A, B, C and the heads simulated
     PairList pairs_;                            // of the heads simulated
 };
 

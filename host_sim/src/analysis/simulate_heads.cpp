@@ -35,7 +35,7 @@ Eigen::Matrix3d head_mounting(int head) {
     return m;
 }
 
-MountingsFile simulated_mountings(HeadSet heads) {
+MountingsFile simulated_mountings(HeadMask heads) {
     MountingsFile m;
     m.sigmas = true;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {

@@ -25,7 +25,7 @@ void refuse_window(const char* option, const char* form, const DayWindow& w, dou
     }
 }
 
-void refuse_bad_head(const char* option, std::size_t head, HeadSet heads) {
+void refuse_bad_head(const char* option, std::size_t head, HeadMask heads) {
     if (head >= kMaxHeads || !has_head(heads, static_cast<std::uint8_t>(head))) {
         throw std::invalid_argument(std::string(option) + ": HEAD must be " + head_words(heads, " or ") +
                                     " (the heads simulated, --heads), got " +
@@ -107,7 +107,7 @@ std::string truth_name(const std::string& path) {
 // coefficients. A head beyond C (index h ≥ 3) simulated that the file has
 // none for takes head h − 3's with the opposite sign (D: −A's): a deformation
 // of its own, not a rotation common to the heads.
-ModelFile truth_model(const std::string& path, HeadSet heads) {
+ModelFile truth_model(const std::string& path, HeadMask heads) {
     ModelFile truth_file = path.empty() ? table2_model() : read_model_file(path);
     for (std::size_t h = 0; h < kOwnHeads; ++h) {
         if (!truth_file.present[h]) {

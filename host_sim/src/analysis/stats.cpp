@@ -212,14 +212,14 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     // Every pair of kMaxHeads while reading; those of the file's heads at the end.
     constexpr PairList kAllPairs = pairs_of(kAllHeads);
     std::size_t rows_seen = 0;
-    HeadSet with_rows = 0U;
+    HeadMask with_rows = 0U;
     std::array<HeadTally, kMaxHeads> heads{};
     std::array<std::size_t, kMaxPairs> both_present{};
     std::array<PairSeries, kMaxPairs> series;
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, both_present, series); });
     rows([&](const SolutionRecord& rec) {
         ++rows_seen;
-        with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : 0U;
+        with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : HeadMask{0};
         if (!within_time_range(opt, rec.t)) {
             return;
         }

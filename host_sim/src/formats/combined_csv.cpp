@@ -119,7 +119,7 @@ private:
                 fail(c_.heads, "heads must be letters of " + std::string(kHeadLetters) + ", in that order, got '" +
                                    std::string(heads) + "'");
             }
-            row.heads |= 1U << h;
+            row.heads |= head_bit(h);
             last = h;
         }
         if (row.has_q != (row.heads != 0U)) {
@@ -176,10 +176,7 @@ private:
             fail(c_.status, "column 'status': " + std::to_string(row.status) +
                                 " is no combined status (exactly one of 1, 2 and 8, with or without 4)");
         }
-        unsigned n = 0U;
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            n += (row.heads >> h) & 1U;
-        }
+        const unsigned n = head_count(row.heads);
         const unsigned kind = static_cast<unsigned>(st) & (cs::kTwoOrMoreHeads | cs::kOneHead | cs::kNoHead);
         const unsigned expected = static_cast<unsigned>(n == 0U   ? cs::kNoHead
                                                         : n == 1U ? cs::kOneHead
@@ -266,7 +263,7 @@ void append_combined_row(std::string& out, const AttitudeRow& row, CombinedColum
     }
     out += ',';
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (((row.heads >> h) & 1U) != 0U) {
+        if (has_head(row.heads, h)) {
             out += head_letter(h);
         }
     }

@@ -88,7 +88,7 @@ Eigen::Vector3d boresight_crf(const Quaternion<double>& q_chu_crf) noexcept;
 Eigen::Matrix3d information_crf(const Quaternion<double>& q_chu_crf, double sigma_cross_arcsec,
                                 double sigma_about_arcsec) noexcept;
 
-// Every set of heads: indexed by its HeadSet bits.
+// Every set of heads: indexed by its HeadMask bits.
 inline constexpr std::size_t kHeadSets = std::size_t{1} << kMaxHeads;
 
 // The sums of one pass over the data.
@@ -108,12 +108,12 @@ public:
         Eigen::MatrixXd scatter;  // Σ over windows of Σ (d − window mean)(…)ᵀ
         double dof = 0.0;         // Σ over windows of (n_window − 1)
     };
-    const SetSums& set(HeadSet s) const noexcept { return total_[s]; }
+    const SetSums& set(HeadMask s) const noexcept { return total_[s]; }
     // Epochs with two or more heads in which head h is (per head), and in all.
     std::size_t head_epochs(std::uint8_t h) const noexcept { return head_epochs_[h]; }
     std::size_t joint_epochs() const noexcept { return joint_; }
     std::size_t single_epochs() const noexcept { return single_; }
-    HeadSet heads() const noexcept { return heads_; }  // heads of the joint epochs
+    HeadMask heads() const noexcept { return heads_; }  // heads of the joint epochs
     double noise_window_s() const noexcept { return window_s_; }
 
 private:
@@ -131,7 +131,7 @@ private:
     std::array<std::size_t, kMaxHeads> head_epochs_{};
     std::size_t joint_ = 0;
     std::size_t single_ = 0;
-    HeadSet heads_ = 0U;
+    HeadMask heads_ = 0U;
 };
 
 enum class NoiseModel : std::uint8_t {
@@ -148,7 +148,7 @@ struct HeadNoise {
 };
 
 struct NoiseEstimate {
-    HeadSet heads = 0U;
+    HeadMask heads = 0U;
     std::array<HeadNoise, kMaxHeads> head{};
     NoiseModel model = NoiseModel::kPerHead;
     std::size_t iterations = 0;
@@ -160,11 +160,11 @@ struct NoiseEstimate {
 // those estimated (each in some joint epoch), boresight_crf by head index.
 // Throws std::invalid_argument when the data do not identify them even with
 // one shared σc.
-NoiseEstimate estimate_noise(const AlignSums& sums, HeadSet heads,
+NoiseEstimate estimate_noise(const AlignSums& sums, HeadMask heads,
                              const std::array<Eigen::Vector3d, kMaxHeads>& boresight_crf);
 
 struct Alignment {
-    HeadSet heads = 0U;
+    HeadMask heads = 0U;
     std::array<Eigen::Vector3d, kMaxHeads> delta_arcsec{};           // δ_i, CRF axes
     std::array<Eigen::Matrix3d, kMaxHeads> covariance{};             // of δ_i, arcsec²
     Eigen::Vector3d weighted_mean_arcsec = Eigen::Vector3d::Zero();  // (ΣW)⁻¹ Σ W_i (Δ_i + δ_i), zero up to rounding
@@ -175,11 +175,11 @@ struct Alignment {
 // passes; zero: the datum Σ W_i δ_i = 0), so that the datum holds for the
 // total rotation with the latest weights. Throws std::invalid_argument naming
 // a head that shares no epoch with the others.
-Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+Alignment solve_alignment(const AlignSums& sums, HeadMask heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information,
                           const std::array<Eigen::Vector3d, kMaxHeads>& turned_arcsec);
 // The same with every Δ_i zero.
-Alignment solve_alignment(const AlignSums& sums, HeadSet heads,
+Alignment solve_alignment(const AlignSums& sums, HeadMask heads,
                           const std::array<Eigen::Matrix3d, kMaxHeads>& information);
 
 // ---- `ascorr align`: the passes over a file
@@ -240,7 +240,7 @@ struct AlignReport {
     std::string out;
     std::optional<double> from;
     std::optional<double> to;
-    HeadSet heads = 0U;  // of the mountings: every one aligned
+    HeadMask heads = 0U;  // of the mountings: every one aligned
     std::array<HeadAlignment, kMaxHeads> head{};
     NoiseEstimate noise;
     std::size_t rows = 0;                                    // all rows of the input

@@ -42,6 +42,7 @@
 
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/combine/usable.hpp"
+#include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
@@ -97,7 +98,7 @@ struct CombineSummary {
     std::array<std::size_t, 4> status_bit{};                 // epochs with bit 1, 2, 4, 8
     std::array<std::size_t, kLeftOutKinds> rows_left_out{};  // by LeftOut (kUsed: rows averaged in)
     bool out_of_order = false;                               // the rows were sorted
-    std::uint32_t full = 0;                                  // the mounted heads
+    HeadMask full = 0;                                       // the mounted heads
     std::array<HeadSetStep, 1U << kMaxHeads> steps{};        // by subset mask of `full` (days 0: none)
 };
 std::string describe(const CombineSummary& s);
@@ -146,7 +147,7 @@ private:
 // set's combination (combine/subset_tables.hpp's P_S⁻¹), by HeadMask; zeros
 // for a set with a head not in `mounted`.
 using SubsetCovariances = std::array<std::array<double, 3>, combine::kSubsetCount>;
-SubsetCovariances subset_covariances(const combine::Mountings& m, std::uint32_t mounted) noexcept;
+SubsetCovariances subset_covariances(const combine::Mountings& m, HeadMask mounted) noexcept;
 
 // Rows in, one combined row per epoch out (see the top).
 class CombineStage : public CorrectedRowSink {

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
 
 namespace ascorr::host {
@@ -33,7 +34,7 @@ struct CombinedStatsOptions {
 };
 
 struct HeadSetReport {
-    std::uint32_t heads = 0;  // mask (bit h: head h); 0: no usable head
+    HeadMask heads = 0;  // mask (bit h: head h); 0: no usable head
     std::size_t epochs = 0;
     std::size_t with_truth = 0;  // epochs with a truth row
     std::array<double, 3> error_rms{};
@@ -47,7 +48,7 @@ struct CombinedStats {
     std::size_t epochs = 0;
     std::array<std::size_t, 4> status_bit{};  // epochs with status 1, 2, 4, 8
     bool truth = false;
-    std::uint32_t full = 0;           // the full head set
+    HeadMask full = 0;                // the full head set
     std::vector<HeadSetReport> sets;  // most heads first, then heads.hpp's order; "-" last
     std::size_t epochs_without_truth = 0;
 };
@@ -61,6 +62,6 @@ std::string combined_stats_table(const CombinedStats& s);
 std::string combined_stats_json(const CombinedStats& s);
 
 // The letters of a head mask, "-" for none.
-std::string head_set_name(std::uint32_t heads);
+std::string head_set_name(HeadMask heads);
 
 }  // namespace ascorr::host

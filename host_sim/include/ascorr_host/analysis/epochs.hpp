@@ -5,7 +5,7 @@
 // EpochAssembler groups the rows of the heads that share an epoch (t to the
 // millisecond, docs/contract.md), in any row order. Which heads make an epoch
 // complete:
-//  - a given HeadSet (fit: the heads of its analysis): the epoch is handed on
+//  - a given HeadMask (fit: the heads of its analysis): the epoch is handed on
 //    as soon as all of them are in;
 //  - or the heads the file has shown so far (stats, plot: they do not know
 //    the file's heads beforehand): the epoch is handed on once it holds every
@@ -65,7 +65,7 @@ class EpochAssembler {
 public:
     using Sink = std::function<void(const Epoch<Payload>&)>;
     // Complete with the heads of `complete`.
-    EpochAssembler(std::string file, Sink sink, HeadSet complete)
+    EpochAssembler(std::string file, Sink sink, HeadMask complete)
         : file_(std::move(file)), sink_(std::move(sink)), complete_(complete), open_(false) {}
     // Complete with the heads seen so far.
     EpochAssembler(std::string file, Sink sink) : file_(std::move(file)), sink_(std::move(sink)), open_(true) {}
@@ -128,12 +128,12 @@ public:
     }
 
     // The heads of the rows added so far (open), or the set given.
-    HeadSet heads() const noexcept { return complete_; }
+    HeadMask heads() const noexcept { return complete_; }
 
 private:
     struct Entry {
         Epoch<Payload> epoch;
-        HeadSet heads = 0U;
+        HeadMask heads = 0U;
     };
 
     void hand_on(std::int64_t key) {
@@ -145,7 +145,7 @@ private:
 
     std::string file_;
     Sink sink_;
-    HeadSet complete_ = 0U;
+    HeadMask complete_ = 0U;
     bool open_ = false;
     std::unordered_map<std::int64_t, Entry> pending_;
     std::set<std::int64_t> held_;  // open: complete, waiting for a later epoch

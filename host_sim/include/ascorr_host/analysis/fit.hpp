@@ -73,7 +73,7 @@ inline constexpr std::array<std::uint8_t, 2> kDefaultFrameHeads{0, 2};  // A and
 inline std::string frame_heads_text(const std::array<std::uint8_t, 2>& f) {
     return {head_letter(f[0]), head_letter(f[1])};
 }
-constexpr HeadSet frame_set(const std::array<std::uint8_t, 2>& f) noexcept {
+constexpr HeadMask frame_set(const std::array<std::uint8_t, 2>& f) noexcept {
     return head_bit(f[0]) | head_bit(f[1]);
 }
 
@@ -96,7 +96,7 @@ struct FitOptions {
     // The fit's heads (--heads), two or more, F's among them; rows of other
     // heads are left out. Default: A, B, C, F's two and every head with rows
     // in the modelling period (analysis_heads).
-    std::optional<HeadSet> heads;
+    std::optional<HeadMask> heads;
     // The mountings (--mountings): the combination's weights for the rule
     // `combined`; every head fitted must be in them, with its sigmas.
     std::optional<MountingsFile> mountings;
@@ -122,7 +122,7 @@ struct FitReport {
     std::size_t rows = 0;              // of the heads fitted, in [from, to]
     std::size_t rows_other_heads = 0;  // of other heads in [from, to], left out (FitOptions::heads)
     std::array<std::size_t, kDropKinds> dropped{};
-    HeadSet heads = kPaperHeads;                                   // the heads fitted
+    HeadMask heads = kPaperHeads;                                  // the heads fitted
     std::array<std::uint8_t, 2> frame_heads = kDefaultFrameHeads;  // F's
     std::size_t epochs = 0;                                        // with all of them selected
     std::size_t orbits_used = 0;

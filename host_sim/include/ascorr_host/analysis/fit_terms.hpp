@@ -81,8 +81,8 @@ struct Centring {
 
 struct TermsFit {
     Terms terms = Terms::kLinear;
-    HeadSet heads = kPaperHeads;  // the heads fitted, jointly
-    std::string refused;          // non-empty: the data do not support this model (why); no model
+    HeadMask heads = kPaperHeads;  // the heads fitted, jointly
+    std::string refused;           // non-empty: the data do not support this model (why); no model
     int unknowns = 0;
     int rank = 0;                         // observable directions: unknowns − 9 (the gauge)
     std::vector<double> singular_values;  // of the centred, unit-norm-column design, descending
@@ -103,8 +103,8 @@ using HeadOrientations = std::array<Eigen::Matrix3d, kMaxHeads>;  // N_i by head
 // The 9 unobservable directions are fixed by `rule` over the same orbits; a
 // rule that the orbits do not fix uniquely (T029 and T032 never vary apart) is
 // refused.
-TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadSet heads, Terms terms,
-                     double max_condition, double min_range_c, const CommonRotation& rule = {});
+TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientations& n_ref, HeadMask heads,
+                     Terms terms, double max_condition, double min_range_c, const CommonRotation& rule = {});
 
 // One epoch with all the fit's heads selected: the aberration-corrected
 // attitudes and each head's (T1, T2, T3), by head index.
@@ -117,8 +117,8 @@ struct FitEpoch {
 // IBA RMS per pair of `heads` (pairs_of, by position) of the epochs with t in
 // [from, to), thermally corrected by m (the core, double). Epochs the core
 // does not correct are left out. epochs must be sorted by t.
-std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadSet heads, double from, double to,
-                                             const ModelFile& m);
+std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
+                                             double to, const ModelFile& m);
 
 struct ModelScore {
     TermsFit fit;                      // fitted on the part of the period before t_split
@@ -146,7 +146,7 @@ std::string selection_verdict(double linear_rms, double quadratic_rms);
 // epochs before and after it. holdout 0: fits and scores on the whole period,
 // no verdict.
 Selection select_terms(const std::vector<OrbitAverage>& orbits, const std::vector<FitEpoch>& epochs,
-                       const HeadOrientations& n_ref, HeadSet heads, double t_first, double t_last, double holdout,
+                       const HeadOrientations& n_ref, HeadMask heads, double t_first, double t_last, double holdout,
                        double max_condition, double min_range_c, const CommonRotation& rule = {});
 
 std::string describe_centring(const TermsFit& f);

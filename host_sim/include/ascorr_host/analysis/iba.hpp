@@ -1,7 +1,7 @@
 // ascorr_host/analysis/iba.hpp: inter-boresight angles and their statistics.
 //
 // Conventions (docs/contract.md, "Statistics"):
-//  - the heads of an analysis are a HeadSet (bit h: head h of heads.hpp); its
+//  - the heads of an analysis are a HeadMask (bit h: head h of heads.hpp); its
 //    pairs are every two of them in heads.hpp's order, pairs_of() below, the
 //    one place that derives them: A–B, A–C, A–D, B–C, B–D, C–D for A–D, the
 //    paper's A–B, A–C, B–C for A, B, C. Results are indexed by the position of
@@ -28,33 +28,18 @@
 
 namespace ascorr::host {
 
-// A set of heads: bit h is head h (heads.hpp).
-using HeadSet = std::uint32_t;
-static_assert(kMaxHeads <= 16, "a HeadSet holds every head");
-inline constexpr HeadSet kAllHeads = (HeadSet{1} << kMaxHeads) - 1U;
+// A set of heads is the core's HeadMask (bit h: head h; heads.hpp), with its
+// head_bit, has_head and head_count; the analyses' own sets follow.
+inline constexpr HeadMask kAllHeads = static_cast<HeadMask>((1U << kMaxHeads) - 1U);
 // A, B and C, the paper's heads: always in an analysis, so that a missing one is
 // named (no rows, no clean rows) rather than silently left out.
-inline constexpr HeadSet kPaperHeads = 0x7U;
+inline constexpr HeadMask kPaperHeads = 0x7U;
 static_assert(kMaxHeads >= 3, "the paper's three heads");
-
-constexpr HeadSet head_bit(std::uint8_t head) noexcept {
-    return HeadSet{1} << head;
-}
-constexpr bool has_head(HeadSet s, std::uint8_t head) noexcept {
-    return (s & head_bit(head)) != 0U;
-}
-constexpr std::size_t head_count(HeadSet s) noexcept {
-    std::size_t n = 0;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        n += has_head(s, h) ? 1U : 0U;
-    }
-    return n;
-}
 
 // The heads an analysis holds: the paper's A, B, C, every head with rows in
 // the data (with_rows), and the heads it needs besides (e.g. frame F's).
-constexpr HeadSet analysis_heads(HeadSet with_rows, HeadSet needed = 0U) noexcept {
-    return (kPaperHeads | with_rows | needed) & kAllHeads;
+constexpr HeadMask analysis_heads(HeadMask with_rows, HeadMask needed = 0U) noexcept {
+    return static_cast<HeadMask>((kPaperHeads | with_rows | needed) & kAllHeads);
 }
 
 inline constexpr std::size_t kMaxPairs = std::size_t{kMaxHeads} * (kMaxHeads - 1U) / 2U;
@@ -75,7 +60,7 @@ struct PairList {
     std::size_t count = 0;
 };
 
-constexpr HeadList heads_of(HeadSet s) noexcept {
+constexpr HeadList heads_of(HeadMask s) noexcept {
     HeadList l{};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if (has_head(s, h)) {
@@ -86,7 +71,7 @@ constexpr HeadList heads_of(HeadSet s) noexcept {
 }
 
 // Every two heads of s, in heads.hpp's order (the one place pairs are derived).
-constexpr PairList pairs_of(HeadSet s) noexcept {
+constexpr PairList pairs_of(HeadMask s) noexcept {
     PairList l{};
     for (std::uint8_t i = 0; i < kMaxHeads; ++i) {
         for (std::uint8_t j = i + 1U; j < kMaxHeads; ++j) {
@@ -110,11 +95,11 @@ inline constexpr PairList kPaperPairs = pairs_of(kPaperHeads);  // A-B, A-C, B-C
 std::string pair_name(const HeadPair& p);
 
 // The letters of the heads of s, "ABD"; and in words, "A, B and D" (last: " or ": "A, B or D").
-std::string head_letters(HeadSet s);
-std::string head_words(HeadSet s, const char* last = " and ");
+std::string head_letters(HeadMask s);
+std::string head_words(HeadMask s, const char* last = " and ");
 // The set named by letters ("ABCD": each a head of heads.hpp, in its order, none
 // twice); std::nullopt for anything else.
-std::optional<HeadSet> parse_head_letters(const std::string& letters);
+std::optional<HeadMask> parse_head_letters(const std::string& letters);
 
 inline constexpr double kSmoothingWindowS = 200.0;
 

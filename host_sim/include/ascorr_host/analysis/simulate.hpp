@@ -115,7 +115,7 @@ struct SimulateOptions {
     std::vector<DayWindow> gaps;
     std::vector<ThermistorFault> thermistor_faults;
     std::vector<HeadBias> head_biases;
-    HeadSet heads = kPaperHeads;  // the heads simulated (--heads)
+    HeadMask heads = kPaperHeads;  // the heads simulated (--heads)
 };
 
 // Throws std::invalid_argument, naming the option (--truth-change, --gap,
@@ -133,7 +133,7 @@ struct HeaterEvent {
 struct SimulateSummary {
     std::size_t epochs = 0;
     std::size_t rows = 0;
-    HeadSet heads = kPaperHeads;                       // simulated
+    HeadMask heads = kPaperHeads;                      // simulated
     PairList pairs = kPaperPairs;                      // pairs_of(heads): floor is indexed by position in it
     std::array<std::size_t, kMaxHeads> outage_rows{};  // per head, not written (Sun or Moon in view)
     std::size_t flagged_rows = 0;                      // flags != 0 or confidence > 5
@@ -180,7 +180,7 @@ inline constexpr double kSimNoiseAboutArcsec = 10.0;
 
 // The mountings of the heads `heads`, q_chu_crf = head_mounting(h), with the
 // true noise above (the file simulate writes beside the data).
-MountingsFile simulated_mountings(HeadSet heads);
+MountingsFile simulated_mountings(HeadMask heads);
 
 std::string describe(const SimulateSummary& s);
 std::string floor_json(const std::array<Rms, kMaxPairs>& floor, const PairList& pairs);

@@ -47,7 +47,7 @@ struct PairSeries {
 struct StatsResult {
     bool thermal = false;
     bool corrected_input = false;  // StatsOptions::corrected_input: only the "original" stage
-    HeadSet heads = kPaperHeads;   // analysis_heads of the heads with rows in the file
+    HeadMask heads = kPaperHeads;  // analysis_heads of the heads with rows in the file
     PairList pairs = kPaperPairs;  // pairs_of(heads): the arrays below are indexed by position in it
     std::array<std::array<Rms, kStages>, kMaxPairs> rms{};
     std::array<std::size_t, kMaxPairs> n{};

@@ -23,6 +23,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ascorr/core/heads.hpp"
 #include "ascorr/core/quaternion.hpp"
 
 namespace ascorr::host {
@@ -45,7 +46,7 @@ struct AttitudeRow {
     double t = 0.0;
     bool has_q = false;
     Quaternion<double> q_crf_icrf{};
-    std::uint32_t heads = 0;
+    HeadMask heads = 0;
     std::array<double, 3> sigma_arcsec{};  // about CRF x, y, z
     unsigned status = 0;
     bool has_cov = false;                 // read: the file has the columns and the row a q
