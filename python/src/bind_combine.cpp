@@ -65,9 +65,9 @@ host::CorrectedRowSource rows_source(const CombineRows& c) {
         host::SolutionRecord rec;
         for (py::ssize_t i = 0; i < c.rows.n; ++i) {
             record_of(c.rows, i, rec);
-            const bool corrected = !c.status.empty();
-            fn(host::CorrectedRow::of(rec, corrected,
-                                      corrected ? c.status[static_cast<std::size_t>(i)] : StatusBits{0}));
+            fn(host::CorrectedRow::of(rec, c.status.empty()
+                                               ? std::nullopt
+                                               : std::optional<StatusBits>(c.status[static_cast<std::size_t>(i)])));
         }
     };
 }

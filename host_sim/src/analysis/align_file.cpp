@@ -55,9 +55,10 @@ struct PassCounts {
 
 using CurrentMountings = std::array<Quaternion<double>, kMaxHeads>;
 
-// A row of an epoch and why it is left out on its own.
+// A row of an epoch, as the selection sees it, and why it is left out on its own.
 struct Judged {
     CorrectedRow row;
+    combine::RowFacts facts;
     LeftOut why;
 };
 
@@ -71,7 +72,7 @@ StatusBits select_rows(const Epoch<Judged>& e, std::array<LeftOut, kMaxHeads>& w
     std::size_t n = 0;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         if (e.head[h]) {
-            facts[n] = row_facts(e.head[h]->row);
+            facts[n] = e.head[h]->facts;
             whys[n] = e.head[h]->why;
             heads[n++] = h;
         }
@@ -180,18 +181,20 @@ void run_pass(const CorrectedRowSource& rows, const std::string& file, const Mou
               const CurrentMountings& q_chu_crf, const StageGates* gate, const AlignOptions& opt, AlignSums& sums,
               PassCounts& c) {
     OrderedEpochs epochs(file, [&](const Epoch<Judged>& e) { add_epoch(e, q_chu_crf, gate, sums, c); });
+    const HeadMask mounted = combine::mounted_heads(m.mountings);
     rows([&](const CorrectedRow& r) {
         ++c.rows;
         if (!in_period(r.t, opt)) {
             return;
         }
         ++c.rows_in_period;
-        const LeftOut why = why_unusable(r, m);
+        const combine::RowFacts f = row_facts(r);
+        const LeftOut why = combine::left_out_alone(f, mounted);
         if (why == LeftOut::kNotAHead || why == LeftOut::kNotInMountings || why == LeftOut::kNoEpoch) {
             ++c.left_out[static_cast<std::size_t>(why)];
             return;
         }
-        epochs.add(r.head, r.line, Judged{r, why});
+        epochs.add(r.head, r.line, Judged{r, f, why});
     });
     epochs.finish();
     sums.finish();
@@ -264,14 +267,6 @@ double largest(const Alignment& a) {
 // The rotation (CRF axes, arcsec) head h's current mounting is turned by from the given one.
 Eigen::Vector3d turned_from(const MountingsFile& m, const CurrentMountings& q, std::uint8_t h) noexcept {
     return rotation_arcsec(conjugate(m.mountings.head[h].q_chu_crf) * q[h], {1.0, 0.0, 0.0, 0.0});
-}
-
-HeadMask heads_of_mountings(const MountingsFile& m) noexcept {
-    HeadMask s = 0U;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        s |= m.mountings.head[h].present ? head_bit(h) : HeadMask{0};
-    }
-    return s;
 }
 
 using Information = std::array<Eigen::Matrix3d, kMaxHeads>;
@@ -356,7 +351,7 @@ AlignReport start_report(const std::string& file, const MountingsFile& m, const 
     r.from = opt.from;
     r.to = opt.to;
     r.noise_window_s = opt.noise_window_s;
-    r.heads = heads_of_mountings(m);
+    r.heads = combine::mounted_heads(m.mountings);
     if (head_count(r.heads) < 2U) {
         throw AlignRefused("the mountings have " + std::to_string(head_count(r.heads)) +
                            " head: align needs two or more (their relative attitudes are its data)");

@@ -44,7 +44,17 @@ struct Kept {
     std::uint8_t head;
     LeftOut why;
     std::uint8_t stages;  // status & (1|2) of a corrected row; 0 for a raw one
+    bool unit;            // RowFacts::unit, tested once, when read
 };
+
+bool flagged(const CorrectedRow& r) noexcept {
+    return r.flags != 0;
+}
+
+// NaN: not confident.
+bool confident(const CorrectedRow& r) noexcept {
+    return r.confidence <= combine::kMaxCleanConfidenceArcsec;
+}
 
 }  // namespace
 
@@ -52,13 +62,13 @@ combine::RowFacts row_facts(const CorrectedRow& r) noexcept {
     return {pipeline::has_epoch_key(r.t),
             r.head,
             r.corrected ? r.status : StatusBits{0},
-            r.flags != 0,
-            r.confidence <= combine::kMaxCleanConfidenceArcsec,
+            flagged(r),
+            confident(r),
             norm_within(r.q_chu_icrf, ScalarTraits<double>::unit_norm_tolerance)};
 }
 
-LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept {
-    return combine::left_out_alone(row_facts(r), combine::mounted_heads(m.mountings));
+bool clean_for_combination(const CorrectedRow& r) noexcept {
+    return !flagged(r) && confident(r);
 }
 
 namespace {
@@ -229,7 +239,8 @@ struct CombineStage::Impl {
 
     void add(const CorrectedRow& r) {
         ++sum.rows;
-        const LeftOut why = why_unusable(r, m);
+        const combine::RowFacts f = row_facts(r);
+        const LeftOut why = combine::left_out_alone(f, mounted);
         if (why == LeftOut::kNoEpoch) {
             ++sum.rows_left_out[static_cast<std::size_t>(LeftOut::kNoEpoch)];
             diag.report("in no epoch", where(r.line) + "t = " + number_text(r.t) +
@@ -237,7 +248,8 @@ struct CombineStage::Impl {
             return;
         }
         Kept k{r.t,    r.q_chu_icrf, static_cast<std::uint32_t>(r.line),
-               r.head, why,          static_cast<std::uint8_t>(r.corrected ? (r.status & kBothStages) : 0U)};
+               r.head, why,          static_cast<std::uint8_t>(f.status & combine::kStagesApplied),
+               f.unit};
         const std::int64_t key = epoch_key(r.t);
         if (mode == Mode::kKeep) {
             kept.push_back({key, k});
@@ -277,8 +289,8 @@ struct CombineStage::Impl {
         facts.clear();
         whys.clear();
         for (const Kept& k : rows) {
-            facts.push_back(
-                {true, k.head, k.stages, false, true, norm_within(k.q, ScalarTraits<double>::unit_norm_tolerance)});
+            // Step 1's answer is k.why: its facts here are those of a row it kept.
+            facts.push_back({true, k.head, k.stages, false, true, k.unit});
             whys.push_back(k.why);
         }
         const StatusBits stages =
@@ -472,7 +484,7 @@ struct CombineStage::Impl {
         std::size_t n = 0;
         std::array<double, 3> sum{};
     };
-    HeadMask mounted = gates.of(kBothStages).mounted();
+    HeadMask mounted = combine::mounted_heads(m.mountings);
     SubsetCovariances covariance{};  // with cols.covariance
     std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
     double t_first = 0.0;
@@ -559,8 +571,8 @@ void for_each_corrected_row(const std::string& path, const std::function<void(co
     for_each_solution_row(
         path, [&status_col](const SolutionsReader& h) { status_col = h.header().index(kStatusColumn); },
         [&](const SolutionsReader& reader, const SolutionRecord& rec) {
-            const bool corrected = status_col >= 0;
-            fn(CorrectedRow::of(rec, corrected, corrected ? status_of(reader, rec, status_col) : StatusBits{0}));
+            fn(CorrectedRow::of(
+                rec, status_col >= 0 ? std::optional<StatusBits>(status_of(reader, rec, status_col)) : std::nullopt));
         },
         label);
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <limits>
 #include <numeric>
 
 #include "ascorr/combine/combined_status.hpp"
@@ -88,10 +89,8 @@ struct Interpolator::Impl {
         if (n >= 1) {
             exact_last(window[n - 1]);
         }
-        for (; next < order.size(); ++next) {  // beyond the last usable epoch, or none at all
-            set(order[next], no_attitude(at[order[next]]));
-            ++sum.outside;
-        }
+        // Beyond the last usable epoch, or none at all (every time is finite: read_times).
+        outside_before(std::numeric_limits<double>::infinity());
         return out;
     }
 

@@ -233,16 +233,11 @@ void append_attitude_row(std::string& out, double t, const Quaternion<double>& q
 }
 
 Quaternion<double> attitude_as_written(const Quaternion<double>& q_crf_icrf) {
-    std::string text;
-    append_quaternion(text, canonical(q_crf_icrf));
-    std::array<double, 4> c{};
-    std::size_t from = 1;  // past the leading ','
-    for (double& x : c) {
-        const std::size_t to = std::min(text.find(',', from), text.size());
-        x = *parse_double(std::string_view(text).substr(from, to - from));
-        from = to + 1;
-    }
-    return {c[0], c[1], c[2], c[3]};
+    std::string line;
+    append_quaternion(line, canonical(q_crf_icrf));  // ",w,x,y,z": the fields a reader splits
+    std::vector<std::string_view> f;
+    split_fields(line, f);
+    return {*parse_double(f[1]), *parse_double(f[2]), *parse_double(f[3]), *parse_double(f[4])};
 }
 
 std::string combined_header(CombinedColumns c) {

@@ -181,7 +181,7 @@ private:
         if (opt_.self_calibrate) {
             calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
         } else if (combination_ != nullptr) {
-            calib_use = clean_for_combination(CorrectedRow::of(rec, false, 0U)) ? link::kCalibClean : 0U;
+            calib_use = clean_for_combination(CorrectedRow::of(rec, std::nullopt)) ? link::kCalibClean : 0U;
         }
         return calib_use;
     }

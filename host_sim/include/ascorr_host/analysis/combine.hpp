@@ -62,15 +62,7 @@ combine::RowFacts row_facts(const CorrectedRow& r) noexcept;
 
 // The camera head's own selection of the row (flags 0, confidence <= 5):
 // what a target's pipeline takes with a solution (SOLUTION_IN's clean bit).
-inline bool clean_for_combination(const CorrectedRow& r) noexcept {
-    const combine::RowFacts f = row_facts(r);
-    return !f.flagged && f.confident;
-}
-
-// Why a row is left out on its own (kUsed: usable so far; the core's
-// left_out_alone against the mountings); the epoch decides the rest
-// (combine::select_epoch, then the combiner's gate). Also align's rule.
-LeftOut why_unusable(const CorrectedRow& r, const MountingsFile& m) noexcept;
+bool clean_for_combination(const CorrectedRow& r) noexcept;
 
 // Every row of a corrected or solutions file as the combination takes it, in
 // file order (status: the corrected file's column; InputError at
@@ -123,9 +115,6 @@ combine::CombinerConfig gate_config(const GateOptions& g, bool both_stages) noex
 // The options over `base` (replay: the flight's gate, combine::flight_gate).
 combine::CombinerConfig gate_config(const GateOptions& g, const combine::CombinerConfig& base) noexcept;
 
-// Both stages: the status bits of a row corrected by aberration and thermal.
-inline constexpr StatusBits kBothStages = combine::kStagesApplied;
-
 // The ground's gates of GateOptions, one combiner's tables for each kind of
 // epoch (combine's and align's): the epoch's stages pick one.
 class StageGates {
@@ -133,9 +122,9 @@ public:
     StageGates(const combine::Mountings& m, const GateOptions& g)
         : both_(m, gate_config(g, true)), other_(m, gate_config(g, false)) {}
     bool valid() const noexcept { return both_.valid() && other_.valid(); }
-    // The combiner of an epoch whose usable rows have `stages` (status & kBothStages).
+    // The combiner of an epoch whose usable rows have `stages` (status & 3).
     const combine::Combiner<double>& of(StatusBits stages) const noexcept {
-        return stages == kBothStages ? both_ : other_;
+        return stages == combine::kStagesApplied ? both_ : other_;
     }
 
 private:

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,9 +75,10 @@ struct CorrectedRow {
     bool corrected = false;   // status is the row's (false: a raw row, taken as it is)
     StatusBits status = 0;
 
-    // A solution's row, corrected with `status` or raw (status 0).
-    static CorrectedRow of(const SolutionRecord& rec, bool corrected, StatusBits status) noexcept {
-        return {rec.t, rec.line, rec.head, rec.q_chu_icrf, rec.flags, rec.confidence, corrected, status};
+    // A solution's row, corrected with `status`, or raw (nullopt: status 0).
+    static CorrectedRow of(const SolutionRecord& rec, std::optional<StatusBits> status) noexcept {
+        return {rec.t,     rec.line,       rec.head,           rec.q_chu_icrf,
+                rec.flags, rec.confidence, status.has_value(), status.value_or(StatusBits{0})};
     }
 };
 
