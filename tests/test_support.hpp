@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -143,10 +144,14 @@ inline ScratchCleaner& scratch_cleaner() {
 }
 
 // A fresh, empty directory for one test; removed when the program passes.
+// One level: a parameterized test's name ("CleanLink/qemu_m3") has its '/'
+// replaced, or the cleaner would remove the leaf and leave its parent.
 inline std::filesystem::path scratch_dir(const std::string& name) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string test = info->name();
+    std::replace(test.begin(), test.end(), '/', '_');
     auto dir = std::filesystem::temp_directory_path() /
-               ("ascorr-test-" + std::to_string(::getpid()) + "-" + name + "-" + info->name());
+               ("ascorr-test-" + std::to_string(::getpid()) + "-" + name + "-" + test);
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     scratch_cleaner().add(dir);
