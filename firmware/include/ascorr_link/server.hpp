@@ -15,20 +15,15 @@
 //                        service's velocity at the solution's time tag)
 //   kServiceConfig     → kAck: the velocity service restarts with the horizon
 //                        (its states are dropped)
-//   kCalibStart        → kAck: from then on the estimator (ascorr/calib/
-//                        estimator.hpp) runs on the solutions, one at a time
-//                        through the epoch pipeline (pipeline/epoch_pipeline.hpp): each epoch
-//                        (a time tag) is corrected with the model the
-//                        estimator holds active at the epoch's first solution,
-//                        so a new model never changes within an epoch; the
-//                        first clean, usable solution of each of A, B and C
-//                        feeds it, and its per-orbit update runs to its end
-//                        (four bounded steps). A solution flagged
-//                        kCalibNoTime is corrected without a model. Before
-//                        kCalibStart: the uploaded model. With
-//                        common_rotation 1, the estimator's rule for the
-//                        rotation common to all heads takes the weights of
-//                        the mountings staged so far (kMountingLoad first).
+//   kCalibStart        → kAck: from then on the estimator (calib/estimator.hpp)
+//                        runs on the solutions through the epoch pipeline
+//                        (pipeline/epoch_pipeline.hpp says which solutions
+//                        feed it and which model corrects an epoch). A
+//                        solution flagged kCalibNoTime is corrected without
+//                        a model. Before kCalibStart: the uploaded model.
+//                        With common_rotation 1, the rule for the rotation
+//                        common to all heads takes the weights of the
+//                        mountings staged so far (kMountingLoad first).
 //   kCalibCommand      → kAck (freeze, resume, reset)
 //   kCalibModelLoad    → kAck (a head staged; with `load`, the staged model
 //                        becomes the estimator's, active from the next epoch)
