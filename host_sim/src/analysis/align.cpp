@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/combine/mountings.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/rotation_vector.hpp"
 #include "ascorr_host/formats/csv.hpp"
@@ -44,10 +45,14 @@ Eigen::Vector3d boresight_crf(const Quaternion<double>& q_chu_crf) noexcept {
 
 Eigen::Matrix3d information_crf(const Quaternion<double>& q_chu_crf, double sigma_cross_arcsec,
                                 double sigma_about_arcsec) noexcept {
-    const Eigen::Matrix3d m = rotation_matrix_of(q_chu_crf);
-    const double c = 1.0 / (sigma_cross_arcsec * sigma_cross_arcsec);
-    const double a = 1.0 / (sigma_about_arcsec * sigma_about_arcsec);
-    return m.transpose() * Eigen::Vector3d(c, c, a).asDiagonal() * m;
+    const combine::Matrix3 w = combine::information({true, q_chu_crf, sigma_cross_arcsec, sigma_about_arcsec});
+    Eigen::Matrix3d e;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            e(i, j) = w.m[i][j];
+        }
+    }
+    return e;
 }
 
 // ---- The sums

@@ -83,7 +83,8 @@ Eigen::Vector3d rotation_arcsec(const Quaternion<double>& a, const Quaternion<do
 Quaternion<double> rotation_quaternion(const Eigen::Vector3d& theta_arcsec) noexcept;
 
 // A head's boresight in CRF (third row of R(q_chu_crf)) and its information
-// W = M_iᵀ diag(1/σc², 1/σc², 1/σa²) M_i (1/arcsec²).
+// W = M_iᵀ diag(1/σc², 1/σc², 1/σa²) M_i (1/arcsec²): the combination's own
+// (combine::information, mountings.hpp) in Eigen's type.
 Eigen::Vector3d boresight_crf(const Quaternion<double>& q_chu_crf) noexcept;
 Eigen::Matrix3d information_crf(const Quaternion<double>& q_chu_crf, double sigma_cross_arcsec,
                                 double sigma_about_arcsec) noexcept;
