@@ -1,9 +1,7 @@
 #include "ascorr_host/analysis/combine.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <map>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -13,8 +11,6 @@
 #include "ascorr/combine/combiner.hpp"
 #include "ascorr/combine/subset_tables.hpp"
 #include "ascorr/combine/usable.hpp"
-#include "ascorr/core/constants.hpp"
-#include "ascorr/core/rotation_vector.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/align.hpp"
@@ -28,24 +24,14 @@
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_error.hpp"
 #include "ascorr_text/input_name.hpp"
+#include "combine_parts.hpp"
 
 namespace ascorr::host {
 
 namespace {
 
 namespace cs = combine::combined_status;
-
-// A row as kept between reading and combining (48 bytes, 56 with its key): whether it is
-// usable is decided when it is read, from what needs no other row.
-struct Kept {
-    double t;
-    Quaternion<double> q;
-    std::uint32_t line;  // (a file of 4e9 lines is beyond any recording)
-    std::uint8_t head;
-    LeftOut why;
-    std::uint8_t stages;  // status & (1|2) of a corrected row; 0 for a raw one
-    bool unit;            // RowFacts::unit, tested once, when read
-};
+using detail::Kept;
 
 bool flagged(const CorrectedRow& r) noexcept {
     return r.flags != 0;
@@ -70,16 +56,6 @@ combine::RowFacts row_facts(const CorrectedRow& r) noexcept {
 bool clean_for_combination(const CorrectedRow& r) noexcept {
     return !flagged(r) && confident(r);
 }
-
-namespace {
-
-std::string time_text(double t) {
-    char buf[48];
-    text::c_snprintf(buf, sizeof buf, "%.3f", t);
-    return buf;
-}
-
-}  // namespace
 
 std::string describe(const CombineSummary& s) {
     std::ostringstream o;
@@ -243,8 +219,7 @@ struct CombineStage::Impl {
         const LeftOut why = combine::left_out_alone(f, mounted);
         if (why == LeftOut::kNoEpoch) {
             ++sum.rows_left_out[static_cast<std::size_t>(LeftOut::kNoEpoch)];
-            diag.report("in no epoch", where(r.line) + "t = " + number_text(r.t) +
-                                           " s has no millisecond key: the row is in no epoch");
+            reports.no_epoch(r.line, r.t);
             return;
         }
         Kept k{r.t,    r.q_chu_icrf, static_cast<std::uint32_t>(r.line),
@@ -276,10 +251,8 @@ struct CombineStage::Impl {
         epoch.clear();
         flush();
         diag.summarize();
-        finish_steps();
+        steps.finish(sum);
     }
-
-    std::string where(std::size_t line) const { return text::input_name(file) + ":" + std::to_string(line) + ": "; }
 
     // Step 2 of the core's selection (combine/usable.hpp) over the epoch's
     // rows, sorted by head and line: two rows of one head (both left out,
@@ -295,94 +268,11 @@ struct CombineStage::Impl {
         }
         const StatusBits stages =
             combine::select_epoch(facts.data(), whys.data(), rows.size(), combine::Repeated::kLeaveAllOut);
-        std::size_t first = 0;  // the first row of rows[i]'s head
+        reports.epoch(rows, whys, stages);
         for (std::size_t i = 0; i < rows.size(); ++i) {
-            first = rows[i].head == rows[first].head ? first : i;
-            if (whys[i] == LeftOut::kDuplicate && i != first) {
-                diag.report("two rows of one head", where(rows[i].line) + "a second row of CHU " +
-                                                        head_name(rows[i].head) + " at t = " + time_text(rows[i].t) +
-                                                        " (the first on line " + std::to_string(rows[first].line) +
-                                                        "): both left out (status 4)");
-            }
-        }
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-            if (whys[i] == LeftOut::kStageMissing) {
-                const Kept& k = rows[i];
-                diag.report("stage missing", where(k.line) + "CHU " + head_name(k.head) + " at t = " + time_text(k.t) +
-                                                 ": status " + std::to_string(k.stages) +
-                                                 " lacks a stage applied to another head of the epoch (status " +
-                                                 std::to_string(stages) + "): left out (status 4)");
-            }
             rows[i].why = whys[i];
         }
         return stages;
-    }
-
-    void report_left_out(const Kept& k) {
-        if (k.why == LeftOut::kNotInMountings) {
-            diag.report("not in the mountings", where(k.line) + "CHU " + head_name(k.head) + " at t = " +
-                                                    time_text(k.t) + " is not in the mountings: left out (status 4)");
-        } else if (k.why == LeftOut::kNotAHead) {
-            diag.report("not a head",
-                        where(k.line) + "chu is not a camera head (" + kHeadChoices.text + "): left out (status 4)");
-        } else if (k.why == LeftOut::kNotUnit) {
-            diag.report("quaternion not unit", where(k.line) + "CHU " + head_name(k.head) +
-                                                   " at t = " + time_text(k.t) +
-                                                   ": the quaternion is not unit: left out (status 4)");
-        } else if (k.why == LeftOut::kInconsistent) {
-            diag.report("inconsistent", where(k.line) + "CHU " + head_name(k.head) + " at t = " + time_text(k.t) +
-                                            " disagrees with the other heads beyond the combiner's gate: left out "
-                                            "(status 4)");
-        }
-    }
-
-    // The full set's epoch combined again with each proper subset (HeadSetStep).
-    void add_steps(const combine::Combiner<double>& combiner, const combine::HeadAttitude<double>* heads,
-                   std::uint8_t n, const Quaternion<double>& q_full, double t) {
-        if (!any_epoch) {
-            t_first = t;
-            any_epoch = true;
-        }
-        const auto day = static_cast<long long>(std::floor((t - t_first) / kSecondsPerDay));
-        combine::HeadAttitude<double> subset[kMaxHeads];
-        for (unsigned sub = 1; sub < mounted; ++sub) {
-            const auto set = static_cast<HeadMask>(sub);
-            if ((set & ~mounted) != 0) {
-                continue;
-            }
-            for (std::uint8_t i = 0; i < n; ++i) {
-                subset[i] = heads[i];
-                subset[i].usable = has_head(set, heads[i].head);
-            }
-            const combine::CombinedAttitude<double> c = combiner.combine(subset, n);
-            if (c.used != set) {
-                continue;  // the gate left a head of the subset out: no step of this set
-            }
-            DaySum& d = daily[set][day];
-            const Vector3<double> v = rotation_vector_arcsec(c.q_crf_icrf, q_full);
-            ++d.n;
-            d.sum[0] += v.x;
-            d.sum[1] += v.y;
-            d.sum[2] += v.z;
-        }
-    }
-
-    void finish_steps() {
-        sum.full = mounted;
-        for (unsigned set = 1; set < mounted; ++set) {
-            HeadSetStep& st = sum.steps[set];
-            std::array<double, 3> sq{};
-            for (const auto& [day, d] : daily[set]) {
-                for (std::size_t a = 0; a < 3; ++a) {
-                    const double mean = d.sum[a] / static_cast<double>(d.n);
-                    sq[a] += mean * mean;
-                }
-                ++st.days;
-            }
-            for (std::size_t a = 0; a < 3; ++a) {
-                st.rms_daily_mean[a] = st.days == 0 ? 0.0 : std::sqrt(sq[a] / static_cast<double>(st.days));
-            }
-        }
     }
 
     // A row of `key`, in time order: the open epoch is emitted first when the row is of another.
@@ -424,7 +314,7 @@ struct CombineStage::Impl {
         for (const Kept& k : rows) {
             left_out = left_out || k.why != LeftOut::kUsed;
             ++sum.rows_left_out[static_cast<std::size_t>(k.why)];
-            report_left_out(k);
+            reports.row(k);
         }
         AttitudeRow row;
         row.t = rows.front().t;  // the epoch's earliest t, as written: the same in any row order
@@ -442,7 +332,7 @@ struct CombineStage::Impl {
             row.cov_arcsec2 = covariance[c.subset];
         }
         if (c.used == mounted && head_count(mounted) >= 2) {
-            add_steps(combiner, heads, n, c.q_crf_icrf, row.t);
+            steps.add(combiner, heads, n, c.q_crf_icrf, row.t);
         }
         for (std::size_t b = 0; b < sum.status_bit.size(); ++b) {
             sum.status_bit[b] += (row.status >> b) & 1U;
@@ -479,16 +369,10 @@ struct CombineStage::Impl {
     pipeline::ConsecutiveEpochs epochs;  // the open epoch: consecutive rows with one key
     std::vector<std::pair<std::int64_t, Kept>> kept;
     CombineSummary sum;
-    // The steps (HeadSetStep): per subset, per day, the sum of d_S.
-    struct DaySum {
-        std::size_t n = 0;
-        std::array<double, 3> sum{};
-    };
     HeadMask mounted = combine::mounted_heads(m.mountings);
     SubsetCovariances covariance{};  // with cols.covariance
-    std::array<std::map<long long, DaySum>, 1U << kMaxHeads> daily;
-    double t_first = 0.0;
-    bool any_epoch = false;
+    detail::LeftOutReports reports{diag, file};
+    detail::HeadSetSteps steps{mounted};
 };
 
 CombineStage::CombineStage(const MountingsFile& m, const GateOptions& gate, AtomicFile& out, std::string file,
