@@ -89,7 +89,7 @@ struct Interpolator::Impl {
         if (n >= 1) {
             exact_last(window[n - 1]);
         }
-        // Beyond the last usable epoch, or none at all (every time is finite: read_times).
+        // Beyond the last usable epoch, or none at all (every time is finite: the constructor's precondition).
         outside_before(std::numeric_limits<double>::infinity());
         return out;
     }

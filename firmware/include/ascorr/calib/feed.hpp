@@ -12,18 +12,26 @@
 
 namespace ascorr::calib {
 
+// Whether a corrected solution may feed the estimator: the aberration stage
+// applied, not rejected, three valid temperatures (the ground fit's
+// selection; the loop's solutions carry no flags or confidence). The epoch
+// pipeline's feed stage and selected_solution test it; feed_estimator's loop
+// over the frame heads writes it out (its comment says why).
+template <typename T>
+constexpr bool feeds_estimator(const CorrectedSolution<T>& s, const HeadTemperatures<T>& tp) noexcept {
+    return (s.status & status::kAberrationApplied) != 0U && (s.status & status::kRejected) == 0U && tp.t_chu.valid &&
+           tp.t_029.valid && tp.t_032.valid;
+}
+
 // Head h's solution as the estimator takes it: false when it does not pass
-// the selection (the aberration stage applied, not rejected, three valid
-// temperatures: the ground fit's; the loop's solutions carry no flags or
-// confidence). Its quaternion without the thermal stage is q_ab = q_th⁻¹ ⊗
+// the selection (feeds_estimator). Its quaternion without the thermal stage is q_ab = q_th⁻¹ ⊗
 // q_corr, with q_th the stage the core applied (thermal_stage(), correct.hpp,
 // the same model and temperatures), formed as the core forms it: the increment
 // (q_th⁻¹ − 1) ⊗ q_corr from small terms, one renormalised sum (quaternion.hpp).
 template <typename T>
 bool selected_solution(std::uint8_t h, const ThermalModel<T>* model, const CorrectedSolution<T>& s,
                        const HeadTemperatures<T>& tp, Quaternion<T>& q_ab) noexcept {
-    if ((s.status & status::kAberrationApplied) == 0U || (s.status & status::kRejected) != 0U ||
-        !(tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid)) {
+    if (!feeds_estimator(s, tp)) {
         return false;
     }
     q_ab = s.q_chu_icrf;
@@ -47,7 +55,10 @@ bool feed_estimator(Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>
     // The frame heads: selected_solution's body, written out (the M3's and
     // M4F's per-cycle cost; the loop is the one the three-head estimator had).
     // Calling it instead, even always_inline, costs the M3 13 instructions per
-    // cycle (1218 → 1231, flight report; M4F unchanged).
+    // cycle (1218 → 1231, flight report; M4F unchanged); its test as
+    // feeds_estimator(s, tp), the M4F 9 (correction 711 → 720: GCC 12 then
+    // inlines this function into the flight image's calib entry). The test
+    // below is feeds_estimator's, term for term: change both together.
     for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
         const CorrectedSolution<T>& s = corrected[h];
         const HeadTemperatures<T>& tp = *temperatures[h];

@@ -273,17 +273,12 @@ private:
         ++combined_n_;
     }
 
-    static bool usable(const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp) noexcept {
-        return (c.status & status::kAberrationApplied) != 0U && (c.status & status::kRejected) == 0U &&
-               tp.t_chu.valid && tp.t_029.valid && tp.t_032.valid;
-    }
-
     // Stage 5: the first clean, usable solution of each calibrated head; the
     // feed when A, B and C are there (with the further heads kept so far), on
     // the schedule's epochs; a further head that comes after it, alone.
     template <typename Meter>
     void keep(std::uint8_t h, const CorrectedSolution<T>& c, const HeadTemperatures<T>& tp, Meter& meter) noexcept {
-        if (!have_epoch_ || h >= N || (kept_ & (1U << h)) != 0U || !usable(c, tp)) {
+        if (!have_epoch_ || h >= N || (kept_ & (1U << h)) != 0U || !calib::feeds_estimator(c, tp)) {
             return;
         }
         if ((kept_ & kFed) != 0U) {

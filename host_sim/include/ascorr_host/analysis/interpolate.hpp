@@ -64,8 +64,9 @@ std::string describe(const InterpolateSummary& s);
 // The interpolation over a combined file's rows, streamed in time order.
 class Interpolator {
 public:
-    // at: the times asked for, in the caller's order; max_gap_s in
-    // [kMinMaxGapS, kMaxMaxGapS]. covariance: the rows carry cov_xy..yz.
+    // at: the times asked for, in the caller's order, each finite (|t| <
+    // kMaxEpochTimeS, as read_times and Python's interpolate check); max_gap_s
+    // in [kMinMaxGapS, kMaxMaxGapS]. covariance: the rows carry cov_xy..yz.
     Interpolator(std::vector<double> at, double max_gap_s, bool covariance);
     ~Interpolator();
     Interpolator(const Interpolator&) = delete;
