@@ -197,15 +197,42 @@ TEST(Refusals, MessagesNameDirectoriesAndCrOnlyLineEndsAndNeverLineZero) {
     const fs::path dir = scratch_dir("messages");
     fs::create_directories(dir / "d");
     const CliRun r = run_in("correct --in d --out out.csv", dir);
-    expect_refused(r, 1, {"d: is a directory, not a file"});
+    expect_refused(r, 1, {"cannot open d: is a directory, not a file"});
     EXPECT_EQ(r.err.find(":0"), std::string::npos) << r.err;
-    expect_refused(run_in("correct --in missing.csv --out out.csv", dir), 1, {"missing.csv: cannot open"});
+    expect_refused(run_in("correct --in missing.csv --out out.csv", dir), 1,
+                   {"cannot open missing.csv: No such file or directory"});
     std::string text = slurp(data_path("solutions.csv"));
     for (char& c : text) {
         c = c == '\n' ? '\r' : c;
     }
     std::ofstream(dir / "mac.csv", std::ios::binary) << text;
     expect_refused(run_in("correct --in mac.csv --out out.csv", dir), 1, {"mac.csv:1:", "CR-only line ends"});
+    EXPECT_FALSE(fs::exists(dir / "out.csv"));
+}
+
+// One reader of files (ascorr_text/text_file.hpp): a NUL byte is refused at
+// its line and column with an escaped excerpt, in the host's block reader
+// (solutions), its whole-file reader (model) and the HAL's (board
+// configuration) alike; before, the host said "binary data (NUL byte) in a
+// text file" without a column.
+TEST(Refusals, ANulByteIsRefusedAtItsLineAndColumnByEveryReader) {
+    const fs::path dir = scratch_dir("nul");
+    const auto with_nul = [&](const std::string& from, const std::string& name) {
+        std::string text = slurp(from);
+        const std::size_t line3 = text.find('\n', text.find('\n') + 1) + 1;  // the third line's first byte
+        text.insert(line3 + 2, 1, '\0');
+        std::ofstream(dir / name, std::ios::binary) << text;
+    };
+    with_nul(data_path("solutions.csv"), "s.csv");
+    with_nul(data_path("model_table2.csv"), "m.csv");
+    const std::string ex = ASCORR_HAL_EXAMPLES;
+    with_nul(ex + "/board.cfg", "board.cfg");
+    const std::string nul = "binary data (byte 0x00): not a text file, line starts";
+    expect_refused(run_in("correct --in s.csv --out out.csv", dir), 1, {"s.csv:3:3: " + nul});
+    expect_refused(run_in("correct --in " + data_path("solutions.csv") + " --model m.csv --out out.csv", dir), 1,
+                   {"m.csv:3:3: " + nul});
+    expect_refused(run_in("thermistors --config board.cfg --replay " + ex + "/replay.csv", dir), 1,
+                   {"board.cfg:3:3: " + nul});
     EXPECT_FALSE(fs::exists(dir / "out.csv"));
 }
 

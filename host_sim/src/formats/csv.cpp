@@ -18,52 +18,12 @@
 
 namespace ascorr::host {
 
-namespace {
-void refuse_directory(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) {
-        throw text::InputError(path, 0, 0, "is a directory, not a file");
-    }
-}
-}  // namespace
-
-std::string read_text_file(const std::string& path) {
-    refuse_directory(path);
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-    if (!f) {
-        throw text::InputError(path, 0, 0, std::string("cannot open: ") + std::strerror(errno));
-    }
-    std::string data;
-    char buf[1 << 16];
-    std::size_t n = 0;
-    text::LineLengthScan scan;
-    while ((n = std::fread(buf, 1, sizeof buf, f.get())) > 0) {
-        if (!scan.feed(std::string_view(buf, n))) {
-            throw text::InputError(path, scan.too_long_line(), 0, text::line_too_long());
-        }
-        data.append(buf, n);
-        if (std::memchr(buf, '\0', n) != nullptr) {
-            break;  // binary data: refused below, without reading on (/dev/zero)
-        }
-    }
-    if (std::ferror(f.get()) != 0) {
-        throw text::InputError(path, 0, 0, "read error");
-    }
-    if (data.find('\0') != std::string::npos) {
-        const std::size_t at = data.find('\0');
-        const std::size_t line = 1 + static_cast<std::size_t>(std::count(
-                                         data.begin(), data.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
-        throw text::InputError(path, line, 0, "binary data (NUL byte) in a text file");
-    }
-    return data;
-}
-
 BlockReader::BlockReader(std::string path, std::size_t block_bytes)
     : path_(std::move(path)), block_bytes_(block_bytes) {
-    refuse_directory(path_);
+    text::refuse_directory(path_);
     f_ = std::fopen(path_.c_str(), "rb");
     if (f_ == nullptr) {
-        throw text::InputError(path_, 0, 0, std::string("cannot open: ") + std::strerror(errno));
+        throw text::cannot_open(path_, std::strerror(errno));
     }
 }
 
@@ -117,7 +77,7 @@ bool BlockReader::next(std::string_view& block) {
         size_ += n;
         if (n == 0) {
             if (std::ferror(f_) != 0) {
-                throw text::InputError(path_, lines_before_ + 1, 0, "read error");
+                throw text::cannot_read(path_, std::strerror(errno));
             }
             eof_ = true;
         }
@@ -129,10 +89,8 @@ bool BlockReader::next(std::string_view& block) {
     const std::size_t last_nl = all.rfind('\n');
     consumed_ = eof_ || last_nl == std::string_view::npos ? size_ : last_nl + 1;
     block = all.substr(0, consumed_);
-    if (const void* nul = std::memchr(block.data(), '\0', block.size()); nul != nullptr) {
-        const auto at = static_cast<std::size_t>(static_cast<const char*>(nul) - block.data());
-        throw text::InputError(path_, lines_before_ + 1 + count_line_ends(block.substr(0, at)), 0,
-                               "binary data (NUL byte) in a text file");
+    if (std::memchr(block.data(), '\0', block.size()) != nullptr) {
+        text::refuse_binary(path_, block, lines_before_ + 1);  // throws, as read_text_file does
     }
     lines_in_last_ = count_line_ends(block) + (block.back() != '\n' ? 1 : 0);
     return true;

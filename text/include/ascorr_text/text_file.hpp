@@ -6,11 +6,13 @@
 //
 // Conventions: lines end at '\n'; a '\r' before it is dropped; line numbers
 // start at 1 and columns at 1, as the file:line:column messages give them. A
-// final '\n' does not start another line. The whole file is checked as UTF-8
-// text (refuse_binary) and read with the HAL's words ("cannot open FILE:
-// reason"); the host's solutions, model and states readers read in bounded
-// blocks and refuse only a NUL byte, in their own words ("FILE: cannot open:
-// reason", ascorr_host/formats/csv.hpp): both wordings are the contract's.
+// final '\n' does not start another line. Every reader of ours, the HAL's and
+// the host's, opens a file with read_text_file or refuse_directory and
+// cannot_open below, so a file that cannot be opened reads "cannot open FILE:
+// reason" everywhere, and a NUL byte is refused by refuse_binary at its line
+// and column as soon as it is read. The HAL's readers check the whole file
+// as UTF-8 text (TextLines); the host's solutions, model and states readers
+// (ascorr_host/formats/csv.hpp, in bounded blocks) refuse a NUL byte only.
 #pragma once
 
 #include <cerrno>
@@ -141,8 +143,9 @@ inline bool printable_line(std::string_view line) noexcept {
 // convert it with iconv -f latin1 -t utf-8), line starts \"…\""; anything
 // else "file:line:column: binary data (byte 0xHH): not a text file, line
 // starts \"…\"" (or a CR not followed by LF).
-inline void refuse_binary(const std::string& file, std::string_view text) {
-    std::size_t line = 1;
+// first_line: the number of the text's first line (a block of a larger file).
+inline void refuse_binary(const std::string& file, std::string_view text, std::size_t first_line = 1) {
+    std::size_t line = first_line;
     std::size_t line_start = 0;
     for (std::size_t i = 0; i < text.size();) {
         const auto c = static_cast<unsigned char>(text[i]);
@@ -212,19 +215,35 @@ private:
     text::LineReader lines_{std::string_view{}};
 };
 
-// The whole text of a file. A file that cannot be opened or read, or a
-// directory: InputError "cannot open FILE: reason" (no line, no column). A
-// line beyond text::kMaxLineBytes: InputError at file:line, as soon as it is
-// read (/dev/zero fails at once, not when memory runs out).
-inline std::string read_text_file(const std::string& path) {
+// A file that cannot be opened, for `reason`: InputError "cannot open FILE:
+// reason", naming the file alone (no line, no column).
+inline InputError cannot_open(const std::string& path, const std::string& reason) {
+    return InputError::whole_file(path, "cannot open " + input_name(path) + ": " + reason);
+}
+
+// A file whose reading failed: "cannot read FILE: reason" (no line, no column).
+inline InputError cannot_read(const std::string& path, const std::string& reason) {
+    return InputError::whole_file(path, "cannot read " + input_name(path) + ": " + reason);
+}
+
+// A directory given as a file: cannot_open(path, "is a directory, not a file").
+inline void refuse_directory(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) {
-        throw text::InputError::whole_file(path,
-                                           "cannot open " + text::input_name(path) + ": is a directory, not a file");
+        throw cannot_open(path, "is a directory, not a file");
     }
+}
+
+// The whole text of a file. A file that cannot be opened, or a directory:
+// cannot_open; one that cannot be read: cannot_read. A line
+// beyond text::kMaxLineBytes, or a NUL byte (refuse_binary: its line and
+// column): InputError as soon as it is read (/dev/zero fails at once, not
+// when memory runs out).
+inline std::string read_text_file(const std::string& path) {
+    refuse_directory(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) {
-        throw text::InputError::whole_file(path, "cannot open " + text::input_name(path) + ": " + std::strerror(errno));
+        throw cannot_open(path, std::strerror(errno));
     }
     std::string text;
     text::LineLengthScan scan;
@@ -235,9 +254,12 @@ inline std::string read_text_file(const std::string& path) {
             throw text::InputError(path, scan.too_long_line(), 0, text::line_too_long());
         }
         text.append(piece);
+        if (piece.find('\0') != std::string_view::npos) {
+            refuse_binary(path, text);  // throws: the first byte that is not text, at or before the NUL
+        }
     }
     if (in.bad()) {
-        throw text::InputError::whole_file(path, "cannot read " + text::input_name(path) + ": " + std::strerror(errno));
+        throw cannot_read(path, std::strerror(errno));
     }
     return text;
 }

@@ -21,18 +21,19 @@
 #include "ascorr_text/line_limit.hpp"
 #include "ascorr_text/line_reader.hpp"
 #include "ascorr_text/number_fields.hpp"
+#include "ascorr_text/text_file.hpp"
 
 namespace ascorr::host {
 
-// The whole content of a file. Throws InputError (line 0) if it cannot be read,
-// and at file:line for a line beyond text::kMaxLineBytes or a NUL byte,
-// as soon as it is read.
-std::string read_text_file(const std::string& path);
+// The whole content of a file: the one reader of text/ (text_file.hpp), the
+// HAL's too.
+using text::read_text_file;
 
 // Reads a file in blocks of whole lines, so that a recorded mission of any
 // size is processed in bounded memory. Each block ends at a line end (the last
 // one may lack it), is free of NUL bytes and has no line beyond
-// text::kMaxLineBytes (InputError at file:line otherwise).
+// text::kMaxLineBytes (InputError at file:line otherwise; a NUL byte as
+// read_text_file refuses it). A file that cannot be opened: text::cannot_open.
 class BlockReader {
 public:
     static constexpr std::size_t kDefaultBlockBytes = 32U << 20;
