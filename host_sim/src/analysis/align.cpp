@@ -23,11 +23,6 @@ Eigen::Matrix3d rotation_matrix_of(const Quaternion<double>& q) noexcept {
     return Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
 }
 
-// The heads of s in heads.hpp's order; the first is the reference of the set's differences.
-HeadList members(HeadMask s) noexcept {
-    return heads_of(s);
-}
-
 }  // namespace
 
 Eigen::Vector3d rotation_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) noexcept {
@@ -75,7 +70,7 @@ void AlignSums::add(double t, const std::array<std::optional<Quaternion<double>>
         single_ += head_count(s) == 1U ? 1U : 0U;
         return;
     }
-    const HeadList l = members(s);
+    const HeadList l = heads_of(s);  // the first is the reference of the set's differences
     const auto dim = static_cast<Eigen::Index>(3U * (l.count - 1U));
     Eigen::VectorXd d(dim);
     const Quaternion<double>& ref = *q_crf_icrf[l.head[0]];

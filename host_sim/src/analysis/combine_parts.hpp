@@ -9,7 +9,6 @@
 #include <cstdint>
 #include <map>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "ascorr/combine/combiner.hpp"
@@ -37,7 +36,8 @@ struct Kept {
 // kind counted, the first ones shown), each naming file:line.
 class LeftOutReports {
 public:
-    LeftOutReports(Diagnostics& diag, std::string file) : diag_(diag), file_(std::move(file)) {}
+    // file: the input's name, held by the caller for the reports' life.
+    LeftOutReports(Diagnostics& diag, const std::string& file) : diag_(diag), file_(file) {}
     // A row whose t has no millisecond key.
     void no_epoch(std::size_t line, double t);
     // Step 2's reasons of an epoch's rows (sorted by head and line; `why`
@@ -50,7 +50,7 @@ public:
 private:
     std::string where(std::size_t line) const;
     Diagnostics& diag_;
-    std::string file_;
+    const std::string& file_;
 };
 
 // The steps of the combined attitude when heads drop out (HeadSetStep): each

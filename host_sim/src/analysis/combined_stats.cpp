@@ -85,17 +85,13 @@ private:
     bool more_ = false;
 };
 
-std::size_t set_size(HeadMask heads) {
-    return head_count(heads);
-}
-
 // Most heads first, then heads.hpp's order (the mask's lowest bits first); none last.
 bool set_order(HeadMask a, HeadMask b) {
     if ((a == 0) != (b == 0)) {
         return b == 0;
     }
-    if (set_size(a) != set_size(b)) {
-        return set_size(a) > set_size(b);
+    if (head_count(a) != head_count(b)) {
+        return head_count(a) > head_count(b);
     }
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         const bool ha = has_head(a, h);
@@ -190,8 +186,8 @@ CombinedStats combined_stats(const CombinedStatsOptions& opt) {
         r.sigma_rms = a.sigma.rms();
         r.step = {std::nan(""), std::nan(""), std::nan("")};
         s.sets.push_back(r);
-        const bool fuller = heads != 0 && (set_size(heads) > set_size(s.full) ||
-                                           (set_size(heads) == set_size(s.full) && a.epochs > full_epochs));
+        const bool fuller = heads != 0 && (head_count(heads) > head_count(s.full) ||
+                                           (head_count(heads) == head_count(s.full) && a.epochs > full_epochs));
         if (fuller) {
             s.full = heads;
             full_epochs = a.epochs;
