@@ -187,6 +187,17 @@ void add_simulate_command(CLI::App& app) {
                         "(docs/contract.md)")
         ->check(head_letters_in(2, kMaxHeads));
     add_event_options(cmd, *events);
+    cmd->add_option("--bench-lag", opt->bench.lag_s,
+                    "the bench deforms with its temperatures through a first-order lag of this time constant, "
+                    "[0, 86400] s (default 0: at once); the rows record the temperatures themselves")
+        ->check(real_in(0.0, 86400.0));
+    cmd->add_option("--orbit-term", opt->bench.orbit_arcsec,
+                    "an orbit-periodic deformation no thermistor reads, [0, 60] arcsec at full amplitude (default 0: "
+                    "none); its amplitude follows the Sun's angle to the orbital plane")
+        ->check(real_in(0.0, 60.0));
+    cmd->add_flag("--noise-iba", opt->noise_iba,
+                  "also write OUT.noise-iba.csv: t,pair,iba, the IBA of the attitudes with noise only at each clean "
+                  "epoch (for stats --noise-iba)");
     cmd->callback([opt, events]() {
         opt->heads = host::parse_head_letters(events->heads).value_or(host::kPaperHeads);  // checked already
         opt->truth_changes = parsed(events->truth_changes, &parse_truth_change);

@@ -21,6 +21,11 @@ void add_stats_command(CLI::App& app) {
     CLI::Option* model =
         cmd->add_option("--model", opt->model, "thermal model file (CSV); without it the thermal stage is null")
             ->check(non_empty_path());
+    CLI::Option* noise =
+        cmd->add_option("--noise-iba", opt->noise_iba,
+                        "simulate's OUT.noise-iba.csv: also the systematic IBA residual per pair and stage (the IBA "
+                        "minus the noise-only IBA, RMS about the mean over the epochs both have)")
+            ->check(non_empty_path());
     CLI::Option* from = cmd->add_option("--from", opt->from, "first epoch, s since J2000 TT")->check(real_number());
     CLI::Option* to = cmd->add_option("--to", opt->to, "last epoch, s since J2000 TT")->check(real_number());
     CLI::Option* comb =
@@ -33,7 +38,7 @@ void add_stats_command(CLI::App& app) {
                                          "simulate's OUT.attitude.csv)")
                              ->check(non_empty_path());
     in->excludes(comb);
-    for (CLI::Option* o : {model, from, to}) {
+    for (CLI::Option* o : {model, from, to, noise}) {
         o->excludes(comb);
     }
     truth->needs(comb);
@@ -51,8 +56,8 @@ void add_stats_command(CLI::App& app) {
             outputs.commit();
             return;
         }
-        host::OutputSet outputs =
-            open_run_files({{"--in", &opt->in}, {"--model", &opt->model}}, {host::kStandardOutput});
+        host::OutputSet outputs = open_run_files(
+            {{"--in", &opt->in}, {"--model", &opt->model}, {"--noise-iba", &opt->noise_iba}}, {host::kStandardOutput});
         const host::StatsResult r = host::compute_stats(*opt, std::cerr);
         outputs[host::kStandardOutput.option].write(*json ? host::stats_json(r) : host::stats_table(r));
         outputs.commit();

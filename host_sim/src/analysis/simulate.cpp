@@ -43,6 +43,7 @@ public:
           orbit_(opt.start_t, sky_),
           heaters_(opt.start_t, rnd_.engine),
           stuck_(opt.thermistor_faults.size()),
+          lag_(opt.bench.lag_s, opt.step_s),
           solved_(kPaperHeads | opt.heads),
           pairs_(pairs_of(opt.heads)) {
         for (int h = 0; h < kMaxHeads; ++h) {
@@ -78,6 +79,7 @@ public:
                     extra_chu_temperature(h, exposure(e.orbit, e.sun), op, extra_wander_[h], opt_.step_s, *extra_[h]);
             }
         }
+        bench_dynamics(e);
         e.no_temperature = telemetry_gap_.step(2e-4, 10, 120, rnd_.engine);
         e.no_velocity = gps_gap_.step(1e-4, 5, 60, rnd_.engine);
 
@@ -96,6 +98,9 @@ public:
             const auto j = pairs_.pair[pr].second;
             if (heads.clean[i] && heads.clean[j]) {
                 const double iba = angle_arcsec(heads.z_floor[i], heads.z_floor[j]);
+                if (opt_.noise_iba) {
+                    noise_iba_.push_back({e.t, static_cast<std::uint8_t>(pr), iba});
+                }
                 floor_t_[pr].push_back(e.t);
                 floor_v_[pr].push_back(iba);
                 FloorSums& f = daily_[day_index][pr];
@@ -128,6 +133,7 @@ public:
     }
 
     const DailyFloor& daily() const { return daily_; }
+    const std::vector<NoiseIba>& noise_iba() const { return noise_iba_; }
 
 private:
     // Which heads are written and clean at an epoch, and their floor boresights.
@@ -177,6 +183,19 @@ private:
             ++v;
         }
         return truths_[v];
+    }
+
+    // --bench-lag, --orbit-term: what the bench deforms with at the epoch
+    // (every epoch, in gaps too, so that the lag runs on).
+    void bench_dynamics(EpochState& e) {
+        for (std::size_t i = 0; i < e.temp.size(); ++i) {
+            e.bench[i] = lag_.follow(i, e.temp[i]);
+        }
+        for (std::size_t h = kOwnHeads; h < kMaxHeads; ++h) {
+            e.bench_extra_chu[h] = extra_[h] ? lag_.follow(e.temp.size() + h, e.extra_chu[h]) : 0.0;
+        }
+        const Eigen::Vector3d v_hat = e.orbit.body_icrf.row(0).transpose();
+        e.orbit_term_arcsec = opt_.bench.orbit_arcsec * v_hat.dot(e.sun);
     }
 
     // --head-bias: the rotation of head h at `day`, radians (the sum of the windows holding it).
@@ -237,8 +256,10 @@ private:
     std::array<std::vector<double>, kMaxPairs> floor_v_;
     DailyFloor daily_;
     std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
-    HeadMask solved_;                           // A, B, C and the heads simulated
-    PairList pairs_;                            // of the heads simulated
+    BenchLag lag_;
+    std::vector<NoiseIba> noise_iba_;  // --noise-iba
+    HeadMask solved_;                  // A, B, C and the heads simulated
+    PairList pairs_;                   // of the heads simulated
 };
 
 }  // namespace
@@ -254,14 +275,18 @@ std::vector<NamedPath> simulate_inputs(const SimulateOptions& opt) {
 }
 
 std::vector<NamedPath> simulate_outputs(const SimulateOptions& opt) {
-    return {{"--out", opt.out},
-            {"--out (truth model)", opt.out + ".truth.csv"},
-            {"--out (truth history)", opt.out + ".truth-history.csv"},
-            {"--out (noise floor)", opt.out + ".floor.json"},
-            {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
-            {"--out (heater events)", opt.out + ".heaters.csv"},
-            {"--out (mountings)", opt.out + ".mountings.csv"},
-            {"--out (true attitude)", opt.out + ".attitude.csv"}};
+    std::vector<NamedPath> out = {{"--out", opt.out},
+                                  {"--out (truth model)", opt.out + ".truth.csv"},
+                                  {"--out (truth history)", opt.out + ".truth-history.csv"},
+                                  {"--out (noise floor)", opt.out + ".floor.json"},
+                                  {"--out (daily noise floor)", opt.out + ".floor-daily.csv"},
+                                  {"--out (heater events)", opt.out + ".heaters.csv"},
+                                  {"--out (mountings)", opt.out + ".mountings.csv"},
+                                  {"--out (true attitude)", opt.out + ".attitude.csv"}};
+    if (opt.noise_iba) {
+        out.push_back({"--out (noise-only IBAs)", opt.out + ".noise-iba.csv"});
+    }
+    return out;
 }
 
 SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
@@ -306,6 +331,9 @@ SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
     outputs["--out (noise floor)"].write(floor_json(sum.floor, sum.pairs));
     outputs["--out (daily noise floor)"].write(floor_daily_csv(mission.daily(), opt.start_t, sum.pairs));
     outputs["--out (heater events)"].write(heaters_csv(sum.heaters));
+    if (opt.noise_iba) {
+        outputs["--out (noise-only IBAs)"].write(noise_iba_csv(mission.noise_iba(), sum.pairs));
+    }
     return sum;
 }
 

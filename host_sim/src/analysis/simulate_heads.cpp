@@ -121,15 +121,22 @@ Quaternion<double> raw_attitude(const Quaternion<double>& q_meas, double t, std:
     text::c_snprintf(what, sizeof what,
                      "CHU %c %s: the truth model gives %g degrees, beyond 1 degree, at t = %.17g s (T_CHU %g, "
                      "T029 %g, T032 %g degC)",
-                     head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t, t_chu(e, h),
-                     e.temp[3], e.temp[4]);
+                     head_name(static_cast<std::uint8_t>(h)), kAxisNames[axis], angle * 180.0 / kPi, e.t,
+                     bench_t_chu(e, h), e.bench[3], e.bench[4]);
     throw text::InputError(truth.name, truth.file.line[h][axis], 0, what);
 }
 
 }  // namespace
 
-// Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), rotated
-// by bias_rad about the head's x axis (--head-bias), then the raw attitude
+Eigen::Vector3d orbit_term_axis(std::size_t h) {
+    const double r = std::sqrt(0.5);
+    const Eigen::Vector3d own[kOwnHeads] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), {-r, r, 0.0}};
+    return h < kOwnHeads ? own[h] : Eigen::Vector3d(-own[(h - kOwnHeads) % kOwnHeads]);
+}
+
+// Measured attitude: noise ⊗ deformation⁻¹ ⊗ truth (see the header), the
+// deformation at the bench's temperatures, then the orbit term's rotation
+// and bias_rad about the head's x axis (--head-bias), then the raw attitude
 // before the aberration correction.
 HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moon_deg, const EpochState& e,
                         const Truth& truth, double bias_rad, EarthVelocity& earth, Random& rnd) {
@@ -146,12 +153,16 @@ HeadSolution solve_head(std::size_t h, const Eigen::Matrix3d& r_true, double moo
     const Eigen::Quaterniond q_true(r_true);
     const Eigen::Quaterniond q_noisy_true = (q_noise * q_true).normalized();
 
-    HeadTemperatures<double> ht{{t_chu(e, h), true}, {e.temp[3], true}, {e.temp[4], true}};
+    HeadTemperatures<double> ht{{bench_t_chu(e, h), true}, {e.bench[3], true}, {e.bench[4], true}};
     const ThermalStage<double> th = thermal_stage(truth.model, static_cast<std::uint8_t>(h), ht);
     if (th.skip != 0U) {
         refuse_truth_angle(h, e, ht, truth);
     }
     Quaternion<double> q_meas = renormalized(conjugate(to_quaternion(th.q_th)) * from_eigen(q_noisy_true));
+    if (e.orbit_term_arcsec != 0.0) {  // --orbit-term: no thermistor reads it
+        const Eigen::Quaterniond q_orbit(Eigen::AngleAxisd(e.orbit_term_arcsec * kArcsecToRad, orbit_term_axis(h)));
+        q_meas = renormalized(from_eigen(q_orbit) * q_meas);
+    }
     if (bias_rad != 0.0) {
         const Eigen::Quaterniond q_bias(Eigen::AngleAxisd(bias_rad, Eigen::Vector3d::UnitX()));
         q_meas = renormalized(from_eigen(q_bias) * q_meas);

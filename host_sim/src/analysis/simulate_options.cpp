@@ -67,6 +67,17 @@ void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
     }
 }
 
+// --bench-lag and --orbit-term out of their ranges (BenchDynamics).
+void refuse_bad_bench(const BenchDynamics& b) {
+    if (!(b.lag_s >= 0.0 && b.lag_s <= 86400.0)) {
+        throw std::invalid_argument("--bench-lag must be in [0, 86400] s (0: no lag), got " + number_text(b.lag_s));
+    }
+    if (!(b.orbit_arcsec >= 0.0 && b.orbit_arcsec <= 60.0)) {
+        throw std::invalid_argument("--orbit-term must be in [0, 60] arcsec (0: none), got " +
+                                    number_text(b.orbit_arcsec));
+    }
+}
+
 void refuse_bad_event_options(const SimulateOptions& opt) {
     if ((opt.heads & ~kAllHeads) != 0U || head_count(opt.heads) < 2) {
         throw std::invalid_argument("--heads " + head_letters(opt.heads) + ": expected two or more of the heads " +
@@ -77,6 +88,7 @@ void refuse_bad_event_options(const SimulateOptions& opt) {
         refuse_window("--gap", "FROM_DAY:TO_DAY", g, opt.days);
     }
     refuse_bad_thermistor_faults(opt);
+    refuse_bad_bench(opt.bench);
     for (const HeadBias& b : opt.head_biases) {
         refuse_bad_head("--head-bias", b.head, opt.heads);
         refuse_window("--head-bias", "HEAD:FROM_DAY:TO_DAY:ARCSEC", b.window, opt.days);

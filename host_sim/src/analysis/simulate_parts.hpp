@@ -9,7 +9,9 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <climits>
+#include <cmath>
 #include <cstddef>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -160,14 +162,47 @@ struct EpochState {
     Eigen::Vector3d moon;
     std::array<double, 5> temp{};               // T_CHU A, B, C, T029, T032
     std::array<double, kMaxHeads> extra_chu{};  // T_CHU of the heads beyond C, by head index
-    bool no_temperature = false;                // telemetry gap
-    bool no_velocity = false;                   // GPS gap
+    // What the bench deforms with (BenchDynamics): temp and extra_chu through
+    // the lag (equal to them without one), and the orbit term's angle A·(v̂·ŝ), arcsec.
+    std::array<double, 5> bench{};
+    std::array<double, kMaxHeads> bench_extra_chu{};
+    double orbit_term_arcsec = 0.0;
+    bool no_temperature = false;  // telemetry gap
+    bool no_velocity = false;     // GPS gap
 };
 
-// Head h's T_CHU at the epoch.
+// Head h's T_CHU at the epoch, as recorded and as the bench feels it.
 inline double t_chu(const EpochState& e, std::size_t h) {
     return h < kOwnHeads ? e.temp[h] : e.extra_chu[h];
 }
+inline double bench_t_chu(const EpochState& e, std::size_t h) {
+    return h < kOwnHeads ? e.bench[h] : e.bench_extra_chu[h];
+}
+
+// --bench-lag: each temperature through a first-order filter of time
+// constant τ sampled every step (exact for a temperature constant over the
+// step), started at its first value; τ = 0 passes every value through as it is.
+class BenchLag {
+public:
+    BenchLag(double tau_s, double step_s) : gain_(tau_s > 0.0 ? -std::expm1(-step_s / tau_s) : 1.0), on_(tau_s > 0.0) {}
+    // The bench's value of temperature `slot` (0 … 4: e.temp, 5 …: a head beyond C's T_CHU) for the reading x.
+    double follow(std::size_t slot, double x) {
+        if (!on_) {
+            return x;
+        }
+        std::optional<double>& l = lagged_[slot];
+        l = l ? *l + gain_ * (x - *l) : x;
+        return *l;
+    }
+
+private:
+    double gain_;
+    bool on_;
+    std::array<std::optional<double>, 5 + kMaxHeads> lagged_{};
+};
+
+// --orbit-term: head h's axis of the orbit term, head axes (simulate.hpp's top).
+Eigen::Vector3d orbit_term_axis(std::size_t h);
 
 // One head's solution at an epoch (when the head is not blinded).
 struct HeadSolution {

@@ -1,8 +1,11 @@
 #include "ascorr_host/analysis/stats.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <map>
 #include <numeric>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -10,6 +13,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -199,6 +203,46 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
         model ? &*model : nullptr, log);
 }
 
+namespace {
+
+// Per stage, the RMS about the mean of the pair's IBA minus its noise-only
+// IBA (noise, keyed by t in ms) over the epochs both have; n those epochs.
+void systematic(const PairSeries& s, const std::map<long long, double>& noise, std::array<Rms, kStages>& out,
+                std::size_t& n) {
+    PairSeries d;
+    for (std::size_t k = 0; k < s.t.size(); ++k) {
+        const auto it = noise.find(std::llround(s.t[k] * 1000.0));
+        if (it == noise.end()) {
+            continue;
+        }
+        d.t.push_back(s.t[k]);
+        for (std::size_t st = 0; st < kStages; ++st) {
+            d.iba[st].push_back(s.iba[st][k] - it->second);
+        }
+    }
+    n = d.t.size();
+    for (std::size_t st = 0; st < kStages; ++st) {
+        out[st] = rms_about_mean(d.t, d.iba[st]);
+    }
+}
+
+// Pair p's RMS per stage and, with its noise-only IBAs, its systematic
+// residual; its series dropped unless kept.
+void summarize_pair(const StatsOptions& opt, const std::map<long long, double>* noise, std::size_t p, StatsResult& r) {
+    PairSeries& s = r.series[p];
+    for (std::size_t st = 0; st < kStages; ++st) {
+        r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
+    }
+    if (noise != nullptr) {
+        systematic(s, *noise, r.systematic_rms[p], r.systematic_n[p]);
+    }
+    if (!opt.keep_series) {
+        s = PairSeries{};
+    }
+}
+
+}  // namespace
+
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
                           std::ostream& log) {
     const CorrectionConfig<double> ab_only{true, nullptr};
@@ -253,6 +297,11 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 
     r.heads = analysis_heads(with_rows);
     r.pairs = pairs_of(r.heads);
+    r.systematic = !opt.noise_iba.empty();
+    std::optional<std::array<std::map<long long, double>, kMaxPairs>> noise;
+    if (r.systematic) {
+        noise = read_noise_iba(opt.noise_iba, r.pairs);
+    }
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
         const std::size_t all = index_of_pair(kAllPairs, r.pairs.pair[p]);
         PairSeries& s = r.series[p];
@@ -263,12 +312,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
             r.no_epochs_reason[p] = why_no_epochs(r.pairs.pair[p], opt, rows_seen, r.rows, heads, both_present[all]);
             log_empty_pair(opt, r.pairs.pair[p].name, r.no_epochs_reason[p], log);
         }
-        for (std::size_t st = 0; st < kStages; ++st) {
-            r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
-        }
-        if (!opt.keep_series) {
-            s = PairSeries{};
-        }
+        summarize_pair(opt, noise ? &(*noise)[p] : nullptr, p, r);
     }
     return r;
 }
@@ -276,6 +320,34 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept {
     return r.n[p] >= kMinEpochsForRms && (st != 2 || r.thermal) && (st == 0 || !r.corrected_input);
 }
+
+// Whether pair p has a systematic residual at stage st (rms_defined over the
+// epochs with a noise-only IBA).
+bool systematic_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept {
+    return r.systematic && r.systematic_n[p] >= kMinEpochsForRms && rms_defined(r, p, st);
+}
+
+namespace {
+
+std::string systematic_table(const StatsResult& r) {
+    std::ostringstream o;
+    o << "systematic IBA residual (IBA minus the noise-only IBA), RMS about the mean, arcsec\n";
+    char buf[200];
+    for (std::size_t p = 0; p < r.pairs.count; ++p) {
+        std::string cells[kStages];
+        for (std::size_t s = 0; s < kStages; ++s) {
+            char c[64];
+            text::c_snprintf(c, sizeof c, "%6.3f", r.systematic_rms[p][s].rms);
+            cells[s] = systematic_defined(r, p, s) ? std::string(c) : std::string("-");
+        }
+        text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.systematic_n[p],
+                         cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
+        o << buf;
+    }
+    return o.str();
+}
+
+}  // namespace
 
 std::string stats_table(const StatsResult& r) {
     std::ostringstream o;
@@ -299,6 +371,9 @@ std::string stats_table(const StatsResult& r) {
                          cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
         o << buf;
     }
+    if (r.systematic) {
+        o << systematic_table(r);
+    }
     return o.str();
 }
 
@@ -318,7 +393,20 @@ std::string stats_json(const StatsResult& r) {
         o << ", \"thermal\": " << cell(2);
         o << ", \"n\": " << r.n[p] << '}';
     }
-    o << "}}\n";
+    o << '}';
+    if (r.systematic) {
+        o << ", \"systematic\": {";
+        for (std::size_t p = 0; p < r.pairs.count; ++p) {
+            const auto cell = [&](std::size_t st) {
+                return systematic_defined(r, p, st) ? num(r.systematic_rms[p][st].rms) : "null";
+            };
+            o << (p ? ", " : "") << '"' << r.pairs.pair[p].name << "\": {\"original\": " << cell(0)
+              << ", \"aberration\": " << cell(1) << ", \"thermal\": " << cell(2) << ", \"n\": " << r.systematic_n[p]
+              << '}';
+        }
+        o << '}';
+    }
+    o << "}\n";
     return o.str();
 }
 

@@ -51,6 +51,19 @@
 //    the real temperature; a head whose measured attitude is rotated about its
 //    x axis (not in the truth model, not in the floor). They draw no random
 //    numbers: outside its window an event leaves every row as without it.
+//  - The bench inside the orbit (BenchDynamics; none by default, and then
+//    every file is byte for byte as without it). With a lag τ the bench
+//    deforms with its temperatures (each T_CHU, T029, T032) through a
+//    first-order filter, L ← L + (1 − e^(−Δt/τ))·(T − L) per epoch from
+//    L = T at the first one, while the rows record T. With an orbit term A
+//    each head is rotated, on top, by A·(v̂·ŝ) about an axis of its own (head
+//    axes: A x, B y, C (y − x)/√2; a head beyond C the opposite of the head
+//    three before it): one side heated along the orbit where no thermistor
+//    reads, v̂·ŝ = −cos β·sin(u − u_☉), so its amplitude follows the season.
+//    Both are in the measured attitudes only: not in the truth model, not in
+//    the floor, so `correct` with the truth model no longer returns
+//    q_noise ⊗ q_true and its IBA minus the floor's (OUT.noise-iba.csv) is
+//    what the static model leaves.
 #pragma once
 
 #include <Eigen/Core>
@@ -58,6 +71,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -104,6 +118,12 @@ struct HeadBias {
     double arcsec = 0.0;
 };
 
+// The bench inside the orbit (see the top): --bench-lag, --orbit-term.
+struct BenchDynamics {
+    double lag_s = 0.0;         // τ, s, in [0, 86400]; 0: the bench follows its temperatures at once
+    double orbit_arcsec = 0.0;  // A, arcsec, in [0, 60]
+};
+
 struct SimulateOptions {
     std::string out;
     double days = 920.0;  // 2.5 years
@@ -116,12 +136,15 @@ struct SimulateOptions {
     std::vector<ThermistorFault> thermistor_faults;
     std::vector<HeadBias> head_biases;
     HeadMask heads = kPaperHeads;  // the heads simulated (--heads)
+    BenchDynamics bench;
+    bool noise_iba = false;  // --noise-iba: also OUT.noise-iba.csv
 };
 
 // Throws std::invalid_argument, naming the option (--truth-change, --gap,
-// --thermistor-fault, --head-bias) and what it accepts, for events outside the
-// mission [0, days], empty or reversed windows, truth changes not in increasing
-// days, heads not simulated, fewer than two heads (--heads), non-finite values.
+// --thermistor-fault, --head-bias, --bench-lag, --orbit-term) and what it
+// accepts, for events outside the mission [0, days], empty or reversed
+// windows, truth changes not in increasing days, heads not simulated, fewer
+// than two heads (--heads), non-finite or out-of-range values.
 void refuse_bad_events(const SimulateOptions& opt);
 
 struct HeaterEvent {
@@ -157,14 +180,15 @@ struct SimulateSummary {
 // opt.out + ".floor-daily.csv", opt.out + ".heaters.csv" (start,end,heater:
 // operational or survival), opt.out + ".mountings.csv" (simulated_mountings)
 // and opt.out + ".attitude.csv" (t,qw,qx,qy,qz: q_crf_icrf at every epoch k·step,
-// in --gap too; combined_csv.hpp).
+// in --gap too; combined_csv.hpp); with opt.noise_iba also
+// opt.out + ".noise-iba.csv" (noise_iba_csv).
 // Throws std::invalid_argument for bad options, InputError for a bad truth file.
-// The eight files are one OutputSet (atomic_file.hpp): all written or none.
+// The eight (nine) files are one OutputSet (atomic_file.hpp): all written or none.
 SimulateSummary simulate(const SimulateOptions& opt);
 // The command's files: its inputs, and its eight outputs by option ("--out",
 // "--out (truth model)", "--out (truth history)", "--out (noise floor)",
 // "--out (daily noise floor)", "--out (heater events)", "--out (mountings)",
-// "--out (true attitude)").
+// "--out (true attitude)", and with --noise-iba "--out (noise-only IBAs)").
 std::vector<NamedPath> simulate_inputs(const SimulateOptions& opt);
 std::vector<NamedPath> simulate_outputs(const SimulateOptions& opt);
 // Writes into outputs (opened from simulate_outputs, committed by the caller).
@@ -209,5 +233,22 @@ struct WindowFloor {
 };
 std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long long from_day, long long to_day,
                                                  const PairList& pairs = kPaperPairs);
+
+// OUT.noise-iba.csv: `t,pair,iba`, a row per clean epoch (the floor's) and
+// pair in time order: the IBA (arcsec, 6 decimals) of the heads' attitudes
+// with noise only, q_noise ⊗ q_true. A corrected file's IBA minus it, at the
+// same t, is what the correction left of the deformation (the systematic
+// residual, `stats --noise-iba`).
+struct NoiseIba {
+    double t = 0.0;
+    std::uint8_t pair = 0;  // position in the summary's pairs
+    double iba = 0.0;
+};
+std::string noise_iba_csv(const std::vector<NoiseIba>& ibas, const PairList& pairs);
+// Its rows of the pairs `pairs` (rows of other pairs are skipped), by
+// position in it, keyed by t in ms. Throws InputError (file:line:column) for
+// a malformed file.
+std::array<std::map<long long, double>, kMaxPairs> read_noise_iba(const std::string& path,
+                                                                  const PairList& pairs = kPaperPairs);
 
 }  // namespace ascorr::host

@@ -37,6 +37,10 @@ struct StatsOptions {
     bool corrected_input = false;
     // Log a line per pair without clean epochs (plot says it once, itself).
     bool log_empty_pairs = true;
+    // simulate's OUT.noise-iba.csv (empty: none): the systematic residual per
+    // pair and stage, the RMS about the mean of IBA − noise-only IBA over the
+    // clean epochs the file has too.
+    std::string noise_iba;
 };
 
 struct PairSeries {
@@ -58,6 +62,9 @@ struct StatsResult {
     // file or in [from, to], a head without rows or without clean rows (and
     // what kept them out), or the two heads' clean rows never at one epoch.
     std::array<std::string, kMaxPairs> no_epochs_reason;
+    bool systematic = false;  // StatsOptions::noise_iba given
+    std::array<std::array<Rms, kStages>, kMaxPairs> systematic_rms{};
+    std::array<std::size_t, kMaxPairs> systematic_n{};  // epochs with a noise-only IBA
 };
 
 // docs/contract.md's clean solution (before the core has seen it).
@@ -80,6 +87,9 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 // says "-", the JSON null, Python None.
 inline constexpr std::size_t kMinEpochsForRms = 2;
 bool rms_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept;
+// The same for the systematic residual: rms_defined, a noise-only IBA file,
+// and two of its epochs in the pair at least.
+bool systematic_defined(const StatsResult& r, std::size_t p, std::size_t st) noexcept;
 
 std::string stats_table(const StatsResult& r);
 std::string stats_json(const StatsResult& r);
