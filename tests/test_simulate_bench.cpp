@@ -60,7 +60,7 @@ std::array<std::map<long long, double>, host::kMaxPairs> residuals(const std::st
         const host::PairSeries& series = r.series[p];
         for (std::size_t k = 0; k < series.t.size(); ++k) {
             const long long key = std::llround(series.t[k] * 1000.0);
-            out[p][key] = series.iba[stage][k] - noise[p].at(key);
+            out[p][key] = series.iba[stage][k] - *host::noise_iba_at(noise[p], key);
         }
     }
     return out;

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -151,7 +150,13 @@ std::string noise_iba_csv(const std::vector<NoiseIba>& ibas, const PairList& pai
     return s;
 }
 
-std::array<std::map<long long, double>, kMaxPairs> read_noise_iba(const std::string& path, const PairList& pairs) {
+const double* noise_iba_at(const NoiseIbaSeries& s, long long t_ms) {
+    const auto it = std::lower_bound(s.begin(), s.end(), t_ms,
+                                     [](const std::pair<long long, double>& e, long long k) { return e.first < k; });
+    return it != s.end() && it->first == t_ms ? &it->second : nullptr;
+}
+
+std::array<NoiseIbaSeries, kMaxPairs> read_noise_iba(const std::string& path, const PairList& pairs) {
     std::ifstream in(path);
     if (!in) {
         throw text::InputError(path, 0, 0, "cannot open the noise-only IBA file");
@@ -161,7 +166,12 @@ std::array<std::map<long long, double>, kMaxPairs> read_noise_iba(const std::str
     if (!std::getline(in, line) || line != kNoiseIbaHeader) {
         throw text::InputError(path, 1, 1, std::string("expected the header ") + kNoiseIbaHeader);
     }
-    std::array<std::map<long long, double>, kMaxPairs> out;
+    struct Read {
+        long long key;
+        double iba;
+        std::size_t line;
+    };
+    std::array<std::vector<Read>, kMaxPairs> rows;
     while (std::getline(in, line)) {
         ++number_of_line;
         const Fields f = split(line);
@@ -175,9 +185,23 @@ std::array<std::map<long long, double>, kMaxPairs> read_noise_iba(const std::str
             throw text::InputError(path, number_of_line, f.column[std::fabs(t) < 1e12L ? 2 : 0],
                                    "t must be a time (|t| < 1e12 s) and iba an angle in [0, 648000] arcsec");
         }
-        if (pair < pairs.count &&
-            !out[pair].emplace(std::llround(static_cast<double>(t) * 1000.0), static_cast<double>(iba)).second) {
-            throw text::InputError(path, number_of_line, f.column[0], "pair " + f.text[1] + " twice at this t");
+        if (pair < pairs.count) {
+            rows[pair].push_back(
+                {std::llround(static_cast<double>(t) * 1000.0), static_cast<double>(iba), number_of_line});
+        }
+    }
+    std::array<NoiseIbaSeries, kMaxPairs> out;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        std::vector<Read>& r = rows[p];
+        std::stable_sort(r.begin(), r.end(), [](const Read& a, const Read& b) { return a.key < b.key; });
+        out[p].reserve(r.size());
+        for (std::size_t k = 0; k < r.size(); ++k) {
+            if (k > 0 && r[k].key == r[k - 1].key) {
+                throw text::InputError(path, r[k].line, 1,
+                                       "pair " + pair_name(pairs.pair[p]) + " twice at this t (also line " +
+                                           std::to_string(r[k - 1].line) + ")");
+            }
+            out[p].emplace_back(r[k].key, r[k].iba);
         }
     }
     return out;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <numeric>
 #include <optional>
 #include <ostream>
@@ -207,17 +206,16 @@ namespace {
 
 // Per stage, the RMS about the mean of the pair's IBA minus its noise-only
 // IBA (noise, keyed by t in ms) over the epochs both have; n those epochs.
-void systematic(const PairSeries& s, const std::map<long long, double>& noise, std::array<Rms, kStages>& out,
-                std::size_t& n) {
+void systematic(const PairSeries& s, const NoiseIbaSeries& noise, std::array<Rms, kStages>& out, std::size_t& n) {
     PairSeries d;
     for (std::size_t k = 0; k < s.t.size(); ++k) {
-        const auto it = noise.find(std::llround(s.t[k] * 1000.0));
-        if (it == noise.end()) {
+        const double* noise_iba = noise_iba_at(noise, std::llround(s.t[k] * 1000.0));
+        if (noise_iba == nullptr) {
             continue;
         }
         d.t.push_back(s.t[k]);
         for (std::size_t st = 0; st < kStages; ++st) {
-            d.iba[st].push_back(s.iba[st][k] - it->second);
+            d.iba[st].push_back(s.iba[st][k] - *noise_iba);
         }
     }
     n = d.t.size();
@@ -228,7 +226,7 @@ void systematic(const PairSeries& s, const std::map<long long, double>& noise, s
 
 // Pair p's RMS per stage and, with its noise-only IBAs, its systematic
 // residual; its series dropped unless kept.
-void summarize_pair(const StatsOptions& opt, const std::map<long long, double>* noise, std::size_t p, StatsResult& r) {
+void summarize_pair(const StatsOptions& opt, const NoiseIbaSeries* noise, std::size_t p, StatsResult& r) {
     PairSeries& s = r.series[p];
     for (std::size_t st = 0; st < kStages; ++st) {
         r.rms[p][st] = rms_about_mean(s.t, s.iba[st]);
@@ -298,7 +296,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     r.heads = analysis_heads(with_rows);
     r.pairs = pairs_of(r.heads);
     r.systematic = !opt.noise_iba.empty();
-    std::optional<std::array<std::map<long long, double>, kMaxPairs>> noise;
+    std::optional<std::array<NoiseIbaSeries, kMaxPairs>> noise;
     if (r.systematic) {
         noise = read_noise_iba(opt.noise_iba, r.pairs);
     }

@@ -71,8 +71,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
-#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ascorr_host/analysis/iba.hpp"
@@ -245,10 +245,14 @@ struct NoiseIba {
     double iba = 0.0;
 };
 std::string noise_iba_csv(const std::vector<NoiseIba>& ibas, const PairList& pairs);
+// A pair's noise-only IBAs (arcsec) by t in ms, in increasing t, one per t
+// (a sorted vector: 16 bytes an epoch, a mission of years in memory).
+using NoiseIbaSeries = std::vector<std::pair<long long, double>>;
+// The IBA at t_ms, or nullptr.
+const double* noise_iba_at(const NoiseIbaSeries& s, long long t_ms);
 // Its rows of the pairs `pairs` (rows of other pairs are skipped), by
-// position in it, keyed by t in ms. Throws InputError (file:line:column) for
-// a malformed file.
-std::array<std::map<long long, double>, kMaxPairs> read_noise_iba(const std::string& path,
-                                                                  const PairList& pairs = kPaperPairs);
+// position in it. Throws InputError (file:line:column) for a malformed file
+// or a pair twice at one t.
+std::array<NoiseIbaSeries, kMaxPairs> read_noise_iba(const std::string& path, const PairList& pairs = kPaperPairs);
 
 }  // namespace ascorr::host
