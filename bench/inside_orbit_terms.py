@@ -109,6 +109,10 @@ def geometry(raw):
     n = np.cross(v[:-1], v[1:])
     n = np.vstack([n, n[-1:]])
     n /= np.linalg.norm(n, axis=1)[:, None]
+    # Across a gap the two velocities are not a short arc: the normal from the
+    # last short arc before it (the plane turns 1 deg a day at most).
+    close = np.append(np.diff(t) <= 300.0, False)
+    n = pd.DataFrame(np.where(close[:, None], n, np.nan)).ffill().bfill().to_numpy()
     r_hat = np.cross(v_hat, n)
     s = sun_gcrs(t)
     node = np.cross(np.array([0.0, 0.0, 1.0]), n)

@@ -252,6 +252,7 @@ TEST(CliInputsAndOutputs, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
     std::ofstream(dir / "board.cfg") << slurp(cfg) << "#" << std::string(limit + 1, ' ') << "\n";
     std::ofstream(dir / "history.csv") << "t,t_chu,t_029,t_032\n0,1,2,3\n" << std::string(limit + 1, '1') << "\n";
     std::ofstream(dir / "replay.csv") << "t,x\n" << std::string(limit + 1, '1');  // no line end at all
+    std::ofstream(dir / "noise.csv") << "t,pair,iba\n" << std::string(limit + 1, '1') << "\n";
     struct Case {
         std::string args;
         std::string where;
@@ -261,6 +262,8 @@ TEST(CliInputsAndOutputs, EveryReaderBoundsItsLinesAndNamesFileAndLine) {
         {"correct --in " + kSolutions + " --out o.csv --states /dev/zero", "/dev/zero:1:1: binary data (byte 0x00)"},
         {"correct --in solutions.csv --out o.csv", "solutions.csv:2: line longer than 1048576"},
         {"stats --in solutions.csv", "solutions.csv:2: line longer than 1048576"},
+        {"stats --in " + kSolutions + " --noise-iba noise.csv", "noise.csv:2: line longer than 1048576"},
+        {"stats --in " + kSolutions + " --noise-iba /dev/zero", "/dev/zero:1: line longer than 1048576"},
         {"replay --target loopback-float --in solutions.csv --model " + kModel + " --out o.csv",
          "solutions.csv:2: line longer than 1048576"},
         {"correct --in " + kSolutions + " --model model.csv --out o.csv", "model.csv:2: line longer than 1048576"},

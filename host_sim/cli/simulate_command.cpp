@@ -166,7 +166,8 @@ void add_simulate_command(CLI::App& app) {
         app.add_subcommand("simulate", "write a Swarm-like recorded data set, its truth model and noise floor");
     cmd->add_option("--out", opt->out,
                     "solutions file (CSV); beside it OUT.truth.csv, OUT.truth-history.csv, OUT.floor.json, "
-                    "OUT.floor-daily.csv, OUT.heaters.csv, OUT.mountings.csv and OUT.attitude.csv (not '-')")
+                    "OUT.floor-daily.csv, OUT.heaters.csv, OUT.mountings.csv and OUT.attitude.csv, with --noise-iba "
+                    "OUT.noise-iba.csv (not '-')")
         ->required()
         ->check(non_empty_path())
         ->check(not_standard_output("simulate writes eight files (OUT, OUT.truth.csv, OUT.truth-history.csv, "
@@ -190,11 +191,11 @@ void add_simulate_command(CLI::App& app) {
     cmd->add_option("--bench-lag", opt->bench.lag_s,
                     "the bench deforms with its temperatures through a first-order lag of this time constant, "
                     "[0, 86400] s (default 0: at once); the rows record the temperatures themselves")
-        ->check(real_in(0.0, 86400.0));
+        ->check(real_in(0.0, host::kMaxBenchLagS));
     cmd->add_option("--orbit-term", opt->bench.orbit_arcsec,
                     "an orbit-periodic deformation no thermistor reads, [0, 60] arcsec at full amplitude (default 0: "
                     "none); its amplitude follows the Sun's angle to the orbital plane")
-        ->check(real_in(0.0, 60.0));
+        ->check(real_in(0.0, host::kMaxOrbitTermArcsec));
     cmd->add_flag("--noise-iba", opt->noise_iba,
                   "also write OUT.noise-iba.csv: t,pair,iba, the IBA of the attitudes with noise only at each clean "
                   "epoch (for stats --noise-iba)");

@@ -1,5 +1,5 @@
 // OUT.floor-daily.csv (ascorr_host/analysis/simulate.hpp): the floor's per-day sums,
-// and the floor of a window of days from them; OUT.noise-iba.csv, the floor's IBAs themselves.
+// and the floor of a window of days from them.
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -8,7 +8,6 @@
 #include <limits>
 #include <string>
 #include <system_error>
-#include <vector>
 
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_text/c_format.hpp"
@@ -19,7 +18,6 @@ namespace ascorr::host {
 namespace {
 
 constexpr const char* kFloorDailyHeader = "day,t_start,pair,n,sum,sum_sq";
-constexpr const char* kNoiseIbaHeader = "t,pair,iba";
 
 // The fields of one line, split at commas, with the 1-based column of each.
 struct Fields {
@@ -56,22 +54,21 @@ long double number(const std::string& path, std::size_t line, const Fields& f, s
     return x;
 }
 
-// The position of the line's pair (field i) in `pairs`, pairs.count for
-// another pair of heads.hpp's heads; InputError for a name that is no pair of them.
-std::size_t pair_position(const std::string& path, std::size_t line, const Fields& f, std::size_t i,
-                          const PairList& pairs) {
+// The position of the line's pair in `pairs`, pairs.count for another pair of
+// heads.hpp's heads; InputError for a name that is no pair of them.
+std::size_t pair_position(const std::string& path, std::size_t line, const Fields& f, const PairList& pairs) {
     constexpr PairList kAllPairs = pairs_of(kAllHeads);
     bool known = false;
     for (std::size_t p = 0; p < kAllPairs.count; ++p) {
-        known = known || f.text[i] == kAllPairs.pair[p].name;
+        known = known || f.text[2] == kAllPairs.pair[p].name;
     }
     if (!known) {
-        throw text::InputError(path, line, f.column[i],
-                               "pair '" + f.text[i] + "' is not two heads of " + kHeadLetters + " (as A-B)");
+        throw text::InputError(path, line, f.column[2],
+                               "pair '" + f.text[2] + "' is not two heads of " + kHeadLetters + " (as A-B)");
     }
     std::size_t position = pairs.count;
     for (std::size_t p = 0; p < pairs.count; ++p) {
-        position = f.text[i] == pairs.pair[p].name ? p : position;
+        position = f.text[2] == pairs.pair[p].name ? p : position;
     }
     return position;
 }
@@ -111,7 +108,7 @@ std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long l
             throw text::InputError(path, number_of_line, 1,
                                    "expected 6 fields (" + std::string(kFloorDailyHeader) + ")");
         }
-        const std::size_t pair = pair_position(path, number_of_line, f, 2, pairs);
+        const std::size_t pair = pair_position(path, number_of_line, f, pairs);
         const long double day = number(path, number_of_line, f, 0);
         const long double n = number(path, number_of_line, f, 3);
         if (day < 0 || day != std::floor(day) || n < 0 || n != std::floor(n)) {
@@ -135,74 +132,6 @@ std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long l
         const long double mean = t.sum / static_cast<long double>(t.n);
         const long double var = t.sum_sq / static_cast<long double>(t.n) - mean * mean;
         out[p].rms = static_cast<double>(std::sqrt(std::max(var, 0.0L)));
-    }
-    return out;
-}
-
-std::string noise_iba_csv(const std::vector<NoiseIba>& ibas, const PairList& pairs) {
-    std::string s = std::string(kNoiseIbaHeader) + '\n';
-    s.reserve(40 * ibas.size() + s.size());
-    char line[96];
-    for (const NoiseIba& x : ibas) {
-        const int n = text::c_snprintf(line, sizeof line, "%.3f,%s,%.6f\n", x.t, pairs.pair[x.pair].name, x.iba);
-        s.append(line, static_cast<std::size_t>(n));
-    }
-    return s;
-}
-
-const double* noise_iba_at(const NoiseIbaSeries& s, long long t_ms) {
-    const auto it = std::lower_bound(s.begin(), s.end(), t_ms,
-                                     [](const std::pair<long long, double>& e, long long k) { return e.first < k; });
-    return it != s.end() && it->first == t_ms ? &it->second : nullptr;
-}
-
-std::array<NoiseIbaSeries, kMaxPairs> read_noise_iba(const std::string& path, const PairList& pairs) {
-    std::ifstream in(path);
-    if (!in) {
-        throw text::InputError(path, 0, 0, "cannot open the noise-only IBA file");
-    }
-    std::string line;
-    std::size_t number_of_line = 1;
-    if (!std::getline(in, line) || line != kNoiseIbaHeader) {
-        throw text::InputError(path, 1, 1, std::string("expected the header ") + kNoiseIbaHeader);
-    }
-    struct Read {
-        long long key;
-        double iba;
-        std::size_t line;
-    };
-    std::array<std::vector<Read>, kMaxPairs> rows;
-    while (std::getline(in, line)) {
-        ++number_of_line;
-        const Fields f = split(line);
-        if (f.count != 3) {
-            throw text::InputError(path, number_of_line, 1, "expected 3 fields (" + std::string(kNoiseIbaHeader) + ")");
-        }
-        const std::size_t pair = pair_position(path, number_of_line, f, 1, pairs);
-        const long double t = number(path, number_of_line, f, 0);
-        const long double iba = number(path, number_of_line, f, 2);
-        if (!(std::fabs(t) < 1e12L) || !(iba >= 0.0L && iba <= 648000.0L)) {
-            throw text::InputError(path, number_of_line, f.column[std::fabs(t) < 1e12L ? 2 : 0],
-                                   "t must be a time (|t| < 1e12 s) and iba an angle in [0, 648000] arcsec");
-        }
-        if (pair < pairs.count) {
-            rows[pair].push_back(
-                {std::llround(static_cast<double>(t) * 1000.0), static_cast<double>(iba), number_of_line});
-        }
-    }
-    std::array<NoiseIbaSeries, kMaxPairs> out;
-    for (std::size_t p = 0; p < pairs.count; ++p) {
-        std::vector<Read>& r = rows[p];
-        std::stable_sort(r.begin(), r.end(), [](const Read& a, const Read& b) { return a.key < b.key; });
-        out[p].reserve(r.size());
-        for (std::size_t k = 0; k < r.size(); ++k) {
-            if (k > 0 && r[k].key == r[k - 1].key) {
-                throw text::InputError(path, r[k].line, 1,
-                                       "pair " + pair_name(pairs.pair[p]) + " twice at this t (also line " +
-                                           std::to_string(r[k - 1].line) + ")");
-            }
-            out[p].emplace_back(r[k].key, r[k].iba);
-        }
     }
     return out;
 }

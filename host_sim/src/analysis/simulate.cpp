@@ -99,7 +99,7 @@ public:
             if (heads.clean[i] && heads.clean[j]) {
                 const double iba = angle_arcsec(heads.z_floor[i], heads.z_floor[j]);
                 if (opt_.noise_iba) {
-                    noise_iba_.push_back({e.t, static_cast<std::uint8_t>(pr), iba});
+                    append_noise_iba_row(noise_iba_, e.t, pairs_.pair[pr], iba);
                 }
                 floor_t_[pr].push_back(e.t);
                 floor_v_[pr].push_back(iba);
@@ -124,6 +124,7 @@ public:
         sum_.heaters_path = opt_.out + ".heaters.csv";
         sum_.mountings_path = opt_.out + ".mountings.csv";
         sum_.attitude_path = opt_.out + ".attitude.csv";
+        sum_.noise_iba_path = opt_.noise_iba ? opt_.out + ".noise-iba.csv" : std::string();
         for (const HeaterEvent& ev : heaters_.events()) {
             if (ev.start <= t_last) {
                 sum_.heaters.push_back(ev);
@@ -133,7 +134,8 @@ public:
     }
 
     const DailyFloor& daily() const { return daily_; }
-    const std::vector<NoiseIba>& noise_iba() const { return noise_iba_; }
+    // --noise-iba: the rows since the caller last took them.
+    std::string& noise_iba_rows() { return noise_iba_; }
 
 private:
     // Which heads are written and clean at an epoch, and their floor boresights.
@@ -257,9 +259,9 @@ private:
     DailyFloor daily_;
     std::vector<std::optional<double>> stuck_;  // per --thermistor-fault: the stuck value once in its window
     BenchLag lag_;
-    std::vector<NoiseIba> noise_iba_;  // --noise-iba
-    HeadMask solved_;                  // A, B, C and the heads simulated
-    PairList pairs_;                   // of the heads simulated
+    std::string noise_iba_;  // --noise-iba: rows not yet written
+    HeadMask solved_;        // A, B, C and the heads simulated
+    PairList pairs_;         // of the heads simulated
 };
 
 }  // namespace
@@ -305,6 +307,10 @@ SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
     attitude_buf.reserve(2U << 20);
     attitude_buf += kAttitudeHeader;
     attitude_buf += '\n';
+    AtomicFile* noise_iba = opt.noise_iba ? &outputs["--out (noise-only IBAs)"] : nullptr;
+    if (noise_iba != nullptr) {
+        noise_iba->write(std::string(kNoiseIbaHeader) + '\n');
+    }
     const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
@@ -320,6 +326,13 @@ SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
             attitude.write(attitude_buf);
             attitude_buf.clear();
         }
+        if (noise_iba != nullptr && mission.noise_iba_rows().size() > (1U << 20)) {
+            noise_iba->write(mission.noise_iba_rows());
+            mission.noise_iba_rows().clear();
+        }
+    }
+    if (noise_iba != nullptr) {
+        noise_iba->write(mission.noise_iba_rows());
     }
     out.write(buf);
     attitude.write(attitude_buf);
@@ -331,9 +344,6 @@ SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
     outputs["--out (noise floor)"].write(floor_json(sum.floor, sum.pairs));
     outputs["--out (daily noise floor)"].write(floor_daily_csv(mission.daily(), opt.start_t, sum.pairs));
     outputs["--out (heater events)"].write(heaters_csv(sum.heaters));
-    if (opt.noise_iba) {
-        outputs["--out (noise-only IBAs)"].write(noise_iba_csv(mission.noise_iba(), sum.pairs));
-    }
     return sum;
 }
 

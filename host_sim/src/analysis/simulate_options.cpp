@@ -69,12 +69,13 @@ void refuse_bad_thermistor_faults(const SimulateOptions& opt) {
 
 // --bench-lag and --orbit-term out of their ranges (BenchDynamics).
 void refuse_bad_bench(const BenchDynamics& b) {
-    if (!(b.lag_s >= 0.0 && b.lag_s <= 86400.0)) {
-        throw std::invalid_argument("--bench-lag must be in [0, 86400] s (0: no lag), got " + number_text(b.lag_s));
+    if (!(b.lag_s >= 0.0 && b.lag_s <= kMaxBenchLagS)) {
+        throw std::invalid_argument("--bench-lag must be in [0, " + number_text(kMaxBenchLagS) +
+                                    "] s (0: no lag), got " + number_text(b.lag_s));
     }
-    if (!(b.orbit_arcsec >= 0.0 && b.orbit_arcsec <= 60.0)) {
-        throw std::invalid_argument("--orbit-term must be in [0, 60] arcsec (0: none), got " +
-                                    number_text(b.orbit_arcsec));
+    if (!(b.orbit_arcsec >= 0.0 && b.orbit_arcsec <= kMaxOrbitTermArcsec)) {
+        throw std::invalid_argument("--orbit-term must be in [0, " + number_text(kMaxOrbitTermArcsec) +
+                                    "] arcsec (0: none), got " + number_text(b.orbit_arcsec));
     }
 }
 

@@ -185,7 +185,8 @@ inline double bench_t_chu(const EpochState& e, std::size_t h) {
 class BenchLag {
 public:
     BenchLag(double tau_s, double step_s) : gain_(tau_s > 0.0 ? -std::expm1(-step_s / tau_s) : 1.0), on_(tau_s > 0.0) {}
-    // The bench's value of temperature `slot` (0 … 4: e.temp, 5 …: a head beyond C's T_CHU) for the reading x.
+    // The bench's value of temperature `slot` (0 … 4: e.temp; 5 + h: T_CHU of
+    // head h beyond C, slots 5 … 7 unused) for the reading x.
     double follow(std::size_t slot, double x) {
         if (!on_) {
             return x;

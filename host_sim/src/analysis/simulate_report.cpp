@@ -64,6 +64,9 @@ std::string describe(const SimulateSummary& s) {
     o << "\ntruth model: " << s.truth_path << " (history: " << s.truth_history_path << ")\nfloor: " << s.floor_path
       << " (per day: " << s.floor_daily_path << ")\nheater events (" << s.heaters.size() << "): " << s.heaters_path
       << "\nmountings (true noise): " << s.mountings_path << "\ntrue CRF attitude: " << s.attitude_path;
+    if (!s.noise_iba_path.empty()) {
+        o << "\nnoise-only IBAs: " << s.noise_iba_path;
+    }
     if (s.gap_epochs != 0) {
         o << "\nepochs without rows (--gap): " << s.gap_epochs;
     }

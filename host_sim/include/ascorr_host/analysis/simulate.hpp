@@ -119,9 +119,11 @@ struct HeadBias {
 };
 
 // The bench inside the orbit (see the top): --bench-lag, --orbit-term.
+inline constexpr double kMaxBenchLagS = 86400.0;
+inline constexpr double kMaxOrbitTermArcsec = 60.0;
 struct BenchDynamics {
-    double lag_s = 0.0;         // τ, s, in [0, 86400]; 0: the bench follows its temperatures at once
-    double orbit_arcsec = 0.0;  // A, arcsec, in [0, 60]
+    double lag_s = 0.0;         // τ, s, in [0, kMaxBenchLagS]; 0: the bench follows its temperatures at once
+    double orbit_arcsec = 0.0;  // A, arcsec, in [0, kMaxOrbitTermArcsec]
 };
 
 struct SimulateOptions {
@@ -172,6 +174,7 @@ struct SimulateSummary {
     std::string heaters_path;
     std::string mountings_path;
     std::string attitude_path;
+    std::string noise_iba_path;  // empty without --noise-iba
 };
 
 // Writes opt.out, opt.out + ".truth.csv" (the initial truth),
@@ -234,25 +237,27 @@ struct WindowFloor {
 std::array<WindowFloor, kMaxPairs> floor_of_days(const std::string& path, long long from_day, long long to_day,
                                                  const PairList& pairs = kPaperPairs);
 
-// OUT.noise-iba.csv: `t,pair,iba`, a row per clean epoch (the floor's) and
-// pair in time order: the IBA (arcsec, 6 decimals) of the heads' attitudes
-// with noise only, q_noise ⊗ q_true. A corrected file's IBA minus it, at the
-// same t, is what the correction left of the deformation (the systematic
-// residual, `stats --noise-iba`).
-struct NoiseIba {
-    double t = 0.0;
-    std::uint8_t pair = 0;  // position in the summary's pairs
-    double iba = 0.0;
-};
-std::string noise_iba_csv(const std::vector<NoiseIba>& ibas, const PairList& pairs);
-// A pair's noise-only IBAs (arcsec) by t in ms, in increasing t, one per t
-// (a sorted vector: 16 bytes an epoch, a mission of years in memory).
+// OUT.noise-iba.csv (noise_iba.cpp): `t,pair,iba`, a row per clean epoch
+// (the floor's) and pair, in time order: the IBA (arcsec, 6 decimals) of the
+// heads' attitudes with noise only, q_noise ⊗ q_true. A corrected file's IBA
+// minus it, at the same t, is what the correction left of the deformation
+// (the systematic residual, `stats --noise-iba`). Written as the mission
+// runs, a row at a time, as the solutions are.
+inline constexpr const char* kNoiseIbaHeader = "t,pair,iba";
+void append_noise_iba_row(std::string& buf, double t, const HeadPair& pair, double iba);
+
+// A pair's noise-only IBAs (arcsec) by t in ms, in increasing t, one per t:
+// a sorted vector (16 bytes a row once read; the reader peaks at about 40).
 using NoiseIbaSeries = std::vector<std::pair<long long, double>>;
 // The IBA at t_ms, or nullptr.
 const double* noise_iba_at(const NoiseIbaSeries& s, long long t_ms);
-// Its rows of the pairs `pairs` (rows of other pairs are skipped), by
-// position in it. Throws InputError (file:line:column) for a malformed file
-// or a pair twice at one t.
+// The rows of the pairs `pairs` (rows of other pairs of heads.hpp's heads are
+// skipped), by position in it, read through the solutions' block reader
+// (csv.hpp: "cannot open FILE: reason", a directory, a NUL byte or an
+// over-long line refused as there). Throws InputError (file:line:column) for
+// another header, a row that is not three fields, a t that is no time of an
+// epoch, a pair that is not two heads, an iba outside [0, 648000] arcsec, a
+// pair twice at one t.
 std::array<NoiseIbaSeries, kMaxPairs> read_noise_iba(const std::string& path, const PairList& pairs = kPaperPairs);
 
 }  // namespace ascorr::host
