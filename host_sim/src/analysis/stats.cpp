@@ -181,7 +181,7 @@ void log_empty_pair(const StatsOptions& opt, const Name& name, const std::string
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
-    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}}, {}, true);
+    refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--noise-iba", opt.noise_iba}}, {}, true);
     refuse_bad_time_range(opt.from, opt.to);
     StatsOptions o = opt;
     o.corrected_input = is_corrected_file(opt.in);
@@ -258,6 +258,12 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     std::array<HeadTally, kMaxHeads> heads{};
     std::array<std::size_t, kMaxPairs> both_present{};
     std::array<PairSeries, kMaxPairs> series;
+    // By position in kAllPairs; read before the rows, so that a bad file fails at once.
+    r.systematic = !opt.noise_iba.empty();
+    std::array<NoiseIbaSeries, kMaxPairs> noise;
+    if (r.systematic) {
+        noise = read_noise_iba(opt.noise_iba, kAllPairs);
+    }
     EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, both_present, series); });
     rows([&](const SolutionRecord& rec) {
         ++rows_seen;
@@ -295,11 +301,6 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
 
     r.heads = analysis_heads(with_rows);
     r.pairs = pairs_of(r.heads);
-    r.systematic = !opt.noise_iba.empty();
-    std::optional<std::array<NoiseIbaSeries, kMaxPairs>> noise;
-    if (r.systematic) {
-        noise = read_noise_iba(opt.noise_iba, r.pairs);
-    }
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
         const std::size_t all = index_of_pair(kAllPairs, r.pairs.pair[p]);
         PairSeries& s = r.series[p];
@@ -310,7 +311,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
             r.no_epochs_reason[p] = why_no_epochs(r.pairs.pair[p], opt, rows_seen, r.rows, heads, both_present[all]);
             log_empty_pair(opt, r.pairs.pair[p].name, r.no_epochs_reason[p], log);
         }
-        summarize_pair(opt, noise ? &(*noise)[p] : nullptr, p, r);
+        summarize_pair(opt, r.systematic ? &noise[all] : nullptr, p, r);
     }
     return r;
 }
