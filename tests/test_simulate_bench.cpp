@@ -320,7 +320,11 @@ TEST(SimulateBench, StatsNoiseIbaOnTheCommandLine) {
     ASSERT_EQ(ok.exit_code, 0) << ok.err;
     const std::string json = slurp(dir / "out.txt");
     EXPECT_NE(json.find("\"systematic\": {\"A-B\": {\"original\": "), std::string::npos) << json;
-    EXPECT_NE(json.find("\"thermal\": 0.000000"), std::string::npos) << json;
+    const std::string systematic = json.substr(json.find("\"systematic\""));
+    for (const char* pair : {"A-B", "A-C", "B-C"}) {
+        const std::string entry = systematic.substr(systematic.find(std::string("\"") + pair + "\""));
+        EXPECT_EQ(entry.find("\"thermal\": 0.000000"), entry.find("\"thermal\"")) << pair << ": " << json;
+    }
     const std::string noise = slurp(dir / "s.csv.noise-iba.csv");
     const std::string first =
         noise.substr(noise.find('\n') + 1, noise.find('\n', noise.find('\n') + 1) - noise.find('\n'));
@@ -334,6 +338,11 @@ TEST(SimulateBench, StatsNoiseIbaOnTheCommandLine) {
         {"t,pair,iba\n1.0,A-B,-3\n", "n.csv:2:9: column 'iba': -3 is no angle in [0, 648000] arcsec"},
         {"t,pair,iba\n" + first + first, "n.csv:3:1: pair A-B twice at this t (also line 2)"},
     };
+    // A byte-order mark and CRLF line ends are read as every reader reads them.
+    write(dir / "n.csv", "\xEF\xBB\xBFt,pair,iba\r\n" + first.substr(0, first.size() - 1) + "\r\n");
+    const CliRun bom = run_in("stats --in s.csv --noise-iba n.csv --json > out.txt", dir);
+    EXPECT_EQ(bom.exit_code, 0) << bom.err;
+    EXPECT_NE(slurp(dir / "out.txt").find("\"systematic\""), std::string::npos);
     for (const auto& c : cases) {
         write(dir / "n.csv", c.first);
         const CliRun r = run_in("stats --in s.csv --noise-iba n.csv > out.txt", dir);

@@ -172,7 +172,7 @@ void add_simulate_command(CLI::App& app) {
         ->check(non_empty_path())
         ->check(not_standard_output("simulate writes eight files (OUT, OUT.truth.csv, OUT.truth-history.csv, "
                                     "OUT.floor.json, OUT.floor-daily.csv, OUT.heaters.csv, OUT.mountings.csv, "
-                                    "OUT.attitude.csv); give a path"));
+                                    "OUT.attitude.csv; with --noise-iba also OUT.noise-iba.csv); give a path"));
     cmd->add_option("--days", opt->days, "length of the mission in days, (0, 36600] (default 920, 2.5 years)")
         ->check(real_in(0.0, 36600.0, End::kOpen));
     cmd->add_option("--step", opt->step_s, "time between epochs in s, 1..600 (default 60)")->check(real_in(1.0, 600.0));

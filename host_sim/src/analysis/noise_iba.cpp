@@ -102,6 +102,9 @@ std::array<NoiseIbaSeries, kMaxPairs> read_noise_iba(const std::string& path, co
         LineReader lines(block, blocks.lines_before());
         for (std::string_view line; lines.next(line);) {
             if (!header) {
+                if (line.substr(0, 3) == "\xEF\xBB\xBF") {  // a UTF-8 byte-order mark, as every reader drops it
+                    line.remove_prefix(3);
+                }
                 if (line != kNoiseIbaHeader) {
                     throw text::InputError(path, lines.line_number(), 1,
                                            std::string("expected the header ") + kNoiseIbaHeader);
