@@ -312,23 +312,23 @@ SimulateSummary simulate(const SimulateOptions& opt, OutputSet& outputs) {
         noise_iba->write(std::string(kNoiseIbaHeader) + '\n');
     }
     const auto epochs = static_cast<std::size_t>(std::floor(opt.days * kSecondsPerDay / opt.step_s)) + 1;
+    // Writes what a buffer holds once it is beyond `at` bytes.
+    const auto flush = [](AtomicFile& f, std::string& b, std::size_t at) {
+        if (b.size() > at) {
+            f.write(b);
+            b.clear();
+        }
+    };
     Progress progress("simulate");
     for (std::size_t k = 0; k < epochs; ++k) {
         if ((k & 4095U) == 0) {
             progress.update(static_cast<double>(k) / static_cast<double>(epochs));
         }
         mission.epoch(k, buf, attitude_buf);
-        if (buf.size() > (1U << 20)) {
-            out.write(buf);
-            buf.clear();
-        }
-        if (attitude_buf.size() > (1U << 20)) {
-            attitude.write(attitude_buf);
-            attitude_buf.clear();
-        }
-        if (noise_iba != nullptr && mission.noise_iba_rows().size() > (1U << 20)) {
-            noise_iba->write(mission.noise_iba_rows());
-            mission.noise_iba_rows().clear();
+        flush(out, buf, 1U << 20);
+        flush(attitude, attitude_buf, 1U << 20);
+        if (noise_iba != nullptr) {
+            flush(*noise_iba, mission.noise_iba_rows(), 1U << 20);
         }
     }
     if (noise_iba != nullptr) {

@@ -328,10 +328,17 @@ bool systematic_defined(const StatsResult& r, std::size_t p, std::size_t st) noe
 
 namespace {
 
+// A row of the table: the pair, its epochs and a cell per stage.
+std::string table_row(const char* pair, std::size_t n, const std::string (&cells)[kStages]) {
+    char buf[200];
+    text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", pair, n, cells[0].c_str(), cells[1].c_str(),
+                     cells[2].c_str());
+    return buf;
+}
+
 std::string systematic_table(const StatsResult& r) {
     std::ostringstream o;
     o << "systematic IBA residual (IBA minus the noise-only IBA), RMS about the mean, arcsec\n";
-    char buf[200];
     for (std::size_t p = 0; p < r.pairs.count; ++p) {
         std::string cells[kStages];
         for (std::size_t s = 0; s < kStages; ++s) {
@@ -339,11 +346,27 @@ std::string systematic_table(const StatsResult& r) {
             text::c_snprintf(c, sizeof c, "%6.3f", r.systematic_rms[p][s].rms);
             cells[s] = systematic_defined(r, p, s) ? std::string(c) : std::string("-");
         }
-        text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.systematic_n[p],
-                         cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
-        o << buf;
+        o << table_row(r.pairs.pair[p].name, r.systematic_n[p], cells);
     }
     return o.str();
+}
+
+// The JSON object of the pairs, {"A-B": {"original": x, "aberration": x,
+// "thermal": x, "n": N}, ...}: rms[p][st] where defined(r, p, st), else null.
+void json_pairs(std::ostream& o, const StatsResult& r, const std::array<std::array<Rms, kStages>, kMaxPairs>& rms,
+                const std::array<std::size_t, kMaxPairs>& n,
+                bool (*defined)(const StatsResult&, std::size_t, std::size_t) noexcept) {
+    o << '{';
+    for (std::size_t p = 0; p < r.pairs.count; ++p) {
+        o << (p ? ", " : "") << '"' << r.pairs.pair[p].name << "\": {";
+        for (std::size_t st = 0; st < kStages; ++st) {
+            char c[32];
+            text::c_snprintf(c, sizeof c, "%.6f", rms[p][st].rms);
+            o << (st ? ", " : "") << '"' << kStageNames[st] << "\": " << (defined(r, p, st) ? c : "null");
+        }
+        o << ", \"n\": " << n[p] << '}';
+    }
+    o << '}';
 }
 
 }  // namespace
@@ -366,9 +389,7 @@ std::string stats_table(const StatsResult& r) {
                 cells[s] = c;
             }
         }
-        text::c_snprintf(buf, sizeof buf, "%-5s %9zu  %-18s %-18s %-18s\n", r.pairs.pair[p].name, r.n[p],
-                         cells[0].c_str(), cells[1].c_str(), cells[2].c_str());
-        o << buf;
+        o << table_row(r.pairs.pair[p].name, r.n[p], cells);
     }
     if (r.systematic) {
         o << systematic_table(r);
@@ -378,32 +399,11 @@ std::string stats_table(const StatsResult& r) {
 
 std::string stats_json(const StatsResult& r) {
     std::ostringstream o;
-    const auto num = [](double x) {
-        char c[32];
-        text::c_snprintf(c, sizeof c, "%.6f", x);
-        return std::string(c);
-    };
-    o << "{\"pairs\": {";
-    for (std::size_t p = 0; p < r.pairs.count; ++p) {
-        const auto cell = [&](std::size_t st) { return rms_defined(r, p, st) ? num(r.rms[p][st].rms) : "null"; };
-        o << (p ? ", " : "") << '"' << r.pairs.pair[p].name << "\": {";
-        o << "\"original\": " << cell(0);
-        o << ", \"aberration\": " << cell(1);
-        o << ", \"thermal\": " << cell(2);
-        o << ", \"n\": " << r.n[p] << '}';
-    }
-    o << '}';
+    o << "{\"pairs\": ";
+    json_pairs(o, r, r.rms, r.n, &rms_defined);
     if (r.systematic) {
-        o << ", \"systematic\": {";
-        for (std::size_t p = 0; p < r.pairs.count; ++p) {
-            const auto cell = [&](std::size_t st) {
-                return systematic_defined(r, p, st) ? num(r.systematic_rms[p][st].rms) : "null";
-            };
-            o << (p ? ", " : "") << '"' << r.pairs.pair[p].name << "\": {\"original\": " << cell(0)
-              << ", \"aberration\": " << cell(1) << ", \"thermal\": " << cell(2) << ", \"n\": " << r.systematic_n[p]
-              << '}';
-        }
-        o << '}';
+        o << ", \"systematic\": ";
+        json_pairs(o, r, r.systematic_rms, r.systematic_n, &systematic_defined);
     }
     o << "}\n";
     return o.str();
