@@ -434,6 +434,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         calib::EstimatorConfig ecfg;
         ecfg.time_constant_days = opt.time_constant_days;
         ecfg.common_rotation = opt.common_rotation;
+        ecfg.regauge_arcsec = opt.regauge_arcsec;
         const SelfCalibration sc = self_calibrate<T>(
             opt.in,
             [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },

@@ -22,9 +22,15 @@
 // heads always; 2^(N − 3) sets), and each set's bench weights B_h are those of
 // its heads that the candidate solved and the rule weighs.
 //
+// The bench weights B_h of a set depend only on its heads, their
+// orientations and the rule's weights, all fixed between clear()s (N_h is a
+// head's reference from its first orbit): they are formed once per set and
+// heads and kept, so a solve is the contraction alone.
+//
 // Double (per orbit, in Estimator::step's phases); fixed trip counts, no
-// allocation. Cost per fed orbit: 9 + 12·|heads| multiply-adds; per
-// candidate about 1 000 flops (N = 4).
+// allocation. Cost per fed orbit: 9 + 12·|heads| multiply-adds; per solve
+// about 100 + 63·|heads| per set of heads (N = 4: 600), and about 300 per
+// set the first time its heads are weighed.
 #pragma once
 
 #include <cstddef>
@@ -79,12 +85,12 @@ public:
     }
 
     // The rule's ω for the centred solution b of the heads `solved`, with the
-    // weights wt and the heads' orientations n (F → head axes): w[axis] =
-    // {w0, w2, w3} about 0 °C. Where T029 and T032 have not varied apart
-    // within the memory (the first days), the constant alone (w2 = w3 = 0).
-    // false: no set has weighted heads.
+    // weights wt and the heads' orientations n (F → head axes; both the same
+    // at every call between clear()s): w[axis] = {w0, w2, w3} about 0 °C.
+    // Where T029 and T032 have not varied apart within the memory (the first
+    // days), the constant alone (w2 = w3 = 0). false: no set has weighted heads.
     bool solve(const double (&b)[N][kUnknowns][3], const Matrix3 (&n)[N], std::uint8_t solved,
-               const CommonRotationWeights& wt, double (&w)[3][3]) const noexcept {
+               const CommonRotationWeights& wt, double (&w)[3][3]) noexcept {
         CommonRotationSums sums;
         sums.t2_centre = t2_;
         sums.t3_centre = t3_;
@@ -94,7 +100,11 @@ public:
             if (set_[m].count == 0U || heads == 0U) {
                 continue;
             }
-            any = add_set(set_[m], b, n, heads, wt, sums) || any;
+            const Weights& bw = weights(m, heads, n, wt);
+            if (bw.ok) {
+                add_set(set_[m], bw, b, sums);
+                any = true;
+            }
         }
         if (!any) {
             return false;
@@ -117,11 +127,23 @@ private:
         std::uint32_t count = 0;      // orbits added (not forgotten)
     };
 
-    // Σ y·rᵀ of one set into sums: Σ_h B_h·(b_hᵀ·S_h).
-    static bool add_set(const Set& s, const double (&b)[N][kUnknowns][3], const Matrix3 (&n)[N], std::uint8_t heads,
-                        const CommonRotationWeights& wt, CommonRotationSums& sums) noexcept {
+    // A set's bench weights B_h (bench_weights) for its heads `heads`, by head index.
+    struct Weights {
+        std::uint8_t heads = 0;  // 0: not formed
+        bool ok = false;         // false: Σ A_h·N_h singular (no head weighs)
+        Matrix3 b[N]{};
+    };
+
+    // Set m's weights for `heads`, formed when its heads differ from the last.
+    const Weights& weights(std::size_t m, std::uint8_t heads, const Matrix3 (&n)[N],
+                           const CommonRotationWeights& wt) noexcept {
+        Weights& c = weights_[m];
+        if (c.heads == heads) {
+            return c;
+        }
         Matrix3 a[N]{};
         Matrix3 nn[N]{};
+        Matrix3 bw[N]{};
         std::size_t idx[N]{};
         std::size_t k = 0;
         for (std::size_t h = 0; h < N; ++h) {
@@ -131,12 +153,22 @@ private:
                 idx[k++] = h;
             }
         }
-        Matrix3 bw[N]{};
-        if (!bench_weights(a, nn, k, bw)) {
-            return false;
+        c = Weights{};
+        c.heads = heads;
+        c.ok = bench_weights(a, nn, k, bw);
+        for (std::size_t i = 0; i < k && c.ok; ++i) {
+            c.b[idx[i]] = bw[i];
         }
-        for (std::size_t i = 0; i < k; ++i) {
-            const std::size_t h = idx[i];
+        return c;
+    }
+
+    // Σ y·rᵀ of one set into sums: Σ_h B_h·(b_hᵀ·S_h) over the heads weighed.
+    static void add_set(const Set& s, const Weights& bw, const double (&b)[N][kUnknowns][3],
+                        CommonRotationSums& sums) noexcept {
+        for (std::size_t h = 0; h < N; ++h) {
+            if (((static_cast<unsigned>(bw.heads) >> h) & 1U) == 0U) {
+                continue;
+            }
             Matrix3 cr{};  // Σ c_h·rᵀ = b_hᵀ·S_h (head axes × r)
             for (int ax = 0; ax < 3; ++ax) {
                 for (int j = 0; j < 3; ++j) {
@@ -145,7 +177,7 @@ private:
                     }
                 }
             }
-            const Matrix3 y = product(bw[i], cr);
+            const Matrix3 y = product(bw.b[h], cr);
             for (int r = 0; r < 3; ++r) {
                 for (int j = 0; j < 3; ++j) {
                     sums.yr.m[r][j] += y.m[r][j];
@@ -157,12 +189,12 @@ private:
                 sums.rr.m[r][j] += s.rr.m[r][j];
             }
         }
-        return true;
     }
 
     double t2_ = 0.0;
     double t3_ = 0.0;
     Set set_[kSets]{};
+    Weights weights_[kSets]{};
 };
 
 }  // namespace ascorr::calib

@@ -43,6 +43,13 @@
 // Outlier orbits are held back, and a persistent change is taken as real
 // (README.md, "Outliers and changes").
 //
+// The rule for the common rotation (cfg.common_rotation) gauges each
+// candidate over the rule's memory; an orbit that adopts none re-gauges the
+// active adopted model over the memory as it has grown since (it changes no
+// IBA, so no gate): a new version when the bench moves by more than
+// cfg.regauge_arcsec at the orbit's T029 and T032 and the limits hold
+// (otherwise kAngleLimit is counted and the active model stays).
+//
 // Model versions: the model given at start is version 0; each adopted or
 // loaded model is the active version + 1 (the first is 1 without one). Its identity is the
 // CRC-32C of its coefficients (model_identity.hpp). Models are kept in
@@ -82,7 +89,7 @@ class Estimator {
 public:
     static constexpr std::size_t kHeads = N;
 
-    enum class Phase : std::uint8_t { kIdle, kAverages, kUpdate, kCandidate, kGate };
+    enum class Phase : std::uint8_t { kIdle, kAverages, kUpdate, kCandidate, kGate, kRegauge };
 
     explicit Estimator(const EstimatorConfig& cfg = EstimatorConfig{},
                        const ModelCoefficients* initial = nullptr) noexcept
@@ -159,10 +166,13 @@ public:
                 phase_ = Phase::kCandidate;
                 return true;
             case Phase::kCandidate:
-                phase_ = candidate() ? Phase::kGate : Phase::kIdle;
+                phase_ = candidate() ? Phase::kGate : Phase::kRegauge;
                 return true;
             case Phase::kGate:
-                gate();
+                phase_ = gate() ? Phase::kIdle : Phase::kRegauge;
+                return true;
+            case Phase::kRegauge:
+                regauge();
                 phase_ = Phase::kIdle;
                 return true;
         }
@@ -268,21 +278,31 @@ private:
     void feed(const OrbitRecord<N>& o) noexcept;
     bool candidate() noexcept;
     bool further_solved(std::size_t h, double (&b)[kUnknowns][3]) noexcept;
-    void gate() noexcept;
+    bool gate() noexcept;
     void keep_heads_not_learnt(ModelCoefficients& m, std::uint8_t learnt) const noexcept;
     void apply_rule() noexcept;
     std::uint8_t rule_on_kept_heads() noexcept;
+    void regauge() noexcept;
 
     void refuse(Refusal r) noexcept {
         last_refusal_ = r;
         ++refusals_[static_cast<std::size_t>(r)];
     }
 
-    // The back buffer: coefficients, the core's form, version and CRC.
+    // The back buffer: coefficients, the core's form, version and CRC; for
+    // an adopted model (learnt ≠ 0) its ω and the centred solution b it was
+    // formed from.
     void prepare(const ModelCoefficients& m, std::uint32_t version, std::uint8_t learnt = 0U,
-                 const Omega& omega = Omega{}) noexcept {
+                 const Omega& omega = Omega{}, const double (*b)[kUnknowns][3] = nullptr) noexcept {
         const std::size_t k = back();
         learnt_[k] = learnt;
+        for (std::size_t h = 0; h < N && b != nullptr; ++h) {
+            for (std::size_t u = 0; u < kUnknowns; ++u) {
+                for (std::size_t a = 0; a < 3; ++a) {
+                    solution_[k][h][u][a] = b[h][u][a];
+                }
+            }
+        }
         omega_[k] = omega;
         omega_valid_[k] = true;
         model_[k] = m;
@@ -296,8 +316,9 @@ private:
     // The memory of the rule for the common rotation (cfg_.common_rotation).
     CommonRotationMemory<N> rule_memory_{};
     Omega cand_omega_{};
-    Omega omega_[2]{};       // per buffer: the ω its learnt heads carry (0: given, loaded)
-    bool omega_valid_[2]{};  // false: adopted before a reset (its ω is in the frame forgotten)
+    Omega omega_[2]{};                       // per buffer: the ω its learnt heads carry (0: given, loaded)
+    bool omega_valid_[2]{};                  // false: adopted before a reset (its ω is in the frame forgotten)
+    double solution_[2][N][kUnknowns][3]{};  // per buffer: an adopted model's b_ (its learnt heads)
     // The cycle's side.
     bool frozen_ = false;
     OrbitCollector<T, N> orbit_;

@@ -219,16 +219,17 @@ inline bool Estimator<T, N>::further_solved(std::size_t h, double (&b)[kUnknowns
 
 // Phase 4: the comparison with the active model; the back buffer and swap.
 // After a change, only the orbits since it are compared: the older ones
-// favour the active model, made for the bench before the change.
+// favour the active model, made for the bench before the change. false: no
+// candidate adopted.
 template <typename T, std::size_t N>
-inline void Estimator<T, N>::gate() noexcept {
+inline bool Estimator<T, N>::gate() noexcept {
     const std::uint32_t n = since_change_ < cfg_.window_orbits ? since_change_ : cfg_.window_orbits;
     candidate_rms_ = window_rms(cand_, window_, n_mat_, n, solved_);
     if (has_[active_]) {
         active_rms_ = window_rms(model_[active_], window_, n_mat_, n, solved_);
         if (!(candidate_rms_ <= (1.0 - cfg_.adoption_margin) * active_rms_)) {
             refuse(Refusal::kNoGain);
-            return;
+            return false;
         }
     }
     last_refusal_ = Refusal::kNone;
@@ -236,11 +237,12 @@ inline void Estimator<T, N>::gate() noexcept {
     const std::uint8_t moved = rule_on_kept_heads();
     if (moved != 0U && !within_limits(cand_, window_, cfg_.angle_check_margin_c, moved)) {
         refuse(Refusal::kAngleLimit);  // a kept head the rule moved beyond the limits
-        return;
+        return false;
     }
-    prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_, cand_omega_);
+    prepare(cand_, has_[active_] ? version_[active_] + 1U : 1U, solved_, cand_omega_, b_);
     active_rms_ = candidate_rms_;
     swap_pending_ = true;
+    return true;
 }
 
 // The heads candidate m did not learn (not in `learnt`) keep the active
@@ -305,6 +307,50 @@ inline std::uint8_t Estimator<T, N>::rule_on_kept_heads() noexcept {
         }
     }
     return moved;
+}
+
+// Phase 5, after an orbit that adopted no candidate: the active adopted
+// model's ω re-solved over the rule's memory (its solution b is kept), and
+// the difference d added to every head that carries ω (learnt, and kept
+// ones seen: rule_on_kept_heads), so no IBA changes. A new version when
+// |d(T029, T032)| at this orbit exceeds regauge_arcsec: the bench's motion
+// from the model changes by exactly d (common_rotation.hpp, "The rule").
+template <typename T, std::size_t N>
+inline void Estimator<T, N>::regauge() noexcept {
+    const std::size_t k = active_;
+    Omega w{};
+    if (cfg_.common_rotation.heads == 0U || swap_pending_ || !has_[k] || !omega_valid_[k] || learnt_[k] == 0U ||
+        !rule_memory_.solve(solution_[k], n_mat_, learnt_[k], cfg_.common_rotation, w.w)) {
+        return;
+    }
+    const double t2 = record_.x[0][0] + record_.x[0][1];  // the orbit's T029, T032 (head A's)
+    const double t3 = record_.x[0][0] + record_.x[0][2];
+    Omega d{};
+    double move2 = 0.0;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) {
+            d.w[r][c] = w.w[r][c] - omega_[k].w[r][c];
+        }
+        const double m = d.w[r][0] + d.w[r][1] * t2 + d.w[r][2] * t3;
+        move2 += m * m;
+    }
+    if (!(move2 > cfg_.regauge_arcsec * cfg_.regauge_arcsec)) {
+        return;  // also NaN: the model stays
+    }
+    cand_ = model_[k];
+    std::uint8_t moved = 0U;
+    for (std::size_t h = 0; h < N; ++h) {
+        if (cand_.present[h] && learns_head(h, n_heads_)) {
+            add_common_rotation(n_mat_[h], d.w, cand_.coefficient[h]);
+            moved = static_cast<std::uint8_t>(moved | (1U << h));
+        }
+    }
+    if (!within_limits(cand_, window_, cfg_.angle_check_margin_c, moved)) {
+        refuse(Refusal::kAngleLimit);
+        return;
+    }
+    prepare(cand_, version_[k] + 1U, learnt_[k], w, solution_[k]);
+    swap_pending_ = true;
 }
 
 }  // namespace ascorr::calib

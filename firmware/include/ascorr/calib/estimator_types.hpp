@@ -99,6 +99,13 @@ struct EstimatorConfig {
     // undone the same way (README.md, "Outliers and changes").
     std::uint32_t persistence_orbits = 3;
     CommonRotationWeights common_rotation{};  // the rule's weights (none: the estimator's frame)
+    // With the rule: an orbit that adopts no candidate re-gauges the active
+    // adopted model over the rule's memory, which has grown since it was
+    // adopted; it becomes a new version (same IBAs) when that moves the
+    // bench by more than this at the orbit's T029 and T032 (arcsec, 1/40 of
+    // the 2" noise of an IBA; measured 1.257 → 1.230" on x from day 30,
+    // test_common_rotation). +inf: never (each adopted model keeps its gauge).
+    double regauge_arcsec = 0.05;
 };
 
 enum class Refusal : std::uint8_t {

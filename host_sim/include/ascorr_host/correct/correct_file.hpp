@@ -49,6 +49,9 @@ struct CorrectOptions {
     // The estimator's rule for the rotation common to all heads (with
     // --mountings: pipeline/common_rotation_weights.hpp; none: its own frame).
     calib::CommonRotationWeights common_rotation{};
+    // The rule's re-gauge of the active model (calib::EstimatorConfig; no
+    // command-line option: the flight's default; +inf turns it off).
+    double regauge_arcsec = calib::EstimatorConfig{}.regauge_arcsec;
 };
 
 struct CorrectSummary {
