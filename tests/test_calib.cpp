@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "ascorr/calib/common_rotation.hpp"
@@ -509,6 +511,106 @@ TEST(CalibEstimator, CommandsAndTheDoubleBuffer) {
     EXPECT_EQ(est.report().active_version, active + 1U);
     EXPECT_EQ(est.report().active_crc, calib::model_crc(m));
     EXPECT_DOUBLE_EQ(core->head[2].beta.c0, 1.25 * kArcsecToRad);
+}
+
+// |Δc_h(T)| per head of two models' corrections at the temperatures T
+// (arcsec): a common rotation ω turns each head by N_h·ω, of the same norm.
+std::array<double, 3> correction_change(const ModelCoefficients& a, const ModelCoefficients& b,
+                                        const double (&x)[kRegressors]) {
+    std::array<double, 3> norm{};
+    for (std::size_t h = 0; h < 3; ++h) {
+        double ss = 0.0;
+        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
+            const double d = model_polynomial(a.coefficient[h][ax], x) - model_polynomial(b.coefficient[h][ax], x);
+            ss += d * d;
+        }
+        norm[h] = std::sqrt(ss);
+    }
+    return norm;
+}
+
+// The rule's re-gauge (estimator_orbit.hpp, regauge()): with a threshold of
+// 0 every orbit that adopts no candidate re-gauges, with +inf none does; the
+// same candidates are adopted at the same cycles, and the two active models
+// differ by a common rotation (the same |Δc| for every head), so no IBA
+// changes. None after a reset (the active ω is in the frame forgotten), and
+// neither the re-gauge nor the gate overwrites a ground model loaded while
+// an orbit's work is pending.
+TEST(CalibEstimator, TheRuleRegaugesTheActiveModelAndNoIba) {
+    calib::EstimatorConfig cfg;
+    cfg.common_rotation.heads = 0b111;
+    for (std::size_t h = 0; h < 3; ++h) {
+        cfg.common_rotation.a[h] = calib::Matrix3{{{1.0 + 0.5 * static_cast<double>(h), 0.0, 0.0},
+                                                   {0.0, 1.0, 0.0},
+                                                   {0.0, 0.0, 0.2 + static_cast<double>(h)}}};
+    }
+    calib::EstimatorConfig never = cfg;
+    cfg.regauge_arcsec = 0.0;
+    never.regauge_arcsec = std::numeric_limits<double>::infinity();
+    calib::Estimator<double> on(cfg);
+    calib::Estimator<double> off(never);
+    long k = 0;
+    for (; k < 288 * 15; ++k) {
+        const calib::CalibCycle<double> c = synthetic_cycle(k);
+        (void)on.model_for_cycle(c.t_us);
+        (void)off.model_for_cycle(c.t_us);
+        // Every version of `on` is an adoption of `off`'s, at the same cycle, or a re-gauge.
+        ASSERT_EQ(on.active_version(), off.active_version() + on.regauges().made) << k;
+        on.accumulate(c);
+        off.accumulate(c);
+        while (on.step()) {
+        }
+        while (off.step()) {
+        }
+    }
+    (void)on.model_for_cycle(synthetic_cycle(k).t_us);
+    (void)off.model_for_cycle(synthetic_cycle(k).t_us);
+    EXPECT_GT(on.regauges().made, 20U);
+    EXPECT_EQ(on.regauges().beyond_limits, 0U);
+    EXPECT_EQ(off.regauges().made, 0U);
+    EXPECT_GE(off.active_version(), 1U);
+    double largest = 0.0;
+    for (const double t1 : {4.0, 10.0, 16.0}) {
+        const double x[kRegressors] = {t1, 5.0 - t1, -1.0 - t1};
+        const std::array<double, 3> d = correction_change(*on.active_coefficients(), *off.active_coefficients(), x);
+        EXPECT_NEAR(d[1], d[0], 1e-9 + 1e-9 * d[0]);
+        EXPECT_NEAR(d[2], d[0], 1e-9 + 1e-9 * d[0]);
+        largest = std::max(largest, d[0]);
+    }
+    EXPECT_GT(largest, 1e-6) << "the re-gauged model is the adopted one: nothing was tested";
+    // After a reset no re-gauge, until a candidate is adopted (30 orbits).
+    on.reset();
+    const std::uint32_t made = on.regauges().made;
+    const std::uint32_t version = on.active_version();
+    for (long i = 0; i < 19L * 25L; ++i, ++k) {
+        const calib::CalibCycle<double> c = synthetic_cycle(k);
+        (void)on.model_for_cycle(c.t_us);
+        on.accumulate(c);
+        while (on.step()) {
+        }
+    }
+    EXPECT_EQ(on.regauges().made, made);
+    EXPECT_EQ(on.active_version(), version);
+    // A ground model loaded when an orbit has closed stays the next model.
+    calib::Estimator<double> est(cfg);
+    ModelCoefficients m{};
+    m.present[0] = m.present[1] = m.present[2] = true;
+    m.coefficient[1][0][0] = 2.5;
+    bool loaded = false;
+    for (long i = 0; i < 288 * 10 && !loaded; ++i) {
+        const calib::CalibCycle<double> c = synthetic_cycle(i);
+        (void)est.model_for_cycle(c.t_us);
+        est.accumulate(c);
+        if (est.regauges().made > 3U && est.step()) {  // an orbit closed: its work is under way
+            est.load_model(m);
+            loaded = true;
+        }
+        while (est.step()) {
+        }
+    }
+    ASSERT_TRUE(loaded);
+    (void)est.model_for_cycle(synthetic_cycle(288 * 10).t_us);
+    EXPECT_EQ(est.active_crc(), calib::model_crc(m));
 }
 
 }  // namespace

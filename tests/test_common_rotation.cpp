@@ -458,6 +458,7 @@ TEST(CommonRotationOnBoard, FromDay30NoWorseThanTheAberrationStageAlone) {
     bool own_outside = false;
     for (int a = 0; a < 3; ++a) {
         EXPECT_LE(est(a), ab(a)) << "axis " << a;
+        EXPECT_LT(est(a), kept(a)) << "axis " << a;
         EXPECT_NEAR(est(a) / r(a), 1.0, 0.05) << "axis " << a;
         own_outside = own_outside || std::fabs(own(a) / r(a) - 1.0) > 0.05;
     }
@@ -485,6 +486,14 @@ TEST(CommonRotationOnBoard, TheRegaugeChangesNoInterBoresightAngle) {
         kept[s.no_regauge.key[k]] = k;
     }
     double worst = 0.0;
+    std::vector<Eigen::Vector3d> turned;  // head A with and without: the re-gauge did something
+    for (std::size_t k = 0; k < s.estimator.key.size(); ++k) {
+        const auto it = kept.find(s.estimator.key[k]);
+        if (it != kept.end()) {
+            turned.push_back(s.estimator.theta[k][0] - s.no_regauge.theta[it->second][0]);
+        }
+    }
+    EXPECT_GT(time_varying_rms(turned).maxCoeff(), 0.01) << "no re-gauge: the check below tests nothing";
     for (std::uint8_t i = 0; i < 3; ++i) {
         for (std::uint8_t j = static_cast<std::uint8_t>(i + 1); j < 3; ++j) {
             std::vector<Eigen::Vector3d> d;

@@ -84,6 +84,7 @@ public:
                                 : static_cast<double>(calib::EstimatorConfig{}.orbit_period_us) / 1e6);
         }
         out_.report = est_->report();
+        out_.regauges = est_->regauges();
         out_.untimed = untimed;
         return out_;
     }
@@ -654,6 +655,10 @@ std::string describe(const SelfCalibration& s) {
         o << buf;
     } else {
         o << "; no model adopted";
+    }
+    if (s.regauges.made + s.regauges.beyond_limits > 0U) {
+        o << "; re-gauged by the rule " << s.regauges.made << " (beyond the core's limits, not made "
+          << s.regauges.beyond_limits << ")";
     }
     if (s.untimed > 0) {
         o << "; " << s.untimed

@@ -24,13 +24,15 @@
 //
 // The bench weights B_h of a set depend only on its heads, their
 // orientations and the rule's weights, all fixed between clear()s (N_h is a
-// head's reference from its first orbit): they are formed once per set and
-// heads and kept, so a solve is the contraction alone.
+// head's reference from its first orbit): each set keeps those of the heads
+// of its last solve, so a solve is mostly the contraction.
 //
 // Double (per orbit, in Estimator::step's phases); fixed trip counts, no
 // allocation. Cost per fed orbit: 9 + 12·|heads| multiply-adds; per solve
-// about 100 + 63·|heads| per set of heads (N = 4: 600), and about 300 per
-// set the first time its heads are weighed.
+// 63 multiply-adds per head of each set and about 100 flops for ω, plus
+// about 300 to form a set's weights when its heads differ from the last
+// solve's (a candidate with a head the active model did not learn: twice
+// an orbit until one is adopted; one slot per set keeps RAM at 8 + 72·N B).
 #pragma once
 
 #include <cstddef>

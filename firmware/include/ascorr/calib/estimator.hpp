@@ -46,9 +46,9 @@
 // The rule for the common rotation (cfg.common_rotation) gauges each
 // candidate over the rule's memory; an orbit that adopts none re-gauges the
 // active adopted model over the memory as it has grown since (it changes no
-// IBA, so no gate): a new version when the bench moves by more than
-// cfg.regauge_arcsec at the orbit's T029 and T032 and the limits hold
-// (otherwise kAngleLimit is counted and the active model stays).
+// IBA among the heads it turns, so no gate): a new version when the bench
+// moves by more than cfg.regauge_arcsec at the orbit's T029 and T032 and the
+// limits hold (otherwise the active model stays; regauges() counts both).
 //
 // Model versions: the model given at start is version 0; each adopted or
 // loaded model is the active version + 1 (the first is 1 without one). Its identity is the
@@ -90,6 +90,8 @@ public:
     static constexpr std::size_t kHeads = N;
 
     enum class Phase : std::uint8_t { kIdle, kAverages, kUpdate, kCandidate, kGate, kRegauge };
+    // The most step() calls an orbit's work takes (one per phase but kIdle).
+    static constexpr int kPhases = static_cast<int>(Phase::kRegauge);
 
     explicit Estimator(const EstimatorConfig& cfg = EstimatorConfig{},
                        const ModelCoefficients* initial = nullptr) noexcept
@@ -245,6 +247,7 @@ public:
     std::uint32_t active_crc() const noexcept { return has_[active_] ? crc_[active_] : 0U; }
     // The heads the active model learnt (bit h; 0: given or loaded).
     std::uint8_t active_learnt() const noexcept { return has_[active_] ? learnt_[active_] : 0U; }
+    RegaugeCounts regauges() const noexcept { return regauges_; }
     // When the active model became active (the t of the first cycle using it).
     std::int64_t adopted_at_us() const noexcept { return adopted_at_us_; }
     const EstimatorConfig& config() const noexcept { return cfg_; }
@@ -283,6 +286,8 @@ private:
     void apply_rule() noexcept;
     std::uint8_t rule_on_kept_heads() noexcept;
     void regauge() noexcept;
+    static Omega omega_minus(const Omega& a, const Omega& b) noexcept;
+    std::uint8_t turn_seen_heads(const Omega& d, std::uint8_t skip) noexcept;
 
     void refuse(Refusal r) noexcept {
         last_refusal_ = r;
@@ -355,6 +360,7 @@ private:
     double candidate_rms_ = std::numeric_limits<double>::quiet_NaN();
     Refusal last_refusal_ = Refusal::kNone;
     std::uint32_t refusals_[kRefusalKinds]{};
+    RegaugeCounts regauges_{};
     // The models: double-buffered.
     ModelCoefficients cand_{};
     ModelCoefficients model_[2]{};

@@ -1,6 +1,6 @@
 // ascorr/calib/estimator_orbit.hpp: the estimator's per-orbit work, one bounded
-// phase per step() (averages, update, candidate, gate) and the rule for the
-// common rotation. Part of estimator.hpp (its conventions are there); include
+// phase per step() (averages, update, candidate, gate, re-gauge) and the rule
+// for the common rotation. Part of estimator.hpp (its conventions are there); include
 // that one.
 #pragma once
 
@@ -220,9 +220,13 @@ inline bool Estimator<T, N>::further_solved(std::size_t h, double (&b)[kUnknowns
 // Phase 4: the comparison with the active model; the back buffer and swap.
 // After a change, only the orbits since it are compared: the older ones
 // favour the active model, made for the bench before the change. false: no
-// candidate adopted.
+// candidate adopted; nor while a ground model loaded since the orbit closed
+// waits to start (the back buffer is its).
 template <typename T, std::size_t N>
 inline bool Estimator<T, N>::gate() noexcept {
+    if (swap_pending_) {
+        return false;
+    }
     const std::uint32_t n = since_change_ < cfg_.window_orbits ? since_change_ : cfg_.window_orbits;
     candidate_rms_ = window_rms(cand_, window_, n_mat_, n, solved_);
     if (has_[active_]) {
@@ -293,15 +297,28 @@ inline std::uint8_t Estimator<T, N>::rule_on_kept_heads() noexcept {
     if (cfg_.common_rotation.heads == 0U || !has_[active_] || !omega_valid_[active_]) {
         return 0U;
     }
+    return turn_seen_heads(omega_minus(cand_omega_, omega_[active_]), solved_);
+}
+
+template <typename T, std::size_t N>
+inline typename Estimator<T, N>::Omega Estimator<T, N>::omega_minus(const Omega& a, const Omega& b) noexcept {
     Omega d{};
     for (int r = 0; r < 3; ++r) {
         for (int c = 0; c < 3; ++c) {
-            d.w[r][c] = cand_omega_.w[r][c] - omega_[active_].w[r][c];
+            d.w[r][c] = a.w[r][c] - b.w[r][c];
         }
     }
+    return d;
+}
+
+// cand_'s heads that are present and have an orbit since the start or the
+// last reset (an orientation N_h), but not those of `skip`, turned by the
+// common rotation d; the heads turned. A head without N_h cannot be turned.
+template <typename T, std::size_t N>
+inline std::uint8_t Estimator<T, N>::turn_seen_heads(const Omega& d, std::uint8_t skip) noexcept {
     std::uint8_t moved = 0U;
     for (std::size_t h = 0; h < N; ++h) {
-        if (!learns_head(h, solved_) && cand_.present[h] && learns_head(h, n_heads_)) {
+        if (!learns_head(h, skip) && cand_.present[h] && learns_head(h, n_heads_)) {
             add_common_rotation(n_mat_[h], d.w, cand_.coefficient[h]);
             moved = static_cast<std::uint8_t>(moved | (1U << h));
         }
@@ -310,47 +327,42 @@ inline std::uint8_t Estimator<T, N>::rule_on_kept_heads() noexcept {
 }
 
 // Phase 5, after an orbit that adopted no candidate: the active adopted
-// model's ω re-solved over the rule's memory (its solution b is kept), and
-// the difference d added to every head that carries ω (learnt, and kept
-// ones seen: rule_on_kept_heads), so no IBA changes. A new version when
-// |d(T029, T032)| at this orbit exceeds regauge_arcsec: the bench's motion
-// from the model changes by exactly d (common_rotation.hpp, "The rule").
+// model's ω re-solved over the rule's memory (its solution b is kept with
+// it), and the difference d added to every head that carries ω (learnt, and
+// kept ones seen: rule_on_kept_heads), so no IBA among them changes. A new
+// version when |d(T029, T032)| at this orbit exceeds regauge_arcsec: the
+// bench's motion from the model changes by exactly d (common_rotation.hpp,
+// "The rule"). Not after a held orbit (the memory is as it was; its
+// temperatures may be a fault's), nor over a ground model waiting to start.
 template <typename T, std::size_t N>
 inline void Estimator<T, N>::regauge() noexcept {
     const std::size_t k = active_;
     Omega w{};
-    if (cfg_.common_rotation.heads == 0U || swap_pending_ || !has_[k] || !omega_valid_[k] || learnt_[k] == 0U ||
+    const bool adopted = has_[k] && omega_valid_[k] && learnt_[k] != 0U;
+    if (cfg_.common_rotation.heads == 0U || record_.held || swap_pending_ || !adopted ||
         !rule_memory_.solve(solution_[k], n_mat_, learnt_[k], cfg_.common_rotation, w.w)) {
         return;
     }
     const double t2 = record_.x[0][0] + record_.x[0][1];  // the orbit's T029, T032 (head A's)
     const double t3 = record_.x[0][0] + record_.x[0][2];
-    Omega d{};
+    const Omega d = omega_minus(w, omega_[k]);
     double move2 = 0.0;
-    for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) {
-            d.w[r][c] = w.w[r][c] - omega_[k].w[r][c];
-        }
-        const double m = d.w[r][0] + d.w[r][1] * t2 + d.w[r][2] * t3;
+    for (const auto& axis : d.w) {
+        const double m = axis[0] + axis[1] * t2 + axis[2] * t3;
         move2 += m * m;
     }
     if (!(move2 > cfg_.regauge_arcsec * cfg_.regauge_arcsec)) {
         return;  // also NaN: the model stays
     }
     cand_ = model_[k];
-    std::uint8_t moved = 0U;
-    for (std::size_t h = 0; h < N; ++h) {
-        if (cand_.present[h] && learns_head(h, n_heads_)) {
-            add_common_rotation(n_mat_[h], d.w, cand_.coefficient[h]);
-            moved = static_cast<std::uint8_t>(moved | (1U << h));
-        }
-    }
+    const std::uint8_t moved = turn_seen_heads(d, 0U);
     if (!within_limits(cand_, window_, cfg_.angle_check_margin_c, moved)) {
-        refuse(Refusal::kAngleLimit);
+        ++regauges_.beyond_limits;
         return;
     }
     prepare(cand_, version_[k] + 1U, learnt_[k], w, solution_[k]);
     swap_pending_ = true;
+    ++regauges_.made;
 }
 
 }  // namespace ascorr::calib

@@ -92,7 +92,7 @@ struct InlineCalls {
 // right after a feed (the rest: idle()).
 struct FeedSchedule {
     std::uint32_t feed_every = 1U;
-    int steps_after_feed = static_cast<int>(calib::Estimator<double>::Phase::kGate);
+    int steps_after_feed = calib::Estimator<double>::kPhases;
 };
 
 // N: the heads the estimator learns (estimator.hpp).

@@ -41,6 +41,7 @@ struct ActiveModel {
 struct SelfCalibration {
     std::vector<ActiveModel> history;  // in time order
     calib::EstimatorReport report;     // at the end of the file
+    calib::RegaugeCounts regauges;     // the rule's re-gauges (versions among history)
     double orbit_period_s = 0.0;
     std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
