@@ -63,9 +63,7 @@ public:
     // One fed orbit: its heads' design rows (centred as the filter's, centre[h]).
     void add(const OrbitRecord<N>& o, const double (&centre)[N][3]) noexcept {
         Set& s = set_[o.heads() >> kFrameHeads];
-        const double t2 = o.x[0][0] + o.x[0][1];
-        const double t3 = o.x[0][0] + o.x[0][2];
-        const double r[3] = {1.0, t2 - t2_, t3 - t3_};
+        const double r[3] = {1.0, o.t2() - t2_, o.t3() - t3_};
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) {
                 s.rr.m[i][j] += r[i] * r[j];

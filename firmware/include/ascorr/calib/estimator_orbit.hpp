@@ -53,8 +53,8 @@ inline bool Estimator<T, N>::averages() noexcept {
             for (std::size_t j = 0; j < 3; ++j) {
                 centre_[h][j] = o.x[h][j];
             }
-            if (h == 0U) {  // T2 and T3 are head A's T1 + D2, T1 + D3
-                rule_memory_.set_centre(o.x[0][0] + o.x[0][1], o.x[0][0] + o.x[0][2]);
+            if (h == 0U) {  // the rule's centre: this first orbit's T029, T032
+                rule_memory_.set_centre(o.t2(), o.t3());
             }
         }
     }
@@ -343,8 +343,8 @@ inline void Estimator<T, N>::regauge() noexcept {
         !rule_memory_.solve(solution_[k], n_mat_, learnt_[k], cfg_.common_rotation, w.w)) {
         return;
     }
-    const double t2 = record_.x[0][0] + record_.x[0][1];  // the orbit's T029, T032 (head A's)
-    const double t3 = record_.x[0][0] + record_.x[0][2];
+    const double t2 = record_.t2();
+    const double t3 = record_.t3();
     const Omega d = omega_minus(w, omega_[k]);
     double move2 = 0.0;
     for (const auto& axis : d.w) {

@@ -27,6 +27,9 @@ struct OrbitRecord {
         }
         return m;
     }
+    // The bench's T029 and T032 (°C): head A's T1 + (T2 − T1), T1 + (T3 − T1).
+    double t2() const noexcept { return x[0][0] + x[0][1]; }
+    double t3() const noexcept { return x[0][0] + x[0][2]; }
 };
 
 template <std::size_t N = kCalibHeads>
