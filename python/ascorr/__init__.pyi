@@ -3,7 +3,7 @@
 # word (python/src/docstrings.hpp and ascorr/__init__.py; python/tests/test_docs.py
 # fails when they differ).
 from os import PathLike
-from typing import Any, Literal, Optional, Sequence, TypedDict, Union
+from typing import Any, Literal, NotRequired, Optional, Sequence, TypedDict, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -125,8 +125,15 @@ class _PairStats(TypedDict):
     thermal_smoothed: Optional[float]
     n: int
 
+class _PairSystematic(TypedDict):
+    original: Optional[float]
+    aberration: Optional[float]
+    thermal: Optional[float]
+    n: int
+
 class _Stats(TypedDict):
     pairs: dict[str, _PairStats]
+    systematic: NotRequired[dict[str, _PairSystematic]]  # with noise_iba
     rows: int
     clean_rows: int
     table: str
@@ -143,17 +150,22 @@ def stats(
     model: Optional[Model] = ...,
     t_from: Optional[float] = ...,
     t_to: Optional[float] = ...,
+    noise_iba: Optional[_Path] = ...,
 ) -> _Stats:
     """IBA statistics as `ascorr stats`: per pair and stage (original, aberration, thermal), the
     IBA RMS about the mean over the clean epochs (flags 0, confidence a number <= 5,
     temperatures and velocity present and accepted), and after 200 s smoothing.
     flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN where not given;
     None: none given (a row without a confidence is not clean, as in a file);
-    t_from, t_to: the period (inclusive).
+    t_from, t_to: the period (inclusive); noise_iba: the path of `ascorr simulate
+    --noise-iba`'s F.noise-iba.csv (as --noise-iba), or None.
     Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
     (arcsec; None with fewer than two clean epochs, or thermal without a model, as
-    null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),
-    "messages" (rows left out, one line each)}."""
+    null in `ascorr stats --json`), "n"}}, with noise_iba "systematic": {pair:
+    {"original", "aberration", "thermal" (the RMS about the mean of the IBA minus the
+    noise-only IBA at the same t; None as null in --json's "systematic"), "n" (the
+    epochs in both)}}, "rows", "clean_rows", "table" (the command's text, with the
+    systematic table), "messages" (rows left out, one line each)}."""
 def fit(
     t: _Real,
     chu: npt.ArrayLike,

@@ -100,12 +100,28 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     return out;
 }
 
+// Pair p's systematic residual per stage as `stats --json`'s "systematic":
+// None where that has null.
+py::dict systematic_of(const host::StatsResult& s, std::size_t p) {
+    py::dict d;
+    for (std::size_t st = 0; st < host::kStages; ++st) {
+        d[host::kStageNames[st]] = host::systematic_defined(s, p, st)
+                                       ? py::object(py::float_(s.systematic_rms[p][st].rms))
+                                       : py::object(py::none());
+    }
+    d["n"] = s.systematic_n[p];
+    return d;
+}
+
 py::dict stats(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
-               const py::object& t_from, const py::object& t_to) {
+               const py::object& t_from, const py::object& t_to, const py::object& noise_iba) {
     const host::ModelFile* m = model_arg(model);
     host::StatsOptions opt;
     opt.in = kArrayRows;
+    if (!noise_iba.is_none()) {
+        opt.noise_iba = path_arg(noise_iba, "noise_iba");  // simulate's file, read as `stats --noise-iba` reads it
+    }
     opt.from = time_arg(t_from, "t_from");
     opt.to = time_arg(t_to, "t_to");
     opt.period_options = "t_from/t_to";
@@ -118,7 +134,11 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     std::ostringstream log;
     const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log);
     py::dict pairs;
+    py::dict systematic;
     for (std::size_t p = 0; p < s.pairs.count; ++p) {
+        if (s.systematic) {
+            systematic[s.pairs.pair[p].name] = systematic_of(s, p);
+        }
         py::dict d;
         for (std::size_t st = 0; st < host::kStages; ++st) {
             const bool have = host::rms_defined(s, p, st);
@@ -131,6 +151,9 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     }
     py::dict out;
     out["pairs"] = pairs;
+    if (s.systematic) {
+        out["systematic"] = systematic;
+    }
     out["rows"] = s.rows;
     out["clean_rows"] = s.clean_rows;
     out["table"] = host::stats_table(s);
@@ -291,7 +314,7 @@ void bind_analysis(py::module_& mod) {
     mod.def("iba", &iba, "t"_a, "chu"_a, "q"_a, docstring(docs::kIba));
     mod.def("stats", &stats, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
             "confidence"_a = py::none(), "model"_a = py::none(), "t_from"_a = py::none(), "t_to"_a = py::none(),
-            docstring(docs::kStats));
+            "noise_iba"_a = py::none(), docstring(docs::kStats));
     mod.def("fit", &fit, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(), "confidence"_a = py::none(),
             "t_from"_a = py::none(), "t_to"_a = py::none(), "min_days"_a = host::kDefaultMinSpanDays,
             "min_orbits"_a = host::kDefaultMinOrbits, "max_condition"_a = host::kDefaultMaxCondition,

@@ -121,11 +121,15 @@ IBA RMS about the mean over the clean epochs (flags 0, confidence a number <= 5,
 temperatures and velocity present and accepted), and after 200 s smoothing.
 flags: integers (n,) or None (0); confidence: (n,) arcsec, NaN where not given;
 None: none given (a row without a confidence is not clean, as in a file);
-t_from, t_to: the period (inclusive).
+t_from, t_to: the period (inclusive); noise_iba: the path of `ascorr simulate
+--noise-iba`'s F.noise-iba.csv (as --noise-iba), or None.
 Returns {"pairs": {pair: {"original", "aberration", "thermal", "<stage>_smoothed"
 (arcsec; None with fewer than two clean epochs, or thermal without a model, as
-null in `ascorr stats --json`), "n"}}, "rows", "clean_rows", "table" (the command's text),
-"messages" (rows left out, one line each)}.)doc";
+null in `ascorr stats --json`), "n"}}, with noise_iba "systematic": {pair:
+{"original", "aberration", "thermal" (the RMS about the mean of the IBA minus the
+noise-only IBA at the same t; None as null in --json's "systematic"), "n" (the
+epochs in both)}}, "rows", "clean_rows", "table" (the command's text, with the
+systematic table), "messages" (rows left out, one line each)}.)doc";
 
 inline constexpr const char* kFit =
     R"doc(Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),

@@ -3,6 +3,7 @@ same file (stats, fit), a NumPy evaluation of the angles (iba) and pyerfa
 (earth_velocity)."""
 
 import json
+import pathlib
 
 import numpy as np
 import pytest
@@ -104,6 +105,44 @@ def test_stats_on_arrays_is_ascorr_stats(exe, mission, period):
         for stage in ("original", "aberration", "thermal"):
             assert f"{got[stage]:.6f}" == f"{want[stage]:.6f}", (pair, stage)
     assert s["clean_rows"] > 0 and "A-B" in s["table"]
+
+
+def test_stats_noise_iba_is_ascorr_stats_and_numpy(exe, tmp_path):
+    """noise_iba= as --noise-iba: the systematic residual per pair and stage is
+    the command line's, and its original stage is NumPy's IBA minus the
+    noise-only IBA at the same t, RMS about the mean (a bench lagging by 900 s:
+    a residual well above zero). A malformed file names its line."""
+    import pandas as pd
+
+    path = tmp_path / "lag.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 6, "--step", 120, "--bench-lag", 900, "--noise-iba")
+    noise = pathlib.Path(str(path) + ".noise-iba.csv")
+    cli = json.loads(run_cli(exe, "stats", "--in", path, "--noise-iba", noise, "--json").stdout)
+    d = ascorr.read_solutions(str(path))
+    s = ascorr.stats(*as_args(d), d["flags"], d["confidence"], noise_iba=noise)
+    assert "systematic" not in ascorr.stats(*as_args(d), d["flags"], d["confidence"])
+    assert list(s["systematic"]) == list(cli["systematic"]) == ["A-B", "A-C", "B-C"]
+    assert "systematic IBA residual" in s["table"]
+    ibas = ascorr.iba(d["t"], d["chu"], d["q"])
+    n = pd.read_csv(noise)
+    for pair, want in cli["systematic"].items():
+        got = s["systematic"][pair]
+        assert got["n"] == want["n"] > 1000 and got["thermal"] is None and want["thermal"] is None
+        for stage in ("original", "aberration"):
+            assert f"{got[stage]:.6f}" == f"{want[stage]:.6f}", (pair, stage)
+        t, iba = ibas[pair]
+        ref = n[n["pair"] == pair].set_index(np.round(n[n["pair"] == pair]["t"] * 1000).astype(np.int64))["iba"]
+        key = np.round(t * 1000).astype(np.int64)
+        both = np.isin(key, ref.index)
+        assert both.sum() == got["n"]  # every simulated row is clean
+        r = iba[both] - ref.loc[key[both]].to_numpy()
+        assert got["original"] == pytest.approx(np.std(r), abs=2e-6) and got["original"] > 0.05
+    bad = tmp_path / "bad-noise.csv"
+    bad.write_text(noise.read_text().replace("A-C", "A-X", 1))
+    with pytest.raises(ascorr.InputError, match=r"bad-noise.csv:\d+"):
+        ascorr.stats(*as_args(d), noise_iba=bad)
+    with pytest.raises(ValueError, match="argument 'noise_iba': expected a path"):
+        ascorr.stats(*as_args(d), noise_iba=3)
 
 
 def test_iba_against_numpy(mission):
