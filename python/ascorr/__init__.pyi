@@ -3,7 +3,9 @@
 # word (python/src/docstrings.hpp and ascorr/__init__.py; python/tests/test_docs.py
 # fails when they differ).
 from os import PathLike
-from typing import Any, Literal, NotRequired, Optional, Sequence, TypedDict, Union
+from typing import Any, Literal, Optional, Sequence, TypedDict, Union
+
+from typing_extensions import NotRequired  # typing's from Python 3.11; the package takes 3.9
 
 import numpy as np
 import numpy.typing as npt

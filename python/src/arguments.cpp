@@ -138,7 +138,11 @@ std::string path_arg(const py::handle& x, const char* name) {
     if (py::isinstance<py::str>(x) || py::hasattr(x, "__fspath__")) {
         const py::object p = py::module_::import("os").attr("fspath")(x);
         if (py::isinstance<py::str>(p)) {
-            return p.cast<std::string>();
+            std::string path = p.cast<std::string>();
+            if (path.empty()) {
+                bad_argument(name, "an empty path names no file");  // as the command line's options
+            }
+            return path;
         }
     }
     bad_argument(name, "expected a path (str or os.PathLike such as pathlib.Path), got " + value_text(x));

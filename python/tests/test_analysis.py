@@ -143,6 +143,8 @@ def test_stats_noise_iba_is_ascorr_stats_and_numpy(exe, tmp_path):
         ascorr.stats(*as_args(d), noise_iba=bad)
     with pytest.raises(ValueError, match="argument 'noise_iba': expected a path"):
         ascorr.stats(*as_args(d), noise_iba=3)
+    with pytest.raises(ValueError, match="argument 'noise_iba': an empty path names no file"):
+        ascorr.stats(*as_args(d), noise_iba="")
 
 
 def test_iba_against_numpy(mission):

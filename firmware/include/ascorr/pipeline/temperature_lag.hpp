@@ -11,9 +11,9 @@
 // ΔT the change of the reading since the channel's last one,
 //     D ← (1 − α)·(D − ΔT) = u − α·u,   u = D − ΔT.
 // D is what a lagged model term regresses on (L − T), and it stays small
-// (about the temperature's rate times τ, a few °C), so a float state keeps
-// float's relative precision of D rather than of T (at 22 Hz and τ = 900 s,
-// α·(T − L) is a few float ulps of a 25 °C L: the plain form would lose it).
+// (about the temperature's rate times τ, a few °C), so each step rounds D,
+// not a 20 °C L: in float at 22 Hz and τ = 900 s, 1.9e-5 °C against the
+// plain form's 1.6e-4 °C (test TemperatureLag.FloatAt22HzKeepsTheDeviationsPrecision).
 //
 // Channels: T1 (T_CHU), T2 (THT00029), T3 (THT00032) of HeadTemperatures,
 // each with its own last time, so a reading withheld on one channel leaves
@@ -21,15 +21,22 @@
 // interval (its reading held, as across a gap).
 // Time: TT µs, a signed 64-bit count (the flight loop's tag; the host passes
 // llround(t · 1e6) of a row's t).
-// Cost per channel and step: one integer compare of Δt with the channel's
-// previous Δt (a head's cadence repeats), then two subtractions and one
-// multiply-add; only a new Δt costs expm1. No division on the step (1/τ is
-// formed by configure()), no loop, no allocation, no exceptions.
+// Cost per channel and step: two integer compares of Δt with the channel's
+// last two Δt (a head's cadence repeats, or alternates between two values
+// when times are rounded, as 45/46 ms at 22 Hz), then two subtractions and
+// one multiply-add; only a third Δt costs expm1. No division on the step
+// (1/τ is formed by configure()), no loop on the step, no allocation, no
+// exceptions.
+// Open (before a stage uses it on a target and the host alike): expm1 is
+// the C library's, not correctly rounded, and glibc's and picolibc's may
+// differ in the last bit; replay's bit-for-bit comparison will need α from
+// + − × alone, as matrix3.hpp keeps to them.
 // Bad input, each leaves the channel as it was and says why (LagStep):
 // a reading not valid or outside the core's domain (±kMaxAbsTemperatureC,
-// NaN included) is kHeld; a time not after the channel's last, or not a
-// time of an epoch (|t| ≥ 9.2e12 µs), is kTimeNotIncreasing / kBadTime; an
-// unconfigured lag (τ outside (0, kMaxLagTauS]) is kNotConfigured.
+// NaN included) is kHeld; a time not after the channel's last is
+// kTimeNotIncreasing, one with |t| ≥ kMaxLagTimeUs (4.6e18 µs) kBadTime; a
+// lag never configured (τ in [kMinLagTauS, kMaxLagTauS]) is kNotConfigured.
+// configure() with a τ out of range changes nothing and returns false.
 // Scalars: double and float. Q30 has no kernel yet: T must be floating point.
 #pragma once
 
@@ -42,6 +49,7 @@
 
 namespace ascorr::pipeline {
 
+inline constexpr double kMinLagTauS = 1.0;      // shorter is no lag at a head's cadence
 inline constexpr double kMaxLagTauS = 86400.0;  // as simulate's --bench-lag: one day
 // |t| below this (µs), so that t − t_last cannot overflow int64: 1/2 of 2⁶³
 // rounded down, about 146 000 years.
@@ -67,15 +75,19 @@ class TemperatureLag {
     static_assert(std::is_floating_point<T>::value, "temperature_lag.hpp: double or float (no Q30 kernel yet)");
 
 public:
-    // τ in seconds, in (0, kMaxLagTauS]; false (and not configured) otherwise.
-    // Every channel starts again at its next reading.
+    // τ in seconds, in [kMinLagTauS, kMaxLagTauS]: every channel starts
+    // again at its next reading. Otherwise (NaN included) false, and the lag
+    // stays as it was.
     bool configure(double tau_s) noexcept {
-        configured_ = tau_s > 0.0 && tau_s <= kMaxLagTauS;  // false for NaN
-        inv_tau_per_us_ = configured_ ? static_cast<T>(1.0 / (tau_s * 1e6)) : T(0);
+        if (!(tau_s >= kMinLagTauS && tau_s <= kMaxLagTauS)) {
+            return false;
+        }
+        inv_tau_per_us_ = static_cast<T>(1.0 / (tau_s * 1e6));  // in [1.2e-11, 1e-6]: a normal float
         for (Channel& c : ch_) {
             c = Channel{};
         }
-        return configured_;
+        configured_ = true;
+        return true;
     }
 
     // One reading of the head's temperatures at t_us; each channel's outcome.
@@ -102,8 +114,9 @@ private:
         T d = T(0);          // D = L − T at the last reading, °C
         T t_reading = T(0);  // the last reading, °C
         std::int64_t t_us = 0;
-        std::int64_t dt_us = -1;  // the Δt alpha was formed for; none yet
-        T alpha = T(0);
+        std::int64_t dt_us[2] = {-1, -1};  // the last two Δt α was formed for; −1 none
+        T alpha[2] = {T(0), T(0)};
+        std::uint8_t newer = 0;  // the slot used last; a third Δt replaces the other
         bool started = false;
     };
 
@@ -118,23 +131,37 @@ private:
             return LagStep::kHeld;
         }
         if (!c.started) {
-            c = Channel{T(0), r.value, t_us, -1, T(0), true};
+            c = Channel{};
+            c.t_reading = r.value;
+            c.t_us = t_us;
+            c.started = true;
             return LagStep::kStarted;
         }
         if (t_us <= c.t_us) {
             return LagStep::kTimeNotIncreasing;
         }
         const std::int64_t dt_us = t_us - c.t_us;  // no overflow: both within ±kMaxLagTimeUs
-        if (dt_us != c.dt_us) {
-            using std::expm1;
-            c.alpha = -expm1(-static_cast<T>(dt_us) * inv_tau_per_us_);  // in (0, 1]
-            c.dt_us = dt_us;
-        }
         const T u = c.d - (r.value - c.t_reading);
-        c.d = u - c.alpha * u;
+        c.d = u - alpha_for(c, dt_us) * u;
         c.t_reading = r.value;
         c.t_us = t_us;
         return LagStep::kAdvanced;
+    }
+
+    // α = 1 − e^(−Δt/τ) for dt_us > 0, in (0, 1]: one of the channel's last
+    // two, or formed into the older slot.
+    T alpha_for(Channel& c, std::int64_t dt_us) const noexcept {
+        if (dt_us == c.dt_us[c.newer]) {
+            return c.alpha[c.newer];
+        }
+        const std::uint8_t other = c.newer ^ 1U;
+        if (dt_us != c.dt_us[other]) {
+            using std::expm1;
+            c.alpha[other] = -expm1(-static_cast<T>(dt_us) * inv_tau_per_us_);
+            c.dt_us[other] = dt_us;
+        }
+        c.newer = other;
+        return c.alpha[other];
     }
 
     Channel ch_[kLagChannels]{};
