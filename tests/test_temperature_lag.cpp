@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -196,6 +197,25 @@ TEST(TemperatureLag, EachBadInputLeavesItsChannelAsItWas) {
     ASSERT_TRUE(lag.configure(300.0));
     EXPECT_FALSE(lag.deviation(0).valid);
     EXPECT_EQ(lag.step(0, ok).channel[1], LagStep::kStarted);
+}
+
+// α's e^x − 1 with + − × ÷ alone (calib/portable_math.hpp) against the
+// C library's expm1l in long double: relative error ≲ (k + 2)·2⁻⁵³, k ≤ 20.
+TEST(TemperatureLag, PortableExpm1IsWithinItsBoundOfLongDouble) {
+    using ascorr::calib::expm1_nonpositive;
+    double worst = 0.0;
+    for (int i = 0; i <= 20000; ++i) {
+        const double x = -std::pow(10.0, -16.0 + 18.8 * i / 20000.0);  // −1e-16 … −630
+        const long double ref = std::expm1l(static_cast<long double>(x));
+        const auto rel = static_cast<double>(std::fabs((static_cast<long double>(expm1_nonpositive(x)) - ref) / ref));
+        worst = rel <= worst ? worst : rel;
+    }
+    EXPECT_LT(worst, 22 * 0x1p-53);
+    EXPECT_EQ(expm1_nonpositive(0.0), 0.0);
+    EXPECT_EQ(expm1_nonpositive(1.0), 0.0);  // outside its domain
+    EXPECT_EQ(expm1_nonpositive(-746.0), -1.0);
+    EXPECT_EQ(expm1_nonpositive(-std::numeric_limits<double>::infinity()), -1.0);
+    EXPECT_TRUE(std::isnan(expm1_nonpositive(std::nan(""))));
 }
 
 TEST(TemperatureLag, TimesAtTheLimitsStepWithoutOverflow) {

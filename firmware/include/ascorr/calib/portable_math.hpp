@@ -1,5 +1,6 @@
-// ascorr/calib/portable_math.hpp: the two elementary functions the estimator
-// needs beyond +, −, ×, ÷ and √, written with those alone, so that the DPU
+// ascorr/calib/portable_math.hpp: the elementary functions the estimator
+// (and pipeline/temperature_lag.hpp) need beyond +, −, ×, ÷ and √, written
+// with those alone, so that the DPU
 // (picolibc, software double on the M3) and the host (glibc, SSE2) compute
 // the same bits: IEEE 754 rounds each basic operation and √ correctly
 // everywhere, while libm's exp and hypot are not correctly rounded and differ
@@ -36,6 +37,34 @@ inline double exp_nonpositive(double x) noexcept {
         e *= e;
     }
     return e;
+}
+
+// e^x − 1 for x ≤ 0 (a first-order lag's −α): as exp_nonpositive, x halved
+// k times until |x/2^k| ≤ 2⁻¹⁰ (k ≤ 20 for x ≥ −745), a Taylor polynomial
+// of degree 6 (truncation |y|⁶/720 of |y|, ≤ 2e-21 relative), then doubled k
+// times by expm1(2y) = m·(m + 2), which keeps the relative precision of a
+// small result (where 1 − e^x would cancel): relative error ≲ (k + 2)·2⁻⁵³.
+// NaN stays NaN; x > 0 is not its domain and gives 0; below −745, −1.
+inline double expm1_nonpositive(double x) noexcept {
+    if (std::isnan(x)) {
+        return x;
+    }
+    if (!(x < 0.0)) {
+        return 0.0;
+    }
+    if (x < -745.0) {
+        return -1.0;
+    }
+    int k = 0;
+    double y = x;
+    for (; k < 64 && y < -0x1p-10; ++k) {  // bounded: 745 < 2^10
+        y *= 0.5;
+    }
+    double m = y * (1.0 + y / 2.0 * (1.0 + y / 3.0 * (1.0 + y / 4.0 * (1.0 + y / 5.0 * (1.0 + y / 6.0)))));
+    for (int i = 0; i < k; ++i) {
+        m *= m + 2.0;
+    }
+    return m;
 }
 
 // √(p² + q²) without overflow or underflow of the squares: a·√(1 + (b/a)²),

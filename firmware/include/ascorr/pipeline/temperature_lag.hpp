@@ -24,13 +24,12 @@
 // Cost per channel and step: two integer compares of Δt with the channel's
 // last two Δt (a head's cadence repeats, or alternates between two values
 // when times are rounded, as 45/46 ms at 22 Hz), then two subtractions and
-// one multiply-add; only a third Δt costs expm1. No division on the step
-// (1/τ is formed by configure()), no loop on the step, no allocation, no
-// exceptions.
-// Open (before a stage uses it on a target and the host alike): expm1 is
-// the C library's, not correctly rounded, and glibc's and picolibc's may
-// differ in the last bit; replay's bit-for-bit comparison will need α from
-// + − × alone, as matrix3.hpp keeps to them.
+// one multiply-add; only a third Δt forms α, in double by
+// calib::expm1_nonpositive (+ − × ÷ alone, so the DPU and the host form the
+// same bits, as the estimator's forgetting factor; libm's expm1 is not
+// correctly rounded and differs between libraries), rounded once to T.
+// No division on the step (1/τ is formed by configure()), no loop on the
+// step but α's bounded halvings, no allocation, no exceptions.
 // Bad input, each leaves the channel as it was and says why (LagStep):
 // a reading not valid or outside the core's domain (±kMaxAbsTemperatureC,
 // NaN included) is kHeld; a time not after the channel's last is
@@ -40,10 +39,10 @@
 // Scalars: double and float. Q30 has no kernel yet: T must be floating point.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 #include <type_traits>
 
+#include "../calib/portable_math.hpp"
 #include "../core/constants.hpp"
 #include "../core/thermal.hpp"
 
@@ -82,7 +81,7 @@ public:
         if (!(tau_s >= kMinLagTauS && tau_s <= kMaxLagTauS)) {
             return false;
         }
-        inv_tau_per_us_ = static_cast<T>(1.0 / (tau_s * 1e6));  // in [1.2e-11, 1e-6]: a normal float
+        inv_tau_per_us_ = 1.0 / (tau_s * 1e6);  // in [1.2e-11, 1e-6]
         for (Channel& c : ch_) {
             c = Channel{};
         }
@@ -156,8 +155,7 @@ private:
         }
         const std::uint8_t other = c.newer ^ 1U;
         if (dt_us != c.dt_us[other]) {
-            using std::expm1;
-            c.alpha[other] = -expm1(-static_cast<T>(dt_us) * inv_tau_per_us_);
+            c.alpha[other] = static_cast<T>(-calib::expm1_nonpositive(-static_cast<double>(dt_us) * inv_tau_per_us_));
             c.dt_us[other] = dt_us;
         }
         c.newer = other;
@@ -165,7 +163,7 @@ private:
     }
 
     Channel ch_[kLagChannels]{};
-    T inv_tau_per_us_ = T(0);
+    double inv_tau_per_us_ = 0.0;  // α is formed in double (alpha_for)
     bool configured_ = false;
 };
 
