@@ -12,6 +12,17 @@
 
 namespace ascorr::calib {
 
+// The range reduction of exp_nonpositive and expm1_nonpositive: y ≤ 0
+// halved until |y| ≤ 2⁻¹⁰, in place; the count k of halvings (k ≤ 20 for
+// y ≥ −745: bounded). Each halving is exact.
+inline int halve_into_series_range(double& y) noexcept {
+    int k = 0;
+    for (; k < 64 && y < -0x1p-10; ++k) {  // bounded: 745 < 2^10
+        y *= 0.5;
+    }
+    return k;
+}
+
 // e^x for x ≤ 0 (the forgetting factor): x halved k times until |x/2^k| ≤
 // 2⁻¹⁰ (k ≤ 20 for x ≥ −745, below which e^x is 0 in double), a Taylor
 // polynomial of degree 5 (truncation |y|⁶/720 ≤ 2e-21), then squared k times
@@ -27,11 +38,8 @@ inline double exp_nonpositive(double x) noexcept {
     if (x < -745.0) {
         return 0.0;
     }
-    int k = 0;
     double y = x;
-    for (; k < 64 && y < -0x1p-10; ++k) {  // bounded: 745 < 2^10
-        y *= 0.5;
-    }
+    const int k = halve_into_series_range(y);
     double e = 1.0 + y * (1.0 + y / 2.0 * (1.0 + y / 3.0 * (1.0 + y / 4.0 * (1.0 + y / 5.0))));
     for (int i = 0; i < k; ++i) {
         e *= e;
@@ -55,11 +63,8 @@ inline double expm1_nonpositive(double x) noexcept {
     if (x < -745.0) {
         return -1.0;
     }
-    int k = 0;
     double y = x;
-    for (; k < 64 && y < -0x1p-10; ++k) {  // bounded: 745 < 2^10
-        y *= 0.5;
-    }
+    const int k = halve_into_series_range(y);
     double m = y * (1.0 + y / 2.0 * (1.0 + y / 3.0 * (1.0 + y / 4.0 * (1.0 + y / 5.0 * (1.0 + y / 6.0)))));
     for (int i = 0; i < k; ++i) {
         m *= m + 2.0;

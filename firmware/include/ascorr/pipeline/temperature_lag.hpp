@@ -104,8 +104,8 @@ public:
 
     // Channel k's lagged temperature L = T + D at its last reading (°C).
     TemperatureReading<T> lagged(std::uint8_t k) const noexcept {
-        const Channel& c = ch_[k < kLagChannels ? k : 0];
-        return {c.t_reading + c.d, k < kLagChannels && c.started};
+        const TemperatureReading<T> d = deviation(k);
+        return {ch_[k < kLagChannels ? k : 0].t_reading + d.value, d.valid};
     }
 
 private:
