@@ -61,7 +61,25 @@ void add_fit_command(CLI::App& app) {
         ->check([](const std::string& v) {
             return host::common_rotation_named(v) ? std::string() : "expected " + host::common_rotation_choices();
         });
-    cmd->callback([opt, frame, heads, mountings, rule]() {
+    auto lag = std::make_shared<std::string>();
+    cmd->add_option("--lag", *lag,
+                    "the bench's lag in s: auto (default: chosen per head on the held-out part, none unless the data "
+                    "support one), TAU for every head, or X:TAU,... for the heads named (the others none); each TAU "
+                    "0 (none) or in [1, 86400]. The terms take each head's temperatures through a first-order lag "
+                    "of TAU, and the model says so (lag_s), for correct")
+        ->type_name("LAG")
+        ->check([](const std::string& v) {
+            try {
+                host::parse_lags(v);
+            } catch (const host::FitRefused& e) {
+                return std::string(e.what());
+            }
+            return std::string();
+        });
+    cmd->callback([opt, frame, heads, mountings, rule, lag]() {
+        if (!lag->empty()) {
+            opt->lag_s = host::parse_lags(*lag);  // checked already; "auto": nullopt
+        }
         opt->frame_heads = {head_index((*frame)[0]), head_index((*frame)[1])};  // checked already
         if (!heads->empty()) {
             opt->heads = host::parse_head_letters(*heads);  // checked already

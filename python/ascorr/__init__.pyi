@@ -31,8 +31,12 @@ class Model:
     Model(coefficients, heads="ABCD"): coefficients of shape (4, 3, 4) or (4, 3, 7),
     indexed [head 'A'..'D'][axis alpha, beta, gamma][c0, c1, c2, c3, c1_2, c2_2, c3_2],
     in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
-    coefficients (a head not listed gets status 256 in correct())."""
-    def __init__(self, coefficients: npt.ArrayLike, heads: Optional[str] = ...) -> None: ...
+    coefficients (a head not listed gets status 256 in correct()); lag_s: None
+    or 4 numbers [head 'A'..'D'], the bench's lag in s of each head, 0 (none) or
+    in [1, 86400] (the model file's lag_s column)."""
+    def __init__(
+        self, coefficients: npt.ArrayLike, heads: Optional[str] = ..., lag_s: Optional[npt.ArrayLike] = ...
+    ) -> None: ...
     # (len(HEADS), 3, len(MODEL_TERMS)) arcsec
     @property
     def coefficients(self) -> npt.NDArray[np.float64]:
@@ -46,6 +50,9 @@ class Model:
     @property
     def common_rotation(self) -> str:
         """The rule that fixed the rotation common to all heads: 'smallest', 'combined' or 'rigid-X' (the model file's common_rotation column; docs/contract.md)."""
+    @property
+    def lag_s(self) -> npt.NDArray[np.float64]:
+        """The bench's lag per head, float64 (4,): [head 'A'..'D'] s, 0 none (the model file's lag_s column; its terms take the head's temperatures through a first-order lag; docs/contract.md)."""
     def write(self, path: _Path) -> None:
         """Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike."""
     def to_csv(self) -> str:
@@ -53,8 +60,8 @@ class Model:
     # the same model file; Model pickles
     def __eq__(self, other: object) -> bool:
         """Equal when both would write the same model file (heads, coefficients, columns)."""
-    def __getstate__(self) -> tuple[npt.NDArray[np.float64], str, bool]: ...
-    def __setstate__(self, state: tuple[npt.NDArray[np.float64], str, bool]) -> None: ...
+    def __getstate__(self) -> tuple[npt.NDArray[np.float64], str, bool, str, npt.NDArray[np.float64]]: ...
+    def __setstate__(self, state: tuple[Any, ...]) -> None: ...
 
 # Enumerations are names in any case ("GCRS" is "gcrs"), as on the command line.
 def read_model(path: _Path) -> Model:
@@ -189,6 +196,7 @@ def fit(
     heads: Optional[str] = ...,
     mountings: Optional[dict[str, Any]] = ...,
     common_rotation: Optional[str] = ...,
+    lag: Union[str, float] = ...,
 ) -> tuple[Model, dict[str, Any]]:
     """Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),
     with its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2;
@@ -200,12 +208,15 @@ def fit(
     mountings: read_mountings()'s dict, with sigmas (as --mountings): the rotation common
     to all heads, which no IBA sees, is then fixed so that the heads' combined attitude
     moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
-    (as --common-rotation; None: 'combined' with mountings, 'smallest' without). Returns
+    (as --common-rotation; None: 'combined' with mountings, 'smallest' without); lag: the
+    bench's lag, as --lag: 'auto' (chosen on the held-out part, none unless the data
+    support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s). Returns
     (model, report): model an ascorr.Model (model.write(path) writes the model file),
     report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
     dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
     rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
-    (len(heads), 3) arcsec [head][alpha, beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+    (len(heads), 3) arcsec [head][alpha, beta, gamma], lag (auto's verdict, '' with a lag
+    given), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
     determine the model (period shorter than min_days, fewer than min_orbits orbits,
     condition number above max_condition, too small a temperature range for quadratic
     terms) or a setting is out of its range; its text, and the report's, name the settings

@@ -117,6 +117,11 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
                const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
                const py::object& t_from, const py::object& t_to, const py::object& noise_iba) {
     const host::ModelFile* m = model_arg(model);
+    if (m != nullptr && host::has_lag(*m)) {
+        bad_argument("model",
+                     "its lag_s makes its terms take lagged temperatures, which stats does not give them; "
+                     "give stats the rows correct() corrected with it");
+    }
     host::StatsOptions opt;
     opt.in = kArrayRows;
     if (!noise_iba.is_none()) {
@@ -162,7 +167,7 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
 }
 
 // The value after "--terms ", "--holdout ", "--heads " or "--frame-heads "
-// at text[i], as a keyword's: "='linear'", "=0", "='ABD'"; empty (and i
+// at text[i], as a keyword's: "='linear'", "=0", "='ABD'", "='auto'"; empty (and i
 // unchanged) when none follows.
 std::string keyword_value(const std::string& name, const std::string& text, std::size_t& i) {
     if (i >= text.size() || text[i] != ' ') {
@@ -180,7 +185,7 @@ std::string keyword_value(const std::string& name, const std::string& text, std:
         i = v;
         return "='" + value + "'";
     }
-    if (name != "terms" && name != "holdout") {
+    if (name != "terms" && name != "holdout" && name != "lag") {
         return {};
     }
     std::size_t v = i + 1;
@@ -189,7 +194,7 @@ std::string keyword_value(const std::string& name, const std::string& text, std:
         ++v;
     }
     const std::string value = text.substr(i + 1, v - i - 1);
-    if (name == "terms" && (value == "linear" || value == "quadratic")) {
+    if ((name == "terms" && (value == "linear" || value == "quadratic")) || (name == "lag" && value == "auto")) {
         i = v;
         return "='" + value + "'";
     }
@@ -230,7 +235,8 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
               const py::object& t_to, const py::object& min_days, const py::object& min_orbits,
               const py::object& max_condition, const py::object& orbit_period, const py::object& terms,
               const py::object& holdout, const py::object& min_temperature_range, const py::object& frame_heads,
-              const py::object& heads, const py::object& mountings, const py::object& common_rotation) {
+              const py::object& heads, const py::object& mountings, const py::object& common_rotation,
+              const py::object& lag) {
     host::FitOptions opt;
     opt.in = kArrayRows;
     opt.from = time_arg(t_from, "t_from");
@@ -263,6 +269,21 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
         }
         opt.common_rotation.emplace();
         static_cast<host::CommonRotationId&>(*opt.common_rotation) = *id;
+    }
+    if (py::isinstance<py::str>(lag)) {
+        try {
+            opt.lag_s = host::parse_lags(lag.cast<std::string>());
+        } catch (const host::FitRefused& e) {
+            bad_argument("lag", as_keywords(e.what()));
+        }
+    } else {
+        const double x = real_arg(lag, "lag");
+        if (!host::lag_acceptable(x)) {
+            bad_argument("lag", "expected 'auto', 'X:TAU,...' or a lag in s, " + host::lag_range_text() + ", got " +
+                                    number_text(x));
+        }
+        opt.lag_s.emplace();
+        opt.lag_s->fill(x);
     }
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
@@ -304,6 +325,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["signal_rms"] = sig;
     d["terms"] = host::terms_name(rep.terms);
     d["common_rotation"] = host::common_rotation_name(rep.common_rotation);
+    d["lag"] = rep.lag.verdict;
     d["text"] = as_keywords(host::describe(rep));
     return py::make_tuple(py::cast(rep.model), d);
 }
@@ -321,7 +343,7 @@ void bind_analysis(py::module_& mod) {
             "orbit_period"_a = py::none(), "terms"_a = "linear", "holdout"_a = host::kDefaultHoldout,
             "min_temperature_range"_a = host::kDefaultMinTemperatureRange,
             "frame_heads"_a = host::frame_heads_text(host::kDefaultFrameHeads), "heads"_a = py::none(),
-            "mountings"_a = py::none(), "common_rotation"_a = py::none(), docstring(docs::kFit));
+            "mountings"_a = py::none(), "common_rotation"_a = py::none(), "lag"_a = "auto", docstring(docs::kFit));
 }
 
 }  // namespace ascorr::python

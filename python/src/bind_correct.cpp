@@ -21,6 +21,7 @@
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/correct/workers.hpp"
 #include "ascorr_host/formats/diagnostics.hpp"
@@ -37,6 +38,24 @@ namespace {
 
 // Below this many rows per thread a thread costs more than it saves.
 constexpr std::size_t kRowsPerThread = 16384;
+
+// A lagged model's heads: their temperatures through the lag, as by `ascorr
+// correct` (every row's reading, in time order per head); none without one.
+std::optional<host::LaggedTemperatures> lagged_temperatures(const Rows& r, const host::ModelFile* m) {
+    if (m == nullptr || !host::has_lag(*m)) {
+        return std::nullopt;
+    }
+    std::vector<host::LagReading> readings;
+    SolutionRecord rec;
+    host::LagReading x;
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        if (host::lag_reading_of(rec, x)) {
+            readings.push_back(x);
+        }
+    }
+    return host::LaggedTemperatures(host::head_lags(*m), std::move(readings));
+}
 
 template <typename T>
 void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, const host::StatesFile* states,
@@ -62,6 +81,7 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
         table.emplace(*states, host::service_config(max_propagation_s), std::move(times),
                       host::worker_count(static_cast<std::size_t>(r.n), kRowsPerThread));
     }
+    const std::optional<host::LaggedTemperatures> lag = lagged_temperatures(r, m);
     const auto n = static_cast<std::size_t>(r.n);
     host::for_each_piece(n, host::worker_count(n, kRowsPerThread), [&](std::size_t begin, std::size_t end) {
         host::EarthVelocity earth;
@@ -72,6 +92,9 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
         SolutionRecord rec;
         for (auto i = static_cast<py::ssize_t>(begin); i < static_cast<py::ssize_t>(end); ++i) {
             record_of(r, i, rec);
+            if (lag && cfg.thermal != nullptr) {
+                lag->apply(rec);
+            }
             put_row(host::correct_row(rec, &earth, cfg, service ? &*service : nullptr), i, q_out, st_out);
         }
     });

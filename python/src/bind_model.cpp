@@ -33,7 +33,28 @@ py::array_t<double> model_coefficients(const host::ModelFile& m) {
     return a;
 }
 
-host::ModelFile model_from(const py::object& coefficients, const py::object& heads) {
+// lag_s: None (no head lags) or @N_HEADS@ numbers, each 0 or a lag the model file takes.
+void lags_into(const py::object& lag_s, host::ModelFile& m) {
+    if (lag_s.is_none()) {
+        return;
+    }
+    const py::array a = as_numpy(lag_s);
+    const char kind = a.dtype().kind();
+    if ((kind != 'f' && kind != 'i' && kind != 'u') || a.ndim() != 1 || a.shape(0) != py::ssize_t{kMaxHeads}) {
+        bad_argument("lag_s", "expected " + std::to_string(kMaxHeads) + " real numbers (head " + head_letter_range() +
+                                  ") or None, got " + shape_text(a) + " of dtype " + std::string(py::str(a.dtype())));
+    }
+    const Doubles d = Doubles::ensure(a);
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        if (!host::lag_acceptable(d.data()[h])) {
+            bad_argument("lag_s", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) + "'s " +
+                                      number_text(d.data()[h]) + " is not " + host::lag_range_text());
+        }
+        m.lag_s[h] = d.data()[h];
+    }
+}
+
+host::ModelFile model_from(const py::object& coefficients, const py::object& heads, const py::object& lag_s) {
     const py::array a = as_numpy(coefficients);
     const char kind = a.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u') {
@@ -78,6 +99,7 @@ host::ModelFile model_from(const py::object& coefficients, const py::object& hea
         }
         m.present[h] = true;
     }
+    lags_into(lag_s, m);
     return m;
 }
 
@@ -95,24 +117,35 @@ std::string model_heads(const host::ModelFile& m) {
 // heads, coefficients and columns (where they were read from is no part of it).
 bool models_equal(const host::ModelFile& a, const host::ModelFile& b) {
     return a.present == b.present && a.coefficients == b.coefficients && a.quadratic == b.quadratic &&
-           host::common_rotation_name(a.common_rotation) == host::common_rotation_name(b.common_rotation);
+           host::common_rotation_name(a.common_rotation) == host::common_rotation_name(b.common_rotation) &&
+           host::format_model(a) == host::format_model(b);  // the lags as written
 }
 
-// Pickling: (coefficients (heads, 3, 7), heads, quadratic, common_rotation),
-// rebuilt by Model(); a state of three (pickled before the rule had a name) is
-// the rule 'smallest'.
+py::array_t<double> model_lags(const host::ModelFile& m) {
+    py::array_t<double> a(py::ssize_t{kMaxHeads});
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        a.mutable_data()[h] = m.lag_s[h];
+    }
+    return a;
+}
+
+// Pickling: (coefficients (heads, 3, 7), heads, quadratic, common_rotation,
+// lag_s), rebuilt by Model(); a state of three (pickled before the rule had a
+// name) is the rule 'smallest', one of four (before the lag) has no lag.
 py::tuple model_state(const host::ModelFile& m) {
     return py::make_tuple(model_coefficients(m), model_heads(m), m.quadratic,
-                          host::common_rotation_name(m.common_rotation));
+                          host::common_rotation_name(m.common_rotation), model_lags(m));
 }
 
 host::ModelFile model_from_state(const py::tuple& state) {
-    if (state.size() != 3 && state.size() != 4) {
-        throw py::value_error("ascorr.Model: a pickled state is (coefficients, heads, quadratic, common_rotation)");
+    if (state.size() < 3 || state.size() > 5) {
+        throw py::value_error(
+            "ascorr.Model: a pickled state is (coefficients, heads, quadratic, common_rotation, lag_s)");
     }
-    host::ModelFile m = model_from(state[0], state[1]);
+    const py::object lag_s = state.size() == 5 ? py::object(state[4]) : py::object(py::none());
+    host::ModelFile m = model_from(state[0], state[1], lag_s);
     m.quadratic = state[2].cast<bool>();
-    if (state.size() == 4) {
+    if (state.size() >= 4) {
         const std::optional<host::CommonRotationId> rule =
             host::common_rotation_named(py::str(state[3]).cast<std::string>());
         if (!rule) {
@@ -131,7 +164,7 @@ constexpr const char* kSelf = "ascorr.Model";
 
 void bind_model(py::module_& mod) {
     py::class_<host::ModelFile>(mod, "Model", docstring(docs::kModel))
-        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none())
+        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none(), "lag_s"_a = py::none())
         .def_property_readonly(
             "coefficients", [](const py::object& self) { return model_coefficients(model_of(self, kSelf)); },
             docstring(docs::kModelCoefficients))
@@ -145,6 +178,9 @@ void bind_model(py::module_& mod) {
             "common_rotation",
             [](const py::object& self) { return host::common_rotation_name(model_of(self, kSelf).common_rotation); },
             docstring(docs::kModelCommonRotation))
+        .def_property_readonly(
+            "lag_s", [](const py::object& self) { return model_lags(model_of(self, kSelf)); },
+            docstring(docs::kModelLag))
         .def(
             "write",
             [](const py::object& self, const py::object& path) {
@@ -170,7 +206,8 @@ void bind_model(py::module_& mod) {
                 return std::string("<ascorr.Model, not initialised>");
             }
             const host::ModelFile& m = self.cast<const host::ModelFile&>();
-            return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") + ">";
+            return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") +
+                   (host::has_lag(m) ? " lagged" : "") + ">";
         });
 
     mod.def(

@@ -26,7 +26,9 @@ optionally quadratic) in T_CHU, T029 - T_CHU and T032 - T_CHU (docs/contract.md,
 Model(coefficients, heads="@HEADS@"): coefficients of shape (@N_HEADS@, 3, @N_LINEAR_TERMS@) or (@N_HEADS@, 3, @N_TERMS@),
 indexed [head @HEAD_LETTERS@][axis alpha, beta, gamma][@TERMS@],
 in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
-coefficients (a head not listed gets status 256 in correct()).)doc";
+coefficients (a head not listed gets status 256 in correct()); lag_s: None
+or @N_HEADS@ numbers [head @HEAD_LETTERS@], the bench's lag in s of each head, 0 (none) or
+in [1, 86400] (the model file's lag_s column).)doc";
 
 inline constexpr const char* kModelCoefficients =
     "Coefficients, float64 (@N_HEADS@, 3, @N_TERMS@): [head @HEAD_LETTERS@][alpha, beta, gamma][@TERMS@], arcsec (a "
@@ -37,6 +39,9 @@ inline constexpr const char* kModelQuadratic =
 inline constexpr const char* kModelCommonRotation =
     "The rule that fixed the rotation common to all heads: 'smallest', 'combined' or 'rigid-X' (the model "
     "file's common_rotation column; docs/contract.md).";
+inline constexpr const char* kModelLag =
+    "The bench's lag per head, float64 (@N_HEADS@,): [head @HEAD_LETTERS@] s, 0 none (the model file's lag_s "
+    "column; its terms take the head's temperatures through a first-order lag; docs/contract.md).";
 inline constexpr const char* kModelWrite =
     "Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike.";
 inline constexpr const char* kModelToCsv = "The model file's text.";
@@ -142,12 +147,15 @@ without C (as --heads; None: A, B, C, F's two and every other head with rows);
 mountings: read_mountings()'s dict, with sigmas (as --mountings): the rotation common
 to all heads, which no IBA sees, is then fixed so that the heads' combined attitude
 moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
-(as --common-rotation; None: 'combined' with mountings, 'smallest' without). Returns
+(as --common-rotation; None: 'combined' with mountings, 'smallest' without); lag: the
+bench's lag, as --lag: 'auto' (chosen on the held-out part, none unless the data
+support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s). Returns
 (model, report): model an ascorr.Model (model.write(path) writes the model file),
 report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
 dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
 rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
-(len(heads), 3) arcsec [head][alpha, beta, gamma], text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+(len(heads), 3) arcsec [head][alpha, beta, gamma], lag (auto's verdict, '' with a lag
+given), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
 determine the model (period shorter than min_days, fewer than min_orbits orbits,
 condition number above max_condition, too small a temperature range for quadratic
 terms) or a setting is out of its range; its text, and the report's, name the settings

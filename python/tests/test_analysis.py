@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import ascorr
-from conftest import DATA, core_constant, run_cli
+from conftest import DATA, core_constant, read_csv_text, run_cli
 
 T0 = 456148800.0  # the simulation's first epoch
 DAY = core_constant("kSecondsPerDay")
@@ -246,3 +246,57 @@ def test_model_terms_are_the_model_files_columns():
     assert model.to_csv().splitlines()[0] == ",".join(("chu", "axis") + terms)
     linear = ascorr.Model(np.zeros((len(ascorr.HEADS), 3, 4)))
     assert linear.to_csv().splitlines()[0] == ",".join(("chu", "axis") + terms[:4])
+
+
+@pytest.fixture(scope="module")
+def lag_mission(exe, tmp_path_factory):
+    """30 days of a bench that lags its thermistors by 1800 s, a solution per head every 120 s."""
+    d = tmp_path_factory.mktemp("lag_mission")
+    path = d / "lag.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 30, "--step", 120, "--bench-lag", 1800)
+    return path
+
+
+def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_path):
+    """lag= as --lag (auto, a number, X:TAU); the lagged model corrects the rows as
+    `ascorr correct` does, to the bit, in any row order; Model(lag_s=) and pickling keep it."""
+    import pickle
+
+    d = ascorr.read_solutions(str(lag_mission))
+    for cli, py in (("auto", "auto"), ("1800", 1800), ("A:900,C:1800", "A:900,C:1800")):
+        out = tmp_path / f"model_{cli.replace(':', '_').replace(',', '_')}.csv"
+        run_cli(exe, "fit", "--in", lag_mission, "--out", out, "--min-days", 20, "--lag", cli)
+        model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=20, lag=py)
+        assert model.to_csv() == out.read_text(), cli
+        assert (report["lag"] != "") == (cli == "auto")
+    assert list(model.lag_s) == [900.0, 0.0, 1800.0, 0.0]
+    assert "lagged" in repr(model)
+    assert pickle.loads(pickle.dumps(model)) == model
+    assert ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s) == model
+    assert ascorr.Model(model.coefficients, model.heads) != model
+
+    corrected = tmp_path / "corrected.csv"
+    run_cli(exe, "correct", "--in", lag_mission, "--model", out, "--out", corrected)
+    header, rows = read_csv_text(corrected)
+    q, status = ascorr.correct(*as_args(d), model=ascorr.read_model(str(out)))
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    assert [int(r[header.index("status")]) for r in rows] == list(status)
+    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
+    assert all(same) and len(same) > 0.9 * len(rows)
+    # Reversed rows: the same corrections, reversed.
+    rev = [np.asarray(a)[::-1].copy() for a in as_args(d)]
+    q_rev, status_rev = ascorr.correct(*rev, model=model)
+    q_fwd, status_fwd = ascorr.correct(*as_args(d), model=model)
+    assert np.array_equal(q_rev[::-1], q_fwd) and np.array_equal(status_rev[::-1], status_fwd)
+    # Without the lag the corrections differ: the lag is used.
+    q_none, _ = ascorr.correct(*as_args(d), model=ascorr.Model(model.coefficients, model.heads))
+    assert np.abs(q_none - q_fwd).max() > 1e-9
+
+    with pytest.raises(ValueError, match="lag_s makes its terms take lagged temperatures"):
+        ascorr.stats(*as_args(d), model=model)
+    with pytest.raises(ValueError, match="lag"):
+        ascorr.fit(*as_args(d), min_days=20, lag=-3)
+    with pytest.raises(ValueError, match="A:900,A:1"):
+        ascorr.fit(*as_args(d), min_days=20, lag="A:900,A:1")
+    with pytest.raises(ValueError, match="lag_s"):
+        ascorr.Model(model.coefficients, model.heads, lag_s=[1e6, 0, 0, 0])

@@ -20,6 +20,7 @@
 #include "ascorr/nav/orbit_propagation.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_text/c_format.hpp"
 #include "ascorr_text/input_name.hpp"
@@ -62,7 +63,8 @@ std::string time_text(double t) {
 }  // namespace
 
 namespace {
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads);
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads,
+                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search);
 
 // The heads a reading assumes: the given ones, else the analysis's with the
 // heads seen with rows so far.
@@ -70,8 +72,23 @@ HeadMask fit_heads(const FitOptions& opt, HeadMask with_rows) {
     return opt.heads ? *opt.heads : analysis_heads(with_rows, frame_set(opt.frame_heads));
 }
 
+// A lag --lag's parser would refuse (an option set by a library caller).
+void refuse_bad_lags(const FitOptions& opt) {
+    for (std::size_t h = 0; opt.lag_s && h < kMaxHeads; ++h) {
+        if (!lag_acceptable((*opt.lag_s)[h])) {
+            throw FitRefused(std::string("--lag: head ") + head_name(static_cast<std::uint8_t>(h)) + "'s " +
+                             number_text((*opt.lag_s)[h]) + " is not " + lag_range_text());
+        }
+    }
+}
+
+bool any_lag(const std::array<double, kMaxHeads>& lag_s) {
+    return std::any_of(lag_s.begin(), lag_s.end(), [](double x) { return x != 0.0; });
+}
+
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
+    refuse_bad_lags(opt);
     if (opt.from && !std::isfinite(*opt.from)) {
         throw FitRefused("--from " + number_text(*opt.from) + ": not a finite time");
     }
@@ -119,6 +136,23 @@ FitReport fit_model(const FitOptions& opt) {
     return r;
 }
 
+namespace {
+
+// Every row's reading, sorted for the lag (lag_order): one more reading of the rows.
+std::vector<LagReading> lag_readings(const RowSource& rows) {
+    std::vector<LagReading> readings;
+    rows([&](const SolutionRecord& rec) {
+        LagReading r;
+        if (lag_reading_of(rec, r)) {
+            readings.push_back(r);
+        }
+    });
+    std::sort(readings.begin(), readings.end(), lag_order);
+    return readings;
+}
+
+}  // namespace
+
 FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     refuse_bad_fit_options(opt);
     if (opt.from && opt.to && !(*opt.from < *opt.to)) {
@@ -136,7 +170,62 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          number_text(opt.min_temperature_range_c));
     }
-    return fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U));
+    const bool choose = !opt.lag_s && opt.selection_report && opt.holdout > 0.0;
+    const bool given = opt.lag_s && any_lag(*opt.lag_s);
+    std::vector<LagReading> readings = choose || given ? lag_readings(rows) : std::vector<LagReading>{};
+    std::optional<LaggedTemperatures> lag;
+    if (given) {
+        lag.emplace(*opt.lag_s, readings);
+    }
+    FitReport r =
+        fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), lag ? &*lag : nullptr, choose ? &readings : nullptr);
+    if (choose && any_lag(r.lag.lag_s)) {
+        // The model of the lags chosen, from all of the period: as --lag with them.
+        lag.emplace(r.lag.lag_s, std::move(readings));
+        const LagSelection chosen = r.lag;
+        r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &*lag, nullptr);
+        r.lag = chosen;
+    }
+    const std::array<double, kMaxHeads> lag_s = opt.lag_s ? *opt.lag_s : r.lag.lag_s;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        r.model.lag_s[h] = r.model.present[h] ? lag_s[h] : 0.0;
+    }
+    return r;
+}
+
+std::optional<std::array<double, kMaxHeads>> parse_lags(std::string_view text) {
+    if (text == "auto") {
+        return std::nullopt;
+    }
+    std::array<double, kMaxHeads> lag{};
+    const auto value = [&](std::string_view v, std::string_view item) {
+        const std::optional<double> x = parse_double(v);
+        if (!x || !lag_acceptable(*x)) {
+            throw FitRefused("--lag " + std::string(text) + ": '" + std::string(item) + "': the lag must be " +
+                             lag_range_text());
+        }
+        return *x;
+    };
+    if (text.find(':') == std::string_view::npos) {
+        lag.fill(value(text, text));
+        return lag;
+    }
+    HeadMask named = 0U;
+    for (std::size_t start = 0; start <= text.size();) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string_view item = text.substr(start, end - start);
+        const std::uint8_t h = item.size() > 2 && item[1] == ':' ? head_index(item[0]) : kMaxHeads;
+        if (h >= kMaxHeads || (named & head_bit(h)) != 0U) {
+            throw FitRefused("--lag " + std::string(text) + ": '" + std::string(item) +
+                             "': expected TAU (every head) "
+                             "or X:TAU,... (X a head, " +
+                             kHeadChoices.text + ", once each)");
+        }
+        named |= head_bit(h);
+        lag[h] = value(item.substr(2), item);
+        start = end + 1;
+    }
+    return lag;
 }
 
 namespace {
@@ -163,7 +252,8 @@ struct Pass {
     double earliest_row_speed = 0.0;
     std::size_t earliest_row_line = 0;
     std::map<long long, OrbitSums> orbits;
-    std::vector<FitEpoch> fit_epochs;  // for the selection report's IBA RMS
+    std::vector<FitEpoch> fit_epochs;                     // for the selection report's IBA RMS
+    const std::vector<LagReading>* lag_search = nullptr;  // --lag auto: every row, by lag_order
 };
 
 Quaternion<double> to_core_q(const Eigen::Quaterniond& q) {
@@ -492,6 +582,20 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
         r.selection = select_terms(averages, p.fit_epochs, n_ref, r.heads, r.t_first, r.t_last, opt.holdout,
                                    opt.max_condition, opt.min_temperature_range_c, r.common_rotation);
     }
+    if (p.lag_search != nullptr) {
+        LagSearchInput in;
+        in.orbits = &averages;
+        in.period = *p.period;
+        in.epochs = &p.fit_epochs;
+        in.readings = p.lag_search;
+        in.n_ref = n_ref;
+        in.heads = r.heads;
+        in.t_split = r.selection.t_split;
+        in.max_condition = opt.max_condition;
+        in.min_range_c = opt.min_temperature_range_c;
+        in.rule = r.common_rotation;
+        r.lag = select_lags(in);
+    }
     r.singular_values = r.fit.singular_values;
     r.condition = r.fit.condition;
     r.head = r.fit.head;
@@ -508,20 +612,30 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // (earliest_period: that second reading.) Likewise the heads, unless
 // --heads names them: a reading assumes them (A, B, C and F's first); when
 // the period holds rows of others, the rows are read again with those too.
-FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period,
-                   HeadMask heads) {
+FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads,
+                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search) {
     EarthVelocity earth;
     Pass p;
+    p.lag_search = lag_search;
     p.r.heads = heads;
     p.r.frame_heads = opt.frame_heads;
     p.period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
     p.period = earliest_period ? earliest_period : opt.orbit_period_s;
     EpochAssembler<Row> epochs(
         opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt); }, heads);
-    rows([&](const SolutionRecord& rec) { add_row(p, opt, earth, epochs, rec); });
+    SolutionRecord lagged;
+    rows([&](const SolutionRecord& rec) {
+        if (lag == nullptr) {
+            add_row(p, opt, earth, epochs, rec);
+            return;
+        }
+        lagged = rec;
+        lag->apply(lagged);  // the terms take the head's lagged temperatures
+        add_row(p, opt, earth, epochs, lagged);
+    });
     epochs.finish();
     if (!opt.heads && (p.with_rows & ~heads) != 0U) {
-        return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows));
+        return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows), lag, lag_search);
     }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
         throw text::InputError(opt.in, p.earliest_row_line, 1,
@@ -530,7 +644,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     }
     if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
         // Rows out of time order: again, with the earliest row's period.
-        return fit_pass(opt, rows, p.earliest_row_period, heads);
+        return fit_pass(opt, rows, p.earliest_row_period, heads, lag, lag_search);
     }
     p.r.orbit_period_s = p.period.value_or(0.0);
     rebase_on_earliest_epoch(p);
@@ -565,6 +679,20 @@ std::string describe_rule(const CommonRotation& c) {
             break;
     }
     return "(9 directions), the one with the smallest corrections over the period is written.\n";
+}
+
+// The heads whose temperatures the terms took through a lag (--lag), or nothing.
+std::string describe_lag(const ModelFile& m) {
+    if (!has_lag(m)) {
+        return {};
+    }
+    std::string out = "each head's temperatures taken through the bench's lag (--lag, the model's lag_s):";
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (m.present[h]) {
+            out += std::string(" ") + head_name(h) + " " + number_text(m.lag_s[h]) + " s";
+        }
+    }
+    return out + "\n";
 }
 
 }  // namespace
@@ -607,6 +735,10 @@ std::string describe(const FitReport& r) {
          "the\n"
          "star trackers (they change no IBA): of the models that differ by one linear in T029 and T032\n";
     o << describe_rule(r.common_rotation);
+    o << describe_lag(r.model);
+    if (!r.lag.verdict.empty()) {
+        o << "bench lag (--lag auto): " << r.lag.verdict << "\n";
+    }
     const auto rank = static_cast<std::size_t>(r.fit.rank);
     text::c_snprintf(buf, sizeof buf,
                      "terms %s; design %zu x %d (columns centred, scaled, unit norm): singular values %.3g .. %.3g (%d "

@@ -195,7 +195,10 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     }
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
-        model = to_core<double>(read_model_file(opt.model));
+        const ModelFile m = read_model_file(opt.model);
+        refuse_lagged_model(m, opt.model,
+                            "stats --model does not lag them; give stats the file ascorr correct wrote with it");
+        model = to_core<double>(m);
     }
     return compute_stats(
         o, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },

@@ -20,6 +20,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
@@ -143,6 +144,7 @@ struct Job {
     VelocityServiceConfig service;
     const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
     const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
+    const LaggedTemperatures* lag;        // the model's lagged heads; nullptr: none
     bool keep_rows;                       // a sink takes the corrected rows
 };
 
@@ -217,6 +219,9 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             continue;
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
+        if (job.lag != nullptr && cfg.thermal != nullptr) {
+            job.lag->apply(rec);  // the written row keeps its own readings (the writer copies its text)
+        }
         const RowCorrection<T> row = correct_row(rec, &earth, cfg, states ? &*states : nullptr);
         const StatusBits st = row.status;
         if (row.from_states) {
@@ -262,21 +267,23 @@ std::vector<std::string_view> split_at_lines(std::string_view block, std::size_t
     return parts;
 }
 
-// The TtTime (µs) of every row that will ask the states for its velocity (no
-// vx,vy,vz; a usable t), read ahead of the correction so that the service
-// answers in time order (StatesVelocityTable), whatever the rows' order.
-// Rows that do not parse are left to the correction, which reports them.
-std::vector<std::int64_t> service_times(const std::string& path, const SolutionsReader& header, std::size_t workers) {
+// What collect(rec, out) gathers from every row of the file that parses, in
+// parallel parts of each block; each part's out is passed to finish(out)
+// before the parts are joined in file order. Rows that do not parse are left
+// to the correction, which reports them.
+template <typename Item, typename Collect, typename Finish>
+std::vector<Item> scan_rows(const std::string& path, const SolutionsReader& header, std::size_t workers,
+                            const Collect& collect, const Finish& finish) {
     BlockReader blocks(path);
     std::string_view block;
-    std::vector<std::int64_t> out;
+    std::vector<Item> out;
     for (bool first = true; blocks.next(block); first = false) {
         if (first) {  // the header line is not data
             const std::size_t nl = block.find('\n');
             block = nl == std::string_view::npos ? std::string_view() : block.substr(nl + 1);
         }
         const std::vector<std::string_view> parts = split_at_lines(block, workers);
-        std::vector<std::vector<std::int64_t>> times(parts.size());
+        std::vector<std::vector<Item>> items(parts.size());
         const auto scan = [&](std::size_t i) {
             SolutionsReader reader(header, parts[i], 0);
             SolutionRecord rec;
@@ -288,20 +295,57 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
                 } catch (const text::InputError&) {
                     continue;
                 }
-                TtTime t{};
-                if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
-                    times[i].push_back(t.us);
-                }
+                collect(rec, items[i]);
             }
-            std::sort(times[i].begin(), times[i].end());  // the heads of an epoch: one time
-            times[i].erase(std::unique(times[i].begin(), times[i].end()), times[i].end());
+            finish(items[i]);
         };
         run_workers(parts.size(), scan);
-        for (const auto& ts : times) {
-            out.insert(out.end(), ts.begin(), ts.end());
+        for (const auto& part : items) {
+            out.insert(out.end(), part.begin(), part.end());
         }
     }
     return out;
+}
+
+// The TtTime (µs) of every row that will ask the states for its velocity (no
+// vx,vy,vz; a usable t), read ahead of the correction so that the service
+// answers in time order (StatesVelocityTable), whatever the rows' order.
+std::vector<std::int64_t> service_times(const std::string& path, const SolutionsReader& header, std::size_t workers) {
+    return scan_rows<std::int64_t>(
+        path, header, workers,
+        [](const SolutionRecord& rec, std::vector<std::int64_t>& times) {
+            TtTime t{};
+            if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
+                times.push_back(t.us);
+            }
+        },
+        [](std::vector<std::int64_t>& times) {
+            std::sort(times.begin(), times.end());  // the heads of an epoch: one time
+            times.erase(std::unique(times.begin(), times.end()), times.end());
+        });
+}
+
+// The readings of the rows of the heads the model lags, read ahead of the
+// correction: each head's lag runs over its rows in time order. None when
+// the thermal stage has no model (`thermal`) or its model no lag.
+template <typename T>
+std::optional<LaggedTemperatures> lagged_temperatures(const std::string& path, const SolutionsReader& header,
+                                                      std::size_t workers, const std::optional<ModelFile>& model,
+                                                      const std::optional<ThermalModel<T>>& thermal) {
+    if (!model || !thermal || !has_lag(*model)) {
+        return std::nullopt;
+    }
+    const std::array<double, kMaxHeads> lag_s = head_lags(*model);
+    std::vector<LagReading> readings = scan_rows<LagReading>(
+        path, header, workers,
+        [&](const SolutionRecord& rec, std::vector<LagReading>& out) {
+            LagReading r;
+            if (rec.head < kMaxHeads && lag_s[rec.head] != 0.0 && lag_reading_of(rec, r)) {
+                out.push_back(r);
+            }
+        },
+        [](std::vector<LagReading>&) {});
+    return LaggedTemperatures(lag_s, std::move(readings));
 }
 
 void refuse_self_calibration_options(const CorrectOptions& opt) {
@@ -345,6 +389,7 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
     check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
+        refuse_lagged_model(*model_file, opt.model, "--self-calibrate does not learn a lagged model yet");
     }
     return to_core<T>(*model_file);
 }
@@ -461,6 +506,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     if (states && opt.aberration) {
         table.emplace(*states, service_config(opt.max_propagation_s), service_times(opt.in, header, workers), workers);
     }
+    const std::optional<LaggedTemperatures> lag = lagged_temperatures(opt.in, header, workers, model_file, model);
     const Job<T> job{opt,
                      cfg,
                      header,
@@ -469,6 +515,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
                      service_config(opt.max_propagation_s),
                      table ? &*table : nullptr,
                      opt.self_calibrate && opt.thermal ? &*schedule : nullptr,
+                     lag ? &*lag : nullptr,
                      sink != nullptr};
 
     AtomicFile& out = outputs["--out"];

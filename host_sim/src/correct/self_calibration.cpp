@@ -540,6 +540,7 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
                                std::size_t memory_budget_bytes, std::size_t max_heads) {
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
+        refuse_lagged_model(*initial, "the initial model", "self-calibration does not learn a lagged model yet");
     }
     return self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg, orbit_period_s,
                                       memory_budget_bytes);

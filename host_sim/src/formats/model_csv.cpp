@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/pipeline/temperature_lag.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -30,7 +31,23 @@ std::string model_header(std::size_t terms) {
 namespace {
 constexpr std::string_view kRigidPrefix = "rigid-";
 constexpr const char* kCommonRotationColumn = "common_rotation";
+constexpr const char* kLagColumn = "lag_s";
 }  // namespace
+
+bool lag_acceptable(double lag_s) noexcept {
+    return lag_s == 0.0 || (lag_s >= pipeline::kMinLagTauS && lag_s <= pipeline::kMaxLagTauS);
+}
+
+std::string lag_range_text() {
+    return "0 (no lag) or [" + number_text(pipeline::kMinLagTauS) + ", " + number_text(pipeline::kMaxLagTauS) + "] s";
+}
+
+void refuse_lagged_model(const ModelFile& m, const std::string& path, const std::string& why) {
+    if (has_lag(m)) {
+        throw std::runtime_error(text::input_name(path) +
+                                 ": the model's lag_s makes its terms take lagged temperatures: " + why);
+    }
+}
 
 std::string common_rotation_name(const CommonRotationId& c) {
     switch (c.rule) {
@@ -145,7 +162,7 @@ void refuse_missing_columns(int col_chu, int col_axis, const int (&col_c)[kModel
 void refuse_unknown_columns(const Header& header, const std::string& file_name) {
     std::size_t column = 1;
     for (const std::string& name : header.names()) {
-        bool known = name == "chu" || name == "axis" || name == kCommonRotationColumn;
+        bool known = name == "chu" || name == "axis" || name == kCommonRotationColumn || name == kLagColumn;
         for (const char* c : kCoefficientNames) {
             known = known || name == c;
         }
@@ -154,7 +171,7 @@ void refuse_unknown_columns(const Header& header, const std::string& file_name) 
                                    "unknown column '" + name + "' (a model has chu, axis, " +
                                        coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
                                        coefficient_columns(kLinearModelTerms, kModelTerms, ", ") +
-                                       "; optionally common_rotation)");
+                                       "; optionally common_rotation and lag_s)");
         }
         column += name.size() + 1;
     }
@@ -243,6 +260,23 @@ void read_common_rotation(const std::string& file_name, std::size_t n, std::stri
     m.common_rotation = *c;
 }
 
+// The lag_s field of line n into head's lag: 0 or an accepted time
+// constant, the same on the head's three rows.
+void read_lag(const std::string& file_name, std::size_t n, std::string_view field, std::size_t column,
+              std::uint8_t head, bool head_seen, ModelFile& m) {
+    const auto x = parse_double(field);
+    if (!x || !lag_acceptable(*x)) {
+        throw text::InputError(file_name, n, column,
+                               "column 'lag_s': expected " + lag_range_text() + ", got '" + std::string(field) + "'");
+    }
+    if (head_seen && *x != m.lag_s[head]) {
+        throw text::InputError(file_name, n, column,
+                               "column 'lag_s': " + number_text(*x) + " differs from head " + head_name(head) +
+                                   "'s rows above (" + number_text(m.lag_s[head]) + "): one lag per head");
+    }
+    m.lag_s[head] = *x;
+}
+
 }  // namespace
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
@@ -269,6 +303,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         m.quadratic = m.quadratic || col_c[i] >= 0;
     }
     const int col_rule = header.index(kCommonRotationColumn);
+    const int col_lag = header.index(kLagColumn);
     bool first_row = true;
     bool seen[kMaxHeads][3] = {};
     std::vector<std::string_view> fields;
@@ -289,6 +324,10 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         if (col_rule >= 0) {
             const auto c = static_cast<std::size_t>(col_rule);
             read_common_rotation(file_name, n, fields[c], starts[c] + 1, first_row, m);
+        }
+        if (col_lag >= 0) {
+            const auto c = static_cast<std::size_t>(col_lag);
+            read_lag(file_name, n, fields[c], starts[c] + 1, head, seen[head][0] || seen[head][1] || seen[head][2], m);
         }
         first_row = false;
         seen[head][axis] = true;
@@ -318,9 +357,13 @@ ModelFile read_model_file(const std::string& path) {
 std::string format_model(const ModelFile& m) {
     const std::size_t ncoef = m.quadratic ? kModelTerms : kLinearModelTerms;
     const bool rule_column = m.common_rotation.rule != CommonRotationRule::kSmallest;
+    const bool lag_column = has_lag(m);
     std::string out = model_header(ncoef);
     if (rule_column) {
         out.insert(out.size() - 1, std::string(",") + kCommonRotationColumn);
+    }
+    if (lag_column) {
+        out.insert(out.size() - 1, std::string(",") + kLagColumn);
     }
     char buf[64];
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -338,6 +381,11 @@ std::string format_model(const ModelFile& m) {
             }
             if (rule_column) {
                 out += ',' + common_rotation_name(m.common_rotation);
+            }
+            if (lag_column) {
+                // %.17g: the lag survives a write/read round trip exactly (an integer reads as one).
+                text::c_snprintf(buf, sizeof buf, ",%.17g", m.lag_s[h]);
+                out += buf;
             }
             out += '\n';
         }

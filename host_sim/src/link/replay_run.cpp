@@ -28,6 +28,7 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     }
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
+    refuse_lagged_model(mf, opt.model, "replay cannot send it: the link's MODEL_UPLOAD has no word for a lag yet");
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(mf, opt.model);
     }

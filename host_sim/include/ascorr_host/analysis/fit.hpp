@@ -52,9 +52,11 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ascorr_host/analysis/epochs.hpp"
+#include "ascorr_host/analysis/fit_lag.hpp"
 #include "ascorr_host/analysis/fit_terms.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -105,7 +107,18 @@ struct FitOptions {
     // `combined` with mountings, `smallest` without. Its `motion` is filled
     // from the mountings by the fit.
     std::optional<CommonRotation> common_rotation;
+    // The bench's lag per head in s (--lag): the fit's terms take each head's
+    // temperatures through it, as `correct` does with the model written (its
+    // lag_s; lagged_temperatures.hpp); 0 none. nullopt (--lag auto, the
+    // default): chosen on the held-out part (fit_lag.hpp), none without one
+    // (holdout 0 or no selection report).
+    std::optional<std::array<double, kMaxHeads>> lag_s;
 };
+
+// --lag's text: "auto" (nullopt), "TAU" (every head) or "X:TAU,Y:TAU" (heads
+// named, the others 0), each TAU 0 or within the lag's range
+// (lag_range_text). Throws FitRefused naming what is wrong.
+std::optional<std::array<double, kMaxHeads>> parse_lags(std::string_view text);
 
 // The rule a fit with these options uses (the default above); the rule
 // `combined` without mountings is refused (FitRefused).
@@ -135,6 +148,7 @@ struct FitReport {
     CommonRotation common_rotation;  // the rule that fixed the 9 unobservable directions
     TermsFit fit;                    // the written model's fit: centring, rank
     Selection selection;             // the model-selection report
+    LagSelection lag;                // --lag auto's choice (verdict empty with a --lag given)
 };
 
 // Refusal of the data given (too short, too few orbits, rank-deficient, for

@@ -3,6 +3,10 @@
 // Header chu,axis and the linear terms' columns (c0,c1,c2,c3), optionally the
 // quadratic ones (c1_2,c2_2,c3_2; absent = 0): the names of
 // ascorr/core/model_terms.hpp, in its order.
+// Optionally lag_s (after common_rotation, when that is written): the time
+// constant of the head's bench lag in seconds, the same on its three rows; 0
+// or absent: no lag. A lagged head's terms take its temperatures through the
+// lag (ascorr/pipeline/temperature_lag.hpp; lagged_temperatures.hpp).
 // One row per head and axis; a head that appears must have all three axes.
 // Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
 // the core's radians (ascorr/core/model_coefficients.hpp).
@@ -62,11 +66,38 @@ struct ModelFile {
     // The rule that fixed its common rotation: a column common_rotation after
     // the coefficients when it is not kSmallest (every row the same name).
     CommonRotationId common_rotation{};
+    // By head index: the bench's lag in s (0 none, else within
+    // [pipeline::kMinLagTauS, kMaxLagTauS]); a column lag_s when any is not 0.
+    std::array<double, kMaxHeads> lag_s{};
     // Where each head and axis was read (1-based line) and each coefficient
     // (1-based character column); 0 for a model not read from a file.
     std::array<std::array<std::size_t, kModelAxes>, kMaxHeads> line{};
     std::array<std::array<std::array<std::size_t, kModelTerms>, kModelAxes>, kMaxHeads> column{};
 };
+
+// Whether any head's terms take lagged temperatures (lag_s not 0).
+inline bool has_lag(const ModelFile& m) noexcept {
+    bool any = false;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        any = any || (m.present[h] && m.lag_s[h] != 0.0);  // head_lags(m), below, not 0
+    }
+    return any;
+}
+// The lag of each head the model has (0 for the others), by head index.
+inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
+    std::array<double, kMaxHeads> lag{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        lag[h] = m.present[h] ? m.lag_s[h] : 0.0;
+    }
+    return lag;
+}
+// Whether lag_s is 0 or a time constant the lag accepts (pipeline::TemperatureLag::configure).
+bool lag_acceptable(double lag_s) noexcept;
+// "0 (no lag) or [1, 86400] s", for messages.
+std::string lag_range_text();
+// Throws (naming the model's file, then `why`) when the model's terms take
+// lagged temperatures: for the consumers that do not lag them yet.
+void refuse_lagged_model(const ModelFile& m, const std::string& path, const std::string& why);
 
 ModelFile read_model_file(const std::string& path);
 ModelFile parse_model(const std::string& file_name, std::string_view text);

@@ -1,0 +1,97 @@
+// ascorr_host/correct/lagged_temperatures.hpp: each row's temperatures as a
+// lagged model's terms take them (the model file's lag_s; issue 40).
+//
+// A head with a lag τ (ModelFile::lag_s) has its three channels stepped
+// through pipeline::TemperatureLag<double> over all of its rows in time
+// order, whatever order the rows come in: the row's terms then take the
+// lagged temperatures L at its t. Rows at the same t of a head are stepped
+// in the order of their readings (a channel advances once, at the first
+// valid one), so the answer does not depend on the rows' order; every row at
+// that t gets the state after them all.
+// A channel whose row has no reading (or one outside the core's domain)
+// keeps the row's own (missing or out of range) reading, so the core says
+// why it cannot use it, as without a lag. A head without a lag, and a row
+// whose t is not a time (tt_from_seconds), is answered with its own readings
+// but for the latter: its lagged head's channels are then marked missing
+// (status 16: no temperature is better than an unlagged one).
+// Double on every scalar: the core is given L as it is given a reading.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "ascorr/core/heads.hpp"
+#include "ascorr/pipeline/temperature_lag.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
+
+namespace ascorr::host {
+
+// One row's reading, as the table is built from it.
+struct LagReading {
+    std::int64_t t_us = 0;  // tt_from_seconds(t)
+    std::uint8_t head = 0;
+    std::array<double, 3> temperature{};  // t_chu, t_029, t_032 (°C)
+    std::array<bool, 3> present{};
+};
+
+// The order the lag steps readings in: by head, then time, then the readings
+// themselves (a missing one first), so that rows at one t step the same way in
+// any input order.
+bool lag_order(const LagReading& a, const LagReading& b) noexcept;
+
+// One head's readings, sorted by lag_order, through a lag of tau_s (accepted
+// by TemperatureLag::configure): at(t_us, lagged, valid) once per distinct t,
+// with the state after its last reading (lagged[k] = L of channel k, valid[k]
+// once the channel has started). The one walk of the table below and of the
+// fit's choice of the lag (fit_lag.hpp).
+template <typename At>
+void walk_lag(double tau_s, const LagReading* first, const LagReading* last, At&& at) {
+    pipeline::TemperatureLag<double> lag;
+    lag.configure(tau_s);
+    for (const LagReading* r = first; r != last; ++r) {
+        lag.step(r->t_us, {{r->temperature[0], r->present[0]},
+                           {r->temperature[1], r->present[1]},
+                           {r->temperature[2], r->present[2]}});
+        if (r + 1 != last && (r + 1)->t_us == r->t_us) {
+            continue;  // the state after every row at this t
+        }
+        std::array<double, 3> lagged{};
+        std::array<bool, 3> valid{};
+        for (std::uint8_t k = 0; k < 3; ++k) {
+            const TemperatureReading<double> l = lag.lagged(k);
+            lagged[k] = l.value;
+            valid[k] = l.valid;
+        }
+        at(r->t_us, lagged, valid);
+    }
+}
+
+class LaggedTemperatures {
+public:
+    // lag_s by head index (0: no lag; otherwise within the lag's range,
+    // checked by the model's reader); readings of any heads, any order (the
+    // heads without a lag are dropped).
+    LaggedTemperatures(const std::array<double, kMaxHeads>& lag_s, std::vector<LagReading> readings);
+
+    bool lags(std::uint8_t head) const noexcept { return head < kMaxHeads && lag_s_[head] != 0.0; }
+
+    // rec's temperatures as its terms take them (above); unchanged when its
+    // head has no lag.
+    void apply(SolutionRecord& rec) const;
+
+private:
+    struct Entry {
+        std::int64_t t_us;
+        std::array<double, 3> lagged;
+        std::array<bool, 3> valid;
+    };
+    std::array<double, kMaxHeads> lag_s_{};
+    std::array<std::vector<Entry>, kMaxHeads> series_{};  // per head, by t_us
+};
+
+// The reading of rec for the table; false when its t is not a time or its
+// head is not one of kMaxHeads.
+bool lag_reading_of(const SolutionRecord& rec, LagReading& out) noexcept;
+
+}  // namespace ascorr::host

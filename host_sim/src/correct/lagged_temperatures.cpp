@@ -1,0 +1,64 @@
+#include "ascorr_host/correct/lagged_temperatures.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+#include "ascorr/nav/tt_time.hpp"
+
+namespace ascorr::host {
+
+bool lag_order(const LagReading& a, const LagReading& b) noexcept {
+    const auto key = [](const LagReading& r) {
+        return std::make_tuple(r.head, r.t_us, r.present[0], r.present[0] ? r.temperature[0] : 0.0, r.present[1],
+                               r.present[1] ? r.temperature[1] : 0.0, r.present[2],
+                               r.present[2] ? r.temperature[2] : 0.0);
+    };
+    return key(a) < key(b);
+}
+
+bool lag_reading_of(const SolutionRecord& rec, LagReading& out) noexcept {
+    TtTime t{};
+    if (rec.head >= kMaxHeads || !tt_from_seconds(rec.t, t)) {
+        return false;
+    }
+    out = {t.us, rec.head, rec.temperature, rec.temperature_present};
+    return true;
+}
+
+LaggedTemperatures::LaggedTemperatures(const std::array<double, kMaxHeads>& lag_s, std::vector<LagReading> readings)
+    : lag_s_(lag_s) {
+    readings.erase(std::remove_if(readings.begin(), readings.end(), [&](const LagReading& r) { return !lags(r.head); }),
+                   readings.end());
+    std::sort(readings.begin(), readings.end(), lag_order);
+    for (auto first = readings.begin(); first != readings.end();) {
+        const std::uint8_t head = first->head;
+        const auto last = std::find_if(first, readings.end(), [&](const LagReading& r) { return r.head != head; });
+        std::vector<Entry>& s = series_[head];
+        walk_lag(lag_s_[head], &*first, &*first + (last - first),
+                 [&](std::int64_t t_us, const std::array<double, 3>& lagged, const std::array<bool, 3>& valid) {
+                     s.push_back({t_us, lagged, valid});
+                 });
+        first = last;
+    }
+}
+
+void LaggedTemperatures::apply(SolutionRecord& rec) const {
+    if (!lags(rec.head)) {
+        return;
+    }
+    LagReading r;
+    const std::vector<Entry>& s = series_[rec.head];
+    const auto it = lag_reading_of(rec, r) ? std::lower_bound(s.begin(), s.end(), r.t_us,
+                                                              [](const Entry& e, std::int64_t t) { return e.t_us < t; })
+                                           : s.end();
+    const bool found = it != s.end() && it->t_us == r.t_us;
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (!found) {
+            rec.temperature_present[k] = false;  // a row not in the table: no unlagged temperature
+        } else if (rec.temperature_present[k] && temperature_in_domain<double>(rec.temperature[k]) && it->valid[k]) {
+            rec.temperature[k] = it->lagged[k];
+        }
+    }
+}
+
+}  // namespace ascorr::host

@@ -1,0 +1,386 @@
+// The bench's lag (issue 40): the model file's lag_s, the lagged temperatures
+// `correct` and `fit` give the terms, and `fit --lag auto`'s choice, each
+// measured against what the test computes itself: its own first-order filter
+// in long double, a file whose temperatures it lagged itself, and the
+// simulator's noise-only IBAs (the systematic residual).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "ascorr/nav/tt_time.hpp"
+#include "ascorr_host/analysis/fit.hpp"
+#include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
+#include "cli_run.hpp"
+#include "test_support.hpp"
+
+namespace ascorr::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// ---- The test's own lag: L ← L + (1 − e^(−Δt/τ))·(T − L) per channel in
+// long double, a reading held over its step, Δt since the channel's last
+// reading; L = T at the first one.
+struct OwnLag {
+    long double tau_s;
+    std::array<long double, 3> l{};
+    std::array<std::int64_t, 3> t_us{};
+    std::array<bool, 3> started{};
+
+    void step(std::int64_t t, const std::array<double, 3>& temp, const std::array<bool, 3>& present) {
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (!present[k]) {
+                continue;
+            }
+            if (!started[k]) {
+                l[k] = temp[k];
+                started[k] = true;
+            } else if (t > t_us[k]) {
+                const long double a = -std::expm1(-static_cast<long double>(t - t_us[k]) * 1e-6L / tau_s);
+                l[k] += a * (static_cast<long double>(temp[k]) - l[k]);
+            } else {
+                continue;  // not after the channel's last reading: unchanged
+            }
+            t_us[k] = t;
+        }
+    }
+};
+
+host::SolutionRecord record(std::uint8_t head, double t, const std::array<double, 3>& temp,
+                            const std::array<bool, 3>& present) {
+    host::SolutionRecord rec;
+    rec.head = head;
+    rec.t = t;
+    rec.temperature = temp;
+    rec.temperature_present = present;
+    return rec;
+}
+
+TEST(LaggedTemperatures, AreTheTestsOwnFilterInAnyRowOrder) {
+    // Heads A (τ 900 s) and B (1800 s), C without a lag: 45/46 ms steps (22 Hz
+    // rounded to ms), an orbit's swing, a channel missing now and then, an hour's
+    // gap, and a row twice.
+    const std::array<double, kMaxHeads> lag_s{900.0, 1800.0, 0.0, 0.0};
+    std::vector<host::SolutionRecord> rows;
+    double t = 456148800.0;
+    for (int i = 0; i < 30000; ++i) {
+        t += (i % 2 == 0 ? 0.045 : 0.046) + (i == 15000 ? 3600.0 : 0.0);
+        for (std::uint8_t h = 0; h < 3; ++h) {
+            const double w = 2.0 * 3.141592653589793 * (t - 456148800.0) / 5600.0;
+            const std::array<double, 3> temp{20.0 + 3.0 * std::sin(w + h), -5.0 + 2.0 * std::cos(w),
+                                             -15.0 + std::sin(2.0 * w)};
+            rows.push_back(record(h, t, temp, {i % 37 != 5, i % 53 != 7, true}));
+        }
+    }
+    rows.push_back(rows[3000]);
+    std::vector<host::LagReading> readings;
+    for (const host::SolutionRecord& r : rows) {
+        host::LagReading x;
+        ASSERT_TRUE(host::lag_reading_of(r, x));
+        readings.push_back(x);
+    }
+    std::vector<host::LagReading> shuffled = readings;
+    std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937_64(40));
+    const host::LaggedTemperatures table(lag_s, readings);
+    const host::LaggedTemperatures table_shuffled(lag_s, shuffled);
+
+    std::array<OwnLag, 2> own{OwnLag{900.0L}, OwnLag{1800.0L}};
+    double worst = 0.0;
+    double deviation = 0.0;
+    for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+        const host::SolutionRecord& r = rows[i];
+        TtTime tt{};
+        ASSERT_TRUE(tt_from_seconds(r.t, tt));
+        host::SolutionRecord a = r;
+        host::SolutionRecord b = r;
+        table.apply(a);
+        table_shuffled.apply(b);
+        for (std::size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ(a.temperature[k], b.temperature[k]) << "row " << i;  // the same bits in any order
+            EXPECT_EQ(a.temperature_present[k], r.temperature_present[k]);
+        }
+        if (r.head == 2) {
+            EXPECT_EQ(a.temperature, r.temperature) << "a head without a lag keeps its readings";
+            continue;
+        }
+        own[r.head].step(tt.us, r.temperature, r.temperature_present);
+        if (r.head == 0 && r.temperature_present[0]) {
+            deviation = std::max(deviation, std::abs(a.temperature[0] - r.temperature[0]));
+        }
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (r.temperature_present[k]) {
+                worst = std::max(worst, std::abs(static_cast<double>(a.temperature[k] - own[r.head].l[k])));
+            }
+        }
+    }
+    EXPECT_LT(worst, 1e-9) << "degC";
+    // Not vacuous: A's T1 falls behind its swing by more than a degree (1.43 °C).
+    EXPECT_GT(deviation, 1.0) << "degC";
+
+    // A row of a lagged head whose t is not a time: no unlagged temperature.
+    host::SolutionRecord bad = record(0, std::nan(""), {20.0, 0.0, 0.0}, {true, true, true});
+    table.apply(bad);
+    EXPECT_EQ(bad.temperature_present, (std::array<bool, 3>{false, false, false}));
+}
+
+TEST(ModelFileLag, RoundTripsAndTodaysFilesAreUnaffected) {
+    const std::string linear =
+        "chu,axis,c0,c1,c2,c3\nA,alpha,1,2,3,4\nA,beta,1,2,3,4\nA,gamma,1,2,3,4\n"
+        "B,alpha,1,2,3,4\nB,beta,1,2,3,4\nB,gamma,1,2,3,4\n";
+    const host::ModelFile plain = host::parse_model("m.csv", linear);
+    EXPECT_FALSE(host::has_lag(plain));
+    EXPECT_EQ(plain.lag_s, (std::array<double, kMaxHeads>{}));
+    EXPECT_EQ(host::format_model(plain).find("lag_s"), std::string::npos);
+
+    host::ModelFile lagged = plain;
+    lagged.lag_s = {1800.0, 912.5, 0.0, 0.0};
+    lagged.common_rotation.rule = host::CommonRotationRule::kCombined;
+    const std::string text = host::format_model(lagged);
+    EXPECT_EQ(text.substr(0, text.find('\n')), "chu,axis,c0,c1,c2,c3,common_rotation,lag_s");
+    const host::ModelFile back = host::parse_model("m.csv", text);
+    EXPECT_EQ(back.lag_s, lagged.lag_s);
+    EXPECT_EQ(host::format_model(back), text);
+    EXPECT_TRUE(host::has_lag(back));
+}
+
+TEST(ModelFileLag, RefusesALagItCannotTake) {
+    const auto model = [](const std::string& a, const std::string& b) {
+        return "chu,axis,c0,c1,c2,c3,lag_s\nA,alpha,1,2,3,4," + a + "\nA,beta,1,2,3,4," + b + "\nA,gamma,1,2,3,4," + b +
+               "\n";
+    };
+    const std::pair<std::string, std::string> cases[] = {
+        {model("-1", "-1"), "m.csv:2:17: column 'lag_s': expected 0 (no lag) or [1, 86400] s, got '-1'"},
+        {model("0.5", "0.5"), "got '0.5'"},
+        {model("86401", "86401"), "got '86401'"},
+        {model("nan", "nan"), "got 'nan'"},
+        {model("", ""), "got ''"},
+        {model("900", "1800"),
+         "m.csv:3:16: column 'lag_s': 1800 differs from head A's rows above (900): one lag "
+         "per head"},
+        {"chu,axis,c0,c1,c2,c3,lag\nA,alpha,1,2,3,4,1\n", "unknown column 'lag'"},
+    };
+    for (const auto& [text, part] : cases) {
+        const std::string why =
+            thrown_by<std::exception>([&] { host::parse_model("m.csv", text); }, "accepted: " + text);
+        EXPECT_NE(why.find(part), std::string::npos) << text << ": " << why;
+    }
+}
+
+TEST(ModelFileLag, ConsumersThatDoNotLagRefuseIt) {
+    const fs::path dir = scratch_dir("lag-consumers");
+    ASSERT_EQ(run_in("simulate --days 0.3 --out s.csv > /dev/null", dir).exit_code, 0);
+    std::ostringstream model;
+    model << "chu,axis,c0,c1,c2,c3,lag_s\n";
+    for (const char* h : {"A", "B", "C"}) {
+        for (const char* a : {"alpha", "beta", "gamma"}) {
+            model << h << ',' << a << ",1,0.1,0.2,0.3,900\n";
+        }
+    }
+    write(dir / "m.csv", model.str());
+    const std::pair<std::string, std::string> cases[] = {
+        {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
+         "--self-calibrate does not learn a lagged model yet"},
+        {"stats --in s.csv --model m.csv", "stats --model does not lag them; give stats the file ascorr correct"},
+        {"simulate --days 0.1 --truth m.csv --out t.csv",
+         "a truth model takes no lag: --bench-lag lags the simulated bench"},
+    };
+    for (const auto& [args, part] : cases) {
+        const CliRun r = run_in(args + " > out.txt", dir);
+        expect_refused(r, kAnyFailure, {"m.csv: the model's lag_s makes its terms take lagged temperatures", part});
+        expect_absent(dir, {"c.csv", "t.csv"});
+    }
+    const CliRun ok = run_in("correct --in s.csv --model m.csv --out c.csv", dir);
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
+TEST(FitLag, ParsesItsOption) {
+    EXPECT_FALSE(host::parse_lags("auto").has_value());
+    EXPECT_EQ(*host::parse_lags("900"), (std::array<double, kMaxHeads>{900.0, 900.0, 900.0, 900.0}));
+    EXPECT_EQ(*host::parse_lags("A:900,C:1800"), (std::array<double, kMaxHeads>{900.0, 0.0, 1800.0, 0.0}));
+    for (const char* bad : {"-5", "0.5", "A:900,A:100", "X:5", "A900", "A:", "A:9e9", "", "A:900,"}) {
+        EXPECT_NE(
+            thrown_by<host::FitRefused>([&] { host::parse_lags(bad); }, std::string("accepted: ") + bad).find("--lag"),
+            std::string::npos)
+            << bad;
+    }
+    const fs::path dir = scratch_dir("lag-option");
+    const CliRun r = run_in("fit --in none.csv --out m.csv --lag B:-1", dir);
+    expect_refused(r, 2, {"--lag B:-1: 'B:-1': the lag must be 0 (no lag) or [1, 86400] s"});
+    expect_absent(dir, {"m.csv"});
+}
+
+// ---- A mission whose bench lags by 1800 s (60 days, seed 3), fitted and
+// corrected; the systematic residual per pair against its noise-only IBAs.
+
+constexpr double kLagS = 1800.0;
+constexpr double kBound = 0.15;  // arcsec per pair, issue 40's
+
+const fs::path& lag_mission() {
+    static const fs::path dir = [] {
+        const fs::path d = scratch_dir("lag-mission");
+        const CliRun r = run_in("simulate --days 60 --seed 3 --bench-lag 1800 --noise-iba --out m.csv > /dev/null", d);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return d;
+    }();
+    return dir;
+}
+
+// The systematic residual per pair of the corrected file `corrected`.
+std::array<double, 3> systematic(const fs::path& dir, const std::string& corrected) {
+    host::StatsOptions s;
+    s.in = (dir / corrected).string();
+    s.noise_iba = (lag_mission() / "m.csv.noise-iba.csv").string();
+    s.log_empty_pairs = false;
+    std::ostringstream log;
+    const host::StatsResult r = host::compute_stats(s, log);
+    return {r.systematic_rms[0][0].rms, r.systematic_rms[1][0].rms, r.systematic_rms[2][0].rms};
+}
+
+// fit ARGS on IN into MODEL, then correct IN with it into OUT.
+void fit_and_correct(const fs::path& dir, const std::string& in, const std::string& args, const std::string& model,
+                     const std::string& out) {
+    const CliRun f =
+        run_in("fit --in " + in + " --out " + model + " --min-days 20 " + args + " > " + model + ".txt", dir);
+    ASSERT_EQ(f.exit_code, 0) << f.err;
+    const CliRun c = run_in("correct --in " + in + " --model " + model + " --out " + out, dir);
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+}
+
+TEST(FitLag, TheDefaultFitFindsTheLagAndRemovesTheResidualInsideTheOrbit) {
+    const fs::path& dir = lag_mission();
+    fit_and_correct(dir, "m.csv", "", "auto.csv", "c_auto.csv");
+    const host::ModelFile m = host::read_model_file((dir / "auto.csv").string());
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        EXPECT_GE(m.lag_s[h], kLagS / 1.5) << host::head_name(h);
+        EXPECT_LE(m.lag_s[h], kLagS * 1.5) << host::head_name(h);
+    }
+    EXPECT_TRUE(has(slurp(dir / "auto.csv.txt"), "bench lag (--lag auto): lagged: the best lags found"));
+    const std::array<double, 3> with_lag = systematic(dir, "c_auto.csv");
+    // Mutation: the same fit without the lag leaves the bench's lag inside the orbit.
+    fit_and_correct(dir, "m.csv", "--lag 0", "none.csv", "c_none.csv");
+    EXPECT_EQ(slurp(dir / "none.csv").find("lag_s"), std::string::npos);
+    const std::array<double, 3> without = systematic(dir, "c_none.csv");
+    for (std::size_t p = 0; p < 3; ++p) {
+        EXPECT_LE(with_lag[p], kBound) << "pair " << p;
+        RecordProperty("systematic_lagged_" + std::to_string(p), std::to_string(with_lag[p]));
+    }
+    EXPECT_GT(*std::max_element(without.begin(), without.end()), 2.0 * kBound) << "without the lag the bound must fail";
+}
+
+// The file's temperatures lagged by the test itself (OwnLag, each head over
+// its rows in time order: simulate writes them so), written back with 9
+// decimals.
+void write_own_lagged(const fs::path& from, const fs::path& to, double tau_s) {
+    std::array<OwnLag, kMaxHeads> own{OwnLag{tau_s}, OwnLag{tau_s}, OwnLag{tau_s}, OwnLag{tau_s}};
+    rewrite_csv_rows(from, to, [&](const std::string& line, std::ofstream& out) {
+        std::vector<std::string> f;
+        std::stringstream ss(line);
+        for (std::string x; std::getline(ss, x, ',');) {
+            f.push_back(x);
+        }
+        f.resize(14);  // t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence
+        const std::uint8_t h = head_index(f[1][0]);
+        std::array<double, 3> temp{};
+        std::array<bool, 3> present{};
+        for (std::size_t k = 0; k < 3; ++k) {
+            present[k] = !f[6 + k].empty();
+            temp[k] = present[k] ? std::stod(f[6 + k]) : 0.0;
+        }
+        TtTime tt{};
+        ASSERT_TRUE(tt_from_seconds(std::stod(f[0]), tt));
+        own[h].step(tt.us, temp, present);
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (present[k]) {
+                char buf[40];
+                std::snprintf(buf, sizeof buf, "%.9f", static_cast<double>(own[h].l[k]));
+                f[6 + k] = buf;
+            }
+        }
+        for (std::size_t i = 0; i < f.size(); ++i) {
+            out << (i == 0 ? "" : ",") << f[i];
+        }
+        out << '\n';
+    });
+}
+
+TEST(FitLag, CorrectLagsAsTheTestsOwnFilterDoes) {
+    const fs::path& dir = lag_mission();
+    write_own_lagged(dir / "m.csv", dir / "own.csv", kLagS);
+    fit_and_correct(dir, "own.csv", "--lag 0", "own_model.csv", "c_own.csv");
+    fit_and_correct(dir, "m.csv", "--lag 1800", "given.csv", "c_given.csv");
+    const std::array<double, 3> own = systematic(dir, "c_own.csv");
+    const std::array<double, 3> given = systematic(dir, "c_given.csv");
+    for (std::size_t p = 0; p < 3; ++p) {
+        EXPECT_NEAR(given[p], own[p], 0.002) << "pair " << p;
+        EXPECT_LE(given[p], kBound) << "pair " << p;
+    }
+    const host::ModelFile a = host::read_model_file((dir / "own_model.csv").string());
+    const host::ModelFile b = host::read_model_file((dir / "given.csv").string());
+    EXPECT_EQ(b.lag_s, (std::array<double, kMaxHeads>{kLagS, kLagS, kLagS, 0.0}));
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t k = 0; k < kLinearModelTerms; ++k) {
+                EXPECT_NEAR(a.coefficients[h][ax][k], b.coefficients[h][ax][k],
+                            1e-6 * (1.0 + std::abs(b.coefficients[h][ax][k])));
+            }
+        }
+    }
+}
+
+TEST(FitLag, RowOrderDoesNotMatter) {
+    // Reversed rows: the same lagged temperatures, so the same model (to the
+    // rounding of the fit's sums, which add in another order) and, with one
+    // model, the same corrected rows to the bit.
+    const fs::path& dir = lag_mission();
+    std::vector<std::string> lines = lines_of_file(dir / "m.csv");
+    std::reverse(lines.begin() + 1, lines.end());
+    write_lines(dir / "reversed.csv", lines);
+    if (!fs::exists(dir / "given.csv")) {
+        fit_and_correct(dir, "m.csv", "--lag 1800", "given.csv", "c_given.csv");
+    }
+    const CliRun f = run_in("fit --in reversed.csv --out reversed_model.csv --min-days 20 --lag 1800 > /dev/null", dir);
+    ASSERT_EQ(f.exit_code, 0) << f.err;
+    const host::ModelFile a = host::read_model_file((dir / "reversed_model.csv").string());
+    const host::ModelFile b = host::read_model_file((dir / "given.csv").string());
+    EXPECT_EQ(a.lag_s, b.lag_s);
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (std::size_t ax = 0; ax < 3; ++ax) {
+            for (std::size_t k = 0; k < kLinearModelTerms; ++k) {
+                EXPECT_NEAR(a.coefficients[h][ax][k], b.coefficients[h][ax][k],
+                            1e-9 * (1.0 + std::abs(b.coefficients[h][ax][k])));
+            }
+        }
+    }
+    const CliRun c = run_in("correct --in reversed.csv --model given.csv --out c_reversed.csv", dir);
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    std::vector<std::string> x = lines_of_file(dir / "c_reversed.csv");
+    std::vector<std::string> y = lines_of_file(dir / "c_given.csv");
+    ASSERT_EQ(x.size(), y.size());
+    std::reverse(x.begin() + 1, x.end());
+    EXPECT_TRUE(x == y) << "the corrected rows, reversed back, are the same bytes";
+}
+
+TEST(FitLag, AStaticBenchGetsTodaysModelByteForByte) {
+    const fs::path dir = scratch_dir("lag-static");
+    ASSERT_EQ(run_in("simulate --days 60 --seed 3 --out s.csv > /dev/null", dir).exit_code, 0);
+    const CliRun a = run_in("fit --in s.csv --out auto.csv --min-days 20 > auto.txt", dir);
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    const CliRun n = run_in("fit --in s.csv --out none.csv --min-days 20 --lag 0 > none.txt", dir);
+    ASSERT_EQ(n.exit_code, 0) << n.err;
+    EXPECT_EQ(slurp(dir / "auto.csv"), slurp(dir / "none.csv"));
+    EXPECT_TRUE(has(slurp(dir / "auto.txt"), "bench lag (--lag auto): no lag: the best lags found"))
+        << slurp(dir / "auto.txt");
+}
+
+}  // namespace
+}  // namespace ascorr::test
