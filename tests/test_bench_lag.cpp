@@ -82,7 +82,12 @@ TEST(LaggedTemperatures, AreTheTestsOwnFilterInAnyRowOrder) {
             rows.push_back(record(h, t, temp, {i % 37 != 5, i % 53 != 7, true}));
         }
     }
-    rows.push_back(rows[3000]);
+    // A second row of head A at one time, its T1 higher: it comes after the
+    // first in the lag's order (by reading), so the channel advanced at the
+    // first, and both rows get the state after them.
+    host::SolutionRecord twice = rows[3000];
+    twice.temperature[0] += 0.5;
+    rows.insert(rows.begin() + 3001, twice);
     std::vector<host::LagReading> readings;
     for (const host::SolutionRecord& r : rows) {
         host::LagReading x;
@@ -97,7 +102,7 @@ TEST(LaggedTemperatures, AreTheTestsOwnFilterInAnyRowOrder) {
     std::array<OwnLag, 2> own{OwnLag{900.0L}, OwnLag{1800.0L}};
     double worst = 0.0;
     double deviation = 0.0;
-    for (std::size_t i = 0; i + 1 < rows.size(); ++i) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
         const host::SolutionRecord& r = rows[i];
         TtTime tt{};
         ASSERT_TRUE(tt_from_seconds(r.t, tt));
@@ -113,7 +118,7 @@ TEST(LaggedTemperatures, AreTheTestsOwnFilterInAnyRowOrder) {
             EXPECT_EQ(a.temperature, r.temperature) << "a head without a lag keeps its readings";
             continue;
         }
-        own[r.head].step(tt.us, r.temperature, r.temperature_present);
+        own[r.head].step(tt.us, r.temperature, r.temperature_present);  // `twice`: not after, unchanged
         if (r.head == 0 && r.temperature_present[0]) {
             deviation = std::max(deviation, std::abs(a.temperature[0] - r.temperature[0]));
         }
@@ -124,6 +129,11 @@ TEST(LaggedTemperatures, AreTheTestsOwnFilterInAnyRowOrder) {
         }
     }
     EXPECT_LT(worst, 1e-9) << "degC";
+    host::SolutionRecord first = rows[3000];
+    host::SolutionRecord second = rows[3001];
+    table_shuffled.apply(first);
+    table_shuffled.apply(second);
+    EXPECT_EQ(first.temperature, second.temperature) << "rows of a head at one t: one state";
     // Not vacuous: A's T1 falls behind its swing by more than a degree (1.43 °C).
     EXPECT_GT(deviation, 1.0) << "degC";
 
@@ -190,14 +200,20 @@ TEST(ModelFileLag, ConsumersThatDoNotLagRefuseIt) {
     const std::pair<std::string, std::string> cases[] = {
         {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
          "--self-calibrate does not learn a lagged model yet"},
-        {"stats --in s.csv --model m.csv", "stats --model does not lag them; give stats the file ascorr correct"},
+        {"replay --target loopback-float --in s.csv --model m.csv --out c.csv",
+         "replay cannot send it: the link's MODEL_UPLOAD has no word for a lag yet"},
+        {"plot --in s.csv --model m.csv --out c.png", "stats and plot (--model) do not lag them"},
+        {"simulate --days 0.2 --truth-change 0.1:m.csv --out t.csv",
+         "a truth model takes no lag: --bench-lag lags the simulated bench"},
+        {"stats --in s.csv --model m.csv",
+         "stats and plot (--model) do not lag them; give them the file ascorr correct"},
         {"simulate --days 0.1 --truth m.csv --out t.csv",
          "a truth model takes no lag: --bench-lag lags the simulated bench"},
     };
     for (const auto& [args, part] : cases) {
         const CliRun r = run_in(args + " > out.txt", dir);
-        expect_refused(r, kAnyFailure, {"m.csv: the model's lag_s makes its terms take lagged temperatures", part});
-        expect_absent(dir, {"c.csv", "t.csv"});
+        expect_refused(r, 1, {"m.csv: the model's lag_s makes its terms take lagged temperatures", part});
+        expect_absent(dir, {"c.csv", "t.csv", "c.png"});
     }
     const CliRun ok = run_in("correct --in s.csv --model m.csv --out c.csv", dir);
     EXPECT_EQ(ok.exit_code, 0) << ok.err;
@@ -368,6 +384,42 @@ TEST(FitLag, RowOrderDoesNotMatter) {
     ASSERT_EQ(x.size(), y.size());
     std::reverse(x.begin() + 1, x.end());
     EXPECT_TRUE(x == y) << "the corrected rows, reversed back, are the same bytes";
+}
+
+TEST(FitLag, TheChoiceTakesEachHeadsOwnTime) {
+    // Head B's rows 300 µs after the epoch's others (the same millisecond, so
+    // the same epochs): the choice must look each head's lag up at its own t,
+    // whichever head's row an epoch met first; reversed rows choose the same.
+    const fs::path& dir = lag_mission();
+    rewrite_csv_rows(dir / "m.csv", dir / "late_b.csv", [](const std::string& line, std::ofstream& out) {
+        const std::size_t comma = line.find(',');
+        if (line.compare(comma + 1, 2, "B,") == 0) {
+            char t[40];
+            std::snprintf(t, sizeof t, "%.4f", std::stod(line.substr(0, comma)) + 0.0003);
+            out << t << line.substr(comma) << '\n';
+        } else {
+            out << line << '\n';
+        }
+    });
+    std::vector<std::string> lines = lines_of_file(dir / "late_b.csv");
+    std::reverse(lines.begin() + 1, lines.end());
+    write_lines(dir / "late_b_reversed.csv", lines);
+    for (const char* in : {"late_b.csv", "late_b_reversed.csv"}) {
+        const CliRun f =
+            run_in(std::string("fit --in ") + in + " --out " + in + ".model --min-days 20 > " + in + ".txt", dir);
+        ASSERT_EQ(f.exit_code, 0) << f.err;
+    }
+    const host::ModelFile a = host::read_model_file((dir / "late_b.csv.model").string());
+    const host::ModelFile b = host::read_model_file((dir / "late_b_reversed.csv.model").string());
+    EXPECT_EQ(a.lag_s, b.lag_s);
+    EXPECT_TRUE(host::has_lag(a)) << slurp(dir / "late_b.csv.txt");
+    const std::string report = slurp(dir / "late_b.csv.txt");
+    const std::string verdict = report.substr(report.find("bench lag"));
+    EXPECT_EQ(verdict.substr(0, verdict.find(" candidates")), [&] {
+        const std::string r = slurp(dir / "late_b_reversed.csv.txt");
+        const std::string v = r.substr(r.find("bench lag"));
+        return v.substr(0, v.find(" candidates"));
+    }()) << "the same scores in either order";
 }
 
 TEST(FitLag, AStaticBenchGetsTodaysModelByteForByte) {

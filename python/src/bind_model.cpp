@@ -50,6 +50,11 @@ void lags_into(const py::object& lag_s, host::ModelFile& m) {
             bad_argument("lag_s", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) + "'s " +
                                       number_text(d.data()[h]) + " is not " + host::lag_range_text());
         }
+        if (!m.present[h] && d.data()[h] != 0.0) {
+            bad_argument("lag_s", std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) +
+                                      " has no coefficients (heads): its lag must be 0, got " +
+                                      number_text(d.data()[h]));
+        }
         m.lag_s[h] = d.data()[h];
     }
 }

@@ -104,6 +104,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     if (m != nullptr) {
         try {
             host::refuse_quadratic_initial_model(*m, "the model given");
+            host::refuse_lagged_model(*m, "the model given", "self-calibration does not learn a lagged model yet");
         } catch (const std::runtime_error& e) {
             bad_argument("model", e.what());
         }

@@ -269,6 +269,8 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
         model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=20, lag=py)
         assert model.to_csv() == out.read_text(), cli
         assert (report["lag"] != "") == (cli == "auto")
+        if cli == "auto":
+            assert report["lag"].startswith("lagged: "), report["lag"]  # the second pass ran
     assert list(model.lag_s) == [900.0, 0.0, 1800.0, 0.0]
     assert "lagged" in repr(model)
     assert pickle.loads(pickle.dumps(model)) == model

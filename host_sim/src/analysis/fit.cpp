@@ -32,6 +32,7 @@ namespace {
 struct Row {
     Eigen::Quaterniond q;        // aberration-corrected, ICRF into head
     std::array<double, 3> temp;  // T1, T2, T3
+    double t;                    // the row's own (an epoch's heads agree to the millisecond)
 };
 
 // Sums over one orbit's epochs, per head. q: the rotations a = q_head_f ⊗ r⁻¹
@@ -138,6 +139,16 @@ FitReport fit_model(const FitOptions& opt) {
 
 namespace {
 
+// The lags of the heads present (the others none).
+std::array<double, kMaxHeads> lags_of_heads(const std::array<bool, kMaxHeads>& present,
+                                            const std::array<double, kMaxHeads>& lag_s) {
+    std::array<double, kMaxHeads> out{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        out[h] = present[h] ? lag_s[h] : 0.0;
+    }
+    return out;
+}
+
 // Every row's reading, sorted for the lag (lag_order): one more reading of the rows.
 std::vector<LagReading> lag_readings(const RowSource& rows) {
     std::vector<LagReading> readings;
@@ -149,6 +160,28 @@ std::vector<LagReading> lag_readings(const RowSource& rows) {
     });
     std::sort(readings.begin(), readings.end(), lag_order);
     return readings;
+}
+
+// --lag auto: the fit without a lag, whose pass chooses one (select_lags);
+// then, when it took one, the fit with it, as --lag with those lags. A lagged
+// model the data refuse (its terms, its condition) leaves the unlagged one.
+FitReport fit_choosing_lag(const FitOptions& opt, const RowSource& rows) {
+    std::vector<LagReading> readings = opt.holdout > 0.0 ? lag_readings(rows) : std::vector<LagReading>{};
+    FitReport r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), nullptr, &readings);
+    if (!any_lag(r.lag.lag_s)) {
+        return r;
+    }
+    const LaggedTemperatures lag(r.lag.lag_s, std::move(readings));
+    try {
+        FitReport lagged = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &lag, nullptr);
+        lagged.lag = r.lag;
+        lagged.model.lag_s = lags_of_heads(lagged.model.present, r.lag.lag_s);
+        return lagged;
+    } catch (const FitRefused& e) {
+        r.lag.lag_s = {};
+        r.lag.verdict += std::string("; but the fit with them is refused (") + e.what() + "): no lag";
+        return r;
+    }
 }
 
 }  // namespace
@@ -170,27 +203,16 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          number_text(opt.min_temperature_range_c));
     }
-    const bool choose = !opt.lag_s && opt.selection_report && opt.holdout > 0.0;
-    const bool given = opt.lag_s && any_lag(*opt.lag_s);
-    std::vector<LagReading> readings = choose || given ? lag_readings(rows) : std::vector<LagReading>{};
-    std::optional<LaggedTemperatures> lag;
-    if (given) {
-        lag.emplace(*opt.lag_s, readings);
+    if (opt.lag_s && any_lag(*opt.lag_s)) {
+        const LaggedTemperatures lag(*opt.lag_s, lag_readings(rows));
+        FitReport r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &lag, nullptr);
+        r.model.lag_s = lags_of_heads(r.model.present, *opt.lag_s);  // a head not fitted has none
+        return r;
     }
-    FitReport r =
-        fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), lag ? &*lag : nullptr, choose ? &readings : nullptr);
-    if (choose && any_lag(r.lag.lag_s)) {
-        // The model of the lags chosen, from all of the period: as --lag with them.
-        lag.emplace(r.lag.lag_s, std::move(readings));
-        const LagSelection chosen = r.lag;
-        r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &*lag, nullptr);
-        r.lag = chosen;
+    if (opt.lag_s || !opt.selection_report) {
+        return fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), nullptr, nullptr);
     }
-    const std::array<double, kMaxHeads> lag_s = opt.lag_s ? *opt.lag_s : r.lag.lag_s;
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        r.model.lag_s[h] = r.model.present[h] ? lag_s[h] : 0.0;
-    }
-    return r;
+    return fit_choosing_lag(opt, rows);
 }
 
 std::optional<std::array<double, kMaxHeads>> parse_lags(std::string_view text) {
@@ -294,6 +316,7 @@ FitEpoch fit_epoch_of(const Epoch<Row>& e, HeadMask heads) {
         const Eigen::Quaterniond& q = e.head[h]->q;
         fe.q_chu_icrf[h] = {q.w(), q.x(), q.y(), q.z()};
         fe.temp[h] = e.head[h]->temp;
+        fe.t_head[h] = e.head[h]->t;
     }
     return fe;
 }
@@ -401,6 +424,7 @@ void add_row(Pass& p, const FitOptions& opt, EarthVelocity& earth, EpochAssemble
     Row row;
     row.q = Eigen::Quaterniond(c.q_chu_icrf.w, c.q_chu_icrf.x, c.q_chu_icrf.y, c.q_chu_icrf.z);
     row.temp = rec.temperature;
+    row.t = rec.t;
     epochs.add(rec.t, rec.head, rec.line, row);
 }
 

@@ -16,6 +16,7 @@ namespace {
 constexpr int kGridPoints = 14;  // 300·2^(k/3) s, k = 0 … 13: 300 … 6048 s
 constexpr int kHeadSpan = 3;     // a head's own search: an octave either side of the common lag
 constexpr int kGoldenSteps = 5;  // the bracket of two grid steps shrinks to 0.618⁵ ≈ 9 % of it (±2 % in τ)
+constexpr std::int64_t kNoTime = std::numeric_limits<std::int64_t>::min();  // a t the clock cannot hold
 using Lags = std::array<double, kMaxHeads>;
 
 double grid_tau(int k) {
@@ -28,12 +29,15 @@ double grid_tau(int k) {
 class LagScorer {
 public:
     explicit LagScorer(const LagSearchInput& in) : in_(in) {
-        std::vector<FitEpoch>& epochs = *in.epochs;
-        t_us_.resize(epochs.size());
-        for (std::size_t i = 0; i < epochs.size(); ++i) {
-            TtTime t{};
-            t_us_[i] = tt_from_seconds(epochs[i].t, t) ? t.us : std::numeric_limits<std::int64_t>::min();
-            for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        const std::vector<FitEpoch>& epochs = *in.epochs;
+        std::int64_t t_end = std::numeric_limits<std::int64_t>::min();
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            t_us_[h].resize(epochs.size());
+            for (std::size_t i = 0; i < epochs.size(); ++i) {
+                TtTime t{};
+                // A head's own time, as `correct` looks its row up; none: never lagged, as there.
+                t_us_[h][i] = tt_from_seconds(epochs[i].t_head[h], t) ? t.us : kNoTime;
+                t_end = std::max(t_end, t_us_[h][i]);
                 raw_[h].push_back(epochs[i].temp[h]);
             }
         }
@@ -51,7 +55,6 @@ public:
         }
         // Each head's readings up to the last epoch (the later ones change no epoch's lag).
         const std::vector<LagReading>& r = *in.readings;
-        const std::int64_t t_end = t_us_.empty() ? 0 : t_us_.back();
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
             const auto before = [](const LagReading& x, const std::pair<std::size_t, std::int64_t>& k) {
                 return x.head < k.first || (x.head == k.first && x.t_us < k.second);
@@ -104,10 +107,17 @@ public:
         }
         ++trials_;
         scores_[key] = s;
+        if (s < best_score_) {
+            best_score_ = s;
+            best_ = lag;
+        }
         return s;
     }
 
     std::size_t trials() const noexcept { return trials_; }
+    // The lowest score of all candidates, and its lags.
+    double best_score() const noexcept { return best_score_; }
+    const Lags& best() const noexcept { return best_; }
 
 private:
     // Head h's temperatures at the epochs through a lag of tau (0: its readings).
@@ -121,15 +131,17 @@ private:
             return;
         }
         const LagReading* r = in_.readings->data();
-        std::size_t i = 0;
+        const std::vector<std::int64_t>& t_us = t_us_[h];
+        std::size_t i = 0;  // a head's own times rise with the epochs' (one millisecond key each)
         walk_lag(tau, r + first_[h], r + last_[h],
-                 [&](std::int64_t t_us, const std::array<double, 3>& lagged, const std::array<bool, 3>& valid) {
-                     while (i < epochs.size() && t_us_[i] < t_us) {
+                 [&](std::int64_t t, const std::array<double, 3>& lagged, const std::array<bool, 3>& valid) {
+                     while (i < epochs.size() && t_us[i] < t) {
                          ++i;
                      }
-                     for (std::size_t j = i; j < epochs.size() && t_us_[j] == t_us; ++j) {
+                     for (std::size_t j = i; j < epochs.size() && t_us[j] == t; ++j) {
                          for (std::size_t k = 0; k < 3; ++k) {
-                             epochs[j].temp[h][k] = valid[k] ? lagged[k] : raw_[h][j][k];
+                             const double raw = raw_[h][j][k];
+                             epochs[j].temp[h][k] = lagged_reading_usable(true, raw, valid[k]) ? lagged[k] : raw;
                          }
                      }
                  });
@@ -169,7 +181,7 @@ private:
     }
 
     const LagSearchInput& in_;
-    std::vector<std::int64_t> t_us_;
+    std::array<std::vector<std::int64_t>, kMaxHeads> t_us_;  // [head][epoch], kNoTime for none
     std::array<std::vector<std::array<double, 3>>, kMaxHeads> raw_;
     Lags applied_{};
     std::array<std::size_t, kMaxHeads> first_{};
@@ -178,6 +190,8 @@ private:
     std::vector<long long> orbit_of_;
     std::map<std::vector<double>, double> scores_;
     std::size_t trials_ = 0;
+    double best_score_ = std::numeric_limits<double>::infinity();
+    Lags best_{};
 };
 
 struct Best {
@@ -316,11 +330,15 @@ LagSelection select_lags(const LagSearchInput& in) {
             cur[h] = own.tau;
         }
     }
-    sel.best_lag_s = cur;
-    sel.best_rms = scorer.score(cur);
-    sel.decided = std::isfinite(sel.best_rms);
-    if (sel.decided && lower_by_margin(sel.best_rms, sel.none_rms)) {
+    const double chosen = scorer.score(cur);
+    sel.decided = std::isfinite(chosen);
+    if (sel.decided && lower_by_margin(chosen, sel.none_rms)) {
         sel.lag_s = cur;
+        sel.best_lag_s = cur;
+        sel.best_rms = chosen;
+    } else {  // the closest any candidate came, for the report
+        sel.best_lag_s = scorer.best();
+        sel.best_rms = scorer.best_score();
     }
     sel.trials = scorer.trials();
     sel.verdict = verdict_of(sel, in.heads);

@@ -196,8 +196,8 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
     std::optional<ThermalModel<double>> model;
     if (!opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
-        refuse_lagged_model(m, opt.model,
-                            "stats --model does not lag them; give stats the file ascorr correct wrote with it");
+        refuse_lagged_model(
+            m, opt.model, "stats and plot (--model) do not lag them; give them the file ascorr correct wrote with it");
         model = to_core<double>(m);
     }
     return compute_stats(

@@ -213,6 +213,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         states.emplace(*job.states, job.service, job.table);
     }
     SolutionRecord rec;
+    SolutionRecord lagged;  // rec as a lagged model's terms take it
     res.out.reserve(body.size() + body.size() / 8);
     for (RowRead got = read_row(reader, rec, opt, res); got != RowRead::kEnd; got = read_row(reader, rec, opt, res)) {
         if (got == RowRead::kSkipped) {
@@ -220,9 +221,11 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
         if (job.lag != nullptr && cfg.thermal != nullptr) {
-            job.lag->apply(rec);  // the written row keeps its own readings (the writer copies its text)
+            lagged = rec;  // the messages and the written row keep the row's own readings
+            job.lag->apply(lagged);
         }
-        const RowCorrection<T> row = correct_row(rec, &earth, cfg, states ? &*states : nullptr);
+        const bool lag = job.lag != nullptr && cfg.thermal != nullptr;
+        const RowCorrection<T> row = correct_row(lag ? lagged : rec, &earth, cfg, states ? &*states : nullptr);
         const StatusBits st = row.status;
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);

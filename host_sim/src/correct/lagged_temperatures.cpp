@@ -55,7 +55,7 @@ void LaggedTemperatures::apply(SolutionRecord& rec) const {
     for (std::size_t k = 0; k < 3; ++k) {
         if (!found) {
             rec.temperature_present[k] = false;  // a row not in the table: no unlagged temperature
-        } else if (rec.temperature_present[k] && temperature_in_domain<double>(rec.temperature[k]) && it->valid[k]) {
+        } else if (lagged_reading_usable(rec.temperature_present[k], rec.temperature[k], it->valid[k])) {
             rec.temperature[k] = it->lagged[k];
         }
     }

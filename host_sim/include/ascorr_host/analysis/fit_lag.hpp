@@ -43,7 +43,7 @@ inline constexpr double kLagSelectionMargin = 0.0015;
 struct LagSelection {
     bool decided = false;                        // false: no held-out part, or a pair without held-out epochs
     std::array<double, kMaxHeads> lag_s{};       // taken (all 0: none), s, whole seconds
-    std::array<double, kMaxHeads> best_lag_s{};  // the best found, taken or not
+    std::array<double, kMaxHeads> best_lag_s{};  // taken: lag_s; otherwise the candidate that scored best
     double none_rms = 0.0;                       // held-out IBA RMS, mean over the pairs, without a lag (arcsec)
     double best_rms = 0.0;                       // with best_lag_s
     std::size_t trials = 0;                      // candidates scored

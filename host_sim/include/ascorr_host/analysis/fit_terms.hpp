@@ -112,6 +112,7 @@ struct FitEpoch {
     double t = 0.0;
     std::array<Quaternion<double>, kMaxHeads> q_chu_icrf{};
     std::array<std::array<double, 3>, kMaxHeads> temp{};
+    std::array<double, kMaxHeads> t_head{};  // each head's row's own t (within the epoch's millisecond)
 };
 
 // IBA RMS per pair of `heads` (pairs_of, by position) of the epochs with t in

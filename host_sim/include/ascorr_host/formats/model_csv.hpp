@@ -79,7 +79,7 @@ struct ModelFile {
 inline bool has_lag(const ModelFile& m) noexcept {
     bool any = false;
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        any = any || (m.present[h] && m.lag_s[h] != 0.0);  // head_lags(m), below, not 0
+        any = any || (m.present[h] && m.lag_s[h] != 0.0);  // a head without coefficients lags nothing
     }
     return any;
 }
