@@ -117,11 +117,6 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
                const py::object& v, const py::object& flags, const py::object& confidence, const py::object& model,
                const py::object& t_from, const py::object& t_to, const py::object& noise_iba) {
     const host::ModelFile* m = model_arg(model);
-    if (m != nullptr && host::has_lag(*m)) {
-        bad_argument("model",
-                     "its lag_s makes its terms take lagged temperatures, which stats does not give them; "
-                     "give stats the rows correct() corrected with it");
-    }
     host::StatsOptions opt;
     opt.in = kArrayRows;
     if (!noise_iba.is_none()) {
@@ -133,11 +128,14 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     host::refuse_bad_time_range(opt.from, opt.to, "t_from", "t_to");  // as `ascorr stats`: an empty period is refused
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     std::optional<ThermalModel<double>> core_model;
+    std::optional<host::LaggedTemperatures> lag;
     if (m != nullptr) {
         core_model = host::to_core<double>(*m);
+        lag = host::lagged_temperatures(host::head_lags(*m), source_of(r));  // as `ascorr stats --model`
     }
     std::ostringstream log;
-    const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log);
+    const host::StatsResult s =
+        host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log, lag ? &*lag : nullptr);
     py::dict pairs;
     py::dict systematic;
     for (std::size_t p = 0; p < s.pairs.count; ++p) {

@@ -39,24 +39,6 @@ namespace {
 // Below this many rows per thread a thread costs more than it saves.
 constexpr std::size_t kRowsPerThread = 16384;
 
-// A lagged model's heads: their temperatures through the lag, as by `ascorr
-// correct` (every row's reading, in time order per head); none without one.
-std::optional<host::LaggedTemperatures> lagged_temperatures(const Rows& r, const host::ModelFile* m) {
-    if (m == nullptr || !host::has_lag(*m)) {
-        return std::nullopt;
-    }
-    std::vector<host::LagReading> readings;
-    SolutionRecord rec;
-    host::LagReading x;
-    for (py::ssize_t i = 0; i < r.n; ++i) {
-        record_of(r, i, rec);
-        if (host::lag_reading_of(rec, x)) {
-            readings.push_back(x);
-        }
-    }
-    return host::LaggedTemperatures(host::head_lags(*m), std::move(readings));
-}
-
 template <typename T>
 void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, const host::StatesFile* states,
                   double max_propagation_s, double* q_out, std::uint16_t* st_out) {
@@ -81,7 +63,9 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
         table.emplace(*states, host::service_config(max_propagation_s), std::move(times),
                       host::worker_count(static_cast<std::size_t>(r.n), kRowsPerThread));
     }
-    const std::optional<host::LaggedTemperatures> lag = lagged_temperatures(r, m);
+    // A lagged model's heads: their temperatures through the lag, as by `ascorr correct`.
+    const std::optional<host::LaggedTemperatures> lag =
+        m != nullptr ? host::lagged_temperatures(host::head_lags(*m), source_of(r)) : std::nullopt;
     const auto n = static_cast<std::size_t>(r.n);
     host::for_each_piece(n, host::worker_count(n, kRowsPerThread), [&](std::size_t begin, std::size_t end) {
         host::EarthVelocity earth;

@@ -294,8 +294,13 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
     q_none, _ = ascorr.correct(*as_args(d), model=ascorr.Model(model.coefficients, model.heads))
     assert np.abs(q_none - q_fwd).max() > 1e-9
 
+    # stats with the lagged model: the command line's numbers.
+    cli_stats = json.loads(run_cli(exe, "stats", "--in", lag_mission, "--model", out, "--json").stdout)
+    py_stats = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
+    for pair, v in cli_stats["pairs"].items():
+        assert py_stats["pairs"][pair]["thermal"] == pytest.approx(v["thermal"], abs=1e-6), pair
     with pytest.raises(ValueError, match="lag_s makes its terms take lagged temperatures"):
-        ascorr.stats(*as_args(d), model=model)
+        ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model)
     with pytest.raises(ValueError, match="lag"):
         ascorr.fit(*as_args(d), min_days=20, lag=-3)
     with pytest.raises(ValueError, match="A:900,A:1"):

@@ -149,19 +149,6 @@ std::array<double, kMaxHeads> lags_of_heads(const std::array<bool, kMaxHeads>& p
     return out;
 }
 
-// Every row's reading, sorted for the lag (lag_order): one more reading of the rows.
-std::vector<LagReading> lag_readings(const RowSource& rows) {
-    std::vector<LagReading> readings;
-    rows([&](const SolutionRecord& rec) {
-        LagReading r;
-        if (lag_reading_of(rec, r)) {
-            readings.push_back(r);
-        }
-    });
-    std::sort(readings.begin(), readings.end(), lag_order);
-    return readings;
-}
-
 // --lag auto: the fit without a lag, whose pass chooses one (select_lags);
 // then, when it took one, the fit with it, as --lag with those lags. A lagged
 // model the data refuse (its terms, its condition) leaves the unlagged one.

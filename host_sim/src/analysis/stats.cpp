@@ -14,6 +14,7 @@
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/simulate.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -178,6 +179,20 @@ void log_empty_pair(const StatsOptions& opt, const Name& name, const std::string
     }
 }
 
+// The core's input of rec with its lagged head's temperatures (the thermal
+// stage's; the others take the row as it is); `in` without a lag (nullptr).
+SolutionInput<double> lagged_input(const SolutionRecord& rec, const LaggedTemperatures* lag,
+                                   const SolutionInput<double>& in) {
+    if (lag == nullptr || !lag->lags(rec.head)) {
+        return in;
+    }
+    SolutionRecord lagged = rec;
+    lag->apply(lagged);
+    SolutionInput<double> out = in;
+    out.temperatures = to_core_input<double>(lagged, nullptr).temperatures;
+    return out;
+}
+
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
@@ -194,15 +209,16 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
                "applied again\n";
     }
     std::optional<ThermalModel<double>> model;
+    const RowSource rows = [&](const std::function<void(const SolutionRecord&)>& fn) {
+        for_each_solution(opt.in, fn, "stats");
+    };
+    std::optional<LaggedTemperatures> lag;
     if (!opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
-        refuse_lagged_model(
-            m, opt.model, "stats and plot (--model) do not lag them; give them the file ascorr correct wrote with it");
         model = to_core<double>(m);
+        lag = lagged_temperatures(head_lags(m), rows);  // as `correct` lags them
     }
-    return compute_stats(
-        o, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "stats"); },
-        model ? &*model : nullptr, log);
+    return compute_stats(o, rows, model ? &*model : nullptr, log, lag ? &*lag : nullptr);
 }
 
 namespace {
@@ -245,7 +261,7 @@ void summarize_pair(const StatsOptions& opt, const NoiseIbaSeries* noise, std::s
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                          std::ostream& log) {
+                          std::ostream& log, const LaggedTemperatures* lag) {
     const CorrectionConfig<double> ab_only{true, nullptr};
     const CorrectionConfig<double> both{true, model};
     StatsResult r;
@@ -284,7 +300,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         row.clean = is_clean(rec);
         const SolutionInput<double> in = to_core_input<double>(rec, &earth);
         const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
-        const CorrectedSolution<double> c2 = correct_solution(in, both);
+        const CorrectedSolution<double> c2 = correct_solution(lagged_input(rec, lag, in), both);
         if (row.clean && !corrected(c1.status, c2.status, model != nullptr)) {
             diag.report("not corrected", text::input_name(opt.in) + ":" + std::to_string(rec.line) +
                                              ": clean row the core did not correct (status " +

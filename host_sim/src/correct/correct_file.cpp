@@ -203,6 +203,20 @@ void count_status_bits(StatusBits st, Summary& summary) {
     }
 }
 
+// rec as the thermal stage's terms take it: with a lagged model, its head's
+// lagged temperatures, in `lagged` (the messages and the written row keep the
+// row's own readings); otherwise rec itself.
+template <typename T>
+const SolutionRecord& as_terms_take(const Job<T>& job, const CorrectionConfig<T>& cfg, const SolutionRecord& rec,
+                                    SolutionRecord& lagged) {
+    if (job.lag == nullptr || cfg.thermal == nullptr) {
+        return rec;
+    }
+    lagged = rec;
+    job.lag->apply(lagged);
+    return lagged;
+}
+
 template <typename T>
 void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_before, ChunkResult& res) {
     const CorrectOptions& opt = job.opt;
@@ -220,12 +234,8 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             continue;
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
-        if (job.lag != nullptr && cfg.thermal != nullptr) {
-            lagged = rec;  // the messages and the written row keep the row's own readings
-            job.lag->apply(lagged);
-        }
-        const bool lag = job.lag != nullptr && cfg.thermal != nullptr;
-        const RowCorrection<T> row = correct_row(lag ? lagged : rec, &earth, cfg, states ? &*states : nullptr);
+        const RowCorrection<T> row =
+            correct_row(as_terms_take(job, cfg, rec, lagged), &earth, cfg, states ? &*states : nullptr);
         const StatusBits st = row.status;
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);

@@ -42,6 +42,30 @@ LaggedTemperatures::LaggedTemperatures(const std::array<double, kMaxHeads>& lag_
     }
 }
 
+std::vector<LagReading> lag_readings(const RowSource& rows, HeadMask heads) {
+    std::vector<LagReading> readings;
+    rows([&](const SolutionRecord& rec) {
+        LagReading r;
+        if (lag_reading_of(rec, r) && has_head(heads, r.head)) {
+            readings.push_back(r);
+        }
+    });
+    std::sort(readings.begin(), readings.end(), lag_order);
+    return readings;
+}
+
+std::optional<LaggedTemperatures> lagged_temperatures(const std::array<double, kMaxHeads>& lag_s,
+                                                      const RowSource& rows) {
+    HeadMask lagged = 0U;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        lagged |= lag_s[h] != 0.0 ? head_bit(h) : HeadMask{0};
+    }
+    if (lagged == 0U) {
+        return std::nullopt;
+    }
+    return LaggedTemperatures(lag_s, lag_readings(rows, lagged));
+}
+
 void LaggedTemperatures::apply(SolutionRecord& rec) const {
     if (!lags(rec.head)) {
         return;

@@ -18,6 +18,7 @@
 #include "ascorr/core/thermal.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/iba.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
@@ -76,9 +77,10 @@ bool is_clean(const SolutionRecord& rec) noexcept;
 // is refused; without one it is shown as it is (corrected_input).
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 // The same on rows from elsewhere (opt.in names them in messages; opt.model is
-// not read: model, nullptr for no thermal stage).
+// not read: model, nullptr for no thermal stage; lag, a lagged model's table
+// over the same rows (lagged_temperatures.hpp), nullptr for none).
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                          std::ostream& log);
+                          std::ostream& log, const LaggedTemperatures* lag = nullptr);
 
 // Whether pair p has an RMS at stage st: two clean epochs at least (the RMS
 // of one epoch about itself is 0, not a measurement) and, for the thermal

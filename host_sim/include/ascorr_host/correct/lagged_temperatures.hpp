@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -106,5 +107,15 @@ private:
 // The reading of rec for the table; false when its t is not a time or its
 // head is not one of kMaxHeads.
 bool lag_reading_of(const SolutionRecord& rec, LagReading& out) noexcept;
+
+// The readings of every row of `heads` that rows gives, sorted by lag_order
+// (one reading of the rows).
+std::vector<LagReading> lag_readings(const RowSource& rows,
+                                     HeadMask heads = static_cast<HeadMask>((1U << kMaxHeads) - 1U));
+
+// The table of a model's lagged heads over the rows (nullopt when no head of
+// `lag_s` lags: then the rows are not read).
+std::optional<LaggedTemperatures> lagged_temperatures(const std::array<double, kMaxHeads>& lag_s,
+                                                      const RowSource& rows);
 
 }  // namespace ascorr::host
