@@ -232,8 +232,9 @@ TEST(FitLag, ParsesItsOption) {
     expect_absent(dir, {"m.csv"});
 }
 
-// ---- A mission whose bench lags by 1800 s (60 days, seed 3), fitted and
-// corrected; the systematic residual per pair against its noise-only IBAs.
+// ---- A mission whose bench lags by 1800 s (40 days, an epoch every 120 s,
+// seed 3: small enough for the sanitizers' build), fitted and corrected; the
+// systematic residual per pair against its noise-only IBAs.
 
 constexpr double kLagS = 1800.0;
 constexpr double kBound = 0.15;  // arcsec per pair, issue 40's
@@ -241,7 +242,8 @@ constexpr double kBound = 0.15;  // arcsec per pair, issue 40's
 const fs::path& lag_mission() {
     static const fs::path dir = [] {
         const fs::path d = scratch_dir("lag-mission");
-        const CliRun r = run_in("simulate --days 60 --seed 3 --bench-lag 1800 --noise-iba --out m.csv > /dev/null", d);
+        const CliRun r =
+            run_in("simulate --days 40 --step 120 --seed 3 --bench-lag 1800 --noise-iba --out m.csv > /dev/null", d);
         EXPECT_EQ(r.exit_code, 0) << r.err;
         return d;
     }();
@@ -448,7 +450,7 @@ TEST(FitLag, StatsWithALaggedModelIsStatsOfTheCorrectedFile) {
 
 TEST(FitLag, AStaticBenchGetsTodaysModelByteForByte) {
     const fs::path dir = scratch_dir("lag-static");
-    ASSERT_EQ(run_in("simulate --days 60 --seed 3 --out s.csv > /dev/null", dir).exit_code, 0);
+    ASSERT_EQ(run_in("simulate --days 40 --step 120 --seed 3 --out s.csv > /dev/null", dir).exit_code, 0);
     const CliRun a = run_in("fit --in s.csv --out auto.csv --min-days 20 > auto.txt", dir);
     ASSERT_EQ(a.exit_code, 0) << a.err;
     const CliRun n = run_in("fit --in s.csv --out none.csv --min-days 20 --lag 0 > none.txt", dir);
