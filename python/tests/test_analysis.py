@@ -30,9 +30,9 @@ def as_args(d):
 
 def test_fit_on_arrays_is_ascorr_fit(exe, mission, tmp_path):
     out = tmp_path / "model.csv"
-    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30)
+    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30, "--lag", 0)  # auto: the lag's test
     d = ascorr.read_solutions(str(mission))
-    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, lag=0)
     assert model.to_csv() == out.read_text()
     assert report["orbits_used"] > 100 and report["condition"] > 1.0
     assert report["residual_rms"].shape == (3, 3)
@@ -50,17 +50,17 @@ def test_fit_with_mountings_is_ascorr_fit_and_names_its_rule(exe, mission, tmp_p
 
     mountings_path = str(mission) + ".mountings.csv"
     out = tmp_path / "model.csv"
-    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30, "--mountings", mountings_path)
+    run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30, "--mountings", mountings_path, "--lag", 0)
     d = ascorr.read_solutions(str(mission))
     m = ascorr.read_mountings(mountings_path)
-    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, mountings=m)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, mountings=m, lag=0)
     assert model.to_csv() == out.read_text()
     assert model.common_rotation == "combined" and report["common_rotation"] == "combined"
     assert ascorr.read_model(str(out)).common_rotation == "combined"
     assert pickle.loads(pickle.dumps(model)) == model
-    plain, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    plain, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, lag=0)
     assert plain.common_rotation == "smallest" and plain != model
-    rigid, _ = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, common_rotation="rigid-B")
+    rigid, _ = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, common_rotation="rigid-B", lag=0)
     assert rigid.common_rotation == "rigid-B"
     # The rule changes no IBA: the thermal-corrected stats are the same.
     a = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
@@ -194,9 +194,9 @@ def test_four_heads_fit_stats_and_iba_are_the_command_lines(exe, tmp_path):
     path = tmp_path / "four.csv"
     run_cli(exe, "simulate", "--out", path, "--days", 40, "--step", 120, "--heads", "ABCD")
     out = tmp_path / "model.csv"
-    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30)
+    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30, "--lag", 0)
     d = ascorr.read_solutions(str(path))
-    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, lag=0)
     assert model.to_csv() == out.read_text() and model.heads == "ABCD"
     assert report["heads"] == "ABCD" and report["residual_rms"].shape == (4, 3)
     six = ["A-B", "A-C", "A-D", "B-C", "B-D", "C-D"]
@@ -220,8 +220,9 @@ def test_a_mission_without_c_is_fitted_on_its_heads_as_the_command_line(exe, tmp
                                                r"to fit \(e\.g\. heads='ABD' frame_heads='AD'\)"):
         ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30)
     out = tmp_path / "model.csv"
-    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30, "--heads", "ABD", "--frame-heads", "AD")
-    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, heads="ABD",
+    run_cli(exe, "fit", "--in", path, "--out", out, "--min-days", 30, "--heads", "ABD", "--frame-heads", "AD",
+            "--lag", 0)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=30, lag=0, heads="ABD",
                                frame_heads="AD")
     assert model.to_csv() == out.read_text() and model.heads == "ABD"
     assert report["heads"] == "ABD" and report["residual_rms"].shape == (3, 3)

@@ -200,7 +200,7 @@ def everything_written(d, tmp_path, tag):
     """Every text the library writes for Python from the arrays d: the model file
     (to_csv, write), the fit report, the stats table, a refusal's message."""
     args = (d["t"], d["chu"], d["q"], d["temps"], d["v"], d["flags"], d["confidence"])
-    model, report = ascorr.fit(*args, min_days=19)
+    model, report = ascorr.fit(*args, min_days=19, lag=0)
     path = tmp_path / f"model-{tag}.csv"
     model.write(str(path))
     assert ascorr.read_model(str(path)) == model  # read_model refused '-4,67e-01'
@@ -297,11 +297,11 @@ def test_a_missing_confidence_is_not_clean_anywhere(exe, short_mission, tmp_path
     clean = ascorr.stats(*args[:5], d["flags"], short_mission["confidence"])
     assert all(s["pairs"][p]["n"] < clean["pairs"][p]["n"] for p in s["pairs"])  # the rows were left out
 
-    model, report = ascorr.fit(*args, min_days=19)
+    model, report = ascorr.fit(*args, min_days=19, lag=0)
     dropped = report["dropped"]["confidence > 5 or missing"]
     assert dropped >= gone.sum()
     for path in (empty, nan):
-        r = cli_json(exe, "fit", "--in", path, "--out", tmp_path / "m.csv", "--min-days", 19)
+        r = cli_json(exe, "fit", "--in", path, "--out", tmp_path / "m.csv", "--min-days", 19, "--lag", 0)
         text = r.stdout + r.stderr
         assert f"confidence > 5 or missing {dropped}" in text, text
         assert ascorr.read_model(str(tmp_path / "m.csv")) == model

@@ -411,8 +411,8 @@ def test_fit_takes_terms_holdout_and_min_temperature_range_as_the_command_line(e
     a = (d["t"], d["chu"], d["q"], d["temps"], d["v"], d["flags"], d["confidence"])
     out = tmp_path / "quadratic.csv"
     cli = run_cli(exe, "fit", "--in", mission, "--out", out, "--min-days", 30, "--terms", "quadratic",
-                  "--holdout", 0.3)
-    model, report = ascorr.fit(*a, min_days=30, terms="quadratic", holdout=0.3)
+                  "--holdout", 0.3, "--lag", 0)
+    model, report = ascorr.fit(*a, min_days=30, terms="quadratic", holdout=0.3, lag=0)
     assert model.quadratic and report["terms"] == "quadratic"
     assert model.to_csv() == out.read_text()
     assert model == ascorr.read_model(str(out))
