@@ -139,16 +139,6 @@ FitReport fit_model(const FitOptions& opt) {
 
 namespace {
 
-// The lags of the heads present (the others none).
-std::array<double, kMaxHeads> lags_of_heads(const std::array<bool, kMaxHeads>& present,
-                                            const std::array<double, kMaxHeads>& lag_s) {
-    std::array<double, kMaxHeads> out{};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        out[h] = present[h] ? lag_s[h] : 0.0;
-    }
-    return out;
-}
-
 // --lag auto: the fit without a lag, whose pass chooses one (select_lags);
 // then, when it took one, the fit with it, as --lag with those lags. A lagged
 // model the data refuse (its terms, its condition) leaves the unlagged one.
@@ -162,7 +152,8 @@ FitReport fit_choosing_lag(const FitOptions& opt, const RowSource& rows) {
     try {
         FitReport lagged = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &lag, nullptr);
         lagged.lag = r.lag;
-        lagged.model.lag_s = lags_of_heads(lagged.model.present, r.lag.lag_s);
+        lagged.model.lag_s = r.lag.lag_s;
+        lagged.model.lag_s = head_lags(lagged.model);  // a head not fitted has none
         return lagged;
     } catch (const FitRefused& e) {
         r.lag.lag_s = {};
@@ -193,7 +184,8 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
     if (opt.lag_s && any_lag(*opt.lag_s)) {
         const LaggedTemperatures lag(*opt.lag_s, lag_readings(rows));
         FitReport r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &lag, nullptr);
-        r.model.lag_s = lags_of_heads(r.model.present, *opt.lag_s);  // a head not fitted has none
+        r.model.lag_s = *opt.lag_s;
+        r.model.lag_s = head_lags(r.model);  // a head not fitted has none
         return r;
     }
     if (opt.lag_s || !opt.selection_report) {
