@@ -25,6 +25,13 @@
 // the contract's noise, the true attitudes those of the selected records),
 // against a function that only copies the first head's quaternion
 // ("bench <scalar> combination <instructions>").
+// The lag stage of a lagged head (pipeline/head_lags.hpp, the out-of-line
+// entry of firmware/app/lag_entry_*.cpp) is measured per solution: heads A,
+// B and C in turn at 22 Hz on millisecond time tags (each head's Δt 45 or
+// 46 ms, so each channel's α comes from its cache once warmed up), τ = 900 s,
+// the selected records' temperatures, against a function that only copies a
+// reading ("bench <scalar> lag <instructions>": what a lagged head adds to
+// its solution's correction).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -37,6 +44,7 @@
 #include "combine_entry.hpp"
 #include "core_entry.hpp"
 #include "earth_series_entry.hpp"
+#include "lag_entry.hpp"
 #include "systick_counter.hpp"
 #include "vector_convert.hpp"
 
@@ -290,6 +298,49 @@ void bench_combination(const char* name, const combine::Combiner<T>& c, Combinat
                 static_cast<unsigned>(e < 4294967295.0 ? e : 4294967295.0));
 }
 
+// The lag stage: one solution per call.
+template <typename T>
+using LagFn = void (*)(pipeline::HeadLags<T>&, std::uint8_t, std::int64_t, HeadTemperatures<T>&) noexcept;
+
+template <typename T>
+__attribute__((noinline)) void lag_copy(pipeline::HeadLags<T>& /*lags*/, std::uint8_t /*head*/, std::int64_t /*t_us*/,
+                                        HeadTemperatures<T>& temps) noexcept {
+    temps.t_032 = temps.t_chu;
+}
+
+template <typename T>
+__attribute__((noinline)) void lag_call(pipeline::HeadLags<T>& lags, std::uint8_t head, std::int64_t t_us,
+                                        HeadTemperatures<T>& temps) noexcept {
+    app::lag(lags, head, t_us, temps);
+}
+
+// kRuns solutions from the epoch after `epoch` on (22 Hz, millisecond tags).
+template <typename T>
+std::uint32_t run_lag(volatile LagFn<T> fn, pipeline::HeadLags<T>& lags, const Fixture<T>& fx, std::uint32_t& epoch) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kRuns; ++i) {
+            const std::uint32_t e = epoch + i / 3U;
+            const std::int64_t t_us = std::int64_t{e} * 1000 / 22 * 1000;
+            HeadTemperatures<T> temps = fx.in[i % kInputs].temperatures;
+            fn(lags, static_cast<std::uint8_t>(i % 3U), t_us, temps);
+            g_sink_status = static_cast<std::uint16_t>(temps.t_chu.valid ? 1U : 0U);
+        }
+        epoch += kRuns / 3U + 1U;
+    });
+}
+
+template <typename T>
+void bench_lag(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
+    static pipeline::HeadLags<T> lags;
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        (void)lags.configure(h, 900.0);
+    }
+    std::uint32_t epoch = 0U;
+    (void)run_lag<T>(&lag_call<T>, lags, fx, epoch);  // warm-up: every channel started, both α formed
+    const std::uint32_t c0 = run_lag<T>(&lag_copy<T>, lags, fx, epoch);
+    report(name, "lag", run_lag<T>(&lag_call<T>, lags, fx, epoch), c0, ipc);
+}
+
 Fixture<Q30> g_fixed;
 combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
 CombinationFixture<Q30> g_combination_fixed;
@@ -336,9 +387,11 @@ int main() {
     std::printf("bench calibration %u instructions per SysTick count\n", static_cast<unsigned>(ipc));
 #if !defined(ASCORR_TARGET_FIXED)
     bench_scalar<float>("float", g_float, ipc);
+    bench_lag<float>("float", g_float, ipc);
     bench_combination<float>("float", g_combiner_float, g_combination_float, ipc);
 #endif
     bench_scalar<Q30>("fixed", g_fixed, ipc);
+    bench_lag<Q30>("fixed", g_fixed, ipc);
     bench_combination<Q30>("fixed", g_combiner_fixed, g_combination_fixed, ipc);
     bench_baseline(ipc);
     bench_series(ipc);

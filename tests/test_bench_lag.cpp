@@ -200,8 +200,8 @@ TEST(ModelFileLag, ConsumersThatDoNotLagRefuseIt) {
     const std::pair<std::string, std::string> cases[] = {
         {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
          "--self-calibrate does not learn a lagged model yet"},
-        {"replay --target loopback-float --in s.csv --model m.csv --out c.csv",
-         "replay cannot send it: the link's MODEL_UPLOAD has no word for a lag yet"},
+        {"replay --target loopback-float --in s.csv --model m.csv --self-calibrate --out c.csv",
+         "--self-calibrate does not learn a lagged model yet"},
         {"simulate --days 0.2 --truth-change 0.1:m.csv --out t.csv",
          "a truth model takes no lag: --bench-lag lags the simulated bench"},
         {"simulate --days 0.1 --truth m.csv --out t.csv",

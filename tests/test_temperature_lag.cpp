@@ -69,11 +69,20 @@ long double rk4(long double l, long double temp, long double dt, long double tau
     return l;
 }
 
+// A reading in T's temperature format, and back in double.
+template <typename T>
+ascorr::Celsius<T> celsius(double x) {
+    return ascorr::ScalarTraits<T>::celsius(x);
+}
+template <typename T>
+double widened(const ascorr::Celsius<T>& x) {
+    return ascorr::ScalarTraits<T>::to_double(x);
+}
+
 template <typename T>
 HeadTemperatures<T> reading(const Sample& s) {
-    return {{static_cast<T>(s.temp[0]), s.valid[0]},
-            {static_cast<T>(s.temp[1]), s.valid[1]},
-            {static_cast<T>(s.temp[2]), s.valid[2]}};
+    return {
+        {celsius<T>(s.temp[0]), s.valid[0]}, {celsius<T>(s.temp[1]), s.valid[1]}, {celsius<T>(s.temp[2]), s.valid[2]}};
 }
 
 // The largest |D − (L_ref − T)| over the samples, °C, per channel's valid
@@ -92,14 +101,15 @@ double worst_against_reference(const std::vector<Sample>& samples, double tau_s)
             if (!s.valid[k]) {
                 continue;
             }
-            // The reference sees the value the filter saw (float: rounded).
-            const long double temp = static_cast<T>(s.temp[k]);
+            // The reference sees the value the filter saw (float, Q30: rounded).
+            const long double temp = widened<T>(celsius<T>(s.temp[k]));
             l[k] = started[k] ? rk4(l[k], temp, static_cast<long double>(s.t_us - last[k]) * 1e-6L, tau_s) : temp;
             started[k] = true;
             last[k] = s.t_us;
             const auto d = lag.deviation(k);
             EXPECT_TRUE(d.valid);
-            const auto err = static_cast<double>(std::fabs(static_cast<long double>(d.value) - (l[k] - temp)));
+            const auto err =
+                static_cast<double>(std::fabs(static_cast<long double>(widened<T>(d.value)) - (l[k] - temp)));
             worst = err <= worst ? worst : err;  // a NaN D makes worst NaN, and fails every bound
         }
     }
@@ -145,6 +155,37 @@ TEST(TemperatureLag, FloatAt22HzKeepsTheDeviationsPrecision) {
         plain_worst = std::max(plain_worst, static_cast<double>(std::fabs(l - ref)));
     }
     EXPECT_GT(plain_worst, 3 * 3e-5);
+}
+
+// Q30 (QCelsius readings, Q30 α, D in int64 at 2⁻⁵⁰ °C) at 22 Hz at
+// millisecond times, τ = 900 s and a day (α ≈ 5e-5 and 5e-7). The error is
+// α's rounding (a relative error of τ ≤ 2⁻³¹·τ/Δt: 1e-5 and 9e-4) times D,
+// plus D's and T's rounding to QCelsius (≤ 2⁻²¹ °C each): measured 1.3e-5
+// and 1.4e-5 °C, against a bound of 3e-5 °C, the float path's (0.15 mas of a
+// 5"/°C coefficient).
+TEST(TemperatureLag, Q30At22HzIsWithinItsResolution) {
+    using ascorr::Q30;
+    const auto samples = readings(1.0 / 22.0, 0.5, 13, 0.0, true);
+    EXPECT_LT(worst_against_reference<Q30>(samples, 900.0), 3e-5);
+    EXPECT_LT(worst_against_reference<Q30>(samples, 86400.0), 3e-5);
+    // Mutation check: D held in QCelsius itself (int32, 2⁻²⁰ °C), with the
+    // same rounded product: a step whose α·u is below half an LSB does not
+    // decay, a dead band of 0.5/α LSB (0.01 °C at 900 s), far past the bound.
+    std::int32_t d = 0;
+    std::int32_t last = celsius<Q30>(samples[0].temp[0]).raw;
+    long double ref = widened<Q30>(celsius<Q30>(samples[0].temp[0]));
+    double narrow_worst = 0.0;
+    for (std::size_t i = 1; i < samples.size(); ++i) {
+        const double dt = static_cast<double>(samples[i].t_us - samples[i - 1].t_us) * 1e-6;
+        const ascorr::QCelsius temp = celsius<Q30>(samples[i].temp[0]);
+        const Q30 alpha = ascorr::ScalarTraits<Q30>::from_double(-std::expm1(-dt / 900.0));
+        const std::int32_t u = d - (temp.raw - last);
+        d = u - ascorr::fx::narrow<30>(0, alpha.raw, u);
+        last = temp.raw;
+        ref = rk4(ref, widened<Q30>(temp), dt, 900.0L);
+        narrow_worst = std::max(narrow_worst, std::fabs(static_cast<double>((last + d) * 0x1p-20L - ref)));
+    }
+    EXPECT_GT(narrow_worst, 10 * 3e-5);
 }
 
 TEST(TemperatureLag, EachBadInputLeavesItsChannelAsItWas) {
@@ -229,6 +270,36 @@ TEST(TemperatureLag, TimesAtTheLimitsStepWithoutOverflow) {
     EXPECT_EQ(lag.step(kMaxLagTimeUs - 1, ok).channel[0], LagStep::kAdvanced);
     EXPECT_EQ(lag.deviation(0).value, 0.0F);
     EXPECT_EQ(lag.step(kMaxLagTimeUs, ok).channel[0], LagStep::kBadTime);
+}
+
+// Q30 at the ends of its ranges (the sanitizers' builds trap any overflow):
+// readings swinging across the whole domain, ±200 °C, at every α from a
+// microsecond against a day to α = 1; D stays within ±400 °C and L within
+// the readings' hull, and a step with α = 1 forgets exactly.
+TEST(TemperatureLag, Q30AtTheEndsOfItsRangesNeitherOverflowsNorLeavesTheHull) {
+    using ascorr::Q30;
+    const double edge = ascorr::kMaxAbsTemperatureC;
+    for (double tau : {1.0, 900.0, ascorr::pipeline::kMaxLagTauS}) {
+        TemperatureLag<Q30> lag;
+        ASSERT_TRUE(lag.configure(tau));
+        std::int64_t t = 0;
+        for (int i = 0; i < 2000; ++i) {
+            const double v = (i % 2 == 0 ? edge : -edge);
+            const HeadTemperatures<Q30> r{{celsius<Q30>(v), true}, {celsius<Q30>(-v), true}, {celsius<Q30>(v), true}};
+            t += i % 3 == 0 ? 1 : 1'000'000;  // a microsecond, a second
+            ASSERT_NE(lag.step(t, r).channel[0], LagStep::kHeld);
+            for (std::uint8_t k = 0; k < 3; ++k) {
+                const double l = widened<Q30>(lag.lagged(k).value);
+                ASSERT_LE(std::fabs(l), edge + 0x1p-20) << tau << " " << i;
+                ASSERT_LE(std::fabs(widened<Q30>(lag.deviation(k).value)), 2 * edge + 0x1p-20);
+            }
+        }
+        const HeadTemperatures<Q30> last{
+            {celsius<Q30>(12.5), true}, {celsius<Q30>(-3.0), true}, {celsius<Q30>(0.0), true}};
+        EXPECT_EQ(lag.step(t + 1'000'000'000'000'000, last).channel[2], LagStep::kAdvanced);  // 10⁹ s: α = 1
+        EXPECT_EQ(lag.deviation(0).value.raw, 0);
+        EXPECT_EQ(lag.lagged(1).value.raw, celsius<Q30>(-3.0).raw);
+    }
 }
 
 }  // namespace

@@ -119,6 +119,7 @@ constexpr Part part_of(pipeline::Stage stage) noexcept {
     switch (stage) {
         case pipeline::Stage::kVelocity:
             return Part::kQuery;
+        case pipeline::Stage::kLag:  // part of the solution's correction
         case pipeline::Stage::kCorrect:
             return Part::kCorrect;
         case pipeline::Stage::kStep:

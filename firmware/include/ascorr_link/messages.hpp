@@ -20,6 +20,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/velocity_service.hpp"
+#include "ascorr/pipeline/temperature_lag.hpp"
 #include "calib_messages.hpp"
 #include "combine_messages.hpp"
 #include "frame.hpp"
@@ -68,10 +69,15 @@ struct Hello {
     std::uint8_t scalar_kind;
 };
 
+// lag_s: the head's lag τ in seconds (docs/contract.md, "The bench's lag";
+// pipeline/head_lags.hpp), 0 for none. On the wire an IEEE binary64 after
+// the words, sent only when the head lags (absent: 0, the bytes a target
+// before it takes); a τ outside [kMinLagTauS, kMaxLagTauS] is a bad payload.
 template <typename T>
 struct ModelUpload {
     std::uint8_t head;
     HeadThermalModel<T> model;
+    double lag_s = 0.0;
 };
 
 template <typename T>
@@ -148,6 +154,9 @@ std::size_t encode(const ModelUpload<T>& m, std::uint8_t* out) noexcept {
     for (const AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
         for_each_term(*a, [&w](auto, const auto& c) { w.word(c); });
     }
+    if (m.lag_s != 0.0) {
+        w.f64(m.lag_s);
+    }
     return w.size();
 }
 template <typename T>
@@ -162,7 +171,11 @@ bool decode(const std::uint8_t* p, std::size_t n, ModelUpload<T>& m) noexcept {
     for (AxisPolynomial<T>* a : {&m.model.alpha, &m.model.beta, &m.model.gamma}) {
         for_each_term(*a, [&](auto, auto& c) { ok = ok && r.word(c); });
     }
-    return ok && r.done();
+    m.lag_s = 0.0;
+    if (!ok || r.done()) {
+        return ok;
+    }
+    return r.f64(m.lag_s) && r.done() && m.lag_s >= pipeline::kMinLagTauS && m.lag_s <= pipeline::kMaxLagTauS;
 }
 
 template <typename T>

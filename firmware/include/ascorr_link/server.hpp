@@ -5,14 +5,19 @@
 // temperatures. It takes received bytes one at a time and hands each response
 // frame to a sink. Requests and answers:
 //   kHelloRequest      → kHello
-//   kModelUpload       → kAck (kBadPayload for a bad head or length)
+//   kModelUpload       → kAck (kBadPayload for a bad head, length or lag);
+//                        with a lag τ, the head's temperatures go through
+//                        the lag stage from then on, its lag started afresh
+//                        (pipeline/head_lags.hpp)
 //   kVelocityUpdate    → kAck
 //   kTemperatureUpdate → kAck
 //   kStateUpdate       → kAck (the state goes to the velocity service, which
 //                        may refuse it: velocity_service.hpp)
 //   kSolutionIn        → kSolutionOut (corrected by correct_solution<T>, with
 //                        the last velocity update or, if from_states, the
-//                        service's velocity at the solution's time tag)
+//                        service's velocity at the solution's time tag; a
+//                        lagged head's solution flagged kCalibNoTime has no
+//                        lagged temperatures: status 8)
 //   kServiceConfig     → kAck: the velocity service restarts with the horizon
 //                        (its states are dropped)
 //   kCalibStart        → kAck: from then on the estimator (calib/estimator.hpp)
@@ -123,7 +128,7 @@ private:
                 send_hello(f.seq, sink);
                 return;
             case MessageType::kModelUpload:
-                update<ModelUpload<T>>(f, sink, [this](const ModelUpload<T>& m) { model_.head[m.head] = m.model; });
+                update<ModelUpload<T>>(f, sink, [this](const ModelUpload<T>& m) { upload_model(m); });
                 return;
             case MessageType::kVelocityUpdate:
                 // A velocity outside the core's domain (|v| > 1000 km/s, 1/s
@@ -213,6 +218,14 @@ private:
         emit(type, f.seq, p, encode(make(), p), sink, true);
     }
 
+    // A head's model and lag (decode() checked τ's range); the lag stage
+    // runs only while some head lags.
+    void upload_model(const ModelUpload<T>& m) noexcept {
+        model_.head[m.head] = m.model;
+        (void)lags_.configure(m.head, m.lag_s);
+        pipeline_.use_lags(lags_.any() ? &lags_ : nullptr);
+    }
+
     void start_estimator(const CalibStart& m) noexcept {
         calib::EstimatorConfig cfg{};
         cfg.orbit_period_us = m.orbit_period_us;
@@ -291,8 +304,7 @@ private:
             return from_states ? pipeline::from_service(service_.velocity_at(s.t))
                                : pipeline::given_velocity(velocity_);
         };
-        const bool timed = (s.calib & kCalibNoTime) == 0U;
-        const bool in_epoch = timed || !pipeline_.calibrating();
+        const bool in_epoch = pipeline_.in_epoch(in.head, (s.calib & kCalibNoTime) == 0U);
         CostMeter meter{counter_, false, 0U, 0U};
         CorrectedSolution<T> c{};
         if (in_epoch) {
@@ -419,6 +431,7 @@ private:
     CycleCounter counter_;
     FrameDecoder decoder_;
     ThermalModel<T> model_{};
+    pipeline::HeadLags<T> lags_{};  // the uploaded model's (use_lags once a head lags)
     ObserverVelocity<T> velocity_{};
     // Catches up to any solution within the horizon in one call (horizon / 10 s + 1 RK4 steps).
     VelocityService<T> service_{default_velocity_service_config()};

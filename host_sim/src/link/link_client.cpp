@@ -6,6 +6,7 @@
 
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/core/status.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 
 namespace ascorr::host {
 
@@ -66,8 +67,9 @@ link::Hello LinkClient<T>::connect() {
 }
 
 template <typename T>
-void LinkClient<T>::upload_model(const ThermalModel<T>& model) {
+void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s) {
     model_ = model;
+    lag_s_ = lag_s;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         update(model_message(h));
     }
@@ -308,6 +310,12 @@ void LinkClient<T>::restore() {
     if (combining_) {
         throw LinkError("the target restarted while combining: its mountings and the epoch's solutions are lost");
     }
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (lag_s_[h] != 0.0) {
+            throw LinkError(std::string("the target restarted while head ") + head_name(h) +
+                            " lags: the lag's state of its temperatures is lost");
+        }
+    }
     for (int round = 0; round < max_attempts_; ++round) {
         ++stats_.restarts;
         if (!restore_round()) {
@@ -360,7 +368,8 @@ bool LinkClient<T>::answer_shows_restart(const link::SolutionOut<T>& out) const 
 
 template <typename T>
 typename LinkClient<T>::Message LinkClient<T>::model_message(std::uint8_t head) const {
-    return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head]}), "model upload"};
+    return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head], lag_s_[head]}),
+            "model upload"};
 }
 
 template <typename T>

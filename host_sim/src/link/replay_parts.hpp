@@ -16,6 +16,7 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
 #include "ascorr_host/analysis/combine.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -94,6 +95,8 @@ private:
 // --self-calibrate the host's run of the estimator over the file.
 template <typename T>
 struct HostSide {
+    pipeline::HeadLags<T> lags;                  // the model's, as the target's lag stage
+    std::optional<LaggedTemperatures> lagged_d;  // the reference's: `correct`'s lag, in double
     std::optional<SelfCalibration> sc;
     std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
     std::optional<link::LinkEstimator<T>> estimator;  // the link's

@@ -1,4 +1,5 @@
 // One `ascorr replay` session over an open transport: the inputs read, the host's side started, the outputs written.
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -28,8 +29,8 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     }
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
-    refuse_lagged_model(mf, opt.model, "replay cannot send it: the link's MODEL_UPLOAD has no word for a lag yet");
     if (opt.self_calibrate) {
+        refuse_lagged_model(mf, opt.model, "--self-calibrate does not learn a lagged model yet");
         refuse_quadratic_initial_model(mf, opt.model);
     }
     return mf;
@@ -55,8 +56,21 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
                 const ThermalModel<T>& model_t, LinkClient<T>& client, HostSide<T>& host, ReplaySummary& sum,
                 const calib::CommonRotationWeights& rule) {
     if (!opt.self_calibrate) {
-        client.upload_model(model_t);
+        // The model's lags, on both sides (the target's lag stage, in its
+        // scalar), and the reference's in double over the whole file, as
+        // `ascorr correct` lags (lagged_temperatures.hpp).
+        const std::array<double, kMaxHeads> lag_s = mf ? head_lags(*mf) : std::array<double, kMaxHeads>{};
+        client.upload_model(model_t, lag_s);
         host.pipeline.use_model(&model_t);
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            (void)host.lags.configure(h, lag_s[h]);  // the model's reader checked each τ
+        }
+        host.pipeline.use_lags(host.lags.any() ? &host.lags : nullptr);
+        host.lagged_d = lagged_temperatures(lag_s, [&](const std::function<void(const SolutionRecord&)>& fn) {
+            for (const SolutionRecord& r : rows) {
+                fn(r);
+            }
+        });
         return;
     }
     calib::EstimatorConfig ecfg;

@@ -115,7 +115,7 @@ private:
     // Everything before the solution: the velocity (the states up to the
     // row's time, or the row's own) and the head's temperatures.
     SentRow send_inputs(const SolutionRecord& rec) {
-        SentRow s{to_core_input<T>(rec, &earth_), to_core_input<double>(rec, &earth_)};
+        SentRow s{to_core_input<T>(rec, &earth_), to_core_input<double>(lagged_d(rec), &earth_)};
         s.timed = tt_from_seconds(rec.t, s.t);
         const bool wants_states = states_ && rec.velocity_components == 0;
         s.from_states = wants_states && s.timed;
@@ -129,6 +129,17 @@ private:
         ++sum_.frames;
         s.calib_use = calib_use_of(rec, s.timed);
         return s;
+    }
+
+    // The row as the reference's terms take it: lagged in double over the
+    // whole file, as `ascorr correct` lags (the target lags in its scalar,
+    // row by row: the host's pipeline mirrors that).
+    SolutionRecord lagged_d(const SolutionRecord& rec) const {
+        SolutionRecord r = rec;
+        if (host_.lagged_d) {
+            host_.lagged_d->apply(r);
+        }
+        return r;
     }
 
     // The reference: the same rows and models in double.
@@ -171,19 +182,22 @@ private:
         status_d = vd.status;
     }
 
-    // SOLUTION_IN's clean bit: the selection of what the target learns from,
+    // SOLUTION_IN's calibration use: kCalibNoTime for a row with no time, and
+    // the clean bit: the selection of what the target learns from,
     // as the host's self-calibration over the file (calibration_clean, which
     // also needs the row's own velocity and temperatures); otherwise the
     // combination's, as `correct --combined` (the camera head's own: flags 0,
     // confidence <= 5; the target's pipeline adds the status, usable.hpp).
     std::uint8_t calib_use_of(const SolutionRecord& rec, bool timed) const {
-        std::uint8_t calib_use = 0U;
+        // No time: in no epoch while calibrating, nor when its head lags.
+        const std::uint8_t no_time = timed ? 0U : link::kCalibNoTime;
+        bool clean = false;
         if (opt_.self_calibrate) {
-            calib_use = !timed ? link::kCalibNoTime : (calibration_clean(rec) ? link::kCalibClean : 0U);
+            clean = timed && calibration_clean(rec);
         } else if (combination_ != nullptr) {
-            calib_use = clean_for_combination(CorrectedRow::of(rec, std::nullopt)) ? link::kCalibClean : 0U;
+            clean = clean_for_combination(CorrectedRow::of(rec, std::nullopt));
         }
-        return calib_use;
+        return static_cast<std::uint8_t>(no_time | (clean ? link::kCalibClean : 0U));
     }
 
     CorrectedSolution<T> host_solution(const SolutionRecord& rec, const SolutionInput<T>& in,
@@ -193,7 +207,7 @@ private:
         link::LinkPipeline<T>& p = host_.pipeline;
         CorrectedSolution<T> host{};
         std::optional<std::uint32_t> host_version;
-        if (p.calibrating() && !timed) {
+        if (!p.in_epoch(in.head, timed)) {
             host = p.untimed_solution(in, answer);
         } else {
             (void)p.begin(t_us);

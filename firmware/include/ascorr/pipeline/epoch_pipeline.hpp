@@ -4,6 +4,9 @@
 // Conventions: an epoch is one time tag on the on-board clock (TT µs; the
 // flight loop: one cycle). Its solutions, of any heads in any order, go
 // through a fixed list of stages:
+//   0. lag       (use_lags; each solution): a lagged head's temperatures as
+//                its terms take them, stepped at the epoch's time
+//                (head_lags.hpp); a solution with no time has none;
 //   1. model     (begin(), at the epoch's first solution): the thermal model of
 //                the whole epoch: a fixed one (use_model), or the one the
 //                on-board estimator holds active (use_estimator; a new model
@@ -45,11 +48,12 @@
 #include "../combine/combiner.hpp"
 #include "../combine/usable.hpp"
 #include "../core/correct.hpp"
+#include "head_lags.hpp"
 #include "solution_stage.hpp"
 
 namespace ascorr::pipeline {
 
-enum class Stage : std::uint8_t { kModel, kVelocity, kCorrect, kFeed, kStep, kCombine };
+enum class Stage : std::uint8_t { kLag, kModel, kVelocity, kCorrect, kFeed, kStep, kCombine };
 
 struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
@@ -123,6 +127,18 @@ public:
     }
 
     bool calibrating() const noexcept { return estimator_ != nullptr; }
+
+    // Stage 0's lags (nullptr, or none of its heads lagging: no lag stage).
+    void use_lags(HeadLags<T>* lags) noexcept { lags_ = lags; }
+
+    // Whether a solution of `head` goes through an epoch (begin(), then
+    // solution()) or, with no time (`timed` false), untimed_solution(): a
+    // solution with no time belongs to no epoch while calibrating, nor when
+    // its head lags (it has no lagged temperatures); otherwise it takes the
+    // fixed model in the epoch its caller gives it.
+    bool in_epoch(std::uint8_t head, bool timed) const noexcept {
+        return timed || (!calibrating() && (lags_ == nullptr || !lags_->lags(head)));
+    }
 
     // Stage 6's combiner (nullptr: no combination); forgets the solutions
     // not combined yet.
@@ -200,7 +216,13 @@ public:
     template <typename Velocity, typename Meter = NoMeter>
     CorrectedSolution<T> solution(SolutionInput<T> in, Velocity&& velocity, bool clean, bool aberration,
                                   Meter& meter) noexcept {
-        std::uint32_t start = meter.now();
+        std::uint32_t start = 0U;
+        if (lags_ != nullptr) {
+            start = meter.now();
+            lags_->apply(in.head, t_us_, in.temperatures);
+            meter.add(Stage::kLag, start);
+        }
+        start = meter.now();
         const VelocityAnswer<T> v = velocity();
         meter.add(Stage::kVelocity, start);
         take_velocity(in, v);
@@ -224,10 +246,14 @@ public:
         return solution(in, velocity, clean, aberration, m);
     }
 
-    // A solution that belongs to no epoch (no time tag): corrected without a
-    // model when calibrating (status 256), never fed.
+    // A solution that belongs to no epoch (no time tag, in_epoch false):
+    // corrected without a model when calibrating (status 256), without
+    // temperatures when its head lags (status 8), never fed nor combined.
     template <typename Velocity>
     CorrectedSolution<T> untimed_solution(SolutionInput<T> in, Velocity&& velocity, bool aberration = true) noexcept {
+        if (lags_ != nullptr) {
+            lags_->without_time(in.head, in.temperatures);
+        }
         const CorrectionConfig<T> cfg{aberration, estimator_ != nullptr ? &kNoModel : fixed_};
         CorrectedSolution<T> c = correct_stage(in, velocity(), cfg, CallsCorrect{});
         c.status = Calls::status(in.head, c.status);
@@ -331,6 +357,7 @@ private:
     static constexpr std::uint8_t kCombineSlots = 2U * kMaxHeads;
 
     FeedSchedule schedule_;
+    HeadLags<T>* lags_ = nullptr;
     const ThermalModel<T>* fixed_ = nullptr;
     calib::Estimator<T, N>* estimator_ = nullptr;
     bool have_epoch_ = false;

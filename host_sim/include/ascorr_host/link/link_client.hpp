@@ -27,6 +27,7 @@
 // records it and sends it with update(), and its line in session().
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -68,7 +69,10 @@ public:
     // Opens a session: request_hello(), and the scalar kind must be T's.
     link::Hello connect();
 
-    void upload_model(const ThermalModel<T>& model);
+    // lag_s: each head's lag τ (0: none), sent with its model; a restart
+    // while a head lags is an error (restore() refuses it): the lag's state
+    // is lost with it.
+    void upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s = {});
     void set_velocity(const ObserverVelocity<T>& v);
     void set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t);
 
@@ -172,6 +176,7 @@ private:
     std::uint16_t seq_ = 0;
     std::uint32_t boot_id_ = 0;
     std::optional<ThermalModel<T>> model_;
+    std::array<double, kMaxHeads> lag_s_{};  // upload_model()'s
     std::optional<ObserverVelocity<T>> velocity_;
     std::optional<std::int64_t> horizon_us_;  // set_service_horizon()
     std::optional<link::StateUpdate> state_;  // the latest accepted spacecraft state
