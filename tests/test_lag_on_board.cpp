@@ -30,6 +30,7 @@
 #include "ascorr_host/link/replay.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "lagged_models.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -39,19 +40,13 @@ namespace fs = std::filesystem;
 
 constexpr double kTauS = 900.0;
 
-// The mission (0.3 days, an epoch every 30 s, bench lag 900 s) and two
+// The mission (0.3 days, an epoch a minute, bench lag 900 s) and two
 // models made from its truth: m.csv as is, m_lag.csv with lag_s 900.
 const fs::path& mission() {
     static const fs::path dir = [] {
         const fs::path d = scratch_dir("lag-on-board");
         EXPECT_EQ(run_in("simulate --days 0.3 --bench-lag 900 --out s.csv > /dev/null", d).exit_code, 0);
-        const std::vector<std::string> truth = lines_of_file(d / "s.csv.truth.csv");
-        std::vector<std::string> lagged{truth[0] + ",lag_s"};
-        for (std::size_t i = 1; i < truth.size(); ++i) {
-            lagged.push_back(truth[i] + ",900");
-        }
-        write_lines(d / "m.csv", truth);
-        write_lines(d / "m_lag.csv", lagged);
+        write_truth_models(d, "900");
         return d;
     }();
     return dir;

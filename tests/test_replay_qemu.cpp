@@ -20,6 +20,7 @@
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "cli_run.hpp"
+#include "lagged_models.hpp"
 #include "replay_boards.hpp"
 #include "replay_recording.hpp"
 #include "test_support.hpp"
@@ -135,17 +136,13 @@ TEST_P(ReplayQemu, RestartMidRunIsRecovered) {
 // lags as `ascorr correct` does); the lag stage runs inside the measured
 // window, so the instructions per solution grow (printed against the same
 // mission without the lag; bench/target_bench.cpp measures the stage alone).
+// An epoch a second (τ/Δt = 900, α from its series; the loopback test,
+// test_lag_on_board.cpp, takes the double path at a minute).
 TEST_P(ReplayQemu, LaggedModel) {
     const host::QemuTarget& board = GetParam();
     const auto dir = scratch_dir(scratch_name(board, "_lag"));
-    ASSERT_EQ(run_in("simulate --days 0.1 --bench-lag 900 --out s.csv > /dev/null", dir).exit_code, 0);
-    const std::vector<std::string> truth = lines_of_file(dir / "s.csv.truth.csv");
-    std::vector<std::string> lagged{truth[0] + ",lag_s"};
-    for (std::size_t i = 1; i < truth.size(); ++i) {
-        lagged.push_back(truth[i] + ",900");
-    }
-    write_lines(dir / "m.csv", truth);
-    write_lines(dir / "m_lag.csv", lagged);
+    ASSERT_EQ(run_in("simulate --days 0.004 --step 1 --bench-lag 900 --out s.csv > /dev/null", dir).exit_code, 0);
+    write_truth_models(dir, "900");
     const auto through = [&](const char* model) {
         host::ReplayOptions o;
         o.target = std::string(board.replay);

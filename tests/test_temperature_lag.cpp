@@ -188,6 +188,34 @@ TEST(TemperatureLag, Q30At22HzIsWithinItsResolution) {
     EXPECT_GT(narrow_worst, 10 * 3e-5);
 }
 
+// α from its series in float and Q30 (Δt ≤ τ/256, no double on the step)
+// against expm1 in long double, over every τ the lag takes and Δt from a
+// microsecond to τ/256: Q30 within half an LSB plus k's rounding (2⁵¹/τ to
+// an integer: 2e-5 relative at a day), float within 4 roundings of 2⁻²⁴.
+TEST(TemperatureLag, AlphaSeriesIsWithinItsFormatsResolution) {
+    using ascorr::Q30;
+    using ascorr::pipeline::LagArithmetic;
+    double worst_q30 = 0.0;
+    double worst_float = 0.0;
+    for (double tau_s : {1.0, 7.3, 300.0, 900.0, 1800.0, 6048.0, 86400.0}) {
+        const double tau_us = tau_s * 1e6;
+        const auto q30 = LagArithmetic<Q30>::AlphaSeries::of(tau_us);
+        const auto f = LagArithmetic<float>::AlphaSeries::of(tau_us);
+        const auto longest = static_cast<std::int32_t>(tau_us * ascorr::pipeline::kSeriesFraction);
+        for (int i = 0; i <= 400; ++i) {
+            const auto dt = std::max(std::int32_t{1}, static_cast<std::int32_t>(longest * std::pow(1e-7, i / 400.0)));
+            const long double exact = -std::expm1l(-static_cast<long double>(dt) / tau_us);
+            const double a_q30 = ascorr::ScalarTraits<Q30>::to_double(q30(dt));
+            const double q30_bound = 0x1p-31 + 2.0 / (0x1p51 / tau_us) * static_cast<double>(exact);
+            worst_q30 = std::max(worst_q30, static_cast<double>(std::fabs(a_q30 - exact)) / q30_bound);
+            const double a_f = static_cast<double>(f(dt));
+            worst_float = std::max(worst_float, static_cast<double>(std::fabs(a_f - exact) / exact) / (4 * 0x1p-24));
+        }
+    }
+    EXPECT_LE(worst_q30, 1.0);
+    EXPECT_LE(worst_float, 1.0);
+}
+
 TEST(TemperatureLag, EachBadInputLeavesItsChannelAsItWas) {
     TemperatureLag<double> lag;
     const HeadTemperatures<double> ok{{20.0, true}, {21.0, true}, {22.0, true}};

@@ -22,14 +22,20 @@
 // Time: TT µs, a signed 64-bit count (the flight loop's tag; the host passes
 // llround(t · 1e6) of a row's t).
 // Cost per step: the channels that advanced at the lag's last time (all of
-// them, but after a withheld reading) share one Δt and so one α, looked up
-// once among the lag's last two Δt (a head's cadence repeats, or alternates
-// between two values when times are rounded, as 45/46 ms at 22 Hz); then per
-// channel two subtractions and one multiply-add. Only a third Δt, or a
-// channel catching up over its own interval, forms α, in double by
-// calib::expm1_nonpositive (+ − × ÷ alone, so the DPU and the host form the
+// them, but after a withheld reading) share one Δt and so one α, formed once;
+// then per channel two subtractions and one multiply-add. α in double (the
+// host) is calib::expm1_nonpositive (+ − × ÷ alone, so every build forms the
 // same bits, as the estimator's forgetting factor; libm's expm1 is not
-// correctly rounded and differs between libraries), rounded once to T.
+// correctly rounded and differs between libraries), rounded once to T, and
+// kept for the lag's last two Δt (a head's cadence repeats, or alternates
+// between two values when times are rounded, as 45/46 ms at 22 Hz). In float
+// and Q30 (the targets, whose double is software) α comes from its series in
+// T when Δt ≤ τ/256 (LagArithmetic::AlphaSeries, below): a few products
+// whatever the times' jitter (22 Hz against any τ from 12 s); a longer Δt
+// takes the double path and its two kept values.
+// The usual step (every channel in step, every reading usable) takes a path
+// of its own (lag_in_place), the same operations without the bookkeeping:
+// measured per solution in bench/target_bench.cpp (docs/figures.md).
 // No division on the step (1/τ is formed by configure()), no loop on the
 // step but α's bounded halvings, no allocation, no exceptions.
 // Bad input, each leaves the channel as it was and says why (LagStep):
@@ -40,7 +46,8 @@
 // configure() with a τ out of range changes nothing and returns false.
 // Scalars: double, float and Q30. Fixed point (Q30, the core's temperatures
 // in QCelsius Q11.20, q_formats.hpp): T and L are QCelsius, α is Q30 in
-// (0, 1] (rounded to nearest from the double α; α = 1 exact), and the state
+// (0, 1] (its series, or rounded to nearest from the double α; α = 1
+// exact), and the state
 // D is held in int64 at 2⁻⁵⁰ °C, the exact scale of a Q30·QCelsius product,
 // so that a small α·u is never rounded away. (In QCelsius itself a step with
 // |α·u| below half an LSB would not decay at all: a dead band of 0.5/α LSB,
@@ -58,6 +65,8 @@
 // operation can overflow, none saturates.
 // α's own rounding (≤ 2⁻³¹) is a relative error of τ of at most 2⁻³¹·τ/Δt:
 // 1e-5 at τ = 900 s and 22 Hz, 9e-4 at a day (below any τ a fit resolves).
+// Channels: each channel's last time is the lag's (in_step_) or its own
+// (Channel::t_us), so that the usual step stores one time, not three.
 #pragma once
 
 #include <cstdint>
@@ -73,10 +82,25 @@ namespace ascorr::pipeline {
 // The step's arithmetic in T's formats: State holds D, input() forms u,
 // decay() u − α·u, deviation() D as a temperature (floating point: as
 // written, in T; Q30: the int64 state above).
+// AlphaSeries: α = 1 − e^(−x) = x − x²/2 + x³/6 − …, x = Δt/τ ≤ 2⁻⁸
+// (kSeriesFraction): the terms from x⁴/24 on are below 2⁻³²·x/24, under
+// float's and Q30's resolution of α. Double has none (its α is expm1's).
+inline constexpr double kSeriesFraction = 0x1p-8;
+
 template <typename T>
 struct LagArithmetic {
     using C = Celsius<T>;
     using State = C;
+    // Float: x = Δt·(1/τ) in T (Δt ≤ τ/256 < 2³¹ µs); each operation rounds
+    // to 2⁻²⁴ relative, so α's relative error is a few 2⁻²⁴.
+    struct AlphaSeries {
+        T inv_tau_per_us{};
+        static AlphaSeries of(double tau_us) noexcept { return {static_cast<T>(1.0 / tau_us)}; }
+        T operator()(std::int32_t dt_us) const noexcept {
+            const T x = static_cast<T>(dt_us) * inv_tau_per_us;
+            return x * (T(1) - x * (T(0.5) - x * T(1.0 / 6.0)));
+        }
+    };
     static constexpr State input(State d, C reading, C last) noexcept { return d - (reading - last); }
     static constexpr State decay(T alpha, State u) noexcept { return u - alpha * u; }
     static constexpr C deviation(State d) noexcept { return d; }
@@ -88,6 +112,28 @@ struct LagArithmetic<Q30> {
     using C = QCelsius;
     using State = std::int64_t;                    // D·2⁵⁰ (°C)
     static constexpr int kExtra = Q30::kFracBits;  // the state's bits below QCelsius'
+    // Q30: x = Δt·k·2⁻⁵¹ (k = 2⁵¹/τ in µs, rounded at configure: from
+    // 2.3e9 at τ = 1 s down to 26 062 at a day, so k's rounding is a
+    // relative error of τ below 2e-5, under α's own at a day, 9e-4). Δt <
+    // 2²⁹ µs (τ/256 ≤ 3.4e8), so Δt·k < 2⁶¹ in uint64. The series is summed
+    // at 2⁻⁴⁶ (x ≤ 2⁻⁸: x·2⁴⁶ ≤ 2³⁸; x², x³ from x rounded to Q30, ≤ 2²²
+    // raw, an error below 2⁻³⁸ in them) and rounded to Q30 once: α within
+    // half an LSB (4.7e-10) plus 2⁻⁴⁴ and k's rounding.
+    struct AlphaSeries {
+        std::uint32_t k = 0;
+        static AlphaSeries of(double tau_us) noexcept {
+            return {static_cast<std::uint32_t>(0x1p51 / tau_us + 0.5)};  // τ ≥ 1 s: < 2³²
+        }
+        Q30 operator()(std::int32_t dt_us) const noexcept {
+            const std::uint64_t p = std::uint64_t{static_cast<std::uint32_t>(dt_us)} * k;
+            const std::uint64_t x46 = (p + 16U) >> 5U;                                              // x·2⁴⁶
+            const auto x30 = static_cast<std::uint32_t>((x46 + (1U << 15U)) >> 16U);                // ≤ 2²²
+            const std::uint64_t sq = std::uint64_t{x30} * x30;                                      // x²·2⁶⁰
+            const std::uint64_t cube = std::uint64_t{static_cast<std::uint32_t>(sq >> 30U)} * x30;  // x³·2⁶⁰
+            const std::uint64_t a46 = x46 - (sq >> 15U) + static_cast<std::uint32_t>(cube >> 14U) / 6U;
+            return {static_cast<std::int32_t>((a46 + (1U << 15U)) >> 16U)};
+        }
+    };
     static constexpr State input(State d, C reading, C last) noexcept {
         return d - fx::mul(reading.raw - last.raw, std::int32_t{1} << kExtra);  // ΔT ≤ 400 °C: exact
     }
@@ -136,11 +182,14 @@ public:
             return false;
         }
         inv_tau_per_us_ = 1.0 / (tau_s * 1e6);  // in [1.2e-11, 1e-6]
+        series_ = Arithmetic::AlphaSeries::of(tau_s * 1e6);
+        series_max_us_ = static_cast<std::int64_t>(tau_s * 1e6 * kSeriesFraction);  // ≤ 3.4e8 µs
         for (Channel& c : ch_) {
             c = Channel{};
         }
         cache_ = AlphaCache{};
         have_time_ = false;
+        in_step_ = 0U;
         configured_ = true;
         return true;
     }
@@ -153,17 +202,28 @@ public:
         if (!(t_us > -kMaxLagTimeUs && t_us < kMaxLagTimeUs)) {
             return {{LagStep::kBadTime, LagStep::kBadTime, LagStep::kBadTime}};
         }
-        // The α of the channels that advanced at the lag's last time.
+        // Each channel's last time, and the α of those in step (whose last
+        // time is the lag's).
+        const std::int64_t last[kLagChannels] = {time_of(0), time_of(1), time_of(2)};
         const bool ahead = have_time_ && t_us > t_us_;
         const T alpha = ahead ? alpha_for(t_us - t_us_) : T{};
-        const LagSteps s{{advance(ch_[0], t_us, temps.t_chu, ahead, alpha),
-                          advance(ch_[1], t_us, temps.t_029, ahead, alpha),
-                          advance(ch_[2], t_us, temps.t_032, ahead, alpha)}};
-        if (!have_time_ || t_us > t_us_) {
-            const bool moved = moves(s);
-            t_us_ = moved ? t_us : t_us_;
-            have_time_ = have_time_ || moved;
+        const LagSteps s{{advance(ch_[0], last[0], t_us, temps.t_chu, ahead && in_step(0), alpha),
+                          advance(ch_[1], last[1], t_us, temps.t_029, ahead && in_step(1), alpha),
+                          advance(ch_[2], last[2], t_us, temps.t_032, ahead && in_step(2), alpha)}};
+        if (moves(s) && (!have_time_ || t_us > t_us_)) {
+            t_us_ = t_us;
+            have_time_ = true;
         }
+        // Which channels are in step now; the others keep their own time.
+        std::uint8_t bits = 0U;
+        for (std::uint8_t k = 0; k < kLagChannels; ++k) {
+            const bool now = s.channel[k] == LagStep::kStarted || s.channel[k] == LagStep::kAdvanced;
+            const std::int64_t tk = now ? t_us : last[k];
+            const bool step_k = ch_[k].started && tk == t_us_;
+            bits = static_cast<std::uint8_t>(bits | (step_k ? 1U << k : 0U));
+            ch_[k].t_us = tk;
+        }
+        in_step_ = bits;
         return s;
     }
 
@@ -175,18 +235,19 @@ public:
     // advanced, started, or at the same t as its last) replaced by L. false,
     // temps unchanged, when t_us is before the lag's last time or not a time,
     // or no τ was configured.
+    // The usual step, every channel in step and every reading usable, takes
+    // a path of its own: the same operations as step()'s, straight.
     bool lag_in_place(std::int64_t t_us, HeadTemperatures<T>& temps) noexcept {
-        if (before_last(t_us)) {
-            return false;
+        if (in_step_ == kAllInStep && t_us > t_us_ && t_us < kMaxLagTimeUs && usable(temps.t_chu) &&
+            usable(temps.t_029) && usable(temps.t_032)) {
+            const T alpha = alpha_for(t_us - t_us_);
+            advance_in_place(ch_[0], temps.t_chu, alpha);
+            advance_in_place(ch_[1], temps.t_029, alpha);
+            advance_in_place(ch_[2], temps.t_032, alpha);
+            t_us_ = t_us;
+            return true;
         }
-        const LagSteps s = step(t_us, temps);
-        if (s.channel[0] == LagStep::kBadTime || s.channel[0] == LagStep::kNotConfigured) {  // every channel's
-            return false;
-        }
-        put(s.channel[0], ch_[0], temps.t_chu);
-        put(s.channel[1], ch_[1], temps.t_029);
-        put(s.channel[2], ch_[2], temps.t_032);
-        return true;
+        return lag_in_place_in_general(t_us, temps);
     }
 
     // Channel k's deviation D = L − T at its last reading (°C), valid once
@@ -203,10 +264,26 @@ public:
     }
 
 private:
+    // lag_in_place() but for the usual step (out of line: the usual one
+    // keeps a small frame).
+    [[gnu::noinline]] bool lag_in_place_in_general(std::int64_t t_us, HeadTemperatures<T>& temps) noexcept {
+        if (before_last(t_us)) {
+            return false;
+        }
+        const LagSteps s = step(t_us, temps);
+        if (s.channel[0] == LagStep::kBadTime || s.channel[0] == LagStep::kNotConfigured) {  // every channel's
+            return false;
+        }
+        put(s.channel[0], ch_[0], temps.t_chu);
+        put(s.channel[1], ch_[1], temps.t_029);
+        put(s.channel[2], ch_[2], temps.t_032);
+        return true;
+    }
+
     struct Channel {
         typename Arithmetic::State d{};  // D = L − T at the last reading, °C
         C t_reading{};                   // the last reading, °C
-        std::int64_t t_us = 0;           // the time of the last reading
+        std::int64_t t_us = 0;           // the time of the last reading, unless in step (time_of)
         bool started = false;
     };
     // The last two Δt an α was formed for (−1: none), and which was used last.
@@ -230,46 +307,77 @@ private:
         return m;
     }
 
-    // ahead: t_us is after the lag's last time, whose channels take `alpha`.
-    LagStep advance(Channel& c, std::int64_t t_us, const TemperatureReading<T>& r, bool ahead, T alpha) const noexcept {
-        if (!r.valid || !temperature_in_domain<T>(r.value)) {
+    static bool usable(const TemperatureReading<T>& r) noexcept { return r.valid && temperature_in_domain<T>(r.value); }
+
+    bool in_step(std::uint8_t k) const noexcept { return ((in_step_ >> k) & 1U) != 0U; }
+    // Channel k's last time (once started).
+    std::int64_t time_of(std::uint8_t k) const noexcept { return in_step(k) ? t_us_ : ch_[k].t_us; }
+
+    // One channel whose last time is `last`; shared: it was in step, and
+    // t_us is after the lag's last time, so it takes the step's `alpha`.
+    LagStep advance(Channel& c, std::int64_t last, std::int64_t t_us, const TemperatureReading<T>& r, bool shared,
+                    T alpha) const noexcept {
+        if (!usable(r)) {
             return LagStep::kHeld;
         }
         if (!c.started) {
             c = Channel{};
             c.t_reading = r.value;
-            c.t_us = t_us;
             c.started = true;
             return LagStep::kStarted;
         }
-        if (t_us <= c.t_us) {
+        if (t_us <= last) {
             return LagStep::kTimeNotIncreasing;
         }
         // No overflow: both times within ±kMaxLagTimeUs. A channel that was
         // withheld since catches up over its own interval.
-        const T a = ahead && c.t_us == t_us_ ? alpha : alpha_of(t_us - c.t_us);
+        const T a = shared ? alpha : alpha_of(t_us - last);
         const typename Arithmetic::State u = Arithmetic::input(c.d, r.value, c.t_reading);
         c.d = Arithmetic::decay(a, u);
         c.t_reading = r.value;
-        c.t_us = t_us;
         return LagStep::kAdvanced;
     }
 
-    // α = 1 − e^(−Δt/τ) for dt_us > 0, in (0, 1], in double by
-    // expm1_nonpositive, rounded once to T.
+    // The usual step of a channel in step (lag_in_place): advanced with the
+    // step's α, and the reading replaced by L.
+    [[gnu::always_inline]] static void advance_in_place(Channel& c, TemperatureReading<T>& r, T alpha) noexcept {
+        const typename Arithmetic::State u = Arithmetic::input(c.d, r.value, c.t_reading);
+        c.d = Arithmetic::decay(alpha, u);
+        c.t_reading = r.value;
+        r.value = Arithmetic::sum(r.value, Arithmetic::deviation(c.d));
+    }
+
+    // α = 1 − e^(−Δt/τ) for dt_us > 0, in (0, 1]: in float and Q30 its
+    // series when Δt ≤ τ/256, otherwise in double by expm1_nonpositive,
+    // rounded once to T.
     T alpha_of(std::int64_t dt_us) const noexcept {
+        if constexpr (!ScalarTraits<T>::double_precision) {
+            if (dt_us <= series_max_us_) {
+                return series_(static_cast<std::int32_t>(dt_us));
+            }
+        }
+        return alpha_in_double(dt_us);
+    }
+    [[gnu::noinline]] T alpha_in_double(std::int64_t dt_us) const noexcept {
         return ScalarTraits<T>::from_double(-calib::expm1_nonpositive(-static_cast<double>(dt_us) * inv_tau_per_us_));
     }
 
-    // alpha_of(dt_us): one of the last two, or formed into the older slot.
+    // The step's shared α: in float and Q30 its series when Δt ≤ τ/256;
+    // otherwise one of the last two formed, or formed (in double) into the
+    // older slot.
     T alpha_for(std::int64_t dt_us) noexcept {
+        if constexpr (!ScalarTraits<T>::double_precision) {
+            if (dt_us <= series_max_us_) {
+                return series_(static_cast<std::int32_t>(dt_us));
+            }
+        }
         AlphaCache& k = cache_;
         if (dt_us == k.dt_us[k.newer]) {
             return k.alpha[k.newer];
         }
         const std::uint8_t other = k.newer ^ 1U;
         if (dt_us != k.dt_us[other]) {
-            k.alpha[other] = alpha_of(dt_us);
+            k.alpha[other] = alpha_in_double(dt_us);
             k.dt_us[other] = dt_us;
         }
         k.newer = other;
@@ -280,7 +388,12 @@ private:
     AlphaCache cache_{};
     std::int64_t t_us_ = 0;  // the last time a channel started or advanced at (have_time_)
     bool have_time_ = false;
-    double inv_tau_per_us_ = 0.0;  // α is formed in double (alpha_of)
+    // Bit k: channel k's last reading was at t_us_ (its own t_us is then stale).
+    static constexpr std::uint8_t kAllInStep = (1U << kLagChannels) - 1U;
+    std::uint8_t in_step_ = 0U;
+    double inv_tau_per_us_ = 0.0;  // α in double (alpha_in_double)
+    typename Arithmetic::AlphaSeries series_{};
+    std::int64_t series_max_us_ = 0;  // the longest Δt of the series: τ/256
     bool configured_ = false;
 };
 
