@@ -28,7 +28,7 @@
 // The lag stage of a lagged head (pipeline/head_lags.hpp, the out-of-line
 // entry of firmware/app/lag_entry_*.cpp) is measured per solution: heads A,
 // B and C in turn at 22 Hz on millisecond time tags (each head's Δt 45 or
-// 46 ms, so each channel's α comes from its cache once warmed up), τ = 900 s,
+// 46 ms: α from its series, every channel in step: the usual path), τ = 900 s,
 // the selected records' temperatures, against a function that only copies a
 // reading ("bench <scalar> lag <instructions>": what a lagged head adds to
 // its solution's correction).
@@ -336,7 +336,7 @@ void bench_lag(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
         (void)lags.configure(h, 900.0);
     }
     std::uint32_t epoch = 0U;
-    (void)run_lag<T>(&lag_call<T>, lags, fx, epoch);  // warm-up: every channel started, both α formed
+    (void)run_lag<T>(&lag_call<T>, lags, fx, epoch);  // warm-up: every channel started and in step
     const std::uint32_t c0 = run_lag<T>(&lag_copy<T>, lags, fx, epoch);
     report(name, "lag", run_lag<T>(&lag_call<T>, lags, fx, epoch), c0, ipc);
 }

@@ -263,6 +263,30 @@ TEST(LagLink, AnUntimedSolutionOfALaggedHeadHasNoTemperaturesAndARestartIsAnErro
     }
 }
 
+// A restart before any timed solution of a lagged head loses no lag state:
+// the model and its lags are restored. The estimator does not start while a
+// head lags, and a lag is refused while it runs: it would learn from lagged
+// temperatures, which no ground run reproduces yet.
+TEST(LagLink, ARestartBeforeTheLagHasStateIsRestoredAndTheEstimatorRefusesALag) {
+    const ThermalModel<float> model = host::to_core<float>(host::read_model_file((mission() / "m.csv").string()));
+    RestartingTarget target(2);  // during the model's upload
+    host::LoopbackTransport t(
+        [&](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& r) { target.serve(p, n, r); });
+    host::LinkClient<float> client(t, 1, 20);
+    client.connect();
+    client.upload_model(model, {kTauS, 0.0, 0.0, 0.0});
+    EXPECT_EQ(client.stats().restarts, 1U);
+    client.set_velocity({{1e-4F, -2e-5F, 3e-5F}, 1.0F, true});
+    client.set_temperatures(0, {{10.0F, true}, {-5.0F, true}, {-20.0F, true}});
+    const Quaternion<float> q{0.5F, 0.5F, 0.5F, 0.5F};
+    EXPECT_EQ(client.correct(0, 0, q, TtTime{5'000'000'000'000}).status,
+              status::kAberrationApplied | status::kThermalApplied);
+    EXPECT_THROW(client.start_calibration(5'700'000'000, 30.0, nullptr), host::LinkError);
+    client.upload_model(model);  // no lag: the estimator may start, and then takes no lag
+    client.start_calibration(5'700'000'000, 30.0, nullptr);
+    EXPECT_THROW(client.upload_model(model, {0.0, kTauS, 0.0, 0.0}), host::LinkError);
+}
+
 // The corrected rows of a file, by line: status and quaternion.
 struct Corrected {
     std::string status;

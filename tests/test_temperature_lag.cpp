@@ -8,8 +8,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "ascorr/pipeline/temperature_lag.hpp"
@@ -214,6 +216,136 @@ TEST(TemperatureLag, AlphaSeriesIsWithinItsFormatsResolution) {
     }
     EXPECT_LE(worst_q30, 1.0);
     EXPECT_LE(worst_float, 1.0);
+}
+
+// The lag as first written (6a379b0): every channel with its own last time,
+// α formed for each channel's own Δt; the reference of the bookkeeping that
+// replaced it (a time per lag, channels in step, the straight usual step),
+// which in double must give the same bits for any sequence.
+class ChannelwiseLag {
+public:
+    explicit ChannelwiseLag(double tau_s) : inv_tau_per_us_(1.0 / (tau_s * 1e6)) {}
+    LagStep step(std::uint8_t k, std::int64_t t_us, double reading, bool valid) {
+        Channel& c = ch_[k];
+        if (!(t_us > -ascorr::pipeline::kMaxLagTimeUs && t_us < ascorr::pipeline::kMaxLagTimeUs)) {
+            return LagStep::kBadTime;
+        }
+        if (!valid || !ascorr::temperature_in_domain<double>(reading)) {
+            return LagStep::kHeld;
+        }
+        if (!c.started) {
+            c = {0.0, reading, t_us, true};
+            return LagStep::kStarted;
+        }
+        if (t_us <= c.t_us) {
+            return LagStep::kTimeNotIncreasing;
+        }
+        const double alpha = -ascorr::calib::expm1_nonpositive(-static_cast<double>(t_us - c.t_us) * inv_tau_per_us_);
+        const double u = c.d - (reading - c.t_reading);
+        c = {u - alpha * u, reading, t_us, true};
+        return LagStep::kAdvanced;
+    }
+    double lagged(std::uint8_t k) const { return ch_[k].t_reading + ch_[k].d; }
+    bool started(std::uint8_t k) const { return ch_[k].started; }
+
+private:
+    struct Channel {
+        double d = 0.0;
+        double t_reading = 0.0;
+        std::int64_t t_us = 0;
+        bool started = false;
+    };
+    double inv_tau_per_us_;
+    Channel ch_[3];
+};
+
+// Random sequences: 22 Hz steps, tiny and long ones, repeats, times going
+// back, readings withheld, NaN, beyond the domain, at its edge.
+struct Sequence {
+    std::mt19937_64 rng;
+    std::int64_t t = 0;
+    double temp[3] = {20.0, 21.0, 22.0};
+    double u() { return std::uniform_real_distribution<double>(0.0, 1.0)(rng); }
+    std::int64_t next_time() {
+        const double r = u();
+        if (r < 0.6) {
+            t += r < 0.3 ? 45'000 : 46'000;
+        } else if (r < 0.7) {
+            t += 1 + static_cast<std::int64_t>(u() * 100);
+        } else if (r < 0.78) {
+            t -= static_cast<std::int64_t>(u() * 200'000);  // a repeat, or back
+        } else if (r < 0.88) {
+            t += static_cast<std::int64_t>(u() * 4e11);  // a gap, up to 4.6 days
+        } else {
+            t += static_cast<std::int64_t>(u() * 4e8);  // around τ/256 at a day
+        }
+        return t;
+    }
+    void next_readings(double out[3], bool valid[3]) {
+        for (int k = 0; k < 3; ++k) {
+            const double r = u();
+            temp[k] = r < 0.85 ? temp[k] + (u() - 0.5) * 0.01 : r < 0.93 ? (u() - 0.5) * 400.0 : 200.0;
+            out[k] = u() < 0.02 ? std::nan("") : u() < 0.02 ? 250.0 : temp[k];
+            valid[k] = u() < 0.85;
+        }
+    }
+};
+
+template <typename T>
+HeadTemperatures<T> of(const double v[3], const bool ok[3]) {
+    return {{celsius<T>(v[0]), ok[0]}, {celsius<T>(v[1]), ok[1]}, {celsius<T>(v[2]), ok[2]}};
+}
+
+template <typename T>
+bool same(const ascorr::Celsius<T>& a, const ascorr::Celsius<T>& b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+// lag_in_place (its straight usual step, or the general one) against step()
+// and lagged() of a second lag fed alike, bit for bit, in T; in double both
+// also against ChannelwiseLag.
+template <typename T>
+std::size_t differences(std::uint64_t seed, double tau_s, int steps) {
+    Sequence seq{std::mt19937_64(seed)};
+    TemperatureLag<T> in_place;
+    TemperatureLag<T> stepped;
+    ChannelwiseLag reference(tau_s);
+    EXPECT_TRUE(in_place.configure(tau_s) && stepped.configure(tau_s));
+    std::size_t n = 0;
+    for (int i = 0; i < steps; ++i) {
+        const std::int64_t t = seq.next_time();
+        double v[3];
+        bool ok[3];
+        seq.next_readings(v, ok);
+        HeadTemperatures<T> a = of<T>(v, ok);
+        const bool taken = in_place.lag_in_place(t, a);
+        const bool earlier = stepped.before_last(t);
+        const auto s = earlier ? ascorr::pipeline::LagSteps{} : stepped.step(t, of<T>(v, ok));
+        const ascorr::TemperatureReading<T>* got[3] = {&a.t_chu, &a.t_029, &a.t_032};
+        for (std::uint8_t k = 0; k < 3; ++k) {
+            const bool took = !earlier && s.channel[k] != LagStep::kHeld && s.channel[k] != LagStep::kBadTime;
+            n += taken != (!earlier && s.channel[0] != LagStep::kBadTime) ? 1U : 0U;
+            const ascorr::Celsius<T> want = took ? stepped.lagged(k).value : celsius<T>(v[k]);
+            n += same<T>(got[k]->value, want) ? 0U : 1U;
+            if constexpr (std::is_same_v<T, double>) {
+                if (!earlier) {
+                    const LagStep r = reference.step(k, t, v[k], ok[k]);
+                    n += r == s.channel[k] ? 0U : 1U;
+                    n += !reference.started(k) || same<double>(reference.lagged(k), stepped.lagged(k).value) ? 0U : 1U;
+                }
+            }
+        }
+    }
+    return n;
+}
+
+TEST(TemperatureLag, TheTimeOfALagAndItsStraightStepAreTheChannelwiseLagsBits) {
+    for (std::uint64_t seed = 1; seed <= 60; ++seed) {
+        const double tau = seed % 3 == 0 ? 1.0 : seed % 3 == 1 ? 900.0 : 86400.0;
+        EXPECT_EQ(differences<double>(seed, tau, 3000), 0U) << seed;
+        EXPECT_EQ(differences<float>(seed, tau, 3000), 0U) << seed;
+        EXPECT_EQ(differences<ascorr::Q30>(seed, tau, 3000), 0U) << seed;
+    }
 }
 
 TEST(TemperatureLag, EachBadInputLeavesItsChannelAsItWas) {

@@ -5,10 +5,10 @@
 // temperatures. It takes received bytes one at a time and hands each response
 // frame to a sink. Requests and answers:
 //   kHelloRequest      → kHello
-//   kModelUpload       → kAck (kBadPayload for a bad head, length or lag);
-//                        with a lag τ, the head's temperatures go through
-//                        the lag stage from then on, its lag started afresh
-//                        (pipeline/head_lags.hpp)
+//   kModelUpload       → kAck (kBadPayload for a bad head, length or lag, or
+//                        a lag while the estimator runs); with a lag τ, the
+//                        head's temperatures go through the lag stage from
+//                        then on, its lag started afresh (pipeline/head_lags.hpp)
 //   kVelocityUpdate    → kAck
 //   kTemperatureUpdate → kAck
 //   kStateUpdate       → kAck (the state goes to the velocity service, which
@@ -20,7 +20,8 @@
 //                        lagged temperatures: status 8)
 //   kServiceConfig     → kAck: the velocity service restarts with the horizon
 //                        (its states are dropped)
-//   kCalibStart        → kAck: from then on the estimator (calib/estimator.hpp)
+//   kCalibStart        → kAck (kBadPayload while a head lags): from then on
+//                        the estimator (calib/estimator.hpp)
 //                        runs on the solutions through the epoch pipeline
 //                        (pipeline/epoch_pipeline.hpp says which solutions
 //                        feed it and which model corrects an epoch). A
@@ -128,7 +129,11 @@ private:
                 send_hello(f.seq, sink);
                 return;
             case MessageType::kModelUpload:
-                update<ModelUpload<T>>(f, sink, [this](const ModelUpload<T>& m) { upload_model(m); });
+                // A lag is refused while the estimator runs: it would learn
+                // from lagged temperatures, which no ground run reproduces.
+                update<ModelUpload<T>>(
+                    f, sink, [this](const ModelUpload<T>& m) { upload_model(m); },
+                    [this](const ModelUpload<T>& m) { return m.lag_s == 0.0 || !pipeline_.calibrating(); });
                 return;
             case MessageType::kVelocityUpdate:
                 // A velocity outside the core's domain (|v| > 1000 km/s, 1/s
@@ -152,7 +157,9 @@ private:
                     f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
                 return;
             case MessageType::kCalibStart:
-                update<CalibStart>(f, sink, [this](const CalibStart& m) { start_estimator(m); });
+                update<CalibStart>(
+                    f, sink, [this](const CalibStart& m) { start_estimator(m); },
+                    [this](const CalibStart& /*m*/) { return !lags_.any(); });  // not while a head lags (above)
                 return;
             case MessageType::kServiceConfig:
                 update<ServiceConfig>(f, sink, [this](const ServiceConfig& m) {
@@ -265,8 +272,8 @@ private:
     }
 
     // The meter of a solution's cost: one window, from the first stage's
-    // start to the end of the correction (the model, velocity and correction
-    // stages; not the estimator's feed and steps), two counter reads.
+    // start to the end of the correction (the lag, model, velocity and
+    // correction stages; not the estimator's feed and steps), two counter reads.
     struct CostMeter {
         CycleCounter& counter;
         bool started;

@@ -120,6 +120,9 @@ link::SolutionOut<T> LinkClient<T>::correct(std::uint32_t id, std::uint8_t head,
     from_states_ = from_states;
     velocity_expected_ = velocity_expected;
     calib_ = calib;
+    if (lagging_ == kUnknownHead && head < kMaxHeads && lag_s_[head] != 0.0 && (calib & link::kCalibNoTime) == 0U) {
+        lagging_ = head;  // from now on the target holds lag state a restart would lose
+    }
     for (int attempt = 0; attempt < max_attempts_; ++attempt) {
         const auto a = request(m, link::MessageType::kSolutionOut);
         link::SolutionOut<T> out{};
@@ -310,11 +313,9 @@ void LinkClient<T>::restore() {
     if (combining_) {
         throw LinkError("the target restarted while combining: its mountings and the epoch's solutions are lost");
     }
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        if (lag_s_[h] != 0.0) {
-            throw LinkError(std::string("the target restarted while head ") + head_name(h) +
-                            " lags: the lag's state of its temperatures is lost");
-        }
+    if (lagging_ != kUnknownHead) {
+        throw LinkError(std::string("the target restarted while head ") + head_name(lagging_) +
+                        " lags: the lag's state of its temperatures is lost");
     }
     for (int round = 0; round < max_attempts_; ++round) {
         ++stats_.restarts;

@@ -210,7 +210,7 @@ public:
     // Epochs that fed the estimator so far (wraps at 2^32).
     std::uint32_t feeds() const noexcept { return feeds_; }
 
-    // Stages 2–5 for one solution of the current epoch (begin() came first).
+    // Stages 0 and 2–5 for one solution of the current epoch (begin() came first).
     // `velocity` () → VelocityAnswer<T>; `clean`: the source's selection
     // (flags, confidence) lets it feed the estimator.
     template <typename Velocity, typename Meter = NoMeter>

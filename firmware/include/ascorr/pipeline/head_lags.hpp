@@ -10,8 +10,8 @@
 //  - a reading the solution has (valid, within the core's domain) becomes L
 //    once its channel has started; otherwise the reading stays as it came,
 //    so the core says why it cannot use it, as without a lag;
-//  - a solution at the head's last time takes the state at that time (the
-//    lag advanced at the first solution there);
+//  - a solution at the head's last time takes the state at that time (each
+//    channel advanced at its first usable reading there);
 //  - a solution earlier than the head's last time, or with no time at all,
 //    has no lagged temperatures: its channels are marked missing (status 8,
 //    no thermal stage), never the unlagged readings.

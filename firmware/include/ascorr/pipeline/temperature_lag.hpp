@@ -46,7 +46,7 @@
 // configure() with a τ out of range changes nothing and returns false.
 // Scalars: double, float and Q30. Fixed point (Q30, the core's temperatures
 // in QCelsius Q11.20, q_formats.hpp): T and L are QCelsius, α is Q30 in
-// (0, 1] (its series, or rounded to nearest from the double α; α = 1
+// [0, 1] (its series, or rounded to nearest from the double α; α = 1
 // exact), and the state
 // D is held in int64 at 2⁻⁵⁰ °C, the exact scale of a Q30·QCelsius product,
 // so that a small α·u is never rounded away. (In QCelsius itself a step with
@@ -347,7 +347,8 @@ private:
         r.value = Arithmetic::sum(r.value, Arithmetic::deviation(c.d));
     }
 
-    // α = 1 − e^(−Δt/τ) for dt_us > 0, in (0, 1]: in float and Q30 its
+    // α = 1 − e^(−Δt/τ) for dt_us > 0, in [0, 1] (0 only when Q30 rounds a
+    // Δt of a few µs against a day away, which leaves D as it was): in float and Q30 its
     // series when Δt ≤ τ/256, otherwise in double by expm1_nonpositive,
     // rounded once to T.
     T alpha_of(std::int64_t dt_us) const noexcept {

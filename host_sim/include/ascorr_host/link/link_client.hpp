@@ -70,8 +70,8 @@ public:
     link::Hello connect();
 
     // lag_s: each head's lag τ (0: none), sent with its model; a restart
-    // while a head lags is an error (restore() refuses it): the lag's state
-    // is lost with it.
+    // once a lagged head's timed solution was sent is an error (restore()
+    // refuses it): the lag's state is lost with it.
     void upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s = {});
     void set_velocity(const ObserverVelocity<T>& v);
     void set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t);
@@ -177,6 +177,7 @@ private:
     std::uint32_t boot_id_ = 0;
     std::optional<ThermalModel<T>> model_;
     std::array<double, kMaxHeads> lag_s_{};  // upload_model()'s
+    std::uint8_t lagging_ = kUnknownHead;    // a lagged head whose timed solution was sent
     std::optional<ObserverVelocity<T>> velocity_;
     std::optional<std::int64_t> horizon_us_;  // set_service_horizon()
     std::optional<link::StateUpdate> state_;  // the latest accepted spacecraft state
