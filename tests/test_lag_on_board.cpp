@@ -345,7 +345,7 @@ TEST(ReplayLag, LoopbackTargetAnswersAsCorrectDoesInAnyRowOrder) {
     EXPECT_LE(s.max_error_arcsec, 0.05);
     const double against_correct = largest_difference(dir / "r.csv", dir / "c.csv");
     EXPECT_LE(against_correct, 0.05);
-    EXPECT_GT(largest_difference(dir / "c.csv", dir / "c0.csv"), 20 * 0.05);
+    EXPECT_GT(largest_difference(dir / "c.csv", dir / "c0.csv"), 10 * 0.05);  // measured 1.1"
     // The rows shuffled: the target still takes them in time order.
     std::vector<std::string> lines = lines_of_file(dir / "s.csv");
     std::mt19937 rng(5);
