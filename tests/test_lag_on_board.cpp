@@ -110,12 +110,7 @@ double worst_against_host(const std::vector<host::SolutionRecord>& rows, const h
 TEST(LagStage, EachScalarFollowsTheHostsLagOfTheSameRows) {
     const std::vector<host::SolutionRecord> rows = rows_of(mission() / "s.csv");
     const std::array<double, kMaxHeads> lag_s{kTauS, kTauS, kTauS, 0.0};
-    const std::optional<host::LaggedTemperatures> table =
-        host::lagged_temperatures(lag_s, [&](const std::function<void(const host::SolutionRecord&)>& fn) {
-            for (const host::SolutionRecord& r : rows) {
-                fn(r);
-            }
-        });
+    const std::optional<host::LaggedTemperatures> table = host::lagged_temperatures(lag_s, host::rows_in(rows));
     ASSERT_TRUE(table.has_value());
     std::size_t moved = 0;
     EXPECT_EQ(worst_against_host<double>(rows, *table, &moved), 0.0);

@@ -230,7 +230,7 @@ private:
     void upload_model(const ModelUpload<T>& m) noexcept {
         model_.head[m.head] = m.model;
         (void)lags_.configure(m.head, m.lag_s);
-        pipeline_.use_lags(lags_.any() ? &lags_ : nullptr);
+        pipeline_.use_lags(&lags_);
     }
 
     void start_estimator(const CalibStart& m) noexcept {

@@ -187,6 +187,14 @@ void refuse_corrected_file(const std::string& path) {
     }
 }
 
+RowSource rows_in(const std::vector<SolutionRecord>& rows) {
+    return [&rows](const std::function<void(const SolutionRecord&)>& fn) {
+        for (const SolutionRecord& r : rows) {
+            fn(r);
+        }
+    };
+}
+
 void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
                        const std::string& label) {
     for_each_solution_row(

@@ -65,25 +65,14 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             (void)host.lags.configure(h, lag_s[h]);  // the model's reader checked each τ
         }
-        host.pipeline.use_lags(host.lags.any() ? &host.lags : nullptr);
-        host.lagged_d = lagged_temperatures(lag_s, [&](const std::function<void(const SolutionRecord&)>& fn) {
-            for (const SolutionRecord& r : rows) {
-                fn(r);
-            }
-        });
+        host.pipeline.use_lags(&host.lags);
+        host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));
         return;
     }
     calib::EstimatorConfig ecfg;
     ecfg.time_constant_days = opt.time_constant_days;
     ecfg.common_rotation = rule;
-    host.sc = self_calibrate<T>(
-        opt.in,
-        [&](const std::function<void(const SolutionRecord&)>& fn) {
-            for (const SolutionRecord& r : rows) {
-                fn(r);
-            }
-        },
-        mf, ecfg, opt.orbit_period_s);
+    host.sc = self_calibrate<T>(opt.in, rows_in(rows), mf, ecfg, opt.orbit_period_s);
     host.schedule_d.emplace(host.sc->history);
     std::optional<ModelCoefficients> initial;
     if (mf) {

@@ -128,8 +128,9 @@ public:
 
     bool calibrating() const noexcept { return estimator_ != nullptr; }
 
-    // Stage 0's lags (nullptr, or none of its heads lagging: no lag stage).
-    void use_lags(HeadLags<T>* lags) noexcept { lags_ = lags; }
+    // Stage 0's lags (nullptr, or none of its heads lagging: no lag stage;
+    // call again after configuring them).
+    void use_lags(HeadLags<T>* lags) noexcept { lags_ = lags != nullptr && lags->any() ? lags : nullptr; }
 
     // Whether a solution of `head` goes through an epoch (begin(), then
     // solution()) or, with no time (`timed` false), untimed_solution(): a

@@ -217,8 +217,7 @@ public:
         // Which channels are in step now; the others keep their own time.
         std::uint8_t bits = 0U;
         for (std::uint8_t k = 0; k < kLagChannels; ++k) {
-            const bool now = s.channel[k] == LagStep::kStarted || s.channel[k] == LagStep::kAdvanced;
-            const std::int64_t tk = now ? t_us : last[k];
+            const std::int64_t tk = moved(s.channel[k]) ? t_us : last[k];
             const bool step_k = ch_[k].started && tk == t_us_;
             bits = static_cast<std::uint8_t>(bits | (step_k ? 1U << k : 0U));
             ch_[k].t_us = tk;
@@ -259,8 +258,7 @@ public:
 
     // Channel k's lagged temperature L = T + D at its last reading (°C).
     TemperatureReading<T> lagged(std::uint8_t k) const noexcept {
-        const TemperatureReading<T> d = deviation(k);
-        return {Arithmetic::sum(ch_[k < kLagChannels ? k : 0].t_reading, d.value), d.valid};
+        return {lagged_of(ch_[k < kLagChannels ? k : 0]), k < kLagChannels && ch_[k].started};
     }
 
 private:
@@ -293,18 +291,19 @@ private:
         std::uint8_t newer = 0;
     };
 
+    // L = T + D of a channel at its last reading.
+    static C lagged_of(const Channel& c) noexcept { return Arithmetic::sum(c.t_reading, Arithmetic::deviation(c.d)); }
+
     static void put(LagStep s, const Channel& c, TemperatureReading<T>& r) noexcept {
         if (s != LagStep::kHeld) {
-            r.value = Arithmetic::sum(c.t_reading, Arithmetic::deviation(c.d));
+            r.value = lagged_of(c);
         }
     }
 
+    // Whether a channel took the step's reading as its last.
+    static bool moved(LagStep k) noexcept { return k == LagStep::kStarted || k == LagStep::kAdvanced; }
     static bool moves(const LagSteps& s) noexcept {
-        bool m = false;
-        for (const LagStep k : s.channel) {
-            m = m || k == LagStep::kStarted || k == LagStep::kAdvanced;
-        }
-        return m;
+        return moved(s.channel[0]) || moved(s.channel[1]) || moved(s.channel[2]);
     }
 
     static bool usable(const TemperatureReading<T>& r) noexcept { return r.valid && temperature_in_domain<T>(r.value); }
@@ -344,20 +343,19 @@ private:
         const typename Arithmetic::State u = Arithmetic::input(c.d, r.value, c.t_reading);
         c.d = Arithmetic::decay(alpha, u);
         c.t_reading = r.value;
-        r.value = Arithmetic::sum(r.value, Arithmetic::deviation(c.d));
+        r.value = lagged_of(c);
     }
 
     // α = 1 − e^(−Δt/τ) for dt_us > 0, in [0, 1] (0 only when Q30 rounds a
-    // Δt of a few µs against a day away, which leaves D as it was): in float and Q30 its
-    // series when Δt ≤ τ/256, otherwise in double by expm1_nonpositive,
-    // rounded once to T.
+    // Δt of a few µs against a day away, which leaves D as it was): in float
+    // and Q30 its series when Δt ≤ τ/256, otherwise in double by
+    // expm1_nonpositive, rounded once to T.
     T alpha_of(std::int64_t dt_us) const noexcept {
-        if constexpr (!ScalarTraits<T>::double_precision) {
-            if (dt_us <= series_max_us_) {
-                return series_(static_cast<std::int32_t>(dt_us));
-            }
-        }
-        return alpha_in_double(dt_us);
+        return by_series(dt_us) ? series_(static_cast<std::int32_t>(dt_us)) : alpha_in_double(dt_us);
+    }
+    // Whether α of dt_us > 0 comes from the series: float and Q30, Δt ≤ τ/256.
+    bool by_series(std::int64_t dt_us) const noexcept {
+        return !ScalarTraits<T>::double_precision && dt_us <= series_max_us_;
     }
     [[gnu::noinline]] T alpha_in_double(std::int64_t dt_us) const noexcept {
         return ScalarTraits<T>::from_double(-calib::expm1_nonpositive(-static_cast<double>(dt_us) * inv_tau_per_us_));
@@ -367,10 +365,8 @@ private:
     // otherwise one of the last two formed, or formed (in double) into the
     // older slot.
     T alpha_for(std::int64_t dt_us) noexcept {
-        if constexpr (!ScalarTraits<T>::double_precision) {
-            if (dt_us <= series_max_us_) {
-                return series_(static_cast<std::int32_t>(dt_us));
-            }
+        if (by_series(dt_us)) {
+            return series_(static_cast<std::int32_t>(dt_us));
         }
         AlphaCache& k = cache_;
         if (dt_us == k.dt_us[k.newer]) {

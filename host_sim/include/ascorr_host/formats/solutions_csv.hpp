@@ -102,6 +102,9 @@ bool is_corrected_file(const std::string& path);
 // passes arrays (python/src/arguments.cpp, source_of).
 using RowSource = std::function<void(const std::function<void(const SolutionRecord&)>&)>;
 
+// The rows of a vector, in its order (the vector outlives the source).
+RowSource rows_in(const std::vector<SolutionRecord>& rows);
+
 // Calls fn for every data row of the file, in file order. Throws InputError
 // for a malformed row. label: shown with the progress on a terminal.
 void for_each_solution(const std::string& path, const std::function<void(const SolutionRecord&)>& fn,
