@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -198,8 +199,6 @@ TEST(ModelFileLag, ConsumersThatDoNotLagRefuseIt) {
     }
     write(dir / "m.csv", model.str());
     const std::pair<std::string, std::string> cases[] = {
-        {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
-         "--self-calibrate does not learn a lagged model yet"},
         {"replay --target loopback-float --in s.csv --model m.csv --self-calibrate --out c.csv",
          "--self-calibrate does not learn a lagged model yet"},
         {"simulate --days 0.2 --truth-change 0.1:m.csv --out t.csv",
@@ -250,10 +249,13 @@ const fs::path& lag_mission() {
     return dir;
 }
 
-// The systematic residual per pair of the corrected file `corrected`.
-std::array<double, 3> systematic(const fs::path& dir, const std::string& corrected) {
+// The systematic residual per pair of the corrected file `corrected` (from
+// `from` on, a time in s; all of it by default).
+std::array<double, 3> systematic(const fs::path& dir, const std::string& corrected,
+                                 std::optional<double> from = std::nullopt) {
     host::StatsOptions s;
     s.in = (dir / corrected).string();
+    s.from = from;
     s.noise_iba = (lag_mission() / "m.csv.noise-iba.csv").string();
     s.log_empty_pairs = false;
     std::ostringstream log;
@@ -292,17 +294,23 @@ TEST(FitLag, TheDefaultFitFindsTheLagAndRemovesTheResidualInsideTheOrbit) {
     EXPECT_GT(*std::max_element(without.begin(), without.end()), 2.0 * kBound) << "without the lag the bound must fail";
 }
 
+// A CSV line's fields (none quoted).
+std::vector<std::string> fields_of(const std::string& line) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) {
+        f.push_back(x);
+    }
+    return f;
+}
+
 // The file's temperatures lagged by the test itself (OwnLag, each head over
 // its rows in time order: simulate writes them so), written back with 9
 // decimals.
 void write_own_lagged(const fs::path& from, const fs::path& to, double tau_s) {
     std::array<OwnLag, kMaxHeads> own{OwnLag{tau_s}, OwnLag{tau_s}, OwnLag{tau_s}, OwnLag{tau_s}};
     rewrite_csv_rows(from, to, [&](const std::string& line, std::ofstream& out) {
-        std::vector<std::string> f;
-        std::stringstream ss(line);
-        for (std::string x; std::getline(ss, x, ',');) {
-            f.push_back(x);
-        }
+        std::vector<std::string> f = fields_of(line);
         f.resize(14);  // t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence
         const std::uint8_t h = head_index(f[1][0]);
         std::array<double, 3> temp{};
@@ -458,6 +466,108 @@ TEST(FitLag, AStaticBenchGetsTodaysModelByteForByte) {
     EXPECT_EQ(slurp(dir / "auto.csv"), slurp(dir / "none.csv"));
     EXPECT_TRUE(has(slurp(dir / "auto.txt"), "bench lag (--lag auto): no lag: the best lags found"))
         << slurp(dir / "auto.txt");
+}
+
+// ---- Self-calibration with the bench's lag (`correct --self-calibrate
+// --lag`): the estimator learns the lagged model from none, on the same
+// mission, measured from its second half (issue 40 measures a 600-day
+// mission from day 60; this one has 40 days).
+
+constexpr double kSelfCalibrationBound = 0.2;  // arcsec per pair, issue 40's
+constexpr double kLearntFromDays = 20.0;
+
+// The first row's t of the mission, + days.
+double mission_day(double days) {
+    const std::vector<std::string> lines = lines_of_file(lag_mission() / "m.csv");
+    return std::stod(lines.at(1).substr(0, lines.at(1).find(','))) + days * 86400.0;
+}
+
+CliRun self_calibrate_in(const fs::path& dir, const std::string& in, const std::string& args, const std::string& out) {
+    return run_in(
+        "correct --in " + in + " --self-calibrate --out " + out + " --model-history " + out + ".history.csv " + args,
+        dir);
+}
+
+TEST(SelfCalibrationLag, LearnsTheLaggedModelFromNoModel) {
+    const fs::path& dir = lag_mission();
+    const CliRun r = self_calibrate_in(dir, "m.csv", "--lag 1800", "sc_lag.csv");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const double from = mission_day(kLearntFromDays);
+    const std::array<double, 3> with_lag = systematic(dir, "sc_lag.csv", from);
+    // Mutation: the same estimator without the lag.
+    ASSERT_EQ(self_calibrate_in(dir, "m.csv", "", "sc_none.csv").exit_code, 0);
+    const std::array<double, 3> without = systematic(dir, "sc_none.csv", from);
+    for (std::size_t p = 0; p < 3; ++p) {
+        EXPECT_LE(with_lag[p], kSelfCalibrationBound) << "pair " << p;
+        RecordProperty("self_calibrated_lagged_" + std::to_string(p), std::to_string(with_lag[p]));
+    }
+    EXPECT_GT(*std::max_element(without.begin(), without.end()), 1.5 * kSelfCalibrationBound)
+        << "without the lag the bound must fail";
+    // The history says which lag its models take; without one it is as before.
+    const std::vector<std::string> h = lines_of_file(dir / "sc_lag.csv.history.csv");
+    ASSERT_GT(h.size(), 10U);
+    EXPECT_EQ(h[0], "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin,lag_s");
+    for (std::size_t i = 1; i < h.size(); ++i) {
+        EXPECT_EQ(h[i].substr(h[i].rfind(',')), ",1800") << h[i];
+    }
+    EXPECT_EQ(lines_of_file(dir / "sc_none.csv.history.csv").at(0),
+              "t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin");
+}
+
+// The test's own lag of the rows (OwnLag, long double, written with 9
+// decimals) learnt from without a lag: the same models, to the rounding of
+// the temperatures written.
+TEST(SelfCalibrationLag, LearnsAsFromTheTestsOwnLaggedFile) {
+    const fs::path& dir = lag_mission();
+    write_own_lagged(dir / "m.csv", dir / "own_sc.csv", kLagS);
+    ASSERT_EQ(self_calibrate_in(dir, "own_sc.csv", "", "sc_own.csv").exit_code, 0);
+    ASSERT_EQ(self_calibrate_in(dir, "m.csv", "--lag 1800", "sc_given.csv").exit_code, 0);
+    const std::vector<std::string> own = lines_of_file(dir / "sc_own.csv.history.csv");
+    const std::vector<std::string> given = lines_of_file(dir / "sc_given.csv.history.csv");
+    ASSERT_EQ(own.size(), given.size());
+    for (std::size_t i = 1; i < own.size(); ++i) {
+        const std::vector<std::string> a = fields_of(own[i]);
+        const std::vector<std::string> b = fields_of(given[i]);
+        ASSERT_EQ(b.size(), a.size() + 1U);  // lag_s
+        for (std::size_t c = 0; c < a.size(); ++c) {
+            if (c >= 4 && c < 8) {  // c0..c3
+                EXPECT_NEAR(std::stod(a[c]), std::stod(b[c]), 1e-5 * (1.0 + std::abs(std::stod(b[c])))) << i;
+            } else if (c != 8) {  // not crc32c: the coefficients' bits
+                EXPECT_EQ(a[c], b[c]) << i;
+            }
+        }
+    }
+    const double from = mission_day(kLearntFromDays);
+    const std::array<double, 3> a = systematic(dir, "sc_own.csv", from);
+    const std::array<double, 3> b = systematic(dir, "sc_given.csv", from);
+    for (std::size_t p = 0; p < 3; ++p) {
+        EXPECT_NEAR(a[p], b[p], 0.002) << "pair " << p;
+    }
+}
+
+TEST(SelfCalibrationLag, StartsFromALaggedModelAndRefusesAnotherLag) {
+    const fs::path& dir = lag_mission();
+    ASSERT_EQ(run_in("fit --in m.csv --out sc_model.csv --min-days 20 --lag 1800 > /dev/null", dir).exit_code, 0);
+    const CliRun ok = self_calibrate_in(dir, "m.csv", "--model sc_model.csv", "sc_start.csv");
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    const std::vector<std::string> h = lines_of_file(dir / "sc_start.csv.history.csv");
+    EXPECT_TRUE(has(h.at(1), ",given,1800")) << h.at(1);
+    // The same start with --lag 1800 is the same run, to the byte.
+    ASSERT_EQ(self_calibrate_in(dir, "m.csv", "--model sc_model.csv --lag 1800", "sc_same.csv").exit_code, 0);
+    EXPECT_EQ(slurp(dir / "sc_same.csv"), slurp(dir / "sc_start.csv"));
+    EXPECT_EQ(slurp(dir / "sc_same.csv.history.csv"), slurp(dir / "sc_start.csv.history.csv"));
+
+    const CliRun other = self_calibrate_in(dir, "m.csv", "--model sc_model.csv --lag A:900,B:1800,C:1800", "x.csv");
+    expect_refused(other, 1, {"sc_model.csv: head A lags by 1800 s, but the self-calibration lags it by 900 s"});
+    const std::pair<std::string, std::string> refused[] = {
+        {"correct --in m.csv --lag 900 --out x.csv", "--lag: needs --self-calibrate"},
+        {"correct --in m.csv --self-calibrate --lag auto --out x.csv", "auto is fit's choice"},
+        {"correct --in m.csv --self-calibrate --lag A:0.5 --out x.csv", "the lag must be 0 (no lag) or [1, 86400] s"},
+    };
+    for (const auto& [args, part] : refused) {
+        expect_refused(run_in(args + " > out.txt", dir), 2, {part});
+    }
+    expect_absent(dir, {"x.csv", "x.csv.history.csv"});
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr_host/analysis/combine.hpp"
+#include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/scalar_kind.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
@@ -142,10 +143,29 @@ void add_correct_command(CLI::App& app) {
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
         add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s);
+    auto lag = std::make_shared<std::string>();
+    cmd->add_option("--lag", *lag,
+                    "with --self-calibrate: the bench's lag in s the estimator learns with, TAU for every head or "
+                    "X:TAU,... for the heads named (the others none), each 0 (none) or in [1, 86400]; the history's "
+                    "models say so (lag_s). Default: --model's lag_s, or none")
+        ->type_name("LAG")
+        ->check([](const std::string& v) {
+            try {
+                return host::parse_lags(v) ? std::string() : std::string("auto is fit's choice: give TAU or X:TAU,...");
+            } catch (const host::FitRefused& e) {
+                return std::string(e.what());
+            }
+        });
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
-    cmd->callback([opt, self_cal, combine]() {
+    cmd->callback([opt, self_cal, combine, lag]() {
         check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
+        if (!lag->empty()) {
+            if (!opt->self_calibrate) {
+                throw CLI::ValidationError("--lag", "needs --self-calibrate (a model's lag_s gives correct its lag)");
+            }
+            opt->lag_s = host::parse_lags(*lag);  // checked already
+        }
         if (!combine->combined.empty()) {
             correct_and_combine(*opt, *combine);
             return;

@@ -242,6 +242,7 @@ def self_calibrate(
     time_constant: float = ...,
     orbit_period: Optional[float] = ...,
     mountings: Optional[dict[str, Any]] = ...,
+    lag: Union[None, str, float] = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
@@ -253,6 +254,10 @@ def self_calibrate(
     or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
     mountings: read_mountings()'s dict (as correct --mountings): the rotation common to all
     heads is then fixed by the rule 'combined' (mountings without sigmas are refused).
+    lag: the bench's lag the estimator learns with, as correct --lag: 'TAU', 'X:TAU,...'
+    or a number (s), or None: the model's lag_s, or none; a lagged model with another lag
+    is refused. Every model of the history then has that lag_s, and the rows are learnt
+    from and corrected with their lagged temperatures.
     Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

@@ -16,6 +16,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
@@ -60,6 +61,11 @@ void bind_gracefo(py::module_& mod);  // import_gracefo
 // A mountings dict (read_mountings()'s) as the mountings file's reader takes
 // it, with its rules and messages (ValueError naming argument 'mountings').
 host::MountingsFile mountings_arg(const py::handle& obj);
+
+// fit()'s and self_calibrate()'s lag=: 'auto' (nullopt; refused unless
+// auto_allowed), 'TAU' or 'X:TAU,...' as --lag (host::parse_lags), or a
+// number for every head; ValueError naming 'lag' otherwise (bind_analysis.cpp).
+std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag, bool auto_allowed);
 
 // ---- arguments (arguments.cpp)
 

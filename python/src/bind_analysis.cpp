@@ -228,6 +228,33 @@ std::string as_keywords(const std::string& text) {
     return out;
 }
 
+}  // namespace
+
+std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag, bool auto_allowed) {
+    if (py::isinstance<py::str>(lag)) {
+        std::optional<std::array<double, kMaxHeads>> out;
+        try {
+            out = host::parse_lags(lag.cast<std::string>());
+        } catch (const host::FitRefused& e) {
+            bad_argument("lag", as_keywords(e.what()));
+        }
+        if (!out && !auto_allowed) {
+            bad_argument("lag", "'auto' is fit()'s choice: give 'TAU', 'X:TAU,...' or a lag in s");
+        }
+        return out;
+    }
+    const double x = real_arg(lag, "lag");
+    if (!host::lag_acceptable(x)) {
+        bad_argument("lag", std::string("expected ") + (auto_allowed ? "'auto', " : "") +
+                                "'X:TAU,...' or a lag in s, " + host::lag_range_text() + ", got " + number_text(x));
+    }
+    std::array<double, kMaxHeads> out{};
+    out.fill(x);
+    return out;
+}
+
+namespace {
+
 py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
               const py::object& v, const py::object& flags, const py::object& confidence, const py::object& t_from,
               const py::object& t_to, const py::object& min_days, const py::object& min_orbits,
@@ -268,21 +295,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
         opt.common_rotation.emplace();
         static_cast<host::CommonRotationId&>(*opt.common_rotation) = *id;
     }
-    if (py::isinstance<py::str>(lag)) {
-        try {
-            opt.lag_s = host::parse_lags(lag.cast<std::string>());
-        } catch (const host::FitRefused& e) {
-            bad_argument("lag", as_keywords(e.what()));
-        }
-    } else {
-        const double x = real_arg(lag, "lag");
-        if (!host::lag_acceptable(x)) {
-            bad_argument("lag", "expected 'auto', 'X:TAU,...' or a lag in s, " + host::lag_range_text() + ", got " +
-                                    number_text(x));
-        }
-        opt.lag_s.emplace();
-        opt.lag_s->fill(x);
-    }
+    opt.lag_s = lags_arg(lag, true);
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
         try {

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -21,6 +22,7 @@
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "bind.hpp"
 #include "docstrings.hpp"
@@ -35,18 +37,23 @@ namespace {
 template <typename T>
 py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days,
                               std::optional<double> orbit_period_s, const calib::CommonRotationWeights& rule,
-                              double* q_out, std::uint16_t* st_out) {
+                              const std::array<double, kMaxHeads>& lag_s, double* q_out, std::uint16_t* st_out) {
     calib::EstimatorConfig cfg;
     cfg.time_constant_days = time_constant_days;
     cfg.common_rotation = rule;
-    const host::SelfCalibration sc =
-        host::self_calibrate<T>(kArrayRows, source_of(r),
-                                m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s);
+    // The lagged heads' temperatures, learnt from and corrected with, as by `ascorr correct`.
+    const std::optional<host::LaggedTemperatures> lag = host::lagged_temperatures(lag_s, source_of(r));
+    const host::SelfCalibration sc = host::self_calibrate<T>(
+        kArrayRows, source_of(r), m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s,
+        host::kSelfCalibrationMemoryBytes, kMaxHeads, lag ? &*lag : nullptr);
     const host::ModelSchedule<T> schedule(sc.history);
     host::EarthVelocity earth;
     SolutionRecord rec;
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
+        if (lag) {
+            lag->apply(rec);
+        }
         const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
         put_row(host::correct_row<T>(rec, &earth, c, nullptr), i, q_out, st_out);
     }
@@ -74,8 +81,13 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
 py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                          const py::object& v, const py::object& flags, const py::object& confidence,
                          const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj,
-                         const py::object& orbit_period_obj, const py::object& mountings) {
+                         const py::object& orbit_period_obj, const py::object& mountings, const py::object& lag_obj) {
     const host::ModelFile* m = model_arg(model);
+    // The run's lag: lag= (never 'auto'), otherwise the model's, as correct --lag.
+    const std::optional<std::array<double, kMaxHeads>> lag_given =
+        lag_obj.is_none() ? std::nullopt : lags_arg(lag_obj, false);
+    const std::array<double, kMaxHeads> lag_s =
+        lag_given ? *lag_given : (m != nullptr ? host::head_lags(*m) : std::array<double, kMaxHeads>{});
     // The rule for the rotation common to all heads, as correct --mountings M: combined.
     calib::CommonRotationWeights rule{};
     if (!mountings.is_none()) {
@@ -104,7 +116,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     if (m != nullptr) {
         try {
             host::refuse_quadratic_initial_model(*m, "the model given");
-            host::refuse_lagged_model(*m, "the model given", "self-calibration does not learn a lagged model yet");
+            host::refuse_other_lag(*m, "the model given", lag_s);
         } catch (const std::runtime_error& e) {
             bad_argument("model", e.what());
         }
@@ -121,13 +133,13 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     py::array_t<std::uint16_t> st_out(r.n);
     py::list history;
     if (scalar == host::ScalarKind::kDouble) {
-        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
+        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
                                                st_out.mutable_data());
     } else if (scalar == host::ScalarKind::kFloat) {
-        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
+        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
                                               st_out.mutable_data());
     } else {
-        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, q_out.mutable_data(),
+        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
                                             st_out.mutable_data());
     }
     return py::make_tuple(q_out, st_out, history);
@@ -138,7 +150,8 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
 void bind_self_calibration(py::module_& mod) {
     mod.def("self_calibrate", &self_calibrate, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
             "confidence"_a = py::none(), "model"_a = py::none(), "scalar"_a = "double", "time_constant"_a = 30.0,
-            "orbit_period"_a = py::none(), "mountings"_a = py::none(), docstring(docs::kSelfCalibrate));
+            "orbit_period"_a = py::none(), "mountings"_a = py::none(), "lag"_a = py::none(),
+            docstring(docs::kSelfCalibrate));
 }
 
 }  // namespace ascorr::python

@@ -94,6 +94,10 @@ time_constant: the estimator's forgetting in days. orbit_period: seconds in [600
 or None: from the median speed of the first 99 rows learnt from (as --orbit-period).
 mountings: read_mountings()'s dict (as correct --mountings): the rotation common to all
 heads is then fixed by the rule 'combined' (mountings without sigmas are refused).
+lag: the bench's lag the estimator learns with, as correct --lag: 'TAU', 'X:TAU,...'
+or a number (s), or None: the model's lag_s, or none; a lagged model with another lag
+is refused. Every model of the history then has that lag_s, and the rows are learnt
+from and corrected with their lagged temperatures.
 Returns (q_corrected float64
 (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
 "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

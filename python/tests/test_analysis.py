@@ -300,11 +300,39 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
     py_stats = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
     for pair, v in cli_stats["pairs"].items():
         assert py_stats["pairs"][pair]["thermal"] == pytest.approx(v["thermal"], abs=1e-6), pair
-    with pytest.raises(ValueError, match="lag_s makes its terms take lagged temperatures"):
-        ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model)
+    with pytest.raises(ValueError, match="head A lags by 900 s, but the self-calibration lags it by 1800 s"):
+        ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model, lag=1800)
     with pytest.raises(ValueError, match="lag"):
         ascorr.fit(*as_args(d), min_days=20, lag=-3)
     with pytest.raises(ValueError, match="A:900,A:1"):
         ascorr.fit(*as_args(d), min_days=20, lag="A:900,A:1")
     with pytest.raises(ValueError, match="lag_s"):
         ascorr.Model(model.coefficients, model.heads, lag_s=[1e6, 0, 0, 0])
+
+
+def test_self_calibrate_lag_is_ascorr_correct_self_calibrate(exe, lag_mission, tmp_path):
+    """lag= as correct --self-calibrate --lag: the same corrections to the bit and the same
+    history, whose models carry the lag; 'auto' and a bad lag are refused."""
+    d = ascorr.read_solutions(str(lag_mission))
+    corrected = tmp_path / "sc.csv"
+    history = tmp_path / "sc.history.csv"
+    run_cli(exe, "correct", "--in", lag_mission, "--self-calibrate", "--lag", "A:1800,B:1800,C:900", "--out",
+            corrected, "--model-history", history)
+    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="A:1800,B:1800,C:900")
+    header, rows = read_csv_text(corrected)
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    assert [int(r[header.index("status")]) for r in rows] == list(status)
+    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
+    assert all(same) and len(same) > 0.9 * len(rows)
+    h_header, h_rows = read_csv_text(history)
+    assert h_header[-1] == "lag_s"
+    assert len(h_rows) == 9 * len(hist)
+    for a in hist:
+        assert list(a["model"].lag_s) == [1800.0, 1800.0, 900.0, 0.0]
+    # Without the lag the corrections differ: the lag is used.
+    q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"])
+    assert np.abs(q_none - q).max() > 1e-9
+    with pytest.raises(ValueError, match="auto"):
+        ascorr.self_calibrate(*as_args(d), lag="auto")
+    with pytest.raises(ValueError, match="lag"):
+        ascorr.self_calibrate(*as_args(d), lag=0.5)

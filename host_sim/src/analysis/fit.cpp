@@ -83,10 +83,6 @@ void refuse_bad_lags(const FitOptions& opt) {
     }
 }
 
-bool any_lag(const std::array<double, kMaxHeads>& lag_s) {
-    return std::any_of(lag_s.begin(), lag_s.end(), [](double x) { return x != 0.0; });
-}
-
 // NaN, zero or negative thresholds would silently accept or refuse everything.
 void refuse_bad_fit_options(const FitOptions& opt) {
     refuse_bad_lags(opt);

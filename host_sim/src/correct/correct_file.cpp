@@ -338,17 +338,24 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
         });
 }
 
-// The readings of the rows of the heads the model lags, read ahead of the
-// correction: each head's lag runs over its rows in time order. None when
-// the thermal stage has no model (`thermal`) or its model no lag.
-template <typename T>
+// The bench's lag of the run: --lag (the self-calibration's), otherwise the
+// model file's.
+std::array<double, kMaxHeads> run_lags(const CorrectOptions& opt, const std::optional<ModelFile>& model) {
+    if (opt.lag_s) {
+        return *opt.lag_s;
+    }
+    return model ? head_lags(*model) : std::array<double, kMaxHeads>{};
+}
+
+// The readings of the rows of the heads the run lags (run_lags), read ahead of
+// the correction and of the self-calibration: each head's lag runs over its
+// rows in time order. None without a thermal stage, or when no head lags.
 std::optional<LaggedTemperatures> lagged_temperatures(const std::string& path, const SolutionsReader& header,
-                                                      std::size_t workers, const std::optional<ModelFile>& model,
-                                                      const std::optional<ThermalModel<T>>& thermal) {
-    if (!model || !thermal || !has_lag(*model)) {
+                                                      std::size_t workers, const std::array<double, kMaxHeads>& lag_s,
+                                                      bool thermal) {
+    if (!thermal || !any_lag(lag_s)) {
         return std::nullopt;
     }
-    const std::array<double, kMaxHeads> lag_s = head_lags(*model);
     std::vector<LagReading> readings = scan_rows<LagReading>(
         path, header, workers,
         [&](const SolutionRecord& rec, std::vector<LagReading>& out) {
@@ -359,6 +366,29 @@ std::optional<LaggedTemperatures> lagged_temperatures(const std::string& path, c
         },
         [](std::vector<LagReading>&) {});
     return LaggedTemperatures(lag_s, std::move(readings));
+}
+
+// --self-calibrate's run (self_calibration.hpp): the models the rows are
+// corrected with, the history file's text and the terminal's account.
+template <typename T>
+struct SelfCalibrated {
+    ModelSchedule<T> schedule;
+    std::string history;
+    std::string account;
+};
+
+template <typename T>
+SelfCalibrated<T> self_calibrated(const CorrectOptions& opt, const std::optional<ModelFile>& model_file,
+                                  const LaggedTemperatures* lag) {
+    calib::EstimatorConfig ecfg;
+    ecfg.time_constant_days = opt.time_constant_days;
+    ecfg.common_rotation = opt.common_rotation;
+    ecfg.regauge_arcsec = opt.regauge_arcsec;
+    const SelfCalibration sc = self_calibrate<T>(
+        opt.in, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
+        model_file, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes, kMaxHeads, lag);
+    return {ModelSchedule<T>(sc.history), format_model_history(sc.history, opt.common_rotation.heads != 0U),
+            describe(sc)};
 }
 
 void refuse_self_calibration_options(const CorrectOptions& opt) {
@@ -402,7 +432,7 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
     check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
-        refuse_lagged_model(*model_file, opt.model, "--self-calibrate does not learn a lagged model yet");
+        refuse_other_lag(*model_file, opt.model, run_lags(opt, model_file));
     }
     return to_core<T>(*model_file);
 }
@@ -478,31 +508,37 @@ void wait_for(std::future<void>& writing) {
     }
 }
 
+// The velocities the states give the rows without their own (--states,
+// with the aberration stage), by the on-board service.
+template <typename T>
+std::optional<StatesVelocityTable<T>> velocity_table(const CorrectOptions& opt, const std::optional<StatesFile>& states,
+                                                     const SolutionsReader& header, std::size_t workers) {
+    std::optional<StatesVelocityTable<T>> table;
+    if (states && opt.aberration) {
+        table.emplace(*states, service_config(opt.max_propagation_s), service_times(opt.in, header, workers), workers);
+    }
+    return table;
+}
+
+// What the options cannot do together: the self-calibration's
+// (refuse_self_calibration_options), and --lag without it.
+void refuse_run_options(const CorrectOptions& opt) {
+    if (opt.self_calibrate) {
+        refuse_self_calibration_options(opt);
+    } else if (opt.lag_s) {
+        throw std::runtime_error(
+            "--lag is the lag the self-calibration learns with: it needs --self-calibrate (a model's lag_s gives "
+            "correct its lag)");
+    }
+}
+
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     std::optional<ModelFile> model_file;
     std::optional<ThermalModel<T>> model = read_model<T>(opt, model_file);
-    std::optional<ModelSchedule<T>> schedule;
-    std::string history;
-    std::string account;
-    if (opt.self_calibrate) {
-        refuse_self_calibration_options(opt);
-        calib::EstimatorConfig ecfg;
-        ecfg.time_constant_days = opt.time_constant_days;
-        ecfg.common_rotation = opt.common_rotation;
-        ecfg.regauge_arcsec = opt.regauge_arcsec;
-        const SelfCalibration sc = self_calibrate<T>(
-            opt.in,
-            [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
-            model_file, ecfg, opt.orbit_period_s);
-        schedule.emplace(sc.history);
-        history = format_model_history(sc.history, opt.common_rotation.heads != 0U);
-        account = describe(sc);
-        model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
-    }
-    const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
+    refuse_run_options(opt);
 
     BlockReader blocks(opt.in);
     std::string_view block;
@@ -515,11 +551,16 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     Diagnostics diag(log);
     const std::optional<StatesFile> states = read_states(opt, diag);
     const std::size_t workers = worker_count();
-    std::optional<StatesVelocityTable<T>> table;
-    if (states && opt.aberration) {
-        table.emplace(*states, service_config(opt.max_propagation_s), service_times(opt.in, header, workers), workers);
+    const std::optional<StatesVelocityTable<T>> table = velocity_table<T>(opt, states, header, workers);
+    // (Without --model or --self-calibrate no head lags: --lag needs the latter.)
+    const std::optional<LaggedTemperatures> lag =
+        lagged_temperatures(opt.in, header, workers, run_lags(opt, model_file), opt.thermal);
+    std::optional<SelfCalibrated<T>> sc;
+    if (opt.self_calibrate) {
+        sc.emplace(self_calibrated<T>(opt, model_file, lag ? &*lag : nullptr));
+        model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
     }
-    const std::optional<LaggedTemperatures> lag = lagged_temperatures(opt.in, header, workers, model_file, model);
+    const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
     const Job<T> job{opt,
                      cfg,
                      header,
@@ -527,7 +568,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
                      states ? &*states : nullptr,
                      service_config(opt.max_propagation_s),
                      table ? &*table : nullptr,
-                     opt.self_calibrate && opt.thermal ? &*schedule : nullptr,
+                     sc ? &sc->schedule : nullptr,
                      lag ? &*lag : nullptr,
                      sink != nullptr};
 
@@ -568,12 +609,12 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     wait_for(writing);
     report_rows(opt, sum, empty_lines, diag, log);
     if (outputs.has("--model-history")) {
-        outputs["--model-history"].write(history);
+        outputs["--model-history"].write(sc->history);
     }
     if (sink != nullptr) {
         sink->finish();  // into its own output of the set
     }
-    sum.self_calibration = account;
+    sum.self_calibration = sc ? sc->account : std::string();
     return sum;
 }
 

@@ -66,6 +66,16 @@ std::optional<LaggedTemperatures> lagged_temperatures(const std::array<double, k
     return LaggedTemperatures(lag_s, lag_readings(rows, lagged));
 }
 
+RowSource lagged_rows(const RowSource& rows, const LaggedTemperatures& lag) {
+    return [&rows, &lag](const std::function<void(const SolutionRecord&)>& fn) {
+        rows([&](const SolutionRecord& rec) {
+            SolutionRecord lagged = rec;
+            lag.apply(lagged);
+            fn(lagged);
+        });
+    };
+}
+
 void LaggedTemperatures::apply(SolutionRecord& rec) const {
     if (!lags(rec.head)) {
         return;

@@ -409,6 +409,18 @@ private:
 
 }  // namespace
 
+void refuse_other_lag(const ModelFile& m, const std::string& name, const std::array<double, kMaxHeads>& lag_s) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        if (m.present[h] && m.lag_s[h] != 0.0 && m.lag_s[h] != lag_s[h]) {
+            throw std::runtime_error(
+                name + ": head " + std::string(1, head_name(h)) + " lags by " + number_text(m.lag_s[h]) +
+                " s, but the self-calibration " +
+                (lag_s[h] == 0.0 ? std::string("lags it by none") : "lags it by " + number_text(lag_s[h]) + " s") +
+                ": its coefficients belong to its lag; give the same lag (--lag) or none");
+        }
+    }
+}
+
 void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name) {
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         for (std::size_t a = 0; a < kModelAxes; ++a) {
@@ -537,24 +549,31 @@ SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& fi
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes, std::size_t max_heads) {
+                               std::size_t memory_budget_bytes, std::size_t max_heads, const LaggedTemperatures* lag) {
+    const std::array<double, kMaxHeads> lag_s = lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{};
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
-        refuse_lagged_model(*initial, "the initial model", "self-calibration does not learn a lagged model yet");
+        refuse_other_lag(*initial, "the initial model", lag_s);
     }
-    return self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg, orbit_period_s,
-                                      memory_budget_bytes);
+    const RowSource learnt_from = lag != nullptr ? lagged_rows(rows, *lag) : rows;
+    SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(learnt_from, max_heads), file, learnt_from, initial,
+                                                     cfg, orbit_period_s, memory_budget_bytes);
+    for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
+        a.model.lag_s = lag_s;
+        a.model.lag_s = head_lags(a.model);
+    }
+    return out;
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                 const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                                std::size_t);
+                                                std::size_t, const LaggedTemperatures*);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                               std::size_t);
+                                               std::size_t, const LaggedTemperatures*);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                             std::size_t);
+                                             std::size_t, const LaggedTemperatures*);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {
@@ -596,28 +615,44 @@ const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learn
     return calib::learns_head(h, learnt) ? "learnt" : "kept";
 }
 
-std::string format_model_history(const std::vector<ActiveModel>& history, bool combined) {
-    std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin" +
-                      (combined ? ",common_rotation\n" : "\n");
+namespace {
+
+// One row of the history: head h, axis a of model m (the columns above).
+void append_history_row(std::string& out, const ActiveModel& m, std::size_t h, std::size_t a, bool combined,
+                        bool lagged) {
     char buf[96];
+    text::c_snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version, head_name(static_cast<std::uint8_t>(h)),
+                     kAxisNames[a]);
+    out += buf;
+    for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
+        text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
+        out += buf;
+    }
+    text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s", m.crc, static_cast<long long>(m.t_us),
+                     head_origin(m.version, h, m.learnt));
+    out += buf;
+    // A given model (version 0) is in the rule it was made by, which the history does not know.
+    if (combined) {
+        out += m.version == 0U ? ",given" : ",combined";
+    }
+    if (lagged) {
+        text::c_snprintf(buf, sizeof buf, ",%.17g", m.model.lag_s[h]);  // as the model file writes it
+        out += buf;
+    }
+    out += '\n';
+}
+
+}  // namespace
+
+std::string format_model_history(const std::vector<ActiveModel>& history, bool combined) {
+    const bool lagged =
+        std::any_of(history.begin(), history.end(), [](const ActiveModel& m) { return has_lag(m.model); });
+    std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin" +
+                      (combined ? ",common_rotation" : "") + (lagged ? ",lag_s\n" : "\n");
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
-            if (!m.model.present[h]) {
-                continue;
-            }
-            for (std::size_t a = 0; a < kModelAxes; ++a) {
-                text::c_snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version,
-                                 head_name(static_cast<std::uint8_t>(h)), kAxisNames[a]);
-                out += buf;
-                for (std::size_t i = 0; i < kLinearModelTerms; ++i) {
-                    text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.coefficients[h][a][i]);
-                    out += buf;
-                }
-                text::c_snprintf(buf, sizeof buf, ",%08x,%lld,%s", m.crc, static_cast<long long>(m.t_us),
-                                 head_origin(m.version, h, m.learnt));
-                out += buf;
-                // A given model (version 0) is in the rule it was made by, which the history does not know.
-                out += combined ? (m.version == 0U ? ",given\n" : ",combined\n") : "\n";
+            for (std::size_t a = 0; a < kModelAxes && m.model.present[h]; ++a) {
+                append_history_row(out, m, h, a, combined, lagged);
             }
         }
     }

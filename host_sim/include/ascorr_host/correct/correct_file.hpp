@@ -46,6 +46,10 @@ struct CorrectOptions {
     std::string model_history;
     double time_constant_days = 30.0;      // --time-constant
     std::optional<double> orbit_period_s;  // --orbit-period; nullopt: from the rows' speeds
+    // --lag (self-calibration only): the bench's lag per head the estimator
+    // learns with (fit's parse_lags; a lagged `model` must have the same);
+    // nullopt: the model's lag_s, or none.
+    std::optional<std::array<double, kMaxHeads>> lag_s;
     // The estimator's rule for the rotation common to all heads (with
     // --mountings: pipeline/common_rotation_weights.hpp; none: its own frame).
     calib::CommonRotationWeights common_rotation{};

@@ -89,6 +89,8 @@ public:
     LaggedTemperatures(const std::array<double, kMaxHeads>& lag_s, std::vector<LagReading> readings);
 
     bool lags(std::uint8_t head) const noexcept { return head < kMaxHeads && lag_s_[head] != 0.0; }
+    // Each head's τ in s (0: none), by head index.
+    const std::array<double, kMaxHeads>& lag_s() const noexcept { return lag_s_; }
 
     // rec's temperatures as its terms take them (above); unchanged when its
     // head has no lag.
@@ -112,6 +114,10 @@ bool lag_reading_of(const SolutionRecord& rec, LagReading& out) noexcept;
 // (one reading of the rows).
 std::vector<LagReading> lag_readings(const RowSource& rows,
                                      HeadMask heads = static_cast<HeadMask>((1U << kMaxHeads) - 1U));
+
+// rows as their terms take them: each row through lag.apply (the table must
+// have been made from the same rows).
+RowSource lagged_rows(const RowSource& rows, const LaggedTemperatures& lag);
 
 // The table of a model's lagged heads over the rows (nullopt when no head of
 // `lag_s` lags: then the rows are not read).

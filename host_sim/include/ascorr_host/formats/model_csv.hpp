@@ -91,6 +91,14 @@ inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
     }
     return lag;
 }
+// Whether any head of lag_s (by head index) lags.
+inline bool any_lag(const std::array<double, kMaxHeads>& lag_s) noexcept {
+    bool any = false;
+    for (const double x : lag_s) {
+        any = any || x != 0.0;
+    }
+    return any;
+}
 // Whether lag_s is 0 or a time constant the lag accepts (pipeline::TemperatureLag::configure).
 bool lag_acceptable(double lag_s) noexcept;
 // "0 (no lag) or [1, 86400] s", for messages.
