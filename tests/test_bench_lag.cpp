@@ -199,8 +199,6 @@ TEST(ModelFileLag, ConsumersThatDoNotLagRefuseIt) {
     }
     write(dir / "m.csv", model.str());
     const std::pair<std::string, std::string> cases[] = {
-        {"replay --target loopback-float --in s.csv --model m.csv --self-calibrate --out c.csv",
-         "--self-calibrate does not learn a lagged model yet"},
         {"simulate --days 0.2 --truth-change 0.1:m.csv --out t.csv",
          "a truth model takes no lag: --bench-lag lags the simulated bench"},
         {"simulate --days 0.1 --truth m.csv --out t.csv",

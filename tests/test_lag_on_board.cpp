@@ -258,11 +258,43 @@ TEST(LagLink, AnUntimedSolutionOfALaggedHeadHasNoTemperaturesAndARestartIsAnErro
     }
 }
 
+// CALIB_START: the lags after common_rotation, only when a head lags.
+TEST(LagLink, CalibStartCarriesTheLagsOnlyWhenAHeadLags) {
+    std::uint8_t p[link::kMaxPayload];
+    link::CalibStart m{5'700'000'000, 30.0, 1U, 0U};
+    EXPECT_EQ(link::encode(m, p), 17U);
+    m.common_rotation = 1U;
+    EXPECT_EQ(link::encode(m, p), 18U);
+    m.common_rotation = 0U;
+    m.lag_s[0] = 900.0;
+    m.lag_s[2] = 1800.5;
+    const std::size_t n = link::encode(m, p);
+    ASSERT_EQ(n, 18U + 4U * 8U);
+    link::CalibStart back{};
+    ASSERT_TRUE(link::decode(p, n, back));
+    EXPECT_EQ(back.common_rotation, 0U);
+    EXPECT_EQ(back.lag_s[0], 900.0);
+    EXPECT_EQ(back.lag_s[1], 0.0);
+    EXPECT_EQ(back.lag_s[2], 1800.5);
+    EXPECT_EQ(back.lag_s[3], 0.0);
+    ASSERT_TRUE(link::decode(p, 17U, back));  // as a host before it: no lag
+    EXPECT_FALSE(link::lags_any(back));
+    // A τ out of range (NaN included), or a frame cut short.
+    for (double bad : {0.5, 86400.5, -900.0, std::nan("")}) {
+        std::uint8_t q[link::kMaxPayload];
+        std::memcpy(q, p, n);
+        std::memcpy(q + 18 + 8, &bad, sizeof bad);  // head B's, little-endian as the wire
+        EXPECT_FALSE(link::decode(q, n, back)) << bad;
+    }
+    EXPECT_FALSE(link::decode(p, n - 8U, back));
+    EXPECT_FALSE(link::decode(p, 19U, back));
+}
+
 // A restart before any timed solution of a lagged head loses no lag state:
-// the model and its lags are restored. The estimator does not start while a
-// head lags, and a lag is refused while it runs: it would learn from lagged
-// temperatures, which no ground run reproduces yet.
-TEST(LagLink, ARestartBeforeTheLagHasStateIsRestoredAndTheEstimatorRefusesALag) {
+// the model and its lags are restored. While the estimator runs, its lags
+// are CALIB_START's (here none: the model's lag ends), and a MODEL_UPLOAD's
+// lag is refused.
+TEST(LagLink, ARestartBeforeTheLagHasStateIsRestoredAndTheEstimatorTakesCalibStartsLags) {
     const ThermalModel<float> model = host::to_core<float>(host::read_model_file((mission() / "m.csv").string()));
     RestartingTarget target(2);  // during the model's upload
     host::LoopbackTransport t(
@@ -276,8 +308,6 @@ TEST(LagLink, ARestartBeforeTheLagHasStateIsRestoredAndTheEstimatorRefusesALag) 
     const Quaternion<float> q{0.5F, 0.5F, 0.5F, 0.5F};
     EXPECT_EQ(client.correct(0, 0, q, TtTime{5'000'000'000'000}).status,
               status::kAberrationApplied | status::kThermalApplied);
-    EXPECT_THROW(client.start_calibration(5'700'000'000, 30.0, nullptr), host::LinkError);
-    client.upload_model(model);  // no lag: the estimator may start, and then takes no lag
     client.start_calibration(5'700'000'000, 30.0, nullptr);
     EXPECT_THROW(client.upload_model(model, {0.0, kTauS, 0.0, 0.0}), host::LinkError);
 }

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #include "ascorr_link/messages.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "lagged_models.hpp"
 #include "replay_boards.hpp"
 #include "rewriting_loopback.hpp"
 #include "test_support.hpp"
@@ -295,6 +297,97 @@ TEST(ReplaySelfCalibration, OptionsAreChecked) {
     EXPECT_FALSE(std::filesystem::exists(o.out));
 }
 
+// ---- The estimator with the bench's lag on the link (CALIB_START's lags):
+// the target lags in its scalar and learns from what it lagged, bit for bit
+// as the host's run of the same rows lagged as the target lags them.
+
+constexpr double kLagS = 900.0;
+
+std::filesystem::path lagged_mission(const std::string& name) {
+    const auto dir = simulated(name, " --bench-lag 900");
+    write_truth_models(dir, "900", "sim.csv");
+    return dir;
+}
+
+host::ReplaySummary replay_lagged(const std::filesystem::path& dir, const std::string& target,
+                                  const std::string& label) {
+    host::ReplayOptions o = options(dir, target);
+    o.lag_s = std::array<double, kMaxHeads>{kLagS, kLagS, kLagS, 0.0};
+    std::ostringstream log;
+    return replay_printed(o, log, label);
+}
+
+// The first four columns (t, version, chu, axis) of each history row, and
+// whether the header has lag_s and every row ends with the lag.
+std::vector<std::string> versions_of(const std::string& history, bool& lagged) {
+    std::vector<std::string> out;
+    std::istringstream in(history);
+    const auto ends_with = [](const std::string& l, const std::string& end) {
+        return l.size() >= end.size() && l.compare(l.size() - end.size(), end.size(), end) == 0;
+    };
+    lagged = true;
+    for (std::string l; std::getline(in, l);) {
+        std::size_t cut = 0;
+        for (int k = 0; k < 4; ++k) {
+            cut = l.find(',', cut) + 1;
+        }
+        out.push_back(l.substr(0, cut));
+        lagged = lagged && ends_with(l, out.size() == 1 ? ",lag_s" : ",900");
+    }
+    return out;
+}
+
+// The lagged estimator on the target and on the host, and against `correct
+// --self-calibrate --lag` (which lags in double): the same versions at the
+// same times, the corrections within the float bound.
+void expect_lagged_as_the_host(const std::filesystem::path& dir, const host::ReplaySummary& s,
+                               const std::string& scalar) {
+    expect_agreement(s);
+    EXPECT_LE(s.max_error_arcsec, 0.05);
+    const CliRun c = run_in("correct --in sim.csv --out corrected.csv --self-calibrate --lag 900 --scalar " + scalar +
+                                " --model-history corrected.history.csv",
+                            dir);
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    bool lagged_target = false;
+    bool lagged_host = false;
+    const std::vector<std::string> target = versions_of(slurp(dir / "replayed.history.csv"), lagged_target);
+    const std::vector<std::string> host = versions_of(slurp(dir / "corrected.history.csv"), lagged_host);
+    ASSERT_GT(target.size(), 9U) << "no model was adopted: the comparison would be vacuous";
+    EXPECT_EQ(target, host);
+    EXPECT_TRUE(lagged_target);
+    EXPECT_TRUE(lagged_host);
+    // Mutation: the estimator without the lag learns other models.
+    const CliRun plain = run_in("correct --in sim.csv --out plain.csv --self-calibrate --scalar " + scalar +
+                                    " --model-history plain.history.csv",
+                                dir);
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    EXPECT_NE(slurp(dir / "plain.history.csv").substr(100), slurp(dir / "replayed.history.csv").substr(100));
+}
+
+TEST(ReplaySelfCalibration, ALaggedEstimatorOnTheLinkIsTheHostsBitForBit) {
+    const auto dir = lagged_mission("replay_sc_lag");
+    const host::ReplaySummary s = replay_lagged(dir, "loopback-float", "");
+    expect_lagged_as_the_host(dir, s, "float");
+    // From a lagged model (its lag: CALIB_START's), and the same from --lag.
+    std::ostringstream log;
+    const host::ReplaySummary m = replay_from_model(dir, "loopback-float", "m_lag.csv", log);
+    expect_models_agree(m, log.str());
+    const std::string history = slurp(dir / "replayed.history.csv");
+    EXPECT_NE(history.find(",given,900\n"), std::string::npos) << history.substr(0, 300);
+    // A lagged model with another lag than --lag's is refused before the target sees it.
+    host::ReplayOptions o = options(dir, "loopback-float");
+    o.model = (dir / "m_lag.csv").string();
+    o.lag_s = std::array<double, kMaxHeads>{1800.0, 1800.0, 1800.0, 0.0};
+    std::ostringstream refused;
+    try {
+        (void)host::replay(o, refused);
+        ADD_FAILURE() << "another lag than the model's was taken";
+    } catch (const std::runtime_error& e) {
+        EXPECT_TRUE(has(e.what(), "m_lag.csv: head A lags by 900 s, but the self-calibration lags it by 1800 s"))
+            << e.what();
+    }
+}
+
 #ifdef ASCORR_REPLAY_QEMU
 class ReplaySelfCalibrationQemu : public ::testing::TestWithParam<host::QemuTarget> {};
 
@@ -327,6 +420,16 @@ TEST_P(ReplaySelfCalibrationQemu, FourHeadsLearnHeadDAsTheHost) {
     EXPECT_EQ(s.restarts, 0U);
     expect_same_as_correct(dir, board_scalar(board), " --model sim.csv.truth.csv");
     EXPECT_TRUE(learnt(slurp(dir / "replayed.history.csv"), "D")) << "D never learnt on the board";
+}
+
+// The lagged estimator on each board (Q30 on the M3, float on the M4F), bit
+// for bit as the host's run of the rows lagged in the board's scalar.
+TEST_P(ReplaySelfCalibrationQemu, ALaggedEstimatorAsTheHost) {
+    const host::QemuTarget& board = GetParam();
+    const auto dir = lagged_mission("replay_sc_lag_" + board_name(board));
+    const host::ReplaySummary s = replay_lagged(dir, std::string(board.replay), std::string(board.replay) + ": ");
+    expect_lagged_as_the_host(dir, s, board_scalar(board));
+    EXPECT_EQ(s.restarts, 0U);
 }
 
 INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <array>
 #include <cctype>
 #include <optional>
 #include <stdexcept>
@@ -135,9 +136,13 @@ void add_fit_command(CLI::App& app);
 struct SelfCalibrationOptions {
     CLI::Option* time_constant;
     CLI::Option* orbit_period;
+    CLI::Option* lag;
 };
-SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds);
-// Refuses --model-history, --time-constant and --orbit-period without --self-calibrate.
+// --time-constant, --orbit-period and --lag (the estimator's bench lag, as
+// fit --lag but for auto) of correct and replay.
+SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds,
+                                                    std::optional<std::array<double, kMaxHeads>>& lag_s);
+// Refuses --model-history, --time-constant, --orbit-period and --lag without --self-calibrate.
 void check_needs_self_calibrate(bool self_calibrate, const std::string& model_history,
                                 const SelfCalibrationOptions& given);
 void add_stats_command(CLI::App& app);

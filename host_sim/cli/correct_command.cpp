@@ -75,8 +75,23 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
 
 }  // namespace
 
-SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds) {
+SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds,
+                                                    std::optional<std::array<double, kMaxHeads>>& lag_s) {
     SelfCalibrationOptions o{};
+    o.lag = cmd.add_option_function<std::string>(
+                   "--lag", [&lag_s](const std::string& v) { lag_s = host::parse_lags(v); },
+                   "with --self-calibrate: the bench's lag in s the estimator learns with, TAU for every head or "
+                   "X:TAU,... for the heads named (the others none), each 0 (none) or in [1, 86400]; the history's "
+                   "models say so (lag_s). Default: --model's lag_s, or none")
+                ->type_name("LAG")
+                ->check([](const std::string& v) {
+                    try {
+                        return host::parse_lags(v) ? std::string()
+                                                   : std::string("auto is fit's choice: give TAU or X:TAU,...");
+                    } catch (const host::FitRefused& e) {
+                        return std::string(e.what());
+                    }
+                });
     o.time_constant = cmd.add_option("--time-constant", days,
                                      "with --self-calibrate: the estimator's forgetting time constant in days, " +
                                          host::time_constant_range() + " (default " +
@@ -101,6 +116,9 @@ void check_needs_self_calibrate(bool self_calibrate, const std::string& model_hi
     }
     if (!self_calibrate && given.orbit_period->count() > 0) {
         throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
+    }
+    if (!self_calibrate && given.lag->count() > 0) {
+        throw CLI::ValidationError("--lag", "needs --self-calibrate (a model's lag_s gives the lag otherwise)");
     }
 }
 
@@ -142,30 +160,11 @@ void add_correct_command(CLI::App& app) {
                     "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
-        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s);
-    auto lag = std::make_shared<std::string>();
-    cmd->add_option("--lag", *lag,
-                    "with --self-calibrate: the bench's lag in s the estimator learns with, TAU for every head or "
-                    "X:TAU,... for the heads named (the others none), each 0 (none) or in [1, 86400]; the history's "
-                    "models say so (lag_s). Default: --model's lag_s, or none")
-        ->type_name("LAG")
-        ->check([](const std::string& v) {
-            try {
-                return host::parse_lags(v) ? std::string() : std::string("auto is fit's choice: give TAU or X:TAU,...");
-            } catch (const host::FitRefused& e) {
-                return std::string(e.what());
-            }
-        });
+        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s);
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
-    cmd->callback([opt, self_cal, combine, lag]() {
+    cmd->callback([opt, self_cal, combine]() {
         check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
-        if (!lag->empty()) {
-            if (!opt->self_calibrate) {
-                throw CLI::ValidationError("--lag", "needs --self-calibrate (a model's lag_s gives correct its lag)");
-            }
-            opt->lag_s = host::parse_lags(*lag);  // checked already
-        }
         if (!combine->combined.empty()) {
             correct_and_combine(*opt, *combine);
             return;

@@ -43,9 +43,11 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     cfg.common_rotation = rule;
     // The lagged heads' temperatures, learnt from and corrected with, as by `ascorr correct`.
     const std::optional<host::LaggedTemperatures> lag = host::lagged_temperatures(lag_s, source_of(r));
-    const host::SelfCalibration sc = host::self_calibrate<T>(
-        kArrayRows, source_of(r), m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s,
-        host::kSelfCalibrationMemoryBytes, kMaxHeads, lag ? &*lag : nullptr);
+    const host::RowSource rows = source_of(r);
+    const host::SelfCalibration sc =
+        host::self_calibrate<T>(kArrayRows, lag ? host::lagged_rows(rows, *lag) : rows,
+                                m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s,
+                                host::kSelfCalibrationMemoryBytes, kMaxHeads, lag_s);
     const host::ModelSchedule<T> schedule(sc.history);
     host::EarthVelocity earth;
     SolutionRecord rec;

@@ -13,6 +13,7 @@
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
+#include "ascorr/pipeline/temperature_lag.hpp"
 #include "wire.hpp"
 
 namespace ascorr::link {
@@ -30,7 +31,23 @@ struct CalibStart {
     // sigmas; pipeline/common_rotation_weights.hpp); 0: the estimator's own
     // frame. Absent from the payload when 0 (as a host before it sent it).
     std::uint8_t common_rotation = 0;
+    // The bench's lag of each head the estimator learns with (s; 0 none,
+    // otherwise in [pipeline::kMinLagTauS, kMaxLagTauS]): the lag stage
+    // lags those heads' solutions (pipeline/head_lags.hpp), and the
+    // estimator learns from the lagged temperatures. On the wire 4 IEEE
+    // binary64 after common_rotation (then always sent), only when a head
+    // lags: absent, none (the 17 or 18 bytes a target before it takes).
+    double lag_s[kMaxHeads] = {};
 };
+
+// Whether m lags a head (its payload then carries lag_s).
+inline bool lags_any(const CalibStart& m) noexcept {
+    bool any = false;
+    for (const double x : m.lag_s) {
+        any = any || x != 0.0;
+    }
+    return any;
+}
 
 enum class CalibCommand : std::uint8_t {
     kFreeze = 1,
@@ -73,18 +90,42 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
     w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
     w.f64(m.time_constant_days);
     w.u8(m.initial);
-    if (m.common_rotation != 0U) {  // absent when 0: a target before it takes the message as it was
+    const bool lagged = lags_any(m);
+    if (m.common_rotation != 0U || lagged) {  // absent when 0: a target before it takes the message as it was
         w.u8(m.common_rotation);
     }
+    for (std::size_t h = 0; lagged && h < kMaxHeads; ++h) {
+        w.f64(m.lag_s[h]);
+    }
     return w.size();
+}
+// CALIB_START's optional tail: common_rotation, then the lags (above).
+// Refused: a τ neither 0 nor in the lag's range (NaN included).
+inline bool decode_calib_start_tail(Reader& r, CalibStart& m) noexcept {
+    if (r.done()) {
+        return true;
+    }
+    if (!r.u8(m.common_rotation)) {
+        return false;
+    }
+    if (r.done()) {
+        return true;
+    }
+    bool ok = true;
+    for (double& tau : m.lag_s) {
+        ok = ok && r.f64(tau) && (tau == 0.0 || (tau >= pipeline::kMinLagTauS && tau <= pipeline::kMaxLagTauS));
+    }
+    return ok && r.done();
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
     Reader r(p, n);
     m.common_rotation = 0U;
+    for (double& tau : m.lag_s) {
+        tau = 0.0;
+    }
     return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) &&
-           (r.done() || (r.u8(m.common_rotation) && r.done())) &&
-           calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) && m.initial <= 1U &&
-           m.common_rotation <= 1U;
+           decode_calib_start_tail(r, m) && calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) &&
+           m.initial <= 1U && m.common_rotation <= 1U;
 }
 
 inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {

@@ -8,7 +8,8 @@
 //   kModelUpload       → kAck (kBadPayload for a bad head, length or lag, or
 //                        a lag while the estimator runs); with a lag τ, the
 //                        head's temperatures go through the lag stage from
-//                        then on, its lag started afresh (pipeline/head_lags.hpp)
+//                        then on, its lag started afresh (pipeline/head_lags.hpp);
+//                        while the estimator runs, the lags stay kCalibStart's
 //   kVelocityUpdate    → kAck
 //   kTemperatureUpdate → kAck
 //   kStateUpdate       → kAck (the state goes to the velocity service, which
@@ -20,8 +21,9 @@
 //                        lagged temperatures: status 8)
 //   kServiceConfig     → kAck: the velocity service restarts with the horizon
 //                        (its states are dropped)
-//   kCalibStart        → kAck (kBadPayload while a head lags): from then on
-//                        the estimator (calib/estimator.hpp)
+//   kCalibStart        → kAck: from then on the estimator (calib/estimator.hpp),
+//                        with its lags (each head's lag started afresh, or
+//                        none: a MODEL_UPLOAD's lag ends),
 //                        runs on the solutions through the epoch pipeline
 //                        (pipeline/epoch_pipeline.hpp says which solutions
 //                        feed it and which model corrects an epoch). A
@@ -129,8 +131,8 @@ private:
                 send_hello(f.seq, sink);
                 return;
             case MessageType::kModelUpload:
-                // A lag is refused while the estimator runs: it would learn
-                // from lagged temperatures, which no ground run reproduces.
+                // A lag is refused while the estimator runs: its lags are
+                // kCalibStart's, which the ground run reproduces.
                 update<ModelUpload<T>>(
                     f, sink, [this](const ModelUpload<T>& m) { upload_model(m); },
                     [this](const ModelUpload<T>& m) { return m.lag_s == 0.0 || !pipeline_.calibrating(); });
@@ -157,9 +159,7 @@ private:
                     f, sink, [this](const TemperatureUpdate<T>& t) { temperatures_[t.head] = t.temperatures; });
                 return;
             case MessageType::kCalibStart:
-                update<CalibStart>(
-                    f, sink, [this](const CalibStart& m) { start_estimator(m); },
-                    [this](const CalibStart& /*m*/) { return !lags_.any(); });  // not while a head lags (above)
+                update<CalibStart>(f, sink, [this](const CalibStart& m) { start_estimator(m); });
                 return;
             case MessageType::kServiceConfig:
                 update<ServiceConfig>(f, sink, [this](const ServiceConfig& m) {
@@ -226,11 +226,14 @@ private:
     }
 
     // A head's model and lag (decode() checked τ's range); the lag stage
-    // runs only while some head lags.
+    // runs only while some head lags. While the estimator runs the model
+    // waits for a restart, and the lags are its own (start_estimator).
     void upload_model(const ModelUpload<T>& m) noexcept {
         model_.head[m.head] = m.model;
-        (void)lags_.configure(m.head, m.lag_s);
-        pipeline_.use_lags(&lags_);
+        if (!pipeline_.calibrating()) {
+            (void)lags_.configure(m.head, m.lag_s);
+            pipeline_.use_lags(&lags_);
+        }
     }
 
     void start_estimator(const CalibStart& m) noexcept {
@@ -242,6 +245,10 @@ private:
         }
         // In place: no 10-KiB temporary on the stack (trivially destructible).
         new (&estimator_) LinkEstimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            (void)lags_.configure(h, m.lag_s[h]);  // decode() checked each τ
+        }
+        pipeline_.use_lags(&lags_);
         pipeline_.use_estimator(&estimator_);
     }
 

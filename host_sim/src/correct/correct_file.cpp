@@ -384,9 +384,12 @@ SelfCalibrated<T> self_calibrated(const CorrectOptions& opt, const std::optional
     ecfg.time_constant_days = opt.time_constant_days;
     ecfg.common_rotation = opt.common_rotation;
     ecfg.regauge_arcsec = opt.regauge_arcsec;
-    const SelfCalibration sc = self_calibrate<T>(
-        opt.in, [&](const std::function<void(const SolutionRecord&)>& fn) { for_each_solution(opt.in, fn, "correct"); },
-        model_file, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes, kMaxHeads, lag);
+    const RowSource rows = [&](const std::function<void(const SolutionRecord&)>& fn) {
+        for_each_solution(opt.in, fn, "correct");
+    };
+    const SelfCalibration sc = self_calibrate<T>(opt.in, lag != nullptr ? lagged_rows(rows, *lag) : rows, model_file,
+                                                 ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes, kMaxHeads,
+                                                 lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{});
     return {ModelSchedule<T>(sc.history), format_model_history(sc.history, opt.common_rotation.heads != 0U),
             describe(sc)};
 }

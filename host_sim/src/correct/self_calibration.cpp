@@ -549,15 +549,14 @@ SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& fi
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
-                               std::size_t memory_budget_bytes, std::size_t max_heads, const LaggedTemperatures* lag) {
-    const std::array<double, kMaxHeads> lag_s = lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{};
+                               std::size_t memory_budget_bytes, std::size_t max_heads,
+                               const std::array<double, kMaxHeads>& lag_s) {
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
         refuse_other_lag(*initial, "the initial model", lag_s);
     }
-    const RowSource learnt_from = lag != nullptr ? lagged_rows(rows, *lag) : rows;
-    SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(learnt_from, max_heads), file, learnt_from, initial,
-                                                     cfg, orbit_period_s, memory_budget_bytes);
+    SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg,
+                                                     orbit_period_s, memory_budget_bytes);
     for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
         a.model.lag_s = lag_s;
         a.model.lag_s = head_lags(a.model);
@@ -567,13 +566,13 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                 const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                                std::size_t, const LaggedTemperatures*);
+                                                std::size_t, const std::array<double, kMaxHeads>&);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                               std::size_t, const LaggedTemperatures*);
+                                               std::size_t, const std::array<double, kMaxHeads>&);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                             std::size_t, const LaggedTemperatures*);
+                                             std::size_t, const std::array<double, kMaxHeads>&);
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {

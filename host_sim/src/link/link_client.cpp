@@ -399,13 +399,16 @@ typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t
 
 template <typename T>
 void LinkClient<T>::start_calibration(std::int64_t orbit_period_us, double time_constant_days,
-                                      const ModelCoefficients* initial, bool common_rotation) {
+                                      const ModelCoefficients* initial, bool common_rotation,
+                                      const std::array<double, kMaxHeads>& lag_s) {
     if (initial != nullptr) {
         send_calib_model(*initial, false);
     }
-    const link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U),
-                                 static_cast<std::uint8_t>(common_rotation ? 1U : 0U)};
+    link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U),
+                           static_cast<std::uint8_t>(common_rotation ? 1U : 0U)};
+    std::copy(lag_s.begin(), lag_s.end(), start.lag_s);
     update({link::MessageType::kCalibStart, encoded(start), "calibration start"});
+    lag_s_ = lag_s;  // the target's lags from now on (a restart is an error while calibrating anyway)
     calibrating_ = true;
 }
 

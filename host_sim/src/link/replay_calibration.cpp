@@ -90,6 +90,10 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
         if (a.model.present[h] != b.model.present[h]) {
             return "head " + head + (a.model.present[h] ? " present" : " absent") + " on the target only";
         }
+        if (a.model.lag_s[h] != b.model.lag_s[h]) {
+            return "head " + head + " lags by " + number_text(a.model.lag_s[h]) + " s on the target, " +
+                   number_text(b.model.lag_s[h]) + " s on the host";
+        }
         for (std::size_t x = 0; x < kModelAxes; ++x) {
             for (std::size_t i = 0; i < kModelTerms; ++i) {
                 if (!same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i])) {
@@ -128,6 +132,8 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     }
     target_history.push_back(target_model(client, rec.t));
     ActiveModel& mine = target_history.back();
+    mine.model.lag_s = client.lag_s();  // CALIB_START's: CALIB_MODEL carries no lag
+    mine.model.lag_s = head_lags(mine.model);
     const auto host = std::find_if(host_sc.history.begin(), host_sc.history.end(),
                                    [&](const ActiveModel& a) { return a.version == mine.version; });
     if (host != host_sc.history.end()) {

@@ -37,6 +37,11 @@ Quaternion<double> widen(const Quaternion<T>& q) {
     return {d(q.w), d(q.x), d(q.y), d(q.z)};
 }
 
+// The order the rows go to the target in (row_replay.cpp): the on-board
+// clock's (TT µs; rows within one microsecond in file order); rows whose t
+// the clock cannot hold last.
+std::vector<std::size_t> time_order(const std::vector<SolutionRecord>& rows);
+
 constexpr std::size_t kMaxCalibMessages = 20;  // per kind, as the diagnostics of `ascorr correct`
 
 // The session over an open transport, in the target's scalar T (float or

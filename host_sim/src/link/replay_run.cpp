@@ -20,6 +20,49 @@ namespace ascorr::host::detail {
 
 namespace {
 
+// The heads' lags of the run: --lag (self-calibration), otherwise the model's.
+std::array<double, kMaxHeads> replay_lags(const ReplayOptions& opt, const std::optional<ModelFile>& mf) {
+    if (opt.lag_s) {
+        return *opt.lag_s;
+    }
+    return mf ? head_lags(*mf) : std::array<double, kMaxHeads>{};
+}
+
+// The rows as the target's lag stage gives them to its terms: each lagged
+// head's temperatures through pipeline::HeadLags<T> in the order the rows
+// are sent (time_order; a row with no time has none), written back in double
+// (exactly: each is a value of T), so that the host's self-calibration learns
+// from what the target's estimator learns from, bit for bit. A reading the
+// stage leaves as it came (not usable) stays the row's own.
+template <typename T>
+std::vector<SolutionRecord> lagged_as_sent(const std::vector<SolutionRecord>& rows,
+                                           const std::array<double, kMaxHeads>& lag_s) {
+    pipeline::HeadLags<T> lags;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        (void)lags.configure(h, lag_s[h]);  // checked: the model's reader, --lag's parser
+    }
+    std::vector<SolutionRecord> out = rows;
+    for (const std::size_t k : time_order(rows)) {
+        SolutionRecord& r = out[k];
+        HeadTemperatures<T> temps = to_core_input<T>(r, nullptr).temperatures;
+        TtTime tt{};
+        if (tt_from_seconds(r.t, tt)) {
+            lags.apply(r.head, tt.us, temps);
+        } else {
+            lags.without_time(r.head, temps);
+        }
+        const TemperatureReading<T>* const reading[3] = {&temps.t_chu, &temps.t_029, &temps.t_032};
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double v = ScalarTraits<T>::to_double(reading[c]->value);
+            if (reading[c]->valid && v != ScalarTraits<T>::to_double(ScalarTraits<T>::celsius(r.temperature[c]))) {
+                r.temperature[c] = v;  // lagged
+            }
+            r.temperature_present[c] = reading[c]->valid;
+        }
+    }
+    return out;
+}
+
 // --model read and checked for the target's scalar (refused before the
 // target sees it, as by `correct`); none without --model.
 template <typename T>
@@ -30,7 +73,7 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
-        refuse_lagged_model(mf, opt.model, "--self-calibrate does not learn a lagged model yet");
+        refuse_other_lag(mf, opt.model, replay_lags(opt, mf));
         refuse_quadratic_initial_model(mf, opt.model);
     }
     return mf;
@@ -72,14 +115,25 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
     calib::EstimatorConfig ecfg;
     ecfg.time_constant_days = opt.time_constant_days;
     ecfg.common_rotation = rule;
-    host.sc = self_calibrate<T>(opt.in, rows_in(rows), mf, ecfg, opt.orbit_period_s);
+    // The lags: CALIB_START's on the target, the host's pipeline alike, the
+    // host's estimator over the rows lagged as the target lags them, and the
+    // reference's as `correct` lags (in double).
+    const std::array<double, kMaxHeads> lag_s = replay_lags(opt, mf);
+    const std::vector<SolutionRecord> lagged = any_lag(lag_s) ? lagged_as_sent<T>(rows, lag_s) : rows;
+    host.sc = self_calibrate<T>(opt.in, rows_in(lagged), mf, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes,
+                                kMaxHeads, lag_s);
     host.schedule_d.emplace(host.sc->history);
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        (void)host.lags.configure(h, lag_s[h]);
+    }
+    host.pipeline.use_lags(&host.lags);
+    host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));
     std::optional<ModelCoefficients> initial;
     if (mf) {
         initial = coefficients_of(*mf);
     }
     const std::int64_t period_us = std::llround(host.sc->orbit_period_s * 1e6);
-    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U);
+    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U, lag_s);
     calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
     host_cfg.orbit_period_us = period_us;
     host_cfg.time_constant_days = opt.time_constant_days;

@@ -28,20 +28,6 @@ double angle_arcsec(const Quaternion<double>& a, const Quaternion<double>& b) {
     return 2.0 * std::asin(std::min(1.0, s)) * kRadToArcsec;
 }
 
-// Time order is the on-board clock's (TT µs; rows within one microsecond
-// in file order, as the target and the host's self-calibration take
-// them); rows whose t the clock cannot hold come last.
-std::vector<std::size_t> time_order(const std::vector<SolutionRecord>& rows) {
-    const auto key = [&](std::size_t i) {
-        TtTime tt{};
-        return tt_from_seconds(rows[i].t, tt) ? tt.us : std::numeric_limits<std::int64_t>::max();
-    };
-    std::vector<std::size_t> order(rows.size());
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
-    return order;
-}
-
 // One row through the target and the host: the target's velocity service
 // fed the states up to the row's time (mirrored in its scalar and in
 // double), the row corrected by the target, by the host's pipeline and, in
@@ -283,6 +269,18 @@ private:
 };
 
 }  // namespace
+
+// (replay_parts.hpp) As the target and the host's self-calibration take them.
+std::vector<std::size_t> time_order(const std::vector<SolutionRecord>& rows) {
+    const auto key = [&](std::size_t i) {
+        TtTime tt{};
+        return tt_from_seconds(rows[i].t, tt) ? tt.us : std::numeric_limits<std::int64_t>::max();
+    };
+    std::vector<std::size_t> order(rows.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+    return order;
+}
 
 template <typename T>
 ReplayedRows replay_rows(const ReplayOptions& opt, const std::vector<SolutionRecord>& rows, LinkClient<T>& client,

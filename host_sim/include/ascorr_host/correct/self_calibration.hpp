@@ -25,7 +25,6 @@
 #include <vector>
 
 #include "ascorr/calib/estimator.hpp"
-#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -84,17 +83,18 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // are read again and sorted within memory_budget_bytes (beyond it, in sorted
 // runs on a temporary file, merged). Throws InputError for a file whose rows
 // cannot be read.
-// lag: the bench's lag (lagged_temperatures.hpp, a table of these rows):
-// the estimator learns from the rows as a lagged model's terms take them,
-// and every model of the history has the table's lag_s (the heads it has);
-// nullptr: no lag. A lagged initial model must have the table's lag for each
-// of its lagged heads (refuse_other_lag; an unlagged one may start a lagged
-// run: its coefficients are those of the orbit means).
+// lag_s: the bench's lag of each head (0 none), with which the caller has
+// lagged the rows' temperatures (the estimator learns from the rows as a
+// lagged model's terms take them: lagged_rows() over `correct`'s table, in
+// double; `replay`, as its target in its scalar); every model of the history
+// has it (the heads it has). A lagged initial model must have the same lag
+// for each of its lagged heads (refuse_other_lag; an unlagged one may start
+// a lagged run: its coefficients are those of the orbit means).
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
-                               std::size_t max_heads = kMaxHeads, const LaggedTemperatures* lag = nullptr);
+                               std::size_t max_heads = kMaxHeads, const std::array<double, kMaxHeads>& lag_s = {});
 
 // A lagged head of m whose τ is not lag_s's: its coefficients belong to
 // another lag. Throws std::runtime_error naming `name` and the head.

@@ -97,9 +97,13 @@ public:
     // while the target's estimator runs is an error (restore() refuses it):
     // what it had learnt is lost with it.
     // common_rotation: the rule 'combined' with the mountings loaded before
-    // (load_mountings), CALIB_START's common_rotation 1.
+    // (load_mountings), CALIB_START's common_rotation 1. lag_s: the heads'
+    // lags the estimator learns with (CALIB_START's; 0 none).
     void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial,
-                           bool common_rotation = false);
+                           bool common_rotation = false, const std::array<double, kMaxHeads>& lag_s = {});
+    // The heads' lags the target runs with (the last upload_model's or
+    // start_calibration's; 0 none).
+    const std::array<double, kMaxHeads>& lag_s() const noexcept { return lag_s_; }
     void calib_command(link::CalibCommand c);
     // A model for the estimator, active from the next epoch (version + 1).
     void load_calib_model(const ModelCoefficients& m);

@@ -28,6 +28,7 @@
 // with the formal σ of the host's tables (they depend on the head set only).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -63,6 +64,9 @@ struct ReplayOptions {
     int max_attempts = 20;
     std::uint64_t seed = 1;
     unsigned baud = 115200;
+    // --lag (self-calibration only): the lags the target's estimator learns
+    // with (CALIB_START's); nullopt: the model's lag_s, or none.
+    std::optional<std::array<double, kMaxHeads>> lag_s;
 };
 
 struct ReplaySummary {
