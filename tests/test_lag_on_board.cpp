@@ -312,6 +312,71 @@ TEST(LagLink, ARestartBeforeTheLagHasStateIsRestoredAndTheEstimatorTakesCalibSta
     EXPECT_THROW(client.upload_model(model, {0.0, kTauS, 0.0, 0.0}), host::LinkError);
 }
 
+// Head A's answers over a step of its temperatures, the estimator started
+// from the mission's model with `calib_lags` (CALIB_START's), after
+// `before` (a MODEL_UPLOAD's lags, or none) and, while it runs, a
+// MODEL_UPLOAD without a lag when `upload_while` (the target keeps
+// CALIB_START's lags: the same answers).
+std::vector<Quaternion<float>> answers_while_calibrating(const std::optional<std::array<double, kMaxHeads>>& before,
+                                                         const std::array<double, kMaxHeads>& calib_lags,
+                                                         bool upload_while) {
+    const host::ModelFile mf = host::read_model_file((mission() / "m.csv").string());
+    const ThermalModel<float> model = host::to_core<float>(mf);
+    const ModelCoefficients initial = host::coefficients_of(mf);
+    RestartingTarget target(1'000'000);  // no restart
+    host::LoopbackTransport t(
+        [&](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& r) { target.serve(p, n, r); });
+    host::LinkClient<float> client(t, 1, 20);
+    client.connect();
+    if (before) {
+        client.upload_model(model, *before);
+    }
+    client.start_calibration(5'700'000'000, 30.0, &initial, false, calib_lags);
+    if (upload_while) {
+        client.upload_model(model);
+        // A lag now is refused before the target sees it, and changes nothing.
+        EXPECT_THROW(client.upload_model(model, {0.0, kTauS, 0.0, 0.0}), host::LinkError);
+        EXPECT_EQ(client.lag_s(), calib_lags);
+    }
+    client.set_velocity({{1e-4F, -2e-5F, 3e-5F}, 1.0F, true});
+    const Quaternion<float> q{0.5F, 0.5F, 0.5F, 0.5F};
+    std::vector<Quaternion<float>> out;
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        const float step = i < 10 ? 0.0F : 8.0F;  // the lag follows it over τ
+        client.set_temperatures(0, {{10.0F + step, true}, {-5.0F + step, true}, {-20.0F, true}});
+        const link::SolutionOut<float> a =
+            client.correct(i, 0, q, TtTime{5'000'000'000'000 + std::int64_t{i} * 60'000'000});
+        EXPECT_NE(a.status & status::kThermalApplied, 0U) << i;
+        out.push_back(a.q_chu_icrf);
+    }
+    return out;
+}
+
+bool same_answers(const std::vector<Quaternion<float>>& a, const std::vector<Quaternion<float>>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0;
+}
+
+// While the estimator runs its lags are CALIB_START's: a MODEL_UPLOAD
+// without one changes none, one with τ is refused; CALIB_START without lags
+// ends a MODEL_UPLOAD's. Mutation: the lag changes the answers.
+TEST(LagLink, WhileTheEstimatorRunsItsLagsAreCalibStarts) {
+    const std::array<double, kMaxHeads> lagged{kTauS, 0.0, 0.0, 0.0};
+    const auto with = answers_while_calibrating(std::nullopt, lagged, false);
+    EXPECT_TRUE(same_answers(answers_while_calibrating(std::nullopt, lagged, true), with));
+    const auto without = answers_while_calibrating(std::nullopt, {}, false);
+    EXPECT_FALSE(same_answers(with, without)) << "the lag changes no answer: the test would be vacuous";
+    EXPECT_TRUE(same_answers(answers_while_calibrating(lagged, {}, false), without));
+    // A CALIB_START with every τ 0 on the wire (50 bytes) is no lag.
+    std::uint8_t p[link::kMaxPayload];
+    link::CalibStart m{5'700'000'000, 30.0, 0U, 0U};
+    m.lag_s[3] = 900.0;
+    const std::size_t n = link::encode(m, p);
+    std::memset(p + n - 8, 0, 8);
+    link::CalibStart back{};
+    ASSERT_TRUE(link::decode(p, n, back));
+    EXPECT_FALSE(link::lags_any(back));
+}
+
 // The corrected rows of a file, by line: status and quaternion.
 struct Corrected {
     std::string status;

@@ -157,7 +157,7 @@ void add_correct_command(CLI::App& app) {
                   "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
     cmd->add_option("--model-history", opt->model_history,
                     "with --self-calibrate: write every model that became active (CSV "
-                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin)")
+                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin; common_rotation with --combined, lag_s with a lag)")
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
         add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s);

@@ -75,11 +75,9 @@ HeadMask fit_heads(const FitOptions& opt, HeadMask with_rows) {
 
 // A lag --lag's parser would refuse (an option set by a library caller).
 void refuse_bad_lags(const FitOptions& opt) {
-    for (std::size_t h = 0; opt.lag_s && h < kMaxHeads; ++h) {
-        if (!lag_acceptable((*opt.lag_s)[h])) {
-            throw FitRefused(std::string("--lag: head ") + head_name(static_cast<std::uint8_t>(h)) + "'s " +
-                             number_text((*opt.lag_s)[h]) + " is not " + lag_range_text());
-        }
+    const std::string bad = bad_lag_text(opt.lag_s);
+    if (!bad.empty()) {
+        throw FitRefused(bad);
     }
 }
 

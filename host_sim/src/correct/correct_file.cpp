@@ -526,6 +526,9 @@ std::optional<StatesVelocityTable<T>> velocity_table(const CorrectOptions& opt, 
 // What the options cannot do together: the self-calibration's
 // (refuse_self_calibration_options), and --lag without it.
 void refuse_run_options(const CorrectOptions& opt) {
+    if (const std::string bad = bad_lag_text(opt.lag_s); !bad.empty()) {
+        throw std::runtime_error(bad);
+    }
     if (opt.self_calibrate) {
         refuse_self_calibration_options(opt);
     } else if (opt.lag_s) {

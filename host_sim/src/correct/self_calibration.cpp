@@ -416,7 +416,7 @@ void refuse_other_lag(const ModelFile& m, const std::string& name, const std::ar
                 name + ": head " + std::string(1, head_name(h)) + " lags by " + number_text(m.lag_s[h]) +
                 " s, but the self-calibration " +
                 (lag_s[h] == 0.0 ? std::string("lags it by none") : "lags it by " + number_text(lag_s[h]) + " s") +
-                ": its coefficients belong to its lag; give the same lag (--lag) or none");
+                ": its coefficients belong to its lag; give --lag with its lag for that head, or leave --lag out");
         }
     }
 }

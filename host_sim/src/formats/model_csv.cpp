@@ -38,6 +38,16 @@ bool lag_acceptable(double lag_s) noexcept {
     return lag_s == 0.0 || (lag_s >= pipeline::kMinLagTauS && lag_s <= pipeline::kMaxLagTauS);
 }
 
+std::string bad_lag_text(const std::optional<std::array<double, kMaxHeads>>& lag_s) {
+    for (std::uint8_t h = 0; lag_s && h < kMaxHeads; ++h) {
+        if (!lag_acceptable((*lag_s)[h])) {
+            return std::string("--lag: head ") + head_name(h) + "'s " + number_text((*lag_s)[h]) + " is not " +
+                   lag_range_text();
+        }
+    }
+    return {};
+}
+
 std::string lag_range_text() {
     return "0 (no lag) or [" + number_text(pipeline::kMinLagTauS) + ", " + number_text(pipeline::kMaxLagTauS) + "] s";
 }

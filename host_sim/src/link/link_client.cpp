@@ -68,8 +68,18 @@ link::Hello LinkClient<T>::connect() {
 
 template <typename T>
 void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s) {
+    if (calibrating_) {
+        // The target keeps CALIB_START's lags while its estimator runs.
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            if (lag_s[h] != 0.0) {
+                throw LinkError(std::string("a lag for head ") + head_name(h) +
+                                " while the target's estimator runs: its lags are CALIB_START's");
+            }
+        }
+    } else {
+        lag_s_ = lag_s;
+    }
     model_ = model;
-    lag_s_ = lag_s;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         update(model_message(h));
     }
@@ -369,7 +379,9 @@ bool LinkClient<T>::answer_shows_restart(const link::SolutionOut<T>& out) const 
 
 template <typename T>
 typename LinkClient<T>::Message LinkClient<T>::model_message(std::uint8_t head) const {
-    return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head], lag_s_[head]}),
+    // While the estimator runs, the lags are CALIB_START's: MODEL_UPLOAD sends none.
+    const double tau = calibrating_ ? 0.0 : lag_s_[head];
+    return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head], tau}),
             "model upload"};
 }
 

@@ -124,6 +124,12 @@ void check_calibration_options(const ReplayOptions& opt) {
         if (opt.orbit_period_s) {
             throw std::runtime_error("--orbit-period needs --self-calibrate");
         }
+        if (opt.lag_s) {
+            throw std::runtime_error("--lag needs --self-calibrate (a model's lag_s gives the lag otherwise)");
+        }
+    }
+    if (const std::string bad = bad_lag_text(opt.lag_s); !bad.empty()) {
+        throw std::runtime_error(bad);
     }
 }
 

@@ -90,10 +90,6 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
         if (a.model.present[h] != b.model.present[h]) {
             return "head " + head + (a.model.present[h] ? " present" : " absent") + " on the target only";
         }
-        if (a.model.lag_s[h] != b.model.lag_s[h]) {
-            return "head " + head + " lags by " + number_text(a.model.lag_s[h]) + " s on the target, " +
-                   number_text(b.model.lag_s[h]) + " s on the host";
-        }
         for (std::size_t x = 0; x < kModelAxes; ++x) {
             for (std::size_t i = 0; i < kModelTerms; ++i) {
                 if (!same_double(a.model.coefficients[h][x][i], b.model.coefficients[h][x][i])) {

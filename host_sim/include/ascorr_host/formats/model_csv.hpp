@@ -99,6 +99,10 @@ inline bool any_lag(const std::array<double, kMaxHeads>& lag_s) noexcept {
     }
     return any;
 }
+// What is wrong with a --lag its parser would refuse (an option set by a
+// library caller): "--lag: head A's 0.5 is not 0 (no lag) or [1, 86400] s";
+// empty when nothing is (or none is given).
+std::string bad_lag_text(const std::optional<std::array<double, kMaxHeads>>& lag_s);
 // Whether lag_s is 0 or a time constant the lag accepts (pipeline::TemperatureLag::configure).
 bool lag_acceptable(double lag_s) noexcept;
 // "0 (no lag) or [1, 86400] s", for messages.

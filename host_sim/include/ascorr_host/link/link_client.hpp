@@ -101,8 +101,8 @@ public:
     // lags the estimator learns with (CALIB_START's; 0 none).
     void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial,
                            bool common_rotation = false, const std::array<double, kMaxHeads>& lag_s = {});
-    // The heads' lags the target runs with (the last upload_model's or
-    // start_calibration's; 0 none).
+    // The heads' lags the target runs with (start_calibration's once the
+    // estimator runs, otherwise the last upload_model's; 0 none).
     const std::array<double, kMaxHeads>& lag_s() const noexcept { return lag_s_; }
     void calib_command(link::CalibCommand c);
     // A model for the estimator, active from the next epoch (version + 1).
