@@ -138,6 +138,9 @@ struct SelfCalibrationOptions {
     CLI::Option* orbit_period;
     CLI::Option* lag;
 };
+// What is wrong with a --lag (host::parse_lags; `auto` only where
+// auto_allowed: fit's); empty when nothing is (fit_command.cpp).
+std::string lag_option_problem(const std::string& text, bool auto_allowed);
 // --time-constant, --orbit-period and --lag (the estimator's bench lag, as
 // fit --lag but for auto) of correct and replay.
 SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds,

@@ -84,14 +84,7 @@ SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days,
                    "X:TAU,... for the heads named (the others none), each 0 (none) or in [1, 86400]; the history's "
                    "models say so (lag_s). Default: --model's lag_s, or none")
                 ->type_name("LAG")
-                ->check([](const std::string& v) {
-                    try {
-                        return host::parse_lags(v) ? std::string()
-                                                   : std::string("auto is fit's choice: give TAU or X:TAU,...");
-                    } catch (const host::FitRefused& e) {
-                        return std::string(e.what());
-                    }
-                });
+                ->check([](const std::string& v) { return lag_option_problem(v, false); });
     o.time_constant = cmd.add_option("--time-constant", days,
                                      "with --self-calibrate: the estimator's forgetting time constant in days, " +
                                          host::time_constant_range() + " (default " +

@@ -8,6 +8,15 @@
 
 namespace ascorr::cli {
 
+std::string lag_option_problem(const std::string& text, bool auto_allowed) {
+    try {
+        return host::parse_lags(text) || auto_allowed ? std::string()
+                                                      : std::string("auto is fit's choice: give TAU or X:TAU,...");
+    } catch (const host::FitRefused& e) {
+        return e.what();
+    }
+}
+
 void add_fit_command(CLI::App& app) {
     auto opt = std::make_shared<host::FitOptions>();
     auto frame = std::make_shared<std::string>(host::frame_heads_text(host::kDefaultFrameHeads));
@@ -68,14 +77,7 @@ void add_fit_command(CLI::App& app) {
                     "0 (none) or in [1, 86400]. The terms take each head's temperatures through a first-order lag "
                     "of TAU, and the model says so (lag_s), for correct")
         ->type_name("LAG")
-        ->check([](const std::string& v) {
-            try {
-                host::parse_lags(v);
-            } catch (const host::FitRefused& e) {
-                return std::string(e.what());
-            }
-            return std::string();
-        });
+        ->check([](const std::string& v) { return lag_option_problem(v, true); });
     cmd->callback([opt, frame, heads, mountings, rule, lag]() {
         if (!lag->empty()) {
             opt->lag_s = host::parse_lags(*lag);  // checked already; "auto": nullopt
