@@ -338,15 +338,6 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
         });
 }
 
-// The bench's lag of the run: --lag (the self-calibration's), otherwise the
-// model file's.
-std::array<double, kMaxHeads> run_lags(const CorrectOptions& opt, const std::optional<ModelFile>& model) {
-    if (opt.lag_s) {
-        return *opt.lag_s;
-    }
-    return model ? head_lags(*model) : std::array<double, kMaxHeads>{};
-}
-
 // The readings of the rows of the heads the run lags (run_lags), read ahead of
 // the correction and of the self-calibration: each head's lag runs over its
 // rows in time order. None without a thermal stage, or when no head lags.
@@ -435,7 +426,7 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
     check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
-        refuse_other_lag(*model_file, opt.model, run_lags(opt, model_file));
+        refuse_other_lag(*model_file, opt.model, run_lags(opt.lag_s, model_file));
     }
     return to_core<T>(*model_file);
 }
@@ -560,7 +551,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     const std::optional<StatesVelocityTable<T>> table = velocity_table<T>(opt, states, header, workers);
     // (Without --model or --self-calibrate no head lags: --lag needs the latter.)
     const std::optional<LaggedTemperatures> lag =
-        lagged_temperatures(opt.in, header, workers, run_lags(opt, model_file), opt.thermal);
+        lagged_temperatures(opt.in, header, workers, run_lags(opt.lag_s, model_file), opt.thermal);
     std::optional<SelfCalibrated<T>> sc;
     if (opt.self_calibrate) {
         sc.emplace(self_calibrated<T>(opt, model_file, lag ? &*lag : nullptr));

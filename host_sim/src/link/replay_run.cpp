@@ -20,14 +20,6 @@ namespace ascorr::host::detail {
 
 namespace {
 
-// The heads' lags of the run: --lag (self-calibration), otherwise the model's.
-std::array<double, kMaxHeads> replay_lags(const ReplayOptions& opt, const std::optional<ModelFile>& mf) {
-    if (opt.lag_s) {
-        return *opt.lag_s;
-    }
-    return mf ? head_lags(*mf) : std::array<double, kMaxHeads>{};
-}
-
 // The rows as the target's lag stage gives them to its terms: each lagged
 // head's temperatures through pipeline::HeadLags<T> in the order the rows
 // are sent (time_order; a row with no time has none), written back in double
@@ -73,7 +65,7 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
-        refuse_other_lag(mf, opt.model, replay_lags(opt, mf));
+        refuse_other_lag(mf, opt.model, run_lags(opt.lag_s, mf));
         refuse_quadratic_initial_model(mf, opt.model);
     }
     return mf;
@@ -118,7 +110,7 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
     // The lags: CALIB_START's on the target, the host's pipeline alike, the
     // host's estimator over the rows lagged as the target lags them, and the
     // reference's as `correct` lags (in double).
-    const std::array<double, kMaxHeads> lag_s = replay_lags(opt, mf);
+    const std::array<double, kMaxHeads> lag_s = run_lags(opt.lag_s, mf);
     const std::vector<SolutionRecord> lagged = any_lag(lag_s) ? lagged_as_sent<T>(rows, lag_s) : rows;
     host.sc = self_calibrate<T>(opt.in, rows_in(lagged), mf, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes,
                                 kMaxHeads, lag_s);

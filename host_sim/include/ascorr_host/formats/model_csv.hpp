@@ -99,6 +99,15 @@ inline bool any_lag(const std::array<double, kMaxHeads>& lag_s) noexcept {
     }
     return any;
 }
+// The heads' lags of a run (correct, replay): `given` (--lag), otherwise the
+// model's (head_lags), otherwise none.
+inline std::array<double, kMaxHeads> run_lags(const std::optional<std::array<double, kMaxHeads>>& given,
+                                              const std::optional<ModelFile>& model) {
+    if (given) {
+        return *given;
+    }
+    return model ? head_lags(*model) : std::array<double, kMaxHeads>{};
+}
 // What is wrong with a --lag its parser would refuse (an option set by a
 // library caller): "--lag: head A's 0.5 is not 0 (no lag) or [1, 86400] s";
 // empty when nothing is (or none is given).
