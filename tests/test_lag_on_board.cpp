@@ -167,6 +167,29 @@ TEST(LagStage, WhatItCannotLagHasNoTemperatures) {
     EXPECT_EQ(x.t_chu.value, 20.0);
 }
 
+TEST(LagStage, EveryHeadsLagAtOnce) {
+    pipeline::HeadLags<double> lags;
+    std::array<double, kMaxHeads> tau{};
+    EXPECT_FALSE(pipeline::any_lagged(tau));
+    EXPECT_TRUE(lags.configure_all(tau));
+    EXPECT_FALSE(lags.any());
+    tau[1] = 900.0;
+    tau[kMaxHeads - 1] = 1800.0;
+    EXPECT_TRUE(pipeline::any_lagged(tau));
+    EXPECT_TRUE(lags.configure_all(tau));
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        EXPECT_EQ(lags.lags(h), tau[h] != 0.0) << int{h};
+    }
+    // One refused τ: false, that head as it was, the others configured.
+    std::array<double, kMaxHeads> bad{};
+    bad[0] = 600.0;
+    bad[1] = 0.5;
+    EXPECT_FALSE(lags.configure_all(bad));
+    EXPECT_TRUE(lags.lags(0));
+    EXPECT_TRUE(lags.lags(1));
+    EXPECT_FALSE(lags.lags(kMaxHeads - 1));
+}
+
 // MODEL_UPLOAD: τ after the words, only when the head lags.
 TEST(LagLink, ModelUploadCarriesTheLagOnlyWhenTheHeadLags) {
     const ThermalModel<float> model = host::to_core<float>(host::read_model_file((mission() / "m.csv").string()));
@@ -278,7 +301,7 @@ TEST(LagLink, CalibStartCarriesTheLagsOnlyWhenAHeadLags) {
     EXPECT_EQ(back.lag_s[2], 1800.5);
     EXPECT_EQ(back.lag_s[3], 0.0);
     ASSERT_TRUE(link::decode(p, 17U, back));  // as a host before it: no lag
-    EXPECT_FALSE(link::lags_any(back));
+    EXPECT_FALSE(pipeline::any_lagged(back.lag_s));
     // A τ out of range (NaN included), or a frame cut short.
     for (double bad : {0.5, 86400.5, -900.0, std::nan("")}) {
         std::uint8_t q[link::kMaxPayload];
@@ -374,7 +397,7 @@ TEST(LagLink, WhileTheEstimatorRunsItsLagsAreCalibStarts) {
     std::memset(p + n - 8, 0, 8);
     link::CalibStart back{};
     ASSERT_TRUE(link::decode(p, n, back));
-    EXPECT_FALSE(link::lags_any(back));
+    EXPECT_FALSE(pipeline::any_lagged(back.lag_s));
 }
 
 // The corrected rows of a file, by line: status and quaternion.

@@ -12,6 +12,7 @@
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_text/input_error.hpp"
 #include "commands.hpp"
 #include "number_options.hpp"
@@ -111,7 +112,7 @@ void check_needs_self_calibrate(bool self_calibrate, const std::string& model_hi
         throw CLI::ValidationError("--orbit-period", "needs --self-calibrate");
     }
     if (!self_calibrate && given.lag->count() > 0) {
-        throw CLI::ValidationError("--lag", "needs --self-calibrate (a model's lag_s gives the lag otherwise)");
+        throw CLI::ValidationError("--lag", host::kLagNeedsSelfCalibration);
     }
 }
 

@@ -44,8 +44,9 @@ void add_replay_command(CLI::App& app) {
         ->check(real_in(host::kMinPropagationS, host::kMaxPropagationLimitS));
     cmd->add_flag("--self-calibrate", opt->self_calibrate,
                   "the target runs its estimator of the thermal model on the solutions, starting from --model or from "
-                  "none; its answers, model versions, models and final report are compared with the host's run "
-                  "(ascorr correct --self-calibrate) bit for bit");
+                  "none; its answers, model versions, models and final report are compared bit for bit with the "
+                  "host's run of ascorr correct --self-calibrate in the target's scalar (with a lag, over the rows "
+                  "lagged as the target lags them)");
     cmd->add_option("--model-history", opt->model_history,
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());

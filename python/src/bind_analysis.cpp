@@ -31,11 +31,24 @@ using namespace pybind11::literals;
 
 namespace {
 
+// The heads the rows have.
+HeadMask heads_of(const Rows& r) {
+    HeadMask heads = 0U;
+    SolutionRecord rec;
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        heads |= rec.head < kMaxHeads ? head_bit(rec.head) : HeadMask{0};
+    }
+    return heads;
+}
+
 py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     const Rows r = rows_of(t, chu, q, py::none(), py::none());
     // Every pair of kMaxHeads while reading; those of the rows' heads at the end (as stats()).
     constexpr host::PairList kAllPairs = host::pairs_of(host::kAllHeads);
-    HeadMask with_rows = 0U;
+    // The rows' heads first, so that the epochs group alike in any row order
+    // (an epoch is complete with every head the rows have).
+    const HeadMask with_rows = heads_of(r);
     std::array<std::vector<double>, host::kMaxPairs> pt;
     std::array<std::vector<double>, host::kMaxPairs> pv;
     // A row whose quaternion the core rejects (not finite, not unit: status 16
@@ -45,7 +58,8 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
         Vector3<double> z;
         bool accepted;
     };
-    host::EpochAssembler<Boresight> epochs(kArrayRows, [&](const host::Epoch<Boresight>& e) {
+    SolutionRecord rec;
+    const auto pairs_of_epoch = [&](const host::Epoch<Boresight>& e) {
         for (std::size_t p = 0; p < kAllPairs.count; ++p) {
             const auto& a = e.head[kAllPairs.pair[p].first];
             const auto& b = e.head[kAllPairs.pair[p].second];
@@ -54,14 +68,13 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
                 pv[p].push_back(host::angle_arcsec(a->z, b->z));
             }
         }
-    });
+    };
+    host::EpochAssembler<Boresight> epochs(kArrayRows, pairs_of_epoch, with_rows);
     std::ostringstream log;
     host::Diagnostics diag(log);
-    SolutionRecord rec;
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
         if (rec.head < kMaxHeads) {
-            with_rows |= head_bit(rec.head);
             SolutionInput<double> in{};
             in.q_chu_icrf = rec.q_chu_icrf;
             in.head = rec.head;

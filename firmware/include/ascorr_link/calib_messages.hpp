@@ -13,7 +13,7 @@
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
-#include "ascorr/pipeline/temperature_lag.hpp"
+#include "ascorr/pipeline/head_lags.hpp"
 #include "wire.hpp"
 
 namespace ascorr::link {
@@ -39,15 +39,6 @@ struct CalibStart {
     // lags: absent, none (the 17 or 18 bytes a target before it takes).
     double lag_s[kMaxHeads] = {};
 };
-
-// Whether m lags a head (its payload then carries lag_s).
-inline bool lags_any(const CalibStart& m) noexcept {
-    bool any = false;
-    for (const double x : m.lag_s) {
-        any = any || x != 0.0;
-    }
-    return any;
-}
 
 enum class CalibCommand : std::uint8_t {
     kFreeze = 1,
@@ -90,8 +81,8 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
     w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
     w.f64(m.time_constant_days);
     w.u8(m.initial);
-    const bool lagged = lags_any(m);
-    if (m.common_rotation != 0U || lagged) {  // absent when 0: a target before it takes the message as it was
+    const bool lagged = pipeline::any_lagged(m.lag_s);  // the payload then carries lag_s
+    if (m.common_rotation != 0U || lagged) {            // absent when 0: a target before it takes the message as it was
         w.u8(m.common_rotation);
     }
     for (std::size_t h = 0; lagged && h < kMaxHeads; ++h) {

@@ -245,9 +245,7 @@ private:
         }
         // In place: no 10-KiB temporary on the stack (trivially destructible).
         new (&estimator_) LinkEstimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            (void)lags_.configure(h, m.lag_s[h]);  // decode() checked each τ
-        }
+        (void)lags_.configure_all(m.lag_s);  // decode() checked each τ
         pipeline_.use_lags(&lags_);
         pipeline_.use_estimator(&estimator_);
     }

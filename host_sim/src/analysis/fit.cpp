@@ -139,7 +139,7 @@ namespace {
 FitReport fit_choosing_lag(const FitOptions& opt, const RowSource& rows) {
     std::vector<LagReading> readings = opt.holdout > 0.0 ? lag_readings(rows) : std::vector<LagReading>{};
     FitReport r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), nullptr, &readings);
-    if (!any_lag(r.lag.lag_s)) {
+    if (!pipeline::any_lagged(r.lag.lag_s)) {
         return r;
     }
     const LaggedTemperatures lag(r.lag.lag_s, std::move(readings));
@@ -175,7 +175,7 @@ FitReport fit_model(const FitOptions& opt, const RowSource& rows) {
         throw FitRefused("--min-temperature-range must be a finite number of degC >= 0, got " +
                          number_text(opt.min_temperature_range_c));
     }
-    if (opt.lag_s && any_lag(*opt.lag_s)) {
+    if (opt.lag_s && pipeline::any_lagged(*opt.lag_s)) {
         const LaggedTemperatures lag(*opt.lag_s, lag_readings(rows));
         FitReport r = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), &lag, nullptr);
         r.model.lag_s = *opt.lag_s;

@@ -265,7 +265,7 @@ std::string lags_text(const Lags& lag, HeadMask heads) {
 
 std::string verdict_of(const LagSelection& s, HeadMask heads) {
     const double change = 100.0 * (s.best_rms / s.none_rms - 1.0);
-    const bool taken = std::any_of(s.lag_s.begin(), s.lag_s.end(), [](double x) { return x != 0.0; });
+    const bool taken = pipeline::any_lagged(s.lag_s);
     char buf[512];
     text::c_snprintf(
         buf, sizeof buf,

@@ -260,33 +260,37 @@ void summarize_pair(const StatsOptions& opt, const NoiseIbaSeries* noise, std::s
 
 }  // namespace
 
-StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                          std::ostream& log, const LaggedTemperatures* lag) {
-    const CorrectionConfig<double> ab_only{true, nullptr};
-    const CorrectionConfig<double> both{true, model};
-    StatsResult r;
-    r.thermal = model != nullptr && !opt.corrected_input;
-    r.corrected_input = opt.corrected_input;
-    EarthVelocity earth;
-    Diagnostics diag(log);
+namespace {
 
-    // Every pair of kMaxHeads while reading; those of the file's heads at the end.
-    constexpr PairList kAllPairs = pairs_of(kAllHeads);
+// One reading of the rows: each head's tally and each pair's series (every
+// pair of kMaxHeads, by position in kAllPairs).
+struct StatsPass {
     std::size_t rows_seen = 0;
+    std::size_t rows = 0;  // in [from, to]
+    std::size_t clean_rows = 0;
     HeadMask with_rows = 0U;
     std::array<HeadTally, kMaxHeads> heads{};
     std::array<std::size_t, kMaxPairs> both_present{};
     std::array<PairSeries, kMaxPairs> series;
-    // By position in kAllPairs; read before the rows, so that a bad file fails at once.
-    r.systematic = !opt.noise_iba.empty();
-    std::array<NoiseIbaSeries, kMaxPairs> noise;
-    if (r.systematic) {
-        noise = read_noise_iba(opt.noise_iba, kAllPairs);
-    }
-    EpochAssembler<Row> epochs(opt.in, [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, both_present, series); });
+    bool regroup = false;  // the epochs were grouped before every head was known (EpochAssembler)
+};
+
+constexpr PairList kAllPairs = pairs_of(kAllHeads);
+
+// The pass over the rows: epochs complete with the heads seen so far (none
+// given), or with `heads`.
+StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                    const LaggedTemperatures* lag, std::optional<HeadMask> heads, std::ostream& log) {
+    const CorrectionConfig<double> ab_only{true, nullptr};
+    const CorrectionConfig<double> both{true, model};
+    EarthVelocity earth;
+    Diagnostics diag(log);
+    StatsPass r;
+    const auto sink = [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, r.both_present, r.series); };
+    EpochAssembler<Row> epochs = heads ? EpochAssembler<Row>(opt.in, sink, *heads) : EpochAssembler<Row>(opt.in, sink);
     rows([&](const SolutionRecord& rec) {
-        ++rows_seen;
-        with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : HeadMask{0};
+        ++r.rows_seen;
+        r.with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : HeadMask{0};
         if (!within_time_range(opt, rec.t)) {
             return;
         }
@@ -294,7 +298,7 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
         if (rec.head >= kMaxHeads) {
             return;  // not in any pair (an unknown head: left to `correct` to report)
         }
-        HeadTally& tally = heads[rec.head];
+        HeadTally& tally = r.heads[rec.head];
         tally_row(rec, tally);
         Row row;
         row.clean = is_clean(rec);
@@ -317,6 +321,40 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     });
     epochs.finish();
     diag.summarize();
+    r.regroup = epochs.regroup();
+    return r;
+}
+
+}  // namespace
+
+StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
+                          std::ostream& log, const LaggedTemperatures* lag) {
+    StatsResult r;
+    r.thermal = model != nullptr && !opt.corrected_input;
+    r.corrected_input = opt.corrected_input;
+    // By position in kAllPairs; read before the rows, so that a bad file fails at once.
+    r.systematic = !opt.noise_iba.empty();
+    std::array<NoiseIbaSeries, kMaxPairs> noise;
+    if (r.systematic) {
+        noise = read_noise_iba(opt.noise_iba, kAllPairs);
+    }
+    // Rows out of time order that met an epoch already handed on: read again
+    // with the file's heads known, so that no row order loses an epoch (the
+    // first reading's diagnostics are dropped, the second's are the same).
+    std::ostringstream first_log;
+    StatsPass pass = read_pass(opt, rows, model, lag, std::nullopt, first_log);
+    if (pass.regroup) {
+        pass = read_pass(opt, rows, model, lag, pass.with_rows, log);
+    } else {
+        log << first_log.str();
+    }
+    const std::size_t rows_seen = pass.rows_seen;
+    const std::array<HeadTally, kMaxHeads>& heads = pass.heads;
+    const std::array<std::size_t, kMaxPairs>& both_present = pass.both_present;
+    std::array<PairSeries, kMaxPairs>& series = pass.series;
+    const HeadMask with_rows = pass.with_rows;
+    r.rows = pass.rows;
+    r.clean_rows = pass.clean_rows;
 
     r.heads = analysis_heads(with_rows);
     r.pairs = pairs_of(r.heads);

@@ -344,7 +344,7 @@ std::vector<std::int64_t> service_times(const std::string& path, const Solutions
 std::optional<LaggedTemperatures> lagged_temperatures(const std::string& path, const SolutionsReader& header,
                                                       std::size_t workers, const std::array<double, kMaxHeads>& lag_s,
                                                       bool thermal) {
-    if (!thermal || !any_lag(lag_s)) {
+    if (!thermal || !pipeline::any_lagged(lag_s)) {
         return std::nullopt;
     }
     std::vector<LagReading> readings = scan_rows<LagReading>(
@@ -523,9 +523,7 @@ void refuse_run_options(const CorrectOptions& opt) {
     if (opt.self_calibrate) {
         refuse_self_calibration_options(opt);
     } else if (opt.lag_s) {
-        throw std::runtime_error(
-            "--lag is the lag the self-calibration learns with: it needs --self-calibrate (a model's lag_s gives "
-            "correct its lag)");
+        throw std::runtime_error(std::string("--lag ") + kLagNeedsSelfCalibration);
     }
 }
 

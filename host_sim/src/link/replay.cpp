@@ -12,6 +12,7 @@
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
 #include "ascorr_host/formats/csv.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/link/link_client.hpp"
 #include "ascorr_host/link/link_transport.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
@@ -125,7 +126,7 @@ void check_calibration_options(const ReplayOptions& opt) {
             throw std::runtime_error("--orbit-period needs --self-calibrate");
         }
         if (opt.lag_s) {
-            throw std::runtime_error("--lag needs --self-calibrate (a model's lag_s gives the lag otherwise)");
+            throw std::runtime_error(std::string("--lag ") + kLagNeedsSelfCalibration);
         }
     }
     if (const std::string bad = bad_lag_text(opt.lag_s); !bad.empty()) {

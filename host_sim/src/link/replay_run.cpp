@@ -30,9 +30,7 @@ template <typename T>
 std::vector<SolutionRecord> lagged_as_sent(const std::vector<SolutionRecord>& rows,
                                            const std::array<double, kMaxHeads>& lag_s) {
     pipeline::HeadLags<T> lags;
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        (void)lags.configure(h, lag_s[h]);  // checked: the model's reader, --lag's parser
-    }
+    (void)lags.configure_all(lag_s);  // checked: the model's reader, --lag's parser
     std::vector<SolutionRecord> out = rows;
     for (const std::size_t k : time_order(rows)) {
         SolutionRecord& r = out[k];
@@ -97,9 +95,7 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
         const std::array<double, kMaxHeads> lag_s = mf ? head_lags(*mf) : std::array<double, kMaxHeads>{};
         client.upload_model(model_t, lag_s);
         host.pipeline.use_model(&model_t);
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            (void)host.lags.configure(h, lag_s[h]);  // the model's reader checked each τ
-        }
+        (void)host.lags.configure_all(lag_s);  // the model's reader checked each τ
         host.pipeline.use_lags(&host.lags);
         host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));
         return;
@@ -111,13 +107,11 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
     // host's estimator over the rows lagged as the target lags them, and the
     // reference's as `correct` lags (in double).
     const std::array<double, kMaxHeads> lag_s = run_lags(opt.lag_s, mf);
-    const std::vector<SolutionRecord> lagged = any_lag(lag_s) ? lagged_as_sent<T>(rows, lag_s) : rows;
+    const std::vector<SolutionRecord> lagged = pipeline::any_lagged(lag_s) ? lagged_as_sent<T>(rows, lag_s) : rows;
     host.sc = self_calibrate<T>(opt.in, rows_in(lagged), mf, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes,
                                 kMaxHeads, lag_s);
     host.schedule_d.emplace(host.sc->history);
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        (void)host.lags.configure(h, lag_s[h]);
-    }
+    (void)host.lags.configure_all(lag_s);
     host.pipeline.use_lags(&host.lags);
     host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));
     std::optional<ModelCoefficients> initial;

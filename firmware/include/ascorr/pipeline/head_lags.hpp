@@ -27,6 +27,17 @@
 
 namespace ascorr::pipeline {
 
+// Whether any of kMaxHeads τ (tau_s[h] for head h, 0 for none) lags a head:
+// the one test of "a head lags" for a model, CALIB_START and the host.
+template <typename Taus>
+constexpr bool any_lagged(const Taus& tau_s) noexcept {
+    bool any = false;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        any = any || tau_s[h] != 0.0;
+    }
+    return any;
+}
+
 template <typename T>
 class HeadLags {
 public:
@@ -46,6 +57,17 @@ public:
         }
         on_[h] = true;
         return true;
+    }
+
+    // Every head's τ at once (tau_s[h] for head h, as configure()); false
+    // when one is refused (that head unchanged, the others configured).
+    template <typename Taus>
+    bool configure_all(const Taus& tau_s) noexcept {
+        bool ok = true;
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            ok = configure(h, tau_s[h]) && ok;
+        }
+        return ok;
     }
 
     bool lags(std::uint8_t h) const noexcept { return h < kMaxHeads && on_[h]; }

@@ -10,8 +10,11 @@
 //  - or the heads the file has shown so far (stats, plot: they do not know
 //    the file's heads beforehand): the epoch is handed on once it holds every
 //    head seen so far and a row of a later epoch has been read (in a file in
-//    time order, when the next epoch begins). A head whose first row comes
-//    after an epoch was handed on is missing from that epoch.
+//    time order, when the next epoch begins). A row that goes back in time
+//    to or before an epoch handed on may belong to it (in a file out of
+//    time order, a head whose first row comes late would be missing from
+//    epochs handed on without it): regroup() then says to read the rows
+//    again with heads() given, which groups them exactly in any order.
 // The incomplete ones are handed on at the end. A second row of the same head
 // at the same epoch is an input error.
 #pragma once
@@ -76,6 +79,7 @@ public:
             return;  // no millisecond key: in no epoch (iba.hpp)
         }
         const std::int64_t key = epoch_key(t);
+        regroup_ = regroup_ || (open_ && handed_any_ && key <= handed_max_ && pending_.count(key) == 0U);
         Entry& e = pending_[key];
         if (e.epoch.head[head]) {
             throw second_solution(file_, line, head, t, e.epoch.line[head]);
@@ -129,6 +133,10 @@ public:
 
     // The heads of the rows added so far (open), or the set given.
     HeadMask heads() const noexcept { return complete_; }
+    // Open: whether a row came at or before the time of an epoch already
+    // handed on (not pending), to which it may have belonged; the caller
+    // reads the rows again with heads() given.
+    bool regroup() const noexcept { return regroup_; }
 
 private:
     struct Entry {
@@ -138,6 +146,8 @@ private:
 
     void hand_on(std::int64_t key) {
         held_.erase(key);
+        handed_max_ = handed_any_ ? std::max(handed_max_, key) : key;
+        handed_any_ = true;
         const auto it = pending_.find(key);
         sink_(it->second.epoch);
         pending_.erase(it);
@@ -151,6 +161,9 @@ private:
     std::set<std::int64_t> held_;  // open: complete, waiting for a later epoch
     std::int64_t last_key_ = 0;
     bool any_key_ = false;
+    std::int64_t handed_max_ = 0;  // open: the latest epoch handed on (handed_any_)
+    bool handed_any_ = false;
+    bool regroup_ = false;
 };
 
 }  // namespace ascorr::host

@@ -21,6 +21,7 @@
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/model_coefficients.hpp"
 #include "ascorr/core/thermal.hpp"
+#include "ascorr/pipeline/head_lags.hpp"
 
 namespace ascorr::host {
 
@@ -75,15 +76,8 @@ struct ModelFile {
     std::array<std::array<std::array<std::size_t, kModelTerms>, kModelAxes>, kMaxHeads> column{};
 };
 
-// Whether any head's terms take lagged temperatures (lag_s not 0).
-inline bool has_lag(const ModelFile& m) noexcept {
-    bool any = false;
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        any = any || (m.present[h] && m.lag_s[h] != 0.0);  // a head without coefficients lags nothing
-    }
-    return any;
-}
-// The lag of each head the model has (0 for the others), by head index.
+// The lag of each head the model has (0 for the others: a head without
+// coefficients lags nothing), by head index.
 inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
     std::array<double, kMaxHeads> lag{};
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
@@ -91,13 +85,9 @@ inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
     }
     return lag;
 }
-// Whether any head of lag_s (by head index) lags.
-inline bool any_lag(const std::array<double, kMaxHeads>& lag_s) noexcept {
-    bool any = false;
-    for (const double x : lag_s) {
-        any = any || x != 0.0;
-    }
-    return any;
+// Whether any head's terms take lagged temperatures.
+inline bool has_lag(const ModelFile& m) noexcept {
+    return pipeline::any_lagged(head_lags(m));
 }
 // The heads' lags of a run (correct, replay): `given` (--lag), otherwise the
 // model's (head_lags), otherwise none.
@@ -114,6 +104,10 @@ inline std::array<double, kMaxHeads> run_lags(const std::optional<std::array<dou
 std::string bad_lag_text(const std::optional<std::array<double, kMaxHeads>>& lag_s);
 // Whether lag_s is 0 or a time constant the lag accepts (pipeline::TemperatureLag::configure).
 bool lag_acceptable(double lag_s) noexcept;
+// Why --lag (the lag the self-calibration learns with) is refused without
+// --self-calibrate, after "--lag" or "--lag: ".
+inline constexpr const char* kLagNeedsSelfCalibration =
+    "needs --self-calibrate (a model's lag_s gives the lag otherwise)";
 // "0 (no lag) or [1, 86400] s", for messages.
 std::string lag_range_text();
 // Throws (naming the model's file, then `why`) when the model's terms take
