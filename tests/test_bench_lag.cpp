@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include "ascorr/nav/tt_time.hpp"
 #include "ascorr_host/analysis/fit.hpp"
 #include "ascorr_host/analysis/stats.hpp"
+#include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "cli_run.hpp"
@@ -564,6 +566,21 @@ TEST(SelfCalibrationLag, StartsFromALaggedModelAndRefusesAnotherLag) {
     };
     for (const auto& [args, part] : refused) {
         expect_refused(run_in(args + " > out.txt", dir), 2, {part});
+    }
+    // A library caller's τ out of range with a lagged model: the range is
+    // named, as by the parser, not another τ than the model's.
+    host::CorrectOptions o;
+    o.in = (dir / "m.csv").string();
+    o.out = (dir / "x.csv").string();
+    o.model = (dir / "sc_model.csv").string();
+    o.self_calibrate = true;
+    o.lag_s = std::array<double, kMaxHeads>{0.5, 1800.0, 1800.0, 0.0};
+    std::ostringstream log;
+    try {
+        (void)host::correct_file(o, log);
+        ADD_FAILURE() << "a lag of 0.5 s was taken";
+    } catch (const std::runtime_error& e) {
+        EXPECT_TRUE(has(e.what(), "--lag: head A's 0.5 is not 0 (no lag) or [1, 86400] s")) << e.what();
     }
     expect_absent(dir, {"x.csv", "x.csv.history.csv"});
 }

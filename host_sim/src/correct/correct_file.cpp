@@ -531,9 +531,9 @@ template <typename T>
 CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
+    refuse_run_options(opt);  // before the model: a --lag out of range is named as such, not as another τ
     std::optional<ModelFile> model_file;
     std::optional<ThermalModel<T>> model = read_model<T>(opt, model_file);
-    refuse_run_options(opt);
 
     BlockReader blocks(opt.in);
     std::string_view block;
