@@ -109,5 +109,36 @@ TEST(RowOrder, StatsGivesTheSameEpochsForAShuffledCopy) {
     }
 }
 
+// A second row of a head in an epoch is an input error wherever it comes: at
+// the end of a file in time order, or anywhere in a shuffled one (before,
+// one that came after its epoch was handed on was taken silently).
+TEST(RowOrder, ASecondRowOfAHeadIsRefusedWhereverItComes) {
+    const fs::path dir = scratch_dir("order_second");
+    const fs::path sim = dir / "sim.csv";
+    ASSERT_EQ(run("simulate --days 1 --seed 1 --out " + sim.string()), 0);
+    const std::vector<std::string> lines = lines_of_file(sim);
+    ASSERT_GT(lines.size(), 100U);
+    // Line 12 again, last: a row of an epoch of every head (t = 456149100,
+    // lines 12 to 14), which is handed on before the second comes.
+    std::ofstream(dir / "late.csv") << slurp(sim) << lines[11] << '\n';
+    shuffle_rows(dir / "late.csv", dir / "late_shuffled.csv", 3U);
+    const std::string fit_opts = " --out " + (dir / "m.csv").string() + " --min-days 0.5 --min-orbits 5 --lag 0";
+    for (const char* file : {"late.csv", "late_shuffled.csv"}) {
+        const std::string in = (dir / file).string();
+        for (const std::string& args : {"stats --in " + in, "fit --in " + in + fit_opts}) {
+            const CliRun r = run_shell(std::string(ASCORR_EXE) + " " + args + " > /dev/null", dir);
+            EXPECT_EQ(r.exit_code, 1) << args;
+            EXPECT_TRUE(has(r.err, "second solution of CHU ")) << args << ": " << r.err;
+        }
+    }
+    // The line of the second row and of the first are named (in time order:
+    // the last line and line 12).
+    const CliRun r =
+        run_shell(std::string(ASCORR_EXE) + " stats --in " + (dir / "late.csv").string() + " > /dev/null", dir);
+    EXPECT_TRUE(has(r.err, "late.csv:" + std::to_string(lines.size() + 1) + ":1: second solution of CHU")) << r.err;
+    EXPECT_TRUE(has(r.err, "at t = 456149100.000 (the first is on line 12)")) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "m.csv"));
+}
+
 }  // namespace
 }  // namespace ascorr::test

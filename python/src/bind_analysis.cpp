@@ -47,7 +47,9 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
     // Every pair of kMaxHeads while reading; those of the rows' heads at the end (as stats()).
     constexpr host::PairList kAllPairs = host::pairs_of(host::kAllHeads);
     // The rows' heads first, so that the epochs group alike in any row order
-    // (an epoch is complete with every head the rows have).
+    // (an epoch is complete with every head the rows have), and the epochs
+    // handed on kept: a second row of a head in one is refused wherever it
+    // comes (the arrays are in memory anyway).
     const HeadMask with_rows = heads_of(r);
     std::array<std::vector<double>, host::kMaxPairs> pt;
     std::array<std::vector<double>, host::kMaxPairs> pv;
@@ -69,7 +71,7 @@ py::dict iba(const py::object& t, const py::object& chu, const py::object& q) {
             }
         }
     };
-    host::EpochAssembler<Boresight> epochs(kArrayRows, pairs_of_epoch, with_rows);
+    host::EpochAssembler<Boresight> epochs(kArrayRows, pairs_of_epoch, with_rows, host::Handed::kRemember);
     std::ostringstream log;
     host::Diagnostics diag(log);
     for (py::ssize_t i = 0; i < r.n; ++i) {

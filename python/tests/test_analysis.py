@@ -191,6 +191,13 @@ def test_iba_duplicate_epoch_is_an_input_error(mission):
     chu[1] = chu[0]  # two rows of one head at the first epoch
     with pytest.raises(ascorr.InputError, match="second solution of CHU A"):
         ascorr.iba(d["t"], chu, d["q"])
+    # A row of the first epoch of every head again, last: refused as well
+    # (its epoch was complete, and handed on, long before).
+    t = d["t"]
+    values, counts = np.unique(t, return_counts=True)
+    k = np.flatnonzero(t == values[counts == 3][0])[0]
+    with pytest.raises(ascorr.InputError, match=f"second solution of CHU {d['chu'][k]}.*first is on line {k + 1}"):
+        ascorr.iba(np.append(t, t[k]), np.append(d["chu"], d["chu"][k]), np.vstack([d["q"], d["q"][k]]))
 
 
 def test_earth_velocity_against_pyerfa():

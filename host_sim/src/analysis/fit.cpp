@@ -65,7 +65,8 @@ std::string time_text(double t) {
 
 namespace {
 FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads,
-                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search);
+                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search,
+                   Handed handed = Handed::kForget);
 
 // The heads a reading assumes: the given ones, else the analysis's with the
 // heads seen with rows so far.
@@ -609,8 +610,11 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
 // (earliest_period: that second reading.) Likewise the heads, unless
 // --heads names them: a reading assumes them (A, B, C and F's first); when
 // the period holds rows of others, the rows are read again with those too.
+// And a row that came back to an epoch already handed on (a second row of
+// its head there, unless the file is out of time order): again, keeping the
+// epochs handed on (EpochAssembler::late).
 FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<double> earliest_period, HeadMask heads,
-                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search) {
+                   const LaggedTemperatures* lag, const std::vector<LagReading>* lag_search, Handed handed) {
     EarthVelocity earth;
     Pass p;
     p.lag_search = lag_search;
@@ -619,7 +623,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     p.period_given = opt.orbit_period_s.has_value() || earliest_period.has_value();
     p.period = earliest_period ? earliest_period : opt.orbit_period_s;
     EpochAssembler<Row> epochs(
-        opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt); }, heads);
+        opt.in, [&](const Epoch<Row>& e) { add_epoch(p, e, opt); }, heads, handed);
     SolutionRecord lagged;
     rows([&](const SolutionRecord& rec) {
         if (lag == nullptr) {
@@ -632,7 +636,10 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     });
     epochs.finish();
     if (!opt.heads && (p.with_rows & ~heads) != 0U) {
-        return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows), lag, lag_search);
+        return fit_pass(opt, rows, earliest_period, fit_heads(opt, p.with_rows), lag, lag_search, handed);
+    }
+    if (epochs.late() && handed == Handed::kForget) {
+        return fit_pass(opt, rows, earliest_period, heads, lag, lag_search, Handed::kRemember);
     }
     if (!p.period_given && p.any_row && !(p.earliest_row_speed > 1.0 && p.earliest_row_speed < 12.0)) {
         throw text::InputError(opt.in, p.earliest_row_line, 1,
@@ -641,7 +648,7 @@ FitReport fit_pass(const FitOptions& opt, const RowSource& rows, std::optional<d
     }
     if (!p.period_given && p.period && *p.period != p.earliest_row_period) {
         // Rows out of time order: again, with the earliest row's period.
-        return fit_pass(opt, rows, p.earliest_row_period, heads, lag, lag_search);
+        return fit_pass(opt, rows, p.earliest_row_period, heads, lag, lag_search, handed);
     }
     p.r.orbit_period_s = p.period.value_or(0.0);
     rebase_on_earliest_epoch(p);

@@ -272,13 +272,13 @@ struct StatsPass {
     std::array<HeadTally, kMaxHeads> heads{};
     std::array<std::size_t, kMaxPairs> both_present{};
     std::array<PairSeries, kMaxPairs> series;
-    bool regroup = false;  // the epochs were grouped before every head was known (EpochAssembler)
+    bool late = false;  // a row came back to an epoch already handed on (EpochAssembler::late)
 };
 
 constexpr PairList kAllPairs = pairs_of(kAllHeads);
 
 // The pass over the rows: epochs complete with the heads seen so far (none
-// given), or with `heads`.
+// given), or with `heads`, keeping those handed on.
 StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
                     const LaggedTemperatures* lag, std::optional<HeadMask> heads, std::ostream& log) {
     const CorrectionConfig<double> ab_only{true, nullptr};
@@ -287,7 +287,8 @@ StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const Therma
     Diagnostics diag(log);
     StatsPass r;
     const auto sink = [&](const Epoch<Row>& e) { add_epoch(e, kAllPairs, r.both_present, r.series); };
-    EpochAssembler<Row> epochs = heads ? EpochAssembler<Row>(opt.in, sink, *heads) : EpochAssembler<Row>(opt.in, sink);
+    EpochAssembler<Row> epochs =
+        heads ? EpochAssembler<Row>(opt.in, sink, *heads, Handed::kRemember) : EpochAssembler<Row>(opt.in, sink);
     rows([&](const SolutionRecord& rec) {
         ++r.rows_seen;
         r.with_rows |= rec.head < kMaxHeads ? head_bit(rec.head) : HeadMask{0};
@@ -321,7 +322,7 @@ StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const Therma
     });
     epochs.finish();
     diag.summarize();
-    r.regroup = epochs.regroup();
+    r.late = epochs.late();
     return r;
 }
 
@@ -338,12 +339,13 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     if (r.systematic) {
         noise = read_noise_iba(opt.noise_iba, kAllPairs);
     }
-    // Rows out of time order that met an epoch already handed on: read again
-    // with the file's heads known, so that no row order loses an epoch (the
-    // first reading's diagnostics are dropped, the second's are the same).
+    // Rows out of time order that came back to an epoch already handed on:
+    // read again with the file's heads known, so that no row order loses an
+    // epoch or hides a second row of a head in one (the first reading's
+    // diagnostics are dropped, the second's are the same).
     std::ostringstream first_log;
     StatsPass pass = read_pass(opt, rows, model, lag, std::nullopt, first_log);
-    if (pass.regroup) {
+    if (pass.late) {
         pass = read_pass(opt, rows, model, lag, pass.with_rows, log);
     } else {
         log << first_log.str();

@@ -10,13 +10,17 @@
 //  - or the heads the file has shown so far (stats, plot: they do not know
 //    the file's heads beforehand): the epoch is handed on once it holds every
 //    head seen so far and a row of a later epoch has been read (in a file in
-//    time order, when the next epoch begins). A row that goes back in time
-//    to or before an epoch handed on may belong to it (in a file out of
-//    time order, a head whose first row comes late would be missing from
-//    epochs handed on without it): regroup() then says to read the rows
-//    again with heads() given, which groups them exactly in any order.
+//    time order, when the next epoch begins).
 // The incomplete ones are handed on at the end. A second row of the same head
 // at the same epoch is an input error.
+// A row that goes back in time to or before an epoch already handed on may
+// belong to it: a head whose first row comes late would be missing from
+// epochs handed on without it (open), or the row is a second one of its head
+// there, which nothing pending shows. late() then says to read the rows again
+// with heads() given and Handed::kRemember: the epochs handed on are kept
+// (their keys and lines), so that the rows group exactly in any order and a
+// second row is refused wherever it comes. A file in time order is read once
+// and keeps nothing handed on.
 #pragma once
 
 #include <algorithm>
@@ -63,13 +67,20 @@ inline text::InputError second_solution(const std::string& file, std::size_t lin
                                 " (the first is on line " + std::to_string(first_line) + ")");
 }
 
+// Whether an assembler keeps the epochs it handed on (late(), above).
+enum class Handed : bool { kForget, kRemember };
+
 template <typename Payload>
 class EpochAssembler {
 public:
     using Sink = std::function<void(const Epoch<Payload>&)>;
     // Complete with the heads of `complete`.
-    EpochAssembler(std::string file, Sink sink, HeadMask complete)
-        : file_(std::move(file)), sink_(std::move(sink)), complete_(complete), open_(false) {}
+    EpochAssembler(std::string file, Sink sink, HeadMask complete, Handed handed = Handed::kForget)
+        : file_(std::move(file)),
+          sink_(std::move(sink)),
+          complete_(complete),
+          open_(false),
+          remember_(handed == Handed::kRemember) {}
     // Complete with the heads seen so far.
     EpochAssembler(std::string file, Sink sink) : file_(std::move(file)), sink_(std::move(sink)), open_(true) {}
 
@@ -79,7 +90,10 @@ public:
             return;  // no millisecond key: in no epoch (iba.hpp)
         }
         const std::int64_t key = epoch_key(t);
-        regroup_ = regroup_ || (open_ && handed_any_ && key <= handed_max_ && pending_.count(key) == 0U);
+        if (handed_any_ && key <= handed_max_ && pending_.count(key) == 0U) {
+            late_ = true;
+            refuse_second_in_handed(key, t, head, line);
+        }
         Entry& e = pending_[key];
         if (e.epoch.head[head]) {
             throw second_solution(file_, line, head, t, e.epoch.line[head]);
@@ -92,8 +106,7 @@ public:
         e.heads |= head_bit(head);
         if (!open_) {
             if ((e.heads & complete_) == complete_) {
-                sink_(e.epoch);
-                pending_.erase(key);
+                hand_on(key);
             }
             return;
         }
@@ -133,10 +146,10 @@ public:
 
     // The heads of the rows added so far (open), or the set given.
     HeadMask heads() const noexcept { return complete_; }
-    // Open: whether a row came at or before the time of an epoch already
-    // handed on (not pending), to which it may have belonged; the caller
-    // reads the rows again with heads() given.
-    bool regroup() const noexcept { return regroup_; }
+    // Whether a row came at or before the time of an epoch already handed on
+    // (and not pending), to which it may belong: read the rows again with
+    // heads() given and Handed::kRemember (above).
+    bool late() const noexcept { return late_; }
 
 private:
     struct Entry {
@@ -150,7 +163,18 @@ private:
         handed_any_ = true;
         const auto it = pending_.find(key);
         sink_(it->second.epoch);
+        if (remember_) {
+            handed_.emplace(key, it->second.epoch.line);
+        }
         pending_.erase(it);
+    }
+
+    // A row of a head that an epoch kept as handed on has (Handed::kRemember).
+    void refuse_second_in_handed(std::int64_t key, double t, std::uint8_t head, std::size_t line) const {
+        const auto it = handed_.find(key);
+        if (it != handed_.end() && it->second[head] != 0U) {
+            throw second_solution(file_, line, head, t, it->second[head]);
+        }
     }
 
     std::string file_;
@@ -161,9 +185,11 @@ private:
     std::set<std::int64_t> held_;  // open: complete, waiting for a later epoch
     std::int64_t last_key_ = 0;
     bool any_key_ = false;
-    std::int64_t handed_max_ = 0;  // open: the latest epoch handed on (handed_any_)
+    bool remember_ = false;
+    std::unordered_map<std::int64_t, std::array<std::size_t, kMaxHeads>> handed_;  // remember_: lines by key
+    std::int64_t handed_max_ = 0;                                                  // the latest handed on (handed_any_)
     bool handed_any_ = false;
-    bool regroup_ = false;
+    bool late_ = false;
 };
 
 }  // namespace ascorr::host
