@@ -557,9 +557,13 @@ TEST(AlignCli, RefusesBadInputWithExit2NamingFileAndLine) {
          "dup.csv:3:1: second solution of CHU A"},
         // A window whose index of an epoch would not fit an integer (was: an
         // out-of-range cast before the refusal), and one beyond the range.
+        // Usage errors, before any input is read (was, below 0.01: after the
+        // mountings, without "Run with --help").
         {in + " --mountings " + (dir / "truth.csv").string() + " --noise-window 1e-300",
-         "--noise-window 1e-300: expected 0 (one mean over the period) or a window in [0.01, 1e+10] s"},
+         "--noise-window: 1e-300 is out of range: the range is 0 or [0.01, 1e+10]"},
         {in + " --mountings " + (dir / "truth.csv").string() + " --noise-window 1e300", "--noise-window"},
+        {in + " --mountings " + (dir / "absent.csv").string() + " --noise-window 0.005",
+         "--noise-window: 0.005 is out of range: the range is 0 or [0.01, 1e+10]"},
     };
     for (const Case& c : cases) {
         const test::CliRun r = test::run_here("align" + c.args, dir);

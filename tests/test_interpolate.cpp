@@ -183,6 +183,32 @@ TEST(Interpolate, BeyondTheGapOrTheFileStatusEightAndTheLastEpochItself) {
     EXPECT_TRUE(wide[0].has_q);
 }
 
+// A time exactly --max-gap from both neighbours is within it, whatever the
+// times' binary rounding (456148800.1 − 456148800.0 computes as
+// 0.10000002384; before, 1400 of 4000 such times at a mission's t got 8, a
+// review found); a microsecond more is not.
+TEST(Interpolate, ExactlyTheGapAwayIsWithinIt) {
+    const fs::path dir = test::scratch_dir("interpolate_exact_gap");
+    std::ofstream(dir / "a.csv") << "t,qw,qx,qy,qz,heads,sigma_x,sigma_y,sigma_z,status\n"
+                                    "456148800,1,0,0,0,AB,1,1,1,1\n"
+                                    "456148800.2,1,0,0,0,AB,1,1,1,1\n"
+                                    "456148800.4,1,0,0,0,AB,1,1,1,1\n"
+                                    "456148800.7,1,0,0,0,AB,1,1,1,1\n"
+                                    "456148800.9,1,0,0,0,AB,1,1,1,1\n";
+    std::ofstream(dir / "t.csv") << "t\n456148800.1\n456148800.3\n456148800.8\n456148800.55\n";
+    for (const auto& [gap, within] : {std::pair<const char*, bool>{"0.1", true}, {"0.099999", false}}) {
+        ASSERT_EQ(
+            run_in(std::string("interpolate --in a.csv --at t.csv --out out.csv --max-gap ") + gap, dir).exit_code, 0);
+        const std::vector<host::AttitudeRow> r = read_rows(dir / "out.csv");
+        ASSERT_EQ(r.size(), 4U);
+        for (std::size_t i = 0; i < 3; ++i) {
+            EXPECT_EQ(r[i].has_q, within) << gap << " row " << i;
+            EXPECT_EQ(r[i].status, within ? 1U : 8U) << gap << " row " << i;
+        }
+        EXPECT_FALSE(r[3].has_q) << gap;  // 0.15 s from both: beyond either gap
+    }
+}
+
 TEST(Interpolate, BadInputNamesFileLineAndColumnAndWritesNothing) {
     const fs::path dir = test::scratch_dir("interpolate_bad");
     std::ofstream(dir / "a.csv") << kEpochs;

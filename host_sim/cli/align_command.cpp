@@ -30,7 +30,7 @@ void add_align_command(CLI::App& app) {
                     "window (s) of the slowly varying mean the noise is measured about, 0: one mean over the period "
                     "(default " +
                         std::to_string(static_cast<int>(host::kDefaultNoiseWindowS)) + ")")
-        ->check(real_in(0.0, host::kMaxNoiseWindowS));
+        ->check(zero_or_in(host::kMinNoiseWindowS, host::kMaxNoiseWindowS));
     cmd->add_option(
            "--min-epochs", opt->min_epochs,
            "fewest epochs with two or more usable heads (default " + std::to_string(host::kMinAlignEpochs) + ")")

@@ -181,4 +181,25 @@ inline CLI::Validator real_in(double lo, double hi, End lo_end = End::kClosed, E
         "NUMBER");
 }
 
+// A real option that is 0 (an option's "none") or within [lo, hi], lo > 0:
+// as real_in(), the range written "0 or [lo, hi]".
+inline CLI::Validator zero_or_in(double lo, double hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& s) {
+            std::string why = real_number()(s);
+            if (!why.empty()) {
+                return why;
+            }
+            double x = 0.0;
+            detail::classify_real(s, x);
+            if (x == 0.0 || (x >= lo && x <= hi)) {  // NaN is neither
+                return std::string();
+            }
+            char range[80];
+            text::c_snprintf(range, sizeof range, "0 or [%g, %g]", lo, hi);
+            return s + " is out of range: the range is " + range;
+        },
+        "NUMBER");
+}
+
 }  // namespace ascorr::cli

@@ -30,6 +30,15 @@ AttitudeRow no_attitude(double t) {
     return r;
 }
 
+// Whether the later time t1 is more than s seconds after t0. The times are
+// decimals read into doubles, each within half an ulp of its text, and their
+// difference is exact (Sterbenz), so a distance of exactly s computes as up
+// to one ulp(max |t|) ≤ max |t|·2⁻⁵² more (456148800.1 − 456148800.0 =
+// 0.10000002384): that much, and s's own rounding, is not "more than s".
+bool farther_than(double t1, double t0, double s) noexcept {
+    return (t1 - t0) - s > std::max(std::abs(t1), std::abs(t0)) * 0x1p-51;
+}
+
 // The mean rate from a to b (arcsec/s, a's CRF axes).
 Vector3<double> mean_rate(const AttitudeRow& a, const AttitudeRow& b) noexcept {
     const Vector3<double> th = rotation_vector_arcsec(b.q_crf_icrf, a.q_crf_icrf);
@@ -132,10 +141,10 @@ struct Interpolator::Impl {
             const Vector3<double> d{w2.x - w.x, w2.y - w.y, w2.z - w.z};
             alpha = std::max(alpha, std::sqrt(squared_norm(d)) / span);
         };
-        if (before != nullptr && a.t - before->t <= 2.0 * max_gap) {
+        if (before != nullptr && !farther_than(a.t, before->t, 2.0 * max_gap)) {
             change(mean_rate(*before, a), 0.5 * (b.t - before->t));
         }
-        if (after != nullptr && after->t - b.t <= 2.0 * max_gap) {
+        if (after != nullptr && !farther_than(after->t, b.t, 2.0 * max_gap)) {
             change(mean_rate(b, *after), 0.5 * (after->t - a.t));
         }
         return alpha;
@@ -146,7 +155,7 @@ struct Interpolator::Impl {
             ++sum.exact;
             return a;
         }
-        if (t - a.t > max_gap || b.t - t > max_gap) {
+        if (farther_than(t, a.t, max_gap) || farther_than(b.t, t, max_gap)) {
             ++sum.gap;
             return no_attitude(t);
         }

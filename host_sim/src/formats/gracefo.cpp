@@ -387,6 +387,7 @@ MountingsFile import_gracefo(const GracefoOptions& opt, const GracefoSink& sink,
             v.chu = std::string_view(&kHeadLetters[s.head], 1);
             v.q_chu_icrf = conjugate(s.q_icrf_chu);
             v.temperature = {std::nan(""), std::nan(""), std::nan("")};
+            v.no_temperatures = true;  // written empty (docs/contract.md, "Real flight data")
             v.v_sc_kms = {std::nan(""), std::nan(""), std::nan("")};
             v.flags = flags_of(s);
             v.confidence = std::nan("");  // no misfit in arcsec: sca_confid is a code (kGracefoColumns)

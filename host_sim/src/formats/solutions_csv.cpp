@@ -340,7 +340,9 @@ void append_solution_fields(std::string& out, const SolutionValues& row) {
     }
     for (const double c : row.temperature) {
         out += ',';
-        append_number(out, c);
+        if (!row.no_temperatures) {
+            append_number(out, c);
+        }
     }
     for (const double c : row.v_sc_kms) {
         out += ',';

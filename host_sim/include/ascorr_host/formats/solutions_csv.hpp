@@ -154,6 +154,7 @@ struct SolutionValues {
     std::string_view chu;  // written as given: one plain CSV field
     Quaternion<double> q_chu_icrf{};
     std::array<double, 3> temperature{};  // t_chu, t_029, t_032
+    bool no_temperatures = false;         // a source without thermistors: empty fields, as velocities
     std::array<double, 3> v_sc_kms{};     // vx, vy, vz
     long long flags = 0;
     double confidence = 0.0;  // arcsec
@@ -162,8 +163,9 @@ struct SolutionValues {
 // Appends the row's fields in kSolutionsColumns' order, without a line end
 // (a caller appends its extra columns, a status and '\n'). Numbers are written
 // with the fewest digits that read back exactly (std::to_chars); NaN
-// temperatures as "nan", NaN velocities and confidence as empty fields, as the
-// contract writes "not available"; NaN time or quaternion components as "nan".
+// temperatures as "nan" (empty with no_temperatures), NaN velocities and
+// confidence as empty fields, as the contract writes "not available"; NaN time
+// or quaternion components as "nan".
 void append_solution_fields(std::string& out, const SolutionValues& row);
 
 }  // namespace ascorr::host
