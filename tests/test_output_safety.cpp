@@ -273,6 +273,18 @@ TEST(OutputSafety, ACorrectedFileFedBackIsRefused) {
         expect_refused(run_in(c, dir), 1, {"once.csv:1:", "column 'status': this file is already corrected"});
         expect_absent(dir, {"twice.csv", "m.csv"});
     }
+    // The column named is the header's character column of `status`, its
+    // quoted names counted as written (was: unquoted, 2 short per quoted name).
+    const std::vector<std::string> once = lines_of_file(dir / "once.csv");
+    const std::string header = "\"my \"\"note\"\"\"," + once.at(0);
+    std::ofstream quoted(dir / "quoted.csv");
+    quoted << header << '\n';
+    for (std::size_t i = 1; i < once.size(); ++i) {
+        quoted << "x," << once[i] << '\n';
+    }
+    quoted.close();
+    const std::string at = "quoted.csv:1:" + std::to_string(header.find(",status") + 2) + ": column 'status'";
+    expect_refused(run_in("correct --in quoted.csv --out twice.csv", dir), 1, {at});
 }
 
 // Issue 30 item 3: the temporary output was OUT.tmp-PID, opened with O_TRUNC

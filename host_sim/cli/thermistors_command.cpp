@@ -66,8 +66,8 @@ std::string fault_list(hal::FaultBits f) {
 void print_row(std::FILE* out, std::uint64_t t_us, const char* name, const char* role, long counts, double ohm,
                double celsius, hal::FaultBits faults) {
     char c[32] = "";
-    char o[32] = "";
-    char t[32] = "";
+    char o[400] = "";
+    char t[400] = "";  // %.3f of any finite double: at most 309 digits before the point
     if (counts >= 0) {
         text::c_snprintf(c, sizeof c, "%ld", counts);
     }

@@ -142,6 +142,17 @@ TEST(HalSimulated, NaNAndNegativeInjectedValuesAreRefused) {
         EXPECT_STREQ(e.what(), "h.csv:3:3: not a temperature: 'inf' (a finite number, or empty or nan for none)");
     }
     EXPECT_EQ(hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,3,4\n2,nan,,4\n").size(), 2U);
+    // Not above absolute zero: no resistance (was: simulated as a short).
+    for (const char* cold : {"-300", "-273.15", "-1e30"}) {
+        try {
+            hal::parse_history("h.csv", std::string("t,t_chu,t_029,t_032\n1,2,3,4\n2,3,") + cold + ",4\n");
+            ADD_FAILURE() << cold;
+        } catch (const text::InputError& e) {
+            EXPECT_EQ(std::string(e.what()), std::string("h.csv:3:5: not a temperature: '") + cold +
+                                                 "' is not above absolute zero (-273.15 degC): no thermistor reads it");
+        }
+    }
+    EXPECT_EQ(hal::parse_history("h.csv", "t,t_chu,t_029,t_032\n1,2,-273.14,4\n").size(), 1U);
 }
 
 TEST(HalReplay, ErrorsNameLineAndColumn) {
@@ -327,14 +338,14 @@ TEST(HalCli, ThermistorsSimulatesASolutionsFileWithAFault) {
 // A history of three heads at one epoch per second, rows interleaved by head,
 // every temperature warming at 0.5 °C/min (10 min, about 5 °C: some 200
 // counts), with `step_b` °C added to head B's T_CHU from epoch 300 on.
-void write_interleaved_history(const fs::path& path, double step_b) {
+void write_interleaved_history(const fs::path& path, double step_b, double rate_per_min = 0.5) {
     std::ofstream f(path);
     f << "t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz,flags,confidence\n";
     const char heads[3] = {'A', 'B', 'C'};
     const double base[3] = {10.0, 12.0, 8.0};
     char buf[160];
     for (int k = 0; k < 600; ++k) {
-        const double warm = 0.5 / 60.0 * k;
+        const double warm = rate_per_min / 60.0 * k;
         for (int h = 0; h < 3; ++h) {
             const double chu = base[h] + warm + (h == 1 && k >= 300 ? step_b : 0.0);
             std::snprintf(buf, sizeof buf, "%d,%c,1,0,0,0,%.4f,%.4f,%.4f,,,,0,1.00\n", 1000 + k, heads[h], chu,
@@ -382,6 +393,48 @@ TEST(HalCli, ASlowHistoryWithHeadsInterleavedRaisesNoRateFault) {
     ASSERT_EQ(rate.size(), 1U) << s.out.substr(0, 2000);
     EXPECT_EQ(rate[0].substr(0, 24), "1300.000000,CHU_B,chu_b,") << rate[0];
     EXPECT_NE(rate[0].find(",17.50"), std::string::npos) << rate[0];  // 12 + 300 · 0.5/60 + 3 °C
+}
+
+// A steady bench (every temperature constant for 10 min at 1 Hz) raises no
+// stuck fault with board.cfg's stuck_frames=60: the simulated converter's
+// conversions differ by an LSB as a real one's do (before, noise-free, every
+// steady channel was stuck after 60 frames and its vote withheld; a review
+// found it).
+TEST(HalCli, ASteadyBenchIsNotStuck) {
+    const fs::path dir = scratch_dir("hal-cli");
+    write_interleaved_history(dir / "steady.csv", 0.0, 0.0);
+    const CliRun r = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "steady.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(lines_with(r.out, "stuck").size(), 0U) << lines_with(r.out, "stuck").front();
+    EXPECT_NE(r.err.find("600 frames, 0 voted values withheld"), std::string::npos) << r.err;
+    // The readings are the converter's counts of the truth: the median of the
+    // dithered conversions (12 °C on CHU_B throughout).
+    const std::vector<std::string> b = lines_with(r.out, ",CHU_B,");
+    ASSERT_EQ(b.size(), 600U);
+    EXPECT_EQ(b.front().substr(b.front().find(",chu_b,")), b.back().substr(b.back().find(",chu_b,")));
+    // Not vacuous: an injected stuck fault is still found.
+    const CliRun s = run("--config " + kExamples + "/board.cfg --simulate " + (dir / "steady.csv").string() +
+                             " --inject CHU_B:stuck:1100:1300",
+                         dir);
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_FALSE(lines_with(s.out, ",CHU_B,chu_b,").empty());
+    EXPECT_FALSE(lines_with(s.out, "stuck").empty()) << s.err;
+}
+
+// A replayed value beyond the valid range is printed as it came, however
+// large, and flagged (was: cut at 31 characters, 1e40 shown as 1e30).
+TEST(HalCli, ALargeReplayedValueIsPrintedWhole) {
+    const fs::path dir = scratch_dir("hal-cli");
+    std::ofstream(dir / "r.csv") << "t,THT00029,THT00057,THT00087,THT00032,THT00060,THT00090,CHU_A,CHU_B\n"
+                                 << "1,1e40,-9,-9,-18,-18,-18,10,10\n";
+    const CliRun r = run("--config " + kExamples + "/board.cfg --replay " + (dir / "r.csv").string(), dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::vector<std::string> t = lines_with(r.out, ",THT00029,");
+    ASSERT_EQ(t.size(), 1U);
+    const std::string tail = ",0,out_of_range";
+    ASSERT_EQ(t[0].substr(t[0].size() - tail.size()), tail) << t[0];
+    const std::string celsius = t[0].substr(0, t[0].size() - tail.size());
+    EXPECT_EQ(std::stod(celsius.substr(celsius.rfind(',') + 1)), 1e40) << t[0];
 }
 
 // Rows of one epoch (t to the millisecond) that disagree are refused: one

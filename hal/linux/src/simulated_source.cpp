@@ -1,7 +1,9 @@
 // Simulated acquisition from temperature histories (simulated_source.hpp).
 #include "ascorr_hal_linux/simulated_source.hpp"
 #include "ascorr/pipeline/epoch_key.hpp"
+#include "ascorr_hal/thermistor.hpp"
 #include "ascorr_text/c_format.hpp"
+#include "ascorr_text/number_fields.hpp"
 #include "ascorr_text/text_file.hpp"
 
 #include <algorithm>
@@ -162,7 +164,9 @@ int history_head(const std::string& file, std::size_t line_no, const std::vector
     return head_index(v[0]);
 }
 
-// A temperature field: NaN when empty or nan (none), else a finite number.
+// A temperature field: NaN when empty or nan (none), else a finite number
+// not below absolute zero (a thermistor's resistance has no value there:
+// resistance_from_celsius, thermistor.hpp).
 double history_temperature(const std::string& file, std::size_t line_no, const text::Field& field) {
     const auto& [v, c] = field;
     double x = std::numeric_limits<double>::quiet_NaN();
@@ -173,6 +177,11 @@ double history_temperature(const std::string& file, std::size_t line_no, const t
         throw text::InputError(file, line_no, c,
                                text::number_refusal(v, "not a temperature: '" + std::string(v) +
                                                            "' (a finite number, or empty or nan for none)"));
+    }
+    if (x <= -kZeroCelsiusK) {
+        throw text::InputError(file, line_no, c,
+                               "not a temperature: '" + std::string(v) + "' is not above absolute zero (" +
+                                   text::number_text(-kZeroCelsiusK) + " degC): no thermistor reads it");
     }
     return x;
 }
@@ -369,8 +378,11 @@ bool SimulatedAdc::convert(std::uint8_t adc_channel, std::uint16_t& counts) noex
         lcg_ = lcg_ * 1664525U + 1013904223U;
         const double u = static_cast<double>(lcg_ >> 8) / static_cast<double>(1U << 24);  // [0, 1)
         n += static_cast<int>(std::lround((2.0 * u - 1.0) * noise));
-        n = n < 0 ? 0 : (n > c.divider.levels - 1 ? c.divider.levels - 1 : n);
     }
+    const int dither[3] = {0, 1, -1};
+    n += dither[dither_[ch]];
+    dither_[ch] = static_cast<std::uint8_t>((dither_[ch] + 1U) % 3U);
+    n = n < 0 ? 0 : (n > c.divider.levels - 1 ? c.divider.levels - 1 : n);
     counts = static_cast<std::uint16_t>(n);
     frozen_[ch] = counts;
     frozen_valid_[ch] = true;

@@ -162,9 +162,9 @@ bool SolutionsReader::next(SolutionRecord& rec) {
 void refuse_corrected_input(const SolutionsReader& header) {
     const int col = header.header().index("status");
     if (col >= 0) {
-        std::size_t column = 1;  // character column of the name in the header line
-        for (int i = 0; i < col; ++i) {
-            column += header.header().names()[static_cast<std::size_t>(i)].size() + 1;
+        std::size_t column = 1;          // character column of the name in the header line
+        for (int i = 0; i < col; ++i) {  // as written: a quoted name counts its quotes
+            column += header.header().raw_names()[static_cast<std::size_t>(i)].size() + 1;
         }
         throw text::InputError(
             header.file_name(), 1, column,

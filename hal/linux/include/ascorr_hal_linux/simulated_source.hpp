@@ -84,7 +84,13 @@ std::vector<HistoryEpoch> history_epochs(const std::string& file_name, std::vect
 // parse_history + history_epochs of a file.
 std::vector<HistoryEpoch> read_history(const std::string& path);
 
-// An MCP3208 whose inputs are set from temperatures.
+// An MCP3208 whose inputs are set from temperatures. Like a real converter,
+// its conversions of a steady input differ by an LSB: each channel's
+// conversions cycle through the offsets 0, +1, −1 counts (clamped to the
+// range), so that a median of a multiple of three samples is the input's
+// counts and their spread is not 0 (a noise-free converter would trip the
+// stuck check, channel_check.hpp, on every steady channel). An injected
+// stuck fault holds one value: spread 0.
 class SimulatedAdc final : public AdcPort {
 public:
     SimulatedAdc(const AcquisitionConfig<double>& config, Clock& clock) : config_(config), clock_(clock) {}
@@ -106,6 +112,7 @@ private:
     bool frozen_valid_[kMaxChannels] = {};
     std::uint16_t frozen_[kMaxChannels] = {};
     std::uint32_t lcg_ = 12345U;
+    std::uint8_t dither_[kMaxChannels] = {};  // each channel's next offset: 0, +1, −1
 };
 
 class SimulatedSource final : public SampleSetSource<double> {
