@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -717,6 +718,43 @@ TEST(Combine, TwoHeadsThatDisagreeGiveNoCombination) {
     const auto out3 = comb.combine(three, 3);
     EXPECT_EQ(out3.status, cs::kNoHead | cs::kHeadLeftOut);
     EXPECT_EQ(out3.inconsistent, 7);
+}
+
+// Four heads: B and D agree, A and C are beyond the gross gate of both and
+// within it of each other, yet 495″ apart. The vote's two groups are as large;
+// the consistency gate keeps B and D, none of A and C: B and D are averaged
+// (before, the tie gave no combination, a review found). Two pairs that are
+// each consistent stay ambiguous: no combination.
+template <typename T>
+void expect_tie_decided_by_the_gate() {
+    std::mt19937 rng(43);
+    const List<Head> heads = near_orthogonal_heads(rng, 4, 20.0);
+    const Combiner<T> comb(mountings_of(heads));
+    const Quat truth = random_rotation(rng);
+    const Vec3 wild(0.005, 0.0, 0.0);  // 1031″
+    const auto four = [&](const Vec3& c_off) {
+        return std::array<HeadAttitude<T>, 4>{
+            attitude<T>(measure(heads[0], truth, rng, 1.0, wild), 0), attitude<T>(measure(heads[1], truth, rng), 1),
+            attitude<T>(measure(heads[2], truth, rng, 1.0, c_off), 2), attitude<T>(measure(heads[3], truth, rng), 3)};
+    };
+    const std::array<HeadAttitude<T>, 4> apart = four(wild + Vec3(0.0, 0.0024, 0.0));
+    const auto out = comb.combine(apart.data(), 4);
+    EXPECT_EQ(out.used, 0b1010);
+    EXPECT_EQ(out.inconsistent, 0b0101);
+    EXPECT_EQ(out.status, cs::kTwoOrMoreHeads | cs::kHeadLeftOut);
+    const Vec3 err = error_arcsec(to_double(out.q_crf_icrf), truth.toRotationMatrix());
+    EXPECT_LT(err.norm(), 30.0) << err.transpose();
+    const std::array<HeadAttitude<T>, 4> pairs = four(wild);
+    const auto both = comb.combine(pairs.data(), 4);
+    EXPECT_EQ(both.used, 0);
+    EXPECT_EQ(both.inconsistent, 0b1111);
+    EXPECT_EQ(both.status, cs::kNoHead | cs::kHeadLeftOut);
+}
+
+TEST(Combine, ATieOfTheVoteIsDecidedByTheConsistencyGate) {
+    expect_tie_decided_by_the_gate<double>();
+    expect_tie_decided_by_the_gate<float>();
+    expect_tie_decided_by_the_gate<Q30>();
 }
 
 // ---- Monte Carlo with the contract's noise model.

@@ -34,9 +34,11 @@
 //     kGrossAngleRad (2⁻⁸ rad, 806″) of the reference is kept. When one is
 //     not, the reference becomes the head within that angle of the most
 //     others (the first in input order on a tie); heads farther from it are
-//     inconsistent. No two heads within the angle of each other, or a head
-//     outside the reference's group near as many others as the reference
-//     (e.g. two pairs of four heads): no combination (below).
+//     inconsistent. A head outside the reference's group near as many
+//     others (a rival group as large): step 3 decides, the group it keeps
+//     more heads of (Combiner::vote). No two heads within the angle of each
+//     other, no group consistent, or two that keep as many (e.g. two
+//     consistent pairs of four heads): no combination (below).
 //  3. The consistency gate, a gross-error gate. Head i's leave-one-out
 //     residual r_i = θ_i − θ̂_{S∖i} (its estimate against the others'
 //     combination) is normalised by its covariance plus a floor:

@@ -91,6 +91,10 @@ private:
     void select(const HeadAttitude<T>* heads, std::uint8_t n, Epoch& e) const noexcept;
     std::uint8_t linearise(Epoch& e) const noexcept;
     bool vote(Epoch& e) const noexcept;
+    void refer_to(Epoch& e, std::uint8_t r, std::uint8_t near_r) const noexcept;
+    std::uint8_t kept_with(const Epoch& e, std::uint8_t r, std::uint8_t near_r) const noexcept;
+    std::uint8_t decide(const Epoch& e, const std::uint8_t (&near)[kMaxHeads], const std::uint8_t (&count)[kMaxHeads],
+                        std::uint8_t best) const noexcept;
     struct GateResult {
         std::uint8_t failing;  // candidate-index mask beyond the gate
         GateValue<T> largest;  // the largest statistic

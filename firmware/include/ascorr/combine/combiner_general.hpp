@@ -71,10 +71,63 @@ std::uint8_t Combiner<T>::linearise(Epoch& e) const noexcept {
     return near;
 }
 
+// Candidate r as the vote's reference: its group (r and the candidates near
+// it), the others inconsistent.
+template <typename T>
+void Combiner<T>::refer_to(Epoch& e, std::uint8_t r, std::uint8_t near_r) const noexcept {
+    const auto group = static_cast<std::uint8_t>(near_r | 1U << r);
+    e.ref = r;
+    e.inconsistent = static_cast<HeadMask>(e.inconsistent | heads_of(e, static_cast<std::uint8_t>(e.group & ~group)));
+    e.group = group;
+}
+
+// How many heads the consistency gate keeps with candidate r as the
+// reference (0: none, no combination).
+template <typename T>
+std::uint8_t Combiner<T>::kept_with(const Epoch& e, std::uint8_t r, std::uint8_t near_r) const noexcept {
+    Epoch trial = e;
+    refer_to(trial, r, near_r);
+    static_cast<void>(linearise(trial));
+    Vector3<T> est{};
+    return gate(trial, &est) ? detail::kHeadCounts.n[heads_of(trial, trial.group)] : std::uint8_t{0};
+}
+
+// The vote's reference: `best`, unless a candidate outside its group (and
+// every rival's before it) is near as many others; then the candidate whose
+// group the consistency gate keeps more heads of, or e.n (none) when no group
+// keeps any or two keep as many.
+template <typename T>
+std::uint8_t Combiner<T>::decide(const Epoch& e, const std::uint8_t (&near)[kMaxHeads],
+                                 const std::uint8_t (&count)[kMaxHeads], std::uint8_t best) const noexcept {
+    auto tried = static_cast<std::uint8_t>(near[best] | 1U << best);  // each group tried once
+    std::uint8_t chosen = best;
+    std::uint8_t kept = 0;
+    bool rival = false;
+    bool tie = false;
+    for (std::uint8_t i = 0; i < e.n; ++i) {
+        if (in_mask(tried, i) || count[i] != count[best]) {
+            continue;
+        }
+        if (!rival) {
+            kept = kept_with(e, best, near[best]);
+            rival = true;
+        }
+        tried = static_cast<std::uint8_t>(tried | near[i] | 1U << i);
+        const std::uint8_t k = kept_with(e, i, near[i]);
+        tie = k == kept || (k < kept && tie);
+        chosen = k > kept ? i : chosen;
+        kept = k > kept ? k : kept;
+    }
+    return rival && (kept == 0 || tie) ? e.n : chosen;
+}
+
 // Step 2's vote: the reference becomes the candidate near the most others
 // (the first on a tie), the others far from it are inconsistent; false when
-// no two candidates are near each other, or a candidate outside the
-// reference's group is near as many others (ambiguous).
+// no two candidates are near each other. When a candidate outside the
+// reference's group is near as many others (a rival group as large), the
+// consistency gate decides: the group it keeps more heads of; false when
+// none keeps any, or two keep as many (e.g. two consistent pairs of four
+// heads: ambiguous).
 template <typename T>
 bool Combiner<T>::vote(Epoch& e) const noexcept {
     std::uint8_t near[kMaxHeads] = {};  // candidate-index masks, self excluded
@@ -93,18 +146,14 @@ bool Combiner<T>::vote(Epoch& e) const noexcept {
     for (std::uint8_t i = 1; i < e.n; ++i) {
         best = count[i] > count[best] ? i : best;
     }
-    const auto group = static_cast<std::uint8_t>(near[best] | 1U << best);
-    for (std::uint8_t i = 0; i < e.n; ++i) {
-        if (!in_mask(group, i) && count[i] == count[best]) {
-            return false;  // a group outside as large: ambiguous
-        }
-    }
     if (count[best] == 0) {
         return false;
     }
-    e.ref = best;
-    e.inconsistent = static_cast<HeadMask>(e.inconsistent | heads_of(e, static_cast<std::uint8_t>(e.group & ~group)));
-    e.group = group;
+    const std::uint8_t chosen = decide(e, near, count, best);
+    if (chosen >= e.n) {
+        return false;  // ambiguous, or no group consistent
+    }
+    refer_to(e, chosen, near[chosen]);
     return true;
 }
 
