@@ -45,11 +45,7 @@ SolutionsReader::SolutionsReader(std::string file_name, std::string_view text)
     std::string_view header_line;
     lines_.next(header_line);
     if (const auto miss = near_miss_column(header_.names())) {
-        std::size_t column = 1;  // character column of the name in the header line
-        for (std::size_t i = 0; i < miss->column; ++i) {
-            column += header_.raw_names()[i].size() + 1;
-        }
-        throw text::InputError(file_, 1, column, miss->message);
+        throw text::InputError(file_, 1, header_.column_of(miss->column), miss->message);
     }
     const auto need = [&](const char* name) {
         const int i = header_.index(name);
@@ -162,12 +158,8 @@ bool SolutionsReader::next(SolutionRecord& rec) {
 void refuse_corrected_input(const SolutionsReader& header) {
     const int col = header.header().index("status");
     if (col >= 0) {
-        std::size_t column = 1;          // character column of the name in the header line
-        for (int i = 0; i < col; ++i) {  // as written: a quoted name counts its quotes
-            column += header.header().raw_names()[static_cast<std::size_t>(i)].size() + 1;
-        }
         throw text::InputError(
-            header.file_name(), 1, column,
+            header.file_name(), 1, header.header().column_of(static_cast<std::size_t>(col)),
             "column 'status': this file is already corrected (it has the status column of a corrected "
             "file); give the raw solutions file, so that no correction is applied twice");
     }

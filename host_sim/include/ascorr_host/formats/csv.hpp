@@ -106,6 +106,15 @@ public:
     const std::vector<std::string>& names() const noexcept { return names_; }
     // The names as written (quotes kept), for a header copied into an output.
     const std::vector<std::string>& raw_names() const noexcept { return raw_names_; }
+    // The 1-based character column of name i in the header line (the names
+    // as written, quotes counted), for messages that point at a column.
+    std::size_t column_of(std::size_t i) const noexcept {
+        std::size_t column = 1;
+        for (std::size_t k = 0; k < i && k < raw_names_.size(); ++k) {
+            column += raw_names_[k].size() + 1;
+        }
+        return column;
+    }
 
 private:
     std::vector<std::string> names_;
