@@ -561,7 +561,7 @@ TEST(SelfCalibrationLag, StartsFromALaggedModelAndRefusesAnotherLag) {
     expect_refused(other, 1, {"sc_model.csv: head A lags by 1800 s, but the self-calibration lags it by 900 s"});
     const std::pair<std::string, std::string> refused[] = {
         {"correct --in m.csv --lag 900 --out x.csv", "--lag: needs --self-calibrate"},
-        {"correct --in m.csv --self-calibrate --lag auto --out x.csv", "auto is fit's choice"},
+        {"replay --in m.csv --self-calibrate --lag auto --out x.csv", "auto is learnt by ascorr correct"},
         {"correct --in m.csv --self-calibrate --lag A:0.5 --out x.csv", "the lag must be 0 (no lag) or [1, 86400] s"},
     };
     for (const auto& [args, part] : refused) {

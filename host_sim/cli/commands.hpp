@@ -138,13 +138,15 @@ struct SelfCalibrationOptions {
     CLI::Option* orbit_period;
     CLI::Option* lag;
 };
-// What is wrong with a --lag (host::parse_lags; `auto` only where
-// auto_allowed: fit's); empty when nothing is (fit_command.cpp).
-std::string lag_option_problem(const std::string& text, bool auto_allowed);
+// What is wrong with a --lag (host::parse_lags: TAU, X:TAU,... or auto);
+// empty when nothing is (fit_command.cpp).
+std::string lag_option_problem(const std::string& text);
 // --time-constant, --orbit-period and --lag (the estimator's bench lag, as
-// fit --lag but for auto) of correct and replay.
+// fit --lag; auto, learnt, where lag_auto is given: correct's) of correct and
+// replay.
 SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds,
-                                                    std::optional<std::array<double, kMaxHeads>>& lag_s);
+                                                    std::optional<std::array<double, kMaxHeads>>& lag_s,
+                                                    bool* lag_auto);
 // Refuses --model-history, --time-constant, --orbit-period and --lag without --self-calibrate.
 void check_needs_self_calibrate(bool self_calibrate, const std::string& model_history,
                                 const SelfCalibrationOptions& given);

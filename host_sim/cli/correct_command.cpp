@@ -77,15 +77,32 @@ void correct_and_combine(host::CorrectOptions& opt, CombineTexts& t) {
 }  // namespace
 
 SelfCalibrationOptions add_self_calibration_options(CLI::App& cmd, double& days, std::optional<double>& seconds,
-                                                    std::optional<std::array<double, kMaxHeads>>& lag_s) {
+                                                    std::optional<std::array<double, kMaxHeads>>& lag_s,
+                                                    bool* lag_auto) {
     SelfCalibrationOptions o{};
     o.lag = cmd.add_option_function<std::string>(
-                   "--lag", [&lag_s](const std::string& v) { lag_s = host::parse_lags(v); },
-                   "with --self-calibrate: the bench's lag in s the estimator learns with, TAU for every head or "
-                   "X:TAU,... for the heads named (the others none), each 0 (none) or in [1, 86400]; the history's "
-                   "models say so (lag_s). Default: --model's lag_s, or none")
+                   "--lag",
+                   [&lag_s, lag_auto](const std::string& v) {
+                       lag_s = host::parse_lags(v);  // "auto": nullopt
+                       if (lag_auto != nullptr) {
+                           *lag_auto = !lag_s;
+                       }
+                   },
+                   std::string("with --self-calibrate: the bench's lag in s the estimator learns with, TAU for every "
+                               "head or X:TAU,... for the heads named (the others none), each 0 (none) or in [1, "
+                               "86400]; the history's models say so (lag_s). ") +
+                       (lag_auto != nullptr ? "auto: learnt as the estimator runs, from none (one lag for every "
+                                              "head, a third of an octave from 300 to 6048 s). "
+                                            : "") +
+                       "Default: --model's lag_s, or none")
                 ->type_name("LAG")
-                ->check([](const std::string& v) { return lag_option_problem(v, false); });
+                ->check([lag_auto](const std::string& v) {
+                    return lag_auto != nullptr || v != "auto"
+                               ? lag_option_problem(v)
+                               : std::string(
+                                     "auto is learnt by ascorr correct --self-calibrate, not yet by the "
+                                     "target: give TAU or X:TAU,...");
+                });
     o.time_constant = cmd.add_option("--time-constant", days,
                                      "with --self-calibrate: the estimator's forgetting time constant in days, " +
                                          host::time_constant_range() + " (default " +
@@ -154,7 +171,7 @@ void add_correct_command(CLI::App& app) {
                     "t,version,chu,axis,c0..c3,crc32c,tt_us,origin; common_rotation with --combined, lag_s with a lag)")
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
-        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s);
+        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s, &opt->lag_auto);
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
     cmd->callback([opt, self_cal, combine]() {

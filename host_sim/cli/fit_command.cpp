@@ -8,10 +8,10 @@
 
 namespace ascorr::cli {
 
-std::string lag_option_problem(const std::string& text, bool auto_allowed) {
+std::string lag_option_problem(const std::string& text) {
     try {
-        return host::parse_lags(text) || auto_allowed ? std::string()
-                                                      : std::string("auto is fit's choice: give TAU or X:TAU,...");
+        (void)host::parse_lags(text);
+        return {};
     } catch (const host::FitRefused& e) {
         return e.what();
     }
@@ -77,7 +77,7 @@ void add_fit_command(CLI::App& app) {
                     "0 (none) or in [1, 86400]. The terms take each head's temperatures through a first-order lag "
                     "of TAU, and the model says so (lag_s), for correct")
         ->type_name("LAG")
-        ->check([](const std::string& v) { return lag_option_problem(v, true); });
+        ->check([](const std::string& v) { return lag_option_problem(v); });
     cmd->callback([opt, frame, heads, mountings, rule, lag]() {
         if (!lag->empty()) {
             opt->lag_s = host::parse_lags(*lag);  // checked already; "auto": nullopt

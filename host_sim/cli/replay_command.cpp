@@ -51,7 +51,7 @@ void add_replay_command(CLI::App& app) {
                     "with --self-calibrate: write every model the target made active (CSV, as ascorr correct's)")
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
-        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s);
+        add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s, nullptr);
     CLI::Option* mountings =
         cmd->add_option("--mountings", opt->mountings,
                         "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "

@@ -62,10 +62,11 @@ void bind_gracefo(py::module_& mod);  // import_gracefo
 // it, with its rules and messages (ValueError naming argument 'mountings').
 host::MountingsFile mountings_arg(const py::handle& obj);
 
-// fit()'s and self_calibrate()'s lag=: 'auto' (nullopt; refused unless
-// auto_allowed), 'TAU' or 'X:TAU,...' as --lag (host::parse_lags), or a
-// number for every head; ValueError naming 'lag' otherwise (bind_analysis.cpp).
-std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag, bool auto_allowed);
+// fit()'s and self_calibrate()'s lag=: 'auto' (nullopt: fit's choice, or
+// learnt by the self-calibration), 'TAU' or 'X:TAU,...' as --lag
+// (host::parse_lags), or a number for every head; ValueError naming 'lag'
+// otherwise (bind_analysis.cpp).
+std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag);
 
 // ---- arguments (arguments.cpp)
 

@@ -245,7 +245,7 @@ std::string as_keywords(const std::string& text) {
 
 }  // namespace
 
-std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag, bool auto_allowed) {
+std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag) {
     if (py::isinstance<py::str>(lag)) {
         std::optional<std::array<double, kMaxHeads>> out;
         try {
@@ -253,15 +253,12 @@ std::optional<std::array<double, kMaxHeads>> lags_arg(const py::handle& lag, boo
         } catch (const host::FitRefused& e) {
             bad_argument("lag", as_keywords(e.what()));
         }
-        if (!out && !auto_allowed) {
-            bad_argument("lag", "'auto' is fit()'s choice: give 'TAU', 'X:TAU,...' or a lag in s");
-        }
         return out;
     }
     const double x = real_arg(lag, "lag");
     if (!host::lag_acceptable(x)) {
-        bad_argument("lag", std::string("expected ") + (auto_allowed ? "'auto', " : "") +
-                                "'X:TAU,...' or a lag in s, " + host::lag_range_text() + ", got " + number_text(x));
+        bad_argument(
+            "lag", "expected 'auto', 'X:TAU,...' or a lag in s, " + host::lag_range_text() + ", got " + number_text(x));
     }
     std::array<double, kMaxHeads> out{};
     out.fill(x);
@@ -310,7 +307,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
         opt.common_rotation.emplace();
         static_cast<host::CommonRotationId&>(*opt.common_rotation) = *id;
     }
-    opt.lag_s = lags_arg(lag, true);
+    opt.lag_s = lags_arg(lag);
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
         try {

@@ -37,7 +37,8 @@ namespace {
 template <typename T>
 py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days,
                               std::optional<double> orbit_period_s, const calib::CommonRotationWeights& rule,
-                              const std::array<double, kMaxHeads>& lag_s, double* q_out, std::uint16_t* st_out) {
+                              const std::array<double, kMaxHeads>& lag_s, bool learn_lag, double* q_out,
+                              std::uint16_t* st_out) {
     calib::EstimatorConfig cfg;
     cfg.time_constant_days = time_constant_days;
     cfg.common_rotation = rule;
@@ -47,14 +48,18 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     const host::SelfCalibration sc =
         host::self_calibrate<T>(kArrayRows, lag ? host::lagged_rows(rows, *lag) : rows,
                                 m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s,
-                                host::kSelfCalibrationMemoryBytes, kMaxHeads, lag_s);
+                                host::kSelfCalibrationMemoryBytes, kMaxHeads, lag_s, learn_lag);
     const host::ModelSchedule<T> schedule(sc.history);
+    // lag='auto': the lags the history's models took, as `ascorr correct --lag auto`.
+    const std::optional<host::LagSchedule> learnt = learn_lag ? host::learnt_lags(sc.history, rows) : std::nullopt;
     host::EarthVelocity earth;
     SolutionRecord rec;
     for (py::ssize_t i = 0; i < r.n; ++i) {
         record_of(r, i, rec);
         if (lag) {
             lag->apply(rec);
+        } else if (learnt) {
+            learnt->apply(rec);
         }
         const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
         put_row(host::correct_row<T>(rec, &earth, c, nullptr), i, q_out, st_out);
@@ -85,11 +90,17 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
                          const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj,
                          const py::object& orbit_period_obj, const py::object& mountings, const py::object& lag_obj) {
     const host::ModelFile* m = model_arg(model);
-    // The run's lag: lag= (never 'auto'), otherwise the model's, as correct --lag.
-    const std::optional<std::array<double, kMaxHeads>> lag_given =
-        lag_obj.is_none() ? std::nullopt : lags_arg(lag_obj, false);
+    // The run's lag: lag= ('auto': learnt from none), otherwise the model's, as correct --lag.
+    const std::optional<std::array<double, kMaxHeads>> lag_given = lag_obj.is_none() ? std::nullopt : lags_arg(lag_obj);
+    const bool learn_lag = !lag_obj.is_none() && !lag_given;
+    if (learn_lag && m != nullptr && host::has_lag(*m)) {
+        bad_argument("model",
+                     "the model's lag_s gives the bench's lag, and lag='auto' learns it from none: leave lag out to "
+                     "learn with the model's lag, or start from a model without lag_s");
+    }
     const std::array<double, kMaxHeads> lag_s =
-        lag_given ? *lag_given : (m != nullptr ? host::head_lags(*m) : std::array<double, kMaxHeads>{});
+        lag_given || learn_lag ? lag_given.value_or(std::array<double, kMaxHeads>{})
+                               : (m != nullptr ? host::head_lags(*m) : std::array<double, kMaxHeads>{});
     // The rule for the rotation common to all heads, as correct --mountings M: combined.
     calib::CommonRotationWeights rule{};
     if (!mountings.is_none()) {
@@ -135,14 +146,14 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     py::array_t<std::uint16_t> st_out(r.n);
     py::list history;
     if (scalar == host::ScalarKind::kDouble) {
-        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
-                                               st_out.mutable_data());
+        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+                                               q_out.mutable_data(), st_out.mutable_data());
     } else if (scalar == host::ScalarKind::kFloat) {
-        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
-                                              st_out.mutable_data());
+        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+                                              q_out.mutable_data(), st_out.mutable_data());
     } else {
-        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, lag_s, q_out.mutable_data(),
-                                            st_out.mutable_data());
+        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+                                            q_out.mutable_data(), st_out.mutable_data());
     }
     return py::make_tuple(q_out, st_out, history);
 }

@@ -284,6 +284,33 @@ def lag_mission(exe, tmp_path_factory):
     return path
 
 
+def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, lag_mission, tmp_path):
+    """lag='auto' as correct --self-calibrate --lag auto: the lag learnt as the estimator runs
+    (a 5-day forgetting, so that it decides within the 30 days), the same corrections to the
+    bit and the same lag per model; a lagged model to start from is refused."""
+    d = ascorr.read_solutions(str(lag_mission))
+    corrected = tmp_path / "sc.csv"
+    history = tmp_path / "sc.history.csv"
+    run_cli(exe, "correct", "--in", lag_mission, "--self-calibrate", "--lag", "auto", "--time-constant", 5, "--out",
+            corrected, "--model-history", history)
+    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="auto", time_constant=5)
+    header, rows = read_csv_text(corrected)
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    assert [int(r[header.index("status")]) for r in rows] == list(status)
+    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
+    assert all(same) and len(same) > 0.9 * len(rows)
+    h_header, h_rows = read_csv_text(history)
+    assert h_header[-1] == "lag_s" and len(h_rows) == 9 * len(hist)
+    lags = [a["model"].lag_s[0] for a in hist]
+    assert [float(r[-1]) for r in h_rows[::9]] == lags
+    assert lags[0] == 0.0 and lags[-1] > 0.0, lags  # none at first, then the lag learnt
+    # Mutation: with the lag never taken (given as none) the corrections differ.
+    q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0, time_constant=5)
+    assert np.abs(q_none - q).max() > 1e-9
+    with pytest.raises(ValueError, match="lag='auto' learns it from none"):
+        ascorr.self_calibrate(*as_args(d), model=hist[-1]["model"], lag="auto")
+
+
 def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_path):
     """lag= as --lag (auto, a number, X:TAU); the lagged model corrects the rows as
     `ascorr correct` does, to the bit, in any row order; Model(lag_s=) and pickling keep it."""
@@ -338,7 +365,7 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
 
 def test_self_calibrate_lag_is_ascorr_correct_self_calibrate(exe, lag_mission, tmp_path):
     """lag= as correct --self-calibrate --lag: the same corrections to the bit and the same
-    history, whose models carry the lag; 'auto' and a bad lag are refused."""
+    history, whose models carry the lag; a bad lag is refused."""
     d = ascorr.read_solutions(str(lag_mission))
     corrected = tmp_path / "sc.csv"
     history = tmp_path / "sc.history.csv"
@@ -358,7 +385,5 @@ def test_self_calibrate_lag_is_ascorr_correct_self_calibrate(exe, lag_mission, t
     # Without the lag the corrections differ: the lag is used.
     q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"])
     assert np.abs(q_none - q).max() > 1e-9
-    with pytest.raises(ValueError, match="auto"):
-        ascorr.self_calibrate(*as_args(d), lag="auto")
     with pytest.raises(ValueError, match="lag"):
         ascorr.self_calibrate(*as_args(d), lag=0.5)

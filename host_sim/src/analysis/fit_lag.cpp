@@ -13,14 +13,14 @@ namespace ascorr::host {
 
 namespace {
 
-constexpr int kGridPoints = 14;  // 300·2^(k/3) s, k = 0 … 13: 300 … 6048 s
+constexpr int kGridPoints = static_cast<int>(pipeline::kLagGridPoints);  // 300 … 6048 s (kLagGridS)
 constexpr int kHeadSpan = 3;     // a head's own search: an octave either side of the common lag
 constexpr int kGoldenSteps = 5;  // the bracket of two grid steps shrinks to 0.618⁵ ≈ 9 % of it (±2 % in τ)
 constexpr std::int64_t kNoTime = std::numeric_limits<std::int64_t>::min();  // a t the clock cannot hold
 using Lags = std::array<double, kMaxHeads>;
 
 double grid_tau(int k) {
-    return std::round(300.0 * std::exp2(k / 3.0));
+    return pipeline::kLagGridS[static_cast<std::size_t>(k)];
 }
 
 // The scores of candidate lags: the epochs' temperatures lagged per head (a

@@ -145,6 +145,7 @@ struct Job {
     const StatesVelocityTable<T>* table;  // the rows' velocities from the states, in time order
     const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
     const LaggedTemperatures* lag;        // the model's lagged heads; nullptr: none
+    const LagSchedule* learnt_lag;        // --lag auto: the lag the self-calibration took; nullptr: none
     bool keep_rows;                       // a sink takes the corrected rows
 };
 
@@ -209,11 +210,15 @@ void count_status_bits(StatusBits st, Summary& summary) {
 template <typename T>
 const SolutionRecord& as_terms_take(const Job<T>& job, const CorrectionConfig<T>& cfg, const SolutionRecord& rec,
                                     SolutionRecord& lagged) {
-    if (job.lag == nullptr || cfg.thermal == nullptr) {
+    if ((job.lag == nullptr && job.learnt_lag == nullptr) || cfg.thermal == nullptr) {
         return rec;
     }
     lagged = rec;
-    job.lag->apply(lagged);
+    if (job.lag != nullptr) {
+        job.lag->apply(lagged);
+    } else {
+        job.learnt_lag->apply(lagged);
+    }
     return lagged;
 }
 
@@ -366,6 +371,7 @@ struct SelfCalibrated {
     ModelSchedule<T> schedule;
     std::string history;
     std::string account;
+    std::optional<LagSchedule> learnt_lag;  // --lag auto, when a model of the history lags
 };
 
 template <typename T>
@@ -378,11 +384,12 @@ SelfCalibrated<T> self_calibrated(const CorrectOptions& opt, const std::optional
     const RowSource rows = [&](const std::function<void(const SolutionRecord&)>& fn) {
         for_each_solution(opt.in, fn, "correct");
     };
-    const SelfCalibration sc = self_calibrate<T>(opt.in, lag != nullptr ? lagged_rows(rows, *lag) : rows, model_file,
-                                                 ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes, kMaxHeads,
-                                                 lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{});
+    const SelfCalibration sc =
+        self_calibrate<T>(opt.in, lag != nullptr ? lagged_rows(rows, *lag) : rows, model_file, ecfg, opt.orbit_period_s,
+                          kSelfCalibrationMemoryBytes, kMaxHeads,
+                          lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{}, opt.lag_auto);
     return {ModelSchedule<T>(sc.history), format_model_history(sc.history, opt.common_rotation.heads != 0U),
-            describe(sc)};
+            describe(sc), opt.lag_auto ? learnt_lags(sc.history, rows) : std::nullopt};
 }
 
 void refuse_self_calibration_options(const CorrectOptions& opt) {
@@ -426,6 +433,12 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
     check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
+        if (opt.lag_auto && has_lag(*model_file)) {
+            throw std::runtime_error(opt.model +
+                                     ": the model's lag_s gives the bench's lag, and --lag auto learns it from none: "
+                                     "leave --lag auto out to learn with the model's lag, or start from a model "
+                                     "without lag_s");
+        }
         refuse_other_lag(*model_file, opt.model, run_lags(opt.lag_s, model_file));
     }
     return to_core<T>(*model_file);
@@ -522,8 +535,11 @@ void refuse_run_options(const CorrectOptions& opt) {
     }
     if (opt.self_calibrate) {
         refuse_self_calibration_options(opt);
-    } else if (opt.lag_s) {
+    } else if (opt.lag_s || opt.lag_auto) {
         throw std::runtime_error(std::string("--lag ") + kLagNeedsSelfCalibration);
+    }
+    if (opt.lag_s && opt.lag_auto) {
+        throw std::runtime_error("--lag auto learns the lag and --lag TAU gives it: give one");
     }
 }
 
@@ -565,6 +581,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
                      table ? &*table : nullptr,
                      sc ? &sc->schedule : nullptr,
                      lag ? &*lag : nullptr,
+                     sc && sc->learnt_lag ? &*sc->learnt_lag : nullptr,
                      sink != nullptr};
 
     AtomicFile& out = outputs["--out"];

@@ -76,6 +76,50 @@ RowSource lagged_rows(const RowSource& rows, const LaggedTemperatures& lag) {
     };
 }
 
+LagSchedule::LagSchedule(const std::vector<Change>& changes, std::vector<LagReading> readings) {
+    const auto by_time = [](const LagReading& a, const LagReading& b) { return a.t_us < b.t_us; };
+    std::sort(readings.begin(), readings.end(), by_time);
+    for (std::size_t i = 0; i < changes.size(); ++i) {
+        const Change& c = changes[i];
+        from_us_.push_back(c.from_us);
+        if (!pipeline::any_lagged(c.lag_s)) {
+            span_.emplace_back();
+            continue;
+        }
+        LagReading from{};
+        from.t_us = c.from_us;
+        const auto first = std::lower_bound(readings.begin(), readings.end(), from, by_time);
+        auto last = readings.end();
+        if (i + 1 < changes.size()) {
+            from.t_us = changes[i + 1].from_us;
+            last = std::lower_bound(first, readings.end(), from, by_time);
+        }
+        span_.emplace_back(LaggedTemperatures(c.lag_s, std::vector<LagReading>(first, last)));
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            lagged_ |= c.lag_s[h] != 0.0 ? head_bit(h) : HeadMask{0};
+        }
+    }
+}
+
+void LagSchedule::apply(SolutionRecord& rec) const {
+    if (!has_head(lagged_, rec.head)) {
+        return;
+    }
+    TtTime t{};
+    if (!tt_from_seconds(rec.t, t)) {
+        rec.temperature_present = {};  // no time: no lagged temperature, and no unlagged one
+        return;
+    }
+    const auto it = std::upper_bound(from_us_.begin(), from_us_.end(), t.us);
+    if (it == from_us_.begin()) {
+        return;  // before the first change: no lag
+    }
+    const std::optional<LaggedTemperatures>& span = span_[static_cast<std::size_t>(it - from_us_.begin()) - 1U];
+    if (span) {
+        span->apply(rec);
+    }
+}
+
 void LaggedTemperatures::apply(SolutionRecord& rec) const {
     if (!lags(rec.head)) {
         return;

@@ -58,8 +58,8 @@ template <typename T, std::size_t N>
 class Run {
 public:
     Run(const std::string& file, const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
-        std::optional<double> orbit_period_s)
-        : file_(file), cfg_(cfg) {
+        std::optional<double> orbit_period_s, bool learn_lag)
+        : file_(file), cfg_(cfg), learn_lag_(learn_lag) {
         if (initial) {
             initial_ = coefficients_of(*initial);
         }
@@ -86,6 +86,10 @@ public:
         out_.report = est_->report();
         out_.regauges = est_->regauges();
         out_.untimed = untimed;
+        if (search_) {
+            search_->finish();
+            out_.lag_search = search_->report();
+        }
         return out_;
     }
 
@@ -97,6 +101,9 @@ private:
             (void)pipeline_.solution(
                 r.in, [&r] { return pipeline::given_velocity(r.in.velocity); }, true);
             out_.cycles += pipeline_.feeds() - feeds;
+            if (search_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr) {
+                search(r.t_us);
+            }
         }
     }
 
@@ -163,6 +170,9 @@ private:
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
         pipeline_.use_estimator(&*est_);
+        if (learn_lag_) {
+            search_.emplace(cfg_);
+        }
         for (const CalibRow<T>& r : held_) {
             process(r);
         }
@@ -176,14 +186,30 @@ private:
         if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
             out_.history.push_back({t, t_us, pipeline_.version(), est_->active_crc(),
                                     model_file_of(*est_->active_coefficients()), est_->active_learnt()});
+            if (search_) {  // a version takes the lag the search has taken by then
+                ModelFile& m = out_.history.back().model;
+                m.lag_s.fill(search_->tau_s());
+                m.lag_s = head_lags(m);
+            }
             had_ = true;
             version_ = pipeline_.version();
         }
         return model;
     }
 
+    // The fed cycle's frame heads into the lag search, with the epoch's model.
+    void search(std::int64_t t_us) {
+        const HeadTemperatures<T>* tp[calib::kFrameHeads];
+        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+            tp[h] = &pipeline_.kept_temperatures()[h];
+        }
+        (void)search_->take(t_us, *pipeline_.model(), pipeline_.kept_solutions(), tp);
+    }
+
     const std::string& file_;
     calib::EstimatorConfig cfg_;
+    bool learn_lag_;
+    std::optional<calib::LagSearch<T>> search_;  // learn_lag_: the bench's lag (calib/lag_search.hpp)
     std::optional<ModelCoefficients> initial_;
     std::optional<calib::Estimator<T, N>> est_;
     pipeline::EpochPipeline<T, pipeline::InlineCalls<T>, N> pipeline_;
@@ -446,7 +472,8 @@ namespace {
 template <typename T, std::size_t N>
 SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& rows,
                                      const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
-                                     std::optional<double> orbit_period_s, std::size_t memory_budget_bytes) {
+                                     std::optional<double> orbit_period_s, std::size_t memory_budget_bytes,
+                                     bool learn_lag) {
     EarthVelocity earth;
     // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
     const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {
@@ -472,7 +499,7 @@ SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& r
     // sorted (the epoch of each, the input of those fed) within the memory
     // budget (SortedRuns).
     {
-        Run<T, N> run(file, initial, cfg, orbit_period_s);
+        Run<T, N> run(file, initial, cfg, orbit_period_s, learn_lag);
         std::size_t untimed = 0;
         bool ordered = true;
         CalibRow<T> r{};
@@ -511,7 +538,7 @@ SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& r
         }
         runs.add(r);
     });
-    Run<T, N> run(file, initial, cfg, orbit_period_s);
+    Run<T, N> run(file, initial, cfg, orbit_period_s, learn_lag);
     runs.each([&run](const CalibRow<T>& r) { run.take(r); });
     SelfCalibration out = run.finish(untimed);
     out.runs = runs.count();
@@ -534,14 +561,15 @@ std::size_t heads_to_learn(const RowSource& rows, std::size_t max_heads) {
 template <typename T, std::size_t N0 = calib::kMinCalibHeads>
 SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& file, const RowSource& rows,
                                         const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
-                                        std::optional<double> orbit_period_s, std::size_t memory_budget_bytes) {
+                                        std::optional<double> orbit_period_s, std::size_t memory_budget_bytes,
+                                        bool learn_lag) {
     if constexpr (N0 < kMaxHeads) {
         if (heads > N0) {
             return self_calibrate_dispatch<T, N0 + 1U>(heads, file, rows, initial, cfg, orbit_period_s,
-                                                       memory_budget_bytes);
+                                                       memory_budget_bytes, learn_lag);
         }
     }
-    return self_calibrate_heads<T, N0>(file, rows, initial, cfg, orbit_period_s, memory_budget_bytes);
+    return self_calibrate_heads<T, N0>(file, rows, initial, cfg, orbit_period_s, memory_budget_bytes, learn_lag);
 }
 
 }  // namespace
@@ -550,29 +578,49 @@ template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes, std::size_t max_heads,
-                               const std::array<double, kMaxHeads>& lag_s) {
+                               const std::array<double, kMaxHeads>& lag_s, bool learn_lag) {
+    if (learn_lag && pipeline::any_lagged(lag_s)) {
+        throw std::invalid_argument("self_calibrate: a lag is learnt from none, not from a given one");
+    }
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
         refuse_other_lag(*initial, "the initial model", lag_s);
     }
     SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg,
-                                                     orbit_period_s, memory_budget_bytes);
-    for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
-        a.model.lag_s = lag_s;
-        a.model.lag_s = head_lags(a.model);
+                                                     orbit_period_s, memory_budget_bytes, learn_lag);
+    if (!learn_lag) {
+        for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
+            a.model.lag_s = lag_s;
+            a.model.lag_s = head_lags(a.model);
+        }
     }
     return out;
 }
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                 const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                                std::size_t, const std::array<double, kMaxHeads>&);
+                                                std::size_t, const std::array<double, kMaxHeads>&, bool);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                               std::size_t, const std::array<double, kMaxHeads>&);
+                                               std::size_t, const std::array<double, kMaxHeads>&, bool);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                             std::size_t, const std::array<double, kMaxHeads>&);
+                                             std::size_t, const std::array<double, kMaxHeads>&, bool);
+
+std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows) {
+    std::vector<LagSchedule::Change> changes;
+    std::array<double, kMaxHeads> before{};
+    for (const ActiveModel& a : history) {
+        if (a.model.lag_s != before) {
+            changes.push_back({a.t_us, a.model.lag_s});
+            before = a.model.lag_s;
+        }
+    }
+    if (changes.empty()) {
+        return std::nullopt;
+    }
+    return LagSchedule(changes, lag_readings(rows));
+}
 
 template <typename T>
 ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model_(1) {
@@ -672,6 +720,25 @@ std::string time_constant_range() {
     return "[" + number_text(calib::kMinTimeConstantDays) + ", " + number_text(calib::kMaxTimeConstantDays) + "]";
 }
 
+std::string describe(const calib::LagSearchReport& r) {
+    const std::string head = "bench lag (--lag auto): ";
+    if (r.orbits == 0U) {
+        return head + "none taken: no orbit scored (no model active with A, B and C selected)";
+    }
+    const auto lag = [](double tau_s) { return tau_s != 0.0 ? number_text(tau_s) + " s" : std::string("no lag"); };
+    char buf[320];
+    text::c_snprintf(buf, sizeof buf,
+                     "; over %u orbits the IBAs' spread inside the orbit (%.3f\" RMS with no lag) is lowest with %s, "
+                     "%.2f %% of the mean square below no lag's (a lag is taken beyond %.1f %%)",
+                     r.orbits, r.rms_arcsec, lag(r.best_tau_s).c_str(), 100.0 * r.gain,
+                     100.0 * calib::kLagSearchMargin);
+    const std::string taken = r.tau_s != 0.0
+                                  ? lag(r.tau_s) + ", every head, from the first model after it was taken (changes: " +
+                                        std::to_string(r.changes) + ")"
+                                  : std::string("none taken");
+    return head + taken + buf;
+}
+
 std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
@@ -703,6 +770,9 @@ std::string describe(const SelfCalibration& s) {
     o << "; refusals:";
     for (std::size_t k = 1; k < calib::kRefusalKinds; ++k) {
         o << (k > 1 ? "," : "") << ' ' << calib::refusal_name(static_cast<calib::Refusal>(k)) << ' ' << r.refusals[k];
+    }
+    if (s.lag_search) {
+        o << "; " << describe(*s.lag_search);
     }
     return o.str();
 }

@@ -52,7 +52,7 @@ public:
     // Opens the orbit of cycle c (the current one must have been closed or
     // dropped) with empty sums and the references (see the top).
     void open(const CalibCycle<T, N>& c) noexcept {
-        bin_ = floor_div(c.t_us, period_us_);
+        bin_ = orbit_bin(c.t_us, period_us_);
         start_us_ = bin_ * period_us_;
         end_us_ = start_us_ + period_us_;
         open_ = true;
@@ -143,11 +143,6 @@ private:
                 next_ref_.t_ref[h][j] = ref_.t_ref[h][j];
             }
         }
-    }
-
-    static std::int64_t floor_div(std::int64_t a, std::int64_t b) noexcept {
-        const std::int64_t q = a / b;
-        return (a % b != 0 && ((a < 0) != (b < 0))) ? q - 1 : q;
     }
 
     std::int64_t period_us_;

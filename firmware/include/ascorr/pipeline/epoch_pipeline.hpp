@@ -210,6 +210,11 @@ public:
     std::uint32_t version() const noexcept { return version_; }
     // Epochs that fed the estimator so far (wraps at 2^32).
     std::uint32_t feeds() const noexcept { return feeds_; }
+    // The current epoch's solutions and temperatures kept for the feed, by
+    // head (the frame heads' are those fed once feeds() grew in this epoch):
+    // for what learns beside the estimator (calib/lag_search.hpp).
+    const CorrectedSolution<T>* kept_solutions() const noexcept { return solutions_; }
+    const HeadTemperatures<T>* kept_temperatures() const noexcept { return temperatures_; }
 
     // Stages 0 and 2–5 for one solution of the current epoch (begin() came first).
     // `velocity` () → VelocityAnswer<T>; `clean`: the source's selection

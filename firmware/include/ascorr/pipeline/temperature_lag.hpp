@@ -69,6 +69,7 @@
 // (Channel::t_us), so that the usual step stores one time, not three.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
@@ -146,6 +147,14 @@ struct LagArithmetic<Q30> {
     static constexpr C deviation(State d) noexcept { return {static_cast<std::int32_t>(fx::round_shift<kExtra>(d))}; }
     static constexpr C sum(C reading, C d) noexcept { return {reading.raw + d.raw}; }  // |L| ≤ 200 °C: exact
 };
+
+// The lags a search tries (`fit --lag auto`, host_sim's fit_lag.cpp; the
+// self-calibration's, calib/lag_search.hpp): 300·2^(k/3) s rounded to whole
+// seconds, k = 0 … 13, a third of an octave apart from 300 to 6048 s (the
+// bench lags of the orbit's order, ωτ from 0.3 to 7 at 95 min).
+inline constexpr std::size_t kLagGridPoints = 14;
+inline constexpr double kLagGridS[kLagGridPoints] = {300.0,  378.0,  476.0,  600.0,  756.0,  952.0,  1200.0,
+                                                     1512.0, 1905.0, 2400.0, 3024.0, 3810.0, 4800.0, 6048.0};
 
 inline constexpr double kMinLagTauS = 1.0;      // shorter is no lag at a head's cadence
 inline constexpr double kMaxLagTauS = 86400.0;  // as simulate's --bench-lag: one day

@@ -50,6 +50,9 @@ struct CorrectOptions {
     // learns with (fit's parse_lags; a lagged `model` must have the same);
     // nullopt: the model's lag_s, or none.
     std::optional<std::array<double, kMaxHeads>> lag_s;
+    // --lag auto (self-calibration only, lag_s none, a --model without lag_s):
+    // the bench's lag learnt as the estimator runs (calib/lag_search.hpp).
+    bool lag_auto = false;
     // The estimator's rule for the rotation common to all heads (with
     // --mountings: pipeline/common_rotation_weights.hpp; none: its own frame).
     calib::CommonRotationWeights common_rotation{};

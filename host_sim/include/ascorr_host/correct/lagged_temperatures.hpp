@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "ascorr/core/heads.hpp"
+#include "ascorr/pipeline/head_lags.hpp"
 #include "ascorr/pipeline/temperature_lag.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -104,6 +105,34 @@ private:
     };
     std::array<double, kMaxHeads> lag_s_{};
     std::array<std::vector<Entry>, kMaxHeads> series_{};  // per head, by t_us
+};
+
+// Lags that change with time: a self-calibration's learnt lag (`correct
+// --self-calibrate --lag auto`), each model of its history with the lag the
+// search had taken when it became active. From each change on, up to the
+// next, the heads lag by that change's lag_s, their lags started afresh at
+// the change's first readings (as the DPU's lag stage, configured then); rows
+// before the first change, or in a span of no lag, keep their readings. A row
+// whose t is not a time has no temperatures when a span lags its head (as
+// LaggedTemperatures).
+class LagSchedule {
+public:
+    struct Change {
+        std::int64_t from_us;                 // TT µs: the rows whose t rounds to at least this
+        std::array<double, kMaxHeads> lag_s;  // by head index, 0 none
+    };
+    // changes in time order, each lag_s different from the one before (the
+    // first from none); readings of every head, any order.
+    LagSchedule(const std::vector<Change>& changes, std::vector<LagReading> readings);
+
+    bool any() const noexcept { return lagged_ != 0U; }
+    // rec's temperatures as its terms take them at its t (above).
+    void apply(SolutionRecord& rec) const;
+
+private:
+    std::vector<std::int64_t> from_us_;
+    std::vector<std::optional<LaggedTemperatures>> span_;  // nullopt: no head lags in the span
+    HeadMask lagged_ = 0U;                                 // the heads some span lags
 };
 
 // The reading of rec for the table; false when its t is not a time or its

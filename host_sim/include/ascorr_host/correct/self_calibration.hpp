@@ -25,6 +25,8 @@
 #include <vector>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/lag_search.hpp"
+#include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 
@@ -47,6 +49,7 @@ struct SelfCalibration {
     std::size_t cycles = 0;   // epochs that fed the estimator (A, B and C usable)
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
     std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
+    std::optional<calib::LagSearchReport> lag_search;  // learn_lag: the bench's lag, as the search took it
 };
 
 // The fed rows (in time order) whose median speed gives the orbit period
@@ -90,11 +93,23 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // has it (the heads it has). A lagged initial model must have the same lag
 // for each of its lagged heads (refuse_other_lag; an unlagged one may start
 // a lagged run: its coefficients are those of the orbit means).
+// learn_lag (`--lag auto`; lag_s none, and an unlagged initial model): the
+// bench's lag is learnt as the run goes (calib/lag_search.hpp), from the
+// rows' own temperatures, which the estimator learns from too (a lag does
+// not change orbit means); each model of the history takes the lag the
+// search had taken when it became active (lag_s, the same for every head),
+// and lag_search reports the search at the end.
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
-                               std::size_t max_heads = kMaxHeads, const std::array<double, kMaxHeads>& lag_s = {});
+                               std::size_t max_heads = kMaxHeads, const std::array<double, kMaxHeads>& lag_s = {},
+                               bool learn_lag = false);
+
+// The lags of a learnt-lag history's models as they change (each model of
+// it takes the lag its search had taken, self_calibrate's learn_lag), over
+// the rows' readings (read once more); nullopt when no model lags.
+std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows);
 
 // A lagged head of m whose τ is not lag_s's: its coefficients belong to
 // another lag. Throws std::runtime_error naming `name` and the head.
@@ -144,6 +159,8 @@ std::string orbit_period_range();
 std::string time_constant_range();
 
 // One line per model and the estimator's state, for the terminal.
+// The lag search's outcome in a sentence (--lag auto).
+std::string describe(const calib::LagSearchReport& r);
 std::string describe(const SelfCalibration& s);
 
 }  // namespace ascorr::host
