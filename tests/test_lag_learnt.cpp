@@ -201,9 +201,9 @@ struct OwnLag {
     void step(std::int64_t t, const std::array<double, 3>& temp) {
         for (std::size_t k = 0; k < 3; ++k) {
             if (!started) {
-                l[k] = temp[k];
+                l[k] = static_cast<long double>(temp[k]);
             } else {
-                l[k] += -std::expm1(-static_cast<long double>(t - t_us) * 1e-6L / tau_s) * (temp[k] - l[k]);
+                l[k] += -std::expm1(-static_cast<long double>(t - t_us) * 1e-6L / tau_s) * (static_cast<long double>(temp[k]) - l[k]);
             }
         }
         started = true;

@@ -392,6 +392,12 @@ SelfCalibrated<T> self_calibrated(const CorrectOptions& opt, const std::optional
             describe(sc), opt.lag_auto ? learnt_lags(sc.history, rows) : std::nullopt};
 }
 
+// The lags a --lag auto run took (nullptr: none, or no such run).
+template <typename T>
+const LagSchedule* learnt_lag_of(const std::optional<SelfCalibrated<T>>& sc) noexcept {
+    return sc && sc->learnt_lag ? &*sc->learnt_lag : nullptr;
+}
+
 void refuse_self_calibration_options(const CorrectOptions& opt) {
     if (!opt.thermal) {
         throw std::runtime_error("--self-calibrate estimates the thermal model: it cannot go with --no-thermal");
@@ -581,7 +587,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
                      table ? &*table : nullptr,
                      sc ? &sc->schedule : nullptr,
                      lag ? &*lag : nullptr,
-                     sc && sc->learnt_lag ? &*sc->learnt_lag : nullptr,
+                     learnt_lag_of(sc),
                      sink != nullptr};
 
     AtomicFile& out = outputs["--out"];
