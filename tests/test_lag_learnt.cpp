@@ -203,7 +203,8 @@ struct OwnLag {
             if (!started) {
                 l[k] = static_cast<long double>(temp[k]);
             } else {
-                l[k] += -std::expm1(-static_cast<long double>(t - t_us) * 1e-6L / tau_s) * (static_cast<long double>(temp[k]) - l[k]);
+                l[k] += -std::expm1(-static_cast<long double>(t - t_us) * 1e-6L / tau_s) *
+                        (static_cast<long double>(temp[k]) - l[k]);
             }
         }
         started = true;
