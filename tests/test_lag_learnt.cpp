@@ -22,6 +22,7 @@
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/correct/correct_file.hpp"
 #include "ascorr_host/correct/lagged_temperatures.hpp"
+#include "ascorr_host/correct/self_calibration.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -115,6 +116,42 @@ TEST(LagSearch, ScoresNoCycleWithoutItsHeadsAndDecidesNothingOnNone) {
     EXPECT_EQ(search.tau_s(), 0.0);
 }
 
+// The rule that takes a candidate: none gives way to a lag, and a lag to
+// none, only beyond kLagSearchMargin; a lag to another beyond kLagSwitchMargin;
+// ties to the shorter lag.
+TEST(LagSearch, TakesALagOnlyBeyondItsMargins) {
+    using calib::LagSearch;
+    const auto scores = [](std::initializer_list<std::pair<std::size_t, double>> below) {
+        std::array<double, calib::kLagCandidates> s{};
+        s.fill(1000.0);
+        for (const auto& [k, fraction] : below) {
+            s[k] = 1000.0 * (1.0 - fraction);
+        }
+        return s;
+    };
+    const auto next = [](const std::array<double, calib::kLagCandidates>& s, std::size_t taken) {
+        double raw[calib::kLagCandidates];
+        std::copy(s.begin(), s.end(), raw);
+        return LagSearch<double>::next_taken(raw, taken);
+    };
+    EXPECT_EQ(next(scores({}), 0), 0U);
+    EXPECT_EQ(next(scores({{9, 0.0029}}), 0), 0U);
+    EXPECT_EQ(next(scores({{9, 0.0031}}), 0), 9U);
+    EXPECT_EQ(next(scores({{8, 0.0031}, {9, 0.0031}}), 0), 8U) << "a tie goes to the shorter lag";
+    EXPECT_EQ(next(scores({{5, 0.01}, {9, 0.0104}}), 5), 5U) << "within the switch margin";
+    EXPECT_EQ(next(scores({{5, 0.01}, {9, 0.0106}}), 5), 9U);
+    EXPECT_EQ(next(scores({{5, -0.0029}}), 5), 5U) << "none beats the lag by less than the margin";
+    EXPECT_EQ(next(scores({{5, -0.0031}}), 5), 0U);
+    EXPECT_EQ(calib::lag_candidate_tau_s(9), 1905.0);
+    // What the account says of a lag taken after the last model.
+    calib::LagSearchReport r;
+    r.orbits = 500;
+    r.tau_s = 1905.0;
+    r.best_tau_s = 1905.0;
+    EXPECT_TRUE(has(host::describe(r, 0.0), "it takes 1905 s (no model since)")) << host::describe(r, 0.0);
+    EXPECT_FALSE(has(host::describe(r, 1905.0), "no model since"));
+}
+
 TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
     const fs::path& dir = lagging_mission();
     const double from = mission_day(dir, kFromDays);
@@ -137,8 +174,10 @@ TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
         EXPECT_EQ(std::count_if(lags.begin() + 1, lags.end(), [&](double x) { return x != 0.0 && x != taken; }), 0)
             << scalar << ": the lag changed more than once";
         EXPECT_TRUE(std::is_sorted(lags.begin(), lags.end())) << scalar << ": none, then the lag";
-        EXPECT_TRUE(has(log, "bench lag (--lag auto): " + std::to_string(static_cast<int>(taken)) + " s, every head"))
+        EXPECT_TRUE(has(log, "bench lag (--lag auto): the models took " + std::to_string(static_cast<int>(taken)) +
+                                 " s (every head) from version "))
             << log;
+        EXPECT_TRUE(has(log, "; it takes " + std::to_string(static_cast<int>(taken)) + " s\n")) << log;
         const std::array<double, 3> with = systematic(dir, out, from);
         for (std::size_t p = 0; p < 3; ++p) {
             EXPECT_LE(with[p], kBound) << scalar << " pair " << p;
@@ -156,7 +195,8 @@ TEST(LagLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
     ASSERT_EQ(with.exit_code, 0) << with.err;
     EXPECT_EQ(slurp(dir / "s_auto.csv"), slurp(dir / "s_none.csv"));
     EXPECT_EQ(slurp(dir / "s_auto.csv.history.csv"), slurp(dir / "s_none.csv.history.csv"));
-    EXPECT_TRUE(has(with.err, "bench lag (--lag auto): none taken; over ")) << with.err;
+    EXPECT_TRUE(has(with.err, "bench lag (--lag auto): no model took a lag; the search scored ")) << with.err;
+    EXPECT_TRUE(has(with.err, "; it takes no lag\n")) << with.err;
     EXPECT_FALSE(has(none.err, "bench lag")) << "the search runs only with --lag auto";
 }
 
@@ -212,22 +252,30 @@ struct OwnLag {
     }
 };
 
-TEST(LagSchedule, StartsEachSpanAfreshAsTheTestsOwnFilter) {
+// Heads A, B and D every 60 s for 4 hours, an orbit's swing (D's own). The
+// versions: A and B lag by 900 s from 1 h; a version at 1.5 h where D joins
+// with the same lag (A and B go on, D starts); none from 2 h; 1800 s from
+// 2.5 h, B then without a model (0) from 3 h. C has no rows.
+TEST(LagSchedule, EachHeadStartsAfreshAtItsOwnChangesAsTheTestsOwnFilter) {
     const double t0 = 456148800.0;
     const auto us = [](double t) { return static_cast<std::int64_t>(std::llround(t * 1e6)); };
-    const std::vector<host::LagSchedule::Change> changes = {
+    const std::vector<host::LagSchedule::Version> versions = {
+        {us(t0 + 600.0), {0.0, 0.0, 0.0, 0.0}},
         {us(t0 + 3600.0), {900.0, 900.0, 900.0, 0.0}},
+        {us(t0 + 5400.0), {900.0, 900.0, 900.0, 900.0}},
         {us(t0 + 7200.0), {0.0, 0.0, 0.0, 0.0}},
-        {us(t0 + 9000.0), {1800.0, 1800.0, 1800.0, 0.0}},
+        {us(t0 + 9000.0), {1800.0, 1800.0, 1800.0, 1800.0}},
+        {us(t0 + 10800.0), {1800.0, 0.0, 1800.0, 1800.0}},
     };
+    const std::uint8_t heads[] = {0, 1, 3};
     std::vector<host::SolutionRecord> rows;
     std::vector<host::LagReading> readings;
-    for (int i = 0; i < 240; ++i) {  // head A and D every 60 s for 4 hours, an orbit's swing
-        for (const std::uint8_t head : {std::uint8_t{0}, std::uint8_t{3}}) {
+    for (int i = 0; i < 240; ++i) {
+        for (const std::uint8_t head : heads) {
             host::SolutionRecord rec;
             rec.head = head;
             rec.t = t0 + 60.0 * i;
-            const double x = 2.0 * 3.14159265358979 * 60.0 * i / 5640.0;
+            const double x = 2.0 * 3.14159265358979 * 60.0 * i / 5640.0 + head;
             rec.temperature = {20.0 + 5.0 * std::sin(x), -8.0 + 2.0 * std::cos(x), -18.0 + std::sin(2.0 * x)};
             rec.temperature_present = {true, true, true};
             rows.push_back(rec);
@@ -237,37 +285,49 @@ TEST(LagSchedule, StartsEachSpanAfreshAsTheTestsOwnFilter) {
         }
     }
     std::reverse(readings.begin(), readings.end());  // any order
-    const host::LagSchedule schedule(changes, readings);
+    const host::LagSchedule schedule(versions, readings);
     ASSERT_TRUE(schedule.any());
-    OwnLag own;
-    std::size_t span = 0;
+    // The test's own: per head, the lag of the last version at or before the
+    // row, its filter restarted when that lag differs from the one before.
+    std::array<OwnLag, kMaxHeads> own{};
+    std::array<double, kMaxHeads> current{};
+    std::size_t checked = 0;
     for (const host::SolutionRecord& rec : rows) {
         host::SolutionRecord got = rec;
         schedule.apply(got);
         const std::int64_t t = us(rec.t);
-        while (span < changes.size() && t >= changes[span].from_us) {
-            own = OwnLag{changes[span].lag_s[0]};
-            ++span;
+        double lag = 0.0;
+        for (const host::LagSchedule::Version& v : versions) {
+            lag = t >= v.from_us ? v.lag_s[rec.head] : lag;
         }
-        if (rec.head == 3U || span == 0 || own.tau_s == 0) {  // D never lags; nor A before or between
-            EXPECT_EQ(got.temperature, rec.temperature) << rec.t;
+        if (lag != current[rec.head]) {
+            own[rec.head] = OwnLag{lag};
+            current[rec.head] = lag;
+        }
+        if (lag == 0.0) {
+            EXPECT_EQ(got.temperature, rec.temperature) << rec.t << " head " << int{rec.head};
             continue;
         }
-        own.step(t, rec.temperature);
+        own[rec.head].step(t, rec.temperature);
         for (std::size_t k = 0; k < 3; ++k) {
-            EXPECT_NEAR(got.temperature[k], static_cast<double>(own.l[k]), 1e-9) << rec.t << " channel " << k;
+            EXPECT_NEAR(got.temperature[k], static_cast<double>(own[rec.head].l[k]), 1e-9)
+                << rec.t << " head " << int{rec.head} << " channel " << k;
         }
         EXPECT_EQ(got.temperature_present, rec.temperature_present);
+        ++checked;
     }
-    // A row of a lagged head with no time has no temperatures; one of D keeps them.
+    EXPECT_EQ(checked, 150U + 90U + 120U);  // A 1–2 h and 2.5–4 h, B 1–2 h and 2.5–3 h, D 1.5–2 h and 2.5–4 h
+    // A row of a lagged head with no time has no temperatures; a head no span lags keeps them.
     host::SolutionRecord untimed = rows[0];
     untimed.t = std::numeric_limits<double>::quiet_NaN();
     schedule.apply(untimed);
     EXPECT_EQ(untimed.temperature_present, (std::array<bool, 3>{false, false, false}));
-    host::SolutionRecord untimed_d = rows[1];
-    untimed_d.t = std::numeric_limits<double>::quiet_NaN();
-    schedule.apply(untimed_d);
-    EXPECT_EQ(untimed_d.temperature_present, (std::array<bool, 3>{true, true, true}));
+    host::SolutionRecord untimed_c = rows[0];
+    untimed_c.head = 2;
+    untimed_c.t = std::numeric_limits<double>::quiet_NaN();
+    const host::LagSchedule only_d({{us(t0), {0.0, 0.0, 0.0, 900.0}}}, readings);
+    only_d.apply(untimed_c);
+    EXPECT_EQ(untimed_c.temperature_present, (std::array<bool, 3>{true, true, true}));
 }
 
 }  // namespace

@@ -257,7 +257,11 @@ def self_calibrate(
     lag: the bench's lag the estimator learns with, as correct --lag: 'TAU', 'X:TAU,...'
     or a number (s), or None: the model's lag_s, or none; a lagged model with another lag
     is refused. Every model of the history then has that lag_s, and the rows are learnt
-    from and corrected with their lagged temperatures.
+    from and corrected with their lagged temperatures. 'auto' (as correct --lag auto, from
+    a model without lag_s or none): the lag is learnt as the estimator runs, one for every
+    head; each model of the history has the lag taken when it became active (lag_s), and
+    a head's rows are corrected with it from the first model that changed the head's lag,
+    started afresh there.
     Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

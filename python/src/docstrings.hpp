@@ -100,7 +100,8 @@ is refused. Every model of the history then has that lag_s, and the rows are lea
 from and corrected with their lagged temperatures. 'auto' (as correct --lag auto, from
 a model without lag_s or none): the lag is learnt as the estimator runs, one for every
 head; each model of the history has the lag taken when it became active (lag_s), and
-the rows from it on are corrected with that lag, started afresh there.
+a head's rows are corrected with it from the first model that changed the head's lag,
+started afresh there.
 Returns (q_corrected float64
 (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
 "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

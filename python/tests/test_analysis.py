@@ -284,16 +284,24 @@ def lag_mission(exe, tmp_path_factory):
     return path
 
 
-def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, lag_mission, tmp_path):
-    """lag='auto' as correct --self-calibrate --lag auto: the lag learnt as the estimator runs
-    (a 5-day forgetting, so that it decides within the 30 days), the same corrections to the
-    bit and the same lag per model; a lagged model to start from is refused."""
-    d = ascorr.read_solutions(str(lag_mission))
+@pytest.fixture(scope="module")
+def lag_learnt_mission(exe, tmp_path_factory):
+    """50 days of a bench that lags by 1800 s, every 240 s (seed 40): the search decides after 30."""
+    path = tmp_path_factory.mktemp("lag_learnt") / "lag.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 50, "--step", 240, "--seed", 40, "--bench-lag", 1800)
+    return path
+
+
+def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, lag_learnt_mission, tmp_path):
+    """lag='auto' as correct --self-calibrate --lag auto: the lag learnt as the estimator runs,
+    the same corrections to the bit and the same lag per model; a lagged model to start from
+    is refused."""
+    d = ascorr.read_solutions(str(lag_learnt_mission))
     corrected = tmp_path / "sc.csv"
     history = tmp_path / "sc.history.csv"
-    run_cli(exe, "correct", "--in", lag_mission, "--self-calibrate", "--lag", "auto", "--time-constant", 5, "--out",
-            corrected, "--model-history", history)
-    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="auto", time_constant=5)
+    run_cli(exe, "correct", "--in", lag_learnt_mission, "--self-calibrate", "--lag", "auto", "--out", corrected,
+            "--model-history", history)
+    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="auto")
     header, rows = read_csv_text(corrected)
     cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
     assert [int(r[header.index("status")]) for r in rows] == list(status)
@@ -305,7 +313,7 @@ def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, 
     assert [float(r[-1]) for r in h_rows[::9]] == lags
     assert lags[0] == 0.0 and lags[-1] > 0.0, lags  # none at first, then the lag learnt
     # Mutation: with the lag never taken (given as none) the corrections differ.
-    q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0, time_constant=5)
+    q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0)
     assert np.abs(q_none - q).max() > 1e-9
     with pytest.raises(ValueError, match="lag='auto' learns it from none"):
         ascorr.self_calibrate(*as_args(d), model=hist[-1]["model"], lag="auto")

@@ -1,7 +1,10 @@
 #include "ascorr_host/correct/lagged_temperatures.hpp"
 
 #include <algorithm>
+#include <iterator>
+#include <limits>
 #include <tuple>
+#include <utility>
 
 #include "ascorr/nav/tt_time.hpp"
 
@@ -76,27 +79,45 @@ RowSource lagged_rows(const RowSource& rows, const LaggedTemperatures& lag) {
     };
 }
 
-LagSchedule::LagSchedule(const std::vector<Change>& changes, std::vector<LagReading> readings) {
-    const auto by_time = [](const LagReading& a, const LagReading& b) { return a.t_us < b.t_us; };
-    std::sort(readings.begin(), readings.end(), by_time);
-    for (std::size_t i = 0; i < changes.size(); ++i) {
-        const Change& c = changes[i];
-        from_us_.push_back(c.from_us);
-        if (!pipeline::any_lagged(c.lag_s)) {
-            span_.emplace_back();
-            continue;
+namespace {
+
+// Head h's spans: where its lag changes from one version to the next.
+std::vector<std::pair<std::int64_t, double>> lag_changes(const std::vector<LagSchedule::Version>& versions,
+                                                         std::uint8_t h) {
+    std::vector<std::pair<std::int64_t, double>> out;
+    double before = 0.0;
+    for (const LagSchedule::Version& v : versions) {
+        if (v.lag_s[h] != before) {
+            out.emplace_back(v.from_us, v.lag_s[h]);
+            before = v.lag_s[h];
         }
-        LagReading from{};
-        from.t_us = c.from_us;
-        const auto first = std::lower_bound(readings.begin(), readings.end(), from, by_time);
-        auto last = readings.end();
-        if (i + 1 < changes.size()) {
-            from.t_us = changes[i + 1].from_us;
-            last = std::lower_bound(first, readings.end(), from, by_time);
-        }
-        span_.emplace_back(LaggedTemperatures(c.lag_s, std::vector<LagReading>(first, last)));
-        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            lagged_ |= c.lag_s[h] != 0.0 ? head_bit(h) : HeadMask{0};
+    }
+    return out;
+}
+
+}  // namespace
+
+LagSchedule::LagSchedule(const std::vector<Version>& versions, std::vector<LagReading> readings) {
+    std::sort(readings.begin(), readings.end(), lag_order);  // by head, then time
+    const auto before = [](const LagReading& r, const std::pair<std::uint8_t, std::int64_t>& k) {
+        return r.head < k.first || (r.head == k.first && r.t_us < k.second);
+    };
+    const auto at = [&](std::uint8_t h, std::int64_t t_us) {
+        return std::lower_bound(readings.begin(), readings.end(), std::make_pair(h, t_us), before);
+    };
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        const std::vector<std::pair<std::int64_t, double>> changes = lag_changes(versions, h);
+        for (std::size_t i = 0; i < changes.size(); ++i) {
+            Span span{changes[i].first, std::nullopt};
+            if (changes[i].second != 0.0) {
+                std::array<double, kMaxHeads> lag_s{};
+                lag_s[h] = changes[i].second;
+                const auto last = i + 1 < changes.size() ? at(h, changes[i + 1].first)
+                                                         : at(h, std::numeric_limits<std::int64_t>::max());
+                span.table.emplace(lag_s, std::vector<LagReading>(at(h, changes[i].first), last));
+                lagged_ |= head_bit(h);
+            }
+            spans_[h].push_back(std::move(span));
         }
     }
 }
@@ -110,13 +131,11 @@ void LagSchedule::apply(SolutionRecord& rec) const {
         rec.temperature_present = {};  // no time: no lagged temperature, and no unlagged one
         return;
     }
-    const auto it = std::upper_bound(from_us_.begin(), from_us_.end(), t.us);
-    if (it == from_us_.begin()) {
-        return;  // before the first change: no lag
-    }
-    const std::optional<LaggedTemperatures>& span = span_[static_cast<std::size_t>(it - from_us_.begin()) - 1U];
-    if (span) {
-        span->apply(rec);
+    const std::vector<Span>& spans = spans_[rec.head];
+    const auto it =
+        std::upper_bound(spans.begin(), spans.end(), t.us, [](std::int64_t x, const Span& s) { return x < s.from_us; });
+    if (it != spans.begin() && std::prev(it)->table) {  // before the first change: no lag
+        std::prev(it)->table->apply(rec);
     }
 }
 

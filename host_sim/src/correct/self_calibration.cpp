@@ -608,18 +608,16 @@ template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource
                                              std::size_t, const std::array<double, kMaxHeads>&, bool);
 
 std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows) {
-    std::vector<LagSchedule::Change> changes;
-    std::array<double, kMaxHeads> before{};
+    std::vector<LagSchedule::Version> versions;
+    bool any = false;
     for (const ActiveModel& a : history) {
-        if (a.model.lag_s != before) {
-            changes.push_back({a.t_us, a.model.lag_s});
-            before = a.model.lag_s;
-        }
+        versions.push_back({a.t_us, head_lags(a.model)});
+        any = any || has_lag(a.model);
     }
-    if (changes.empty()) {
+    if (!any) {
         return std::nullopt;
     }
-    return LagSchedule(changes, lag_readings(rows));
+    return LagSchedule(versions, lag_readings(rows));
 }
 
 template <typename T>
@@ -720,23 +718,57 @@ std::string time_constant_range() {
     return "[" + number_text(calib::kMinTimeConstantDays) + ", " + number_text(calib::kMaxTimeConstantDays) + "]";
 }
 
-std::string describe(const calib::LagSearchReport& r) {
-    const std::string head = "bench lag (--lag auto): ";
-    if (r.orbits == 0U) {
-        return head + "none taken: no orbit scored (no model active with A, B and C selected)";
+namespace {
+
+std::string lag_text(double tau_s) {
+    return tau_s != 0.0 ? number_text(tau_s) + " s" : std::string("no lag");
+}
+
+// The lag of a learnt-lag history's model: its heads' one τ (0: none).
+double model_lag(const ActiveModel& a) {
+    const std::array<double, kMaxHeads> lag = head_lags(a.model);
+    return *std::max_element(lag.begin(), lag.end());
+}
+
+// What the models of a --lag auto history took, in a clause; `last` their last lag.
+std::string lags_taken(const std::vector<ActiveModel>& history, double& last) {
+    const ActiveModel* first = nullptr;
+    std::size_t changes = 0;
+    last = 0.0;
+    for (const ActiveModel& a : history) {
+        const double tau = model_lag(a);
+        changes += tau != last ? 1U : 0U;
+        last = tau;
+        first = first == nullptr && tau != 0.0 ? &a : first;
     }
-    const auto lag = [](double tau_s) { return tau_s != 0.0 ? number_text(tau_s) + " s" : std::string("no lag"); };
+    if (first == nullptr) {
+        return "no model took a lag";
+    }
+    char buf[160];
+    text::c_snprintf(buf, sizeof buf, "the models took %s (every head) from version %u (t = %.3f)",
+                     lag_text(model_lag(*first)).c_str(), first->version, first->t);
+    std::string out = buf;
+    if (changes > 1U) {
+        out +=
+            ", the lag changing " + std::to_string(changes - 1U) + " more time(s), the last model's " + lag_text(last);
+    }
+    return out;
+}
+
+}  // namespace
+
+std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
+    if (r.orbits == 0U) {
+        return "the search scored no orbit (no model active with A, B and C selected)";
+    }
     char buf[320];
     text::c_snprintf(buf, sizeof buf,
-                     "; over %u orbits the IBAs' spread inside the orbit (%.3f\" RMS with no lag) is lowest with %s, "
-                     "%.2f %% of the mean square below no lag's (a lag is taken beyond %.1f %%)",
-                     r.orbits, r.rms_arcsec, lag(r.best_tau_s).c_str(), 100.0 * r.gain,
-                     100.0 * calib::kLagSearchMargin);
-    const std::string taken = r.tau_s != 0.0
-                                  ? lag(r.tau_s) + ", every head, from the first model after it was taken (changes: " +
-                                        std::to_string(r.changes) + ")"
-                                  : std::string("none taken");
-    return head + taken + buf;
+                     "the search scored %u orbits: the IBAs' spread inside the orbit (%.3f\" RMS with no lag) is "
+                     "lowest with %s, %.2f %% of the mean square below no lag's (a lag is taken beyond %.1f %%); it "
+                     "takes %s",
+                     r.orbits, r.rms_arcsec, lag_text(r.best_tau_s).c_str(), 100.0 * r.gain,
+                     100.0 * calib::kLagSearchMargin, lag_text(r.tau_s).c_str());
+    return std::string(buf) + (r.tau_s != last_model_lag_s ? " (no model since)" : "");
 }
 
 std::string describe(const SelfCalibration& s) {
@@ -772,7 +804,8 @@ std::string describe(const SelfCalibration& s) {
         o << (k > 1 ? "," : "") << ' ' << calib::refusal_name(static_cast<calib::Refusal>(k)) << ' ' << r.refusals[k];
     }
     if (s.lag_search) {
-        o << "; " << describe(*s.lag_search);
+        double last = 0.0;
+        o << "; bench lag (--lag auto): " << lags_taken(s.history, last) << "; " << describe(*s.lag_search, last);
     }
     return o.str();
 }

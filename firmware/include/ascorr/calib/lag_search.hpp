@@ -16,26 +16,33 @@
 // between the boresights, as `stats`). A candidate's score is the IBAs'
 // spread inside each orbit, Σ (x − x̄)² about the orbit's own mean (so that
 // nothing an orbit mean holds counts: that is the estimator's), summed over
-// the pairs and over the orbits with the estimator's forgetting
-// (e^(−Δt/time_constant) per orbit closed). Every candidate is scored on the
-// same epochs, so the star trackers' noise adds the same to each; what differs
-// is the thermal residual inside the orbit.
+// the pairs and over the orbits with a forgetting e^(−Δt/memory) per orbit
+// closed, memory the estimator's time constant but at least
+// kLagSearchMemoryDays. Every candidate is scored on the same epochs, so the
+// star trackers' noise adds the same to each; what differs is the thermal
+// residual inside the orbit.
 //
-// Taken (report().tau_s): at each orbit closed once enough are scored
-// (min_orbits, and a forgetting time constant's: first_decision_orbits),
-// the candidate with the lowest score (ties: the shorter lag, no lag first)
+// Taken (report().tau_s, next_taken): at each orbit closed once a memory's
+// orbits are scored (and at least min_orbits: first_decision_orbits), the
+// candidate with the lowest score (ties: the shorter lag, no lag first)
 // replaces the one taken (at first: no lag) when its score is below the
 // taken one's by more than kLagSearchMargin of it between a lag and none,
 // kLagSwitchMargin between two lags; so a lag is taken only when the data
-// show it, and then kept until another (or none) is clearly better. The answer is a grid point, a third of an octave
-// apart: a τ off by half a step (13 %) leaves about 13 % of the lag's residual.
+// show it, and then kept until another (or none) is clearly better. The
+// answer is a grid point, a third of an octave apart: a τ off by half a step
+// (13 %) leaves about 13 % of the lag's residual.
 //
 // Arithmetic: q_ab (the attitude without the thermal stage) as the
 // estimator's feed forms it (selected_solution), the thermal stage in T as
 // the core's (thermal_stage), each candidate's lag a
-// pipeline::TemperatureLag<T> stepped at the fed cycles (the readings held
-// between, which the filter takes exactly); the corrected attitudes, the
-// IBAs and the sums in double. The IBAs within an orbit are summed about the
+// pipeline::TemperatureLag<T> stepped at the fed cycles only (a reading
+// between two of them is not seen; the feed's cadence, every epoch on the
+// host and 11 Hz on board, is far below any τ of the grid); the corrected
+// attitudes, the IBAs and the sums in double.
+// Time: cycles in time order (the host sorts the rows; on board the clock).
+// A cycle of another orbit than the open one closes it; one earlier than the
+// last scored orbit forgets nothing, and a lag's channel refuses its time
+// (TemperatureLag: kTimeNotIncreasing) and keeps its state. The IBAs within an orbit are summed about the
 // orbit's first no-lag IBA, so that the sums hold arcseconds, not 90°.
 // Cost per fed cycle: 3·kLagGridPoints lag steps, 3·kLagCandidates thermal
 // stages, quaternion products and boresights, 3·kLagCandidates IBAs (an atan2
@@ -78,6 +85,12 @@ inline constexpr double kLagSearchMargin = 0.003;
 // orbits and a young model, is left once the data say so (there 6048 s,
 // 0.11 % above 1905 s).
 inline constexpr double kLagSwitchMargin = 0.0005;
+// The search's memory: at least this, whatever the estimator's forgetting.
+// The lag is the bench's, which does not drift in days as its coefficients
+// may, and the margins above need the noise of a month of orbits: with the
+// estimator's 1 day (`--time-constant 1`) a static bench took a lag by chance
+// and changed it about 20 times in 60 days; with a month, none.
+inline constexpr double kLagSearchMemoryDays = 30.0;
 
 struct LagSearchReport {
     std::uint32_t orbits = 0;           // orbits scored (each with ≥ min_epochs_per_orbit cycles)
@@ -101,7 +114,7 @@ public:
     // cfg as the estimator accepted it (configuration_acceptable).
     explicit LagSearch(const EstimatorConfig& cfg) noexcept
         : period_us_(cfg.orbit_period_us > 0 ? cfg.orbit_period_us : EstimatorConfig{}.orbit_period_us),
-          time_constant_us_(cfg.time_constant_days * 86400e6),
+          memory_us_(memory_days(cfg) * 86400e6),
           min_orbits_(first_decision_orbits(cfg, period_us_)),  // period_us_ is declared before
           min_epochs_(cfg.min_epochs_per_orbit) {
         for (std::size_t k = 0; k < pipeline::kLagGridPoints; ++k) {
@@ -180,16 +193,30 @@ public:
     // The bench's lag as taken so far (s; 0: none).
     double tau_s() const noexcept { return lag_candidate_tau_s(taken_); }
 
+    // The rule (above): the candidate taken after `taken`, given the scores.
+    static constexpr std::size_t next_taken(const double (&score)[kLagCandidates], std::size_t taken) noexcept {
+        std::size_t best = 0;
+        for (std::size_t k = 1; k < kLagCandidates; ++k) {
+            best = score[k] < score[best] ? k : best;
+        }
+        const double margin = best != 0U && taken != 0U ? kLagSwitchMargin : kLagSearchMargin;
+        return best != taken && score[best] < (1.0 - margin) * score[taken] ? best : taken;
+    }
+
 private:
     static constexpr std::size_t kGrid = pipeline::kLagGridPoints;
 
+    static double memory_days(const EstimatorConfig& cfg) noexcept {
+        return cfg.time_constant_days > kLagSearchMemoryDays ? cfg.time_constant_days : kLagSearchMemoryDays;
+    }
+
     // The orbits scored before a first decision: min_orbits, and the
-    // forgetting's time constant (30 days by default, 460 orbits): until the
-    // scores span it, they weigh the orbits of the first, young models, whose
-    // wrong coefficients some lag offsets by chance (on the static 300-day
-    // bench of docs/ground.md, 6048 s at orbit 30, left again 9 versions later).
+    // memory's (about 460 orbits of 95 min in 30 days): until the scores span
+    // it, they weigh the orbits of the first, young models, whose wrong
+    // coefficients some lag offsets by chance (on the static 300-day bench of
+    // docs/ground.md, 6048 s at orbit 30, left again 9 versions later).
     static std::uint32_t first_decision_orbits(const EstimatorConfig& cfg, std::int64_t period_us) noexcept {
-        const double span = cfg.time_constant_days * 86400e6 / static_cast<double>(period_us);
+        const double span = memory_days(cfg) * 86400e6 / static_cast<double>(period_us);
         const double orbits = span < 4e9 ? std::ceil(span) : 4e9;  // any acceptable cfg: ≤ 1.44e6
         return orbits > static_cast<double>(cfg.min_orbits) ? static_cast<std::uint32_t>(orbits) : cfg.min_orbits;
     }
@@ -261,7 +288,7 @@ private:
     void close_orbit() noexcept {
         if (n_ >= min_epochs_ && n_ > 0U) {
             const double lambda = scored_ ? exp_nonpositive(-static_cast<double>(bin_ - last_bin_) *
-                                                            static_cast<double>(period_us_) / time_constant_us_)
+                                                            static_cast<double>(period_us_) / memory_us_)
                                           : 0.0;
             const double n = static_cast<double>(n_);
             for (std::size_t k = 0; k < kLagCandidates; ++k) {
@@ -288,24 +315,18 @@ private:
         open_ = false;
     }
 
-    // The candidate taken, once min_orbits are scored (above).
+    // The candidate taken, once a first decision's orbits are scored (above).
     void reconsider() noexcept {
         if (orbits_ < min_orbits_) {
             return;
         }
-        std::size_t best = 0;
-        for (std::size_t k = 1; k < kLagCandidates; ++k) {
-            best = score_[k] < score_[best] ? k : best;
-        }
-        const double margin = best != 0U && taken_ != 0U ? kLagSwitchMargin : kLagSearchMargin;
-        if (best != taken_ && score_[best] < (1.0 - margin) * score_[taken_]) {
-            taken_ = best;
-            ++changes_;
-        }
+        const std::size_t next = next_taken(score_, taken_);
+        changes_ += next != taken_ ? 1U : 0U;
+        taken_ = next;
     }
 
     std::int64_t period_us_;
-    double time_constant_us_;
+    double memory_us_;  // the forgetting's time constant (memory_days)
     std::uint32_t min_orbits_;
     std::uint32_t min_epochs_;
     pipeline::TemperatureLag<T> lag_[kGrid][kFrameHeads]{};

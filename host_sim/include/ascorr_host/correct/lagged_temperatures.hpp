@@ -109,30 +109,34 @@ private:
 
 // Lags that change with time: a self-calibration's learnt lag (`correct
 // --self-calibrate --lag auto`), each model of its history with the lag the
-// search had taken when it became active. From each change on, up to the
-// next, the heads lag by that change's lag_s, their lags started afresh at
-// the change's first readings (as the DPU's lag stage, configured then); rows
-// before the first change, or in a span of no lag, keep their readings. A row
-// whose t is not a time has no temperatures when a span lags its head (as
-// LaggedTemperatures).
+// search had taken when it became active. Each head on its own: from the
+// first model whose lag of that head differs from the one before (at first:
+// none) up to the next such model, the head's rows take that lag, started
+// afresh at its first reading there (as a lag stage configured then); so a
+// head whose lag stays the same keeps its lag running whatever the models or
+// the other heads do. Rows before, or in a span of no lag, keep their
+// readings; a row whose t is not a time has no temperatures when some span
+// lags its head (as LaggedTemperatures).
 class LagSchedule {
 public:
-    struct Change {
+    struct Version {
         std::int64_t from_us;                 // TT µs: the rows whose t rounds to at least this
-        std::array<double, kMaxHeads> lag_s;  // by head index, 0 none
+        std::array<double, kMaxHeads> lag_s;  // by head index, 0 none (a head the model lacks: 0)
     };
-    // changes in time order, each lag_s different from the one before (the
-    // first from none); readings of every head, any order.
-    LagSchedule(const std::vector<Change>& changes, std::vector<LagReading> readings);
+    // versions in time order; readings of every head, any order.
+    LagSchedule(const std::vector<Version>& versions, std::vector<LagReading> readings);
 
     bool any() const noexcept { return lagged_ != 0U; }
     // rec's temperatures as its terms take them at its t (above).
     void apply(SolutionRecord& rec) const;
 
 private:
-    std::vector<std::int64_t> from_us_;
-    std::vector<std::optional<LaggedTemperatures>> span_;  // nullopt: no head lags in the span
-    HeadMask lagged_ = 0U;                                 // the heads some span lags
+    struct Span {
+        std::int64_t from_us;
+        std::optional<LaggedTemperatures> table;  // nullopt: no lag
+    };
+    std::array<std::vector<Span>, kMaxHeads> spans_{};  // per head, in time order
+    HeadMask lagged_ = 0U;                              // the heads some span lags
 };
 
 // The reading of rec for the table; false when its t is not a time or its

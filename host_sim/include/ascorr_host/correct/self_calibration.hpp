@@ -159,8 +159,9 @@ std::string orbit_period_range();
 std::string time_constant_range();
 
 // One line per model and the estimator's state, for the terminal.
-// The lag search's outcome in a sentence (--lag auto).
-std::string describe(const calib::LagSearchReport& r);
+// The lag search's outcome in a clause (--lag auto), and whether the last
+// model of the history (its lag last_model_lag_s) took what it takes.
+std::string describe(const calib::LagSearchReport& r, double last_model_lag_s);
 std::string describe(const SelfCalibration& s);
 
 }  // namespace ascorr::host
