@@ -296,18 +296,7 @@ def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, 
     """lag='auto' as correct --self-calibrate --lag auto: the lag learnt as the estimator runs,
     the same corrections to the bit and the same lag per model; a lagged model to start from
     is refused."""
-    d = ascorr.read_solutions(str(lag_learnt_mission))
-    corrected = tmp_path / "sc.csv"
-    history = tmp_path / "sc.history.csv"
-    run_cli(exe, "correct", "--in", lag_learnt_mission, "--self-calibrate", "--lag", "auto", "--out", corrected,
-            "--model-history", history)
-    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="auto")
-    header, rows = read_csv_text(corrected)
-    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
-    assert [int(r[header.index("status")]) for r in rows] == list(status)
-    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
-    assert all(same) and len(same) > 0.9 * len(rows)
-    h_header, h_rows = read_csv_text(history)
+    d, q, hist, h_header, h_rows = self_calibrated_as_by_the_cli(exe, lag_learnt_mission, tmp_path, "auto")
     assert h_header[-1] == "lag_s" and len(h_rows) == 9 * len(hist)
     lags = [a["model"].lag_s[0] for a in hist]
     assert [float(r[-1]) for r in h_rows[::9]] == lags
@@ -371,21 +360,28 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
         ascorr.Model(model.coefficients, model.heads, lag_s=[1e6, 0, 0, 0])
 
 
-def test_self_calibrate_lag_is_ascorr_correct_self_calibrate(exe, lag_mission, tmp_path):
-    """lag= as correct --self-calibrate --lag: the same corrections to the bit and the same
-    history, whose models carry the lag; a bad lag is refused."""
-    d = ascorr.read_solutions(str(lag_mission))
+def self_calibrated_as_by_the_cli(exe, mission, tmp_path, lag):
+    """self_calibrate(lag=) and `ascorr correct --self-calibrate --lag` on the same rows: the
+    same status and corrections to the bit; (rows, q, history, the history file's header and rows)."""
+    d = ascorr.read_solutions(str(mission))
     corrected = tmp_path / "sc.csv"
     history = tmp_path / "sc.history.csv"
-    run_cli(exe, "correct", "--in", lag_mission, "--self-calibrate", "--lag", "A:1800,B:1800,C:900", "--out",
-            corrected, "--model-history", history)
-    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag="A:1800,B:1800,C:900")
+    run_cli(exe, "correct", "--in", mission, "--self-calibrate", "--lag", lag, "--out", corrected, "--model-history",
+            history)
+    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=lag)
     header, rows = read_csv_text(corrected)
     cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
     assert [int(r[header.index("status")]) for r in rows] == list(status)
     same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
     assert all(same) and len(same) > 0.9 * len(rows)
     h_header, h_rows = read_csv_text(history)
+    return d, q, hist, h_header, h_rows
+
+
+def test_self_calibrate_lag_is_ascorr_correct_self_calibrate(exe, lag_mission, tmp_path):
+    """lag= as correct --self-calibrate --lag: the same corrections to the bit and the same
+    history, whose models carry the lag; a bad lag is refused."""
+    d, q, hist, h_header, h_rows = self_calibrated_as_by_the_cli(exe, lag_mission, tmp_path, "A:1800,B:1800,C:900")
     assert h_header[-1] == "lag_s"
     assert len(h_rows) == 9 * len(hist)
     for a in hist:
