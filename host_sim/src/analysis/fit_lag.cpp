@@ -307,7 +307,7 @@ LagSelection select_lags(const LagSearchInput& in) {
         for (std::size_t i = 0; i < list.count; ++i) {
             cur[list.head[i]] = common.tau;
         }
-        const int k_common = static_cast<int>(std::lround(3.0 * std::log2(common.tau / 300.0)));
+        const int k_common = pipeline::lag_grid_index(common.tau);
         k_lo = k_common - kHeadSpan;
         k_hi = k_common + kHeadSpan;
     }
@@ -323,7 +323,7 @@ LagSelection select_lags(const LagSearchInput& in) {
         if (none < own.score) {
             own = {0.0, none};
         } else if (lower_by_margin(own.score, scorer.score(cur))) {
-            const int k = static_cast<int>(std::lround(3.0 * std::log2(own.tau / 300.0)));
+            const int k = pipeline::lag_grid_index(own.tau);
             own = minimise_lag(with, k - 1, k + 1, true);  // the grid's scores are remembered
         }
         if (lower_by_margin(own.score, scorer.score(cur))) {  // a head departs only on clear evidence

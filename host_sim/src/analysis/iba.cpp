@@ -2,14 +2,12 @@
 
 #include <cmath>
 
-#include "ascorr/core/constants.hpp"
+#include "ascorr/calib/frame.hpp"
 
 namespace ascorr::host {
 
 double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept {
-    // atan2 of |a×b| and a·b keeps full precision near 0 and 90°, unlike acos.
-    const Vector3<double> c = cross(a, b);
-    return std::atan2(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
+    return calib::angle_arcsec(a, b);
 }
 
 std::string pair_name(const HeadPair& p) {

@@ -609,15 +609,17 @@ template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource
 
 std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows) {
     std::vector<LagSchedule::Version> versions;
-    bool any = false;
+    HeadMask lagged = 0U;  // the heads some model lags: the only readings needed
     for (const ActiveModel& a : history) {
         versions.push_back({a.t_us, head_lags(a.model)});
-        any = any || has_lag(a.model);
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            lagged |= versions.back().lag_s[h] != 0.0 ? head_bit(h) : HeadMask{0};
+        }
     }
-    if (!any) {
+    if (lagged == 0U) {
         return std::nullopt;
     }
-    return LagSchedule(versions, lag_readings(rows));
+    return LagSchedule(versions, lag_readings(rows, lagged));
 }
 
 template <typename T>
@@ -745,7 +747,7 @@ std::string lags_taken(const std::vector<ActiveModel>& history, double& last) {
         return "no model took a lag";
     }
     char buf[160];
-    text::c_snprintf(buf, sizeof buf, "the models took %s (every head) from version %u (t = %.3f)",
+    text::c_snprintf(buf, sizeof buf, "the models took %s (each head they have) from version %u (t = %.3f)",
                      lag_text(model_lag(*first)).c_str(), first->version, first->t);
     std::string out = buf;
     if (changes > 1U) {
@@ -761,14 +763,23 @@ std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
     if (r.orbits == 0U) {
         return "the search scored no orbit (no model active with A, B and C selected)";
     }
-    char buf[320];
+    char buf[400];
     text::c_snprintf(buf, sizeof buf,
                      "the search scored %u orbits: the IBAs' spread inside the orbit (%.3f\" RMS with no lag) is "
-                     "lowest with %s, %.2f %% of the mean square below no lag's (a lag is taken beyond %.1f %%); it "
-                     "takes %s",
-                     r.orbits, r.rms_arcsec, lag_text(r.best_tau_s).c_str(), 100.0 * r.gain,
-                     100.0 * calib::kLagSearchMargin, lag_text(r.tau_s).c_str());
-    return std::string(buf) + (r.tau_s != last_model_lag_s ? " (no model since)" : "");
+                     "lowest with %s, %.2f %% of the mean square below no lag's; ",
+                     r.orbits, r.rms_arcsec, lag_text(r.best_tau_s).c_str(), 100.0 * r.gain);
+    std::string out = buf;
+    if (!r.deciding) {
+        text::c_snprintf(buf, sizeof buf, "it decides once it holds %.0f orbits (it holds %.0f, forgotten)",
+                         r.orbits_to_decide, r.orbits_held);
+        return out + buf;
+    }
+    text::c_snprintf(buf, sizeof buf,
+                     "it takes %s (a lag once %.1f %% below no lag's, kept until another is %.2f %% below it or no "
+                     "lag %.1f %%)",
+                     lag_text(r.tau_s).c_str(), 100.0 * calib::kLagSearchMargin, 100.0 * calib::kLagSwitchMargin,
+                     100.0 * calib::kLagSearchMargin);
+    return out + buf + (r.tau_s != last_model_lag_s ? "; no model since took it" : "");
 }
 
 std::string describe(const SelfCalibration& s) {

@@ -24,6 +24,7 @@
 
 #include <cmath>
 
+#include "../core/constants.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/vector3.hpp"
 
@@ -65,6 +66,13 @@ inline Matrix3 rotation_matrix(const Quaternion<double>& q) noexcept {
 inline Vector3<double> boresight_of(const Quaternion<double>& q) noexcept {
     const Matrix3 r = rotation_matrix(q);
     return {r.m[2][0], r.m[2][1], r.m[2][2]};
+}
+
+// The angle between two unit vectors (arcsec; the IBA of two boresights):
+// atan2 of |a×b| and a·b, which keeps full precision near 0 and 90°, unlike acos.
+inline double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept {
+    const Vector3<double> c = cross(a, b);
+    return std::atan2(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
 }
 
 // A rotation matrix as a unit quaternion with the same rotation (Shepperd's

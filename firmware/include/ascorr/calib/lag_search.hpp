@@ -1,6 +1,6 @@
 // ascorr/calib/lag_search.hpp: the bench's lag, measured by the
-// self-calibration as it runs (issue 40; docs/ground.md, "The bench's lag,
-// learnt").
+// self-calibration as it runs (issue 40; docs/ground.md, "The lag learnt in
+// self-calibration").
 //
 // Why: the estimator learns from orbit means, and an orbit mean does not show
 // a lag of the orbit's order (L's orbit mean is T's, but for the
@@ -22,8 +22,9 @@
 // star trackers' noise adds the same to each; what differs is the thermal
 // residual inside the orbit.
 //
-// Taken (report().tau_s, next_taken): at each orbit closed once a memory's
-// orbits are scored (and at least min_orbits: first_decision_orbits), the
+// Taken (report().tau_s, next_taken): at each orbit closed once the scores
+// hold a memory's orbits (their forgotten count, so that a long gap in the
+// data waits for as many again; and at least min_orbits scored), the
 // candidate with the lowest score (ties: the shorter lag, no lag first)
 // replaces the one taken (at first: no lag) when its score is below the
 // taken one's by more than kLagSearchMargin of it between a lag and none,
@@ -87,9 +88,12 @@ inline constexpr double kLagSearchMargin = 0.003;
 inline constexpr double kLagSwitchMargin = 0.0005;
 // The search's memory: at least this, whatever the estimator's forgetting.
 // The lag is the bench's, which does not drift in days as its coefficients
-// may, and the margins above need the noise of a month of orbits: with the
-// estimator's 1 day (`--time-constant 1`) a static bench took a lag by chance
-// and changed it about 20 times in 60 days; with a month, none.
+// may, and the margins above need the noise of a month of orbits: with a
+// memory of the estimator's 1 day (`--time-constant 1`) a static bench took a
+// lag by chance and changed it about 20 times in 60 days. (With that
+// estimator the models themselves swing by tenths of an arcsecond from day to
+// day, and a lag can still offset some of it: 200-day static benches took
+// lags with it, their residuals 0.5–0.75″ with the lag or without.)
 inline constexpr double kLagSearchMemoryDays = 30.0;
 
 struct LagSearchReport {
@@ -99,9 +103,10 @@ struct LagSearchReport {
     double best_tau_s = 0.0;            // its τ (0: no lag)
     double gain = 0.0;                  // 1 − best's score / no lag's (0 before any orbit)
     double rms_arcsec = 0.0;            // no lag's spread inside the orbit, RMS per pair and cycle
-    std::size_t taken = 0;              // the candidate taken (above; 0: no lag)
-    double tau_s = 0.0;                 // its τ: the bench's lag, 0 none
-    std::uint32_t changes = 0;          // times the taken candidate changed
+    double tau_s = 0.0;                 // the lag taken: the bench's, 0 none
+    bool deciding = false;              // the scores hold a memory's orbits: the rule applies
+    double orbits_held = 0.0;           // their forgotten count of orbits
+    double orbits_to_decide = 0.0;      // ... that the rule needs (a memory's)
     double score[kLagCandidates] = {};  // forgotten sums of squares (arcsec²)
 };
 
@@ -115,7 +120,8 @@ public:
     explicit LagSearch(const EstimatorConfig& cfg) noexcept
         : period_us_(cfg.orbit_period_us > 0 ? cfg.orbit_period_us : EstimatorConfig{}.orbit_period_us),
           memory_us_(memory_days(cfg) * 86400e6),
-          min_orbits_(first_decision_orbits(cfg, period_us_)),  // period_us_ is declared before
+          min_orbits_(cfg.min_orbits),
+          orbits_to_decide_(orbits_of_a_memory(cfg, period_us_)),  // period_us_ is declared before
           min_epochs_(cfg.min_epochs_per_orbit) {
         for (std::size_t k = 0; k < pipeline::kLagGridPoints; ++k) {
             for (pipeline::TemperatureLag<T>& lag : lag_[k]) {
@@ -140,13 +146,15 @@ public:
             bin_ = bin;
         }
         Quaternion<double> q_ab[kFrameHeads];
-        for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
+        for (std::uint8_t h = 0; h < kFrameHeads; ++h) {  // every head selected before any lag steps
             Quaternion<T> q{};
             if (!selected_solution(h, &model, corrected[h], *temperatures[h], q)) {
                 return false;
             }
             q_ab[h] = to_double(q);
-            for (pipeline::TemperatureLag<T>(&lags)[kFrameHeads] : lag_) {
+        }
+        for (pipeline::TemperatureLag<T>(&lags)[kFrameHeads] : lag_) {
+            for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
                 (void)lags[h].step(t_us, *temperatures[h]);
             }
         }
@@ -184,9 +192,10 @@ public:
         if (weight_ > 0.0) {
             r.rms_arcsec = std::sqrt(score_[0] / weight_);
         }
-        r.taken = taken_;
         r.tau_s = lag_candidate_tau_s(taken_);
-        r.changes = changes_;
+        r.deciding = deciding();
+        r.orbits_held = orbits_held_;
+        r.orbits_to_decide = orbits_to_decide_;
         return r;
     }
 
@@ -210,15 +219,24 @@ private:
         return cfg.time_constant_days > kLagSearchMemoryDays ? cfg.time_constant_days : kLagSearchMemoryDays;
     }
 
-    // The orbits scored before a first decision: min_orbits, and the
-    // memory's (about 460 orbits of 95 min in 30 days): until the scores span
-    // it, they weigh the orbits of the first, young models, whose wrong
-    // coefficients some lag offsets by chance (on the static 300-day bench of
-    // docs/ground.md, 6048 s at orbit 30, left again 9 versions later).
-    static std::uint32_t first_decision_orbits(const EstimatorConfig& cfg, std::int64_t period_us) noexcept {
-        const double span = memory_days(cfg) * 86400e6 / static_cast<double>(period_us);
-        const double orbits = span < 4e9 ? std::ceil(span) : 4e9;  // any acceptable cfg: ≤ 1.44e6
-        return orbits > static_cast<double>(cfg.min_orbits) ? static_cast<std::uint32_t>(orbits) : cfg.min_orbits;
+    // The forgotten count of orbits the scores must hold before the rule
+    // applies: that of a memory's orbits scored in a row, N = ⌈memory /
+    // period⌉ (about 461 of 95 min in 30 days), (1 − λᴺ)/(1 − λ) with λ an
+    // orbit's forgetting. Before, the scores weigh the orbits of the first,
+    // young models, whose wrong coefficients some lag offsets by chance (on
+    // the static 300-day bench of docs/ground.md, 6048 s at orbit 30, left
+    // again 9 versions later), or after a long gap a day of new orbits (a
+    // static bench without head B for 120 days took 378 s a day after it).
+    static double orbits_of_a_memory(const EstimatorConfig& cfg, std::int64_t period_us) noexcept {
+        const double x = static_cast<double>(period_us) / (memory_days(cfg) * 86400e6);  // an orbit's, ≤ 1
+        const double n = std::ceil(1.0 / x);
+        return -expm1_nonpositive(-n * x) / -expm1_nonpositive(-x);
+    }
+
+    // Whether the scores hold enough orbits for the rule (above; a relative
+    // 1e-9 below the count of N in a row, which rounds otherwise).
+    bool deciding() const noexcept {
+        return orbits_ >= min_orbits_ && orbits_held_ >= orbits_to_decide_ * (1.0 - 1e-9);
     }
 
     static Quaternion<double> to_double(const Quaternion<T>& q) noexcept {
@@ -242,7 +260,7 @@ private:
         std::size_t p = 0;
         for (std::size_t i = 0; i < kFrameHeads; ++i) {
             for (std::size_t j = i + 1U; j < kFrameHeads; ++j) {
-                out[p++] = angle_arcsec(b[i], b[j]);
+                out[p++] = angle_arcsec(b[i], b[j]);  // frame.hpp
             }
         }
         return true;
@@ -258,13 +276,6 @@ private:
         const SmallRotation<double> r{S::to_double(q_th.dw),
                                       {S::to_double(q_th.v.x), S::to_double(q_th.v.y), S::to_double(q_th.v.z)}};
         return renormalized_sum(q_ab, increment(r) * q_ab);
-    }
-
-    // The angle between two unit vectors (arcsec): atan2 of |a×b| and a·b,
-    // exact near 0 and 90° (as `stats`' IBA).
-    static double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept {
-        const Vector3<double> c = cross(a, b);
-        return std::atan2(std::sqrt(dot(c, c)), dot(a, b)) * kRadToArcsec;
     }
 
     void add(const double (&iba)[kLagCandidates][kPairs]) noexcept {
@@ -299,6 +310,7 @@ private:
                 score_[k] = lambda * score_[k] + spread;
             }
             weight_ = lambda * weight_ + n * static_cast<double>(kPairs);
+            orbits_held_ = lambda * orbits_held_ + 1.0;
             scored_ = true;
             last_bin_ = bin_;
             ++orbits_;
@@ -315,19 +327,17 @@ private:
         open_ = false;
     }
 
-    // The candidate taken, once a first decision's orbits are scored (above).
+    // The candidate taken, once the scores hold a memory's orbits (above).
     void reconsider() noexcept {
-        if (orbits_ < min_orbits_) {
-            return;
+        if (deciding()) {
+            taken_ = next_taken(score_, taken_);
         }
-        const std::size_t next = next_taken(score_, taken_);
-        changes_ += next != taken_ ? 1U : 0U;
-        taken_ = next;
     }
 
     std::int64_t period_us_;
     double memory_us_;  // the forgetting's time constant (memory_days)
     std::uint32_t min_orbits_;
+    double orbits_to_decide_;  // orbits_of_a_memory
     std::uint32_t min_epochs_;
     pipeline::TemperatureLag<T> lag_[kGrid][kFrameHeads]{};
     bool open_ = false;
@@ -342,8 +352,8 @@ private:
     double weight_ = 0.0;  // forgotten cycles × pairs
     std::uint32_t orbits_ = 0U;
     std::uint64_t cycles_ = 0U;
+    double orbits_held_ = 0.0;  // the forgotten count of orbits scored
     std::size_t taken_ = 0U;
-    std::uint32_t changes_ = 0U;
 };
 
 }  // namespace ascorr::calib

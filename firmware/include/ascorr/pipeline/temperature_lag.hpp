@@ -69,6 +69,7 @@
 // (Channel::t_us), so that the usual step stores one time, not three.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -152,9 +153,16 @@ struct LagArithmetic<Q30> {
 // self-calibration's, calib/lag_search.hpp): 300·2^(k/3) s rounded to whole
 // seconds, k = 0 … 13, a third of an octave apart from 300 to 6048 s (the
 // bench lags of the orbit's order, ωτ from 0.3 to 7 at 95 min).
+inline constexpr double kLagGridBaseS = 300.0;
+inline constexpr double kLagGridPerOctave = 3.0;
 inline constexpr std::size_t kLagGridPoints = 14;
 inline constexpr double kLagGridS[kLagGridPoints] = {300.0,  378.0,  476.0,  600.0,  756.0,  952.0,  1200.0,
                                                      1512.0, 1905.0, 2400.0, 3024.0, 3810.0, 4800.0, 6048.0};
+// The index k of the grid point nearest τ (s) on the grid's log scale,
+// round(3·log2(τ/300)); outside [0, kLagGridPoints) for a τ beyond the grid.
+inline int lag_grid_index(double tau_s) noexcept {
+    return static_cast<int>(std::lround(kLagGridPerOctave * std::log2(tau_s / kLagGridBaseS)));
+}
 
 inline constexpr double kMinLagTauS = 1.0;      // shorter is no lag at a head's cadence
 inline constexpr double kMaxLagTauS = 86400.0;  // as simulate's --bench-lag: one day
