@@ -37,14 +37,15 @@
 // estimator's feed forms it (selected_solution), the thermal stage in T as
 // the core's (thermal_stage), each candidate's lag a
 // pipeline::TemperatureLag<T> stepped at the fed cycles only (a reading
-// between two of them is not seen; the feed's cadence, every epoch on the
-// host and 11 Hz on board, is far below any τ of the grid); the corrected
-// attitudes, the IBAs and the sums in double.
+// between two of them is not seen: on the host every epoch with A, B and C
+// selected is one, on board every second cycle, 11 Hz, against τ ≥ 300 s);
+// the corrected attitudes, the IBAs and the sums in double. The IBAs within
+// an orbit are summed about the orbit's first no-lag IBA, so that the sums
+// hold arcseconds, not 90°.
 // Time: cycles in time order (the host sorts the rows; on board the clock).
 // A cycle of another orbit than the open one closes it; one earlier than the
 // last scored orbit forgets nothing, and a lag's channel refuses its time
-// (TemperatureLag: kTimeNotIncreasing) and keeps its state. The IBAs within an orbit are summed about the
-// orbit's first no-lag IBA, so that the sums hold arcseconds, not 90°.
+// (TemperatureLag: kTimeNotIncreasing) and keeps its state.
 // Cost per fed cycle: 3·kLagGridPoints lag steps, 3·kLagCandidates thermal
 // stages, quaternion products and boresights, 3·kLagCandidates IBAs (an atan2
 // and a square root each). Bounded: no allocation, no loop but over the
