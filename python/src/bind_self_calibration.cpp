@@ -93,14 +93,8 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     // The run's lag: lag= ('auto': learnt from none), otherwise the model's, as correct --lag.
     const std::optional<std::array<double, kMaxHeads>> lag_given = lag_obj.is_none() ? std::nullopt : lags_arg(lag_obj);
     const bool learn_lag = !lag_obj.is_none() && !lag_given;
-    if (learn_lag && m != nullptr && host::has_lag(*m)) {
-        bad_argument("model",
-                     "the model's lag_s gives the bench's lag, and lag='auto' learns it from none: leave lag out to "
-                     "learn with the model's lag, or start from a model without lag_s");
-    }
     const std::array<double, kMaxHeads> lag_s =
-        lag_given || learn_lag ? lag_given.value_or(std::array<double, kMaxHeads>{})
-                               : (m != nullptr ? host::head_lags(*m) : std::array<double, kMaxHeads>{});
+        lag_given ? *lag_given : (m != nullptr ? host::head_lags(*m) : std::array<double, kMaxHeads>{});
     // The rule for the rotation common to all heads, as correct --mountings M: combined.
     calib::CommonRotationWeights rule{};
     if (!mountings.is_none()) {
@@ -129,6 +123,9 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     if (m != nullptr) {
         try {
             host::refuse_quadratic_initial_model(*m, "the model given");
+            if (learn_lag) {
+                host::refuse_lag_to_learn(*m, "the model given", "lag='auto'");
+            }
             host::refuse_other_lag(*m, "the model given", lag_s);
         } catch (const std::runtime_error& e) {
             bad_argument("model", e.what());

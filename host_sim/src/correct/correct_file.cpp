@@ -439,11 +439,8 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
     check_model_for_scalar(*model_file, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_quadratic_initial_model(*model_file, opt.model);
-        if (opt.lag_auto && has_lag(*model_file)) {
-            throw std::runtime_error(opt.model +
-                                     ": the model's lag_s gives the bench's lag, and --lag auto learns it from none: "
-                                     "leave --lag auto out to learn with the model's lag, or start from a model "
-                                     "without lag_s");
+        if (opt.lag_auto) {
+            refuse_lag_to_learn(*model_file, opt.model, "--lag auto");
         }
         refuse_other_lag(*model_file, opt.model, run_lags(opt.lag_s, model_file));
     }

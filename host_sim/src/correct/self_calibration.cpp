@@ -447,6 +447,14 @@ void refuse_other_lag(const ModelFile& m, const std::string& name, const std::ar
     }
 }
 
+void refuse_lag_to_learn(const ModelFile& m, const std::string& name, const std::string& option) {
+    if (has_lag(m)) {
+        throw std::runtime_error(name + ": the model's lag_s gives the bench's lag, and " + option +
+                                 " learns it from none: leave " + option +
+                                 " out to learn with the model's lag, or start from a model without lag_s");
+    }
+}
+
 void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name) {
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         for (std::size_t a = 0; a < kModelAxes; ++a) {

@@ -111,7 +111,7 @@ struct EstimatorConfig {
 };
 
 // The orbit of time t_us: floor(t_us / period_us) (EstimatorConfig's bins),
-// for any signs; period_us ≠ 0.
+// for t_us of any sign; period_us > 0 (every caller's: an accepted period).
 constexpr std::int64_t orbit_bin(std::int64_t t_us, std::int64_t period_us) noexcept {
     const std::int64_t q = t_us / period_us;
     return (t_us % period_us != 0 && ((t_us < 0) != (period_us < 0))) ? q - 1 : q;

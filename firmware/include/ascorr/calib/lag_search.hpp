@@ -182,10 +182,8 @@ public:
         r.cycles = cycles_;
         for (std::size_t k = 0; k < kLagCandidates; ++k) {
             r.score[k] = score_[k];
-            if (score_[k] < score_[r.best]) {
-                r.best = k;
-            }
         }
+        r.best = best_of(score_);
         r.best_tau_s = lag_candidate_tau_s(r.best);
         if (score_[0] > 0.0) {
             r.gain = (score_[0] - score_[r.best]) / score_[0];
@@ -205,16 +203,22 @@ public:
 
     // The rule (above): the candidate taken after `taken`, given the scores.
     static constexpr std::size_t next_taken(const double (&score)[kLagCandidates], std::size_t taken) noexcept {
-        std::size_t best = 0;
-        for (std::size_t k = 1; k < kLagCandidates; ++k) {
-            best = score[k] < score[best] ? k : best;
-        }
+        const std::size_t best = best_of(score);
         const double margin = best != 0U && taken != 0U ? kLagSwitchMargin : kLagSearchMargin;
         return best != taken && score[best] < (1.0 - margin) * score[taken] ? best : taken;
     }
 
 private:
     static constexpr std::size_t kGrid = pipeline::kLagGridPoints;
+
+    // The candidate with the lowest score (ties: the first, no lag before any).
+    static constexpr std::size_t best_of(const double (&score)[kLagCandidates]) noexcept {
+        std::size_t best = 0;
+        for (std::size_t k = 1; k < kLagCandidates; ++k) {
+            best = score[k] < score[best] ? k : best;
+        }
+        return best;
+    }
 
     static double memory_days(const EstimatorConfig& cfg) noexcept {
         return cfg.time_constant_days > kLagSearchMemoryDays ? cfg.time_constant_days : kLagSearchMemoryDays;

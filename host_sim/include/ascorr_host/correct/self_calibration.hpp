@@ -114,6 +114,10 @@ std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, 
 // A lagged head of m whose τ is not lag_s's: its coefficients belong to
 // another lag. Throws std::runtime_error naming `name` and the head.
 void refuse_other_lag(const ModelFile& m, const std::string& name, const std::array<double, kMaxHeads>& lag_s);
+// A lagged model to start a run that learns the lag (`option`: how the caller
+// spells it, `--lag auto` or `lag='auto'`). Throws std::runtime_error naming
+// `name`.
+void refuse_lag_to_learn(const ModelFile& m, const std::string& name, const std::string& option);
 
 // The models of a history in turn, for correcting rows: at(t) is the model
 // active at t's epoch (TT µs of the on-board clock), or one with no head
