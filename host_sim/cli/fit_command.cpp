@@ -78,6 +78,13 @@ void add_fit_command(CLI::App& app) {
                     "of TAU, and the model says so (lag_s), for correct")
         ->type_name("LAG")
         ->check([](const std::string& v) { return lag_option_problem(v); });
+    cmd->add_option("--sun-term", opt->sun_term,
+                    "auto (default: the Sun term, the rotation with the Sun's direction in the head's frame, fitted "
+                    "inside the orbit and taken when the held-out part supports it; the model's sun_x, sun_y, "
+                    "sun_z) or none")
+        ->transform(
+            one_of<host::SunTermChoice>({{"auto", host::SunTermChoice::kAuto}, {"none", host::SunTermChoice::kNone}}))
+        ->type_name("NAME");
     cmd->callback([opt, frame, heads, mountings, rule, lag]() {
         if (!lag->empty()) {
             opt->lag_s = host::parse_lags(*lag);  // checked already; "auto": nullopt

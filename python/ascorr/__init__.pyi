@@ -33,9 +33,15 @@ class Model:
     in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
     coefficients (a head not listed gets status 256 in correct()); lag_s: None
     or 4 numbers [head 'A'..'D'], the bench's lag in s of each head, 0 (none) or
-    in [1, 86400] (the model file's lag_s column)."""
+    in [1, 86400] (the model file's lag_s column); sun: None or the Sun term's
+    coefficients, shape (4, 3, 3) [head][alpha, beta, gamma][x, y, z of the Sun's
+    direction in the head's frame], arcsec (the model file's sun_x, sun_y, sun_z)."""
     def __init__(
-        self, coefficients: npt.ArrayLike, heads: Optional[str] = ..., lag_s: Optional[npt.ArrayLike] = ...
+        self,
+        coefficients: npt.ArrayLike,
+        heads: Optional[str] = ...,
+        lag_s: Optional[npt.ArrayLike] = ...,
+        sun: Optional[npt.ArrayLike] = ...,
     ) -> None: ...
     # (len(HEADS), 3, len(MODEL_TERMS)) arcsec
     @property
@@ -53,6 +59,9 @@ class Model:
     @property
     def lag_s(self) -> npt.NDArray[np.float64]:
         """The bench's lag per head, float64 (4,): [head 'A'..'D'] s, 0 none (the model file's lag_s column; its terms take the head's temperatures through a first-order lag; docs/contract.md)."""
+    @property
+    def sun(self) -> npt.NDArray[np.float64]:
+        """The Sun term, float64 (4, 3, 3): [head 'A'..'D'][alpha, beta, gamma][x, y, z of the Sun's direction in the head's frame], arcsec, 0 none (the model file's sun_x, sun_y, sun_z; docs/contract.md)."""
     def write(self, path: _Path) -> None:
         """Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike."""
     def to_csv(self) -> str:
@@ -197,6 +206,7 @@ def fit(
     mountings: Optional[dict[str, Any]] = ...,
     common_rotation: Optional[str] = ...,
     lag: Union[str, float] = ...,
+    sun_term: str = ...,
 ) -> tuple[Model, dict[str, Any]]:
     """Fit the thermal model as `ascorr fit` (the paper's procedure; see docs/ground.md),
     with its defaults and checks. terms: 'linear' or 'quadratic' (also c1_2, c2_2, c3_2;
@@ -210,13 +220,15 @@ def fit(
     moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
     (as --common-rotation; None: 'combined' with mountings, 'smallest' without); lag: the
     bench's lag, as --lag: 'auto' (chosen on the held-out part, none unless the data
-    support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s). Returns
+    support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s);
+    sun_term: 'auto' (the Sun term fitted inside the orbit, taken when the held-out part
+    supports it: the model's sun) or 'none', as --sun-term. Returns
     (model, report): model an ascorr.Model (model.write(path) writes the model file),
     report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
     dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
     rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
     (len(heads), 3) arcsec [head][alpha, beta, gamma], lag (auto's verdict, '' with a lag
-    given), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+    given), sun (sun_term='auto''s verdict, '' with 'none'), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
     determine the model (period shorter than min_days, fewer than min_orbits orbits,
     condition number above max_condition, too small a temperature range for quadratic
     terms) or a setting is out of its range; its text, and the report's, name the settings

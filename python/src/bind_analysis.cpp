@@ -144,13 +144,15 @@ py::dict stats(const py::object& t, const py::object& chu, const py::object& q, 
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     std::optional<ThermalModel<double>> core_model;
     std::optional<host::LaggedTemperatures> lag;
+    std::optional<SunTermModel<double>> sun;
     if (m != nullptr) {
         core_model = host::to_core<double>(*m);
         lag = host::lagged_temperatures(host::head_lags(*m), source_of(r));  // as `ascorr stats --model`
+        sun = host::sun_term_if_any(m);
     }
     std::ostringstream log;
-    const host::StatsResult s =
-        host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log, lag ? &*lag : nullptr);
+    const host::StatsResult s = host::compute_stats(opt, source_of(r), core_model ? &*core_model : nullptr, log,
+                                                    lag ? &*lag : nullptr, sun ? &*sun : nullptr);
     py::dict pairs;
     py::dict systematic;
     for (std::size_t p = 0; p < s.pairs.count; ++p) {
@@ -198,7 +200,7 @@ std::string keyword_value(const std::string& name, const std::string& text, std:
         i = v;
         return "='" + value + "'";
     }
-    if (name != "terms" && name != "holdout" && name != "lag") {
+    if (name != "terms" && name != "holdout" && name != "lag" && name != "sun_term") {
         return {};
     }
     std::size_t v = i + 1;
@@ -207,7 +209,8 @@ std::string keyword_value(const std::string& name, const std::string& text, std:
         ++v;
     }
     const std::string value = text.substr(i + 1, v - i - 1);
-    if ((name == "terms" && (value == "linear" || value == "quadratic")) || (name == "lag" && value == "auto")) {
+    if ((name == "terms" && (value == "linear" || value == "quadratic")) || (name == "lag" && value == "auto") ||
+        (name == "sun_term" && (value == "auto" || value == "none"))) {
         i = v;
         return "='" + value + "'";
     }
@@ -273,7 +276,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
               const py::object& max_condition, const py::object& orbit_period, const py::object& terms,
               const py::object& holdout, const py::object& min_temperature_range, const py::object& frame_heads,
               const py::object& heads, const py::object& mountings, const py::object& common_rotation,
-              const py::object& lag) {
+              const py::object& lag, const py::object& sun_term) {
     host::FitOptions opt;
     opt.in = kArrayRows;
     opt.from = time_arg(t_from, "t_from");
@@ -308,6 +311,8 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
         static_cast<host::CommonRotationId&>(*opt.common_rotation) = *id;
     }
     opt.lag_s = lags_arg(lag);
+    opt.sun_term = choice_arg(sun_term, "sun_term", {"auto", "none"}) == "auto" ? host::SunTermChoice::kAuto
+                                                                                : host::SunTermChoice::kNone;
     const Rows r = rows_of(t, chu, q, temps, v, flags, confidence);
     const host::FitReport rep = [&] {
         try {
@@ -349,6 +354,7 @@ py::tuple fit(const py::object& t, const py::object& chu, const py::object& q, c
     d["terms"] = host::terms_name(rep.terms);
     d["common_rotation"] = host::common_rotation_name(rep.common_rotation);
     d["lag"] = rep.lag.verdict;
+    d["sun"] = rep.sun.verdict;
     d["text"] = as_keywords(host::describe(rep));
     return py::make_tuple(py::cast(rep.model), d);
 }
@@ -366,7 +372,8 @@ void bind_analysis(py::module_& mod) {
             "orbit_period"_a = py::none(), "terms"_a = "linear", "holdout"_a = host::kDefaultHoldout,
             "min_temperature_range"_a = host::kDefaultMinTemperatureRange,
             "frame_heads"_a = host::frame_heads_text(host::kDefaultFrameHeads), "heads"_a = py::none(),
-            "mountings"_a = py::none(), "common_rotation"_a = py::none(), "lag"_a = "auto", docstring(docs::kFit));
+            "mountings"_a = py::none(), "common_rotation"_a = py::none(), "lag"_a = "auto", "sun_term"_a = "auto",
+            docstring(docs::kFit));
 }
 
 }  // namespace ascorr::python

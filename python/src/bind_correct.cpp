@@ -39,6 +39,22 @@ namespace {
 // Below this many rows per thread a thread costs more than it saves.
 constexpr std::size_t kRowsPerThread = 16384;
 
+// The rows' velocities from the states asked in time order, as by `ascorr correct`.
+template <typename T>
+host::StatesVelocityTable<T> velocity_table(const Rows& r, const host::StatesFile& states, double max_propagation_s) {
+    std::vector<std::int64_t> times;
+    SolutionRecord rec;
+    TtTime t{};
+    for (py::ssize_t i = 0; i < r.n; ++i) {
+        record_of(r, i, rec);
+        if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
+            times.push_back(t.us);
+        }
+    }
+    return host::StatesVelocityTable<T>(states, host::service_config(max_propagation_s), std::move(times),
+                                        host::worker_count(static_cast<std::size_t>(r.n), kRowsPerThread));
+}
+
 template <typename T>
 void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, const host::StatesFile* states,
                   double max_propagation_s, double* q_out, std::uint16_t* st_out) {
@@ -46,23 +62,14 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
     if (m != nullptr) {
         model = host::to_core<T>(*m);
     }
+    // Refused but with the scalar double (check_model_for_scalar).
+    const std::optional<SunTermModel<double>> sun = host::sun_term_if_any(m);
     const CorrectionConfig<T> cfg{aberration, model ? &*model : nullptr};
+    const SunTermModel<double>* sun_term = sun ? &*sun : nullptr;
     py::gil_scoped_release unlocked;
-    // The rows' velocities from the states asked in time order, as by `ascorr correct`.
-    std::optional<host::StatesVelocityTable<T>> table;
-    if (states != nullptr && aberration) {
-        std::vector<std::int64_t> times;
-        SolutionRecord rec;
-        TtTime t{};
-        for (py::ssize_t i = 0; i < r.n; ++i) {
-            record_of(r, i, rec);
-            if (rec.velocity_components == 0 && tt_from_seconds(rec.t, t)) {
-                times.push_back(t.us);
-            }
-        }
-        table.emplace(*states, host::service_config(max_propagation_s), std::move(times),
-                      host::worker_count(static_cast<std::size_t>(r.n), kRowsPerThread));
-    }
+    const std::optional<host::StatesVelocityTable<T>> table = states != nullptr && aberration
+                                                                  ? velocity_table<T>(r, *states, max_propagation_s)
+                                                                  : std::optional<host::StatesVelocityTable<T>>{};
     // A lagged model's heads: their temperatures through the lag, as by `ascorr correct`.
     const std::optional<host::LaggedTemperatures> lag =
         m != nullptr ? host::lagged_temperatures(host::head_lags(*m), source_of(r)) : std::nullopt;
@@ -79,7 +86,7 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
             if (lag && cfg.thermal != nullptr) {
                 lag->apply(rec);
             }
-            put_row(host::correct_row(rec, &earth, cfg, service ? &*service : nullptr), i, q_out, st_out);
+            put_row(host::correct_row(rec, &earth, cfg, service ? &*service : nullptr, sun_term), i, q_out, st_out);
         }
     });
 }

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -59,7 +60,54 @@ void lags_into(const py::object& lag_s, host::ModelFile& m) {
     }
 }
 
-host::ModelFile model_from(const py::object& coefficients, const py::object& heads, const py::object& lag_s) {
+// sun: None (no Sun term) or (@N_HEADS@, 3, 3) arcsec, each axis within the core's domain.
+void sun_into(const py::object& sun, host::ModelFile& m) {
+    if (sun.is_none()) {
+        return;
+    }
+    const py::array a = as_numpy(sun);
+    const char kind = a.dtype().kind();
+    if ((kind != 'f' && kind != 'i' && kind != 'u') || a.ndim() != 3 || a.shape(0) != py::ssize_t{kMaxHeads} ||
+        a.shape(1) != py::ssize_t{kModelAxes} || a.shape(2) != py::ssize_t{kSunComponents}) {
+        bad_argument("sun", "expected real numbers of shape (" + std::to_string(kMaxHeads) +
+                                ", 3, 3) (head, axis alpha/beta/gamma, x/y/z) or None, got " + shape_text(a) +
+                                " of dtype " + std::string(py::str(a.dtype())));
+    }
+    const Doubles d = Doubles::ensure(a);
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
+            std::array<double, kSunComponents>& s = m.sun[h][ax];
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                s[c] = d.data()[(h * kModelAxes + ax) * kSunComponents + c];
+            }
+            const std::string why = host::sun_axis_problem(s);
+            const std::string where =
+                std::string("head ") + head_letter(static_cast<std::uint8_t>(h)) + " " + host::kAxisNames[ax] + ": ";
+            if (!why.empty()) {
+                bad_argument("sun", where + why);
+            }
+            if (!m.present[h] && (s[0] != 0.0 || s[1] != 0.0 || s[2] != 0.0)) {
+                bad_argument("sun", where + "the head has no coefficients (heads): its Sun term must be 0");
+            }
+        }
+    }
+}
+
+py::array_t<double> model_sun(const host::ModelFile& m) {
+    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{kModelAxes}, py::ssize_t{kSunComponents}});
+    double* p = a.mutable_data();
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                *p++ = m.sun[h][ax][c];
+            }
+        }
+    }
+    return a;
+}
+
+host::ModelFile model_from(const py::object& coefficients, const py::object& heads, const py::object& lag_s,
+                           const py::object& sun) {
     const py::array a = as_numpy(coefficients);
     const char kind = a.dtype().kind();
     if (kind != 'f' && kind != 'i' && kind != 'u') {
@@ -105,6 +153,7 @@ host::ModelFile model_from(const py::object& coefficients, const py::object& hea
         m.present[h] = true;
     }
     lags_into(lag_s, m);
+    sun_into(sun, m);
     return m;
 }
 
@@ -135,20 +184,22 @@ py::array_t<double> model_lags(const host::ModelFile& m) {
 }
 
 // Pickling: (coefficients (heads, 3, 7), heads, quadratic, common_rotation,
-// lag_s), rebuilt by Model(); a state of three (pickled before the rule had a
-// name) is the rule 'smallest', one of four (before the lag) has no lag.
+// lag_s, sun), rebuilt by Model(); a state of three (pickled before the rule
+// had a name) is the rule 'smallest', one of four (before the lag) has no
+// lag, one of five (before the Sun term) no Sun term.
 py::tuple model_state(const host::ModelFile& m) {
     return py::make_tuple(model_coefficients(m), model_heads(m), m.quadratic,
-                          host::common_rotation_name(m.common_rotation), model_lags(m));
+                          host::common_rotation_name(m.common_rotation), model_lags(m), model_sun(m));
 }
 
 host::ModelFile model_from_state(const py::tuple& state) {
-    if (state.size() < 3 || state.size() > 5) {
+    if (state.size() < 3 || state.size() > 6) {
         throw py::value_error(
-            "ascorr.Model: a pickled state is (coefficients, heads, quadratic, common_rotation, lag_s)");
+            "ascorr.Model: a pickled state is (coefficients, heads, quadratic, common_rotation, lag_s, sun)");
     }
-    const py::object lag_s = state.size() == 5 ? py::object(state[4]) : py::object(py::none());
-    host::ModelFile m = model_from(state[0], state[1], lag_s);
+    const py::object lag_s = state.size() >= 5 ? py::object(state[4]) : py::object(py::none());
+    const py::object sun = state.size() == 6 ? py::object(state[5]) : py::object(py::none());
+    host::ModelFile m = model_from(state[0], state[1], lag_s, sun);
     m.quadratic = state[2].cast<bool>();
     if (state.size() >= 4) {
         const std::optional<host::CommonRotationId> rule =
@@ -169,7 +220,8 @@ constexpr const char* kSelf = "ascorr.Model";
 
 void bind_model(py::module_& mod) {
     py::class_<host::ModelFile>(mod, "Model", docstring(docs::kModel))
-        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none(), "lag_s"_a = py::none())
+        .def(py::init(&model_from), "coefficients"_a, "heads"_a = py::none(), "lag_s"_a = py::none(),
+             "sun"_a = py::none())
         .def_property_readonly(
             "coefficients", [](const py::object& self) { return model_coefficients(model_of(self, kSelf)); },
             docstring(docs::kModelCoefficients))
@@ -186,6 +238,8 @@ void bind_model(py::module_& mod) {
         .def_property_readonly(
             "lag_s", [](const py::object& self) { return model_lags(model_of(self, kSelf)); },
             docstring(docs::kModelLag))
+        .def_property_readonly(
+            "sun", [](const py::object& self) { return model_sun(model_of(self, kSelf)); }, docstring(docs::kModelSun))
         .def(
             "write",
             [](const py::object& self, const py::object& path) {
@@ -212,7 +266,7 @@ void bind_model(py::module_& mod) {
             }
             const host::ModelFile& m = self.cast<const host::ModelFile&>();
             return "<ascorr.Model heads='" + model_heads(m) + "'" + (m.quadratic ? " quadratic" : "") +
-                   (host::has_lag(m) ? " lagged" : "") + ">";
+                   (host::has_lag(m) ? " lagged" : "") + (host::has_sun_term(m) ? " with a Sun term" : "") + ">";
         });
 
     mod.def(

@@ -127,6 +127,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
                 host::refuse_lag_to_learn(*m, "the model given", "lag='auto'");
             }
             host::refuse_other_lag(*m, "the model given", lag_s);
+            host::refuse_sun_term(*m, "the model given", host::kSunTermNotLearnt);
         } catch (const std::runtime_error& e) {
             bad_argument("model", e.what());
         }

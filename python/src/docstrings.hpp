@@ -28,7 +28,9 @@ indexed [head @HEAD_LETTERS@][axis alpha, beta, gamma][@TERMS@],
 in arcsec, arcsec/degC and arcsec/degC^2; heads: the heads that have
 coefficients (a head not listed gets status 256 in correct()); lag_s: None
 or @N_HEADS@ numbers [head @HEAD_LETTERS@], the bench's lag in s of each head, 0 (none) or
-in [1, 86400] (the model file's lag_s column).)doc";
+in [1, 86400] (the model file's lag_s column); sun: None or the Sun term's
+coefficients, shape (@N_HEADS@, 3, 3) [head][alpha, beta, gamma][x, y, z of the Sun's
+direction in the head's frame], arcsec (the model file's sun_x, sun_y, sun_z).)doc";
 
 inline constexpr const char* kModelCoefficients =
     "Coefficients, float64 (@N_HEADS@, 3, @N_TERMS@): [head @HEAD_LETTERS@][alpha, beta, gamma][@TERMS@], arcsec (a "
@@ -42,6 +44,9 @@ inline constexpr const char* kModelCommonRotation =
 inline constexpr const char* kModelLag =
     "The bench's lag per head, float64 (@N_HEADS@,): [head @HEAD_LETTERS@] s, 0 none (the model file's lag_s "
     "column; its terms take the head's temperatures through a first-order lag; docs/contract.md).";
+inline constexpr const char* kModelSun =
+    "The Sun term, float64 (@N_HEADS@, 3, 3): [head @HEAD_LETTERS@][alpha, beta, gamma][x, y, z of the Sun's "
+    "direction in the head's frame], arcsec, 0 none (the model file's sun_x, sun_y, sun_z; docs/contract.md).";
 inline constexpr const char* kModelWrite =
     "Write the model file (docs/contract.md), atomically: the whole file or nothing. path: str or os.PathLike.";
 inline constexpr const char* kModelToCsv = "The model file's text.";
@@ -157,13 +162,15 @@ to all heads, which no IBA sees, is then fixed so that the heads' combined attit
 moves least; common_rotation: the rule for it, 'combined', 'smallest' or 'rigid-X'
 (as --common-rotation; None: 'combined' with mountings, 'smallest' without); lag: the
 bench's lag, as --lag: 'auto' (chosen on the held-out part, none unless the data
-support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s). Returns
+support one), a number of s for every head, or 'X:TAU,...' (the model's lag_s);
+sun_term: 'auto' (the Sun term fitted inside the orbit, taken when the held-out part
+supports it: the model's sun) or 'none', as --sun-term. Returns
 (model, report): model an ascorr.Model (model.write(path) writes the model file),
 report a dict (rows (of the heads fitted), rows_other_heads (left out by heads),
 dropped, epochs, orbits_used, condition, singular_values, terms, common_rotation (the
 rule's name), heads (the letters of the heads fitted), residual_rms and signal_rms
 (len(heads), 3) arcsec [head][alpha, beta, gamma], lag (auto's verdict, '' with a lag
-given), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
+given), sun (sun_term='auto''s verdict, '' with 'none'), text). Raises ascorr.FitRefused (a ValueError) when the data cannot
 determine the model (period shorter than min_days, fewer than min_orbits orbits,
 condition number above max_condition, too small a temperature range for quadratic
 terms) or a setting is out of its range; its text, and the report's, name the settings

@@ -325,7 +325,7 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
     assert list(model.lag_s) == [900.0, 0.0, 1800.0, 0.0]
     assert "lagged" in repr(model)
     assert pickle.loads(pickle.dumps(model)) == model
-    assert ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s) == model
+    assert ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s, sun=model.sun) == model
     assert ascorr.Model(model.coefficients, model.heads) != model
 
     corrected = tmp_path / "corrected.csv"
@@ -358,6 +358,65 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
         ascorr.fit(*as_args(d), min_days=20, lag="A:900,A:1")
     with pytest.raises(ValueError, match="lag_s"):
         ascorr.Model(model.coefficients, model.heads, lag_s=[1e6, 0, 0, 0])
+
+
+@pytest.fixture(scope="module")
+def sun_mission(exe, tmp_path_factory):
+    """40 days of a bench that lags by 900 s and turns with the Sun along the orbit (0.8 arcsec), every 120 s."""
+    path = tmp_path_factory.mktemp("sun_mission") / "sun.csv"
+    run_cli(exe, "simulate", "--out", path, "--days", 40, "--step", 120, "--seed", 3, "--bench-lag", 900,
+            "--orbit-term", 0.8)
+    return path
+
+
+def test_fit_sun_term_and_correct_are_ascorr_fit_and_correct(exe, sun_mission, tmp_path):
+    """sun_term= as --sun-term; the model's Sun term corrects and scores as `ascorr correct` and `stats --model`
+    do, to the bit; Model(sun=) and pickling keep it; the scalars and self_calibrate that do not take it refuse it."""
+    import pickle
+
+    d = ascorr.read_solutions(str(sun_mission))
+    out = tmp_path / "sun_model.csv"
+    run_cli(exe, "fit", "--in", sun_mission, "--out", out, "--min-days", 20)
+    model, report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=20)
+    assert model.to_csv() == out.read_text()
+    assert report["sun"].startswith("taken: "), report["sun"]
+    assert "sun_term='auto'" in report["text"] and "--" not in report["text"]
+    assert model.sun.shape == (4, 3, 3) and np.abs(model.sun[:3]).max() > 0.01 and not model.sun[3].any()
+    assert "with a Sun term" in repr(model)
+    assert pickle.loads(pickle.dumps(model)) == model
+    again = ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s, sun=model.sun)
+    assert again == model and ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s) != model
+    none, none_report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=20, sun_term="none")
+    assert not none.sun.any() and none_report["sun"] == ""
+
+    corrected = tmp_path / "corrected.csv"
+    run_cli(exe, "correct", "--in", sun_mission, "--model", out, "--out", corrected)
+    header, rows = read_csv_text(corrected)
+    q, status = ascorr.correct(*as_args(d), model=ascorr.read_model(str(out)))
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    assert [int(r[header.index("status")]) for r in rows] == list(status)
+    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
+    assert all(same) and len(same) > 0.9 * len(rows)
+    q_none, _ = ascorr.correct(*as_args(d), model=ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s))
+    assert np.abs(q_none - q).max() > 1e-7  # the term is applied
+
+    cli_stats = json.loads(run_cli(exe, "stats", "--in", sun_mission, "--model", out, "--json").stdout)
+    py_stats = ascorr.stats(*as_args(d), d["flags"], d["confidence"], model=model)
+    for pair, v in cli_stats["pairs"].items():
+        assert py_stats["pairs"][pair]["thermal"] == pytest.approx(v["thermal"], abs=1e-6), pair
+
+    with pytest.raises(ValueError, match="model.*Sun term.*evaluated in double only"):
+        ascorr.correct(*as_args(d), model=model, scalar="float")
+    with pytest.raises(ValueError, match="model.*does not learn a Sun term yet"):
+        ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model)
+    bad = model.sun.copy()
+    bad[0, 0] = [1800.0, -1800.0, 1.0]
+    with pytest.raises(ValueError, match="sun.*head A alpha.*3601 arcsec is beyond"):
+        ascorr.Model(model.coefficients, model.heads, sun=bad)
+    with pytest.raises(ValueError, match="sun.*shape"):
+        ascorr.Model(model.coefficients, model.heads, sun=np.zeros((4, 3)))
+    with pytest.raises(ValueError, match="sun_term"):
+        ascorr.fit(*as_args(d), min_days=20, sun_term="yes")
 
 
 def self_calibrated_as_by_the_cli(exe, mission, tmp_path, lag):

@@ -417,7 +417,8 @@ def test_fit_takes_terms_holdout_and_min_temperature_range_as_the_command_line(e
     assert model.to_csv() == out.read_text()
     assert model == ascorr.read_model(str(out))
     assert "--" not in report["text"] and "terms='quadratic'" in report["text"]
-    as_keywords = cli.stdout.replace("--terms quadratic", "terms='quadratic'").replace("--lag auto", "lag='auto'")
+    as_keywords = (cli.stdout.replace("--terms quadratic", "terms='quadratic'").replace("--lag auto", "lag='auto'")
+                   .replace("--sun-term auto", "sun_term='auto'"))
     assert as_keywords.replace("--lag", "lag") == report["text"]
     # The defaults are the command line's: linear, holdout 0.25, 2 degC.
     linear = tmp_path / "linear.csv"

@@ -153,6 +153,7 @@ FitReport fit_choosing_lag(const FitOptions& opt, const RowSource& rows) {
     } catch (const FitRefused& e) {
         r.lag.lag_s = {};
         r.lag.verdict += std::string("; but the fit with them is refused (") + e.what() + "): no lag";
+        r.sun.verdict = "not fitted: it was to follow the lagged fit, which is refused";
         return r;
     }
 }
@@ -542,6 +543,28 @@ void fill_motion(const FitOptions& opt, HeadMask heads, CommonRotation& rule) {
     }
 }
 
+// --sun-term auto: the Sun term fitted inside the orbit after the model
+// written, taken when the held-out part supports it (fit_sun.hpp).
+void choose_sun_term(const FitOptions& opt, Pass& p) {
+    FitReport& r = p.r;
+    const std::size_t scored = r.terms == Terms::kQuadratic ? 1 : 0;
+    const bool held_out =
+        opt.holdout > 0.0 && r.selection.models.size() > scored && r.selection.models[scored].fit.refused.empty();
+    SunSearchInput in;
+    in.epochs = &p.fit_epochs;
+    in.model = &r.model;
+    in.model_before_split = held_out ? &r.selection.models[scored].fit.model : nullptr;
+    in.heads = r.heads;
+    in.frame_heads = r.frame_heads;
+    in.period = *p.period;
+    in.t_split = r.selection.t_split;
+    in.rule = r.common_rotation;
+    r.sun = select_sun_term(in);
+    if (r.sun.taken) {
+        r.model.sun = r.sun.fit.sun;
+    }
+}
+
 // The fit of the orbit averages against the heads' orientations N_i in F,
 // refused as solve_terms says; then the model-selection report.
 void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& averages, const std::string& period_text) {
@@ -600,6 +623,10 @@ void solve(const FitOptions& opt, Pass& p, const std::vector<OrbitAverage>& aver
     r.model = r.fit.model;
     if (r.common_rotation.rule != CommonRotationRule::kSmallest) {
         r.model.common_rotation = r.common_rotation;  // a file without the column: smallest
+    }
+    if (opt.sun_term == SunTermChoice::kAuto && opt.selection_report &&
+        (p.lag_search == nullptr || !pipeline::any_lagged(r.lag.lag_s))) {  // else the lagged pass decides
+        choose_sun_term(opt, p);
     }
 }
 
@@ -742,6 +769,9 @@ std::string describe(const FitReport& r) {
     o << describe_lag(r.model);
     if (!r.lag.verdict.empty()) {
         o << "bench lag (--lag auto): " << r.lag.verdict << "\n";
+    }
+    if (!r.sun.verdict.empty()) {
+        o << "Sun term (--sun-term auto): " << r.sun.verdict << "\n";
     }
     const auto rank = static_cast<std::size_t>(r.fit.rank);
     text::c_snprintf(buf, sizeof buf,

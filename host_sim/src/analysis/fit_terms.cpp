@@ -6,10 +6,13 @@
 #include <cstdarg>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "ascorr/calib/common_rotation.hpp"
 #include "ascorr/core/correct.hpp"
+#include "ascorr/core/sun_term.hpp"
+#include "ascorr/nav/sun_direction.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
 
@@ -461,32 +464,54 @@ TermsFit solve_terms(const std::vector<OrbitAverage>& orbits, const HeadOrientat
     return f;
 }
 
+double mean_pair_rms(const std::array<Rms, kMaxPairs>& r, const PairList& pairs) {
+    double sum = 0.0;
+    for (std::size_t p = 0; p < pairs.count; ++p) {
+        if (r[p].n == 0) {
+            return std::numeric_limits<double>::quiet_NaN();
+        }
+        sum += r[p].rms;
+    }
+    return sum / static_cast<double>(pairs.count);
+}
+
+SolutionInput<double> thermal_input(const FitEpoch& e, std::size_t h) {
+    SolutionInput<double> in{};
+    in.q_chu_icrf = e.q_chu_icrf[h];
+    in.head = static_cast<std::uint8_t>(h);
+    in.temperatures.t_chu = {ScalarTraits<double>::celsius(e.temp[h][0]), true};
+    in.temperatures.t_029 = {ScalarTraits<double>::celsius(e.temp[h][1]), true};
+    in.temperatures.t_032 = {ScalarTraits<double>::celsius(e.temp[h][2]), true};
+    in.velocity.valid = false;
+    return in;
+}
+
 std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
                                              double to, const ModelFile& m) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
+    std::optional<SunTermModel<double>> sun;
+    if (has_sun_term(m)) {
+        sun = sun_term_of<double>(m);
+    }
     const HeadList list = heads_of(heads);
     const PairList pairs = pairs_of(heads);
     std::array<std::vector<double>, kMaxPairs> t;
     std::array<std::vector<double>, kMaxPairs> v;
     for (const FitEpoch& e : epochs) {
-        if (!(e.t >= from && e.t < to)) {
-            continue;
+        Vector3<double> s_icrf{};
+        if (!(e.t >= from && e.t < to) || (sun && !nav::sun_direction_icrf(e.t, s_icrf))) {
+            continue;  // a model with a Sun term corrects only where the Sun's direction is known
         }
         std::array<Vector3<double>, kMaxHeads> z{};
         std::array<bool, kMaxHeads> ok{};
         for (std::size_t i = 0; i < list.count; ++i) {
             const std::size_t h = list.head[i];
-            SolutionInput<double> in{};
-            in.q_chu_icrf = e.q_chu_icrf[h];
-            in.head = static_cast<std::uint8_t>(h);
-            in.temperatures.t_chu = {ScalarTraits<double>::celsius(e.temp[h][0]), true};
-            in.temperatures.t_029 = {ScalarTraits<double>::celsius(e.temp[h][1]), true};
-            in.temperatures.t_032 = {ScalarTraits<double>::celsius(e.temp[h][2]), true};
-            in.velocity.valid = false;
-            const CorrectedSolution<double> c = correct_solution(in, thermal_only);
+            const CorrectedSolution<double> c = correct_solution(thermal_input(e, h), thermal_only);
             ok[h] = (c.status & status::kThermalApplied) != 0U;
-            z[h] = boresight(c.q_chu_icrf);
+            z[h] = boresight(sun ? with_sun_term(c.q_chu_icrf, sun_term_rotation(*sun, static_cast<std::uint8_t>(h),
+                                                                                 c.q_chu_icrf, s_icrf))
+                                 : c.q_chu_icrf);
         }
         for (std::size_t p = 0; p < pairs.count; ++p) {
             const auto i = pairs.pair[p].first;
@@ -511,14 +536,7 @@ namespace {
 // A model's held-out IBA RMS, mean over the pairs; NaN when a pair has no
 // held-out epoch.
 double mean_held_out_rms(const ModelScore& m, const PairList& pairs) {
-    double sum = 0.0;
-    for (std::size_t p = 0; p < pairs.count; ++p) {
-        if (m.out[p].n == 0) {
-            return std::numeric_limits<double>::quiet_NaN();
-        }
-        sum += m.out[p].rms;
-    }
-    return sum / static_cast<double>(pairs.count);
+    return mean_pair_rms(m.out, pairs);
 }
 
 }  // namespace

@@ -123,6 +123,7 @@ std::string truth_name(const std::string& path) {
 ModelFile truth_model(const std::string& path, HeadMask heads) {
     ModelFile truth_file = path.empty() ? table2_model() : read_model_file(path);
     refuse_lagged_model(truth_file, path, "a truth model takes no lag: --bench-lag lags the simulated bench");
+    refuse_sun_term(truth_file, path, "a truth model takes none: --orbit-term gives the simulated bench one");
     for (std::size_t h = 0; h < kOwnHeads; ++h) {
         if (!truth_file.present[h]) {
             throw std::invalid_argument((path.empty() ? std::string("truth model") : path) +

@@ -13,6 +13,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/simulate.hpp"
+#include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/selection.hpp"
@@ -213,12 +214,14 @@ StatsResult compute_stats(const StatsOptions& opt, std::ostream& log) {
         for_each_solution(opt.in, fn, "stats");
     };
     std::optional<LaggedTemperatures> lag;
+    std::optional<SunTermModel<double>> sun;
     if (!opt.model.empty()) {
         const ModelFile m = read_model_file(opt.model);
         model = to_core<double>(m);
         lag = lagged_temperatures(head_lags(m), rows);  // as `correct` lags them
+        sun = sun_term_if_any(&m);
     }
-    return compute_stats(o, rows, model ? &*model : nullptr, log, lag ? &*lag : nullptr);
+    return compute_stats(o, rows, model ? &*model : nullptr, log, lag ? &*lag : nullptr, sun ? &*sun : nullptr);
 }
 
 namespace {
@@ -277,10 +280,26 @@ struct StatsPass {
 
 constexpr PairList kAllPairs = pairs_of(kAllHeads);
 
+// c, the thermal stage's output, with the model's Sun term (sun, nullptr:
+// none) applied as `correct` applies it (correct_row.hpp); where the Sun's
+// direction is unknown, ab (the aberration stage's) with status 128.
+CorrectedSolution<double> with_sun(const CorrectedSolution<double>& c, const CorrectedSolution<double>& ab,
+                                   const SunTermModel<double>* sun, const SolutionRecord& rec) {
+    if (sun == nullptr || (c.status & status::kThermalApplied) == 0U) {
+        return c;
+    }
+    const SunAtRow s = sun_at_row(sun, rec.t);
+    if (!s.known) {
+        return {ab.q_chu_icrf, static_cast<StatusBits>(ab.status | status::kThermalOutOfRange)};
+    }
+    return {with_sun_term(c.q_chu_icrf, sun_term_rotation(*sun, rec.head, c.q_chu_icrf, s.s_icrf)), c.status};
+}
+
 // The pass over the rows: epochs complete with the heads seen so far (none
 // given), or with `heads`, keeping those handed on.
 StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                    const LaggedTemperatures* lag, std::optional<HeadMask> heads, std::ostream& log) {
+                    const LaggedTemperatures* lag, const SunTermModel<double>* sun, std::optional<HeadMask> heads,
+                    std::ostream& log) {
     const CorrectionConfig<double> ab_only{true, nullptr};
     const CorrectionConfig<double> both{true, model};
     EarthVelocity earth;
@@ -305,7 +324,7 @@ StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const Therma
         row.clean = is_clean(rec);
         const SolutionInput<double> in = to_core_input<double>(rec, &earth);
         const CorrectedSolution<double> c1 = correct_solution(in, ab_only);
-        const CorrectedSolution<double> c2 = correct_solution(lagged_input(rec, lag, in), both);
+        const CorrectedSolution<double> c2 = with_sun(correct_solution(lagged_input(rec, lag, in), both), c1, sun, rec);
         if (row.clean && !corrected(c1.status, c2.status, model != nullptr)) {
             diag.report("not corrected", text::input_name(opt.in) + ":" + std::to_string(rec.line) +
                                              ": clean row the core did not correct (status " +
@@ -329,7 +348,7 @@ StatsPass read_pass(const StatsOptions& opt, const RowSource& rows, const Therma
 }  // namespace
 
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                          std::ostream& log, const LaggedTemperatures* lag) {
+                          std::ostream& log, const LaggedTemperatures* lag, const SunTermModel<double>* sun) {
     StatsResult r;
     r.thermal = model != nullptr && !opt.corrected_input;
     r.corrected_input = opt.corrected_input;
@@ -344,9 +363,9 @@ StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const 
     // epoch or hides a second row of a head in one (the first reading's
     // diagnostics are dropped, the second's are the same).
     std::ostringstream first_log;
-    StatsPass pass = read_pass(opt, rows, model, lag, std::nullopt, first_log);
+    StatsPass pass = read_pass(opt, rows, model, lag, sun, std::nullopt, first_log);
     if (pass.late) {
-        pass = read_pass(opt, rows, model, lag, pass.with_rows, log);
+        pass = read_pass(opt, rows, model, lag, sun, pass.with_rows, log);
     } else {
         log << first_log.str();
     }

@@ -46,8 +46,9 @@ std::string where(const std::string& file, const SolutionRecord& rec) {
 
 // Explains, once per affected row, the status bits that mean "bad input".
 template <typename T, typename Sink>
-void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits st, const std::string& file,
+void explain(const SolutionRecord& rec, const RowCorrection<T>& row, StatusBits st, const std::string& file,
              Sink& diag) {
+    const SolutionInput<T>& in = row.in;
     if ((st & status::kRejected) != 0U) {
         std::string why;
         switch (check_solution(in)) {
@@ -101,7 +102,11 @@ void explain(const SolutionRecord& rec, const SolutionInput<T>& in, StatusBits s
                         " C (t_chu=" + number_text(rec.temperature[0]) + ", t_029=" + number_text(rec.temperature[1]) +
                         ", t_032=" + number_text(rec.temperature[2]) + "): thermal skipped");
     }
-    if ((st & status::kThermalOutOfRange) != 0U) {
+    if (row.sun_unknown) {
+        diag.report("thermal out of range", where(file, rec) +
+                                                "t outside the Sun ephemeris' span (2000-2051): the model's Sun "
+                                                "term cannot be evaluated: thermal skipped (status 128)");
+    } else if ((st & status::kThermalOutOfRange) != 0U) {
         diag.report("thermal out of range",
                     where(file, rec) + "model angle beyond 1 degree for these temperatures: thermal skipped");
     }
@@ -146,6 +151,7 @@ struct Job {
     const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
     const LaggedTemperatures* lag;        // the model's lagged heads; nullptr: none
     const LagSchedule* learnt_lag;        // --lag auto: the lag the self-calibration took; nullptr: none
+    const SunTermModel<double>* sun;      // the model's Sun term; nullptr: none
     bool keep_rows;                       // a sink takes the corrected rows
 };
 
@@ -240,7 +246,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
         const RowCorrection<T> row =
-            correct_row(as_terms_take(job, cfg, rec, lagged), &earth, cfg, states ? &*states : nullptr);
+            correct_row(as_terms_take(job, cfg, rec, lagged), &earth, cfg, states ? &*states : nullptr, job.sun);
         const StatusBits st = row.status;
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);
@@ -248,7 +254,7 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
         // A states row whose 32 comes from the service is explained by
         // explain_service(); a 32 from the core itself (speed, Sun distance) by explain().
         const bool service_invalid = row.from_states && (row.service & status::kVelocityInvalid) != 0U;
-        explain(rec, row.in, service_invalid ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
+        explain(rec, row, service_invalid ? static_cast<StatusBits>(st & ~status::kVelocityInvalid) : st, opt.in,
                 res.diag);
         if ((st & status::kRejected) != 0U) {
             job.writer.row(reader, std::nullopt, st, res.out);  // the input text, unchanged
@@ -443,6 +449,7 @@ std::optional<ThermalModel<T>> read_model(const CorrectOptions& opt, std::option
             refuse_lag_to_learn(*model_file, opt.model, "--lag auto");
         }
         refuse_other_lag(*model_file, opt.model, run_lags(opt.lag_s, model_file));
+        refuse_sun_term(*model_file, opt.model, kSunTermNotLearnt);
     }
     return to_core<T>(*model_file);
 }
@@ -575,6 +582,8 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
+    // (Refused with --self-calibrate and with the scalars but double: read_model.)
+    const std::optional<SunTermModel<double>> sun = sun_term_if_any(model_file);
     const Job<T> job{opt,
                      cfg,
                      header,
@@ -585,6 +594,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
                      sc ? &sc->schedule : nullptr,
                      lag ? &*lag : nullptr,
                      learnt_lag_of(sc),
+                     sun ? &*sun : nullptr,
                      sink != nullptr};
 
     AtomicFile& out = outputs["--out"];
@@ -636,6 +646,9 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
 }  // namespace
 
 void check_model_for_scalar(const ModelFile& m, ScalarKind scalar, const std::string& path) {
+    if (scalar != ScalarKind::kDouble) {
+        refuse_sun_term(m, path, "it is evaluated in double only, on the ground (the scalar double)");
+    }
     if (scalar == ScalarKind::kFixed) {
         check_fixed_point_range(m, path);
     } else if (scalar == ScalarKind::kFloat) {

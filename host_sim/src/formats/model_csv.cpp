@@ -32,6 +32,7 @@ namespace {
 constexpr std::string_view kRigidPrefix = "rigid-";
 constexpr const char* kCommonRotationColumn = "common_rotation";
 constexpr const char* kLagColumn = "lag_s";
+constexpr const char* kSunColumns[kSunComponents] = {"sun_x", "sun_y", "sun_z"};
 }  // namespace
 
 bool lag_acceptable(double lag_s) noexcept {
@@ -56,6 +57,27 @@ void refuse_lagged_model(const ModelFile& m, const std::string& path, const std:
     if (has_lag(m)) {
         throw std::runtime_error(text::input_name(path) +
                                  ": the model's lag_s makes its terms take lagged temperatures: " + why);
+    }
+}
+
+std::string sun_axis_problem(const std::array<double, kSunComponents>& sun) {
+    for (std::size_t c = 0; c < kSunComponents; ++c) {
+        if (!std::isfinite(sun[c])) {
+            return std::string(kSunColumns[c]) + " = " + number_text(sun[c]) + " is not a finite number";
+        }
+    }
+    const double largest = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
+    if (!(largest <= kMaxThermalAngleRad * kRadToArcsec)) {
+        return "the Sun term's |sun_x| + |sun_y| + |sun_z| = " + number_text(largest) +
+               " arcsec is beyond a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) + " arcsec";
+    }
+    return {};
+}
+
+void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why) {
+    if (has_sun_term(m)) {
+        throw std::runtime_error(text::input_name(path) +
+                                 ": the model has a Sun term (its sun_x, sun_y, sun_z): " + why);
     }
 }
 
@@ -176,12 +198,15 @@ void refuse_unknown_columns(const Header& header, const std::string& file_name) 
         for (const char* c : kCoefficientNames) {
             known = known || name == c;
         }
+        for (const char* c : kSunColumns) {
+            known = known || name == c;
+        }
         if (!known) {
             throw text::InputError(file_name, 1, column,
                                    "unknown column '" + name + "' (a model has chu, axis, " +
                                        coefficient_columns(0, kLinearModelTerms, ", ") + " and, for a quadratic one, " +
                                        coefficient_columns(kLinearModelTerms, kModelTerms, ", ") +
-                                       "; optionally common_rotation and lag_s)");
+                                       "; optionally common_rotation, lag_s and sun_x, sun_y, sun_z)");
         }
         column += name.size() + 1;
     }
@@ -287,6 +312,43 @@ void read_lag(const std::string& file_name, std::size_t n, std::string_view fiel
     m.lag_s[head] = *x;
 }
 
+// The Sun term's columns: all three or none (-1 each).
+std::array<int, kSunComponents> sun_columns(const Header& header, const std::string& file_name) {
+    std::array<int, kSunComponents> col{};
+    int found = 0;
+    for (std::size_t c = 0; c < kSunComponents; ++c) {
+        col[c] = header.index(kSunColumns[c]);
+        found += col[c] >= 0 ? 1 : 0;
+    }
+    if (found != 0 && found != kSunComponents) {
+        throw text::InputError(file_name, 1, 1, "the Sun term needs all three columns sun_x, sun_y, sun_z");
+    }
+    return col;
+}
+
+// The Sun term's three fields of line n into sun (arcsec), each a finite
+// number, their magnitudes' sum (the axis' largest angle) within the core's
+// domain of a thermal angle (kMaxThermalAngleRad).
+void read_sun(const std::string& file_name, std::size_t n, const std::array<int, kSunComponents>& col,
+              const std::vector<std::string_view>& fields, const std::vector<std::size_t>& starts,
+              std::array<double, kSunComponents>& sun) {
+    for (std::size_t c = 0; c < kSunComponents; ++c) {
+        const auto i = static_cast<std::size_t>(col[c]);
+        const auto x = parse_double(fields[i]);
+        if (!x || !std::isfinite(*x)) {
+            throw text::InputError(file_name, n, starts[i] + 1,
+                                   std::string("column '") + kSunColumns[c] + "': " +
+                                       (x ? "expected a finite number, got '" + std::string(fields[i]) + "'"
+                                          : why_not_a_number(fields[i])));
+        }
+        sun[c] = *x;
+    }
+    const std::string why = sun_axis_problem(sun);
+    if (!why.empty()) {
+        throw text::InputError(file_name, n, starts[static_cast<std::size_t>(col[0])] + 1, why);
+    }
+}
+
 }  // namespace
 
 ModelFile parse_model(const std::string& file_name, std::string_view text) {
@@ -314,6 +376,7 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
     }
     const int col_rule = header.index(kCommonRotationColumn);
     const int col_lag = header.index(kLagColumn);
+    const std::array<int, kSunComponents> col_sun = sun_columns(header, file_name);
     bool first_row = true;
     bool seen[kMaxHeads][3] = {};
     std::vector<std::string_view> fields;
@@ -338,6 +401,9 @@ ModelFile parse_model(const std::string& file_name, std::string_view text) {
         if (col_lag >= 0) {
             const auto c = static_cast<std::size_t>(col_lag);
             read_lag(file_name, n, fields[c], starts[c] + 1, head, seen[head][0] || seen[head][1] || seen[head][2], m);
+        }
+        if (col_sun[0] >= 0) {
+            read_sun(file_name, n, col_sun, fields, starts, m.sun[head][static_cast<std::size_t>(axis)]);
         }
         first_row = false;
         seen[head][axis] = true;
@@ -375,6 +441,10 @@ std::string format_model(const ModelFile& m) {
     if (lag_column) {
         out.insert(out.size() - 1, std::string(",") + kLagColumn);
     }
+    const bool sun_column = has_sun_term(m);
+    if (sun_column) {
+        out.insert(out.size() - 1, std::string(",") + kSunColumns[0] + "," + kSunColumns[1] + "," + kSunColumns[2]);
+    }
     char buf[64];
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         if (!m.present[h]) {
@@ -395,6 +465,10 @@ std::string format_model(const ModelFile& m) {
             if (lag_column) {
                 // %.17g: the lag survives a write/read round trip exactly (an integer reads as one).
                 text::c_snprintf(buf, sizeof buf, ",%.17g", m.lag_s[h]);
+                out += buf;
+            }
+            for (std::size_t c = 0; sun_column && c < kSunComponents; ++c) {
+                text::c_snprintf(buf, sizeof buf, ",%.16e", m.sun[h][a][c]);
                 out += buf;
             }
             out += '\n';

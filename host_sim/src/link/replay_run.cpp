@@ -61,6 +61,7 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
         return std::nullopt;
     }
     ModelFile mf = read_model_file(opt.model);
+    refuse_sun_term(mf, opt.model, "the target does not evaluate it yet (correct evaluates it on the ground)");
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
         refuse_other_lag(mf, opt.model, run_lags(opt.lag_s, mf));

@@ -57,6 +57,7 @@
 
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/fit_lag.hpp"
+#include "ascorr_host/analysis/fit_sun.hpp"
 #include "ascorr_host/analysis/fit_terms.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/formats/atomic_file.hpp"
@@ -113,6 +114,10 @@ struct FitOptions {
     // default): chosen on the held-out part (fit_lag.hpp), none without one
     // (holdout 0 or no selection report).
     std::optional<std::array<double, kMaxHeads>> lag_s;
+    // --sun-term: auto (the default) fits the Sun term inside the orbit and
+    // takes it when the held-out part supports it (fit_sun.hpp; never without
+    // one: holdout 0 or no selection report); none: no Sun term.
+    SunTermChoice sun_term = SunTermChoice::kAuto;
 };
 
 // --lag's text: "auto" (nullopt), "TAU" (every head) or "X:TAU,Y:TAU" (heads
@@ -149,6 +154,7 @@ struct FitReport {
     TermsFit fit;                    // the written model's fit: centring, rank
     Selection selection;             // the model-selection report
     LagSelection lag;                // --lag auto's choice (verdict empty with a --lag given)
+    SunSelection sun;                // --sun-term auto's choice (verdict empty with none)
 };
 
 // Refusal of the data given (too short, too few orbits, rank-deficient, for

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/correct.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr_host/analysis/iba.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
@@ -115,11 +116,18 @@ struct FitEpoch {
     std::array<double, kMaxHeads> t_head{};  // each head's row's own t (within the epoch's millisecond)
 };
 
+// Head h of epoch e as the core's input to its thermal stage alone (no velocity).
+SolutionInput<double> thermal_input(const FitEpoch& e, std::size_t h);
+
 // IBA RMS per pair of `heads` (pairs_of, by position) of the epochs with t in
-// [from, to), thermally corrected by m (the core, double). Epochs the core
+// [from, to), thermally corrected by m (the core, double; its Sun term too,
+// core/sun_term.hpp, where the Sun's direction is known). Epochs the core
 // does not correct are left out. epochs must be sorted by t.
 std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
                                              double to, const ModelFile& m);
+
+// The mean over `pairs` of their RMS; NaN when a pair has no epoch.
+double mean_pair_rms(const std::array<Rms, kMaxPairs>& r, const PairList& pairs);
 
 struct ModelScore {
     TermsFit fit;                      // fitted on the part of the period before t_split

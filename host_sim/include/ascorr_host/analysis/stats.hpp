@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/core/sun_term.hpp"
 #include "ascorr/core/thermal.hpp"
 #include "ascorr_host/analysis/epochs.hpp"
 #include "ascorr_host/analysis/iba.hpp"
@@ -78,9 +79,11 @@ bool is_clean(const SolutionRecord& rec) noexcept;
 StatsResult compute_stats(const StatsOptions& opt, std::ostream& log);
 // The same on rows from elsewhere (opt.in names them in messages; opt.model is
 // not read: model, nullptr for no thermal stage; lag, a lagged model's table
-// over the same rows (lagged_temperatures.hpp), nullptr for none).
+// over the same rows (lagged_temperatures.hpp), nullptr for none; sun, the
+// model's Sun term, nullptr for none).
 StatsResult compute_stats(const StatsOptions& opt, const RowSource& rows, const ThermalModel<double>* model,
-                          std::ostream& log, const LaggedTemperatures* lag = nullptr);
+                          std::ostream& log, const LaggedTemperatures* lag = nullptr,
+                          const SunTermModel<double>* sun = nullptr);
 
 // Whether pair p has an RMS at stage st: two clean epochs at least (the RMS
 // of one epoch about itself is 0, not a measurement) and, for the thermal

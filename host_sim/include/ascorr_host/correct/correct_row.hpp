@@ -17,6 +17,7 @@
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/core/quaternion.hpp"
+#include "ascorr/core/sun_term.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -30,20 +31,34 @@ struct RowCorrection {
     Quaternion<double> q_chu_icrf;  // corrected; the input exactly when status has kRejected
     bool from_states;               // the velocity came from the states (the row had none)
     StatusBits service;             // then the service's bits (0: a usable velocity)
+    bool sun_unknown;               // the model's Sun term could not be evaluated: thermal skipped (128)
 };
+
+// The Sun's direction at a row's t for a model with a Sun term (sun, nullptr:
+// none; core/sun_term.hpp): known is false where the term cannot be
+// evaluated (t outside nav/sun_direction.hpp's span, 2000-2051); the row's
+// thermal stage is then skipped with status 128 (kThermalOutOfRange: the
+// model's angle outside its domain), by correct_row and by stats.
+struct SunAtRow {
+    bool known = true;
+    Vector3<double> s_icrf{};
+};
+SunAtRow sun_at_row(const SunTermModel<double>* sun, double t);
 
 // earth: used when the aberration stage is on (cfg.aberration) and the row
 // has its velocity; states: nullptr without --states (one per thread: it
-// keeps the service's state between rows).
+// keeps the service's state between rows); sun: the model's Sun term, applied
+// in double after the core where its thermal stage was (callers refuse a Sun
+// term with the float and fixed scalars: check_model_for_scalar).
 template <typename T>
 RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
-                             StatesVelocity<T>* states);
-
+                             StatesVelocity<T>* states, const SunTermModel<double>* sun = nullptr);
 extern template RowCorrection<double> correct_row(const SolutionRecord&, EarthVelocity*,
-                                                  const CorrectionConfig<double>&, StatesVelocity<double>*);
+                                                  const CorrectionConfig<double>&, StatesVelocity<double>*,
+                                                  const SunTermModel<double>*);
 extern template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<float>&,
-                                                 StatesVelocity<float>*);
+                                                 StatesVelocity<float>*, const SunTermModel<double>*);
 extern template RowCorrection<Q30> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<Q30>&,
-                                               StatesVelocity<Q30>*);
+                                               StatesVelocity<Q30>*, const SunTermModel<double>*);
 
 }  // namespace ascorr::host

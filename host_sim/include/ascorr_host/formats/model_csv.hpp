@@ -7,6 +7,9 @@
 // constant of the head's bench lag in seconds, the same on its three rows; 0
 // or absent: no lag. A lagged head's terms take its temperatures through the
 // lag (ascorr/pipeline/temperature_lag.hpp; lagged_temperatures.hpp).
+// Optionally sun_x,sun_y,sun_z (after lag_s, all three or none; absent = 0):
+// the Sun term's coefficients of the axis, arcsec per unit of the Sun's
+// direction's component in the head's frame (ascorr/core/sun_term.hpp).
 // One row per head and axis; a head that appears must have all three axes.
 // Values are arcsec and arcsec/°C (°C²) in the file; to_core() converts them to
 // the core's radians (ascorr/core/model_coefficients.hpp).
@@ -20,6 +23,7 @@
 
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/model_coefficients.hpp"
+#include "ascorr/core/sun_term.hpp"
 #include "ascorr/core/thermal.hpp"
 #include "ascorr/pipeline/head_lags.hpp"
 
@@ -70,6 +74,9 @@ struct ModelFile {
     // By head index: the bench's lag in s (0 none, else within
     // [pipeline::kMinLagTauS, kMaxLagTauS]); a column lag_s when any is not 0.
     std::array<double, kMaxHeads> lag_s{};
+    // sun[head][axis][m]: the Sun term's coefficients in arcsec (core/sun_term.hpp);
+    // columns sun_x, sun_y, sun_z when any head's is not 0.
+    std::array<std::array<std::array<double, kSunComponents>, kModelAxes>, kMaxHeads> sun{};
     // Where each head and axis was read (1-based line) and each coefficient
     // (1-based character column); 0 for a model not read from a file.
     std::array<std::array<std::size_t, kModelAxes>, kMaxHeads> line{};
@@ -89,6 +96,55 @@ inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
 inline bool has_lag(const ModelFile& m) noexcept {
     return pipeline::any_lagged(head_lags(m));
 }
+// Whether a head the model has carries a Sun term.
+inline bool has_sun_term(const ModelFile& m) noexcept {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
+            for (const double c : m.sun[h][a]) {
+                if (c != 0.0) {
+                    return true;
+                }
+            }
+        }
+    }
+    return false;
+}
+// What is wrong with one axis' Sun term (a coefficient not finite, or the
+// largest angle |sun_x| + |sun_y| + |sun_z| beyond a thermal angle's 3600″:
+// the core's domain); empty when nothing is.
+std::string sun_axis_problem(const std::array<double, kSunComponents>& sun);
+// Throws (naming the model's file, then `why`) when the model has a Sun
+// term: for the consumers that do not evaluate it yet.
+void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why);
+// Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
+inline constexpr const char* kSunTermNotLearnt =
+    "the self-calibration does not learn a Sun term yet: start it from a model without one";
+// The Sun term in the core's units (radians), for scalar T.
+template <typename T>
+SunTermModel<T> sun_term_of(const ModelFile& m) {
+    SunTermModel<T> out{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        out.present[h] = m.present[h];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                out.coefficient[h][a][c] = static_cast<T>(m.sun[h][a][c] * kArcsecToRad);
+            }
+        }
+    }
+    return out;
+}
+
+// The model's Sun term in double, when it has one (m nullptr: none).
+inline std::optional<SunTermModel<double>> sun_term_if_any(const ModelFile* m) {
+    if (m == nullptr || !has_sun_term(*m)) {
+        return std::nullopt;
+    }
+    return sun_term_of<double>(*m);
+}
+inline std::optional<SunTermModel<double>> sun_term_if_any(const std::optional<ModelFile>& m) {
+    return sun_term_if_any(m ? &*m : nullptr);
+}
+
 // The heads' lags of a run (correct, replay): `given` (--lag), otherwise the
 // model's (head_lags), otherwise none.
 inline std::array<double, kMaxHeads> run_lags(const std::optional<std::array<double, kMaxHeads>>& given,
