@@ -21,17 +21,24 @@ using namespace pybind11::literals;
 
 namespace {
 
-py::array_t<double> model_coefficients(const host::ModelFile& m) {
-    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{kModelAxes}, py::ssize_t{kModelTerms}});
+// Numbers per head, axis and K columns (the terms' or the Sun term's) as a
+// (heads, 3, K) array, a copy.
+template <std::size_t K>
+py::array_t<double> per_head_and_axis(const std::array<std::array<std::array<double, K>, kModelAxes>, kMaxHeads>& x) {
+    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{kModelAxes}, static_cast<py::ssize_t>(K)});
     double* p = a.mutable_data();
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
         for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
-            for (std::size_t c = 0; c < kModelTerms; ++c) {
-                *p++ = m.coefficients[h][ax][c];
+            for (std::size_t c = 0; c < K; ++c) {
+                *p++ = x[h][ax][c];
             }
         }
     }
     return a;
+}
+
+py::array_t<double> model_coefficients(const host::ModelFile& m) {
+    return per_head_and_axis(m.coefficients);
 }
 
 // lag_s: None (no head lags) or @N_HEADS@ numbers, each 0 or a lag the model file takes.
@@ -94,16 +101,7 @@ void sun_into(const py::object& sun, host::ModelFile& m) {
 }
 
 py::array_t<double> model_sun(const host::ModelFile& m) {
-    py::array_t<double> a({py::ssize_t{kMaxHeads}, py::ssize_t{kModelAxes}, py::ssize_t{kSunComponents}});
-    double* p = a.mutable_data();
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t ax = 0; ax < kModelAxes; ++ax) {
-            for (std::size_t c = 0; c < kSunComponents; ++c) {
-                *p++ = m.sun[h][ax][c];
-            }
-        }
-    }
-    return a;
+    return per_head_and_axis(m.sun);
 }
 
 host::ModelFile model_from(const py::object& coefficients, const py::object& heads, const py::object& lag_s,

@@ -308,6 +308,20 @@ def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, 
         ascorr.self_calibrate(*as_args(d), model=hist[-1]["model"], lag="auto")
 
 
+def corrected_as_by_the_cli(exe, mission, model_path, d, tmp_path):
+    """correct(model=read_model(path)) and `ascorr correct --model path` on the same rows (d, read from
+    mission): the same status and corrections to the bit; (q, status)."""
+    corrected = tmp_path / "corrected.csv"
+    run_cli(exe, "correct", "--in", mission, "--model", model_path, "--out", corrected)
+    header, rows = read_csv_text(corrected)
+    q, status = ascorr.correct(*as_args(d), model=ascorr.read_model(str(model_path)))
+    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
+    assert [int(r[header.index("status")]) for r in rows] == list(status)
+    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
+    assert all(same) and len(same) > 0.9 * len(rows)
+    return q, status
+
+
 def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_path):
     """lag= as --lag (auto, a number, X:TAU); the lagged model corrects the rows as
     `ascorr correct` does, to the bit, in any row order; Model(lag_s=) and pickling keep it."""
@@ -328,14 +342,7 @@ def test_fit_lag_and_correct_are_ascorr_fit_and_correct(exe, lag_mission, tmp_pa
     assert ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s, sun=model.sun) == model
     assert ascorr.Model(model.coefficients, model.heads) != model
 
-    corrected = tmp_path / "corrected.csv"
-    run_cli(exe, "correct", "--in", lag_mission, "--model", out, "--out", corrected)
-    header, rows = read_csv_text(corrected)
-    q, status = ascorr.correct(*as_args(d), model=ascorr.read_model(str(out)))
-    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
-    assert [int(r[header.index("status")]) for r in rows] == list(status)
-    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
-    assert all(same) and len(same) > 0.9 * len(rows)
+    q, status = corrected_as_by_the_cli(exe, lag_mission, out, d, tmp_path)
     # Reversed rows: the same corrections, reversed.
     rev = [np.asarray(a)[::-1].copy() for a in as_args(d)]
     q_rev, status_rev = ascorr.correct(*rev, model=model)
@@ -389,14 +396,7 @@ def test_fit_sun_term_and_correct_are_ascorr_fit_and_correct(exe, sun_mission, t
     none, none_report = ascorr.fit(*as_args(d), d["flags"], d["confidence"], min_days=20, sun_term="none")
     assert not none.sun.any() and none_report["sun"] == ""
 
-    corrected = tmp_path / "corrected.csv"
-    run_cli(exe, "correct", "--in", sun_mission, "--model", out, "--out", corrected)
-    header, rows = read_csv_text(corrected)
-    q, status = ascorr.correct(*as_args(d), model=ascorr.read_model(str(out)))
-    cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
-    assert [int(r[header.index("status")]) for r in rows] == list(status)
-    same = [[f"{x:.15f}" for x in q[i]] == [r[c] for c in cols] for i, r in enumerate(rows) if not status[i] & 16]
-    assert all(same) and len(same) > 0.9 * len(rows)
+    q, status = corrected_as_by_the_cli(exe, sun_mission, out, d, tmp_path)
     q_none, _ = ascorr.correct(*as_args(d), model=ascorr.Model(model.coefficients, model.heads, lag_s=model.lag_s))
     assert np.abs(q_none - q).max() > 1e-7  # the term is applied
 
