@@ -292,46 +292,112 @@ TEST(SunTermConsumers, ThoseThatDoNotEvaluateItRefuseIt) {
     EXPECT_EQ(ok.exit_code, 0) << ok.err;
 }
 
-// A row whose t is beyond the Sun ephemeris' span (2051): with a Sun term
-// its thermal stage is skipped (128, named), without one it is applied.
+// Rows whose t is beyond the Sun ephemeris' span (2052): with a Sun term a
+// row whose thermal stage applies has it skipped (128, named); rows whose
+// stage would not apply keep their own bits (8 without temperatures, 256 for
+// a head the model does not have); without a Sun term the stage applies.
 TEST(SunTermRows, WhereTheSunIsNotKnownTheThermalStageIsSkippedAndNamed) {
     const fs::path dir = scratch_dir("sun-rows");
-    ASSERT_EQ(run_in("simulate --days 0.05 --out s.csv > /dev/null", dir).exit_code, 0);
     write(dir / "m.csv", sun_model());
     std::string plain = sun_model();
-    for (std::size_t at = plain.find(",0.5,-0.25,0.125"); at != std::string::npos;
-         at = plain.find(",0.5,-0.25,0.125")) {
-        plain.erase(at, std::string(",0.5,-0.25,0.125").size());
+    const std::string sun_fields = ",0.5,-0.25,0.125";
+    for (std::size_t at = plain.find(sun_fields); at != std::string::npos; at = plain.find(sun_fields)) {
+        plain.erase(at, sun_fields.size());
     }
     plain.replace(0, plain.find('\n'), "chu,axis,c0,c1,c2,c3");
     write(dir / "p.csv", plain);
-    std::size_t n = 0;
-    rewrite_csv_rows(dir / "s.csv", dir / "late.csv", [&](const std::string& line, std::ofstream& out) {
-        // The third data row moved to 2052 (t = 1.65e9 s); the others as they are.
-        out << (++n == 3 ? "1650000000" + line.substr(line.find(',')) : line) << '\n';
-    });
-    for (const char* model : {"m.csv", "p.csv"}) {
+    // t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz: in 2052 (line 2: A; 3: A without
+    // temperatures; 4: D, not in the model) and in 2025 (line 5: A).
+    const std::string q = ",0.5,0.5,0.5,0.5,";
+    write_lines(dir / "late.csv",
+                {"t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz", "1650000000,A" + q + "20,15,10,,,",
+                 "1650000000,A" + q + ",,,,,", "1650000000,D" + q + "20,15,10,,,", "800000000,A" + q + "20,15,10,,,"});
+    const auto statuses = [&](const char* model, std::string& err) {
         const CliRun r = run_in(std::string("correct --in late.csv --model ") + model + " --out c.csv", dir);
-        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        err = r.err;
+        std::vector<int> out;
         std::istringstream rows(slurp(dir / "c.csv"));
-        std::string header;
         std::string line;
-        std::getline(rows, header);
-        for (int k = 0; k < 3; ++k) {
-            std::getline(rows, line);
+        std::getline(rows, line);
+        while (std::getline(rows, line)) {
+            out.push_back(std::stoi(line.substr(line.rfind(',') + 1)));
         }
-        const std::string status = line.substr(line.rfind(',') + 1);
-        const bool sun = std::string(model) == "m.csv";
-        EXPECT_EQ((std::stoi(status) & 128) != 0, sun) << model << ": " << line;
-        EXPECT_EQ((std::stoi(status) & 2) != 0, !sun) << model << ": " << line;
-        EXPECT_EQ(has(r.err,
-                      "late.csv:4: t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot "
-                      "be evaluated: thermal skipped (status 128)"),
-                  sun)
-            << r.err;
-    }
+        return out;
+    };
+    std::string err;
+    // 4 + 32 + ...: no velocity given (4); 128 alone, 8, 256 as documented.
+    EXPECT_EQ(statuses("m.csv", err), (std::vector<int>{4 | 128, 4 | 8, 4 | 256, 4 | 2}));
+    EXPECT_TRUE(has(err,
+                    "late.csv:2: t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot "
+                    "be evaluated: thermal skipped (status 128)"))
+        << err;
+    EXPECT_FALSE(has(err, "late.csv:3: t outside")) << err;
+    EXPECT_FALSE(has(err, "late.csv:4: t outside")) << err;
+    EXPECT_EQ(statuses("p.csv", err), (std::vector<int>{4 | 2, 4 | 8, 4 | 256, 4 | 2}));
+    EXPECT_FALSE(has(err, "Sun term")) << err;
     Vector3<double> s{};
     EXPECT_FALSE(nav::sun_direction_icrf(1650000000.0, s));  // the premise
+    EXPECT_TRUE(nav::sun_direction_icrf(800000000.0, s));
+}
+
+// The rules for the rotation common to every head, which no IBA sees:
+// rigid-B leaves B exactly without a term; combined (with the mountings) makes
+// the heads' terms cancel in the full head set's combined attitude with the
+// mountings' weights, for every Sun direction.
+TEST(FitSun, TheCommonRotationRulesHoldForTheSunTerm) {
+    const fs::path& dir = orbit_mission();
+    ASSERT_EQ(
+        run_in("fit --in m.csv --min-days 20 --common-rotation rigid-B --out rigid.csv > rigid.txt", dir).exit_code, 0);
+    const host::ModelFile rigid = host::read_model_file((dir / "rigid.csv").string());
+    ASSERT_TRUE(host::has_sun_term(rigid));
+    for (std::size_t a = 0; a < kModelAxes; ++a) {
+        EXPECT_EQ(rigid.sun[1][a], (std::array<double, 3>{0.0, 0.0, 0.0})) << a;
+        EXPECT_NE(rigid.sun[0][a], (std::array<double, 3>{0.0, 0.0, 0.0})) << a;
+    }
+    // combined: each head's rotation moves the combined attitude by the
+    // combination's weight Mᵀ·diag(1/σc², 1/σc², 1/σa²) (the test's own, from
+    // the mountings file), and a Sun direction s_crf is M·s_crf in the head:
+    // the terms cancel for every Sun direction when Σ_h Mᵀ_h·D_h·S_h·M_h = 0.
+    ASSERT_EQ(
+        run_in("fit --in m.csv --min-days 20 --mountings m.csv.mountings.csv --out comb.csv > comb.txt", dir).exit_code,
+        0);
+    ASSERT_EQ(run_in("fit --in m.csv --min-days 20 --out smallest.csv > smallest.txt", dir).exit_code, 0);
+    std::istringstream mountings(slurp(dir / "m.csv.mountings.csv"));
+    std::string line;
+    std::getline(mountings, line);
+    std::array<Eigen::Matrix3d, 3> m_chu_crf{};
+    std::array<Eigen::Matrix3d, 3> weight{};
+    for (std::size_t h = 0; h < 3 && std::getline(mountings, line); ++h) {  // A, B, C in order
+        std::vector<double> f;
+        std::stringstream ss(line.substr(line.find(',') + 1));
+        for (std::string x; std::getline(ss, x, ',');) {
+            f.push_back(std::stod(x));
+        }
+        m_chu_crf[h] = Eigen::Quaterniond(f[0], f[1], f[2], f[3]).normalized().toRotationMatrix();
+        weight[h] = Eigen::Vector3d(1.0 / (f[4] * f[4]), 1.0 / (f[4] * f[4]), 1.0 / (f[5] * f[5])).asDiagonal();
+    }
+    // |Σ_h| over Σ_h |each|: 0 when the terms cancel, of order 1 when they do not.
+    const auto imbalance = [&](const std::string& file) {
+        const host::ModelFile m = host::read_model_file((dir / file).string());
+        Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+        double size = 0.0;
+        for (std::size_t h = 0; h < 3; ++h) {
+            Eigen::Matrix3d s_h;
+            for (std::size_t a = 0; a < 3; ++a) {
+                s_h.row(static_cast<Eigen::Index>(a)) = Eigen::Vector3d(m.sun[h][a][0], m.sun[h][a][1], m.sun[h][a][2]);
+            }
+            const Eigen::Matrix3d moved = m_chu_crf[h].transpose() * weight[h] * s_h * m_chu_crf[h];
+            sum += moved;
+            size += moved.norm();
+        }
+        return sum.norm() / size;
+    };
+    const double combined = imbalance("comb.csv");
+    EXPECT_LE(combined, 1e-3);
+    RecordProperty("combined_imbalance", std::to_string(combined));
+    // Mutation: the smallest coefficients (no mountings) move the combined attitude.
+    EXPECT_GT(imbalance("smallest.csv"), 0.05);
 }
 
 }  // namespace

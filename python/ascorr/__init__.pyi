@@ -69,7 +69,9 @@ class Model:
     # the same model file; Model pickles
     def __eq__(self, other: object) -> bool:
         """Equal when both would write the same model file (heads, coefficients, columns)."""
-    def __getstate__(self) -> tuple[npt.NDArray[np.float64], str, bool, str, npt.NDArray[np.float64]]: ...
+    def __getstate__(
+        self,
+    ) -> tuple[npt.NDArray[np.float64], str, bool, str, npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
     def __setstate__(self, state: tuple[Any, ...]) -> None: ...
 
 # Enumerations are names in any case ("GCRS" is "gcrs"), as on the command line.

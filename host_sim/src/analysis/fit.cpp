@@ -151,10 +151,14 @@ FitReport fit_choosing_lag(const FitOptions& opt, const RowSource& rows) {
         lagged.model.lag_s = head_lags(lagged.model);  // a head not fitted has none
         return lagged;
     } catch (const FitRefused& e) {
-        r.lag.lag_s = {};
-        r.lag.verdict += std::string("; but the fit with them is refused (") + e.what() + "): no lag";
-        r.sun.verdict = "not fitted: it was to follow the lagged fit, which is refused";
-        return r;
+        // The fit without a lag again, now with its Sun term (the first pass
+        // left it to the lagged fit).
+        LagSelection chosen = r.lag;
+        chosen.lag_s = {};
+        chosen.verdict += std::string("; but the fit with them is refused (") + e.what() + "): no lag";
+        FitReport plain = fit_pass(opt, rows, std::nullopt, fit_heads(opt, 0U), nullptr, nullptr);
+        plain.lag = chosen;
+        return plain;
     }
 }
 
@@ -547,18 +551,28 @@ void fill_motion(const FitOptions& opt, HeadMask heads, CommonRotation& rule) {
 // written, taken when the held-out part supports it (fit_sun.hpp).
 void choose_sun_term(const FitOptions& opt, Pass& p) {
     FitReport& r = p.r;
-    const std::size_t scored = r.terms == Terms::kQuadratic ? 1 : 0;
-    const bool held_out =
-        opt.holdout > 0.0 && r.selection.models.size() > scored && r.selection.models[scored].fit.refused.empty();
     SunSearchInput in;
     in.epochs = &p.fit_epochs;
     in.model = &r.model;
-    in.model_before_split = held_out ? &r.selection.models[scored].fit.model : nullptr;
     in.heads = r.heads;
     in.frame_heads = r.frame_heads;
     in.period = *p.period;
     in.t_split = r.selection.t_split;
     in.rule = r.common_rotation;
+    // Scored with the written terms fitted before the held-out part, or, when
+    // the data there refuse them (quadratic terms on a smaller range), the
+    // linear ones: the same polynomial on both sides of the comparison.
+    const std::vector<ModelScore>& before = r.selection.models;
+    const std::size_t written = r.terms == Terms::kQuadratic ? 1 : 0;
+    if (opt.holdout <= 0.0) {
+        in.no_split = "nothing held out (--holdout 0)";
+    } else if (before.size() > written && before[written].fit.refused.empty()) {
+        in.model_before_split = &before[written].fit.model;
+    } else if (!before.empty() && before[0].fit.refused.empty()) {
+        in.model_before_split = &before[0].fit.model;
+    } else {
+        in.no_split = "the polynomial cannot be fitted before the held-out part";
+    }
     r.sun = select_sun_term(in);
     if (r.sun.taken) {
         r.model.sun = r.sun.fit.sun;

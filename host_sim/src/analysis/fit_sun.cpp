@@ -9,6 +9,7 @@
 #include "ascorr/calib/head_rotation.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/sun_direction.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "ascorr_text/c_format.hpp"
 
 namespace ascorr::host {
@@ -198,6 +199,9 @@ private:
             const Eigen::Matrix3d n = n_of(list_.head[i]);
             s[list_.head[i]] += n * c * n.transpose();
         }
+        if (rule.rule == CommonRotationRule::kRigid) {
+            s[rule.rigid_head].setZero();  // exactly: the rounding of the sum is no term
+        }
     }
 
     HeadList list_;
@@ -225,6 +229,21 @@ ModelFile with_sun(const ModelFile& m, const SunCoefficients& s) {
     ModelFile out = m;
     out.sun = s;
     return out;
+}
+
+// Why a fitted term is beyond what a model may hold (sun_axis_problem), or empty.
+std::string outside_the_domain(const SunCoefficients& sun, HeadMask heads) {
+    const HeadList list = heads_of(heads);
+    for (std::size_t i = 0; i < list.count; ++i) {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            const std::string why = sun_axis_problem(sun[list.head[i]][a]);
+            if (!why.empty()) {
+                return std::string("head ") + head_name(static_cast<std::uint8_t>(list.head[i])) + " " + kAxisNames[a] +
+                       ": " + why;
+            }
+        }
+    }
+    return {};
 }
 
 std::string verdict_of(const SunSelection& s) {
@@ -270,15 +289,17 @@ SunSelection select_sun_term(const SunSearchInput& in) {
     const double inf = std::numeric_limits<double>::infinity();
     const PairList pairs = pairs_of(in.heads);
     if (in.model_before_split == nullptr) {
-        s.verdict = "none: nothing held out (--holdout 0)";
+        s.verdict = "none: " + in.no_split;
         return s;
     }
     const ModelFile before = polynomial_of(*in.model_before_split);
     const SunFit trial =
         fit_sun_term(*in.epochs, -inf, in.t_split, before, in.heads, in.frame_heads, in.period, in.rule);
-    s.none_rms = mean_pair_rms(corrected_iba_rms(*in.epochs, in.heads, in.t_split, inf, before), pairs);
-    s.sun_rms =
-        mean_pair_rms(corrected_iba_rms(*in.epochs, in.heads, in.t_split, inf, with_sun(before, trial.sun)), pairs);
+    const auto held_out_rms = [&](const ModelFile& m) {
+        return mean_pair_rms(corrected_iba_rms(*in.epochs, in.heads, in.t_split, inf, m, kWhereTheSunIsKnown), pairs);
+    };
+    s.none_rms = held_out_rms(before);
+    s.sun_rms = held_out_rms(with_sun(before, trial.sun));
     if (!(s.none_rms > 0.0 && s.sun_rms > 0.0)) {
         s.verdict = "none: a pair has no held-out epoch";
         return s;
@@ -290,6 +311,11 @@ SunSelection select_sun_term(const SunSearchInput& in) {
     if (s.taken) {
         s.fit =
             fit_sun_term(*in.epochs, -inf, inf, polynomial_of(*in.model), in.heads, in.frame_heads, in.period, in.rule);
+        const std::string why = outside_the_domain(s.fit.sun, in.heads);
+        if (!why.empty()) {
+            s.taken = false;
+            s.verdict += "; but the whole period's term is not taken: " + why;
+        }
     }
     return s;
 }

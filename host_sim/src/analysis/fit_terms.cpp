@@ -487,7 +487,7 @@ SolutionInput<double> thermal_input(const FitEpoch& e, std::size_t h) {
 }
 
 std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
-                                             double to, const ModelFile& m) {
+                                             double to, const ModelFile& m, bool where_the_sun_is_known) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
     std::optional<SunTermModel<double>> sun;
@@ -500,7 +500,8 @@ std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs
     std::array<std::vector<double>, kMaxPairs> v;
     for (const FitEpoch& e : epochs) {
         Vector3<double> s_icrf{};
-        if (!(e.t >= from && e.t < to) || (sun && !nav::sun_direction_icrf(e.t, s_icrf))) {
+        const bool sun_needed = sun || where_the_sun_is_known;
+        if (!(e.t >= from && e.t < to) || (sun_needed && !nav::sun_direction_icrf(e.t, s_icrf))) {
             continue;  // a model with a Sun term corrects only where the Sun's direction is known
         }
         std::array<Vector3<double>, kMaxHeads> z{};

@@ -285,7 +285,7 @@ constexpr PairList kAllPairs = pairs_of(kAllHeads);
 // direction is unknown, ab (the aberration stage's) with status 128.
 CorrectedSolution<double> with_sun(const CorrectedSolution<double>& c, const CorrectedSolution<double>& ab,
                                    const SunTermModel<double>* sun, const SolutionRecord& rec) {
-    if (sun == nullptr || (c.status & status::kThermalApplied) == 0U) {
+    if (sun == nullptr || (c.status & status::kThermalApplied) == 0U || !has_sun_term(*sun, rec.head)) {
         return c;
     }
     const SunAtRow s = sun_at_row(sun, rec.t);

@@ -18,14 +18,20 @@ template <typename T>
 RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
                              StatesVelocity<T>* states, const SunTermModel<double>* sun) {
     RowCorrection<T> r{to_core_input<T>(rec, cfg.aberration ? earth : nullptr), 0, rec.q_chu_icrf, false, 0, false};
-    const SunAtRow s = sun_at_row(cfg.thermal != nullptr ? sun : nullptr, rec.t);
-    r.sun_unknown = !s.known;
-    const CorrectionConfig<T> used{cfg.aberration, s.known ? cfg.thermal : nullptr};
     r.from_states = states != nullptr && cfg.aberration && rec.velocity_components == 0;
     const pipeline::VelocityAnswer<T> v =
         r.from_states ? pipeline::from_service(states->at(rec.t)) : pipeline::given_velocity(r.in.velocity);
     r.service = v.service;
-    const CorrectedSolution<T> c = pipeline::correct_stage(r.in, v, used);
+    CorrectedSolution<T> c = pipeline::correct_stage(r.in, v, cfg);
+    // A head with a Sun term whose thermal stage applied, where the Sun's
+    // direction is unknown: the stage is skipped (the aberration's result, 128).
+    const bool with_sun = sun != nullptr && (c.status & status::kThermalApplied) != 0U && has_sun_term(*sun, rec.head);
+    const SunAtRow s = sun_at_row(with_sun ? sun : nullptr, rec.t);
+    if (!s.known) {
+        c = pipeline::correct_stage(r.in, v, CorrectionConfig<T>{cfg.aberration, nullptr});
+        c.status |= status::kThermalOutOfRange;
+        r.sun_unknown = true;
+    }
     // A velocity given but unusable before the core (1 or 2 of vx,vy,vz, a time
     // outside the ephemeris): the core saw "not available", the row gets 4|32.
     r.status = host_status(rec, cfg.aberration, c.status);
@@ -34,9 +40,7 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
     }
     const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
     r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
-    if (r.sun_unknown) {
-        r.status |= status::kThermalOutOfRange;
-    } else if (sun != nullptr && (r.status & status::kThermalApplied) != 0U) {
+    if (with_sun && s.known) {
         r.q_chu_icrf = with_sun_term(r.q_chu_icrf, sun_term_rotation(*sun, rec.head, r.q_chu_icrf, s.s_icrf));
     }
     return r;

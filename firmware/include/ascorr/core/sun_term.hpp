@@ -12,7 +12,7 @@
 //  - Applied as the thermal stage is, on the CHU side: q ← q_sun ⊗ q with
 //    q_sun = thermal_rotation(angles). Applied after the polynomial's q_th it
 //    differs from the rotation of the summed angles by the two rotations'
-//    commutator, ≤ |θ_th|·|θ_sun|/2 rad (1.5e-4″ for 60″ and 2″).
+//    commutator, ≤ |θ_th|·|θ_sun|/2 rad (2.9e-4″ for 60″ and 2″).
 // Why the head's own frame: the Sun heats the bench by where it stands in the
 // spacecraft's frame, which on a nadir-pointing spacecraft is the orbital
 // frame (v̂, n̂, r̂) the study chose (bench/inside_orbit_terms.py), and every
@@ -41,6 +41,20 @@ struct SunTermModel {
     bool present[kMaxHeads];                               // false: the head has no Sun term
     T coefficient[kMaxHeads][kModelAxes][kSunComponents];  // rad per unit of s_chu's component
 };
+
+// Whether head h has a Sun term (a coefficient not 0): where it has none the
+// term is the identity and needs no Sun direction.
+template <typename T>
+constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcept {
+    constexpr T zero = constant<T>(0.0);
+    bool any = false;
+    for (std::uint8_t a = 0; head < kMaxHeads && m.present[head] && a < kModelAxes; ++a) {
+        for (std::uint8_t c = 0; c < kSunComponents; ++c) {
+            any = any || !(m.coefficient[head][a][c] == zero);
+        }
+    }
+    return any;
+}
 
 // v rotated by q: R(q)·v, the components in q's target frame of a vector
 // given in its source frame (q_b_a maps a into b). Unit q.

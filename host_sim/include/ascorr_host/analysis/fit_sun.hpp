@@ -20,19 +20,24 @@
 // the epochs are read once and not kept. The solution is the pseudo-inverse's
 // over the eigen-directions above kSunRankTolerance of the largest: three of
 // each head's nine do not vary inside the orbit (the orbit normal's component
-// of s, constant over an orbit on a nadir-pointing spacecraft), and nine are
-// the rotation common to every head, which no IBA sees; that one is then
-// fixed by the fit's rule (calib/common_rotation.hpp's three: the smallest
-// coefficients, the full head set's combined attitude unmoved by the term, or
-// a head rigid to the bench). The term's orbit mean along the orbit normal is
-// thereby left to the temperatures' polynomial.
+// of s, constant over an orbit on a nadir-pointing spacecraft), and of the
+// rotation common to every head, which no IBA sees, six more are in the
+// plane that does (3H + 6 unseen of 9H, rank 6H − 6: 12 of 27 for three
+// heads); the common rotation is then fixed by the fit's rule
+// (calib/common_rotation.hpp's three: the smallest coefficients, the full head
+// set's combined attitude unmoved by the term for every Sun direction, or a
+// head rigid to the bench, its coefficients exactly 0). The term's orbit mean
+// along the orbit normal is thereby left to the temperatures' polynomial.
 // Selection: the polynomial fitted before t_split (the selection report's, the
-// written model's terms) is scored on the epochs after it, without and with
-// the Sun term fitted on the same epochs before t_split, by the held-out IBA
-// RMS (mean over the pairs; fit_terms.hpp's corrected_iba_rms, which
-// evaluates the model's Sun term). The term fitted on the whole period is
-// taken when it lowers that RMS by more than kSunSelectionMargin; otherwise
-// the model is the polynomial's, byte for byte.
+// written model's terms, or the linear ones when the part before t_split
+// refuses those) is scored on the epochs after it, without and with the Sun
+// term fitted on the same epochs before t_split, by the held-out IBA RMS (mean
+// over the pairs; fit_terms.hpp's corrected_iba_rms, which evaluates the
+// model's Sun term; both sides on the epochs where the Sun's direction is
+// known). The term fitted on the whole period is taken when it lowers that
+// RMS by more than kSunSelectionMargin and its every axis is within the
+// core's domain (sun_axis_problem); otherwise the model is the polynomial's,
+// byte for byte.
 #pragma once
 
 #include <array>
@@ -83,7 +88,8 @@ struct SunSelection {
 struct SunSearchInput {
     const std::vector<FitEpoch>* epochs = nullptr;  // sorted by t
     const ModelFile* model = nullptr;               // the polynomial written (the whole period)
-    const ModelFile* model_before_split = nullptr;  // the same terms fitted before t_split; nullptr: none
+    const ModelFile* model_before_split = nullptr;  // the polynomial fitted before t_split; nullptr: none
+    std::string no_split;                           // then why not, for the verdict
     HeadMask heads = 0U;
     std::array<std::uint8_t, 2> frame_heads{};
     double period = 0.0;

@@ -123,8 +123,12 @@ SolutionInput<double> thermal_input(const FitEpoch& e, std::size_t h);
 // [from, to), thermally corrected by m (the core, double; its Sun term too,
 // core/sun_term.hpp, where the Sun's direction is known). Epochs the core
 // does not correct are left out. epochs must be sorted by t.
+// kWhereTheSunIsKnown: also without a Sun term, only the epochs where the Sun's
+// direction is known (nav/sun_direction.hpp), so that a model with one and a
+// model without it are scored on the same epochs.
+inline constexpr bool kWhereTheSunIsKnown = true;
 std::array<Rms, kMaxPairs> corrected_iba_rms(const std::vector<FitEpoch>& epochs, HeadMask heads, double from,
-                                             double to, const ModelFile& m);
+                                             double to, const ModelFile& m, bool where_the_sun_is_known = false);
 
 // The mean over `pairs` of their RMS; NaN when a pair has no epoch.
 double mean_pair_rms(const std::array<Rms, kMaxPairs>& r, const PairList& pairs);
