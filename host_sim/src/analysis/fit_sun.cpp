@@ -217,15 +217,8 @@ private:
     std::array<std::optional<Quaternion<double>>, kMaxHeads> reference_{};
 };
 
-// The model without its Sun term.
-ModelFile polynomial_of(const ModelFile& m) {
-    ModelFile p = m;
-    p.sun = {};
-    return p;
-}
-
-// The model with the Sun term s.
-ModelFile with_sun(const ModelFile& m, const SunCoefficients& s) {
+// The model with the Sun term s (none: its polynomial alone).
+ModelFile with_sun(const ModelFile& m, const SunCoefficients& s = {}) {
     ModelFile out = m;
     out.sun = s;
     return out;
@@ -292,7 +285,7 @@ SunSelection select_sun_term(const SunSearchInput& in) {
         s.verdict = "none: " + in.no_split;
         return s;
     }
-    const ModelFile before = polynomial_of(*in.model_before_split);
+    const ModelFile before = with_sun(*in.model_before_split);
     const SunFit trial =
         fit_sun_term(*in.epochs, -inf, in.t_split, before, in.heads, in.frame_heads, in.period, in.rule);
     const auto held_out_rms = [&](const ModelFile& m) {
@@ -309,8 +302,7 @@ SunSelection select_sun_term(const SunSearchInput& in) {
     s.fit = trial;
     s.verdict = verdict_of(s);
     if (s.taken) {
-        s.fit =
-            fit_sun_term(*in.epochs, -inf, inf, polynomial_of(*in.model), in.heads, in.frame_heads, in.period, in.rule);
+        s.fit = fit_sun_term(*in.epochs, -inf, inf, with_sun(*in.model), in.heads, in.frame_heads, in.period, in.rule);
         const std::string why = outside_the_domain(s.fit.sun, in.heads);
         if (!why.empty()) {
             s.taken = false;

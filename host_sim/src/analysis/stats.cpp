@@ -285,12 +285,12 @@ constexpr PairList kAllPairs = pairs_of(kAllHeads);
 // direction is unknown, ab (the aberration stage's) with status 128.
 CorrectedSolution<double> with_sun(const CorrectedSolution<double>& c, const CorrectedSolution<double>& ab,
                                    const SunTermModel<double>* sun, const SolutionRecord& rec) {
-    if (sun == nullptr || (c.status & status::kThermalApplied) == 0U || !has_sun_term(*sun, rec.head)) {
-        return c;
-    }
-    const SunAtRow s = sun_at_row(sun, rec.t);
-    if (!s.known) {
+    const RowSunTerm s = row_sun_term(sun, c.status, rec.head, rec.t);
+    if (s.unknown) {
         return {ab.q_chu_icrf, static_cast<StatusBits>(ab.status | status::kThermalOutOfRange)};
+    }
+    if (!s.apply) {
+        return c;
     }
     return {with_sun_term(c.q_chu_icrf, sun_term_rotation(*sun, rec.head, c.q_chu_icrf, s.s_icrf)), c.status};
 }

@@ -6,11 +6,13 @@
 
 namespace ascorr::host {
 
-SunAtRow sun_at_row(const SunTermModel<double>* sun, double t) {
-    SunAtRow s;
-    if (sun != nullptr) {
-        s.known = nav::sun_direction_icrf(t, s.s_icrf);
+RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status, std::uint8_t head, double t) {
+    RowSunTerm s;
+    if (sun == nullptr || (core_status & status::kThermalApplied) == 0U || !has_sun_term(*sun, head)) {
+        return s;
     }
+    s.apply = nav::sun_direction_icrf(t, s.s_icrf);
+    s.unknown = !s.apply;
     return s;
 }
 
@@ -23,11 +25,8 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
         r.from_states ? pipeline::from_service(states->at(rec.t)) : pipeline::given_velocity(r.in.velocity);
     r.service = v.service;
     CorrectedSolution<T> c = pipeline::correct_stage(r.in, v, cfg);
-    // A head with a Sun term whose thermal stage applied, where the Sun's
-    // direction is unknown: the stage is skipped (the aberration's result, 128).
-    const bool with_sun = sun != nullptr && (c.status & status::kThermalApplied) != 0U && has_sun_term(*sun, rec.head);
-    const SunAtRow s = sun_at_row(with_sun ? sun : nullptr, rec.t);
-    if (!s.known) {
+    const RowSunTerm s = row_sun_term(sun, c.status, rec.head, rec.t);
+    if (s.unknown) {  // the stage skipped: the aberration's result, 128
         c = pipeline::correct_stage(r.in, v, CorrectionConfig<T>{cfg.aberration, nullptr});
         c.status |= status::kThermalOutOfRange;
         r.sun_unknown = true;
@@ -40,7 +39,7 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
     }
     const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
     r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
-    if (with_sun && s.known) {
+    if (s.apply) {
         r.q_chu_icrf = with_sun_term(r.q_chu_icrf, sun_term_rotation(*sun, rec.head, r.q_chu_icrf, s.s_icrf));
     }
     return r;

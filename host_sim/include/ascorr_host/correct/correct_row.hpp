@@ -34,16 +34,19 @@ struct RowCorrection {
     bool sun_unknown;               // the model's Sun term could not be evaluated: thermal skipped (128)
 };
 
-// The Sun's direction at a row's t for a model with a Sun term (sun, nullptr:
-// none; core/sun_term.hpp): known is false where the term cannot be
-// evaluated (t outside nav/sun_direction.hpp's span, 2000-2051); the row's
-// thermal stage is then skipped with status 128 (kThermalOutOfRange: the
-// model's angle outside its domain), by correct_row and by stats.
-struct SunAtRow {
-    bool known = true;
+// What the model's Sun term (sun, nullptr: none; core/sun_term.hpp) does to
+// a row the core corrected with status core_status: nothing (the thermal
+// stage did not apply, or the head has no term), apply at s_icrf, or, where
+// the Sun's direction is unknown (t outside nav/sun_direction.hpp's span,
+// 2000-2051), skip the row's thermal stage with status 128
+// (kThermalOutOfRange: the model's angle outside its domain); for
+// correct_row and stats alike.
+struct RowSunTerm {
+    bool apply = false;
+    bool unknown = false;
     Vector3<double> s_icrf{};
 };
-SunAtRow sun_at_row(const SunTermModel<double>* sun, double t);
+RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status, std::uint8_t head, double t);
 
 // earth: used when the aberration stage is on (cfg.aberration) and the row
 // has its velocity; states: nullptr without --states (one per thread: it
