@@ -277,7 +277,8 @@ TEST(SunTermConsumers, ThoseThatDoNotEvaluateItRefuseIt) {
         {"correct --in s.csv --model m.csv --scalar fixed --out c.csv",
          "it is evaluated in double only, on the ground (the scalar double)"},
         {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
-         "the self-calibration does not learn a Sun term yet: start it from a model without one"},
+         "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
+         "model without one"},
         {"replay --target loopback-float --in s.csv --model m.csv --out c.csv",
          "the target does not evaluate it yet (correct evaluates it on the ground)"},
         {"simulate --days 0.1 --truth m.csv --out c.csv",

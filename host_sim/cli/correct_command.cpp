@@ -168,14 +168,25 @@ void add_correct_command(CLI::App& app) {
                   "order, starting from --model (version 0) or from none (rows before the first model: status 256)");
     cmd->add_option("--model-history", opt->model_history,
                     "with --self-calibrate: write every model that became active (CSV "
-                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin; common_rotation with --combined, lag_s with a lag)")
+                    "t,version,chu,axis,c0..c3,crc32c,tt_us,origin; common_rotation with --combined, lag_s with a lag, "
+                    "sun_x,sun_y,sun_z with a Sun term)")
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
         add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s, &opt->lag_auto);
+    CLI::Option* sun_term =
+        cmd->add_option("--sun-term", opt->sun_auto,
+                        "with --self-calibrate: auto (the Sun term, the rotation with the Sun's direction in the "
+                        "head's frame, learnt as the estimator runs and taken when it predicts the IBAs better; the "
+                        "history's sun_x, sun_y, sun_z) or none (default); the scalar double only")
+            ->transform(one_of<bool>({{"auto", true}, {"none", false}}))
+            ->type_name("NAME");
     auto combine = std::make_shared<CombineTexts>();
     add_combine_options(*cmd, *combine);
-    cmd->callback([opt, self_cal, combine]() {
+    cmd->callback([opt, self_cal, combine, sun_term]() {
         check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
+        if (!opt->self_calibrate && sun_term->count() > 0) {
+            throw CLI::ValidationError("--sun-term", host::kSunTermNeedsSelfCalibration);
+        }
         if (!combine->combined.empty()) {
             correct_and_combine(*opt, *combine);
             return;

@@ -257,6 +257,7 @@ def self_calibrate(
     orbit_period: Optional[float] = ...,
     mountings: Optional[dict[str, Any]] = ...,
     lag: Union[None, str, float] = ...,
+    sun_term: Literal["none", "auto"] = ...,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint16], list[_ActiveModel]]:
     """Correct with a thermal model the on-board estimator learns from the rows themselves, as
     `ascorr correct --self-calibrate`: causally in time order (any row order), from the
@@ -276,6 +277,10 @@ def self_calibrate(
     head; each model of the history has the lag taken when it became active (lag_s), and
     a head's rows are corrected with it from the first model that changed the head's lag,
     started afresh there.
+    sun_term: 'none' (default) or 'auto' (as correct --sun-term auto, from a model without a
+    Sun term or none; scalar='double' only): the Sun term is learnt as the estimator runs;
+    each model of the history has the term taken when it became active (its sun), and the
+    rows are corrected with it.
     Returns (q_corrected float64
     (n, 4), status uint16 (n,), history), history a list of {"t", "version", "crc32c",
     "model", "tt_us", "origin"} for every model that became active, in time order (tt_us: when,

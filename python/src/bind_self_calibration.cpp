@@ -37,7 +37,7 @@ namespace {
 template <typename T>
 py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double time_constant_days,
                               std::optional<double> orbit_period_s, const calib::CommonRotationWeights& rule,
-                              const std::array<double, kMaxHeads>& lag_s, bool learn_lag, double* q_out,
+                              const std::array<double, kMaxHeads>& lag_s, bool learn_lag, bool learn_sun, double* q_out,
                               std::uint16_t* st_out) {
     calib::EstimatorConfig cfg;
     cfg.time_constant_days = time_constant_days;
@@ -48,7 +48,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
     const host::SelfCalibration sc =
         host::self_calibrate<T>(kArrayRows, lag ? host::lagged_rows(rows, *lag) : rows,
                                 m != nullptr ? std::optional<host::ModelFile>(*m) : std::nullopt, cfg, orbit_period_s,
-                                host::kSelfCalibrationMemoryBytes, kMaxHeads, lag_s, learn_lag);
+                                host::kSelfCalibrationMemoryBytes, kMaxHeads, lag_s, learn_lag, learn_sun);
     const host::ModelSchedule<T> schedule(sc.history);
     // lag='auto': the lags the history's models took, as `ascorr correct --lag auto`.
     const std::optional<host::LagSchedule> learnt = learn_lag ? host::learnt_lags(sc.history, rows) : std::nullopt;
@@ -62,7 +62,7 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
             learnt->apply(rec);
         }
         const CorrectionConfig<T> c{true, &schedule.at(rec.t)};
-        put_row(host::correct_row<T>(rec, &earth, c, nullptr), i, q_out, st_out);
+        put_row(host::correct_row<T>(rec, &earth, c, nullptr, schedule.sun_at(rec.t)), i, q_out, st_out);
     }
     py::list history;
     for (const host::ActiveModel& a : sc.history) {
@@ -88,7 +88,8 @@ py::list self_calibrated_rows(const Rows& r, const host::ModelFile* m, double ti
 py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::object& q, const py::object& temps,
                          const py::object& v, const py::object& flags, const py::object& confidence,
                          const py::object& model, const py::object& scalar_obj, const py::object& time_constant_obj,
-                         const py::object& orbit_period_obj, const py::object& mountings, const py::object& lag_obj) {
+                         const py::object& orbit_period_obj, const py::object& mountings, const py::object& lag_obj,
+                         const py::object& sun_term) {
     const host::ModelFile* m = model_arg(model);
     // The run's lag: lag= ('auto': learnt from none), otherwise the model's, as correct --lag.
     const std::optional<std::array<double, kMaxHeads>> lag_given = lag_obj.is_none() ? std::nullopt : lags_arg(lag_obj);
@@ -107,6 +108,14 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
         rule = pipeline::common_rotation_weights(mf.mountings);
     }
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
+    // sun_term='auto': learnt from none, as correct --sun-term auto (evaluated in double only).
+    const bool learn_sun = choice_arg(sun_term, "sun_term", {"auto", "none"}) == "auto";
+    if (learn_sun && scalar != host::ScalarKind::kDouble) {
+        bad_argument("sun_term",
+                     "'auto' learns a Sun term, which is evaluated in double only, on the ground: it "
+                     "cannot go with scalar='" +
+                         std::string(host::scalar_name(scalar)) + "'");
+    }
     const double time_constant = real_arg(time_constant_obj, "time_constant");
     if (!calib::time_constant_acceptable(time_constant)) {
         bad_argument("time_constant",
@@ -144,13 +153,13 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
     py::array_t<std::uint16_t> st_out(r.n);
     py::list history;
     if (scalar == host::ScalarKind::kDouble) {
-        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+        history = self_calibrated_rows<double>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag, learn_sun,
                                                q_out.mutable_data(), st_out.mutable_data());
     } else if (scalar == host::ScalarKind::kFloat) {
-        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+        history = self_calibrated_rows<float>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag, learn_sun,
                                               q_out.mutable_data(), st_out.mutable_data());
     } else {
-        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag,
+        history = self_calibrated_rows<Q30>(r, m, time_constant, orbit_period, rule, lag_s, learn_lag, learn_sun,
                                             q_out.mutable_data(), st_out.mutable_data());
     }
     return py::make_tuple(q_out, st_out, history);
@@ -161,7 +170,7 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
 void bind_self_calibration(py::module_& mod) {
     mod.def("self_calibrate", &self_calibrate, "t"_a, "chu"_a, "q"_a, "temps"_a, "v"_a, "flags"_a = py::none(),
             "confidence"_a = py::none(), "model"_a = py::none(), "scalar"_a = "double", "time_constant"_a = 30.0,
-            "orbit_period"_a = py::none(), "mountings"_a = py::none(), "lag"_a = py::none(),
+            "orbit_period"_a = py::none(), "mountings"_a = py::none(), "lag"_a = py::none(), "sun_term"_a = "none",
             docstring(docs::kSelfCalibrate));
 }
 

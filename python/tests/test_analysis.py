@@ -308,6 +308,24 @@ def test_self_calibrate_lag_auto_is_ascorr_correct_self_calibrate_lag_auto(exe, 
         ascorr.self_calibrate(*as_args(d), model=hist[-1]["model"], lag="auto")
 
 
+def test_self_calibrate_sun_term_auto_is_ascorr_correct_self_calibrate_sun_term_auto(exe, sun_mission, tmp_path):
+    """sun_term='auto' as correct --self-calibrate --sun-term auto: the Sun term learnt as the
+    estimator runs, the same corrections to the bit and the same term per model; the scalars
+    that do not evaluate it refuse it."""
+    d, q, hist, h_header, h_rows = self_calibrated_as_by_the_cli(exe, sun_mission, tmp_path, "0", "auto")
+    assert h_header[-3:] == ["sun_x", "sun_y", "sun_z"] and len(h_rows) == 9 * len(hist)
+    for a, first in zip(hist, h_rows[::9]):
+        assert [float(x) for x in first[-3:]] == list(a["model"].sun[0, 0]), a["version"]
+    assert not hist[0]["model"].sun.any() and np.abs(hist[-1]["model"].sun).max() > 0.01  # none, then a term
+    # Mutation: without the learner the corrections differ.
+    q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0)
+    assert np.abs(q_none - q).max() > 1e-9
+    with pytest.raises(ValueError, match="sun_term.*evaluated in double only.*scalar='float'"):
+        ascorr.self_calibrate(*as_args(d), scalar="float", sun_term="auto")
+    with pytest.raises(ValueError, match="sun_term"):
+        ascorr.self_calibrate(*as_args(d), sun_term="yes")
+
+
 def corrected_as_by_the_cli(exe, mission, model_path, d, tmp_path):
     """correct(model=read_model(path)) and `ascorr correct --model path` on the same rows (d, read from
     mission): the same status and corrections to the bit; (q, status)."""
@@ -407,7 +425,7 @@ def test_fit_sun_term_and_correct_are_ascorr_fit_and_correct(exe, sun_mission, t
 
     with pytest.raises(ValueError, match="model.*Sun term.*evaluated in double only"):
         ascorr.correct(*as_args(d), model=model, scalar="float")
-    with pytest.raises(ValueError, match="model.*does not learn a Sun term yet"):
+    with pytest.raises(ValueError, match="model.*learns a Sun term from none"):
         ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model)
     bad = model.sun.copy()
     bad[0, 0] = [1800.0, -1800.0, 1.0]
@@ -419,15 +437,16 @@ def test_fit_sun_term_and_correct_are_ascorr_fit_and_correct(exe, sun_mission, t
         ascorr.fit(*as_args(d), min_days=20, sun_term="yes")
 
 
-def self_calibrated_as_by_the_cli(exe, mission, tmp_path, lag):
-    """self_calibrate(lag=) and `ascorr correct --self-calibrate --lag` on the same rows: the
-    same status and corrections to the bit; (rows, q, history, the history file's header and rows)."""
+def self_calibrated_as_by_the_cli(exe, mission, tmp_path, lag, sun_term="none"):
+    """self_calibrate(lag=, sun_term=) and `ascorr correct --self-calibrate --lag --sun-term` on the
+    same rows: the same status and corrections to the bit; (rows, q, history, the history file's
+    header and rows)."""
     d = ascorr.read_solutions(str(mission))
     corrected = tmp_path / "sc.csv"
     history = tmp_path / "sc.history.csv"
-    run_cli(exe, "correct", "--in", mission, "--self-calibrate", "--lag", lag, "--out", corrected, "--model-history",
-            history)
-    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=lag)
+    run_cli(exe, "correct", "--in", mission, "--self-calibrate", "--lag", lag, "--sun-term", sun_term, "--out",
+            corrected, "--model-history", history)
+    q, status, hist = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=lag, sun_term=sun_term)
     header, rows = read_csv_text(corrected)
     cols = [header.index(c) for c in ("qw", "qx", "qy", "qz")]
     assert [int(r[header.index("status")]) for r in rows] == list(status)

@@ -1,12 +1,8 @@
 #include "ascorr_host/analysis/fit_sun.hpp"
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <limits>
-#include <optional>
 
-#include "ascorr/calib/frame.hpp"
-#include "ascorr/calib/head_rotation.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/sun_direction.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -16,206 +12,24 @@ namespace ascorr::host {
 
 namespace {
 
-constexpr int kMaxStacked = 3 * kMaxHeads;  // e or s of every head, stacked
-using Stacked = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxStacked, 1>;
-using Moment = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStacked, kMaxStacked>;
-
-Eigen::Vector3d to_eigen(const Vector3<double>& v) {
-    return {v.x, v.y, v.z};
+// The fit's rule as the shared least squares take it (calib::SunRule); the
+// combined rule's weights by head index into `weights`.
+calib::SunRule sun_rule_of(const CommonRotation& rule, calib::Matrix3 (&weights)[kMaxHeads]) {
+    calib::SunRule out;
+    if (rule.rule == CommonRotationRule::kCombined) {
+        for (std::size_t h = 0; h < kMaxHeads; ++h) {
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) {
+                    weights[h].m[r][c] = rule.motion[h](r, c);
+                }
+            }
+        }
+        out.weight = weights;
+    } else if (rule.rule == CommonRotationRule::kRigid) {
+        out.rigid_head = rule.rigid_head;
+    }
+    return out;
 }
-
-// One orbit's sums of the stacked e and s (3 per head, in the order of the
-// fit's heads) and of their products.
-struct OrbitMoments {
-    explicit OrbitMoments(int n)
-        : e(Stacked::Zero(n)), s(Stacked::Zero(n)), ss(Moment::Zero(n, n)), es(Moment::Zero(n, n)) {}
-    std::size_t count = 0;
-    Stacked e;
-    Stacked s;
-    Moment ss;
-    Moment es;
-    void add(const Stacked& e_t, const Stacked& s_t) {
-        ++count;
-        e += e_t;
-        s += s_t;
-        ss.noalias() += s_t * s_t.transpose();
-        es.noalias() += e_t * s_t.transpose();
-    }
-};
-
-// Sums over the orbits of the products about each orbit's own mean, and the
-// references N_h (the first epoch's rotation of each head in F).
-class SunMoments {
-public:
-    SunMoments(HeadMask heads, const std::array<std::uint8_t, 2>& frame_heads, double period)
-        : list_(heads_of(heads)),
-          frame_(frame_heads),
-          period_(period),
-          n_(3 * static_cast<int>(list_.count)),
-          ss_(Moment::Zero(n_, n_)),
-          es_(Moment::Zero(n_, n_)),
-          orbit_(n_) {}
-
-    // One epoch, its heads already corrected by the polynomial; false when the
-    // Sun's direction is not known at t (outside nav/sun_direction.hpp's span).
-    bool add(double t, const std::array<Quaternion<double>, kMaxHeads>& q_chu_icrf) {
-        Vector3<double> s_icrf{};
-        if (!nav::sun_direction_icrf(t, s_icrf)) {
-            return false;
-        }
-        const auto bin = static_cast<long long>(std::floor(t / period_));
-        if (orbit_.count != 0 && bin != bin_) {
-            close_orbit();
-        }
-        bin_ = bin;
-        const Quaternion<double> q_f_icrf = calib::q_f_icrf(q_chu_icrf[frame_[0]], q_chu_icrf[frame_[1]]);
-        Stacked e(n_);
-        Stacked s(n_);
-        for (std::size_t i = 0; i < list_.count; ++i) {
-            const std::size_t h = list_.head[i];
-            const Quaternion<double> q_head_f = calib::q_head_f(q_chu_icrf[h], q_f_icrf);
-            if (!reference_[h]) {
-                reference_[h] = q_head_f;
-            }
-            const Vector3<double> e_rad = calib::small_angle(calib::relative_to(q_head_f, *reference_[h]));
-            e.segment<3>(3 * static_cast<int>(i)) = to_eigen(e_rad) * kRadToArcsec;
-            s.segment<3>(3 * static_cast<int>(i)) = to_eigen(rotated(q_chu_icrf[h], s_icrf));
-        }
-        orbit_.add(e, s);
-        return true;
-    }
-
-    // The fit: the projected normal equations, their pseudo-inverse, the rule.
-    SunFit solve(const CommonRotation& rule) {
-        close_orbit();
-        SunFit out;
-        out.epochs = epochs_;
-        out.orbits = orbits_;
-        if (orbits_ == 0) {
-            return out;
-        }
-        Eigen::MatrixXd normal;
-        Eigen::VectorXd rhs;
-        normal_equations(normal, rhs);
-        const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(normal);
-        const Eigen::VectorXd& lambda = eig.eigenvalues();
-        const double floor = kSunRankTolerance * lambda.maxCoeff();
-        Eigen::VectorXd theta = Eigen::VectorXd::Zero(rhs.size());
-        for (Eigen::Index k = 0; k < rhs.size(); ++k) {
-            if (lambda(k) > floor) {
-                const Eigen::VectorXd v = eig.eigenvectors().col(k);
-                theta += v * (v.dot(rhs) / lambda(k));
-                ++out.rank;
-            }
-        }
-        std::array<Eigen::Matrix3d, kMaxHeads> s_head{};
-        for (std::size_t i = 0; i < list_.count; ++i) {
-            for (int a = 0; a < 3; ++a) {
-                for (int m = 0; m < 3; ++m) {
-                    s_head[list_.head[i]](a, m) = theta(9 * static_cast<int>(i) + 3 * a + m);
-                }
-            }
-        }
-        apply_rule(rule, s_head);
-        for (std::size_t i = 0; i < list_.count; ++i) {
-            const std::size_t h = list_.head[i];
-            for (std::size_t a = 0; a < kModelAxes; ++a) {
-                for (std::size_t m = 0; m < kSunComponents; ++m) {
-                    out.sun[h][a][m] = s_head[h](static_cast<int>(a), static_cast<int>(m));
-                }
-            }
-        }
-        return out;
-    }
-
-private:
-    void close_orbit() {
-        if (orbit_.count == 0) {
-            return;
-        }
-        const double inv = 1.0 / static_cast<double>(orbit_.count);
-        ss_ += orbit_.ss - (orbit_.s * orbit_.s.transpose()) * inv;
-        es_ += orbit_.es - (orbit_.e * orbit_.s.transpose()) * inv;
-        epochs_ += orbit_.count;
-        ++orbits_;
-        orbit_ = OrbitMoments(n_);
-    }
-
-    // The normal equations of the projected equations, from the sums: with
-    // P = projection(), unknown (i, a, m) = S_head(i)[a][m] at 9i + 3a + m and
-    // equation row r = (i, a) = 3i + a, Σ XᵀPX = P[r][r2]·SS[(i, m)][(j, m2)]
-    // and Σ XᵀPe = Σ_r2 P[r][r2]·ES[r2][(i, m)] (X's rows are s's, a Kronecker product).
-    void normal_equations(Eigen::MatrixXd& normal, Eigen::VectorXd& rhs) const {
-        const Eigen::MatrixXd p = projection();
-        normal = Eigen::MatrixXd::Zero(3 * n_, 3 * n_);
-        rhs = Eigen::VectorXd::Zero(3 * n_);
-        for (int r = 0; r < n_; ++r) {
-            for (int m = 0; m < 3; ++m) {
-                const int col = 3 * r + m;
-                const int im = 3 * (r / 3) + m;
-                for (int r2 = 0; r2 < n_; ++r2) {
-                    rhs(col) += p(r, r2) * es_(r2, im);
-                    normal.block<1, 3>(col, 3 * r2) = p(r, r2) * ss_.block<1, 3>(im, 3 * (r2 / 3));
-                }
-            }
-        }
-    }
-
-    // N_h: maps F's components into head h's (the reference's rotation matrix).
-    Eigen::Matrix3d n_of(std::size_t h) const {
-        const Quaternion<double>& q = *reference_[h];
-        return Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
-    }
-
-    // I − Ñ(ÑᵀÑ)⁻¹Ñᵀ, Ñ the N_h stacked: removes F's own rotation at each epoch.
-    Eigen::MatrixXd projection() const {
-        Eigen::MatrixXd stacked(n_, 3);
-        for (std::size_t i = 0; i < list_.count; ++i) {
-            stacked.block<3, 3>(3 * static_cast<int>(i), 0) = n_of(list_.head[i]);
-        }
-        const Eigen::Matrix3d gram = stacked.transpose() * stacked;
-        return Eigen::MatrixXd::Identity(n_, n_) - stacked * gram.inverse() * stacked.transpose();
-    }
-
-    // The rotation common to every head, S_h + N_h·C·N_hᵀ for any C, fixed by
-    // the rule; the pseudo-inverse's is the smallest coefficients'.
-    void apply_rule(const CommonRotation& rule, std::array<Eigen::Matrix3d, kMaxHeads>& s) const {
-        Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
-        if (rule.rule == CommonRotationRule::kCombined) {
-            // The combined attitude moves by Σ A_h·(S_h + N_h·C·N_hᵀ)·N_h·s_F: zero for every s_F.
-            Eigen::Matrix3d an = Eigen::Matrix3d::Zero();
-            Eigen::Matrix3d asn = Eigen::Matrix3d::Zero();
-            for (std::size_t i = 0; i < list_.count; ++i) {
-                const std::size_t h = list_.head[i];
-                an += rule.motion[h] * n_of(h);
-                asn += rule.motion[h] * s[h] * n_of(h);
-            }
-            c = -an.inverse() * asn;
-        } else if (rule.rule == CommonRotationRule::kRigid) {
-            const Eigen::Matrix3d n = n_of(rule.rigid_head);
-            c = -n.transpose() * s[rule.rigid_head] * n;
-        }
-        for (std::size_t i = 0; i < list_.count; ++i) {
-            const Eigen::Matrix3d n = n_of(list_.head[i]);
-            s[list_.head[i]] += n * c * n.transpose();
-        }
-        if (rule.rule == CommonRotationRule::kRigid) {
-            s[rule.rigid_head].setZero();  // exactly: the rounding of the sum is no term
-        }
-    }
-
-    HeadList list_;
-    std::array<std::uint8_t, 2> frame_;
-    double period_;
-    int n_;
-    Moment ss_;
-    Moment es_;
-    OrbitMoments orbit_;
-    long long bin_ = 0;
-    std::size_t epochs_ = 0;
-    std::size_t orbits_ = 0;
-    std::array<std::optional<Quaternion<double>>, kMaxHeads> reference_{};
-};
 
 // The model with the Sun term s (none: its polynomial alone).
 ModelFile with_sun(const ModelFile& m, const SunCoefficients& s = {}) {
@@ -257,12 +71,17 @@ SunFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to,
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
     const HeadList list = heads_of(heads);
-    SunMoments moments(heads, frame_heads, period);
+    std::uint8_t order[kMaxHeads] = {};
+    for (std::size_t i = 0; i < list.count; ++i) {
+        order[i] = static_cast<std::uint8_t>(list.head[i]);
+    }
+    calib::SunMoments<kMaxHeads> moments(order, list.count, frame_heads[0], frame_heads[1]);
+    long long bin = 0;
     for (const FitEpoch& e : epochs) {
         if (!(e.t >= from && e.t < to)) {
             continue;
         }
-        std::array<Quaternion<double>, kMaxHeads> q{};
+        Quaternion<double> q[kMaxHeads]{};
         bool all = true;
         for (std::size_t i = 0; i < list.count; ++i) {
             const std::size_t h = list.head[i];
@@ -270,11 +89,34 @@ SunFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to,
             all = all && (c.status & status::kThermalApplied) != 0U;
             q[h] = c.q_chu_icrf;
         }
-        if (all) {
-            moments.add(e.t, q);
+        Vector3<double> s_icrf{};
+        if (!all || !nav::sun_direction_icrf(e.t, s_icrf)) {
+            continue;
+        }
+        const auto epoch_bin = static_cast<long long>(std::floor(e.t / period));
+        if (moments.open_count() != 0U && epoch_bin != bin) {
+            moments.close_orbit(1.0);  // every orbit kept
+        }
+        bin = epoch_bin;
+        moments.add(q, s_icrf);
+    }
+    moments.close_orbit(1.0);
+    calib::Matrix3 weights[kMaxHeads]{};
+    calib::SunTermFit fit;
+    (void)moments.solve(sun_rule_of(rule, weights), fit);
+    SunFit out;
+    out.epochs = fit.epochs;
+    out.orbits = fit.orbits;
+    out.rank = fit.solved ? fit.rank : 0;
+    for (std::size_t i = 0; fit.solved && i < list.count; ++i) {
+        const std::size_t h = list.head[i];
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                out.sun[h][a][c] = fit.sun[h][a][c];
+            }
         }
     }
-    return moments.solve(rule);
+    return out;
 }
 
 SunSelection select_sun_term(const SunSearchInput& in) {

@@ -165,6 +165,12 @@ CorrectionConfig<T> config_at(const Job<T>& job, double t) {
     return {job.cfg.aberration, job.cfg.thermal != nullptr ? m : nullptr};
 }
 
+// The Sun term of one row: with a schedule, that of the model active at its t.
+template <typename T>
+const SunTermModel<double>* sun_at(const Job<T>& job, double t) {
+    return job.schedule != nullptr ? job.schedule->sun_at(t) : job.sun;
+}
+
 // With --states, a row without its own velocity gets the service's
 // (correct_row); the status bits the service adds (4, 4|512, 4|32) are
 // explained here.
@@ -245,8 +251,8 @@ void correct_chunk(const Job<T>& job, std::string_view body, std::size_t lines_b
             continue;
         }
         const CorrectionConfig<T> cfg = config_at(job, rec.t);
-        const RowCorrection<T> row =
-            correct_row(as_terms_take(job, cfg, rec, lagged), &earth, cfg, states ? &*states : nullptr, job.sun);
+        const RowCorrection<T> row = correct_row(as_terms_take(job, cfg, rec, lagged), &earth, cfg,
+                                                 states ? &*states : nullptr, sun_at(job, rec.t));
         const StatusBits st = row.status;
         if (row.from_states) {
             explain_service(row.service, rec, opt.in, res.diag);
@@ -393,7 +399,7 @@ SelfCalibrated<T> self_calibrated(const CorrectOptions& opt, const std::optional
     const SelfCalibration sc =
         self_calibrate<T>(opt.in, lag != nullptr ? lagged_rows(rows, *lag) : rows, model_file, ecfg, opt.orbit_period_s,
                           kSelfCalibrationMemoryBytes, kMaxHeads,
-                          lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{}, opt.lag_auto);
+                          lag != nullptr ? lag->lag_s() : std::array<double, kMaxHeads>{}, opt.lag_auto, opt.sun_auto);
     return {ModelSchedule<T>(sc.history), format_model_history(sc.history, opt.common_rotation.heads != 0U),
             describe(sc), opt.lag_auto ? learnt_lags(sc.history, rows) : std::nullopt};
 }
@@ -551,6 +557,19 @@ void refuse_run_options(const CorrectOptions& opt) {
     if (opt.lag_s && opt.lag_auto) {
         throw std::runtime_error("--lag auto learns the lag and --lag TAU gives it: give one");
     }
+    if (opt.sun_auto && !opt.self_calibrate) {
+        throw std::runtime_error(std::string("--sun-term ") + kSunTermNeedsSelfCalibration);
+    }
+}
+
+// --sun-term auto's scalar: the term is evaluated in double (correct_row.hpp).
+template <typename T>
+void refuse_sun_term_scalar(const CorrectOptions& opt) {
+    if (opt.sun_auto && scalar_kind_of<T>() != ScalarKind::kDouble) {
+        throw std::runtime_error(
+            "--sun-term auto learns a Sun term, which is evaluated in double only, on the ground: it cannot go with "
+            "--scalar float or fixed");
+    }
 }
 
 template <typename T>
@@ -558,6 +577,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     refuse_run_options(opt);  // before the model: a --lag out of range is named as such, not as another τ
+    refuse_sun_term_scalar<T>(opt);
     std::optional<ModelFile> model_file;
     std::optional<ThermalModel<T>> model = read_model<T>(opt, model_file);
 

@@ -27,6 +27,25 @@ namespace ascorr::host {
 
 namespace {
 
+// The side learners a run has (self_calibrate's learn_lag, learn_sun).
+struct SideLearning {
+    bool lag = false;
+    bool sun = false;
+};
+
+// The model file's Sun term of a learnt one, for the heads m has.
+decltype(ModelFile::sun) sun_coefficients_of(const calib::SunTermFit& f, const ModelFile& m) {
+    decltype(ModelFile::sun) out{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; m.present[h] && ((f.heads >> h) & 1U) != 0U && a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                out[h][a][c] = f.sun[h][a][c];
+            }
+        }
+    }
+    return out;
+}
+
 // One row as the run needs it: its epoch, and for a clean row of A, B or C
 // whose aberration stage applies, its input to the core.
 template <typename T>
@@ -58,8 +77,8 @@ template <typename T, std::size_t N>
 class Run {
 public:
     Run(const std::string& file, const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
-        std::optional<double> orbit_period_s, bool learn_lag)
-        : file_(file), cfg_(cfg), learn_lag_(learn_lag) {
+        std::optional<double> orbit_period_s, SideLearning learn)
+        : file_(file), cfg_(cfg), learn_(learn) {
         if (initial) {
             initial_ = coefficients_of(*initial);
         }
@@ -90,6 +109,10 @@ public:
             search_->finish();
             out_.lag_search = search_->report();
         }
+        if (sun_) {
+            sun_->finish();
+            out_.sun_learnt = sun_->report();
+        }
         return out_;
     }
 
@@ -101,8 +124,8 @@ private:
             (void)pipeline_.solution(
                 r.in, [&r] { return pipeline::given_velocity(r.in.velocity); }, true);
             out_.cycles += pipeline_.feeds() - feeds;
-            if (search_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr) {
-                search(r.t_us);
+            if (pipeline_.feeds() != feeds && pipeline_.model() != nullptr) {
+                learn_beside(r.t_us);
             }
         }
     }
@@ -170,8 +193,11 @@ private:
         cfg_.orbit_period_us = static_cast<std::int64_t>(std::llround(period_s * 1e6));
         est_.emplace(cfg_, initial_ ? &*initial_ : nullptr);
         pipeline_.use_estimator(&*est_);
-        if (learn_lag_) {
+        if (learn_.lag) {
             search_.emplace(cfg_);
+        }
+        if (learn_.sun) {
+            sun_.emplace(cfg_);
         }
         for (const CalibRow<T>& r : held_) {
             process(r);
@@ -186,10 +212,13 @@ private:
         if (model != nullptr && (!had_ || pipeline_.version() != version_)) {
             out_.history.push_back({t, t_us, pipeline_.version(), est_->active_crc(),
                                     model_file_of(*est_->active_coefficients()), est_->active_learnt()});
+            ModelFile& m = out_.history.back().model;
             if (search_) {  // a version takes the lag the search has taken by then
-                ModelFile& m = out_.history.back().model;
                 m.lag_s.fill(search_->tau_s());
                 m.lag_s = head_lags(m);
+            }
+            if (sun_ && sun_->taken() != nullptr) {  // ... and the Sun term the learner has taken
+                m.sun = sun_coefficients_of(*sun_->taken(), m);
             }
             had_ = true;
             version_ = pipeline_.version();
@@ -197,19 +226,42 @@ private:
         return model;
     }
 
-    // The fed cycle's frame heads into the lag search, with the epoch's model.
-    void search(std::int64_t t_us) {
-        const HeadTemperatures<T>* tp[calib::kFrameHeads];
-        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
-            tp[h] = &pipeline_.kept_temperatures()[h];
+    // The fed cycle's frame heads into the lag search, with the epoch's
+    // model, and into the Sun term's learner, as corrected at the lag taken.
+    void learn_beside(std::int64_t t_us) {
+        const CorrectedSolution<T>* kept = pipeline_.kept_solutions();
+        if (search_) {
+            const HeadTemperatures<T>* tp[calib::kFrameHeads];
+            for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+                tp[h] = &pipeline_.kept_temperatures()[h];
+            }
+            if (search_->take(t_us, *pipeline_.model(), kept, tp) && sun_) {
+                (void)sun_->take(t_us, search_->taken_attitudes());
+            }
+            return;
         }
-        (void)search_->take(t_us, *pipeline_.model(), pipeline_.kept_solutions(), tp);
+        Quaternion<double> q[calib::kFrameHeads];
+        for (std::size_t h = 0; sun_ && h < calib::kFrameHeads; ++h) {
+            if ((kept[h].status & status::kThermalApplied) == 0U) {
+                return;  // a head the model did not correct: not the polynomial's residual
+            }
+            q[h] = to_double(kept[h].q_chu_icrf);
+        }
+        if (sun_) {
+            (void)sun_->take(t_us, q);
+        }
+    }
+
+    static Quaternion<double> to_double(const Quaternion<T>& q) noexcept {
+        using S = ScalarTraits<T>;
+        return {S::to_double(q.w), S::to_double(q.x), S::to_double(q.y), S::to_double(q.z)};
     }
 
     const std::string& file_;
     calib::EstimatorConfig cfg_;
-    bool learn_lag_;
-    std::optional<calib::LagSearch<T>> search_;  // learn_lag_: the bench's lag (calib/lag_search.hpp)
+    SideLearning learn_;
+    std::optional<calib::LagSearch<T>> search_;  // learn_.lag: the bench's lag (calib/lag_search.hpp)
+    std::optional<calib::SunLearner> sun_;       // learn_.sun: the Sun term (calib/sun_learner.hpp)
     std::optional<ModelCoefficients> initial_;
     std::optional<calib::Estimator<T, N>> est_;
     pipeline::EpochPipeline<T, pipeline::InlineCalls<T>, N> pipeline_;
@@ -481,7 +533,7 @@ template <typename T, std::size_t N>
 SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& rows,
                                      const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
                                      std::optional<double> orbit_period_s, std::size_t memory_budget_bytes,
-                                     bool learn_lag) {
+                                     SideLearning learn) {
     EarthVelocity earth;
     // A row as the run takes it; false: its t is one the on-board clock cannot hold (no epoch).
     const auto calib_row = [&earth](const SolutionRecord& rec, CalibRow<T>& r) {
@@ -507,7 +559,7 @@ SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& r
     // sorted (the epoch of each, the input of those fed) within the memory
     // budget (SortedRuns).
     {
-        Run<T, N> run(file, initial, cfg, orbit_period_s, learn_lag);
+        Run<T, N> run(file, initial, cfg, orbit_period_s, learn);
         std::size_t untimed = 0;
         bool ordered = true;
         CalibRow<T> r{};
@@ -546,7 +598,7 @@ SelfCalibration self_calibrate_heads(const std::string& file, const RowSource& r
         }
         runs.add(r);
     });
-    Run<T, N> run(file, initial, cfg, orbit_period_s, learn_lag);
+    Run<T, N> run(file, initial, cfg, orbit_period_s, learn);
     runs.each([&run](const CalibRow<T>& r) { run.take(r); });
     SelfCalibration out = run.finish(untimed);
     out.runs = runs.count();
@@ -570,14 +622,14 @@ template <typename T, std::size_t N0 = calib::kMinCalibHeads>
 SelfCalibration self_calibrate_dispatch(std::size_t heads, const std::string& file, const RowSource& rows,
                                         const std::optional<ModelFile>& initial, const calib::EstimatorConfig& cfg,
                                         std::optional<double> orbit_period_s, std::size_t memory_budget_bytes,
-                                        bool learn_lag) {
+                                        SideLearning learn) {
     if constexpr (N0 < kMaxHeads) {
         if (heads > N0) {
             return self_calibrate_dispatch<T, N0 + 1U>(heads, file, rows, initial, cfg, orbit_period_s,
-                                                       memory_budget_bytes, learn_lag);
+                                                       memory_budget_bytes, learn);
         }
     }
-    return self_calibrate_heads<T, N0>(file, rows, initial, cfg, orbit_period_s, memory_budget_bytes, learn_lag);
+    return self_calibrate_heads<T, N0>(file, rows, initial, cfg, orbit_period_s, memory_budget_bytes, learn);
 }
 
 }  // namespace
@@ -586,16 +638,17 @@ template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes, std::size_t max_heads,
-                               const std::array<double, kMaxHeads>& lag_s, bool learn_lag) {
+                               const std::array<double, kMaxHeads>& lag_s, bool learn_lag, bool learn_sun) {
     if (learn_lag && pipeline::any_lagged(lag_s)) {
         throw std::invalid_argument("self_calibrate: a lag is learnt from none, not from a given one");
     }
     if (initial) {
         refuse_quadratic_initial_model(*initial, "the initial model");  // the callers name it first
         refuse_other_lag(*initial, "the initial model", lag_s);
+        refuse_sun_term(*initial, "the initial model", kSunTermNotLearnt);
     }
     SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg,
-                                                     orbit_period_s, memory_budget_bytes, learn_lag);
+                                                     orbit_period_s, memory_budget_bytes, {learn_lag, learn_sun});
     if (!learn_lag) {
         for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
             a.model.lag_s = lag_s;
@@ -607,13 +660,13 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                 const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                                std::size_t, const std::array<double, kMaxHeads>&, bool);
+                                                std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                               std::size_t, const std::array<double, kMaxHeads>&, bool);
+                                               std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                             std::size_t, const std::array<double, kMaxHeads>&, bool);
+                                             std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
 
 std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows) {
     std::vector<LagSchedule::Version> versions;
@@ -636,6 +689,7 @@ ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model
         from_us_.push_back(a.t_us);
         version_.push_back(a.version);
         model_.push_back(to_core<T>(a.model));
+        sun_.push_back(sun_term_if_any(&a.model));
     }
 }
 
@@ -651,6 +705,12 @@ std::size_t ModelSchedule<T>::index_at(double t) const noexcept {
 template <typename T>
 const ThermalModel<T>& ModelSchedule<T>::at(double t) const noexcept {
     return model_[index_at(t)];
+}
+
+template <typename T>
+const SunTermModel<double>* ModelSchedule<T>::sun_at(double t) const noexcept {
+    const std::size_t k = index_at(t);
+    return k == 0 || !sun_[k - 1] ? nullptr : &*sun_[k - 1];
 }
 
 template <typename T>
@@ -674,7 +734,7 @@ namespace {
 
 // One row of the history: head h, axis a of model m (the columns above).
 void append_history_row(std::string& out, const ActiveModel& m, std::size_t h, std::size_t a, bool combined,
-                        bool lagged) {
+                        bool lagged, bool sun) {
     char buf[96];
     text::c_snprintf(buf, sizeof buf, "%.3f,%u,%c,%s", m.t, m.version, head_name(static_cast<std::uint8_t>(h)),
                      kAxisNames[a]);
@@ -694,6 +754,10 @@ void append_history_row(std::string& out, const ActiveModel& m, std::size_t h, s
         text::c_snprintf(buf, sizeof buf, ",%.17g", m.model.lag_s[h]);  // as the model file writes it
         out += buf;
     }
+    for (std::size_t c = 0; sun && c < kSunComponents; ++c) {
+        text::c_snprintf(buf, sizeof buf, ",%.16e", m.model.sun[h][a][c]);  // as the model file writes them
+        out += buf;
+    }
     out += '\n';
 }
 
@@ -702,12 +766,15 @@ void append_history_row(std::string& out, const ActiveModel& m, std::size_t h, s
 std::string format_model_history(const std::vector<ActiveModel>& history, bool combined) {
     const bool lagged =
         std::any_of(history.begin(), history.end(), [](const ActiveModel& m) { return has_lag(m.model); });
+    const bool sun =
+        std::any_of(history.begin(), history.end(), [](const ActiveModel& m) { return has_sun_term(m.model); });
     std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin" +
-                      (combined ? ",common_rotation" : "") + (lagged ? ",lag_s\n" : "\n");
+                      (combined ? ",common_rotation" : "") + (lagged ? ",lag_s" : "") +
+                      (sun ? ",sun_x,sun_y,sun_z\n" : "\n");
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
             for (std::size_t a = 0; a < kModelAxes && m.model.present[h]; ++a) {
-                append_history_row(out, m, h, a, combined, lagged);
+                append_history_row(out, m, h, a, combined, lagged, sun);
             }
         }
     }
@@ -790,6 +857,36 @@ std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
     return out + buf + (r.tau_s != last_model_lag_s ? "; no model since took it" : "");
 }
 
+std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history) {
+    if (r.orbits == 0U) {
+        return "the learner scored no orbit (no model active with A, B and C selected)";
+    }
+    char buf[400];
+    text::c_snprintf(buf, sizeof buf,
+                     "the learner scored %u orbits: the IBAs' spread inside the orbit (%.3f\" RMS with the polynomial "
+                     "alone) is %.2f %% of the mean square %s with the term predicted from the orbits before "
+                     "(rank %d of %u orbits); ",
+                     r.orbits, r.rms_arcsec, 100.0 * std::fabs(r.gain), r.gain >= 0.0 ? "lower" : "higher",
+                     r.candidate.rank, r.candidate.orbits);
+    std::string out = buf;
+    if (!r.deciding) {
+        text::c_snprintf(buf, sizeof buf, "it decides once it holds %.0f orbits (it holds %.0f, forgotten)",
+                         r.orbits_to_decide, r.orbits_held);
+        return out + buf;
+    }
+    const auto first =
+        std::find_if(history.begin(), history.end(), [](const ActiveModel& a) { return has_sun_term(a.model); });
+    text::c_snprintf(buf, sizeof buf, "it %s the term (taken %.1f %% below, left %.1f %% above)",
+                     r.taken ? "takes" : "does not take", 100.0 * calib::kSunLearnMargin,
+                     100.0 * calib::kSunLearnMargin);
+    out += buf;
+    if (first == history.end()) {
+        return out + "; no model took it";
+    }
+    text::c_snprintf(buf, sizeof buf, "; the models took it from version %u (t = %.3f)", first->version, first->t);
+    return out + buf;
+}
+
 std::string describe(const SelfCalibration& s) {
     std::ostringstream o;
     char buf[300];
@@ -825,6 +922,9 @@ std::string describe(const SelfCalibration& s) {
     if (s.lag_search) {
         double last = 0.0;
         o << "; bench lag (--lag auto): " << lags_taken(s.history, last) << "; " << describe(*s.lag_search, last);
+    }
+    if (s.sun_learnt) {
+        o << "; Sun term (--sun-term auto): " << describe(*s.sun_learnt, s.history);
     }
     return o.str();
 }

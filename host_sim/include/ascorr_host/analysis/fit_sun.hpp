@@ -3,31 +3,15 @@
 // orbit and taken when held-out data support it (issue 40, docs/ground.md,
 // "The Sun term").
 //
-// The polynomial is fitted on orbit averages, which average the Sun's
-// direction in the orbital plane away; the Sun term is fitted on what varies
-// inside the orbit, after the polynomial (with its lag) has corrected each
-// epoch. For each epoch with every fitted head, each head's rotation e_h
-// relative to frame F of the corrected attitudes (head axes, arcsec; the
-// model's α, β, γ: calib/head_rotation.hpp) and s_h, the Sun's direction in
-// the corrected head's frame:
-//     e_h(t) = S_h·s_h(t) + N_h·g(t) + b_h(orbit) + noise,
-// S_h the head's 3 × 3 coefficients, g(t) F's own rotation at the epoch (a
-// nuisance, as per orbit in the polynomial's fit, eliminated by projecting
-// each epoch's equations orthogonally to the N_h), b_h a constant per orbit
-// and head (eliminated by taking each orbit's mean out of e and s: the orbit
-// means are the polynomial's). The normal equations are formed from each
-// orbit's sums of s·sᵀ and e·sᵀ (Kronecker structure of the projection), so
-// the epochs are read once and not kept. The solution is the pseudo-inverse's
-// over the eigen-directions above kSunRankTolerance of the largest: three of
-// each head's nine do not vary inside the orbit (the orbit normal's component
-// of s, constant over an orbit on a nadir-pointing spacecraft), and of the
-// rotation common to every head, which no IBA sees, six more are in the
-// plane that does (3H + 6 unseen of 9H, rank 6H − 6: 12 of 27 for three
-// heads); the common rotation is then fixed by the fit's rule
-// (calib/common_rotation.hpp's three: the smallest coefficients, the full head
-// set's combined attitude unmoved by the term for every Sun direction, or a
-// head rigid to the bench, its coefficients exactly 0). The term's orbit mean
-// along the orbit normal is thereby left to the temperatures' polynomial.
+// The least squares inside the orbit are calib/sun_moments.hpp's, shared with
+// the self-calibration's learner (calib/sun_learner.hpp): after the
+// polynomial (with its lag) has corrected each epoch, each head's rotation
+// relative to frame F against the Sun's direction in the head's frame, about
+// each orbit's mean and with F's own rotation projected out, every orbit
+// kept (no forgetting); the common rotation, which no IBA sees, fixed by the
+// fit's rule (CommonRotation: the smallest coefficients, the full head set's
+// combined attitude unmoved by the term for every Sun direction, or a head
+// rigid to the bench, its coefficients exactly 0).
 // Selection: the polynomial fitted before t_split (the selection report's, the
 // written model's terms, or the linear ones when the part before t_split
 // refuses those) is scored on the epochs after it, without and with the Sun
@@ -46,18 +30,15 @@
 #include <string>
 #include <vector>
 
+#include "ascorr/calib/sun_moments.hpp"
 #include "ascorr_host/analysis/fit_terms.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 
 namespace ascorr::host {
 
 // The term is taken when the held-out IBA RMS (mean over the pairs) falls by
-// more than this fraction, the lag's margin (fit_lag.hpp): 0.3 % of the mean
-// square. On the static benches its gain was below 0.01 %.
-inline constexpr double kSunSelectionMargin = 0.0015;
-// Eigen-directions of the normal equations below this fraction of the
-// largest eigenvalue are left out (the pseudo-inverse's rank).
-inline constexpr double kSunRankTolerance = 1e-3;
+// more than calib::kSunSelectionMargin (the lag's margin, fit_lag.hpp).
+using calib::kSunSelectionMargin;
 
 // --sun-term: auto (fitted and taken when supported), none.
 enum class SunTermChoice : std::uint8_t { kAuto, kNone };
@@ -68,7 +49,7 @@ struct SunFit {
     SunCoefficients sun{};  // arcsec, by head (the fit's heads)
     std::size_t epochs = 0;
     std::size_t orbits = 0;
-    int rank = 0;  // eigen-directions kept, of 9 per head
+    int rank = 0;  // eigen-directions kept, of 9 per head (0: not solved)
 };
 
 // The Sun term fitted on the epochs with t in [from, to) corrected by the

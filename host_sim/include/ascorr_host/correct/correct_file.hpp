@@ -53,6 +53,10 @@ struct CorrectOptions {
     // --lag auto (self-calibration only, lag_s none, a --model without lag_s):
     // the bench's lag learnt as the estimator runs (calib/lag_search.hpp).
     bool lag_auto = false;
+    // --sun-term auto (self-calibration only, the scalar double, a --model
+    // without a Sun term): the Sun term learnt as the estimator runs
+    // (calib/sun_learner.hpp).
+    bool sun_auto = false;
     // The estimator's rule for the rotation common to all heads (with
     // --mountings: pipeline/common_rotation_weights.hpp; none: its own frame).
     calib::CommonRotationWeights common_rotation{};

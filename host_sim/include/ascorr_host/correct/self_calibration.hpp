@@ -26,6 +26,7 @@
 
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr/calib/lag_search.hpp"
+#include "ascorr/calib/sun_learner.hpp"
 #include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -50,6 +51,7 @@ struct SelfCalibration {
     std::size_t untimed = 0;  // rows whose t the on-board clock cannot hold
     std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
     std::optional<calib::LagSearchReport> lag_search;  // learn_lag: the bench's lag, as the search took it
+    std::optional<calib::SunLearnReport> sun_learnt;   // learn_sun: the Sun term, as the learner took it
 };
 
 // The fed rows (in time order) whose median speed gives the orbit period
@@ -99,12 +101,19 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // not change orbit means); each model of the history takes the lag the
 // search had taken when it became active (lag_s, the same for every head),
 // and lag_search reports the search at the end.
+// learn_sun (`--sun-term auto`; an initial model without a Sun term,
+// refuse_sun_term): the Sun term is learnt as the run goes
+// (calib/sun_learner.hpp), from the frame heads' attitudes as the active model
+// corrected them (with learn_lag, at the lag the search has taken); each model
+// of the history takes the term the learner had taken when it became active
+// (its sun, for the heads A, B and C it has), and sun_learnt reports the
+// learner at the end.
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
                                std::size_t max_heads = kMaxHeads, const std::array<double, kMaxHeads>& lag_s = {},
-                               bool learn_lag = false);
+                               bool learn_lag = false, bool learn_sun = false);
 
 // The lags of a learnt-lag history's models as they change (each model of
 // it takes the lag its search had taken, self_calibrate's learn_lag), over
@@ -127,6 +136,9 @@ class ModelSchedule {
 public:
     explicit ModelSchedule(const std::vector<ActiveModel>& history);
     const ThermalModel<T>& at(double t) const noexcept;
+    // The Sun term of the model active at t (evaluated in double,
+    // correct_row.hpp); nullptr: none.
+    const SunTermModel<double>* sun_at(double t) const noexcept;
     // The version active at t; nullopt: none.
     std::optional<std::uint32_t> version_at(double t) const noexcept;
 
@@ -134,7 +146,8 @@ private:
     std::size_t index_at(double t) const noexcept;  // 0: none, k: history[k − 1]
     std::vector<std::int64_t> from_us_;
     std::vector<std::uint32_t> version_;
-    std::vector<ThermalModel<T>> model_;  // [0]: no head present
+    std::vector<ThermalModel<T>> model_;                    // [0]: no head present
+    std::vector<std::optional<SunTermModel<double>>> sun_;  // by version (model_[k + 1])
 };
 
 // How head h of a history's model `version` came to be: "given" (version 0,
@@ -144,7 +157,8 @@ private:
 const char* head_origin(std::uint32_t version, std::size_t h, std::uint8_t learnt = calib::kFrameMask);
 
 // The model history file (docs/contract.md): header
-// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin and one row per head and
+// t,version,chu,axis,c0,c1,c2,c3,crc32c,tt_us,origin (then common_rotation,
+// lag_s and sun_x,sun_y,sun_z when they apply) and one row per head and
 // axis of each model (origin: head_origin). t (3 decimals) says when; tt_us (t_us: TT µs of the
 // on-board clock, an integer) says exactly which rows: those whose t rounds
 // (tt_from_seconds) to at least it, up to the next version's.
@@ -166,6 +180,9 @@ std::string time_constant_range();
 // The lag search's outcome in a clause (--lag auto), and whether the last
 // model of the history (its lag last_model_lag_s) took what it takes.
 std::string describe(const calib::LagSearchReport& r, double last_model_lag_s);
+// The Sun term's learner in a clause (--sun-term auto), and the first model
+// of the history that took the term.
+std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history);
 std::string describe(const SelfCalibration& s);
 
 }  // namespace ascorr::host

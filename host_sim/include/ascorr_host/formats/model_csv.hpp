@@ -118,7 +118,8 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun);
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why);
 // Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
 inline constexpr const char* kSunTermNotLearnt =
-    "the self-calibration does not learn a Sun term yet: start it from a model without one";
+    "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
+    "model without one";
 // The Sun term in the core's units (radians), for scalar T.
 template <typename T>
 SunTermModel<T> sun_term_of(const ModelFile& m) {
@@ -164,6 +165,10 @@ bool lag_acceptable(double lag_s) noexcept;
 // --self-calibrate, after "--lag" or "--lag: ".
 inline constexpr const char* kLagNeedsSelfCalibration =
     "needs --self-calibrate (a model's lag_s gives the lag otherwise)";
+// Why correct's --sun-term (the Sun term the self-calibration learns) is
+// refused without --self-calibrate, after "--sun-term" or "--sun-term: ".
+inline constexpr const char* kSunTermNeedsSelfCalibration =
+    "needs --self-calibrate (a model's sun_x, sun_y, sun_z give the Sun term otherwise)";
 // "0 (no lag) or [1, 86400] s", for messages.
 std::string lag_range_text();
 // Throws (naming the model's file, then `why`) when the model's terms take

@@ -1,0 +1,198 @@
+// ascorr/calib/sun_learner.hpp: the thermal model's Sun term (core/sun_term.hpp),
+// learnt by the self-calibration as it runs (issue 40; docs/ground.md, "The
+// Sun term learnt in self-calibration").
+//
+// Why a learner beside the estimator: the estimator learns from orbit means,
+// which average the Sun's direction in the orbital plane away; the term lives
+// inside the orbit. So, as `fit` does on the ground (sun_moments.hpp), the
+// learner sums, at each fed cycle with an active model (heads A, B and C
+// selected), the heads' rotations in F and the Sun's direction in each head's
+// frame, about each orbit's own mean, with a forgetting e^(−Δt/memory) per
+// orbit closed (memory: orbit_spread_scores.hpp's, the estimator's time
+// constant but at least 30 days), and solves them at every orbit closed: the
+// candidate, under the estimator's rule for the common rotation (its weights,
+// `--mountings`' combined attitude; none: the smallest coefficients).
+//
+// Taken (taken(), report().taken): each cycle is corrected by the polynomial
+// alone and by the polynomial and the candidate solved before its orbit
+// began, and both are scored by their IBAs' spread inside the orbit
+// (orbit_spread_scores.hpp): the candidate is scored on orbits it has not
+// seen, as `fit` scores on held-out data. Once the scores hold a memory's
+// orbits, the term is taken when its score is below the polynomial's by more
+// than kSunLearnMargin (fit's margin, in the mean square), and left again when
+// the polynomial's is below its by as much. While taken, the term is the
+// latest candidate (within the core's domain: sun_fit_within_domain; a
+// candidate beyond it is not used).
+//
+// Arithmetic: double (the attitudes as the caller corrected them: the
+// pipeline's kept solutions, or the lag search's at its lag; the Sun from
+// nav/sun_direction.hpp at the cycle's TT). A cycle outside the Sun
+// ephemeris' span (2000–2051) is not taken.
+// Cost per fed cycle: a Sun direction, three Sun-term rotations, six
+// boresights and IBAs, the moments' 2·9² products. Per orbit closed: the
+// normal equations (27 × 27) and their Jacobi eigen-decomposition
+// (symmetric_eigen.hpp, at most 30 sweeps). No allocation, every loop bounded.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "../core/quaternion.hpp"
+#include "../core/sun_term.hpp"
+#include "../nav/sun_direction.hpp"
+#include "estimator_types.hpp"
+#include "orbit_spread_scores.hpp"
+#include "portable_math.hpp"
+#include "sun_moments.hpp"
+
+namespace ascorr::calib {
+
+// The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
+inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
+
+struct SunLearnReport {
+    std::uint32_t orbits = 0;       // orbits scored
+    std::uint64_t cycles = 0;       // cycles scored
+    double score[2] = {};           // forgotten sums of squares: the polynomial alone, with the candidate (arcsec²)
+    double gain = 0.0;              // 1 − score[1]/score[0] (0 before any orbit)
+    double rms_arcsec = 0.0;        // the polynomial's spread inside the orbit, RMS per pair and cycle
+    bool deciding = false;          // the scores hold a memory's orbits: the rule applies
+    double orbits_held = 0.0;       // their forgotten count of orbits
+    double orbits_to_decide = 0.0;  // ... that the rule needs
+    bool taken = false;             // the term is taken
+    SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
+};
+
+class SunLearner {
+public:
+    static constexpr std::size_t kPairs = OrbitSpreadScores<2>::kPairs;
+
+    // cfg as the estimator accepted it (configuration_acceptable); its
+    // common_rotation weights (none: the smallest coefficients) are the rule.
+    explicit SunLearner(const EstimatorConfig& cfg) noexcept
+        : scores_(cfg), moments_(kFrameHeadIndices, kFrameHeads, 0U, 2U), weights_(cfg.common_rotation) {
+        if (weights_.heads != 0U) {
+            rule_.weight = weights_.a;
+        }
+    }
+    SunLearner(const SunLearner&) = delete;  // rule_ points into weights_
+    SunLearner& operator=(const SunLearner&) = delete;
+
+    // One fed cycle at t_us (TT µs since J2000): q[h] the frame heads'
+    // attitudes corrected by the active polynomial. false: not taken (t
+    // outside the Sun ephemeris' span). A cycle of a later orbit closes the
+    // open one first.
+    bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
+        const bool scored = scores_.begin(t_us);
+        const std::int64_t bin = orbit_bin(t_us, scores_.period_us());
+        if (open_ && bin != bin_) {
+            close_orbit();
+        }
+        open_ = true;
+        bin_ = bin;
+        if (scored) {
+            reconsider();
+        }
+        Vector3<double> s_icrf{};
+        if (!nav::sun_direction_icrf(static_cast<double>(t_us) * 1e-6, s_icrf)) {
+            return false;
+        }
+        double iba[2][kPairs];
+        frame_ibas(q, iba[0]);
+        Quaternion<double> with_term[kFrameHeads];
+        for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
+            with_term[h] = with_sun_term(q[h], sun_term_rotation(candidate_model_, h, q[h], s_icrf));
+        }
+        frame_ibas(with_term, iba[1]);
+        scores_.add(iba);
+        Quaternion<double> by_head[kMaxHeads]{};
+        for (std::size_t h = 0; h < kFrameHeads; ++h) {
+            by_head[h] = q[h];
+        }
+        moments_.add(by_head, s_icrf);
+        return true;
+    }
+
+    // Closes the open orbit (the end of the data).
+    void finish() noexcept {
+        if (open_) {
+            close_orbit();
+            open_ = false;
+        }
+        if (scores_.finish()) {
+            reconsider();
+        }
+    }
+
+    // The term taken (arcsec by head), or nullptr: none.
+    const SunTermFit* taken() const noexcept { return taken_ ? &candidate_ : nullptr; }
+
+    SunLearnReport report() const noexcept {
+        SunLearnReport r;
+        r.orbits = scores_.orbits();
+        r.cycles = scores_.cycles();
+        r.score[0] = scores_.score()[0];
+        r.score[1] = scores_.score()[1];
+        if (r.score[0] > 0.0) {
+            r.gain = (r.score[0] - r.score[1]) / r.score[0];
+        }
+        if (scores_.weight() > 0.0) {
+            r.rms_arcsec = std::sqrt(r.score[0] / scores_.weight());
+        }
+        r.deciding = scores_.deciding();
+        r.orbits_held = scores_.orbits_held();
+        r.orbits_to_decide = scores_.orbits_to_decide();
+        r.taken = taken_;
+        r.candidate = candidate_;
+        return r;
+    }
+
+    // The rule (above): whether the term is taken after `taken`, given the
+    // scores (the polynomial's, the candidate's).
+    static constexpr bool next_taken(const double (&score)[2], bool taken) noexcept {
+        return taken ? !(score[0] < (1.0 - kSunLearnMargin) * score[1]) : score[1] < (1.0 - kSunLearnMargin) * score[0];
+    }
+
+private:
+    static constexpr std::uint8_t kFrameHeadIndices[kFrameHeads] = {0U, 1U, 2U};
+
+    // The open orbit into the moments (the older ones forgotten over the time
+    // since the last closed), and the candidate solved again.
+    void close_orbit() noexcept {
+        if (moments_.open_count() == 0U) {
+            return;
+        }
+        const double keep = closed_any_
+                                ? exp_nonpositive(-static_cast<double>(bin_ - last_closed_bin_) *
+                                                  static_cast<double>(scores_.period_us()) / scores_.memory_us())
+                                : 1.0;
+        moments_.close_orbit(keep);
+        closed_any_ = true;
+        last_closed_bin_ = bin_;
+        SunTermFit fit;
+        if (moments_.solve(rule_, fit) && sun_fit_within_domain(fit)) {
+            candidate_ = fit;
+            candidate_model_ = sun_term_model(fit);
+        }
+    }
+
+    void reconsider() noexcept {
+        if (scores_.deciding() && candidate_.solved) {
+            taken_ = next_taken(scores_.score(), taken_);
+        }
+    }
+
+    OrbitSpreadScores<2> scores_;
+    SunMoments<kFrameHeads> moments_;
+    CommonRotationWeights weights_;
+    SunRule rule_{};
+    bool open_ = false;
+    std::int64_t bin_ = 0;
+    bool closed_any_ = false;
+    std::int64_t last_closed_bin_ = 0;
+    SunTermFit candidate_{};
+    SunTermModel<double> candidate_model_{};
+    bool taken_ = false;
+};
+
+}  // namespace ascorr::calib

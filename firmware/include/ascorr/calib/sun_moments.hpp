@@ -1,0 +1,364 @@
+// ascorr/calib/sun_moments.hpp: the Sun term's least squares inside the orbit
+// (core/sun_term.hpp; issue 40, docs/ground.md, "The Sun term"), one
+// implementation for `ascorr fit` (host fit_sun.cpp, every orbit kept) and
+// the self-calibration's learner (sun_learner.hpp, with forgetting).
+//
+// The polynomial is fitted on orbit averages, which average the Sun's
+// direction in the orbital plane away; the Sun term is fitted on what varies
+// inside the orbit, after the polynomial has corrected each epoch. For each
+// epoch with every head, each head's rotation e_h relative to the frame F of
+// the corrected attitudes (head axes, arcsec; head_rotation.hpp, relative to
+// the head's first epoch, N_h) and s_h, the Sun's direction in the corrected
+// head's frame:
+//     e_h(t) = S_h·s_h(t) + N_h·g(t) + b_h(orbit) + noise,
+// S_h the head's 3 × 3 coefficients, g(t) F's own rotation at the epoch (a
+// nuisance, eliminated by projecting each epoch's equations orthogonally to
+// the N_h: common_rotation.hpp's P), b_h a constant per orbit and head
+// (eliminated by taking each orbit's mean out of e and s: the orbit means are
+// the polynomial's). The normal equations are formed from the sums over the
+// orbits of s·sᵀ and e·sᵀ about each orbit's mean (Kronecker structure of the
+// projection), so the epochs are read once and not kept. The solution is the
+// pseudo-inverse's over the eigen-directions above kSunRankTolerance of the
+// largest (symmetric_eigen.hpp): three of each head's nine do not vary inside
+// the orbit (the orbit normal's component of s, constant over an orbit on a
+// nadir-pointing spacecraft), and of the rotation common to every head, which
+// no IBA sees, six more are in the plane that does (3H + 6 unseen of 9H, rank
+// 6H − 6: 12 of 27 for three heads). The pseudo-inverse's solution has the
+// smallest coefficients (it is orthogonal to every common rotation
+// S_h + N_h·C·N_hᵀ); another rule fixes C from weights (SunRule, as
+// common_rotation.hpp's rule: Σ_h A_h·(S_h + N_h·C·N_hᵀ)·N_h = 0, the bench's
+// motion under the weights unmoved for every Sun direction), or a head rigid
+// to the bench (its coefficients exactly 0). The term's orbit mean along the
+// orbit normal is thereby left to the temperatures' polynomial.
+// Double (per orbit: the learner's solve runs once an orbit); no allocation;
+// every loop bounded by H.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "../core/constants.hpp"
+#include "../core/heads.hpp"
+#include "../core/quaternion.hpp"
+#include "../core/sun_term.hpp"
+#include "../core/vector3.hpp"
+#include "common_rotation.hpp"
+#include "frame.hpp"
+#include "head_rotation.hpp"
+#include "symmetric_eigen.hpp"
+
+namespace ascorr::calib {
+
+// Eigen-directions of the normal equations below this fraction of the
+// largest eigenvalue are left out (the pseudo-inverse's rank).
+inline constexpr double kSunRankTolerance = 1e-3;
+// The term is taken when it lowers the held-out (fit) or predicted
+// (sun_learner.hpp) IBA RMS by more than this fraction: the lag's margin,
+// 0.15 % of the RMS, 0.3 % of the mean square. On the static benches its gain
+// was below 0.01 %.
+inline constexpr double kSunSelectionMargin = 0.0015;
+
+// How the rotation common to every head is fixed (above).
+struct SunRule {
+    const Matrix3* weight = nullptr;  // by head index: A_h, head axes to a frame common to all; nullptr: smallest
+    int rigid_head = -1;              // ≥ 0: that head's term exactly 0 (weight ignored)
+};
+
+struct SunTermFit {
+    double sun[kMaxHeads][kModelAxes][kSunComponents] = {};  // arcsec, by head index
+    std::uint8_t heads = 0U;                                 // bit h: head h fitted
+    int rank = 0;                                            // eigen-directions kept
+    std::uint32_t orbits = 0U;                               // orbits closed
+    std::uint64_t epochs = 0U;                               // epochs in them
+    bool solved = false;  // false: no orbit, or equations that are not finite or did not converge
+};
+
+// Whether every axis of every fitted head is within the core's domain
+// (sun_term.hpp: Σ_m |S[a][m]| ≤ kMaxThermalAngleRad) and finite.
+inline bool sun_fit_within_domain(const SunTermFit& f) noexcept {
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; ((f.heads >> h) & 1U) != 0U && a < kModelAxes; ++a) {
+            double sum = 0.0;
+            for (double c : f.sun[h][a]) {
+                sum += std::fabs(c);
+            }
+            if (!(sum * kArcsecToRad <= kMaxThermalAngleRad)) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+// The fit as the core evaluates it (rad).
+inline SunTermModel<double> sun_term_model(const SunTermFit& f) noexcept {
+    SunTermModel<double> m{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        m.present[h] = ((f.heads >> h) & 1U) != 0U;
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                m.coefficient[h][a][c] = f.sun[h][a][c] * kArcsecToRad;
+            }
+        }
+    }
+    return m;
+}
+
+// H: the most heads (3 on board: A, B, C; kMaxHeads on the ground).
+template <std::size_t H>
+class SunMoments {
+public:
+    static constexpr std::size_t kRows = 3U * H;          // e or s of every head, stacked
+    static constexpr std::size_t kUnknowns = 3U * kRows;  // S_h[a][m] at 9i + 3a + m
+
+    // heads[0 … count − 1]: the head indices, in order (count ≤ H, 2 or more);
+    // F of frame_a and frame_c's boresights (frame.hpp).
+    SunMoments(const std::uint8_t* heads, std::size_t count, std::uint8_t frame_a, std::uint8_t frame_c) noexcept
+        : count_(count <= H ? count : H), frame_a_(frame_a), frame_c_(frame_c) {
+        for (std::size_t i = 0; i < count_; ++i) {
+            head_[i] = heads[i];
+        }
+    }
+
+    // One epoch: q_chu_icrf[h] (by head index) the heads' attitudes corrected
+    // by the polynomial, s_icrf the Sun's unit direction.
+    void add(const Quaternion<double>* q_chu_icrf, const Vector3<double>& s_icrf) noexcept {
+        const Quaternion<double> q_f = q_f_icrf(q_chu_icrf[frame_a_], q_chu_icrf[frame_c_]);
+        double e[kRows];
+        double s[kRows];
+        for (std::size_t i = 0; i < count_; ++i) {
+            const Quaternion<double>& q = q_chu_icrf[head_[i]];
+            const Quaternion<double> q_hf = q_head_f(q, q_f);
+            if (!referenced_) {
+                reference_[i] = q_hf;
+            }
+            const Vector3<double> e_rad = small_angle(relative_to(q_hf, reference_[i]));
+            const Vector3<double> s_chu = rotated(q, s_icrf);
+            const double ei[3] = {e_rad.x * kRadToArcsec, e_rad.y * kRadToArcsec, e_rad.z * kRadToArcsec};
+            const double si[3] = {s_chu.x, s_chu.y, s_chu.z};
+            for (std::size_t c = 0; c < 3; ++c) {
+                e[3 * i + c] = ei[c];
+                s[3 * i + c] = si[c];
+            }
+        }
+        referenced_ = true;
+        const std::size_t n = 3 * count_;
+        for (std::size_t r = 0; r < n; ++r) {
+            orbit_e_[r] += e[r];
+            orbit_s_[r] += s[r];
+            for (std::size_t c = 0; c < n; ++c) {
+                orbit_ss_[r][c] += s[r] * s[c];
+                orbit_es_[r][c] += e[r] * s[c];
+            }
+        }
+        ++orbit_count_;
+    }
+
+    // Closes the open orbit: the sums so far multiplied by `keep` (1: no
+    // forgetting), then its products about its own mean added.
+    void close_orbit(double keep) noexcept {
+        if (orbit_count_ == 0U) {
+            return;
+        }
+        const std::size_t n = 3 * count_;
+        const double inv = 1.0 / static_cast<double>(orbit_count_);
+        for (std::size_t r = 0; r < n; ++r) {
+            for (std::size_t c = 0; c < n; ++c) {
+                ss_[r][c] = keep * ss_[r][c] + (orbit_ss_[r][c] - orbit_s_[r] * orbit_s_[c] * inv);
+                es_[r][c] = keep * es_[r][c] + (orbit_es_[r][c] - orbit_e_[r] * orbit_s_[c] * inv);
+                orbit_ss_[r][c] = 0.0;
+                orbit_es_[r][c] = 0.0;
+            }
+        }
+        for (std::size_t r = 0; r < n; ++r) {  // after the loop above, which reads every one of them
+            orbit_e_[r] = 0.0;
+            orbit_s_[r] = 0.0;
+        }
+        epochs_ += orbit_count_;
+        ++orbits_;
+        orbit_count_ = 0U;
+    }
+
+    std::uint32_t open_count() const noexcept { return orbit_count_; }
+
+    // The fit over the orbits closed (above); false (out.solved) when there is none,
+    // or the equations are not finite, or the rule's weights are singular.
+    bool solve(const SunRule& rule, SunTermFit& out) const noexcept {
+        out = SunTermFit{};
+        out.orbits = orbits_;
+        out.epochs = epochs_;
+        if (orbits_ == 0U || count_ < 2U) {
+            return false;
+        }
+        double theta[kUnknowns] = {};
+        if (!pseudo_inverse_solution(theta, out.rank)) {
+            return false;
+        }
+        double s[H][3][3];
+        for (std::size_t i = 0; i < count_; ++i) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t m = 0; m < 3; ++m) {
+                    s[i][a][m] = theta[9 * i + 3 * a + m];
+                }
+            }
+        }
+        if (!apply_rule(rule, s)) {
+            return false;
+        }
+        for (std::size_t i = 0; i < count_; ++i) {
+            out.heads = static_cast<std::uint8_t>(out.heads | (1U << head_[i]));
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t m = 0; m < 3; ++m) {
+                    out.sun[head_[i]][a][m] = s[i][a][m];
+                }
+            }
+        }
+        out.solved = true;
+        return true;
+    }
+
+private:
+    // N_h: maps F's components into head h's (the reference's rotation matrix).
+    void references(Matrix3 (&n)[H]) const noexcept {
+        for (std::size_t i = 0; i < count_; ++i) {
+            n[i] = rotation_matrix(reference_[i]);
+        }
+    }
+
+    // The normal equations of the projected equations, from the sums: with
+    // P the projector, unknown (i, a, m) at 9i + 3a + m and equation row
+    // r = (i, a) = 3i + a, Σ XᵀPX = P[r][r2]·SS[(i, m)][(j, m2)] and
+    // Σ XᵀPe = Σ_r2 P[r][r2]·ES[r2][(i, m)] (X's rows are s's: a Kronecker
+    // product); then θ = Σ_k v_k·(v_k·rhs)/λ_k over λ_k > tolerance·λ_max.
+    bool pseudo_inverse_solution(double (&theta)[kUnknowns], int& rank) const noexcept {
+        const std::size_t n = 3 * count_;
+        const std::size_t u = 3 * n;
+        Matrix3 nh[H];
+        references(nh);
+        double p[kRows * kRows];
+        common_rotation_projector(nh, count_, p);
+        double normal[kUnknowns][kUnknowns];
+        double vectors[kUnknowns][kUnknowns];
+        double rhs[kUnknowns] = {};
+        for (std::size_t r = 0; r < n; ++r) {
+            for (std::size_t m = 0; m < 3; ++m) {
+                const std::size_t col = 3 * r + m;
+                const std::size_t im = 3 * (r / 3) + m;
+                for (std::size_t r2 = 0; r2 < n; ++r2) {
+                    const double prr = p[r * n + r2];
+                    rhs[col] += prr * es_[r2][im];
+                    for (std::size_t m2 = 0; m2 < 3; ++m2) {
+                        normal[col][3 * r2 + m2] = prr * ss_[im][3 * (r2 / 3) + m2];
+                    }
+                }
+            }
+        }
+        const int sweeps = symmetric_eigen(normal, vectors, u);
+        if (sweeps < 0 || sweeps > kMaxJacobiSweeps) {
+            return false;
+        }
+        double largest = 0.0;
+        for (std::size_t k = 0; k < u; ++k) {
+            largest = normal[k][k] > largest ? normal[k][k] : largest;
+        }
+        if (!(largest > 0.0)) {
+            return false;
+        }
+        rank = 0;
+        for (std::size_t k = 0; k < u; ++k) {
+            const double lambda = normal[k][k];
+            if (lambda > kSunRankTolerance * largest) {
+                double dot = 0.0;
+                for (std::size_t j = 0; j < u; ++j) {
+                    dot += vectors[j][k] * rhs[j];
+                }
+                for (std::size_t j = 0; j < u; ++j) {
+                    theta[j] += vectors[j][k] * (dot / lambda);
+                }
+                ++rank;
+            }
+        }
+        return true;
+    }
+
+    // The common rotation S_h + N_h·C·N_hᵀ fixed by the rule (above): C =
+    // −Σ_h B_h·S_h·N_h, B_h = (Σ_j A_j·N_j)⁻¹·A_h (bench_weights).
+    bool apply_rule(const SunRule& rule, double (&s)[H][3][3]) const noexcept {
+        if (rule.weight == nullptr && rule.rigid_head < 0) {
+            return true;  // the pseudo-inverse's: the smallest coefficients
+        }
+        Matrix3 nh[H];
+        references(nh);
+        Matrix3 a[H]{};
+        const std::size_t rigid = rule_weights(rule, a);
+        Matrix3 b[H];
+        if ((rule.rigid_head >= 0 && rigid == H) || !bench_weights(a, nh, count_, b)) {
+            return false;
+        }
+        Matrix3 c{};
+        for (std::size_t i = 0; i < count_; ++i) {
+            const Matrix3 bsn = product(product(b[i], matrix_of(s[i])), nh[i]);
+            for (std::size_t r = 0; r < 3; ++r) {
+                for (std::size_t k = 0; k < 3; ++k) {
+                    c.m[r][k] -= bsn.m[r][k];
+                }
+            }
+        }
+        for (std::size_t i = 0; i < count_; ++i) {
+            const Matrix3 ncn = product(product(nh[i], c), transposed(nh[i]));
+            for (std::size_t r = 0; r < 3; ++r) {
+                for (std::size_t k = 0; k < 3; ++k) {
+                    s[i][r][k] = i == rigid ? 0.0 : s[i][r][k] + ncn.m[r][k];  // rigid: exactly 0
+                }
+            }
+        }
+        return true;
+    }
+
+    // The rule's weights A_h by position: a rigid head's I and the others' 0,
+    // or the rule's. Returns the rigid head's position (H: none, or not among
+    // the heads).
+    std::size_t rule_weights(const SunRule& rule, Matrix3 (&a)[H]) const noexcept {
+        constexpr Matrix3 kIdentity{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
+        std::size_t rigid = H;
+        for (std::size_t i = 0; i < count_; ++i) {
+            const bool is_rigid = rule.rigid_head >= 0 && static_cast<int>(head_[i]) == rule.rigid_head;
+            rigid = is_rigid ? i : rigid;
+            a[i] = rule.rigid_head >= 0 ? (is_rigid ? kIdentity : Matrix3{}) : rule.weight[head_[i]];
+        }
+        return rigid;
+    }
+
+    static Matrix3 matrix_of(const double (&s)[3][3]) noexcept {
+        return {{{s[0][0], s[0][1], s[0][2]}, {s[1][0], s[1][1], s[1][2]}, {s[2][0], s[2][1], s[2][2]}}};
+    }
+
+    static Matrix3 transposed(const Matrix3& m) noexcept {
+        Matrix3 t{};
+        for (std::size_t r = 0; r < 3; ++r) {
+            for (std::size_t k = 0; k < 3; ++k) {
+                t.m[r][k] = m.m[k][r];
+            }
+        }
+        return t;
+    }
+
+    std::size_t count_;
+    std::uint8_t head_[H] = {};
+    std::uint8_t frame_a_;
+    std::uint8_t frame_c_;
+    bool referenced_ = false;
+    Quaternion<double> reference_[H]{};
+    std::uint32_t orbit_count_ = 0U;
+    double orbit_e_[kRows] = {};
+    double orbit_s_[kRows] = {};
+    double orbit_ss_[kRows][kRows] = {};
+    double orbit_es_[kRows][kRows] = {};
+    double ss_[kRows][kRows] = {};
+    double es_[kRows][kRows] = {};
+    std::uint32_t orbits_ = 0U;
+    std::uint64_t epochs_ = 0U;
+};
+
+}  // namespace ascorr::calib

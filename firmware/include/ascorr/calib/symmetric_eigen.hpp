@@ -1,0 +1,102 @@
+// ascorr/calib/symmetric_eigen.hpp: the eigen-decomposition of a small
+// symmetric matrix by the cyclic Jacobi method (Golub & Van Loan, Matrix
+// Computations, 4th ed., §8.5: Algorithm 8.5.1, the 2 × 2 symmetric Schur
+// decomposition, swept row by row as in Algorithm 8.5.3), for the Sun term's
+// pseudo-inverse (sun_moments.hpp), on board and on the ground.
+//
+// Why Jacobi: the matrices are at most 36 × 36 and formed once per orbit; the
+// method needs only +, −, ×, ÷ and √ (the same bits on the DPU and the host,
+// portable_math.hpp's reason), keeps small eigenvalues to a relative accuracy
+// the rank decision needs, and its loops have fixed bounds.
+// Convergence: quadratic once the off-diagonal part is small; 6 to 10 sweeps
+// for these sizes in double. The sweeps stop when the off-diagonal Frobenius
+// norm is ≤ kJacobiTolerance of the matrix's, or after kMaxJacobiSweeps.
+// Double only; no allocation, no recursion.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+
+namespace ascorr::calib {
+
+inline constexpr int kMaxJacobiSweeps = 30;
+inline constexpr double kJacobiTolerance = 1e-15;
+
+// One Jacobi rotation J(p, q, θ) zeroing a[p][q]: a ← Jᵀ·a·J, v ← v·J
+// (Algorithm 8.5.1: τ = (a_qq − a_pp)/(2·a_pq), t the smaller root of
+// t² + 2τt − 1 = 0, c = 1/√(1 + t²), s = t·c).
+template <std::size_t N>
+void jacobi_rotation(double (&a)[N][N], double (&v)[N][N], std::size_t n, std::size_t p, std::size_t q) noexcept {
+    const double apq = a[p][q];
+    if (apq == 0.0) {
+        return;
+    }
+    const double tau = (a[q][q] - a[p][p]) / (2.0 * apq);
+    // For |τ| beyond 1e150 τ² overflows; t = 1/(2τ) there to relative 1e-300.
+    const double t =
+        std::fabs(tau) > 1e150 ? 0.5 / tau : (tau >= 0.0 ? 1.0 : -1.0) / (std::fabs(tau) + std::sqrt(1.0 + tau * tau));
+    const double c = 1.0 / std::sqrt(1.0 + t * t);
+    const double s = t * c;
+    for (std::size_t k = 0; k < n; ++k) {  // a·J: columns p and q
+        const double akp = a[k][p];
+        const double akq = a[k][q];
+        a[k][p] = c * akp - s * akq;
+        a[k][q] = s * akp + c * akq;
+    }
+    for (std::size_t k = 0; k < n; ++k) {  // Jᵀ·(a·J): rows p and q
+        const double apk = a[p][k];
+        const double aqk = a[q][k];
+        a[p][k] = c * apk - s * aqk;
+        a[q][k] = s * apk + c * aqk;
+    }
+    a[p][q] = 0.0;  // zero by construction; its rounding is not kept
+    a[q][p] = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double vkp = v[k][p];
+        const double vkq = v[k][q];
+        v[k][p] = c * vkp - s * vkq;
+        v[k][q] = s * vkp + c * vkq;
+    }
+}
+
+// a (n × n of N × N, symmetric) is overwritten: its diagonal holds the
+// eigenvalues; v's columns the eigenvectors (orthonormal), a = V·diag·Vᵀ.
+// Returns the sweeps done, or −1 when a is not finite or n > N (a and v are
+// then left as they are, resp. v the identity), or kMaxJacobiSweeps + 1 when
+// the bound was reached first (the result is then that of the last sweep).
+template <std::size_t N>
+int symmetric_eigen(double (&a)[N][N], double (&v)[N][N], std::size_t n) noexcept {
+    if (n > N) {
+        return -1;
+    }
+    double total = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) {
+            v[i][j] = i == j ? 1.0 : 0.0;
+            total += a[i][j] * a[i][j];
+        }
+    }
+    if (!std::isfinite(total)) {
+        return -1;
+    }
+    const double bound = kJacobiTolerance * kJacobiTolerance * total;
+    for (int sweep = 0; sweep < kMaxJacobiSweeps; ++sweep) {
+        double off = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t j = 0; j < n; ++j) {
+                off += i == j ? 0.0 : a[i][j] * a[i][j];
+            }
+        }
+        if (off <= bound) {
+            return sweep;
+        }
+        for (std::size_t p = 0; p + 1U < n; ++p) {
+            for (std::size_t q = p + 1U; q < n; ++q) {
+                jacobi_rotation(a, v, n, p, q);
+            }
+        }
+    }
+    return kMaxJacobiSweeps + 1;
+}
+
+}  // namespace ascorr::calib
