@@ -25,6 +25,7 @@
 #include "ascorr_host/correct/lagged_temperatures.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "cli_run.hpp"
+#include "inside_orbit_missions.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -40,42 +41,13 @@ constexpr double kLagGridNear[] = {1512.0, 1905.0, 2400.0};  // the grid points 
 // seed 40: its A-B swing inside the orbit is large enough that no static
 // model meets the bound), and a static one of 60 days (the search decides
 // after 30).
-fs::path mission(const std::string& name, const std::string& args) {
-    const fs::path d = scratch_dir(name);
-    const CliRun r = run_in("simulate " + args + " --noise-iba --out m.csv > /dev/null", d);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return d;
-}
 const fs::path& lagging_mission() {
-    static const fs::path dir = mission("lag-learnt", "--days 150 --step 240 --seed 40 --bench-lag 1800");
+    static const fs::path dir = simulated_mission("lag-learnt", "--days 150 --step 240 --seed 40 --bench-lag 1800");
     return dir;
 }
 const fs::path& static_mission() {
-    static const fs::path dir = mission("lag-learnt-static", "--days 60 --step 240 --seed 40");
+    static const fs::path dir = simulated_mission("lag-learnt-static", "--days 60 --step 240 --seed 40");
     return dir;
-}
-
-// The first row's t of the mission in dir, + days.
-double mission_day(const fs::path& dir, double days) {
-    const std::vector<std::string> lines = lines_of_file(dir / "m.csv");
-    return std::stod(lines.at(1).substr(0, lines.at(1).find(','))) + days * 86400.0;
-}
-
-// The systematic residual per pair of `corrected` from `from` on (arcsec).
-std::array<double, 3> systematic(const fs::path& dir, const std::string& corrected, double from) {
-    host::StatsOptions s;
-    s.in = (dir / corrected).string();
-    s.from = from;
-    s.noise_iba = (dir / "m.csv.noise-iba.csv").string();
-    s.log_empty_pairs = false;
-    std::ostringstream log;
-    const host::StatsResult r = host::compute_stats(s, log);
-    return {r.systematic_rms[0][0].rms, r.systematic_rms[1][0].rms, r.systematic_rms[2][0].rms};
-}
-
-CliRun self_calibrate(const fs::path& dir, const std::string& args, const std::string& out) {
-    return run_in(
-        "correct --in m.csv --self-calibrate --out " + out + " --model-history " + out + ".history.csv " + args, dir);
 }
 
 // The lag_s column of a history, row by row (empty: no such column).
@@ -166,12 +138,12 @@ TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
     const fs::path& dir = lagging_mission();
     const double from = mission_day(dir, kFromDays);
     // Mutation: the same estimator without the search fails the bound.
-    ASSERT_EQ(self_calibrate(dir, "", "sc_none.csv").exit_code, 0);
-    const std::array<double, 3> without = systematic(dir, "sc_none.csv", from);
+    ASSERT_EQ(self_calibrate_mission(dir, "", "sc_none.csv").exit_code, 0);
+    const std::array<double, 3> without = systematic_from(dir, "sc_none.csv", from);
     EXPECT_GT(*std::max_element(without.begin(), without.end()), kBound) << "without the lag the bound must fail";
     for (const char* scalar : {"double", "float", "fixed"}) {
         const std::string out = std::string("sc_auto_") + scalar + ".csv";
-        const CliRun r = self_calibrate(dir, std::string("--lag auto --scalar ") + scalar, out);
+        const CliRun r = self_calibrate_mission(dir, std::string("--lag auto --scalar ") + scalar, out);
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const std::string& log = r.err;
         // The lag taken: one step of the grid from the bench's, once.
@@ -190,7 +162,7 @@ TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
         EXPECT_TRUE(has(log, "; it takes " + std::to_string(static_cast<int>(taken)) + " s (a lag once 0.3 % below"))
             << log;
         EXPECT_FALSE(has(log, "no model since took it")) << log;
-        const std::array<double, 3> with = systematic(dir, out, from);
+        const std::array<double, 3> with = systematic_from(dir, out, from);
         for (std::size_t p = 0; p < 3; ++p) {
             EXPECT_LE(with[p], kBound) << scalar << " pair " << p;
             RecordProperty(std::string("learnt_lag_") + scalar + "_" + std::to_string(p), std::to_string(with[p]));
@@ -201,9 +173,9 @@ TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
 
 TEST(LagLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
     const fs::path& dir = static_mission();
-    const CliRun none = self_calibrate(dir, "", "s_none.csv");
+    const CliRun none = self_calibrate_mission(dir, "", "s_none.csv");
     ASSERT_EQ(none.exit_code, 0) << none.err;
-    const CliRun with = self_calibrate(dir, "--lag auto", "s_auto.csv");
+    const CliRun with = self_calibrate_mission(dir, "--lag auto", "s_auto.csv");
     ASSERT_EQ(with.exit_code, 0) << with.err;
     EXPECT_EQ(slurp(dir / "s_auto.csv"), slurp(dir / "s_none.csv"));
     EXPECT_EQ(slurp(dir / "s_auto.csv.history.csv"), slurp(dir / "s_none.csv.history.csv"));
@@ -217,7 +189,7 @@ TEST(LagLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
 // 40 to 160, seed 40: counted by orbits ever scored, it took 378 s a day after
 // B came back, and kept it).
 TEST(LagLearnt, AfterALongGapItWaitsForAMemoryOfOrbitsAgain) {
-    const fs::path dir = mission("lag-learnt-gap", "--days 200 --step 240 --seed 40");
+    const fs::path dir = simulated_mission("lag-learnt-gap", "--days 200 --step 240 --seed 40");
     const double from = mission_day(dir, 40.0);
     const double to = mission_day(dir, 160.0);
     rewrite_csv_rows(dir / "m.csv", dir / "gap.csv", [&](const std::string& line, std::ofstream& out) {

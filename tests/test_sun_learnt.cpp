@@ -25,6 +25,7 @@
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "cli_run.hpp"
+#include "inside_orbit_missions.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -205,6 +206,17 @@ Eigen::VectorXd explicit_solution(const Synthetic& d) {
     return theta;
 }
 
+// N_h of the synthetic epochs: each head's rotation in F at the first epoch.
+std::array<Eigen::Matrix3d, 3> references_of(const Synthetic& d) {
+    std::array<Eigen::Matrix3d, 3> n{};
+    const Quaternion<double> q_f = calib::q_f_icrf(d.q[0][0], d.q[0][2]);
+    for (std::size_t h = 0; h < 3; ++h) {
+        const Quaternion<double> r = calib::q_head_f(d.q[0][h], q_f);
+        n[h] = Eigen::Quaterniond(r.w, r.x, r.y, r.z).toRotationMatrix();
+    }
+    return n;
+}
+
 TEST(SunMoments, TheSumsSolveAsTheExplicitDesign) {
     const Synthetic d = synthetic(12, 40, 11);
     const std::uint8_t heads[3] = {0, 1, 2};
@@ -262,6 +274,29 @@ TEST(SunMoments, ARigidHeadIsExactlyZeroAndForgettingWeighsTheLatestOrbits) {
     calib::SunTermFit all;
     calib::SunTermFit last;
     ASSERT_TRUE(kept.solve(calib::SunRule{}, all));
+    // The rule adds one common rotation to every head: S_h − S_h(smallest) =
+    // N_h·C·N_hᵀ with the same C, which the rigid head's difference gives.
+    const std::array<Eigen::Matrix3d, 3> n = references_of(d);
+    const auto diff = [&](int h) {
+        Eigen::Matrix3d m;
+        for (int a = 0; a < 3; ++a) {
+            for (int c = 0; c < 3; ++c) {
+                const auto ua = static_cast<std::size_t>(a);
+                const auto uc = static_cast<std::size_t>(c);
+                const auto uh = static_cast<std::size_t>(h);
+                m(a, c) = fit.sun[uh][ua][uc] - all.sun[uh][ua][uc];
+            }
+        }
+        return m;
+    };
+    const Eigen::Matrix3d common = n[1].transpose() * diff(1) * n[1];
+    EXPECT_GT(common.norm(), 1e-3) << "the smallest coefficients are not rigid-B's";
+    for (int h : {0, 2}) {
+        EXPECT_LT(
+            (n[static_cast<std::size_t>(h)] * common * n[static_cast<std::size_t>(h)].transpose() - diff(h)).norm(),
+            1e-9 * common.norm())
+            << h;
+    }
     ASSERT_TRUE(forgot.solve(calib::SunRule{}, last));
     Synthetic tail;
     const std::size_t from = 5 * 40;
@@ -273,6 +308,107 @@ TEST(SunMoments, ARigidHeadIsExactlyZeroAndForgettingWeighsTheLatestOrbits) {
     const Eigen::VectorXd reference = explicit_solution(tail);
     EXPECT_NEAR(last.sun[0][0][0], reference(0), 1e-6 + 1e-6 * std::fabs(reference(0)));
     EXPECT_NE(last.sun[0][0][0], all.sun[0][0][0]);
+}
+
+// With weights A_h, the rule's terms move the weighted bench by nothing:
+// Σ_h A_h·S_h·N_h = 0 (for every Sun direction in F); the smallest
+// coefficients' do not (the test can fail).
+TEST(SunMoments, WeightedRuleLeavesTheWeightedBenchUnmoved) {
+    const Synthetic d = synthetic(8, 40, 13);
+    const std::uint8_t heads[3] = {0, 1, 2};
+    calib::SunMoments<3> moments(heads, 3, 0, 2);
+    for (std::size_t k = 0; k < d.q.size(); ++k) {
+        if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
+            moments.close_orbit(1.0);
+        }
+        ASSERT_TRUE(moments.add(d.q[k].data(), d.s[k]));
+    }
+    moments.close_orbit(1.0);
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> g(0.0, 1.0);
+    calib::Matrix3 weights[kMaxHeads]{};
+    for (std::size_t h = 0; h < 3; ++h) {
+        for (auto& row : weights[h].m) {
+            for (double& v : row) {
+                v = 1e4 * g(rng);  // 1/σ²-sized
+            }
+        }
+    }
+    calib::SunRule rule;
+    rule.weight = weights;
+    calib::SunTermFit weighted;
+    calib::SunTermFit smallest;
+    ASSERT_TRUE(moments.solve(rule, weighted));
+    ASSERT_TRUE(moments.solve(calib::SunRule{}, smallest));
+    const std::array<Eigen::Matrix3d, 3> n = references_of(d);
+    const auto motion = [&](const calib::SunTermFit& f) {
+        Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+        double size = 0.0;
+        for (std::size_t h = 0; h < 3; ++h) {
+            Eigen::Matrix3d a;
+            Eigen::Matrix3d s;
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) {
+                    const auto ur = static_cast<std::size_t>(r);
+                    const auto uc = static_cast<std::size_t>(c);
+                    a(r, c) = weights[h].m[ur][uc];
+                    s(r, c) = f.sun[h][ur][uc];
+                }
+            }
+            m += a * s * n[h];
+            size += (a * s * n[h]).norm();
+        }
+        return m.norm() / size;
+    };
+    EXPECT_LT(motion(weighted), 1e-9);
+    EXPECT_GT(motion(smallest), 1e-3);
+}
+
+TEST(SunMoments, ANonFiniteEpochIsRefusedAndSpoilsNothing) {
+    const Synthetic d = synthetic(3, 40, 14);
+    const std::uint8_t heads[3] = {0, 1, 2};
+    calib::SunMoments<3> clean(heads, 3, 0, 2);
+    calib::SunMoments<3> with_nan(heads, 3, 0, 2);
+    for (std::size_t k = 0; k < d.q.size(); ++k) {
+        if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
+            clean.close_orbit(1.0);
+            with_nan.close_orbit(1.0);
+        }
+        if (k == 50) {
+            std::array<Quaternion<double>, kMaxHeads> bad = d.q[k];
+            bad[1].x = std::nan("");
+            EXPECT_FALSE(with_nan.add(bad.data(), d.s[k]));
+            EXPECT_FALSE(with_nan.add(d.q[k].data(), {std::nan(""), 0.0, 1.0}));
+        }
+        ASSERT_TRUE(clean.add(d.q[k].data(), d.s[k]));
+        ASSERT_TRUE(with_nan.add(d.q[k].data(), d.s[k]));
+    }
+    clean.close_orbit(1.0);
+    with_nan.close_orbit(1.0);
+    calib::SunTermFit a;
+    calib::SunTermFit b;
+    ASSERT_TRUE(clean.solve(calib::SunRule{}, a));
+    ASSERT_TRUE(with_nan.solve(calib::SunRule{}, b));
+    EXPECT_EQ(a.sun[2][1][0], b.sun[2][1][0]);
+    EXPECT_EQ(a.epochs, b.epochs);
+}
+
+// Cycles outside the Sun ephemeris' span are not learnt from, and counted.
+TEST(SunLearner, CyclesWhereTheSunIsNotKnownAreCountedNotLearnt) {
+    calib::SunLearner learner{calib::EstimatorConfig{}};
+    const Quaternion<double> q[calib::kFrameHeads] = {{1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {0.0, 0.0, 1.0, 0.0}};
+    const std::int64_t after_2051 = 1'620'000'000'000'000;  // TT µs since J2000: 2051-05
+    EXPECT_FALSE(learner.take(after_2051, q));
+    EXPECT_FALSE(learner.take(after_2051 + 1'000'000, q));
+    Quaternion<double> bad[calib::kFrameHeads] = {q[0], q[1], q[2]};
+    bad[2].w = std::nan("");
+    EXPECT_FALSE(learner.take(600'000'000'000'000, bad));
+    learner.finish();
+    const calib::SunLearnReport r = learner.report();
+    EXPECT_EQ(r.without_sun, 2U);
+    EXPECT_EQ(r.not_finite, 1U);
+    EXPECT_EQ(r.orbits, 0U);
+    EXPECT_EQ(learner.taken(), nullptr);
 }
 
 TEST(SunMoments, NothingToSolveIsNoTerm) {
@@ -297,60 +433,33 @@ TEST(SunLearner, TheRuleTakesOnlyBeyondTheMarginAndLeavesAlike) {
 constexpr double kBound = 0.2;      // arcsec per pair from day 60, issue 40's for self-calibration
 constexpr double kFromDays = 60.0;  // issue 40's "from day 60 on"
 
-fs::path mission(const std::string& name, const std::string& args) {
-    const fs::path d = scratch_dir(name);
-    const CliRun r = run_in("simulate " + args + " --noise-iba --out m.csv > /dev/null", d);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return d;
-}
 // 150 days whose bench lags by 900 s and turns with the Sun along the velocity
 // (0.8″ × ŝ·v̂ about a fixed axis per head), an epoch every 240 s, seed 40.
 const fs::path& orbit_mission() {
     static const fs::path dir =
-        mission("sun-learnt", "--days 150 --step 240 --seed 40 --bench-lag 900 --orbit-term 0.8");
+        simulated_mission("sun-learnt", "--days 150 --step 240 --seed 40 --bench-lag 900 --orbit-term 0.8");
     return dir;
 }
 const fs::path& static_mission() {
-    static const fs::path dir = mission("sun-learnt-static", "--days 60 --step 240 --seed 40");
+    static const fs::path dir = simulated_mission("sun-learnt-static", "--days 60 --step 240 --seed 40");
     return dir;
-}
-
-double mission_day(const fs::path& dir, double days) {
-    const std::vector<std::string> lines = lines_of_file(dir / "m.csv");
-    return std::stod(lines.at(1).substr(0, lines.at(1).find(','))) + days * 86400.0;
-}
-
-std::array<double, 3> systematic(const fs::path& dir, const std::string& corrected, double from) {
-    host::StatsOptions s;
-    s.in = (dir / corrected).string();
-    s.from = from;
-    s.noise_iba = (dir / "m.csv.noise-iba.csv").string();
-    s.log_empty_pairs = false;
-    std::ostringstream log;
-    const host::StatsResult r = host::compute_stats(s, log);
-    return {r.systematic_rms[0][0].rms, r.systematic_rms[1][0].rms, r.systematic_rms[2][0].rms};
-}
-
-CliRun self_calibrate(const fs::path& dir, const std::string& args, const std::string& out) {
-    return run_in(
-        "correct --in m.csv --self-calibrate --out " + out + " --model-history " + out + ".history.csv " + args, dir);
 }
 
 TEST(SunLearnt, SelfCalibrationLearnsTheSunTermFromNoModelAndMeetsTheBound) {
     const fs::path& dir = orbit_mission();
     const double from = mission_day(dir, kFromDays);
     // Mutation: the same run without the learner (the lag learnt alone) fails the bound.
-    ASSERT_EQ(self_calibrate(dir, "--lag auto", "sc_lag.csv").exit_code, 0);
-    const std::array<double, 3> without = systematic(dir, "sc_lag.csv", from);
+    ASSERT_EQ(self_calibrate_mission(dir, "--lag auto", "sc_lag.csv").exit_code, 0);
+    const std::array<double, 3> without = systematic_from(dir, "sc_lag.csv", from);
     EXPECT_GT(*std::max_element(without.begin(), without.end()), kBound) << "without the Sun term the bound must fail";
-    const CliRun r = self_calibrate(dir, "--lag auto --sun-term auto", "sc_sun.csv");
+    const CliRun r = self_calibrate_mission(dir, "--lag auto --sun-term auto", "sc_sun.csv");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(has(r.err, "; Sun term (--sun-term auto): the learner scored ")) << r.err;
     EXPECT_TRUE(has(r.err,
                     "; it takes the term (taken 0.3 % below, left 0.3 % above); the models took it from "
                     "version "))
         << r.err;
-    const std::array<double, 3> with = systematic(dir, "sc_sun.csv", from);
+    const std::array<double, 3> with = systematic_from(dir, "sc_sun.csv", from);
     for (std::size_t p = 0; p < 3; ++p) {
         EXPECT_LE(with[p], kBound) << "pair " << p;
         RecordProperty("learnt_sun_" + std::to_string(p), std::to_string(with[p]));
@@ -367,9 +476,9 @@ TEST(SunLearnt, SelfCalibrationLearnsTheSunTermFromNoModelAndMeetsTheBound) {
 
 TEST(SunLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
     const fs::path& dir = static_mission();
-    const CliRun none = self_calibrate(dir, "", "s_none.csv");
+    const CliRun none = self_calibrate_mission(dir, "", "s_none.csv");
     ASSERT_EQ(none.exit_code, 0) << none.err;
-    const CliRun with = self_calibrate(dir, "--sun-term auto", "s_auto.csv");
+    const CliRun with = self_calibrate_mission(dir, "--sun-term auto", "s_auto.csv");
     ASSERT_EQ(with.exit_code, 0) << with.err;
     EXPECT_EQ(slurp(dir / "s_auto.csv"), slurp(dir / "s_none.csv"));
     EXPECT_EQ(slurp(dir / "s_auto.csv.history.csv"), slurp(dir / "s_none.csv.history.csv"));
@@ -382,9 +491,9 @@ TEST(SunLearnt, WhatCannotLearnItIsRefused) {
     const fs::path& dir = static_mission();
     const std::pair<std::string, std::string> cases[] = {
         {"correct --in m.csv --sun-term auto --out c.csv", "--sun-term: needs --self-calibrate"},
-        {"correct --in m.csv --self-calibrate --sun-term auto --scalar float --out c.csv",
-         "--sun-term auto learns a Sun term, which is evaluated in double only, on the ground: it cannot go with "
-         "--scalar float or fixed"},
+        {"correct --in m.csv --self-calibrate --sun-term auto --scalar fixed --out c.csv",
+         "--sun-term auto learns a Sun term: it is evaluated in double and float only (the fixed-point core has no "
+         "Sun term yet): it cannot go with --scalar fixed"},
         {"correct --in m.csv --self-calibrate --sun-term sometimes --out c.csv", "--sun-term"},
     };
     for (const auto& [args, part] : cases) {

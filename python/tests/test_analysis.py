@@ -320,8 +320,8 @@ def test_self_calibrate_sun_term_auto_is_ascorr_correct_self_calibrate_sun_term_
     # Mutation: without the learner the corrections differ.
     q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0)
     assert np.abs(q_none - q).max() > 1e-9
-    with pytest.raises(ValueError, match="sun_term.*evaluated in double only.*scalar='float'"):
-        ascorr.self_calibrate(*as_args(d), scalar="float", sun_term="auto")
+    with pytest.raises(ValueError, match="sun_term.*evaluated in double and float only.*scalar='fixed'"):
+        ascorr.self_calibrate(*as_args(d), scalar="fixed", sun_term="auto")
     with pytest.raises(ValueError, match="sun_term"):
         ascorr.self_calibrate(*as_args(d), sun_term="yes")
 
@@ -423,8 +423,10 @@ def test_fit_sun_term_and_correct_are_ascorr_fit_and_correct(exe, sun_mission, t
     for pair, v in cli_stats["pairs"].items():
         assert py_stats["pairs"][pair]["thermal"] == pytest.approx(v["thermal"], abs=1e-6), pair
 
-    with pytest.raises(ValueError, match="model.*Sun term.*evaluated in double only"):
-        ascorr.correct(*as_args(d), model=model, scalar="float")
+    with pytest.raises(ValueError, match="model.*Sun term.*evaluated in double and float only"):
+        ascorr.correct(*as_args(d), model=model, scalar="fixed")
+    q_float, _ = ascorr.correct(*as_args(d), model=model, scalar="float")  # the float core's own Sun term
+    assert np.abs(q_float - q).max() < 1e-6
     with pytest.raises(ValueError, match="model.*learns a Sun term from none"):
         ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], model=model)
     bad = model.sun.copy()

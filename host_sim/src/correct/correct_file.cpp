@@ -562,13 +562,12 @@ void refuse_run_options(const CorrectOptions& opt) {
     }
 }
 
-// --sun-term auto's scalar: the term is evaluated in double (correct_row.hpp).
+// --sun-term auto's scalar: the term is evaluated in double and float (correct_row.hpp).
 template <typename T>
 void refuse_sun_term_scalar(const CorrectOptions& opt) {
-    if (opt.sun_auto && scalar_kind_of<T>() != ScalarKind::kDouble) {
-        throw std::runtime_error(
-            "--sun-term auto learns a Sun term, which is evaluated in double only, on the ground: it cannot go with "
-            "--scalar float or fixed");
+    if (opt.sun_auto && scalar_kind_of<T>() == ScalarKind::kFixed) {
+        throw std::runtime_error(std::string("--sun-term auto learns a Sun term: ") + kSunTermNotInFixedPoint +
+                                 ": it cannot go with --scalar fixed");
     }
 }
 
@@ -666,8 +665,8 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
 }  // namespace
 
 void check_model_for_scalar(const ModelFile& m, ScalarKind scalar, const std::string& path) {
-    if (scalar != ScalarKind::kDouble) {
-        refuse_sun_term(m, path, "it is evaluated in double only, on the ground (the scalar double)");
+    if (scalar == ScalarKind::kFixed) {
+        refuse_sun_term(m, path, kSunTermNotInFixedPoint);
     }
     if (scalar == ScalarKind::kFixed) {
         check_fixed_point_range(m, path);

@@ -1,5 +1,7 @@
 #include "ascorr_host/correct/correct_row.hpp"
 
+#include <type_traits>
+
 #include "ascorr/nav/sun_direction.hpp"
 #include "ascorr/pipeline/solution_stage.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
@@ -15,6 +17,26 @@ RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status,
     s.unknown = !s.apply;
     return s;
 }
+
+namespace {
+
+// The Sun term of `head` in float, as the float core's per-solution path
+// would hold it (each coefficient and ŝ rounded to float once), applied in
+// float to the float core's result (core/sun_term.hpp).
+Quaternion<float> with_sun_term_in_float(const Quaternion<float>& q, const SunTermModel<double>& sun, std::uint8_t head,
+                                         const Vector3<double>& s_icrf) {
+    SunTermModel<float> m{};
+    m.present[head] = sun.present[head];
+    for (std::size_t a = 0; a < kModelAxes; ++a) {
+        for (std::size_t c = 0; c < kSunComponents; ++c) {
+            m.coefficient[head][a][c] = static_cast<float>(sun.coefficient[head][a][c]);
+        }
+    }
+    const Vector3<float> s{static_cast<float>(s_icrf.x), static_cast<float>(s_icrf.y), static_cast<float>(s_icrf.z)};
+    return with_sun_term(q, sun_term_rotation(m, head, q, s));
+}
+
+}  // namespace
 
 template <typename T>
 RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
@@ -37,9 +59,14 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
     if ((r.status & status::kRejected) != 0U) {
         return r;
     }
+    if constexpr (std::is_same_v<T, float>) {
+        if (s.apply) {
+            c.q_chu_icrf = with_sun_term_in_float(c.q_chu_icrf, *sun, rec.head, s.s_icrf);
+        }
+    }
     const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
     r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
-    if (s.apply) {
+    if (!std::is_same_v<T, float> && s.apply) {  // double (Q30: refused by the callers, check_model_for_scalar)
         r.q_chu_icrf = with_sun_term(r.q_chu_icrf, sun_term_rotation(*sun, rec.head, r.q_chu_icrf, s.s_icrf));
     }
     return r;

@@ -237,6 +237,7 @@ private:
             }
             if (search_->take(t_us, *pipeline_.model(), kept, tp) && sun_) {
                 (void)sun_->take(t_us, search_->taken_attitudes());
+                (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
             }
             return;
         }
@@ -249,6 +250,7 @@ private:
         }
         if (sun_) {
             (void)sun_->take(t_us, q);
+            (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
         }
     }
 
@@ -857,9 +859,25 @@ std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
     return out + buf + (r.tau_s != last_model_lag_s ? "; no model since took it" : "");
 }
 
-std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history) {
+namespace {
+
+// The epochs the learner could not take, in a clause ("" when none).
+std::string not_learnt_from(const calib::SunLearnReport& r) {
+    std::string out;
+    if (r.without_sun > 0U) {
+        out += "; " + std::to_string(r.without_sun) +
+               " epoch(s) outside the Sun ephemeris' span (2000-2051) not learnt from";
+    }
+    if (r.not_finite > 0U) {
+        out +=
+            "; " + std::to_string(r.not_finite) + " epoch(s) whose attitudes give no finite rotation not learnt from";
+    }
+    return out;
+}
+
+std::string describe_sun_learner(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history) {
     if (r.orbits == 0U) {
-        return "the learner scored no orbit (no model active with A, B and C selected)";
+        return "the learner scored no orbit (no model active with A, B and C selected and the Sun's direction known)";
     }
     char buf[400];
     text::c_snprintf(buf, sizeof buf,
@@ -885,6 +903,12 @@ std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveMod
     }
     text::c_snprintf(buf, sizeof buf, "; the models took it from version %u (t = %.3f)", first->version, first->t);
     return out + buf;
+}
+
+}  // namespace
+
+std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history) {
+    return describe_sun_learner(r, history) + not_learnt_from(r);
 }
 
 std::string describe(const SelfCalibration& s) {

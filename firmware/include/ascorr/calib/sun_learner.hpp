@@ -9,9 +9,12 @@
 // selected), the heads' rotations in F and the Sun's direction in each head's
 // frame, about each orbit's own mean, with a forgetting e^(−Δt/memory) per
 // orbit closed (memory: orbit_spread_scores.hpp's, the estimator's time
-// constant but at least 30 days), and solves them at every orbit closed: the
-// candidate, under the estimator's rule for the common rotation (its weights,
-// `--mountings`' combined attitude; none: the smallest coefficients).
+// constant but at least 30 days), and solves them after every orbit closed
+// (step(), in idle time): the candidate, under the estimator's weights for
+// the common rotation when it has them (`--mountings`' combined attitude),
+// otherwise the smallest coefficients (not the estimator's own gauge, frame F
+// of A and C: the term's common part then moves F a little). Heads A, B and C
+// only: a further head learnt by the estimator gets no term.
 //
 // Taken (taken(), report().taken): each cycle is corrected by the polynomial
 // alone and by the polynomial and the candidate solved before its orbit
@@ -27,11 +30,13 @@
 // Arithmetic: double (the attitudes as the caller corrected them: the
 // pipeline's kept solutions, or the lag search's at its lag; the Sun from
 // nav/sun_direction.hpp at the cycle's TT). A cycle outside the Sun
-// ephemeris' span (2000–2051) is not taken.
-// Cost per fed cycle: a Sun direction, three Sun-term rotations, six
-// boresights and IBAs, the moments' 2·9² products. Per orbit closed: the
-// normal equations (27 × 27) and their Jacobi eigen-decomposition
-// (symmetric_eigen.hpp, at most 30 sweeps). No allocation, every loop bounded.
+// ephemeris' span (2000–2051), or whose attitudes give no finite rotation, is
+// not taken (counted: report()).
+// Cost per fed cycle (take): a Sun direction, three Sun-term rotations, six
+// boresights and IBAs, the moments' 2·9² products. Per orbit closed (step):
+// the normal equations (27 × 27) and their Jacobi eigen-decomposition
+// (symmetric_eigen.hpp, at most 30 sweeps), one phase, about 12 KiB of stack.
+// No allocation, every loop bounded.
 #pragma once
 
 #include <cstddef>
@@ -61,6 +66,8 @@ struct SunLearnReport {
     double orbits_to_decide = 0.0;  // ... that the rule needs
     bool taken = false;             // the term is taken
     SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
+    std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
+    std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
 };
 
 class SunLearner {
@@ -95,6 +102,15 @@ public:
         }
         Vector3<double> s_icrf{};
         if (!nav::sun_direction_icrf(static_cast<double>(t_us) * 1e-6, s_icrf)) {
+            ++without_sun_;
+            return false;
+        }
+        Quaternion<double> by_head[kMaxHeads]{};
+        for (std::size_t h = 0; h < kFrameHeads; ++h) {
+            by_head[h] = q[h];
+        }
+        if (!moments_.add(by_head, s_icrf)) {
+            ++not_finite_;
             return false;
         }
         double iba[2][kPairs];
@@ -105,20 +121,33 @@ public:
         }
         frame_ibas(with_term, iba[1]);
         scores_.add(iba);
-        Quaternion<double> by_head[kMaxHeads]{};
-        for (std::size_t h = 0; h < kFrameHeads; ++h) {
-            by_head[h] = q[h];
-        }
-        moments_.add(by_head, s_icrf);
         return true;
     }
 
-    // Closes the open orbit (the end of the data).
+    // The per-orbit work, in idle time after a cycle (take) closed an orbit:
+    // the candidate solved again from the sums. Bounded (sun_moments.hpp's
+    // solve: the normal equations and at most kMaxJacobiSweeps sweeps), one
+    // phase; false: nothing pending.
+    bool step() noexcept {
+        if (!solve_pending_) {
+            return false;
+        }
+        solve_pending_ = false;
+        SunTermFit fit;
+        if (moments_.solve(rule_, fit) && sun_fit_within_domain(fit)) {
+            candidate_ = fit;
+            candidate_model_ = sun_term_model(fit);
+        }
+        return true;
+    }
+
+    // Closes the open orbit (the end of the data), its solve included.
     void finish() noexcept {
         if (open_) {
             close_orbit();
             open_ = false;
         }
+        (void)step();
         if (scores_.finish()) {
             reconsider();
         }
@@ -144,6 +173,8 @@ public:
         r.orbits_to_decide = scores_.orbits_to_decide();
         r.taken = taken_;
         r.candidate = candidate_;
+        r.without_sun = without_sun_;
+        r.not_finite = not_finite_;
         return r;
     }
 
@@ -157,7 +188,7 @@ private:
     static constexpr std::uint8_t kFrameHeadIndices[kFrameHeads] = {0U, 1U, 2U};
 
     // The open orbit into the moments (the older ones forgotten over the time
-    // since the last closed), and the candidate solved again.
+    // since the last closed), the candidate to be solved again (step).
     void close_orbit() noexcept {
         if (moments_.open_count() == 0U) {
             return;
@@ -169,11 +200,7 @@ private:
         moments_.close_orbit(keep);
         closed_any_ = true;
         last_closed_bin_ = bin_;
-        SunTermFit fit;
-        if (moments_.solve(rule_, fit) && sun_fit_within_domain(fit)) {
-            candidate_ = fit;
-            candidate_model_ = sun_term_model(fit);
-        }
+        solve_pending_ = true;
     }
 
     void reconsider() noexcept {
@@ -192,7 +219,10 @@ private:
     std::int64_t last_closed_bin_ = 0;
     SunTermFit candidate_{};
     SunTermModel<double> candidate_model_{};
+    bool solve_pending_ = false;
     bool taken_ = false;
+    std::uint64_t without_sun_ = 0U;
+    std::uint64_t not_finite_ = 0U;
 };
 
 }  // namespace ascorr::calib

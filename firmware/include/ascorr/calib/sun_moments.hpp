@@ -122,18 +122,22 @@ public:
     }
 
     // One epoch: q_chu_icrf[h] (by head index) the heads' attitudes corrected
-    // by the polynomial, s_icrf the Sun's unit direction.
-    void add(const Quaternion<double>* q_chu_icrf, const Vector3<double>& s_icrf) noexcept {
+    // by the polynomial, s_icrf the Sun's unit direction. false, nothing
+    // summed, when a rotation or direction formed from them is not finite (a
+    // corrupted attitude: one NaN would otherwise spoil every later solve).
+    bool add(const Quaternion<double>* q_chu_icrf, const Vector3<double>& s_icrf) noexcept {
         const Quaternion<double> q_f = q_f_icrf(q_chu_icrf[frame_a_], q_chu_icrf[frame_c_]);
         double e[kRows];
         double s[kRows];
+        Quaternion<double> first[H]{};
         for (std::size_t i = 0; i < count_; ++i) {
             const Quaternion<double>& q = q_chu_icrf[head_[i]];
             const Quaternion<double> q_hf = q_head_f(q, q_f);
+            const Quaternion<double>& ref = referenced_ ? reference_[i] : q_hf;  // the first epoch's, kept below
             if (!referenced_) {
-                reference_[i] = q_hf;
+                first[i] = q_hf;
             }
-            const Vector3<double> e_rad = small_angle(relative_to(q_hf, reference_[i]));
+            const Vector3<double> e_rad = small_angle(relative_to(q_hf, ref));
             const Vector3<double> s_chu = rotated(q, s_icrf);
             const double ei[3] = {e_rad.x * kRadToArcsec, e_rad.y * kRadToArcsec, e_rad.z * kRadToArcsec};
             const double si[3] = {s_chu.x, s_chu.y, s_chu.z};
@@ -142,8 +146,18 @@ public:
                 s[3 * i + c] = si[c];
             }
         }
-        referenced_ = true;
         const std::size_t n = 3 * count_;
+        bool finite = true;
+        for (std::size_t r = 0; r < n; ++r) {
+            finite = finite && std::isfinite(e[r]) && std::isfinite(s[r]);
+        }
+        if (!finite) {
+            return false;
+        }
+        for (std::size_t i = 0; !referenced_ && i < count_; ++i) {
+            reference_[i] = first[i];
+        }
+        referenced_ = true;
         for (std::size_t r = 0; r < n; ++r) {
             orbit_e_[r] += e[r];
             orbit_s_[r] += s[r];
@@ -153,6 +167,7 @@ public:
             }
         }
         ++orbit_count_;
+        return true;
     }
 
     // Closes the open orbit: the sums so far multiplied by `keep` (1: no
@@ -282,28 +297,17 @@ private:
         return true;
     }
 
-    // The common rotation S_h + N_h·C·N_hᵀ fixed by the rule (above): C =
-    // −Σ_h B_h·S_h·N_h, B_h = (Σ_j A_j·N_j)⁻¹·A_h (bench_weights).
+    // The common rotation S_h + N_h·C·N_hᵀ fixed by the rule (above).
     bool apply_rule(const SunRule& rule, double (&s)[H][3][3]) const noexcept {
         if (rule.weight == nullptr && rule.rigid_head < 0) {
             return true;  // the pseudo-inverse's: the smallest coefficients
         }
         Matrix3 nh[H];
         references(nh);
-        Matrix3 a[H]{};
-        const std::size_t rigid = rule_weights(rule, a);
-        Matrix3 b[H];
-        if ((rule.rigid_head >= 0 && rigid == H) || !bench_weights(a, nh, count_, b)) {
-            return false;
-        }
         Matrix3 c{};
-        for (std::size_t i = 0; i < count_; ++i) {
-            const Matrix3 bsn = product(product(b[i], matrix_of(s[i])), nh[i]);
-            for (std::size_t r = 0; r < 3; ++r) {
-                for (std::size_t k = 0; k < 3; ++k) {
-                    c.m[r][k] -= bsn.m[r][k];
-                }
-            }
+        std::size_t rigid = H;
+        if (!common_part(rule, nh, s, c, rigid)) {
+            return false;
         }
         for (std::size_t i = 0; i < count_; ++i) {
             const Matrix3 ncn = product(product(nh[i], c), transposed(nh[i]));
@@ -316,18 +320,63 @@ private:
         return true;
     }
 
-    // The rule's weights A_h by position: a rigid head's I and the others' 0,
-    // or the rule's. Returns the rigid head's position (H: none, or not among
-    // the heads).
-    std::size_t rule_weights(const SunRule& rule, Matrix3 (&a)[H]) const noexcept {
-        constexpr Matrix3 kIdentity{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}};
-        std::size_t rigid = H;
-        for (std::size_t i = 0; i < count_; ++i) {
-            const bool is_rigid = rule.rigid_head >= 0 && static_cast<int>(head_[i]) == rule.rigid_head;
-            rigid = is_rigid ? i : rigid;
-            a[i] = rule.rigid_head >= 0 ? (is_rigid ? kIdentity : Matrix3{}) : rule.weight[head_[i]];
+    // C of the rule: a rigid head X's C = −N_Xᵀ·S_X·N_X (its term then 0;
+    // `rigid` its position); with weights C = −(Σ_h A_h·N_h)⁻¹·Σ_h A_h·S_h·N_h,
+    // the sum inverted at unit Frobenius norm (its diagonal may be 0: F's
+    // axes need not be near a head's). false: no such head, or the weights'
+    // sum singular or not finite.
+    bool common_part(const SunRule& rule, const Matrix3 (&nh)[H], const double (&s)[H][3][3], Matrix3& c,
+                     std::size_t& rigid) const noexcept {
+        if (rule.rigid_head >= 0) {
+            for (std::size_t i = 0; i < count_; ++i) {
+                rigid = static_cast<int>(head_[i]) == rule.rigid_head ? i : rigid;
+            }
+            if (rigid == H) {
+                return false;
+            }
+            c = scaled(product(product(transposed(nh[rigid]), matrix_of(s[rigid])), nh[rigid]), -1.0);
+            return true;
         }
-        return rigid;
+        Matrix3 an{};
+        Matrix3 asn{};
+        for (std::size_t i = 0; i < count_; ++i) {
+            const Matrix3& a = rule.weight[head_[i]];
+            an = sum(an, product(a, nh[i]));
+            asn = sum(asn, product(product(a, matrix_of(s[i])), nh[i]));
+        }
+        double norm = 0.0;
+        for (const auto& row : an.m) {
+            for (const double v : row) {
+                norm += v * v;
+            }
+        }
+        norm = std::sqrt(norm);
+        Matrix3 inv{};
+        if (!(norm > 0.0 && std::isfinite(norm)) || !inverse_scaled(scaled(an, 1.0 / norm), false, &inv)) {
+            return false;
+        }
+        c = scaled(product(inv, asn), -1.0 / norm);
+        return true;
+    }
+
+    static Matrix3 sum(const Matrix3& a, const Matrix3& b) noexcept {
+        Matrix3 r{};
+        for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t j = 0; j < 3; ++j) {
+                r.m[i][j] = a.m[i][j] + b.m[i][j];
+            }
+        }
+        return r;
+    }
+
+    static Matrix3 scaled(const Matrix3& a, double f) noexcept {
+        Matrix3 r{};
+        for (std::size_t i = 0; i < 3; ++i) {
+            for (std::size_t j = 0; j < 3; ++j) {
+                r.m[i][j] = a.m[i][j] * f;
+            }
+        }
+        return r;
     }
 
     static Matrix3 matrix_of(const double (&s)[3][3]) noexcept {
