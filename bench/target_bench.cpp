@@ -32,6 +32,13 @@
 // the selected records' temperatures, against a function that only copies a
 // reading ("bench <scalar> lag <instructions>": what a lagged head adds to
 // its solution's correction).
+// The thermal model's Sun term of a head (core/sun_term.hpp, the out-of-line
+// entry of firmware/app/sun_entry_*.cpp) is measured per solution: heads A,
+// B and C in turn, the selected records' attitudes, coefficients of ±2″ per
+// head and axis, the Sun's direction given (the loop would form it at the
+// velocity service's rate), against a function that only copies a
+// quaternion component ("bench <scalar> sun <instructions>": what a head with
+// a Sun term would add to its solution's correction).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -45,6 +52,7 @@
 #include "core_entry.hpp"
 #include "earth_series_entry.hpp"
 #include "lag_entry.hpp"
+#include "sun_entry.hpp"
 #include "systick_counter.hpp"
 #include "vector_convert.hpp"
 
@@ -341,6 +349,51 @@ void bench_lag(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     report(name, "lag", run_lag<T>(&lag_call<T>, lags, fx, epoch), c0, ipc);
 }
 
+// The Sun term: one solution per call.
+template <typename T>
+using SunFn = void (*)(const SunTermModel<T>&, std::uint8_t, const Vector3<T>&, Quaternion<T>&) noexcept;
+
+template <typename T>
+__attribute__((noinline)) void sun_copy(const SunTermModel<T>& /*m*/, std::uint8_t /*head*/,
+                                        const Vector3<T>& /*s_icrf*/, Quaternion<T>& q) noexcept {
+    q.z = q.x;
+}
+
+template <typename T>
+__attribute__((noinline)) void sun_call(const SunTermModel<T>& m, std::uint8_t head, const Vector3<T>& s_icrf,
+                                        Quaternion<T>& q) noexcept {
+    app::sun(m, head, s_icrf, q);
+}
+
+template <typename T>
+std::uint32_t run_sun(volatile SunFn<T> fn, const SunTermModel<T>& m, const Vector3<T>& s_icrf, const Fixture<T>& fx) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kRuns; ++i) {
+            Quaternion<T> q = fx.in[i % kInputs].q_chu_icrf;
+            fn(m, static_cast<std::uint8_t>(i % 3U), s_icrf, q);
+            g_sink_q = ScalarTraits<T>::to_double(q.x);
+        }
+    });
+}
+
+template <typename T>
+void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
+    using S = ScalarTraits<T>;
+    static SunTermModel<T> m{};
+    for (std::uint8_t h = 0; h < 3; ++h) {
+        m.present[h] = true;
+        for (std::uint8_t a = 0; a < kModelAxes; ++a) {
+            for (std::uint8_t c = 0; c < kSunComponents; ++c) {
+                const double arcsec = ((h * 9 + a * 3 + c) % 5 - 2.0) * 0.8 + 0.3;  // within ±2″, none 0
+                m.coefficient[h][a][c] = S::from_double(arcsec * kArcsecToRad);
+            }
+        }
+    }
+    const Vector3<T> s_icrf{S::from_double(0.6), S::from_double(-0.64), S::from_double(0.48)};  // unit
+    const std::uint32_t c0 = run_sun<T>(&sun_copy<T>, m, s_icrf, fx);
+    report(name, "sun", run_sun<T>(&sun_call<T>, m, s_icrf, fx), c0, ipc);
+}
+
 Fixture<Q30> g_fixed;
 combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
 CombinationFixture<Q30> g_combination_fixed;
@@ -388,10 +441,12 @@ int main() {
 #if !defined(ASCORR_TARGET_FIXED)
     bench_scalar<float>("float", g_float, ipc);
     bench_lag<float>("float", g_float, ipc);
+    bench_sun<float>("float", g_float, ipc);
     bench_combination<float>("float", g_combiner_float, g_combination_float, ipc);
 #endif
     bench_scalar<Q30>("fixed", g_fixed, ipc);
     bench_lag<Q30>("fixed", g_fixed, ipc);
+    bench_sun<Q30>("fixed", g_fixed, ipc);
     bench_combination<Q30>("fixed", g_combiner_fixed, g_combination_fixed, ipc);
     bench_baseline(ipc);
     bench_series(ipc);

@@ -24,6 +24,7 @@
 #include "ascorr/calib/symmetric_eigen.hpp"
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "cli_run.hpp"
 #include "inside_orbit_missions.hpp"
 #include "test_support.hpp"
@@ -491,11 +492,15 @@ TEST(SunLearnt, WhatCannotLearnItIsRefused) {
     const fs::path& dir = static_mission();
     const std::pair<std::string, std::string> cases[] = {
         {"correct --in m.csv --sun-term auto --out c.csv", "--sun-term: needs --self-calibrate"},
-        {"correct --in m.csv --self-calibrate --sun-term auto --scalar fixed --out c.csv",
-         "--sun-term auto learns a Sun term: it is evaluated in double and float only (the fixed-point core has no "
-         "Sun term yet): it cannot go with --scalar fixed"},
+        {"correct --in m.csv --model start.csv --self-calibrate --sun-term auto --out c.csv",
+         "start.csv: the model has a Sun term (its sun_x, sun_y, sun_z): the self-calibration learns a Sun term "
+         "from none (--sun-term auto), not from a given one"},
         {"correct --in m.csv --self-calibrate --sun-term sometimes --out c.csv", "--sun-term"},
     };
+    host::ModelFile start;
+    start.present = {true, true, true, false};
+    start.sun[1][2][0] = 1.5;
+    host::write_model_file((dir / "start.csv").string(), start);
     for (const auto& [args, part] : cases) {
         const CliRun r = run_in(args, dir);
         EXPECT_NE(r.exit_code, 0) << args;

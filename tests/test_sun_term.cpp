@@ -134,6 +134,63 @@ constexpr const char* kLinear =
     "chu,axis,c0,c1,c2,c3\nA,alpha,1,2,3,4\nA,beta,1,2,3,4\nA,gamma,1,2,3,4\n"
     "B,alpha,1,2,3,4\nB,beta,1,2,3,4\nB,gamma,1,2,3,4\n";
 
+// The term in float and Q30 against the double one (2000 random attitudes,
+// Sun directions and coefficients of ±2″ up to the domain's 1200″ per
+// coefficient): within the rounding sun_term.hpp states.
+TEST(SunTerm, FloatAndQ30AreTheDoublesWithinTheirRounding) {
+    std::mt19937_64 rng(41);
+    double worst_float = 0.0;
+    double worst_q30 = 0.0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        std::uniform_real_distribution<double> coefficient(trial % 2 == 0 ? -2.0 : -1200.0,
+                                                           trial % 2 == 0 ? 2.0 : 1200.0);  // arcsec
+        const auto head = static_cast<std::uint8_t>(trial % kMaxHeads);
+        SunTermModel<double> md{};
+        SunTermModel<float> mf{};
+        SunTermModel<Q30> mq{};
+        md.present[head] = mf.present[head] = mq.present[head] = true;
+        for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                md.coefficient[head][a][c] = coefficient(rng) * kArcsecToRad;
+                mf.coefficient[head][a][c] = static_cast<float>(md.coefficient[head][a][c]);
+                mq.coefficient[head][a][c] = ScalarTraits<Q30>::from_double(md.coefficient[head][a][c]);
+            }
+        }
+        const Quaternion<double> q = from_eigen(random_attitude(rng));
+        const Eigen::Vector3d s_e = random_unit_vector(rng);
+        const Vector3<double> s{s_e.x(), s_e.y(), s_e.z()};
+        const Quaternion<double> core = with_sun_term(q, sun_term_rotation(md, head, q, s));
+        using SF = ScalarTraits<float>;
+        using SQ = ScalarTraits<Q30>;
+        const Quaternion<float> qf{SF::from_double(q.w), SF::from_double(q.x), SF::from_double(q.y),
+                                   SF::from_double(q.z)};
+        const Quaternion<Q30> qq{SQ::from_double(q.w), SQ::from_double(q.x), SQ::from_double(q.y),
+                                 SQ::from_double(q.z)};
+        const Quaternion<float> rf = with_sun_term(
+            qf, sun_term_rotation(mf, head, qf,
+                                  Vector3<float>{SF::from_double(s.x), SF::from_double(s.y), SF::from_double(s.z)}));
+        const Quaternion<Q30> rq = with_sun_term(
+            qq, sun_term_rotation(mq, head, qq,
+                                  Vector3<Q30>{SQ::from_double(s.x), SQ::from_double(s.y), SQ::from_double(s.z)}));
+        const auto d = [](const auto& x) {
+            using S = ScalarTraits<std::decay_t<decltype(x.w)>>;
+            return Quaternion<double>{S::to_double(x.w), S::to_double(x.x), S::to_double(x.y), S::to_double(x.z)};
+        };
+        // Each against the double term applied to its own rounded input, so
+        // that only the term's arithmetic is measured.
+        const Quaternion<double> qf_d = d(qf);
+        const Quaternion<double> qq_d = d(qq);
+        worst_float =
+            std::max(worst_float, angle_arcsec(d(rf), with_sun_term(qf_d, sun_term_rotation(md, head, qf_d, s))));
+        worst_q30 = std::max(worst_q30, angle_arcsec(d(rq), with_sun_term(qq_d, sun_term_rotation(md, head, qq_d, s))));
+        EXPECT_GT(angle_arcsec(core, q), 1e-4) << "the term turns the attitude";
+    }
+    EXPECT_LE(worst_q30, 0.003) << "arcsec";
+    EXPECT_LE(worst_float, 0.05) << "arcsec";
+    RecordProperty("worst_q30_arcsec", std::to_string(worst_q30));
+    RecordProperty("worst_float_arcsec", std::to_string(worst_float));
+}
+
 TEST(ModelFileSun, RoundTripsAndTodaysFilesAreUnaffected) {
     const host::ModelFile plain = host::parse_model("m.csv", kLinear);
     EXPECT_FALSE(host::has_sun_term(plain));
@@ -272,8 +329,6 @@ TEST(SunTermConsumers, ThoseThatDoNotEvaluateItRefuseIt) {
     ASSERT_EQ(run_in("simulate --days 0.3 --out s.csv > /dev/null", dir).exit_code, 0);
     write(dir / "m.csv", sun_model());
     const std::pair<std::string, std::string> cases[] = {
-        {"correct --in s.csv --model m.csv --scalar fixed --out c.csv",
-         "it is evaluated in double and float only (the fixed-point core has no Sun term yet)"},
         {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
          "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
          "model without one"},
@@ -287,7 +342,7 @@ TEST(SunTermConsumers, ThoseThatDoNotEvaluateItRefuseIt) {
         expect_refused(r, kAnyFailure, {"m.csv: the model has a Sun term (its sun_x, sun_y, sun_z)", part});
         expect_absent(dir, {"c.csv"});
     }
-    for (const char* scalar : {"double", "float"}) {
+    for (const char* scalar : {"double", "float", "fixed"}) {
         const CliRun ok = run_in(std::string("correct --in s.csv --model m.csv --out c.csv --scalar ") + scalar, dir);
         EXPECT_EQ(ok.exit_code, 0) << scalar << ": " << ok.err;
     }
@@ -390,26 +445,32 @@ double largest_difference(const fs::path& a, const fs::path& b) {
     return worst;
 }
 
-// The float core applies the Sun term as the double one: within 0.06″ of it
-// on every row (the float core alone is within 0.036″ of the double one on
-// these rows, the term's rotation in float adds its rounding: 0.047″
-// measured); the same float run without the term is far outside it (the
-// test can fail).
-TEST(SunTermFloat, TheFloatCoreAppliesItAsTheDoubleWithinItsBound) {
+// The float and fixed-point cores apply the Sun term as the double one: on
+// every row within 0.06″ (float: the float core alone is within 0.036″ of the
+// double one on these rows, the term's rotation in float adds its rounding;
+// 0.047″ measured) and 0.005″ (Q30; 0.0020″ measured); the same runs without
+// the term are far outside (the test can fail).
+TEST(SunTermScalars, TheFloatAndFixedCoresApplyItAsTheDoubleWithinTheirBounds) {
     const fs::path& dir = orbit_mission();
-    fit_and_correct(dir, "", "float_model.csv", "c_double.csv");
-    ASSERT_TRUE(host::has_sun_term(host::read_model_file((dir / "float_model.csv").string())));
-    ASSERT_EQ(run_in("correct --in m.csv --model float_model.csv --scalar float --out c_float.csv", dir).exit_code, 0);
-    host::ModelFile without = host::read_model_file((dir / "float_model.csv").string());
+    fit_and_correct(dir, "", "scalar_model.csv", "c_double.csv");
+    ASSERT_TRUE(host::has_sun_term(host::read_model_file((dir / "scalar_model.csv").string())));
+    host::ModelFile without = host::read_model_file((dir / "scalar_model.csv").string());
     without.sun = {};
-    host::write_model_file((dir / "float_model_none.csv").string(), without);
-    ASSERT_EQ(
-        run_in("correct --in m.csv --model float_model_none.csv --scalar float --out c_float_none.csv", dir).exit_code,
-        0);
-    const double with_term = largest_difference(dir / "c_float.csv", dir / "c_double.csv");
-    EXPECT_LE(with_term, 0.06);
-    RecordProperty("float_vs_double_arcsec", std::to_string(with_term));
-    EXPECT_GT(largest_difference(dir / "c_float_none.csv", dir / "c_double.csv"), 0.2) << "the term must show";
+    host::write_model_file((dir / "scalar_model_none.csv").string(), without);
+    for (const auto& [scalar, bound] : {std::pair<std::string, double>{"float", 0.06}, {"fixed", 0.005}}) {
+        const std::string with = "c_" + scalar + ".csv";
+        const std::string none = "c_" + scalar + "_none.csv";
+        ASSERT_EQ(
+            run_in("correct --in m.csv --model scalar_model.csv --scalar " + scalar + " --out " + with, dir).exit_code,
+            0);
+        ASSERT_EQ(run_in("correct --in m.csv --model scalar_model_none.csv --scalar " + scalar + " --out " + none, dir)
+                      .exit_code,
+                  0);
+        const double with_term = largest_difference(dir / with, dir / "c_double.csv");
+        EXPECT_LE(with_term, bound) << scalar;
+        RecordProperty(scalar + "_vs_double_arcsec", std::to_string(with_term));
+        EXPECT_GT(largest_difference(dir / none, dir / "c_double.csv"), 0.2) << scalar << ": the term must show";
+    }
 }
 
 TEST(FitSun, TheCommonRotationRulesHoldForTheSunTerm) {

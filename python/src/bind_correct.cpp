@@ -62,7 +62,7 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
     if (m != nullptr) {
         model = host::to_core<T>(*m);
     }
-    // Refused in fixed point (check_model_for_scalar).
+    // In the core's scalar (host::correct_row).
     const std::optional<SunTermModel<double>> sun = host::sun_term_if_any(m);
     const CorrectionConfig<T> cfg{aberration, model ? &*model : nullptr};
     const SunTermModel<double>* sun_term = sun ? &*sun : nullptr;

@@ -108,12 +108,8 @@ py::tuple self_calibrate(const py::object& t, const py::object& chu, const py::o
         rule = pipeline::common_rotation_weights(mf.mountings);
     }
     const host::ScalarKind scalar = scalar_arg(scalar_obj);
-    // sun_term='auto': learnt from none, as correct --sun-term auto (not in fixed point).
+    // sun_term='auto': learnt from none, as correct --sun-term auto.
     const bool learn_sun = choice_arg(sun_term, "sun_term", {"auto", "none"}) == "auto";
-    if (learn_sun && scalar == host::ScalarKind::kFixed) {
-        bad_argument("sun_term", std::string("'auto' learns a Sun term: ") + host::kSunTermNotInFixedPoint +
-                                     ": it cannot go with scalar='fixed'");
-    }
     const double time_constant = real_arg(time_constant_obj, "time_constant");
     if (!calib::time_constant_acceptable(time_constant)) {
         bad_argument("time_constant",

@@ -114,6 +114,8 @@ def core_section(d):
                        ("validation + renormalisation alone", "validation_and_renormalisation_only"),
                        ("the lag stage of a lagged head (issue 40's budget: 1.2× with it)", "lag_stage"),
                        ("thermal + aberration with the lag stage, ratio", "with_lag_ratio"),
+                       ("the Sun term of a head (not in the flight loop yet)", "sun_term"),
+                       ("thermal + aberration with the Sun term, ratio", "with_sun_ratio"),
                        ("combined attitude, per epoch of three heads", "combination_three_heads"),
                        ("combined attitude, error vs double (arcsec)", "combination_max_error_arcsec"),
                        ("ratio to the baseline", "baseline_ratio"), ("error vs double (arcsec)", "max_error_arcsec")):
@@ -121,7 +123,7 @@ def core_section(d):
         for t, s, _ in cols:
             fig = get(d, t, s)
             v = fig.get(key)
-            row.append(num(v, 2) if key == "max_error_arcsec" else num(v, 4) if key == "combination_max_error_arcsec" else (f"{v}×" if key in ("baseline_ratio", "with_lag_ratio") and v is not None else num(v)))
+            row.append(num(v, 2) if key == "max_error_arcsec" else num(v, 4) if key == "combination_max_error_arcsec" else (f"{v}×" if key in ("baseline_ratio", "with_lag_ratio", "with_sun_ratio") and v is not None else num(v)))
         rows.append(row)
     rows.append(["baseline"] + [num(get(d, t, "baseline", "instructions_per_solution")) for t, _, _ in cols])
     out += table([""] + [c for _, _, c in cols], rows)

@@ -562,21 +562,11 @@ void refuse_run_options(const CorrectOptions& opt) {
     }
 }
 
-// --sun-term auto's scalar: the term is evaluated in double and float (correct_row.hpp).
-template <typename T>
-void refuse_sun_term_scalar(const CorrectOptions& opt) {
-    if (opt.sun_auto && scalar_kind_of<T>() == ScalarKind::kFixed) {
-        throw std::runtime_error(std::string("--sun-term auto learns a Sun term: ") + kSunTermNotInFixedPoint +
-                                 ": it cannot go with --scalar fixed");
-    }
-}
-
 template <typename T>
 CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& log, CorrectedRowSink* sink) {
     refuse_output_over_input({{"--in", opt.in}, {"--model", opt.model}, {"--states", opt.states}},
                              {{"--out", opt.out}, {"--model-history", opt.model_history}});
     refuse_run_options(opt);  // before the model: a --lag out of range is named as such, not as another τ
-    refuse_sun_term_scalar<T>(opt);
     std::optional<ModelFile> model_file;
     std::optional<ThermalModel<T>> model = read_model<T>(opt, model_file);
 
@@ -665,9 +655,6 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
 }  // namespace
 
 void check_model_for_scalar(const ModelFile& m, ScalarKind scalar, const std::string& path) {
-    if (scalar == ScalarKind::kFixed) {
-        refuse_sun_term(m, path, kSunTermNotInFixedPoint);
-    }
     if (scalar == ScalarKind::kFixed) {
         check_fixed_point_range(m, path);
     } else if (scalar == ScalarKind::kFloat) {

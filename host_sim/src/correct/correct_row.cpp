@@ -20,19 +20,21 @@ RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status,
 
 namespace {
 
-// The Sun term of `head` in float, as the float core's per-solution path
-// would hold it (each coefficient and ŝ rounded to float once), applied in
-// float to the float core's result (core/sun_term.hpp).
-Quaternion<float> with_sun_term_in_float(const Quaternion<float>& q, const SunTermModel<double>& sun, std::uint8_t head,
-                                         const Vector3<double>& s_icrf) {
-    SunTermModel<float> m{};
+// The Sun term of `head` in the core's scalar T, as its per-solution path
+// holds it (each coefficient and ŝ rounded to T once), applied in T to the
+// core's result (core/sun_term.hpp; float and Q30: the targets' scalars).
+template <typename T>
+Quaternion<T> with_sun_term_in(const Quaternion<T>& q, const SunTermModel<double>& sun, std::uint8_t head,
+                               const Vector3<double>& s_icrf) {
+    using S = ScalarTraits<T>;
+    SunTermModel<T> m{};
     m.present[head] = sun.present[head];
     for (std::size_t a = 0; a < kModelAxes; ++a) {
         for (std::size_t c = 0; c < kSunComponents; ++c) {
-            m.coefficient[head][a][c] = static_cast<float>(sun.coefficient[head][a][c]);
+            m.coefficient[head][a][c] = S::from_double(sun.coefficient[head][a][c]);
         }
     }
-    const Vector3<float> s{static_cast<float>(s_icrf.x), static_cast<float>(s_icrf.y), static_cast<float>(s_icrf.z)};
+    const Vector3<T> s{S::from_double(s_icrf.x), S::from_double(s_icrf.y), S::from_double(s_icrf.z)};
     return with_sun_term(q, sun_term_rotation(m, head, q, s));
 }
 
@@ -59,14 +61,14 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
     if ((r.status & status::kRejected) != 0U) {
         return r;
     }
-    if constexpr (std::is_same_v<T, float>) {
+    if constexpr (!std::is_same_v<T, double>) {
         if (s.apply) {
-            c.q_chu_icrf = with_sun_term_in_float(c.q_chu_icrf, *sun, rec.head, s.s_icrf);
+            c.q_chu_icrf = with_sun_term_in(c.q_chu_icrf, *sun, rec.head, s.s_icrf);
         }
     }
     const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
     r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
-    if (!std::is_same_v<T, float> && s.apply) {  // double (Q30: refused by the callers, check_model_for_scalar)
+    if (std::is_same_v<T, double> && s.apply) {
         r.q_chu_icrf = with_sun_term(r.q_chu_icrf, sun_term_rotation(*sun, rec.head, r.q_chu_icrf, s.s_icrf));
     }
     return r;

@@ -20,8 +20,21 @@
 // Domain: |S| row sums ≤ kMaxThermalAngleRad, as the polynomial's angles;
 // s_icrf of unit norm. An attitude error of ε rad moves s_chu by ε: the
 // term's angle by ≤ |S|·ε (5e-5 of the term for a 10″ attitude error).
-// double and float; Q30 is not built (the deleted specialisation below): the
-// ground evaluates it in double.
+// Scalars: double, float and Q30. In Q30 (q_formats.hpp) the same templates
+// run on the core's Q30 kernels (quaternion.hpp's product, add_left_increment
+// and renormalized_sum, thermal.hpp's thermal_rotation), with:
+//  - range: q and s_icrf unit, so every component of q ⊗ (0, s) ⊗ q* and of
+//    s_chu is within ±1 (+ rounding): no product or sum saturates; the
+//    coefficients in rad within ±kMaxThermalAngleRad (the model's domain:
+//    |S| row sums ≤ 3600″), raw < 2²⁵; each angle Σ_m S[a][m]·s_chu[m]
+//    within ±kMaxThermalAngleRad too, so its two saturating additions never
+//    act, and thermal_rotation's clamp neither;
+//  - rounding: each coefficient rounded to nearest once at conversion
+//    (≤ 2⁻³¹ rad, 1e-4″, relative 1e-5 of a 2″ coefficient); s_chu's
+//    components two products each rounded (≤ 2·2⁻³¹); each angle three
+//    products rounded (≤ 3·2⁻³¹ rad) plus the coefficients' (Σ|s_chu| ≤ √3):
+//    ≤ 5e-9 rad, 1e-3″ per angle; thermal_rotation's and the increment's
+//    rounding as the polynomial's (thermal.hpp: 7.7e-4″).
 #pragma once
 
 #include <cstdint>
@@ -89,9 +102,5 @@ constexpr Quaternion<T> with_sun_term(const Quaternion<T>& q, const SmallRotatio
     constexpr T zero = constant<T>(0.0);
     return canonical(renormalized_sum(q, add_left_increment(Quaternion<T>{zero, zero, zero, zero}, q_sun, q)));
 }
-
-template <>
-constexpr SmallRotation<Q30> sun_term_rotation(const SunTermModel<Q30>&, std::uint8_t, const Quaternion<Q30>&,
-                                               const Vector3<Q30>&) noexcept = delete;
 
 }  // namespace ascorr

@@ -51,9 +51,8 @@ RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status,
 // earth: used when the aberration stage is on (cfg.aberration) and the row
 // has its velocity; states: nullptr without --states (one per thread: it
 // keeps the service's state between rows); sun: the model's Sun term, applied
-// after the core where its thermal stage was, in the core's scalar (double;
-// float: the head's coefficients and ŝ rounded to float); callers refuse a Sun
-// term with the fixed scalar (check_model_for_scalar).
+// after the core where its thermal stage was, in the core's scalar (float and
+// Q30: the head's coefficients and ŝ rounded to it once).
 template <typename T>
 RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
                              StatesVelocity<T>* states, const SunTermModel<double>* sun = nullptr);

@@ -116,9 +116,6 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun);
 // Throws (naming the model's file, then `why`) when the model has a Sun
 // term: for the consumers that do not evaluate it yet.
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why);
-// Why a Sun term is refused in fixed point, after refuse_sun_term's words.
-inline constexpr const char* kSunTermNotInFixedPoint =
-    "it is evaluated in double and float only (the fixed-point core has no Sun term yet)";
 // Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
 inline constexpr const char* kSunTermNotLearnt =
     "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
