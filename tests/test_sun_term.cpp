@@ -368,8 +368,9 @@ TEST(SunTermRows, WhereTheSunIsNotKnownTheThermalStageIsSkippedAndNamed) {
     write_lines(dir / "late.csv",
                 {"t,chu,qw,qx,qy,qz,t_chu,t_029,t_032,vx,vy,vz", "1650000000,A" + q + "20,15,10,,,",
                  "1650000000,A" + q + ",,,,,", "1650000000,D" + q + "20,15,10,,,", "800000000,A" + q + "20,15,10,,,"});
-    const auto statuses = [&](const char* model, std::string& err) {
-        const CliRun r = run_in(std::string("correct --in late.csv --model ") + model + " --out c.csv", dir);
+    const auto statuses = [&](const char* model, std::string& err, const std::string& scalar = "double") {
+        const CliRun r =
+            run_in(std::string("correct --in late.csv --model ") + model + " --out c.csv --scalar " + scalar, dir);
         EXPECT_EQ(r.exit_code, 0) << r.err;
         err = r.err;
         std::vector<int> out;
@@ -390,6 +391,10 @@ TEST(SunTermRows, WhereTheSunIsNotKnownTheThermalStageIsSkippedAndNamed) {
         << err;
     EXPECT_FALSE(has(err, "late.csv:3: t outside")) << err;
     EXPECT_FALSE(has(err, "late.csv:4: t outside")) << err;
+    for (const char* scalar : {"float", "fixed"}) {  // the same bits in the targets' scalars
+        EXPECT_EQ(statuses("m.csv", err, scalar), (std::vector<int>{4 | 128, 4 | 8, 4 | 256, 4 | 2})) << scalar;
+        EXPECT_TRUE(has(err, "late.csv:2: t outside the Sun ephemeris' span")) << scalar << ": " << err;
+    }
     EXPECT_EQ(statuses("p.csv", err), (std::vector<int>{4 | 2, 4 | 8, 4 | 256, 4 | 2}));
     EXPECT_FALSE(has(err, "Sun term")) << err;
     Vector3<double> s{};
@@ -397,10 +402,6 @@ TEST(SunTermRows, WhereTheSunIsNotKnownTheThermalStageIsSkippedAndNamed) {
     EXPECT_TRUE(nav::sun_direction_icrf(800000000.0, s));
 }
 
-// The rules for the rotation common to every head, which no IBA sees:
-// rigid-B leaves B exactly without a term; combined (with the mountings) makes
-// the heads' terms cancel in the full head set's combined attitude with the
-// mountings' weights, for every Sun direction.
 // The corrected attitudes of a corrected file, row by row (rows with status
 // 16, rejected, as NaN: not compared).
 std::vector<Quaternion<double>> corrected_attitudes(const fs::path& file) {
@@ -473,6 +474,10 @@ TEST(SunTermScalars, TheFloatAndFixedCoresApplyItAsTheDoubleWithinTheirBounds) {
     }
 }
 
+// The rules for the rotation common to every head, which no IBA sees:
+// rigid-B leaves B exactly without a term; combined (with the mountings) makes
+// the heads' terms cancel in the full head set's combined attitude with the
+// mountings' weights, for every Sun direction.
 TEST(FitSun, TheCommonRotationRulesHoldForTheSunTerm) {
     const fs::path& dir = orbit_mission();
     ASSERT_EQ(

@@ -174,10 +174,11 @@ void add_correct_command(CLI::App& app) {
     const SelfCalibrationOptions self_cal =
         add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s, &opt->lag_auto);
     CLI::Option* sun_term =
-        cmd->add_option("--sun-term", opt->sun_auto,
-                        "with --self-calibrate: auto (the Sun term, the rotation with the Sun's direction in the "
-                        "head's frame, learnt as the estimator runs and taken when it predicts the IBAs better; the "
-                        "history's sun_x, sun_y, sun_z) or none (default); the scalar double only")
+        cmd->add_option(
+               "--sun-term", opt->sun_auto,
+               "with --self-calibrate: auto (the Sun term, the rotation with the Sun's direction in the "
+               "head's frame, learnt as the estimator runs and taken when it predicts the IBAs better; the "
+               "history's sun_x, sun_y, sun_z; the rows corrected with it in the run's scalar) or none (default)")
             ->transform(one_of<bool>({{"auto", true}, {"none", false}}))
             ->type_name("NAME");
     auto combine = std::make_shared<CombineTexts>();

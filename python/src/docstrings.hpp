@@ -108,7 +108,7 @@ head; each model of the history has the lag taken when it became active (lag_s),
 a head's rows are corrected with it from the first model that changed the head's lag,
 started afresh there.
 sun_term: 'none' (default) or 'auto' (as correct --sun-term auto, from a model without a
-Sun term or none; not scalar='fixed'): the Sun term is learnt as the estimator runs;
+Sun term or none; in every scalar): the Sun term is learnt as the estimator runs;
 each model of the history has the term taken when it became active (its sun), and the
 rows are corrected with it.
 Returns (q_corrected float64

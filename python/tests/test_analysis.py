@@ -319,6 +319,10 @@ def test_self_calibrate_sun_term_auto_is_ascorr_correct_self_calibrate_sun_term_
     # Mutation: without the learner the corrections differ.
     q_none, _, _ = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0)
     assert np.abs(q_none - q).max() > 1e-9
+    # In fixed point the same history's terms (the learner sums in double) within the core's rounding.
+    q_fixed, _, hist_fixed = ascorr.self_calibrate(*as_args(d), d["flags"], d["confidence"], lag=0, scalar="fixed",
+                                                   sun_term="auto")
+    assert np.abs(hist_fixed[-1]["model"].sun).max() > 0.01
     with pytest.raises(ValueError, match="sun_term"):
         ascorr.self_calibrate(*as_args(d), sun_term="yes")
 

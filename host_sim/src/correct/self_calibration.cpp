@@ -236,27 +236,25 @@ private:
                 tp[h] = &pipeline_.kept_temperatures()[h];
             }
             if (search_->take(t_us, *pipeline_.model(), kept, tp) && sun_) {
-                (void)sun_->take(t_us, search_->taken_attitudes());
-                (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
+                learn_sun(t_us, search_->taken_attitudes());
             }
             return;
         }
         Quaternion<double> q[calib::kFrameHeads];
-        for (std::size_t h = 0; sun_ && h < calib::kFrameHeads; ++h) {
+        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
             if ((kept[h].status & status::kThermalApplied) == 0U) {
                 return;  // a head the model did not correct: not the polynomial's residual
             }
-            q[h] = to_double(kept[h].q_chu_icrf);
+            q[h] = in_double(kept[h].q_chu_icrf);
         }
         if (sun_) {
-            (void)sun_->take(t_us, q);
-            (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
+            learn_sun(t_us, q);
         }
     }
 
-    static Quaternion<double> to_double(const Quaternion<T>& q) noexcept {
-        using S = ScalarTraits<T>;
-        return {S::to_double(q.w), S::to_double(q.x), S::to_double(q.y), S::to_double(q.z)};
+    void learn_sun(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads]) {
+        (void)sun_->take(t_us, q);
+        (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
     }
 
     const std::string& file_;

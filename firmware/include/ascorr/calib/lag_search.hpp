@@ -131,7 +131,7 @@ public:
             if (!selected_solution(h, &model, corrected[h], *temperatures[h], q)) {
                 return false;
             }
-            q_ab[h] = to_double(q);
+            q_ab[h] = in_double(q);
         }
         for (pipeline::TemperatureLag<T>(&lags)[kFrameHeads] : lag_) {
             for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
@@ -209,11 +209,6 @@ private:
             best = score[k] < score[best] ? k : best;
         }
         return best;
-    }
-
-    static Quaternion<double> to_double(const Quaternion<T>& q) noexcept {
-        using S = ScalarTraits<T>;
-        return {S::to_double(q.w), S::to_double(q.x), S::to_double(q.y), S::to_double(q.z)};
     }
 
     // The frame heads corrected at candidate k's temperatures; false when a

@@ -20,7 +20,9 @@
 // alone and by the polynomial and the candidate solved before its orbit
 // began, and both are scored by their IBAs' spread inside the orbit
 // (orbit_spread_scores.hpp): the candidate is scored on orbits it has not
-// seen, as `fit` scores on held-out data. Once the scores hold a memory's
+// seen, as `fit` scores on held-out data (the cycle that closes an orbit is
+// scored with the candidate before that orbit's solve, which runs after it:
+// step()). Once the scores hold a memory's
 // orbits, the term is taken when its score is below the polynomial's by more
 // than kSunLearnMargin (fit's margin, in the mean square), and left again when
 // the polynomial's is below its by as much. While taken, the term is the
@@ -87,8 +89,9 @@ public:
 
     // One fed cycle at t_us (TT µs since J2000): q[h] the frame heads'
     // attitudes corrected by the active polynomial. false: not taken (t
-    // outside the Sun ephemeris' span). A cycle of a later orbit closes the
-    // open one first.
+    // outside the Sun ephemeris' span, or attitudes that give no finite
+    // rotation; counted). A cycle of another orbit than the open one closes
+    // it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
         const bool scored = scores_.begin(t_us);
         const std::int64_t bin = orbit_bin(t_us, scores_.period_us());

@@ -58,6 +58,14 @@ constexpr bool norm_within(const Quaternion<T>& q, const T& tol) noexcept {
 }
 
 // The same attitude with w ≥ 0.
+// q's components in double (ScalarTraits<T>::to_double), for the ground's
+// and the side learners' double arithmetic.
+template <typename T>
+constexpr Quaternion<double> in_double(const Quaternion<T>& q) noexcept {
+    using S = ScalarTraits<T>;
+    return {S::to_double(q.w), S::to_double(q.x), S::to_double(q.y), S::to_double(q.z)};
+}
+
 template <typename T>
 constexpr Quaternion<T> canonical(const Quaternion<T>& q) noexcept {
     constexpr T zero = constant<T>(0.0);

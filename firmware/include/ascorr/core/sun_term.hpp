@@ -28,13 +28,16 @@
 //    coefficients in rad within ±kMaxThermalAngleRad (the model's domain:
 //    |S| row sums ≤ 3600″), raw < 2²⁵; each angle Σ_m S[a][m]·s_chu[m]
 //    within ±kMaxThermalAngleRad too, so its two saturating additions never
-//    act, and thermal_rotation's clamp neither;
+//    act;
 //  - rounding: each coefficient rounded to nearest once at conversion
-//    (≤ 2⁻³¹ rad, 1e-4″, relative 1e-5 of a 2″ coefficient); s_chu's
-//    components two products each rounded (≤ 2·2⁻³¹); each angle three
-//    products rounded (≤ 3·2⁻³¹ rad) plus the coefficients' (Σ|s_chu| ≤ √3):
-//    ≤ 5e-9 rad, 1e-3″ per angle; thermal_rotation's and the increment's
-//    rounding as the polynomial's (thermal.hpp: 7.7e-4″).
+//    (≤ 2⁻³¹ rad, 9.6e-5″, relative 4.8e-5 of a 2″ coefficient); s_chu's
+//    components two products each rounded, the first's error carried
+//    through the second (≤ 3·2⁻³¹); each angle three products rounded
+//    (≤ 3·2⁻³¹ rad) plus the coefficients' and s_chu's (Σ|s_chu| ≤ √3):
+//    ≤ 5e-9 rad, 1e-3″ per angle (an angle at the domain's edge may pass
+//    thermal_rotation's clamp by those few LSB, which it then removes);
+//    thermal_rotation's and the increment's rounding as the polynomial's
+//    (thermal.hpp: 7.7e-4″).
 #pragma once
 
 #include <cstdint>
