@@ -218,17 +218,27 @@ std::array<Eigen::Matrix3d, 3> references_of(const Synthetic& d) {
     return n;
 }
 
-TEST(SunMoments, TheSumsSolveAsTheExplicitDesign) {
-    const Synthetic d = synthetic(12, 40, 11);
+// The three heads' moments, F of A and C.
+calib::SunMoments<3> three_heads() {
     const std::uint8_t heads[3] = {0, 1, 2};
-    calib::SunMoments<3> moments(heads, 3, 0, 2);
+    return calib::SunMoments<3>(heads, 3, 0, 2);
+}
+
+// Every synthetic epoch into m, each orbit closed with `keep` (the last too).
+void feed(const Synthetic& d, calib::SunMoments<3>& m, double keep) {
     for (std::size_t k = 0; k < d.q.size(); ++k) {
         if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
-            moments.close_orbit(1.0);
+            m.close_orbit(keep);
         }
-        moments.add(d.q[k].data(), d.s[k]);
+        ASSERT_TRUE(m.add(d.q[k].data(), d.s[k])) << k;
     }
-    moments.close_orbit(1.0);
+    m.close_orbit(keep);
+}
+
+TEST(SunMoments, TheSumsSolveAsTheExplicitDesign) {
+    const Synthetic d = synthetic(12, 40, 11);
+    calib::SunMoments<3> moments = three_heads();
+    feed(d, moments, 1.0);
     calib::SunTermFit fit;
     ASSERT_TRUE(moments.solve(calib::SunRule{}, fit));
     const Eigen::VectorXd reference = explicit_solution(d);
@@ -250,19 +260,10 @@ TEST(SunMoments, TheSumsSolveAsTheExplicitDesign) {
 
 TEST(SunMoments, ARigidHeadIsExactlyZeroAndForgettingWeighsTheLatestOrbits) {
     const Synthetic d = synthetic(6, 40, 12);
-    const std::uint8_t heads[3] = {0, 1, 2};
-    calib::SunMoments<3> kept(heads, 3, 0, 2);
-    calib::SunMoments<3> forgot(heads, 3, 0, 2);
-    for (std::size_t k = 0; k < d.q.size(); ++k) {
-        if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
-            kept.close_orbit(1.0);
-            forgot.close_orbit(0.0);  // only the last orbit counts
-        }
-        kept.add(d.q[k].data(), d.s[k]);
-        forgot.add(d.q[k].data(), d.s[k]);
-    }
-    kept.close_orbit(1.0);
-    forgot.close_orbit(0.0);
+    calib::SunMoments<3> kept = three_heads();
+    calib::SunMoments<3> forgot = three_heads();
+    feed(d, kept, 1.0);
+    feed(d, forgot, 0.0);  // only the last orbit counts
     calib::SunRule rigid;
     rigid.rigid_head = 1;
     calib::SunTermFit fit;
@@ -316,15 +317,8 @@ TEST(SunMoments, ARigidHeadIsExactlyZeroAndForgettingWeighsTheLatestOrbits) {
 // coefficients' do not (the test can fail).
 TEST(SunMoments, WeightedRuleLeavesTheWeightedBenchUnmoved) {
     const Synthetic d = synthetic(8, 40, 13);
-    const std::uint8_t heads[3] = {0, 1, 2};
-    calib::SunMoments<3> moments(heads, 3, 0, 2);
-    for (std::size_t k = 0; k < d.q.size(); ++k) {
-        if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
-            moments.close_orbit(1.0);
-        }
-        ASSERT_TRUE(moments.add(d.q[k].data(), d.s[k]));
-    }
-    moments.close_orbit(1.0);
+    calib::SunMoments<3> moments = three_heads();
+    feed(d, moments, 1.0);
     std::mt19937_64 rng(5);
     std::normal_distribution<double> g(0.0, 1.0);
     calib::Matrix3 weights[kMaxHeads]{};
@@ -367,24 +361,24 @@ TEST(SunMoments, WeightedRuleLeavesTheWeightedBenchUnmoved) {
 
 TEST(SunMoments, ANonFiniteEpochIsRefusedAndSpoilsNothing) {
     const Synthetic d = synthetic(3, 40, 14);
-    const std::uint8_t heads[3] = {0, 1, 2};
-    calib::SunMoments<3> clean(heads, 3, 0, 2);
-    calib::SunMoments<3> with_nan(heads, 3, 0, 2);
+    calib::SunMoments<3> clean = three_heads();
+    calib::SunMoments<3> with_nan = three_heads();
+    // Before the first epoch (the references must come from a finite one) and
+    // inside the first orbit: refused, nothing summed.
+    std::array<Quaternion<double>, kMaxHeads> bad = d.q[0];
+    bad[1].x = std::nan("");
+    EXPECT_FALSE(with_nan.add(bad.data(), d.s[0]));
+    feed(d, clean, 1.0);
     for (std::size_t k = 0; k < d.q.size(); ++k) {
         if (k > 0 && d.orbit[k] != d.orbit[k - 1]) {
-            clean.close_orbit(1.0);
             with_nan.close_orbit(1.0);
         }
-        if (k == 0 || k == 50) {  // the first epoch too: the references are taken from a finite one
-            std::array<Quaternion<double>, kMaxHeads> bad = d.q[k];
-            bad[1].x = std::nan("");
+        if (k == 50) {
             EXPECT_FALSE(with_nan.add(bad.data(), d.s[k]));
             EXPECT_FALSE(with_nan.add(d.q[k].data(), {std::nan(""), 0.0, 1.0}));
         }
-        ASSERT_TRUE(clean.add(d.q[k].data(), d.s[k]));
         ASSERT_TRUE(with_nan.add(d.q[k].data(), d.s[k]));
     }
-    clean.close_orbit(1.0);
     with_nan.close_orbit(1.0);
     calib::SunTermFit a;
     calib::SunTermFit b;
@@ -413,8 +407,7 @@ TEST(SunLearner, CyclesWhereTheSunIsNotKnownAreCountedNotLearnt) {
 }
 
 TEST(SunMoments, NothingToSolveIsNoTerm) {
-    const std::uint8_t heads[3] = {0, 1, 2};
-    calib::SunMoments<3> moments(heads, 3, 0, 2);
+    const calib::SunMoments<3> moments = three_heads();
     calib::SunTermFit fit;
     EXPECT_FALSE(moments.solve(calib::SunRule{}, fit));
     EXPECT_FALSE(fit.solved);

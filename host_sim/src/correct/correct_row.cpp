@@ -66,8 +66,7 @@ RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, co
             c.q_chu_icrf = with_sun_term_in(c.q_chu_icrf, *sun, rec.head, s.s_icrf);
         }
     }
-    const auto d = [](const T& x) { return ScalarTraits<T>::to_double(x); };
-    r.q_chu_icrf = {d(c.q_chu_icrf.w), d(c.q_chu_icrf.x), d(c.q_chu_icrf.y), d(c.q_chu_icrf.z)};
+    r.q_chu_icrf = in_double(c.q_chu_icrf);
     if (std::is_same_v<T, double> && s.apply) {
         r.q_chu_icrf = with_sun_term(r.q_chu_icrf, sun_term_rotation(*sun, rec.head, r.q_chu_icrf, s.s_icrf));
     }
