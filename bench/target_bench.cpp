@@ -32,13 +32,13 @@
 // the selected records' temperatures, against a function that only copies a
 // reading ("bench <scalar> lag <instructions>": what a lagged head adds to
 // its solution's correction).
-// The thermal model's Sun term of a head (core/sun_term.hpp, the out-of-line
-// entry of firmware/app/sun_entry_*.cpp) is measured per solution: heads A,
-// B and C in turn, the selected records' attitudes, coefficients of ±2″ per
-// head and axis, the Sun's direction given (the loop would form it at the
-// velocity service's rate), against a function that only copies a
-// quaternion component ("bench <scalar> sun <instructions>": what a head with
-// a Sun term would add to its solution's correction).
+// The thermal model's Sun term of a head (core/sun_term.hpp, folded into the
+// core's thermal stage: the out-of-line entry of firmware/app/sun_entry_*.cpp)
+// is measured per solution: the selected records, Table 2, every head with
+// coefficients of ±2″ per axis, the Sun's direction given (the loop would
+// form it at the velocity service's rate), against the core without it
+// ("bench <scalar> sun <instructions>": what a head with a Sun term adds to
+// its solution's correction).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -349,29 +349,29 @@ void bench_lag(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     report(name, "lag", run_lag<T>(&lag_call<T>, lags, fx, epoch), c0, ipc);
 }
 
-// The Sun term: one solution per call.
+// The Sun term: one solution per call, the core with it against the core.
 template <typename T>
-using SunFn = void (*)(const SunTermModel<T>&, std::uint8_t, const Vector3<T>&, Quaternion<T>&) noexcept;
+using SunFn = CorrectedSolution<T> (*)(const SolutionInput<T>&, const CorrectionConfig<T>&,
+                                       const SunTermInput<T>&) noexcept;
 
 template <typename T>
-__attribute__((noinline)) void sun_copy(const SunTermModel<T>& /*m*/, std::uint8_t /*head*/,
-                                        const Vector3<T>& /*s_icrf*/, Quaternion<T>& q) noexcept {
-    q.z = q.x;
+__attribute__((noinline)) CorrectedSolution<T> sun_without(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                                           const SunTermInput<T>& /*sun*/) noexcept {
+    return app::correct(in, cfg);
 }
 
 template <typename T>
-__attribute__((noinline)) void sun_call(const SunTermModel<T>& m, std::uint8_t head, const Vector3<T>& s_icrf,
-                                        Quaternion<T>& q) noexcept {
-    app::sun(m, head, s_icrf, q);
+__attribute__((noinline)) CorrectedSolution<T> sun_with(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                                        const SunTermInput<T>& sun) noexcept {
+    return app::correct(in, cfg, sun);
 }
 
 template <typename T>
-std::uint32_t run_sun(volatile SunFn<T> fn, const SunTermModel<T>& m, const Vector3<T>& s_icrf, const Fixture<T>& fx) {
+std::uint32_t run_sun(volatile SunFn<T> fn, const Fixture<T>& fx, const SunTermInput<T>& sun) {
+    const CorrectionConfig<T> both{true, &fx.model[0]};
     return counts([&] {
         for (std::uint32_t i = 0; i < kRuns; ++i) {
-            Quaternion<T> q = fx.in[i % kInputs].q_chu_icrf;
-            fn(m, static_cast<std::uint8_t>(i % 3U), s_icrf, q);
-            g_sink_q = ScalarTraits<T>::to_double(q.x);
+            g_sink_status = fn(fx.in[i % kInputs], both, sun).status;
         }
     });
 }
@@ -380,7 +380,7 @@ template <typename T>
 void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     using S = ScalarTraits<T>;
     static SunTermModel<T> m{};
-    for (std::uint8_t h = 0; h < 3; ++h) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         m.present[h] = true;
         for (std::uint8_t a = 0; a < kModelAxes; ++a) {
             for (std::uint8_t c = 0; c < kSunComponents; ++c) {
@@ -389,9 +389,9 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
             }
         }
     }
-    const Vector3<T> s_icrf{S::from_double(0.6), S::from_double(-0.64), S::from_double(0.48)};  // unit
-    const std::uint32_t c0 = run_sun<T>(&sun_copy<T>, m, s_icrf, fx);
-    report(name, "sun", run_sun<T>(&sun_call<T>, m, s_icrf, fx), c0, ipc);
+    const SunTermInput<T> sun{&m, {S::from_double(0.6), S::from_double(-0.64), S::from_double(0.48)}, true};  // unit
+    const std::uint32_t c0 = run_sun<T>(&sun_without<T>, fx, sun);
+    report(name, "sun", run_sun<T>(&sun_with<T>, fx, sun), c0, ipc);
 }
 
 Fixture<Q30> g_fixed;

@@ -1,35 +1,36 @@
-// firmware/app/sun_entry.hpp: the thermal model's Sun term (core/sun_term.hpp)
-// compiled once per scalar for the DPU, as out-of-line entry points.
+// firmware/app/sun_entry.hpp: the correction core with the heads' Sun terms
+// folded into its thermal stage (core/correct.hpp, the flight form of
+// core/sun_term.hpp), compiled once per scalar for the DPU, as out-of-line
+// entry points.
 //
-// Conventions: as lag_entry.hpp, in its own translation units
-// (sun_entry_fixed.cpp, sun_entry_float.cpp) with the core's options, so that
-// its instructions per solution (bench/target_bench.cpp) are those a head
-// with a Sun term would add to the core's. Not in the flight image: the
+// Conventions: as core_entry.hpp, in its own translation units
+// (sun_entry_fixed.cpp, sun_entry_float.cpp) with the core's options, so
+// that its instructions per solution (bench/target_bench.cpp) less the
+// core's are what a head with a Sun term adds. Not in the flight image: the
 // flight loop does not evaluate the term yet (docs/ground.md, "What each of
 // those needs").
 #pragma once
 
-#include <cstdint>
-
+#include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
-#include "ascorr/core/sun_term.hpp"
 
 namespace ascorr::app {
 
-// q ← the Sun term of `head` applied to q (with_sun_term), s_icrf the Sun's
-// direction (formed at the velocity service's rate, not per solution).
-void sun_fixed(const SunTermModel<Q30>& m, std::uint8_t head, const Vector3<Q30>& s_icrf, Quaternion<Q30>& q) noexcept;
-void sun_float(const SunTermModel<float>& m, std::uint8_t head, const Vector3<float>& s_icrf,
-               Quaternion<float>& q) noexcept;
+// correct_solution(in, cfg, sun); sun.s_icrf is formed at the velocity
+// service's rate, not per solution.
+CorrectedSolution<Q30> correct_sun_fixed(const SolutionInput<Q30>& in, const CorrectionConfig<Q30>& cfg,
+                                         const SunTermInput<Q30>& sun) noexcept;
+CorrectedSolution<float> correct_sun_float(const SolutionInput<float>& in, const CorrectionConfig<float>& cfg,
+                                           const SunTermInput<float>& sun) noexcept;
 
 // The entry for scalar T, for code templated on it.
-inline void sun(const SunTermModel<Q30>& m, std::uint8_t head, const Vector3<Q30>& s_icrf,
-                Quaternion<Q30>& q) noexcept {
-    sun_fixed(m, head, s_icrf, q);
+inline CorrectedSolution<Q30> correct(const SolutionInput<Q30>& in, const CorrectionConfig<Q30>& cfg,
+                                      const SunTermInput<Q30>& sun) noexcept {
+    return correct_sun_fixed(in, cfg, sun);
 }
-inline void sun(const SunTermModel<float>& m, std::uint8_t head, const Vector3<float>& s_icrf,
-                Quaternion<float>& q) noexcept {
-    sun_float(m, head, s_icrf, q);
+inline CorrectedSolution<float> correct(const SolutionInput<float>& in, const CorrectionConfig<float>& cfg,
+                                        const SunTermInput<float>& sun) noexcept {
+    return correct_sun_float(in, cfg, sun);
 }
 
 }  // namespace ascorr::app

@@ -1,10 +1,11 @@
-// firmware/app/sun_entry_fixed.cpp: the fixed Sun term, out of line.
+// firmware/app/sun_entry_fixed.cpp: the fixed core with the Sun term, out of line.
 #include "sun_entry.hpp"
 
 namespace ascorr::app {
 
-void sun_fixed(const SunTermModel<Q30>& m, std::uint8_t head, const Vector3<Q30>& s_icrf, Quaternion<Q30>& q) noexcept {
-    q = with_sun_term(q, sun_term_rotation(m, head, q, s_icrf));
+CorrectedSolution<Q30> correct_sun_fixed(const SolutionInput<Q30>& in, const CorrectionConfig<Q30>& cfg,
+                                         const SunTermInput<Q30>& sun) noexcept {
+    return correct_solution(in, cfg, sun);
 }
 
 }  // namespace ascorr::app

@@ -1,11 +1,11 @@
-// firmware/app/sun_entry_float.cpp: the float Sun term, out of line.
+// firmware/app/sun_entry_float.cpp: the float core with the Sun term, out of line.
 #include "sun_entry.hpp"
 
 namespace ascorr::app {
 
-void sun_float(const SunTermModel<float>& m, std::uint8_t head, const Vector3<float>& s_icrf,
-               Quaternion<float>& q) noexcept {
-    q = with_sun_term(q, sun_term_rotation(m, head, q, s_icrf));
+CorrectedSolution<float> correct_sun_float(const SolutionInput<float>& in, const CorrectionConfig<float>& cfg,
+                                           const SunTermInput<float>& sun) noexcept {
+    return correct_solution(in, cfg, sun);
 }
 
 }  // namespace ascorr::app

@@ -14,11 +14,13 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 
 #include "aberration.hpp"
 #include "quaternion.hpp"
 #include "scalar_traits.hpp"
 #include "status.hpp"
+#include "sun_term.hpp"
 #include "thermal.hpp"
 
 namespace ascorr {
@@ -76,11 +78,29 @@ struct ThermalStage {
     StatusBits skip;  // 0: apply q_th
 };
 
+// Whether three thermal angles are within the core's domain, ±kMaxThermalAngleRad
+// (false for a NaN).
 template <typename T>
-constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
-                                        const HeadTemperatures<T>& temps) noexcept {
+constexpr bool angles_in_domain(const T& alpha, const T& beta, const T& gamma) noexcept {
+    constexpr T lim = constant<T>(kMaxThermalAngleRad);
+    return abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim);
+}
+
+// The polynomial's angles for one solution (rad), or the bits that say why
+// the stage is skipped.
+template <typename T>
+struct ThermalAngles {
+    T alpha;
+    T beta;
+    T gamma;
+    StatusBits skip;  // 0: the angles are within the core's domain
+};
+
+template <typename T>
+[[gnu::always_inline]] constexpr ThermalAngles<T> thermal_angles(const ThermalModel<T>& model, std::uint8_t head,
+                                                                 const HeadTemperatures<T>& temps) noexcept {
     constexpr T zero = constant<T>(0.0);
-    ThermalStage<T> out{{zero, {zero, zero, zero}}, 0U};
+    ThermalAngles<T> out{zero, zero, zero, 0U};
     if (head >= kMaxHeads || !model.head[head].present) {
         out.skip = status::kNoModelForHead;
         return out;
@@ -98,24 +118,97 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
     const Celsius<T>& t1 = temps.t_chu.value;
     const Celsius<T>& t2 = temps.t_029.value;
     const Celsius<T>& t3 = temps.t_032.value;
-    const T alpha = thermal_angle<T>(m.alpha, t1, t2, t3);
-    const T beta = thermal_angle<T>(m.beta, t1, t2, t3);
-    const T gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
-    constexpr T lim = constant<T>(kMaxThermalAngleRad);
-    if (!(abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim))) {  // false for NaN
+    out.alpha = thermal_angle<T>(m.alpha, t1, t2, t3);
+    out.beta = thermal_angle<T>(m.beta, t1, t2, t3);
+    out.gamma = thermal_angle<T>(m.gamma, t1, t2, t3);
+    if (!angles_in_domain(out.alpha, out.beta, out.gamma)) {
         out.skip = status::kThermalOutOfRange;
-        return out;
     }
-    out.q_th = thermal_rotation(alpha, beta, gamma);
     return out;
 }
+
+template <typename T>
+[[gnu::always_inline]] constexpr ThermalStage<T> stage_of(const ThermalAngles<T>& a) noexcept {
+    constexpr T zero = constant<T>(0.0);
+    if (a.skip != 0U) {
+        return {{zero, {zero, zero, zero}}, a.skip};
+    }
+    return {thermal_rotation(a.alpha, a.beta, a.gamma), 0U};
+}
+
+template <typename T>
+constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
+                                        const HeadTemperatures<T>& temps) noexcept {
+    return stage_of(thermal_angles(model, head, temps));
+}
+
+// The Sun term of a solution's head, as the flight loop evaluates it: its
+// model and the Sun's direction, formed at the velocity service's rate.
+template <typename T>
+struct SunTermInput {
+    const SunTermModel<T>* model;  // the heads' Sun terms (sun_term.hpp); present[h]: h has one
+    Vector3<T> s_icrf;             // the Sun's unit direction, ICRF components
+    bool known;                    // false: s_icrf not formed (a time outside nav/sun_direction.hpp's span)
+};
+
+// The thermal stage with the Sun term folded into it, the flight form: for a
+// head with a term, its angles (sun_term.hpp) are added to the polynomial's
+// before the one rotation, ŝ_chu formed from the raw attitude q_chu_icrf.
+// docs/contract.md ("The Sun term") defines the term as a rotation of its own
+// after the polynomial's, ŝ_chu from the attitude after aberration and the
+// polynomial; this form differs from that by
+//   |S|·(|θ_ab| + |θ_th|)  (ŝ_chu from the raw attitude) + |θ_th|·|θ_sun|
+// (the two rotations' commutator and the split of one rotation), rad:
+// 1.3e-3″ for |S| = 2″ per component, a 25″ aberration and a 60″ polynomial.
+// Skipped: as thermal_stage(); for a head with a term, kThermalOutOfRange
+// alone where ŝ is not known or the summed angles leave the core's domain
+// (only for models past ±1° in sum, the polynomial's own domain).
+template <typename T>
+[[gnu::always_inline]] constexpr ThermalStage<T> folded_thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
+                                                                      const HeadTemperatures<T>& temps,
+                                                                      const SunTermInput<T>& sun,
+                                                                      const Quaternion<T>& q_chu_icrf) noexcept {
+    ThermalAngles<T> a = thermal_angles(model, head, temps);
+    if (a.skip != 0U || !sun.model->present[head]) {
+        return stage_of(a);
+    }
+    if (!sun.known) {
+        a.skip = status::kThermalOutOfRange;
+        return stage_of(a);
+    }
+    const Vector3<T> sum =
+        plus_sun_term_angles(Vector3<T>{a.alpha, a.beta, a.gamma}, *sun.model, head, q_chu_icrf, sun.s_icrf);
+    a.alpha = sum.x;
+    a.beta = sum.y;
+    a.gamma = sum.z;
+    if (!angles_in_domain(a.alpha, a.beta, a.gamma)) {
+        a.skip = status::kThermalOutOfRange;
+    }
+    return stage_of(a);
+}
+
+// The same, as a function of its own: GCC then keeps the Q30 kernels' 64-bit
+// chains in registers on Armv7-M (M3: 183 instructions for the term instead
+// of 226), while float is cheapest inlined into the core (M4F: 70 instead of
+// 102); correct_solution() picks by scalar (toolchain/run-target-bench).
+template <typename T>
+constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
+                                        const HeadTemperatures<T>& temps, const SunTermInput<T>& sun,
+                                        const Quaternion<T>& q_chu_icrf) noexcept {
+    return folded_thermal_stage(model, head, temps, sun, q_chu_icrf);
+}
+
+namespace detail {
 
 // The corrected attitude is q_th ⊗ q ⊗ q_ab*. Both corrections are near the
 // identity, so it is computed as q + d with the increment
 //   d = q ⊗ (q_ab* − 1) + (q_th − 1) ⊗ (q + q ⊗ (q_ab* − 1)),
 // formed from small terms only, and q is rounded once, in renormalized_sum().
-template <typename T>
-constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
+// stage(model) is the thermal stage of in's head.
+template <typename T, typename Stage>
+[[gnu::always_inline]] constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in,
+                                                                       const CorrectionConfig<T>& cfg,
+                                                                       const Stage& stage) noexcept {
     if (!solution_acceptable(in)) {
         return {in.q_chu_icrf, status::kRejected};
     }
@@ -141,7 +234,7 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
     }
 
     if (cfg.thermal != nullptr) {
-        const ThermalStage<T> th = thermal_stage(*cfg.thermal, in.head, in.temperatures);
+        const ThermalStage<T> th = stage(*cfg.thermal);
         if (th.skip != 0U) {
             st |= th.skip;
         } else {
@@ -151,6 +244,28 @@ constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, cons
     }
 
     return {canonical(renormalized_sum(q, d)), st};
+}
+
+}  // namespace detail
+
+template <typename T>
+constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
+    return detail::correct_solution(
+        in, cfg, [&in](const ThermalModel<T>& m) { return thermal_stage(m, in.head, in.temperatures); });
+}
+
+// As above, with the heads' Sun terms folded into the thermal stage (its
+// flight form, thermal_stage() above): the target's loop. sun.model not null.
+template <typename T>
+constexpr CorrectedSolution<T> correct_solution(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                                const SunTermInput<T>& sun) noexcept {
+    return detail::correct_solution(in, cfg, [&in, &sun](const ThermalModel<T>& m) {
+        if constexpr (std::is_same_v<T, Q30>) {
+            return thermal_stage(m, in.head, in.temperatures, sun, in.q_chu_icrf);
+        } else {
+            return folded_thermal_stage(m, in.head, in.temperatures, sun, in.q_chu_icrf);
+        }
+    });
 }
 
 }  // namespace ascorr

@@ -73,13 +73,87 @@ constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcep
 }
 
 // v rotated by q: R(q)·v, the components in q's target frame of a vector
-// given in its source frame (q_b_a maps a into b). Unit q.
+// given in its source frame (q_b_a maps a into b). Unit q = (w, u):
+//   R(q)·v = q ⊗ (0, v) ⊗ q* = v + 2·m,  m = w·t + u × t,  t = u × v,
+// 15 products instead of the two quaternion products' 24. Range (Q30): unit
+// q and v give |t| ≤ 1 and |m| ≤ |u|·(|w| + |u|) ≤ (1 + √2)/2 per component,
+// and v + m = (v + R(q)·v)/2 within ±1, so no sum saturates.
 template <typename T>
 constexpr Vector3<T> rotated(const Quaternion<T>& q, const Vector3<T>& v) noexcept {
-    const Quaternion<T> p{constant<T>(0.0), v.x, v.y, v.z};
-    const Quaternion<T> r = q * p * conjugate(q);
-    return {r.x, r.y, r.z};
+    const Vector3<T> u{q.x, q.y, q.z};
+    const Vector3<T> t = cross(u, v);
+    const Vector3<T> m = q.w * t + cross(u, t);
+    return (v + m) + m;
 }
+
+// base + the term's angles (alpha, beta, gamma as x, y, z; rad) for head h
+// at attitude q_chu_icrf: base + S·ŝ_chu. base is the polynomial's angles
+// where the term is folded into its rotation (correct.hpp), else 0.
+// Precondition: h < kMaxHeads.
+template <typename T>
+constexpr Vector3<T> plus_sun_term_angles(const Vector3<T>& base, const SunTermModel<T>& m, std::uint8_t head,
+                                          const Quaternion<T>& q_chu_icrf, const Vector3<T>& s_icrf) noexcept {
+    const Vector3<T> s_chu = rotated(q_chu_icrf, s_icrf);
+    const auto angle = [&](std::uint8_t a) {
+        const T(&c)[kSunComponents] = m.coefficient[head][a];
+        return dot(Vector3<T>{c[0], c[1], c[2]}, s_chu);
+    };
+    return base + Vector3<T>{angle(0), angle(1), angle(2)};
+}
+
+// In Q30 (q_formats.hpp): plus_sun_term_angles as one kernel, each component a
+// chain of exact products rounded once (fx::narrow), with no saturation:
+//   t = u × s      two products per component, |t| ≤ |u|·|s| ≤ 1;
+//   m = w·t + u × t  three, |m| ≤ (1 + √2)/2 (rotated(), above);
+//   ŝ_chu = s + m + m, exact, in 32-bit modular sums: s + m = (s + ŝ_chu)/2
+//     and ŝ_chu are within ±1, so the true sums never wrap;
+//   angle = base + c · ŝ_chu  three, base the accumulator's start (no
+//     instruction of its own); |c| row sums ≤ kMaxThermalAngleRad (the
+//     model's domain, raw < 2²⁵) and |base| ≤ kMaxThermalAngleRad (the
+//     polynomial's, checked before), so the result is within ±2° (raw < 2²⁶).
+// Range: q unit within the core's tolerance (|qᵢ| ≤ 1 + 2⁻²⁰, as the core
+// validates it) and s unit (|sᵢ| ≤ 1 + 2⁻²⁰; the producer forms it so): no
+// int64 sum exceeds 3·2⁶⁰·(1 + 2⁻¹⁹) < 2⁶³. Outside that range (|sᵢ| up to 2)
+// the int64 sums still fit (≤ 2⁶²·1.0001 for t, 3·2⁶¹·1.0001 for m, using
+// |t|'s raw, whatever it wrapped to, ≤ 2³¹) and the 32-bit sums are
+// modular: the angles are then wrong, never undefined.
+// Rounding: t ≤ 2⁻³¹; m ≤ 2⁻³¹ plus (|w| + 2|u|)·2⁻³¹ carried from t; ŝ_chu
+// twice m's, ≤ 8·2⁻³¹ = 3.7e-9; each sum ≤ 2⁻³¹ rad (9.6e-5″) plus
+// |S|·3.7e-9 (≤ 6e-11 rad for |S| ≤ 3600″), as the generic form's within a few LSB.
+constexpr Vector3<Q30> plus_sun_term_angles(const Vector3<Q30>& base, const SunTermModel<Q30>& m, std::uint8_t head,
+                                            const Quaternion<Q30>& q_chu_icrf, const Vector3<Q30>& s_icrf) noexcept {
+    using fx::narrow;
+    using fx::unshared;
+    const std::int32_t w = unshared(q_chu_icrf.w.raw);
+    const std::int32_t ux = unshared(q_chu_icrf.x.raw);
+    const std::int32_t uy = unshared(q_chu_icrf.y.raw);
+    const std::int32_t uz = unshared(q_chu_icrf.z.raw);
+    const std::int32_t sx = unshared(s_icrf.x.raw);
+    const std::int32_t sy = unshared(s_icrf.y.raw);
+    const std::int32_t sz = unshared(s_icrf.z.raw);
+    const std::int32_t nux = unshared(-ux);
+    const std::int32_t nuy = unshared(-uy);
+    const std::int32_t nuz = unshared(-uz);
+    const std::int32_t tx = unshared(narrow<30>(0, uy, sz, nuz, sy));
+    const std::int32_t ty = unshared(narrow<30>(0, uz, sx, nux, sz));
+    const std::int32_t tz = unshared(narrow<30>(0, ux, sy, nuy, sx));
+    const auto twice_plus = [](std::int32_t v, std::int32_t h) {  // v + 2h, modular (above)
+        const auto u = static_cast<std::uint32_t>(h);
+        return unshared(static_cast<std::int32_t>(static_cast<std::uint32_t>(v) + u + u));
+    };
+    const std::int32_t cx = twice_plus(sx, narrow<30>(0, w, tx, uy, tz, nuz, ty));
+    const std::int32_t cy = twice_plus(sy, narrow<30>(0, w, ty, uz, tx, nux, tz));
+    const std::int32_t cz = twice_plus(sz, narrow<30>(0, w, tz, ux, ty, nuy, tx));
+    const auto angle = [&](std::uint8_t a, Q30 b) {
+        const Q30(&c)[kSunComponents] = m.coefficient[head][a];
+        return Q30{narrow<30>(std::int64_t{b.raw} * (std::int64_t{1} << 30), unshared(c[0].raw), cx, unshared(c[1].raw),
+                              cy, unshared(c[2].raw), cz)};
+    };
+    return {angle(0, base.x), angle(1, base.y), angle(2, base.z)};
+}
+template <>
+Vector3<Q30> plus_sun_term_angles<Q30>(const Vector3<Q30>&, const SunTermModel<Q30>&, std::uint8_t,
+                                       const Quaternion<Q30>&, const Vector3<Q30>&) noexcept = delete;
 
 // The term's rotation for head h at attitude q_chu_icrf, or the identity for
 // a head without one.
@@ -90,12 +164,8 @@ constexpr SmallRotation<T> sun_term_rotation(const SunTermModel<T>& m, std::uint
     if (head >= kMaxHeads || !m.present[head]) {
         return {zero, {zero, zero, zero}};
     }
-    const Vector3<T> s_chu = rotated(q_chu_icrf, s_icrf);
-    const auto angle = [&](std::uint8_t a) {
-        const T(&c)[kSunComponents] = m.coefficient[head][a];
-        return c[0] * s_chu.x + c[1] * s_chu.y + c[2] * s_chu.z;
-    };
-    return thermal_rotation(angle(0), angle(1), angle(2));
+    const Vector3<T> a = plus_sun_term_angles(Vector3<T>{zero, zero, zero}, m, head, q_chu_icrf, s_icrf);
+    return thermal_rotation(a.x, a.y, a.z);
 }
 
 // q_sun ⊗ q, renormalised and with w ≥ 0, as correct_solution() ends

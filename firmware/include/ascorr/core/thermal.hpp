@@ -105,8 +105,8 @@ constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
 // term, grouped by regressor (Horner: x·(c + c_2·x)), not a loop over the
 // table: a loop would sum in another order and change float's results.
 template <typename T>
-constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
-                          const Celsius<T>& t3) noexcept {
+[[gnu::always_inline]] constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
+                                                 const Celsius<T>& t3) noexcept {
     static_assert(kModelTerms == 7, "thermal_angle evaluates every term of kModelTermTable");
     const Celsius<T> d2 = t2 - t1;
     const Celsius<T> d3 = t3 - t1;
