@@ -6,7 +6,9 @@
 //      ScalarTraits<T>::unit_norm_tolerance; otherwise kRejected and the input
 //      quaternion is returned unchanged;
 //   2. aberration (if enabled): q ← q ⊗ q_ab*  (aberration.hpp);
-//   3. thermal (if a model is given): q ← q_th ⊗ q  (thermal.hpp);
+//   3. thermal (if a model is given): q ← q_th ⊗ q  (thermal.hpp); with a
+//      SunTermInput, the heads' Sun terms folded into q_th (sun_term.hpp's
+//      flight form, thermal_stage() below);
 //   4. renormalise (one Newton step) and return with w ≥ 0.
 // A stage whose inputs are missing or outside the core's domain is skipped
 // and flagged, never evaluated. No allocation, no exceptions, no loops, no
@@ -144,6 +146,9 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
 
 // The Sun term of a solution's head, as the flight loop evaluates it: its
 // model and the Sun's direction, formed at the velocity service's rate.
+// Preconditions: model not null, its coefficients within the term's domain
+// (|S| row sums ≤ kMaxThermalAngleRad per head and axis: the loader and the
+// link check it; the Q30 kernel's range needs it); s_icrf unit where known.
 template <typename T>
 struct SunTermInput {
     const SunTermModel<T>* model;  // the heads' Sun terms (sun_term.hpp); present[h]: h has one

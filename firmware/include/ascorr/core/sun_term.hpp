@@ -9,10 +9,15 @@
 //    (rad; the model file's sun_x, sun_y, sun_z in arcsec), an angle of the
 //    same axis and sign as the polynomial's (thermal.hpp), so that the model's
 //    angle is the polynomial's plus this one.
-//  - Applied as the thermal stage is, on the CHU side: q ← q_sun ⊗ q with
-//    q_sun = thermal_rotation(angles). Applied after the polynomial's q_th it
-//    differs from the rotation of the summed angles by the two rotations'
-//    commutator, ≤ |θ_th|·|θ_sun|/2 rad (2.9e-4″ for 60″ and 2″).
+//  - Two forms. The contract's (with_sun_term(), sun_term_rotation(): the
+//    host): applied as the thermal stage is, on the CHU side, q ← q_sun ⊗ q
+//    with q_sun = thermal_rotation(angles), after the polynomial's q_th and
+//    with s_chu from the attitude that q_th gave. The flight form
+//    (correct.hpp, correct_solution() with a SunTermInput): the angles added
+//    to the polynomial's before its one rotation, s_chu from the raw
+//    attitude; it differs from the contract's by the bound correct.hpp states
+//    (1.3e-3″ for 2″ coefficients, a 25″ aberration and a 60″ polynomial) and
+//    costs a third of the separate rotation (docs/figures.md).
 // Why the head's own frame: the Sun heats the bench by where it stands in the
 // spacecraft's frame, which on a nadir-pointing spacecraft is the orbital
 // frame (v̂, n̂, r̂) the study chose (bench/inside_orbit_terms.py), and every
@@ -20,24 +25,15 @@
 // Domain: |S| row sums ≤ kMaxThermalAngleRad, as the polynomial's angles;
 // s_icrf of unit norm. An attitude error of ε rad moves s_chu by ε: the
 // term's angle by ≤ |S|·ε (5e-5 of the term for a 10″ attitude error).
-// Scalars: double, float and Q30. In Q30 (q_formats.hpp) the same templates
-// run on the core's Q30 kernels (quaternion.hpp's product, add_left_increment
-// and renormalized_sum, thermal.hpp's thermal_rotation), with:
-//  - range: q and s_icrf unit, so every component of q ⊗ (0, s) ⊗ q* and of
-//    s_chu is within ±1 (+ rounding): no product or sum saturates; the
-//    coefficients in rad within ±kMaxThermalAngleRad (the model's domain:
-//    |S| row sums ≤ 3600″), raw < 2²⁵; each angle Σ_m S[a][m]·s_chu[m]
-//    within ±kMaxThermalAngleRad too, so its two saturating additions never
-//    act;
-//  - rounding: each coefficient rounded to nearest once at conversion
-//    (≤ 2⁻³¹ rad, 9.6e-5″, relative 4.8e-5 of a 2″ coefficient); s_chu's
-//    components two products each rounded, the first's error carried
-//    through the second (≤ 3·2⁻³¹); each angle three products rounded
-//    (≤ 3·2⁻³¹ rad) plus the coefficients' and s_chu's (Σ|s_chu| ≤ √3):
-//    ≤ 5e-9 rad, 1e-3″ per angle (an angle at the domain's edge may pass
-//    thermal_rotation's clamp by those few LSB, which it then removes);
-//    thermal_rotation's and the increment's rounding as the polynomial's
-//    (thermal.hpp: 7.7e-4″).
+// Scalars: double, float and Q30. In Q30 (q_formats.hpp) the angles are one
+// kernel of their own (plus_sun_term_angles, below, with its range and
+// rounding: ≤ 2⁻³¹ rad per angle plus the coefficients' conversion, each
+// rounded to nearest once, ≤ 2⁻³¹ rad, relative 4.8e-5 of a 2″ coefficient);
+// the rotation runs on the core's Q30 kernels (thermal.hpp's
+// thermal_rotation; for the contract's form also quaternion.hpp's
+// add_left_increment and renormalized_sum), with their rounding (thermal.hpp:
+// 7.7e-4″). An angle at the domain's edge may pass thermal_rotation's clamp
+// by a few LSB, which it then removes.
 #pragma once
 
 #include <cstdint>
