@@ -114,7 +114,7 @@ def core_section(d):
                        ("validation + renormalisation alone", "validation_and_renormalisation_only"),
                        ("the lag stage of a lagged head (issue 40's budget: 1.2× with it)", "lag_stage"),
                        ("thermal + aberration with the lag stage, ratio", "with_lag_ratio"),
-                       ("the Sun term of a head (not in the flight loop yet)", "sun_term"),
+                       ("the Sun term of a head, folded into the thermal stage (not in the flight loop yet)", "sun_term"),
                        ("thermal + aberration with the Sun term, ratio", "with_sun_ratio"),
                        ("combined attitude, per epoch of three heads", "combination_three_heads"),
                        ("combined attitude, error vs double (arcsec)", "combination_max_error_arcsec"),
