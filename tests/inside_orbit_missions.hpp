@@ -52,4 +52,30 @@ inline CliRun self_calibrate_mission(const std::filesystem::path& dir, const std
         "correct --in m.csv --self-calibrate --out " + out + " --model-history " + out + ".history.csv " + args, dir);
 }
 
+// A static bench (today's missions: 60 days, an epoch every 240 s, seed 40),
+// simulated once per test program.
+inline const std::filesystem::path& static_mission() {
+    static const std::filesystem::path dir = simulated_mission("static-bench", "--days 60 --step 240 --seed 40");
+    return dir;
+}
+
+// `correct --self-calibrate` on the static bench without and with `option`
+// (a learner that must find nothing there): every byte of the corrected file
+// and of the history the same. The runs, for the caller's account checks.
+struct StaticBenchRuns {
+    CliRun none;
+    CliRun with;
+};
+
+inline StaticBenchRuns expect_static_bench_unchanged_by(const std::string& option) {
+    namespace fs = std::filesystem;
+    const fs::path& dir = static_mission();
+    StaticBenchRuns r{self_calibrate_mission(dir, "", "s_none.csv"), self_calibrate_mission(dir, option, "s_with.csv")};
+    EXPECT_EQ(r.none.exit_code, 0) << r.none.err;
+    EXPECT_EQ(r.with.exit_code, 0) << r.with.err;
+    EXPECT_EQ(slurp(dir / "s_with.csv"), slurp(dir / "s_none.csv")) << option;
+    EXPECT_EQ(slurp(dir / "s_with.csv.history.csv"), slurp(dir / "s_none.csv.history.csv")) << option;
+    return r;
+}
+
 }  // namespace ascorr::test

@@ -45,10 +45,6 @@ const fs::path& lagging_mission() {
     static const fs::path dir = simulated_mission("lag-learnt", "--days 150 --step 240 --seed 40 --bench-lag 1800");
     return dir;
 }
-const fs::path& static_mission() {
-    static const fs::path dir = simulated_mission("lag-learnt-static", "--days 60 --step 240 --seed 40");
-    return dir;
-}
 
 // The lag_s column of a history, row by row (empty: no such column).
 std::vector<double> history_lags(const fs::path& file) {
@@ -172,13 +168,7 @@ TEST(LagLearnt, SelfCalibrationLearnsTheLagFromNoModelInEachScalar) {
 }
 
 TEST(LagLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
-    const fs::path& dir = static_mission();
-    const CliRun none = self_calibrate_mission(dir, "", "s_none.csv");
-    ASSERT_EQ(none.exit_code, 0) << none.err;
-    const CliRun with = self_calibrate_mission(dir, "--lag auto", "s_auto.csv");
-    ASSERT_EQ(with.exit_code, 0) << with.err;
-    EXPECT_EQ(slurp(dir / "s_auto.csv"), slurp(dir / "s_none.csv"));
-    EXPECT_EQ(slurp(dir / "s_auto.csv.history.csv"), slurp(dir / "s_none.csv.history.csv"));
+    const auto [none, with] = expect_static_bench_unchanged_by("--lag auto");
     EXPECT_TRUE(has(with.err, "bench lag (--lag auto): no model took a lag; the search scored ")) << with.err;
     EXPECT_TRUE(has(with.err, "; it takes no lag (")) << with.err;
     EXPECT_FALSE(has(none.err, "bench lag")) << "the search runs only with --lag auto";

@@ -434,10 +434,6 @@ const fs::path& orbit_mission() {
         simulated_mission("sun-learnt", "--days 150 --step 240 --seed 40 --bench-lag 900 --orbit-term 0.8");
     return dir;
 }
-const fs::path& static_mission() {
-    static const fs::path dir = simulated_mission("sun-learnt-static", "--days 60 --step 240 --seed 40");
-    return dir;
-}
 
 TEST(SunLearnt, SelfCalibrationLearnsTheSunTermFromNoModelAndMeetsTheBound) {
     const fs::path& dir = orbit_mission();
@@ -480,13 +476,7 @@ TEST(SunLearnt, SelfCalibrationLearnsTheSunTermFromNoModelAndMeetsTheBound) {
 }
 
 TEST(SunLearnt, AStaticBenchIsByteForByteAsWithoutIt) {
-    const fs::path& dir = static_mission();
-    const CliRun none = self_calibrate_mission(dir, "", "s_none.csv");
-    ASSERT_EQ(none.exit_code, 0) << none.err;
-    const CliRun with = self_calibrate_mission(dir, "--sun-term auto", "s_auto.csv");
-    ASSERT_EQ(with.exit_code, 0) << with.err;
-    EXPECT_EQ(slurp(dir / "s_auto.csv"), slurp(dir / "s_none.csv"));
-    EXPECT_EQ(slurp(dir / "s_auto.csv.history.csv"), slurp(dir / "s_none.csv.history.csv"));
+    const auto [none, with] = expect_static_bench_unchanged_by("--sun-term auto");
     EXPECT_TRUE(has(with.err, "; it does not take the term (")) << with.err;
     EXPECT_TRUE(has(with.err, "; no model took it")) << with.err;
     EXPECT_FALSE(has(none.err, "Sun term")) << "the learner runs only with --sun-term auto";

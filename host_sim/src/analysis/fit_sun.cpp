@@ -31,6 +31,13 @@ calib::SunRule sun_rule_of(const CommonRotation& rule, calib::Matrix3 (&weights)
     return out;
 }
 
+// A fit's coefficients as a model's `sun`: those of `heads`, 0 elsewhere.
+SunCoefficients sun_coefficients_of(const calib::SunTermFit& f, HeadMask heads) {
+    SunCoefficients out{};
+    calib::copy_sun_coefficients(f, heads, out);
+    return out;
+}
+
 // The model with the Sun term s (none: its polynomial alone).
 ModelFile with_sun(const ModelFile& m, const SunCoefficients& s = {}) {
     ModelFile out = m;
@@ -59,15 +66,17 @@ std::string verdict_of(const SunSelection& s) {
     text::c_snprintf(buf, sizeof buf,
                      "%s: fitted inside the orbit before the held-out part (rank %d), it %s the held-out IBA RMS "
                      "(mean over the pairs) from %.4f to %.4f arcsec (%+.2f %%), %s the %.2f %% margin",
-                     s.taken ? "taken" : "none", s.fit.rank, gain >= 0.0 ? "lowers" : "raises", s.none_rms, s.sun_rms,
-                     -100.0 * gain, s.taken ? "more than" : "not more than", 100.0 * kSunSelectionMargin);
+                     s.taken ? "taken" : "none", s.fit.solved ? s.fit.rank : 0, gain >= 0.0 ? "lowers" : "raises",
+                     s.none_rms, s.sun_rms, -100.0 * gain, s.taken ? "more than" : "not more than",
+                     100.0 * kSunSelectionMargin);
     return buf;
 }
 
 }  // namespace
 
-SunFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m, HeadMask heads,
-                    const std::array<std::uint8_t, 2>& frame_heads, double period, const CommonRotation& rule) {
+calib::SunTermFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m,
+                               HeadMask heads, const std::array<std::uint8_t, 2>& frame_heads, double period,
+                               const CommonRotation& rule) {
     const ThermalModel<double> core = to_core<double>(m);
     const CorrectionConfig<double> thermal_only{false, &core};
     const HeadList list = heads_of(heads);
@@ -104,19 +113,7 @@ SunFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to,
     calib::Matrix3 weights[kMaxHeads]{};
     calib::SunTermFit fit;
     (void)moments.solve(sun_rule_of(rule, weights), fit);
-    SunFit out;
-    out.epochs = fit.epochs;
-    out.orbits = fit.orbits;
-    out.rank = fit.solved ? fit.rank : 0;
-    for (std::size_t i = 0; fit.solved && i < list.count; ++i) {
-        const std::size_t h = list.head[i];
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t c = 0; c < kSunComponents; ++c) {
-                out.sun[h][a][c] = fit.sun[h][a][c];
-            }
-        }
-    }
-    return out;
+    return fit;
 }
 
 SunSelection select_sun_term(const SunSearchInput& in) {
@@ -128,13 +125,13 @@ SunSelection select_sun_term(const SunSearchInput& in) {
         return s;
     }
     const ModelFile before = with_sun(*in.model_before_split);
-    const SunFit trial =
+    const calib::SunTermFit trial =
         fit_sun_term(*in.epochs, -inf, in.t_split, before, in.heads, in.frame_heads, in.period, in.rule);
     const auto held_out_rms = [&](const ModelFile& m) {
         return mean_pair_rms(corrected_iba_rms(*in.epochs, in.heads, in.t_split, inf, m, kWhereTheSunIsKnown), pairs);
     };
     s.none_rms = held_out_rms(before);
-    s.sun_rms = held_out_rms(with_sun(before, trial.sun));
+    s.sun_rms = held_out_rms(with_sun(before, sun_coefficients_of(trial, in.heads)));
     if (!(s.none_rms > 0.0 && s.sun_rms > 0.0)) {
         s.verdict = "none: a pair has no held-out epoch";
         return s;
@@ -145,7 +142,7 @@ SunSelection select_sun_term(const SunSearchInput& in) {
     s.verdict = verdict_of(s);
     if (s.taken) {
         s.fit = fit_sun_term(*in.epochs, -inf, inf, with_sun(*in.model), in.heads, in.frame_heads, in.period, in.rule);
-        const std::string why = outside_the_domain(s.fit.sun, in.heads);
+        const std::string why = outside_the_domain(sun_coefficients_of(s.fit, in.heads), in.heads);
         if (!why.empty()) {
             s.taken = false;
             s.verdict += "; but the whole period's term is not taken: " + why;

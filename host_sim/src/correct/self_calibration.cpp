@@ -34,18 +34,6 @@ struct SideLearning {
 };
 
 // The model file's Sun term of a learnt one, for the heads m has.
-decltype(ModelFile::sun) sun_coefficients_of(const calib::SunTermFit& f, const ModelFile& m) {
-    decltype(ModelFile::sun) out{};
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; m.present[h] && ((f.heads >> h) & 1U) != 0U && a < kModelAxes; ++a) {
-            for (std::size_t c = 0; c < kSunComponents; ++c) {
-                out[h][a][c] = f.sun[h][a][c];
-            }
-        }
-    }
-    return out;
-}
-
 // One row as the run needs it: its epoch, and for a clean row of A, B or C
 // whose aberration stage applies, its input to the core.
 template <typename T>
@@ -218,7 +206,7 @@ private:
                 m.lag_s = head_lags(m);
             }
             if (sun_ && sun_->taken() != nullptr) {  // ... and the Sun term the learner has taken
-                m.sun = sun_coefficients_of(*sun_->taken(), m);
+                calib::copy_sun_coefficients(*sun_->taken(), heads_where(m.present), m.sun);
             }
             had_ = true;
             version_ = pipeline_.version();

@@ -76,6 +76,12 @@ public:
         return scored;
     }
 
+    // Whether a cycle at t_us closes the open orbit (begin() would), and
+    // that orbit's bin: for a learner whose own sums close with it.
+    bool closes(std::int64_t t_us) const noexcept { return open_ && orbit_bin(t_us, period_us_) != bin_; }
+    bool open() const noexcept { return open_; }
+    std::int64_t open_bin() const noexcept { return bin_; }
+
     // The cycle's IBAs of every candidate (begin() came first).
     void add(const double (&iba)[K][kPairs]) noexcept {
         if (n_ == 0U) {

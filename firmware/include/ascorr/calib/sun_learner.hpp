@@ -93,14 +93,10 @@ public:
     // rotation; counted). A cycle of another orbit than the open one closes
     // it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
-        const bool scored = scores_.begin(t_us);
-        const std::int64_t bin = orbit_bin(t_us, scores_.period_us());
-        if (open_ && bin != bin_) {
-            close_orbit();
+        if (scores_.closes(t_us)) {
+            close_orbit(scores_.open_bin());
         }
-        open_ = true;
-        bin_ = bin;
-        if (scored) {
+        if (scores_.begin(t_us)) {
             reconsider();
         }
         Vector3<double> s_icrf{};
@@ -146,9 +142,8 @@ public:
 
     // Closes the open orbit (the end of the data), its solve included.
     void finish() noexcept {
-        if (open_) {
-            close_orbit();
-            open_ = false;
+        if (scores_.open()) {
+            close_orbit(scores_.open_bin());
         }
         (void)step();
         if (scores_.finish()) {
@@ -190,19 +185,20 @@ public:
 private:
     static constexpr std::uint8_t kFrameHeadIndices[kFrameHeads] = {0U, 1U, 2U};
 
-    // The open orbit into the moments (the older ones forgotten over the time
-    // since the last closed), the candidate to be solved again (step).
-    void close_orbit() noexcept {
+    // The open orbit (bin: the scores' open one) into the moments (the older
+    // ones forgotten over the time since the last closed), the candidate to
+    // be solved again (step).
+    void close_orbit(std::int64_t bin) noexcept {
         if (moments_.open_count() == 0U) {
             return;
         }
         const double keep = closed_any_
-                                ? exp_nonpositive(-static_cast<double>(bin_ - last_closed_bin_) *
+                                ? exp_nonpositive(-static_cast<double>(bin - last_closed_bin_) *
                                                   static_cast<double>(scores_.period_us()) / scores_.memory_us())
                                 : 1.0;
         moments_.close_orbit(keep);
         closed_any_ = true;
-        last_closed_bin_ = bin_;
+        last_closed_bin_ = bin;
         solve_pending_ = true;
     }
 
@@ -216,8 +212,6 @@ private:
     SunMoments<kFrameHeads> moments_;
     CommonRotationWeights weights_;
     SunRule rule_{};
-    bool open_ = false;
-    std::int64_t bin_ = 0;
     bool closed_any_ = false;
     std::int64_t last_closed_bin_ = 0;
     SunTermFit candidate_{};

@@ -74,6 +74,20 @@ struct SunTermFit {
     bool solved = false;  // false: no orbit, or equations that are not finite or did not converge
 };
 
+// f's coefficients (arcsec) into out[h][a][m] for the heads it fitted that
+// are in keep (bit h: head h), when it was solved; out is left as it was
+// elsewhere. Out: any array indexable as SunTermFit::sun (a model's `sun`).
+template <typename Out>
+void copy_sun_coefficients(const SunTermFit& f, std::uint8_t keep, Out& out) noexcept {
+    for (std::size_t h = 0; f.solved && h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; ((f.heads & keep) >> h & 1U) != 0U && a < kModelAxes; ++a) {
+            for (std::size_t m = 0; m < kSunComponents; ++m) {
+                out[h][a][m] = f.sun[h][a][m];
+            }
+        }
+    }
+}
+
 // Whether every axis of every fitted head is within the core's domain
 // (sun_term.hpp: Σ_m |S[a][m]| ≤ kMaxThermalAngleRad) and finite.
 inline bool sun_fit_within_domain(const SunTermFit& f) noexcept {

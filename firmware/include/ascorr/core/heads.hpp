@@ -31,6 +31,17 @@ constexpr HeadMask head_bit(std::uint8_t head) noexcept {
     return static_cast<HeadMask>(1U << head);
 }
 
+// The heads whose flag is set (flag[h] for h < kMaxHeads: a model's present
+// heads, as bool[] or std::array<bool>).
+template <typename Flags>
+constexpr HeadMask heads_where(const Flags& flag) noexcept {
+    HeadMask s = 0U;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        s = static_cast<HeadMask>(s | (flag[h] ? head_bit(h) : 0U));
+    }
+    return s;
+}
+
 // Bit i of a mask (a HeadMask, or a mask of an epoch's candidates).
 constexpr bool in_mask(std::uint8_t mask, std::uint8_t i) noexcept {
     return ((static_cast<unsigned>(mask) >> i) & 1U) != 0U;

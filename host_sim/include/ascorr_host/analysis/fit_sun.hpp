@@ -45,24 +45,18 @@ enum class SunTermChoice : std::uint8_t { kAuto, kNone };
 
 using SunCoefficients = std::array<std::array<std::array<double, kSunComponents>, kModelAxes>, kMaxHeads>;
 
-struct SunFit {
-    SunCoefficients sun{};  // arcsec, by head (the fit's heads)
-    std::size_t epochs = 0;
-    std::size_t orbits = 0;
-    int rank = 0;  // eigen-directions kept, of 9 per head (0: not solved)
-};
-
 // The Sun term fitted on the epochs with t in [from, to) corrected by the
 // polynomial m (its Sun term, if any, is ignored); epochs sorted by t.
-SunFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m, HeadMask heads,
-                    const std::array<std::uint8_t, 2>& frame_heads, double period, const CommonRotation& rule);
+calib::SunTermFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m,
+                               HeadMask heads, const std::array<std::uint8_t, 2>& frame_heads, double period,
+                               const CommonRotation& rule);
 
 struct SunSelection {
     bool decided = false;  // false: nothing held out, or a pair without held-out epochs
     bool taken = false;
     double none_rms = 0.0;  // held-out IBA RMS, mean over the pairs, the polynomial alone (arcsec)
     double sun_rms = 0.0;   // with the Sun term fitted before t_split
-    SunFit fit;             // the whole period's, written when taken
+    calib::SunTermFit fit;  // the whole period's, written when taken
     std::string verdict;    // one sentence: taken or not, and why
 };
 
