@@ -203,7 +203,9 @@ struct FlightCase {
     Vector3<double> s_icrf;
 };
 
-FlightCase flight_case(std::mt19937_64& rng, double coefficient_arcsec) {
+// one_column: S's rows all the same multiple of one column (c, c, c)ᵀ, the
+// shape that makes the angle vector's error ‖S‖_F·|Δŝ| rather than a row's.
+FlightCase flight_case(std::mt19937_64& rng, double coefficient_arcsec, bool one_column = false) {
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
     FlightCase c{};
     c.in.q_chu_icrf = from_eigen(random_attitude(rng));
@@ -213,9 +215,12 @@ FlightCase flight_case(std::mt19937_64& rng, double coefficient_arcsec) {
     const Eigen::Vector3d v = random_unit_vector(rng) * (38.0 / kSpeedOfLightKmS);  // |v| 38 km/s: up to 26″
     c.in.velocity = {{v.x(), v.y(), v.z()}, 1.0, true};
     c.sun.present[c.in.head] = true;
+    const std::size_t column = rng() % 3U;
+    const double same = coefficient_arcsec * unit(rng) * kArcsecToRad;
     for (std::size_t a = 0; a < 3; ++a) {
         for (std::size_t k = 0; k < 3; ++k) {
-            c.sun.coefficient[c.in.head][a][k] = coefficient_arcsec * unit(rng) * kArcsecToRad;
+            const double own = coefficient_arcsec * unit(rng) * kArcsecToRad;
+            c.sun.coefficient[c.in.head][a][k] = !one_column ? own : (k == column ? same : 0.0);
         }
     }
     const Eigen::Vector3d s = random_unit_vector(rng);
@@ -300,42 +305,44 @@ TEST(SunTerm, TheFlightFormIsTheContractsWithinItsBound) {
     double worst_double = 0.0;   // arcsec, ±2″ coefficients
     double worst_float = 0.0;
     double worst_q30 = 0.0;
-    double smallest_term = 1e9;  // the term's own size, for the mutation
+    double largest_term = 0.0;   // the term's own size: the core without it is off by that
     for (int trial = 0; trial < 2000; ++trial) {
         const double size = trial % 4 == 3 ? 200.0 : 2.0;
-        const FlightCase c = flight_case(rng, size);
+        const FlightCase c = flight_case(rng, size, trial % 3 == 2);
         const CorrectedSolution<double> core = correct_solution(c.in, CorrectionConfig<double>{true, &md});
         ASSERT_EQ(core.status, status::kAberrationApplied | status::kThermalApplied);
         const Mat own = contract_form(c, core.q_chu_icrf);
         const CorrectedSolution<double> fd = flight_form<double>(c, md);
         ASSERT_EQ(fd.status, core.status);
         const double theta_sun = angle_between(matrix_of(core.q_chu_icrf), own);
-        const double theta_rest = angle_arcsec(core.q_chu_icrf, c.in.q_chu_icrf);  // aberration and polynomial
-        double s_norm = 0.0;  // |S|: the largest row sum, rad per unit of ŝ
-        for (std::size_t a = 0; a < 3; ++a) {
-            double row = 0.0;
-            for (std::size_t k = 0; k < 3; ++k) {
-                row += std::abs(c.sun.coefficient[c.in.head][a][k]);
+        const double theta_turn = angle_arcsec(core.q_chu_icrf, c.in.q_chu_icrf);  // aberration and polynomial: |Δŝ|
+        const double theta_th =
+            angle_arcsec(correct_solution(c.in, CorrectionConfig<double>{false, &md}).q_chu_icrf, c.in.q_chu_icrf);
+        double s_frobenius = 0.0;  // ‖S‖_F, rad per unit of ŝ
+        for (const auto& row : c.sun.coefficient[c.in.head]) {
+            for (const double x : row) {
+                s_frobenius += x * x;
             }
-            s_norm = std::max(s_norm, row);
         }
-        const double bound = s_norm * theta_rest + theta_rest * theta_sun * kArcsecToRad;  // arcsec
+        s_frobenius = std::sqrt(s_frobenius);
+        // correct.hpp's bound, with |θ_ab| + |θ_th| as the turn it bounds.
+        const double bound = s_frobenius * theta_turn + theta_th * theta_sun * kArcsecToRad;  // arcsec
         const double err = angle_between(matrix_of(fd.q_chu_icrf), own);
-        worst_excess = std::max(worst_excess, err - bound - 1e-6);
+        worst_excess = std::max(worst_excess, err - 1.001 * bound - 1e-6);
         if (size == 2.0) {
             worst_double = std::max(worst_double, err);
             worst_float = std::max(worst_float, scalar_error<float>(c, md, mf));
             worst_q30 = std::max(worst_q30, scalar_error<Q30>(c, md, mq));
-            smallest_term = std::min(smallest_term, theta_sun);
+            largest_term = std::max(largest_term, theta_sun);
         }
     }
     EXPECT_LE(worst_excess, 0.0) << "arcsec over the bound";
-    EXPECT_LE(worst_double, 0.002) << "arcsec";  // measured 0.0012
+    EXPECT_LE(worst_double, 0.005) << "arcsec";  // correct.hpp's 4e-3 for the largest turns
     EXPECT_LE(worst_float, 0.035) << "arcsec";   // measured 0.019
     EXPECT_LE(worst_q30, 0.003) << "arcsec";     // measured 0.0016
     // Mutation: the core without the term is off by the term itself, which
-    // fails the bound above for every case.
-    EXPECT_GT(smallest_term, 0.01) << "arcsec";
+    // fails each bound above (float's, the widest, by more than ten times).
+    EXPECT_GT(largest_term, 0.5) << "arcsec";
     RecordProperty("worst_double_arcsec", std::to_string(worst_double));
     RecordProperty("worst_float_arcsec", std::to_string(worst_float));
     RecordProperty("worst_q30_arcsec", std::to_string(worst_q30));
@@ -344,14 +351,19 @@ TEST(SunTerm, TheFlightFormIsTheContractsWithinItsBound) {
 // The flight form's statuses: a head without a term is the core's, byte for
 // byte, without ŝ; where ŝ is not known, or the summed angles leave the
 // core's domain, the thermal stage is skipped with 128 alone and the result
-// is the aberration's.
+// is the aberration's; a stage that would not apply keeps its own bits.
 template <typename T>
 void check_flight_statuses(const ThermalModel<T>& model) {
     std::mt19937_64 rng(43);
     const FlightCase c = flight_case(rng, 2.0);
     const SolutionInput<T> in = input_in<T>(c.in);
     const CorrectionConfig<T> both{true, &model};
+    // A head present with every coefficient 0 has no term once its producer
+    // kept present where terms are (keep_present_where_terms, as every
+    // producer does): the core's bytes and bits, with ŝ unknown.
     SunTermModel<T> none{};
+    none.present[c.in.head] = true;
+    keep_present_where_terms(none);
     const SunTermInput<T> unknown_none{&none, {}, false};
     const CorrectedSolution<T> core = correct_solution(in, both);
     const CorrectedSolution<T> without = correct_solution(in, both, unknown_none);
@@ -365,6 +377,11 @@ void check_flight_statuses(const ThermalModel<T>& model) {
     const CorrectedSolution<T> unknown = correct_solution(in, both, SunTermInput<T>{&m, {}, false});
     EXPECT_EQ(unknown.status, status::kAberrationApplied | status::kThermalOutOfRange);
     EXPECT_EQ(std::memcmp(&unknown.q_chu_icrf, &ab.q_chu_icrf, sizeof ab.q_chu_icrf), 0);
+    // A row whose stage would not apply keeps its bits (8: no temperature), ŝ unknown or not.
+    SolutionInput<T> cold = in;
+    cold.temperatures.t_029.valid = false;
+    EXPECT_EQ(correct_solution(cold, both, SunTermInput<T>{&m, {}, false}).status,
+              status::kAberrationApplied | status::kNoTemperature);
 
     // The polynomial just inside 1°, the term pushing it past.
     ThermalModel<T> edge{};

@@ -116,6 +116,7 @@ inline SunTermModel<double> sun_term_model(const SunTermFit& f) noexcept {
             }
         }
     }
+    keep_present_where_terms(m);
     return m;
 }
 

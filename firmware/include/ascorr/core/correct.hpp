@@ -148,7 +148,8 @@ constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8
 // model and the Sun's direction, formed at the velocity service's rate.
 // Preconditions: model not null, its coefficients within the term's domain
 // (|S| row sums ≤ kMaxThermalAngleRad per head and axis: the loader and the
-// link check it; the Q30 kernel's range needs it); s_icrf unit where known.
+// link check it; the Q30 kernel's range needs it), present[h] only where h
+// has a term (keep_present_where_terms); s_icrf unit where known.
 template <typename T>
 struct SunTermInput {
     const SunTermModel<T>* model;  // the heads' Sun terms (sun_term.hpp); present[h]: h has one
@@ -161,13 +162,18 @@ struct SunTermInput {
 // before the one rotation, ŝ_chu formed from the raw attitude q_chu_icrf.
 // docs/contract.md ("The Sun term") defines the term as a rotation of its own
 // after the polynomial's, ŝ_chu from the attitude after aberration and the
-// polynomial; this form differs from that by
-//   |S|·(|θ_ab| + |θ_th|)  (ŝ_chu from the raw attitude) + |θ_th|·|θ_sun|
-// (the two rotations' commutator and the split of one rotation), rad:
-// 1.3e-3″ for |S| = 2″ per component, a 25″ aberration and a 60″ polynomial.
+// polynomial; this form differs from that by at most
+//   ‖S‖_F·(|θ_ab| + |θ_th|)  (ŝ_chu from the raw attitude: the angle vector
+//                             S·Δŝ, |Δŝ| ≤ the attitude's turn)
+//   + |θ_th|·|θ_sun|         (the two rotations' commutator and the split of
+//                             one rotation into three elementary ones), rad:
+// 4e-3″ for 2″ per coefficient (‖S‖_F = 6″), a 25″ aberration and a 60″
+// polynomial (SunTerm.TheFlightFormIsTheContractsWithinItsBound).
 // Skipped: as thermal_stage(); for a head with a term, kThermalOutOfRange
-// alone where ŝ is not known or the summed angles leave the core's domain
-// (only for models past ±1° in sum, the polynomial's own domain).
+// alone where ŝ is not known, and where the summed angles leave the core's
+// domain (±1°: a model whose polynomial and term together reach it, which
+// the contract's form would still apply as two rotations; the link's loader
+// is to refuse such a model before the target evaluates it).
 template <typename T>
 [[gnu::always_inline]] constexpr ThermalStage<T> folded_thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
                                                                       const HeadTemperatures<T>& temps,

@@ -132,6 +132,7 @@ SunTermModel<T> sun_term_of(const ModelFile& m) {
             }
         }
     }
+    keep_present_where_terms(out);
     return out;
 }
 
