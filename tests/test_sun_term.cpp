@@ -305,7 +305,7 @@ TEST(SunTerm, TheFlightFormIsTheContractsWithinItsBound) {
     double worst_double = 0.0;   // arcsec, ±2″ coefficients
     double worst_float = 0.0;
     double worst_q30 = 0.0;
-    double largest_term = 0.0;   // the term's own size: the core without it is off by that
+    double largest_term = 0.0;  // the term's own size: the core without it is off by that
     for (int trial = 0; trial < 2000; ++trial) {
         const double size = trial % 4 == 3 ? 200.0 : 2.0;
         const FlightCase c = flight_case(rng, size, trial % 3 == 2);

@@ -575,7 +575,7 @@ void choose_sun_term(const FitOptions& opt, Pass& p) {
     }
     r.sun = select_sun_term(in);
     if (r.sun.taken) {
-        calib::copy_sun_coefficients(r.sun.fit, r.heads, r.model.sun);
+        r.model.sun = sun_coefficients_of(r.sun.fit, r.heads);
     }
 }
 

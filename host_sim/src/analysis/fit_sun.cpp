@@ -31,13 +31,6 @@ calib::SunRule sun_rule_of(const CommonRotation& rule, calib::Matrix3 (&weights)
     return out;
 }
 
-// A fit's coefficients as a model's `sun`: those of `heads`, 0 elsewhere.
-SunCoefficients sun_coefficients_of(const calib::SunTermFit& f, HeadMask heads) {
-    SunCoefficients out{};
-    calib::copy_sun_coefficients(f, heads, out);
-    return out;
-}
-
 // The model with the Sun term s (none: its polynomial alone).
 ModelFile with_sun(const ModelFile& m, const SunCoefficients& s = {}) {
     ModelFile out = m;
@@ -73,6 +66,12 @@ std::string verdict_of(const SunSelection& s) {
 }
 
 }  // namespace
+
+SunCoefficients sun_coefficients_of(const calib::SunTermFit& f, HeadMask heads) {
+    SunCoefficients out{};
+    calib::copy_sun_coefficients(f, heads, out);
+    return out;
+}
 
 calib::SunTermFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m,
                                HeadMask heads, const std::array<std::uint8_t, 2>& frame_heads, double period,

@@ -78,7 +78,7 @@ struct SunTermFit {
 // are in keep (bit h: head h), when it was solved; out is left as it was
 // elsewhere. Out: any array indexable as SunTermFit::sun (a model's `sun`).
 template <typename Out>
-void copy_sun_coefficients(const SunTermFit& f, std::uint8_t keep, Out& out) noexcept {
+void copy_sun_coefficients(const SunTermFit& f, HeadMask keep, Out& out) noexcept {
     for (std::size_t h = 0; f.solved && h < kMaxHeads; ++h) {
         for (std::size_t a = 0; ((f.heads & keep) >> h & 1U) != 0U && a < kModelAxes; ++a) {
             for (std::size_t m = 0; m < kSunComponents; ++m) {

@@ -104,6 +104,9 @@ constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
 // (the coefficient and temperature formats differ from T's). Written out by
 // term, grouped by regressor (Horner: x·(c + c_2·x)), not a loop over the
 // table: a loop would sum in another order and change float's results.
+// Always inlined, as the Q30 one: left to GCC, the float core called it out
+// of line once the thermal stage grew a Sun term (M4F: 326 instructions per
+// solution instead of 278).
 template <typename T>
 [[gnu::always_inline]] constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
                                                  const Celsius<T>& t3) noexcept {

@@ -45,6 +45,10 @@ enum class SunTermChoice : std::uint8_t { kAuto, kNone };
 
 using SunCoefficients = std::array<std::array<std::array<double, kSunComponents>, kModelAxes>, kMaxHeads>;
 
+// A fit's coefficients as a model's `sun` (arcsec): those of `heads` it
+// fitted, 0 elsewhere and where it was not solved.
+SunCoefficients sun_coefficients_of(const calib::SunTermFit& f, HeadMask heads);
+
 // The Sun term fitted on the epochs with t in [from, to) corrected by the
 // polynomial m (its Sun term, if any, is ignored); epochs sorted by t.
 calib::SunTermFit fit_sun_term(const std::vector<FitEpoch>& epochs, double from, double to, const ModelFile& m,
