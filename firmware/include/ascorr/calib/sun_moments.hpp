@@ -80,7 +80,8 @@ struct SunTermFit {
 template <typename Out>
 void copy_sun_coefficients(const SunTermFit& f, HeadMask keep, Out& out) noexcept {
     for (std::size_t h = 0; f.solved && h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; ((f.heads & keep) >> h & 1U) != 0U && a < kModelAxes; ++a) {
+        for (std::size_t a = 0;
+             in_mask(static_cast<HeadMask>(f.heads & keep), static_cast<std::uint8_t>(h)) && a < kModelAxes; ++a) {
             for (std::size_t m = 0; m < kSunComponents; ++m) {
                 out[h][a][m] = f.sun[h][a][m];
             }
