@@ -30,7 +30,9 @@
 #include "ascorr_host/link/replay.hpp"
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
+#include "corrected_files.hpp"
 #include "lagged_models.hpp"
+#include "restarting_target.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -212,39 +214,6 @@ TEST(LagLink, ModelUploadCarriesTheLagOnlyWhenTheHeadLags) {
     EXPECT_FALSE(link::decode(p, plain + 4, back));
 }
 
-// The target restarts (its state lost) after `restart_after` answers and
-// announces it.
-class RestartingTarget {
-public:
-    struct Counter {
-        std::uint32_t operator()() const { return 0; }
-    };
-    using Server = link::LinkServer<float, Counter>;
-
-    explicit RestartingTarget(int restart_after)
-        : restart_after_(restart_after), server_(std::make_unique<Server>(1, Counter{})) {}
-
-    void serve(const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
-        for (std::size_t i = 0; i < n; ++i) {
-            if (p[i] == 0U && answers_ == restart_after_) {
-                ++answers_;
-                server_ = std::make_unique<Server>(2, Counter{});
-                server_->announce(reply);
-                continue;
-            }
-            server_->on_byte(p[i], [&](const std::uint8_t* r, std::size_t m) {
-                ++answers_;
-                reply(r, m);
-            });
-        }
-    }
-
-private:
-    int restart_after_;
-    int answers_ = 0;
-    std::unique_ptr<Server> server_;
-};
-
 // On the link: a lagged head's solution without a time has no lagged
 // temperatures (status 8), another head's keeps its thermal stage; a restart
 // while a head lags is an error, since the lag's state is lost with it.
@@ -398,43 +367,6 @@ TEST(LagLink, WhileTheEstimatorRunsItsLagsAreCalibStarts) {
     link::CalibStart back{};
     ASSERT_TRUE(link::decode(p, n, back));
     EXPECT_FALSE(pipeline::any_lagged(back.lag_s));
-}
-
-// The corrected rows of a file, by line: status and quaternion.
-struct Corrected {
-    std::string status;
-    Quaternion<double> q;
-};
-std::map<std::string, Corrected> corrected_of(const fs::path& file) {
-    std::map<std::string, Corrected> out;
-    const std::vector<std::string> lines = lines_of_file(file);
-    for (std::size_t i = 1; i < lines.size(); ++i) {
-        std::vector<std::string> f;
-        std::stringstream ss(lines[i]);
-        for (std::string c; std::getline(ss, c, ',');) {
-            f.push_back(c);
-        }
-        out[f[0] + "," + f[1]] = {f.back(), {std::stod(f[2]), std::stod(f[3]), std::stod(f[4]), std::stod(f[5])}};
-    }
-    return out;
-}
-
-// The largest angle between two corrected files' rows (arcsec); statuses must agree.
-double largest_difference(const fs::path& a, const fs::path& b) {
-    const auto ra = corrected_of(a);
-    const auto rb = corrected_of(b);
-    EXPECT_EQ(ra.size(), rb.size());
-    double worst = 0.0;
-    for (const auto& [key, x] : ra) {
-        const auto it = rb.find(key);
-        if (it == rb.end()) {
-            ADD_FAILURE() << key << " missing from " << b;
-            continue;
-        }
-        EXPECT_EQ(x.status, it->second.status) << key;
-        worst = std::max(worst, angle_arcsec(x.q, it->second.q));
-    }
-    return worst;
 }
 
 // `replay` of a lagged model: the target lags in its scalar, row by row in

@@ -162,6 +162,38 @@ TEST_P(ReplayQemu, LaggedModel) {
               << s.instructions_per_solution << " against " << plain.instructions_per_solution << " without the lag\n";
 }
 
+// A model with a Sun term (issue 40): the board folds each head's term into
+// its thermal stage (SUN_TERM_UPLOAD; the flight form, core/correct.hpp)
+// with the Sun's direction of each epoch, bit for bit as the host's
+// pipeline, within the scalar's bound of the double reference (the
+// contract's form, which the target would miss by the term, 2″ per
+// coefficient, if it left it out). The term runs inside the measured window:
+// the instructions per solution, against the same model without it.
+TEST_P(ReplayQemu, SunTermModel) {
+    const host::QemuTarget& board = GetParam();
+    const auto dir = scratch_dir(scratch_name(board, "_sun"));
+    ASSERT_EQ(run_in("simulate --days 0.004 --step 1 --orbit-term 2 --out s.csv > /dev/null", dir).exit_code, 0);
+    write_truth_models(dir, "900");
+    write_sun_model(dir, "m.csv", "m_sun.csv", 2.0);
+    const auto through = [&](const char* model) {
+        host::ReplayOptions o;
+        o.target = std::string(board.replay);
+        o.in = (dir / "s.csv").string();
+        o.model = (dir / model).string();
+        o.out = (dir / (std::string("out_") + model)).string();
+        std::ostringstream log;
+        return host::replay(o, log);
+    };
+    const host::ReplaySummary plain = through("m.csv");
+    const host::ReplaySummary s = through("m_sun.csv");
+    EXPECT_EQ(s.returned, s.frames);
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, bound_arcsec(board));
+    EXPECT_GT(s.instructions_per_solution, plain.instructions_per_solution);
+    std::cout << board.replay << " Sun term: " << host::to_json(s) << "; instructions per solution "
+              << s.instructions_per_solution << " against " << plain.instructions_per_solution << " without it\n";
+}
+
 // Each test once per board: Boards/ReplayQemu.CleanLink/qemu_m3, ...
 INSTANTIATE_TEST_SUITE_P(Boards, ReplayQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);
 

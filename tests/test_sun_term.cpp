@@ -547,8 +547,8 @@ TEST(SunTermConsumers, ThoseThatDoNotEvaluateItRefuseIt) {
         {"correct --in s.csv --model m.csv --self-calibrate --out c.csv",
          "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
          "model without one"},
-        {"replay --target loopback-float --in s.csv --model m.csv --out c.csv",
-         "the target does not evaluate it yet (correct evaluates it on the ground)"},
+        {"replay --target loopback-float --in s.csv --model m.csv --self-calibrate --out c.csv",
+         "the target's estimator does not learn it (its models have none)"},
         {"simulate --days 0.1 --truth m.csv --out c.csv",
          "a truth model takes none: --orbit-term gives the simulated bench one"},
     };

@@ -19,6 +19,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/fixed_point.hpp"
+#include "ascorr/core/sun_term.hpp"
 #include "ascorr/nav/velocity_service.hpp"
 #include "ascorr/pipeline/temperature_lag.hpp"
 #include "calib_messages.hpp"
@@ -50,6 +51,7 @@ enum class MessageType : std::uint8_t {
     kMountingLoad = 19,        // host → target: one head's mounting and noise, staged or built (v5)
     kCombineRequest = 20,      // host → target: combine the solutions since the last request (v5)
     kCombined = 21,            // target → host: the combined attitude of the bench (v5)
+    kSunTermUpload = 22,       // host → target: one head's Sun term (docs/contract.md, "The Sun term on the link")
 };
 
 enum class AckResult : std::uint8_t {
@@ -78,6 +80,17 @@ struct ModelUpload {
     std::uint8_t head;
     HeadThermalModel<T> model;
     double lag_s = 0.0;
+};
+
+// One head's Sun term (core/sun_term.hpp): S[a][c], rad per unit of ŝ_chu's
+// component c, for the axes alpha, beta, gamma, as 9 words after the head.
+// All 0: the head has no term. A word that is not finite, or an axis whose
+// |S| row sum passes the core's domain (kMaxThermalAngleRad, with room for
+// the words' rounding to T), is a bad payload: the Q30 kernel's range needs it.
+template <typename T>
+struct SunTermUpload {
+    std::uint8_t head;
+    T coefficient[kModelAxes][kSunComponents];
 };
 
 template <typename T>
@@ -176,6 +189,45 @@ bool decode(const std::uint8_t* p, std::size_t n, ModelUpload<T>& m) noexcept {
         return ok;
     }
     return r.f64(m.lag_s) && r.done() && m.lag_s >= pipeline::kMinLagTauS && m.lag_s <= pipeline::kMaxLagTauS;
+}
+
+template <typename T>
+std::size_t encode(const SunTermUpload<T>& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    for (const auto& axis : m.coefficient) {
+        for (const T& c : axis) {
+            w.word(c);
+        }
+    }
+    return w.size();
+}
+// Whether an axis' |S| row sum is within the core's domain; the bound has
+// room for three words each rounded to T from a sum at the domain's edge
+// (a relative 2⁻²⁰ ≫ float's 3·2⁻²⁴ and Q30's 1.5 LSB at 1°).
+template <typename T>
+bool sun_row_in_domain(const T (&row)[kSunComponents]) noexcept {
+    double sum = 0.0;
+    for (const T& c : row) {
+        const double x = ScalarTraits<T>::to_double(c);
+        if (!std::isfinite(x)) {
+            return false;
+        }
+        sum += std::fabs(x);
+    }
+    return sum <= kMaxThermalAngleRad * (1.0 + 0x1p-20);
+}
+template <typename T>
+bool decode(const std::uint8_t* p, std::size_t n, SunTermUpload<T>& m) noexcept {
+    Reader r(p, n);
+    bool ok = r.u8(m.head) && m.head < kMaxHeads;
+    for (auto& axis : m.coefficient) {
+        for (T& c : axis) {
+            ok = ok && r.word(c);
+        }
+        ok = ok && sun_row_in_domain(axis);
+    }
+    return ok && r.done();
 }
 
 template <typename T>

@@ -10,6 +10,11 @@
 //                        head's temperatures go through the lag stage from
 //                        then on, its lag started afresh (pipeline/head_lags.hpp);
 //                        while the estimator runs, the lags stay kCalibStart's
+//   kSunTermUpload     → kAck (kBadPayload for a bad head, length or word, or
+//                        while the estimator runs): the head's Sun term,
+//                        folded into the uploaded model's thermal stage with
+//                        the Sun's direction at each epoch's time (the
+//                        epoch pipeline's stage 1); all 0: none
 //   kVelocityUpdate    → kAck
 //   kTemperatureUpdate → kAck
 //   kStateUpdate       → kAck (the state goes to the velocity service, which
@@ -137,6 +142,13 @@ private:
                     f, sink, [this](const ModelUpload<T>& m) { upload_model(m); },
                     [this](const ModelUpload<T>& m) { return m.lag_s == 0.0 || !pipeline_.calibrating(); });
                 return;
+            case MessageType::kSunTermUpload:
+                // The estimator's models have no Sun term (its feed undoes
+                // the polynomial alone): refused while it runs.
+                update<SunTermUpload<T>>(
+                    f, sink, [this](const SunTermUpload<T>& m) { upload_sun_term(m); },
+                    [this](const SunTermUpload<T>&) { return !pipeline_.calibrating(); });
+                return;
             case MessageType::kVelocityUpdate:
                 // A velocity outside the core's domain (|v| > 1000 km/s, 1/s
                 // outside [1/40, 1/0.6] au⁻¹, non-finite) is refused with
@@ -234,6 +246,23 @@ private:
             (void)lags_.configure(m.head, m.lag_s);
             pipeline_.use_lags(&lags_);
         }
+    }
+
+    // A head's Sun term (decode() checked its domain); the pipeline folds
+    // the terms in only while some head has one.
+    void upload_sun_term(const SunTermUpload<T>& m) noexcept {
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                sun_.coefficient[m.head][a][c] = m.coefficient[a][c];
+            }
+        }
+        sun_.present[m.head] = true;
+        sun_.present[m.head] = has_sun_term(sun_, m.head);
+        bool any = false;
+        for (const bool p : sun_.present) {
+            any = any || p;
+        }
+        pipeline_.use_sun_term(any ? &sun_ : nullptr);
     }
 
     void start_estimator(const CalibStart& m) noexcept {
@@ -443,6 +472,7 @@ private:
     CycleCounter counter_;
     FrameDecoder decoder_;
     ThermalModel<T> model_{};
+    SunTermModel<T> sun_{};         // the uploaded model's Sun terms (kSunTermUpload)
     pipeline::HeadLags<T> lags_{};  // the uploaded model's (use_lags once a head lags)
     ObserverVelocity<T> velocity_{};
     // Catches up to any solution within the horizon in one call (horizon / 10 s + 1 RK4 steps).

@@ -1,5 +1,6 @@
 #include "ascorr_host/formats/model_csv.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -78,6 +79,27 @@ void refuse_sun_term(const ModelFile& m, const std::string& path, const std::str
     if (has_sun_term(m)) {
         throw std::runtime_error(text::input_name(path) +
                                  ": the model has a Sun term (its sun_x, sun_y, sun_z): " + why);
+    }
+}
+
+void refuse_sun_term_beyond_flight_domain(const ModelFile& m, const std::string& path) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
+            const auto& sun = m.sun[h][a];
+            double c[kModelTerms];
+            std::copy(m.coefficients[h][a].begin(), m.coefficients[h][a].end(), c);
+            const double polynomial = float_term_sum(c, 1.0);
+            const double term = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
+            if (term != 0.0 && !(polynomial + term <= kMaxThermalAngleRad * kRadToArcsec)) {
+                throw std::runtime_error(
+                    text::input_name(path) + ":" + std::to_string(m.line[h][a]) + ": head " + head_name(h) + ", " +
+                    kAxisNames[a] + ": the polynomial (up to " + number_text(polynomial) +
+                    " arcsec over temperatures within " + number_text(kMaxAbsTemperatureC) +
+                    " degrees C) and the Sun term (up to " + number_text(term) +
+                    " arcsec) together can pass a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) +
+                    " arcsec, where the target's form of the term skips the stage: the target does not take it");
+            }
+        }
     }
 }
 

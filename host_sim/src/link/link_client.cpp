@@ -86,6 +86,14 @@ void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<
 }
 
 template <typename T>
+void LinkClient<T>::upload_sun_term(const SunTermModel<T>& sun) {
+    sun_ = sun;
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        update(sun_term_message(h));
+    }
+}
+
+template <typename T>
 void LinkClient<T>::set_velocity(const ObserverVelocity<T>& v) {
     if (velocity_ && same(*velocity_, v)) {
         return;
@@ -296,6 +304,11 @@ std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
             s.push_back(model_message(h));
         }
     }
+    if (sun_) {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            s.push_back(sun_term_message(h));
+        }
+    }
     if (velocity_) {
         s.push_back(velocity_message());
     }
@@ -383,6 +396,18 @@ typename LinkClient<T>::Message LinkClient<T>::model_message(std::uint8_t head) 
     const double tau = calibrating_ ? 0.0 : lag_s_[head];
     return {link::MessageType::kModelUpload, encoded(link::ModelUpload<T>{head, model_->head[head], tau}),
             "model upload"};
+}
+
+template <typename T>
+typename LinkClient<T>::Message LinkClient<T>::sun_term_message(std::uint8_t head) const {
+    link::SunTermUpload<T> m{};
+    m.head = head;
+    for (std::size_t a = 0; a < kModelAxes; ++a) {
+        for (std::size_t c = 0; c < kSunComponents; ++c) {
+            m.coefficient[a][c] = sun_->present[head] ? sun_->coefficient[head][a][c] : constant<T>(0.0);
+        }
+    }
+    return {link::MessageType::kSunTermUpload, encoded(m), "Sun term upload"};
 }
 
 template <typename T>

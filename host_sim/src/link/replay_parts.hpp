@@ -102,6 +102,8 @@ template <typename T>
 struct HostSide {
     pipeline::HeadLags<T> lags;                  // the model's, as the target's lag stage
     std::optional<LaggedTemperatures> lagged_d;  // the reference's: `correct`'s lag, in double
+    std::optional<SunTermModel<T>> sun;          // the model's Sun term, as the target holds it
+    std::optional<SunTermModel<double>> sun_d;   // the reference's
     std::optional<SelfCalibration> sc;
     std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
     std::optional<link::LinkEstimator<T>> estimator;  // the link's

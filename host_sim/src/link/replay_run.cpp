@@ -61,9 +61,10 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
         return std::nullopt;
     }
     ModelFile mf = read_model_file(opt.model);
-    refuse_sun_term(mf, opt.model, "the target does not evaluate it yet (correct evaluates it on the ground)");
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
+    refuse_sun_term_beyond_flight_domain(mf, opt.model);
     if (opt.self_calibrate) {
+        refuse_sun_term(mf, opt.model, "the target's estimator does not learn it (its models have none)");
         refuse_other_lag(mf, opt.model, run_lags(opt.lag_s, mf));
         refuse_quadratic_initial_model(mf, opt.model);
     }
@@ -96,6 +97,14 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
         const std::array<double, kMaxHeads> lag_s = mf ? head_lags(*mf) : std::array<double, kMaxHeads>{};
         client.upload_model(model_t, lag_s);
         host.pipeline.use_model(&model_t);
+        // The Sun term, folded into the thermal stage on both sides (the
+        // flight form); the reference applies the contract's form in double.
+        if (mf && has_sun_term(*mf)) {
+            host.sun = sun_term_of<T>(*mf);
+            host.sun_d = sun_term_of<double>(*mf);
+            client.upload_sun_term(*host.sun);
+            host.pipeline.use_sun_term(&*host.sun);
+        }
         (void)host.lags.configure_all(lag_s);  // the model's reader checked each τ
         host.pipeline.use_lags(&host.lags);
         host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));

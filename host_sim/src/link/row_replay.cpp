@@ -12,6 +12,7 @@
 
 #include "ascorr/core/correct.hpp"
 #include "ascorr_host/analysis/combine.hpp"
+#include "ascorr_host/correct/correct_row.hpp"
 #include "ascorr_host/correct/selection.hpp"
 #include "ascorr_host/correct/solution_input.hpp"
 #include "ascorr_host/formats/corrected_csv.hpp"
@@ -79,7 +80,7 @@ public:
     std::size_t costed() const noexcept { return costed_; }
 
 private:
-    static constexpr int kMaxVelocityMessages = 20;  // as the diagnostics of `ascorr correct`
+    static constexpr int kMaxRowMessages = 20;  // of each kind, as the diagnostics of `ascorr correct`
 
     // A row as sent to the target: the core's inputs in its scalar and in
     // double, its time on the on-board clock, where its velocity came from
@@ -128,12 +129,24 @@ private:
         return r;
     }
 
-    // The reference: the same rows and models in double.
-    CorrectedSolution<double> reference(const SolutionRecord& rec, SentRow& s) const {
+    // The reference: the same rows and models in double, the Sun term in the
+    // contract's form (as `ascorr correct`; the target's flight form differs
+    // from it by core/correct.hpp's bound). A row whose Sun term cannot be
+    // evaluated (t outside 2000-2051) is named, as `ascorr correct` names it.
+    CorrectedSolution<double> reference(const SolutionRecord& rec, SentRow& s) {
         const pipeline::VelocityAnswer<double> velocity_d{s.in_d.velocity, s.service_status_d, s.from_states};
-        return pipeline::correct_stage(
+        bool sun_unknown = false;
+        const CorrectedSolution<double> ref = correct_stage_with_sun(
             s.in_d, velocity_d,
-            CorrectionConfig<double>{true, host_.schedule_d ? &host_.schedule_d->at(rec.t) : &model_d_});
+            CorrectionConfig<double>{true, host_.schedule_d ? &host_.schedule_d->at(rec.t) : &model_d_},
+            host_.sun_d ? &*host_.sun_d : nullptr, rec.t, sun_unknown);
+        if (sun_unknown && sun_messages_ < kMaxRowMessages) {
+            ++sun_messages_;
+            log_ << opt_.in << ":" << rec.line
+                 << ": t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot be evaluated: "
+                    "thermal skipped (status 128)\n";
+        }
+        return ref;
     }
 
     // --realtime: the rows at the pace of their times.
@@ -238,7 +251,7 @@ private:
         if (time_unusable && (written & status::kNoVelocity) != 0U) {
             written = static_cast<StatusBits>(written | status::kVelocityInvalid);
         }
-        if (written != got && velocity_messages_ < kMaxVelocityMessages) {
+        if (written != got && velocity_messages_ < kMaxRowMessages) {
             ++velocity_messages_;
             log_ << opt_.in << ":" << rec.line << ": "
                  << (time_unusable ? "t is outside the on-board clock's range: no velocity from the states"
@@ -266,6 +279,7 @@ private:
     double instructions_ = 0.0;
     std::size_t costed_ = 0;
     int velocity_messages_ = 0;
+    int sun_messages_ = 0;
 };
 
 }  // namespace

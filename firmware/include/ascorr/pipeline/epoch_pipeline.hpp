@@ -11,10 +11,16 @@
 //                the whole epoch: a fixed one (use_model), or the one the
 //                on-board estimator holds active (use_estimator; a new model
 //                becomes active here, between epochs, never within one);
+//                with the fixed model's Sun term (use_sun_term), the Sun's
+//                direction at the epoch's time (nav/sun_direction.hpp, in
+//                double, once per epoch, outside the meter as the velocity
+//                service's advance is);
 //   2. velocity  (the caller's source: given_velocity or from_service,
 //                solution_stage.hpp);
 //   3. correction and 4. status (correct_stage(), solution_stage.hpp, then
-//                the caller's own bits: Calls::status);
+//                the caller's own bits: Calls::status); with a Sun term, the
+//                core's flight form (correct_solution(in, cfg, sun),
+//                core/correct.hpp), the term folded into its thermal stage;
 //   5. estimator feed: the first clean, usable solution of each of the
 //                calibrated heads is kept; when A, B and C are there and the
 //                epoch is one the schedule feeds (every feed_every-th), they
@@ -41,6 +47,8 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 #include "../calib/estimator.hpp"
 #include "../calib/feed.hpp"
@@ -48,6 +56,9 @@
 #include "../combine/combiner.hpp"
 #include "../combine/usable.hpp"
 #include "../core/correct.hpp"
+#include "../core/sun_term.hpp"
+#include "../nav/sun_direction.hpp"
+#include "../nav/tt_time.hpp"
 #include "head_lags.hpp"
 #include "solution_stage.hpp"
 
@@ -68,6 +79,10 @@ struct InlineCalls {
     }
     static CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) noexcept {
         return correct_solution(in, cfg);
+    }
+    static CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                        const SunTermInput<T>& sun) noexcept {
+        return correct_solution(in, cfg, sun);
     }
     template <std::size_t N>
     static bool feed(calib::Estimator<T, N>& e, std::int64_t t_us, const ThermalModel<T>* model,
@@ -91,6 +106,17 @@ struct InlineCalls {
     // The caller's own status bits for head `head` (none here).
     static StatusBits status(std::uint8_t /*head*/, StatusBits s) noexcept { return s; }
 };
+
+// Whether Calls has the core's flight form with a Sun term
+// (Calls::correct(in, cfg, sun)): a pipeline whose Calls has none (the flight
+// loop's, which does not evaluate the term yet) compiles without its stage.
+template <typename Calls, typename T, typename = void>
+struct TakesSunTerm : std::false_type {};
+template <typename Calls, typename T>
+struct TakesSunTerm<Calls, T,
+                    std::void_t<decltype(Calls::correct(std::declval<const SolutionInput<T>&>(),
+                                                        std::declval<const CorrectionConfig<T>&>(),
+                                                        std::declval<const SunTermInput<T>&>()))>> : std::true_type {};
 
 // Which epochs feed the estimator, and how much of its per-orbit update runs
 // right after a feed (the rest: idle()).
@@ -128,6 +154,19 @@ public:
 
     bool calibrating() const noexcept { return estimator_ != nullptr; }
 
+    // The fixed model's Sun term (nullptr: none; keep_present_where_terms
+    // holds, and the coefficients are within the term's domain, as the
+    // link's decode checks), folded into the thermal stage of the heads that
+    // have one while the model is the fixed one (the estimator's models have
+    // none). The Sun's direction is that of the current epoch's time, if any.
+    void use_sun_term(const SunTermModel<T>* sun) noexcept {
+        static_assert(kTakesSunTerm, "Calls::correct(in, cfg, sun) evaluates the term");
+        sun_ = sun;
+        if (have_epoch_) {
+            form_sun_direction();
+        }
+    }
+
     // Stage 0's lags (nullptr, or none of its heads lagging: no lag stage;
     // call again after configuring them).
     void use_lags(HeadLags<T>* lags) noexcept { lags_ = lags != nullptr && lags->any() ? lags : nullptr; }
@@ -135,10 +174,11 @@ public:
     // Whether a solution of `head` goes through an epoch (begin(), then
     // solution()) or, with no time (`timed` false), untimed_solution(): a
     // solution with no time belongs to no epoch while calibrating, nor when
-    // its head lags (it has no lagged temperatures); otherwise it takes the
-    // fixed model in the epoch its caller gives it.
+    // its head lags (it has no lagged temperatures), nor while a Sun term
+    // is folded in (it has no Sun direction: 128 where its head has a term);
+    // otherwise it takes the fixed model in the epoch its caller gives it.
     bool in_epoch(std::uint8_t head, bool timed) const noexcept {
-        return timed || (!calibrating() && (lags_ == nullptr || !lags_->lags(head)));
+        return timed || (!calibrating() && (lags_ == nullptr || !lags_->lags(head)) && !sun_folded());
     }
 
     // Stage 6's combiner (nullptr: no combination); forgets the solutions
@@ -190,6 +230,7 @@ public:
         have_epoch_ = true;
         t_us_ = t_us;
         kept_ = 0U;
+        form_sun_direction();
         if (estimator_ == nullptr) {
             model_ = fixed_;
             return model_;
@@ -234,7 +275,7 @@ public:
         take_velocity(in, v);
         const CorrectionConfig<T> cfg = config(aberration);
         start = meter.now();
-        CorrectedSolution<T> c = Calls::correct(in, cfg);
+        CorrectedSolution<T> c = correct(in, cfg, sun_known_);
         meter.add(Stage::kCorrect, start);
         c.status = Calls::status(in.head, status_stage(c.status, v, cfg.aberration));
         if (estimator_ != nullptr && clean) {
@@ -261,7 +302,7 @@ public:
             lags_->without_time(in.head, in.temperatures);
         }
         const CorrectionConfig<T> cfg{aberration, estimator_ != nullptr ? &kNoModel : fixed_};
-        CorrectedSolution<T> c = correct_stage(in, velocity(), cfg, CallsCorrect{});
+        CorrectedSolution<T> c = correct_stage(in, velocity(), cfg, CallsCorrect{this});
         c.status = Calls::status(in.head, c.status);
         return c;
     }
@@ -278,9 +319,38 @@ public:
     }
 
 private:
+    static constexpr bool kTakesSunTerm = TakesSunTerm<Calls, T>::value;
+
+    // Whether the fixed model's Sun term is folded in (never without kTakesSunTerm).
+    bool sun_folded() const noexcept { return kTakesSunTerm && sun_ != nullptr && estimator_ == nullptr; }
+
+    // Stage 3: the core, or its flight form where the fixed model has a Sun
+    // term; known: ŝ is the epoch's (a solution in no epoch has none: a head
+    // with a term then gets 128, as the contract's form gives it).
+    CorrectedSolution<T> correct(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                 bool known) const noexcept {
+        if constexpr (kTakesSunTerm) {
+            if (sun_folded()) {
+                return Calls::correct(in, cfg, SunTermInput<T>{sun_, sun_s_, known});
+            }
+        }
+        return Calls::correct(in, cfg);
+    }
+
+    // Stage 1's Sun direction at t_us_, in T; none outside its span.
+    void form_sun_direction() noexcept {
+        if constexpr (kTakesSunTerm) {
+            Vector3<double> s{};
+            sun_known_ = sun_ != nullptr && nav::sun_direction_icrf(tt_seconds(TtTime{t_us_}), s);
+            using S = ScalarTraits<T>;
+            sun_s_ = {S::from_double(s.x), S::from_double(s.y), S::from_double(s.z)};
+        }
+    }
+
     struct CallsCorrect {
+        const EpochPipeline* pipeline;
         CorrectedSolution<T> operator()(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg) const noexcept {
-            return Calls::correct(in, cfg);
+            return pipeline->correct(in, cfg, false);
         }
     };
 
@@ -380,6 +450,11 @@ private:
     combine::HeadAttitude<T> combined_[kCombineSlots]{};
     std::uint8_t combined_n_ = 0U;
     bool overflow_ = false;
+    // Last, so that a Calls without the Sun term (the flight loop's) keeps
+    // the other members' offsets, hence its code.
+    const SunTermModel<T>* sun_ = nullptr;
+    Vector3<T> sun_s_{};      // the Sun's direction at t_us_ (use_sun_term)
+    bool sun_known_ = false;  // sun_s_ was formed
 };
 
 }  // namespace ascorr::pipeline

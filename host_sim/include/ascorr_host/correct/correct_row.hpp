@@ -18,6 +18,7 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/sun_term.hpp"
+#include "ascorr/pipeline/solution_stage.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
 #include "ascorr_host/formats/solutions_csv.hpp"
@@ -47,6 +48,21 @@ struct RowSunTerm {
     Vector3<double> s_icrf{};
 };
 RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status, std::uint8_t head, double t);
+
+// correct_stage() (pipeline/solution_stage.hpp) with the contract's Sun term
+// (docs/contract.md, "The Sun term"; sun nullptr: none) of head in.head at
+// t, in T: where the thermal stage applied, the core's result turned by the
+// term (T float and Q30: the head's coefficients and ŝ rounded to T once);
+// where ŝ is unknown, the stage undone (the aberration's result) and 128,
+// sun_unknown set. For correct_row and replay's double reference alike.
+template <typename T>
+CorrectedSolution<T> correct_stage_with_sun(SolutionInput<T>& in, const pipeline::VelocityAnswer<T>& v,
+                                            const CorrectionConfig<T>& cfg, const SunTermModel<double>* sun, double t,
+                                            bool& sun_unknown);
+extern template CorrectedSolution<double> correct_stage_with_sun(SolutionInput<double>&,
+                                                                 const pipeline::VelocityAnswer<double>&,
+                                                                 const CorrectionConfig<double>&,
+                                                                 const SunTermModel<double>*, double, bool&);
 
 // earth: used when the aberration stage is on (cfg.aberration) and the row
 // has its velocity; states: nullptr without --states (one per thread: it

@@ -116,6 +116,12 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun);
 // Throws (naming the model's file, then `why`) when the model has a Sun
 // term: for the consumers that do not evaluate it yet.
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why);
+// Throws (naming the file, line, head and axis) where a head's polynomial
+// and Sun term together can pass a thermal angle's ±1° at temperatures the
+// core accepts (its terms' largest sum, float_term_sum(), plus |sun_x| +
+// |sun_y| + |sun_z|): there the target's flight form skips the stage (128)
+// while the contract's form applies both rotations. For the link's loader.
+void refuse_sun_term_beyond_flight_domain(const ModelFile& m, const std::string& path);
 // Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
 inline constexpr const char* kSunTermNotLearnt =
     "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
@@ -128,7 +134,7 @@ SunTermModel<T> sun_term_of(const ModelFile& m) {
         out.present[h] = m.present[h];
         for (std::size_t a = 0; a < kModelAxes; ++a) {
             for (std::size_t c = 0; c < kSunComponents; ++c) {
-                out.coefficient[h][a][c] = static_cast<T>(m.sun[h][a][c] * kArcsecToRad);
+                out.coefficient[h][a][c] = ScalarTraits<T>::from_double(m.sun[h][a][c] * kArcsecToRad);
             }
         }
     }

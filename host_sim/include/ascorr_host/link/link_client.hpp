@@ -73,6 +73,10 @@ public:
     // once a lagged head's timed solution was sent is an error (restore()
     // refuses it): the lag's state is lost with it.
     void upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s = {});
+    // The uploaded model's Sun terms (SUN_TERM_UPLOAD), every head (one
+    // without a term as 0: none); restored after a restart with the model.
+    // The target refuses them while its estimator runs.
+    void upload_sun_term(const SunTermModel<T>& sun);
     void set_velocity(const ObserverVelocity<T>& v);
     void set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t);
 
@@ -166,6 +170,7 @@ private:
     bool answer_shows_restart(const link::SolutionOut<T>& out) const;
 
     Message model_message(std::uint8_t head) const;
+    Message sun_term_message(std::uint8_t head) const;
     Message velocity_message() const;
     Message state_message(const link::StateUpdate& s) const;
     Message service_message() const;
@@ -181,6 +186,7 @@ private:
     std::uint32_t boot_id_ = 0;
     std::optional<ThermalModel<T>> model_;
     std::array<double, kMaxHeads> lag_s_{};  // upload_model()'s
+    std::optional<SunTermModel<T>> sun_;     // upload_sun_term()'s
     std::uint8_t lagging_ = kUnknownHead;    // a lagged head whose timed solution was sent
     std::optional<ObserverVelocity<T>> velocity_;
     std::optional<std::int64_t> horizon_us_;  // set_service_horizon()
