@@ -1,5 +1,6 @@
 // tests/corrected_files.hpp: two corrected files (docs/contract.md,
-// "Corrected file") compared row by row.
+// "Corrected file") compared row by row, and a replay on the loopback target
+// compared with `ascorr correct`.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -7,11 +8,13 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <ostream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "ascorr/core/quaternion.hpp"
+#include "ascorr_host/link/replay.hpp"
 #include "cli_run.hpp"
 #include "test_support.hpp"
 
@@ -52,6 +55,34 @@ inline double largest_difference(const std::filesystem::path& a, const std::file
         worst = std::max(worst, angle_arcsec(x.q, it->second.q));
     }
     return worst;
+}
+
+// dir/s.csv replayed on the loopback target (float) with dir/`model` into
+// dir/r.csv, and corrected by `ascorr correct` with it (dir/c.csv) and with
+// dir/m.csv (c0.csv: what `model` adds left out): every answer back, bit for
+// bit as the host's pipeline, within the float bound of the replay tests
+// (0.05″) of the double reference and of correct's file, every status the
+// same; the mutation check: c.csv and c0.csv more than ten bounds apart.
+// Returns the replay's summary; prints it as `what`.
+inline host::ReplaySummary expect_replay_as_correct(const std::filesystem::path& dir, const std::string& model,
+                                                    const std::string& what) {
+    EXPECT_EQ(run_in("correct --in s.csv --model " + model + " --out c.csv > /dev/null 2>&1", dir).exit_code, 0);
+    EXPECT_EQ(run_in("correct --in s.csv --model m.csv --out c0.csv > /dev/null 2>&1", dir).exit_code, 0);
+    host::ReplayOptions o;
+    o.target = "loopback-float";
+    o.in = (dir / "s.csv").string();
+    o.model = (dir / model).string();
+    o.out = (dir / "r.csv").string();
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay(o, log);
+    EXPECT_EQ(s.returned, s.frames);
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, 0.05);
+    const double against_correct = largest_difference(dir / "r.csv", dir / "c.csv");
+    EXPECT_LE(against_correct, 0.05);
+    EXPECT_GT(largest_difference(dir / "c.csv", dir / "c0.csv"), 10 * 0.05);
+    std::cout << what << " replayed against correct: " << against_correct << " arcsec; " << host::to_json(s) << "\n";
+    return s;
 }
 
 }  // namespace ascorr::test

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -130,6 +131,32 @@ TEST_P(ReplayQemu, RestartMidRunIsRecovered) {
     });
 }
 
+// The mission dir/s.csv through the board with dir/`model` (and, first, with
+// dir/m.csv, the same model without what `model` adds): every answer back,
+// bit for bit as the host's pipeline, within the scalar's bound of the double
+// reference, and dearer than without (the addition runs inside the measured
+// window), printed as `what`.
+void expect_dearer_than_plain(const host::QemuTarget& board, const std::filesystem::path& dir, const char* model,
+                              const std::string& what) {
+    const auto through = [&](const char* m) {
+        host::ReplayOptions o;
+        o.target = std::string(board.replay);
+        o.in = (dir / "s.csv").string();
+        o.model = (dir / m).string();
+        o.out = (dir / (std::string("out_") + m)).string();
+        std::ostringstream log;
+        return host::replay(o, log);
+    };
+    const host::ReplaySummary plain = through("m.csv");
+    const host::ReplaySummary s = through(model);
+    EXPECT_EQ(s.returned, s.frames);
+    EXPECT_EQ(s.mismatches, 0U);
+    EXPECT_LE(s.max_error_arcsec, bound_arcsec(board));
+    EXPECT_GT(s.instructions_per_solution, plain.instructions_per_solution);
+    std::cout << board.replay << " " << what << ": " << host::to_json(s) << "; instructions per solution "
+              << s.instructions_per_solution << " against " << plain.instructions_per_solution << " without it\n";
+}
+
 // A lagged model (issue 40): the board lags each head's temperatures in its
 // scalar (MODEL_UPLOAD's τ; pipeline/head_lags.hpp), bit for bit as the
 // host's pipeline, within the scalar's bound of the double reference (which
@@ -143,23 +170,7 @@ TEST_P(ReplayQemu, LaggedModel) {
     const auto dir = scratch_dir(scratch_name(board, "_lag"));
     ASSERT_EQ(run_in("simulate --days 0.004 --step 1 --bench-lag 900 --out s.csv > /dev/null", dir).exit_code, 0);
     write_truth_models(dir, "900");
-    const auto through = [&](const char* model) {
-        host::ReplayOptions o;
-        o.target = std::string(board.replay);
-        o.in = (dir / "s.csv").string();
-        o.model = (dir / model).string();
-        o.out = (dir / (std::string("out_") + model)).string();
-        std::ostringstream log;
-        return host::replay(o, log);
-    };
-    const host::ReplaySummary plain = through("m.csv");
-    const host::ReplaySummary s = through("m_lag.csv");
-    EXPECT_EQ(s.returned, s.frames);
-    EXPECT_EQ(s.mismatches, 0U);
-    EXPECT_LE(s.max_error_arcsec, bound_arcsec(board));
-    EXPECT_GT(s.instructions_per_solution, plain.instructions_per_solution);
-    std::cout << board.replay << " lagged model: " << host::to_json(s) << "; instructions per solution "
-              << s.instructions_per_solution << " against " << plain.instructions_per_solution << " without the lag\n";
+    expect_dearer_than_plain(board, dir, "m_lag.csv", "lagged model");
 }
 
 // A model with a Sun term (issue 40): the board folds each head's term into
@@ -167,31 +178,14 @@ TEST_P(ReplayQemu, LaggedModel) {
 // with the Sun's direction of each epoch, bit for bit as the host's
 // pipeline, within the scalar's bound of the double reference (the
 // contract's form, which the target would miss by the term, 2″ per
-// coefficient, if it left it out). The term runs inside the measured window:
-// the instructions per solution, against the same model without it.
+// coefficient, if it left it out), against the same model without it.
 TEST_P(ReplayQemu, SunTermModel) {
     const host::QemuTarget& board = GetParam();
     const auto dir = scratch_dir(scratch_name(board, "_sun"));
     ASSERT_EQ(run_in("simulate --days 0.004 --step 1 --orbit-term 2 --out s.csv > /dev/null", dir).exit_code, 0);
     write_truth_models(dir, "900");
     write_sun_model(dir, "m.csv", "m_sun.csv", 2.0);
-    const auto through = [&](const char* model) {
-        host::ReplayOptions o;
-        o.target = std::string(board.replay);
-        o.in = (dir / "s.csv").string();
-        o.model = (dir / model).string();
-        o.out = (dir / (std::string("out_") + model)).string();
-        std::ostringstream log;
-        return host::replay(o, log);
-    };
-    const host::ReplaySummary plain = through("m.csv");
-    const host::ReplaySummary s = through("m_sun.csv");
-    EXPECT_EQ(s.returned, s.frames);
-    EXPECT_EQ(s.mismatches, 0U);
-    EXPECT_LE(s.max_error_arcsec, bound_arcsec(board));
-    EXPECT_GT(s.instructions_per_solution, plain.instructions_per_solution);
-    std::cout << board.replay << " Sun term: " << host::to_json(s) << "; instructions per solution "
-              << s.instructions_per_solution << " against " << plain.instructions_per_solution << " without it\n";
+    expect_dearer_than_plain(board, dir, "m_sun.csv", "Sun term");
 }
 
 // Each test once per board: Boards/ReplayQemu.CleanLink/qemu_m3, ...
