@@ -116,11 +116,12 @@ bool same(const CorrectedSolution<float>& want, const link::SolutionOut<float>& 
 
 // The target's answers, head by head: a head with a term takes the flight
 // form at the epoch's Sun, bit for bit (and differs from the core without
-// it: the mutation check); a head without one the core's bytes; a solution
-// with no time, or at a time outside the Sun's span (2052), 128 with the
-// aberration alone; an all-zero upload ends the term. A restart (here at the
-// first solution) restores the terms with the model. While the estimator
-// runs an upload is refused.
+// it: the mutation check); a head without one the core's bytes, with or
+// without a time; a solution of a head with a term with no time, or at a
+// time outside the Sun's span (2052), 128 with the aberration alone; an
+// all-zero upload ends the term, and so does a MODEL_UPLOAD. A restart (here
+// at the first solution) restores the terms with the model. While the
+// estimator runs an upload is refused.
 TEST(SunLink, TheTargetFoldsTheTermIntoEachEpochAndNeedsItsTime) {
     const host::ModelFile mf = model_file("m_sun.csv");
     const ThermalModel<float> model = host::to_core<float>(mf);
@@ -160,8 +161,11 @@ TEST(SunLink, TheTargetFoldsTheTermIntoEachEpochAndNeedsItsTime) {
     EXPECT_TRUE(same(flight_form(in, model, sun, t_2025), a));
     EXPECT_EQ(a.status, status::kAberrationApplied | status::kThermalApplied);
     EXPECT_GT(angle_arcsec(in_double(a.q_chu_icrf), in_double(plain_a.q_chu_icrf)), 0.5);
-    const link::SolutionOut<float> b = answer(1, t_2025);
-    EXPECT_TRUE(same(correct_solution(in, CorrectionConfig<float>{true, &model}), b));
+    for (const std::int64_t t_us : {t_2025, std::int64_t{0}}) {  // a head without a term needs no time
+        const link::SolutionOut<float> b = answer(1, t_us);
+        EXPECT_TRUE(same(correct_solution(in, CorrectionConfig<float>{true, &model}), b)) << t_us;
+        EXPECT_EQ(b.status, status::kAberrationApplied | status::kThermalApplied) << t_us;
+    }
     for (const std::int64_t unknown : {std::int64_t{0}, t_2052}) {
         const link::SolutionOut<float> u = answer(0, unknown);
         EXPECT_EQ(u.status, status::kAberrationApplied | status::kThermalOutOfRange) << unknown;
@@ -169,6 +173,11 @@ TEST(SunLink, TheTargetFoldsTheTermIntoEachEpochAndNeedsItsTime) {
     }
     client.upload_sun_term(SunTermModel<float>{});
     EXPECT_TRUE(same(plain_a, answer(0, t_2025 + 1'000'000)));
+    // A model ends its heads' terms: the next SUN_TERM_UPLOAD gives the new one's.
+    client.upload_sun_term(sun);
+    EXPECT_TRUE(same(flight_form(in, model, sun, t_2025 + 2'000'000), answer(0, t_2025 + 2'000'000)));
+    client.upload_model(model);
+    EXPECT_TRUE(same(plain_a, answer(0, t_2025 + 3'000'000)));
     client.start_calibration(5'700'000'000, 30.0, nullptr);
     EXPECT_THROW(client.upload_sun_term(sun), host::LinkError);
 }
@@ -187,28 +196,34 @@ TEST(ReplaySun, TheLoopbackTargetAnswersAsCorrectDoesWithinItsBound) {
 // ±1° at temperatures the core accepts is refused before the target sees it
 // (where the flight form would skip the stage and the contract's form apply
 // both rotations), naming the file, line, head and axis; at 1° it is taken,
-// and so is a head without a term. `correct` takes every one of them.
-TEST(ReplaySun, AModelWhoseTermCanPassTheDomainIsRefused) {
+// and so is an axis without a term. So is a term that rounds to 0 in the
+// target's scalar (which would take it as none: no 128 where `correct` gives
+// it). `correct` takes every one of them.
+TEST(ReplaySun, AModelTheTargetWouldEvaluateOtherwiseIsRefused) {
     const fs::path& dir = mission();
-    // c1 = 17.5″/°C: 3500″ at 200 °C, plus a 200″ Sun term on A's alpha.
-    const auto model = [&](const char* c1, const char* sun) {
+    // Head A's alpha: c1 (3500″ at 200 °C for 17.5″/°C) and its Sun term; the
+    // other rows a term of 0.75″ and a polynomial of 20″.
+    const auto model = [&](const char* c1, const char* sun, const char* b_sun = "0.5,0.25,0") {
         std::string text = "chu,axis,c0,c1,c2,c3,sun_x,sun_y,sun_z\n";
         for (const char* h : {"A", "B", "C"}) {
             for (const char* a : {"alpha", "beta", "gamma"}) {
                 const bool edge = std::string(h) == "A" && std::string(a) == "alpha";
-                text += std::string(h) + "," + a + ",0," + (edge ? c1 : "0.1") + ",0,0," + (edge ? sun : "0.5") +
-                        ",0.25,0\n";
+                const char* term = edge ? sun : std::string(h) == "B" ? b_sun : "0.5,0.25,0";
+                text += std::string(h) + "," + a + ",0," + (edge ? c1 : "0.1") + ",0,0," + term + "\n";
             }
         }
         return text;
     };
-    write(dir / "big.csv", model("17.5", "200"));
-    write(dir / "edge.csv", model("17", "199.75"));
-    write(dir / "none.csv", model("17.5", "0"));
+    write(dir / "big.csv", model("17.5", "200,0.25,0"));
+    write(dir / "edge.csv", model("17", "199.75,0.25,0"));
+    write(dir / "none.csv", model("18.5", "0,0,0"));
+    write(dir / "tiny.csv", model("0.1", "0.5,0.25,0", "1e-40,0,0"));
     const CliRun refused = run_in("replay --target loopback-float --in s.csv --model big.csv --out rb.csv", dir);
     expect_refused(refused, 1,
-                   {"big.csv:2: head A, alpha: the polynomial (up to 3500 arcsec over temperatures within 200 degrees "
+                   {"big.csv:2:1: A alpha: the polynomial (up to 3500 arcsec over temperatures within 200 degrees "
                     "C) and the Sun term (up to 200.25 arcsec) together can pass a thermal angle's 3600 arcsec"});
+    const CliRun tiny = run_in("replay --target loopback-float --in s.csv --model tiny.csv --out rb.csv", dir);
+    expect_refused(tiny, 1, {"tiny.csv:5:1: B alpha: the Sun term rounds to 0 in the target's scalar"});
     expect_absent(dir, {"rb.csv"});
     for (const char* taken : {"edge.csv", "none.csv"}) {
         const CliRun r = run_in(std::string("replay --target loopback-float --in s.csv --model ") + taken +
@@ -216,7 +231,13 @@ TEST(ReplaySun, AModelWhoseTermCanPassTheDomainIsRefused) {
                                 dir);
         EXPECT_EQ(r.exit_code, 0) << taken << ": " << r.err;
     }
-    EXPECT_EQ(run_in("correct --in s.csv --model big.csv --out cb.csv > /dev/null 2>&1", dir).exit_code, 0);
+    for (const char* model_file : {"big.csv", "tiny.csv"}) {
+        EXPECT_EQ(
+            run_in(std::string("correct --in s.csv --model ") + model_file + " --out cb.csv > /dev/null 2>&1", dir)
+                .exit_code,
+            0)
+            << model_file;
+    }
 }
 
 }  // namespace

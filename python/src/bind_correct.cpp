@@ -63,9 +63,9 @@ void correct_rows(const Rows& r, const host::ModelFile* m, bool aberration, cons
         model = host::to_core<T>(*m);
     }
     // In the core's scalar (host::correct_row).
-    const std::optional<SunTermModel<double>> sun = host::sun_term_if_any(m);
+    const std::optional<SunTermModel<T>> sun = host::sun_term_if_any<T>(m);
     const CorrectionConfig<T> cfg{aberration, model ? &*model : nullptr};
-    const SunTermModel<double>* sun_term = sun ? &*sun : nullptr;
+    const SunTermModel<T>* sun_term = sun ? &*sun : nullptr;
     py::gil_scoped_release unlocked;
     const std::optional<host::StatesVelocityTable<T>> table = states != nullptr && aberration
                                                                   ? velocity_table<T>(r, *states, max_propagation_s)

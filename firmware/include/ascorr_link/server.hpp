@@ -9,7 +9,9 @@
 //                        a lag while the estimator runs); with a lag τ, the
 //                        head's temperatures go through the lag stage from
 //                        then on, its lag started afresh (pipeline/head_lags.hpp);
-//                        while the estimator runs, the lags stay kCalibStart's
+//                        while the estimator runs, the lags stay kCalibStart's;
+//                        the head's Sun term ends (kSunTermUpload gives the
+//                        new model's)
 //   kSunTermUpload     → kAck (kBadPayload for a bad head, length or word, or
 //                        while the estimator runs): the head's Sun term,
 //                        folded into the uploaded model's thermal stage with
@@ -146,7 +148,7 @@ private:
                 // The estimator's models have no Sun term (its feed undoes
                 // the polynomial alone): refused while it runs.
                 update<SunTermUpload<T>>(
-                    f, sink, [this](const SunTermUpload<T>& m) { upload_sun_term(m); },
+                    f, sink, [this](const SunTermUpload<T>& m) { set_sun_term(m.head, m.coefficient); },
                     [this](const SunTermUpload<T>&) { return !pipeline_.calibrating(); });
                 return;
             case MessageType::kVelocityUpdate:
@@ -240,29 +242,35 @@ private:
     // A head's model and lag (decode() checked τ's range); the lag stage
     // runs only while some head lags. While the estimator runs the model
     // waits for a restart, and the lags are its own (start_estimator).
+    // A model ends its head's Sun term (a SUN_TERM_UPLOAD after it gives the
+    // new model's), so that no term outlives the model it was uploaded with.
     void upload_model(const ModelUpload<T>& m) noexcept {
         model_.head[m.head] = m.model;
+        set_sun_term(m.head, SunTermUpload<T>{}.coefficient);
         if (!pipeline_.calibrating()) {
             (void)lags_.configure(m.head, m.lag_s);
             pipeline_.use_lags(&lags_);
         }
     }
 
-    // A head's Sun term (decode() checked its domain); the pipeline folds
-    // the terms in only while some head has one.
-    void upload_sun_term(const SunTermUpload<T>& m) noexcept {
+    // Head h's Sun term (decode() checked its domain; all 0: none); the
+    // pipeline folds the terms in only while some head has one.
+    void set_sun_term(std::uint8_t h, const T (&coefficient)[kModelAxes][kSunComponents]) noexcept {
         for (std::size_t a = 0; a < kModelAxes; ++a) {
             for (std::size_t c = 0; c < kSunComponents; ++c) {
-                sun_.coefficient[m.head][a][c] = m.coefficient[a][c];
+                sun_.coefficient[h][a][c] = coefficient[a][c];
             }
         }
-        sun_.present[m.head] = true;
-        sun_.present[m.head] = has_sun_term(sun_, m.head);
+        sun_.present[h] = true;
+        sun_.present[h] = has_sun_term(sun_, h);
+        pipeline_.use_sun_term(any_sun_term() ? &sun_ : nullptr);
+    }
+    bool any_sun_term() const noexcept {
         bool any = false;
         for (const bool p : sun_.present) {
             any = any || p;
         }
-        pipeline_.use_sun_term(any ? &sun_ : nullptr);
+        return any;
     }
 
     void start_estimator(const CalibStart& m) noexcept {

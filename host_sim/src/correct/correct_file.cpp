@@ -103,9 +103,7 @@ void explain(const SolutionRecord& rec, const RowCorrection<T>& row, StatusBits 
                         ", t_032=" + number_text(rec.temperature[2]) + "): thermal skipped");
     }
     if (row.sun_unknown) {
-        diag.report("thermal out of range", where(file, rec) +
-                                                "t outside the Sun ephemeris' span (2000-2051): the model's Sun "
-                                                "term cannot be evaluated: thermal skipped (status 128)");
+        diag.report("thermal out of range", where(file, rec) + kSunUnknownText);
     } else if ((st & status::kThermalOutOfRange) != 0U) {
         diag.report("thermal out of range",
                     where(file, rec) + "model angle beyond 1 degree for these temperatures: thermal skipped");
@@ -151,7 +149,7 @@ struct Job {
     const ModelSchedule<T>* schedule;     // --self-calibrate; nullptr: cfg's model for every row
     const LaggedTemperatures* lag;        // the model's lagged heads; nullptr: none
     const LagSchedule* learnt_lag;        // --lag auto: the lag the self-calibration took; nullptr: none
-    const SunTermModel<double>* sun;      // the model's Sun term; nullptr: none
+    const SunTermModel<T>* sun;           // the model's Sun term; nullptr: none
     bool keep_rows;                       // a sink takes the corrected rows
 };
 
@@ -167,7 +165,7 @@ CorrectionConfig<T> config_at(const Job<T>& job, double t) {
 
 // The Sun term of one row: with a schedule, that of the model active at its t.
 template <typename T>
-const SunTermModel<double>* sun_at(const Job<T>& job, double t) {
+const SunTermModel<T>* sun_at(const Job<T>& job, double t) {
     return job.schedule != nullptr ? job.schedule->sun_at(t) : job.sun;
 }
 
@@ -592,7 +590,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
     // (Refused with --self-calibrate and with the scalars but double: read_model.)
-    const std::optional<SunTermModel<double>> sun = sun_term_if_any(model_file);
+    const std::optional<SunTermModel<T>> sun = sun_term_if_any<T>(model_file);
     const Job<T> job{opt,
                      cfg,
                      header,

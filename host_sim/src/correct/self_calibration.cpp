@@ -677,7 +677,7 @@ ModelSchedule<T>::ModelSchedule(const std::vector<ActiveModel>& history) : model
         from_us_.push_back(a.t_us);
         version_.push_back(a.version);
         model_.push_back(to_core<T>(a.model));
-        sun_.push_back(sun_term_if_any(&a.model));
+        sun_.push_back(sun_term_if_any<T>(&a.model));
     }
 }
 
@@ -696,7 +696,7 @@ const ThermalModel<T>& ModelSchedule<T>::at(double t) const noexcept {
 }
 
 template <typename T>
-const SunTermModel<double>* ModelSchedule<T>::sun_at(double t) const noexcept {
+const SunTermModel<T>* ModelSchedule<T>::sun_at(double t) const noexcept {
     const std::size_t k = index_at(t);
     return k == 0 || !sun_[k - 1] ? nullptr : &*sun_[k - 1];
 }

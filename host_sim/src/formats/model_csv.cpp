@@ -75,6 +75,27 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun) {
     return {};
 }
 
+namespace {
+
+// float_term_sum() of head h's axis a, arcsec.
+double axis_term_sum_arcsec(const ModelFile& m, std::uint8_t h, std::size_t a) {
+    double c[kModelTerms];
+    std::copy(m.coefficients[h][a].begin(), m.coefficients[h][a].end(), c);
+    return float_term_sum(c, 1.0);
+}
+
+// Throws `what` of head h's axis a, at its line of m's file when it has one.
+[[noreturn]] void refuse_axis(const ModelFile& m, const std::string& path, std::uint8_t h, std::size_t a,
+                              const std::string& what) {
+    const std::string where = std::string(1, head_name(h)) + " " + kAxisNames[a] + ": ";
+    if (m.line[h][a] != 0) {
+        throw text::InputError(path, m.line[h][a], 1, where + what);
+    }
+    throw std::runtime_error(text::input_name(path) + ": " + where + what);
+}
+
+}  // namespace
+
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why) {
     if (has_sun_term(m)) {
         throw std::runtime_error(text::input_name(path) +
@@ -82,23 +103,30 @@ void refuse_sun_term(const ModelFile& m, const std::string& path, const std::str
     }
 }
 
-void refuse_sun_term_beyond_flight_domain(const ModelFile& m, const std::string& path) {
+void refuse_sun_term_for_link(const ModelFile& m, const std::string& path,
+                              const bool (&has_term_in_scalar)[kMaxHeads]) {
+    const double limit = kMaxThermalAngleRad * kRadToArcsec;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        bool any = false;
         for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
             const auto& sun = m.sun[h][a];
-            double c[kModelTerms];
-            std::copy(m.coefficients[h][a].begin(), m.coefficients[h][a].end(), c);
-            const double polynomial = float_term_sum(c, 1.0);
+            const double polynomial = axis_term_sum_arcsec(m, h, a);
             const double term = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
-            if (term != 0.0 && !(polynomial + term <= kMaxThermalAngleRad * kRadToArcsec)) {
-                throw std::runtime_error(
-                    text::input_name(path) + ":" + std::to_string(m.line[h][a]) + ": head " + head_name(h) + ", " +
-                    kAxisNames[a] + ": the polynomial (up to " + number_text(polynomial) +
-                    " arcsec over temperatures within " + number_text(kMaxAbsTemperatureC) +
-                    " degrees C) and the Sun term (up to " + number_text(term) +
-                    " arcsec) together can pass a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) +
-                    " arcsec, where the target's form of the term skips the stage: the target does not take it");
+            any = any || term != 0.0;
+            if (term != 0.0 && !(polynomial + term <= limit)) {
+                refuse_axis(m, path, h, a,
+                            "the polynomial (up to " + number_text(polynomial) + " arcsec over temperatures within " +
+                                number_text(kMaxAbsTemperatureC) + " degrees C) and the Sun term (up to " +
+                                number_text(term) + " arcsec) together can pass a thermal angle's " +
+                                number_text(limit) +
+                                " arcsec, where the target's form of the term skips the stage: the target does not "
+                                "take it");
             }
+        }
+        if (any && !has_term_in_scalar[h]) {
+            refuse_axis(m, path, h, 0,
+                        "the Sun term rounds to 0 in the target's scalar, which would then evaluate it as none "
+                        "(no status 128 where the Sun's direction is unknown): the target does not take it");
         }
     }
 }
@@ -172,13 +200,9 @@ void check_fixed_point_range(const ModelFile& m, const std::string& path) {
 }
 
 void check_float_range(const ModelFile& m, const std::string& path) {
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
-            double c[kModelTerms];
-            for (std::size_t i = 0; i < kModelTerms; ++i) {
-                c[i] = m.coefficients[h][a][i];
-            }
-            const double s = float_term_sum(c, kArcsecToRad);
+            const double s = axis_term_sum_arcsec(m, h, a) * kArcsecToRad;
             if (!(s <= kFloatMaxTermSumRad)) {
                 char limit[200];
                 text::c_snprintf(
@@ -186,14 +210,9 @@ void check_float_range(const ModelFile& m, const std::string& path) {
                     " is beyond what the float core evaluates within %g arcsec over +-%g degC (%.0f arcsec): "
                     "use --scalar double or fixed",
                     kFloatAngleErrorRad * kRadToArcsec, kMaxAbsTemperatureC, kFloatMaxTermSumRad * kRadToArcsec);
-                const std::string what =
-                    std::string(1, head_name(static_cast<std::uint8_t>(h))) + " " + kAxisNames[a] +
-                    ": |c0| + 200|c1| + 400(|c2| + |c3|) + 200^2|c1_2| + 400^2(|c2_2| + |c3_2|) = " +
-                    number_text(s * kRadToArcsec) + " arcsec" + limit;
-                if (m.line[h][a] != 0) {
-                    throw text::InputError(path, m.line[h][a], 1, what);
-                }
-                throw std::runtime_error(text::input_name(path) + ": " + what);
+                refuse_axis(m, path, h, a,
+                            "|c0| + 200|c1| + 400(|c2| + |c3|) + 200^2|c1_2| + 400^2(|c2_2| + |c3_2|) = " +
+                                number_text(s * kRadToArcsec) + " arcsec" + limit);
             }
         }
     }

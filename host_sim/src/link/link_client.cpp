@@ -80,6 +80,7 @@ void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<
         lag_s_ = lag_s;
     }
     model_ = model;
+    sun_.reset();  // the target ends each head's Sun term with its model
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         update(model_message(h));
     }
@@ -87,10 +88,10 @@ void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<
 
 template <typename T>
 void LinkClient<T>::upload_sun_term(const SunTermModel<T>& sun) {
-    sun_ = sun;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        update(sun_term_message(h));
+        update(sun_term_message(sun, h));
     }
+    sun_ = sun;  // the target took them all: a restore sends them again
 }
 
 template <typename T>
@@ -295,7 +296,8 @@ void LinkClient<T>::update(const Message& m) {
     expect_ok(request(m, link::MessageType::kAck), m.what);
 }
 
-// In the order a restore sends them: models, velocity, the service's horizon, state, temperatures.
+// In the order a restore sends them: models and their Sun terms, velocity, the service's horizon, state,
+// temperatures.
 template <typename T>
 std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
     std::vector<Message> s;
@@ -306,7 +308,7 @@ std::vector<typename LinkClient<T>::Message> LinkClient<T>::session() const {
     }
     if (sun_) {
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-            s.push_back(sun_term_message(h));
+            s.push_back(sun_term_message(*sun_, h));
         }
     }
     if (velocity_) {
@@ -399,12 +401,12 @@ typename LinkClient<T>::Message LinkClient<T>::model_message(std::uint8_t head) 
 }
 
 template <typename T>
-typename LinkClient<T>::Message LinkClient<T>::sun_term_message(std::uint8_t head) const {
+typename LinkClient<T>::Message LinkClient<T>::sun_term_message(const SunTermModel<T>& sun, std::uint8_t head) {
     link::SunTermUpload<T> m{};
     m.head = head;
     for (std::size_t a = 0; a < kModelAxes; ++a) {
         for (std::size_t c = 0; c < kSunComponents; ++c) {
-            m.coefficient[a][c] = sun_->present[head] ? sun_->coefficient[head][a][c] : constant<T>(0.0);
+            m.coefficient[a][c] = sun.present[head] ? sun.coefficient[head][a][c] : constant<T>(0.0);
         }
     }
     return {link::MessageType::kSunTermUpload, encoded(m), "Sun term upload"};

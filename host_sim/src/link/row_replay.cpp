@@ -142,9 +142,7 @@ private:
             host_.sun_d ? &*host_.sun_d : nullptr, rec.t, sun_unknown);
         if (sun_unknown && sun_messages_ < kMaxRowMessages) {
             ++sun_messages_;
-            log_ << opt_.in << ":" << rec.line
-                 << ": t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot be evaluated: "
-                    "thermal skipped (status 128)\n";
+            log_ << opt_.in << ":" << rec.line << ": " << kSunUnknownText << "\n";
         }
         return ref;
     }

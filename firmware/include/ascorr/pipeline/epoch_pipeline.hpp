@@ -174,11 +174,11 @@ public:
     // Whether a solution of `head` goes through an epoch (begin(), then
     // solution()) or, with no time (`timed` false), untimed_solution(): a
     // solution with no time belongs to no epoch while calibrating, nor when
-    // its head lags (it has no lagged temperatures), nor while a Sun term
-    // is folded in (it has no Sun direction: 128 where its head has a term);
-    // otherwise it takes the fixed model in the epoch its caller gives it.
+    // its head lags (it has no lagged temperatures), nor when its head has a
+    // Sun term folded in (it has no Sun direction: 128); otherwise it takes
+    // the fixed model in the epoch its caller gives it.
     bool in_epoch(std::uint8_t head, bool timed) const noexcept {
-        return timed || (!calibrating() && (lags_ == nullptr || !lags_->lags(head)) && !sun_folded());
+        return timed || (!calibrating() && (lags_ == nullptr || !lags_->lags(head)) && !sun_folded(head));
     }
 
     // Stage 6's combiner (nullptr: no combination); forgets the solutions
@@ -321,8 +321,10 @@ public:
 private:
     static constexpr bool kTakesSunTerm = TakesSunTerm<Calls, T>::value;
 
-    // Whether the fixed model's Sun term is folded in (never without kTakesSunTerm).
+    // Whether the fixed model's Sun term is folded in (never without
+    // kTakesSunTerm), and for head h, whether h has one.
     bool sun_folded() const noexcept { return kTakesSunTerm && sun_ != nullptr && estimator_ == nullptr; }
+    bool sun_folded(std::uint8_t h) const noexcept { return sun_folded() && h < kMaxHeads && sun_->present[h]; }
 
     // Stage 3: the core, or its flight form where the fixed model has a Sun
     // term; known: ŝ is the epoch's (a solution in no epoch has none: a head

@@ -18,6 +18,7 @@
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/core/quaternion.hpp"
 #include "ascorr/core/sun_term.hpp"
+#include "ascorr/nav/sun_direction.hpp"
 #include "ascorr/pipeline/solution_stage.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
 #include "ascorr_host/correct/states_velocity.hpp"
@@ -42,22 +43,36 @@ struct RowCorrection {
 // 2000-2051), skip the row's thermal stage with status 128
 // (kThermalOutOfRange: the model's angle outside its domain); for
 // correct_row and stats alike.
+// What a row whose Sun term cannot be evaluated is told, after its place.
+inline constexpr const char* kSunUnknownText =
+    "t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot be evaluated: thermal skipped "
+    "(status 128)";
 struct RowSunTerm {
     bool apply = false;
     bool unknown = false;
     Vector3<double> s_icrf{};
 };
-RowSunTerm row_sun_term(const SunTermModel<double>* sun, StatusBits core_status, std::uint8_t head, double t);
+template <typename T>
+RowSunTerm row_sun_term(const SunTermModel<T>* sun, StatusBits core_status, std::uint8_t head, double t) {
+    RowSunTerm s;
+    if (sun == nullptr || (core_status & status::kThermalApplied) == 0U || !has_sun_term(*sun, head)) {
+        return s;
+    }
+    s.apply = nav::sun_direction_icrf(t, s.s_icrf);
+    s.unknown = !s.apply;
+    return s;
+}
 
 // correct_stage() (pipeline/solution_stage.hpp) with the contract's Sun term
 // (docs/contract.md, "The Sun term"; sun nullptr: none) of head in.head at
 // t, in T: where the thermal stage applied, the core's result turned by the
-// term (T float and Q30: the head's coefficients and ŝ rounded to T once);
-// where ŝ is unknown, the stage undone (the aberration's result) and 128,
-// sun_unknown set. For correct_row and replay's double reference alike.
+// term (its coefficients as the caller holds them in T, sun_term_of<T>, and ŝ
+// rounded to T once); where ŝ is unknown, the stage undone (the aberration's
+// result) and 128, sun_unknown set. For correct_row and replay's double
+// reference alike.
 template <typename T>
 CorrectedSolution<T> correct_stage_with_sun(SolutionInput<T>& in, const pipeline::VelocityAnswer<T>& v,
-                                            const CorrectionConfig<T>& cfg, const SunTermModel<double>* sun, double t,
+                                            const CorrectionConfig<T>& cfg, const SunTermModel<T>* sun, double t,
                                             bool& sun_unknown);
 extern template CorrectedSolution<double> correct_stage_with_sun(SolutionInput<double>&,
                                                                  const pipeline::VelocityAnswer<double>&,
@@ -66,18 +81,18 @@ extern template CorrectedSolution<double> correct_stage_with_sun(SolutionInput<d
 
 // earth: used when the aberration stage is on (cfg.aberration) and the row
 // has its velocity; states: nullptr without --states (one per thread: it
-// keeps the service's state between rows); sun: the model's Sun term, applied
-// after the core where its thermal stage was, in the core's scalar (float and
-// Q30: the head's coefficients and ŝ rounded to it once).
+// keeps the service's state between rows); sun: the model's Sun term in the
+// core's scalar (sun_term_of<T>, converted once per model, not per row),
+// applied after the core where its thermal stage was (correct_stage_with_sun).
 template <typename T>
 RowCorrection<T> correct_row(const SolutionRecord& rec, EarthVelocity* earth, const CorrectionConfig<T>& cfg,
-                             StatesVelocity<T>* states, const SunTermModel<double>* sun = nullptr);
+                             StatesVelocity<T>* states, const SunTermModel<T>* sun = nullptr);
 extern template RowCorrection<double> correct_row(const SolutionRecord&, EarthVelocity*,
                                                   const CorrectionConfig<double>&, StatesVelocity<double>*,
                                                   const SunTermModel<double>*);
 extern template RowCorrection<float> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<float>&,
-                                                 StatesVelocity<float>*, const SunTermModel<double>*);
+                                                 StatesVelocity<float>*, const SunTermModel<float>*);
 extern template RowCorrection<Q30> correct_row(const SolutionRecord&, EarthVelocity*, const CorrectionConfig<Q30>&,
-                                               StatesVelocity<Q30>*, const SunTermModel<double>*);
+                                               StatesVelocity<Q30>*, const SunTermModel<Q30>*);
 
 }  // namespace ascorr::host

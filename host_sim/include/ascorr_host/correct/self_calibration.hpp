@@ -136,9 +136,9 @@ class ModelSchedule {
 public:
     explicit ModelSchedule(const std::vector<ActiveModel>& history);
     const ThermalModel<T>& at(double t) const noexcept;
-    // The Sun term of the model active at t (evaluated in double,
-    // correct_row.hpp); nullptr: none.
-    const SunTermModel<double>* sun_at(double t) const noexcept;
+    // The Sun term of the model active at t, in T (correct_row.hpp);
+    // nullptr: none.
+    const SunTermModel<T>* sun_at(double t) const noexcept;
     // The version active at t; nullopt: none.
     std::optional<std::uint32_t> version_at(double t) const noexcept;
 
@@ -146,8 +146,8 @@ private:
     std::size_t index_at(double t) const noexcept;  // 0: none, k: history[k − 1]
     std::vector<std::int64_t> from_us_;
     std::vector<std::uint32_t> version_;
-    std::vector<ThermalModel<T>> model_;                    // [0]: no head present
-    std::vector<std::optional<SunTermModel<double>>> sun_;  // by version (model_[k + 1])
+    std::vector<ThermalModel<T>> model_;               // [0]: no head present
+    std::vector<std::optional<SunTermModel<T>>> sun_;  // by version (model_[k + 1])
 };
 
 // How head h of a history's model `version` came to be: "given" (version 0,

@@ -116,12 +116,15 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun);
 // Throws (naming the model's file, then `why`) when the model has a Sun
 // term: for the consumers that do not evaluate it yet.
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why);
-// Throws (naming the file, line, head and axis) where a head's polynomial
-// and Sun term together can pass a thermal angle's ±1° at temperatures the
-// core accepts (its terms' largest sum, float_term_sum(), plus |sun_x| +
-// |sun_y| + |sun_z|): there the target's flight form skips the stage (128)
-// while the contract's form applies both rotations. For the link's loader.
-void refuse_sun_term_beyond_flight_domain(const ModelFile& m, const std::string& path);
+// The link's loader of a model's Sun term (replay): throws (naming the file,
+// line, head and axis) where a head's polynomial and Sun term together can
+// pass a thermal angle's ±1° at temperatures the core accepts (its terms'
+// largest sum, float_term_sum(), plus |sun_x| + |sun_y| + |sun_z|: there the
+// target's flight form skips the stage, 128, while the contract's form
+// applies both rotations), and where a head's term is not 0 in double but
+// has_term_in_scalar[h] (sun_term_of<T>'s present) says it rounds to 0 in
+// the target's scalar (which would then give no 128 where `correct` does).
+void refuse_sun_term_for_link(const ModelFile& m, const std::string& path, const bool (&has_term_in_scalar)[kMaxHeads]);
 // Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
 inline constexpr const char* kSunTermNotLearnt =
     "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
@@ -142,15 +145,17 @@ SunTermModel<T> sun_term_of(const ModelFile& m) {
     return out;
 }
 
-// The model's Sun term in double, when it has one (m nullptr: none).
-inline std::optional<SunTermModel<double>> sun_term_if_any(const ModelFile* m) {
+// The model's Sun term in T, when it has one (m nullptr: none).
+template <typename T = double>
+std::optional<SunTermModel<T>> sun_term_if_any(const ModelFile* m) {
     if (m == nullptr || !has_sun_term(*m)) {
         return std::nullopt;
     }
-    return sun_term_of<double>(*m);
+    return sun_term_of<T>(*m);
 }
-inline std::optional<SunTermModel<double>> sun_term_if_any(const std::optional<ModelFile>& m) {
-    return sun_term_if_any(m ? &*m : nullptr);
+template <typename T = double>
+std::optional<SunTermModel<T>> sun_term_if_any(const std::optional<ModelFile>& m) {
+    return sun_term_if_any<T>(m ? &*m : nullptr);
 }
 
 // The heads' lags of a run (correct, replay): `given` (--lag), otherwise the

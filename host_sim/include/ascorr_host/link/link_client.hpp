@@ -74,8 +74,10 @@ public:
     // refuses it): the lag's state is lost with it.
     void upload_model(const ThermalModel<T>& model, const std::array<double, kMaxHeads>& lag_s = {});
     // The uploaded model's Sun terms (SUN_TERM_UPLOAD), every head (one
-    // without a term as 0: none); restored after a restart with the model.
-    // The target refuses them while its estimator runs.
+    // without a term as 0: none), after upload_model (whose MODEL_UPLOAD
+    // ends a head's term); restored after a restart with the model. The
+    // target refuses them while its estimator runs (a LinkError; the client
+    // keeps the terms it held before).
     void upload_sun_term(const SunTermModel<T>& sun);
     void set_velocity(const ObserverVelocity<T>& v);
     void set_temperatures(std::uint8_t head, const HeadTemperatures<T>& t);
@@ -170,7 +172,7 @@ private:
     bool answer_shows_restart(const link::SolutionOut<T>& out) const;
 
     Message model_message(std::uint8_t head) const;
-    Message sun_term_message(std::uint8_t head) const;
+    static Message sun_term_message(const SunTermModel<T>& sun, std::uint8_t head);
     Message velocity_message() const;
     Message state_message(const link::StateUpdate& s) const;
     Message service_message() const;
