@@ -182,6 +182,37 @@ TEST(Pipeline, UntimedSolutionsHaveNoModelWhileCalibrating) {
               status::kAberrationApplied | status::kThermalApplied);
 }
 
+// With a Sun term folded in, a solution without a time stays out of the
+// epochs only when its own head has a term (it has no Sun direction: 128);
+// a head without one keeps its epoch (and its combination), as with no term
+// at all; while calibrating no untimed solution has one. The pipeline whose
+// Calls has no flight form (TakesSunTerm) compiles without the stage.
+TEST(Pipeline, AnUntimedSolutionLeavesTheEpochsOnlyWhenItsHeadHasASunTerm) {
+    const ThermalModel<double> table2 = thermal_model<double>(kTable2, kArcsecToRad);
+    SunTermModel<double> sun{};
+    sun.present[0] = true;
+    sun.coefficient[0][1][2] = 1e-5;
+    keep_present_where_terms(sun);
+    pipeline::EpochPipeline<double> pipe;
+    pipe.use_model(&table2);
+    EXPECT_TRUE(pipe.in_epoch(0, false));
+    pipe.use_sun_term(&sun);
+    EXPECT_FALSE(pipe.in_epoch(0, false));
+    EXPECT_TRUE(pipe.in_epoch(1, false));
+    EXPECT_TRUE(pipe.in_epoch(0, true));
+    EXPECT_TRUE(pipe.in_epoch(kMaxHeads, false));  // no such head: no term; the core rejects it
+    const CorrectedSolution<double> c = pipe.untimed_solution(solution(0), given(solution(0)));
+    EXPECT_EQ(c.status, status::kAberrationApplied | status::kThermalOutOfRange);
+    pipe.use_sun_term(nullptr);
+    EXPECT_TRUE(pipe.in_epoch(0, false));
+    calib::Estimator<double> estimator(calib::EstimatorConfig{}, &kTable2);
+    pipe.use_sun_term(&sun);
+    pipe.use_estimator(&estimator);
+    EXPECT_FALSE(pipe.in_epoch(1, false));
+    static_assert(pipeline::TakesSunTerm<pipeline::InlineCalls<double>, double>::value);
+    static_assert(!pipeline::TakesSunTerm<pipeline::NoMeter, double>::value);
+}
+
 TEST(Pipeline, TheServiceBitsJoinOnlyWhenTheServiceWasAsked) {
     const ThermalModel<double> table2 = thermal_model<double>(kTable2, kArcsecToRad);
     pipeline::EpochPipeline<double> pipe;

@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "ascorr/core/fixed_point.hpp"
 #include "ascorr/nav/sun_direction.hpp"
@@ -114,6 +115,50 @@ bool same(const CorrectedSolution<float>& want, const link::SolutionOut<float>& 
     return want.status == got.status && std::memcmp(&want.q_chu_icrf, &got.q_chu_icrf, sizeof got.q_chu_icrf) == 0;
 }
 
+// m_sun.csv in float, with head B's term taken out (B: no term).
+SunTermModel<float> sun_without_b(const host::ModelFile& mf) {
+    SunTermModel<float> sun = host::sun_term_of<float>(mf);
+    for (auto& axis : sun.coefficient[1]) {
+        for (float& c : axis) {
+            c = 0.0F;
+        }
+    }
+    keep_present_where_terms(sun);
+    return sun;
+}
+
+// A solution of head A at `t_us` (TT µs).
+SolutionInput<float> head_a_solution() {
+    SolutionInput<float> in{};
+    in.q_chu_icrf = {0.5F, 0.5F, -0.5F, 0.5F};
+    in.velocity = {{2.5e-5F, -1e-5F, 8e-6F}, 1.0F, true};
+    in.temperatures = {{{12.0F}, true}, {{-3.0F}, true}, {{-18.0F}, true}};
+    return in;
+}
+
+constexpr std::int64_t kT2025 = 800'000'000'000'000;
+
+// A float client over a RestartingTarget (restart_after answers), connected,
+// with m_sun.csv's model and its Sun terms (B: none) uploaded.
+struct SunSession {
+    explicit SunSession(int restart_after)
+        : target(restart_after),
+          transport([this](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& r) {
+              target.serve(p, n, r);
+          }),
+          client(transport, 1, 20) {
+        client.connect();
+        client.upload_model(model);
+        client.upload_sun_term(sun);
+    }
+    host::ModelFile mf = model_file("m_sun.csv");
+    ThermalModel<float> model = host::to_core<float>(mf);
+    SunTermModel<float> sun = sun_without_b(mf);
+    RestartingTarget target;
+    host::LoopbackTransport transport;
+    host::LinkClient<float> client;
+};
+
 // The target's answers, head by head: a head with a term takes the flight
 // form at the epoch's Sun, bit for bit (and differs from the core without
 // it: the mutation check); a head without one the core's bytes, with or
@@ -123,28 +168,13 @@ bool same(const CorrectedSolution<float>& want, const link::SolutionOut<float>& 
 // at the first solution) restores the terms with the model. While the
 // estimator runs an upload is refused.
 TEST(SunLink, TheTargetFoldsTheTermIntoEachEpochAndNeedsItsTime) {
-    const host::ModelFile mf = model_file("m_sun.csv");
-    const ThermalModel<float> model = host::to_core<float>(mf);
-    SunTermModel<float> sun = host::sun_term_of<float>(mf);
-    for (auto& axis : sun.coefficient[1]) {  // head B: no term
-        for (float& c : axis) {
-            c = 0.0F;
-        }
-    }
-    keep_present_where_terms(sun);
-    RestartingTarget target(11);  // connect 1, model 4, Sun term 4, velocity 1, temperatures 1: then a restart
-    host::LoopbackTransport t(
-        [&](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& r) { target.serve(p, n, r); });
-    host::LinkClient<float> client(t, 1, 20);
-    client.connect();
-    client.upload_model(model);
-    client.upload_sun_term(sun);
-    SolutionInput<float> in{};
-    in.q_chu_icrf = {0.5F, 0.5F, -0.5F, 0.5F};
-    in.velocity = {{2.5e-5F, -1e-5F, 8e-6F}, 1.0F, true};
-    in.temperatures = {{{12.0F}, true}, {{-3.0F}, true}, {{-18.0F}, true}};
+    SunSession session(11);  // connect 1, model 4, Sun term 4, velocity 1, temperatures 1: then a restart
+    const ThermalModel<float>& model = session.model;
+    const SunTermModel<float>& sun = session.sun;
+    host::LinkClient<float>& client = session.client;
+    SolutionInput<float> in = head_a_solution();
     client.set_velocity(in.velocity);
-    const std::int64_t t_2025 = 800'000'000'000'000;
+    const std::int64_t t_2025 = kT2025;
     const std::int64_t t_2052 = 1'650'000'000'000'000;
     std::uint32_t id = 0;
     const auto answer = [&](std::uint8_t h, std::int64_t t_us) {
@@ -182,6 +212,21 @@ TEST(SunLink, TheTargetFoldsTheTermIntoEachEpochAndNeedsItsTime) {
     EXPECT_THROW(client.upload_sun_term(sun), host::LinkError);
 }
 
+// A restart in the middle of the terms' upload (at head C's, after A's and
+// B's were taken): the restore sends the model and every term again, so
+// head A's first answer has its term.
+TEST(SunLink, ARestartDuringTheUploadRestoresEveryTerm) {
+    SunSession session(7);  // connect 1, model 4, Sun terms of A and B: then a restart
+    host::LinkClient<float>& client = session.client;
+    EXPECT_EQ(client.stats().restarts, 1U);
+    SolutionInput<float> in = head_a_solution();
+    client.set_velocity(in.velocity);
+    client.set_temperatures(0, in.temperatures);
+    const link::SolutionOut<float> a = client.correct(0, 0, in.q_chu_icrf, TtTime{kT2025});
+    EXPECT_TRUE(same(flight_form(in, session.model, session.sun, kT2025), a));
+    EXPECT_EQ(a.status, status::kAberrationApplied | status::kThermalApplied);
+}
+
 // `replay` of a model with a Sun term: the loopback target (float) folds it
 // in (the flight form), bit for bit as the host's pipeline, within the float
 // bound of the replay tests (0.05″) of the double reference (the contract's
@@ -198,18 +243,21 @@ TEST(ReplaySun, TheLoopbackTargetAnswersAsCorrectDoesWithinItsBound) {
 // both rotations), naming the file, line, head and axis; at 1° it is taken,
 // and so is an axis without a term. So is a term that rounds to 0 in the
 // target's scalar (which would take it as none: no 128 where `correct` gives
-// it). `correct` takes every one of them.
+// it), named at the head's first axis with a term. `correct` takes every one
+// of them, and in every scalar gives such a term's rows beyond 2051 its 128.
 TEST(ReplaySun, AModelTheTargetWouldEvaluateOtherwiseIsRefused) {
     const fs::path& dir = mission();
-    // Head A's alpha: c1 (3500″ at 200 °C for 17.5″/°C) and its Sun term; the
-    // other rows a term of 0.75″ and a polynomial of 20″.
-    const auto model = [&](const char* c1, const char* sun, const char* b_sun = "0.5,0.25,0") {
+    // Head A's alpha: c1 (3500″ at 200 °C for 17.5″/°C) and its Sun term;
+    // head B's gamma its own term; the other rows a term of 0.75″ and a
+    // polynomial of 20″.
+    const auto model = [&](const char* c1, const char* a_sun, const char* b_sun = "0.5,0.25,0") {
         std::string text = "chu,axis,c0,c1,c2,c3,sun_x,sun_y,sun_z\n";
-        for (const char* h : {"A", "B", "C"}) {
-            for (const char* a : {"alpha", "beta", "gamma"}) {
-                const bool edge = std::string(h) == "A" && std::string(a) == "alpha";
-                const char* term = edge ? sun : std::string(h) == "B" ? b_sun : "0.5,0.25,0";
-                text += std::string(h) + "," + a + ",0," + (edge ? c1 : "0.1") + ",0,0," + term + "\n";
+        for (const std::string h : {"A", "B", "C"}) {
+            for (const std::string a : {"alpha", "beta", "gamma"}) {
+                const bool edge = h == "A" && a == "alpha";
+                const std::string b_term = a == "gamma" ? b_sun : "0,0,0";
+                const std::string term = edge ? a_sun : h == "B" ? b_term : "0.5,0.25,0";
+                text += h + "," + a + ",0," + (edge ? c1 : "0.1") + ",0,0," + term + "\n";
             }
         }
         return text;
@@ -223,7 +271,7 @@ TEST(ReplaySun, AModelTheTargetWouldEvaluateOtherwiseIsRefused) {
                    {"big.csv:2:1: A alpha: the polynomial (up to 3500 arcsec over temperatures within 200 degrees "
                     "C) and the Sun term (up to 200.25 arcsec) together can pass a thermal angle's 3600 arcsec"});
     const CliRun tiny = run_in("replay --target loopback-float --in s.csv --model tiny.csv --out rb.csv", dir);
-    expect_refused(tiny, 1, {"tiny.csv:5:1: B alpha: the Sun term rounds to 0 in the target's scalar"});
+    expect_refused(tiny, 1, {"tiny.csv:7:1: B gamma: the Sun term rounds to 0 in the target's scalar"});
     expect_absent(dir, {"rb.csv"});
     for (const char* taken : {"edge.csv", "none.csv"}) {
         const CliRun r = run_in(std::string("replay --target loopback-float --in s.csv --model ") + taken +
@@ -231,12 +279,29 @@ TEST(ReplaySun, AModelTheTargetWouldEvaluateOtherwiseIsRefused) {
                                 dir);
         EXPECT_EQ(r.exit_code, 0) << taken << ": " << r.err;
     }
-    for (const char* model_file : {"big.csv", "tiny.csv"}) {
-        EXPECT_EQ(
-            run_in(std::string("correct --in s.csv --model ") + model_file + " --out cb.csv > /dev/null 2>&1", dir)
-                .exit_code,
-            0)
-            << model_file;
+    // The mission's first rows of B moved to 2052.
+    std::vector<std::string> late{lines_of_file(dir / "s.csv")[0]};
+    for (const std::string& row : lines_of_file(dir / "s.csv")) {
+        if (late.size() < 4 && row.find(",B,") != std::string::npos) {
+            late.push_back("1650000000" + row.substr(row.find(',')));
+        }
+    }
+    write_lines(dir / "late.csv", late);
+    for (const char* scalar : {"double", "float", "fixed"}) {
+        EXPECT_EQ(run_in(std::string("correct --in s.csv --model big.csv --out cb.csv --scalar ") + scalar +
+                             " > /dev/null 2>&1",
+                         dir)
+                      .exit_code,
+                  0)
+            << scalar;
+        const CliRun r =
+            run_in(std::string("correct --in late.csv --model tiny.csv --out cl.csv --scalar ") + scalar, dir);
+        EXPECT_EQ(r.exit_code, 0) << scalar << ": " << r.err;
+        for (const auto& [key, row] : corrected_of(dir / "cl.csv")) {
+            EXPECT_EQ(row.status, std::to_string(status::kAberrationApplied | status::kThermalOutOfRange))
+                << scalar << " " << key;
+        }
+        EXPECT_TRUE(has(r.err, "thermal skipped (status 128)")) << scalar;
     }
 }
 

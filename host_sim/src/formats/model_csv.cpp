@@ -107,12 +107,12 @@ void refuse_sun_term_for_link(const ModelFile& m, const std::string& path,
                               const bool (&has_term_in_scalar)[kMaxHeads]) {
     const double limit = kMaxThermalAngleRad * kRadToArcsec;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        bool any = false;
+        std::size_t first = kModelAxes;  // the first axis with a term
         for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
             const auto& sun = m.sun[h][a];
             const double polynomial = axis_term_sum_arcsec(m, h, a);
             const double term = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
-            any = any || term != 0.0;
+            first = first == kModelAxes && term != 0.0 ? a : first;
             if (term != 0.0 && !(polynomial + term <= limit)) {
                 refuse_axis(m, path, h, a,
                             "the polynomial (up to " + number_text(polynomial) + " arcsec over temperatures within " +
@@ -123,8 +123,8 @@ void refuse_sun_term_for_link(const ModelFile& m, const std::string& path,
                                 "take it");
             }
         }
-        if (any && !has_term_in_scalar[h]) {
-            refuse_axis(m, path, h, 0,
+        if (first != kModelAxes && !has_term_in_scalar[h]) {
+            refuse_axis(m, path, h, first,
                         "the Sun term rounds to 0 in the target's scalar, which would then evaluate it as none "
                         "(no status 128 where the Sun's direction is unknown): the target does not take it");
         }

@@ -88,10 +88,16 @@ void LinkClient<T>::upload_model(const ThermalModel<T>& model, const std::array<
 
 template <typename T>
 void LinkClient<T>::upload_sun_term(const SunTermModel<T>& sun) {
-    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
-        update(sun_term_message(sun, h));
+    const std::optional<SunTermModel<T>> before = sun_;
+    sun_ = sun;  // a restart in the middle restores them all
+    try {
+        for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+            update(sun_term_message(sun, h));
+        }
+    } catch (const LinkError&) {
+        sun_ = before;  // refused: the client holds what it held
+        throw;
     }
-    sun_ = sun;  // the target took them all: a restore sends them again
 }
 
 template <typename T>

@@ -62,13 +62,17 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     }
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
-    const SunTermModel<T> sun = sun_term_of<T>(mf);
-    refuse_sun_term_for_link(mf, opt.model, sun.present);
     if (opt.self_calibrate) {
         refuse_sun_term(mf, opt.model, "the target's estimator does not learn it (its models have none)");
         refuse_other_lag(mf, opt.model, run_lags(opt.lag_s, mf));
         refuse_quadratic_initial_model(mf, opt.model);
     }
+    const SunTermModel<T> sun = sun_term_of<T>(mf);
+    bool has_term_in_scalar[kMaxHeads] = {};
+    for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
+        has_term_in_scalar[h] = has_sun_term(sun, h);
+    }
+    refuse_sun_term_for_link(mf, opt.model, has_term_in_scalar);
     return mf;
 }
 

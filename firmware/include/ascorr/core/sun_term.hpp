@@ -71,7 +71,9 @@ constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcep
 
 // present[h] kept only where head h has a term (a coefficient not 0), as
 // every producer of a model leaves it: the flight form (correct.hpp) keys on
-// present alone, with no loop per solution.
+// present alone, with no loop per solution. (The host's model file decides
+// it on its double coefficients: a term that rounds to 0 in float or Q30
+// stays present there, with angles of 0; the link refuses such a term.)
 template <typename T>
 constexpr void keep_present_where_terms(SunTermModel<T>& m) noexcept {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {

@@ -36,17 +36,18 @@ struct RowCorrection {
     bool sun_unknown;               // the model's Sun term could not be evaluated: thermal skipped (128)
 };
 
-// What the model's Sun term (sun, nullptr: none; core/sun_term.hpp) does to
-// a row the core corrected with status core_status: nothing (the thermal
-// stage did not apply, or the head has no term), apply at s_icrf, or, where
-// the Sun's direction is unknown (t outside nav/sun_direction.hpp's span,
-// 2000-2051), skip the row's thermal stage with status 128
-// (kThermalOutOfRange: the model's angle outside its domain); for
-// correct_row and stats alike.
 // What a row whose Sun term cannot be evaluated is told, after its place.
 inline constexpr const char* kSunUnknownText =
     "t outside the Sun ephemeris' span (2000-2051): the model's Sun term cannot be evaluated: thermal skipped "
     "(status 128)";
+
+// What the model's Sun term (sun, nullptr: none; core/sun_term.hpp) does to
+// a row the core corrected with status core_status: nothing (the thermal
+// stage did not apply, or the head has no term: present, as sun_term_of
+// decides it in double), apply at s_icrf, or, where the Sun's direction is
+// unknown (t outside nav/sun_direction.hpp's span, 2000-2051), skip the
+// row's thermal stage with status 128 (kThermalOutOfRange: the model's angle
+// outside its domain); for correct_row and stats alike.
 struct RowSunTerm {
     bool apply = false;
     bool unknown = false;
@@ -55,7 +56,7 @@ struct RowSunTerm {
 template <typename T>
 RowSunTerm row_sun_term(const SunTermModel<T>* sun, StatusBits core_status, std::uint8_t head, double t) {
     RowSunTerm s;
-    if (sun == nullptr || (core_status & status::kThermalApplied) == 0U || !has_sun_term(*sun, head)) {
+    if (sun == nullptr || (core_status & status::kThermalApplied) == 0U || head >= kMaxHeads || !sun->present[head]) {
         return s;
     }
     s.apply = nav::sun_direction_icrf(t, s.s_icrf);

@@ -96,18 +96,25 @@ inline std::array<double, kMaxHeads> head_lags(const ModelFile& m) noexcept {
 inline bool has_lag(const ModelFile& m) noexcept {
     return pipeline::any_lagged(head_lags(m));
 }
-// Whether a head the model has carries a Sun term.
-inline bool has_sun_term(const ModelFile& m) noexcept {
-    for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
-            for (const double c : m.sun[h][a]) {
-                if (c != 0.0) {
-                    return true;
-                }
+// Whether head h, which the model has, carries a Sun term (a coefficient
+// not 0 in the file's double).
+inline bool has_sun_term(const ModelFile& m, std::size_t h) noexcept {
+    for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
+        for (const double c : m.sun[h][a]) {
+            if (c != 0.0) {
+                return true;
             }
         }
     }
     return false;
+}
+// Whether a head the model has carries a Sun term.
+inline bool has_sun_term(const ModelFile& m) noexcept {
+    bool any = false;
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        any = any || has_sun_term(m, h);
+    }
+    return any;
 }
 // What is wrong with one axis' Sun term (a coefficient not finite, or the
 // largest angle |sun_x| + |sun_y| + |sun_z| beyond a thermal angle's 3600″:
@@ -122,26 +129,29 @@ void refuse_sun_term(const ModelFile& m, const std::string& path, const std::str
 // largest sum, float_term_sum(), plus |sun_x| + |sun_y| + |sun_z|: there the
 // target's flight form skips the stage, 128, while the contract's form
 // applies both rotations), and where a head's term is not 0 in double but
-// has_term_in_scalar[h] (sun_term_of<T>'s present) says it rounds to 0 in
-// the target's scalar (which would then give no 128 where `correct` does).
+// has_term_in_scalar[h] (has_sun_term of sun_term_of<T>) says it rounds to
+// 0 in the target's scalar (which would then give no 128 where `correct`
+// does).
 void refuse_sun_term_for_link(const ModelFile& m, const std::string& path, const bool (&has_term_in_scalar)[kMaxHeads]);
 // Why a Sun term is refused to start a self-calibration, after refuse_sun_term's words.
 inline constexpr const char* kSunTermNotLearnt =
     "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
     "model without one";
-// The Sun term in the core's units (radians), for scalar T.
+// The Sun term in the core's units (radians), for scalar T; present[h]
+// where head h has a term in the file's double (has_sun_term), so that a
+// term that rounds to 0 in T still makes its rows need the Sun's direction
+// (128 beyond 2051), as in double; its angles are then 0.
 template <typename T>
 SunTermModel<T> sun_term_of(const ModelFile& m) {
     SunTermModel<T> out{};
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        out.present[h] = m.present[h];
+        out.present[h] = has_sun_term(m, h);
         for (std::size_t a = 0; a < kModelAxes; ++a) {
             for (std::size_t c = 0; c < kSunComponents; ++c) {
                 out.coefficient[h][a][c] = ScalarTraits<T>::from_double(m.sun[h][a][c] * kArcsecToRad);
             }
         }
     }
-    keep_present_where_terms(out);
     return out;
 }
 
