@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <ostream>
 #include <sstream>
@@ -20,7 +21,8 @@
 
 namespace ascorr::test {
 
-// The corrected rows of a file, by line: status and quaternion.
+// The corrected rows of a file, by t and head (rows alike in both are one
+// key, the last): status and quaternion.
 struct Corrected {
     std::string status;
     Quaternion<double> q;

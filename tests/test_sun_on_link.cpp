@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "ascorr/core/fixed_point.hpp"
@@ -100,7 +101,7 @@ TEST(SunLink, TheUploadCarriesNineWordsAndRefusesWhatTheCoreCannotTake) {
     expect_upload_round_trip<Q30>();
 }
 
-// What the target should answer for head h at t_us (0: no time): the core's
+// What the target should answer for `in` at t_us (0: no time): the core's
 // flight form with the Sun's direction at t, as the target forms it once per
 // epoch (nav/sun_direction.hpp, rounded to float).
 CorrectedSolution<float> flight_form(const SolutionInput<float>& in, const ThermalModel<float>& model,
@@ -127,7 +128,7 @@ SunTermModel<float> sun_without_b(const host::ModelFile& mf) {
     return sun;
 }
 
-// A solution of head A at `t_us` (TT µs).
+// A solution of head A: its attitude, velocity and temperatures (head 0).
 SolutionInput<float> head_a_solution() {
     SolutionInput<float> in{};
     in.q_chu_icrf = {0.5F, 0.5F, -0.5F, 0.5F};
@@ -297,7 +298,9 @@ TEST(ReplaySun, AModelTheTargetWouldEvaluateOtherwiseIsRefused) {
         const CliRun r =
             run_in(std::string("correct --in late.csv --model tiny.csv --out cl.csv --scalar ") + scalar, dir);
         EXPECT_EQ(r.exit_code, 0) << scalar << ": " << r.err;
-        for (const auto& [key, row] : corrected_of(dir / "cl.csv")) {
+        const auto rows = corrected_of(dir / "cl.csv");  // by t and head: the three rows are one key
+        EXPECT_EQ(rows.size(), 1U) << scalar;
+        for (const auto& [key, row] : rows) {
             EXPECT_EQ(row.status, std::to_string(status::kAberrationApplied | status::kThermalOutOfRange))
                 << scalar << " " << key;
         }

@@ -589,7 +589,7 @@ CorrectSummary run(const CorrectOptions& opt, OutputSet& outputs, std::ostream& 
         model = ThermalModel<T>{};  // marks the thermal stage on; the schedule gives the model
     }
     const CorrectionConfig<T> cfg{opt.aberration, model ? &*model : nullptr};
-    // (Refused with --self-calibrate and with the scalars but double: read_model.)
+    // The model's Sun term in T, once (refused with --self-calibrate: read_model).
     const std::optional<SunTermModel<T>> sun = sun_term_if_any<T>(model_file);
     const Job<T> job{opt,
                      cfg,
