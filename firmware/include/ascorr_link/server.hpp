@@ -261,8 +261,7 @@ private:
                 sun_.coefficient[h][a][c] = coefficient[a][c];
             }
         }
-        sun_.present[h] = true;
-        sun_.present[h] = has_sun_term(sun_, h);
+        sun_.present[h] = any_sun_coefficient(sun_, h);
         pipeline_.use_sun_term(any_sun_term() ? &sun_ : nullptr);
     }
     bool any_sun_term() const noexcept {

@@ -61,21 +61,13 @@ void refuse_lagged_model(const ModelFile& m, const std::string& path, const std:
     }
 }
 
-std::string sun_axis_problem(const std::array<double, kSunComponents>& sun) {
-    for (std::size_t c = 0; c < kSunComponents; ++c) {
-        if (!std::isfinite(sun[c])) {
-            return std::string(kSunColumns[c]) + " = " + number_text(sun[c]) + " is not a finite number";
-        }
-    }
-    const double largest = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
-    if (!(largest <= kMaxThermalAngleRad * kRadToArcsec)) {
-        return "the Sun term's |sun_x| + |sun_y| + |sun_z| = " + number_text(largest) +
-               " arcsec is beyond a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) + " arcsec";
-    }
-    return {};
-}
-
 namespace {
+
+// |sun_x| + |sun_y| + |sun_z| of one axis, arcsec: the largest angle its term
+// can give (ŝ_chu a unit vector).
+double sun_row_sum_arcsec(const std::array<double, kSunComponents>& sun) {
+    return std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
+}
 
 // float_term_sum() of head h's axis a, arcsec.
 double axis_term_sum_arcsec(const ModelFile& m, std::uint8_t h, std::size_t a) {
@@ -96,6 +88,20 @@ double axis_term_sum_arcsec(const ModelFile& m, std::uint8_t h, std::size_t a) {
 
 }  // namespace
 
+std::string sun_axis_problem(const std::array<double, kSunComponents>& sun) {
+    for (std::size_t c = 0; c < kSunComponents; ++c) {
+        if (!std::isfinite(sun[c])) {
+            return std::string(kSunColumns[c]) + " = " + number_text(sun[c]) + " is not a finite number";
+        }
+    }
+    const double largest = sun_row_sum_arcsec(sun);
+    if (!(largest <= kMaxThermalAngleRad * kRadToArcsec)) {
+        return "the Sun term's |sun_x| + |sun_y| + |sun_z| = " + number_text(largest) +
+               " arcsec is beyond a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) + " arcsec";
+    }
+    return {};
+}
+
 void refuse_sun_term(const ModelFile& m, const std::string& path, const std::string& why) {
     if (has_sun_term(m)) {
         throw std::runtime_error(text::input_name(path) +
@@ -109,9 +115,8 @@ void refuse_sun_term_for_link(const ModelFile& m, const std::string& path,
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         std::size_t first = kModelAxes;  // the first axis with a term
         for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
-            const auto& sun = m.sun[h][a];
             const double polynomial = axis_term_sum_arcsec(m, h, a);
-            const double term = std::abs(sun[0]) + std::abs(sun[1]) + std::abs(sun[2]);
+            const double term = sun_row_sum_arcsec(m.sun[h][a]);
             first = first == kModelAxes && term != 0.0 ? a : first;
             if (term != 0.0 && !(polynomial + term <= limit)) {
                 refuse_axis(m, path, h, a,

@@ -55,18 +55,25 @@ struct SunTermModel {
     T coefficient[kMaxHeads][kModelAxes][kSunComponents];  // rad per unit of s_chu's component
 };
 
-// Whether head h has a Sun term (a coefficient not 0): where it has none the
-// term is the identity and needs no Sun direction.
+// Whether head h's coefficients hold a term (one not 0), whatever present[h]
+// says: what a producer sets present[h] from. Precondition: h < kMaxHeads.
 template <typename T>
-constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcept {
+constexpr bool any_sun_coefficient(const SunTermModel<T>& m, std::uint8_t head) noexcept {
     constexpr T zero = constant<T>(0.0);
     bool any = false;
-    for (std::uint8_t a = 0; head < kMaxHeads && m.present[head] && a < kModelAxes; ++a) {
-        for (std::uint8_t c = 0; c < kSunComponents; ++c) {
-            any = any || !(m.coefficient[head][a][c] == zero);
+    for (const auto& row : m.coefficient[head]) {
+        for (const T& c : row) {
+            any = any || !(c == zero);
         }
     }
     return any;
+}
+
+// Whether head h has a Sun term (present, and a coefficient not 0): where it
+// has none the term is the identity and needs no Sun direction.
+template <typename T>
+constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcept {
+    return head < kMaxHeads && m.present[head] && any_sun_coefficient(m, head);
 }
 
 // present[h] kept only where head h has a term (a coefficient not 0), as
