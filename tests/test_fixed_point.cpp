@@ -74,6 +74,25 @@ TEST(FixedPoint, MultiplyRoundsToNearestAndSaturates) {
     EXPECT_EQ((Q30{-1} * Q30{1 << 29}).raw, 0);  // -0.5 LSB: tie rounds towards +inf
 }
 
+// fx::mul_high: ⌊a·b·2⁻³²⌋ exactly, for any raws (the ends included), against
+// long double (64-bit mantissa: every a·b exact).
+TEST(FixedPoint, MulHighIsTheProductsFloorAtTwoToThe32) {
+    std::mt19937_64 rng(32);
+    std::uniform_int_distribution<std::int32_t> raw(INT32_MIN, INT32_MAX);
+    const auto floor_high = [](std::int32_t a, std::int32_t b) {
+        return static_cast<std::int64_t>(std::floor(static_cast<long double>(a) * b / 4294967296.0L));
+    };
+    for (int i = 0; i < 100000; ++i) {
+        const std::int32_t a = raw(rng);
+        const std::int32_t b = raw(rng);
+        ASSERT_EQ(fx::mul_high(a, b), floor_high(a, b)) << a << " " << b;
+    }
+    EXPECT_EQ(fx::mul_high(INT32_MIN, INT32_MIN), 1 << 30);
+    EXPECT_EQ(fx::mul_high(INT32_MIN, INT32_MAX), -(1 << 30));  // −2³⁰ + 1/2, floored
+    EXPECT_EQ(fx::mul_high(-1, 1), -1);                         // −2⁻³²: the floor, not towards zero
+    EXPECT_EQ(fx::mul_high(1 << 30, 1 << 30), 1 << 28);
+}
+
 // The fixed-point thermal angle against the same polynomial in double on the
 // fixed-point inputs (coefficients and temperatures as quantised), with
 // quadratic terms and with none.

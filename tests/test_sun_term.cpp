@@ -195,6 +195,53 @@ TEST(SunTerm, FloatAndQ30AreTheDoublesWithinTheirRounding) {
     RecordProperty("worst_float_arcsec", std::to_string(worst_float));
 }
 
+// The Q30 kernel (sun_term.hpp's plus_sun_term_angles) against the double
+// form on the same rounded inputs (attitude, Sun direction, coefficients and
+// base): each angle within the rounding it states, |c| row sum · 7·2⁻²⁶ (ŝ_chu
+// from high words) plus 2⁻³¹ (the angle's own). The bound is nearly reached
+// (the half LSB of the angle's rounding, at small coefficients): the
+// comparison is fine enough to see the kernel's rounding.
+TEST(SunTerm, TheQ30KernelIsWithinItsStatedRounding) {
+    using SQ = ScalarTraits<Q30>;
+    std::mt19937_64 rng(43);
+    double worst = 0.0;  // of the error over its bound
+    for (int trial = 0; trial < 20000; ++trial) {
+        const double scale = (trial % 2 == 0 ? 2.0 : 1200.0) * kArcsecToRad;
+        std::uniform_real_distribution<double> coefficient(-scale, scale);
+        SunTermModel<Q30> mq{};
+        SunTermModel<double> md{};
+        mq.present[0] = md.present[0] = true;
+        double row_sum[3] = {};
+        for (std::size_t a = 0; a < 3; ++a) {
+            for (std::size_t c = 0; c < 3; ++c) {
+                mq.coefficient[0][a][c] = SQ::from_double(coefficient(rng));
+                md.coefficient[0][a][c] = SQ::to_double(mq.coefficient[0][a][c]);
+                row_sum[a] += std::abs(md.coefficient[0][a][c]);
+            }
+        }
+        const Quaternion<double> q = from_eigen(random_attitude(rng));
+        const Eigen::Vector3d s = random_unit_vector(rng);
+        const Quaternion<Q30> qq{SQ::from_double(q.w), SQ::from_double(q.x), SQ::from_double(q.y),
+                                 SQ::from_double(q.z)};
+        const Vector3<Q30> sq{SQ::from_double(s.x()), SQ::from_double(s.y()), SQ::from_double(s.z())};
+        const Vector3<Q30> bq{SQ::from_double(coefficient(rng)), SQ::from_double(coefficient(rng)),
+                              SQ::from_double(coefficient(rng))};
+        const Vector3<Q30> got = plus_sun_term_angles(bq, mq, 0, qq, sq);
+        const Vector3<double> want = plus_sun_term_angles(
+            Vector3<double>{SQ::to_double(bq.x), SQ::to_double(bq.y), SQ::to_double(bq.z)}, md, 0,
+            Quaternion<double>{SQ::to_double(qq.w), SQ::to_double(qq.x), SQ::to_double(qq.y), SQ::to_double(qq.z)},
+            Vector3<double>{SQ::to_double(sq.x), SQ::to_double(sq.y), SQ::to_double(sq.z)});
+        const double error[3] = {SQ::to_double(got.x) - want.x, SQ::to_double(got.y) - want.y,
+                                 SQ::to_double(got.z) - want.z};
+        for (std::size_t a = 0; a < 3; ++a) {
+            worst = std::max(worst, std::abs(error[a]) / (row_sum[a] * 7.0 * 0x1p-26 + 0x1p-31));
+        }
+    }
+    EXPECT_LE(worst, 1.0) << "the error over the kernel's stated rounding";
+    EXPECT_GT(worst, 0.5) << "the angle's own rounding shows: the comparison measures the kernel";
+    RecordProperty("worst_over_bound", std::to_string(worst));
+}
+
 // One solution of the flight-form tests below, in double, with what the
 // bound of correct.hpp's folded thermal stage needs.
 struct FlightCase {

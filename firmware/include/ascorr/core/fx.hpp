@@ -20,6 +20,7 @@
 //                                 → i32                nearest      none: the caller
 //                                                                   states the range
 //   narrow_sat<S>(v)       i64 → i32      v·2^−S       nearest      to [−2³¹, 2³¹ − 1]
+//   mul_high(a, b)         i32 → i32      a·b·2^−32    towards −∞   none (|result| ≤ 2³⁰)
 //
 // and the exact products the sums are made of: mul, accumulate_products,
 // sum_products (and unshared(), which keeps them single SMULL/SMLAL on Armv7-M).
@@ -122,6 +123,13 @@ constexpr std::int32_t unshared(std::int32_t x) noexcept {
 // a·b exactly, in 64 bits (one SMULL; SMLAL into a sum). |a·b| ≤ 2⁶².
 constexpr std::int64_t mul(std::int32_t a, std::int32_t b) noexcept {
     return std::int64_t{a} * b;
+}
+
+// ⌊a·b·2^−32⌋: the high word of one SMULL, for a product whose low bits a
+// kernel can give up (its error, in [0, 1) of the result's LSB, is stated by
+// the caller). Range: any a, b; |result| ≤ 2³⁰.
+constexpr std::int32_t mul_high(std::int32_t a, std::int32_t b) noexcept {
+    return static_cast<std::int32_t>(mul(a, b) >> 32);
 }
 
 // acc + Σ aᵢ·bᵢ over the pairs (a₀, b₀, a₁, b₁, …), exact: a chain of SMLAL.

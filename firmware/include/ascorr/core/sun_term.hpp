@@ -17,8 +17,8 @@
 //    to the polynomial's before its one rotation, s_chu from the raw
 //    attitude; it differs from the contract's by the bound correct.hpp states
 //    (4e-3″ for 2″ coefficients, a 25″ aberration and a 60″ polynomial) and
-//    costs 183 instructions on the M3 instead of the separate rotation's 613,
-//    70 on the M4F instead of 153 (docs/figures.md).
+//    costs 136 instructions on the M3 instead of the separate rotation's 613,
+//    67 on the M4F instead of 153 (docs/figures.md).
 // Why the head's own frame: the Sun heats the bench by where it stands in the
 // spacecraft's frame, which on a nadir-pointing spacecraft is the orbital
 // frame (v̂, n̂, r̂) the study chose (bench/inside_orbit_terms.py), and every
@@ -91,82 +91,87 @@ constexpr void keep_present_where_terms(SunTermModel<T>& m) noexcept {
 // v rotated by q: R(q)·v, the components in q's target frame of a vector
 // given in its source frame (q_b_a maps a into b). Unit q = (w, u):
 //   R(q)·v = q ⊗ (0, v) ⊗ q* = v + 2·m,  m = w·t + u × t,  t = u × v,
-// 15 products instead of the two quaternion products' 24. Range (Q30): unit
-// q and v give |t| ≤ 1 and |m| ≤ |u|·(|w| + |u|) ≤ (1 + √2)/2 per component,
-// and v + m = (v + R(q)·v)/2 within ±1, so no sum saturates.
+// 15 products instead of the two quaternion products' 24; |t| ≤ 1 and
+// |m| ≤ |u|·(|w| + |u|) ≤ (1 + √2)/2 per component for unit q and v. v + 2·m
+// is written as one product and one sum (2·m is exact): one rounding, and
+// one FMA where the build fuses.
 template <typename T>
 constexpr Vector3<T> rotated(const Quaternion<T>& q, const Vector3<T>& v) noexcept {
     const Vector3<T> u{q.x, q.y, q.z};
     const Vector3<T> t = cross(u, v);
     const Vector3<T> m = q.w * t + cross(u, t);
-    return (v + m) + m;
+    return v + constant<T>(2.0) * m;
 }
 
 // base + the term's angles (alpha, beta, gamma as x, y, z; rad) for head h
-// at attitude q_chu_icrf: base + S·ŝ_chu. base is the polynomial's angles
-// where the term is folded into its rotation (correct.hpp), else 0.
-// Precondition: h < kMaxHeads.
+// at attitude q_chu_icrf: base + S·ŝ_chu, each angle summed from base, a
+// product at a time (three FMA where the build fuses). base is the
+// polynomial's angles where the term is folded into its rotation
+// (correct.hpp), else 0. Precondition: h < kMaxHeads.
 template <typename T>
 constexpr Vector3<T> plus_sun_term_angles(const Vector3<T>& base, const SunTermModel<T>& m, std::uint8_t head,
                                           const Quaternion<T>& q_chu_icrf, const Vector3<T>& s_icrf) noexcept {
     const Vector3<T> s_chu = rotated(q_chu_icrf, s_icrf);
-    const auto angle = [&](std::uint8_t a) {
+    const auto angle = [&](std::uint8_t a, T b) {
         const T(&c)[kSunComponents] = m.coefficient[head][a];
-        return dot(Vector3<T>{c[0], c[1], c[2]}, s_chu);
+        return ((b + c[0] * s_chu.x) + c[1] * s_chu.y) + c[2] * s_chu.z;
     };
-    return base + Vector3<T>{angle(0), angle(1), angle(2)};
+    return {angle(0, base.x), angle(1, base.y), angle(2, base.z)};
 }
 
-// In Q30 (q_formats.hpp): plus_sun_term_angles as one kernel, each component a
-// chain of exact products rounded once (fx::narrow), with no saturation:
-//   t = u × s      two products per component, |t| ≤ |u|·|s| ≤ 1;
-//   m = w·t + u × t  three, |m| ≤ (1 + √2)/2 (rotated(), above);
-//   ŝ_chu = s + m + m, exact, in 32-bit modular sums: s + m = (s + ŝ_chu)/2
-//     and ŝ_chu are within ±1, so the true sums never wrap;
-//   angle = base + c · ŝ_chu  three, base the accumulator's start (no
-//     instruction of its own); |c| row sums ≤ kMaxThermalAngleRad (the
-//     model's domain, raw < 2²⁵) and |base| ≤ kMaxThermalAngleRad (the
-//     polynomial's, checked before), so the result is within ±2° (raw < 2²⁶).
-// Range: q unit within the core's tolerance (|qᵢ| ≤ 1 + 2⁻²⁰, as the core
-// validates it) and s unit (|sᵢ| ≤ 1 + 2⁻²⁰; the producer forms it so): no
-// int64 sum exceeds 3·2⁶⁰·(1 + 2⁻¹⁹) < 2⁶³. Outside that range (|sᵢ| up to 2)
-// the int64 sums still fit (≤ 2⁶²·1.0001 for t, 3·2⁶¹·1.0001 for m, using
-// |t|'s raw, whatever it wrapped to, ≤ 2³¹) and the 32-bit sums are
-// modular: the angles are then wrong, never undefined.
-// Rounding: t ≤ 2⁻³¹; m ≤ 2⁻³¹ plus (|w| + 2|u|)·2⁻³¹ carried from t; ŝ_chu
-// twice m's, ≤ 8·2⁻³¹ = 3.7e-9; each sum ≤ 2⁻³¹ rad (9.6e-5″) plus
-// |S|·3.7e-9 (≤ 6.5e-11 rad for |S| ≤ 3600″), as the generic form's within a few LSB.
+// In Q30 (q_formats.hpp): plus_sun_term_angles as one kernel. ŝ_chu feeds
+// only the term, a small angle (|S| row sums ≤ kMaxThermalAngleRad), so it is
+// formed from the high words of single SMULLs (fx::mul_high, ⌊a·b·2⁻³²⌋) in
+// 32-bit sums, at 2⁻²⁶, and only the angles are 64-bit sums rounded once:
+//   t = u × s      at 2⁻²⁸ (Q30·Q30·2⁻³²), |t| ≤ |u|·|s| ≤ 1 + 2⁻¹⁹;
+//   m = w·t + u × t  at 2⁻²⁶, |m| ≤ (1 + √2)/2 (rotated(), above);
+//   ŝ_chu = s·2⁻⁴ + 2m  at 2⁻²⁶ (s's arithmetic shift), within ±(1 + 2⁻¹⁸);
+//   angle = base + round(c · ŝ_chu · 2⁻²⁶)  three SMLAL from the rounding
+//     constant; base (Q30) added after the shift, as it is an exact multiple
+//     of the product's 2⁻⁵⁶ (the same bits as a sum started from base·2²⁶).
+// Range: with q and s unit within the core's tolerance (|qᵢ|, |sᵢ| ≤
+// 1 + 2⁻²⁰; the core validates q, the producer forms s unit), every 32-bit
+// sum is far from ±2³¹ (|t| raw ≤ 2²⁸·1.0001, |m|, |ŝ_chu| raw ≤ 2²⁶·1.21);
+// the 32-bit sums are modular all the same, so that any q and s give wrong
+// angles, never undefined behaviour. The angles' int64 sum: |c| row sums <
+// 2²⁵ raw (the model's domain) times |ŝ_chu| raw < 2³¹ whatever it wrapped to:
+// < 2⁵⁶, fits; the result, base (|base| ≤ kMaxThermalAngleRad, raw < 2²⁵,
+// checked before) plus the term (< 2²⁶ raw for a unit ŝ), fits int32.
+// Rounding (each mul_high rounds towards −∞, an error in [0, 1) of its LSB):
+// t within 2⁻²⁸; m within 2·2⁻²⁶ of its own plus (|w| + |u_y| + |u_z|)·2⁻²⁸
+// < 2⁻²⁶ carried from t; ŝ_chu within 2⁻²⁶ (the shift) + 2·3·2⁻²⁶ = 7·2⁻²⁶
+// (1.04e-7) per component; each angle within |c| row sum · 1.04e-7 (a
+// relative 1e-7 of the term: 6e-7″ for a 6″ row, 3.8e-4″ at the domain's 1°)
+// plus 2⁻³¹ rad (9.6e-5″) from its rounding, plus the coefficients' own
+// conversion (≤ 2⁻³¹ rad each). Instructions: bench "sun" (docs/figures.md).
 constexpr Vector3<Q30> plus_sun_term_angles(const Vector3<Q30>& base, const SunTermModel<Q30>& m, std::uint8_t head,
                                             const Quaternion<Q30>& q_chu_icrf, const Vector3<Q30>& s_icrf) noexcept {
-    using fx::narrow;
-    using fx::unshared;
-    const std::int32_t w = unshared(q_chu_icrf.w.raw);
-    const std::int32_t ux = unshared(q_chu_icrf.x.raw);
-    const std::int32_t uy = unshared(q_chu_icrf.y.raw);
-    const std::int32_t uz = unshared(q_chu_icrf.z.raw);
-    const std::int32_t sx = unshared(s_icrf.x.raw);
-    const std::int32_t sy = unshared(s_icrf.y.raw);
-    const std::int32_t sz = unshared(s_icrf.z.raw);
-    const auto negated = [](std::int32_t v) {  // modular: −(−2) is no concern of a validated q, and never UB
-        return unshared(static_cast<std::int32_t>(0U - static_cast<std::uint32_t>(v)));
+    using fx::mul_high;
+    const auto wrap = [](std::uint32_t v) { return static_cast<std::int32_t>(v); };  // modular (above)
+    const auto u32 = [](std::int32_t v) { return static_cast<std::uint32_t>(v); };
+    const std::int32_t w = q_chu_icrf.w.raw;
+    const std::int32_t ux = q_chu_icrf.x.raw;
+    const std::int32_t uy = q_chu_icrf.y.raw;
+    const std::int32_t uz = q_chu_icrf.z.raw;
+    const std::int32_t sx = s_icrf.x.raw;
+    const std::int32_t sy = s_icrf.y.raw;
+    const std::int32_t sz = s_icrf.z.raw;
+    const auto cross = [&](std::int32_t a1, std::int32_t b2, std::int32_t a2, std::int32_t b1) {  // a1·b2 − a2·b1
+        return wrap(u32(mul_high(a1, b2)) - u32(mul_high(a2, b1)));
     };
-    const std::int32_t nux = negated(ux);
-    const std::int32_t nuy = negated(uy);
-    const std::int32_t nuz = negated(uz);
-    const std::int32_t tx = unshared(narrow<30>(0, uy, sz, nuz, sy));
-    const std::int32_t ty = unshared(narrow<30>(0, uz, sx, nux, sz));
-    const std::int32_t tz = unshared(narrow<30>(0, ux, sy, nuy, sx));
-    const auto twice_plus = [](std::int32_t v, std::int32_t h) {  // v + 2h, modular (above)
-        const auto u = static_cast<std::uint32_t>(h);
-        return unshared(static_cast<std::int32_t>(static_cast<std::uint32_t>(v) + u + u));
+    const std::int32_t tx = cross(uy, sz, uz, sy);
+    const std::int32_t ty = cross(uz, sx, ux, sz);
+    const std::int32_t tz = cross(ux, sy, uy, sx);
+    const auto s_chu = [&](std::int32_t sc, std::int32_t t, std::int32_t cross_t) {  // s·2⁻⁴ + 2(w·t + u × t)
+        const std::uint32_t mc = u32(mul_high(w, t)) + u32(cross_t);
+        return wrap(u32(sc >> 4) + mc + mc);
     };
-    const std::int32_t cx = twice_plus(sx, narrow<30>(0, w, tx, uy, tz, nuz, ty));
-    const std::int32_t cy = twice_plus(sy, narrow<30>(0, w, ty, uz, tx, nux, tz));
-    const std::int32_t cz = twice_plus(sz, narrow<30>(0, w, tz, ux, ty, nuy, tx));
+    const std::int32_t cx = s_chu(sx, tx, cross(uy, tz, uz, ty));
+    const std::int32_t cy = s_chu(sy, ty, cross(uz, tx, ux, tz));
+    const std::int32_t cz = s_chu(sz, tz, cross(ux, ty, uy, tx));
     const auto angle = [&](std::uint8_t a, Q30 b) {
         const Q30(&c)[kSunComponents] = m.coefficient[head][a];
-        return Q30{narrow<30>(std::int64_t{b.raw} * (std::int64_t{1} << 30), unshared(c[0].raw), cx, unshared(c[1].raw),
-                              cy, unshared(c[2].raw), cz)};
+        return Q30{wrap(u32(b.raw) + u32(fx::narrow<26>(0, c[0].raw, cx, c[1].raw, cy, c[2].raw, cz)))};
     };
     return {angle(0, base.x), angle(1, base.y), angle(2, base.z)};
 }
