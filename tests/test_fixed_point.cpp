@@ -77,6 +77,7 @@ TEST(FixedPoint, MultiplyRoundsToNearestAndSaturates) {
 // fx::mul_high: ⌊a·b·2⁻³²⌋ exactly, for any raws (the ends included), against
 // long double (64-bit mantissa: every a·b exact).
 TEST(FixedPoint, MulHighIsTheProductsFloorAtTwoToThe32) {
+    static_assert(std::numeric_limits<long double>::digits >= 63, "the reference needs every a·b exact");
     std::mt19937_64 rng(32);
     std::uniform_int_distribution<std::int32_t> raw(INT32_MIN, INT32_MAX);
     const auto floor_high = [](std::int32_t a, std::int32_t b) {

@@ -100,7 +100,8 @@ constexpr std::int32_t neg_sat(std::int32_t a) noexcept {
 // ---- Exact products.
 
 // x, as a value the compiler cannot identify with x. The Q30 kernels take
-// their operands through this, so that their 64-bit sign extensions are not
+// their operands through this where it measures cheaper (the target bench;
+// sun_term.hpp's kernel does not), so that their 64-bit sign extensions are not
 // shared with other kernels: when one value feeds products in several
 // kernels (inlined into one function), GCC 12 for Armv7-M extends it once and
 // then multiplies 64 × 64 bits with MUL, MLA and UMULL instead of one SMULL

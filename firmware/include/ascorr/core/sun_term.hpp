@@ -28,8 +28,9 @@
 // term's angle by ≤ |S|·ε (5e-5 of the term for a 10″ attitude error).
 // Scalars: double, float and Q30. In Q30 (q_formats.hpp) the angles are one
 // kernel of their own (plus_sun_term_angles, below, with its range and
-// rounding: ≤ 2⁻³¹ rad per angle plus the coefficients' conversion, each
-// rounded to nearest once, ≤ 2⁻³¹ rad, relative 4.8e-5 of a 2″ coefficient);
+// rounding: ≤ 2⁻³¹ rad per angle plus |S| row sum · 7·2⁻²⁶ from ŝ_chu, plus
+// the coefficients' conversion, each rounded to nearest once, ≤ 2⁻³¹ rad,
+// relative 4.8e-5 of a 2″ coefficient);
 // the rotation runs on the core's Q30 kernels (thermal.hpp's
 // thermal_rotation; for the contract's form also quaternion.hpp's
 // add_left_increment and renormalized_sum), with their rounding (thermal.hpp:
@@ -127,8 +128,8 @@ constexpr Vector3<T> plus_sun_term_angles(const Vector3<T>& base, const SunTermM
 //   m = w·t + u × t  at 2⁻²⁶, |m| ≤ (1 + √2)/2 (rotated(), above);
 //   ŝ_chu = s·2⁻⁴ + 2m  at 2⁻²⁶ (s's arithmetic shift), within ±(1 + 2⁻¹⁸);
 //   angle = base + round(c · ŝ_chu · 2⁻²⁶)  three SMLAL from the rounding
-//     constant; base (Q30) added after the shift, as it is an exact multiple
-//     of the product's 2⁻⁵⁶ (the same bits as a sum started from base·2²⁶).
+//     constant; base (Q30) added after the shift: base·2²⁶ is a multiple of
+//     2²⁶, so the same bits as a sum started from base·2²⁶.
 // Range: with q and s unit within the core's tolerance (|qᵢ|, |sᵢ| ≤
 // 1 + 2⁻²⁰; the core validates q, the producer forms s unit), every 32-bit
 // sum is far from ±2³¹ (|t| raw ≤ 2²⁸·1.0001, |m|, |ŝ_chu| raw ≤ 2²⁶·1.21);
