@@ -198,10 +198,10 @@ template <typename T>
     return stage_of(a);
 }
 
-// The same, as a function of its own: GCC then keeps the Q30 kernels' 64-bit
-// chains in registers on Armv7-M (M3: 136 instructions for the term instead
-// of 189), while float is cheapest inlined into the core (M4F: 67 instead of
-// 102); correct_solution() picks by scalar (toolchain/run-target-bench).
+// The same, as a function of its own: GCC then spills less of the Q30 kernel
+// on Armv7-M (M3: 136 instructions for the term instead of 189 inlined),
+// while float is cheapest inlined into the core (M4F: 67 instead of 102);
+// correct_solution() picks by scalar (toolchain/run-target-bench).
 template <typename T>
 constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,
                                         const HeadTemperatures<T>& temps, const SunTermInput<T>& sun,
