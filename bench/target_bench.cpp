@@ -39,6 +39,15 @@
 // form it at the velocity service's rate), against the core without it
 // ("bench <scalar> sun <instructions>": what a head with a Sun term adds to
 // its solution's correction).
+// The self-calibration's Sun-term learner (calib/sun_learner.hpp, double:
+// software floating point on both targets; the out-of-line entry of
+// firmware/app/sun_learner_entry.cpp) on a 600 s orbit of 300 fed cycles 2 s
+// apart in 2026, the combination fixture's three heads on a bench turning
+// once per orbit: per fed cycle, the mean take over three orbits (the cycles
+// that close an orbit included) against a function that only reads an
+// attitude; per orbit closed, its solve's steps each timed alone, as idle
+// time runs them between cycles ("bench double sun_learner_<figure> <n>":
+// take, steps, solve (their sum), worst_step, and ram, sizeof(SunLearner)).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -53,6 +62,7 @@
 #include "earth_series_entry.hpp"
 #include "lag_entry.hpp"
 #include "sun_entry.hpp"
+#include "sun_learner_entry.hpp"
 #include "systick_counter.hpp"
 #include "vector_convert.hpp"
 
@@ -394,6 +404,109 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     report(name, "sun", run_sun<T>(&sun_with<T>, fx, sun), c0, ipc);
 }
 
+// The Sun term's learner: one fed cycle per take, one idle step per step.
+constexpr std::uint32_t kLearnerCycles = 300;  // an orbit of kMinOrbitPeriodUs
+constexpr std::int64_t kLearnerCycleUs = calib::kMinOrbitPeriodUs / kLearnerCycles;
+constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
+Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
+
+using TakeFn = bool (*)(calib::SunLearner&, std::int64_t, const Quaternion<double> (&)[calib::kFrameHeads]) noexcept;
+using StepFn = bool (*)(calib::SunLearner&) noexcept;
+
+__attribute__((noinline)) bool take_copy(calib::SunLearner& /*learner*/, std::int64_t t_us,
+                                         const Quaternion<double> (&q)[calib::kFrameHeads]) noexcept {
+    g_sink_q = q[0].w;
+    return t_us > 0;
+}
+
+__attribute__((noinline)) bool step_none(calib::SunLearner& /*learner*/) noexcept {
+    return false;
+}
+
+calib::EstimatorConfig learner_config() {
+    calib::EstimatorConfig cfg;
+    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;
+    return cfg;
+}
+
+calib::SunLearner g_learner{learner_config()};
+
+std::uint32_t run_takes(volatile TakeFn fn, std::int64_t t0_us) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kLearnerCycles; ++i) {
+            g_sink_status = fn(g_learner, t0_us + std::int64_t{i} * kLearnerCycleUs, g_learner_q[i]) ? 1U : 0U;
+        }
+    });
+}
+
+// SysTick counts of one call of fn (a step).
+std::uint32_t run_step(volatile StepFn fn, bool& more) {
+    return counts([&] { more = fn(g_learner); });
+}
+
+struct SolveCost {
+    std::uint32_t steps = 0;
+    std::uint32_t total = 0;  // SysTick counts
+    std::uint32_t worst = 0;
+};
+
+SolveCost run_solve() {
+    SolveCost c;
+    bool more = false;
+    const std::uint32_t c0 = run_step(&step_none, more);
+    for (int i = 0; i < calib::SunLearner::kMaxSolveSteps; ++i) {
+        const std::uint32_t n = run_step(&app::sun_learner_step, more) - c0;
+        if (!more) {
+            break;
+        }
+        ++c.steps;
+        c.total += n;
+        c.worst = n > c.worst ? n : c.worst;
+    }
+    return c;
+}
+
+void bench_sun_learner(std::uint32_t ipc) {
+    constexpr double kPeriodS = static_cast<double>(calib::kMinOrbitPeriodUs) * 1e-6;
+    const combine::Mountings m = bench::combination_mountings();
+    std::uint32_t state = 7U;
+    const double* q0 = g_records[0].q;
+    for (std::uint32_t i = 0; i < kLearnerCycles; ++i) {
+        const double phase =
+            2.0 * kPi * static_cast<double>(i) * (static_cast<double>(kLearnerCycleUs) * 1e-6) / kPeriodS;
+        const Quaternion<double> q_crf_icrf =
+            bench::axis_angle(0.0, 0.6, 0.8, phase) * Quaternion<double>{q0[0], q0[1], q0[2], q0[3]};
+        Quaternion<double> heads[bench::kCombinationHeads];
+        bench::combination_epoch(m, q_crf_icrf, &state, heads);
+        for (std::uint8_t h = 0; h < calib::kFrameHeads; ++h) {
+            g_learner_q[i][h] = heads[h];
+        }
+    }
+    const std::int64_t start_us = 820'000'000'000'000;  // TT µs since J2000: 2026
+    const std::int64_t t0_us = start_us - start_us % calib::kMinOrbitPeriodUs;
+    std::uint64_t takes = 0;
+    SolveCost last;
+    std::uint32_t worst = 0;
+    for (std::uint32_t o = 0; o < kLearnerOrbits; ++o) {
+        const std::int64_t t_us = t0_us + std::int64_t{o} * calib::kMinOrbitPeriodUs;
+        const std::uint32_t c = run_takes(&app::sun_learner_take, t_us);
+        if (o > 0U) {
+            takes += c - run_takes(&take_copy, t_us);
+            last = run_solve();  // the orbit closed by this one's first take
+            worst = last.worst > worst ? last.worst : worst;
+        }
+    }
+    const std::uint64_t n = std::uint64_t{kLearnerCycles} * (kLearnerOrbits - 1U);
+    std::printf("bench double sun_learner_take %u\n", static_cast<unsigned>((takes * ipc + n / 2U) / n));
+    std::printf("bench double sun_learner_steps %u\n", static_cast<unsigned>(last.steps));
+    std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
+    std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
+    std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
+    if (!g_learner.report().candidate.solved) {
+        std::puts("bench: the Sun learner's bench solved no candidate");
+    }
+}
+
 Fixture<Q30> g_fixed;
 combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
 CombinationFixture<Q30> g_combination_fixed;
@@ -450,5 +563,6 @@ int main() {
     bench_combination<Q30>("fixed", g_combiner_fixed, g_combination_fixed, ipc);
     bench_baseline(ipc);
     bench_series(ipc);
+    bench_sun_learner(ipc);
     return 0;
 }

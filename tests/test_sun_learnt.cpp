@@ -11,7 +11,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -420,6 +422,65 @@ TEST(SunLearner, TheRuleTakesOnlyBeyondTheMarginAndLeavesAlike) {
     EXPECT_TRUE(calib::SunLearner::next_taken({1.0, 1.0 - 1.5 * m}, false));
     EXPECT_TRUE(calib::SunLearner::next_taken({1.0, 1.0 + 0.5 * m}, true)) << "kept within the margin";
     EXPECT_FALSE(calib::SunLearner::next_taken({1.0, 1.0 + 1.5 * m}, true));
+}
+
+// The learner's solve in bounded steps (on board: one per idle time) gives
+// the candidate the ground's whole solve after each cycle gives, bit for
+// bit, also when a solve spans a later orbit's close: each candidate is
+// compared with the ground learner's of the same orbit count. A step every
+// second cycle makes a solve span more than an orbit of 300 cycles.
+TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
+    calib::EstimatorConfig cfg;
+    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;  // 600 s
+    calib::SunLearner ground{cfg};
+    calib::SunLearner board{cfg};
+    const Quaternion<double> mount[3] = {unit(Quaternion<double>{0.9, 0.1, -0.3, 0.2}),
+                                         unit(Quaternion<double>{0.2, 0.8, 0.1, -0.4}),
+                                         unit(Quaternion<double>{-0.3, 0.2, 0.9, 0.1})};
+    std::mt19937_64 rng(40);
+    std::normal_distribution<double> noise(0.0, 5e-6);
+    std::map<std::uint32_t, calib::SunTermFit> by_orbits;  // the ground's candidates
+    std::uint32_t board_orbits = 0;
+    int compared = 0;
+    int steps = 0;
+    int longest = 0;                              // the most steps of one solve on board
+    const std::int64_t t0 = 820'000'000'000'000;  // TT µs since J2000: 2026
+    for (std::int64_t k = 0; k < 16 * 300; ++k) {
+        const std::int64_t t_us = t0 + k * 2'000'000;
+        const double phase =
+            2.0 * kPi * static_cast<double>(t_us % cfg.orbit_period_us) / static_cast<double>(cfg.orbit_period_us);
+        const Quaternion<double> bench{std::cos(0.5 * phase), 0.0, std::sin(0.5 * phase), 0.0};
+        Quaternion<double> q[calib::kFrameHeads];
+        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+            q[h] = turned(mount[h] * bench, noise(rng), noise(rng), noise(rng));
+        }
+        ASSERT_TRUE(ground.take(t_us, q));
+        (void)ground.step_all();
+        const calib::SunTermFit g = ground.report().candidate;
+        by_orbits.emplace(g.orbits, g);
+        ASSERT_TRUE(board.take(t_us, q));
+        if (k % 2 == 0 && board.step()) {
+            ++steps;
+        }
+        const calib::SunTermFit b = board.report().candidate;
+        if (b.orbits != board_orbits) {
+            board_orbits = b.orbits;
+            ASSERT_TRUE(b.solved);
+            ASSERT_EQ(by_orbits.count(b.orbits), 1U) << b.orbits;
+            const calib::SunTermFit& want = by_orbits.at(b.orbits);
+            EXPECT_GT(b.rank, 0);
+            EXPECT_EQ(b.rank, want.rank);
+            EXPECT_EQ(b.epochs, want.epochs);
+            EXPECT_EQ(std::memcmp(b.sun, want.sun, sizeof b.sun), 0) << "orbits " << b.orbits;
+            ++compared;
+            longest = std::max(longest, steps);  // solves follow each other: the steps of this one
+            steps = 0;
+        }
+    }
+    EXPECT_GE(compared, 4);
+    EXPECT_GT(longest, 100) << "one solve took many steps (a row of a sweep each)";
+    EXPECT_LE(longest, calib::SunLearner::kMaxSolveSteps);
+    EXPECT_LT(board_orbits, ground.report().candidate.orbits) << "a solve on board spans an orbit's close";
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

@@ -36,7 +36,7 @@ SOURCES = {
 }
 
 TARGET_NAMES = {"cortex-m4f": "M4F", "cortex-m3": "M3"}
-NOT_TARGETS = {"earth_series", "estimator", "host", "baseline", "flight_loop"}
+NOT_TARGETS = {"earth_series", "estimator", "sun_learner", "host", "baseline", "flight_loop"}
 
 
 class DataError(Exception):
@@ -204,6 +204,31 @@ def estimator_section(d):
     return out + table([""] + [tname(t) for t in ts], rows) + [""]
 
 
+def sun_learner_section(d):
+    e = get(d, "sun_learner")
+    est = d["result"].get("estimator", {})
+    ts = list(e)
+    out = ["## The Sun-term learner", "",
+           "The self-calibration's learner of the Sun term (`calib/sun_learner.hpp`, double: software floating "
+           "point on both targets), measured alone by the target bench: not in the flight loop yet. A take per "
+           "fed cycle (every 2nd cycle in the loop), the solve after each orbit in idle time, a step at a time.", ""]
+
+    def against_estimator(t):
+        per_cycle = e[t]["per_fed_cycle"] / 2
+        base = (est.get(t) or {}).get("per_cycle")
+        return f"{num(round(per_cycle))} ({per_cycle / base:.0f}× the estimator's)" if base else num(round(per_cycle))
+    rows = [
+        ["per fed cycle (take)"] + [num(e[t]["per_fed_cycle"]) for t in ts],
+        ["per cycle, mean (feed every 2nd cycle)"] + [against_estimator(t) for t in ts],
+        ["per orbit (the solve, idle time)"] + [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps"
+                                                for t in ts],
+        ["worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],
+        ["RAM (`sizeof(SunLearner)`)"] + [f"{num(e[t]['ram_bytes'])} B" for t in ts],
+        ["stack (its entry's frames, summed)"] + [f"{num(e[t]['stack_bytes'])} B" for t in ts],
+    ]
+    return out + table([""] + [tname(t) for t in ts], rows) + [""]
+
+
 def acquisition_section(d):
     r = d["result"]
     ts = list(r)
@@ -354,6 +379,8 @@ def page():
         if "flight_loop" in tb["result"]:
             out += flight_section(tb)
         out += estimator_section(tb)
+        if "sun_learner" in tb["result"]:
+            out += sun_learner_section(tb)
     if loaded["acquisition-bench"] is not None:
         out += acquisition_section(loaded["acquisition-bench"])
     if loaded["row-order"] is not None:

@@ -242,7 +242,7 @@ private:
 
     void learn_sun(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads]) {
         (void)sun_->take(t_us, q);
-        (void)sun_->step();  // its per-orbit work, as in idle time after the cycle
+        (void)sun_->step_all();  // its per-orbit work, as in idle time after the cycle
     }
 
     const std::string& file_;

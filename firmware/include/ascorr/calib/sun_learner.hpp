@@ -37,7 +37,11 @@
 // Cost per fed cycle (take): a Sun direction, three Sun-term rotations, six
 // boresights and IBAs, the moments' 2·9² products. Per orbit closed (step):
 // the normal equations (27 × 27) and their Jacobi eigen-decomposition
-// (symmetric_eigen.hpp, at most 30 sweeps), one phase, about 12 KiB of stack.
+// (symmetric_eigen.hpp, at most 30 sweeps), a bounded step per call (the
+// normal equations, one row of a sweep, or the result), in the learner's own
+// 12 KiB workspace (SunMoments::Solve), not on the stack. Measured on the
+// targets by bench/target_bench.cpp (docs/figures.md, "The Sun-term
+// learner").
 // No allocation, every loop bounded.
 #pragma once
 
@@ -123,21 +127,44 @@ public:
         return true;
     }
 
+    // The most step() calls one solve takes (sun_moments.hpp's solve_step).
+    static constexpr int kMaxSolveSteps = SunMoments<kFrameHeads>::kMaxSolveSteps;
+
     // The per-orbit work, in idle time after a cycle (take) closed an orbit:
-    // the candidate solved again from the sums. Bounded (sun_moments.hpp's
-    // solve: the normal equations and at most kMaxJacobiSweeps sweeps), one
-    // phase; false: nothing pending.
+    // the candidate solved again from the sums, one bounded step of the
+    // solve per call (sun_moments.hpp's solve_step: the normal equations,
+    // one row of a Jacobi sweep, or the result), at most kMaxSolveSteps per
+    // solve. A solve begun goes on with the sums as they were when it began;
+    // an orbit closed meanwhile is solved after it. false: nothing pending.
     bool step() noexcept {
-        if (!solve_pending_) {
-            return false;
+        if (!solving_) {
+            if (!solve_pending_) {
+                return false;
+            }
+            solve_pending_ = false;
+            solving_ = true;
         }
-        solve_pending_ = false;
-        SunTermFit fit;
-        if (moments_.solve(rule_, fit) && sun_fit_within_domain(fit)) {
-            candidate_ = fit;
-            candidate_model_ = sun_term_model(fit);
+        const SunSolveStep s = moments_.solve_step(solve_, rule_);
+        if (s == SunSolveStep::kRunning) {
+            return true;
+        }
+        solving_ = false;
+        if (s == SunSolveStep::kSolved && sun_fit_within_domain(solve_.fit)) {
+            candidate_ = solve_.fit;
+            candidate_model_ = sun_term_model(solve_.fit);
         }
         return true;
+    }
+
+    // step() until nothing is pending (at most kMaxSolveSteps per solve: the
+    // one begun, and one pending): what idle time does after each cycle on
+    // the ground. false: nothing was.
+    bool step_all() noexcept {
+        bool any = false;
+        for (int i = 0; i < 2 * kMaxSolveSteps && step(); ++i) {
+            any = true;
+        }
+        return any;
     }
 
     // Closes the open orbit (the end of the data), its solve included.
@@ -145,7 +172,7 @@ public:
         if (scores_.open()) {
             close_orbit(scores_.open_bin());
         }
-        (void)step();
+        (void)step_all();
         if (scores_.finish()) {
             reconsider();
         }
@@ -216,6 +243,8 @@ private:
     std::int64_t last_closed_bin_ = 0;
     SunTermFit candidate_{};
     SunTermModel<double> candidate_model_{};
+    SunMoments<kFrameHeads>::Solve solve_{};  // the solve's workspace (step)
+    bool solving_ = false;                    // a solve begun (solve_)
     bool solve_pending_ = false;
     bool taken_ = false;
     std::uint64_t without_sun_ = 0U;

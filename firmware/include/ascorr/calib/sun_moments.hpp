@@ -30,8 +30,8 @@
 // motion under the weights unmoved for every Sun direction), or a head rigid
 // to the bench (its coefficients exactly 0). The term's orbit mean along the
 // orbit normal is thereby left to the temperatures' polynomial.
-// Double (per orbit: the learner's solve runs once an orbit); no allocation;
-// every loop bounded by H.
+// Double (per orbit: the learner's solve runs once an orbit, in bounded
+// steps: solve_step); no allocation; every loop bounded by H.
 #pragma once
 
 #include <cmath>
@@ -120,6 +120,11 @@ inline SunTermModel<double> sun_term_model(const SunTermFit& f) noexcept {
     keep_present_where_terms(m);
     return m;
 }
+
+// A solve in steps (SunMoments::solve_step): what a step did, and where the
+// next begins.
+enum class SunSolveStep : unsigned char { kRunning, kSolved, kFailed };
+enum class SunSolvePhase : unsigned char { kForm, kEigen, kResult };
 
 // H: the most heads (3 on board: A, B, C; kMaxHeads on the ground).
 template <std::size_t H>
@@ -213,40 +218,57 @@ public:
 
     std::uint32_t open_count() const noexcept { return orbit_count_; }
 
+    // The solve's workspace and progress (solve_step): on board the
+    // learner's (sun_learner.hpp), so that no step needs the 12 KiB of the
+    // normal equations and their eigenvectors on its stack.
+    struct Solve {
+        double normal[kUnknowns][kUnknowns];  // the normal equations, then their eigenvalues (diagonal)
+        double vectors[kUnknowns][kUnknowns];
+        double rhs[kUnknowns];
+        JacobiProgress jacobi;
+        SunSolvePhase phase = SunSolvePhase::kForm;
+        SunTermFit fit;  // the result (fit.solved), once solve_step has returned kSolved
+    };
+    // The most solve_step() calls of one solve: forming, the eigen-decomposition a
+    // row per step, the result.
+    static constexpr int kMaxSolveSteps = 2 + jacobi_max_steps(kUnknowns);
+
     // The fit over the orbits closed (above); false (out.solved) when there is none,
     // or the equations are not finite, or the rule's weights are singular.
+    // solve_step() to the end, at once (the ground fit).
     bool solve(const SunRule& rule, SunTermFit& out) const noexcept {
-        out = SunTermFit{};
-        out.orbits = orbits_;
-        out.epochs = epochs_;
-        if (orbits_ == 0U || count_ < 2U) {
-            return false;
+        Solve w;
+        SunSolveStep s = SunSolveStep::kRunning;
+        for (int i = 0; i < kMaxSolveSteps && s == SunSolveStep::kRunning; ++i) {
+            s = solve_step(w, rule);
         }
-        double theta[kUnknowns] = {};
-        if (!pseudo_inverse_solution(theta, out.rank)) {
-            return false;
+        out = w.fit;
+        return s == SunSolveStep::kSolved;
+    }
+
+    // One bounded step of a solve (w.phase kForm: a new one). The first
+    // forms the normal equations from the sums as they are then (later
+    // orbits closed do not change this solve); each of the eigen-
+    // decomposition's does one row of a Jacobi sweep (n − 1 rotations of
+    // 3·3H order); the last forms the fit (w.fit) under the rule. At most
+    // kMaxSolveSteps; then kSolved or kFailed, and w.phase is kForm again.
+    SunSolveStep solve_step(Solve& w, const SunRule& rule) const noexcept {
+        SunSolveStep s = SunSolveStep::kRunning;
+        switch (w.phase) {
+            case SunSolvePhase::kForm:
+                s = form(w);
+                break;
+            case SunSolvePhase::kEigen:
+                s = eigen_row(w);
+                break;
+            case SunSolvePhase::kResult:
+                s = result(w, rule);
+                break;
         }
-        double s[H][3][3];
-        for (std::size_t i = 0; i < count_; ++i) {
-            for (std::size_t a = 0; a < 3; ++a) {
-                for (std::size_t m = 0; m < 3; ++m) {
-                    s[i][a][m] = theta[9 * i + 3 * a + m];
-                }
-            }
+        if (s != SunSolveStep::kRunning) {
+            w.phase = SunSolvePhase::kForm;
         }
-        if (!apply_rule(rule, s)) {
-            return false;
-        }
-        for (std::size_t i = 0; i < count_; ++i) {
-            out.heads = static_cast<std::uint8_t>(out.heads | (1U << head_[i]));
-            for (std::size_t a = 0; a < 3; ++a) {
-                for (std::size_t m = 0; m < 3; ++m) {
-                    out.sun[head_[i]][a][m] = s[i][a][m];
-                }
-            }
-        }
-        out.solved = true;
-        return true;
+        return s;
     }
 
 private:
@@ -261,56 +283,102 @@ private:
     // P the projector, unknown (i, a, m) at 9i + 3a + m and equation row
     // r = (i, a) = 3i + a, Σ XᵀPX = P[r][r2]·SS[(i, m)][(j, m2)] and
     // Σ XᵀPe = Σ_r2 P[r][r2]·ES[r2][(i, m)] (X's rows are s's: a Kronecker
-    // product); then θ = Σ_k v_k·(v_k·rhs)/λ_k over λ_k > tolerance·λ_max.
-    bool pseudo_inverse_solution(double (&theta)[kUnknowns], int& rank) const noexcept {
+    // product); then the eigen-decomposition begins.
+    SunSolveStep form(Solve& w) const noexcept {
+        w.fit = SunTermFit{};
+        w.fit.orbits = orbits_;
+        w.fit.epochs = epochs_;
+        if (orbits_ == 0U || count_ < 2U) {
+            return SunSolveStep::kFailed;
+        }
         const std::size_t n = 3 * count_;
-        const std::size_t u = 3 * n;
         Matrix3 nh[H];
         references(nh);
         double p[kRows * kRows];
         common_rotation_projector(nh, count_, p);
-        double normal[kUnknowns][kUnknowns];
-        double vectors[kUnknowns][kUnknowns];
-        double rhs[kUnknowns] = {};
+        for (double& r : w.rhs) {
+            r = 0.0;
+        }
         for (std::size_t r = 0; r < n; ++r) {
             for (std::size_t m = 0; m < 3; ++m) {
                 const std::size_t col = 3 * r + m;
                 const std::size_t im = 3 * (r / 3) + m;
                 for (std::size_t r2 = 0; r2 < n; ++r2) {
                     const double prr = p[r * n + r2];
-                    rhs[col] += prr * es_[r2][im];
+                    w.rhs[col] += prr * es_[r2][im];
                     for (std::size_t m2 = 0; m2 < 3; ++m2) {
-                        normal[col][3 * r2 + m2] = prr * ss_[im][3 * (r2 / 3) + m2];
+                        w.normal[col][3 * r2 + m2] = prr * ss_[im][3 * (r2 / 3) + m2];
                     }
                 }
             }
         }
-        const int sweeps = symmetric_eigen(normal, vectors, u);
-        if (sweeps < 0 || sweeps > kMaxJacobiSweeps) {
-            return false;
+        if (!jacobi_start(w.normal, w.vectors, 3 * n, w.jacobi)) {
+            return SunSolveStep::kFailed;
         }
+        w.phase = SunSolvePhase::kEigen;
+        return SunSolveStep::kRunning;
+    }
+
+    SunSolveStep eigen_row(Solve& w) const noexcept {
+        switch (jacobi_row(w.normal, w.vectors, w.jacobi)) {
+            case JacobiStep::kRunning:
+                return SunSolveStep::kRunning;
+            case JacobiStep::kConverged:
+                w.phase = SunSolvePhase::kResult;
+                return SunSolveStep::kRunning;
+            case JacobiStep::kNotConverged:
+                break;
+        }
+        return SunSolveStep::kFailed;
+    }
+
+    // θ = Σ_k v_k·(v_k·rhs)/λ_k over λ_k > tolerance·λ_max, then the rule.
+    SunSolveStep result(Solve& w, const SunRule& rule) const noexcept {
+        const std::size_t u = w.jacobi.n;
         double largest = 0.0;
         for (std::size_t k = 0; k < u; ++k) {
-            largest = normal[k][k] > largest ? normal[k][k] : largest;
+            largest = w.normal[k][k] > largest ? w.normal[k][k] : largest;
         }
         if (!(largest > 0.0)) {
-            return false;
+            return SunSolveStep::kFailed;
         }
-        rank = 0;
+        double theta[kUnknowns] = {};
+        int rank = 0;
         for (std::size_t k = 0; k < u; ++k) {
-            const double lambda = normal[k][k];
+            const double lambda = w.normal[k][k];
             if (lambda > kSunRankTolerance * largest) {
                 double dot = 0.0;
                 for (std::size_t j = 0; j < u; ++j) {
-                    dot += vectors[j][k] * rhs[j];
+                    dot += w.vectors[j][k] * w.rhs[j];
                 }
                 for (std::size_t j = 0; j < u; ++j) {
-                    theta[j] += vectors[j][k] * (dot / lambda);
+                    theta[j] += w.vectors[j][k] * (dot / lambda);
                 }
                 ++rank;
             }
         }
-        return true;
+        w.fit.rank = rank;
+        double s[H][3][3];
+        for (std::size_t i = 0; i < count_; ++i) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t m = 0; m < 3; ++m) {
+                    s[i][a][m] = theta[9 * i + 3 * a + m];
+                }
+            }
+        }
+        if (!apply_rule(rule, s)) {
+            return SunSolveStep::kFailed;
+        }
+        for (std::size_t i = 0; i < count_; ++i) {
+            w.fit.heads = static_cast<std::uint8_t>(w.fit.heads | (1U << head_[i]));
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t m = 0; m < 3; ++m) {
+                    w.fit.sun[head_[i]][a][m] = s[i][a][m];
+                }
+            }
+        }
+        w.fit.solved = true;
+        return SunSolveStep::kSolved;
     }
 
     // The common rotation S_h + N_h·C·N_hᵀ fixed by the rule (above).

@@ -59,15 +59,37 @@ void jacobi_rotation(double (&a)[N][N], double (&v)[N][N], std::size_t n, std::s
     }
 }
 
-// a (n × n of N × N, symmetric) is overwritten: its diagonal holds the
-// eigenvalues; v's columns the eigenvectors (orthonormal), a = V·diag·Vᵀ.
-// Returns the sweeps done, or −1 when a is not finite or n > N (a and v are
-// then left as they are, resp. v the identity), or kMaxJacobiSweeps + 1 when
-// the bound was reached first (the result is then that of the last sweep).
+// The decomposition in bounded steps (on board, in idle time: one row of a
+// sweep per step, n − 1 rotations): JacobiProgress holds where it is,
+// jacobi_start() begins it, jacobi_row() does the next row (at a sweep's
+// first row the convergence test first). The same operations in the same
+// order as symmetric_eigen() below, which is made of them: the same bits.
+struct JacobiProgress {
+    std::size_t n = 0;    // the matrix's order
+    double bound = 0.0;   // the off-diagonal sum of squares that ends the sweeps
+    int sweep = 0;        // sweeps done
+    std::size_t row = 0;  // the next row p of the current sweep
+};
+
+enum class JacobiStep : unsigned char {
+    kRunning,       // a row done; more to do
+    kConverged,     // the off-diagonal part within the tolerance: done (progress.sweep sweeps)
+    kNotConverged,  // kMaxJacobiSweeps sweeps done first (the result is that of the last)
+};
+
+// The most jacobi_row() calls of one decomposition of order n: a row per
+// step, n − 1 per sweep, and the final test.
+constexpr int jacobi_max_steps(std::size_t n) noexcept {
+    return kMaxJacobiSweeps * static_cast<int>(n > 1U ? n - 1U : 1U) + 1;
+}
+
+// Begins the decomposition of a (n × n of N × N, symmetric): v = I. false
+// when a is not finite or n > N (a and v then left as they are, resp. v the
+// identity).
 template <std::size_t N>
-int symmetric_eigen(double (&a)[N][N], double (&v)[N][N], std::size_t n) noexcept {
+bool jacobi_start(const double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress) noexcept {
     if (n > N) {
-        return -1;
+        return false;
     }
     double total = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -77,26 +99,60 @@ int symmetric_eigen(double (&a)[N][N], double (&v)[N][N], std::size_t n) noexcep
         }
     }
     if (!std::isfinite(total)) {
-        return -1;
+        return false;
     }
-    const double bound = kJacobiTolerance * kJacobiTolerance * total;
-    for (int sweep = 0; sweep < kMaxJacobiSweeps; ++sweep) {
+    progress = {n, kJacobiTolerance * kJacobiTolerance * total, 0, 0U};
+    return true;
+}
+
+// The next row of the current sweep (progress from jacobi_start): its
+// rotations J(row, q) for q > row.
+template <std::size_t N>
+JacobiStep jacobi_row(double (&a)[N][N], double (&v)[N][N], JacobiProgress& progress) noexcept {
+    const std::size_t n = progress.n;
+    if (progress.row == 0U) {
+        if (progress.sweep >= kMaxJacobiSweeps) {
+            return JacobiStep::kNotConverged;
+        }
         double off = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
             for (std::size_t j = 0; j < n; ++j) {
                 off += i == j ? 0.0 : a[i][j] * a[i][j];
             }
         }
-        if (off <= bound) {
-            return sweep;
-        }
-        for (std::size_t p = 0; p + 1U < n; ++p) {
-            for (std::size_t q = p + 1U; q < n; ++q) {
-                jacobi_rotation(a, v, n, p, q);
-            }
+        if (off <= progress.bound) {
+            return JacobiStep::kConverged;
         }
     }
-    return kMaxJacobiSweeps + 1;
+    const std::size_t p = progress.row;
+    for (std::size_t q = p + 1U; q < n; ++q) {
+        jacobi_rotation(a, v, n, p, q);
+    }
+    if (p + 2U < n) {
+        ++progress.row;
+    } else {  // the sweep's last row (p = n − 2; n ≥ 2 here: n ≤ 1 has converged above)
+        progress.row = 0U;
+        ++progress.sweep;
+    }
+    return JacobiStep::kRunning;
+}
+
+// a (n × n of N × N, symmetric) is overwritten: its diagonal holds the
+// eigenvalues; v's columns the eigenvectors (orthonormal), a = V·diag·Vᵀ.
+// Returns the sweeps done, or −1 when a is not finite or n > N (a and v are
+// then left as they are, resp. v the identity), or kMaxJacobiSweeps + 1 when
+// the bound was reached first (the result is then that of the last sweep).
+template <std::size_t N>
+int symmetric_eigen(double (&a)[N][N], double (&v)[N][N], std::size_t n) noexcept {
+    JacobiProgress progress;
+    if (!jacobi_start(a, v, n, progress)) {
+        return -1;
+    }
+    JacobiStep s = JacobiStep::kRunning;
+    for (int i = 0; i < jacobi_max_steps(n) && s == JacobiStep::kRunning; ++i) {
+        s = jacobi_row(a, v, progress);
+    }
+    return s == JacobiStep::kConverged ? progress.sweep : kMaxJacobiSweeps + 1;
 }
 
 }  // namespace ascorr::calib
