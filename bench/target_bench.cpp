@@ -41,13 +41,14 @@
 // its solution's correction).
 // The self-calibration's Sun-term learner (calib/sun_learner.hpp, double:
 // software floating point on both targets; the out-of-line entry of
-// firmware/app/sun_learner_entry.cpp) on a 600 s orbit of 300 fed cycles 2 s
-// apart in 2026, the combination fixture's three heads on a bench turning
-// once per orbit: per fed cycle, the mean take over three orbits (the cycles
-// that close an orbit included) against a function that only reads an
-// attitude; per orbit closed, its solve's steps each timed alone, as idle
+// firmware/app/sun_learner_entry.cpp) on a 600 s orbit of 25 cycles 24 s
+// apart (each one taken: the learner takes one per 24 s) in 2026, the
+// combination fixture's three heads on a bench turning once per orbit: per
+// cycle taken, the mean take over three orbits (the cycles that close an
+// orbit included) against a function that only reads an attitude; per orbit closed, its solve's steps each timed alone, as idle
 // time runs them between cycles ("bench double sun_learner_<figure> <n>":
-// take, steps, solve (their sum), worst_step, and ram, sizeof(SunLearner)).
+// take, steps, solve (their sum), worst_step, ram, sizeof(SunLearner), and
+// interval_us, the learner's kSunLearnIntervalUs).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -405,8 +406,9 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
 }
 
 // The Sun term's learner: one fed cycle per take, one idle step per step.
-constexpr std::uint32_t kLearnerCycles = 300;  // an orbit of kMinOrbitPeriodUs
-constexpr std::int64_t kLearnerCycleUs = calib::kMinOrbitPeriodUs / kLearnerCycles;
+// Cycles one interval apart: each one taken (calib::kSunLearnIntervalUs).
+constexpr std::int64_t kLearnerCycleUs = calib::kSunLearnIntervalUs;
+constexpr std::uint32_t kLearnerCycles = calib::kMinOrbitPeriodUs / kLearnerCycleUs;  // an orbit
 constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
 Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
 
@@ -502,6 +504,7 @@ void bench_sun_learner(std::uint32_t ipc) {
     std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
     std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
+    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnIntervalUs));
     if (!g_learner.report().candidate.solved) {
         std::puts("bench: the Sun learner's bench solved no candidate");
     }

@@ -424,44 +424,54 @@ TEST(SunLearner, TheRuleTakesOnlyBeyondTheMarginAndLeavesAlike) {
     EXPECT_FALSE(calib::SunLearner::next_taken({1.0, 1.0 + 1.5 * m}, true));
 }
 
-// The learner's solve in bounded steps (on board: one per idle time) gives
-// the candidate the ground's whole solve after each cycle gives, bit for
-// bit, also when a solve spans a later orbit's close: each candidate is
-// compared with the ground learner's of the same orbit count. A step every
-// second cycle makes a solve span more than an orbit of 300 cycles.
-TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
-    calib::EstimatorConfig cfg;
-    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;  // 600 s
-    calib::SunLearner ground{cfg};
-    calib::SunLearner board{cfg};
+// Three heads on a bench turning once per orbit (period_us), each with its
+// own noise (rng), at t_us.
+void turning_bench(std::int64_t t_us, std::int64_t period_us, std::mt19937_64& rng,
+                   Quaternion<double> (&q)[calib::kFrameHeads]) {
     const Quaternion<double> mount[3] = {unit(Quaternion<double>{0.9, 0.1, -0.3, 0.2}),
                                          unit(Quaternion<double>{0.2, 0.8, 0.1, -0.4}),
                                          unit(Quaternion<double>{-0.3, 0.2, 0.9, 0.1})};
-    std::mt19937_64 rng(40);
     std::normal_distribution<double> noise(0.0, 5e-6);
+    const double phase = 2.0 * kPi * static_cast<double>(t_us % period_us) / static_cast<double>(period_us);
+    const Quaternion<double> bench{std::cos(0.5 * phase), 0.0, std::sin(0.5 * phase), 0.0};
+    for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+        q[h] = turned(mount[h] * bench, noise(rng), noise(rng), noise(rng));
+    }
+}
+
+constexpr std::int64_t kLearnT0Us = 820'800'000'000'000;  // TT µs since J2000 (2026), a whole 600 s and 24 s
+
+calib::EstimatorConfig short_orbits() {
+    calib::EstimatorConfig cfg;
+    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;  // 600 s: 25 cycles taken per orbit
+    return cfg;
+}
+
+// The learner's solve in bounded steps (on board: one per idle time) gives
+// the candidate the ground's whole solve after each cycle gives, bit for
+// bit, also when a solve spans later orbits' closes: each candidate is
+// compared with the ground learner's of the same orbit count. A step per
+// cycle, each taken (24 s apart), makes a solve span about 12 orbits.
+TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
+    const calib::EstimatorConfig cfg = short_orbits();
+    calib::SunLearner ground{cfg};
+    calib::SunLearner board{cfg};
+    std::mt19937_64 rng(40);
     std::map<std::uint32_t, calib::SunTermFit> by_orbits;  // the ground's candidates
     std::uint32_t board_orbits = 0;
     int compared = 0;
     int steps = 0;
-    int longest = 0;                              // the most steps of one solve on board
-    const std::int64_t t0 = 820'000'000'000'000;  // TT µs since J2000: 2026
-    for (std::int64_t k = 0; k < 16 * 300; ++k) {
-        const std::int64_t t_us = t0 + k * 2'000'000;
-        const double phase =
-            2.0 * kPi * static_cast<double>(t_us % cfg.orbit_period_us) / static_cast<double>(cfg.orbit_period_us);
-        const Quaternion<double> bench{std::cos(0.5 * phase), 0.0, std::sin(0.5 * phase), 0.0};
+    int longest = 0;  // the most steps of a solve on board (those since the last candidate)
+    for (std::int64_t k = 0; k < 60 * 25; ++k) {
+        const std::int64_t t_us = kLearnT0Us + k * calib::kSunLearnIntervalUs;
         Quaternion<double> q[calib::kFrameHeads];
-        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
-            q[h] = turned(mount[h] * bench, noise(rng), noise(rng), noise(rng));
-        }
+        turning_bench(t_us, cfg.orbit_period_us, rng, q);
         ASSERT_TRUE(ground.take(t_us, q));
         (void)ground.step_all();
         const calib::SunTermFit g = ground.report().candidate;
         by_orbits.emplace(g.orbits, g);
         ASSERT_TRUE(board.take(t_us, q));
-        if (k % 2 == 0 && board.step()) {
-            ++steps;
-        }
+        steps += board.step() ? 1 : 0;
         const calib::SunTermFit b = board.report().candidate;
         if (b.orbits != board_orbits) {
             board_orbits = b.orbits;
@@ -480,7 +490,55 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     EXPECT_GE(compared, 4);
     EXPECT_GT(longest, 100) << "one solve took many steps (a row of a sweep each)";
     EXPECT_LE(longest, calib::SunLearner::kMaxSolveSteps);
-    EXPECT_LT(board_orbits, ground.report().candidate.orbits) << "a solve on board spans an orbit's close";
+    EXPECT_LT(board_orbits + 1U, ground.report().candidate.orbits) << "a solve on board spans orbits' closes";
+}
+
+// Fed at 2 s, the learner takes the first cycle of each 24 s and nothing of
+// the others: the same report, bit for bit, as a learner fed those alone.
+TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
+    const calib::EstimatorConfig cfg = short_orbits();
+    calib::SunLearner every{cfg};
+    calib::SunLearner thinned{cfg};
+    std::mt19937_64 rng(41);
+    constexpr std::int64_t kCycleUs = 2'000'000;
+    constexpr std::int64_t kCycles = 8 * calib::kMinOrbitPeriodUs / kCycleUs;
+    std::uint64_t first_of_interval = 0;
+    for (std::int64_t k = 0; k < kCycles; ++k) {
+        const std::int64_t t_us = kLearnT0Us + k * kCycleUs;
+        Quaternion<double> q[calib::kFrameHeads];
+        turning_bench(t_us, cfg.orbit_period_us, rng, q);
+        const bool first = t_us % calib::kSunLearnIntervalUs == 0;
+        EXPECT_EQ(every.take(t_us, q), first) << k;
+        (void)every.step_all();
+        if (first) {
+            ++first_of_interval;
+            ASSERT_TRUE(thinned.take(t_us, q));
+            (void)thinned.step_all();
+        }
+    }
+    every.finish();
+    thinned.finish();
+    const calib::SunLearnReport a = every.report();
+    const calib::SunLearnReport b = thinned.report();
+    EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(kCycles) - first_of_interval);
+    EXPECT_EQ(b.thinned, 0U);
+    EXPECT_EQ(a.cycles, first_of_interval);
+    EXPECT_EQ(a.cycles, b.cycles);
+    EXPECT_EQ(a.orbits, b.orbits);
+    EXPECT_EQ(std::memcmp(a.score, b.score, sizeof a.score), 0);
+    ASSERT_TRUE(a.candidate.solved);
+    EXPECT_EQ(std::memcmp(a.candidate.sun, b.candidate.sun, sizeof a.candidate.sun), 0);
+}
+
+// The account names the epochs the learner skipped, and the interval.
+TEST(SunLearner, TheAccountCountsTheEpochsThinnedOut) {
+    calib::SunLearnReport r;
+    EXPECT_EQ(host::describe(r, {}).find("within"), std::string::npos);
+    r.thinned = 23;
+    EXPECT_NE(
+        host::describe(r, {}).find("; 23 epoch(s) within 24 s of one learnt from not learnt from (the DPU's cost)"),
+        std::string::npos)
+        << host::describe(r, {});
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

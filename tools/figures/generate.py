@@ -210,16 +210,17 @@ def sun_learner_section(d):
     ts = list(e)
     out = ["## The Sun-term learner", "",
            "The self-calibration's learner of the Sun term (`calib/sun_learner.hpp`, double: software floating "
-           "point on both targets), measured alone by the target bench: not in the flight loop yet. A take per "
-           "fed cycle (every 2nd cycle in the loop), the solve after each orbit in idle time, a step at a time.", ""]
+           "point on both targets), measured alone by the target bench: not in the flight loop yet. It takes one "
+           "cycle per interval; its solve runs after each orbit in idle time, a step at a time.", ""]
 
-    def against_estimator(t):
-        per_cycle = e[t]["per_fed_cycle"] / 2
+    def per_cycle(t):
+        """The mean per 22 Hz cycle, against the estimator's per cycle."""
+        mean = e[t]["per_take"] / (22 * e[t]["interval_us"] * 1e-6)
         base = (est.get(t) or {}).get("per_cycle")
-        return f"{num(round(per_cycle))} ({per_cycle / base:.0f}× the estimator's)" if base else num(round(per_cycle))
+        return f"{num(round(mean))} ({100 * mean / base:.0f} % of the estimator's)" if base else num(round(mean))
     rows = [
-        ["per fed cycle (take)"] + [num(e[t]["per_fed_cycle"]) for t in ts],
-        ["per cycle, mean (feed every 2nd cycle)"] + [against_estimator(t) for t in ts],
+        ["per cycle taken (take)"] + [num(e[t]["per_take"]) for t in ts],
+        ["per 22 Hz cycle, mean"] + [f"{per_cycle(t)}, one taken per {e[t]['interval_us'] / 1e6:g} s" for t in ts],
         ["per orbit (the solve, idle time)"] + [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps"
                                                 for t in ts],
         ["worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],

@@ -858,6 +858,11 @@ std::string not_learnt_from(const calib::SunLearnReport& r) {
         out +=
             "; " + std::to_string(r.not_finite) + " epoch(s) whose attitudes give no finite rotation not learnt from";
     }
+    if (r.thinned > 0U) {
+        out += "; " + std::to_string(r.thinned) + " epoch(s) within " +
+               std::to_string(calib::kSunLearnIntervalUs / 1'000'000) +
+               " s of one learnt from not learnt from (the DPU's cost)";
+    }
     return out;
 }
 

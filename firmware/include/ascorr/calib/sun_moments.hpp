@@ -332,17 +332,17 @@ private:
         return SunSolveStep::kFailed;
     }
 
-    // θ = Σ_k v_k·(v_k·rhs)/λ_k over λ_k > tolerance·λ_max, then the rule.
-    SunSolveStep result(Solve& w, const SunRule& rule) const noexcept {
+    // θ = Σ_k v_k·(v_k·rhs)/λ_k over λ_k > tolerance·λ_max (theta zero on
+    // entry); the rank, or −1 when no eigenvalue is positive.
+    static int pseudo_inverse(const Solve& w, double (&theta)[kUnknowns]) noexcept {
         const std::size_t u = w.jacobi.n;
         double largest = 0.0;
         for (std::size_t k = 0; k < u; ++k) {
             largest = w.normal[k][k] > largest ? w.normal[k][k] : largest;
         }
         if (!(largest > 0.0)) {
-            return SunSolveStep::kFailed;
+            return -1;
         }
-        double theta[kUnknowns] = {};
         int rank = 0;
         for (std::size_t k = 0; k < u; ++k) {
             const double lambda = w.normal[k][k];
@@ -356,6 +356,16 @@ private:
                 }
                 ++rank;
             }
+        }
+        return rank;
+    }
+
+    // The fit from the decomposition, under the rule.
+    SunSolveStep result(Solve& w, const SunRule& rule) const noexcept {
+        double theta[kUnknowns] = {};
+        const int rank = pseudo_inverse(w, theta);
+        if (rank < 0) {
+            return SunSolveStep::kFailed;
         }
         w.fit.rank = rank;
         double s[H][3][3];
