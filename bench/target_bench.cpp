@@ -45,10 +45,11 @@
 // apart (each one taken: the learner takes one per 24 s) in 2026, the
 // combination fixture's three heads on a bench turning once per orbit: per
 // cycle taken, the mean take over three orbits (the cycles that close an
-// orbit included) against a function that only reads an attitude; per orbit closed, its solve's steps each timed alone, as idle
-// time runs them between cycles ("bench double sun_learner_<figure> <n>":
-// take, steps, solve (their sum), worst_step, ram, sizeof(SunLearner), and
-// interval_us, the learner's kSunLearnIntervalUs).
+// orbit included) against a function that only reads an attitude; per orbit
+// closed, its solve's steps each timed alone, as idle time runs them between
+// cycles ("bench double sun_learner_<figure> <n>": take, steps, solve (their
+// sum), worst_step, ram, sizeof(SunLearner), and interval_us, the learner's
+// kSunLearnIntervalUs).
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
