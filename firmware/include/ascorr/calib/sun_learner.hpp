@@ -66,9 +66,9 @@ namespace ascorr::calib {
 // The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
 inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
 // The learner takes at most one cycle in this interval (µs). A take costs
-// 123,000 instructions in software double on either target
+// 125,000 instructions in software double on either target
 // (docs/figures.md, "The Sun-term learner"): at the loop's 22 Hz one per
-// 24 s is 233 per cycle on average, 19 % and 27 % of the estimator's per
+// 24 s is 237 per cycle on average, 20 % and 28 % of the estimator's per
 // cycle on the M3 and the M4F (issue 40's budget: 30 %). The term is the
 // orbit's slow variation: 235 takes per 94-min orbit hold it, as the test
 // missions' 120 to 240 s epochs do (which every one of them takes).
