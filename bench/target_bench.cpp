@@ -39,17 +39,22 @@
 // form it at the velocity service's rate), against the core without it
 // ("bench <scalar> sun <instructions>": what a head with a Sun term adds to
 // its solution's correction).
+// The self-calibration's lag search (calib/lag_search.hpp, the out-of-line
+// entry of firmware/app/lag_search_entry_*.cpp) per cycle taken, the
+// selected records as heads A, B and C corrected with Table 2, against a
+// function that only reads a status ("bench <scalar> lag_search
+// <instructions>"; lag_search_ram, its sizeof).
 // The self-calibration's Sun-term learner (calib/sun_learner.hpp, double:
 // software floating point on both targets; the out-of-line entry of
-// firmware/app/sun_learner_entry.cpp) on a 600 s orbit of 25 cycles 24 s
-// apart (each one taken: the learner takes one per 24 s) in 2026, the
-// combination fixture's three heads on a bench turning once per orbit: per
-// cycle taken, the mean take over three orbits (the cycles that close an
+// firmware/app/sun_learner_entry.cpp) on the default 5640 s orbit in 2026,
+// the combination fixture's three heads on a bench turning once per orbit:
+// per cycle taken, the mean take over three orbits (the cycles that close an
 // orbit included) against a function that only reads an attitude; per orbit
 // closed, its solve's steps each timed alone, as idle time runs them between
 // cycles ("bench double sun_learner_<figure> <n>": take, steps, solve (their
-// sum), worst_step, ram, sizeof(SunLearner), and interval_us, the learner's
-// kSunLearnIntervalUs).
+// sum), worst_step, ram, sizeof(SunLearner), and interval_us,
+// kSideLearnerIntervalUs). The side learners' cycles are an interval apart
+// (each taken: one per interval), at the 11 Hz feed's phase in it.
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -63,6 +68,7 @@
 #include "core_entry.hpp"
 #include "earth_series_entry.hpp"
 #include "lag_entry.hpp"
+#include "lag_search_entry.hpp"
 #include "sun_entry.hpp"
 #include "sun_learner_entry.hpp"
 #include "systick_counter.hpp"
@@ -406,10 +412,88 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     report(name, "sun", run_sun<T>(&sun_with<T>, fx, sun), c0, ipc);
 }
 
+// The side learners take one cycle per interval, the first fed in it: the
+// cycles of their benches are an interval apart, each at the 11 Hz feed's
+// phase in it (a Δt that varies by up to 91 ms, as on board).
+std::int64_t learner_cycle_us(std::int64_t k) {
+    return k * calib::kSideLearnerIntervalUs + (k * 45'454) % 90'909;
+}
+
+// The lag search: one cycle per take, the frame heads corrected with
+// Table 2 (each record's input as head A, B and C in turn).
+constexpr std::uint32_t kLagSearchCycles = 64;
+
+template <typename T>
+struct LagSearchFixture {
+    CorrectedSolution<T> corrected[kInputs][calib::kFrameHeads];
+    HeadTemperatures<T> temperatures[kInputs][calib::kFrameHeads];
+};
+
+template <typename T>
+using LagSearchFn = bool (*)(calib::LagSearch<T>&, std::int64_t, const ThermalModel<T>&, const CorrectedSolution<T>*,
+                             const HeadTemperatures<T>* const*) noexcept;
+
+template <typename T>
+__attribute__((noinline)) bool lag_search_copy(calib::LagSearch<T>& /*search*/, std::int64_t t_us,
+                                               const ThermalModel<T>& /*model*/, const CorrectedSolution<T>* corrected,
+                                               const HeadTemperatures<T>* const* /*temperatures*/) noexcept {
+    g_sink_status = corrected[0].status;
+    return t_us > 0;
+}
+
+template <typename T>
+__attribute__((noinline)) bool lag_search_call(calib::LagSearch<T>& search, std::int64_t t_us,
+                                               const ThermalModel<T>& model, const CorrectedSolution<T>* corrected,
+                                               const HeadTemperatures<T>* const* temperatures) noexcept {
+    return app::lag_search_take(search, t_us, model, corrected, temperatures);
+}
+
+// kLagSearchCycles takes from cycle *cycle on; the takes that scored.
+template <typename T>
+std::uint32_t run_lag_search(volatile LagSearchFn<T> fn, calib::LagSearch<T>& search, const ThermalModel<T>& model,
+                             const LagSearchFixture<T>& fx, std::int64_t& cycle, std::uint32_t& scored) {
+    return counts([&] {
+        for (std::uint32_t i = 0; i < kLagSearchCycles; ++i, ++cycle) {
+            const std::uint32_t k = i % kInputs;
+            const HeadTemperatures<T>* tp[calib::kFrameHeads] = {&fx.temperatures[k][0], &fx.temperatures[k][1],
+                                                                 &fx.temperatures[k][2]};
+            const std::int64_t t_us = 820'800'000'000'000 + learner_cycle_us(cycle);
+            scored += fn(search, t_us, model, fx.corrected[k], tp) ? 1U : 0U;
+        }
+    });
+}
+
+template <typename T>
+void bench_lag_search(const char* name, const Fixture<T>& fx, LagSearchFixture<T>& lf, std::uint32_t ipc) {
+    static calib::LagSearch<T> search{calib::EstimatorConfig{}};
+    const CorrectionConfig<T> both{true, &fx.model[0]};
+    for (std::uint32_t k = 0; k < kInputs; ++k) {
+        for (std::uint8_t h = 0; h < calib::kFrameHeads; ++h) {
+            SolutionInput<T> in = fx.in[k];
+            in.head = h;
+            lf.corrected[k][h] = app::correct(in, both);
+            lf.temperatures[k][h] = in.temperatures;
+        }
+    }
+    std::int64_t cycle = 0;
+    std::uint32_t scored = 0U;
+    (void)run_lag_search<T>(&lag_search_call<T>, search, fx.model[0], lf, cycle, scored);  // warm-up: lags started
+    scored = 0U;
+    const std::uint32_t c = run_lag_search<T>(&lag_search_call<T>, search, fx.model[0], lf, cycle, scored);
+    std::uint32_t none = 0U;
+    const std::uint32_t c0 = run_lag_search<T>(&lag_search_copy<T>, search, fx.model[0], lf, cycle, none);
+    std::printf("bench %s lag_search %u\n", name,
+                static_cast<unsigned>(((c - c0) * ipc + kLagSearchCycles / 2U) / kLagSearchCycles));
+    std::printf("bench %s lag_search_ram %u\n", name, static_cast<unsigned>(sizeof(calib::LagSearch<T>)));
+    if (scored != kLagSearchCycles) {
+        std::printf("bench: %s lag search scored %u of %u cycles\n", name, static_cast<unsigned>(scored),
+                    static_cast<unsigned>(kLagSearchCycles));
+    }
+}
+
 // The Sun term's learner: one fed cycle per take, one idle step per step.
-// Cycles one interval apart: each one taken (calib::kSunLearnIntervalUs).
-constexpr std::int64_t kLearnerCycleUs = calib::kSunLearnIntervalUs;
-constexpr std::uint32_t kLearnerCycles = calib::kMinOrbitPeriodUs / kLearnerCycleUs;  // an orbit
+constexpr std::int64_t kLearnerOrbitUs = calib::EstimatorConfig{}.orbit_period_us;
+constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSideLearnerIntervalUs;  // an orbit
 constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
 Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
 
@@ -426,18 +510,12 @@ __attribute__((noinline)) bool step_none(calib::SunLearner& /*learner*/) noexcep
     return false;
 }
 
-calib::EstimatorConfig learner_config() {
-    calib::EstimatorConfig cfg;
-    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;
-    return cfg;
-}
-
-calib::SunLearner g_learner{learner_config()};
+calib::SunLearner g_learner{calib::EstimatorConfig{}};
 
 std::uint32_t run_takes(volatile TakeFn fn, std::int64_t t0_us) {
     return counts([&] {
         for (std::uint32_t i = 0; i < kLearnerCycles; ++i) {
-            g_sink_status = fn(g_learner, t0_us + std::int64_t{i} * kLearnerCycleUs, g_learner_q[i]) ? 1U : 0U;
+            g_sink_status = fn(g_learner, t0_us + learner_cycle_us(i), g_learner_q[i]) ? 1U : 0U;
         }
     });
 }
@@ -470,13 +548,12 @@ SolveCost run_solve() {
 }
 
 void bench_sun_learner(std::uint32_t ipc) {
-    constexpr double kPeriodS = static_cast<double>(calib::kMinOrbitPeriodUs) * 1e-6;
     const combine::Mountings m = bench::combination_mountings();
     std::uint32_t state = 7U;
     const double* q0 = g_records[0].q;
     for (std::uint32_t i = 0; i < kLearnerCycles; ++i) {
         const double phase =
-            2.0 * kPi * static_cast<double>(i) * (static_cast<double>(kLearnerCycleUs) * 1e-6) / kPeriodS;
+            2.0 * kPi * static_cast<double>(learner_cycle_us(i)) / static_cast<double>(kLearnerOrbitUs);
         const Quaternion<double> q_crf_icrf =
             bench::axis_angle(0.0, 0.6, 0.8, phase) * Quaternion<double>{q0[0], q0[1], q0[2], q0[3]};
         Quaternion<double> heads[bench::kCombinationHeads];
@@ -486,12 +563,12 @@ void bench_sun_learner(std::uint32_t ipc) {
         }
     }
     const std::int64_t start_us = 820'000'000'000'000;  // TT µs since J2000: 2026
-    const std::int64_t t0_us = start_us - start_us % calib::kMinOrbitPeriodUs;
+    const std::int64_t t0_us = start_us - start_us % kLearnerOrbitUs;
     std::uint64_t takes = 0;
     SolveCost last;
     std::uint32_t worst = 0;
     for (std::uint32_t o = 0; o < kLearnerOrbits; ++o) {
-        const std::int64_t t_us = t0_us + std::int64_t{o} * calib::kMinOrbitPeriodUs;
+        const std::int64_t t_us = t0_us + std::int64_t{o} * kLearnerOrbitUs;
         const std::uint32_t c = run_takes(&app::sun_learner_take, t_us);
         if (o > 0U) {
             takes += c - run_takes(&take_copy, t_us);
@@ -505,17 +582,19 @@ void bench_sun_learner(std::uint32_t ipc) {
     std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
     std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
-    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnIntervalUs));
+    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSideLearnerIntervalUs));
     if (!g_learner.report().candidate.solved) {
         std::puts("bench: the Sun learner's bench solved no candidate");
     }
 }
 
 Fixture<Q30> g_fixed;
+LagSearchFixture<Q30> g_lag_search_fixed;
 combine::Combiner<Q30> g_combiner_fixed{bench::combination_mountings()};
 CombinationFixture<Q30> g_combination_fixed;
 #if !defined(ASCORR_TARGET_FIXED)
 Fixture<float> g_float;
+LagSearchFixture<float> g_lag_search_float;
 combine::Combiner<float> g_combiner_float{bench::combination_mountings()};
 CombinationFixture<float> g_combination_float;
 #endif
@@ -559,11 +638,13 @@ int main() {
     bench_scalar<float>("float", g_float, ipc);
     bench_lag<float>("float", g_float, ipc);
     bench_sun<float>("float", g_float, ipc);
+    bench_lag_search<float>("float", g_float, g_lag_search_float, ipc);
     bench_combination<float>("float", g_combiner_float, g_combination_float, ipc);
 #endif
     bench_scalar<Q30>("fixed", g_fixed, ipc);
     bench_lag<Q30>("fixed", g_fixed, ipc);
     bench_sun<Q30>("fixed", g_fixed, ipc);
+    bench_lag_search<Q30>("fixed", g_fixed, g_lag_search_fixed, ipc);
     bench_combination<Q30>("fixed", g_combiner_fixed, g_combination_fixed, ipc);
     bench_baseline(ipc);
     bench_series(ipc);

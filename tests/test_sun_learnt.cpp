@@ -439,21 +439,18 @@ void turning_bench(std::int64_t t_us, std::int64_t period_us, std::mt19937_64& r
     }
 }
 
-constexpr std::int64_t kLearnT0Us = 820'800'000'000'000;  // TT µs since J2000 (2026), a whole 600 s and 24 s
-
-calib::EstimatorConfig short_orbits() {
-    calib::EstimatorConfig cfg;
-    cfg.orbit_period_us = calib::kMinOrbitPeriodUs;  // 600 s: 25 cycles taken per orbit
-    return cfg;
-}
+// TT µs since J2000 (2026): whole orbits of the default 5640 s, whole 120 s.
+constexpr std::int64_t kLearnT0Us = 145'532 * calib::EstimatorConfig{}.orbit_period_us;
+static_assert(kLearnT0Us % calib::kSideLearnerIntervalUs == 0);
 
 // The learner's solve in bounded steps (on board: one per idle time) gives
 // the candidate the ground's whole solve after each cycle gives, bit for
 // bit, also when a solve spans later orbits' closes: each candidate is
 // compared with the ground learner's of the same orbit count. A step per
-// cycle, each taken (24 s apart), makes a solve span about 12 orbits.
+// cycle, each taken (120 s apart, 47 an orbit), makes a solve span about 6
+// orbits.
 TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
-    const calib::EstimatorConfig cfg = short_orbits();
+    const calib::EstimatorConfig cfg;
     calib::SunLearner ground{cfg};
     calib::SunLearner board{cfg};
     std::mt19937_64 rng(40);
@@ -462,8 +459,8 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     int compared = 0;
     int steps = 0;
     int longest = 0;  // the most steps of a solve on board (those since the last candidate)
-    for (std::int64_t k = 0; k < 60 * 25; ++k) {
-        const std::int64_t t_us = kLearnT0Us + k * calib::kSunLearnIntervalUs;
+    for (std::int64_t k = 0; k < 40 * 47; ++k) {
+        const std::int64_t t_us = kLearnT0Us + k * calib::kSideLearnerIntervalUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
         ASSERT_TRUE(ground.take(t_us, q));
@@ -493,52 +490,112 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     EXPECT_LT(board_orbits + 1U, ground.report().candidate.orbits) << "a solve on board spans orbits' closes";
 }
 
-// Fed at 2 s, the learner takes the first cycle of each 24 s and nothing of
-// the others: the same report, bit for bit, as a learner fed those alone.
-TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
-    const calib::EstimatorConfig cfg = short_orbits();
-    calib::SunLearner every{cfg};
-    calib::SunLearner thinned{cfg};
-    std::mt19937_64 rng(41);
-    constexpr std::int64_t kCycleUs = 2'000'000;
-    constexpr std::int64_t kCycles = 8 * calib::kMinOrbitPeriodUs / kCycleUs;
+// Fed at 10 s, a side learner takes the first cycle of each 120 s and
+// nothing of the others: the same report, bit for bit, as one fed those
+// alone. Learner: SunLearner or LagSearch<double> (take(t, q): the frame
+// heads' attitudes as the model corrected them).
+template <typename Learner>
+void thinned_as_a_thinned_feed(Learner& every, Learner& thinned, std::uint64_t seed) {
+    const calib::EstimatorConfig cfg;
+    std::mt19937_64 rng(seed);
+    constexpr std::int64_t kCycleUs = 10'000'000;
+    const std::int64_t cycles = 6 * cfg.orbit_period_us / kCycleUs;
     std::uint64_t first_of_interval = 0;
-    for (std::int64_t k = 0; k < kCycles; ++k) {
+    for (std::int64_t k = 0; k < cycles; ++k) {
         const std::int64_t t_us = kLearnT0Us + k * kCycleUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
-        const bool first = t_us % calib::kSunLearnIntervalUs == 0;
-        EXPECT_EQ(every.take(t_us, q), first) << k;
-        (void)every.step_all();
+        const bool first = t_us % calib::kSideLearnerIntervalUs == 0;
+        first_of_interval += first ? 1U : 0U;
+        EXPECT_EQ(every.take(t_us, q, k), first) << k;
         if (first) {
-            ++first_of_interval;
-            ASSERT_TRUE(thinned.take(t_us, q));
-            (void)thinned.step_all();
+            ASSERT_TRUE(thinned.take(t_us, q, k));
         }
     }
-    every.finish();
-    thinned.finish();
-    const calib::SunLearnReport a = every.report();
-    const calib::SunLearnReport b = thinned.report();
-    EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(kCycles) - first_of_interval);
+    const auto a = every.report();
+    const auto b = thinned.report();
+    EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(cycles) - first_of_interval);
     EXPECT_EQ(b.thinned, 0U);
     EXPECT_EQ(a.cycles, first_of_interval);
     EXPECT_EQ(a.cycles, b.cycles);
+    EXPECT_GE(a.orbits, 4U);
     EXPECT_EQ(a.orbits, b.orbits);
     EXPECT_EQ(std::memcmp(a.score, b.score, sizeof a.score), 0);
-    ASSERT_TRUE(a.candidate.solved);
-    EXPECT_EQ(std::memcmp(a.candidate.sun, b.candidate.sun, sizeof a.candidate.sun), 0);
 }
 
-// The account names the epochs the learner skipped, and the interval.
-TEST(SunLearner, TheAccountCountsTheEpochsThinnedOut) {
-    calib::SunLearnReport r;
-    EXPECT_EQ(host::describe(r, {}).find("within"), std::string::npos);
-    r.thinned = 23;
-    EXPECT_NE(
-        host::describe(r, {}).find("; 23 epoch(s) within 24 s of one learnt from not learnt from (the DPU's cost)"),
-        std::string::npos)
-        << host::describe(r, {});
+// The learners as thinned_as_a_thinned_feed takes them.
+struct SunLearnerFeed {
+    calib::SunLearner learner{calib::EstimatorConfig{}};
+    bool take(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads], std::int64_t /*k*/) {
+        const bool taken = learner.take(t_us, q);
+        (void)learner.step_all();
+        return taken;
+    }
+    calib::SunLearnReport report() {
+        learner.finish();
+        return learner.report();
+    }
+};
+
+// The search with a model whose heads are present and whose coefficients
+// are 0 (q_th = 1), the heads' temperatures rising 1 °C an hour and
+// wobbling with the cycle.
+struct LagSearchFeed {
+    calib::LagSearch<double> search{calib::EstimatorConfig{}};
+    ThermalModel<double> model = present_heads();
+    bool take(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads], std::int64_t k) {
+        CorrectedSolution<double> c[calib::kFrameHeads];
+        HeadTemperatures<double> tp[calib::kFrameHeads];
+        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+            c[h] = {q[h], static_cast<StatusBits>(status::kAberrationApplied | status::kThermalApplied)};
+            const double t =
+                20.0 + static_cast<double>(k) * (10.0 / 3600.0) + 0.3 * std::sin(0.1 * static_cast<double>(k));
+            tp[h] = {{t, true}, {t - 5.0, true}, {t + static_cast<double>(h), true}};
+        }
+        const HeadTemperatures<double>* t[calib::kFrameHeads] = {&tp[0], &tp[1], &tp[2]};
+        return search.take(t_us, model, c, t);
+    }
+    calib::LagSearchReport report() {
+        search.finish();
+        return search.report();
+    }
+    static ThermalModel<double> present_heads() {
+        ThermalModel<double> m{};
+        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
+            m.head[h].present = true;
+        }
+        return m;
+    }
+};
+
+TEST(SideLearners, EachTakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
+    SunLearnerFeed sun_every;
+    SunLearnerFeed sun_thinned;
+    thinned_as_a_thinned_feed(sun_every, sun_thinned, 41);
+    ASSERT_TRUE(sun_every.learner.report().candidate.solved);
+    EXPECT_EQ(std::memcmp(sun_every.learner.report().candidate.sun, sun_thinned.learner.report().candidate.sun,
+                          sizeof(calib::SunTermFit::sun)),
+              0);
+    LagSearchFeed lag_every;
+    LagSearchFeed lag_thinned;
+    thinned_as_a_thinned_feed(lag_every, lag_thinned, 42);
+}
+
+// The accounts name the epochs the learners skipped, and the interval.
+TEST(SideLearners, TheAccountsCountTheEpochsThinnedOut) {
+    calib::SunLearnReport sun;
+    calib::LagSearchReport lag;
+    EXPECT_EQ(host::describe(sun, {}).find("interval"), std::string::npos);
+    EXPECT_EQ(host::describe(lag, 0.0).find("interval"), std::string::npos);
+    sun.thinned = 23;
+    lag.thinned = 5;
+    EXPECT_NE(host::describe(sun, {}).find(
+                  "; 23 epoch(s) in a 120 s interval learnt from already not taken (one per interval: the DPU's cost)"),
+              std::string::npos)
+        << host::describe(sun, {});
+    EXPECT_NE(host::describe(lag, 0.0).find("; 5 epoch(s) in a 120 s interval scored already not taken"),
+              std::string::npos)
+        << host::describe(lag, 0.0);
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

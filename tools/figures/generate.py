@@ -204,28 +204,36 @@ def estimator_section(d):
     return out + table([""] + [tname(t) for t in ts], rows) + [""]
 
 
-def sun_learner_section(d):
+def side_learners_section(d):
     e = get(d, "sun_learner")
-    est = d["result"].get("estimator", {})
+    r = d["result"]
     ts = list(e)
-    out = ["## The Sun-term learner", "",
-           "The self-calibration's learner of the Sun term (`calib/sun_learner.hpp`, double: software floating "
-           "point on both targets), measured alone by the target bench: not in the flight loop yet. It takes one "
-           "cycle per interval; its solve runs after each orbit in idle time, a step at a time.", ""]
+    # Each target's flight scalar: the one its core's memory is recorded for (core_<scalar>).
+    flight = {t: next(k[len("core_"):] for k in r[t] if k.startswith("core_")) for t in ts}
+    lag = {t: r[t][flight[t]] for t in ts}
+    out = ["## The side learners", "",
+           "The self-calibration's lag search (`calib/lag_search.hpp`, the core's scalar for the thermal stage, "
+           "double for the IBAs) and Sun-term learner (`calib/sun_learner.hpp`, double), software floating point "
+           "on both targets, measured alone by the target bench: not in the flight loop yet. Each takes one epoch "
+           "per interval; the Sun learner's solve runs after each orbit in idle time, a step at a time.", ""]
 
     def per_cycle(t):
-        """The mean per 22 Hz cycle, against the estimator's per cycle."""
-        mean = e[t]["per_take"] / (22 * e[t]["interval_us"] * 1e-6)
-        base = (est.get(t) or {}).get("per_cycle")
-        return f"{num(round(mean))} ({100 * mean / base:.0f} % of the estimator's)" if base else num(round(mean))
+        """Both learners' mean per 22 Hz cycle, against the estimator's per cycle."""
+        mean = (e[t]["per_take"] + lag[t]["lag_search_per_take"]) / (22 * e[t]["interval_us"] * 1e-6)
+        base = (r.get("estimator", {}).get(t) or {}).get("per_cycle")
+        share = f" ({100 * mean / base:.0f} % of the estimator's)" if base else ""
+        return f"{num(round(mean))}{share}, an epoch per {e[t]['interval_us'] / 1e6:g} s"
     rows = [
-        ["per cycle taken (take)"] + [num(e[t]["per_take"]) for t in ts],
-        ["per 22 Hz cycle, mean"] + [f"{per_cycle(t)}, one taken per {e[t]['interval_us'] / 1e6:g} s" for t in ts],
-        ["per orbit (the solve, idle time)"] + [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps"
-                                                for t in ts],
-        ["worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],
-        ["RAM (`sizeof(SunLearner)`)"] + [f"{num(e[t]['ram_bytes'])} B" for t in ts],
-        ["stack (its entry's frames, summed)"] + [f"{num(e[t]['stack_bytes'])} B" for t in ts],
+        ["the lag search, per epoch taken (the flight scalar)"] +
+        [f"{num(lag[t]['lag_search_per_take'])} ({flight[t]})" for t in ts],
+        ["the Sun-term learner, per epoch taken"] + [num(e[t]["per_take"]) for t in ts],
+        ["both, per 22 Hz cycle, mean"] + [per_cycle(t) for t in ts],
+        ["the Sun-term learner per orbit (its solve, idle time)"] +
+        [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps" for t in ts],
+        ["its worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],
+        ["RAM: the lag search, the Sun-term learner (`sizeof`)"] +
+        [f"{num(lag[t]['lag_search_ram_bytes'])} B, {num(e[t]['ram_bytes'])} B" for t in ts],
+        ["the Sun-term learner's stack (its entry's frames, summed)"] + [f"{num(e[t]['stack_bytes'])} B" for t in ts],
     ]
     return out + table([""] + [tname(t) for t in ts], rows) + [""]
 
@@ -381,7 +389,7 @@ def page():
             out += flight_section(tb)
         out += estimator_section(tb)
         if "sun_learner" in tb["result"]:
-            out += sun_learner_section(tb)
+            out += side_learners_section(tb)
     if loaded["acquisition-bench"] is not None:
         out += acquisition_section(loaded["acquisition-bench"])
     if loaded["row-order"] is not None:

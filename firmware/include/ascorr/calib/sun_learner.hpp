@@ -29,10 +29,10 @@
 // latest candidate (within the core's domain: sun_fit_within_domain; a
 // candidate beyond it is not used).
 //
-// Thinned: at most one cycle per kSunLearnIntervalUs is taken (the first
-// fed in each interval, intervals floor(t / 24 s)), so that the per-cycle
-// cost on the DPU stays within issue 40's budget (below); the others are
-// skipped, counted (report().thinned).
+// Thinned: at most one cycle per kSideLearnerIntervalUs is taken
+// (orbit_spread_scores.hpp: the first fed in each 120 s, as the lag search),
+// so that the per-cycle cost on the DPU stays within issue 40's budget; the
+// others are skipped, counted (report().thinned).
 //
 // Arithmetic: double (the attitudes as the caller corrected them: the
 // pipeline's kept solutions, or the lag search's at its lag; the Sun from
@@ -45,8 +45,8 @@
 // (symmetric_eigen.hpp, at most 30 sweeps), a bounded step per call (the
 // normal equations, one row of a sweep, or the result), in the learner's own
 // 12 KiB workspace (SunMoments::Solve), not on the stack. Measured on the
-// targets by bench/target_bench.cpp (docs/figures.md, "The Sun-term
-// learner").
+// targets by bench/target_bench.cpp (docs/figures.md, "The side
+// learners").
 // No allocation, every loop bounded.
 #pragma once
 
@@ -65,14 +65,6 @@ namespace ascorr::calib {
 
 // The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
 inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
-// The learner takes at most one cycle in this interval (µs). A take costs
-// 125,000 instructions in software double on either target
-// (docs/figures.md, "The Sun-term learner"): at the loop's 22 Hz one per
-// 24 s is 237 per cycle on average, 20 % and 28 % of the estimator's per
-// cycle on the M3 and the M4F (issue 40's budget: 30 %). The term is the
-// orbit's slow variation: 235 takes per 94-min orbit hold it, as the test
-// missions' 120 to 240 s epochs do (which every one of them takes).
-inline constexpr std::int64_t kSunLearnIntervalUs = 24'000'000;
 
 struct SunLearnReport {
     std::uint32_t orbits = 0;       // orbits scored
@@ -87,7 +79,7 @@ struct SunLearnReport {
     SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
-    std::uint64_t thinned = 0;      // cycles not taken: within kSunLearnIntervalUs of one taken
+    std::uint64_t thinned = 0;      // cycles not taken: an interval's taken already (kSideLearnerIntervalUs)
 };
 
 class SunLearner {
@@ -112,9 +104,7 @@ public:
     // counted, and nothing else done). A cycle of another orbit than the
     // open one closes it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
-        const std::int64_t interval = orbit_bin(t_us, kSunLearnIntervalUs);
-        if (took_any_ && interval == last_interval_) {
-            ++thinned_;
+        if (!thinning_.due(t_us)) {
             return false;
         }
         if (scores_.closes(t_us)) {
@@ -144,8 +134,7 @@ public:
         }
         frame_ibas(with_term, iba[1]);
         scores_.add(iba);
-        took_any_ = true;
-        last_interval_ = interval;
+        thinning_.taken(t_us);
         return true;
     }
 
@@ -222,7 +211,7 @@ public:
         r.candidate = candidate_;
         r.without_sun = without_sun_;
         r.not_finite = not_finite_;
-        r.thinned = thinned_;
+        r.thinned = thinning_.thinned();
         return r;
     }
 
@@ -272,9 +261,7 @@ private:
     bool taken_ = false;
     std::uint64_t without_sun_ = 0U;
     std::uint64_t not_finite_ = 0U;
-    std::uint64_t thinned_ = 0U;
-    bool took_any_ = false;          // a cycle taken (last_interval_)
-    std::int64_t last_interval_ = 0;  // the interval of the last cycle taken
+    SideLearnerThinning thinning_;
 };
 
 }  // namespace ascorr::calib
