@@ -52,10 +52,11 @@ inline std::int64_t side_learner_period_us(const EstimatorConfig& cfg) noexcept 
 // (µs), the first fed in each interval floor(t / 120 s). Why: on the
 // targets a take costs about 445,000 instructions (the lag search) and
 // 124,000 (the Sun term), in software double (docs/figures.md, "The side
-// learners"); one of each per 120 s is 216 per 22 Hz cycle on average, 18 %
-// (M3) and 25 % (M4F) of the estimator's per cycle, within issue 40's 30 %.
-// The missions that measured them (docs/ground.md) have an epoch every 120
-// to 240 s, every one taken: 47 a 94-min orbit hold the orbit's variation.
+// learners"); one of each per 120 s is 216 (M3) and 214 (M4F) per 22 Hz
+// cycle on average, 18 % and 25 % of the estimator's per cycle, within
+// issue 40's 30 %. The missions that measured them (docs/ground.md) have an
+// epoch every 120 to 240 s, every one taken: 47 a 94-min orbit hold the
+// orbit's variation.
 inline constexpr std::int64_t kSideLearnerIntervalUs = 120'000'000;
 
 // Which fed cycles a side learner takes (above): due() when no cycle of the
