@@ -77,6 +77,9 @@ double axis_term_sum_arcsec(const ModelFile& m, std::uint8_t h, std::size_t a) {
 }
 
 // Throws `what` of head h's axis a, at its line of m's file when it has one.
+// A thermal angle's limit (kMaxThermalAngleRad) in the model file's unit.
+constexpr double kMaxThermalAngleArcsec = kMaxThermalAngleRad * kRadToArcsec;
+
 [[noreturn]] void refuse_axis(const ModelFile& m, const std::string& path, std::uint8_t h, std::size_t a,
                               const std::string& what) {
     const std::string where = std::string(1, head_name(h)) + " " + kAxisNames[a] + ": ";
@@ -95,9 +98,9 @@ std::string sun_axis_problem(const std::array<double, kSunComponents>& sun) {
         }
     }
     const double largest = sun_row_sum_arcsec(sun);
-    if (!(largest <= kMaxThermalAngleRad * kRadToArcsec)) {
+    if (!(largest <= kMaxThermalAngleArcsec)) {
         return "the Sun term's |sun_x| + |sun_y| + |sun_z| = " + number_text(largest) +
-               " arcsec is beyond a thermal angle's " + number_text(kMaxThermalAngleRad * kRadToArcsec) + " arcsec";
+               " arcsec is beyond a thermal angle's " + number_text(kMaxThermalAngleArcsec) + " arcsec";
     }
     return {};
 }
@@ -111,19 +114,18 @@ void refuse_sun_term(const ModelFile& m, const std::string& path, const std::str
 
 void refuse_sun_term_for_link(const ModelFile& m, const std::string& path,
                               const bool (&has_term_in_scalar)[kMaxHeads]) {
-    const double limit = kMaxThermalAngleRad * kRadToArcsec;
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         std::size_t first = kModelAxes;  // the first axis with a term
         for (std::size_t a = 0; m.present[h] && a < kModelAxes; ++a) {
             const double polynomial = axis_term_sum_arcsec(m, h, a);
             const double term = sun_row_sum_arcsec(m.sun[h][a]);
             first = first == kModelAxes && term != 0.0 ? a : first;
-            if (term != 0.0 && !(polynomial + term <= limit)) {
+            if (term != 0.0 && !(polynomial + term <= kMaxThermalAngleArcsec)) {
                 refuse_axis(m, path, h, a,
                             "the polynomial (up to " + number_text(polynomial) + " arcsec over temperatures within " +
                                 number_text(kMaxAbsTemperatureC) + " degrees C) and the Sun term (up to " +
                                 number_text(term) + " arcsec) together can pass a thermal angle's " +
-                                number_text(limit) +
+                                number_text(kMaxThermalAngleArcsec) +
                                 " arcsec, where the target's form of the term skips the stage: the target does not "
                                 "take it");
             }
