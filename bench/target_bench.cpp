@@ -40,10 +40,10 @@
 // ("bench <scalar> sun <instructions>": what a head with a Sun term adds to
 // its solution's correction).
 // The self-calibration's lag search (calib/lag_search.hpp, the out-of-line
-// entry of firmware/app/lag_search_entry_*.cpp) per cycle taken, the
-// selected records as heads A, B and C corrected with Table 2, against a
-// function that only reads a status ("bench <scalar> lag_search
-// <instructions>"; lag_search_ram, its sizeof).
+// entry of firmware/app/lag_search_entry_*.cpp) per fed cycle at 11 Hz
+// (the loop's feed every 2nd cycle), the selected records as heads A, B and
+// C corrected with Table 2, against a function that only reads a status
+// ("bench <scalar> lag_search <instructions>"; lag_search_ram, its sizeof).
 // The self-calibration's Sun-term learner (calib/sun_learner.hpp, double:
 // software floating point on both targets; the out-of-line entry of
 // firmware/app/sun_learner_entry.cpp) on the default 5640 s orbit in 2026,
@@ -52,9 +52,9 @@
 // orbit included) against a function that only reads an attitude; per orbit
 // closed, its solve's steps each timed alone, as idle time runs them between
 // cycles ("bench double sun_learner_<figure> <n>": take, steps, solve (their
-// sum), worst_step, ram, sizeof(SunLearner), and interval_us,
-// kSideLearnerIntervalUs). The side learners' cycles are an interval apart
-// (each taken: one per interval), at the 11 Hz feed's phase in it.
+// sum), worst_step, ram, sizeof(SunLearner), interval_us,
+// kSunLearnIntervalUs, and orbit_s). Its cycles are an interval apart (each
+// taken: one per interval), at the 11 Hz feed's phase in it.
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -412,16 +412,18 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
     report(name, "sun", run_sun<T>(&sun_with<T>, fx, sun), c0, ipc);
 }
 
-// The side learners take one cycle per interval, the first fed in it: the
-// cycles of their benches are an interval apart, each at the 11 Hz feed's
-// phase in it (a Δt that varies by up to 91 ms, as on board).
+// The Sun learner takes one cycle per interval, the first fed in it: the
+// cycles of its bench are an interval apart, each at the 11 Hz feed's phase
+// in it (a Δt that varies by up to 91 ms, as on board).
 std::int64_t learner_cycle_us(std::int64_t k) {
-    return k * calib::kSideLearnerIntervalUs + (k * 45'454) % 90'909;
+    return k * calib::kSunLearnIntervalUs + (k * 45'454) % 90'909;
 }
 
-// The lag search: one cycle per take, the frame heads corrected with
-// Table 2 (each record's input as head A, B and C in turn).
+// The lag search: one fed cycle per take at 11 Hz (the loop's feed every
+// 2nd cycle), the frame heads corrected with Table 2 (each record's input
+// as head A, B and C in turn).
 constexpr std::uint32_t kLagSearchCycles = 64;
+constexpr std::int64_t kLagSearchCycleUs = 1'000'000 / 11;
 
 template <typename T>
 struct LagSearchFixture {
@@ -457,7 +459,7 @@ std::uint32_t run_lag_search(volatile LagSearchFn<T> fn, calib::LagSearch<T>& se
             const std::uint32_t k = i % kInputs;
             const HeadTemperatures<T>* tp[calib::kFrameHeads] = {&fx.temperatures[k][0], &fx.temperatures[k][1],
                                                                  &fx.temperatures[k][2]};
-            const std::int64_t t_us = 820'800'000'000'000 + learner_cycle_us(cycle);
+            const std::int64_t t_us = 820'800'000'000'000 + cycle * kLagSearchCycleUs;
             scored += fn(search, t_us, model, fx.corrected[k], tp) ? 1U : 0U;
         }
     });
@@ -493,7 +495,7 @@ void bench_lag_search(const char* name, const Fixture<T>& fx, LagSearchFixture<T
 
 // The Sun term's learner: one fed cycle per take, one idle step per step.
 constexpr std::int64_t kLearnerOrbitUs = calib::EstimatorConfig{}.orbit_period_us;
-constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSideLearnerIntervalUs;  // an orbit
+constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSunLearnIntervalUs;  // an orbit
 constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
 Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
 
@@ -582,7 +584,8 @@ void bench_sun_learner(std::uint32_t ipc) {
     std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
     std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
-    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSideLearnerIntervalUs));
+    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnIntervalUs));
+    std::printf("bench double sun_learner_orbit_s %u\n", static_cast<unsigned>(kLearnerOrbitUs / 1'000'000));
     if (!g_learner.report().candidate.solved) {
         std::puts("bench: the Sun learner's bench solved no candidate");
     }

@@ -82,6 +82,65 @@ TEST(SymmetricEigen, ReconstructsAndMatchesEigenOnRandomMatrices) {
     }
 }
 
+// The whole sweeps as symmetric_eigen() ran them before its steps
+// (jacobi_start, jacobi_row), copied from it: the steps must give its bits,
+// so that the ground fit and the learner's candidates did not move.
+template <std::size_t N>
+int whole_sweeps(double (&a)[N][N], double (&v)[N][N], std::size_t n) {
+    double total = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) {
+            v[i][j] = i == j ? 1.0 : 0.0;
+            total += a[i][j] * a[i][j];
+        }
+    }
+    const double bound = calib::kJacobiTolerance * calib::kJacobiTolerance * total;
+    for (int sweep = 0; sweep < calib::kMaxJacobiSweeps; ++sweep) {
+        double off = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t j = 0; j < n; ++j) {
+                off += i == j ? 0.0 : a[i][j] * a[i][j];
+            }
+        }
+        if (off <= bound) {
+            return sweep;
+        }
+        for (std::size_t p = 0; p + 1U < n; ++p) {
+            for (std::size_t q = p + 1U; q < n; ++q) {
+                calib::jacobi_rotation(a, v, n, p, q);
+            }
+        }
+    }
+    return calib::kMaxJacobiSweeps + 1;
+}
+
+TEST(SymmetricEigen, ItsStepsGiveTheBitsOfTheWholeSweeps) {
+    std::mt19937_64 rng(8);
+    std::normal_distribution<double> g(0.0, 1.0);
+    int compared = 0;
+    for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{27}}) {
+        for (int trial = 0; trial < 3; ++trial) {
+            static double a[kMax][kMax];
+            static double b[kMax][kMax];
+            static double va[kMax][kMax];
+            static double vb[kMax][kMax];
+            for (std::size_t i = 0; i < kMax; ++i) {
+                for (std::size_t j = 0; j <= i; ++j) {
+                    a[i][j] = a[j][i] = trial == 0 && (i % 3 == 2 || j % 3 == 2) ? 0.0 : g(rng);
+                }
+            }
+            std::memcpy(b, a, sizeof a);
+            std::memset(va, 0, sizeof va);
+            std::memset(vb, 0, sizeof vb);
+            EXPECT_EQ(calib::symmetric_eigen(a, va, n), whole_sweeps(b, vb, n)) << n;
+            EXPECT_EQ(std::memcmp(a, b, sizeof a), 0) << n;
+            EXPECT_EQ(std::memcmp(va, vb, sizeof va), 0) << n;
+            ++compared;
+        }
+    }
+    EXPECT_EQ(compared, 15);
+}
+
 TEST(SymmetricEigen, RefusesWhatIsNotFiniteOrTooLarge) {
     double a[3][3] = {{1.0, 0.0, 0.0}, {0.0, std::nan(""), 0.0}, {0.0, 0.0, 1.0}};
     double v[3][3] = {};
@@ -441,7 +500,7 @@ void turning_bench(std::int64_t t_us, std::int64_t period_us, std::mt19937_64& r
 
 // TT µs since J2000 (2026): whole orbits of the default 5640 s, whole 120 s.
 constexpr std::int64_t kLearnT0Us = 145'532 * calib::EstimatorConfig{}.orbit_period_us;
-static_assert(kLearnT0Us % calib::kSideLearnerIntervalUs == 0);
+static_assert(kLearnT0Us % calib::kSunLearnIntervalUs == 0);
 
 // The learner's solve in bounded steps (on board: one per idle time) gives
 // the candidate the ground's whole solve after each cycle gives, bit for
@@ -460,7 +519,7 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     int steps = 0;
     int longest = 0;  // the most steps of a solve on board (those since the last candidate)
     for (std::int64_t k = 0; k < 40 * 47; ++k) {
-        const std::int64_t t_us = kLearnT0Us + k * calib::kSideLearnerIntervalUs;
+        const std::int64_t t_us = kLearnT0Us + k * calib::kSunLearnIntervalUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
         ASSERT_TRUE(ground.take(t_us, q));
@@ -488,16 +547,24 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     EXPECT_GT(longest, 100) << "one solve took many steps (a row of a sweep each)";
     EXPECT_LE(longest, calib::SunLearner::kMaxSolveSteps);
     EXPECT_LT(board_orbits + 1U, ground.report().candidate.orbits) << "a solve on board spans orbits' closes";
+    // The end of the data in the middle of a solve: finish() completes it and
+    // solves the last orbit too, as the ground's.
+    ASSERT_GT(steps, 0) << "a solve under way";
+    board.finish();
+    ground.finish();
+    const calib::SunTermFit b = board.report().candidate;
+    const calib::SunTermFit g = ground.report().candidate;
+    EXPECT_EQ(b.orbits, g.orbits);
+    EXPECT_EQ(std::memcmp(b.sun, g.sun, sizeof b.sun), 0);
 }
 
-// Fed at 10 s, a side learner takes the first cycle of each 120 s and
-// nothing of the others: the same report, bit for bit, as one fed those
-// alone. Learner: SunLearner or LagSearch<double> (take(t, q): the frame
-// heads' attitudes as the model corrected them).
-template <typename Learner>
-void thinned_as_a_thinned_feed(Learner& every, Learner& thinned, std::uint64_t seed) {
+// Fed at 10 s, the learner takes the first cycle of each 120 s and nothing
+// of the others: the same report, bit for bit, as a learner fed those alone.
+TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
     const calib::EstimatorConfig cfg;
-    std::mt19937_64 rng(seed);
+    calib::SunLearner every{cfg};
+    calib::SunLearner thinned{cfg};
+    std::mt19937_64 rng(41);
     constexpr std::int64_t kCycleUs = 10'000'000;
     const std::int64_t cycles = 6 * cfg.orbit_period_us / kCycleUs;
     std::uint64_t first_of_interval = 0;
@@ -505,15 +572,19 @@ void thinned_as_a_thinned_feed(Learner& every, Learner& thinned, std::uint64_t s
         const std::int64_t t_us = kLearnT0Us + k * kCycleUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
-        const bool first = t_us % calib::kSideLearnerIntervalUs == 0;
+        const bool first = t_us % calib::kSunLearnIntervalUs == 0;
         first_of_interval += first ? 1U : 0U;
-        EXPECT_EQ(every.take(t_us, q, k), first) << k;
+        EXPECT_EQ(every.take(t_us, q), first) << k;
+        (void)every.step_all();
         if (first) {
-            ASSERT_TRUE(thinned.take(t_us, q, k));
+            ASSERT_TRUE(thinned.take(t_us, q));
+            (void)thinned.step_all();
         }
     }
-    const auto a = every.report();
-    const auto b = thinned.report();
+    every.finish();
+    thinned.finish();
+    const calib::SunLearnReport a = every.report();
+    const calib::SunLearnReport b = thinned.report();
     EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(cycles) - first_of_interval);
     EXPECT_EQ(b.thinned, 0U);
     EXPECT_EQ(a.cycles, first_of_interval);
@@ -521,81 +592,39 @@ void thinned_as_a_thinned_feed(Learner& every, Learner& thinned, std::uint64_t s
     EXPECT_GE(a.orbits, 4U);
     EXPECT_EQ(a.orbits, b.orbits);
     EXPECT_EQ(std::memcmp(a.score, b.score, sizeof a.score), 0);
+    ASSERT_TRUE(a.candidate.solved);
+    EXPECT_EQ(std::memcmp(a.candidate.sun, b.candidate.sun, sizeof a.candidate.sun), 0);
 }
 
-// The learners as thinned_as_a_thinned_feed takes them.
-struct SunLearnerFeed {
-    calib::SunLearner learner{calib::EstimatorConfig{}};
-    bool take(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads], std::int64_t /*k*/) {
-        const bool taken = learner.take(t_us, q);
-        (void)learner.step_all();
-        return taken;
-    }
-    calib::SunLearnReport report() {
-        learner.finish();
-        return learner.report();
-    }
-};
-
-// The search with a model whose heads are present and whose coefficients
-// are 0 (q_th = 1), the heads' temperatures rising 1 °C an hour and
-// wobbling with the cycle.
-struct LagSearchFeed {
-    calib::LagSearch<double> search{calib::EstimatorConfig{}};
-    ThermalModel<double> model = present_heads();
-    bool take(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads], std::int64_t k) {
-        CorrectedSolution<double> c[calib::kFrameHeads];
-        HeadTemperatures<double> tp[calib::kFrameHeads];
-        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
-            c[h] = {q[h], static_cast<StatusBits>(status::kAberrationApplied | status::kThermalApplied)};
-            const double t =
-                20.0 + static_cast<double>(k) * (10.0 / 3600.0) + 0.3 * std::sin(0.1 * static_cast<double>(k));
-            tp[h] = {{t, true}, {t - 5.0, true}, {t + static_cast<double>(h), true}};
-        }
-        const HeadTemperatures<double>* t[calib::kFrameHeads] = {&tp[0], &tp[1], &tp[2]};
-        return search.take(t_us, model, c, t);
-    }
-    calib::LagSearchReport report() {
-        search.finish();
-        return search.report();
-    }
-    static ThermalModel<double> present_heads() {
-        ThermalModel<double> m{};
-        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
-            m.head[h].present = true;
-        }
-        return m;
-    }
-};
-
-TEST(SideLearners, EachTakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
-    SunLearnerFeed sun_every;
-    SunLearnerFeed sun_thinned;
-    thinned_as_a_thinned_feed(sun_every, sun_thinned, 41);
-    ASSERT_TRUE(sun_every.learner.report().candidate.solved);
-    EXPECT_EQ(std::memcmp(sun_every.learner.report().candidate.sun, sun_thinned.learner.report().candidate.sun,
-                          sizeof(calib::SunTermFit::sun)),
-              0);
-    LagSearchFeed lag_every;
-    LagSearchFeed lag_thinned;
-    thinned_as_a_thinned_feed(lag_every, lag_thinned, 42);
+// The gate by itself: intervals floor(t / 120 s) for times of either sign;
+// a cycle of an interval before the latest taken is thinned, as one of it.
+TEST(SunLearner, TheThinningTakesOncePerIntervalAndNeverGoesBack) {
+    calib::SunLearnThinning gate;
+    constexpr std::int64_t kI = calib::kSunLearnIntervalUs;
+    EXPECT_TRUE(gate.due(-kI - 1));  // interval −2
+    gate.taken(-kI - 1);
+    EXPECT_FALSE(gate.due(-kI - 1 - (kI - 2)));  // the same interval, its start
+    EXPECT_TRUE(gate.due(-1));                   // interval −1
+    gate.taken(-1);
+    EXPECT_FALSE(gate.due(-kI));  // −1 too
+    EXPECT_FALSE(gate.due(-kI - 1)) << "an earlier interval after a later one";
+    EXPECT_TRUE(gate.due(0));
+    gate.taken(0);
+    EXPECT_FALSE(gate.due(kI - 1));
+    EXPECT_TRUE(gate.due(kI));
+    EXPECT_EQ(gate.thinned(), 4U);
 }
 
-// The accounts name the epochs the learners skipped, and the interval.
-TEST(SideLearners, TheAccountsCountTheEpochsThinnedOut) {
-    calib::SunLearnReport sun;
-    calib::LagSearchReport lag;
-    EXPECT_EQ(host::describe(sun, {}).find("interval"), std::string::npos);
-    EXPECT_EQ(host::describe(lag, 0.0).find("interval"), std::string::npos);
-    sun.thinned = 23;
-    lag.thinned = 5;
-    EXPECT_NE(host::describe(sun, {}).find(
-                  "; 23 epoch(s) in a 120 s interval learnt from already not taken (one per interval: the DPU's cost)"),
+// The account names the epochs the learner skipped, and the interval.
+TEST(SunLearner, TheAccountCountsTheEpochsThinnedOut) {
+    calib::SunLearnReport r;
+    EXPECT_EQ(host::describe(r, {}).find("interval"), std::string::npos);
+    r.thinned = 23;
+    EXPECT_NE(host::describe(r, {}).find(
+                  "; 23 epoch(s) not learnt from: their 120 s interval had one already (one per interval: the "
+                  "DPU's cost)"),
               std::string::npos)
-        << host::describe(sun, {});
-    EXPECT_NE(host::describe(lag, 0.0).find("; 5 epoch(s) in a 120 s interval scored already not taken"),
-              std::string::npos)
-        << host::describe(lag, 0.0);
+        << host::describe(r, {});
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

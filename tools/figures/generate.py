@@ -214,26 +214,30 @@ def side_learners_section(d):
     out = ["## The side learners", "",
            "The self-calibration's lag search (`calib/lag_search.hpp`, the core's scalar for the thermal stage, "
            "double for the IBAs) and Sun-term learner (`calib/sun_learner.hpp`, double), software floating point "
-           "on both targets, measured alone by the target bench: not in the flight loop yet. Each takes one epoch "
-           "per interval; the Sun learner's solve runs after each orbit in idle time, a step at a time.", ""]
+           "on both targets, measured alone by the target bench: not in the flight loop yet. Per 22 Hz cycle, "
+           "the mean over the cycles, against the estimator's per cycle: the lag search takes every fed cycle "
+           "(every 2nd), the Sun learner one per interval; its solve runs after each orbit in idle time, a step "
+           "at a time.", ""]
 
-    def per_cycle(t):
-        """Both learners' mean per 22 Hz cycle, against the estimator's per cycle."""
-        mean = (e[t]["per_take"] + lag[t]["lag_search_per_take"]) / (22 * e[t]["interval_us"] * 1e-6)
+    def per_cycle(t, mean):
         base = (r.get("estimator", {}).get(t) or {}).get("per_cycle")
-        share = f" ({100 * mean / base:.0f} % of the estimator's)" if base else ""
-        return f"{num(round(mean))}{share}, an epoch per {e[t]['interval_us'] / 1e6:g} s"
+        return f"{num(round(mean))} ({100 * mean / base:.0f} % of the estimator's)" if base else num(round(mean))
     rows = [
-        ["the lag search, per epoch taken (the flight scalar)"] +
+        ["the lag search, per fed cycle (the flight scalar)"] +
         [f"{num(lag[t]['lag_search_per_take'])} ({flight[t]})" for t in ts],
+        ["… per 22 Hz cycle"] + [per_cycle(t, lag[t]["lag_search_per_take"] / 2) for t in ts],
         ["the Sun-term learner, per epoch taken"] + [num(e[t]["per_take"]) for t in ts],
-        ["both, per 22 Hz cycle, mean"] + [per_cycle(t) for t in ts],
-        ["the Sun-term learner per orbit (its solve, idle time)"] +
-        [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps" for t in ts],
+        ["… per 22 Hz cycle, one taken per interval"] +
+        [f"{per_cycle(t, e[t]['per_take'] / (22 * e[t]['interval_us'] * 1e-6))}, {e[t]['interval_us'] / 1e6:g} s"
+         for t in ts],
+        ["its solve per orbit (idle time)"] +
+        [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps ({e[t]['orbit_s']} s orbit)" for t in ts],
+        ["… per 22 Hz cycle"] + [per_cycle(t, e[t]["per_orbit"] / (22 * e[t]["orbit_s"])) for t in ts],
         ["its worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],
         ["RAM: the lag search, the Sun-term learner (`sizeof`)"] +
         [f"{num(lag[t]['lag_search_ram_bytes'])} B, {num(e[t]['ram_bytes'])} B" for t in ts],
-        ["the Sun-term learner's stack (its entry's frames, summed)"] + [f"{num(e[t]['stack_bytes'])} B" for t in ts],
+        ["the Sun-term learner's stack (its entry's frames summed; callees in libgcc and libm not included)"] +
+        [f"{num(e[t]['stack_bytes'])} B" for t in ts],
     ]
     return out + table([""] + [tname(t) for t in ts], rows) + [""]
 

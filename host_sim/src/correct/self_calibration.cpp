@@ -785,16 +785,6 @@ std::string time_constant_range() {
 
 namespace {
 
-// The epochs a side learner skipped (SideLearnerThinning), in a clause ("" when none).
-std::string thinned_out(std::uint64_t thinned, const char* what) {
-    if (thinned == 0U) {
-        return "";
-    }
-    return "; " + std::to_string(thinned) + " epoch(s) in a " +
-           std::to_string(calib::kSideLearnerIntervalUs / 1'000'000) + " s interval " + what +
-           " already not taken (one per interval: the DPU's cost)";
-}
-
 std::string lag_text(double tau_s) {
     return tau_s != 0.0 ? number_text(tau_s) + " s" : std::string("no lag");
 }
@@ -832,9 +822,7 @@ std::string lags_taken(const std::vector<ActiveModel>& history, double& last) {
 
 }  // namespace
 
-namespace {
-
-std::string describe_lag_search(const calib::LagSearchReport& r, double last_model_lag_s) {
+std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
     if (r.orbits == 0U) {
         return "the search scored no orbit (no model active with A, B and C selected)";
     }
@@ -857,12 +845,6 @@ std::string describe_lag_search(const calib::LagSearchReport& r, double last_mod
     return out + buf + (r.tau_s != last_model_lag_s ? "; no model since took it" : "");
 }
 
-}  // namespace
-
-std::string describe(const calib::LagSearchReport& r, double last_model_lag_s) {
-    return describe_lag_search(r, last_model_lag_s) + thinned_out(r.thinned, "scored");
-}
-
 namespace {
 
 // The epochs the learner could not take, in a clause ("" when none).
@@ -875,6 +857,11 @@ std::string not_learnt_from(const calib::SunLearnReport& r) {
     if (r.not_finite > 0U) {
         out +=
             "; " + std::to_string(r.not_finite) + " epoch(s) whose attitudes give no finite rotation not learnt from";
+    }
+    if (r.thinned > 0U) {
+        out += "; " + std::to_string(r.thinned) + " epoch(s) not learnt from: their " +
+               std::to_string(calib::kSunLearnIntervalUs / 1'000'000) +
+               " s interval had one already (one per interval: the DPU's cost)";
     }
     return out;
 }
@@ -912,7 +899,7 @@ std::string describe_sun_learner(const calib::SunLearnReport& r, const std::vect
 }  // namespace
 
 std::string describe(const calib::SunLearnReport& r, const std::vector<ActiveModel>& history) {
-    return describe_sun_learner(r, history) + not_learnt_from(r) + thinned_out(r.thinned, "learnt from");
+    return describe_sun_learner(r, history) + not_learnt_from(r);
 }
 
 std::string describe(const SelfCalibration& s) {

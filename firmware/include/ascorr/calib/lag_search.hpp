@@ -39,13 +39,7 @@
 // (orbit_spread_scores.hpp); one earlier than the last scored orbit forgets
 // nothing, and a lag's channel refuses its time
 // (TemperatureLag: kTimeNotIncreasing) and keeps its state.
-// Thinned: at most one cycle per kSideLearnerIntervalUs is taken
-// (orbit_spread_scores.hpp: the first fed in each 120 s whose heads are
-// selected, as the Sun term's learner), so that its cost on the DPU stays
-// within issue 40's budget; the others are counted (report().thinned), and
-// the lags step at the cycles taken (as above: a reading between two is not
-// seen; τ ≥ 300 s).
-// Cost per cycle taken: 3·kLagGridPoints lag steps, 3·kLagCandidates thermal
+// Cost per fed cycle: 3·kLagGridPoints lag steps, 3·kLagCandidates thermal
 // stages, quaternion products and boresights, 3·kLagCandidates IBAs (an atan2
 // and a square root each). Bounded: no allocation, no loop but over the
 // candidates, heads and pairs. A cycle whose model cannot correct a head at
@@ -104,7 +98,6 @@ struct LagSearchReport {
     double orbits_held = 0.0;           // their forgotten count of orbits
     double orbits_to_decide = 0.0;      // ... that the rule needs (a memory's)
     double score[kLagCandidates] = {};  // forgotten sums of squares (arcsec²)
-    std::uint64_t thinned = 0;          // cycles not taken: an interval's taken already (kSideLearnerIntervalUs)
 };
 
 template <typename T>
@@ -124,14 +117,11 @@ public:
 
     // One fed cycle at t_us (TT µs): the frame heads' corrected solutions
     // (corrected[h], with `model` at temperatures[h], as the pipeline kept
-    // them for the feed). false: not scored (thinned: an interval's cycle
-    // taken already; a head not selected, or a candidate that cannot
-    // correct it). A cycle of a later orbit closes the open one first.
+    // them for the feed). false: not scored (a head not selected, or a
+    // candidate that cannot correct it). A cycle of a later orbit closes the
+    // open one first.
     bool take(std::int64_t t_us, const ThermalModel<T>& model, const CorrectedSolution<T>* corrected,
               const HeadTemperatures<T>* const* temperatures) noexcept {
-        if (!thinning_.due(t_us)) {
-            return false;
-        }
         if (scores_.begin(t_us)) {
             reconsider();
         }
@@ -143,7 +133,6 @@ public:
             }
             q_ab[h] = in_double(q);
         }
-        thinning_.taken(t_us);  // the lags step at it
         for (pipeline::TemperatureLag<T>(&lags)[kFrameHeads] : lag_) {
             for (std::uint8_t h = 0; h < kFrameHeads; ++h) {
                 (void)lags[h].step(t_us, *temperatures[h]);
@@ -193,7 +182,6 @@ public:
         r.deciding = scores_.deciding();
         r.orbits_held = scores_.orbits_held();
         r.orbits_to_decide = scores_.orbits_to_decide();
-        r.thinned = thinning_.thinned();
         return r;
     }
 
@@ -262,7 +250,6 @@ private:
     pipeline::TemperatureLag<T> lag_[kGrid][kFrameHeads]{};
     std::size_t taken_ = 0U;
     Quaternion<double> q_taken_[kFrameHeads]{};
-    SideLearnerThinning thinning_;
 };
 
 }  // namespace ascorr::calib

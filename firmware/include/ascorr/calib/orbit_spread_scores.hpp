@@ -48,41 +48,6 @@ inline std::int64_t side_learner_period_us(const EstimatorConfig& cfg) noexcept 
     return cfg.orbit_period_us > 0 ? cfg.orbit_period_us : EstimatorConfig{}.orbit_period_us;
 }
 
-// The side learners take at most one fed cycle per interval of this length
-// (µs), the first fed in each interval floor(t / 120 s). Why: on the
-// targets a take costs about 445,000 instructions (the lag search) and
-// 124,000 (the Sun term), in software double (docs/figures.md, "The side
-// learners"); one of each per 120 s is 216 (M3) and 214 (M4F) per 22 Hz
-// cycle on average, 18 % and 25 % of the estimator's per cycle, within
-// issue 40's 30 %. The missions that measured them (docs/ground.md) have an
-// epoch every 120 to 240 s, every one taken: 47 a 94-min orbit hold the
-// orbit's variation.
-inline constexpr std::int64_t kSideLearnerIntervalUs = 120'000'000;
-
-// Which fed cycles a side learner takes (above): due() when no cycle of the
-// interval has been taken (otherwise the cycle is counted as thinned),
-// taken() once one is.
-class SideLearnerThinning {
-public:
-    bool due(std::int64_t t_us) noexcept {
-        if (any_ && orbit_bin(t_us, kSideLearnerIntervalUs) == interval_) {
-            ++thinned_;
-            return false;
-        }
-        return true;
-    }
-    void taken(std::int64_t t_us) noexcept {
-        any_ = true;
-        interval_ = orbit_bin(t_us, kSideLearnerIntervalUs);
-    }
-    std::uint64_t thinned() const noexcept { return thinned_; }
-
-private:
-    bool any_ = false;           // a cycle taken (interval_)
-    std::int64_t interval_ = 0;  // the interval of the last one
-    std::uint64_t thinned_ = 0U;
-};
-
 template <std::size_t K>
 class OrbitSpreadScores {
 public:

@@ -5,8 +5,8 @@
 // Why a learner beside the estimator: the estimator learns from orbit means,
 // which average the Sun's direction in the orbital plane away; the term lives
 // inside the orbit. So, as `fit` does on the ground (sun_moments.hpp), the
-// learner sums, at each fed cycle with an active model (heads A, B and C
-// selected), the heads' rotations in F and the Sun's direction in each head's
+// learner sums, at fed cycles with an active model (heads A, B and C
+// selected; one per 120 s, below), the heads' rotations in F and the Sun's direction in each head's
 // frame, about each orbit's own mean, with a forgetting e^(−Δt/memory) per
 // orbit closed (memory: orbit_spread_scores.hpp's, the estimator's time
 // constant but at least 30 days), and solves them after every orbit closed
@@ -29,17 +29,20 @@
 // latest candidate (within the core's domain: sun_fit_within_domain; a
 // candidate beyond it is not used).
 //
-// Thinned: at most one cycle per kSideLearnerIntervalUs is taken
-// (orbit_spread_scores.hpp: the first fed in each 120 s, as the lag search),
-// so that the per-cycle cost on the DPU stays within issue 40's budget; the
-// others are skipped, counted (report().thinned).
+// Thinned: at most one cycle per kSunLearnIntervalUs (120 s) is taken, the
+// first taken in each interval floor(t / 120 s); the others, and any cycle
+// of an interval before it, are skipped and counted (report().thinned).
+// Why: a take costs the DPU about as much as 100 of the estimator's cycles
+// (docs/figures.md, "The side learners"). Thinning biases nothing here: the
+// moments are sums over the epochs taken, with no state between them (the
+// lag search cannot be thinned so: its lags must step as the pipeline's).
 //
 // Arithmetic: double (the attitudes as the caller corrected them: the
 // pipeline's kept solutions, or the lag search's at its lag; the Sun from
 // nav/sun_direction.hpp at the cycle's TT). A cycle outside the Sun
 // ephemeris' span (2000–2051), or whose attitudes give no finite rotation, is
 // not taken (counted: report()).
-// Cost per fed cycle (take): a Sun direction, three Sun-term rotations, six
+// Cost per cycle taken (take): a Sun direction, three Sun-term rotations, six
 // boresights and IBAs, the moments' 2·9² products. Per orbit closed (step):
 // the normal equations (27 × 27) and their Jacobi eigen-decomposition
 // (symmetric_eigen.hpp, at most 30 sweeps), a bounded step per call (the
@@ -65,6 +68,35 @@ namespace ascorr::calib {
 
 // The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
 inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
+// The learner takes at most one cycle per interval of this length (µs;
+// above). The missions that measured it (docs/ground.md) have an epoch every
+// 120 to 240 s, every one taken: 47 a 94-min orbit hold the term's variation
+// inside the orbit.
+inline constexpr std::int64_t kSunLearnIntervalUs = 120'000'000;
+
+// Which cycles the learner takes (above): due() unless a cycle of the
+// interval, or of a later one, was taken (then counted as thinned);
+// taken() once one is.
+class SunLearnThinning {
+public:
+    bool due(std::int64_t t_us) noexcept {
+        if (any_ && orbit_bin(t_us, kSunLearnIntervalUs) <= interval_) {
+            ++thinned_;
+            return false;
+        }
+        return true;
+    }
+    void taken(std::int64_t t_us) noexcept {
+        any_ = true;
+        interval_ = orbit_bin(t_us, kSunLearnIntervalUs);
+    }
+    std::uint64_t thinned() const noexcept { return thinned_; }
+
+private:
+    bool any_ = false;           // a cycle taken (interval_)
+    std::int64_t interval_ = 0;  // the interval of the latest one
+    std::uint64_t thinned_ = 0U;
+};
 
 struct SunLearnReport {
     std::uint32_t orbits = 0;       // orbits scored
@@ -79,7 +111,7 @@ struct SunLearnReport {
     SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
-    std::uint64_t thinned = 0;      // cycles not taken: an interval's taken already (kSideLearnerIntervalUs)
+    std::uint64_t thinned = 0;      // cycles not taken: their interval (kSunLearnIntervalUs) or a later one had one
 };
 
 class SunLearner {
@@ -100,8 +132,8 @@ public:
     // One fed cycle at t_us (TT µs since J2000): q[h] the frame heads'
     // attitudes corrected by the active polynomial. false: not taken (t
     // outside the Sun ephemeris' span, or attitudes that give no finite
-    // rotation; counted), or thinned (an interval's cycle taken already:
-    // counted, and nothing else done). A cycle of another orbit than the
+    // rotation; counted), or thinned (its interval, or a later one, had a
+    // cycle taken: counted, and nothing else done). A cycle of another orbit than the
     // open one closes it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
         if (!thinning_.due(t_us)) {
@@ -261,7 +293,7 @@ private:
     bool taken_ = false;
     std::uint64_t without_sun_ = 0U;
     std::uint64_t not_finite_ = 0U;
-    SideLearnerThinning thinning_;
+    SunLearnThinning thinning_;
 };
 
 }  // namespace ascorr::calib

@@ -78,7 +78,9 @@ enum class JacobiStep : unsigned char {
 };
 
 // The most jacobi_row() calls of one decomposition of order n: a row per
-// step, n − 1 per sweep, and the final test.
+// call, n − 1 per sweep, and the call that ends it (converged, or the
+// sweeps' bound reached). n ≤ 1 converges at its first call; its bound is
+// kept above that only to keep the formula one line.
 constexpr int jacobi_max_steps(std::size_t n) noexcept {
     return kMaxJacobiSweeps * static_cast<int>(n > 1U ? n - 1U : 1U) + 1;
 }
