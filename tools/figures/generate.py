@@ -221,7 +221,10 @@ def side_learners_section(d):
 
     def per_cycle(t, mean):
         base = (r.get("estimator", {}).get(t) or {}).get("per_cycle")
-        return f"{num(round(mean))} ({100 * mean / base:.0f} % of the estimator's)" if base else num(round(mean))
+        if not base:
+            return num(round(mean))
+        share = f"{mean / base:.0f}×" if mean >= 2 * base else f"{100 * mean / base:.0f} % of"
+        return f"{num(round(mean))} ({share} the estimator's)"
     rows = [
         ["the lag search, per fed cycle (the flight scalar)"] +
         [f"{num(lag[t]['lag_search_per_take'])} ({flight[t]})" for t in ts],
