@@ -6,10 +6,11 @@
 // which average the Sun's direction in the orbital plane away; the term lives
 // inside the orbit. So, as `fit` does on the ground (sun_moments.hpp), the
 // learner sums, at fed cycles with an active model (heads A, B and C
-// selected; one per 120 s, below), the heads' rotations in F and the Sun's direction in each head's
-// frame, about each orbit's own mean, with a forgetting e^(−Δt/memory) per
-// orbit closed (memory: orbit_spread_scores.hpp's, the estimator's time
-// constant but at least 30 days), and solves them after every orbit closed
+// selected; one per 120 s, below), the heads' rotations in F and the Sun's
+// direction in each head's frame, about each orbit's own mean, with a
+// forgetting e^(−Δt/memory) per orbit closed (memory:
+// orbit_spread_scores.hpp's, the estimator's time constant but at least 30
+// days), and solves them after every orbit closed
 // (step(), in idle time): the candidate, under the estimator's weights for
 // the common rotation when it has them (`--mountings`' combined attitude),
 // otherwise the smallest coefficients (not the estimator's own gauge, frame F
@@ -32,7 +33,7 @@
 // Thinned: at most one cycle per kSunLearnIntervalUs (120 s) is taken, the
 // first taken in each interval floor(t / 120 s); the others, and any cycle
 // of an interval before it, are skipped and counted (report().thinned).
-// Why: a take costs the DPU about as much as 100 of the estimator's cycles
+// Why: a take costs the DPU as much as 100 to 150 of the estimator's cycles
 // (docs/figures.md, "The side learners"). Thinning biases nothing here: the
 // moments are sums over the epochs taken, with no state between them (the
 // lag search cannot be thinned so: its lags must step as the pipeline's).
@@ -133,8 +134,8 @@ public:
     // attitudes corrected by the active polynomial. false: not taken (t
     // outside the Sun ephemeris' span, or attitudes that give no finite
     // rotation; counted), or thinned (its interval, or a later one, had a
-    // cycle taken: counted, and nothing else done). A cycle of another orbit than the
-    // open one closes it first (its solve then waits for step()).
+    // cycle taken: counted, and nothing else done). A cycle of another orbit
+    // than the open one closes it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
         if (!thinning_.due(t_us)) {
             return false;
