@@ -52,9 +52,9 @@
 // orbit included) against a function that only reads an attitude; per orbit
 // closed, its solve's steps each timed alone, as idle time runs them between
 // cycles ("bench double sun_learner_<figure> <n>": take, steps, solve (their
-// sum), worst_step, ram, sizeof(SunLearner), interval_us,
-// kSunLearnIntervalUs, and orbit_s). Its cycles are an interval apart (each
-// taken: one per interval), at the 11 Hz feed's phase in it.
+// sum), worst_step, ram, sizeof(SunLearner), interval_us, the DPU's
+// kSunLearnOnBoardIntervalUs, and orbit_s). Its cycles are an interval
+// apart (each taken: one per interval), at the 11 Hz feed's phase in it.
 // Output: one line per figure, "bench <scalar> <stage> <instructions>".
 #include <cmath>
 #include <cstdint>
@@ -416,7 +416,7 @@ void bench_sun(const char* name, const Fixture<T>& fx, std::uint32_t ipc) {
 // cycles of its bench are an interval apart, each at the 11 Hz feed's phase
 // in it (a Δt that varies by up to 91 ms, as on board).
 std::int64_t learner_cycle_us(std::int64_t k) {
-    return k * calib::kSunLearnIntervalUs + (k * 45'454) % 90'909;
+    return k * calib::kSunLearnOnBoardIntervalUs + (k * 45'454) % 90'909;
 }
 
 // The lag search: one fed cycle per take at 11 Hz (the loop's feed every
@@ -495,7 +495,7 @@ void bench_lag_search(const char* name, const Fixture<T>& fx, LagSearchFixture<T
 
 // The Sun term's learner: one fed cycle per take, one idle step per step.
 constexpr std::int64_t kLearnerOrbitUs = calib::EstimatorConfig{}.orbit_period_us;
-constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSunLearnIntervalUs;  // an orbit
+constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSunLearnOnBoardIntervalUs;  // an orbit
 constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
 Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
 
@@ -512,7 +512,7 @@ __attribute__((noinline)) bool step_none(calib::SunLearner& /*learner*/) noexcep
     return false;
 }
 
-calib::SunLearner g_learner{calib::EstimatorConfig{}};
+calib::SunLearner g_learner{calib::EstimatorConfig{}, calib::kSunLearnOnBoardIntervalUs};
 
 std::uint32_t run_takes(volatile TakeFn fn, std::int64_t t0_us) {
     return counts([&] {
@@ -584,7 +584,7 @@ void bench_sun_learner(std::uint32_t ipc) {
     std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
     std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
-    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnIntervalUs));
+    std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnOnBoardIntervalUs));
     std::printf("bench double sun_learner_orbit_s %u\n", static_cast<unsigned>(kLearnerOrbitUs / 1'000'000));
     if (!g_learner.report().candidate.solved) {
         std::puts("bench: the Sun learner's bench solved no candidate");

@@ -500,7 +500,7 @@ void turning_bench(std::int64_t t_us, std::int64_t period_us, std::mt19937_64& r
 
 // TT µs since J2000 (2026): whole orbits of the default 5640 s, whole 120 s.
 constexpr std::int64_t kLearnT0Us = 145'532 * calib::EstimatorConfig{}.orbit_period_us;
-static_assert(kLearnT0Us % calib::kSunLearnIntervalUs == 0);
+static_assert(kLearnT0Us % calib::kSunLearnOnBoardIntervalUs == 0);
 
 // The learner's solve in bounded steps (on board: one per idle time) gives
 // the candidate the ground's whole solve after each cycle gives, bit for
@@ -519,7 +519,7 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     int steps = 0;
     int longest = 0;  // the most steps of a solve on board (those since the last candidate)
     for (std::int64_t k = 0; k < 40 * 47; ++k) {
-        const std::int64_t t_us = kLearnT0Us + k * calib::kSunLearnIntervalUs;
+        const std::int64_t t_us = kLearnT0Us + k * calib::kSunLearnOnBoardIntervalUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
         ASSERT_TRUE(ground.take(t_us, q));
@@ -558,12 +558,13 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
     EXPECT_EQ(std::memcmp(b.sun, g.sun, sizeof b.sun), 0);
 }
 
-// Fed at 10 s, the learner takes the first cycle of each 120 s and nothing
-// of the others: the same report, bit for bit, as a learner fed those alone.
+// Fed at 10 s, the learner with the DPU's interval takes the first cycle of
+// each 120 s and nothing of the others: the same report, bit for bit, as a
+// learner without one fed those alone.
 TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
     const calib::EstimatorConfig cfg;
-    calib::SunLearner every{cfg};
-    calib::SunLearner thinned{cfg};
+    calib::SunLearner every{cfg, calib::kSunLearnOnBoardIntervalUs};
+    calib::SunLearner thinned{cfg};  // every cycle it is given
     std::mt19937_64 rng(41);
     constexpr std::int64_t kCycleUs = 10'000'000;
     const std::int64_t cycles = 6 * cfg.orbit_period_us / kCycleUs;
@@ -572,7 +573,7 @@ TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
         const std::int64_t t_us = kLearnT0Us + k * kCycleUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
-        const bool first = t_us % calib::kSunLearnIntervalUs == 0;
+        const bool first = t_us % calib::kSunLearnOnBoardIntervalUs == 0;
         first_of_interval += first ? 1U : 0U;
         EXPECT_EQ(every.take(t_us, q), first) << k;
         (void)every.step_all();
@@ -599,8 +600,14 @@ TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
 // The gate by itself: intervals floor(t / 120 s) for times of either sign;
 // a cycle of an interval before the latest taken is thinned, as one of it.
 TEST(SunLearner, TheThinningTakesOncePerIntervalAndNeverGoesBack) {
-    calib::SunLearnThinning gate;
-    constexpr std::int64_t kI = calib::kSunLearnIntervalUs;
+    calib::SunLearnThinning every;  // the ground's: no interval
+    for (std::int64_t t : {std::int64_t{0}, std::int64_t{1}, std::int64_t{-5}}) {
+        EXPECT_TRUE(every.due(t));
+        every.taken(t);
+    }
+    EXPECT_EQ(every.thinned(), 0U);
+    calib::SunLearnThinning gate{calib::kSunLearnOnBoardIntervalUs};
+    constexpr std::int64_t kI = calib::kSunLearnOnBoardIntervalUs;
     EXPECT_TRUE(gate.due(-kI - 1));  // interval −2
     gate.taken(-kI - 1);
     EXPECT_FALSE(gate.due(-kI - 1 - (kI - 2)));  // the same interval, its start
@@ -613,18 +620,6 @@ TEST(SunLearner, TheThinningTakesOncePerIntervalAndNeverGoesBack) {
     EXPECT_FALSE(gate.due(kI - 1));
     EXPECT_TRUE(gate.due(kI));
     EXPECT_EQ(gate.thinned(), 4U);
-}
-
-// The account names the epochs the learner skipped, and the interval.
-TEST(SunLearner, TheAccountCountsTheEpochsThinnedOut) {
-    calib::SunLearnReport r;
-    EXPECT_EQ(host::describe(r, {}).find("interval"), std::string::npos);
-    r.thinned = 23;
-    EXPECT_NE(host::describe(r, {}).find(
-                  "; 23 epoch(s) not learnt from: their 120 s interval had one already (one per interval: the "
-                  "DPU's cost)"),
-              std::string::npos)
-        << host::describe(r, {});
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

@@ -858,11 +858,6 @@ std::string not_learnt_from(const calib::SunLearnReport& r) {
         out +=
             "; " + std::to_string(r.not_finite) + " epoch(s) whose attitudes give no finite rotation not learnt from";
     }
-    if (r.thinned > 0U) {
-        out += "; " + std::to_string(r.thinned) + " epoch(s) not learnt from: their " +
-               std::to_string(calib::kSunLearnIntervalUs / 1'000'000) +
-               " s interval had one already (one per interval: the DPU's cost)";
-    }
     return out;
 }
 

@@ -6,9 +6,9 @@
 // which average the Sun's direction in the orbital plane away; the term lives
 // inside the orbit. So, as `fit` does on the ground (sun_moments.hpp), the
 // learner sums, at fed cycles with an active model (heads A, B and C
-// selected; one per 120 s, below), the heads' rotations in F and the Sun's
-// direction in each head's frame, about each orbit's own mean, with a
-// forgetting e^(−Δt/memory) per orbit closed (memory:
+// selected; on board one per 120 s, below), the heads' rotations in F and
+// the Sun's direction in each head's frame, about each orbit's own mean,
+// with a forgetting e^(−Δt/memory) per orbit closed (memory:
 // orbit_spread_scores.hpp's, the estimator's time constant but at least 30
 // days), and solves them after every orbit closed
 // (step(), in idle time): the candidate, under the estimator's weights for
@@ -30,13 +30,16 @@
 // latest candidate (within the core's domain: sun_fit_within_domain; a
 // candidate beyond it is not used).
 //
-// Thinned: at most one cycle per kSunLearnIntervalUs (120 s) is taken, the
-// first taken in each interval floor(t / 120 s); the others, and any cycle
-// of an interval before it, are skipped and counted (report().thinned).
-// Why: a take costs the DPU as much as 100 to 150 of the estimator's cycles
-// (docs/figures.md, "The side learners"). Thinning biases nothing here: the
-// moments are sums over the epochs taken, with no state between them (the
-// lag search cannot be thinned so: its lags must step as the pipeline's).
+// Thinned on board: given an interval (the DPU's: kSunLearnOnBoardIntervalUs,
+// 120 s), at most one cycle per interval floor(t / interval) is taken, the
+// first taken in it; the others, and any cycle of an interval before it,
+// are skipped and counted (report().thinned). Why: a take costs the DPU as
+// much as 100 to 150 of the estimator's cycles (docs/figures.md, "The side
+// learners"). It biases nothing: the moments are sums over the epochs taken,
+// with no state between them (the lag search cannot be thinned so: its lags
+// must step as the pipeline's). Without an interval (0, the ground's
+// `correct --self-calibrate`, as the contract says) every fed cycle is
+// taken.
 //
 // Arithmetic: double (the attitudes as the caller corrected them: the
 // pipeline's kept solutions, or the lag search's at its lag; the Sun from
@@ -69,19 +72,20 @@ namespace ascorr::calib {
 
 // The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
 inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
-// The learner takes at most one cycle per interval of this length (µs;
-// above). The missions that measured it (docs/ground.md) have an epoch every
-// 120 to 240 s, every one taken: 47 a 94-min orbit hold the term's variation
-// inside the orbit.
-inline constexpr std::int64_t kSunLearnIntervalUs = 120'000'000;
+// The DPU's interval for the learner (µs; above). The missions that measured
+// it (docs/ground.md) have an epoch every 120 to 240 s, every one taken: 47
+// a 94-min orbit hold the term's variation inside the orbit.
+inline constexpr std::int64_t kSunLearnOnBoardIntervalUs = 120'000'000;
 
-// Which cycles the learner takes (above): due() unless a cycle of the
-// interval, or of a later one, was taken (then counted as thinned);
-// taken() once one is.
+// Which cycles the learner takes (above): with an interval (µs, > 0), due()
+// unless a cycle of the interval, or of a later one, was taken (then counted
+// as thinned), taken() once one is; without (0), every one.
 class SunLearnThinning {
 public:
+    explicit SunLearnThinning(std::int64_t interval_us = 0) noexcept
+        : interval_us_(interval_us > 0 ? interval_us : 0) {}
     bool due(std::int64_t t_us) noexcept {
-        if (any_ && orbit_bin(t_us, kSunLearnIntervalUs) <= interval_) {
+        if (interval_us_ != 0 && any_ && orbit_bin(t_us, interval_us_) <= interval_) {
             ++thinned_;
             return false;
         }
@@ -89,11 +93,12 @@ public:
     }
     void taken(std::int64_t t_us) noexcept {
         any_ = true;
-        interval_ = orbit_bin(t_us, kSunLearnIntervalUs);
+        interval_ = interval_us_ != 0 ? orbit_bin(t_us, interval_us_) : 0;
     }
     std::uint64_t thinned() const noexcept { return thinned_; }
 
 private:
+    std::int64_t interval_us_;   // 0: every cycle
     bool any_ = false;           // a cycle taken (interval_)
     std::int64_t interval_ = 0;  // the interval of the latest one
     std::uint64_t thinned_ = 0U;
@@ -112,7 +117,7 @@ struct SunLearnReport {
     SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
-    std::uint64_t thinned = 0;      // cycles not taken: their interval (kSunLearnIntervalUs) or a later one had one
+    std::uint64_t thinned = 0;      // cycles not taken: their interval, or a later one, had one (thinned)
 };
 
 class SunLearner {
@@ -121,8 +126,13 @@ public:
 
     // cfg as the estimator accepted it (configuration_acceptable); its
     // common_rotation weights (none: the smallest coefficients) are the rule.
-    explicit SunLearner(const EstimatorConfig& cfg) noexcept
-        : scores_(cfg), moments_(kFrameHeadIndices, kFrameHeads, 0U, 2U), weights_(cfg.common_rotation) {
+    // interval_us: take one cycle per interval (the DPU's,
+    // kSunLearnOnBoardIntervalUs); 0, every one (the ground's).
+    explicit SunLearner(const EstimatorConfig& cfg, std::int64_t interval_us = 0) noexcept
+        : scores_(cfg),
+          moments_(kFrameHeadIndices, kFrameHeads, 0U, 2U),
+          weights_(cfg.common_rotation),
+          thinning_(interval_us) {
         if (weights_.heads != 0U) {
             rule_.weight = weights_.a;
         }
