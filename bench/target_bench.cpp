@@ -586,8 +586,9 @@ void bench_sun_learner(std::uint32_t ipc) {
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
     std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnOnBoardIntervalUs));
     std::printf("bench double sun_learner_orbit_s %u\n", static_cast<unsigned>(kLearnerOrbitUs / 1'000'000));
-    if (!g_learner.report().candidate.solved) {
-        std::puts("bench: the Sun learner's bench solved no candidate");
+    const calib::SunLearnReport r = g_learner.report();
+    if (!r.candidate.solved || r.thinned != 0U || r.without_sun != 0U || r.not_finite != 0U) {
+        std::puts("bench: the Sun learner's bench did not take every cycle or solved no candidate");
     }
 }
 

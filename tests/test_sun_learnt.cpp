@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <random>
 #include <sstream>
@@ -27,6 +28,7 @@
 #include "ascorr_host/analysis/stats.hpp"
 #include "ascorr_host/correct/self_calibration.hpp"
 #include "ascorr_host/formats/model_csv.hpp"
+#include "ascorr_host/formats/solutions_csv.hpp"
 #include "cli_run.hpp"
 #include "inside_orbit_missions.hpp"
 #include "test_support.hpp"
@@ -560,66 +562,119 @@ TEST(SunLearner, ASolveInStepsGivesTheWholeSolvesCandidateBitForBit) {
 
 // Fed at 10 s, the learner with the DPU's interval takes the first cycle of
 // each 120 s and nothing of the others: the same report, bit for bit, as a
-// learner without one fed those alone.
+// learner without one fed those alone. The orbit (5650 s) is not a whole
+// number of intervals, so that a cycle thinned can be an orbit's first (it
+// must not close the orbit: the next taken does).
 TEST(SunLearner, TakesTheFirstCycleOfEachIntervalAsAThinnedFeedWould) {
-    const calib::EstimatorConfig cfg;
-    calib::SunLearner every{cfg, calib::kSunLearnOnBoardIntervalUs};
-    calib::SunLearner thinned{cfg};  // every cycle it is given
+    calib::EstimatorConfig cfg;
+    cfg.orbit_period_us = 5'650'000'000;
+    calib::SunLearner gated{cfg, calib::kSunLearnOnBoardIntervalUs};
+    calib::SunLearner fed_firsts{cfg};  // no interval: every cycle it is given
     std::mt19937_64 rng(41);
     constexpr std::int64_t kCycleUs = 10'000'000;
+    constexpr std::int64_t kStartUs = kLearnT0Us + 60'000'000;
     const std::int64_t cycles = 6 * cfg.orbit_period_us / kCycleUs;
-    std::uint64_t first_of_interval = 0;
+    std::uint64_t firsts = 0;
+    int orbits_begun_thinned = 0;  // orbits whose first cycle is thinned
     for (std::int64_t k = 0; k < cycles; ++k) {
-        const std::int64_t t_us = kLearnT0Us + k * kCycleUs;
+        const std::int64_t t_us = kStartUs + k * kCycleUs;
         Quaternion<double> q[calib::kFrameHeads];
         turning_bench(t_us, cfg.orbit_period_us, rng, q);
-        const bool first = t_us % calib::kSunLearnOnBoardIntervalUs == 0;
-        first_of_interval += first ? 1U : 0U;
-        EXPECT_EQ(every.take(t_us, q), first) << k;
-        (void)every.step_all();
+        const bool first = k == 0 || t_us % calib::kSunLearnOnBoardIntervalUs == 0;
+        firsts += first ? 1U : 0U;
+        orbits_begun_thinned += !first && t_us % cfg.orbit_period_us < kCycleUs ? 1 : 0;
+        EXPECT_EQ(gated.take(t_us, q), first) << k;
+        (void)gated.step_all();
         if (first) {
-            ASSERT_TRUE(thinned.take(t_us, q));
-            (void)thinned.step_all();
+            ASSERT_TRUE(fed_firsts.take(t_us, q));
+            (void)fed_firsts.step_all();
         }
     }
-    every.finish();
-    thinned.finish();
-    const calib::SunLearnReport a = every.report();
-    const calib::SunLearnReport b = thinned.report();
-    EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(cycles) - first_of_interval);
+    gated.finish();
+    fed_firsts.finish();
+    const calib::SunLearnReport a = gated.report();
+    const calib::SunLearnReport b = fed_firsts.report();
+    EXPECT_GT(orbits_begun_thinned, 0);
+    EXPECT_EQ(a.thinned, static_cast<std::uint64_t>(cycles) - firsts);
     EXPECT_EQ(b.thinned, 0U);
-    EXPECT_EQ(a.cycles, first_of_interval);
+    EXPECT_GT(a.cycles, firsts / 2U);
     EXPECT_EQ(a.cycles, b.cycles);
     EXPECT_GE(a.orbits, 4U);
     EXPECT_EQ(a.orbits, b.orbits);
     EXPECT_EQ(std::memcmp(a.score, b.score, sizeof a.score), 0);
     ASSERT_TRUE(a.candidate.solved);
+    EXPECT_EQ(a.candidate.epochs, b.candidate.epochs);
     EXPECT_EQ(std::memcmp(a.candidate.sun, b.candidate.sun, sizeof a.candidate.sun), 0);
 }
 
-// The gate by itself: intervals floor(t / 120 s) for times of either sign;
-// a cycle of an interval before the latest taken is thinned, as one of it.
-TEST(SunLearner, TheThinningTakesOncePerIntervalAndNeverGoesBack) {
+// The gate by itself: intervals floor(t / 120 s) for times of either sign,
+// one cycle each; a time that goes back takes again, and one that jumps far
+// ahead stops nothing after it comes back.
+TEST(SunLearner, TheThinningTakesOncePerIntervalAndRecoversFromAJump) {
     calib::SunLearnThinning every;  // the ground's: no interval
     for (std::int64_t t : {std::int64_t{0}, std::int64_t{1}, std::int64_t{-5}}) {
         EXPECT_TRUE(every.due(t));
-        every.taken(t);
+        every.mark(t);
     }
     EXPECT_EQ(every.thinned(), 0U);
     calib::SunLearnThinning gate{calib::kSunLearnOnBoardIntervalUs};
     constexpr std::int64_t kI = calib::kSunLearnOnBoardIntervalUs;
     EXPECT_TRUE(gate.due(-kI - 1));  // interval −2
-    gate.taken(-kI - 1);
-    EXPECT_FALSE(gate.due(-kI - 1 - (kI - 2)));  // the same interval, its start
-    EXPECT_TRUE(gate.due(-1));                   // interval −1
-    gate.taken(-1);
-    EXPECT_FALSE(gate.due(-kI));  // −1 too
-    EXPECT_FALSE(gate.due(-kI - 1)) << "an earlier interval after a later one";
-    EXPECT_TRUE(gate.due(0));
-    gate.taken(0);
+    gate.mark(-kI - 1);
+    EXPECT_FALSE(gate.due(-2 * kI));  // interval −2's first µs
+    EXPECT_TRUE(gate.due(-1));        // interval −1
+    gate.mark(-1);
+    EXPECT_FALSE(gate.due(-kI));
+    EXPECT_TRUE(gate.due(-kI - 1)) << "back to interval −2: taken again";
+    gate.mark(-kI - 1);
+    EXPECT_TRUE(gate.due(20 * 365 * 86'400'000'000LL)) << "a jump 20 years ahead";
+    gate.mark(20 * 365 * 86'400'000'000LL);
+    EXPECT_TRUE(gate.due(0)) << "and back: the learner goes on";
+    gate.mark(0);
     EXPECT_FALSE(gate.due(kI - 1));
     EXPECT_TRUE(gate.due(kI));
-    EXPECT_EQ(gate.thinned(), 4U);
+    EXPECT_EQ(gate.thinned(), 3U);
+}
+
+// A refused cycle (no Sun) takes its interval: the bound holds whatever the
+// input, and the next interval is taken.
+TEST(SunLearner, ARefusedCycleTakesItsIntervalToo) {
+    calib::SunLearner gated{calib::EstimatorConfig{}, calib::kSunLearnOnBoardIntervalUs};
+    Quaternion<double> q[calib::kFrameHeads] = {{1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {0.0, 0.0, 1.0, 0.0}};
+    q[1].w = std::nan("");
+    EXPECT_FALSE(gated.take(kLearnT0Us, q));
+    EXPECT_FALSE(gated.take(kLearnT0Us + 10'000'000, q));
+    EXPECT_FALSE(gated.take(kLearnT0Us + calib::kSunLearnOnBoardIntervalUs, q));
+    const calib::SunLearnReport r = gated.report();
+    EXPECT_EQ(r.not_finite, 2U);
+    EXPECT_EQ(r.thinned, 1U);
+}
+
+// The ground learns at every epoch the estimator learns from (the contract:
+// docs/contract.md, "The Sun term learnt in self-calibration"): on a mission
+// with an epoch every 30 s it takes more cycles than one per 120 s over the
+// whole mission could give, and thins none.
+TEST(SunLearnt, TheGroundsLearnerTakesEveryEpochAsTheContractSays) {
+    const fs::path file = simulated_mission("sun-every-epoch", "--days 6 --step 30 --seed 12") / "m.csv";
+    const std::string text = host::read_text_file(file.string());
+    host::SolutionsReader reader(file.string(), text);
+    std::vector<host::SolutionRecord> rows;
+    for (host::SolutionRecord r; reader.next(r);) {
+        rows.push_back(r);
+    }
+    ASSERT_GT(rows.size(), 1U);
+    const host::RowSource source = [&rows](const std::function<void(const host::SolutionRecord&)>& fn) {
+        for (const host::SolutionRecord& r : rows) {
+            fn(r);
+        }
+    };
+    const host::SelfCalibration sc =
+        host::self_calibrate<double>(file.string(), source, std::nullopt, calib::EstimatorConfig{}, std::nullopt,
+                                     host::kSelfCalibrationMemoryBytes, kMaxHeads, {}, false, true);
+    ASSERT_TRUE(sc.sun_learnt.has_value());
+    EXPECT_EQ(sc.sun_learnt->thinned, 0U);
+    const double span_s = rows.back().t - rows.front().t;
+    EXPECT_GT(static_cast<double>(sc.sun_learnt->cycles), span_s / 120.0);
 }
 
 // ---- correct --self-calibrate --sun-term auto on missions the code did not make

@@ -227,8 +227,8 @@ def side_learners_section(d):
         return f"{num(round(mean))} ({share} the estimator's)"
     rows = [
         ["the lag search, per fed cycle (the flight scalar)"] +
-        [f"{num(lag[t]['lag_search_per_take'])} ({flight[t]})" for t in ts],
-        ["… per 22 Hz cycle"] + [per_cycle(t, lag[t]["lag_search_per_take"] / 2) for t in ts],
+        [f"{num(lag[t]['lag_search_per_fed_cycle'])} ({flight[t]})" for t in ts],
+        ["… per 22 Hz cycle"] + [per_cycle(t, lag[t]["lag_search_per_fed_cycle"] / 2) for t in ts],
         ["the Sun-term learner, per epoch taken"] + [num(e[t]["per_take"]) for t in ts],
         ["… per 22 Hz cycle, one taken per interval"] +
         [f"{per_cycle(t, e[t]['per_take'] / (22 * e[t]['interval_us'] * 1e-6))}, {e[t]['interval_us'] / 1e6:g} s"

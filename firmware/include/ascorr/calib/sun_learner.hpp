@@ -31,13 +31,16 @@
 // candidate beyond it is not used).
 //
 // Thinned on board: given an interval (the DPU's: kSunLearnOnBoardIntervalUs,
-// 120 s), at most one cycle per interval floor(t / interval) is taken, the
-// first taken in it; the others, and any cycle of an interval before it,
-// are skipped and counted (report().thinned). Why: a take costs the DPU as
-// much as 100 to 150 of the estimator's cycles (docs/figures.md, "The side
-// learners"). It biases nothing: the moments are sums over the epochs taken,
-// with no state between them (the lag search cannot be thinned so: its lags
-// must step as the pipeline's). Without an interval (0, the ground's
+// 120 s), the learner takes a cycle only when its interval floor(t /
+// interval) is not the last one taken; the others are skipped and counted
+// (report().thinned). A cycle refused (no Sun, not finite) takes its
+// interval too, so that the bound holds whatever the input. Why: a take
+// costs the DPU as much as 100 to 150 of the estimator's cycles
+// (docs/figures.md, "The side learners"). It biases nothing: the moments are
+// sums over the epochs taken, with no state between them (the lag search
+// cannot be thinned so: its lags must step as the pipeline's). A time that
+// jumps forward and back costs at most one extra take, never a learner
+// stopped until the clock comes back. Without an interval (0, the ground's
 // `correct --self-calibrate`, as the contract says) every fed cycle is
 // taken.
 //
@@ -73,25 +76,26 @@ namespace ascorr::calib {
 // The learner's margin on the scores (mean squares): fit's on the RMS, doubled.
 inline constexpr double kSunLearnMargin = 2.0 * kSunSelectionMargin;
 // The DPU's interval for the learner (µs; above). The missions that measured
-// it (docs/ground.md) have an epoch every 120 to 240 s, every one taken: 47
-// a 94-min orbit hold the term's variation inside the orbit.
+// the term have an epoch every 120 to 240 s, and 47 epochs in a 94-min orbit
+// hold its variation inside the orbit.
 inline constexpr std::int64_t kSunLearnOnBoardIntervalUs = 120'000'000;
 
-// Which cycles the learner takes (above): with an interval (µs, > 0), due()
-// unless a cycle of the interval, or of a later one, was taken (then counted
-// as thinned), taken() once one is; without (0), every one.
+// Which cycles the learner takes (above): with an interval (µs, > 0; any
+// other value: none), due() unless the cycle's interval is the last one
+// marked (then counted as thinned), mark() once a cycle was looked at;
+// without an interval, every one.
 class SunLearnThinning {
 public:
     explicit SunLearnThinning(std::int64_t interval_us = 0) noexcept
         : interval_us_(interval_us > 0 ? interval_us : 0) {}
     bool due(std::int64_t t_us) noexcept {
-        if (interval_us_ != 0 && any_ && orbit_bin(t_us, interval_us_) <= interval_) {
+        if (interval_us_ != 0 && any_ && orbit_bin(t_us, interval_us_) == interval_) {
             ++thinned_;
             return false;
         }
         return true;
     }
-    void taken(std::int64_t t_us) noexcept {
+    void mark(std::int64_t t_us) noexcept {
         any_ = true;
         interval_ = interval_us_ != 0 ? orbit_bin(t_us, interval_us_) : 0;
     }
@@ -99,8 +103,8 @@ public:
 
 private:
     std::int64_t interval_us_;   // 0: every cycle
-    bool any_ = false;           // a cycle taken (interval_)
-    std::int64_t interval_ = 0;  // the interval of the latest one
+    bool any_ = false;           // a cycle marked (interval_)
+    std::int64_t interval_ = 0;  // the interval of the last one
     std::uint64_t thinned_ = 0U;
 };
 
@@ -117,7 +121,7 @@ struct SunLearnReport {
     SunTermFit candidate;           // the latest solution (its rank, orbits, epochs)
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
-    std::uint64_t thinned = 0;      // cycles not taken: their interval, or a later one, had one (thinned)
+    std::uint64_t thinned = 0;      // cycles not taken: their interval had one (thinned)
 };
 
 class SunLearner {
@@ -143,13 +147,14 @@ public:
     // One fed cycle at t_us (TT µs since J2000): q[h] the frame heads'
     // attitudes corrected by the active polynomial. false: not taken (t
     // outside the Sun ephemeris' span, or attitudes that give no finite
-    // rotation; counted), or thinned (its interval, or a later one, had a
-    // cycle taken: counted, and nothing else done). A cycle of another orbit
-    // than the open one closes it first (its solve then waits for step()).
+    // rotation; counted), or thinned (its interval had a cycle: counted,
+    // and nothing else done). A cycle of another orbit than the open one
+    // closes it first (its solve then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
         if (!thinning_.due(t_us)) {
             return false;
         }
+        thinning_.mark(t_us);
         if (scores_.closes(t_us)) {
             close_orbit(scores_.open_bin());
         }
@@ -177,7 +182,6 @@ public:
         }
         frame_ibas(with_term, iba[1]);
         scores_.add(iba);
-        thinning_.taken(t_us);
         return true;
     }
 

@@ -249,8 +249,8 @@ public:
     // One bounded step of a solve (w.phase kForm: a new one). The first
     // forms the normal equations from the sums as they are then (later
     // orbits closed do not change this solve); each of the eigen-
-    // decomposition's does one row of a Jacobi sweep (n − 1 rotations of
-    // 3·3H order); the last forms the fit (w.fit) under the rule. At most
+    // decomposition's does one row of a Jacobi sweep (at most n − 1
+    // rotations, n = 3·3H); the last forms the fit (w.fit) under the rule. At most
     // kMaxSolveSteps; then kSolved or kFailed, and w.phase is kForm again.
     SunSolveStep solve_step(Solve& w, const SunRule& rule) const noexcept {
         SunSolveStep s = SunSolveStep::kRunning;
