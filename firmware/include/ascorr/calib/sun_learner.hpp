@@ -32,9 +32,10 @@
 //
 // Thinned on board: given an interval (the DPU's: kSunLearnOnBoardIntervalUs,
 // 120 s), the learner takes a cycle only when its interval floor(t /
-// interval) is not the last one taken; the others are skipped and counted
-// (report().thinned). A cycle refused (no Sun, not finite) takes its
-// interval too, so that the bound holds whatever the input. Why: a take
+// interval) is not that of the last cycle it looked at; the others are
+// skipped and counted (report().thinned). A cycle refused (no Sun, not
+// finite) takes its interval too, so that the bound holds whatever the
+// input. Why: a take
 // costs the DPU as much as 100 to 150 of the estimator's cycles
 // (docs/figures.md, "The side learners"). It biases nothing: the moments are
 // sums over the epochs taken, with no state between them (the lag search
