@@ -321,6 +321,39 @@ TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
 // estimator, a loaded model corrects from the next epoch, and every bad
 // payload is refused with kBadPayload and changes nothing (the report, bit
 // for bit, and the staged model: a later load gives the same CRC).
+// The learnt Sun term on the wire (issue 40): CALIB_START's sun_term after
+// the lags (absent, the message as it was; beyond 1, refused), and
+// CALIB_SUN_TERM whole, within a frame's payload.
+TEST(LinkCodecs, TheLearntSunTermsMessagesDecodeWholeOrAsBefore) {
+    std::uint8_t p[kMaxPayload] = {};
+    CalibStart start{5'640'000'000, 30.0, 0};
+    EXPECT_EQ(encode(start, p), 17U);
+    start.sun_term = 1U;
+    const std::size_t n = encode(start, p);
+    EXPECT_EQ(n, 17U + 1U + 8U * kMaxHeads + 1U);  // common_rotation and the lags (0) come with it
+    CalibStart back{};
+    EXPECT_TRUE(decode(p, n, back) && back.sun_term == 1U && !pipeline::any_lagged(back.lag_s));
+    EXPECT_TRUE(decode(p, n - 1U, back) && back.sun_term == 0U);  // a host before it: none
+    EXPECT_FALSE(decode(p, n + 1U, back));
+    p[n - 1U] = 2U;
+    EXPECT_FALSE(decode(p, n, back));
+
+    CalibSunTerm m{2, 7, {}};
+    m.sun[2][1] = -0.75;
+    const std::size_t k = encode(m, p);
+    EXPECT_EQ(k, 1U + 4U + 8U * kModelAxes * kSunComponents);
+    EXPECT_LE(k, kMaxPayload);
+    CalibSunTerm got{};
+    ASSERT_TRUE(decode(p, k, got));
+    EXPECT_EQ(got.head, 2U);
+    EXPECT_EQ(got.version, 7U);
+    EXPECT_EQ(got.sun[2][1], -0.75);
+    EXPECT_FALSE(decode(p, k - 1U, got));
+    EXPECT_FALSE(decode(p, k + 1U, got));
+    p[0] = kMaxHeads;
+    EXPECT_FALSE(decode(p, k, got));
+}
+
 TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     Loop loop;
     loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "ascorr_host/correct/states_velocity.hpp"
+#include "ascorr_host/formats/model_csv.hpp"
 #include "ascorr_host/link/qemu_targets.hpp"
 #include "ascorr_host/link/replay.hpp"
 #include "commands.hpp"
@@ -52,6 +53,13 @@ void add_replay_command(CLI::App& app) {
         ->check(non_empty_path());
     const SelfCalibrationOptions self_cal =
         add_self_calibration_options(*cmd, opt->time_constant_days, opt->orbit_period_s, opt->lag_s, nullptr);
+    CLI::Option* sun_term =
+        cmd->add_option("--sun-term", opt->sun_auto,
+                        "with --self-calibrate: auto (the target learns the Sun term beside its estimator, one "
+                        "epoch per 120 s, and each model version takes the term taken when it becomes active; "
+                        "compared bit for bit with the host's run thinned alike) or none (default)")
+            ->transform(one_of<bool>({{"auto", true}, {"none", false}}))
+            ->type_name("NAME");
     CLI::Option* mountings =
         cmd->add_option("--mountings", opt->mountings,
                         "with --combined: mountings file (CSV chu,qw,qx,qy,qz,sigma_cross,sigma_about), built into "
@@ -75,12 +83,15 @@ void add_replay_command(CLI::App& app) {
         ->transform(integer_in<int>(1, 60000));
     cmd->add_option("--seed", opt->seed, "seed of the fault injection")->transform(integer_in<std::uint64_t>());
     cmd->add_option("--baud", opt->baud, "serial baud rate (serial devices)")->transform(integer_in<unsigned>());
-    cmd->callback([opt, speed, self_cal]() {
+    cmd->callback([opt, speed, self_cal, sun_term]() {
         opt->realtime = *speed == "realtime";
         if (!opt->self_calibrate && opt->model.empty()) {
             throw CLI::RequiredError("--model (or --self-calibrate)");
         }
         check_needs_self_calibrate(opt->self_calibrate, opt->model_history, self_cal);
+        if (!opt->self_calibrate && sun_term->count() > 0) {
+            throw CLI::ValidationError("--sun-term", host::kSunTermNeedsSelfCalibration);
+        }
         std::vector<host::NamedPath> outputs = host::replay_outputs(*opt);
         outputs.push_back(host::kStandardOutput);  // the summary
         host::OutputSet files = open_run_files({{"--in", &opt->in},

@@ -13,6 +13,7 @@
 #include "ascorr/calib/estimator.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
+#include "ascorr/core/sun_term.hpp"
 #include "ascorr/pipeline/head_lags.hpp"
 #include "wire.hpp"
 
@@ -38,6 +39,12 @@ struct CalibStart {
     // binary64 after common_rotation (then always sent), only when a head
     // lags: absent, none (the 17 or 18 bytes a target before it takes).
     double lag_s[kMaxHeads] = {};
+    // 1: the Sun term is learnt beside the estimator (calib/sun_learner.hpp,
+    // one cycle per kSunLearnOnBoardIntervalUs) and each model version takes
+    // the term taken when it becomes active (server.hpp); 0: none. On the
+    // wire a u8 after the lags (then always sent, 0 when none lags), only
+    // when 1: absent, 0 (the message as a target before it takes it).
+    std::uint8_t sun_term = 0;
 };
 
 enum class CalibCommand : std::uint8_t {
@@ -71,6 +78,18 @@ struct CalibModel {
     double c[kModelAxes][kLinearModelTerms];
 };
 
+// One head's Sun term of the estimator's active model version (answer to
+// kCalibSunTermRequest, whose payload is the head u8): the version (as in
+// CalibModel; none: kNoModelVersion) and its term for the head in arcsec
+// (the model file's sun_x, sun_y, sun_z per axis α, β, γ), the one the
+// version took when it became active (CalibStart::sun_term; none: 0). Its
+// own message: with CALIB_MODEL's coefficients it would not fit a frame.
+struct CalibSunTerm {
+    std::uint8_t head;
+    std::uint32_t version;
+    double sun[kModelAxes][kSunComponents];
+};
+
 // The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
 // coefficient format's range, 2⁻⁵ rad (ScalarTraits<Q30>::max_coefficient).
 inline constexpr double kMaxLoadCoefficient = 0x1p-5 * kRadToArcsec;
@@ -81,16 +100,22 @@ inline std::size_t encode(const CalibStart& m, std::uint8_t* out) noexcept {
     w.u64(static_cast<std::uint64_t>(m.orbit_period_us));
     w.f64(m.time_constant_days);
     w.u8(m.initial);
-    const bool lagged = pipeline::any_lagged(m.lag_s);  // the payload then carries lag_s
-    if (m.common_rotation != 0U || lagged) {            // absent when 0: a target before it takes the message as it was
+    // Each optional field is sent when it or a later one is not 0: absent,
+    // a target before it takes the message as it was.
+    const bool learns_sun = m.sun_term != 0U;
+    const bool lags = pipeline::any_lagged(m.lag_s) || learns_sun;
+    if (m.common_rotation != 0U || lags) {
         w.u8(m.common_rotation);
     }
-    for (std::size_t h = 0; lagged && h < kMaxHeads; ++h) {
+    for (std::size_t h = 0; lags && h < kMaxHeads; ++h) {
         w.f64(m.lag_s[h]);
+    }
+    if (learns_sun) {
+        w.u8(m.sun_term);
     }
     return w.size();
 }
-// CALIB_START's optional tail: common_rotation, then the lags (above).
+// CALIB_START's optional tail: common_rotation, the lags, sun_term (above).
 // Refused: a τ neither 0 nor in the lag's range (NaN included).
 inline bool decode_calib_start_tail(Reader& r, CalibStart& m) noexcept {
     if (r.done()) {
@@ -106,17 +131,21 @@ inline bool decode_calib_start_tail(Reader& r, CalibStart& m) noexcept {
     for (double& tau : m.lag_s) {
         ok = ok && r.f64(tau) && (tau == 0.0 || (tau >= pipeline::kMinLagTauS && tau <= pipeline::kMaxLagTauS));
     }
+    if (ok && !r.done()) {
+        ok = r.u8(m.sun_term);
+    }
     return ok && r.done();
 }
 inline bool decode(const std::uint8_t* p, std::size_t n, CalibStart& m) noexcept {
     Reader r(p, n);
     m.common_rotation = 0U;
+    m.sun_term = 0U;
     for (double& tau : m.lag_s) {
         tau = 0.0;
     }
     return r.i64(m.orbit_period_us) && r.f64(m.time_constant_days) && r.u8(m.initial) &&
            decode_calib_start_tail(r, m) && calib::configuration_acceptable(m.orbit_period_us, m.time_constant_days) &&
-           m.initial <= 1U && m.common_rotation <= 1U;
+           m.initial <= 1U && m.common_rotation <= 1U && m.sun_term <= 1U;
 }
 
 inline std::size_t encode(CalibCommand m, std::uint8_t* out) noexcept {
@@ -205,6 +234,29 @@ inline bool decode(const std::uint8_t* p, std::size_t n, CalibModel& m) noexcept
     Reader r(p, n);
     return r.u8(m.head) && r.u8(m.present) && r.u32(m.version) && r.u32(m.crc) && r.i64(m.active_from_us) &&
            m.head < kMaxHeads && m.present <= 1U && get_linear(r, m.c, [](double) { return true; }) && r.done();
+}
+
+inline std::size_t encode(const CalibSunTerm& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u8(m.head);
+    w.u32(m.version);
+    for (const auto& axis : m.sun) {
+        for (const double c : axis) {
+            w.f64(c);
+        }
+    }
+    return w.size();
+}
+// As CalibModel's: any value decodes (the host compares it).
+inline bool decode(const std::uint8_t* p, std::size_t n, CalibSunTerm& m) noexcept {
+    Reader r(p, n);
+    bool ok = r.u8(m.head) && r.u32(m.version) && m.head < kMaxHeads;
+    for (auto& axis : m.sun) {
+        for (double& c : axis) {
+            ok = ok && r.f64(c);
+        }
+    }
+    return ok && r.done();
 }
 
 }  // namespace ascorr::link

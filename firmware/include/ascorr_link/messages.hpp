@@ -52,6 +52,9 @@ enum class MessageType : std::uint8_t {
     kCombineRequest = 20,      // host → target: combine the solutions since the last request (v5)
     kCombined = 21,            // target → host: the combined attitude of the bench (v5)
     kSunTermUpload = 22,       // host → target: one head's Sun term (docs/contract.md, "The Sun term on the link")
+    kCalibSunTermRequest =
+        23,              // host → target: answer with kCalibSunTerm for a head ("The Sun term learnt on the link")
+    kCalibSunTerm = 24,  // target → host: one head's Sun term of the active model version
 };
 
 enum class AckResult : std::uint8_t {

@@ -39,11 +39,22 @@
 //                        With common_rotation 1, the rule for the rotation
 //                        common to all heads takes the weights of the
 //                        mountings staged so far (kMountingLoad first).
+//                        With sun_term 1, the Sun term's learner
+//                        (calib/sun_learner.hpp, one cycle per
+//                        kSunLearnOnBoardIntervalUs) takes the fed cycles'
+//                        frame heads as the polynomial corrected them, and
+//                        solves after each orbit closed, right after the
+//                        cycle (as the estimator's per-orbit update runs
+//                        here); each model version takes the term taken when
+//                        it becomes active, for the heads it has, applied to
+//                        the answers after the feed (epoch_pipeline.hpp).
 //   kCalibCommand      → kAck (freeze, resume, reset)
 //   kCalibModelLoad    → kAck (a head staged; with `load`, the staged model
 //                        becomes the estimator's, active from the next epoch)
 //   kCalibReportRequest → kCalibReport (the estimator's report)
 //   kCalibModelRequest → kCalibModel (one head of the active model)
+//   kCalibSunTermRequest → kCalibSunTerm (one head's Sun term of the active
+//                        model's version: kCalibStart's sun_term)
 //   kMountingLoad      → kAck (a head's mounting staged; with `build`, the
 //                        staged mountings become the combiner's, refused with
 //                        kBadPayload when not usable: combine::check_mountings)
@@ -66,6 +77,7 @@
 #include <type_traits>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/sun_learner.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/nav/velocity_service.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
@@ -145,8 +157,8 @@ private:
                     [this](const ModelUpload<T>& m) { return m.lag_s == 0.0 || !pipeline_.calibrating(); });
                 return;
             case MessageType::kSunTermUpload:
-                // The estimator's models have no Sun term (its feed undoes
-                // the polynomial alone): refused while it runs.
+                // The estimator's versions take the learnt term alone
+                // (kCalibStart's sun_term): refused while it runs.
                 update<SunTermUpload<T>>(
                     f, sink, [this](const SunTermUpload<T>& m) { set_sun_term(m.head, m.coefficient); },
                     [this](const SunTermUpload<T>&) { return !pipeline_.calibrating(); });
@@ -185,6 +197,11 @@ private:
                     f, f.length == 1U && f.payload[0] < kMaxHeads, MessageType::kCalibModel,
                     [this, &f] { return active_model(f.payload[0]); }, sink);
                 return;
+            case MessageType::kCalibSunTermRequest:
+                reply(
+                    f, f.length == 1U && f.payload[0] < kMaxHeads, MessageType::kCalibSunTerm,
+                    [this, &f] { return active_sun_term(f.payload[0]); }, sink);
+                return;
             case MessageType::kCalibCommand:
                 update<CalibCommand>(f, sink, [this](CalibCommand c) { command_estimator(c); });
                 return;
@@ -219,6 +236,7 @@ private:
             case MessageType::kCombined:
             case MessageType::kCalibReport:
             case MessageType::kCalibModel:
+            case MessageType::kCalibSunTerm:
             case MessageType::kSolutionOut:
             case MessageType::kAck:
             case MessageType::kNak:
@@ -262,7 +280,32 @@ private:
             }
         }
         sun_.present[h] = any_sun_coefficient(sun_, h);
-        pipeline_.use_sun_term(any_sun_term() ? &sun_ : nullptr);
+        if (!pipeline_.calibrating()) {  // while calibrating, the versions' (follow_version)
+            pipeline_.use_sun_term(any_sun_term() ? &sun_ : nullptr);
+        }
+    }
+
+    // At an epoch of a model version new to the Sun term's learning: the
+    // term the learner has taken (its solves done: they run after each
+    // cycle), for the heads the version has, kept in arcsec (kCalibModel)
+    // and in T for the pipeline (sun_term_from_arcsec, as the host converts
+    // a model file's), as `correct --self-calibrate --sun-term auto` makes
+    // the history's models.
+    void follow_version() noexcept {
+        const ModelCoefficients* active = estimator_.active_coefficients();
+        if (!learning_sun_ || pipeline_.model() == nullptr || active == nullptr ||
+            (version_term_.set && version_term_.version == pipeline_.version())) {
+            return;
+        }
+        version_term_.set = true;
+        version_term_.version = pipeline_.version();
+        sun_learner_.version_term(heads_where(active->present), version_term_.arcsec);
+        version_term_.model = sun_term_from_arcsec<T>(version_term_.arcsec);
+        bool any = false;
+        for (const bool p : version_term_.model.present) {
+            any = any || p;
+        }
+        pipeline_.use_sun_term(any ? &version_term_.model : nullptr);
     }
     bool any_sun_term() const noexcept {
         bool any = false;
@@ -281,6 +324,11 @@ private:
         }
         // In place: no 10-KiB temporary on the stack (trivially destructible).
         new (&estimator_) LinkEstimator<T>(cfg, m.initial == 1U ? &staged_ : nullptr);
+        new (&sun_learner_) calib::SunLearner(cfg, calib::kSunLearnOnBoardIntervalUs);
+        learning_sun_ = m.sun_term == 1U;
+        version_term_ = {};
+        pipeline_.use_sun_term(nullptr);  // an uploaded model's term is not the versions'
+
         (void)lags_.configure_all(m.lag_s);  // decode() checked each τ
         pipeline_.use_lags(&lags_);
         pipeline_.use_estimator(&estimator_);
@@ -296,6 +344,7 @@ private:
                 return;
             case CalibCommand::kReset:
                 estimator_.reset();
+                version_term_.set = false;  // its versions may come again: each takes the term anew
                 return;
         }
     }
@@ -357,7 +406,13 @@ private:
         CorrectedSolution<T> c{};
         if (in_epoch) {
             (void)pipeline_.begin(s.t.us, meter);
+            follow_version();
+            const std::uint32_t feeds = pipeline_.feeds();
             c = pipeline_.solution(in, velocity, (s.calib & kCalibClean) != 0U, true, meter);
+            if (learning_sun_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr) {
+                (void)sun_learner_.take_kept(s.t.us, pipeline_.kept_solutions());
+                (void)sun_learner_.step_all();  // its per-orbit work, after the cycle (outside the meter)
+            }
         } else {
             const std::uint32_t start = counter_();
             c = pipeline_.untimed_solution(in, velocity);
@@ -422,6 +477,22 @@ private:
             for (std::size_t a = 0; a < kModelAxes; ++a) {
                 for (std::size_t t = 0; t < kLinearModelTerms; ++t) {
                     m.c[a][t] = c->coefficient[h][a][t];
+                }
+            }
+        }
+        return m;
+    }
+
+    // Head h's Sun term of the active model's version, as kCalibSunTerm (0
+    // until an epoch of that version took one: follow_version).
+    CalibSunTerm active_sun_term(std::uint8_t h) const noexcept {
+        CalibSunTerm m{};
+        m.head = h;
+        m.version = estimator_.active_coefficients() != nullptr ? estimator_.active_version() : kNoModelVersion;
+        if (version_term_.set && version_term_.version == m.version) {
+            for (std::size_t a = 0; a < kModelAxes; ++a) {
+                for (std::size_t k = 0; k < kSunComponents; ++k) {
+                    m.sun[a][k] = version_term_.arcsec[h][a][k];
                 }
             }
         }
@@ -497,6 +568,17 @@ private:
     static_assert(std::is_trivially_destructible_v<VelocityService<T>>, "restarted in place");
     LinkEstimator<T> estimator_{};
     ModelCoefficients staged_{};
+    // The Sun term learnt beside it (kCalibStart's sun_term), and the term
+    // of the model version the epochs use (follow_version).
+    static_assert(std::is_trivially_destructible_v<calib::SunLearner>, "restarted in place");
+    calib::SunLearner sun_learner_{calib::EstimatorConfig{}, calib::kSunLearnOnBoardIntervalUs};
+    bool learning_sun_ = false;
+    struct VersionTerm {
+        bool set = false;  // version is the last one seen with a model
+        std::uint32_t version = 0U;
+        double arcsec[kMaxHeads][kModelAxes][kSunComponents] = {};
+        SunTermModel<T> model{};
+    } version_term_{};
     // Before kCalibStart: the uploaded model (use_model, in the constructor).
     LinkPipeline<T> pipeline_{};
     // The combination (kMountingLoad with build): none until then.

@@ -31,6 +31,7 @@ namespace {
 struct SideLearning {
     bool lag = false;
     bool sun = false;
+    std::int64_t sun_interval_us = 0;  // the learner's (SunLearner: 0, every cycle)
 };
 
 // The model file's Sun term of a learnt one, for the heads m has.
@@ -185,7 +186,7 @@ private:
             search_.emplace(cfg_);
         }
         if (learn_.sun) {
-            sun_.emplace(cfg_);
+            sun_.emplace(cfg_, learn_.sun_interval_us);
         }
         for (const CalibRow<T>& r : held_) {
             process(r);
@@ -205,8 +206,8 @@ private:
                 m.lag_s.fill(search_->tau_s());
                 m.lag_s = head_lags(m);
             }
-            if (sun_ && sun_->taken() != nullptr) {  // ... and the Sun term the learner has taken
-                calib::copy_sun_coefficients(*sun_->taken(), heads_where(m.present), m.sun);
+            if (sun_) {  // ... and the Sun term the learner has taken
+                sun_->version_term(heads_where(m.present), m.sun);
             }
             had_ = true;
             version_ = pipeline_.version();
@@ -228,21 +229,15 @@ private:
             }
             return;
         }
-        Quaternion<double> q[calib::kFrameHeads];
-        for (std::size_t h = 0; h < calib::kFrameHeads; ++h) {
-            if ((kept[h].status & status::kThermalApplied) == 0U) {
-                return;  // a head the model did not correct: not the polynomial's residual
-            }
-            q[h] = in_double(kept[h].q_chu_icrf);
-        }
         if (sun_) {
-            learn_sun(t_us, q);
+            (void)sun_->take_kept(t_us, kept);
+            (void)sun_->step_all();  // its per-orbit work, as the link server runs it after the cycle
         }
     }
 
     void learn_sun(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads]) {
         (void)sun_->take(t_us, q);
-        (void)sun_->step_all();  // its per-orbit work, as in idle time after the cycle
+        (void)sun_->step_all();
     }
 
     const std::string& file_;
@@ -626,7 +621,8 @@ template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes, std::size_t max_heads,
-                               const std::array<double, kMaxHeads>& lag_s, bool learn_lag, bool learn_sun) {
+                               const std::array<double, kMaxHeads>& lag_s, bool learn_lag, bool learn_sun,
+                               std::int64_t sun_interval_us) {
     if (learn_lag && pipeline::any_lagged(lag_s)) {
         throw std::invalid_argument("self_calibrate: a lag is learnt from none, not from a given one");
     }
@@ -635,8 +631,9 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
         refuse_other_lag(*initial, "the initial model", lag_s);
         refuse_sun_term(*initial, "the initial model", kSunTermNotLearnt);
     }
-    SelfCalibration out = self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg,
-                                                     orbit_period_s, memory_budget_bytes, {learn_lag, learn_sun});
+    SelfCalibration out =
+        self_calibrate_dispatch<T>(heads_to_learn(rows, max_heads), file, rows, initial, cfg, orbit_period_s,
+                                   memory_budget_bytes, {learn_lag, learn_sun, sun_interval_us});
     if (!learn_lag) {
         for (ActiveModel& a : out.history) {  // every model the run makes takes the run's lag
             a.model.lag_s = lag_s;
@@ -648,13 +645,16 @@ SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, c
 
 template SelfCalibration self_calibrate<double>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                 const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                                std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
+                                                std::size_t, const std::array<double, kMaxHeads>&, bool, bool,
+                                                std::int64_t);
 template SelfCalibration self_calibrate<float>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                                const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                               std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
+                                               std::size_t, const std::array<double, kMaxHeads>&, bool, bool,
+                                               std::int64_t);
 template SelfCalibration self_calibrate<Q30>(const std::string&, const RowSource&, const std::optional<ModelFile>&,
                                              const calib::EstimatorConfig&, std::optional<double>, std::size_t,
-                                             std::size_t, const std::array<double, kMaxHeads>&, bool, bool);
+                                             std::size_t, const std::array<double, kMaxHeads>&, bool, bool,
+                                             std::int64_t);
 
 std::optional<LagSchedule> learnt_lags(const std::vector<ActiveModel>& history, const RowSource& rows) {
     std::vector<LagSchedule::Version> versions;

@@ -33,7 +33,6 @@ namespace {
 constexpr std::string_view kRigidPrefix = "rigid-";
 constexpr const char* kCommonRotationColumn = "common_rotation";
 constexpr const char* kLagColumn = "lag_s";
-constexpr const char* kSunColumns[kSunComponents] = {"sun_x", "sun_y", "sun_z"};
 }  // namespace
 
 bool lag_acceptable(double lag_s) noexcept {

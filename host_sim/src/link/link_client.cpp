@@ -445,13 +445,14 @@ typename LinkClient<T>::Message LinkClient<T>::temperatures_message(std::uint8_t
 template <typename T>
 void LinkClient<T>::start_calibration(std::int64_t orbit_period_us, double time_constant_days,
                                       const ModelCoefficients* initial, bool common_rotation,
-                                      const std::array<double, kMaxHeads>& lag_s) {
+                                      const std::array<double, kMaxHeads>& lag_s, bool learn_sun) {
     if (initial != nullptr) {
         send_calib_model(*initial, false);
     }
     link::CalibStart start{orbit_period_us, time_constant_days, static_cast<std::uint8_t>(initial ? 1U : 0U),
                            static_cast<std::uint8_t>(common_rotation ? 1U : 0U)};
     std::copy(lag_s.begin(), lag_s.end(), start.lag_s);
+    start.sun_term = learn_sun ? 1U : 0U;
     update({link::MessageType::kCalibStart, encoded(start), "calibration start"});
     lag_s_ = lag_s;  // the target's lags from now on (a restart is an error while calibrating anyway)
     calibrating_ = true;
@@ -485,6 +486,18 @@ link::CalibModel LinkClient<T>::calib_model(std::uint8_t head) {
     link::CalibModel m{};
     if (!link::decode(a.data(), a.size(), m) || m.head != head) {
         throw LinkError("malformed calibration model from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return m;
+}
+
+template <typename T>
+link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
+    const std::vector<std::uint8_t> a =
+        request({link::MessageType::kCalibSunTermRequest, {head}, "calibration Sun term request"},
+                link::MessageType::kCalibSunTerm);
+    link::CalibSunTerm m{};
+    if (!link::decode(a.data(), a.size(), m) || m.head != head) {
+        throw LinkError("malformed calibration Sun term from the target (" + std::to_string(a.size()) + " bytes)");
     }
     return m;
 }

@@ -128,6 +128,9 @@ void check_calibration_options(const ReplayOptions& opt) {
         if (opt.lag_s) {
             throw std::runtime_error(std::string("--lag ") + kLagNeedsSelfCalibration);
         }
+        if (opt.sun_auto) {
+            throw std::runtime_error(std::string("--sun-term ") + kSunTermNeedsSelfCalibration);
+        }
     }
     if (const std::string bad = bad_lag_text(opt.lag_s); !bad.empty()) {
         throw std::runtime_error(bad);

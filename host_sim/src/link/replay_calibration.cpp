@@ -57,10 +57,11 @@ std::string first_report_difference(const calib::EstimatorReport& a, const calib
     return {};
 }
 
-// The target's model `version`, head by head (CALIB_MODEL), as a history entry
-// active from t (the first solution corrected with it).
+// The target's model `version`, head by head (CALIB_MODEL, and with
+// learn_sun CALIB_SUN_TERM), as a history entry active from t (the first
+// solution corrected with it).
 template <typename T>
-ActiveModel target_model(LinkClient<T>& client, double t) {
+ActiveModel target_model(LinkClient<T>& client, double t, bool learn_sun) {
     ActiveModel a{t, 0, 0, 0, ModelFile{}};
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         const link::CalibModel m = client.calib_model(h);
@@ -73,13 +74,38 @@ ActiveModel target_model(LinkClient<T>& client, double t) {
                 a.model.coefficients[h][x][i] = m.c[x][i];
             }
         }
+        const link::CalibSunTerm s = learn_sun ? client.calib_sun_term(h) : link::CalibSunTerm{};
+        if (learn_sun && s.version != m.version) {
+            throw LinkError("the target's Sun term is of model version " + std::to_string(s.version) +
+                            ", its model of version " + std::to_string(m.version));
+        }
+        for (std::size_t x = 0; x < kModelAxes; ++x) {
+            for (std::size_t k = 0; k < kSunComponents; ++k) {
+                a.model.sun[h][x][k] = s.sun[x][k];
+            }
+        }
     }
     return a;
 }
 
+// The first of head h's Sun term coefficients that differs between a (the
+// target's) and b (the host's) model, with both values; empty: none.
+std::string first_sun_difference(const ModelFile& a, const ModelFile& b, std::size_t h) {
+    for (std::size_t x = 0; x < kModelAxes; ++x) {
+        for (std::size_t k = 0; k < kSunComponents; ++k) {
+            if (!same_double(a.sun[h][x][k], b.sun[h][x][k])) {
+                return std::string("head ") + head_name(static_cast<std::uint8_t>(h)) + " " + kAxisNames[x] + " " +
+                       kSunColumns[k] + ": target " + number_text(a.sun[h][x][k]) + ", host " +
+                       number_text(b.sun[h][x][k]);
+            }
+        }
+    }
+    return {};
+}
+
 // What differs first between a (the target's) and b (the host's) model of
-// one version: the epoch, a head's presence, a coefficient or the CRC; empty
-// when they are the same model, active from the same epoch.
+// one version: the epoch, a head's presence, a coefficient, its Sun term
+// or the CRC; empty when they are the same model, active from the same epoch.
 std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
     if (a.t_us != b.t_us) {
         return "active from TT " + std::to_string(a.t_us) + " us on the target, " + std::to_string(b.t_us) +
@@ -98,6 +124,9 @@ std::string first_model_difference(const ActiveModel& a, const ActiveModel& b) {
                            number_text(b.model.coefficients[h][x][i]);
                 }
             }
+        }
+        if (std::string d = first_sun_difference(a.model, b.model, h); !d.empty()) {
+            return d;
         }
     }
     if (a.crc == b.crc) {
@@ -126,7 +155,7 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     if (got == link::kNoModelVersion || (!target_history.empty() && target_history.back().version == got)) {
         return;
     }
-    target_history.push_back(target_model(client, rec.t));
+    target_history.push_back(target_model(client, rec.t, host_sc.sun_learnt.has_value()));
     ActiveModel& mine = target_history.back();
     mine.model.lag_s = client.lag_s();  // CALIB_START's: CALIB_MODEL carries no lag
     mine.model.lag_s = head_lags(mine.model);

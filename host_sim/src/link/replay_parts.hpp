@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -106,6 +107,11 @@ struct HostSide {
     std::optional<SunTermModel<double>> sun_d;   // the reference's
     std::optional<SelfCalibration> sc;
     std::optional<ModelSchedule<double>> schedule_d;  // the host's models in double, for the reference
+    // --sun-term auto: each model version's Sun term in T (the host's run's
+    // history), which the host's pipeline applies as the target its own;
+    // sun_version: the version whose term the pipeline has.
+    std::map<std::uint32_t, SunTermModel<T>> version_sun;
+    std::optional<std::uint32_t> sun_version;
     std::optional<link::LinkEstimator<T>> estimator;  // the link's
     link::LinkPipeline<T> pipeline;
     std::vector<ActiveModel> target_history;

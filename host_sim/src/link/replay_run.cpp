@@ -63,7 +63,9 @@ std::optional<ModelFile> read_replay_model(const ReplayOptions& opt) {
     ModelFile mf = read_model_file(opt.model);
     check_model_for_scalar(mf, scalar_kind_of<T>(), opt.model);
     if (opt.self_calibrate) {
-        refuse_sun_term(mf, opt.model, "the target's estimator does not learn it (its models have none)");
+        refuse_sun_term(
+            mf, opt.model,
+            opt.sun_auto ? kSunTermNotLearnt : "the target's estimator does not learn it (its models have none)");
         refuse_other_lag(mf, opt.model, run_lags(opt.lag_s, mf));
         refuse_quadratic_initial_model(mf, opt.model);
     }
@@ -124,8 +126,13 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
     const std::array<double, kMaxHeads> lag_s = run_lags(opt.lag_s, mf);
     const std::vector<SolutionRecord> lagged = pipeline::any_lagged(lag_s) ? lagged_as_sent<T>(rows, lag_s) : rows;
     host.sc = self_calibrate<T>(opt.in, rows_in(lagged), mf, ecfg, opt.orbit_period_s, kSelfCalibrationMemoryBytes,
-                                kMaxHeads, lag_s);
+                                kMaxHeads, lag_s, false, opt.sun_auto, calib::kSunLearnOnBoardIntervalUs);
     host.schedule_d.emplace(host.sc->history);
+    for (const ActiveModel& a : host.sc->history) {  // --sun-term auto: each version's term, as the target holds it
+        if (has_sun_term(a.model)) {
+            host.version_sun.emplace(a.version, sun_term_of<T>(a.model));
+        }
+    }
     (void)host.lags.configure_all(lag_s);
     host.pipeline.use_lags(&host.lags);
     host.lagged_d = lagged_temperatures(lag_s, rows_in(rows));
@@ -134,7 +141,8 @@ void start_host(const ReplayOptions& opt, const std::vector<SolutionRecord>& row
         initial = coefficients_of(*mf);
     }
     const std::int64_t period_us = std::llround(host.sc->orbit_period_s * 1e6);
-    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U, lag_s);
+    client.start_calibration(period_us, opt.time_constant_days, initial ? &*initial : nullptr, rule.heads != 0U, lag_s,
+                             opt.sun_auto);
     calib::EstimatorConfig host_cfg{};  // as the target's CALIB_START makes it
     host_cfg.orbit_period_us = period_us;
     host_cfg.time_constant_days = opt.time_constant_days;

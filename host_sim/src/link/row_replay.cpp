@@ -139,7 +139,8 @@ private:
         const CorrectedSolution<double> ref = correct_stage_with_sun(
             s.in_d, velocity_d,
             CorrectionConfig<double>{true, host_.schedule_d ? &host_.schedule_d->at(rec.t) : &model_d_},
-            host_.sun_d ? &*host_.sun_d : nullptr, rec.t, sun_unknown);
+            host_.schedule_d ? host_.schedule_d->sun_at(rec.t) : (host_.sun_d ? &*host_.sun_d : nullptr), rec.t,
+            sun_unknown);
         if (sun_unknown && sun_messages_ < kMaxRowMessages) {
             ++sun_messages_;
             log_ << opt_.in << ":" << rec.line << ": " << kSunUnknownText << "\n";
@@ -208,6 +209,7 @@ private:
             host = p.untimed_solution(in, answer);
         } else {
             (void)p.begin(t_us);
+            follow_version(p);
             host = p.solution(in, answer, (calib_use & link::kCalibClean) != 0U);
             if (p.calibrating() && p.model() != nullptr) {
                 host_version = p.version();
@@ -218,6 +220,17 @@ private:
                                 log_, *host_.sc);
         }
         return host;
+    }
+
+    // At an epoch of a model version new to the pipeline: that version's
+    // Sun term (--sun-term auto), as the target's server follows its own.
+    void follow_version(link::LinkPipeline<T>& p) {
+        if (!opt_.sun_auto || !p.calibrating() || p.model() == nullptr || host_.sun_version == p.version()) {
+            return;
+        }
+        host_.sun_version = p.version();
+        const auto term = host_.version_sun.find(p.version());
+        p.use_sun_term(term != host_.version_sun.end() ? &term->second : nullptr);
     }
 
     void compare(const SolutionRecord& rec, const link::SolutionOut<T>& got, const CorrectedSolution<T>& host,

@@ -64,7 +64,9 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "../core/correct.hpp"
 #include "../core/quaternion.hpp"
+#include "../core/status.hpp"
 #include "../core/sun_term.hpp"
 #include "../nav/sun_direction.hpp"
 #include "estimator_types.hpp"
@@ -186,6 +188,23 @@ public:
         return true;
     }
 
+    // A fed cycle's frame heads as the epoch pipeline kept them
+    // (kept_solutions(), in T) into take(), in double, when the polynomial
+    // corrected every one (otherwise they are not its residual: false, and
+    // nothing counted). What the link server and the ground's run without a
+    // lag search take.
+    template <typename T>
+    bool take_kept(std::int64_t t_us, const CorrectedSolution<T>* kept) noexcept {
+        Quaternion<double> q[kFrameHeads];
+        for (std::size_t h = 0; h < kFrameHeads; ++h) {
+            if ((kept[h].status & status::kThermalApplied) == 0U) {
+                return false;
+            }
+            q[h] = in_double(kept[h].q_chu_icrf);
+        }
+        return take(t_us, q);
+    }
+
     // The most step() calls one solve takes (sun_moments.hpp's solve_step).
     static constexpr int kMaxSolveSteps = SunMoments<kFrameHeads>::kMaxSolveSteps;
 
@@ -239,6 +258,24 @@ public:
 
     // The term taken (arcsec by head), or nullptr: none.
     const SunTermFit* taken() const noexcept { return taken_ ? &candidate_ : nullptr; }
+
+    // The term a model version takes as it becomes active (docs/contract.md,
+    // "The Sun term learnt in self-calibration"): the term taken, for the
+    // heads of `heads` (bit h: head h, those the version has), into out
+    // (arcsec, indexable as SunTermFit::sun); 0 elsewhere and when none is.
+    template <typename Out>
+    void version_term(HeadMask heads, Out& out) const noexcept {
+        for (auto& head : out) {
+            for (auto& axis : head) {
+                for (double& c : axis) {
+                    c = 0.0;
+                }
+            }
+        }
+        if (taken_) {
+            copy_sun_coefficients(candidate_, heads, out);
+        }
+    }
 
     SunLearnReport report() const noexcept {
         SunLearnReport r;

@@ -38,11 +38,14 @@
 // by a few LSB, which it then removes.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
+#include "constants.hpp"
 #include "heads.hpp"
 #include "model_terms.hpp"
 #include "quaternion.hpp"
+#include "scalar_traits.hpp"
 #include "thermal.hpp"
 #include "vector3.hpp"
 
@@ -87,6 +90,29 @@ constexpr void keep_present_where_terms(SunTermModel<T>& m) noexcept {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         m.present[h] = has_sun_term(m, h);
     }
+}
+
+// A term given in arcsec (sun[h][a][m], as a model file's sun_x, sun_y,
+// sun_z and the self-calibration's learnt term hold it; Arcsec: any array so
+// indexable) in the core's units in T: each coefficient × kArcsecToRad
+// rounded to T once; present[h] where a coefficient is not 0 in double, so
+// that a term that rounds to 0 in T still needs the Sun's direction (128
+// beyond 2051), as in double; its angles are then 0. The one conversion of
+// every producer in T (the host's model reader, the link server's learnt
+// term), so that they hold the same bits.
+template <typename T, typename Arcsec>
+constexpr SunTermModel<T> sun_term_from_arcsec(const Arcsec& sun) noexcept {
+    SunTermModel<T> out{};
+    for (std::size_t h = 0; h < kMaxHeads; ++h) {
+        out.present[h] = false;
+        for (std::size_t a = 0; a < kModelAxes; ++a) {
+            for (std::size_t c = 0; c < kSunComponents; ++c) {
+                out.present[h] = out.present[h] || sun[h][a][c] != 0.0;
+                out.coefficient[h][a][c] = ScalarTraits<T>::from_double(sun[h][a][c] * kArcsecToRad);
+            }
+        }
+    }
+    return out;
 }
 
 // v rotated by q: R(q)·v, the components in q's target frame of a vector

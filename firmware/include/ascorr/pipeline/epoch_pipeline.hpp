@@ -18,9 +18,15 @@
 //   2. velocity  (the caller's source: given_velocity or from_service,
 //                solution_stage.hpp);
 //   3. correction and 4. status (correct_stage(), solution_stage.hpp, then
-//                the caller's own bits: Calls::status); with a Sun term, the
-//                core's flight form (correct_solution(in, cfg, sun),
-//                core/correct.hpp), the term folded into its thermal stage;
+//                the caller's own bits: Calls::status); with the fixed
+//                model's Sun term, the core's flight form
+//                (correct_solution(in, cfg, sun), core/correct.hpp), the
+//                term folded into its thermal stage; while calibrating, the
+//                active version's Sun term (use_sun_term) is applied after
+//                stage 5 took the solution, in the contract's form
+//                (with_sun_term, core/sun_term.hpp), to what is returned
+//                and combined: the feed and what learns beside it take the
+//                polynomial's correction, as on the ground;
 //   5. estimator feed: the first clean, usable solution of each of the
 //                calibrated heads is kept; when A, B and C are there and the
 //                epoch is one the schedule feeds (every feed_every-th), they
@@ -154,11 +160,14 @@ public:
 
     bool calibrating() const noexcept { return estimator_ != nullptr; }
 
-    // The fixed model's Sun term (nullptr: none; keep_present_where_terms
-    // holds, and the coefficients are within the term's domain, as the
-    // link's decode checks), folded into the thermal stage of the heads that
-    // have one while the model is the fixed one (the estimator's models have
-    // none). The Sun's direction is that of the current epoch's time, if any.
+    // The Sun term (nullptr: none; the coefficients within the term's
+    // domain, as the link's decode and the learner check): with the fixed
+    // model, its term (keep_present_where_terms holds), folded into the
+    // thermal stage of the heads that have one; while calibrating, the
+    // active version's (the caller's, set at each new version: the term the
+    // learner had taken, calib/sun_learner.hpp), applied after the feed in
+    // the contract's form (stage 3 above). The Sun's direction is that of
+    // the current epoch's time, if any.
     void use_sun_term(const SunTermModel<T>* sun) noexcept {
         static_assert(kTakesSunTerm, "Calls::correct(in, cfg, sun) evaluates the term");
         sun_ = sun;
@@ -281,6 +290,11 @@ public:
         if (estimator_ != nullptr && clean) {
             keep(in.head, c, in.temperatures, meter);
         }
+        if constexpr (kTakesSunTerm) {
+            if (sun_after()) {
+                c = with_version_term(in, cfg, v, c);
+            }
+        }
         if (combiner_ != nullptr) {
             to_combine(in.head, c, clean);
         }
@@ -325,6 +339,28 @@ private:
     // kTakesSunTerm), and for head h, whether h has one.
     bool sun_folded() const noexcept { return kTakesSunTerm && sun_ != nullptr && estimator_ == nullptr; }
     bool sun_folded(std::uint8_t h) const noexcept { return sun_folded() && h < kMaxHeads && sun_->present[h]; }
+    // Whether the active version's Sun term is applied after the feed.
+    bool sun_after() const noexcept { return kTakesSunTerm && sun_ != nullptr && estimator_ != nullptr; }
+
+    // The version's term on c (correct_stage_with_sun's contract form, the
+    // host's): where the thermal stage applied and the head has a term, c
+    // turned by it with ŝ the epoch's; where ŝ is unknown, the stage undone
+    // (the aberration's result: the core again without a model) and 128.
+    CorrectedSolution<T> with_version_term(const SolutionInput<T>& in, const CorrectionConfig<T>& cfg,
+                                           const VelocityAnswer<T>& v, CorrectedSolution<T> c) const noexcept {
+        if ((c.status & status::kThermalApplied) == 0U || in.head >= kMaxHeads || !sun_->present[in.head]) {
+            return c;
+        }
+        if (!sun_known_) {
+            c = Calls::correct(in, CorrectionConfig<T>{cfg.aberration, nullptr});
+            c.status = Calls::status(
+                in.head,
+                status_stage(static_cast<StatusBits>(c.status | status::kThermalOutOfRange), v, cfg.aberration));
+            return c;
+        }
+        c.q_chu_icrf = with_sun_term(c.q_chu_icrf, sun_term_rotation(*sun_, in.head, c.q_chu_icrf, sun_s_));
+        return c;
+    }
 
     // Stage 3: the core, or its flight form where the fixed model has a Sun
     // term; known: ŝ is the epoch's (a solution in no epoch has none: a head

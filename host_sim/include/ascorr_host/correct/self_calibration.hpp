@@ -107,13 +107,15 @@ void refuse_quadratic_initial_model(const ModelFile& m, const std::string& name)
 // corrected them (with learn_lag, at the lag the search has taken); each model
 // of the history takes the term the learner had taken when it became active
 // (its sun, for the heads A, B and C it has), and sun_learnt reports the
-// learner at the end.
+// learner at the end. sun_interval_us: the learner takes one cycle per
+// interval (SunLearner's thinning; `replay`: the target's,
+// calib::kSunLearnOnBoardIntervalUs); 0, every one (`correct`).
 template <typename T>
 SelfCalibration self_calibrate(const std::string& file, const RowSource& rows, const std::optional<ModelFile>& initial,
                                const calib::EstimatorConfig& cfg, std::optional<double> orbit_period_s,
                                std::size_t memory_budget_bytes = kSelfCalibrationMemoryBytes,
                                std::size_t max_heads = kMaxHeads, const std::array<double, kMaxHeads>& lag_s = {},
-                               bool learn_lag = false, bool learn_sun = false);
+                               bool learn_lag = false, bool learn_sun = false, std::int64_t sun_interval_us = 0);
 
 // The lags of a learnt-lag history's models as they change (each model of
 // it takes the lag its search had taken, self_calibrate's learn_lag), over

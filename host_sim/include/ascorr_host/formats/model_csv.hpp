@@ -31,6 +31,8 @@ namespace ascorr::host {
 
 enum Axis : int { kAlpha = 0, kBeta = 1, kGamma = 2 };
 inline constexpr const char* kAxisNames[kModelAxes] = {"alpha", "beta", "gamma"};
+// The Sun term's columns, by component of ŝ_chu (core/sun_term.hpp).
+inline constexpr const char* kSunColumns[kSunComponents] = {"sun_x", "sun_y", "sun_z"};
 // The terms' columns, by term index (core/model_terms.hpp).
 inline constexpr std::array<const char*, kModelTerms> kCoefficientNames = [] {
     std::array<const char*, kModelTerms> names{};
@@ -137,20 +139,14 @@ void refuse_sun_term_for_link(const ModelFile& m, const std::string& path, const
 inline constexpr const char* kSunTermNotLearnt =
     "the self-calibration learns a Sun term from none (--sun-term auto), not from a given one: start it from a "
     "model without one";
-// The Sun term in the core's units (radians), for scalar T; present[h]
-// where head h has a term in the file's double (has_sun_term), so that a
-// term that rounds to 0 in T still makes its rows need the Sun's direction
-// (128 beyond 2051), as in double; its angles are then 0.
+// The Sun term in the core's units (radians), for scalar T, as
+// sun_term_from_arcsec (core/sun_term.hpp) converts it; present[h] where
+// head h, one the model has, has a term in the file's double (has_sun_term).
 template <typename T>
 SunTermModel<T> sun_term_of(const ModelFile& m) {
-    SunTermModel<T> out{};
+    SunTermModel<T> out = sun_term_from_arcsec<T>(m.sun);
     for (std::size_t h = 0; h < kMaxHeads; ++h) {
-        out.present[h] = has_sun_term(m, h);
-        for (std::size_t a = 0; a < kModelAxes; ++a) {
-            for (std::size_t c = 0; c < kSunComponents; ++c) {
-                out.coefficient[h][a][c] = ScalarTraits<T>::from_double(m.sun[h][a][c] * kArcsecToRad);
-            }
-        }
+        out.present[h] = has_sun_term(m, h);  // the heads the model has
     }
     return out;
 }

@@ -104,9 +104,11 @@ public:
     // what it had learnt is lost with it.
     // common_rotation: the rule 'combined' with the mountings loaded before
     // (load_mountings), CALIB_START's common_rotation 1. lag_s: the heads'
-    // lags the estimator learns with (CALIB_START's; 0 none).
+    // lags the estimator learns with (CALIB_START's; 0 none). learn_sun:
+    // the Sun term learnt beside it (CALIB_START's sun_term 1).
     void start_calibration(std::int64_t orbit_period_us, double time_constant_days, const ModelCoefficients* initial,
-                           bool common_rotation = false, const std::array<double, kMaxHeads>& lag_s = {});
+                           bool common_rotation = false, const std::array<double, kMaxHeads>& lag_s = {},
+                           bool learn_sun = false);
     // The heads' lags the target runs with (start_calibration's once the
     // estimator runs, otherwise the last upload_model's; 0 none).
     const std::array<double, kMaxHeads>& lag_s() const noexcept { return lag_s_; }
@@ -116,6 +118,9 @@ public:
     calib::EstimatorReport calib_report();
     // Head h of the estimator's active model (protocol v4).
     link::CalibModel calib_model(std::uint8_t head);
+    // Head h's Sun term of the active model's version (start_calibration's
+    // learn_sun; a target before it: a LinkError, its unknown type).
+    link::CalibSunTerm calib_sun_term(std::uint8_t head);
 
     // The combination (protocol v5): the mountings, head by head, built into
     // the target's combiner (a LinkError when the target refuses them); then

@@ -67,6 +67,10 @@ struct ReplayOptions {
     // --lag (self-calibration only): the lags the target's estimator learns
     // with (CALIB_START's); nullopt: the model's lag_s, or none.
     std::optional<std::array<double, kMaxHeads>> lag_s;
+    // --sun-term auto (self-calibration only): the target learns the Sun
+    // term beside its estimator (CALIB_START's sun_term), and the host's run
+    // with the target's thinning (calib::kSunLearnOnBoardIntervalUs).
+    bool sun_auto = false;
 };
 
 struct ReplaySummary {
