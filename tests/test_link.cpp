@@ -317,10 +317,6 @@ TEST(LinkServer, VelocityOutsideTheDomainIsRefusedAndDropsTheHeldOne) {
     EXPECT_EQ(ack_of(loop.request(MessageType::kVelocityUpdate, 9, none)), AckResult::kOk);
 }
 
-// Self-calibration on the link (protocol v3): the commands act on the
-// estimator, a loaded model corrects from the next epoch, and every bad
-// payload is refused with kBadPayload and changes nothing (the report, bit
-// for bit, and the staged model: a later load gives the same CRC).
 // The learnt Sun term on the wire (issue 40): CALIB_START's sun_term after
 // the lags (absent, the message as it was; beyond 1, refused), and
 // CALIB_SUN_TERM whole, within a frame's payload.
@@ -354,6 +350,10 @@ TEST(LinkCodecs, TheLearntSunTermsMessagesDecodeWholeOrAsBefore) {
     EXPECT_FALSE(decode(p, k, got));
 }
 
+// Self-calibration on the link (protocol v3): the commands act on the
+// estimator, a loaded model corrects from the next epoch, and every bad
+// payload is refused with kBadPayload and changes nothing (the report, bit
+// for bit, and the staged model: a later load gives the same CRC).
 TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     Loop loop;
     loop.send(wire_frame(MessageType::kHelloRequest, 1, {}));
@@ -435,6 +435,8 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{4});     // a head beyond D
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{0, 0});  // a byte too many
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{});
+    bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{4});  // a head beyond D
+    bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{0, 0});
     CalibModelLoad good{};
     good.head = 0;
     good.present = 1;

@@ -344,7 +344,6 @@ private:
                 return;
             case CalibCommand::kReset:
                 estimator_.reset();
-                version_term_.set = false;  // its versions may come again: each takes the term anew
                 return;
         }
     }
@@ -409,7 +408,8 @@ private:
             follow_version();
             const std::uint32_t feeds = pipeline_.feeds();
             c = pipeline_.solution(in, velocity, (s.calib & kCalibClean) != 0U, true, meter);
-            if (learning_sun_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr) {
+            // Frozen, the estimator takes nothing from the feed: nor does the learner.
+            if (learning_sun_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr && !estimator_.frozen()) {
                 (void)sun_learner_.take_kept(s.t.us, pipeline_.kept_solutions());
                 (void)sun_learner_.step_all();  // its per-orbit work, after the cycle (outside the meter)
             }

@@ -198,6 +198,7 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     SelfCalibration on_target = host_sc;
     on_target.history = target_history;
     on_target.report = r;
+    on_target.sun_learnt.reset();  // the target's learner reports nothing over the link: its models say what it took
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }
 

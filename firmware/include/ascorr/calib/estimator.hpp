@@ -188,6 +188,7 @@ public:
         orbit_.drop();
     }
     void resume() noexcept { frozen_ = false; }
+    bool frozen() const noexcept { return frozen_; }
     // Forget everything learnt; the active model stays.
     void reset() noexcept {
         rule_memory_.clear();
