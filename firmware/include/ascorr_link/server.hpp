@@ -43,9 +43,10 @@
 //                        (calib/sun_learner.hpp, one cycle per
 //                        kSunLearnOnBoardIntervalUs) takes the fed cycles'
 //                        frame heads as the polynomial corrected them, and
-//                        solves after each orbit closed, right after the
-//                        cycle (as the estimator's per-orbit update runs
-//                        here); each model version takes the term taken when
+//                        solves after each orbit closed, a few bounded
+//                        steps after each answer and the rest, if any,
+//                        when it next takes an epoch (SunLearner::settle);
+//                        each model version takes the term taken when
 //                        it becomes active, for the heads it has, applied to
 //                        the answers after the feed (epoch_pipeline.hpp).
 //   kCalibCommand      → kAck (freeze, resume, reset)
@@ -286,8 +287,9 @@ private:
     }
 
     // At an epoch of a model version new to the Sun term's learning: the
-    // term the learner has taken (its solves done: they run after each
-    // cycle), for the heads the version has, kept in arcsec (kCalibModel)
+    // term the learner has taken (its candidate as of the last epoch it
+    // took: SunLearner::settle), for the heads the version has, kept in
+    // arcsec (kCalibSunTerm)
     // and in T for the pipeline (sun_term_from_arcsec, as the host converts
     // a model file's), as `correct --self-calibrate --sun-term auto` makes
     // the history's models.
@@ -411,7 +413,6 @@ private:
             // Frozen, the estimator takes nothing from the feed: nor does the learner.
             if (learning_sun_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr && !estimator_.frozen()) {
                 (void)sun_learner_.take_kept(s.t.us, pipeline_.kept_solutions());
-                (void)sun_learner_.step_all();  // its per-orbit work, after the cycle (outside the meter)
             }
         } else {
             const std::uint32_t start = counter_();
@@ -419,6 +420,11 @@ private:
             meter.cost = counter_() - start;
         }
         ++solutions_;
+        // The learner's per-orbit solve in bounded steps after each answer
+        // (outside the meter: the link's idle time); what is left when the
+        // learner next takes an epoch runs then (SunLearner::settle).
+        for (int i = 0; learning_sun_ && i < kSunStepsPerSolution && sun_learner_.step(); ++i) {
+        }
         const std::uint32_t version =
             pipeline_.calibrating() && in_epoch && pipeline_.model() != nullptr ? pipeline_.version() : kNoModelVersion;
         return {s.id, s.head, c.status, c.q_chu_icrf, meter.cost, version};
@@ -569,7 +575,10 @@ private:
     LinkEstimator<T> estimator_{};
     ModelCoefficients staged_{};
     // The Sun term learnt beside it (kCalibStart's sun_term), and the term
-    // of the model version the epochs use (follow_version).
+    // of the model version the epochs use (follow_version). Its solve's
+    // steps per SOLUTION_IN: each at most ~0.95 million instructions
+    // (docs/figures.md, "The side learners").
+    static constexpr int kSunStepsPerSolution = 8;
     static_assert(std::is_trivially_destructible_v<calib::SunLearner>, "restarted in place");
     calib::SunLearner sun_learner_{calib::EstimatorConfig{}, calib::kSunLearnOnBoardIntervalUs};
     bool learning_sun_ = false;

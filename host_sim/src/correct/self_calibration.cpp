@@ -231,7 +231,7 @@ private:
         }
         if (sun_) {
             (void)sun_->take_kept(t_us, kept);
-            (void)sun_->step_all();  // its per-orbit work, as the link server runs it after the cycle
+            (void)sun_->step_all();  // its per-orbit work, in idle time (in use from the next cycle taken)
         }
     }
 

@@ -10,8 +10,10 @@
 // the Sun's direction in each head's frame, about each orbit's own mean,
 // with a forgetting e^(−Δt/memory) per orbit closed (memory:
 // orbit_spread_scores.hpp's, the estimator's time constant but at least 30
-// days), and solves them after every orbit closed
-// (step(), in idle time): the candidate, under the estimator's weights for
+// days), and solves them after every orbit closed (step(), in idle time;
+// put to use from the next cycle taken, settle(), so that the ground, the
+// link and the flight loop agree whatever their idle time): the candidate,
+// under the estimator's weights for
 // the common rotation when it has them (`--mountings`' combined attitude),
 // otherwise the smallest coefficients (not the estimator's own gauge, frame F
 // of A and C: the term's common part then moves F a little). Heads A, B and C
@@ -125,6 +127,8 @@ struct SunLearnReport {
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
     std::uint64_t thinned = 0;      // cycles not taken: their interval had one (thinned)
+    std::uint64_t late = 0;         // cycles taken with a solve idle time had not finished (settle)
+    int late_steps = 0;             // ... the most steps one of them ran
 };
 
 class SunLearner {
@@ -151,13 +155,15 @@ public:
     // attitudes corrected by the active polynomial. false: not taken (t
     // outside the Sun ephemeris' span, or attitudes that give no finite
     // rotation; counted), or thinned (its interval had a cycle: counted,
-    // and nothing else done). A cycle of another orbit than the open one
-    // closes it first (its solve then waits for step()).
+    // and nothing else done). First the solve under way is settled (settle());
+    // then a cycle of another orbit than the open one closes it (its solve
+    // then waits for step()).
     bool take(std::int64_t t_us, const Quaternion<double> (&q)[kFrameHeads]) noexcept {
         if (!thinning_.due(t_us)) {
             return false;
         }
         thinning_.mark(t_us);
+        (void)settle();
         if (scores_.closes(t_us)) {
             close_orbit(scores_.open_bin());
         }
@@ -212,8 +218,9 @@ public:
     // the candidate solved again from the sums, one bounded step of the
     // solve per call (sun_moments.hpp's solve_step: the normal equations,
     // one row of a Jacobi sweep, or the result), at most kMaxSolveSteps per
-    // solve. A solve begun goes on with the sums as they were when it began;
-    // an orbit closed meanwhile is solved after it. false: nothing pending.
+    // solve, with the sums as they were when it began. Its candidate is put
+    // to use by the next settle() (the next cycle taken), not here, so that
+    // when idle time ran the steps changes nothing. false: nothing pending.
     bool step() noexcept {
         if (!solving_) {
             if (!solve_pending_) {
@@ -227,16 +234,40 @@ public:
             return true;
         }
         solving_ = false;
-        if (s == SunSolveStep::kSolved && sun_fit_within_domain(solve_.fit)) {
+        solved_ = s == SunSolveStep::kSolved && sun_fit_within_domain(solve_.fit);
+        return true;
+    }
+
+    // The solve under way (or pending) run to its end and its candidate put
+    // to use: what take() does first, before its cycle can close another
+    // orbit, so that the candidate a cycle is scored with and a model takes
+    // is the solve of the orbits closed before the last cycle taken,
+    // whatever idle time did (the ground's run, the link's and the flight
+    // loop's alike). Where idle time had not finished it, the rest runs
+    // here (counted: report().late, late_steps). Returns the steps it ran.
+    // Out of line: take()'s frame stays a cycle's, the solve's frames are
+    // a step's.
+    [[gnu::noinline]] int settle() noexcept {
+        int n = 0;
+        while (n < 2 * kMaxSolveSteps && step()) {
+            ++n;
+        }
+        if (solved_) {
             candidate_ = solve_.fit;
             candidate_model_ = sun_term_model(solve_.fit);
+            solved_ = false;
         }
-        return true;
+        if (n > 0) {
+            ++late_;
+            late_steps_ = n > late_steps_ ? n : late_steps_;
+        }
+        return n;
     }
 
     // step() until nothing is pending (at most kMaxSolveSteps per solve: the
     // one begun, and one pending): what idle time does after each cycle on
-    // the ground. false: nothing was.
+    // the ground (its candidate in use from the next cycle taken: settle()).
+    // false: nothing was.
     bool step_all() noexcept {
         bool any = false;
         for (int i = 0; i < 2 * kMaxSolveSteps && step(); ++i) {
@@ -251,6 +282,7 @@ public:
             close_orbit(scores_.open_bin());
         }
         (void)step_all();
+        (void)settle();
         if (scores_.finish()) {
             reconsider();
         }
@@ -297,6 +329,8 @@ public:
         r.without_sun = without_sun_;
         r.not_finite = not_finite_;
         r.thinned = thinning_.thinned();
+        r.late = late_;
+        r.late_steps = late_steps_;
         return r;
     }
 
@@ -343,6 +377,9 @@ private:
     SunMoments<kFrameHeads>::Solve solve_{};  // the solve's workspace (step)
     bool solving_ = false;                    // a solve begun (solve_)
     bool solve_pending_ = false;
+    bool solved_ = false;  // solve_.fit holds a candidate not yet in use (settle)
+    std::uint64_t late_ = 0U;
+    int late_steps_ = 0;
     bool taken_ = false;
     std::uint64_t without_sun_ = 0U;
     std::uint64_t not_finite_ = 0U;
