@@ -38,7 +38,7 @@
 // skipped and counted (report().thinned). A cycle refused (no Sun, not
 // finite) takes its interval too, so that the bound holds whatever the
 // input. Why: a take
-// costs the DPU as much as 100 to 150 of the estimator's cycles
+// costs the DPU as much as 110 to 155 of the estimator's cycles
 // (docs/figures.md, "The side learners"). It biases nothing: the moments are
 // sums over the epochs taken, with no state between them (the lag search
 // cannot be thinned so: its lags must step as the pipeline's). A time that
