@@ -752,48 +752,57 @@ TEST(SunLearnt, WhatCannotLearnItIsRefused) {
 
 // ---- replay --self-calibrate --sun-term auto: the learner on the link
 
-// A bench that turns with the Sun by 0.8″, without a lag (a lag's float
-// steps on the target are not `correct`'s double ones, so the models would
-// differ in their last bits), over 60 days (seed 41): the target learns the
-// term beside its estimator, bit for bit as the host's run thinned alike;
-// with epochs 240 s apart its thinning (one per 120 s) takes every epoch, so
-// its history is `correct --sun-term auto`'s in float byte for byte, and its
-// file within the replay tests' float bound (0.05″). Mutation: correct's file
-// without the term is more than ten bounds away, so the target applies it.
+// A bench that turns with the Sun by 0.8″, without a lag (a lag's steps in
+// the target's scalar are not `correct`'s double ones, so the models would
+// differ in their last bits), over 60 days (seed 41), replayed on the
+// in-process targets of both flight scalars (float: the M4F's; Q30: the
+// M3's): the target learns the term beside its estimator, bit for bit as
+// the host's run thinned alike; with epochs 240 s apart its thinning (one
+// per 120 s) takes every epoch, so its history is `correct --sun-term auto`'s
+// in its scalar byte for byte, and its file within the replay tests' float
+// bound (0.05″). Mutation: correct's file without the term is more than ten
+// bounds away, so the target applies it.
 TEST(SunLearntOnLink, TheTargetLearnsTheTermAsTheHostAndCorrectsWithIt) {
     const fs::path dir = simulated_mission("sun-on-link", "--days 60 --step 240 --seed 41 --orbit-term 0.8");
-    ASSERT_EQ(self_calibrate_mission(dir, "--sun-term auto --scalar float", "c.csv").exit_code, 0);
-    ASSERT_EQ(self_calibrate_mission(dir, "--scalar float", "c0.csv").exit_code, 0);
-    host::ReplayOptions o;
-    o.target = "loopback-float";
-    o.in = (dir / "m.csv").string();
-    o.out = (dir / "r.csv").string();
-    o.model_history = (dir / "r.history.csv").string();
-    o.self_calibrate = true;
-    o.sun_auto = true;
-    std::ostringstream log;
-    const host::ReplaySummary s = host::replay(o, log);
-    EXPECT_EQ(s.returned, s.frames);
-    EXPECT_EQ(s.mismatches, 0U) << log.str();
-    EXPECT_EQ(s.version_mismatches, 0U) << log.str();
-    EXPECT_EQ(s.history_mismatches, 0U) << log.str();
-    EXPECT_TRUE(s.report_matches) << log.str();
-    EXPECT_LE(s.max_error_arcsec, 0.05);
-    // The target's history: its models took a term, as correct's did.
-    const std::vector<std::string> h = lines_of_file(dir / "r.history.csv");
-    ASSERT_GT(h.size(), 2U);
-    EXPECT_EQ(h[0].substr(h[0].size() - 18), ",sun_x,sun_y,sun_z") << h[0];
-    EXPECT_EQ(h.back().find(",0.0000000000000000e+00,0.0000000000000000e+00,0.0000000000000000e+00"), std::string::npos)
-        << h.back();
-    EXPECT_EQ(slurp(dir / "r.history.csv"), slurp(dir / "c.csv.history.csv"));
-    const double against_correct = largest_difference(dir / "r.csv", dir / "c.csv");
-    EXPECT_LE(against_correct, 0.05);
-    const double term = largest_difference(dir / "c.csv", dir / "c0.csv");
-    EXPECT_GT(term, 10 * 0.05);
-    RecordProperty("replayed_against_correct_arcsec", std::to_string(against_correct));
-    RecordProperty("term_arcsec", std::to_string(term));
-    std::cout << "replayed against correct: " << against_correct << " arcsec (the term moves rows by up to " << term
-              << "); " << host::to_json(s) << "\n";
+    const std::pair<const char*, const char*> targets[] = {{host::kLoopbackFloat, "float"},
+                                                           {host::kLoopbackFixed, "fixed"}};
+    for (const auto& [target, scalar] : targets) {
+        const std::string c = std::string("c_") + scalar + ".csv";
+        const std::string c0 = std::string("c0_") + scalar + ".csv";
+        ASSERT_EQ(self_calibrate_mission(dir, std::string("--sun-term auto --scalar ") + scalar, c).exit_code, 0);
+        ASSERT_EQ(self_calibrate_mission(dir, std::string("--scalar ") + scalar, c0).exit_code, 0);
+        host::ReplayOptions o;
+        o.target = target;
+        o.in = (dir / "m.csv").string();
+        o.out = (dir / "r.csv").string();
+        o.model_history = (dir / "r.history.csv").string();
+        o.self_calibrate = true;
+        o.sun_auto = true;
+        std::ostringstream log;
+        const host::ReplaySummary s = host::replay(o, log);
+        EXPECT_EQ(s.returned, s.frames) << target;
+        EXPECT_EQ(s.mismatches, 0U) << target << log.str();
+        EXPECT_EQ(s.version_mismatches, 0U) << target << log.str();
+        EXPECT_EQ(s.history_mismatches, 0U) << target << log.str();
+        EXPECT_TRUE(s.report_matches) << target << log.str();
+        EXPECT_LE(s.max_error_arcsec, 0.05) << target;
+        // The target's history: its models took a term, as correct's did.
+        const std::vector<std::string> h = lines_of_file(dir / "r.history.csv");
+        ASSERT_GT(h.size(), 2U);
+        EXPECT_EQ(h[0].substr(h[0].size() - 18), ",sun_x,sun_y,sun_z") << h[0];
+        EXPECT_EQ(h.back().find(",0.0000000000000000e+00,0.0000000000000000e+00,0.0000000000000000e+00"),
+                  std::string::npos)
+            << h.back();
+        EXPECT_EQ(slurp(dir / "r.history.csv"), slurp(dir / (c + ".history.csv"))) << target;
+        const double against_correct = largest_difference(dir / "r.csv", dir / c);
+        EXPECT_LE(against_correct, 0.05) << target;
+        const double term = largest_difference(dir / c, dir / c0);
+        EXPECT_GT(term, 10 * 0.05) << target;
+        RecordProperty(std::string("replayed_against_correct_arcsec_") + scalar, std::to_string(against_correct));
+        RecordProperty(std::string("term_arcsec_") + scalar, std::to_string(term));
+        std::cout << target << " replayed against correct: " << against_correct
+                  << " arcsec (the term moves rows by up to " << term << "); " << host::to_json(s) << "\n";
+    }
 }
 
 }  // namespace

@@ -19,7 +19,8 @@ void add_replay_command(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("replay", "replay a recorded file through a target over the serial link");
     // The QEMU boards come from toolchain/targets.txt (the generated ascorr_host/link/qemu_targets.hpp).
     cmd->add_option("--target", opt->target,
-                    host::qemu_target_choices() + ", loopback-float, or a serial device such as /dev/ttyUSB0")
+                    host::qemu_target_choices() + ", " + host::kLoopbackFloat + ", " + host::kLoopbackFixed +
+                        ", or a serial device such as /dev/ttyUSB0")
         ->required();
     cmd->add_option("--firmware", opt->firmware, "qemu targets: the link image (default: the one of this build)")
         ->check(non_empty_path());

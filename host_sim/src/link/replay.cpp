@@ -224,8 +224,12 @@ ReplaySummary replay(const ReplayOptions& opt, std::ostream& log) {
 ReplaySummary replay(const ReplayOptions& opt, OutputSet& outputs, std::ostream& log) {
     check_options(opt);
     ReplayOptions o = opt;
-    if (opt.target == "loopback-float") {
+    if (opt.target == kLoopbackFloat || opt.target == kLoopbackFixed) {
         o.timeout_ms = opt.timeout_ms > 0 ? opt.timeout_ms : 1;  // answers are there at once or never
+        if (opt.target == kLoopbackFixed) {
+            LoopbackTarget<Q30> target;
+            return detail::run<Q30>(o, target.transport(), outputs, log);
+        }
         LoopbackTarget<float> target;
         return detail::run<float>(o, target.transport(), outputs, log);
     }
@@ -249,8 +253,8 @@ ReplaySummary replay(const ReplayOptions& opt, OutputSet& outputs, std::ostream&
         SerialTransport serial(opt.target, opt.baud);
         return run_as_announced(o, serial, outputs, log);
     }
-    throw std::runtime_error("--target " + opt.target + ": unknown target (loopback-float, " + qemu_target_names() +
-                             " or a serial device such as /dev/ttyUSB0)");
+    throw std::runtime_error("--target " + opt.target + ": unknown target (" + kLoopbackFloat + ", " + kLoopbackFixed +
+                             ", " + qemu_target_names() + " or a serial device such as /dev/ttyUSB0)");
 }
 
 std::vector<std::string> qemu_link_command(const std::string& machine, const std::string& image) {

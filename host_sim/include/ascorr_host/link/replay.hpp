@@ -40,8 +40,13 @@
 
 namespace ascorr::host {
 
+// The in-process targets: the firmware's link server in float (the M4F's
+// scalar) or Q30 (the M3's), behind a loopback, for tests.
+inline constexpr const char* kLoopbackFloat = "loopback-float";
+inline constexpr const char* kLoopbackFixed = "loopback-fixed";
+
 struct ReplayOptions {
-    std::string target;    // a replay name of ascorr_host/link/qemu_targets.hpp, loopback-float, or a serial device
+    std::string target;  // a replay name of ascorr_host/link/qemu_targets.hpp, kLoopbackFloat/Fixed, or a serial device
     std::string firmware;  // qemu targets: the link image; empty: the one of this build tree
     std::string in;
     std::string model;
