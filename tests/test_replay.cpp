@@ -319,7 +319,9 @@ TEST(Replay, HelpOffersEveryQemuTargetOfTheTableWithItsScalar) {
             std::string(t.replay) + (t.scalar == host::ScalarKind::kFixed ? " (Q30)" : " (float)");
         EXPECT_NE(squeezed.find(choice), std::string::npos) << choice << " not in:\n" << help;
     }
-    EXPECT_NE(squeezed.find(host::qemu_target_choices() + ", loopback-float, loopback-fixed"), std::string::npos) << help;
+    EXPECT_NE(squeezed.find(host::qemu_target_choices() + ", " + host::kLoopbackFloat + ", " + host::kLoopbackFixed),
+              std::string::npos)
+        << help;
 }
 
 }  // namespace

@@ -15,7 +15,6 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
-#include <map>
 #include <random>
 #include <sstream>
 #include <string>

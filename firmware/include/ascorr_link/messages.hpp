@@ -30,31 +30,30 @@
 namespace ascorr::link {
 
 enum class MessageType : std::uint8_t {
-    kHello = 1,                // target → host: boot id, protocol, scalar kind
-    kModelUpload = 2,          // host → target: one head's thermal model
-    kVelocityUpdate = 3,       // host → target: observer velocity (v/c) and 1/s
-    kTemperatureUpdate = 4,    // host → target: one head's temperatures with validity
-    kSolutionIn = 5,           // host → target: a raw attitude solution
-    kSolutionOut = 6,          // target → host: the corrected solution, status, cost
-    kAck = 7,                  // target → host: a request without data reply was applied (or why not)
-    kHelloRequest = 8,         // host → target: answer with kHello
-    kNak = 9,                  // target → host: a frame arrived broken; resend
-    kStateUpdate = 10,         // host → target: a spacecraft state for the velocity service (v2)
-    kCalibStart = 11,          // host → target: run the estimator on the solutions, its configuration (v3)
-    kCalibCommand = 12,        // host → target: freeze, resume or reset the estimator (v3)
-    kCalibModelLoad = 13,      // host → target: one head of a model for the estimator, staged or loaded (v3)
-    kCalibReportRequest = 14,  // host → target: answer with kCalibReport (v3)
-    kCalibReport = 15,         // target → host: the estimator's state (v3)
-    kCalibModelRequest = 16,   // host → target: answer with kCalibModel for a head (v4)
-    kCalibModel = 17,          // target → host: one head of the estimator's active model (v4)
-    kServiceConfig = 18,       // host → target: the velocity service's horizon (v4)
-    kMountingLoad = 19,        // host → target: one head's mounting and noise, staged or built (v5)
-    kCombineRequest = 20,      // host → target: combine the solutions since the last request (v5)
-    kCombined = 21,            // target → host: the combined attitude of the bench (v5)
-    kSunTermUpload = 22,       // host → target: one head's Sun term (docs/contract.md, "The Sun term on the link")
-    kCalibSunTermRequest =
-        23,              // host → target: answer with kCalibSunTerm for a head ("The Sun term learnt on the link")
-    kCalibSunTerm = 24,  // target → host: one head's Sun term of the active model version
+    kHello = 1,                 // target → host: boot id, protocol, scalar kind
+    kModelUpload = 2,           // host → target: one head's thermal model
+    kVelocityUpdate = 3,        // host → target: observer velocity (v/c) and 1/s
+    kTemperatureUpdate = 4,     // host → target: one head's temperatures with validity
+    kSolutionIn = 5,            // host → target: a raw attitude solution
+    kSolutionOut = 6,           // target → host: the corrected solution, status, cost
+    kAck = 7,                   // target → host: a request without data reply was applied (or why not)
+    kHelloRequest = 8,          // host → target: answer with kHello
+    kNak = 9,                   // target → host: a frame arrived broken; resend
+    kStateUpdate = 10,          // host → target: a spacecraft state for the velocity service (v2)
+    kCalibStart = 11,           // host → target: run the estimator on the solutions, its configuration (v3)
+    kCalibCommand = 12,         // host → target: freeze, resume or reset the estimator (v3)
+    kCalibModelLoad = 13,       // host → target: one head of a model for the estimator, staged or loaded (v3)
+    kCalibReportRequest = 14,   // host → target: answer with kCalibReport (v3)
+    kCalibReport = 15,          // target → host: the estimator's state (v3)
+    kCalibModelRequest = 16,    // host → target: answer with kCalibModel for a head (v4)
+    kCalibModel = 17,           // target → host: one head of the estimator's active model (v4)
+    kServiceConfig = 18,        // host → target: the velocity service's horizon (v4)
+    kMountingLoad = 19,         // host → target: one head's mounting and noise, staged or built (v5)
+    kCombineRequest = 20,       // host → target: combine the solutions since the last request (v5)
+    kCombined = 21,             // target → host: the combined attitude of the bench (v5)
+    kSunTermUpload = 22,        // host → target: one head's Sun term (docs/contract.md, "The Sun term on the link")
+    kCalibSunTermRequest = 23,  // host → target: answer with kCalibSunTerm for a head
+    kCalibSunTerm = 24,         // target → host: one head's Sun term of the active model version
 };
 
 enum class AckResult : std::uint8_t {

@@ -222,6 +222,7 @@ private:
                 const SolutionOut<T> out = correct(s);
                 std::uint8_t p[kMaxPayload];
                 emit(MessageType::kSolutionOut, f.seq, p, encode(out, p), sink, true);
+                step_sun_learner();  // after the answer: the link's idle time
                 return;
             }
             case MessageType::kMountingLoad:
@@ -286,6 +287,14 @@ private:
         }
     }
 
+    // The learner's per-orbit solve in bounded steps after each answer; what
+    // is left when it next takes an epoch runs then (SunLearner::settle),
+    // so that where the steps run changes no bit.
+    void step_sun_learner() noexcept {
+        for (int i = 0; learning_sun_ && i < kSunStepsPerSolution && sun_learner_.step(); ++i) {
+        }
+    }
+
     // At an epoch of a model version new to the Sun term's learning: the
     // term the learner has taken (its candidate as of the last epoch it
     // took: SunLearner::settle), for the heads the version has, kept in
@@ -346,6 +355,8 @@ private:
                 return;
             case CalibCommand::kReset:
                 estimator_.reset();
+                // The learner forgets too (the active version keeps its term).
+                new (&sun_learner_) calib::SunLearner(estimator_.config(), calib::kSunLearnOnBoardIntervalUs);
                 return;
         }
     }
@@ -420,11 +431,6 @@ private:
             meter.cost = counter_() - start;
         }
         ++solutions_;
-        // The learner's per-orbit solve in bounded steps after each answer
-        // (outside the meter: the link's idle time); what is left when the
-        // learner next takes an epoch runs then (SunLearner::settle).
-        for (int i = 0; learning_sun_ && i < kSunStepsPerSolution && sun_learner_.step(); ++i) {
-        }
         const std::uint32_t version =
             pipeline_.calibrating() && in_epoch && pipeline_.model() != nullptr ? pipeline_.version() : kNoModelVersion;
         return {s.id, s.head, c.status, c.q_chu_icrf, meter.cost, version};

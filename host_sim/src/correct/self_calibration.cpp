@@ -231,14 +231,17 @@ private:
         }
         if (sun_) {
             (void)sun_->take_kept(t_us, kept);
-            (void)sun_->step_all();  // its per-orbit work, in idle time (in use from the next cycle taken)
+            sun_idle();
         }
     }
 
     void learn_sun(std::int64_t t_us, const Quaternion<double> (&q)[calib::kFrameHeads]) {
         (void)sun_->take(t_us, q);
-        (void)sun_->step_all();
+        sun_idle();
     }
+    // After the learner's take: its per-orbit work, as idle time (in use
+    // from the next cycle it takes: SunLearner::settle).
+    void sun_idle() { (void)sun_->step_all(); }
 
     const std::string& file_;
     calib::EstimatorConfig cfg_;
@@ -758,7 +761,8 @@ std::string format_model_history(const std::vector<ActiveModel>& history, bool c
         std::any_of(history.begin(), history.end(), [](const ActiveModel& m) { return has_sun_term(m.model); });
     std::string out = "t,version,chu,axis," + coefficient_columns(0, kLinearModelTerms, ",") + ",crc32c,tt_us,origin" +
                       (combined ? ",common_rotation" : "") + (lagged ? ",lag_s" : "") +
-                      (sun ? ",sun_x,sun_y,sun_z\n" : "\n");
+                      (sun ? std::string(",") + kSunColumns[0] + "," + kSunColumns[1] + "," + kSunColumns[2] : "") +
+                      "\n";
     for (const ActiveModel& m : history) {
         for (std::size_t h = 0; h < kMaxHeads; ++h) {
             for (std::size_t a = 0; a < kModelAxes && m.model.present[h]; ++a) {

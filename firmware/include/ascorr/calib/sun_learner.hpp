@@ -53,7 +53,9 @@
 // ephemeris' span (2000–2051), or whose attitudes give no finite rotation, is
 // not taken (counted: report()).
 // Cost per cycle taken (take): a Sun direction, three Sun-term rotations, six
-// boresights and IBAs, the moments' 2·9² products. Per orbit closed (step):
+// boresights and IBAs, the moments' 2·9² products; and, where idle time
+// left a solve unfinished, its rest (settle: up to a whole solve, counted in
+// report().late). Per orbit closed (step):
 // the normal equations (27 × 27) and their Jacobi eigen-decomposition
 // (symmetric_eigen.hpp, at most 30 sweeps), a bounded step per call (the
 // normal equations, one row of a sweep, or the result), in the learner's own
@@ -127,7 +129,7 @@ struct SunLearnReport {
     std::uint64_t without_sun = 0;  // cycles not taken: t outside the Sun ephemeris' span
     std::uint64_t not_finite = 0;   // cycles not taken: an attitude that is not finite
     std::uint64_t thinned = 0;      // cycles not taken: their interval had one (thinned)
-    std::uint64_t late = 0;         // cycles taken with a solve idle time had not finished (settle)
+    std::uint64_t late = 0;         // cycles looked at (not thinned) with a solve idle time had not finished (settle)
     int late_steps = 0;             // ... the most steps one of them ran
 };
 
@@ -278,6 +280,7 @@ public:
 
     // Closes the open orbit (the end of the data), its solve included.
     void finish() noexcept {
+        (void)settle();  // as take(): the solve before the last orbit's close in use first
         if (scores_.open()) {
             close_orbit(scores_.open_bin());
         }
