@@ -298,10 +298,9 @@ private:
     // At an epoch of a model version new to the Sun term's learning: the
     // term the learner has taken (its candidate as of the last epoch it
     // took: SunLearner::settle), for the heads the version has, kept in
-    // arcsec (kCalibSunTerm)
-    // and in T for the pipeline (sun_term_from_arcsec, as the host converts
-    // a model file's), as `correct --self-calibrate --sun-term auto` makes
-    // the history's models.
+    // arcsec (kCalibSunTerm) and in T for the pipeline (sun_term_from_arcsec,
+    // as the host converts a model file's), as `correct --self-calibrate
+    // --sun-term auto` makes the history's models.
     void follow_version() noexcept {
         const ModelCoefficients* active = estimator_.active_coefficients();
         if (!learning_sun_ || pipeline_.model() == nullptr || active == nullptr ||
@@ -339,7 +338,6 @@ private:
         learning_sun_ = m.sun_term == 1U;
         version_term_ = {};
         pipeline_.use_sun_term(nullptr);  // an uploaded model's term is not the versions'
-
         (void)lags_.configure_all(m.lag_s);  // decode() checked each τ
         pipeline_.use_lags(&lags_);
         pipeline_.use_estimator(&estimator_);
