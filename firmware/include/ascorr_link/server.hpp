@@ -337,7 +337,7 @@ private:
         new (&sun_learner_) calib::SunLearner(cfg, calib::kSunLearnOnBoardIntervalUs);
         learning_sun_ = m.sun_term == 1U;
         version_term_ = {};
-        pipeline_.use_sun_term(nullptr);  // an uploaded model's term is not the versions'
+        pipeline_.use_sun_term(nullptr);     // an uploaded model's term is not the versions'
         (void)lags_.configure_all(m.lag_s);  // decode() checked each τ
         pipeline_.use_lags(&lags_);
         pipeline_.use_estimator(&estimator_);
