@@ -283,7 +283,7 @@ private:
         }
         sun_.present[h] = any_sun_coefficient(sun_, h);
         if (!pipeline_.calibrating()) {  // while calibrating, the versions' (follow_version)
-            pipeline_.use_sun_term(any_sun_term() ? &sun_ : nullptr);
+            pipeline_.use_sun_term(any_sun_term(sun_) ? &sun_ : nullptr);
         }
     }
 
@@ -311,15 +311,12 @@ private:
         version_term_.version = pipeline_.version();
         sun_learner_.version_term(heads_where(active->present), version_term_.arcsec);
         version_term_.model = sun_term_from_arcsec<T>(version_term_.arcsec);
-        bool any = false;
-        for (const bool p : version_term_.model.present) {
-            any = any || p;
-        }
-        pipeline_.use_sun_term(any ? &version_term_.model : nullptr);
+        pipeline_.use_sun_term(any_sun_term(version_term_.model) ? &version_term_.model : nullptr);
     }
-    bool any_sun_term() const noexcept {
+    // Whether some head of m has a term (present: keep_present_where_terms or sun_term_from_arcsec).
+    static bool any_sun_term(const SunTermModel<T>& m) noexcept {
         bool any = false;
-        for (const bool p : sun_.present) {
+        for (const bool p : m.present) {
             any = any || p;
         }
         return any;
