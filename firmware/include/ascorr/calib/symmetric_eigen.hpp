@@ -25,7 +25,11 @@ inline constexpr double kJacobiTolerance = 1e-15;
 
 // One Jacobi rotation J(p, q, θ) zeroing a[p][q]: a ← Jᵀ·a·J, v ← v·J
 // (Algorithm 8.5.1: τ = (a_qq − a_pp)/(2·a_pq), t the smaller root of
-// t² + 2τt − 1 = 0, c = 1/√(1 + t²), s = t·c).
+// t² + 2τt − 1 = 0, c = 1/√(1 + t²), s = t·c). a must be symmetric to the
+// bit (jacobi_start makes it so), and stays so: outside the 2 × 2 block,
+// rows p and q of Jᵀ·(a·J) are columns p and q of a·J, whose products they
+// would repeat with the same operands in the same order, so they are copied
+// (a third fewer operations; the same bits as forming them).
 template <std::size_t N>
 void jacobi_rotation(double (&a)[N][N], double (&v)[N][N], std::size_t n, std::size_t p, std::size_t q) noexcept {
     const double apq = a[p][q];
@@ -44,14 +48,22 @@ void jacobi_rotation(double (&a)[N][N], double (&v)[N][N], std::size_t n, std::s
         a[k][p] = c * akp - s * akq;
         a[k][q] = s * akp + c * akq;
     }
-    for (std::size_t k = 0; k < n; ++k) {  // Jᵀ·(a·J): rows p and q
-        const double apk = a[p][k];
-        const double aqk = a[q][k];
-        a[p][k] = c * apk - s * aqk;
-        a[q][k] = s * apk + c * aqk;
-    }
-    a[p][q] = 0.0;  // zero by construction; its rounding is not kept
+    // Jᵀ·(a·J): rows p and q; in the block, from a·J's block (its off-diagonal
+    // pair is zero by construction, its rounding not kept) ...
+    const double app = a[p][p];
+    const double aqp = a[q][p];
+    const double apq1 = a[p][q];
+    const double aqq = a[q][q];
+    a[p][p] = c * app - s * aqp;
+    a[q][q] = s * apq1 + c * aqq;
+    a[p][q] = 0.0;
     a[q][p] = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {  // ... and elsewhere by symmetry
+        if (k != p && k != q) {
+            a[p][k] = a[k][p];
+            a[q][k] = a[k][q];
+        }
+    }
     for (std::size_t k = 0; k < n; ++k) {
         const double vkp = v[k][p];
         const double vkq = v[k][q];
@@ -86,23 +98,30 @@ constexpr int jacobi_max_steps(std::size_t n) noexcept {
     return kMaxJacobiSweeps * static_cast<int>(n > 1U ? n - 1U : 1U) + 1;
 }
 
-// Begins the decomposition of a (n × n of N × N, symmetric): v = I. false
-// when a is not finite or n > N (a and v then left as they are, resp. v the
-// identity).
+// Begins the decomposition of a (n × n of N × N, symmetric: its lower
+// triangle is set from its upper one, a no-op when it is symmetric to the
+// bit, which jacobi_rotation needs): v = I. false when a is not finite or
+// n > N (a and v then left as they are, resp. v the identity).
 template <std::size_t N>
-bool jacobi_start(const double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress) noexcept {
+bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress) noexcept {
     if (n > N) {
         return false;
     }
     double total = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t j = 0; j < n; ++j) {
+            const double x = j < i ? a[j][i] : a[i][j];  // the upper triangle's
             v[i][j] = i == j ? 1.0 : 0.0;
-            total += a[i][j] * a[i][j];
+            total += x * x;
         }
     }
     if (!std::isfinite(total)) {
         return false;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < i; ++j) {
+            a[i][j] = a[j][i];
+        }
     }
     progress = {n, kJacobiTolerance * kJacobiTolerance * total, 0, 0U};
     return true;
