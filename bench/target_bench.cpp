@@ -496,8 +496,10 @@ void bench_lag_search(const char* name, const Fixture<T>& fx, LagSearchFixture<T
 // The Sun term's learner: one fed cycle per take, one idle step per step.
 constexpr std::int64_t kLearnerOrbitUs = calib::EstimatorConfig{}.orbit_period_us;
 constexpr std::uint32_t kLearnerCycles = kLearnerOrbitUs / calib::kSunLearnOnBoardIntervalUs;  // an orbit
-constexpr std::uint32_t kLearnerOrbits = 4;                          // the first closed by the second's first take
-Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the same each orbit
+// The first orbit's solve starts from the identity, the others warm (the
+// one before's basis: sun_moments.hpp), as on board between its cold ones.
+constexpr std::uint32_t kLearnerOrbits = 8;                          // the first closed by the second's first take
+Quaternion<double> g_learner_q[kLearnerCycles][calib::kFrameHeads];  // the orbit's: its own noise
 
 using TakeFn = bool (*)(calib::SunLearner&, std::int64_t, const Quaternion<double> (&)[calib::kFrameHeads]) noexcept;
 using StepFn = bool (*)(calib::SunLearner&) noexcept;
@@ -555,9 +557,10 @@ SolveCost run_solve() {
     return c;
 }
 
-void bench_sun_learner(std::uint32_t ipc) {
-    const combine::Mountings m = bench::combination_mountings();
-    std::uint32_t state = 7U;
+// One orbit's frame heads: the bench turning once about a fixed axis, each
+// head with its own noise (state: the noise generator's, continued from
+// orbit to orbit, so that the sums change as a mission's do).
+void learner_orbit(const combine::Mountings& m, std::uint32_t& state) {
     const double* q0 = g_records[0].q;
     for (std::uint32_t i = 0; i < kLearnerCycles; ++i) {
         const double phase =
@@ -570,27 +573,50 @@ void bench_sun_learner(std::uint32_t ipc) {
             g_learner_q[i][h] = heads[h];
         }
     }
+}
+
+void bench_sun_learner(std::uint32_t ipc) {
+    const combine::Mountings m = bench::combination_mountings();
+    std::uint32_t state = 7U;
     const std::int64_t start_us = 820'000'000'000'000;  // TT µs since J2000: 2026
     const std::int64_t t0_us = start_us - start_us % kLearnerOrbitUs;
     std::uint64_t takes = 0;
-    SolveCost last;
+    SolveCost cold;
+    std::uint64_t warm = 0;  // SysTick counts of the warm solves
+    std::uint32_t warm_steps = 0;
     std::uint32_t worst = 0;
     // Each orbit's first take closes the one before; its solve runs in
     // idle time before the next take (which would otherwise settle it).
     for (std::uint32_t o = 0; o < kLearnerOrbits; ++o) {
+        learner_orbit(m, state);
         const std::int64_t t_us = t0_us + std::int64_t{o} * kLearnerOrbitUs;
         const std::uint32_t first = run_takes_net(t_us, 0U, 1U);
         if (o > 0U) {
-            last = run_solve();  // the orbit closed by this one's first take
-            worst = last.worst > worst ? last.worst : worst;
+            const SolveCost c = run_solve();  // the orbit closed by this one's first take
+            worst = c.worst > worst ? c.worst : worst;
+            cold = o == 1U ? c : cold;
+            warm += o > 1U ? c.total : 0U;
+            warm_steps += o > 1U ? c.steps : 0U;
         }
         const std::uint32_t rest = run_takes_net(t_us, 1U, kLearnerCycles);
         takes += o > 0U ? first + rest : 0U;
     }
     const std::uint64_t n = std::uint64_t{kLearnerCycles} * (kLearnerOrbits - 1U);
+    constexpr std::uint32_t kWarm = kLearnerOrbits - 2U;
+    const std::uint64_t warm_solve = (warm * ipc + kWarm / 2U) / kWarm;
+    const std::uint64_t warm_mean_steps = (warm_steps + kWarm / 2U) / kWarm;
+    // Per orbit on board: of kWarmSolves solves, one from the identity.
+    constexpr std::uint64_t kRun = calib::SunMoments<calib::kFrameHeads>::kWarmSolves;
+    const std::uint64_t per_orbit = (std::uint64_t{cold.total} * ipc + (kRun - 1U) * warm_solve + kRun / 2U) / kRun;
+    const std::uint64_t steps = (cold.steps + (kRun - 1U) * warm_mean_steps + kRun / 2U) / kRun;
     std::printf("bench double sun_learner_take %u\n", static_cast<unsigned>((takes * ipc + n / 2U) / n));
-    std::printf("bench double sun_learner_steps %u\n", static_cast<unsigned>(last.steps));
-    std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(last.total * ipc));
+    std::printf("bench double sun_learner_steps %u\n", static_cast<unsigned>(steps));
+    std::printf("bench double sun_learner_solve %u\n", static_cast<unsigned>(per_orbit));
+    std::printf("bench double sun_learner_cold_solve %u\n", static_cast<unsigned>(cold.total * ipc));
+    std::printf("bench double sun_learner_cold_steps %u\n", static_cast<unsigned>(cold.steps));
+    std::printf("bench double sun_learner_warm_solve %u\n", static_cast<unsigned>(warm_solve));
+    std::printf("bench double sun_learner_warm_steps %u\n", static_cast<unsigned>(warm_mean_steps));
+    std::printf("bench double sun_learner_warm_solves %u\n", static_cast<unsigned>(kRun));
     std::printf("bench double sun_learner_worst_step %u\n", static_cast<unsigned>(worst * ipc));
     std::printf("bench double sun_learner_ram %u\n", static_cast<unsigned>(sizeof(calib::SunLearner)));
     std::printf("bench double sun_learner_interval_us %u\n", static_cast<unsigned>(calib::kSunLearnOnBoardIntervalUs));

@@ -99,6 +99,7 @@ int whole_sweeps(double (&a)[N][N], double (&v)[N][N], std::size_t n) {
         }
     }
     const double bound = calib::kJacobiTolerance * calib::kJacobiTolerance * total;
+    const double skip = bound / static_cast<double>(n * n);  // the threshold's (jacobi_row)
     for (int sweep = 0; sweep < calib::kMaxJacobiSweeps; ++sweep) {
         double off = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
@@ -111,7 +112,9 @@ int whole_sweeps(double (&a)[N][N], double (&v)[N][N], std::size_t n) {
         }
         for (std::size_t p = 0; p + 1U < n; ++p) {
             for (std::size_t q = p + 1U; q < n; ++q) {
-                calib::jacobi_rotation(a, v, n, p, q);
+                if (a[p][q] * a[p][q] > skip) {
+                    calib::jacobi_rotation(a, v, n, p, q);
+                }
             }
         }
     }
@@ -143,6 +146,72 @@ TEST(SymmetricEigen, ItsStepsGiveTheBitsOfTheWholeSweeps) {
         }
     }
     EXPECT_EQ(compared, 15);
+}
+
+// The warm start (jacobi_to_basis, jacobi_resume): a matrix near one
+// decomposed, begun in that decomposition's basis, decomposes as Eigen does,
+// in fewer sweeps than from the identity, whatever the lines per step.
+TEST(SymmetricEigen, FromAnEarlierBasisItDecomposesInFewerSweeps) {
+    std::mt19937_64 rng(9);
+    std::normal_distribution<double> g(0.0, 1.0);
+    constexpr std::size_t n = 27;
+    static double a0[kMax][kMax];
+    static double a[kMax][kMax];
+    static double v[kMax][kMax];
+    static double cold_v[kMax][kMax];
+    Eigen::MatrixXd m(n, n);
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j <= i; ++j) {
+            a0[i][j] = a0[j][i] = g(rng);
+        }
+    }
+    std::memcpy(a, a0, sizeof a);
+    ASSERT_GE(calib::symmetric_eigen(a, v, n), 0);
+    for (std::size_t i = 0; i < n; ++i) {  // the next orbit's: 0.3 % more
+        for (std::size_t j = 0; j <= i; ++j) {
+            a0[i][j] = a0[j][i] = a0[i][j] + 3e-3 * g(rng);
+            m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = a0[i][j];
+            m(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) = a0[i][j];
+        }
+    }
+    std::memcpy(a, a0, sizeof a);
+    const int cold = calib::symmetric_eigen(a, cold_v, n);
+    for (std::size_t lines : {std::size_t{1}, std::size_t{8}, std::size_t{54}}) {
+        static double w[kMax][kMax];
+        static double wv[kMax][kMax];
+        std::memcpy(w, a0, sizeof w);
+        std::memcpy(wv, v, sizeof wv);
+        std::size_t line = 0;
+        int calls = 0;
+        while (!calib::jacobi_to_basis(w, wv, n, line, lines)) {
+            ++calls;
+        }
+        EXPECT_EQ(calls + 1, static_cast<int>((2 * n + lines - 1) / lines)) << lines;
+        calib::JacobiProgress progress;
+        ASSERT_TRUE(calib::jacobi_resume(w, wv, n, progress));
+        calib::JacobiStep s = calib::JacobiStep::kRunning;
+        for (int i = 0; i < calib::jacobi_max_steps(n) && s == calib::JacobiStep::kRunning; ++i) {
+            s = calib::jacobi_row(w, wv, progress);
+        }
+        ASSERT_EQ(s, calib::JacobiStep::kConverged);
+        EXPECT_LT(progress.sweep, cold) << "the warm start must save sweeps: " << progress.sweep << " of " << cold;
+        Eigen::MatrixXd vm(n, n);
+        Eigen::VectorXd lambda(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            lambda(static_cast<Eigen::Index>(i)) = w[i][i];
+            for (std::size_t j = 0; j < n; ++j) {
+                vm(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = wv[i][j];
+            }
+        }
+        const double scale = m.norm();
+        EXPECT_LT((vm * lambda.asDiagonal() * vm.transpose() - m).norm(), 1e-13 * scale) << lines;
+        EXPECT_LT((vm.transpose() * vm - Eigen::MatrixXd::Identity(n, n)).norm(), 1e-13 * 27.0) << lines;
+        std::sort(lambda.data(), lambda.data() + n);
+        const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> reference(m);
+        EXPECT_LT((lambda - reference.eigenvalues()).norm(), 1e-13 * scale) << lines;
+        RecordProperty("sweeps_cold", cold);
+        RecordProperty("sweeps_warm", progress.sweep);
+    }
 }
 
 TEST(SymmetricEigen, RefusesWhatIsNotFiniteOrTooLarge) {
@@ -469,6 +538,69 @@ TEST(SunLearner, CyclesWhereTheSunIsNotKnownAreCountedNotLearnt) {
     EXPECT_EQ(r.not_finite, 1U);
     EXPECT_EQ(r.orbits, 0U);
     EXPECT_EQ(learner.taken(), nullptr);
+}
+
+// The learner's warm start (solve_step with its Solve kept from one solve
+// to the next, as SunLearner keeps it): each fit the ground's cold solve()
+// of the same sums to rounding, the same rank, in fewer steps; every
+// kWarmSolves-th from the identity, with the cold one's bits.
+TEST(SunMoments, AWarmStartSolvesAsTheColdOneInFewerSteps) {
+    using Moments = calib::SunMoments<3>;
+    constexpr std::size_t kOrbits = 70;
+    static_assert(kOrbits > Moments::kWarmSolves, "a cold restart is in the run");
+    const Synthetic d = synthetic(kOrbits, 40, 13);
+    Moments m = three_heads();
+    static Moments::Solve kept;  // 12 KiB
+    static Moments::Solve fresh;
+    const auto run = [&m](Moments::Solve& w) {
+        int n = 0;
+        calib::SunSolveStep r = calib::SunSolveStep::kRunning;
+        for (; r == calib::SunSolveStep::kRunning && n < Moments::kMaxSolveSteps; ++n) {
+            r = m.solve_step(w, calib::SunRule{});
+        }
+        EXPECT_EQ(r, calib::SunSolveStep::kSolved);
+        return n;
+    };
+    long warm_steps = 0;
+    long cold_steps = 0;
+    double worst = 0.0;
+    std::size_t k = 0;
+    for (std::size_t o = 0; o < kOrbits; ++o) {
+        for (; k < d.q.size() && d.orbit[k] == static_cast<int>(o); ++k) {
+            ASSERT_TRUE(m.add(d.q[k].data(), d.s[k])) << k;
+        }
+        m.close_orbit(0.998);  // the on-board memory's forgetting: 30 days of 94-min orbits
+        const int nw = run(kept);
+        fresh = Moments::Solve{};
+        const int nc = run(fresh);
+        ASSERT_EQ(kept.fit.rank, fresh.fit.rank) << o;
+        if (o % Moments::kWarmSolves == 0U) {  // from the identity: the cold solve's bits
+            EXPECT_EQ(nw, nc) << o;
+            EXPECT_EQ(std::memcmp(kept.fit.sun, fresh.fit.sun, sizeof kept.fit.sun), 0) << o;
+            continue;
+        }
+        warm_steps += nw;
+        cold_steps += nc;
+        double largest = 0.0;
+        double diff = 0.0;
+        for (std::size_t h = 0; h < 3; ++h) {
+            for (std::size_t a = 0; a < 3; ++a) {
+                for (std::size_t c = 0; c < 3; ++c) {
+                    largest = std::max(largest, std::fabs(fresh.fit.sun[h][a][c]));
+                    diff = std::max(diff, std::fabs(kept.fit.sun[h][a][c] - fresh.fit.sun[h][a][c]));
+                }
+            }
+        }
+        ASSERT_GT(largest, 0.0) << o;
+        worst = std::max(worst, diff / largest);
+    }
+    EXPECT_LT(worst, 1e-10) << "the warm fit is the cold one to rounding";
+    // Steps are rows of sweeps (a warm sweep's rows skip most rotations:
+    // fewer instructions still, target_bench.cpp); 61 % here, 100 % cold.
+    EXPECT_LT(warm_steps * 10, cold_steps * 7) << warm_steps << " steps warm, " << cold_steps << " cold";
+    RecordProperty("warm_steps", std::to_string(warm_steps));
+    RecordProperty("cold_steps", std::to_string(cold_steps));
+    RecordProperty("worst_relative_difference", std::to_string(worst));
 }
 
 TEST(SunMoments, NothingToSolveIsNoTerm) {

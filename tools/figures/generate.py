@@ -233,8 +233,12 @@ def side_learners_section(d):
         ["… per 22 Hz cycle, one taken per interval"] +
         [f"{per_cycle(t, e[t]['per_take'] / (22 * e[t]['interval_us'] * 1e-6))}, {e[t]['interval_us'] / 1e6:g} s"
          for t in ts],
-        ["its solve per orbit (idle time)"] +
+        ["its solve per orbit (idle time; of every " + str(e[ts[0]].get("warm_solves", 1)) +
+         ", one from the identity, the others from the last basis)"] +
         [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps ({e[t]['orbit_s']} s orbit)" for t in ts],
+        ["… from the identity / from the last basis (the bench's mean)"] +
+        [f"{num(e[t]['cold_solve'])} in {e[t]['cold_steps']} / {num(e[t]['warm_solve'])} in {e[t]['warm_steps']}"
+         if "cold_solve" in e[t] else "—" for t in ts],
         ["… per 22 Hz cycle"] + [per_cycle(t, e[t]["per_orbit"] / (22 * e[t]["orbit_s"])) for t in ts],
         ["its worst idle step"] + [num(e[t]["worst_step"]) + period_share(d, t, e[t]["worst_step"]) for t in ts],
         ["RAM: the lag search, the Sun-term learner (`sizeof`)"] +

@@ -577,7 +577,7 @@ private:
     ModelCoefficients staged_{};
     // The Sun term learnt beside it (kCalibStart's sun_term), and the term
     // of the model version the epochs use (follow_version). Its solve's
-    // steps per SOLUTION_IN: each at most ~0.95 million instructions
+    // steps per SOLUTION_IN: each at most ~0.72 million instructions
     // (docs/figures.md, "The side learners").
     static constexpr int kSunStepsPerSolution = 8;
     static_assert(std::is_trivially_destructible_v<calib::SunLearner>, "restarted in place");

@@ -58,8 +58,10 @@
 // report().late). Per orbit closed (step):
 // the normal equations (27 × 27) and their Jacobi eigen-decomposition
 // (symmetric_eigen.hpp, at most 30 sweeps), a bounded step per call (the
-// normal equations, one row of a sweep, or the result), in the learner's own
-// 12 KiB workspace (SunMoments::Solve), not on the stack. Measured on the
+// normal equations, 8 lines of the change to the last solve's basis, one row
+// of a sweep, or the result), in the learner's own 12 KiB workspace
+// (SunMoments::Solve, kept from solve to solve: each begins in the last
+// one's eigenvectors, every 64th from the identity), not on the stack. Measured on the
 // targets by bench/target_bench.cpp (docs/figures.md, "The side
 // learners").
 // No allocation, every loop bounded.

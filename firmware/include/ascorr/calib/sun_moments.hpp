@@ -124,7 +124,7 @@ inline SunTermModel<double> sun_term_model(const SunTermFit& f) noexcept {
 // A solve in steps (SunMoments::solve_step): what a step did, and where the
 // next begins.
 enum class SunSolveStep : unsigned char { kRunning, kSolved, kFailed };
-enum class SunSolvePhase : unsigned char { kForm, kEigen, kResult };
+enum class SunSolvePhase : unsigned char { kForm, kBasis, kEigen, kResult };
 
 // H: the most heads (3 on board: A, B, C; kMaxHeads on the ground).
 template <std::size_t H>
@@ -228,10 +228,23 @@ public:
         JacobiProgress jacobi;
         SunSolvePhase phase = SunSolvePhase::kForm;
         SunTermFit fit;  // the result (fit.solved), once solve_step has returned kSolved
+        // The warm start (solve_step): vectors hold a converged decomposition
+        // of order basis_n, reached in `warm` warm starts from the identity.
+        bool basis = false;
+        std::size_t basis_n = 0U;
+        int warm = 0;
+        std::size_t basis_line = 0U;  // jacobi_to_basis's progress
     };
-    // The most solve_step() calls of one solve: forming, the eigen-decomposition a
-    // row per step, the result.
-    static constexpr int kMaxSolveSteps = 2 + jacobi_max_steps(kUnknowns);
+    // Of kWarmSolves solves in a row, the first starts from the identity:
+    // what each warm start adds to V's rounding (a few ulps) stays bounded.
+    static constexpr int kWarmSolves = 64;
+    // Lines of the basis change per step: the cost of a sweep's row or less.
+    static constexpr std::size_t kBasisLinesPerStep = 8U;
+    // The most solve_step() calls of one solve: forming, the basis change,
+    // the eigen-decomposition a row per step, the result.
+    static constexpr int kMaxSolveSteps =
+        2 + static_cast<int>((2U * kUnknowns + kBasisLinesPerStep - 1U) / kBasisLinesPerStep) +
+        jacobi_max_steps(kUnknowns);
 
     // The fit over the orbits closed (above); false (out.solved) when there is none,
     // or the equations are not finite, or the rule's weights are singular.
@@ -252,11 +265,22 @@ public:
     // decomposition's does one row of a Jacobi sweep (at most n − 1
     // rotations, n = 3·3H); the last forms the fit (w.fit) under the rule. At most
     // kMaxSolveSteps; then kSolved or kFailed, and w.phase is kForm again.
+    // Warm start: where w holds the last solve's converged eigenvectors (a
+    // learner's own Solve, solve after solve: sun_learner.hpp), the
+    // decomposition begins in their basis (symmetric_eigen.hpp,
+    // jacobi_to_basis, kBasisLinesPerStep lines a step): the sums move
+    // little from one orbit to the next, so it needs fewer sweeps (the same
+    // eigen-directions and rank; the fit to rounding). A fresh Solve (the
+    // ground fit's solve()) starts from the identity, as does every
+    // kWarmSolves-th.
     SunSolveStep solve_step(Solve& w, const SunRule& rule) const noexcept {
         SunSolveStep s = SunSolveStep::kRunning;
         switch (w.phase) {
             case SunSolvePhase::kForm:
                 s = form(w);
+                break;
+            case SunSolvePhase::kBasis:
+                s = basis_lines(w);
                 break;
             case SunSolvePhase::kEigen:
                 s = eigen_row(w);
@@ -312,7 +336,28 @@ private:
                 }
             }
         }
+        const bool warm = w.basis && w.basis_n == 3 * n && w.warm + 1 < kWarmSolves;
+        w.basis = false;  // until this decomposition converges (eigen_row)
+        if (warm) {
+            ++w.warm;
+            w.basis_line = 0U;
+            w.phase = SunSolvePhase::kBasis;
+            return SunSolveStep::kRunning;
+        }
+        w.warm = 0;
         if (!jacobi_start(w.normal, w.vectors, 3 * n, w.jacobi)) {
+            return SunSolveStep::kFailed;
+        }
+        w.phase = SunSolvePhase::kEigen;
+        return SunSolveStep::kRunning;
+    }
+
+    // The warm start's basis change, kBasisLinesPerStep lines; then the sweeps.
+    static SunSolveStep basis_lines(Solve& w) noexcept {
+        if (!jacobi_to_basis(w.normal, w.vectors, w.basis_n, w.basis_line, kBasisLinesPerStep)) {
+            return SunSolveStep::kRunning;
+        }
+        if (!jacobi_resume(w.normal, w.vectors, w.basis_n, w.jacobi)) {
             return SunSolveStep::kFailed;
         }
         w.phase = SunSolvePhase::kEigen;
@@ -324,6 +369,8 @@ private:
             case JacobiStep::kRunning:
                 return SunSolveStep::kRunning;
             case JacobiStep::kConverged:
+                w.basis = true;
+                w.basis_n = w.jacobi.n;
                 w.phase = SunSolvePhase::kResult;
                 return SunSolveStep::kRunning;
             case JacobiStep::kNotConverged:

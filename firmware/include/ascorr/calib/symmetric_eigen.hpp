@@ -9,9 +9,10 @@
 // portable_math.hpp's reason), keeps small eigenvalues to a relative accuracy
 // the rank decision needs, and its loops have fixed bounds.
 // Convergence: quadratic once the off-diagonal part is small; 6 to 12 sweeps
-// for these sizes in double (11 for the learner's 27 × 27 on the target
-// bench). The sweeps stop when the off-diagonal Frobenius norm is ≤
-// kJacobiTolerance of the matrix's, or after kMaxJacobiSweeps.
+// for these sizes in double (10 to 12 for the learner's 27 × 27 from the
+// identity, mostly 5 to 7 from the last orbit's basis: jacobi_to_basis). The sweeps
+// stop when the off-diagonal Frobenius norm is ≤ kJacobiTolerance of the
+// matrix's, or after kMaxJacobiSweeps.
 // Double only; no allocation, no recursion.
 #pragma once
 
@@ -82,6 +83,7 @@ struct JacobiProgress {
     double bound = 0.0;   // the off-diagonal sum of squares that ends the sweeps
     int sweep = 0;        // sweeps done
     std::size_t row = 0;  // the next row p of the current sweep
+    double skip = 0.0;    // a_pq² at or below this is not rotated: bound / n²
 };
 
 enum class JacobiStep : unsigned char {
@@ -100,10 +102,12 @@ constexpr int jacobi_max_steps(std::size_t n) noexcept {
 
 // Begins the decomposition of a (n × n of N × N, symmetric: its lower
 // triangle is set from its upper one, a no-op when it is symmetric to the
-// bit, which jacobi_rotation needs): v = I. false when a is not finite or
-// n > N (a and v then left as they are, resp. v the identity).
+// bit, which jacobi_rotation needs): v = I, or with `keep_vectors` v as it
+// is (jacobi_resume). false when a is not finite or n > N (a and v then left
+// as they are, resp. v the identity).
 template <std::size_t N>
-bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress) noexcept {
+bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress,
+                  bool keep_vectors = false) noexcept {
     if (n > N) {
         return false;
     }
@@ -111,7 +115,7 @@ bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiPro
     for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t j = 0; j < n; ++j) {
             const double x = j < i ? a[j][i] : a[i][j];  // the upper triangle's
-            v[i][j] = i == j ? 1.0 : 0.0;
+            v[i][j] = keep_vectors ? v[i][j] : (i == j ? 1.0 : 0.0);
             total += x * x;
         }
     }
@@ -123,12 +127,74 @@ bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiPro
             a[i][j] = a[j][i];
         }
     }
-    progress = {n, kJacobiTolerance * kJacobiTolerance * total, 0, 0U};
+    const double bound = kJacobiTolerance * kJacobiTolerance * total;
+    progress = {n, bound, 0, 0U, bound / static_cast<double>(n * n)};
     return true;
 }
 
+// ---- From a known basis (the Sun learner's warm start, sun_moments.hpp)
+//
+// A matrix near one already decomposed, a ≈ V·Λ·Vᵀ, is nearly diagonal in
+// V's basis: with a ← Vᵀ·a·V first and v = V, the sweeps begin from a small
+// off-diagonal part, where cyclic Jacobi converges quadratically (Golub & Van
+// Loan §8.5.5), and v ends as the eigenvectors of the original a (V·J·J…),
+// its diagonal as their eigenvalues. V: the columns of an earlier
+// decomposition's v, orthonormal to double's rounding (each rotation keeps
+// them so to a few ulps; the caller bounds how many decompositions follow
+// one from the identity).
+
+// The basis change in bounded steps: `lines` more of its 2n lines per call
+// (line < n: row `line` of a·V; then column line − n of Vᵀ·(a·V), its upper
+// triangle), each n or fewer sums of n products, in place with one line's
+// temporary. true once all 2n are done (a's lower triangle is then left to
+// jacobi_resume, which mirrors the upper); `line` holds where it is.
+template <std::size_t N>
+bool jacobi_to_basis(double (&a)[N][N], const double (&v)[N][N], std::size_t n, std::size_t& line,
+                     std::size_t lines) noexcept {
+    for (std::size_t k = 0; k < lines && line < 2U * n && n <= N; ++k, ++line) {
+        double t[N];
+        if (line < n) {  // a row of a·V needs only that row of a
+            const std::size_t i = line;
+            for (std::size_t j = 0; j < n; ++j) {
+                double x = 0.0;
+                for (std::size_t l = 0; l < n; ++l) {
+                    x += a[i][l] * v[l][j];
+                }
+                t[j] = x;
+            }
+            for (std::size_t j = 0; j < n; ++j) {
+                a[i][j] = t[j];
+            }
+        } else {  // a column of Vᵀ·(a·V) needs only that column of a·V
+            const std::size_t j = line - n;
+            for (std::size_t i = 0; i <= j; ++i) {
+                double x = 0.0;
+                for (std::size_t l = 0; l < n; ++l) {
+                    x += v[l][i] * a[l][j];
+                }
+                t[i] = x;
+            }
+            for (std::size_t i = 0; i <= j; ++i) {
+                a[i][j] = t[i];
+            }
+        }
+    }
+    return line >= 2U * n;
+}
+
+// The sweeps after jacobi_to_basis: as jacobi_start, with v = V kept.
+template <std::size_t N>
+bool jacobi_resume(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiProgress& progress) noexcept {
+    return jacobi_start(a, v, n, progress, true);
+}
+
 // The next row of the current sweep (progress from jacobi_start): its
-// rotations J(row, q) for q > row.
+// rotations J(row, q) for q > row, but for those whose a_pq² is at or below
+// progress.skip (a threshold as Rutishauser's, Numer. Math. 9:1, 1966): the
+// n(n − 1) off-diagonal entries all that small sum to less than the bound,
+// so a skipped one never keeps the sweeps from ending, and the rotations
+// late sweeps spend on what is already negligible are not done (a warm
+// start's sweeps are mostly such).
 template <std::size_t N>
 JacobiStep jacobi_row(double (&a)[N][N], double (&v)[N][N], JacobiProgress& progress) noexcept {
     const std::size_t n = progress.n;
@@ -148,7 +214,9 @@ JacobiStep jacobi_row(double (&a)[N][N], double (&v)[N][N], JacobiProgress& prog
     }
     const std::size_t p = progress.row;
     for (std::size_t q = p + 1U; q < n; ++q) {
-        jacobi_rotation(a, v, n, p, q);
+        if (a[p][q] * a[p][q] > progress.skip) {
+            jacobi_rotation(a, v, n, p, q);
+        }
     }
     if (p + 2U < n) {
         ++progress.row;
