@@ -87,8 +87,8 @@ TEST(SymmetricEigen, ReconstructsAndMatchesEigenOnRandomMatrices) {
 }
 
 // The whole sweeps as symmetric_eigen() ran them before its steps
-// (jacobi_start, jacobi_row), copied from it: the steps must give its bits,
-// so that the ground fit and the learner's candidates did not move.
+// (jacobi_start, jacobi_row), copied from it, with its threshold: the steps
+// must give its bits.
 template <std::size_t N>
 int whole_sweeps(double (&a)[N][N], double (&v)[N][N], std::size_t n) {
     double total = 0.0;
@@ -146,6 +146,75 @@ TEST(SymmetricEigen, ItsStepsGiveTheBitsOfTheWholeSweeps) {
         }
     }
     EXPECT_EQ(compared, 15);
+}
+
+// The rotation as it was before it copied rows p and q (both passes formed
+// in full), the test's own: on a symmetric matrix the copy gives its bits.
+template <std::size_t N>
+void two_pass_rotation(double (&a)[N][N], double (&v)[N][N], std::size_t n, std::size_t p, std::size_t q) {
+    const double apq = a[p][q];
+    if (apq == 0.0) {
+        return;
+    }
+    const double tau = (a[q][q] - a[p][p]) / (2.0 * apq);
+    const double t =
+        std::fabs(tau) > 1e150 ? 0.5 / tau : (tau >= 0.0 ? 1.0 : -1.0) / (std::fabs(tau) + std::sqrt(1.0 + tau * tau));
+    const double c = 1.0 / std::sqrt(1.0 + t * t);
+    const double s = t * c;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double akp = a[k][p];
+        const double akq = a[k][q];
+        a[k][p] = c * akp - s * akq;
+        a[k][q] = s * akp + c * akq;
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        const double apk = a[p][k];
+        const double aqk = a[q][k];
+        a[p][k] = c * apk - s * aqk;
+        a[q][k] = s * apk + c * aqk;
+    }
+    a[p][q] = 0.0;
+    a[q][p] = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double vkp = v[k][p];
+        const double vkq = v[k][q];
+        v[k][p] = c * vkp - s * vkq;
+        v[k][q] = s * vkp + c * vkq;
+    }
+}
+
+TEST(SymmetricEigen, ItsRotationGivesTheTwoPassFormsBits) {
+    std::mt19937_64 rng(10);
+    std::normal_distribution<double> g(0.0, 1.0);
+    int rotations = 0;
+    for (std::size_t n : {std::size_t{2}, std::size_t{9}, std::size_t{27}, std::size_t{36}}) {
+        static double a[kMax][kMax];
+        static double b[kMax][kMax];
+        static double va[kMax][kMax];
+        static double vb[kMax][kMax];
+        for (std::size_t i = 0; i < kMax; ++i) {
+            for (std::size_t j = 0; j <= i; ++j) {
+                a[i][j] = a[j][i] = std::ldexp(g(rng), static_cast<int>((i + j) % 7) - 3);  // graded
+            }
+            for (std::size_t j = 0; j < kMax; ++j) {
+                va[i][j] = i == j ? 1.0 : 0.0;
+            }
+        }
+        std::memcpy(b, a, sizeof a);
+        std::memcpy(vb, va, sizeof va);
+        for (int sweep = 0; sweep < 6; ++sweep) {
+            for (std::size_t p = 0; p + 1U < n; ++p) {
+                for (std::size_t q = p + 1U; q < n; ++q) {
+                    calib::jacobi_rotation(a, va, n, p, q);
+                    two_pass_rotation(b, vb, n, p, q);
+                    ++rotations;
+                }
+            }
+        }
+        EXPECT_EQ(std::memcmp(a, b, sizeof a), 0) << n;
+        EXPECT_EQ(std::memcmp(va, vb, sizeof va), 0) << n;
+    }
+    EXPECT_GT(rotations, 0);
 }
 
 // The warm start (jacobi_to_basis, jacobi_resume): a matrix near one

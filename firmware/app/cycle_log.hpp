@@ -16,6 +16,7 @@
 
 #include "app_scalar.hpp"
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/sun_learner.hpp"
 #include "ascorr/core/correct.hpp"
 #include "ascorr/core/status.hpp"
 #include "ascorr_link/crc32c.hpp"
@@ -159,6 +160,49 @@ private:
     CorrectedSolution<Scalar> samples_[kMaxSamples][kRecords]{};
     std::uint32_t samples_taken_ = 0U;
 };
+
+// The Sun learner's candidate (its coefficients' bits, arcsec by head, axis
+// and component, little-endian doubles) as one CRC-32C: what the loop's
+// report and the host's prediction of it compare.
+inline std::uint32_t sun_fit_crc(const calib::SunTermFit& f) noexcept {
+    std::uint32_t crc = 0U;
+    for (const auto& head : f.sun) {
+        for (const auto& axis : head) {
+            for (const double c : axis) {
+                std::uint64_t b = 0U;
+                std::memcpy(&b, &c, sizeof b);
+                std::uint8_t bytes[8];
+                for (std::uint32_t i = 0; i < 8U; ++i) {
+                    bytes[i] = static_cast<std::uint8_t>(b >> (8U * i));
+                }
+                crc = link::crc32c(bytes, 8U, crc);
+            }
+        }
+    }
+    return crc;
+}
+
+// "sun learner: cycles C orbits O thinned T candidate orbits K rank R taken X
+// crc32c Z": the learner's state as the loop reports it, the line its host
+// prediction checks (tests/target/flight_expectation.cpp).
+inline void print_sun_learner_state(const calib::SunLearnReport& r) noexcept {
+    using namespace report;
+    text("sun learner: cycles ");
+    u32(static_cast<std::uint32_t>(r.cycles));
+    text(" orbits ");
+    u32(r.orbits);
+    text(" thinned ");
+    u32(static_cast<std::uint32_t>(r.thinned));
+    text(" candidate orbits ");
+    u32(r.candidate.orbits);
+    text(" rank ");
+    u32(static_cast<std::uint32_t>(r.candidate.rank));
+    text(" taken ");
+    u32(r.taken ? 1U : 0U);
+    text(" crc32c ");
+    hex32(sun_fit_crc(r.candidate));
+    text("\n");
+}
 
 // The models the estimator made active, in turn (the first kMaxModels): the
 // cycle from which each was used, its version and CRC-32C (model_identity.hpp)

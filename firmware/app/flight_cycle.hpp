@@ -21,10 +21,23 @@
 // of the estimator's per-orbit update runs (idle()). Times are TT µs
 // (integers: no time in the scalar). Every loop has a fixed trip count.
 //
+// The Sun term (calib/sun_learner.hpp, sun_learner_entry.hpp): at each cycle
+// that fed the estimator, the learner takes the frame heads as the
+// polynomial corrected them (one per kSunLearnOnBoardIntervalUs; in the
+// accelerated time of a test run every fed cycle is further apart); each
+// model version takes the term the learner has taken when it becomes active
+// (pipeline/version_sun_term.hpp), applied after the feed (sun_entry.hpp's
+// core; none until the learner takes a term: it decides after its memory's
+// orbits, at least 30 days). The learner's per-orbit solve runs in the
+// period's idle time after the cycle (learn_in_idle), a step while the Meter
+// says there is room; what is left runs at its next take (settle), so the
+// host, which runs it all at once, learns the same bits.
+//
 // The cost of each part is measured by the caller's Meter (main.cpp: SysTick
 // counts; the host: NoMeter), which sees the work but never changes it:
 //   std::uint32_t now() noexcept;                    a time stamp
 //   void add(Part part, std::uint32_t start) noexcept;  the part just done since `start`
+//   bool idle_room() noexcept;                       the period has room for an idle step
 //
 // The loop's record of its solutions and models: cycle_log.hpp.
 #pragma once
@@ -38,6 +51,7 @@
 #include "ascorr/nav/velocity_service.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
+#include "ascorr/pipeline/version_sun_term.hpp"
 #include "calib_entry.hpp"
 #include "combine_entry.hpp"
 #include "core_entry.hpp"
@@ -47,6 +61,8 @@
 #include "gnss_feed.hpp"
 #include "loop_rate.hpp"
 #include "recorded_orbit.hpp"
+#include "sun_entry.hpp"
+#include "sun_learner_entry.hpp"
 #include "temperature_source.hpp"
 #include "velocity_entry.hpp"
 
@@ -78,11 +94,14 @@ enum class Part : std::uint8_t {
     kCalibCycle,  // the estimator's per-cycle part: the cycle's model, the feed (calib_entry.hpp)
     kCalibStep,   // one step() of the estimator's per-orbit update, in idle time
     kCombine,     // the combined attitude of the cycle's heads (combine_entry.hpp)
+    kSunTake,     // the Sun learner's take of a fed cycle (its settle included)
+    kSunStep,     // one step of the Sun learner's per-orbit solve, in idle time
 };
 
 struct NoMeter {
     std::uint32_t now() noexcept { return 0U; }
     void add(Part /*part*/, std::uint32_t /*start*/) noexcept {}
+    bool idle_room() noexcept { return true; }  // the host: every step at once
 };
 
 // The pipeline's calls: the image's out-of-line entries (core_entry.hpp,
@@ -94,6 +113,10 @@ struct EntryCalls {
     static CorrectedSolution<Scalar> correct(const SolutionInput<Scalar>& in,
                                              const CorrectionConfig<Scalar>& cfg) noexcept {
         return app::correct(in, cfg);
+    }
+    static CorrectedSolution<Scalar> correct(const SolutionInput<Scalar>& in, const CorrectionConfig<Scalar>& cfg,
+                                             const SunTermInput<Scalar>& sun) noexcept {
+        return app::correct(in, cfg, sun);
     }
     static bool feed(FlightEstimator<Scalar>& e, std::int64_t t_us, const ThermalModel<Scalar>* model,
                      const CorrectedSolution<Scalar>* corrected, const HeadTemperatures<Scalar>* const* temperatures,
@@ -192,6 +215,8 @@ public:
     void correct_heads(std::uint32_t cycle, Meter& meter) noexcept {
         StageMeter<Meter> stages{meter};
         const ThermalModel<Scalar>* model = pipeline_.begin(calib_time_us(cycle), stages);
+        version_sun_.follow(sun_learner_, estimator_.active_coefficients(), pipeline_);
+        const std::uint32_t feeds = pipeline_.feeds();
         for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
             const TtTime t = solution_time(cycle, h);
             const std::uint32_t start = meter.now();
@@ -205,6 +230,9 @@ public:
                 in, [&] { return pipeline::from_service(velocity_query(service_, t)); }, true, true, stages);
         }
         combined_ = pipeline_.close(stages);
+        if (pipeline_.feeds() != feeds) {
+            take_sun(cycle, meter);
+        }
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
             model_ = model;
             if (model != nullptr) {
@@ -222,6 +250,20 @@ public:
         (void)pipeline_.idle(stages);
     }
 
+    // The Sun learner's solve in the period's idle time after the cycle: a
+    // step while the meter has room (at most two solves' steps: the one
+    // under way and one pending).
+    template <typename Meter>
+    void learn_in_idle(Meter& meter) noexcept {
+        for (int i = 0; i < 2 * calib::SunLearner::kMaxSolveSteps && meter.idle_room(); ++i) {
+            const std::uint32_t start = meter.now();
+            if (!sun_learner_step(sun_learner_)) {
+                return;
+            }
+            meter.add(Part::kSunStep, start);
+        }
+    }
+
     // The cycle's combined attitude of the bench (kBenchMountings).
     const combine::CombinedAttitude<Scalar>& combined() const noexcept { return combined_; }
     const CorrectedSolution<Scalar>& corrected(std::uint8_t head) const noexcept {
@@ -233,8 +275,23 @@ public:
     const CorrectionLog& record() const noexcept { return record_; }
     const FlightEstimator<Scalar>& estimator() const noexcept { return estimator_; }
     const ModelHistory& history() const noexcept { return history_; }
+    const calib::SunLearner& sun_learner() const noexcept { return sun_learner_; }
 
 private:
+    // A fed cycle's frame heads into the Sun learner (as the link server's:
+    // with a model, the estimator not frozen).
+    template <typename Meter>
+    void take_sun(std::uint32_t cycle, Meter& meter) noexcept {
+        Quaternion<double> q[calib::kFrameHeads];
+        if (pipeline_.model() == nullptr || estimator_.frozen() ||
+            !calib::SunLearner::frame_heads_of(pipeline_.kept_solutions(), q)) {
+            return;
+        }
+        const std::uint32_t start = meter.now();
+        (void)sun_learner_take(sun_learner_, calib_time_us(cycle), q);
+        meter.add(Part::kSunTake, start);
+    }
+
     VelocityService<Scalar> service_{kServiceConfig};
     GnssFeed gnss_;
     CorrectedSolution<Scalar> corrected_[kMaxHeads]{};  // latest corrected solution per head
@@ -251,6 +308,10 @@ private:
     combine::CombinedAttitude<Scalar> combined_{};
     const ThermalModel<Scalar>* model_ = nullptr;  // the last cycle's
     ModelHistory history_;
+    // The Sun term's learner, under the estimator's rule for the common
+    // rotation, and the term of the version the cycles use.
+    calib::SunLearner sun_learner_{calib_config(), calib::kSunLearnOnBoardIntervalUs};
+    pipeline::VersionSunTerm<Scalar> version_sun_{};
 };
 
 template <typename Meter>

@@ -39,6 +39,10 @@ constexpr std::uint32_t kPeriod = board::kCoreClockHz / kRateHz;  // 1136363 < 2
 constexpr std::uint32_t kCycles = ASCORR_APP_CYCLES;
 
 volatile std::uint32_t g_ticks = 0U;
+std::uint32_t g_cycle_tick = 0U;  // g_ticks when the current cycle began
+// Idle steps (the Sun learner's solve) run while more than this is left of
+// the period: an eighth, some 8 of its worst steps (docs/figures.md).
+constexpr std::uint32_t kIdleReserve = kPeriod / 8U;
 
 FlightCycle g_flight;  // the service, the GNSS feed, the solutions and their record (flight_cycle.hpp)
 
@@ -61,6 +65,8 @@ struct VelocityCosts {
     Cost calib_cycle;  // the estimator's per-cycle part (two calls per cycle: the model, the feed)
     Cost calib_step;   // one step() of the estimator's per-orbit update (idle time)
     Cost combine;      // the cycle's combined attitude (combine_entry.hpp)
+    Cost sun_take;     // the Sun learner's take of a fed cycle (its settle included)
+    Cost sun_step;     // one step of the Sun learner's solve (idle time)
 };
 VelocityCosts g_costs{};
 
@@ -98,8 +104,17 @@ struct SysTickMeter {
             case Part::kCombine:
                 g_costs.combine.add(c);
                 break;
+            case Part::kSunTake:
+                g_costs.sun_take.add(c);
+                break;
+            case Part::kSunStep:
+                g_costs.sun_step.add(c);
+                break;
         }
     }
+    // Room for an idle step: the cycle's tick is the current one, and more
+    // than kIdleReserve counts are left before the next (SysTick counts down).
+    bool idle_room() noexcept { return g_ticks == g_cycle_tick && board::systick_value() > kIdleReserve; }
 };
 SysTickMeter g_meter;
 
@@ -231,6 +246,23 @@ void print_combination() noexcept {
     text(" bytes\n");
 }
 
+// The Sun-term learner in the loop: what it took and solved (the line the
+// host's prediction checks: "sun learner: ..."), then its costs and RAM.
+void print_sun_learner() noexcept {
+    using namespace report;
+    const calib::SunLearnReport r = g_flight.sun_learner().report();
+    print_sun_learner_state(r);
+    cost("  sun learner take", g_costs.sun_take);
+    cost("  sun learner idle step", g_costs.sun_step);
+    text("sun learner: takes settled late ");
+    u32(static_cast<std::uint32_t>(r.late));
+    text(" (most steps ");
+    u32(static_cast<std::uint32_t>(r.late_steps));
+    text("), RAM ");
+    u32(static_cast<std::uint32_t>(sizeof(calib::SunLearner)));
+    text(" bytes\n");
+}
+
 void print_report() noexcept {
     using namespace report;
     text(ASCORR_APP_SCALAR_NAME " core, ");
@@ -291,6 +323,7 @@ void print_report() noexcept {
                                   : " (service above the correction's cost)\n");
     print_estimator(correction3);
     print_combination();
+    print_sun_learner();
 }
 
 }  // namespace
@@ -315,8 +348,10 @@ int main() {
             g_stats.overruns += start - seen - 1U;
         }
         seen = start;
+        g_cycle_tick = start;
         g_flight.run(cycle, g_meter, kCycles != 0U);  // temperatures, states, heads (, record: a test run)
         const std::uint32_t busy = kPeriod - 1U - board::systick_value();
+        g_flight.learn_in_idle(g_meter);  // the period's rest, less kIdleReserve: not in `busy`
         if (g_ticks != seen) {
             ++g_stats.overruns;
         } else if (busy > g_stats.worst_busy) {

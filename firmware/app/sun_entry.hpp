@@ -6,9 +6,8 @@
 // Conventions: as core_entry.hpp, in its own translation units
 // (sun_entry_fixed.cpp, sun_entry_float.cpp) with the core's options, so
 // that its instructions per solution (bench/target_bench.cpp) less the
-// core's are what a head with a Sun term adds. Not in the flight image: the
-// flight loop does not evaluate the term yet (docs/ground.md, "What each of
-// those needs").
+// core's are what a head with a Sun term adds. In the flight image: the
+// term each model version takes from the loop's learner (flight_cycle.hpp).
 #pragma once
 
 #include "ascorr/core/correct.hpp"

@@ -6,7 +6,7 @@
 // software floating point on both targets). In its own translation unit
 // (sun_learner_entry.cpp) so that its instructions per fed cycle and per idle
 // step (bench/target_bench.cpp) and its stack (-fstack-usage) are measured
-// alone. Not in the flight image: the loop does not learn the term yet.
+// alone. In the flight image: flight_cycle.hpp's learner.
 #pragma once
 
 #include <cstdint>

@@ -125,6 +125,17 @@ struct Report {
         bool row_seen[ascorr::kMaxHeads][ascorr::kModelAxes] = {};
     };
     std::vector<Model> models;
+    // The Sun learner's state ("sun learner: ...", cycle_log.hpp).
+    struct Sun {
+        bool seen = false;
+        unsigned cycles = 0U;
+        unsigned orbits = 0U;
+        unsigned thinned = 0U;
+        unsigned candidate_orbits = 0U;
+        unsigned rank = 0U;
+        unsigned taken = 0U;
+        std::uint32_t crc = 0U;
+    } sun;
 };
 
 Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
@@ -243,8 +254,16 @@ bool parse_report(const std::string& path, Report& out) {
                 out.models.back().bits[h][c][t] = w[t];
             }
             out.models.back().row_seen[h][c] = true;
+        } else if (Report::Sun s;
+                   std::sscanf(line.c_str(),
+                               "sun learner: cycles %u orbits %u thinned %u candidate orbits %u rank %u taken %u "
+                               "crc32c %8x%c",
+                               &s.cycles, &s.orbits, &s.thinned, &s.candidate_orbits, &s.rank, &s.taken, &s.crc,
+                               &rest) == 7) {
+            s.seen = true;
+            out.sun = s;
         } else if (line.rfind("head ", 0) == 0 || line.rfind("sample ", 0) == 0 || line.rfind("solutions ", 0) == 0 ||
-                   line.rfind("model ", 0) == 0) {
+                   line.rfind("model ", 0) == 0 || line.rfind("sun learner: cycles", 0) == 0) {
             std::cerr << path << ":" << n << ": malformed line: " << line << "\n";
             return false;
         }
@@ -489,8 +508,50 @@ ascorr::app::FlightCycle& run(std::uint32_t cycles) {
     ascorr::app::NoMeter meter;
     for (std::uint32_t cycle = 0U; cycle < cycles; ++cycle) {
         flight.run(cycle, meter, true);
+        flight.learn_in_idle(meter);  // all at once: the DPU's spread gives the same bits (SunLearner::settle)
     }
     return flight;
+}
+
+Report::Sun sun_of(const ascorr::calib::SunLearnReport& r) {
+    return {true,
+            static_cast<unsigned>(r.cycles),
+            r.orbits,
+            static_cast<unsigned>(r.thinned),
+            r.candidate.orbits,
+            static_cast<unsigned>(r.candidate.rank),
+            r.taken ? 1U : 0U,
+            ascorr::app::sun_fit_crc(r.candidate)};
+}
+
+// The Sun learner's state, the image's against the host's: the counts, the
+// rank and whether the term is taken; bit for bit (bits), the candidate's
+// CRC too. Each difference named; their number.
+int sun_differences(const Report::Sun& host, const Report::Sun& image, bool bits, bool print) {
+    if (!image.seen) {
+        if (print) {
+            std::cout << "  the image printed no \"sun learner:\" line\n";
+        }
+        return 1;
+    }
+    const std::pair<const char*, std::pair<unsigned, unsigned>> fields[] = {
+        {"cycles", {host.cycles, image.cycles}},
+        {"orbits", {host.orbits, image.orbits}},
+        {"thinned", {host.thinned, image.thinned}},
+        {"candidate orbits", {host.candidate_orbits, image.candidate_orbits}},
+        {"rank", {host.rank, image.rank}},
+        {"taken", {host.taken, image.taken}},
+        {"crc32c", {bits ? host.crc : 0U, bits ? image.crc : 0U}}};
+    int n = 0;
+    for (const auto& [name, v] : fields) {
+        if (v.first != v.second) {
+            ++n;
+            if (print) {
+                std::cout << "  sun learner " << name << ": image " << v.second << ", host " << v.first << "\n";
+            }
+        }
+    }
+    return n;
 }
 
 bool parse_count(const char* s, unsigned long max, unsigned long& out) {
@@ -517,6 +578,7 @@ int main(int argc, char** argv) {
         flight.record().print_heads();
         flight.record().print_solutions();
         flight.history().print();
+        ascorr::app::print_sun_learner_state(flight.sun_learner().report());
         const ascorr::calib::EstimatorReport r = flight.estimator().report();
         std::cout << "self-calibration: orbits used " << r.orbits_used << " short " << r.orbits_short << " held "
                   << r.orbits_held << " late " << r.orbits_late << ", last refusal "
@@ -563,7 +625,18 @@ int main(int argc, char** argv) {
         std::cout << "  the estimator adopted no model in " << image.cycles << " cycles\n";
         return 1;
     }
+    host.sun = sun_of(flight.sun_learner().report());
+    if (sun_differences(host.sun, image.sun, bound == 0.0, true) != 0) {
+        std::cout << "  the image's Sun learner is not the host's\n";
+        return 1;
+    }
+    if (host.sun.orbits == 0U || host.sun.rank == 0U) {
+        std::cout << "  the Sun learner solved nothing in " << image.cycles << " cycles\n";
+        return 1;
+    }
     std::cout << "solutions match the host core's" << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
+    std::cout << "Sun learner (" << host.sun.cycles << " cycles, " << host.sun.orbits << " orbits, rank "
+              << host.sun.rank << ") matches the host's" << (bound == 0.0 ? " bit for bit" : " in its counts") << "\n";
     std::cout << "model history (" << host.models.size() << " models, the last version " << host.models.back().version
               << " from cycle " << host.models.back().cycle << ") matches the host's"
               << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
@@ -579,6 +652,13 @@ int main(int argc, char** argv) {
     const Outcome mm = compare(mutated_model(host, bound), image_models, bound, false);
     if (mm.differences == 0) {
         std::cout << "  a mutated expectation (last model perturbed) still matches: the comparison is vacuous\n";
+        return 1;
+    }
+    Report::Sun mutated_sun = host.sun;
+    mutated_sun.crc ^= 1U;  // bit for bit: the candidate's last bit
+    mutated_sun.orbits += bound == 0.0 ? 0U : 1U;
+    if (sun_differences(mutated_sun, image.sun, bound == 0.0, false) == 0) {
+        std::cout << "  a mutated expectation (the Sun learner's) still matches: the comparison is vacuous\n";
         return 1;
     }
     std::cout << "mutated expectation refused\n";

@@ -38,7 +38,9 @@ foreach(scalar fixed float)
                  ${PROJECT_SOURCE_DIR}/firmware/app/velocity_entry_${scalar}.cpp
                  ${PROJECT_SOURCE_DIR}/firmware/app/calib_entry_${scalar}.cpp
                  ${PROJECT_SOURCE_DIR}/firmware/app/calib_idle_${scalar}.cpp
-                 ${PROJECT_SOURCE_DIR}/firmware/app/combine_entry_${scalar}.cpp)
+                 ${PROJECT_SOURCE_DIR}/firmware/app/combine_entry_${scalar}.cpp
+                 ${PROJECT_SOURCE_DIR}/firmware/app/sun_entry_${scalar}.cpp
+                 ${PROJECT_SOURCE_DIR}/firmware/app/sun_learner_entry.cpp)
   target_include_directories(ascorr_flight_expectation_${scalar} PRIVATE ${PROJECT_SOURCE_DIR}/firmware/app)
   target_link_libraries(ascorr_flight_expectation_${scalar} PRIVATE ascorr_core ascorr::hal ascorr_warnings)
   target_compile_options(ascorr_flight_expectation_${scalar} PRIVATE -ffp-contract=off)

@@ -114,7 +114,7 @@ def core_section(d):
                        ("validation + renormalisation alone", "validation_and_renormalisation_only"),
                        ("the lag stage of a lagged head (issue 40's budget: 1.2× with it)", "lag_stage"),
                        ("thermal + aberration with the lag stage, ratio", "with_lag_ratio"),
-                       ("the Sun term of a head, folded into the thermal stage (not in the flight loop yet)", "sun_term"),
+                       ("the Sun term of a head, folded into the thermal stage", "sun_term"),
                        ("thermal + aberration with the Sun term, ratio", "with_sun_ratio"),
                        ("combined attitude, per epoch of three heads", "combination_three_heads"),
                        ("combined attitude, error vs double (arcsec)", "combination_max_error_arcsec"),
@@ -214,7 +214,7 @@ def side_learners_section(d):
     out = ["## The side learners", "",
            "The self-calibration's lag search (`calib/lag_search.hpp`, the core's scalar for the thermal stage, "
            "double for the IBAs) and Sun-term learner (`calib/sun_learner.hpp`, double), software floating point "
-           "on both targets, measured alone by the target bench: not in the flight loop yet. Per 22 Hz cycle, "
+           "on both targets, measured alone by the target bench (the Sun learner is in the flight loop too). Per 22 Hz cycle, "
            "the mean over the cycles, against the estimator's per cycle: the lag search takes every fed cycle "
            "(every 2nd), the Sun learner one per interval; its solve runs after each orbit in idle time, a step "
            "at a time.", ""]
@@ -233,8 +233,8 @@ def side_learners_section(d):
         ["… per 22 Hz cycle, one taken per interval"] +
         [f"{per_cycle(t, e[t]['per_take'] / (22 * e[t]['interval_us'] * 1e-6))}, {e[t]['interval_us'] / 1e6:g} s"
          for t in ts],
-        ["its solve per orbit (idle time; of every " + str(e[ts[0]].get("warm_solves", 1)) +
-         ", one from the identity, the others from the last basis)"] +
+        ["its solve per orbit (idle time" + (f"; of every {e[ts[0]]['warm_solves']}, one from the identity, "
+                                              "the others from the last basis)" if "warm_solves" in e[ts[0]] else ")")] +
         [f"{num(e[t]['per_orbit'])} in {e[t]['steps_per_orbit']} steps ({e[t]['orbit_s']} s orbit)" for t in ts],
         ["… from the identity / from the last basis (the bench's mean)"] +
         [f"{num(e[t]['cold_solve'])} in {e[t]['cold_steps']} / {num(e[t]['warm_solve'])} in {e[t]['warm_steps']}"

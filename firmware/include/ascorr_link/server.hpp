@@ -83,6 +83,7 @@
 #include "ascorr/nav/velocity_service.hpp"
 #include "ascorr/pipeline/common_rotation_weights.hpp"
 #include "ascorr/pipeline/epoch_pipeline.hpp"
+#include "ascorr/pipeline/version_sun_term.hpp"
 #include "frame.hpp"
 #include "messages.hpp"
 
@@ -296,30 +297,13 @@ private:
     }
 
     // At an epoch of a model version new to the Sun term's learning: the
-    // term the learner has taken (its candidate as of the last epoch it
-    // took: SunLearner::settle), for the heads the version has, kept in
-    // arcsec (kCalibSunTerm) and in T for the pipeline (sun_term_from_arcsec,
-    // as the host converts a model file's), as `correct --self-calibrate
-    // --sun-term auto` makes the history's models.
+    // term the learner has taken, for the heads the version has
+    // (pipeline/version_sun_term.hpp; kCalibSunTerm reports its arcsec), as
+    // `correct --self-calibrate --sun-term auto` makes the history's models.
     void follow_version() noexcept {
-        const ModelCoefficients* active = estimator_.active_coefficients();
-        if (!learning_sun_ || pipeline_.model() == nullptr || active == nullptr ||
-            (version_term_.set && version_term_.version == pipeline_.version())) {
-            return;
+        if (learning_sun_) {
+            version_term_.follow(sun_learner_, estimator_.active_coefficients(), pipeline_);
         }
-        version_term_.set = true;
-        version_term_.version = pipeline_.version();
-        sun_learner_.version_term(heads_where(active->present), version_term_.arcsec);
-        version_term_.model = sun_term_from_arcsec<T>(version_term_.arcsec);
-        pipeline_.use_sun_term(any_sun_term(version_term_.model) ? &version_term_.model : nullptr);
-    }
-    // Whether some head of m has a term (present: keep_present_where_terms or sun_term_from_arcsec).
-    static bool any_sun_term(const SunTermModel<T>& m) noexcept {
-        bool any = false;
-        for (const bool p : m.present) {
-            any = any || p;
-        }
-        return any;
     }
 
     void start_estimator(const CalibStart& m) noexcept {
@@ -583,12 +567,7 @@ private:
     static_assert(std::is_trivially_destructible_v<calib::SunLearner>, "restarted in place");
     calib::SunLearner sun_learner_{calib::EstimatorConfig{}, calib::kSunLearnOnBoardIntervalUs};
     bool learning_sun_ = false;
-    struct VersionTerm {
-        bool set = false;  // version is the last one seen with a model
-        std::uint32_t version = 0U;
-        double arcsec[kMaxHeads][kModelAxes][kSunComponents] = {};
-        SunTermModel<T> model{};
-    } version_term_{};
+    pipeline::VersionSunTerm<T> version_term_{};
     // Before kCalibStart: the uploaded model (use_model, in the constructor).
     LinkPipeline<T> pipeline_{};
     // The combination (kMountingLoad with build): none until then.

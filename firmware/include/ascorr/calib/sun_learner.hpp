@@ -206,13 +206,20 @@ public:
     template <typename T>
     bool take_kept(std::int64_t t_us, const CorrectedSolution<T>* kept) noexcept {
         Quaternion<double> q[kFrameHeads];
+        return frame_heads_of(kept, q) && take(t_us, q);
+    }
+    // take_kept's conversion (for a caller whose take() is out of line): the
+    // kept frame heads in double; false when the polynomial did not correct
+    // every one.
+    template <typename T>
+    static bool frame_heads_of(const CorrectedSolution<T>* kept, Quaternion<double> (&q)[kFrameHeads]) noexcept {
         for (std::size_t h = 0; h < kFrameHeads; ++h) {
             if ((kept[h].status & status::kThermalApplied) == 0U) {
                 return false;
             }
             q[h] = in_double(kept[h].q_chu_icrf);
         }
-        return take(t_us, q);
+        return true;
     }
 
     // The most step() calls one solve takes (sun_moments.hpp's solve_step).
@@ -221,7 +228,8 @@ public:
     // The per-orbit work, in idle time after a cycle (take) closed an orbit:
     // the candidate solved again from the sums, one bounded step of the
     // solve per call (sun_moments.hpp's solve_step: the normal equations,
-    // one row of a Jacobi sweep, or the result), at most kMaxSolveSteps per
+    // 8 lines of the change to the last solve's basis, one row of a Jacobi
+    // sweep, or the result), at most kMaxSolveSteps per
     // solve, with the sums as they were when it began. Its candidate is put
     // to use by the next settle() (the next cycle taken), not here, so that
     // when idle time ran the steps changes nothing. false: nothing pending.

@@ -238,7 +238,8 @@ public:
     // Of kWarmSolves solves in a row, the first starts from the identity:
     // what each warm start adds to V's rounding (a few ulps) stays bounded.
     static constexpr int kWarmSolves = 64;
-    // Lines of the basis change per step: the cost of a sweep's row or less.
+    // Lines of the basis change per step: about a sweep's first row's cost
+    // (8 × 27² multiply-adds; the target bench's worst step includes them).
     static constexpr std::size_t kBasisLinesPerStep = 8U;
     // The most solve_step() calls of one solve: forming, the basis change,
     // the eigen-decomposition a row per step, the result.
@@ -270,9 +271,10 @@ public:
     // decomposition begins in their basis (symmetric_eigen.hpp,
     // jacobi_to_basis, kBasisLinesPerStep lines a step): the sums move
     // little from one orbit to the next, so it needs fewer sweeps (the same
-    // eigen-directions and rank; the fit to rounding). A fresh Solve (the
-    // ground fit's solve()) starts from the identity, as does every
-    // kWarmSolves-th.
+    // decomposition to rounding: the fit too, unless an eigenvalue lies at
+    // kSunRankTolerance's cut within rounding, where the rank may differ). A
+    // fresh Solve (the ground fit's solve()) starts from the identity, as
+    // does every kWarmSolves-th.
     SunSolveStep solve_step(Solve& w, const SunRule& rule) const noexcept {
         SunSolveStep s = SunSolveStep::kRunning;
         switch (w.phase) {

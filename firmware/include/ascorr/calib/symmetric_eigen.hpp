@@ -128,7 +128,7 @@ bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiPro
         }
     }
     const double bound = kJacobiTolerance * kJacobiTolerance * total;
-    progress = {n, bound, 0, 0U, bound / static_cast<double>(n * n)};
+    progress = {n, bound, 0, 0U, n > 0U ? bound / static_cast<double>(n * n) : 0.0};
     return true;
 }
 
@@ -147,11 +147,15 @@ bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiPro
 // (line < n: row `line` of a·V; then column line − n of Vᵀ·(a·V), its upper
 // triangle), each n or fewer sums of n products, in place with one line's
 // temporary. true once all 2n are done (a's lower triangle is then left to
-// jacobi_resume, which mirrors the upper); `line` holds where it is.
+// jacobi_resume, which mirrors the upper); `line` holds where it is. n > N:
+// true at once, nothing done (jacobi_resume then refuses it); lines 0 is 1.
 template <std::size_t N>
 bool jacobi_to_basis(double (&a)[N][N], const double (&v)[N][N], std::size_t n, std::size_t& line,
                      std::size_t lines) noexcept {
-    for (std::size_t k = 0; k < lines && line < 2U * n && n <= N; ++k, ++line) {
+    if (n > N) {
+        return true;
+    }
+    for (std::size_t k = 0; k < (lines > 0U ? lines : 1U) && line < 2U * n; ++k, ++line) {
         double t[N];
         if (line < n) {  // a row of a·V needs only that row of a
             const std::size_t i = line;

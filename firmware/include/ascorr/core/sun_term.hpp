@@ -80,6 +80,17 @@ constexpr bool has_sun_term(const SunTermModel<T>& m, std::uint8_t head) noexcep
     return head < kMaxHeads && m.present[head] && any_sun_coefficient(m, head);
 }
 
+// Whether some head of m has a term (present: as keep_present_where_terms
+// or sun_term_from_arcsec leave it).
+template <typename T>
+constexpr bool any_sun_term(const SunTermModel<T>& m) noexcept {
+    bool any = false;
+    for (const bool p : m.present) {
+        any = any || p;
+    }
+    return any;
+}
+
 // present[h] kept only where head h has a term (a coefficient not 0), as
 // every producer of a model leaves it: the flight form (correct.hpp) keys on
 // present alone, with no loop per solution. (The host's model file decides
