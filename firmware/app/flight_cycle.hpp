@@ -26,9 +26,11 @@
 // polynomial corrected them (one per kSunLearnOnBoardIntervalUs; in the
 // accelerated time of a test run every fed cycle is further apart); each
 // model version takes the term the learner has taken when it becomes active
-// (pipeline/version_sun_term.hpp), applied after the feed (sun_entry.hpp's
-// core; none until the learner takes a term: it decides after its memory's
-// orbits, at least 30 days). The learner's per-orbit solve runs in the
+// (pipeline/version_sun_term.hpp), applied after the feed in the contract's
+// form (the pipeline's with_version_term; sun_entry.hpp's core form, which
+// Calls must have for the stage, serves a fixed model's term). None until
+// the learner takes a term: it decides after its memory's orbits, at least
+// 30 days, beyond a test run's 44. The learner's per-orbit solve runs in the
 // period's idle time after the cycle (learn_in_idle), a step while the Meter
 // says there is room; what is left runs at its next take (settle), so the
 // host, which runs it all at once, learns the same bits.

@@ -114,7 +114,12 @@ struct SysTickMeter {
     }
     // Room for an idle step: the cycle's tick is the current one, and more
     // than kIdleReserve counts are left before the next (SysTick counts down).
-    bool idle_room() noexcept { return g_ticks == g_cycle_tick && board::systick_value() > kIdleReserve; }
+    // SysTick first: read after a reload whose tick is already counted it
+    // would claim the next period's time.
+    bool idle_room() noexcept {
+        const std::uint32_t left = board::systick_value();
+        return g_ticks == g_cycle_tick && left > kIdleReserve;
+    }
 };
 SysTickMeter g_meter;
 
@@ -168,7 +173,7 @@ void cost(const char* name, const Cost& c) noexcept {
     text(" calls ");
     u32(c.calls);
     text(" instructions total ");
-    u32(c.total * 40U);
+    u64(std::uint64_t{c.total} * 40U);  // a long run's idle steps pass 2^32
     text(" worst ");
     u32(c.worst * 40U);
     text(" mean ");

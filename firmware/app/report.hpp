@@ -26,6 +26,18 @@ inline void u32(std::uint32_t v) noexcept {
     text(&buf[i]);
 }
 
+// A 64-bit count (an instruction total), in decimal.
+inline void u64(std::uint64_t v) noexcept {
+    char buf[21];
+    int i = 20;
+    buf[i] = '\0';
+    do {  // at most 20 digits
+        buf[--i] = static_cast<char>('0' + v % 10U);
+        v /= 10U;
+    } while (v != 0U && i > 0);
+    text(&buf[i]);
+}
+
 inline void hex32(std::uint32_t v) noexcept {
     char buf[9];
     for (int i = 7; i >= 0; --i) {

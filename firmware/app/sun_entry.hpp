@@ -6,8 +6,10 @@
 // Conventions: as core_entry.hpp, in its own translation units
 // (sun_entry_fixed.cpp, sun_entry_float.cpp) with the core's options, so
 // that its instructions per solution (bench/target_bench.cpp) less the
-// core's are what a head with a Sun term adds. In the flight image: the
-// term each model version takes from the loop's learner (flight_cycle.hpp).
+// core's are what a head with a Sun term adds. Linked into the flight image
+// for a fixed model's term (the pipeline's stage needs it: TakesSunTerm);
+// a model version's learnt term is applied in the contract's form there
+// (flight_cycle.hpp).
 #pragma once
 
 #include "ascorr/core/correct.hpp"

@@ -137,11 +137,42 @@ bool jacobi_start(double (&a)[N][N], double (&v)[N][N], std::size_t n, JacobiPro
 // A matrix near one already decomposed, a ≈ V·Λ·Vᵀ, is nearly diagonal in
 // V's basis: with a ← Vᵀ·a·V first and v = V, the sweeps begin from a small
 // off-diagonal part, where cyclic Jacobi converges quadratically (Golub & Van
-// Loan §8.5.5), and v ends as the eigenvectors of the original a (V·J·J…),
+// Loan §8.5), and v ends as the eigenvectors of the original a (V·J·J…),
 // its diagonal as their eigenvalues. V: the columns of an earlier
 // decomposition's v, orthonormal to double's rounding (each rotation keeps
 // them so to a few ulps; the caller bounds how many decompositions follow
 // one from the identity).
+
+// Row i of a·V into a (it needs only that row of a); t: a line's temporary.
+template <std::size_t N>
+void basis_row(double (&a)[N][N], const double (&v)[N][N], std::size_t n, std::size_t i, double (&t)[N]) noexcept {
+    for (std::size_t j = 0; j < n; ++j) {
+        double x = 0.0;
+        for (std::size_t l = 0; l < n; ++l) {
+            x += a[i][l] * v[l][j];
+        }
+        t[j] = x;
+    }
+    for (std::size_t j = 0; j < n; ++j) {
+        a[i][j] = t[j];
+    }
+}
+
+// Column j of Vᵀ·(a·V) into a, its upper triangle (it needs only that
+// column of a·V); t: a line's temporary.
+template <std::size_t N>
+void basis_column(double (&a)[N][N], const double (&v)[N][N], std::size_t n, std::size_t j, double (&t)[N]) noexcept {
+    for (std::size_t i = 0; i <= j; ++i) {
+        double x = 0.0;
+        for (std::size_t l = 0; l < n; ++l) {
+            x += v[l][i] * a[l][j];
+        }
+        t[i] = x;
+    }
+    for (std::size_t i = 0; i <= j; ++i) {
+        a[i][j] = t[i];
+    }
+}
 
 // The basis change in bounded steps: `lines` more of its 2n lines per call
 // (line < n: row `line` of a·V; then column line − n of Vᵀ·(a·V), its upper
@@ -155,32 +186,13 @@ bool jacobi_to_basis(double (&a)[N][N], const double (&v)[N][N], std::size_t n, 
     if (n > N) {
         return true;
     }
-    for (std::size_t k = 0; k < (lines > 0U ? lines : 1U) && line < 2U * n; ++k, ++line) {
-        double t[N];
-        if (line < n) {  // a row of a·V needs only that row of a
-            const std::size_t i = line;
-            for (std::size_t j = 0; j < n; ++j) {
-                double x = 0.0;
-                for (std::size_t l = 0; l < n; ++l) {
-                    x += a[i][l] * v[l][j];
-                }
-                t[j] = x;
-            }
-            for (std::size_t j = 0; j < n; ++j) {
-                a[i][j] = t[j];
-            }
-        } else {  // a column of Vᵀ·(a·V) needs only that column of a·V
-            const std::size_t j = line - n;
-            for (std::size_t i = 0; i <= j; ++i) {
-                double x = 0.0;
-                for (std::size_t l = 0; l < n; ++l) {
-                    x += v[l][i] * a[l][j];
-                }
-                t[i] = x;
-            }
-            for (std::size_t i = 0; i <= j; ++i) {
-                a[i][j] = t[i];
-            }
+    const std::size_t count = lines > 0U ? lines : 1U;
+    double t[N];  // one for both phases: a step's frame holds one line
+    for (std::size_t k = 0; k < count && line < 2U * n; ++k, ++line) {
+        if (line < n) {
+            basis_row(a, v, n, line, t);
+        } else {
+            basis_column(a, v, n, line - n, t);
         }
     }
     return line >= 2U * n;

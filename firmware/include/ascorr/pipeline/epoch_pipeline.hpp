@@ -114,8 +114,8 @@ struct InlineCalls {
 };
 
 // Whether Calls has the core's flight form with a Sun term
-// (Calls::correct(in, cfg, sun)): a pipeline whose Calls has none (the flight
-// loop's, which does not evaluate the term yet) compiles without its stage.
+// (Calls::correct(in, cfg, sun)): a pipeline whose Calls has none compiles
+// without the term's stage (the link's and the flight loop's have it).
 template <typename Calls, typename T, typename = void>
 struct TakesSunTerm : std::false_type {};
 template <typename Calls, typename T>
@@ -488,8 +488,8 @@ private:
     combine::HeadAttitude<T> combined_[kCombineSlots]{};
     std::uint8_t combined_n_ = 0U;
     bool overflow_ = false;
-    // Last, so that a Calls without the Sun term (the flight loop's) keeps
-    // the other members' offsets, hence its code.
+    // Last, so that a Calls without the Sun term keeps the other members'
+    // offsets, hence its code.
     const SunTermModel<T>* sun_ = nullptr;
     Vector3<T> sun_s_{};      // the Sun's direction at t_us_ (use_sun_term)
     bool sun_known_ = false;  // sun_s_ was formed
