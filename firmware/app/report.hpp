@@ -15,18 +15,7 @@ inline void text(const char* s) noexcept {
     std::fputs(s, stdout);
 }
 
-inline void u32(std::uint32_t v) noexcept {
-    char buf[11];
-    int i = 10;
-    buf[i] = '\0';
-    do {  // at most 10 digits
-        buf[--i] = static_cast<char>('0' + v % 10U);
-        v /= 10U;
-    } while (v != 0U && i > 0);
-    text(&buf[i]);
-}
-
-// A 64-bit count (an instruction total), in decimal.
+// A count in decimal (u32: the same digits).
 inline void u64(std::uint64_t v) noexcept {
     char buf[21];
     int i = 20;
@@ -36,6 +25,10 @@ inline void u64(std::uint64_t v) noexcept {
         v /= 10U;
     } while (v != 0U && i > 0);
     text(&buf[i]);
+}
+
+inline void u32(std::uint32_t v) noexcept {
+    u64(v);
 }
 
 inline void hex32(std::uint32_t v) noexcept {
