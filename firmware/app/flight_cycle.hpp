@@ -232,7 +232,7 @@ public:
                 in, [&] { return pipeline::from_service(velocity_query(service_, t)); }, true, true, stages);
         }
         combined_ = pipeline_.close(stages);
-        if (pipeline_.feeds() != feeds) {
+        if (pipeline::learner_takes_feed(pipeline_, feeds, estimator_)) {
             take_sun(cycle, meter);
         }
         if (model != model_) {  // a model became active (double-buffered: a new one is at the other address)
@@ -280,13 +280,12 @@ public:
     const calib::SunLearner& sun_learner() const noexcept { return sun_learner_; }
 
 private:
-    // A fed cycle's frame heads into the Sun learner (as the link server's:
-    // with a model, the estimator not frozen).
+    // A fed cycle's frame heads into the Sun learner (as the link server's,
+    // pipeline::learner_takes_feed).
     template <typename Meter>
     void take_sun(std::uint32_t cycle, Meter& meter) noexcept {
         Quaternion<double> q[calib::kFrameHeads];
-        if (pipeline_.model() == nullptr || estimator_.frozen() ||
-            !calib::SunLearner::frame_heads_of(pipeline_.kept_solutions(), q)) {
+        if (!calib::SunLearner::frame_heads_of(pipeline_.kept_solutions(), q)) {
             return;
         }
         const std::uint32_t start = meter.now();

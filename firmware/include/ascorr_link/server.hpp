@@ -400,8 +400,7 @@ private:
             follow_version();
             const std::uint32_t feeds = pipeline_.feeds();
             c = pipeline_.solution(in, velocity, (s.calib & kCalibClean) != 0U, true, meter);
-            // Frozen, the estimator takes nothing from the feed: nor does the learner.
-            if (learning_sun_ && pipeline_.feeds() != feeds && pipeline_.model() != nullptr && !estimator_.frozen()) {
+            if (learning_sun_ && pipeline::learner_takes_feed(pipeline_, feeds, estimator_)) {
                 (void)sun_learner_.take_kept(s.t.us, pipeline_.kept_solutions());
             }
         } else {

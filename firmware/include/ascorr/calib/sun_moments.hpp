@@ -229,9 +229,8 @@ public:
         SunSolvePhase phase = SunSolvePhase::kForm;
         SunTermFit fit;  // the result (fit.solved), once solve_step has returned kSolved
         // The warm start (solve_step): vectors hold a converged decomposition
-        // of order basis_n, reached in `warm` warm starts from the identity.
+        // of order jacobi.n, reached in `warm` warm starts from the identity.
         bool basis = false;
-        std::size_t basis_n = 0U;
         int warm = 0;
         std::size_t basis_line = 0U;  // jacobi_to_basis's progress
     };
@@ -338,7 +337,7 @@ private:
                 }
             }
         }
-        const bool warm = w.basis && w.basis_n == 3 * n && w.warm + 1 < kWarmSolves;
+        const bool warm = w.basis && w.jacobi.n == 3 * n && w.warm + 1 < kWarmSolves;
         w.basis = false;  // until this decomposition converges (eigen_row)
         if (warm) {
             ++w.warm;
@@ -356,10 +355,10 @@ private:
 
     // The warm start's basis change, kBasisLinesPerStep lines; then the sweeps.
     static SunSolveStep basis_lines(Solve& w) noexcept {
-        if (!jacobi_to_basis(w.normal, w.vectors, w.basis_n, w.basis_line, kBasisLinesPerStep)) {
+        if (!jacobi_to_basis(w.normal, w.vectors, w.jacobi.n, w.basis_line, kBasisLinesPerStep)) {
             return SunSolveStep::kRunning;
         }
-        if (!jacobi_resume(w.normal, w.vectors, w.basis_n, w.jacobi)) {
+        if (!jacobi_resume(w.normal, w.vectors, w.jacobi.n, w.jacobi)) {
             return SunSolveStep::kFailed;
         }
         w.phase = SunSolvePhase::kEigen;
@@ -371,8 +370,7 @@ private:
             case JacobiStep::kRunning:
                 return SunSolveStep::kRunning;
             case JacobiStep::kConverged:
-                w.basis = true;
-                w.basis_n = w.jacobi.n;
+                w.basis = true;  // of order w.jacobi.n, which only the next start changes
                 w.phase = SunSolvePhase::kResult;
                 return SunSolveStep::kRunning;
             case JacobiStep::kNotConverged:

@@ -9,8 +9,9 @@
 // the heads the version has, kept in arcsec (what CALIB_SUN_TERM reports)
 // and in T (sun_term_from_arcsec, the one conversion the host's model reader
 // uses too), and given to the pipeline, which applies it after the feed
-// (use_sun_term). Later epochs of the same version change nothing. No
-// allocation; loops over the heads only.
+// (use_sun_term). Later epochs of the same version change nothing. The
+// learner takes an epoch's frame heads only where the estimator took its
+// feed (learner_takes_feed). No allocation; loops over the heads only.
 #pragma once
 
 #include <cstdint>
@@ -43,5 +44,13 @@ struct VersionSunTerm {
         pipeline.use_sun_term(any_sun_term(model) ? &model : nullptr);
     }
 };
+
+// Whether an epoch's feed goes to the learner too: the estimator took it
+// (the pipeline's feeds grew past feeds_before) under a model, and is not
+// frozen (frozen, it takes nothing from the feed: nor does the learner).
+template <typename Pipeline, typename Estimator>
+bool learner_takes_feed(const Pipeline& pipeline, std::uint32_t feeds_before, const Estimator& estimator) noexcept {
+    return pipeline.feeds() != feeds_before && pipeline.model() != nullptr && !estimator.frozen();
+}
 
 }  // namespace ascorr::pipeline
