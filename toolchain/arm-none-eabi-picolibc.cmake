@@ -30,9 +30,10 @@ set(CMAKE_CXX_FLAGS_INIT
     "${ASCORR_CPU_FLAGS} --specs=picolibcpp.specs -ffunction-sections -fdata-sections -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-unwind-tables -fno-asynchronous-unwind-tables")
 set(CMAKE_C_FLAGS_INIT "${ASCORR_CPU_FLAGS} --specs=picolibc.specs -ffunction-sections -fdata-sections")
 # MPS2 AN385/AN386: 4 MiB code SSRAM at 0x0 (our "flash"), 4 MiB data SSRAM at
-# 0x20000000. picolibc's crt0 sets up .data/.bss, the vector table and the FPU.
+# 0x20000000. picolibc's crt0 sets up .data/.bss, the vector table and the FPU;
+# its linker script, with the stack's size: ascorr-picolibc.ld.
 set(CMAKE_EXE_LINKER_FLAGS_INIT
-    "--oslib=semihost --crt0=semihost -Wl,--gc-sections -Wl,--defsym=__flash=0x0 -Wl,--defsym=__flash_size=0x400000 -Wl,--defsym=__ram=0x20000000 -Wl,--defsym=__ram_size=0x400000 -Wl,--defsym=__stack_size=0x2000")
+    "--oslib=semihost --crt0=semihost -Wl,--gc-sections -Wl,--defsym=__flash=0x0 -Wl,--defsym=__flash_size=0x400000 -Wl,--defsym=__ram=0x20000000 -Wl,--defsym=__ram_size=0x400000 -T${CMAKE_CURRENT_LIST_DIR}/ascorr-picolibc.ld")
 
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)

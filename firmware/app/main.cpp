@@ -20,13 +20,16 @@
 // sleep_until_changed), so a tick can never slip in between and cost a whole
 // period unseen. ASCORR_APP_CYCLES > 0 ends the run after that many cycles with a
 // report (with the solutions' record: samples and CRC-32C per head,
-// flight_cycle.hpp) and exit status 0 (no overrun) or 1; 0 runs forever (flight).
+// flight_cycle.hpp, and the stack's high-water mark, stack_watch.hpp) and exit
+// status 0 (no overrun, the stack within its size) or 1; 0 runs forever
+// (flight).
 #include <cstdint>
 
 #include "app_scalar.hpp"
 #include "board.hpp"
 #include "flight_cycle.hpp"
 #include "report.hpp"
+#include "stack_watch.hpp"
 
 #ifndef ASCORR_APP_CYCLES
 #define ASCORR_APP_CYCLES 0
@@ -331,6 +334,19 @@ void print_report() noexcept {
     print_sun_learner();
 }
 
+// "stack: high water N of S bytes" (stack_watch.hpp), measured after the
+// run and its report; true when within the stack.
+bool print_stack() noexcept {
+    using namespace report;
+    const std::uint32_t used = stack_watch::high_water();
+    text("stack: high water ");
+    u32(used);
+    text(" of ");
+    u32(stack_watch::size());
+    text(" bytes\n");
+    return used <= stack_watch::size();
+}
+
 }  // namespace
 }  // namespace ascorr::app
 
@@ -340,6 +356,7 @@ extern "C" void arm_systick_isr() {
 
 int main() {
     using namespace ascorr::app;
+    stack_watch::paint();
     board::systick_start(kPeriod, true);
     calibrate();
     std::uint32_t seen = g_ticks;
@@ -367,5 +384,6 @@ int main() {
     print_report();
     g_flight.record().print_solutions();
     g_flight.history().print();
-    return g_stats.overruns == 0U ? 0 : 1;
+    const bool stack_within = print_stack();
+    return g_stats.overruns == 0U && stack_within ? 0 : 1;
 }

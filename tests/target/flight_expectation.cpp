@@ -22,8 +22,10 @@
 // rotation angle between them). Then the mutation check: the same comparison
 // against the host's record with its first sample perturbed (its lowest bit
 // of w flipped; with a bound, rotated by twice the bound) must fail, so that
-// the check cannot pass vacuously. Exit 0 when both hold, 1 otherwise, every
-// difference named (line, head, cycle, value).
+// the check cannot pass vacuously. The image's stack high-water mark
+// ("stack: high water N of S bytes", stack_watch.hpp) must be present, not
+// empty and within its size (a mark one word beyond must fail). Exit 0 when
+// all hold, 1 otherwise, every difference named (line, head, cycle, value).
 // print: the lines the image prints of its solutions after CYCLES cycles.
 #include <cmath>
 #include <cstdint>
@@ -136,6 +138,12 @@ struct Report {
         unsigned taken = 0U;
         std::uint32_t crc = 0U;
     } sun;
+    // The stack's high-water mark (main.cpp, stack_watch.hpp).
+    struct Stack {
+        bool seen = false;
+        unsigned used = 0U;
+        unsigned size = 0U;
+    } stack;
 };
 
 Printed printed(const ascorr::CorrectedSolution<Scalar>& c) {
@@ -262,8 +270,11 @@ bool parse_report(const std::string& path, Report& out) {
                                &rest) == 7) {
             s.seen = true;
             out.sun = s;
+        } else if (std::sscanf(line.c_str(), "stack: high water %u of %u bytes%c", &a, &c, &rest) == 2) {
+            out.stack = {true, a, c};
         } else if (line.rfind("head ", 0) == 0 || line.rfind("sample ", 0) == 0 || line.rfind("solutions ", 0) == 0 ||
-                   line.rfind("model ", 0) == 0 || line.rfind("sun learner: cycles", 0) == 0) {
+                   line.rfind("model ", 0) == 0 || line.rfind("sun learner: cycles", 0) == 0 ||
+                   line.rfind("stack: ", 0) == 0) {
             std::cerr << path << ":" << n << ": malformed line: " << line << "\n";
             return false;
         }
@@ -555,6 +566,21 @@ int sun_differences(const Report::Sun& host, const Report::Sun& image, bool bits
     return n;
 }
 
+// The image's stack: measured (some use: painting and its scan worked) and
+// within its size. An empty string, or what is wrong.
+std::string stack_problem(const Report::Stack& st) {
+    if (!st.seen) {
+        return "the image printed no \"stack:\" line";
+    }
+    if (st.size == 0U || st.used == 0U) {
+        return "the image's stack high-water mark is empty: its painting or scan is broken";
+    }
+    if (st.used > st.size) {
+        return "the image's stack reached " + std::to_string(st.used) + " bytes, beyond its " + std::to_string(st.size);
+    }
+    return {};
+}
+
 bool parse_count(const char* s, unsigned long max, unsigned long& out) {
     char* end = nullptr;
     out = std::strtoul(s, &end, 10);
@@ -635,6 +661,11 @@ int main(int argc, char** argv) {
         std::cout << "  the Sun learner solved nothing in " << image.cycles << " cycles\n";
         return 1;
     }
+    if (const std::string p = stack_problem(image.stack); !p.empty()) {
+        std::cout << "  " << p << "\n";
+        return 1;
+    }
+    std::cout << "stack: " << image.stack.used << " of " << image.stack.size << " bytes at most\n";
     std::cout << "solutions match the host core's" << (bound == 0.0 ? " bit for bit" : " within the bound") << "\n";
     std::cout << "Sun learner (" << host.sun.cycles << " cycles, " << host.sun.orbits << " orbits, rank "
               << host.sun.rank << ") matches the host's" << (bound == 0.0 ? " bit for bit" : " in its counts") << "\n";
@@ -660,6 +691,12 @@ int main(int argc, char** argv) {
     mutated_sun.orbits += bound == 0.0 ? 0U : 1U;
     if (sun_differences(mutated_sun, image.sun, bound == 0.0, false) == 0) {
         std::cout << "  a mutated expectation (the Sun learner's) still matches: the comparison is vacuous\n";
+        return 1;
+    }
+    Report::Stack deeper = image.stack;
+    deeper.used = deeper.size + 4U;
+    if (stack_problem(deeper).empty()) {
+        std::cout << "  a stack one word beyond its size passes the check: the check is vacuous\n";
         return 1;
     }
     std::cout << "mutated expectation refused\n";
