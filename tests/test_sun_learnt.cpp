@@ -668,7 +668,7 @@ TEST(SunMoments, AWarmStartSolvesAsTheColdOneInFewerSteps) {
     }
     EXPECT_LT(worst, 1e-10) << "the warm fit is the cold one to rounding";
     // Steps are rows of sweeps (a warm sweep's rows skip most rotations:
-    // fewer instructions still, target_bench.cpp); 61 % here, 100 % cold.
+    // fewer instructions still, target_bench.cpp); 44 % here, 100 % cold.
     EXPECT_LT(warm_steps * 10, cold_steps * 7) << warm_steps << " steps warm, " << cold_steps << " cold";
     RecordProperty("warm_steps", std::to_string(warm_steps));
     RecordProperty("cold_steps", std::to_string(cold_steps));
