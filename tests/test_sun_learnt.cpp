@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <random>
 #include <sstream>
@@ -614,8 +615,10 @@ TEST(SunLearner, CyclesWhereTheSunIsNotKnownAreCountedNotLearnt) {
 
 // The learner's warm start (solve_step with its Solve kept from one solve
 // to the next, as SunLearner keeps it): each fit the ground's cold solve()
-// of the same sums to rounding, the same rank, in fewer steps; every
-// kWarmSolves-th from the identity, with the cold one's bits.
+// of the same sums to twice the decomposition's bound on either
+// (symmetric_eigen.hpp: kJacobiTolerance/kSunRankTolerance·√27 relative),
+// the same rank, in fewer steps; every kWarmSolves-th from the identity,
+// with the cold one's bits.
 TEST(SunMoments, AWarmStartSolvesAsTheColdOneInFewerSteps) {
     using Moments = calib::SunMoments<3>;
     constexpr std::size_t kOrbits = 70;
@@ -666,13 +669,16 @@ TEST(SunMoments, AWarmStartSolvesAsTheColdOneInFewerSteps) {
         ASSERT_GT(largest, 0.0) << o;
         worst = std::max(worst, diff / largest);
     }
-    EXPECT_LT(worst, 1e-10) << "the warm fit is the cold one to rounding";
+    const double bound = 2.0 * calib::kJacobiTolerance / calib::kSunRankTolerance * std::sqrt(27.0);
+    EXPECT_LT(worst, bound) << "the warm fit is the cold one to the decomposition's tolerance";
     // Steps are rows of sweeps (a warm sweep's rows skip most rotations:
     // fewer instructions still, target_bench.cpp); 44 % here, 100 % cold.
     EXPECT_LT(warm_steps * 10, cold_steps * 7) << warm_steps << " steps warm, " << cold_steps << " cold";
     RecordProperty("warm_steps", std::to_string(warm_steps));
     RecordProperty("cold_steps", std::to_string(cold_steps));
-    RecordProperty("worst_relative_difference", std::to_string(worst));
+    std::ostringstream worst_text;
+    worst_text << std::setprecision(3) << worst;
+    RecordProperty("worst_relative_difference", worst_text.str());
 }
 
 TEST(SunMoments, NothingToSolveIsNoTerm) {
@@ -988,6 +994,15 @@ TEST(SunLearntOnLink, TheTargetLearnsTheTermAsTheHostAndCorrectsWithIt) {
         EXPECT_EQ(s.version_mismatches, 0U) << target << log.str();
         EXPECT_EQ(s.history_mismatches, 0U) << target << log.str();
         EXPECT_TRUE(s.report_matches) << target << log.str();
+        // The target's learner, read over the link (SUN_LEARNER_REPORT) and
+        // compared above with the host's at its last epoch: the account of
+        // the target describes it.
+        const std::string text = log.str();
+        const std::size_t on_target = text.find("ascorr replay: on the target, ");
+        ASSERT_NE(on_target, std::string::npos) << text;
+        EXPECT_NE(text.substr(on_target, text.find('\n', on_target) - on_target).find("the learner scored "),
+                  std::string::npos)
+            << text;
         EXPECT_LE(s.max_error_arcsec, 0.05) << target;
         // The target's history: its models took a term, as correct's did.
         const std::vector<std::string> h = lines_of_file(dir / "r.history.csv");

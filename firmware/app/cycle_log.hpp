@@ -161,27 +161,6 @@ private:
     std::uint32_t samples_taken_ = 0U;
 };
 
-// The Sun learner's candidate (its coefficients' bits, arcsec by head, axis
-// and component, little-endian doubles) as one CRC-32C: what the loop's
-// report and the host's prediction of it compare.
-inline std::uint32_t sun_fit_crc(const calib::SunTermFit& f) noexcept {
-    std::uint32_t crc = 0U;
-    for (const auto& head : f.sun) {
-        for (const auto& axis : head) {
-            for (const double c : axis) {
-                std::uint64_t b = 0U;
-                std::memcpy(&b, &c, sizeof b);
-                std::uint8_t bytes[8];
-                for (std::uint32_t i = 0; i < 8U; ++i) {
-                    bytes[i] = static_cast<std::uint8_t>(b >> (8U * i));
-                }
-                crc = link::crc32c(bytes, 8U, crc);
-            }
-        }
-    }
-    return crc;
-}
-
 // "sun learner: cycles C orbits O thinned T candidate orbits K rank R taken X
 // crc32c Z": the learner's state as the loop reports it, the line its host
 // prediction checks (tests/target/flight_expectation.cpp).
@@ -200,7 +179,7 @@ inline void print_sun_learner_state(const calib::SunLearnReport& r) noexcept {
     text(" taken ");
     u32(r.taken ? 1U : 0U);
     text(" crc32c ");
-    hex32(sun_fit_crc(r.candidate));
+    hex32(calib::sun_fit_crc(r.candidate));
     text("\n");
 }
 

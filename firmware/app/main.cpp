@@ -47,6 +47,9 @@ std::uint32_t g_cycle_tick = 0U;  // g_ticks when the current cycle began
 // the period: an eighth, some 8 of its worst steps (docs/figures.md).
 constexpr std::uint32_t kIdleReserve = kPeriod / 8U;
 
+// The stack painted at boot, before the static constructors (stack_watch.hpp).
+__attribute__((section(".preinit_array"), used)) void (*const g_paint_at_boot)() = &stack_watch::paint;
+
 FlightCycle g_flight;  // the service, the GNSS feed, the solutions and their record (flight_cycle.hpp)
 
 // SysTick counts spent in each part (40 instructions each under QEMU).
@@ -356,7 +359,6 @@ extern "C" void arm_systick_isr() {
 
 int main() {
     using namespace ascorr::app;
-    stack_watch::paint();
     board::systick_start(kPeriod, true);
     calibrate();
     std::uint32_t seen = g_ticks;

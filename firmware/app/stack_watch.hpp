@@ -6,7 +6,8 @@
 // Conventions: picolibc's linker script (picolibcpp.ld) puts the stack at the
 // top of RAM, [__heap_end, __stack): __stack_size bytes (the toolchain's
 // one definition, toolchain/ascorr-picolibc.ld), and below it the heap's
-// room, unused (nothing allocates). paint() fills with kPaint the stack
+// room, unused (nothing allocates). paint() (at boot, before the static
+// constructors) fills with kPaint the stack
 // below its caller's frame and a guard of one more stack size below the
 // stack (within the heap's room); high_water() finds the lowest word no
 // longer kPaint and returns the bytes from it to the top: the deepest the
@@ -52,7 +53,10 @@ inline std::uintptr_t guard_bottom() noexcept {
 }
 
 // Paints the guard and the stack below the caller's frame. noinline: the
-// words below this function's own stack pointer are all free.
+// words below this function's own stack pointer are all free. An image runs
+// it from .preinit_array, which crt0 calls before .init_array (the static
+// constructors, whose frames are then measured too: FlightCycle's, some
+// 900 B).
 __attribute__((noinline)) inline void paint() noexcept {
     std::uintptr_t sp = 0U;
     __asm__ volatile("mov %0, sp" : "=r"(sp));

@@ -173,10 +173,9 @@ def flight_section(d):
         ["worst cycle, SysTick counts (of the period)"] +
         [f"{num(f[t]['worst_cycle_systick'])} (of {num(f[t]['period_systick'])})" for t in ts],
         ["cycles / overruns"] + [f"{num(f[t]['cycles'])} / {num(f[t]['overruns'])}" for t in ts],
+        ["stack high-water mark, painted (of the stack)"] +
+        [f"{num(f[t]['stack']['high_water'])} B (of {num(f[t]['stack']['size'])} B)" for t in ts],
     ]
-    if all("stack" in f[t] for t in ts):
-        rows.append(["stack high-water mark, painted (of the stack)"] +
-                    [f"{num(f[t]['stack']['high_water'])} B (of {num(f[t]['stack']['size'])} B)" for t in ts])
     return out + table([""] + [tname(t) for t in ts], rows) + [""]
 
 

@@ -46,6 +46,7 @@
 #include "common_rotation.hpp"
 #include "frame.hpp"
 #include "head_rotation.hpp"
+#include "model_identity.hpp"
 #include "symmetric_eigen.hpp"
 
 namespace ascorr::calib {
@@ -73,6 +74,22 @@ struct SunTermFit {
     std::uint64_t epochs = 0U;                               // epochs in them
     bool solved = false;  // false: no orbit, or equations that are not finite or did not converge
 };
+
+// A fit's coefficients as one CRC-32C (their bits, arcsec, head, axis and
+// component ascending, each as model_identity.hpp's crc32c_of): what the
+// flight loop's report and the link's SUN_LEARNER_REPORT give of a
+// candidate whose 27 doubles they cannot carry.
+inline std::uint32_t sun_fit_crc(const SunTermFit& f) noexcept {
+    std::uint32_t crc = 0U;
+    for (const auto& head : f.sun) {
+        for (const auto& axis : head) {
+            for (const double c : axis) {
+                crc = crc32c_of(c, crc);
+            }
+        }
+    }
+    return crc;
+}
 
 // f's coefficients (arcsec) into out[h][a][m] for the heads it fitted that
 // are in keep (bit h: head h), when it was solved; out is left as it was
@@ -270,8 +287,9 @@ public:
     // decomposition begins in their basis (symmetric_eigen.hpp,
     // jacobi_to_basis, kBasisLinesPerStep lines a step): the sums move
     // little from one orbit to the next, so it needs fewer sweeps (the same
-    // decomposition to rounding: the fit too, unless an eigenvalue lies at
-    // kSunRankTolerance's cut within rounding, where the rank may differ). A
+    // decomposition to kJacobiTolerance: the fit too, to the bound
+    // symmetric_eigen.hpp gives, unless an eigenvalue lies that close to
+    // kSunRankTolerance's cut, where the rank may differ). A
     // fresh Solve (the ground fit's solve()) starts from the identity, as
     // does every kWarmSolves-th.
     SunSolveStep solve_step(Solve& w, const SunRule& rule) const noexcept {
