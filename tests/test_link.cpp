@@ -348,6 +348,52 @@ TEST(LinkCodecs, TheLearntSunTermsMessagesDecodeWholeOrAsBefore) {
     EXPECT_FALSE(decode(p, k + 1U, got));
     p[0] = kMaxHeads;
     EXPECT_FALSE(decode(p, k, got));
+
+    // SUN_LEARNER_REPORT: every field through, the candidate by its CRC.
+    SunLearnerReport r{1U, {}, 0xC0FFEE11U};
+    r.report.orbits = 461U;
+    r.report.cycles = 21'000'000'000ULL;
+    r.report.score[0] = 2.5;
+    r.report.score[1] = 1.25;
+    r.report.gain = 0.5;
+    r.report.rms_arcsec = 0.31;
+    r.report.deciding = true;
+    r.report.orbits_held = 455.5;
+    r.report.orbits_to_decide = 450.0;
+    r.report.taken = true;
+    r.report.candidate.heads = 7U;
+    r.report.candidate.rank = 18;
+    r.report.candidate.orbits = 460U;
+    r.report.candidate.epochs = 21'620ULL;
+    r.report.candidate.solved = true;
+    r.report.candidate.sun[0][0][0] = 0.8;  // not carried
+    r.report.without_sun = 3U;
+    r.report.not_finite = 4U;
+    r.report.thinned = 5U;
+    r.report.late = 6U;
+    r.report.late_steps = 77;
+    const std::size_t kr = encode(r, p);
+    EXPECT_EQ(kr, 118U);
+    EXPECT_LE(kr, kMaxPayload);
+    SunLearnerReport back_r{};
+    ASSERT_TRUE(decode(p, kr, back_r));
+    EXPECT_EQ(back_r.learning, 1U);
+    EXPECT_EQ(back_r.candidate_crc, 0xC0FFEE11U);
+    const calib::SunLearnReport& b = back_r.report;
+    EXPECT_TRUE(b.orbits == 461U && b.cycles == 21'000'000'000ULL && b.score[0] == 2.5 && b.score[1] == 1.25 &&
+                b.gain == 0.5 && b.rms_arcsec == 0.31 && b.deciding && b.orbits_held == 455.5 &&
+                b.orbits_to_decide == 450.0 && b.taken && b.without_sun == 3U && b.not_finite == 4U &&
+                b.thinned == 5U && b.late == 6U && b.late_steps == 77);
+    EXPECT_TRUE(b.candidate.heads == 7U && b.candidate.rank == 18 && b.candidate.orbits == 460U &&
+                b.candidate.epochs == 21'620ULL && b.candidate.solved);
+    EXPECT_EQ(b.candidate.sun[0][0][0], 0.0);
+    EXPECT_FALSE(decode(p, kr - 1U, back_r));
+    EXPECT_FALSE(decode(p, kr + 1U, back_r));
+    p[0] = 2U;  // learning is 0 or 1
+    EXPECT_FALSE(decode(p, kr, back_r));
+    p[0] = 1U;
+    p[kr - 4U - 8U - 4U - 1U] = 28U;  // a rank beyond the fit's 27 unknowns
+    EXPECT_FALSE(decode(p, kr, back_r));
 }
 
 // Self-calibration on the link (protocol v3): the commands act on the
@@ -437,6 +483,7 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     bad.emplace_back(MessageType::kCalibModelRequest, Bytes{});
     bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{4});  // a head beyond D
     bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{0, 0});
+    bad.emplace_back(MessageType::kSunLearnerReportRequest, Bytes{0});  // it has no payload
     CalibModelLoad good{};
     good.head = 0;
     good.present = 1;

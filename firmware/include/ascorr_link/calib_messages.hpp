@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "ascorr/calib/estimator.hpp"
+#include "ascorr/calib/sun_learner.hpp"
 #include "ascorr/core/constants.hpp"
 #include "ascorr/core/heads.hpp"
 #include "ascorr/core/sun_term.hpp"
@@ -88,6 +89,18 @@ struct CalibSunTerm {
     std::uint8_t head;
     std::uint32_t version;
     double sun[kModelAxes][kSunComponents];
+};
+
+// The Sun term learner's state (answer to kSunLearnerReportRequest, no
+// payload): whether it learns (CalibStart::sun_term), its report
+// (calib/sun_learner.hpp; the candidate's coefficients, 27 doubles, do not
+// fit a frame: report.candidate.sun stays 0 on decode, and candidate_crc,
+// calib::sun_fit_crc of them, identifies them). Not learning: a report of
+// zeros. 118 bytes.
+struct SunLearnerReport {
+    std::uint8_t learning;
+    calib::SunLearnReport report;
+    std::uint32_t candidate_crc;
 };
 
 // The largest coefficient a model may have (arcsec or arcsec/°C): the Q30
@@ -257,6 +270,58 @@ inline bool decode(const std::uint8_t* p, std::size_t n, CalibSunTerm& m) noexce
         }
     }
     return ok && r.done();
+}
+
+// learning, then the report's counts, flags and doubles, then the candidate
+// (its CRC for its coefficients).
+inline std::size_t encode(const SunLearnerReport& m, std::uint8_t* out) noexcept {
+    const calib::SunLearnReport& r = m.report;
+    Writer w(out);
+    w.u8(m.learning);
+    w.u8(r.deciding ? 1U : 0U);
+    w.u8(r.taken ? 1U : 0U);
+    w.u32(r.orbits);
+    w.u64(r.cycles);
+    w.u64(r.without_sun);
+    w.u64(r.not_finite);
+    w.u64(r.thinned);
+    w.u64(r.late);
+    w.u32(static_cast<std::uint32_t>(r.late_steps));
+    for (const double d : {r.score[0], r.score[1], r.gain, r.rms_arcsec, r.orbits_held, r.orbits_to_decide}) {
+        w.f64(d);
+    }
+    w.u8(r.candidate.solved ? 1U : 0U);
+    w.u8(r.candidate.heads);
+    w.u8(static_cast<std::uint8_t>(r.candidate.rank));
+    w.u32(r.candidate.orbits);
+    w.u64(r.candidate.epochs);
+    w.u32(m.candidate_crc);
+    return w.size();
+}
+// As CalibModel's: any value decodes (the host compares it); flags are 0 or
+// 1, a rank at most the fit's unknowns.
+inline bool decode(const std::uint8_t* p, std::size_t n, SunLearnerReport& m) noexcept {
+    calib::SunLearnReport& r = m.report;
+    r = calib::SunLearnReport{};
+    Reader rd(p, n);
+    std::uint8_t flags[4] = {};
+    std::uint8_t rank = 0U;
+    std::uint32_t late_steps = 0U;
+    bool ok = rd.u8(m.learning) && rd.u8(flags[0]) && rd.u8(flags[1]) && rd.u32(r.orbits) && rd.u64(r.cycles) &&
+              rd.u64(r.without_sun) && rd.u64(r.not_finite) && rd.u64(r.thinned) && rd.u64(r.late) &&
+              rd.u32(late_steps);
+    for (double* d : {&r.score[0], &r.score[1], &r.gain, &r.rms_arcsec, &r.orbits_held, &r.orbits_to_decide}) {
+        ok = ok && rd.f64(*d);
+    }
+    ok = ok && rd.u8(flags[2]) && rd.u8(r.candidate.heads) && rd.u8(rank) && rd.u32(r.candidate.orbits) &&
+         rd.u64(r.candidate.epochs) && rd.u32(m.candidate_crc) && rd.done();
+    r.deciding = flags[0] == 1U;
+    r.taken = flags[1] == 1U;
+    r.candidate.solved = flags[2] == 1U;
+    r.candidate.rank = rank;
+    r.late_steps = static_cast<int>(late_steps & 0x7FFFFFFFU);
+    return ok && m.learning <= 1U && flags[0] <= 1U && flags[1] <= 1U && flags[2] <= 1U &&
+           rank <= calib::SunMoments<calib::kFrameHeads>::kUnknowns && late_steps <= 0x7FFFFFFFU;
 }
 
 }  // namespace ascorr::link

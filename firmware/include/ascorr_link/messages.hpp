@@ -54,6 +54,8 @@ enum class MessageType : std::uint8_t {
     kSunTermUpload = 22,        // host → target: one head's Sun term (docs/contract.md, "The Sun term on the link")
     kCalibSunTermRequest = 23,  // host → target: answer with kCalibSunTerm for a head
     kCalibSunTerm = 24,         // target → host: one head's Sun term of the active model version
+    kSunLearnerReportRequest = 25,  // host → target: answer with kSunLearnerReport
+    kSunLearnerReport = 26,         // target → host: the Sun term learner's state
 };
 
 enum class AckResult : std::uint8_t {

@@ -56,6 +56,9 @@
 //   kCalibModelRequest → kCalibModel (one head of the active model)
 //   kCalibSunTermRequest → kCalibSunTerm (one head's Sun term of the active
 //                        model's version: kCalibStart's sun_term)
+//   kSunLearnerReportRequest → kSunLearnerReport (the Sun learner's state:
+//                        counts, scores, decision, its candidate's rank and
+//                        CRC; zeros when kCalibStart's sun_term is 0)
 //   kMountingLoad      → kAck (a head's mounting staged; with `build`, the
 //                        staged mountings become the combiner's, refused with
 //                        kBadPayload when not usable: combine::check_mountings)
@@ -214,6 +217,10 @@ private:
                 reply(
                     f, f.length == 0U, MessageType::kCalibReport, [this] { return estimator_.report(); }, sink);
                 return;
+            case MessageType::kSunLearnerReportRequest:
+                reply(
+                    f, f.length == 0U, MessageType::kSunLearnerReport, [this] { return sun_learner_report(); }, sink);
+                return;
             case MessageType::kSolutionIn: {
                 SolutionIn<T> s{};
                 if (!decode(f.payload, f.length, s)) {
@@ -240,6 +247,7 @@ private:
             case MessageType::kCalibReport:
             case MessageType::kCalibModel:
             case MessageType::kCalibSunTerm:
+            case MessageType::kSunLearnerReport:
             case MessageType::kSolutionOut:
             case MessageType::kAck:
             case MessageType::kNak:
@@ -471,6 +479,15 @@ private:
             }
         }
         return m;
+    }
+
+    // The Sun learner's state, as kSunLearnerReport (not learning: zeros).
+    SunLearnerReport sun_learner_report() const noexcept {
+        if (!learning_sun_) {
+            return SunLearnerReport{0U, calib::SunLearnReport{}, 0U};
+        }
+        const calib::SunLearnReport r = sun_learner_.report();
+        return SunLearnerReport{1U, r, calib::sun_fit_crc(r.candidate)};
     }
 
     // Head h's Sun term of the active model's version, as kCalibSunTerm (0

@@ -99,6 +99,7 @@ public:
             out_.lag_search = search_->report();
         }
         if (sun_) {
+            out_.sun_learnt_at_last_epoch = sun_->report();
             sun_->finish();
             out_.sun_learnt = sun_->report();
         }

@@ -503,6 +503,17 @@ link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
 }
 
 template <typename T>
+link::SunLearnerReport LinkClient<T>::sun_learner_report() {
+    const std::vector<std::uint8_t> a = request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report"},
+                                                link::MessageType::kSunLearnerReport);
+    link::SunLearnerReport r{};
+    if (!link::decode(a.data(), a.size(), r)) {
+        throw LinkError("malformed Sun learner report from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return r;
+}
+
+template <typename T>
 void LinkClient<T>::send_calib_model(const ModelCoefficients& m, bool load) {
     for (std::uint8_t h = 0; h < kMaxHeads; ++h) {
         link::CalibModelLoad f{};

@@ -57,6 +57,51 @@ std::string first_report_difference(const calib::EstimatorReport& a, const calib
     return {};
 }
 
+// The same for the Sun learner's report (b: the host's learner); its
+// candidate's coefficients by their CRC (what the message carries). Not its
+// takes settled late: they count how the target spread the solve over its
+// idle time, where the host solves at once (the same bits: SunLearner::settle).
+std::string first_sun_report_difference(const link::SunLearnerReport& a, const calib::SunLearnReport& b) {
+    if (a.learning != 1U) {
+        return "the target's learner does not learn (CALIB_START's sun term not taken)";
+    }
+    const calib::SunLearnReport& r = a.report;
+    const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
+        return x == y ? std::string()
+                      : std::string(name) + ": target " + std::to_string(x) + ", host " + std::to_string(y);
+    };
+    const auto d = [](const char* name, double x, double y) {
+        return same_double(x, y) ? std::string()
+                                 : std::string(name) + ": target " + number_text(x) + ", host " + number_text(y);
+    };
+    const std::string fields[] = {
+        u("orbits", r.orbits, b.orbits),
+        u("cycles", r.cycles, b.cycles),
+        u("cycles without the Sun", r.without_sun, b.without_sun),
+        u("cycles not finite", r.not_finite, b.not_finite),
+        u("cycles thinned", r.thinned, b.thinned),
+        d("score with the polynomial alone", r.score[0], b.score[0]),
+        d("score with the candidate", r.score[1], b.score[1]),
+        d("gain", r.gain, b.gain),
+        d("RMS inside the orbit", r.rms_arcsec, b.rms_arcsec),
+        d("orbits held", r.orbits_held, b.orbits_held),
+        d("orbits to decide", r.orbits_to_decide, b.orbits_to_decide),
+        u("deciding", r.deciding ? 1U : 0U, b.deciding ? 1U : 0U),
+        u("taken", r.taken ? 1U : 0U, b.taken ? 1U : 0U),
+        u("candidate solved", r.candidate.solved ? 1U : 0U, b.candidate.solved ? 1U : 0U),
+        u("candidate heads", r.candidate.heads, b.candidate.heads),
+        u("candidate rank", static_cast<std::uint64_t>(r.candidate.rank), static_cast<std::uint64_t>(b.candidate.rank)),
+        u("candidate orbits", r.candidate.orbits, b.candidate.orbits),
+        u("candidate epochs", r.candidate.epochs, b.candidate.epochs),
+        u("candidate CRC-32C", a.candidate_crc, calib::sun_fit_crc(b.candidate))};
+    for (const std::string& f : fields) {
+        if (!f.empty()) {
+            return f;
+        }
+    }
+    return {};
+}
+
 // The target's model `version`, head by head (CALIB_MODEL, and with
 // learn_sun CALIB_SUN_TERM), as a history entry active from t (the first
 // solution corrected with it).
@@ -198,7 +243,17 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     SelfCalibration on_target = host_sc;
     on_target.history = target_history;
     on_target.report = r;
-    on_target.sun_learnt.reset();  // the target's learner reports nothing over the link: its models say what it took
+    // The target's learner: its report, its candidate's coefficients by their
+    // CRC, against the host's as of the last epoch (the target's data do not end).
+    if (host_sc.sun_learnt_at_last_epoch) {
+        const link::SunLearnerReport sun = client.sun_learner_report();
+        const std::string sun_difference = first_sun_report_difference(sun, *host_sc.sun_learnt_at_last_epoch);
+        if (!sun_difference.empty()) {
+            sum.report_matches = false;
+            log << "ascorr replay: the target's Sun learner report differs from the host's: " << sun_difference << "\n";
+        }
+        on_target.sun_learnt = sun.report;
+    }
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }
 

@@ -52,6 +52,10 @@ struct SelfCalibration {
     std::size_t runs = 0;     // rows out of time order: sorted runs (more than 1: merged from a temporary file)
     std::optional<calib::LagSearchReport> lag_search;  // learn_lag: the bench's lag, as the search took it
     std::optional<calib::SunLearnReport> sun_learnt;   // learn_sun: the Sun term, as the learner took it
+    // learn_sun: the learner as of the last epoch, before the end of the data
+    // closed its open orbit (SunLearner::finish): what a target, whose data
+    // do not end, reports (`replay`, SUN_LEARNER_REPORT).
+    std::optional<calib::SunLearnReport> sun_learnt_at_last_epoch;
 };
 
 // The fed rows (in time order) whose median speed gives the orbit period

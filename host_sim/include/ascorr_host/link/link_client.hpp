@@ -121,6 +121,9 @@ public:
     // Head h's Sun term of the active model's version (start_calibration's
     // learn_sun; a target before it: a LinkError, its unknown type).
     link::CalibSunTerm calib_sun_term(std::uint8_t head);
+    // The target's Sun learner (SUN_LEARNER_REPORT; its candidate's
+    // coefficients by their CRC only; a target before it: a LinkError).
+    link::SunLearnerReport sun_learner_report();
 
     // The combination (protocol v5): the mountings, head by head, built into
     // the target's combiner (a LinkError when the target refuses them); then
