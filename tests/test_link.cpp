@@ -349,6 +349,16 @@ TEST(LinkCodecs, TheLearntSunTermsMessagesDecodeWholeOrAsBefore) {
     p[0] = kMaxHeads;
     EXPECT_FALSE(decode(p, k, got));
 
+    // STACK_REPORT: two counts, exactly 8 bytes.
+    const StackReport st{4224U, 8192U};
+    const std::size_t ks = encode(st, p);
+    EXPECT_EQ(ks, 8U);
+    StackReport st_back{};
+    ASSERT_TRUE(decode(p, ks, st_back));
+    EXPECT_TRUE(st_back.high_water == 4224U && st_back.size == 8192U);
+    EXPECT_FALSE(decode(p, ks - 1U, st_back));
+    EXPECT_FALSE(decode(p, ks + 1U, st_back));
+
     // SUN_LEARNER_REPORT: every field through, the candidate by its CRC.
     SunLearnerReport r{1U, {}, 0xC0FFEE11U};
     r.report.orbits = 461U;
@@ -484,6 +494,7 @@ TEST(LinkServer, SelfCalibrationCommandsAndBadPayloads) {
     bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{4});  // a head beyond D
     bad.emplace_back(MessageType::kCalibSunTermRequest, Bytes{0, 0});
     bad.emplace_back(MessageType::kSunLearnerReportRequest, Bytes{0});  // it has no payload
+    bad.emplace_back(MessageType::kStackReportRequest, Bytes{0});       // it has no payload
     CalibModelLoad good{};
     good.head = 0;
     good.present = 1;

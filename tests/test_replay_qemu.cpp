@@ -74,6 +74,16 @@ TEST_P(ReplayQemu, CleanLink) {
     expect_complete(GetParam(), s);
     EXPECT_EQ(s.crc_errors, 0U);
     EXPECT_EQ(s.injected, 0U);
+    // The link image's stack (STACK_REPORT, painted at boot): measured (at
+    // least 1 KiB: the server's frames reach beyond it) and within three
+    // quarters of its 8 KiB (a replay takes not every path; the Sun learner,
+    // not started here, adds its frames: docs/figures.md).
+    EXPECT_EQ(s.target_stack_size, 8192U);
+    EXPECT_GE(s.target_stack_bytes, 1024U);
+    EXPECT_LE(4U * s.target_stack_bytes, 3U * s.target_stack_size);
+    RecordProperty("target_stack_bytes", std::to_string(s.target_stack_bytes));
+    std::cout << board_name(GetParam()) << " link image stack: " << s.target_stack_bytes << " of "
+              << s.target_stack_size << " bytes\n";
 }
 
 TEST_P(ReplayQemu, OnePercentFaults) {

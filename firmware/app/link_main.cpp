@@ -17,12 +17,15 @@
 // -icount shift=0, board.hpp), refined by polling (SysTickCounter). On the
 // board the same figures are core clocks with kInstructionsPerCount = 1 (and
 // the poll's cost in clocks). The figure includes part of the counter reads.
+// The stack is painted at boot and its high-water mark answers STACK_REPORT
+// (stack_watch.hpp).
 #include <cstdint>
 
 #include "app_scalar.hpp"
 #include "ascorr_link/server.hpp"
 #include "board.hpp"
 #include "cmsdk_uart.hpp"
+#include "stack_watch.hpp"
 
 #ifndef ASCORR_LINK_INSTRUCTIONS_PER_COUNT
 #define ASCORR_LINK_INSTRUCTIONS_PER_COUNT 40
@@ -72,7 +75,15 @@ struct SysTickCounter {
 std::uint32_t SysTickCounter::last = 0U;
 std::uint32_t SysTickCounter::total = 0U;
 
-using Server = link::LinkServer<Scalar, SysTickCounter>;
+// The stack painted at boot, before the static constructors (the server's
+// among them), and its mark scanned for STACK_REPORT (stack_watch.hpp: at
+// most 4096 words).
+__attribute__((section(".preinit_array"), used)) void (*const g_paint_at_boot)() = &stack_watch::paint;
+struct PaintedStack {
+    link::StackReport operator()() const noexcept { return {stack_watch::high_water(), stack_watch::size()}; }
+};
+
+using Server = link::LinkServer<Scalar, SysTickCounter, PaintedStack>;
 Server g_server(kBootId, SysTickCounter{});  // static: model, velocity, temperatures and caches
 std::uint32_t g_tx_dropped = 0U;             // bytes the UART could not take (inspect with a debugger)
 

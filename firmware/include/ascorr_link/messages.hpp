@@ -56,6 +56,8 @@ enum class MessageType : std::uint8_t {
     kCalibSunTerm = 24,         // target → host: one head's Sun term of the active model version
     kSunLearnerReportRequest = 25,  // host → target: answer with kSunLearnerReport
     kSunLearnerReport = 26,         // target → host: the Sun term learner's state
+    kStackReportRequest = 27,       // host → target: answer with kStackReport
+    kStackReport = 28,              // target → host: the image's stack high-water mark
 };
 
 enum class AckResult : std::uint8_t {
@@ -148,6 +150,14 @@ struct Ack {
 // the states).
 struct ServiceConfig {
     std::int64_t horizon_us;
+};
+
+// The image's stack (answer to kStackReportRequest, no payload): the most
+// bytes it has used since boot and its size (firmware/app/stack_watch.hpp);
+// 0 and 0 where the server does not measure it (a host's in-process one).
+struct StackReport {
+    std::uint32_t high_water;
+    std::uint32_t size;
 };
 
 // ---- messages (encode returns the payload size; buffers of kMaxPayload suffice)
@@ -348,6 +358,17 @@ bool decode(const std::uint8_t* p, std::size_t n, SolutionOut<T>& m) noexcept {
     return r.u32(m.id) && r.u8(m.head) && r.u16(m.status) && r.word(m.q_chu_icrf.w) && r.word(m.q_chu_icrf.x) &&
            r.word(m.q_chu_icrf.y) && r.word(m.q_chu_icrf.z) && r.u32(m.instructions) && r.u32(m.model_version) &&
            r.done();
+}
+
+inline std::size_t encode(const StackReport& m, std::uint8_t* out) noexcept {
+    Writer w(out);
+    w.u32(m.high_water);
+    w.u32(m.size);
+    return w.size();
+}
+inline bool decode(const std::uint8_t* p, std::size_t n, StackReport& m) noexcept {
+    Reader r(p, n);
+    return r.u32(m.high_water) && r.u32(m.size) && r.done();
 }
 
 inline std::size_t encode(const Ack& m, std::uint8_t* out) noexcept {

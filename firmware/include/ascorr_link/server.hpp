@@ -56,6 +56,8 @@
 //   kCalibModelRequest → kCalibModel (one head of the active model)
 //   kCalibSunTermRequest → kCalibSunTerm (one head's Sun term of the active
 //                        model's version: kCalibStart's sun_term)
+//   kStackReportRequest → kStackReport (StackProbe's: the image's stack
+//                        high-water mark and size; 0, 0 unmeasured)
 //   kSunLearnerReportRequest → kSunLearnerReport (the Sun learner's state:
 //                        counts, scores, decision, its candidate's rank and
 //                        CRC; zeros when kCalibStart's sun_term is 0)
@@ -101,9 +103,16 @@ using LinkEstimator = calib::Estimator<T, kMaxHeads>;
 template <typename T>
 using LinkPipeline = pipeline::EpochPipeline<T, pipeline::InlineCalls<T>, kMaxHeads>;
 
+// A server that does not measure its stack (StackProbe's default): 0, 0.
+struct NoStackProbe {
+    StackReport operator()() const noexcept { return {0U, 0U}; }
+};
+
 // CycleCounter: a callable returning a free-running std::uint32_t counter
-// (SysTick or DWT on target), read around correct_solution().
-template <typename T, typename CycleCounter>
+// (SysTick or DWT on target), read around correct_solution(). StackProbe: a
+// callable returning the image's StackReport (firmware/app/link_main.cpp's
+// paints the stack; bounded).
+template <typename T, typename CycleCounter, typename StackProbe = NoStackProbe>
 class LinkServer {
 public:
     LinkServer(std::uint32_t boot_id, CycleCounter counter) noexcept : boot_id_(boot_id), counter_(counter) {
@@ -217,6 +226,10 @@ private:
                 reply(
                     f, f.length == 0U, MessageType::kCalibReport, [this] { return estimator_.report(); }, sink);
                 return;
+            case MessageType::kStackReportRequest:
+                reply(
+                    f, f.length == 0U, MessageType::kStackReport, [this] { return stack_(); }, sink);
+                return;
             case MessageType::kSunLearnerReportRequest:
                 reply(
                     f, f.length == 0U, MessageType::kSunLearnerReport, [this] { return sun_learner_report(); }, sink);
@@ -248,6 +261,7 @@ private:
             case MessageType::kCalibModel:
             case MessageType::kCalibSunTerm:
             case MessageType::kSunLearnerReport:
+            case MessageType::kStackReport:
             case MessageType::kSolutionOut:
             case MessageType::kAck:
             case MessageType::kNak:
@@ -555,6 +569,7 @@ private:
 
     std::uint32_t boot_id_;
     CycleCounter counter_;
+    StackProbe stack_{};
     FrameDecoder decoder_;
     ThermalModel<T> model_{};
     SunTermModel<T> sun_{};         // the uploaded model's Sun terms (kSunTermUpload)

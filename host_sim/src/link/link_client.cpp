@@ -38,6 +38,21 @@ void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
     }
 }
 
+// An answer's payload decoded as M and accepted by `fits` (the request's
+// own fields echoed), or a LinkError naming `what` and its size.
+template <typename M, typename Fits>
+M answer_of(const std::vector<std::uint8_t>& a, const char* what, Fits fits) {
+    M m{};
+    if (!link::decode(a.data(), a.size(), m) || !fits(m)) {
+        throw LinkError(std::string("malformed ") + what + " from the target (" + std::to_string(a.size()) + " bytes)");
+    }
+    return m;
+}
+template <typename M>
+M answer_of(const std::vector<std::uint8_t>& a, const char* what) {
+    return answer_of<M>(a, what, [](const M&) { return true; });
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -470,47 +485,40 @@ void LinkClient<T>::load_calib_model(const ModelCoefficients& m) {
 
 template <typename T>
 calib::EstimatorReport LinkClient<T>::calib_report() {
-    const std::vector<std::uint8_t> a =
-        request({link::MessageType::kCalibReportRequest, {}, "calibration report"}, link::MessageType::kCalibReport);
-    calib::EstimatorReport r{};
-    if (!link::decode(a.data(), a.size(), r)) {
-        throw LinkError("malformed calibration report from the target (" + std::to_string(a.size()) + " bytes)");
-    }
-    return r;
+    return answer_of<calib::EstimatorReport>(
+        request({link::MessageType::kCalibReportRequest, {}, "calibration report"}, link::MessageType::kCalibReport),
+        "calibration report");
 }
 
 template <typename T>
 link::CalibModel LinkClient<T>::calib_model(std::uint8_t head) {
-    const std::vector<std::uint8_t> a = request(
-        {link::MessageType::kCalibModelRequest, {head}, "calibration model request"}, link::MessageType::kCalibModel);
-    link::CalibModel m{};
-    if (!link::decode(a.data(), a.size(), m) || m.head != head) {
-        throw LinkError("malformed calibration model from the target (" + std::to_string(a.size()) + " bytes)");
-    }
-    return m;
+    return answer_of<link::CalibModel>(
+        request({link::MessageType::kCalibModelRequest, {head}, "calibration model request"},
+                link::MessageType::kCalibModel),
+        "calibration model", [head](const link::CalibModel& m) { return m.head == head; });
 }
 
 template <typename T>
 link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
-    const std::vector<std::uint8_t> a =
+    return answer_of<link::CalibSunTerm>(
         request({link::MessageType::kCalibSunTermRequest, {head}, "calibration Sun term request"},
-                link::MessageType::kCalibSunTerm);
-    link::CalibSunTerm m{};
-    if (!link::decode(a.data(), a.size(), m) || m.head != head) {
-        throw LinkError("malformed calibration Sun term from the target (" + std::to_string(a.size()) + " bytes)");
-    }
-    return m;
+                link::MessageType::kCalibSunTerm),
+        "calibration Sun term", [head](const link::CalibSunTerm& m) { return m.head == head; });
+}
+
+template <typename T>
+link::StackReport LinkClient<T>::stack_report() {
+    return answer_of<link::StackReport>(
+        request({link::MessageType::kStackReportRequest, {}, "stack report"}, link::MessageType::kStackReport),
+        "stack report");
 }
 
 template <typename T>
 link::SunLearnerReport LinkClient<T>::sun_learner_report() {
-    const std::vector<std::uint8_t> a = request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report"},
-                                                link::MessageType::kSunLearnerReport);
-    link::SunLearnerReport r{};
-    if (!link::decode(a.data(), a.size(), r)) {
-        throw LinkError("malformed Sun learner report from the target (" + std::to_string(a.size()) + " bytes)");
-    }
-    return r;
+    return answer_of<link::SunLearnerReport>(
+        request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report"},
+                link::MessageType::kSunLearnerReport),
+        "Sun learner report");
 }
 
 template <typename T>

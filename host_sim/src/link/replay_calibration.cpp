@@ -18,35 +18,48 @@ bool same_double(double a, double b) {
     return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-// The first field in which a (the target's) and b (the host's) differ, with
-// both values; empty when they are the same (doubles: same_double).
-std::string first_report_difference(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
-    const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
-        return x == y ? std::string()
-                      : std::string(name) + ": target " + std::to_string(x) + ", host " + std::to_string(y);
-    };
-    const auto d = [](const char* name, double x, double y) {
-        return same_double(x, y) ? std::string()
-                                 : std::string(name) + ": target " + number_text(x) + ", host " + number_text(y);
-    };
-    const std::string fields[] = {
-        u("orbits used", a.orbits_used, b.orbits_used),
-        u("orbits short", a.orbits_short, b.orbits_short),
-        u("orbits held back", a.orbits_held, b.orbits_held),
-        u("orbits late", a.orbits_late, b.orbits_late),
-        u("changes", a.changes, b.changes),
-        d("condition", a.condition, b.condition),
-        d("residual RMS", a.residual_rms_arcsec, b.residual_rms_arcsec),
-        d("candidate RMS", a.candidate_rms_arcsec, b.candidate_rms_arcsec),
-        u("has a model", a.has_active, b.has_active),
-        u("active version", a.active_version, b.active_version),
-        u("active CRC-32C", a.active_crc, b.active_crc),
-        u("last refusal", static_cast<unsigned>(a.last_refusal), static_cast<unsigned>(b.last_refusal)),
-        u("frozen", a.frozen, b.frozen)};
+// A field that differs, named with the target's and the host's values;
+// empty when the same (doubles: same_double).
+std::string count_difference(const char* name, std::uint64_t target, std::uint64_t host) {
+    return target == host ? std::string()
+                          : std::string(name) + ": target " + std::to_string(target) + ", host " + std::to_string(host);
+}
+std::string double_difference(const char* name, double target, double host) {
+    return same_double(target, host)
+               ? std::string()
+               : std::string(name) + ": target " + number_text(target) + ", host " + number_text(host);
+}
+
+// The first of the fields' differences; empty: none.
+template <std::size_t N>
+std::string first_of(const std::string (&fields)[N]) {
     for (const std::string& f : fields) {
         if (!f.empty()) {
             return f;
         }
+    }
+    return {};
+}
+
+// The first field in which a (the target's) and b (the host's) differ, with
+// both values; empty when they are the same (doubles: same_double).
+std::string first_report_difference(const calib::EstimatorReport& a, const calib::EstimatorReport& b) {
+    const std::string fields[] = {
+        count_difference("orbits used", a.orbits_used, b.orbits_used),
+        count_difference("orbits short", a.orbits_short, b.orbits_short),
+        count_difference("orbits held back", a.orbits_held, b.orbits_held),
+        count_difference("orbits late", a.orbits_late, b.orbits_late),
+        count_difference("changes", a.changes, b.changes),
+        double_difference("condition", a.condition, b.condition),
+        double_difference("residual RMS", a.residual_rms_arcsec, b.residual_rms_arcsec),
+        double_difference("candidate RMS", a.candidate_rms_arcsec, b.candidate_rms_arcsec),
+        count_difference("has a model", a.has_active, b.has_active),
+        count_difference("active version", a.active_version, b.active_version),
+        count_difference("active CRC-32C", a.active_crc, b.active_crc),
+        count_difference("last refusal", static_cast<unsigned>(a.last_refusal), static_cast<unsigned>(b.last_refusal)),
+        count_difference("frozen", a.frozen, b.frozen)};
+    if (std::string f = first_of(fields); !f.empty()) {
+        return f;
     }
     for (std::size_t i = 1; i < calib::kRefusalKinds; ++i) {
         if (a.refusals[i] != b.refusals[i]) {
@@ -66,40 +79,28 @@ std::string first_sun_report_difference(const link::SunLearnerReport& a, const c
         return "the target's learner does not learn (CALIB_START's sun term not taken)";
     }
     const calib::SunLearnReport& r = a.report;
-    const auto u = [](const char* name, std::uint64_t x, std::uint64_t y) {
-        return x == y ? std::string()
-                      : std::string(name) + ": target " + std::to_string(x) + ", host " + std::to_string(y);
-    };
-    const auto d = [](const char* name, double x, double y) {
-        return same_double(x, y) ? std::string()
-                                 : std::string(name) + ": target " + number_text(x) + ", host " + number_text(y);
-    };
     const std::string fields[] = {
-        u("orbits", r.orbits, b.orbits),
-        u("cycles", r.cycles, b.cycles),
-        u("cycles without the Sun", r.without_sun, b.without_sun),
-        u("cycles not finite", r.not_finite, b.not_finite),
-        u("cycles thinned", r.thinned, b.thinned),
-        d("score with the polynomial alone", r.score[0], b.score[0]),
-        d("score with the candidate", r.score[1], b.score[1]),
-        d("gain", r.gain, b.gain),
-        d("RMS inside the orbit", r.rms_arcsec, b.rms_arcsec),
-        d("orbits held", r.orbits_held, b.orbits_held),
-        d("orbits to decide", r.orbits_to_decide, b.orbits_to_decide),
-        u("deciding", r.deciding ? 1U : 0U, b.deciding ? 1U : 0U),
-        u("taken", r.taken ? 1U : 0U, b.taken ? 1U : 0U),
-        u("candidate solved", r.candidate.solved ? 1U : 0U, b.candidate.solved ? 1U : 0U),
-        u("candidate heads", r.candidate.heads, b.candidate.heads),
-        u("candidate rank", static_cast<std::uint64_t>(r.candidate.rank), static_cast<std::uint64_t>(b.candidate.rank)),
-        u("candidate orbits", r.candidate.orbits, b.candidate.orbits),
-        u("candidate epochs", r.candidate.epochs, b.candidate.epochs),
-        u("candidate CRC-32C", a.candidate_crc, calib::sun_fit_crc(b.candidate))};
-    for (const std::string& f : fields) {
-        if (!f.empty()) {
-            return f;
-        }
-    }
-    return {};
+        count_difference("orbits", r.orbits, b.orbits),
+        count_difference("cycles", r.cycles, b.cycles),
+        count_difference("cycles without the Sun", r.without_sun, b.without_sun),
+        count_difference("cycles not finite", r.not_finite, b.not_finite),
+        count_difference("cycles thinned", r.thinned, b.thinned),
+        double_difference("score with the polynomial alone", r.score[0], b.score[0]),
+        double_difference("score with the candidate", r.score[1], b.score[1]),
+        double_difference("gain", r.gain, b.gain),
+        double_difference("RMS inside the orbit", r.rms_arcsec, b.rms_arcsec),
+        double_difference("orbits held", r.orbits_held, b.orbits_held),
+        double_difference("orbits to decide", r.orbits_to_decide, b.orbits_to_decide),
+        count_difference("deciding", r.deciding ? 1U : 0U, b.deciding ? 1U : 0U),
+        count_difference("taken", r.taken ? 1U : 0U, b.taken ? 1U : 0U),
+        count_difference("candidate solved", r.candidate.solved ? 1U : 0U, b.candidate.solved ? 1U : 0U),
+        count_difference("candidate heads", r.candidate.heads, b.candidate.heads),
+        count_difference("candidate rank", static_cast<std::uint64_t>(r.candidate.rank),
+                         static_cast<std::uint64_t>(b.candidate.rank)),
+        count_difference("candidate orbits", r.candidate.orbits, b.candidate.orbits),
+        count_difference("candidate epochs", r.candidate.epochs, b.candidate.epochs),
+        count_difference("candidate CRC-32C", a.candidate_crc, calib::sun_fit_crc(b.candidate))};
+    return first_of(fields);
 }
 
 // The target's model `version`, head by head (CALIB_MODEL, and with

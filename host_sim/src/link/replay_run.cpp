@@ -206,6 +206,21 @@ void count_link(ReplaySummary& sum, const LinkStats& st, const ReplayedRows& rep
     }
 }
 
+// The target's stack at the end of the run (STACK_REPORT), into the summary
+// and the log: its deepest use since boot, against its size.
+template <typename T>
+void report_stack(LinkClient<T>& client, ReplaySummary& sum, std::ostream& log) {
+    const link::StackReport st = client.stack_report();
+    sum.target_stack_bytes = st.high_water;
+    sum.target_stack_size = st.size;
+    if (st.size == 0U) {
+        log << "ascorr replay: the target does not measure its stack\n";
+        return;
+    }
+    log << "ascorr replay: the target's stack: at most " << st.high_water << " of " << st.size
+        << " bytes used since its boot\n";
+}
+
 }  // namespace
 
 template <typename T>
@@ -267,6 +282,7 @@ ReplaySummary run(const ReplayOptions& opt, Transport& raw, OutputSet& outputs, 
         combination->finish(sum);
         outputs["--combined"].write(combination->text());
     }
+    report_stack(client, sum, log);
     count_link(sum, client.stats(), replayed, injector.get());
     return sum;
 }

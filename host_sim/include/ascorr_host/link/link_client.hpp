@@ -124,6 +124,9 @@ public:
     // The target's Sun learner (SUN_LEARNER_REPORT; its candidate's
     // coefficients by their CRC only; a target before it: a LinkError).
     link::SunLearnerReport sun_learner_report();
+    // The target's stack high-water mark and size (STACK_REPORT; 0, 0: it
+    // does not measure it; a target before it: a LinkError).
+    link::StackReport stack_report();
 
     // The combination (protocol v5): the mountings, head by head, built into
     // the target's combiner (a LinkError when the target refuses them); then

@@ -99,6 +99,10 @@ struct ReplaySummary {
     std::size_t combined_epochs = 0;                // rows of the combined file
     std::size_t combined_mismatches = 0;            // epochs whose combination differs from the host's
     double combination_instructions_per_epoch = 0;  // mean over epochs of two or more heads
+    // The target's stack at the end (STACK_REPORT): the most bytes used since
+    // its boot, of its size; 0, 0: the target does not measure it.
+    std::uint32_t target_stack_bytes = 0;
+    std::uint32_t target_stack_size = 0;
 };
 
 // The command's files (atomic_file.hpp's OutputSet): its inputs, and its
