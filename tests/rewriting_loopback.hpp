@@ -2,8 +2,10 @@
 // host::LoopbackTransport) whose incoming frames pass through a rewrite
 // first: a test double that changes or records what the host sent, frame by
 // frame (MOUNTING_LOAD turned, SOLUTION_IN's clean bit erased, build frames
-// measured). The rewrite gets the frame's type and its payload, which it may
-// change in place (with its new length); the frame is then encoded anew.
+// measured, a request's type made one the target does not know, as a
+// firmware from before it would see it). The rewrite gets the frame's type
+// and its payload, which it may change in place (with its new length); the
+// frame is then encoded anew.
 #pragma once
 
 #include <algorithm>
@@ -20,7 +22,7 @@ namespace ascorr::test {
 
 class RewritingLoopback {
 public:
-    using Rewrite = std::function<void(std::uint8_t type, std::uint8_t* payload, std::size_t& length)>;
+    using Rewrite = std::function<void(std::uint8_t& type, std::uint8_t* payload, std::size_t& length)>;
 
     explicit RewritingLoopback(Rewrite rewrite)
         : rewrite_(std::move(rewrite)),
@@ -41,9 +43,10 @@ private:
         std::uint8_t payload[link::kMaxPayload];
         std::size_t n = f.length;
         std::copy(f.payload, f.payload + n, payload);
-        rewrite_(f.type, payload, n);
+        std::uint8_t type = f.type;
+        rewrite_(type, payload, n);
         std::uint8_t wire[link::kMaxWire];
-        const std::size_t w = link::encode_frame(f.type, f.seq, payload, n, wire, sizeof wire);
+        const std::size_t w = link::encode_frame(type, f.seq, payload, n, wire, sizeof wire);
         for (std::size_t i = 0; i < w; ++i) {
             server_.on_byte(wire[i], reply);
         }

@@ -80,6 +80,34 @@ TEST(CalibHeadRotation, SameBitsAsEigensProduct) {
     }
 }
 
+// The IBA's atan2 with + − × ÷ and √ alone (portable_math.hpp's
+// atan2_upper, the same bits on the DPU as here) against the C library's
+// atan2 in long double, over the upper half-plane's angles and lengths:
+// within 2⁻⁵⁰ rad (2e-10″); its edges as atan2's.
+TEST(CalibPortableMath, Atan2UpperIsWithinItsBoundOfLongDouble) {
+    using calib::atan2_upper;
+    std::mt19937_64 rng(40);
+    std::uniform_real_distribution<double> angle(0.0, 3.14159265358979323846);
+    std::uniform_real_distribution<double> decade(-30.0, 30.0);
+    double worst = 0.0;
+    for (int i = 0; i < 200000; ++i) {
+        const double r = std::pow(10.0, decade(rng));
+        const double y = std::fabs(r * std::sin(angle(rng)));
+        const double x = r * std::cos(angle(rng) * (i % 2 == 0 ? 1.0 : 0.5));
+        const long double ref = std::atan2(static_cast<long double>(y), static_cast<long double>(x));
+        const auto err = static_cast<double>(std::fabs(static_cast<long double>(atan2_upper(y, x)) - ref));
+        worst = err <= worst ? worst : err;
+    }
+    EXPECT_LT(worst, 0x1p-50);
+    EXPECT_EQ(atan2_upper(0.0, 1.0), 0.0);
+    EXPECT_EQ(atan2_upper(0.0, 0.0), 0.0);
+    EXPECT_EQ(atan2_upper(1.0, 0.0), std::atan2(1.0, 0.0));
+    EXPECT_EQ(atan2_upper(0.0, -1.0), std::atan2(0.0, -1.0));
+    EXPECT_NEAR(atan2_upper(1.0, 1.0), std::atan2(1.0, 1.0), 0x1p-52);
+    EXPECT_TRUE(std::isnan(atan2_upper(std::nan(""), 1.0)));
+    EXPECT_TRUE(std::isnan(atan2_upper(1.0, std::nan(""))));
+}
+
 // F relative to A from C relative to A is F_icrf ⊗ A_icrf⁻¹ (frame.hpp q_f_a).
 TEST(CalibFrame, FRelativeToHeadAIsTheSameFrame) {
     std::mt19937_64 rng(8);

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -24,6 +25,7 @@
 #include "ascorr_link/server.hpp"
 #include "cli_run.hpp"
 #include "replay_recording.hpp"
+#include "rewriting_loopback.hpp"
 #include "test_support.hpp"
 
 namespace ascorr::test {
@@ -176,6 +178,45 @@ TEST(Replay, RestartWithItsHelloLostIsDetectedFromTheAnswer) {
 TEST(Replay, AnAnswerForAnotherSolutionIsNeverAccepted) {
     MisbehavingTarget target(-1, 10);
     check_against_host_core(target, 0);
+}
+
+// A request the target refuses is a LinkRefused with its result and the
+// request named; a report the target does not know (a firmware from before
+// it) is none, not an error; any other refusal of it is.
+TEST(Replay, RefusalsCarryTheirResultAndNameTheRequest) {
+    std::optional<std::uint8_t> rewrite_to;
+    std::size_t pad = 0;
+    RewritingLoopback target([&](std::uint8_t& type, std::uint8_t* payload, std::size_t& n) {
+        if (type != static_cast<std::uint8_t>(link::MessageType::kStackReportRequest)) {
+            return;
+        }
+        type = rewrite_to.value_or(type);
+        for (; pad > 0 && n < link::kMaxPayload; --pad) {
+            payload[n++] = 0U;
+        }
+    });
+    host::LinkClient<float> client(target.transport(), 50, 3);
+    client.connect();
+    ASSERT_TRUE(client.stack_report().has_value());  // in process: 0 of 0 bytes, not measured
+    EXPECT_EQ(client.stack_report()->size, 0U);
+    rewrite_to = std::uint8_t{0xEE};  // a type no target knows
+    EXPECT_FALSE(client.stack_report().has_value());
+    rewrite_to.reset();
+    pad = 1;  // the request with a payload it must not have
+    try {
+        (void)client.stack_report();
+        ADD_FAILURE() << "a refused stack report was accepted";
+    } catch (const host::LinkRefused& e) {
+        EXPECT_EQ(e.result(), link::AckResult::kBadPayload);
+        EXPECT_STREQ(e.what(), "stack report request refused by the target (result 2: bad payload)");
+    }
+    try {
+        (void)client.calib_sun_term(9);  // no such head
+        ADD_FAILURE() << "a Sun term of head 9 was answered";
+    } catch (const host::LinkRefused& e) {
+        EXPECT_EQ(e.result(), link::AckResult::kBadPayload);
+        EXPECT_NE(std::string(e.what()).find("calibration Sun term request refused"), std::string::npos) << e.what();
+    }
 }
 
 // A serial device without hardware: a pseudo-terminal whose master end is

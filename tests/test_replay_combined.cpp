@@ -131,7 +131,7 @@ TEST(ReplayCombined, TheCleanBitIsTheCombinationsSelection) {
 TEST(ReplayCombined, ATargetWithOtherMountingsIsCaught) {
     const auto dir = simulated("replay_combined_mutant");
     std::size_t twisted = 0;
-    RewritingLoopback target([&](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
+    RewritingLoopback target([&](std::uint8_t& type, std::uint8_t* payload, std::size_t& n) {
         link::MountingLoad m{};
         if (type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && link::decode(payload, n, m) &&
             m.head == 0U) {
@@ -208,7 +208,7 @@ TEST(ReplayCombined, AGateSetByTheGroundIsTheTargetsToo) {
         }
         // The length of each MOUNTING_LOAD build frame.
         std::vector<std::size_t> build_lengths;
-        RewritingLoopback target([&](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
+        RewritingLoopback target([&](std::uint8_t& type, std::uint8_t* payload, std::size_t& n) {
             if (type == static_cast<std::uint8_t>(link::MessageType::kMountingLoad) && n > 2U && payload[2] == 1U) {
                 build_lengths.push_back(n);
             }

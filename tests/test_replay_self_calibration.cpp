@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -240,7 +241,7 @@ TEST(ReplaySelfCalibration, AQuadraticInitialModelIsRefused) {
 // see.
 struct CleanBitEraser {
     explicit CleanBitEraser(std::uint32_t from_id)
-        : target([this, from_id](std::uint8_t type, std::uint8_t* payload, std::size_t& n) {
+        : target([this, from_id](std::uint8_t& type, std::uint8_t* payload, std::size_t& n) {
               link::SolutionIn<float> s{};
               if (type == static_cast<std::uint8_t>(link::MessageType::kSolutionIn) && link::decode(payload, n, s) &&
                   s.head == 1U && s.id >= from_id && (s.calib & link::kCalibClean) != 0U) {
@@ -277,6 +278,65 @@ TEST(ReplaySelfCalibration, ATargetThatLearnsOtherwiseIsCaught) {
     EXPECT_GT(s.version_mismatches + s.history_mismatches, 0U);
     EXPECT_GT(s.mismatches, 0U);  // rows corrected with no model instead of the host's
     EXPECT_NE(log.str().find("differs from the host's"), std::string::npos) << log.str();
+}
+
+// ---- A firmware from before a report: the target answers its request
+// kUnknownType (here: the request's type made one no target knows, so the
+// in-process server answers as such a firmware does).
+
+constexpr std::uint8_t kTypeNoTargetKnows = 0xEE;
+
+// A loopback target that does not know requests of type `unknown` (none:
+// it knows them all); counts them.
+struct TargetWithout {
+    explicit TargetWithout(std::optional<link::MessageType> unknown)
+        : target([this, unknown](std::uint8_t& type, std::uint8_t*, std::size_t&) {
+              if (unknown && type == static_cast<std::uint8_t>(*unknown)) {
+                  type = kTypeNoTargetKnows;
+                  ++asked;
+              }
+          }) {}
+    std::size_t asked = 0;
+    RewritingLoopback target;
+};
+
+// Its stack is not known; everything it corrected and learnt still is, and
+// the run's outputs are written (before STACK_REPORT the replay ended with
+// an error and lost them).
+TEST(ReplaySelfCalibration, ATargetBeforeTheStackReportStillReplays) {
+    const auto dir = simulated("replay_sc_before_stack");
+    TargetWithout old(link::MessageType::kStackReportRequest);
+    std::ostringstream log;
+    const host::ReplaySummary s = host::replay_over(options(dir, "link double"), old.target.transport(), log);
+    EXPECT_EQ(old.asked, 1U);
+    expect_agreement(s);
+    EXPECT_EQ(s.target_stack_size, 0U);
+    EXPECT_NE(log.str().find("the target does not report its stack (firmware before STACK_REPORT)"), std::string::npos)
+        << log.str();
+    expect_same_as_correct(dir, "float");
+}
+
+// Its Sun learner cannot be compared: the replay ends, but does not agree.
+// Control: the same target answering it agrees.
+TEST(ReplaySelfCalibration, ATargetThatCannotReportItsSunLearnerDoesNotMatch) {
+    const auto dir = simulated("replay_sc_before_sun_report", " --orbit-term 0.8");
+    host::ReplayOptions o = options(dir, "link double");
+    o.sun_auto = true;
+    for (const bool reports : {true, false}) {
+        TargetWithout old(reports ? std::nullopt
+                                  : std::optional<link::MessageType>(link::MessageType::kSunLearnerReportRequest));
+        std::ostringstream log;
+        const host::ReplaySummary s = host::replay_over(o, old.target.transport(), log);
+        EXPECT_EQ(old.asked, reports ? 0U : 1U);
+        EXPECT_EQ(s.returned, 2751U);
+        EXPECT_EQ(s.mismatches, 0U) << log.str();
+        EXPECT_EQ(s.report_matches, reports) << log.str();
+        EXPECT_EQ(
+            log.str().find("does not report its Sun learner (firmware before SUN_LEARNER_REPORT)") != std::string::npos,
+            !reports)
+            << log.str();
+        EXPECT_TRUE(std::filesystem::exists(o.out));
+    }
 }
 
 TEST(ReplaySelfCalibration, OptionsAreChecked) {
@@ -437,6 +497,26 @@ TEST_P(ReplaySelfCalibrationQemu, ALaggedEstimatorAsTheHost) {
     const host::ReplaySummary s = replay_lagged(dir, std::string(board.replay), std::string(board.replay) + ": ");
     expect_lagged_as_the_host(dir, s, board_scalar(board));
     EXPECT_EQ(s.restarts, 0U);
+}
+
+// The Sun learner beside the estimator on each board: its report
+// (SUN_LEARNER_REPORT) as the host's learner at its last epoch, every answer
+// and model as the host's, and the link image's stack, painted at boot and
+// now holding the learner's solve steps, within 1 KiB to three quarters of
+// its size (as ReplayQemu.CleanLink's without the learner).
+TEST_P(ReplaySelfCalibrationQemu, TheSunLearnerAsTheHostWithinTheStack) {
+    const host::QemuTarget& board = GetParam();
+    const auto dir = simulated("replay_sc_sun_" + board_name(board), " --orbit-term 0.8");
+    host::ReplayOptions o = options(dir, std::string(board.replay));
+    o.sun_auto = true;
+    o.timeout_ms = 2000;  // an answer may wait for a solve's rest (settle)
+    const host::ReplaySummary s = replay_on_board(board, o);
+    expect_agreement(s);
+    EXPECT_EQ(s.restarts, 0U);
+    EXPECT_EQ(s.target_stack_size, 8192U);
+    EXPECT_GE(s.target_stack_bytes, 1024U);
+    EXPECT_LE(4U * s.target_stack_bytes, 3U * s.target_stack_size);
+    RecordProperty("target_stack_bytes", std::to_string(s.target_stack_bytes));
 }
 
 INSTANTIATE_TEST_SUITE_P(Boards, ReplaySelfCalibrationQemu, ::testing::ValuesIn(host::kQemuTargets), board_test_name);

@@ -30,11 +30,46 @@ std::vector<std::uint8_t> encoded(const M& m) {
     return {p, p + n};
 }
 
+const char* ack_result_name(link::AckResult r) {
+    switch (r) {
+        case link::AckResult::kOk:
+            return "ok";
+        case link::AckResult::kUnknownType:
+            return "unknown message type";
+        case link::AckResult::kBadPayload:
+            return "bad payload";
+    }
+    return "unknown result";
+}
+
+LinkRefused refusal(const char* what, link::AckResult r) {
+    return {std::string(what) + " refused by the target (result " + std::to_string(static_cast<int>(r)) + ": " +
+                ack_result_name(r) + ")",
+            r};
+}
+
 void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
     link::Ack a{};
-    if (!link::decode(p.data(), p.size(), a) || a.result != link::AckResult::kOk) {
-        throw LinkError(std::string(what) + " refused by the target (result " +
-                        std::to_string(static_cast<int>(a.result)) + ")");
+    if (!link::decode(p.data(), p.size(), a)) {
+        throw LinkError(std::string("malformed acknowledgement of ") + what + " from the target (" +
+                        std::to_string(p.size()) + " bytes)");
+    }
+    if (a.result != link::AckResult::kOk) {
+        throw refusal(what, a.result);
+    }
+}
+
+// m's answer, or none when the target does not know m's type (a firmware
+// from before it); any other refusal propagates.
+template <typename F>
+auto unless_unknown(F ask) -> std::optional<decltype(ask())> {
+    try {
+        return ask();
+    } catch (const LinkRefused& e) {
+        if (e.result() != link::AckResult::kUnknownType) {
+            throw;
+        }
+        return std::nullopt;
     }
 }
 
@@ -192,11 +227,9 @@ typename LinkClient<T>::Request LinkClient<T>::begin(const Message& m, link::Mes
     std::uint8_t wire[link::kMaxWire];
     const std::size_t w = link::encode_frame(static_cast<std::uint8_t>(m.type), seq_, m.payload.data(),
                                              m.payload.size(), wire, sizeof wire);
-    return Request{answer,
-                   seq_,
-                   {wire, wire + w},
-                   0,
-                   std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs)};
+    return Request{m.what, answer,
+                   seq_,   {wire, wire + w},
+                   0,      std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs)};
 }
 
 // Sends r until its answer arrives (returned) or the target announces a
@@ -289,8 +322,7 @@ std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear_frame(const Req
     if (f.seq == r.seq && t == link::MessageType::kAck) {
         link::Ack a{};
         if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
-            throw LinkError("request type " + std::to_string(static_cast<int>(r.answer)) +
-                            " refused by the target (result " + std::to_string(static_cast<int>(a.result)) + ")");
+            throw refusal(r.what, a.result);
         }
     }
     ++stats_.stale_answers;
@@ -507,18 +539,23 @@ link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
 }
 
 template <typename T>
-link::StackReport LinkClient<T>::stack_report() {
-    return answer_of<link::StackReport>(
-        request({link::MessageType::kStackReportRequest, {}, "stack report"}, link::MessageType::kStackReport),
-        "stack report");
+std::optional<link::StackReport> LinkClient<T>::stack_report() {
+    return unless_unknown([this] {
+        return answer_of<link::StackReport>(
+            request({link::MessageType::kStackReportRequest, {}, "stack report request"},
+                    link::MessageType::kStackReport),
+            "stack report");
+    });
 }
 
 template <typename T>
-link::SunLearnerReport LinkClient<T>::sun_learner_report() {
-    return answer_of<link::SunLearnerReport>(
-        request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report"},
-                link::MessageType::kSunLearnerReport),
-        "Sun learner report");
+std::optional<link::SunLearnerReport> LinkClient<T>::sun_learner_report() {
+    return unless_unknown([this] {
+        return answer_of<link::SunLearnerReport>(
+            request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report request"},
+                    link::MessageType::kSunLearnerReport),
+            "Sun learner report");
+    });
 }
 
 template <typename T>

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -222,6 +223,34 @@ void check_model_version(LinkClient<T>& client, const std::string& file, const S
     }
 }
 
+// The target's learner: its report, its candidate's coefficients by their
+// CRC, against the host's as of the last epoch (the target's data do not
+// end). Its takes settled late are said, not compared: the target spreads
+// its solve over cycles, the host solves at once. A target that cannot
+// report its learner (a firmware before SUN_LEARNER_REPORT) does not match:
+// what it learnt is unknown. Returns the target's report, if any.
+template <typename T>
+std::optional<calib::SunLearnReport> compare_sun_learner(LinkClient<T>& client, const calib::SunLearnReport& host,
+                                                         ReplaySummary& sum, std::ostream& log) {
+    const std::optional<link::SunLearnerReport> sun = client.sun_learner_report();
+    if (!sun) {
+        sum.report_matches = false;
+        log << "ascorr replay: the target does not report its Sun learner (firmware before SUN_LEARNER_REPORT): "
+               "what it learnt cannot be compared\n";
+        return std::nullopt;
+    }
+    const std::string difference = first_sun_report_difference(*sun, host);
+    if (!difference.empty()) {
+        sum.report_matches = false;
+        log << "ascorr replay: the target's Sun learner report differs from the host's: " << difference << "\n";
+    }
+    if (sun->report.late > 0U) {
+        log << "ascorr replay: the target's Sun learner finished " << sun->report.late
+            << " solves in a cycle (idle time had not; at most " << sun->report.late_steps << " steps in one)\n";
+    }
+    return sun->report;
+}
+
 // The end of a self-calibrating replay: the host's models the target never
 // used, and the final report.
 template <typename T>
@@ -244,16 +273,8 @@ void finish_self_calibration(LinkClient<T>& client, ReplaySummary& sum, const st
     SelfCalibration on_target = host_sc;
     on_target.history = target_history;
     on_target.report = r;
-    // The target's learner: its report, its candidate's coefficients by their
-    // CRC, against the host's as of the last epoch (the target's data do not end).
     if (host_sc.sun_learnt_at_last_epoch) {
-        const link::SunLearnerReport sun = client.sun_learner_report();
-        const std::string sun_difference = first_sun_report_difference(sun, *host_sc.sun_learnt_at_last_epoch);
-        if (!sun_difference.empty()) {
-            sum.report_matches = false;
-            log << "ascorr replay: the target's Sun learner report differs from the host's: " << sun_difference << "\n";
-        }
-        on_target.sun_learnt = sun.report;
+        on_target.sun_learnt = compare_sun_learner(client, *host_sc.sun_learnt_at_last_epoch, sum, log);
     }
     log << "ascorr replay: on the target, " << describe(on_target) << "\n";
 }

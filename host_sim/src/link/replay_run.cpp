@@ -207,10 +207,16 @@ void count_link(ReplaySummary& sum, const LinkStats& st, const ReplayedRows& rep
 }
 
 // The target's stack at the end of the run (STACK_REPORT), into the summary
-// and the log: its deepest use since boot, against its size.
+// and the log: its deepest use since boot, against its size. A firmware
+// from before the message is said so; its run's outputs stand.
 template <typename T>
 void report_stack(LinkClient<T>& client, ReplaySummary& sum, std::ostream& log) {
-    const link::StackReport st = client.stack_report();
+    const std::optional<link::StackReport> report = client.stack_report();
+    if (!report) {
+        log << "ascorr replay: the target does not report its stack (firmware before STACK_REPORT)\n";
+        return;
+    }
+    const link::StackReport& st = *report;
     sum.target_stack_bytes = st.high_water;
     sum.target_stack_size = st.size;
     if (st.size == 0U) {

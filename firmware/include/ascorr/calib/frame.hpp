@@ -19,7 +19,7 @@
 // Domain: the heads' boresights are far from parallel or opposite (the µASC's
 // are 60°–120° apart); degenerate inputs give non-finite results, which the
 // callers' finiteness checks refuse.
-// No allocation, no loop beyond the fixed 3 × 3.
+// No allocation, no loop beyond the fixed 3 × 3 (and atan2_upper's 11 terms).
 #pragma once
 
 #include <cmath>
@@ -27,6 +27,7 @@
 #include "../core/constants.hpp"
 #include "../core/quaternion.hpp"
 #include "../core/vector3.hpp"
+#include "portable_math.hpp"
 
 namespace ascorr::calib {
 
@@ -69,10 +70,12 @@ inline Vector3<double> boresight_of(const Quaternion<double>& q) noexcept {
 }
 
 // The angle between two unit vectors (arcsec; the IBA of two boresights):
-// atan2 of |a×b| and a·b, which keeps full precision near 0 and 90°, unlike acos.
+// atan2 of |a×b| and a·b, which keeps full precision near 0 and 90°, unlike acos;
+// portable_math.hpp's, so that the DPU's Sun learner and lag search score
+// the IBAs with the host's bits (libm's atan2 differs in the last bit).
 inline double angle_arcsec(const Vector3<double>& a, const Vector3<double>& b) noexcept {
     const Vector3<double> c = cross(a, b);
-    return std::atan2(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
+    return atan2_upper(std::sqrt(squared_norm(c)), dot(a, b)) * kRadToArcsec;
 }
 
 // A rotation matrix as a unit quaternion with the same rotation (Shepperd's

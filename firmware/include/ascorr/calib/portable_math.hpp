@@ -1,14 +1,17 @@
 // ascorr/calib/portable_math.hpp: the elementary functions the estimator
-// (and pipeline/temperature_lag.hpp) need beyond +, −, ×, ÷ and √, written
+// (and pipeline/temperature_lag.hpp, and the IBA of frame.hpp's
+// angle_arcsec) need beyond +, −, ×, ÷ and √, written
 // with those alone, so that the DPU
 // (picolibc, software double on the M3) and the host (glibc, SSE2) compute
 // the same bits: IEEE 754 rounds each basic operation and √ correctly
-// everywhere, while libm's exp and hypot are not correctly rounded and differ
+// everywhere, while libm's exp, hypot and atan2 are not correctly rounded and differ
 // between libraries in the last bit. The on-board model history is checked
 // bit for bit against the host's (tests/target/flight_expectation.cpp).
 #pragma once
 
 #include <cmath>
+
+#include "../core/constants.hpp"
 
 namespace ascorr::calib {
 
@@ -87,6 +90,41 @@ inline double hypot2(double p, double q) noexcept {
     }
     const double t = b / a;
     return a * std::sqrt(1.0 + t * t);
+}
+
+// atan(t) for |t| ≤ 1: t halved twice by the half-angle identity
+// atan t = 2·atan(t / (1 + √(1 + t²))), so that |t| ≤ tan(π/16) < 0.199,
+// then the Taylor polynomial t − t³/3 + … − t²³/23 (truncation
+// t²⁴/25 ≤ 0.0396¹²/25 < 2e-19 of |t|): relative error ≲ 6·2⁻⁵³ (measured
+// against long double; tests/test_calib.cpp bounds atan2_upper), two √ and
+// two ÷ (libm's atan does about as much work, with other bits).
+inline double atan_unit(double t) noexcept {
+    t = t / (1.0 + std::sqrt(1.0 + t * t));
+    t = t / (1.0 + std::sqrt(1.0 + t * t));
+    const double u = t * t;
+    double p = 1.0 / 23.0;
+    constexpr double kOdd[] = {1.0 / 21.0, 1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0 / 13.0, 1.0 / 11.0,
+                               1.0 / 9.0,  1.0 / 7.0,  1.0 / 5.0,  1.0 / 3.0,  1.0};
+    for (const double c : kOdd) {  // Horner, alternating: c − u·p
+        p = c - u * p;
+    }
+    return 4.0 * (t * p);
+}
+
+// atan2(y, x) for y ≥ 0, in [0, π] (the angle between two vectors from
+// |a×b| and a·b): atan_unit of the smaller over the larger of y and |x|,
+// then reflected, so that every argument is ≤ 1 and nothing cancels but
+// π − a (absolute error ≲ 2⁻⁵⁰ rad < 2e-10″). 0 for y = x = 0, NaN for NaN.
+inline double atan2_upper(double y, double x) noexcept {
+    const double ax = std::fabs(x);
+    if (y == 0.0 && ax == 0.0) {
+        return 0.0;
+    }
+    if (y <= ax) {
+        const double a = atan_unit(y / ax);
+        return x > 0.0 ? a : kPi - a;
+    }
+    return kPi / 2.0 - atan_unit(x / y);  // NaN y or x: NaN
 }
 
 }  // namespace ascorr::calib

@@ -33,6 +33,7 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "ascorr_host/link/link_transport.hpp"
@@ -54,6 +55,18 @@ struct LinkStats {
 class LinkError : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
+};
+
+// The target answered a request with an ACK that is not kOk: it refused it
+// (kBadPayload) or does not know its type (kUnknownType: a firmware from
+// before that message). The caller decides which of these it can live with.
+class LinkRefused : public LinkError {
+public:
+    LinkRefused(const std::string& what, link::AckResult result) : LinkError(what), result_(result) {}
+    link::AckResult result() const noexcept { return result_; }
+
+private:
+    link::AckResult result_;
 };
 
 template <typename T>
@@ -119,14 +132,15 @@ public:
     // Head h of the estimator's active model (protocol v4).
     link::CalibModel calib_model(std::uint8_t head);
     // Head h's Sun term of the active model's version (start_calibration's
-    // learn_sun; a target before it: a LinkError, its unknown type).
+    // learn_sun; a target before it: a LinkRefused, kUnknownType).
     link::CalibSunTerm calib_sun_term(std::uint8_t head);
     // The target's Sun learner (SUN_LEARNER_REPORT; its candidate's
-    // coefficients by their CRC only; a target before it: a LinkError).
-    link::SunLearnerReport sun_learner_report();
+    // coefficients by their CRC only); none: a firmware before the message
+    // (it answered kUnknownType). Any other refusal is a LinkRefused.
+    std::optional<link::SunLearnerReport> sun_learner_report();
     // The target's stack high-water mark and size (STACK_REPORT; 0, 0: it
-    // does not measure it; a target before it: a LinkError).
-    link::StackReport stack_report();
+    // does not measure it); none: a firmware before the message, as above.
+    std::optional<link::StackReport> stack_report();
 
     // The combination (protocol v5): the mountings, head by head, built into
     // the target's combiner (a LinkError when the target refuses them); then
@@ -151,6 +165,7 @@ private:
     // A request on the wire: its frame (with its sequence number, kept across
     // resends), the answer it wants and how far its attempts have gone.
     struct Request {
+        const char* what;  // the Message's, for a refusal
         link::MessageType answer;
         std::uint16_t seq;
         std::vector<std::uint8_t> wire;

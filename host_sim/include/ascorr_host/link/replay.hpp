@@ -100,7 +100,8 @@ struct ReplaySummary {
     std::size_t combined_mismatches = 0;            // epochs whose combination differs from the host's
     double combination_instructions_per_epoch = 0;  // mean over epochs of two or more heads
     // The target's stack at the end (STACK_REPORT): the most bytes used since
-    // its boot, of its size; 0, 0: the target does not measure it.
+    // its boot, of its size; 0, 0: the target does not measure it, or (a
+    // firmware from before the message) does not report it.
     std::uint32_t target_stack_bytes = 0;
     std::uint32_t target_stack_size = 0;
 };
