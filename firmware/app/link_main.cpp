@@ -75,10 +75,9 @@ struct SysTickCounter {
 std::uint32_t SysTickCounter::last = 0U;
 std::uint32_t SysTickCounter::total = 0U;
 
-// The stack painted at boot, before the static constructors (the server's
-// among them), and its mark scanned for STACK_REPORT (stack_watch.hpp: at
-// most 4096 words).
-__attribute__((section(".preinit_array"), used)) void (*const g_paint_at_boot)() = &stack_watch::paint;
+// The stack's mark, scanned for STACK_REPORT (stack_watch.hpp: at most 4096
+// words; painted at boot by stack_watch_boot.cpp, before the static
+// constructors, the server's among them).
 struct PaintedStack {
     link::StackReport operator()() const noexcept { return {stack_watch::high_water(), stack_watch::size()}; }
 };

@@ -47,9 +47,6 @@ std::uint32_t g_cycle_tick = 0U;  // g_ticks when the current cycle began
 // the period: an eighth, some 8 of its worst steps (docs/figures.md).
 constexpr std::uint32_t kIdleReserve = kPeriod / 8U;
 
-// The stack painted at boot, before the static constructors (stack_watch.hpp).
-__attribute__((section(".preinit_array"), used)) void (*const g_paint_at_boot)() = &stack_watch::paint;
-
 FlightCycle g_flight;  // the service, the GNSS feed, the solutions and their record (flight_cycle.hpp)
 
 // SysTick counts spent in each part (40 instructions each under QEMU).
