@@ -80,10 +80,12 @@ TEST(CalibHeadRotation, SameBitsAsEigensProduct) {
     }
 }
 
-// The IBA's atan2 with + − × ÷ and √ alone (portable_math.hpp's
-// atan2_upper, the same bits on the DPU as here) against the C library's
-// atan2 in long double, over the upper half-plane's angles and lengths:
-// within 2⁻⁵⁰ rad (2e-10″); its edges as atan2's.
+// The IBA's atan2 with + − × ÷ alone (portable_math.hpp's atan2_upper, the
+// same bits on the DPU as here) against the C library's atan2 in long
+// double, over the upper half-plane's angles and lengths: within 2⁻⁵⁰ rad
+// (2e-10″). Its bits are pinned at two points (a reordered polynomial or a
+// fused multiply-add would move them, and the DPU's with them), and its
+// edges are as its comment says.
 TEST(CalibPortableMath, Atan2UpperIsWithinItsBoundOfLongDouble) {
     using calib::atan2_upper;
     std::mt19937_64 rng(40);
@@ -99,13 +101,22 @@ TEST(CalibPortableMath, Atan2UpperIsWithinItsBoundOfLongDouble) {
         worst = err <= worst ? worst : err;
     }
     EXPECT_LT(worst, 0x1p-50);
+    EXPECT_EQ(atan2_upper(0.6309296214223089, -0.7758400690940769), 0x1.3abb5418d3e35p+1);
+    EXPECT_EQ(atan2_upper(0.3, 0.9), 0x1.4978fa3269ee1p-2);
     EXPECT_EQ(atan2_upper(0.0, 1.0), 0.0);
     EXPECT_EQ(atan2_upper(0.0, 0.0), 0.0);
+    EXPECT_EQ(atan2_upper(0.0, -0.0), 0.0);
     EXPECT_EQ(atan2_upper(1.0, 0.0), std::atan2(1.0, 0.0));
     EXPECT_EQ(atan2_upper(0.0, -1.0), std::atan2(0.0, -1.0));
+    EXPECT_EQ(atan2_upper(-0.0, -1.0), std::atan2(0.0, -1.0));
     EXPECT_NEAR(atan2_upper(1.0, 1.0), std::atan2(1.0, 1.0), 0x1p-52);
+    const double inf = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(atan2_upper(inf, 1.0), std::atan2(inf, 1.0));
+    EXPECT_TRUE(std::isnan(atan2_upper(inf, inf)));
+    EXPECT_TRUE(std::isnan(atan2_upper(-1.0, 1.0)));
     EXPECT_TRUE(std::isnan(atan2_upper(std::nan(""), 1.0)));
     EXPECT_TRUE(std::isnan(atan2_upper(1.0, std::nan(""))));
+    EXPECT_TRUE(std::isnan(calib::atan_unit(1.5)));
 }
 
 // F relative to A from C relative to A is F_icrf ⊗ A_icrf⁻¹ (frame.hpp q_f_a).

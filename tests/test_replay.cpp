@@ -219,6 +219,47 @@ TEST(Replay, RefusalsCarryTheirResultAndNameTheRequest) {
     }
 }
 
+// An ACK that does not decode (here: cut to its first byte) is an error of
+// its own, naming the request, not a refusal and not a stale answer to
+// resend for: the answer cannot be read.
+TEST(Replay, AMalformedAcknowledgementNamesTheRequest) {
+    using Counter = std::uint32_t (*)();
+    link::LinkServer<float, Counter> server(0x54455354U, [] { return std::uint32_t{0}; });
+    link::FrameDecoder from_target;
+    bool cut_acks = false;
+    host::LoopbackTransport transport([&](const std::uint8_t* p, std::size_t n,
+                                          const host::LoopbackTransport::Reply& reply) {
+        const auto cut = [&](const std::uint8_t* q, std::size_t m) {
+            for (std::size_t i = 0; i < m; ++i) {
+                if (from_target.push(q[i]) != link::FrameDecoder::Event::kFrame) {
+                    continue;
+                }
+                const link::Frame& f = from_target.frame();
+                const bool ack = f.type == static_cast<std::uint8_t>(link::MessageType::kAck);
+                std::uint8_t wire[link::kMaxWire];
+                const std::size_t w =
+                    link::encode_frame(f.type, f.seq, f.payload, cut_acks && ack ? 1U : f.length, wire, sizeof wire);
+                reply(wire, w);
+            }
+        };
+        for (std::size_t i = 0; i < n; ++i) {
+            server.on_byte(p[i], cut);
+        }
+    });
+    host::LinkClient<float> client(transport, 50, 3);
+    client.connect();
+    cut_acks = true;
+    try {
+        (void)client.calib_sun_term(9);  // refused (no such head), its ACK cut
+        ADD_FAILURE() << "a malformed acknowledgement was accepted";
+    } catch (const host::LinkRefused& e) {
+        ADD_FAILURE() << "a malformed acknowledgement read as a refusal: " << e.what();
+    } catch (const host::LinkError& e) {
+        EXPECT_STREQ(e.what(), "malformed acknowledgement of calibration Sun term request from the target (1 bytes)");
+    }
+    EXPECT_EQ(client.stats().stale_answers, 0U);
+}
+
 // A serial device without hardware: a pseudo-terminal whose master end is
 // served, in a thread, by the firmware's LinkServer<T>, as a DPU on a UART
 // would. The host opens the slave end (/dev/pts/N) as it would /dev/ttyUSB0.

@@ -42,31 +42,36 @@ const char* ack_result_name(link::AckResult r) {
     return "unknown result";
 }
 
-LinkRefused refusal(const char* what, link::AckResult r) {
+LinkRefused refusal(const char* what, link::MessageType type, link::AckResult r) {
     return {std::string(what) + " refused by the target (result " + std::to_string(static_cast<int>(r)) + ": " +
                 ack_result_name(r) + ")",
-            r};
+            type, r};
 }
 
-void expect_ok(const std::vector<std::uint8_t>& p, const char* what) {
+// An ACK to the request `what` of type `type` (its payload, n bytes):
+// returns when it is ok; a LinkError when it does not decode, a
+// LinkRefused when it refuses.
+void expect_ok(const std::uint8_t* p, std::size_t n, const char* what, link::MessageType type) {
     link::Ack a{};
-    if (!link::decode(p.data(), p.size(), a)) {
-        throw LinkError(std::string("malformed acknowledgement of ") + what + " from the target (" +
-                        std::to_string(p.size()) + " bytes)");
+    if (!link::decode(p, n, a)) {
+        throw LinkError(std::string("malformed acknowledgement of ") + what + " from the target (" + std::to_string(n) +
+                        " bytes)");
     }
     if (a.result != link::AckResult::kOk) {
-        throw refusal(what, a.result);
+        throw refusal(what, type, a.result);
     }
 }
 
-// m's answer, or none when the target does not know m's type (a firmware
-// from before it); any other refusal propagates.
+// The answer of `ask` (a request of type `type`), or none when the target
+// does not know that type (a firmware from before it). Any other refusal
+// propagates, a refusal of `type` for another reason, and one of another
+// request on the way (a restart's restore).
 template <typename F>
-auto unless_unknown(F ask) -> std::optional<decltype(ask())> {
+auto unless_unknown(link::MessageType type, F ask) -> std::optional<decltype(ask())> {
     try {
         return ask();
     } catch (const LinkRefused& e) {
-        if (e.result() != link::AckResult::kUnknownType) {
+        if (e.result() != link::AckResult::kUnknownType || e.request() != type) {
             throw;
         }
         return std::nullopt;
@@ -227,9 +232,13 @@ typename LinkClient<T>::Request LinkClient<T>::begin(const Message& m, link::Mes
     std::uint8_t wire[link::kMaxWire];
     const std::size_t w = link::encode_frame(static_cast<std::uint8_t>(m.type), seq_, m.payload.data(),
                                              m.payload.size(), wire, sizeof wire);
-    return Request{m.what, answer,
-                   seq_,   {wire, wire + w},
-                   0,      std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs)};
+    return Request{m.what,
+                   m.type,
+                   answer,
+                   seq_,
+                   {wire, wire + w},
+                   0,
+                   std::chrono::steady_clock::now() + std::chrono::milliseconds(kMinPatienceMs)};
 }
 
 // Sends r until its answer arrives (returned) or the target announces a
@@ -320,10 +329,7 @@ std::optional<typename LinkClient<T>::Heard> LinkClient<T>::hear_frame(const Req
         return Heard::kAnswer;
     }
     if (f.seq == r.seq && t == link::MessageType::kAck) {
-        link::Ack a{};
-        if (link::decode(f.payload, f.length, a) && a.result != link::AckResult::kOk) {
-            throw refusal(r.what, a.result);
-        }
+        expect_ok(f.payload, f.length, r.what, r.type);  // ok: not the answer wanted, stale
     }
     ++stats_.stale_answers;
     return std::nullopt;
@@ -346,7 +352,8 @@ std::vector<std::uint8_t> LinkClient<T>::request(const Message& m, link::Message
 
 template <typename T>
 void LinkClient<T>::update(const Message& m) {
-    expect_ok(request(m, link::MessageType::kAck), m.what);
+    const std::vector<std::uint8_t> ack = request(m, link::MessageType::kAck);
+    expect_ok(ack.data(), ack.size(), m.what, m.type);
 }
 
 // In the order a restore sends them: models and their Sun terms, velocity, the service's horizon, state,
@@ -416,7 +423,7 @@ bool LinkClient<T>::restore_round() {
         while (!(a = exchange(r))) {
             restarted = true;
         }
-        expect_ok(*a, m.what);
+        expect_ok(a->data(), a->size(), m.what, m.type);
     }
     return restarted;
 }
@@ -540,7 +547,7 @@ link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
 
 template <typename T>
 std::optional<link::StackReport> LinkClient<T>::stack_report() {
-    return unless_unknown([this] {
+    return unless_unknown(link::MessageType::kStackReportRequest, [this] {
         return answer_of<link::StackReport>(
             request({link::MessageType::kStackReportRequest, {}, "stack report request"},
                     link::MessageType::kStackReport),
@@ -550,7 +557,7 @@ std::optional<link::StackReport> LinkClient<T>::stack_report() {
 
 template <typename T>
 std::optional<link::SunLearnerReport> LinkClient<T>::sun_learner_report() {
-    return unless_unknown([this] {
+    return unless_unknown(link::MessageType::kSunLearnerReportRequest, [this] {
         return answer_of<link::SunLearnerReport>(
             request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report request"},
                     link::MessageType::kSunLearnerReport),

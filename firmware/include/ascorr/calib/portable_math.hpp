@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "../core/constants.hpp"
 
@@ -92,31 +93,46 @@ inline double hypot2(double p, double q) noexcept {
     return a * std::sqrt(1.0 + t * t);
 }
 
-// atan(t) for |t| ≤ 1: t halved twice by the half-angle identity
-// atan t = 2·atan(t / (1 + √(1 + t²))), so that |t| ≤ tan(π/16) < 0.199,
-// then the Taylor polynomial t − t³/3 + … − t²³/23 (truncation
-// t²⁴/25 ≤ 0.0396¹²/25 < 2e-19 of |t|): relative error ≲ 6·2⁻⁵³ (measured
-// against long double; tests/test_calib.cpp bounds atan2_upper), two √ and
-// two ÷ (libm's atan does about as much work, with other bits).
+// atan(t) for |t| ≤ 1 (NaN beyond, and for NaN). |t| is reduced to
+// r = (|t| − c)/(1 + c·|t|), c = k/4 the nearest of 0, ¼, ½, ¾, 1, so that
+// |r| ≤ ⅛ and atan|t| = atan c + atan r; |t| − c is exact (Sterbenz), c·|t|
+// too but for c = ¾. atan r is the Taylor polynomial r − r³/3 + … + r¹⁷/17
+// (truncation r¹⁹/19 ≤ 2⁻⁵⁷/19 of |r|); atan c is a double and its
+// remainder (kAtanQuarterHi/Lo). One ÷ and no √: relative error ≲ 4·2⁻⁵³
+// (measured against long double; tests/test_calib.cpp bounds atan2_upper).
+inline constexpr double kAtanQuarterHi[5] = {0.0, 0x1.f5b75f92c80ddp-3, 0x1.dac670561bb4fp-2, 0x1.4978fa3269ee1p-1,
+                                             0x1.921fb54442d18p-1};  // atan(k/4) to the nearest double
+inline constexpr double kAtanQuarterLo[5] = {0.0, 0x1.8ab6e3cf7afbdp-57, 0x1.a2b7f222f65e2p-56, 0x1.2419a87f2a458p-56,
+                                             0x1.1a62633145c07p-55};  // atan(k/4) − Hi (mpmath, 50 digits)
 inline double atan_unit(double t) noexcept {
-    t = t / (1.0 + std::sqrt(1.0 + t * t));
-    t = t / (1.0 + std::sqrt(1.0 + t * t));
-    const double u = t * t;
-    double p = 1.0 / 23.0;
-    constexpr double kOdd[] = {1.0 / 21.0, 1.0 / 19.0, 1.0 / 17.0, 1.0 / 15.0, 1.0 / 13.0, 1.0 / 11.0,
-                               1.0 / 9.0,  1.0 / 7.0,  1.0 / 5.0,  1.0 / 3.0,  1.0};
-    for (const double c : kOdd) {  // Horner, alternating: c − u·p
-        p = c - u * p;
+    const double a = std::fabs(t);
+    if (!(a <= 1.0)) {
+        return std::numeric_limits<double>::quiet_NaN();  // out of the domain, or NaN given
     }
-    return 4.0 * (t * p);
+    const auto k = static_cast<int>(4.0 * a + 0.5);  // 0 … 4: a ≤ 1, no overflow
+    const double c = 0.25 * k;
+    const double r = (a - c) / (1.0 + c * a);
+    const double u = r * r;
+    double p = 1.0 / 17.0;
+    constexpr double kOdd[] = {1.0 / 15.0, 1.0 / 13.0, 1.0 / 11.0, 1.0 / 9.0, 1.0 / 7.0, 1.0 / 5.0, 1.0 / 3.0, 1.0};
+    for (const double co : kOdd) {  // Horner, alternating: co − u·p
+        p = co - u * p;
+    }
+    const double at = kAtanQuarterHi[k] + (kAtanQuarterLo[k] + r * p);
+    return t < 0.0 ? -at : at;
 }
 
-// atan2(y, x) for y ≥ 0, in [0, π] (the angle between two vectors from
-// |a×b| and a·b): atan_unit of the smaller over the larger of y and |x|,
-// then reflected, so that every argument is ≤ 1 and nothing cancels but
-// π − a (absolute error ≲ 2⁻⁵⁰ rad < 2e-10″). 0 for y = x = 0, NaN for NaN.
+// atan2(y, x) in the upper half-plane, y ≥ 0 (the angle between two vectors
+// from |a×b| and a·b): [0, π]. atan_unit of the smaller over the larger of y
+// and |x|, then reflected, so that every argument is ≤ 1 and nothing cancels
+// but π − a (absolute error ≲ 2⁻⁵⁰ rad < 2e-10″). Its edges: 0 for y = 0 and
+// x ≥ ±0 (atan2 gives π for x = −0), π for x < 0; NaN for y < 0, for NaN and
+// for y = |x| = ∞ (atan2: π/4, 3π/4).
 inline double atan2_upper(double y, double x) noexcept {
     const double ax = std::fabs(x);
+    if (!(y >= 0.0)) {
+        return std::numeric_limits<double>::quiet_NaN();  // not the upper half-plane, or NaN
+    }
     if (y == 0.0 && ax == 0.0) {
         return 0.0;
     }
@@ -124,7 +140,7 @@ inline double atan2_upper(double y, double x) noexcept {
         const double a = atan_unit(y / ax);
         return x > 0.0 ? a : kPi - a;
     }
-    return kPi / 2.0 - atan_unit(x / y);  // NaN y or x: NaN
+    return kPi / 2.0 - atan_unit(x / y);  // NaN x: NaN
 }
 
 }  // namespace ascorr::calib

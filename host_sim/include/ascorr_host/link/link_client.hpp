@@ -59,13 +59,17 @@ public:
 
 // The target answered a request with an ACK that is not kOk: it refused it
 // (kBadPayload) or does not know its type (kUnknownType: a firmware from
-// before that message). The caller decides which of these it can live with.
+// before that message). The caller decides which of these it can live with,
+// for which request (a restart's restore may refuse another on the way).
 class LinkRefused : public LinkError {
 public:
-    LinkRefused(const std::string& what, link::AckResult result) : LinkError(what), result_(result) {}
+    LinkRefused(const std::string& what, link::MessageType request, link::AckResult result)
+        : LinkError(what), request_(request), result_(result) {}
+    link::MessageType request() const noexcept { return request_; }
     link::AckResult result() const noexcept { return result_; }
 
 private:
+    link::MessageType request_;
     link::AckResult result_;
 };
 
@@ -159,13 +163,14 @@ private:
     struct Message {
         link::MessageType type;
         std::vector<std::uint8_t> payload;
-        const char* what;
+        const char* what;  // a string literal: requests keep the pointer
     };
 
     // A request on the wire: its frame (with its sequence number, kept across
     // resends), the answer it wants and how far its attempts have gone.
     struct Request {
-        const char* what;  // the Message's, for a refusal
+        const char* what;  // the Message's (a literal: static storage), for a refusal
+        link::MessageType type;
         link::MessageType answer;
         std::uint16_t seq;
         std::vector<std::uint8_t> wire;
