@@ -19,7 +19,7 @@
 // Domain: the heads' boresights are far from parallel or opposite (the µASC's
 // are 60°–120° apart); degenerate inputs give non-finite results, which the
 // callers' finiteness checks refuse.
-// No allocation, no loop beyond the fixed 3 × 3 (and atan2_upper's 11 terms).
+// No allocation, no loop beyond the fixed 3 × 3 (and atan_unit's 8 terms).
 #pragma once
 
 #include <cmath>

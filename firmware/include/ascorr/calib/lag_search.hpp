@@ -41,10 +41,10 @@
 // (TemperatureLag: kTimeNotIncreasing) and keeps its state.
 // Cost per fed cycle: 3·kLagGridPoints lag steps, 3·kLagCandidates thermal
 // stages, quaternion products and boresights, 3·kLagCandidates IBAs (a square
-// root and portable_math.hpp's atan2_upper each). Bounded: no allocation, no loop but over the
-// candidates, heads and pairs. A cycle whose model cannot correct a head at
-// some candidate's temperatures (no coefficients for it, an angle beyond the
-// core's limits) scores no candidate.
+// root and portable_math.hpp's atan2_upper each). Bounded: no allocation, no
+// loop but over the candidates, heads and pairs. A cycle whose model cannot
+// correct a head at some candidate's temperatures (no coefficients for it, an
+// angle beyond the core's limits) scores no candidate.
 #pragma once
 
 #include <cmath>
