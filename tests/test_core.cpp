@@ -4,8 +4,10 @@
 
 #include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "ascorr/ascorr.hpp"
 #include "ascorr_host/correct/earth_velocity.hpp"
@@ -460,6 +462,54 @@ TEST(BadInput, ThermalAngleOutOfDomainIsSkipped) {
     m.coefficients[0][2][0] = 3599.0;
     const ThermalModel<double> model2 = host::to_core<double>(m);
     EXPECT_EQ(correct_solution(input(q, 0), CorrectionConfig<double>{false, &model2}).status, status::kThermalApplied);
+}
+
+// abs_within in float (bit patterns) against fabs(x) <= lim: the core's
+// limits and the edges of lim ≥ 0, over the edges of x and a sweep of all
+// 2³² patterns.
+TEST(Core, FloatAbsWithinIsTheFabsOne) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<float> lims{constant<float>(kMaxThermalAngleRad),
+                                  static_cast<float>(kMaxAbsTemperatureC),
+                                  ScalarTraits<float>::unit_norm_tolerance,
+                                  0.0F,
+                                  -0.0F,
+                                  std::numeric_limits<float>::denorm_min(),
+                                  1.0F,
+                                  std::numeric_limits<float>::max(),
+                                  inf};
+    std::vector<float> xs{0.0F,
+                          -0.0F,
+                          inf,
+                          -inf,
+                          nan,
+                          -nan,
+                          std::numeric_limits<float>::signaling_NaN(),
+                          std::numeric_limits<float>::denorm_min(),
+                          std::numeric_limits<float>::max(),
+                          -std::numeric_limits<float>::max()};
+    for (const float lim : lims) {
+        for (const float x : {lim, std::nextafter(lim, inf), std::nextafter(lim, 0.0F)}) {
+            xs.push_back(x);
+            xs.push_back(-x);
+        }
+    }
+    constexpr std::uint64_t kStride = 4099;  // prime: every exponent, both signs
+    for (std::uint64_t bits = 0; bits < (std::uint64_t{1} << 32U); bits += kStride) {
+        xs.push_back(__builtin_bit_cast(float, static_cast<std::uint32_t>(bits)));
+    }
+    for (const float lim : lims) {
+        std::size_t inside = 0;
+        for (const float x : xs) {
+            const bool want = std::fabs(x) <= lim;
+            inside += want ? 1U : 0U;
+            ASSERT_EQ(abs_within(x, lim), want) << x << " against " << lim;
+        }
+        // Both verdicts occur (not a sweep that only sees one side).
+        EXPECT_GT(inside, 0U) << lim;
+        EXPECT_LT(inside, xs.size()) << lim;
+    }
 }
 
 }  // namespace

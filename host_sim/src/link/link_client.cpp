@@ -546,23 +546,22 @@ link::CalibSunTerm LinkClient<T>::calib_sun_term(std::uint8_t head) {
 }
 
 template <typename T>
+template <typename A>
+std::optional<A> LinkClient<T>::report_if_known(const Message& ask, link::MessageType answer, const char* what) {
+    return unless_unknown(ask.type, [&] { return answer_of<A>(request(ask, answer), what); });
+}
+
+template <typename T>
 std::optional<link::StackReport> LinkClient<T>::stack_report() {
-    return unless_unknown(link::MessageType::kStackReportRequest, [this] {
-        return answer_of<link::StackReport>(
-            request({link::MessageType::kStackReportRequest, {}, "stack report request"},
-                    link::MessageType::kStackReport),
-            "stack report");
-    });
+    return report_if_known<link::StackReport>({link::MessageType::kStackReportRequest, {}, "stack report request"},
+                                              link::MessageType::kStackReport, "stack report");
 }
 
 template <typename T>
 std::optional<link::SunLearnerReport> LinkClient<T>::sun_learner_report() {
-    return unless_unknown(link::MessageType::kSunLearnerReportRequest, [this] {
-        return answer_of<link::SunLearnerReport>(
-            request({link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report request"},
-                    link::MessageType::kSunLearnerReport),
-            "Sun learner report");
-    });
+    return report_if_known<link::SunLearnerReport>(
+        {link::MessageType::kSunLearnerReportRequest, {}, "Sun learner report request"},
+        link::MessageType::kSunLearnerReport, "Sun learner report");
 }
 
 template <typename T>

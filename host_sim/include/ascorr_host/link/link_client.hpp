@@ -194,6 +194,11 @@ private:
 
     // The session.
     std::vector<std::uint8_t> request(const Message& m, link::MessageType answer);
+    // A report the target may not know: request(ask, answer) decoded as A
+    // (`what` names it), or none when the target refused ask's type as unknown
+    // (a firmware before the message); any other refusal is a LinkRefused.
+    template <typename A>
+    std::optional<A> report_if_known(const Message& ask, link::MessageType answer, const char* what);
     void update(const Message& m);
     std::vector<Message> session() const;
     void restore();
