@@ -464,10 +464,10 @@ TEST(BadInput, ThermalAngleOutOfDomainIsSkipped) {
     EXPECT_EQ(correct_solution(input(q, 0), CorrectionConfig<double>{false, &model2}).status, status::kThermalApplied);
 }
 
-// abs_within in float (bit patterns) against fabs(x) <= lim: the core's
+// abs_within_bits (float bit patterns) against fabs(x) <= lim: the core's
 // limits and the edges of lim ≥ 0, over the edges of x and a sweep of all
 // 2³² patterns.
-TEST(Core, FloatAbsWithinIsTheFabsOne) {
+TEST(Core, FloatBitsWithinIsTheFabsOne) {
     const float inf = std::numeric_limits<float>::infinity();
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const std::vector<float> lims{constant<float>(kMaxThermalAngleRad),
@@ -504,7 +504,7 @@ TEST(Core, FloatAbsWithinIsTheFabsOne) {
         for (const float x : xs) {
             const bool want = std::fabs(x) <= lim;
             inside += want ? 1U : 0U;
-            ASSERT_EQ(abs_within(x, lim), want) << x << " against " << lim;
+            ASSERT_EQ(abs_within_bits(x, lim), want) << x << " against " << lim;
         }
         // Both verdicts occur (not a sweep that only sees one side).
         EXPECT_GT(inside, 0U) << lim;

@@ -80,12 +80,24 @@ struct ThermalStage {
     StatusBits skip;  // 0: apply q_th
 };
 
-// Whether three thermal angles are within the core's domain, ±kMaxThermalAngleRad
-// (false for a NaN).
+// Whether a thermal angle is within the core's domain, ±kMaxThermalAngleRad
+// (false for a NaN). Float compares bit patterns (abs_within_bits: on the M4F
+// 3 instructions a check instead of 4; 5 fewer per solution in the core, 5
+// fewer in the Sun term's second check).
+template <typename T>
+constexpr bool angle_in_domain(const T& x) noexcept {
+    constexpr T lim = constant<T>(kMaxThermalAngleRad);
+    if constexpr (std::is_same_v<T, float>) {
+        return abs_within_bits(x, lim);
+    } else {
+        return abs_within(x, lim);
+    }
+}
+
+// Whether three thermal angles are within the core's domain.
 template <typename T>
 constexpr bool angles_in_domain(const T& alpha, const T& beta, const T& gamma) noexcept {
-    constexpr T lim = constant<T>(kMaxThermalAngleRad);
-    return abs_within(alpha, lim) && abs_within(beta, lim) && abs_within(gamma, lim);
+    return angle_in_domain(alpha) && angle_in_domain(beta) && angle_in_domain(gamma);
 }
 
 // The polynomial's angles for one solution (rad), or the bits that say why

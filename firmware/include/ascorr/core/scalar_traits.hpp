@@ -80,14 +80,19 @@ inline bool is_finite(float x) noexcept {
 inline bool abs_within(double x, double lim) noexcept {
     return std::fabs(x) <= lim;
 }
-// In float the comparison is of the IEEE 754 binary32 bit patterns shifted
-// left by one (the sign dropped): they order as the magnitudes do, and a
-// NaN's lies above +∞'s, so for lim ≥ 0 this is exactly fabs(x) ≤ lim (test
-// Core.FloatAbsWithinIsTheFabsOne). On the M4F one integer compare with a
-// shifted operand after the move out of the FPU, 3 instructions where vabs,
-// vcmpe and vmrs before the branch take 4; the core makes 7 such checks per
-// solution (quaternion, temperatures, thermal angles), the Sun term 3 more.
 inline bool abs_within(float x, float lim) noexcept {
+    return std::fabs(x) <= lim;
+}
+// The same in float on the IEEE 754 binary32 bit patterns shifted left by one
+// (the sign dropped): they order as the magnitudes do, and a NaN's lies above
+// +∞'s, so for lim ≥ 0 this is exactly fabs(x) ≤ lim (test
+// Core.FloatBitsWithinIsTheFabsOne). On the M4F, where x is in an FPU
+// register, a move and one compare with a shifted operand: 3 instructions
+// before the branch where vabs, vcmpe and vmrs take 4. Where x is read from
+// memory GCC 12 may pass it through the stack instead (the lag stage, the
+// velocity service: +3 and +12 measured), so only the thermal angles, which
+// are computed in registers, use it (correct.hpp).
+inline bool abs_within_bits(float x, float lim) noexcept {
     return (__builtin_bit_cast(std::uint32_t, x) << 1U) <= (__builtin_bit_cast(std::uint32_t, lim) << 1U);
 }
 
