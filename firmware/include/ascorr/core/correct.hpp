@@ -212,7 +212,7 @@ template <typename T>
 
 // The same, as a function of its own: GCC then spills less of the Q30 kernel
 // on Armv7-M (M3: 136 instructions for the term instead of 189 inlined),
-// while float is cheapest inlined into the core (M4F: 67 instead of 102);
+// while float is cheapest inlined into the core (M4F: 63 instead of 102);
 // correct_solution() picks by scalar (toolchain/run-target-bench).
 template <typename T>
 constexpr ThermalStage<T> thermal_stage(const ThermalModel<T>& model, std::uint8_t head,

@@ -18,7 +18,7 @@
 //    attitude; it differs from the contract's by the bound correct.hpp states
 //    (4e-3″ for 2″ coefficients, a 25″ aberration and a 60″ polynomial) and
 //    costs 136 instructions on the M3 instead of the separate rotation's 613,
-//    67 on the M4F instead of 153 (docs/figures.md).
+//    63 on the M4F instead of 153 (docs/figures.md).
 // Why the head's own frame: the Sun heats the bench by where it stands in the
 // spacecraft's frame, which on a nadir-pointing spacecraft is the orbital
 // frame (v̂, n̂, r̂) the study chose (bench/inside_orbit_terms.py), and every
