@@ -260,6 +260,55 @@ TEST(Replay, AMalformedAcknowledgementNamesTheRequest) {
     EXPECT_EQ(client.stats().stale_answers, 0U);
 }
 
+// A restart's HELLO that arrives in the same read as the answer before it
+// (a DPU that resets just after answering) is heard at the next request, not
+// dropped with the rest of the read: the session is restored before that
+// request is answered, and the target corrects as the host's core does.
+TEST(Replay, ARestartsHelloInTheSameReadAsAnAnswerIsHeard) {
+    using Counter = std::uint32_t (*)();
+    using Server = link::LinkServer<float, Counter>;
+    auto server = std::make_unique<Server>(1, [] { return std::uint32_t{0}; });
+    bool restart_after_answer = false;
+    std::size_t hellos = 0;
+    host::LoopbackTransport transport(
+        [&](const std::uint8_t* p, std::size_t n, const host::LoopbackTransport::Reply& reply) {
+            for (std::size_t i = 0; i < n; ++i) {
+                bool answered = false;
+                server->on_byte(p[i], [&](const std::uint8_t* r, std::size_t m) {
+                    answered = true;
+                    reply(r, m);
+                });
+                if (answered && restart_after_answer) {  // power cycle: state lost, the HELLO queued after the answer
+                    restart_after_answer = false;
+                    server = std::make_unique<Server>(2, [] { return std::uint32_t{0}; });
+                    server->announce(reply);
+                    ++hellos;
+                }
+            }
+        });
+    host::LinkClient<float> client(transport, 50, 3);
+    client.connect();
+    const ThermalModel<float> model = host::to_core<float>(host::read_model_file(data_path("model_table2.csv")));
+    client.upload_model(model);
+    SolutionInput<float> in{};
+    in.q_chu_icrf = {0.5F, 0.5F, 0.5F, 0.5F};
+    in.head = 1;
+    in.temperatures = {{10.0F, true}, {-5.0F, true}, {-20.0F, true}};
+    in.velocity = {{1e-4F, -2e-5F, 3e-5F}, 1.0F, true};
+    client.set_velocity(in.velocity);
+    restart_after_answer = true;
+    client.set_temperatures(0, in.temperatures);  // answered, then the target restarts
+    ASSERT_EQ(hellos, 1U);
+    EXPECT_EQ(client.stats().restarts, 0U);
+    client.set_temperatures(in.head, in.temperatures);
+    EXPECT_EQ(client.stats().restarts, 1U);  // heard before any solution could show it
+    const auto got = client.correct(7, in.head, in.q_chu_icrf);
+    const auto want = correct_solution(in, CorrectionConfig<float>{true, &model});
+    EXPECT_EQ(got.status, want.status);
+    EXPECT_EQ(std::memcmp(&got.q_chu_icrf, &want.q_chu_icrf, sizeof want.q_chu_icrf), 0);
+    EXPECT_EQ(client.stats().restarts, 1U);
+}
+
 // A serial device without hardware: a pseudo-terminal whose master end is
 // served, in a thread, by the firmware's LinkServer<T>, as a DPU on a UART
 // would. The host opens the slave end (/dev/pts/N) as it would /dev/ttyUSB0.

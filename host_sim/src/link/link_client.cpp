@@ -265,12 +265,22 @@ std::optional<std::vector<std::uint8_t>> LinkClient<T>::exchange(Request& r) {
     throw LinkError("no answer from the target after " + std::to_string(max_attempts_) + " attempts");
 }
 
-// Reads until r's answer, a restart, or the time-out.
+// Reads until r's answer, a restart, or the time-out. The bytes of a read
+// after the frame that ends a wait (an answer, a NAK, a restart, a refusal
+// thrown) stay in unread_ for the next wait: a restart's HELLO that shares a
+// read with an answer is heard, and the decoder never sees a frame with a
+// hole in it.
 template <typename T>
 typename LinkClient<T>::Heard LinkClient<T>::await(const Request& r, std::vector<std::uint8_t>& answer) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms_);
     std::uint8_t buf[256];
     for (;;) {
+        while (unread_at_ < unread_.size()) {
+            const std::uint8_t byte = unread_[unread_at_++];  // taken before hear(), which may throw
+            if (const std::optional<Heard> heard = hear(r, byte, answer)) {
+                return *heard;
+            }
+        }
         // Read what is there even when the time is up: an answer that has
         // arrived is never thrown away for a resend.
         const auto left =
@@ -280,11 +290,8 @@ typename LinkClient<T>::Heard LinkClient<T>::await(const Request& r, std::vector
             ++stats_.timeouts;
             return Heard::kResend;
         }
-        for (std::size_t i = 0; i < n; ++i) {
-            if (const std::optional<Heard> heard = hear(r, buf[i], answer)) {
-                return *heard;
-            }
-        }
+        unread_.assign(buf, buf + n);
+        unread_at_ = 0;
     }
 }
 

@@ -220,6 +220,9 @@ private:
     int timeout_ms_;
     int max_attempts_;
     link::FrameDecoder decoder_;
+    // Bytes read but not yet heard: unread_[unread_at_..] (await()).
+    std::vector<std::uint8_t> unread_;
+    std::size_t unread_at_ = 0;
     std::uint16_t seq_ = 0;
     std::uint32_t boot_id_ = 0;
     std::optional<ThermalModel<T>> model_;
