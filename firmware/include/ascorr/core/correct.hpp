@@ -82,7 +82,7 @@ struct ThermalStage {
 
 // Whether a thermal angle is within the core's domain, ±kMaxThermalAngleRad
 // (false for a NaN). Float compares bit patterns (abs_within_bits: on the M4F
-// 3 instructions a check instead of 4; 5 fewer per solution in the core, 5
+// 3 instructions a check instead of 4; 4 fewer per solution in the core, 4
 // fewer in the Sun term's second check).
 template <typename T>
 constexpr bool angle_in_domain(const T& x) noexcept {

@@ -89,8 +89,8 @@ inline bool abs_within(float x, float lim) noexcept {
 // Core.FloatBitsWithinIsTheFabsOne). On the M4F, where x is in an FPU
 // register, a move and one compare with a shifted operand: 3 instructions
 // before the branch where vabs, vcmpe and vmrs take 4. Where x is read from
-// memory GCC 12 may pass it through the stack instead (the lag stage, the
-// velocity service: +3 and +12 measured), so only the thermal angles, which
+// memory GCC 12 may pass it through the stack instead (the lag stage +3
+// measured with every float check so), so only the thermal angles, which
 // are computed in registers, use it (correct.hpp).
 inline bool abs_within_bits(float x, float lim) noexcept {
     return (__builtin_bit_cast(std::uint32_t, x) << 1U) <= (__builtin_bit_cast(std::uint32_t, lim) << 1U);

@@ -106,7 +106,7 @@ constexpr bool temperature_in_domain(const Celsius<T>& t) noexcept {
 // table: a loop would sum in another order and change float's results.
 // Always inlined, as the Q30 one: left to GCC, the float core called it out
 // of line once the thermal stage grew a Sun term (M4F: 326 instructions per
-// solution instead of 278).
+// solution instead of the 278 it then took).
 template <typename T>
 [[gnu::always_inline]] constexpr T thermal_angle(const AxisPolynomial<T>& p, const Celsius<T>& t1, const Celsius<T>& t2,
                                                  const Celsius<T>& t3) noexcept {
