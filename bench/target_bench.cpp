@@ -324,19 +324,20 @@ void bench_combination(const char* name, const combine::Combiner<T>& c, Combinat
                 static_cast<unsigned>(e < 4294967295.0 ? e : 4294967295.0));
 }
 
-// The lag stage: one solution per call.
+// The lag stage: one solution per call, in the entry's order of arguments
+// (lag_entry.hpp).
 template <typename T>
-using LagFn = void (*)(pipeline::HeadLags<T>&, std::uint8_t, std::int64_t, HeadTemperatures<T>&) noexcept;
+using LagFn = void (*)(pipeline::HeadLags<T>&, HeadTemperatures<T>&, std::int64_t, std::uint8_t) noexcept;
 
 template <typename T>
-__attribute__((noinline)) void lag_copy(pipeline::HeadLags<T>& /*lags*/, std::uint8_t /*head*/, std::int64_t /*t_us*/,
-                                        HeadTemperatures<T>& temps) noexcept {
+__attribute__((noinline)) void lag_copy(pipeline::HeadLags<T>& /*lags*/, HeadTemperatures<T>& temps,
+                                        std::int64_t /*t_us*/, std::uint8_t /*head*/) noexcept {
     temps.t_032 = temps.t_chu;
 }
 
 template <typename T>
-__attribute__((noinline)) void lag_call(pipeline::HeadLags<T>& lags, std::uint8_t head, std::int64_t t_us,
-                                        HeadTemperatures<T>& temps) noexcept {
+__attribute__((noinline)) void lag_call(pipeline::HeadLags<T>& lags, HeadTemperatures<T>& temps, std::int64_t t_us,
+                                        std::uint8_t head) noexcept {
     app::lag(lags, head, t_us, temps);
 }
 
@@ -348,7 +349,7 @@ std::uint32_t run_lag(volatile LagFn<T> fn, pipeline::HeadLags<T>& lags, const F
             const std::uint32_t e = epoch + i / 3U;
             const std::int64_t t_us = std::int64_t{e} * 1000 / 22 * 1000;
             HeadTemperatures<T> temps = fx.in[i % kInputs].temperatures;
-            fn(lags, static_cast<std::uint8_t>(i % 3U), t_us, temps);
+            fn(lags, temps, t_us, static_cast<std::uint8_t>(i % 3U));
             g_sink_status = static_cast<std::uint16_t>(temps.t_chu.valid ? 1U : 0U);
         }
         epoch += kRuns / 3U + 1U;

@@ -464,9 +464,10 @@ TEST(BadInput, ThermalAngleOutOfDomainIsSkipped) {
     EXPECT_EQ(correct_solution(input(q, 0), CorrectionConfig<double>{false, &model2}).status, status::kThermalApplied);
 }
 
-// abs_within_bits (float bit patterns) against fabs(x) <= lim: the core's
-// limits and the edges of lim ≥ 0, over the edges of x and every 4099th of
-// the 2³² patterns (about a million, every exponent of both signs).
+// abs_within_bits (float bit patterns) and abs_within_bits_at (the same read
+// from memory) against fabs(x) <= lim: the core's limits and the edges of
+// lim ≥ 0, over the edges of x and every 4099th of the 2³² patterns (about a
+// million, every exponent of both signs).
 TEST(Core, FloatBitsWithinIsTheFabsOne) {
     const float inf = std::numeric_limits<float>::infinity();
     const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -505,6 +506,7 @@ TEST(Core, FloatBitsWithinIsTheFabsOne) {
             const bool want = std::fabs(x) <= lim;
             inside += want ? 1U : 0U;
             ASSERT_EQ(abs_within_bits(x, lim), want) << x << " against " << lim;
+            ASSERT_EQ(abs_within_bits_at(x, lim), want) << x << " in memory against " << lim;
         }
         // Both verdicts occur (not a sweep that only sees one side).
         EXPECT_GT(inside, 0U) << lim;

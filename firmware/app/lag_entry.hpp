@@ -14,19 +14,22 @@
 
 namespace ascorr::app {
 
-void lag_fixed(pipeline::HeadLags<Q30>& lags, std::uint8_t head, std::int64_t t_us,
-               HeadTemperatures<Q30>& temps) noexcept;
-void lag_float(pipeline::HeadLags<float>& lags, std::uint8_t head, std::int64_t t_us,
-               HeadTemperatures<float>& temps) noexcept;
+// The arguments in this order fill r0–r3 with all but the head (AAPCS: the
+// 64-bit time takes an even pair), so that the temperatures' address stays in
+// a register.
+void lag_fixed(pipeline::HeadLags<Q30>& lags, HeadTemperatures<Q30>& temps, std::int64_t t_us,
+               std::uint8_t head) noexcept;
+void lag_float(pipeline::HeadLags<float>& lags, HeadTemperatures<float>& temps, std::int64_t t_us,
+               std::uint8_t head) noexcept;
 
 // The entry for scalar T, for code templated on it.
 inline void lag(pipeline::HeadLags<Q30>& lags, std::uint8_t head, std::int64_t t_us,
                 HeadTemperatures<Q30>& temps) noexcept {
-    lag_fixed(lags, head, t_us, temps);
+    lag_fixed(lags, temps, t_us, head);
 }
 inline void lag(pipeline::HeadLags<float>& lags, std::uint8_t head, std::int64_t t_us,
                 HeadTemperatures<float>& temps) noexcept {
-    lag_float(lags, head, t_us, temps);
+    lag_float(lags, temps, t_us, head);
 }
 
 }  // namespace ascorr::app

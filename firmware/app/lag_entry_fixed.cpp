@@ -3,8 +3,8 @@
 
 namespace ascorr::app {
 
-void lag_fixed(pipeline::HeadLags<Q30>& lags, std::uint8_t head, std::int64_t t_us,
-               HeadTemperatures<Q30>& temps) noexcept {
+void lag_fixed(pipeline::HeadLags<Q30>& lags, HeadTemperatures<Q30>& temps, std::int64_t t_us,
+               std::uint8_t head) noexcept {
     lags.apply(head, t_us, temps);
 }
 

@@ -3,8 +3,8 @@
 
 namespace ascorr::app {
 
-void lag_float(pipeline::HeadLags<float>& lags, std::uint8_t head, std::int64_t t_us,
-               HeadTemperatures<float>& temps) noexcept {
+void lag_float(pipeline::HeadLags<float>& lags, HeadTemperatures<float>& temps, std::int64_t t_us,
+               std::uint8_t head) noexcept {
     lags.apply(head, t_us, temps);
 }
 

@@ -24,6 +24,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace ascorr {
 
@@ -94,6 +95,15 @@ inline bool abs_within(float x, float lim) noexcept {
 // are computed in registers, use it (correct.hpp).
 inline bool abs_within_bits(float x, float lim) noexcept {
     return (__builtin_bit_cast(std::uint32_t, x) << 1U) <= (__builtin_bit_cast(std::uint32_t, lim) << 1U);
+}
+// The same for an x in memory, read as an integer: an integer load, a
+// compare with a shifted operand and a branch on the M4F, where a value
+// loaded into an FPU register takes vabs, vcmpe and vmrs (the lag stage's
+// readings, temperature_lag.hpp).
+inline bool abs_within_bits_at(const float& x, float lim) noexcept {
+    std::uint32_t bits = 0U;
+    std::memcpy(&bits, &x, sizeof bits);
+    return (bits << 1U) <= (__builtin_bit_cast(std::uint32_t, lim) << 1U);
 }
 
 // A fixed-point scalar holds unit quantities (quaternions, v/c, radians) in a

@@ -31,8 +31,9 @@
 // between two values when times are rounded, as 45/46 ms at 22 Hz). In float
 // and Q30 (the targets, whose double is software) α comes from its series in
 // T when Δt ≤ τ/256 (LagArithmetic::AlphaSeries, below): a few products
-// whatever the times' jitter (22 Hz against any τ from 12 s); a longer Δt
-// takes the double path and its two kept values.
+// whatever the times' jitter (22 Hz against any τ from 12 s), of which the
+// usual step keeps the last two by Δt; a longer Δt takes the double path and
+// its two kept values.
 // The usual step (every channel in step, every reading usable) takes a path
 // of its own (lag_in_place), the same operations without the bookkeeping:
 // measured per solution in bench/target_bench.cpp (docs/figures.md).
@@ -166,9 +167,9 @@ inline int lag_grid_index(double tau_s) noexcept {
 
 inline constexpr double kMinLagTauS = 1.0;      // shorter is no lag at a head's cadence
 inline constexpr double kMaxLagTauS = 86400.0;  // as simulate's --bench-lag: one day
-// |t| below this (µs), so that t − t_last cannot overflow int64: 1/2 of 2⁶³
-// rounded down, about 146 000 years.
-inline constexpr std::int64_t kMaxLagTimeUs = 4'611'686'018'427'387'903;
+// |t| below this (µs), so that t − t_last cannot overflow int64: 2⁶², 1/2 of
+// 2⁶³ (t < 2⁶² is one compare of t's upper word), about 146 000 years.
+inline constexpr std::int64_t kMaxLagTimeUs = std::int64_t{1} << 62U;
 
 enum class LagStep : std::uint8_t {
     kStarted,            // the channel's first reading: D = 0
@@ -200,11 +201,12 @@ public:
         }
         inv_tau_per_us_ = 1.0 / (tau_s * 1e6);  // in [1.2e-11, 1e-6]
         series_ = Arithmetic::AlphaSeries::of(tau_s * 1e6);
-        series_max_us_ = static_cast<std::int64_t>(tau_s * 1e6 * kSeriesFraction);  // ≤ 3.4e8 µs
+        series_max_us_ = static_cast<std::uint32_t>(tau_s * 1e6 * kSeriesFraction);  // ≤ 3.4e8 µs
         for (Channel& c : ch_) {
             c = Channel{};
         }
         cache_ = AlphaCache{};
+        series_cache_ = SeriesCache{};
         have_time_ = false;
         in_step_ = 0U;
         configured_ = true;
@@ -253,10 +255,12 @@ public:
     // or no τ was configured.
     // The usual step, every channel in step and every reading usable, takes
     // a path of its own: the same operations as step()'s, straight.
-    bool lag_in_place(std::int64_t t_us, HeadTemperatures<T>& temps) noexcept {
-        if (in_step_ == kAllInStep && t_us > t_us_ && t_us < kMaxLagTimeUs && usable(temps.t_chu) &&
-            usable(temps.t_029) && usable(temps.t_032)) {
-            const T alpha = alpha_for(t_us - t_us_);
+    [[gnu::always_inline]] bool lag_in_place(std::int64_t t_us, HeadTemperatures<T>& temps) noexcept {
+        // Δt modulo 2⁶⁴: the usual step's test needs no signed 64-bit compare.
+        const std::uint64_t dt = static_cast<std::uint64_t>(t_us) - static_cast<std::uint64_t>(t_us_);
+        if (in_step_ == kAllInStep && usual_dt(t_us, dt) && usable(temps.t_chu) && usable(temps.t_029) &&
+            usable(temps.t_032)) {
+            const T alpha = usual_alpha(dt);
             advance_in_place(ch_[0], temps.t_chu, alpha);
             advance_in_place(ch_[1], temps.t_029, alpha);
             advance_in_place(ch_[2], temps.t_032, alpha);
@@ -323,7 +327,16 @@ private:
         return moved(s.channel[0]) || moved(s.channel[1]) || moved(s.channel[2]);
     }
 
-    static bool usable(const TemperatureReading<T>& r) noexcept { return r.valid && temperature_in_domain<T>(r.value); }
+    // A reading the lag takes: valid, and within the core's domain (float: on
+    // its bit pattern, abs_within_bits_at, exactly temperature_in_domain's
+    // verdict at one instruction fewer a channel on the M4F).
+    static bool usable(const TemperatureReading<T>& r) noexcept {
+        if constexpr (std::is_same_v<T, float>) {
+            return r.valid && abs_within_bits_at(r.value, ScalarTraits<float>::celsius(kMaxAbsTemperatureC));
+        } else {
+            return r.valid && temperature_in_domain<T>(r.value);
+        }
+    }
 
     bool in_step(std::uint8_t k) const noexcept { return ((in_step_ >> k) & 1U) != 0U; }
     // Channel k's last time (once started).
@@ -355,12 +368,53 @@ private:
     }
 
     // The usual step of a channel in step (lag_in_place): advanced with the
-    // step's α, and the reading replaced by L.
+    // step's α, and the reading replaced by L. The reading is read once: a
+    // store to the channel (the same type) would otherwise force a load again.
     [[gnu::always_inline]] static void advance_in_place(Channel& c, TemperatureReading<T>& r, T alpha) noexcept {
-        const typename Arithmetic::State u = Arithmetic::input(c.d, r.value, c.t_reading);
-        c.d = Arithmetic::decay(alpha, u);
-        c.t_reading = r.value;
-        r.value = lagged_of(c);
+        const C reading = r.value;
+        const typename Arithmetic::State d = Arithmetic::decay(alpha, Arithmetic::input(c.d, reading, c.t_reading));
+        c.d = d;
+        c.t_reading = reading;
+        r.value = Arithmetic::sum(reading, Arithmetic::deviation(d));
+    }
+
+    // Whether a step at t_us, dt = t_us − t_us_ modulo 2⁶⁴, may take the
+    // usual path: after the lag's last time and below kMaxLagTimeUs (t_us_ is
+    // above −kMaxLagTimeUs); in float and Q30 also 0 < Δt ≤ τ/256, tested on
+    // dt's words (a t_us not after t_us_ wraps to an upper word ≠ 0), so α is
+    // its series. A longer Δt takes step(), which forms the same α (alpha_for).
+    bool usual_dt(std::int64_t t_us, std::uint64_t dt) const noexcept {
+        if constexpr (ScalarTraits<T>::double_precision) {
+            return t_us > t_us_ && t_us < kMaxLagTimeUs;
+        } else {
+            // τ/256 < 2³²: Δt's upper word is 0, its lower within (0, τ/256].
+            return (dt >> 32U) == 0U && static_cast<std::uint32_t>(dt) - 1U < series_max_us_ && t_us < kMaxLagTimeUs;
+        }
+    }
+    // The usual step's α (usual_dt true): alpha_for's, without its test.
+    // Float and Q30 keep the series' last two values by Δt (a head's cadence
+    // repeats or alternates, as 45/46 ms at 22 Hz): a hit is a few
+    // instructions, where the series takes about 10 on the M4F and its 64-bit
+    // products about 30 on the M3. The value is the series' either way, so
+    // the step's bits are too.
+    T usual_alpha(std::uint64_t dt) noexcept {
+        if constexpr (ScalarTraits<T>::double_precision) {
+            return alpha_for(static_cast<std::int64_t>(dt));
+        } else {
+            const auto d = static_cast<std::uint32_t>(dt);  // in (0, τ/256]: usual_dt
+            SeriesCache& k = series_cache_;
+            if (d == k.dt_us[0]) {
+                return k.alpha[0];
+            }
+            if (d == k.dt_us[1]) {
+                return k.alpha[1];
+            }
+            const std::uint8_t slot = k.next;
+            k.next ^= 1U;
+            k.dt_us[slot] = d;
+            k.alpha[slot] = series_(static_cast<std::int32_t>(d));
+            return k.alpha[slot];
+        }
     }
 
     // α = 1 − e^(−Δt/τ) for dt_us > 0, in [0, 1] (0 only when Q30 rounds a
@@ -372,7 +426,7 @@ private:
     }
     // Whether α of dt_us > 0 comes from the series: float and Q30, Δt ≤ τ/256.
     bool by_series(std::int64_t dt_us) const noexcept {
-        return !ScalarTraits<T>::double_precision && dt_us <= series_max_us_;
+        return !ScalarTraits<T>::double_precision && dt_us <= std::int64_t{series_max_us_};
     }
     [[gnu::noinline]] T alpha_in_double(std::int64_t dt_us) const noexcept {
         return ScalarTraits<T>::from_double(-calib::expm1_nonpositive(-static_cast<double>(dt_us) * inv_tau_per_us_));
@@ -398,6 +452,14 @@ private:
         return k.alpha[other];
     }
 
+    // The series' last two α by Δt (µs; 0: none) for the usual step in
+    // float and Q30 (usual_alpha), and the slot the next one goes to.
+    struct SeriesCache {
+        std::uint32_t dt_us[2] = {0U, 0U};
+        T alpha[2]{};
+        std::uint8_t next = 0U;
+    };
+
     Channel ch_[kLagChannels]{};
     AlphaCache cache_{};
     std::int64_t t_us_ = 0;  // the last time a channel started or advanced at (have_time_)
@@ -407,8 +469,9 @@ private:
     std::uint8_t in_step_ = 0U;
     double inv_tau_per_us_ = 0.0;  // α in double (alpha_in_double)
     typename Arithmetic::AlphaSeries series_{};
-    std::int64_t series_max_us_ = 0;  // the longest Δt of the series: τ/256
+    std::uint32_t series_max_us_ = 0U;  // the longest Δt of the series: τ/256
     bool configured_ = false;
+    SeriesCache series_cache_{};  // last: float's layout as without it
 };
 
 }  // namespace ascorr::pipeline
